@@ -1,0 +1,8 @@
+//! # semismooth-problems
+//!
+//! Concrete periodic contact problems built only on the public API of the `semismooth`
+//! core: the structural model `M u'' + D u' + K u = f(t) + G^T lambda(t)` with unilateral
+//! contact `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, the finite-element rod of
+//! Shi & Legrand, and the formulations that solve it.
+
+pub mod model;
