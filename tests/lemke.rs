@@ -11,6 +11,35 @@ use semismooth::lemke::{
     LemkeTermination,
 };
 
+/// Counts heap allocations made by the current thread (tests run on parallel threads,
+/// so the count is per thread).
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
 fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
@@ -174,6 +203,28 @@ fn workspace_reuse_gives_the_same_answer_as_a_fresh_workspace() {
         let fresh = solve_lcp(m.as_ref(), &q, &LemkeOptions::default()).unwrap();
         assert_eq!(reused, fresh, "n = {n}");
         assert_eq!(lemke.dim(), n);
+    }
+}
+
+/// With a workspace of the right size, a solve allocates only the two vectors of its
+/// report (`z` and `w`), however many pivots it makes.
+#[test]
+fn solve_allocates_only_the_report_whatever_the_pivot_count() {
+    let mut lemke = Lemke::new(300);
+    let options = LemkeOptions::default();
+    for (seed, n) in [(1u64, 300usize), (2, 300), (3, 300)] {
+        let mut r = rng(seed);
+        let m = spd_matrix(n, 1.0, &mut r);
+        let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..0.5)).collect();
+        let before = allocations();
+        let report = lemke.solve(m.as_ref(), &q, &options).unwrap();
+        let count = allocations() - before;
+        assert!(
+            report.solved() && report.pivots > 100,
+            "pivots {}",
+            report.pivots
+        );
+        assert_eq!(count, 2, "{count} allocations for {} pivots", report.pivots);
     }
 }
 
