@@ -1095,7 +1095,7 @@ where
                 &mut smallest,
             );
             match corrected {
-                Ok(c) => return Some(self.accept(&last, x, p, ds, c)),
+                Ok(c) => return self.accept(&last, x, p, ds, c),
                 Err(failure) => {
                     self.counters.rejected_steps += 1;
                     self.counters.rejected_iterations +=
@@ -1134,7 +1134,7 @@ where
         mut p: f64,
         ds: f64,
         corrected: Corrected,
-    ) -> BranchPoint {
+    ) -> Option<BranchPoint> {
         let n = self.ws.n;
         self.consecutive_failures = 0;
         let direction = self.direction.clone();
@@ -1151,6 +1151,15 @@ where
         } else {
             None
         };
+        if bound == Some(last.parameter) {
+            // Already on the bound and heading out: nothing new to report.
+            self.problem.set_parameter(last.parameter);
+            self.finish(ContinuationTermination::ReachedBound {
+                parameter: last.parameter,
+                bound: last.parameter,
+            });
+            return None;
+        }
         if let Some(pb) = bound {
             let lambda = (pb - last.parameter) / (p - last.parameter);
             let mut xb: Vec<f64> = last
@@ -1256,7 +1265,7 @@ where
                 points: self.points,
             });
         }
-        point
+        Some(point)
     }
 }
 

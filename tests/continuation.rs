@@ -278,6 +278,26 @@ fn s_curve_followed_downwards_ends_at_the_lower_root() {
     // x^3 - x + 1 = 0 has the root -plastic.
     assert!((last.state[0] + plastic).abs() < 1e-10);
     assert_eq!(problem.parameter(), -1.0);
+
+    // Started on the lower bound heading down: the start is the whole branch.
+    let mut problem = s_curve();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        direction: Direction::Decreasing,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(branch.points.len(), 1);
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::ReachedBound {
+            parameter: -1.0,
+            bound: -1.0
+        }
+    );
 }
 
 /// Follows the circle from (x, p) = (1, 0) once around (unwrapped polar angle 2π), using
@@ -504,6 +524,12 @@ fn singular_jacobian_plateau_needs_the_dense_bordered_fallback() {
     let last = branch.points.last().unwrap();
     assert!(last.state[0] > 2.0 && last.parameter == 1.0, "{last:?}");
     assert!(branch.counters.dense_bordered_factorizations > 0);
+    // Each corrector iteration still calls `factor` once (it fails on the plateau, then the
+    // dense bordered LU takes over).
+    assert_eq!(
+        branch.counters.factorizations,
+        branch.counters.corrector_iterations
+    );
     assert_eq!(
         branch.termination,
         ContinuationTermination::MaxPoints { points: 80 }
@@ -787,4 +813,198 @@ fn bad_input_is_a_typed_error_with_the_numbers() {
         Some(Err(ContinuationError::StartNotConverged { parameter, .. })) if parameter == 0.0
     ));
     assert!(it.next().is_none());
+}
+
+/// A structured (diagonal) Jacobian that cannot be assembled densely, with its own solver:
+/// the continuation must work through `LinearSolve` alone.
+struct Diagonal(Vec<f64>);
+
+struct DiagonalSolver {
+    diagonal: Vec<f64>,
+}
+
+impl semismooth::LinearSolve<Diagonal> for DiagonalSolver {
+    fn factor(&mut self, jac: &Diagonal) -> Result<(), LinearSolveError> {
+        let max_pivot = jac.0.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        if let Some(index) = jac.0.iter().position(|d| *d == 0.0 || !d.is_finite()) {
+            return Err(LinearSolveError::Singular {
+                index,
+                pivot: jac.0[index].abs(),
+                max_pivot,
+            });
+        }
+        self.diagonal.clone_from(&jac.0);
+        Ok(())
+    }
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        for (r, d) in rhs.iter_mut().zip(&self.diagonal) {
+            *r /= d;
+        }
+        Ok(())
+    }
+}
+
+/// `F_0 = x_0^3 - x_0 - p` (the S-curve, which makes the folds) and, for `i >= 1`,
+/// `F_i = x_i^3 + (1 + i/n) x_i - p` (monotone in `x_i`, one root for every `p`).
+struct DecoupledCurves {
+    n: usize,
+    p: f64,
+}
+
+impl DecoupledCurves {
+    fn coefficient(&self, i: usize) -> f64 {
+        if i == 0 {
+            -1.0
+        } else {
+            1.0 + i as f64 / self.n as f64
+        }
+    }
+}
+
+impl Residual for DecoupledCurves {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        for i in 0..self.n {
+            out[i] = x[i].powi(3) + self.coefficient(i) * x[i] - self.p;
+        }
+    }
+}
+
+impl ParameterDependent for DecoupledCurves {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+    }
+}
+
+impl GeneralizedJacobian for DecoupledCurves {
+    type Jacobian = Diagonal;
+    fn new_jacobian(&self) -> Diagonal {
+        Diagonal(vec![0.0; self.n])
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Diagonal) {
+        for i in 0..self.n {
+            jac.0[i] = 3.0 * x[i] * x[i] + self.coefficient(i);
+        }
+    }
+}
+
+/// The same problem with a dense Jacobian, to solve with the dense LU.
+struct DenseDecoupled(DecoupledCurves);
+
+impl Residual for DenseDecoupled {
+    fn dim(&self) -> usize {
+        self.0.n
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        self.0.residual(x, out)
+    }
+}
+
+impl ParameterDependent for DenseDecoupled {
+    fn parameter(&self) -> f64 {
+        self.0.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.0.p = p;
+    }
+}
+
+impl GeneralizedJacobian for DenseDecoupled {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.0.n, self.0.n)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+        let mut d = self.0.new_jacobian();
+        self.0.jacobian(x, &mut d);
+        for i in 0..self.0.n {
+            for j in 0..self.0.n {
+                jac[(i, j)] = if i == j { d.0[i] } else { 0.0 };
+            }
+        }
+    }
+}
+
+#[test]
+fn structured_jacobian_branch_equals_the_dense_one_and_passes_the_folds() {
+    let n = 40;
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    // Start at p = -1: x_0 on the lower branch; x_i (i >= 1) from Newton-free bisection.
+    let root = |c: f64, p: f64| {
+        let (mut lo, mut hi) = (-2.0_f64, 2.0_f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid.powi(3) + c * mid - p > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let mut structured = DecoupledCurves { n, p: -1.0 };
+    let x0: Vec<f64> = (0..n)
+        .map(|i| {
+            if i == 0 {
+                -1.3
+            } else {
+                root(structured.coefficient(i), -1.0)
+            }
+        })
+        .collect();
+    let mut diagonal_solver = DiagonalSolver {
+        diagonal: Vec::new(),
+    };
+    let branch = Continuation::new(
+        &mut structured,
+        &mut diagonal_solver,
+        &x0,
+        -1.0,
+        options.clone(),
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    let mut dense = DenseDecoupled(DecoupledCurves { n, p: -1.0 });
+    let mut lu = FaerDenseLu::new();
+    let reference = Continuation::new(&mut dense, &mut lu, &x0, -1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    // Same arithmetic up to the LU's rounding on a diagonal matrix: the branches agree
+    // point by point to 1e-12 (on O(1) values).
+    assert_eq!(branch.points.len(), reference.points.len());
+    for (a, b) in branch.points.iter().zip(&reference.points) {
+        assert!((a.parameter - b.parameter).abs() < 1e-12);
+        for (u, v) in a.state.iter().zip(&b.state) {
+            assert!((u - v).abs() < 1e-12);
+        }
+    }
+    // Components i >= 1 are the unique real roots of their cubics (bisection, 1e-12 after
+    // 200 halvings of [-2, 2]; corrector residual 1e-10 over slope >= 1 gives 1e-10).
+    let probe = DecoupledCurves { n, p: 0.0 };
+    for q in &branch.points {
+        for i in 1..n {
+            let exact = root(probe.coefficient(i), q.parameter);
+            assert!((q.state[i] - exact).abs() < 1e-9);
+        }
+    }
+    let folds = branch.fold_parameters();
+    println!(
+        "structured n = {n}: {} points, folds {folds:?}",
+        branch.points.len()
+    );
+    assert_eq!(folds.len(), 2);
+    // Fold tolerance as for the scalar S-curve (the x_0 component dominates p(s) there).
+    assert!((folds[0] - FOLD_S).abs() < 1e-4 && (folds[1] + FOLD_S).abs() < 1e-4);
+    assert_one_factorization_per_iteration(&branch);
 }
