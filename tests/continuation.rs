@@ -866,8 +866,8 @@ impl Residual for DecoupledCurves {
         self.n
     }
     fn residual(&mut self, x: &[f64], out: &mut [f64]) {
-        for i in 0..self.n {
-            out[i] = x[i].powi(3) + self.coefficient(i) * x[i] - self.p;
+        for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
+            *o = xi.powi(3) + self.coefficient(i) * xi - self.p;
         }
     }
 }
@@ -887,8 +887,8 @@ impl GeneralizedJacobian for DecoupledCurves {
         Diagonal(vec![0.0; self.n])
     }
     fn jacobian(&mut self, x: &[f64], jac: &mut Diagonal) {
-        for i in 0..self.n {
-            jac.0[i] = 3.0 * x[i] * x[i] + self.coefficient(i);
+        for (i, (d, xi)) in jac.0.iter_mut().zip(x).enumerate() {
+            *d = 3.0 * xi * xi + self.coefficient(i);
         }
     }
 }
