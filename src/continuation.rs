@@ -534,6 +534,21 @@ struct Work<J> {
 }
 
 impl<J> Work<J> {
+    fn new(n: usize, theta: f64, jac: J) -> Self {
+        Self {
+            n,
+            theta,
+            jac,
+            f: vec![0.0; n],
+            fp: vec![0.0; n],
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            w: vec![0.0; n],
+            tangent: vec![0.0; n + 1],
+            dense: None,
+        }
+    }
+
     /// `<(ax, ap), (bx, bp)>_θ`.
     fn dot(&self, ax: &[f64], ap: f64, bx: &[f64], bp: f64) -> f64 {
         let s: f64 = ax.iter().zip(bx).map(|(u, v)| u * v).sum();
@@ -888,18 +903,7 @@ where
                 max: options.parameter_max,
             });
         }
-        let ws = Work {
-            n,
-            theta: options.theta,
-            jac: problem.new_jacobian(),
-            f: vec![0.0; n],
-            fp: vec![0.0; n],
-            a: vec![0.0; n],
-            b: vec![0.0; n],
-            w: vec![0.0; n],
-            tangent: vec![0.0; n + 1],
-            dense: None,
-        };
+        let ws = Work::new(n, options.theta, problem.new_jacobian());
         let fft_start = problem.fft_count();
         Ok(Self {
             problem,
@@ -940,6 +944,12 @@ where
         let mut c = self.counters;
         c.ffts = self.problem.fft_count().saturating_sub(self.fft_start);
         c
+    }
+
+    /// The problem (its parameter is that of the last accepted point between items), e.g.
+    /// to evaluate user quantities at the point just returned.
+    pub fn problem(&self) -> &P {
+        self.problem
     }
 
     /// The step length the next attempt will use.
@@ -1305,6 +1315,13 @@ where
     }
 }
 
+impl<P, S> std::iter::FusedIterator for Continuation<'_, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: LinearSolve<P::Jacobian> + ?Sized,
+{
+}
+
 /// Runs a whole continuation: [`Continuation::new`] then [`Continuation::run`].
 pub fn run<P, S>(
     problem: &mut P,
@@ -1425,18 +1442,7 @@ where
             max: f64::INFINITY,
         });
     }
-    let mut ws = Work {
-        n,
-        theta: corrector.theta,
-        jac: problem.new_jacobian(),
-        f: vec![0.0; n],
-        fp: vec![0.0; n],
-        a: vec![0.0; n],
-        b: vec![0.0; n],
-        w: vec![0.0; n],
-        tangent: vec![0.0; n + 1],
-        dense: None,
-    };
+    let mut ws = Work::new(n, corrector.theta, problem.new_jacobian());
     let fft_start = problem.fft_count();
     let mut counters = ContinuationCounters::default();
     let mut points: Vec<SweepPoint> = Vec::with_capacity(parameters.len());
