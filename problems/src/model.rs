@@ -54,4 +54,30 @@ impl StructuralModel {
     pub fn contact_count(&self) -> usize {
         self.contacts.len()
     }
+
+    /// Stiffness scale seen by the contacts: the mean of `K[dof, dof]` over the contact
+    /// dofs (1 when there is no contact). It converts a length into a force and is the
+    /// default for the complementarity constant `c` and the unit of penalty stiffnesses.
+    pub fn contact_stiffness_scale(&self) -> f64 {
+        if self.contacts.is_empty() {
+            return 1.0;
+        }
+        let sum: f64 = self
+            .contacts
+            .iter()
+            .map(|c| diagonal_entry(&self.stiffness, c.dof))
+            .sum();
+        sum / self.contacts.len() as f64
+    }
+}
+
+/// Entry `(i, i)` of a column-compressed matrix (0 when not stored).
+pub fn diagonal_entry(matrix: &SparseMatrix, i: usize) -> f64 {
+    let m = matrix.as_ref();
+    let rows = m.row_idx_of_col(i);
+    let vals = m.val_of_col(i);
+    rows.zip(vals.iter())
+        .filter(|(r, _)| *r == i)
+        .map(|(_, v)| *v)
+        .sum()
 }
