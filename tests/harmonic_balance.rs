@@ -625,3 +625,75 @@ fn structured_solve_stays_backward_stable_for_stiff_penalties() {
         );
     }
 }
+
+/// Counts allocations made by the current thread (tests run in parallel threads).
+mod counting {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    pub struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    pub fn allocations() -> u64 {
+        ALLOCATIONS.with(|c| c.get())
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: counting::Counting = counting::Counting;
+
+/// One Newton iteration's work (residual, Jacobian, structured factor, solve) at a fixed
+/// frequency allocates nothing once the workspaces exist.
+#[test]
+fn newton_iteration_work_is_allocation_free() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::default()).unwrap();
+    fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, p.dim(), 0.5);
+        let mut r = vec![0.0; p.dim()];
+        let mut jac = p.new_jacobian();
+        let mut solver = StructuredHbSolver::new();
+        // Warm-up: builds the plans' scratch, the sparse factors and the workspaces.
+        p.residual(&x, &mut r);
+        p.jacobian(&x, &mut jac);
+        solver.factor(&jac).unwrap();
+        solver.solve_in_place(&mut r).unwrap();
+        let before = counting::allocations();
+        for _ in 0..3 {
+            p.residual(&x, &mut r);
+            p.jacobian(&x, &mut jac);
+            solver.factor(&jac).unwrap();
+            solver.solve_in_place(&mut r).unwrap();
+        }
+        counting::allocations() - before
+    }
+    // The counter sees allocations at all.
+    let before = counting::allocations();
+    let probe = std::hint::black_box(vec![1u8; 16]);
+    assert!(counting::allocations() > before && probe.len() == 16);
+    assert_eq!(iterate(&mut ssn, 1), 0, "SSN-HB iteration allocated");
+    assert_eq!(
+        iterate(&mut penalty, 2),
+        0,
+        "penalty HB iteration allocated"
+    );
+}
