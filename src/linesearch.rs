@@ -142,8 +142,9 @@ pub fn backtrack(
         }
         backtracks += 1;
         let next = alpha * options.shrink;
-        // `!(next < alpha)` also catches NaN and shrink >= 1.
-        if next < options.min_step || !(next < alpha) {
+        // Not strictly smaller (shrink >= 1) or incomparable (NaN): stop as well.
+        let decreasing = next.partial_cmp(&alpha) == Some(std::cmp::Ordering::Less);
+        if next < options.min_step || !decreasing {
             return Err(LineSearchFailure {
                 last_step: alpha,
                 last_merit: m,
