@@ -14,6 +14,7 @@ use semismooth_problems::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
 use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel};
+use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
 /// `D = beta K` (or none), forcing `amplitude` on every dof at `omega`.
@@ -539,4 +540,160 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
         HbError::InvalidOption { name: "omega", .. }
     ));
+}
+
+fn canonical_modified_rod() -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = MassModel::Modified;
+    build_rod(&spec).unwrap().model
+}
+
+#[test]
+fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(
+        &model,
+        &PenaltyHbOptions {
+            penalty_stiffness: 1e3 * model.contact_stiffness_scale(),
+            ..PenaltyHbOptions::default()
+        },
+    )
+    .unwrap();
+    // A point where the tip overshoots the gap over part of the period: the constant
+    // coefficient of every dof is 0.45 * (position along the rod), first cosine 0.3 * x.
+    let (n, size) = (model.dofs(), 41);
+    let mut u = vec![0.0; n * size];
+    for dof in 0..n {
+        let x = (dof + 1) as f64 / n as f64;
+        u[dof] = 0.45 * x;
+        u[n + dof] = 0.3 * x;
+        u[4 * n + dof] = 0.02 * x;
+    }
+    let mut x = u.clone();
+    x.extend((0..size).map(|j| if j == 0 { -0.1 } else { 0.01 }));
+    let err = structured_vs_dense_step(&mut ssn, &x);
+    assert!(err < 1e-10, "SSN-HB: relative step difference {err:e}");
+    let err = structured_vs_dense_step(&mut penalty, &u);
+    assert!(err < 1e-10, "penalty HB: relative step difference {err:e}");
+}
+
+/// The condensed (Woodbury) solve subtracts large terms when the penalty is stiff; with
+/// one refinement step its residual `|J d - r| / |r|` stays at rounding level, like the
+/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (issue 5's finest setting).
+#[test]
+fn structured_solve_stays_backward_stable_for_stiff_penalties() {
+    let model = canonical_modified_rod();
+    let (n, size) = (model.dofs(), 41);
+    let mut u = vec![0.0; n * size];
+    for dof in 0..n {
+        let x = (dof + 1) as f64 / n as f64;
+        u[dof] = 0.45 * x;
+        u[n + dof] = 0.3 * x;
+        u[4 * n + dof] = 0.02 * x;
+    }
+    for relative in [1e1, 1e3, 1e5] {
+        let mut penalty = PenaltyHb::new(
+            &model,
+            &PenaltyHbOptions {
+                penalty_stiffness: relative * model.contact_stiffness_scale(),
+                ..PenaltyHbOptions::default()
+            },
+        )
+        .unwrap();
+        let mut r = vec![0.0; u.len()];
+        penalty.residual(&u, &mut r);
+        let mut jac = penalty.new_jacobian();
+        penalty.jacobian(&u, &mut jac);
+        let dense_j = assemble(&jac);
+        let mut solver = StructuredHbSolver::new();
+        solver.factor(&jac).unwrap();
+        let mut d = r.clone();
+        solver.solve_in_place(&mut d).unwrap();
+        let mut sum = 0.0;
+        for i in 0..r.len() {
+            let mut acc = -r[i];
+            for (j, dj) in d.iter().enumerate() {
+                acc += dense_j[(i, j)] * dj;
+            }
+            sum += acc * acc;
+        }
+        let backward = sum.sqrt() / norm(&r);
+        assert!(
+            backward < 1e-12,
+            "k_p = {relative:e} x scale: |J d - r| / |r| = {backward:e}"
+        );
+    }
+}
+
+/// Counts allocations made by the current thread (tests run in parallel threads).
+mod counting {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    pub struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    pub fn allocations() -> u64 {
+        ALLOCATIONS.with(|c| c.get())
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: counting::Counting = counting::Counting;
+
+/// One Newton iteration's work (residual, Jacobian, structured factor, solve) at a fixed
+/// frequency allocates nothing once the workspaces exist.
+#[test]
+fn newton_iteration_work_is_allocation_free() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::default()).unwrap();
+    fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, p.dim(), 0.5);
+        let mut r = vec![0.0; p.dim()];
+        let mut jac = p.new_jacobian();
+        let mut solver = StructuredHbSolver::new();
+        // Warm-up: builds the plans' scratch, the sparse factors and the workspaces.
+        p.residual(&x, &mut r);
+        p.jacobian(&x, &mut jac);
+        solver.factor(&jac).unwrap();
+        solver.solve_in_place(&mut r).unwrap();
+        let before = counting::allocations();
+        for _ in 0..3 {
+            p.residual(&x, &mut r);
+            p.jacobian(&x, &mut jac);
+            solver.factor(&jac).unwrap();
+            solver.solve_in_place(&mut r).unwrap();
+        }
+        counting::allocations() - before
+    }
+    // The counter sees allocations at all.
+    let before = counting::allocations();
+    let probe = std::hint::black_box(vec![1u8; 16]);
+    assert!(counting::allocations() > before && probe.len() == 16);
+    assert_eq!(iterate(&mut ssn, 1), 0, "SSN-HB iteration allocated");
+    assert_eq!(
+        iterate(&mut penalty, 2),
+        0,
+        "penalty HB iteration allocated"
+    );
 }

@@ -173,6 +173,15 @@ impl LinearData {
 
     /// `out = A(w) U - F`.
     pub(crate) fn dynamic_residual(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        self.apply_dynamic(omega, u, out);
+        let n = self.dofs;
+        for (o, f) in out[n..2 * n].iter_mut().zip(&self.forcing) {
+            *o -= f;
+        }
+    }
+
+    /// `out = A(w) U`.
+    pub(crate) fn apply_dynamic(&self, omega: f64, u: &[f64], out: &mut [f64]) {
         let n = self.dofs;
         out.fill(0.0);
         spmv_add(&self.stiffness, &u[..n], &mut out[..n], 1.0);
@@ -189,9 +198,6 @@ impl LinearData {
                 spmv_add(d, b, out_c, kw);
                 spmv_add(d, a, out_s, -kw);
             }
-        }
-        for (o, f) in out[n..2 * n].iter_mut().zip(&self.forcing) {
-            *o -= f;
         }
     }
 

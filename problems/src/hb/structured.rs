@@ -132,6 +132,10 @@ pub struct StructuredHbSolver {
     work_a: Vec<f64>,
     work_b: Mat<f64>,
     work_c: Vec<f64>,
+    work_d: Vec<f64>,
+    work_rhs: Vec<f64>,
+    work_res: Vec<f64>,
+    refinement_steps: usize,
     mem: MemBuffer,
     pivot_threshold: f64,
     dynamic_factorizations: u64,
@@ -174,11 +178,22 @@ impl StructuredHbSolver {
             work_a: Vec::new(),
             work_b: Mat::zeros(0, 0),
             work_c: Vec::new(),
+            work_d: Vec::new(),
+            work_rhs: Vec::new(),
+            work_res: Vec::new(),
+            refinement_steps: 1,
             mem: MemBuffer::new(StackReq::EMPTY),
             pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
             dynamic_factorizations: 0,
             schur_factorizations: 0,
         }
+    }
+
+    /// Sets the number of iterative-refinement steps after each solve (default 1; 0 gives
+    /// the bare condensed solve). Each step costs one structured product and one solve.
+    pub fn with_refinement_steps(mut self, steps: usize) -> Self {
+        self.refinement_steps = steps;
+        self
     }
 
     /// Number of times the per-harmonic dynamic blocks were factored (once per frequency).
@@ -308,6 +323,9 @@ impl StructuredHbSolver {
         self.work_u.resize(n * size, 0.0);
         self.work_a.resize(nc, 0.0);
         self.work_c.resize(nc, 0.0);
+        self.work_d.resize(nc, 0.0);
+        self.work_rhs.reserve(n * size + nc);
+        self.work_res.reserve(n * size + nc);
         self.work_b = Mat::zeros(nc, 1);
         self.schur = Mat::zeros(nc, nc);
         self.perm.resize(nc, 0);
@@ -505,6 +523,34 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        self.work_rhs.clear();
+        self.work_rhs.extend_from_slice(rhs);
+        self.solve_once(rhs)?;
+        // Iterative refinement with the exact structured operator: the condensation
+        // subtracts large terms when A(w) is ill-conditioned (near resonance, stiff
+        // penalties); a correction step restores dense-LU accuracy.
+        for _ in 0..self.refinement_steps {
+            let mut correction = std::mem::take(&mut self.work_res);
+            correction.resize(rhs.len(), 0.0);
+            self.apply_jacobian(rhs, &mut correction);
+            for (c, o) in correction.iter_mut().zip(&self.work_rhs) {
+                *c = *o - *c;
+            }
+            let solved = self.solve_once(&mut correction);
+            if solved.is_ok() {
+                for (x, c) in rhs.iter_mut().zip(&correction) {
+                    *x += c;
+                }
+            }
+            self.work_res = correction;
+            solved?;
+        }
+        Ok(())
+    }
+}
+
+impl StructuredHbSolver {
+    fn solve_once(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         if !self.schur_ready {
             return Err(LinearSolveError::NotFactored);
         }
@@ -576,6 +622,43 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
 }
 
 impl StructuredHbSolver {
+    /// `out = J x` with the Jacobian last factored (structured product, no assembly).
+    fn apply_jacobian(&mut self, x: &[f64], out: &mut [f64]) {
+        let Some((lin, omega)) = self.factored_for.clone() else {
+            return;
+        };
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let nu = n * size;
+        lin.apply_dynamic(omega, &x[..nu], &mut out[..nu]);
+        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            for j in 0..size {
+                self.work_a[j * m + i] = x[j * n + dof];
+            }
+        }
+        Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        match self.coupling {
+            ContactCoupling::Complementarity { c } => {
+                let (out_u, out_l) = out.split_at_mut(nu);
+                let x_l = &x[nu..];
+                Self::apply_coupling(&self.q, m, x_l, &mut self.work_d);
+                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    for j in 0..size {
+                        let r = j * m + i;
+                        out_u[j * n + dof] -= x_l[r];
+                        out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
+                    }
+                }
+            }
+            ContactCoupling::Penalty { stiffness } => {
+                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    for j in 0..size {
+                        out[j * n + dof] += stiffness * self.work_c[j * m + i];
+                    }
+                }
+            }
+        }
+    }
+
     /// `work_b <- S^{-1} work_b` with the factored condensed matrix.
     fn solve_schur(&mut self) {
         let nc = self.schur.nrows();
