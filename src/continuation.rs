@@ -328,9 +328,10 @@ pub enum ContinuationEvent {
 }
 
 /// Why a corrector attempt failed (the step is then rejected).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CorrectorFailure {
     /// No convergence within `max_corrector_iterations`.
+    #[error("no convergence in {iterations} iterations (|F| = {residual_norm:e})")]
     MaxIterations {
         /// Iterations performed.
         iterations: usize,
@@ -338,11 +339,15 @@ pub enum CorrectorFailure {
         residual_norm: f64,
     },
     /// The residual, `F_p` or a correction was NaN or infinite.
+    #[error("non-finite residual, F_p or correction at iteration {iteration}")]
     NonFinite {
         /// Iteration at which it happened.
         iteration: usize,
     },
     /// The corrections became negligible while `|F|` stayed above the tolerance.
+    #[error(
+        "stalled at iteration {iteration}: correction {step_norm:e} with |F| = {residual_norm:e}"
+    )]
     Stalled {
         /// Iteration at which it happened.
         iteration: usize,
@@ -353,6 +358,7 @@ pub enum CorrectorFailure {
     },
     /// The linear solver failed (a singular Jacobian without dense fallback, or a solver
     /// error).
+    #[error("linear solve failed at iteration {iteration}: {error}")]
     LinearSolve {
         /// Iteration at which it happened.
         iteration: usize,
@@ -360,6 +366,7 @@ pub enum CorrectorFailure {
         error: LinearSolveError,
     },
     /// The block-elimination pivot `w_p - w_x·a` vanished and no dense fallback is set.
+    #[error("bordered system singular at iteration {iteration}: pivot w_p - w_x·a = {pivot:e}")]
     SingularBorder {
         /// Iteration at which it happened.
         iteration: usize,
@@ -408,6 +415,41 @@ pub enum ContinuationTermination {
         /// Why the last attempt failed.
         failure: CorrectorFailure,
     },
+}
+
+impl std::fmt::Display for ContinuationTermination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::ReachedBound { parameter, bound } => {
+                write!(
+                    f,
+                    "reached the parameter bound {bound} (last point at {parameter})"
+                )
+            }
+            Self::MaxPoints { points } => write!(f, "reached the point limit ({points} points)"),
+            Self::StepTooSmall {
+                parameter,
+                step,
+                residual_norm,
+                failure,
+            } => write!(
+                f,
+                "step too small: the attempt with step {step:e} from p = {parameter} failed \
+                 (smallest |F| {residual_norm:e}): {failure}"
+            ),
+            Self::TooManyFailures {
+                parameter,
+                step,
+                failures,
+                residual_norm,
+                failure,
+            } => write!(
+                f,
+                "{failures} failed attempts in a row from p = {parameter}, last step {step:e} \
+                 (smallest |F| {residual_norm:e}): {failure}"
+            ),
+        }
+    }
 }
 
 /// Work done by a continuation run.
@@ -503,7 +545,7 @@ pub enum ContinuationError {
         max: f64,
     },
     /// The starting point could not be corrected at fixed parameter.
-    #[error("the starting point could not be corrected at p = {parameter}: {failure:?}")]
+    #[error("the starting point could not be corrected at p = {parameter}: {failure}")]
     StartNotConverged {
         /// The starting parameter.
         parameter: f64,

@@ -573,7 +573,8 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
         .unwrap()
         .run()
         .unwrap();
-    println!("{:?}", branch.termination);
+    println!("{}", branch.termination);
+    assert!(branch.termination.to_string().contains("step too small"));
     let ContinuationTermination::StepTooSmall {
         parameter,
         step,
