@@ -158,10 +158,11 @@ fn massless_contact_trapezoidal_never_penetrates_and_is_complementary_at_every_s
     assert_eq!(marcher.counters().active_steps, contact_steps);
 }
 
-fn canonical_modified_period(spp: usize) -> (SteadyPeriod, f64) {
+fn canonical_modified_period(spp: usize, tolerance: f64) -> (SteadyPeriod, f64) {
     let rod = modified_rod();
     let options = MarchOptions {
         steps_per_period: spp,
+        tolerance,
         ..MarchOptions::default()
     };
     let start = Instant::now();
@@ -176,19 +177,44 @@ fn extremes(x: &[f64]) -> (f64, f64) {
         })
 }
 
+/// Minimum of a periodic sampled signal (last sample = first), refined by the parabola
+/// through the smallest sample and its neighbours (removes the O(h^2) sampling error).
+fn parabolic_min(x: &[f64]) -> f64 {
+    let n = x.len() - 1;
+    let i = (0..n).min_by(|&a, &b| x[a].total_cmp(&x[b])).unwrap();
+    let (a, b, c) = (x[(i + n - 1) % n], x[i], x[(i + 1) % n]);
+    let curvature = a - 2.0 * b + c;
+    if curvature > 0.0 {
+        b - (c - a) * (c - a) / (8.0 * curvature)
+    } else {
+        b
+    }
+}
+
+/// Mean over one period of a periodic sampled signal (trapezoidal rule).
+fn period_mean(x: &[f64]) -> f64 {
+    x.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>() / (x.len() - 1) as f64
+}
+
 #[test]
 fn modified_mass_steady_period_converges_under_step_refinement() {
-    // The tip minimum converges as steps_per_period doubles (differences shrink by about
-    // 4, second order); the steady period is complementary at every reported sample.
+    // Canonical rod with the modified mass at 1000, 2000, 4000 steps per period. The mean
+    // contact force converges at second order (differences shrink by ~4.5); the tip
+    // minimum (refined by a parabola through the grid minimum) agrees to ~5e-7 relative
+    // between levels, far below the 1e-4 expected between this reference and SSN-HB.
+    // The steady period is complementary at every reported sample.
     let mut minima = Vec::new();
-    for spp in [500, 1000, 2000] {
-        let (period, seconds) = canonical_modified_period(spp);
+    let mut means = Vec::new();
+    for spp in [1000, 2000, 4000] {
+        let (period, seconds) = canonical_modified_period(spp, 1e-10);
         let tip = &period.displacements[0];
         let lambda = &period.contact_forces[0];
         let (lo, hi) = extremes(tip);
+        let refined = parabolic_min(tip);
+        let mean = period_mean(lambda);
         println!(
-            "spp {spp}: periods {} change {:.2e} tip min {lo:.10} max {hi:.10} \
-             active steps {} ({seconds:.3} s)",
+            "spp {spp}: periods {} change {:.2e} tip min {lo:.10} (parabola {refined:.10}) \
+             max {hi:.10} mean lambda {mean:.10e} active steps {} ({seconds:.3} s)",
             period.periods, period.period_change, period.counters.active_steps
         );
         for (u, l) in tip.iter().zip(lambda) {
@@ -196,16 +222,17 @@ fn modified_mass_steady_period_converges_under_step_refinement() {
             assert!(*l == 0.0 || (u - 0.5).abs() <= 1e-12);
         }
         assert!(hi > 0.5 - 1e-12, "the tip reaches the gap in steady state");
-        minima.push(lo);
+        minima.push(refined);
+        means.push(mean);
     }
-    let d1 = (minima[0] - minima[1]).abs();
-    let d2 = (minima[1] - minima[2]).abs();
-    let order = (d1 / d2).log2();
-    println!("tip minima {minima:?}, differences {d1:.3e} {d2:.3e}, observed order {order:.2}");
-    assert!(d2 < 0.5 * d1, "refinement converges: {d1:e} then {d2:e}");
-    // Relative agreement of the two finest levels, the scale needed for a 1e-4 comparison
-    // with harmonic balance.
-    assert!(d2 / minima[2].abs() < 1e-4, "{d2:e}");
+    let (m1, m2) = ((means[0] - means[1]).abs(), (means[1] - means[2]).abs());
+    let order = (m1 / m2).log2();
+    println!("mean contact force differences {m1:.3e} {m2:.3e}, observed order {order:.2}");
+    assert!(order > 1.6, "{means:?}");
+    for w in minima.windows(2) {
+        assert!(((w[0] - w[1]) / w[1]).abs() < 1e-5, "{minima:?}");
+    }
+    println!("tip minima (parabola) {minima:?}");
 }
 
 #[test]
@@ -529,17 +556,22 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
 #[test]
 #[ignore]
 fn report_canonical_modified_mass_refinement_table() {
-    println!("spp | periods | tip max | tip min | mean lambda | active steps | seconds");
-    for spp in [1000, 2000, 4000, 8000] {
-        let (period, seconds) = canonical_modified_period(spp);
-        let (lo, hi) = extremes(&period.displacements[0]);
-        let lambda = &period.contact_forces[0];
-        // Trapezoidal mean over the period.
-        let mean =
-            lambda.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>() / (lambda.len() - 1) as f64;
+    for tolerance in [1e-8, 1e-11] {
+        println!("tolerance {tolerance:e}");
         println!(
-            "{spp} | {} | {hi:.10} | {lo:.10} | {mean:.10e} | {} | {seconds:.3}",
-            period.periods, period.counters.active_steps
+            "spp | periods | tip max | tip min | tip min (parabola) | mean lambda \
+             | active steps | seconds"
         );
+        for spp in [1000, 2000, 4000, 8000] {
+            let (period, seconds) = canonical_modified_period(spp, tolerance);
+            let (lo, hi) = extremes(&period.displacements[0]);
+            let mean = period_mean(&period.contact_forces[0]);
+            let refined = parabolic_min(&period.displacements[0]);
+            println!(
+                "{spp} | {} | {hi:.10} | {lo:.10} | {refined:.10} | {mean:.10e} | {} | \
+                 {seconds:.3}",
+                period.periods, period.counters.active_steps
+            );
+        }
     }
 }
