@@ -24,6 +24,9 @@ use crate::scene::{
     GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
 };
 
+/// Ratio between successive penalty stiffnesses of the penalty homotopy.
+pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
+
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 512;
 
@@ -286,17 +289,42 @@ pub fn solve_rod(
             Ok(sol)
         }
         Method::PenaltyHb => {
+            let target = settings
+                .penalty_stiffness
+                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
             let options = PenaltyHbOptions {
                 harmonics: settings.harmonics,
                 time_samples: Some(settings.time_samples),
-                penalty_stiffness: settings
-                    .penalty_stiffness
-                    .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale),
+                penalty_stiffness: target,
             };
             let mut problem = PenaltyHb::new(model, &options)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
-            let report = newton_hb(&mut problem, &mut x, settings)?;
+            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+            // is the linear response, deep in the obstacle), so without a warm start the
+            // stiffness is raised from the contact scale by factors of 10, each stage
+            // starting from the previous answer.
+            let mut counters = WorkCounters::default();
+            if warm_start.is_none() {
+                let mut k = scale;
+                while k < target {
+                    let stage_options = PenaltyHbOptions {
+                        penalty_stiffness: k,
+                        ..options
+                    };
+                    let mut stage = PenaltyHb::new(model, &stage_options)?;
+                    let mut trial = x.clone();
+                    let report = newton_hb(&mut stage, &mut trial, settings)?;
+                    counters += report.counters;
+                    if report.converged() {
+                        x = trial;
+                    }
+                    k *= PENALTY_HOMOTOPY_FACTOR;
+                }
+            }
+            let mut report = newton_hb(&mut problem, &mut x, settings)?;
+            counters += report.counters;
+            report.counters = counters;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let tip_series = problem.displacement_samples(&x, tip, points)?;
