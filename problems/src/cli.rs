@@ -74,11 +74,14 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "tip_max": finite_or_null(s.stats.max),
         "tip_min": finite_or_null(s.stats.min),
         "max_penetration": finite_or_null(s.stats.max_penetration),
-        "mean_contact_force": finite_or_null(s.stats.mean_contact_force),
+        "contact_force_mean": finite_or_null(s.stats.mean_contact_force),
         "counters": counters_json(&s.counters),
     });
     if let Some(h) = s.harmonics {
         v["harmonics"] = json!(h);
+    }
+    if let Some(c) = s.c {
+        v["c"] = json!(c);
     }
     v
 }

@@ -28,7 +28,7 @@ use crate::scene::{
 pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
-pub const HB_OUTPUT_POINTS: usize = 512;
+pub const HB_OUTPUT_POINTS: usize = 1024;
 
 /// Why a run could not be carried out.
 #[derive(Debug, thiserror::Error)]
@@ -105,6 +105,8 @@ pub struct Solution {
     pub harmonics: Option<usize>,
     /// AFT samples (HB), time steps per period (LCP, time marching).
     pub time_samples: usize,
+    /// Complementarity constant `c` (SSN-HB only).
+    pub c: Option<f64>,
     /// Forcing frequency.
     pub omega: f64,
     /// First natural frequency of the rod.
@@ -208,6 +210,7 @@ fn hb_solution(
         method: settings.method,
         harmonics: Some(settings.harmonics),
         time_samples: settings.time_samples,
+        c: None,
         omega,
         omega_1: rod.omega_1,
         converged: report.converged(),
@@ -286,6 +289,7 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            sol.c = (problem.contacts() > 0).then(|| problem.c());
             Ok(sol)
         }
         Method::PenaltyHb => {
@@ -433,6 +437,7 @@ fn solve_lcp(
         method,
         harmonics: None,
         time_samples: settings.time_samples,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged,
@@ -487,6 +492,7 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         method: Method::March,
         harmonics: None,
         time_samples: settings.steps_per_period,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged: true,
