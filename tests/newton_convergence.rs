@@ -819,3 +819,116 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
         "the obstacle is partly active ({contacts} nodes)"
     );
 }
+
+/// Counts heap allocations made by the current thread (tests run in parallel threads).
+struct CountingAllocator;
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, size) }
+    }
+}
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(Cell::get)
+}
+
+/// A reused `NewtonSolver` with a reused faer solver (dense or sparse) allocates only
+/// the report's three history vectors per solve, however many iterations it takes:
+/// nothing per iteration. Measured with a counting global allocator on this thread.
+#[test]
+fn repeated_solves_allocate_nothing_per_iteration() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let (mut lcp, _) = strictly_complementary_lcp(Phi::FischerBurmeister);
+    let mut lu = FaerDenseLu::new();
+    let mut z = vec![1.0; 8];
+    newton.solve(&mut lcp, &mut lu, &mut z).unwrap(); // warm-up: buffers, Jacobian
+    for start in [1.0, 3.0, -2.0] {
+        z.fill(start);
+        let before = allocations();
+        let report = newton.solve(&mut lcp, &mut lu, &mut z).unwrap();
+        let made = allocations() - before;
+        assert!(report.converged() && report.iterations >= 3);
+        assert_eq!(
+            made, 3,
+            "dense: {made} allocations for {} iterations",
+            report.iterations
+        );
+    }
+
+    let n = 200;
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push(Triplet::new(i, i, 0.0));
+        if i + 1 < n {
+            t.push(Triplet::new(i + 1, i, 0.0));
+            t.push(Triplet::new(i, i + 1, 0.0));
+        }
+    }
+    /// F(u) = K u + u^3 / 10 - 1 with K = tridiag(-1, 3, -1), sparse Jacobian.
+    struct Chain(SparseColMat<usize, f64>);
+    impl Residual for Chain {
+        fn dim(&self) -> usize {
+            self.0.nrows()
+        }
+        fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+            let n = u.len();
+            for i in 0..n {
+                let l = if i > 0 { u[i - 1] } else { 0.0 };
+                let r = if i + 1 < n { u[i + 1] } else { 0.0 };
+                out[i] = 3.0 * u[i] - l - r + u[i].powi(3) / 10.0 - 1.0;
+            }
+        }
+    }
+    impl GeneralizedJacobian for Chain {
+        type Jacobian = SparseColMat<usize, f64>;
+        fn new_jacobian(&self) -> Self::Jacobian {
+            self.0.clone()
+        }
+        fn jacobian(&mut self, u: &[f64], jac: &mut Self::Jacobian) {
+            for j in 0..u.len() {
+                let (symbolic, values) = jac.parts_mut();
+                let rows = symbolic.row_idx_of_col_raw(j);
+                let range = symbolic.col_range(j);
+                for (v, &i) in values[range].iter_mut().zip(rows) {
+                    *v = if i == j {
+                        3.0 + 0.3 * u[j] * u[j]
+                    } else {
+                        -1.0
+                    };
+                }
+            }
+        }
+    }
+    let mut chain = Chain(SparseColMat::try_new_from_triplets(n, n, &t).unwrap());
+    let mut slu = FaerSparseLu::new();
+    let mut u = vec![0.0; n];
+    let mut newton_sparse = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    newton_sparse.solve(&mut chain, &mut slu, &mut u).unwrap();
+    for start in [0.0, 5.0] {
+        u.fill(start);
+        let before = allocations();
+        let report = newton_sparse.solve(&mut chain, &mut slu, &mut u).unwrap();
+        let made = allocations() - before;
+        assert!(report.converged() && report.iterations >= 3);
+        assert_eq!(
+            made, 3,
+            "sparse: {made} allocations for {} iterations",
+            report.iterations
+        );
+    }
+    assert_eq!(slu.symbolic_analyses(), 1);
+}
