@@ -56,6 +56,18 @@ fn scalar(
     Scalar { f, df }
 }
 
+/// F(x) = x^3: root 0 with a singular Jacobian; Newton gives x_{k+1} = 2/3 x_k.
+fn cube() -> Scalar<impl Fn(f64) -> f64, impl Fn(f64) -> f64> {
+    scalar(|x| x * x * x, |x| 3.0 * x * x)
+}
+
+/// Newton on [`cube`] from x0 = 1 with the dense LU: the report and the final x.
+fn newton_on_cube(opts: &NewtonOptions) -> (semismooth::newton::NewtonReport, [f64; 1]) {
+    let mut x = [1.0];
+    let report = solve(&mut cube(), &mut FaerDenseLu::new(), &mut x, opts).unwrap();
+    (report, x)
+}
+
 /// Gradient of Rosenbrock's function f = (1 - x)^2 + 100 (y - x^2)^2; its only root is
 /// the minimizer (1, 1), where the Hessian [[802, -400], [-400, 200]] is regular.
 struct RosenbrockGradient;
@@ -193,13 +205,10 @@ fn smooth_regular_root_converges_with_order_at_least_1_8() {
 /// the estimate is 1 (to round-off).
 #[test]
 fn singular_root_is_reported_with_order_one() {
-    let mut p = scalar(|x| x * x * x, |x| 3.0 * x * x);
-    let mut x = [1.0];
-    let opts = NewtonOptions {
+    let (report, _) = newton_on_cube(&NewtonOptions {
         absolute_tolerance: 1e-12,
         ..options(Globalization::None)
-    };
-    let report = solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
+    });
     assert!(report.converged());
     let q = report.observed_order.unwrap();
     assert!((q - 1.0).abs() < 1e-6, "order {q}");
@@ -593,14 +602,11 @@ fn non_finite_residual_is_reported_and_x_kept() {
 /// stops as Stalled at the first k with x_k / 3 <= 0.01 (1 + x_{k+1}), x_k = (2/3)^k.
 #[test]
 fn small_steps_without_convergence_are_reported_as_stalled() {
-    let mut p = scalar(|x| x * x * x, |x| 3.0 * x * x);
-    let mut x = [1.0];
-    let opts = NewtonOptions {
+    let (report, x) = newton_on_cube(&NewtonOptions {
         absolute_tolerance: 1e-300,
         step_tolerance: 0.01,
         ..options(Globalization::None)
-    };
-    let report = solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
+    });
     assert_eq!(report.termination, Termination::Stalled);
     let r = 2.0f64 / 3.0;
     let k = (0..)
@@ -616,13 +622,10 @@ fn small_steps_without_convergence_are_reported_as_stalled() {
 
 #[test]
 fn max_iterations_is_a_termination_not_an_error() {
-    let mut p = scalar(|x| x * x * x, |x| 3.0 * x * x);
-    let mut x = [1.0];
-    let opts = NewtonOptions {
+    let (report, x) = newton_on_cube(&NewtonOptions {
         max_iterations: 3,
         ..Default::default()
-    };
-    let report = solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
+    });
     assert_eq!(report.termination, Termination::MaxIterations);
     assert_eq!(report.iterations, 3);
     assert_eq!(report.residual_norms.len(), 4);
@@ -664,14 +667,11 @@ fn bad_options_and_dimensions_are_errors_before_any_evaluation() {
 /// r_k = (8/27)^k) and rel = 1e-3, at the first k with (8/27)^k <= 1e-3, i.e. k = 6.
 #[test]
 fn relative_tolerance_is_relative_to_initial_residual() {
-    let mut p = scalar(|x| x * x * x, |x| 3.0 * x * x);
-    let mut x = [1.0];
-    let opts = NewtonOptions {
+    let (report, _) = newton_on_cube(&NewtonOptions {
         absolute_tolerance: 0.0,
         relative_tolerance: 1e-3,
         ..options(Globalization::None)
-    };
-    let report = solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
+    });
     assert!(report.converged());
     assert_eq!(report.iterations, 6);
 }
@@ -845,6 +845,37 @@ fn allocations() -> u64 {
     ALLOCATIONS.with(Cell::get)
 }
 
+/// One warm-up solve (buffers, Jacobian, factor storage), then from each start: the
+/// solve converges in >= 3 iterations and makes exactly 3 allocations (the report's
+/// residual, step-length and step-norm histories).
+fn warm_then_count_allocations<P, S>(
+    newton: &mut NewtonSolver<P::Jacobian>,
+    problem: &mut P,
+    lu: &mut S,
+    x: &mut [f64],
+    starts: &[f64],
+) where
+    P: GeneralizedJacobian,
+    S: semismooth::LinearSolve<P::Jacobian>,
+{
+    newton.solve(problem, lu, x).unwrap();
+    for &start in starts {
+        x.fill(start);
+        let before = allocations();
+        let report = newton.solve(problem, lu, x).unwrap();
+        let made = allocations() - before;
+        assert!(
+            report.converged() && report.iterations >= 3,
+            "start {start}"
+        );
+        assert_eq!(
+            made, 3,
+            "start {start}: {made} allocations for {} iterations",
+            report.iterations
+        );
+    }
+}
+
 /// A reused `NewtonSolver` with a reused faer solver (dense or sparse) allocates only
 /// the report's three history vectors per solve, however many iterations it takes:
 /// nothing per iteration. Measured with a counting global allocator on this thread.
@@ -855,19 +886,7 @@ fn repeated_solves_allocate_nothing_per_iteration() {
     let (mut lcp, _) = strictly_complementary_lcp(Phi::FischerBurmeister);
     let mut lu = FaerDenseLu::new();
     let mut z = vec![1.0; 8];
-    newton.solve(&mut lcp, &mut lu, &mut z).unwrap(); // warm-up: buffers, Jacobian
-    for start in [1.0, 3.0, -2.0] {
-        z.fill(start);
-        let before = allocations();
-        let report = newton.solve(&mut lcp, &mut lu, &mut z).unwrap();
-        let made = allocations() - before;
-        assert!(report.converged() && report.iterations >= 3);
-        assert_eq!(
-            made, 3,
-            "dense: {made} allocations for {} iterations",
-            report.iterations
-        );
-    }
+    warm_then_count_allocations(&mut newton, &mut lcp, &mut lu, &mut z, &[1.0, 3.0, -2.0]);
 
     let n = 200;
     let mut t = Vec::new();
@@ -899,16 +918,12 @@ fn repeated_solves_allocate_nothing_per_iteration() {
             self.0.clone()
         }
         fn jacobian(&mut self, u: &[f64], jac: &mut Self::Jacobian) {
-            for j in 0..u.len() {
+            for (j, uj) in u.iter().enumerate() {
                 let (symbolic, values) = jac.parts_mut();
                 let rows = symbolic.row_idx_of_col_raw(j);
                 let range = symbolic.col_range(j);
                 for (v, &i) in values[range].iter_mut().zip(rows) {
-                    *v = if i == j {
-                        3.0 + 0.3 * u[j] * u[j]
-                    } else {
-                        -1.0
-                    };
+                    *v = if i == j { 3.0 + 0.3 * uj * uj } else { -1.0 };
                 }
             }
         }
@@ -917,18 +932,12 @@ fn repeated_solves_allocate_nothing_per_iteration() {
     let mut slu = FaerSparseLu::new();
     let mut u = vec![0.0; n];
     let mut newton_sparse = NewtonSolver::new(NewtonOptions::default()).unwrap();
-    newton_sparse.solve(&mut chain, &mut slu, &mut u).unwrap();
-    for start in [0.0, 5.0] {
-        u.fill(start);
-        let before = allocations();
-        let report = newton_sparse.solve(&mut chain, &mut slu, &mut u).unwrap();
-        let made = allocations() - before;
-        assert!(report.converged() && report.iterations >= 3);
-        assert_eq!(
-            made, 3,
-            "sparse: {made} allocations for {} iterations",
-            report.iterations
-        );
-    }
+    warm_then_count_allocations(
+        &mut newton_sparse,
+        &mut chain,
+        &mut slu,
+        &mut u,
+        &[0.0, 5.0],
+    );
     assert_eq!(slu.symbolic_analyses(), 1);
 }
