@@ -54,11 +54,21 @@
 //! between consecutive accepted points, and located by cubic Hermite interpolation of
 //! `p(s)` (values and slopes `dp/ds = t_p` at both points).
 //!
+//! The corrector takes full Newton steps unless
+//! [`ContinuationOptions::corrector_line_search`] asks for Armijo backtracking on
+//! `(|F|^2 + N^2) / 2` ([`crate::linesearch::backtrack`]).
+//!
 //! # Style
 //!
 //! [`Continuation`] is an [`Iterator`] over accepted points (BifurcationKit's style); the
 //! first item is the starting point corrected at fixed `p0`. [`Continuation::run`] collects a
-//! whole [`Branch`].
+//! whole [`Branch`]. [`natural_sweep`] solves at a list of parameters with
+//! [`crate::newton`] from the previous solution, for comparison: it fails or jumps at folds.
+//!
+//! References: H. B. Keller, *Numerical solution of bifurcation and nonlinear eigenvalue
+//! problems* (1977); E. Allgower & K. Georg, *Numerical Continuation Methods* (1990), for
+//! the bordered system and its block elimination; BifurcationKit.jl (`Palc`) for the
+//! θ-weighted arclength and the iterator; NLvib for the step bounds.
 //!
 //! ```
 //! use faer::Mat;

@@ -189,17 +189,7 @@ const FOLD_S: f64 = 0.384_900_179_459_750_5; // 2 / (3 √3)
 
 #[test]
 fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
-    let mut problem = s_curve();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: -1.0,
-        parameter_max: 1.0,
-        ..Default::default()
-    };
-    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options.clone())
-        .unwrap()
-        .run()
-        .unwrap();
+    let branch = s_curve_branch();
     // Every point is on the curve (the corrector's tolerance on |F|).
     for q in &branch.points {
         let x = q.state[0];
@@ -240,14 +230,17 @@ fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
     // Without refinement the fold is reported at the point after the sign change, which is
     // within one step of the fold in the parameter.
     let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
     let coarse = Continuation::new(
         &mut problem,
         &mut solver,
         &[-1.3],
         -1.0,
         ContinuationOptions {
+            parameter_min: -1.0,
+            parameter_max: 1.0,
             refine_folds: false,
-            ..options
+            ..Default::default()
         },
     )
     .unwrap()
