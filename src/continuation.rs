@@ -10,6 +10,7 @@
 //! <(a, α), (b, β)>_θ = (θ / n) a·b + (1 - θ) α β,        |y|_θ = sqrt(<y, y>_θ),
 //! ```
 //!
+//! (with [`ContinuationOptions::state_scale`] `s`, `a·b` becomes `Σ a_i b_i / s_i^2`),
 //! and step lengths `ds` are lengths in that norm. From an accepted point `y0` with unit
 //! direction `t` (tangent for the first step, secant afterwards by default) the predictor is
 //! `y0 + ds t`; the corrector is Newton on the bordered system
@@ -185,6 +186,10 @@ pub struct ContinuationOptions {
     /// Weight `θ` in `(0, 1)` between the state (`θ/n` per component) and the parameter
     /// (`1 - θ`) in the arclength. Default `0.5`.
     pub theta: f64,
+    /// Typical magnitude `s_i > 0` of each unknown (length `n`): the state part of the
+    /// inner product becomes `(θ/n) Σ a_i b_i / s_i^2`, so that unknowns of different
+    /// units (displacements and contact forces) weigh alike. Default `None` (all `1`).
+    pub state_scale: Option<Vec<f64>>,
     /// Direction of the parameter on the first step. Default [`Direction::Increasing`].
     pub direction: Direction,
     /// Predictor after the first step. Default [`Predictor::Secant`].
@@ -215,6 +220,7 @@ impl Default for ContinuationOptions {
             max_points: 1000,
             max_consecutive_failures: 3,
             theta: 0.5,
+            state_scale: None,
             direction: Direction::Increasing,
             predictor: Predictor::Secant,
             corrector_line_search: None,
@@ -307,6 +313,11 @@ impl ContinuationOptions {
         }
         if !(self.theta > 0.0 && self.theta < 1.0) {
             return Err(invalid("theta", self.theta, "in the open interval (0, 1)"));
+        }
+        if let Some(scale) = &self.state_scale {
+            if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+                return Err(invalid("state_scale", bad, "finite and > 0 entries"));
+            }
         }
         if let Some(ls) = &self.corrector_line_search {
             ls.validate().map_err(|e| {
@@ -599,6 +610,8 @@ type DenseAssembler<J> = fn(&J, MatMut<'_, f64>);
 struct Work<J> {
     n: usize,
     theta: f64,
+    /// `1 / s_i^2` from [`ContinuationOptions::state_scale`] (empty: all ones).
+    weights: Vec<f64>,
     jac: J,
     f: Vec<f64>,
     fp: Vec<f64>,
@@ -616,10 +629,13 @@ struct Work<J> {
 }
 
 impl<J> Work<J> {
-    fn new(n: usize, theta: f64, jac: J) -> Self {
+    fn new(n: usize, theta: f64, scale: Option<&[f64]>, jac: J) -> Self {
         Self {
             n,
             theta,
+            weights: scale
+                .map(|s| s.iter().map(|v| 1.0 / (v * v)).collect())
+                .unwrap_or_default(),
             jac,
             f: vec![0.0; n],
             fp: vec![0.0; n],
@@ -634,7 +650,15 @@ impl<J> Work<J> {
 
     /// `<(ax, ap), (bx, bp)>_θ`.
     fn dot(&self, ax: &[f64], ap: f64, bx: &[f64], bp: f64) -> f64 {
-        let s: f64 = ax.iter().zip(bx).map(|(u, v)| u * v).sum();
+        let s: f64 = if self.weights.is_empty() {
+            ax.iter().zip(bx).map(|(u, v)| u * v).sum()
+        } else {
+            ax.iter()
+                .zip(bx)
+                .zip(&self.weights)
+                .map(|((u, v), w)| u * v * w)
+                .sum()
+        };
         self.theta / self.n as f64 * s + (1.0 - self.theta) * ap * bp
     }
     fn norm(&self, x: &[f64], p: f64) -> f64 {
@@ -1025,7 +1049,21 @@ where
                 max: options.parameter_max,
             });
         }
-        let ws = Work::new(n, options.theta, problem.new_jacobian());
+        if let Some(scale) = &options.state_scale {
+            if scale.len() != n {
+                return Err(ContinuationError::InvalidOption {
+                    name: "state_scale",
+                    value: scale.len() as f64,
+                    allowed: "one entry per unknown (the problem's dimension)",
+                });
+            }
+        }
+        let ws = Work::new(
+            n,
+            options.theta,
+            options.state_scale.as_deref(),
+            problem.new_jacobian(),
+        );
         let fft_start = problem.fft_count();
         Ok(Self {
             problem,
@@ -1196,6 +1234,11 @@ where
             {
                 *xi = si + ds * di;
                 *wi = theta_x * di;
+            }
+            if !self.ws.weights.is_empty() {
+                for (wi, v) in self.ws.w.iter_mut().zip(&self.ws.weights) {
+                    *wi *= v;
+                }
             }
             let mut p = last.parameter + ds * self.direction[n];
             let w_p = (1.0 - self.options.theta) * self.direction[n];

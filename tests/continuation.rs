@@ -1116,3 +1116,88 @@ fn structured_jacobian_branch_equals_the_dense_one_and_passes_the_folds() {
     assert!((folds[0] - FOLD_S).abs() < 1e-4 && (folds[1] + FOLD_S).abs() < 1e-4);
     assert_one_factorization_per_iteration(&branch);
 }
+
+#[test]
+fn state_scale_equals_continuing_the_rescaled_problem() {
+    // With x = S z, the θ-product Σ a_i b_i / s_i^2 on x is the plain product on z: the
+    // branch of F with state_scale S must be the branch of G(z, ω) = F(S z, ω) without
+    // scale, mapped by x = S z. S = (0.3, 3) makes the two unknowns differ by 100 in
+    // weight, so a wrong weighting would change the steps and the points.
+    let scale = [0.3, 3.0];
+    let residual = duffing().f;
+    let jacobian = duffing().j;
+    let mut rescaled = Closure {
+        n: 2,
+        p: 0.0,
+        f: Box::new(move |z, w, out| residual(&[scale[0] * z[0], scale[1] * z[1]], w, out)),
+        j: Box::new(move |z, w, jac| {
+            jacobian(&[scale[0] * z[0], scale[1] * z[1]], w, jac);
+            for i in 0..2 {
+                for (j, s) in scale.iter().enumerate() {
+                    jac[(i, j)] *= s;
+                }
+            }
+        }),
+        fp: None,
+    };
+    let options = ContinuationOptions {
+        parameter_min: 0.5,
+        parameter_max: 2.0,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    let x0 = [0.13, 0.0];
+    let z0 = [x0[0] / scale[0], x0[1] / scale[1]];
+    let reference = Continuation::new(&mut rescaled, &mut solver, &z0, 0.5, options.clone())
+        .unwrap()
+        .run()
+        .unwrap();
+    let mut problem = duffing();
+    let branch = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &x0,
+        0.5,
+        ContinuationOptions {
+            state_scale: Some(scale.to_vec()),
+            ..options
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    assert_eq!(branch.points.len(), reference.points.len());
+    // The same Newton iterates in both coordinates up to the rounding of S z: the points
+    // agree to rounding, amplified by at most the corrector's conditioning; 1e-10 leaves
+    // room (measured 1e-14).
+    let mut worst = 0.0_f64;
+    for (a, b) in branch.points.iter().zip(&reference.points) {
+        worst = worst.max((a.parameter - b.parameter).abs());
+        for i in 0..2 {
+            worst = worst.max((a.state[i] - scale[i] * b.state[i]).abs());
+        }
+    }
+    println!(
+        "scaled vs rescaled: {} points, largest difference {worst:e}",
+        branch.points.len()
+    );
+    assert!(worst < 1e-10);
+    println!("{}", branch.termination);
+    assert_eq!(branch.fold_parameters().len(), 2);
+    // A scale of the wrong length is refused with the numbers.
+    let mut problem = duffing();
+    assert!(matches!(
+        Continuation::new(
+            &mut problem,
+            &mut solver,
+            &x0,
+            0.5,
+            ContinuationOptions {
+                state_scale: Some(vec![1.0; 3]),
+                ..Default::default()
+            }
+        )
+        .err(),
+        Some(ContinuationError::InvalidOption { name: "state_scale", value, .. }) if value == 3.0
+    ));
+}
