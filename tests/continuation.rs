@@ -1173,8 +1173,8 @@ fn state_scale_equals_continuing_the_rescaled_problem() {
     let mut worst = 0.0_f64;
     for (a, b) in branch.points.iter().zip(&reference.points) {
         worst = worst.max((a.parameter - b.parameter).abs());
-        for i in 0..2 {
-            worst = worst.max((a.state[i] - scale[i] * b.state[i]).abs());
+        for ((x, z), s) in a.state.iter().zip(&b.state).zip(&scale) {
+            worst = worst.max((x - s * z).abs());
         }
     }
     println!(
