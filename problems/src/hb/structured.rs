@@ -408,28 +408,6 @@ impl StructuredHbSolver {
         }
     }
 
-    /// `out = R p`: contact-displacement coefficients from contact-force coefficients.
-    fn apply_receptance(receptance: &[Mat<c64>], m: usize, p: &[f64], out: &mut [f64]) {
-        for (k, r) in receptance.iter().enumerate() {
-            for i in 0..m {
-                if k == 0 {
-                    out[i] = (0..m).map(|ip| r[(i, ip)].re * p[ip]).sum();
-                } else {
-                    let (c, s) = ((2 * k - 1) * m, 2 * k * m);
-                    let (mut a, mut b) = (0.0, 0.0);
-                    for ip in 0..m {
-                        let (cr, ci) = (r[(i, ip)].re, r[(i, ip)].im);
-                        let (pc, ps) = (p[c + ip], p[s + ip]);
-                        a += cr * pc + ci * ps;
-                        b += -ci * pc + cr * ps;
-                    }
-                    out[c + i] = a;
-                    out[s + i] = b;
-                }
-            }
-        }
-    }
-
     /// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
     fn apply_coupling(q: &Mat<f64>, m: usize, p: &[f64], out: &mut [f64]) {
         let size = q.nrows();
