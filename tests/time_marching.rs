@@ -3,6 +3,8 @@
 //! convergence under step refinement, the energy balance of the trapezoidal scheme, the
 //! restitution dependence of Moreau–Jean, and typed errors for bad input.
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::time::Instant;
 
 use nalgebra::{DMatrix, DVector};
@@ -14,6 +16,35 @@ use semismooth_problems::model::{SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{
     build_rod, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
 };
+
+/// Counts heap allocations per thread (tests run on parallel threads), to check that
+/// stepping does not allocate.
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(|c| c.get())
+}
 
 fn dense(m: &SparseMatrix) -> DMatrix<f64> {
     let r = m.as_ref();
@@ -233,6 +264,37 @@ fn modified_mass_steady_period_converges_under_step_refinement() {
         assert!(((w[0] - w[1]) / w[1]).abs() < 1e-5, "{minima:?}");
     }
     println!("tip minima (parabola) {minima:?}");
+}
+
+#[test]
+fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
+    // Free steps allocate nothing (buffers and the sparse-LU scratch are kept); a step
+    // with a closed contact allocates only the two vectors of Lemke's report.
+    for spec in [
+        RodSpec {
+            mass: MassModel::Modified,
+            ..RodSpec::canonical()
+        },
+        RodSpec::canonical(),
+    ] {
+        let rod = build_rod(&spec).unwrap();
+        let options = MarchOptions {
+            steps_per_period: 500,
+            ..MarchOptions::default()
+        };
+        let mut marcher =
+            TimeMarcher::new(&rod.model, &options, &MarchState::rest(&rod.model)).unwrap();
+        for _ in 0..20 * 500 {
+            let (before, solves) = (allocations(), marcher.counters().contact_solves);
+            marcher.step().unwrap();
+            let allocated = allocations() - before;
+            let lcp = marcher.counters().contact_solves - solves;
+            assert!(allocated <= 2 * lcp, "{allocated} allocations, {lcp} LCPs");
+        }
+        let counters = marcher.counters();
+        println!("{:?}: {counters:?}", marcher.scheme());
+        assert!(counters.contact_solves > 100);
+    }
 }
 
 #[test]
@@ -543,9 +605,16 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         ..MarchOptions::default()
     };
     match march_to_steady_state(model, &options, &[19]).unwrap_err() {
-        MarchError::NotSteady { periods, change } => {
+        MarchError::NotSteady {
+            periods,
+            change,
+            last_period,
+        } => {
             assert_eq!(periods, 3);
             assert!(change.is_finite() && change > options.tolerance);
+            assert_eq!(last_period.period_change, change);
+            assert_eq!(last_period.displacements[0].len(), 101);
+            assert!(last_period.displacements[0].iter().all(|u| u.is_finite()));
         }
         other => panic!("{other}"),
     }
