@@ -11,6 +11,35 @@ use semismooth::lemke::{
     LemkeTermination,
 };
 
+/// Counts heap allocations made by the current thread (tests run on parallel threads,
+/// so the count is per thread).
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
 fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
 }
@@ -174,6 +203,28 @@ fn workspace_reuse_gives_the_same_answer_as_a_fresh_workspace() {
         let fresh = solve_lcp(m.as_ref(), &q, &LemkeOptions::default()).unwrap();
         assert_eq!(reused, fresh, "n = {n}");
         assert_eq!(lemke.dim(), n);
+    }
+}
+
+/// With a workspace of the right size, a solve allocates only the two vectors of its
+/// report (`z` and `w`), however many pivots it makes.
+#[test]
+fn solve_allocates_only_the_report_whatever_the_pivot_count() {
+    let mut lemke = Lemke::new(300);
+    let options = LemkeOptions::default();
+    for (seed, n) in [(1u64, 300usize), (2, 300), (3, 300)] {
+        let mut r = rng(seed);
+        let m = spd_matrix(n, 1.0, &mut r);
+        let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..0.5)).collect();
+        let before = allocations();
+        let report = lemke.solve(m.as_ref(), &q, &options).unwrap();
+        let count = allocations() - before;
+        assert!(
+            report.solved() && report.pivots > 100,
+            "pivots {}",
+            report.pivots
+        );
+        assert_eq!(count, 2, "{count} allocations for {} pivots", report.pivots);
     }
 }
 
@@ -515,6 +566,15 @@ fn circulant_case(n: usize) -> (Mat<f64>, Vec<f64>) {
     (m, q)
 }
 
+/// CPU time of the current thread in seconds (Linux `/proc/thread-self/schedstat`; the
+/// machine this was measured on is shared, so wall time overstates the cost).
+fn thread_cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
 /// Timing of n = 2048 (not asserted): run with
 /// `cargo test --release --test lemke -- --ignored --nocapture timing`.
 #[test]
@@ -522,35 +582,27 @@ fn circulant_case(n: usize) -> (Mat<f64>, Vec<f64>) {
 fn timing_n2048() {
     let n = 2048;
     let mut lemke = Lemke::new(n);
-    let (m, q) = circulant_case(n);
-    for _ in 0..2 {
+    let mut timed = |label: &str, m: &Mat<f64>, q: &[f64]| {
         let start = std::time::Instant::now();
+        let cpu = thread_cpu_seconds();
         let report = lemke
-            .solve(m.as_ref(), &q, &LemkeOptions::default())
+            .solve(m.as_ref(), q, &LemkeOptions::default())
             .unwrap();
-        let elapsed = start.elapsed();
+        let cpu = thread_cpu_seconds() - cpu;
         println!(
-            "circulant n={n}: {:?}, {} pivots, {} active, error {:e}, {:.3} s",
+            "{label} n={n}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
             report.termination,
             report.pivots,
             report.z.iter().filter(|&&z| z > 0.0).count(),
             report.complementarity_error,
-            elapsed.as_secs_f64()
+            start.elapsed().as_secs_f64()
         );
-    }
+    };
+    let (m, q) = circulant_case(n);
+    timed("circulant", &m, &q);
+    timed("circulant (reused workspace)", &m, &q);
     let mut r = rng(7);
     let m = spd_matrix(n, 1.0, &mut r);
     let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
-    let start = std::time::Instant::now();
-    let report = lemke
-        .solve(m.as_ref(), &q, &LemkeOptions::default())
-        .unwrap();
-    println!(
-        "random SPD n={n}: {:?}, {} pivots, {} active, error {:e}, {:.3} s",
-        report.termination,
-        report.pivots,
-        report.z.iter().filter(|&&z| z > 0.0).count(),
-        report.complementarity_error,
-        start.elapsed().as_secs_f64()
-    );
+    timed("random SPD", &m, &q);
 }

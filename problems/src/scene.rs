@@ -565,7 +565,7 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             let step = ck.positive("sweep.step", sw.step.unwrap_or(0.01))?;
             let min_step = ck.positive("sweep.min_step", sw.min_step.unwrap_or(1e-5))?;
             let max_step = ck.positive("sweep.max_step", sw.max_step.unwrap_or(0.05))?;
-            if !(min_step <= step && step <= max_step) {
+            if step < min_step || step > max_step {
                 return Err(ck.invalid(
                     "sweep.step",
                     step,

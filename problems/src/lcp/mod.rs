@@ -1,0 +1,874 @@
+//! The periodic time-domain linear complementarity problem (after Meingast, Legrand &
+//! Pierre, *A linear complementarity problem formulation for periodic solutions to
+//! unilateral contact problems*, IJNLM 66, 2014).
+//!
+//! # Discretisation
+//!
+//! One period `T = 2 pi / omega` is split into `Nt` steps `dt = T / Nt`, nodes
+//! `t_n = n dt`. The linear dynamics `M u'' + D u' + K u = f + G^T lambda` is discretised by
+//! the periodic trapezoidal (energy-conserving) rule. Written with the shift `x_{n+1}`,
+//! the trapezoidal rule maps `d/dt` to `(2/dt) (E - 1)/(E + 1)`; on the DFT bin `k`
+//! (`E = e^{i theta_k}`, `theta_k = 2 pi k / Nt`) this is the bilinear (Tustin) map
+//!
+//! ```text
+//! s_k = (2/dt) i tan(pi k / Nt),     Z_k = K + s_k D + s_k^2 M,     Z_k U_k = F_k + G^T Lambda_k,
+//! ```
+//!
+//! so the discrete periodic problem is diagonalised by the DFT. Frequencies are warped:
+//! `(2/dt) tan(pi k/Nt) = k omega (1 + (pi k / Nt)^2 / 3 + ...)`, a second-order error.
+//!
+//! **Nyquist bin** (`k = Nt/2`, even `Nt`), where `tan` blows up: the receptance is taken
+//! as the limit `s -> i infinity` of `Z(s)^{-1}`. Split the dofs into those with mass,
+//! those without mass but with damping, and the set `V` with neither (columns of `M` and
+//! `D` both zero). As `s -> infinity`, `Z^{-1}` on the massive dofs behaves like
+//! `(s^2 M)^{-1} -> 0`, on the damped massless ones like `(s D)^{-1} -> 0`, and the Schur
+//! complement onto `V` tends to `K_VV`: `lim Z(s)^{-1} = P_V K_VV^{-1} P_V^T`, the static
+//! receptance of the part of the structure that has neither inertia nor damping, with
+//! everything else held fixed. (Derivation: with `M` positive definite on the massive
+//! block and `D` positive semi-definite, `D` vanishes on every row of `V`, so the coupling
+//! `Z_aV = K_aV` stays bounded while `Z_aa^{-1} = O(s^{-2})`.) This is what the trapezoidal
+//! rule with the force balance of `V` collocated at the nodes gives (the massless-node
+//! "modified mass" scheme): for an undamped massless tip the Nyquist receptance is
+//! `1 / K_tt`; with stiffness-proportional damping `V` is empty and it is `0`, so `A` then
+//! has the alternating null vector `(-1)^n` (the familiar contact-force oscillation of the
+//! trapezoidal rule, here invisible in the displacements). The limit assumes `ker M` and
+//! `ker D` are spanned by coordinate directions (true for the rod's consistent, lumped and
+//! modified masses).
+//!
+//! # The LCP
+//!
+//! Eliminating the displacements, the contact displacements at the nodes are
+//! `G u = u_lin + R lambda`, `R` block-circulant with `m x m` blocks `a_{n-j}` and kernel
+//! `a_p = (1/Nt) sum_k H_k e^{2 pi i k p / Nt}`, `H_k = G Z_k^{-1} G^T` (one complex sparse LU
+//! per bin `k = 0..=Nt/2`, the other bins by conjugate symmetry; the kernel by FFT, never
+//! by `Nt` solves). With `z = -lambda >= 0` (a compressive force) and the gap
+//! `w = g - G u >= 0`:
+//!
+//! ```text
+//! w = q + A z,   q = g - u_lin,   A = R,   w >= 0, z >= 0, w . z = 0.
+//! ```
+//!
+//! A compressive `z > 0` pushes the structure away from the obstacle and opens the gap,
+//! so `A` is the (positive at low frequency) receptance circulant. Unknowns are ordered
+//! time-major: index `n m + c` for node `n` and contact `c`.
+//!
+//! `A` is symmetric iff its kernel is even in time, i.e. every `H_k` is real symmetric:
+//! true without damping. The symmetric part `(A + A^T)/2` has the eigenvalues of the
+//! Hermitian parts `(H_k + H_k^*)/2` ([`PeriodicLcp::symmetric_part_spectrum`]); above a
+//! resonance `Re H_k < 0`, so it is generally indefinite and Lemke's method is not
+//! guaranteed to succeed (it may end on a ray).
+//!
+//! Solvers: [`PeriodicLcp::solve_with_lemke`] (method `"lcp-lemke"`) and the semismooth
+//! equation `min(z, q + A z) = 0`, [`MinMapLcp`] with the [`ActiveSetSolver`] (method
+//! `"lcp-ssn"`).
+
+mod dft;
+mod min_map;
+
+pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp};
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{c64, Mat, MatRef};
+
+use crate::model::{SparseMatrix, StructuralModel};
+use dft::Dft;
+
+/// Default number of time steps per period `Nt` of the periodic LCP.
+pub const DEFAULT_LCP_TIME_SAMPLES: usize = 256;
+/// Smallest accepted `Nt`.
+pub const MIN_LCP_TIME_SAMPLES: usize = 8;
+/// Largest accepted LCP size `contacts * Nt` (the dense matrix holds its square: 512 MB).
+pub const MAX_LCP_SIZE: usize = 8192;
+
+/// Relative residual `|Z x - b| / (|Z| |x| + |b|)` above which a bin solve is rejected
+/// (a forcing-free resonance: `Z_k` numerically singular).
+const BIN_RESIDUAL_TOLERANCE: f64 = 1e-8;
+
+/// Options of [`PeriodicLcp::new`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PeriodicLcpOptions {
+    /// Number of time steps per period `Nt` (default [`DEFAULT_LCP_TIME_SAMPLES`]);
+    /// `Nt >= 8` and `contacts * Nt <= MAX_LCP_SIZE`. Powers of two use a radix-2 FFT.
+    pub time_samples: usize,
+    /// Degrees of freedom whose displacement history [`PeriodicLcp::displacements`]
+    /// returns (default none; the contact dofs are always available through
+    /// [`PeriodicLcp::contact_displacements`]).
+    pub observed_dofs: Vec<usize>,
+}
+
+impl Default for PeriodicLcpOptions {
+    fn default() -> Self {
+        Self {
+            time_samples: DEFAULT_LCP_TIME_SAMPLES,
+            observed_dofs: Vec::new(),
+        }
+    }
+}
+
+impl PeriodicLcpOptions {
+    /// Checks `time_samples` for a model with `contacts` contacts and `dofs` dofs, and the
+    /// observed dofs.
+    pub fn validate(&self, contacts: usize, dofs: usize) -> Result<(), LcpError> {
+        let nt = self.time_samples;
+        if nt < MIN_LCP_TIME_SAMPLES || contacts.saturating_mul(nt) > MAX_LCP_SIZE {
+            return Err(LcpError::InvalidOption {
+                name: "time_samples",
+                value: nt as f64,
+                allowed: "an integer >= 8 with contacts * time_samples <= 8192",
+            });
+        }
+        if let Some(&dof) = self.observed_dofs.iter().find(|&&d| d >= dofs) {
+            return Err(LcpError::ObservedDofOutOfRange { dof, dofs });
+        }
+        Ok(())
+    }
+}
+
+/// Why a periodic LCP could not be built, or a result could not be produced.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LcpError {
+    /// An option is out of range.
+    #[error("invalid option {name} = {value}: allowed {allowed}")]
+    InvalidOption {
+        /// Which option.
+        name: &'static str,
+        /// The value received.
+        value: f64,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+    /// The model has no contact: there is no complementarity problem.
+    #[error("the model has no contact: the periodic LCP needs at least one")]
+    NoContacts,
+    /// A model quantity has the wrong size.
+    #[error("dimension mismatch in {what}: expected {expected}, found {found}")]
+    DimensionMismatch {
+        /// Which quantity.
+        what: &'static str,
+        /// Expected size.
+        expected: usize,
+        /// Size found.
+        found: usize,
+    },
+    /// A scalar of the model is not acceptable.
+    #[error("invalid model {name} = {value}: allowed {allowed}")]
+    InvalidModel {
+        /// Which quantity.
+        name: &'static str,
+        /// The value found.
+        value: f64,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+    /// An observed dof does not exist.
+    #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
+    ObservedDofOutOfRange {
+        /// The dof requested.
+        dof: usize,
+        /// Number of dofs.
+        dofs: usize,
+    },
+    /// A contact refers to a dof that does not exist.
+    #[error("contact dof {dof} is out of range: the model has {dofs} dofs")]
+    ContactDofOutOfRange {
+        /// The dof of the contact.
+        dof: usize,
+        /// Number of dofs.
+        dofs: usize,
+    },
+    /// The sparse factorization of a dynamic stiffness failed.
+    #[error("factorization of the dynamic stiffness of bin {bin} failed: {reason}")]
+    Factorization {
+        /// DFT bin (`Nt/2` is the Nyquist limit problem).
+        bin: usize,
+        /// Backend's description.
+        reason: String,
+    },
+    /// `Z_k` is numerically singular (a warped bin frequency on a natural frequency of an
+    /// undamped model).
+    #[error(
+        "dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: \
+         relative residual {relative_residual:e}"
+    )]
+    SingularBin {
+        /// DFT bin.
+        bin: usize,
+        /// Warped angular frequency `(2/dt) tan(pi k / Nt)`.
+        frequency: f64,
+        /// Relative residual of the solve.
+        relative_residual: f64,
+    },
+    /// A vector passed in has the wrong length.
+    #[error("{what} has length {found}, expected {expected}")]
+    WrongLength {
+        /// Which argument.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length received.
+        found: usize,
+    },
+}
+
+/// The periodic LCP `w = q + A z, w >= 0, z >= 0, w . z = 0` of a structural model
+/// (see the module documentation for the discretisation and the conventions).
+#[derive(Debug, Clone)]
+pub struct PeriodicLcp {
+    nt: usize,
+    contacts: usize,
+    omega: f64,
+    gaps: Vec<f64>,
+    contact_dofs: Vec<usize>,
+    observed_dofs: Vec<usize>,
+    /// Dense `A`, `(m Nt) x (m Nt)`, time-major.
+    matrix: Mat<f64>,
+    q: Vec<f64>,
+    /// Per bin `k = 0..=Nt/2`, the transfer `(Z_k^{-1} G^T)[r, c]` for the rows
+    /// `r` = contact dofs then observed dofs, stored `[(k * rows + r) * m + c]`.
+    transfer: Vec<c64>,
+    /// Complex amplitude `X_r` of the linear response: `u_lin,r(t_n) = Re(X_r e^{i 2 pi n/Nt})`.
+    linear_amplitude: Vec<c64>,
+    /// (min, max) eigenvalue of `(A + A^T)/2`.
+    symmetric_spectrum: (f64, f64),
+    /// Number of dofs without mass and damping (the Nyquist-limit set `V`).
+    static_dofs: usize,
+}
+
+/// Column-compressed union pattern of `K`, `M`, `D` with, for each source matrix, the
+/// position of each of its stored entries in the union.
+struct UnionPattern {
+    pattern: SparseColMat<usize, c64>,
+    stiffness: Vec<usize>,
+    mass: Vec<usize>,
+    damping: Vec<usize>,
+}
+
+fn union_pattern(model: &StructuralModel) -> Result<UnionPattern, LcpError> {
+    let n = model.dofs();
+    let mut triplets = Vec::new();
+    let mut sources: Vec<&SparseMatrix> = vec![&model.stiffness, &model.mass];
+    if let Some(d) = &model.damping {
+        sources.push(d);
+    }
+    for m in &sources {
+        let r = m.as_ref();
+        for j in 0..n {
+            for i in r.row_idx_of_col(j) {
+                triplets.push(Triplet::new(i, j, c64::new(0.0, 0.0)));
+            }
+        }
+    }
+    // The diagonal is always present so that the symbolic LU can pivot on it.
+    for j in 0..n {
+        triplets.push(Triplet::new(j, j, c64::new(0.0, 0.0)));
+    }
+    let pattern =
+        SparseColMat::<usize, c64>::try_new_from_triplets(n, n, &triplets).map_err(|e| {
+            LcpError::Factorization {
+                bin: 0,
+                reason: format!("pattern assembly failed: {e:?}"),
+            }
+        })?;
+    let positions = |m: &SparseMatrix| -> Vec<usize> {
+        let symbolic = pattern.symbolic();
+        let rows = symbolic.row_idx();
+        let r = m.as_ref();
+        let mut out = Vec::with_capacity(r.compute_nnz());
+        for j in 0..n {
+            let range = symbolic.col_range(j);
+            let col_rows = &rows[range.clone()];
+            for i in r.row_idx_of_col(j) {
+                let offset = col_rows
+                    .binary_search(&i)
+                    .expect("every entry is in the union pattern");
+                out.push(range.start + offset);
+            }
+        }
+        out
+    };
+    let stiffness = positions(&model.stiffness);
+    let mass = positions(&model.mass);
+    let damping = model.damping.as_ref().map(positions).unwrap_or_default();
+    Ok(UnionPattern {
+        pattern,
+        stiffness,
+        mass,
+        damping,
+    })
+}
+
+fn check_square(what: &'static str, m: &SparseMatrix, n: usize) -> Result<(), LcpError> {
+    for found in [m.nrows(), m.ncols()] {
+        if found != n {
+            return Err(LcpError::DimensionMismatch {
+                what,
+                expected: n,
+                found,
+            });
+        }
+    }
+    if let Some(&value) = m.val().iter().find(|v| !v.is_finite()) {
+        return Err(LcpError::InvalidModel {
+            name: what,
+            value,
+            allowed: "finite entries",
+        });
+    }
+    Ok(())
+}
+
+fn validate_model(model: &StructuralModel) -> Result<(), LcpError> {
+    let n = model.dofs();
+    check_square("stiffness", &model.stiffness, n)?;
+    check_square("mass", &model.mass, n)?;
+    if let Some(d) = &model.damping {
+        check_square("damping", d, n)?;
+    }
+    if model.forcing.amplitude.len() != n {
+        return Err(LcpError::DimensionMismatch {
+            what: "forcing amplitude",
+            expected: n,
+            found: model.forcing.amplitude.len(),
+        });
+    }
+    if let Some(&value) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
+        return Err(LcpError::InvalidModel {
+            name: "forcing amplitude",
+            value,
+            allowed: "finite entries",
+        });
+    }
+    let omega = model.forcing.omega;
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(LcpError::InvalidModel {
+            name: "omega",
+            value: omega,
+            allowed: "a finite number > 0",
+        });
+    }
+    if model.contacts.is_empty() {
+        return Err(LcpError::NoContacts);
+    }
+    for c in &model.contacts {
+        if c.dof >= n {
+            return Err(LcpError::ContactDofOutOfRange {
+                dof: c.dof,
+                dofs: n,
+            });
+        }
+        if !c.gap.is_finite() {
+            return Err(LcpError::InvalidModel {
+                name: "gap",
+                value: c.gap,
+                allowed: "a finite number",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `true` when column `j` of `m` has no non-zero entry.
+fn column_is_zero(m: &SparseMatrix, j: usize) -> bool {
+    m.as_ref().val_of_col(j).iter().all(|v| *v == 0.0)
+}
+
+impl PeriodicLcp {
+    /// Builds `A` and `q` for `model` with `options.time_samples` steps per period.
+    ///
+    /// Cost: `Nt/2 + 1` sparse complex LU factorizations of size `N` (one symbolic
+    /// analysis), `m` solves each, and `m^2` FFTs of length `Nt` for the kernel.
+    pub fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, LcpError> {
+        validate_model(model)?;
+        let n = model.dofs();
+        let m = model.contact_count();
+        options.validate(m, n)?;
+        let nt = options.time_samples;
+        let omega = model.forcing.omega;
+        let dt = 2.0 * std::f64::consts::PI / omega / nt as f64;
+        let contact_dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
+        let gaps: Vec<f64> = model.contacts.iter().map(|c| c.gap).collect();
+        let rows: Vec<usize> = contact_dofs
+            .iter()
+            .chain(&options.observed_dofs)
+            .copied()
+            .collect();
+        let nr = rows.len();
+        let bins = nt / 2 + 1;
+        let zero = c64::new(0.0, 0.0);
+        let mut transfer = vec![zero; bins * nr * m];
+        let mut linear_amplitude = vec![zero; nr];
+
+        let mut union = union_pattern(model)?;
+        let symbolic =
+            SymbolicLu::try_new(union.pattern.symbolic()).map_err(|e| LcpError::Factorization {
+                bin: 0,
+                reason: format!("symbolic analysis failed: {e:?}"),
+            })?;
+        let stiffness_max = model
+            .stiffness
+            .val()
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        for k in 0..bins {
+            if 2 * k == nt {
+                continue; // Nyquist: the limit problem below.
+            }
+            let sigma = bin_frequency(nt, dt, k);
+            let values = union.pattern.val_mut();
+            values.fill(zero);
+            for (p, v) in union.stiffness.iter().zip(model.stiffness.val()) {
+                values[*p] += c64::new(*v, 0.0);
+            }
+            for (p, v) in union.mass.iter().zip(model.mass.val()) {
+                values[*p] += c64::new(-sigma * sigma * v, 0.0);
+            }
+            if let Some(d) = &model.damping {
+                for (p, v) in union.damping.iter().zip(d.val()) {
+                    values[*p] += c64::new(0.0, sigma * v);
+                }
+            }
+            let lu = Lu::try_new_with_symbolic(symbolic.clone(), union.pattern.as_ref()).map_err(
+                |e| LcpError::Factorization {
+                    bin: k,
+                    reason: format!("{e:?}"),
+                },
+            )?;
+            let with_forcing = k == 1;
+            let ncols = m + usize::from(with_forcing);
+            let mut rhs = Mat::<c64>::zeros(n, ncols);
+            for (c, &dof) in contact_dofs.iter().enumerate() {
+                rhs[(dof, c)] = c64::new(1.0, 0.0);
+            }
+            if with_forcing {
+                for (i, a) in model.forcing.amplitude.iter().enumerate() {
+                    rhs[(i, m)] = c64::new(*a, 0.0);
+                }
+            }
+            let b = rhs.clone();
+            lu.solve_in_place(rhs.as_mut());
+            let relative_residual = bin_residual(&union.pattern, &rhs, &b, stiffness_max);
+            if !(relative_residual <= BIN_RESIDUAL_TOLERANCE) {
+                return Err(LcpError::SingularBin {
+                    bin: k,
+                    frequency: sigma,
+                    relative_residual,
+                });
+            }
+            for (r, &dof) in rows.iter().enumerate() {
+                for c in 0..m {
+                    transfer[(k * nr + r) * m + c] = rhs[(dof, c)];
+                }
+                if with_forcing {
+                    linear_amplitude[r] = rhs[(dof, m)];
+                }
+            }
+        }
+
+        // Nyquist limit: static receptance of the dofs with neither mass nor damping.
+        let static_set: Vec<usize> = (0..n)
+            .filter(|&j| {
+                column_is_zero(&model.mass, j)
+                    && model.damping.as_ref().is_none_or(|d| column_is_zero(d, j))
+            })
+            .collect();
+        if nt % 2 == 0 && !static_set.is_empty() {
+            let k = nt / 2;
+            let columns = nyquist_static_receptance(model, &static_set, &contact_dofs, k)?;
+            for (r, &dof) in rows.iter().enumerate() {
+                if let Ok(v) = static_set.binary_search(&dof) {
+                    for c in 0..m {
+                        transfer[(k * nr + r) * m + c] = c64::new(columns[(v, c)], 0.0);
+                    }
+                }
+            }
+        }
+
+        // Kernel a_p = (1/Nt) sum_k H_k e^{2 pi i k p / Nt} for every contact pair, by FFT.
+        let mut plan = Dft::new(nt);
+        let mut spectrum = vec![zero; nt];
+        let mut kernel = vec![0.0; nt * m * m];
+        for c in 0..m {
+            for c2 in 0..m {
+                fill_spectrum(&mut spectrum, |k| transfer[(k * nr + c) * m + c2]);
+                plan.backward(&mut spectrum);
+                for (p, v) in spectrum.iter().enumerate() {
+                    kernel[(p * m + c) * m + c2] = v.re / nt as f64;
+                }
+            }
+        }
+        let size = m * nt;
+        let matrix = Mat::from_fn(size, size, |i, j| {
+            let (ni, ci) = (i / m, i % m);
+            let (nj, cj) = (j / m, j % m);
+            let p = (ni + nt - nj) % nt;
+            kernel[(p * m + ci) * m + cj]
+        });
+        let mut q = vec![0.0; size];
+        for node in 0..nt {
+            let phase = 2.0 * std::f64::consts::PI * node as f64 / nt as f64;
+            let e = c64::new(phase.cos(), phase.sin());
+            for c in 0..m {
+                q[node * m + c] = gaps[c] - (linear_amplitude[c] * e).re;
+            }
+        }
+        let symmetric_spectrum = hermitian_part_range(&transfer, bins, nr, m);
+        Ok(Self {
+            nt,
+            contacts: m,
+            omega,
+            gaps,
+            contact_dofs,
+            observed_dofs: options.observed_dofs,
+            matrix,
+            q,
+            transfer,
+            linear_amplitude,
+            symmetric_spectrum,
+            static_dofs: static_set.len(),
+        })
+    }
+
+    /// Number of time steps per period `Nt`.
+    pub fn time_samples(&self) -> usize {
+        self.nt
+    }
+
+    /// Number of contacts `m`.
+    pub fn contact_count(&self) -> usize {
+        self.contacts
+    }
+
+    /// Size of the LCP, `m Nt`.
+    pub fn dim(&self) -> usize {
+        self.contacts * self.nt
+    }
+
+    /// Forcing angular frequency `omega` (the period is `2 pi / omega`).
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// The time nodes `t_n = n T / Nt`, `n = 0..Nt`.
+    pub fn times(&self) -> Vec<f64> {
+        let dt = self.time_step();
+        (0..self.nt).map(|n| n as f64 * dt).collect()
+    }
+
+    /// Time step `dt = T / Nt`.
+    pub fn time_step(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.omega / self.nt as f64
+    }
+
+    /// The warped angular frequency of bin `k`, `(2/dt) tan(pi k / Nt)` (infinite at the
+    /// Nyquist bin `k = Nt/2`).
+    pub fn bin_frequency(&self, k: usize) -> f64 {
+        bin_frequency(self.nt, self.time_step(), k)
+    }
+
+    /// The contact dofs, in contact order.
+    pub fn contact_dofs(&self) -> &[usize] {
+        &self.contact_dofs
+    }
+
+    /// The observed dofs given in the options.
+    pub fn observed_dofs(&self) -> &[usize] {
+        &self.observed_dofs
+    }
+
+    /// Number of dofs with neither mass nor damping (the set whose static receptance is
+    /// the Nyquist-bin limit).
+    pub fn static_dof_count(&self) -> usize {
+        self.static_dofs
+    }
+
+    /// The LCP matrix `A` (`m Nt` square, time-major: index `n m + c`).
+    pub fn matrix(&self) -> MatRef<'_, f64> {
+        self.matrix.as_ref()
+    }
+
+    /// The LCP vector `q = g - u_lin` at the nodes (time-major).
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// The receptance `H_k = G Z_k^{-1} G^T` of bin `k` (`m x m`, row-major; bins above
+    /// `Nt/2` by conjugate symmetry). These are the eigenvalue blocks of `A`.
+    pub fn receptance(&self, k: usize) -> Vec<c64> {
+        let k = k % self.nt;
+        let (bin, conj) = if 2 * k > self.nt {
+            (self.nt - k, true)
+        } else {
+            (k, false)
+        };
+        let m = self.contacts;
+        let nr = self.rows();
+        (0..m * m)
+            .map(|i| {
+                let v = self.transfer[(bin * nr + i / m) * m + i % m];
+                if conj {
+                    v.conj()
+                } else {
+                    v
+                }
+            })
+            .collect()
+    }
+
+    /// Smallest and largest eigenvalue of the symmetric part `(A + A^T)/2`, from the
+    /// Hermitian parts of the bin receptances (exact, no dense eigensolver). A negative
+    /// minimum means `A` is not positive semi-definite, so Lemke's method may end on a ray.
+    pub fn symmetric_part_spectrum(&self) -> (f64, f64) {
+        self.symmetric_spectrum
+    }
+
+    fn rows(&self) -> usize {
+        self.contacts + self.observed_dofs.len()
+    }
+
+    fn check_z(&self, z: &[f64]) -> Result<(), LcpError> {
+        if z.len() != self.dim() {
+            return Err(LcpError::WrongLength {
+                what: "z",
+                expected: self.dim(),
+                found: z.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The gap `w = q + A z` at the nodes (time-major).
+    pub fn gap(&self, z: &[f64]) -> Result<Vec<f64>, LcpError> {
+        self.check_z(z)?;
+        let mut w = self.q.clone();
+        min_map::add_mat_vec(self.matrix.as_ref(), z, &mut w);
+        Ok(w)
+    }
+
+    /// Contact displacements `G u = g - w` at the nodes, one series of length `Nt` per
+    /// contact, for the compressive contact forces `z` (time-major, length `m Nt`).
+    pub fn contact_displacements(&self, z: &[f64]) -> Result<Vec<Vec<f64>>, LcpError> {
+        let w = self.gap(z)?;
+        let m = self.contacts;
+        Ok((0..m)
+            .map(|c| (0..self.nt).map(|n| self.gaps[c] - w[n * m + c]).collect())
+            .collect())
+    }
+
+    /// Contact forces `lambda = -z` at the nodes, one series of length `Nt` per contact.
+    pub fn contact_forces(&self, z: &[f64]) -> Result<Vec<Vec<f64>>, LcpError> {
+        self.check_z(z)?;
+        let m = self.contacts;
+        Ok((0..m)
+            .map(|c| (0..self.nt).map(|n| -z[n * m + c]).collect())
+            .collect())
+    }
+
+    /// Displacements of the observed dofs at the nodes for the contact forces `z`, one
+    /// series of length `Nt` per observed dof (options order), by FFT:
+    /// `U_k = X_k - sum_c (Z_k^{-1} G^T)[dof, c] Zhat_{c,k}`.
+    pub fn displacements(&self, z: &[f64]) -> Result<Vec<Vec<f64>>, LcpError> {
+        self.check_z(z)?;
+        let rows: Vec<usize> = (self.contacts..self.rows()).collect();
+        Ok(self.response_rows(z, &rows))
+    }
+
+    /// The same as [`PeriodicLcp::displacements`] for the contact dofs, through the FFT
+    /// route (an independent check of `g - q - A z`).
+    pub fn contact_displacements_by_fft(&self, z: &[f64]) -> Result<Vec<Vec<f64>>, LcpError> {
+        self.check_z(z)?;
+        let rows: Vec<usize> = (0..self.contacts).collect();
+        Ok(self.response_rows(z, &rows))
+    }
+
+    fn response_rows(&self, z: &[f64], rows: &[usize]) -> Vec<Vec<f64>> {
+        let nt = self.nt;
+        let m = self.contacts;
+        let nr = self.rows();
+        let zero = c64::new(0.0, 0.0);
+        let mut plan = Dft::new(nt);
+        // Spectra of the contact forces z_c.
+        let spectra: Vec<Vec<c64>> = (0..m)
+            .map(|c| {
+                let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
+                plan.forward(&mut s);
+                s
+            })
+            .collect();
+        let mut buffer = vec![zero; nt];
+        rows.iter()
+            .map(|&r| {
+                for (k, out) in buffer.iter_mut().enumerate() {
+                    let (bin, conj) = if 2 * k > nt {
+                        (nt - k, true)
+                    } else {
+                        (k, false)
+                    };
+                    let mut sum = zero;
+                    for (c, s) in spectra.iter().enumerate() {
+                        let t = self.transfer[(bin * nr + r) * m + c];
+                        sum += if conj { t.conj() } else { t } * s[k];
+                    }
+                    *out = sum;
+                }
+                plan.backward(&mut buffer);
+                (0..nt)
+                    .map(|n| {
+                        let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
+                        let linear =
+                            (self.linear_amplitude[r] * c64::new(phase.cos(), phase.sin())).re;
+                        linear - buffer[n].re / nt as f64
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The semismooth equation `min(z, q + A z) = 0` of this LCP (method `"lcp-ssn"`).
+    pub fn min_map(&self) -> MinMapLcp<'_> {
+        MinMapLcp::new(self.matrix.as_ref(), &self.q).expect("A and q have matching sizes")
+    }
+}
+
+/// `(2/dt) tan(pi k / Nt)`, infinite at the Nyquist bin.
+fn bin_frequency(nt: usize, dt: f64, k: usize) -> f64 {
+    if 2 * k == nt {
+        return f64::INFINITY;
+    }
+    2.0 / dt * (std::f64::consts::PI * k as f64 / nt as f64).tan()
+}
+
+/// Fills a length-`Nt` spectrum from bins `0..=Nt/2` by conjugate symmetry.
+fn fill_spectrum(spectrum: &mut [c64], bin: impl Fn(usize) -> c64) {
+    let nt = spectrum.len();
+    for (k, s) in spectrum.iter_mut().enumerate() {
+        *s = if 2 * k > nt {
+            bin(nt - k).conj()
+        } else {
+            bin(k)
+        };
+    }
+    // Bin 0 (and Nyquist) of a real sequence are real.
+    spectrum[0].im = 0.0;
+    if nt % 2 == 0 {
+        spectrum[nt / 2].im = 0.0;
+    }
+}
+
+/// `max |Z x - b| / (|K|_max |x|_max + |b|_max)` over all columns (Z in the union pattern).
+fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale: f64) -> f64 {
+    let n = z.nrows();
+    let zr = z.as_ref();
+    let z_max = z.val().iter().fold(scale, |a, v| a.max(v.norm()));
+    let mut worst = 0.0f64;
+    for col in 0..x.ncols() {
+        let mut r: Vec<c64> = (0..n).map(|i| -b[(i, col)]).collect();
+        for j in 0..n {
+            let xj = x[(j, col)];
+            for (i, v) in zr.row_idx_of_col(j).zip(zr.val_of_col(j)) {
+                r[i] += *v * xj;
+            }
+        }
+        let x_max = (0..n).fold(0.0f64, |a, i| a.max(x[(i, col)].norm()));
+        let b_max = (0..n).fold(0.0f64, |a, i| a.max(b[(i, col)].norm()));
+        let r_max = r.iter().fold(0.0f64, |a, v| a.max(v.norm()));
+        let denominator = z_max * x_max + b_max;
+        let rel = if denominator > 0.0 {
+            r_max / denominator
+        } else {
+            0.0
+        };
+        if !rel.is_finite() || !x_max.is_finite() {
+            return f64::INFINITY;
+        }
+        worst = worst.max(rel);
+    }
+    worst
+}
+
+/// `K_VV^{-1}` applied to the contact columns restricted to `V` (columns of contacts
+/// outside `V` are zero), as a dense `|V| x m` matrix.
+fn nyquist_static_receptance(
+    model: &StructuralModel,
+    static_set: &[usize],
+    contact_dofs: &[usize],
+    bin: usize,
+) -> Result<Mat<f64>, LcpError> {
+    let nv = static_set.len();
+    let k = model.stiffness.as_ref();
+    let mut triplets = Vec::new();
+    for (jv, &j) in static_set.iter().enumerate() {
+        for (i, v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
+            if let Ok(iv) = static_set.binary_search(&i) {
+                triplets.push(Triplet::new(iv, jv, *v));
+            }
+        }
+    }
+    let kvv =
+        SparseColMat::<usize, f64>::try_new_from_triplets(nv, nv, &triplets).map_err(|e| {
+            LcpError::Factorization {
+                bin,
+                reason: format!("Nyquist static block assembly: {e:?}"),
+            }
+        })?;
+    let symbolic = SymbolicLu::try_new(kvv.symbolic()).map_err(|e| LcpError::Factorization {
+        bin,
+        reason: format!("Nyquist static block symbolic analysis: {e:?}"),
+    })?;
+    let lu =
+        Lu::try_new_with_symbolic(symbolic, kvv.as_ref()).map_err(|e| LcpError::Factorization {
+            bin,
+            reason: format!("Nyquist static block: {e:?}"),
+        })?;
+    let mut rhs = Mat::<f64>::zeros(nv, contact_dofs.len());
+    for (c, dof) in contact_dofs.iter().enumerate() {
+        if let Ok(v) = static_set.binary_search(dof) {
+            rhs[(v, c)] = 1.0;
+        }
+    }
+    lu.solve_in_place(rhs.as_mut());
+    if let Some((i, j)) = (0..nv)
+        .flat_map(|i| (0..contact_dofs.len()).map(move |j| (i, j)))
+        .find(|&(i, j)| !rhs[(i, j)].is_finite())
+    {
+        return Err(LcpError::Factorization {
+            bin,
+            reason: format!(
+                "Nyquist static block is singular (entry ({i}, {j}) of its inverse is not finite)"
+            ),
+        });
+    }
+    Ok(rhs)
+}
+
+/// Range of the eigenvalues of the Hermitian parts `(H_k + H_k^*)/2` over all bins.
+fn hermitian_part_range(transfer: &[c64], bins: usize, nr: usize, m: usize) -> (f64, f64) {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for k in 0..bins {
+        let h = |i: usize, j: usize| transfer[(k * nr + i) * m + j];
+        if m == 1 {
+            let v = h(0, 0).re;
+            lo = lo.min(v);
+            hi = hi.max(v);
+            continue;
+        }
+        // Real symmetric embedding [[Re S, -Im S], [Im S, Re S]] of the Hermitian
+        // S = (H + H^*)/2: same eigenvalues, each twice.
+        let s = |i: usize, j: usize| (h(i, j) + h(j, i).conj()) * 0.5;
+        let e = nalgebra::DMatrix::from_fn(2 * m, 2 * m, |i, j| {
+            let v = s(i % m, j % m);
+            match (i < m, j < m) {
+                (true, true) | (false, false) => v.re,
+                (true, false) => -v.im,
+                (false, true) => v.im,
+            }
+        });
+        for v in nalgebra::SymmetricEigen::new(e).eigenvalues.iter() {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+    }
+    (lo, hi)
+}
