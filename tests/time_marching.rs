@@ -644,3 +644,125 @@ fn report_canonical_modified_mass_refinement_table() {
         }
     }
 }
+
+/// Cross-check for the report: SSN-HB (H = 10, 20, 40, from zero, structured solver)
+/// against this reference at 8000 steps per period on the canonical modified-mass case.
+/// `cargo test --release --test time_marching -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn report_harmonic_balance_against_the_reference() {
+    use semismooth::newton::{solve, NewtonOptions};
+    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+    let rod = modified_rod();
+    let tip = rod.tip_dof();
+    let (period, _) = canonical_modified_period(8000, 1e-10);
+    let u = &period.displacements[0];
+    let reference_min = parabolic_min(u);
+    let reference_rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
+    let reference_mean = period_mean(&period.contact_forces[0]);
+    println!("reference: tip min {reference_min:.9} rms {reference_rms:.9} mean lambda {reference_mean:.9e}");
+    for harmonics in [10, 20, 40] {
+        let mut hb = SsnHb::new(
+            &rod.model,
+            &HbOptions {
+                harmonics,
+                ..HbOptions::default()
+            },
+        )
+        .unwrap();
+        let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
+        let mut solver = StructuredHbSolver::new();
+        let report = solve(&mut hb, &mut solver, &mut x, &NewtonOptions::default()).unwrap();
+        let s = hb.summary(&x, tip, 4096).unwrap();
+        println!(
+            "H {harmonics}: converged {} in {} iterations; tip min {:.9} ({:.2e} rel), rms {:.9} \
+             ({:.2e} rel), mean lambda {:.9e} ({:.2e} rel)",
+            report.converged(),
+            report.iterations,
+            s.displacement_min,
+            ((s.displacement_min - reference_min) / reference_min).abs(),
+            s.displacement_rms,
+            ((s.displacement_rms - reference_rms) / reference_rms).abs(),
+            s.contact_force_mean[0],
+            ((s.contact_force_mean[0] - reference_mean) / reference_mean).abs()
+        );
+    }
+}
+
+/// Consistent mass, for the report: SSN-HB (H = 40) against Moreau–Jean (e = 0 and 0.5, at
+/// 1000 and 4000 steps per period; the last period when the march does not lock onto the
+/// forcing period). `cargo test --release --test time_marching -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
+    use semismooth::newton::{solve, NewtonOptions};
+    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+    let rod = build_rod(&RodSpec::canonical()).unwrap();
+    let tip = rod.tip_dof();
+    let mut summaries = Vec::new();
+    for harmonics in [20, 40] {
+        let mut hb = SsnHb::new(
+            &rod.model,
+            &HbOptions {
+                harmonics,
+                ..HbOptions::default()
+            },
+        )
+        .unwrap();
+        let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
+        let report = solve(
+            &mut hb,
+            &mut StructuredHbSolver::new(),
+            &mut x,
+            &NewtonOptions {
+                max_iterations: 1000,
+                ..NewtonOptions::default()
+            },
+        )
+        .unwrap();
+        let s = hb.summary(&x, tip, 4096).unwrap();
+        println!(
+            "SSN-HB H {harmonics} ({:?} after {} iterations, |F| {:.1e}): tip min {:.7} rms {:.7} \
+             mean lambda {:.6e}",
+            report.termination,
+            report.iterations,
+            report.residual_norm(),
+            s.displacement_min,
+            s.displacement_rms,
+            s.contact_force_mean[0]
+        );
+        summaries.push(s);
+    }
+    let s = summaries.pop().unwrap();
+    for e in [0.0, 0.5] {
+        for spp in [1000, 4000] {
+            let options = MarchOptions {
+                steps_per_period: spp,
+                max_periods: 400,
+                scheme: MarchScheme::MoreauJean {
+                    theta: 0.5,
+                    restitution: e,
+                },
+                ..MarchOptions::default()
+            };
+            let period = match march_to_steady_state(&rod.model, &options, &[tip]) {
+                Ok(p) => p,
+                Err(MarchError::NotSteady { last_period, .. }) => *last_period,
+                Err(other) => panic!("{other}"),
+            };
+            let u = &period.displacements[0];
+            let min = parabolic_min(u);
+            let rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
+            let mean = period_mean(&period.contact_forces[0]);
+            println!(
+                "MJ e {e} spp {spp}: periods {} change {:.1e}; tip min {min:.7} ({:.2e} rel to HB) \
+                 rms {rms:.7} ({:.2e}) mean lambda {mean:.6e} ({:.2e})",
+                period.periods,
+                period.period_change,
+                ((min - s.displacement_min) / s.displacement_min).abs(),
+                ((rms - s.displacement_rms) / s.displacement_rms).abs(),
+                ((mean - s.contact_force_mean[0]) / s.contact_force_mean[0]).abs()
+            );
+        }
+    }
+}
