@@ -293,6 +293,13 @@ fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
         }
         let counters = marcher.counters();
         println!("{:?}: {counters:?}", marcher.scheme());
+        // Auto: trapezoidal for the massless tip, Moreau–Jean (theta 1/2, e = 0) otherwise.
+        let expected = if spec.mass == MassModel::Modified {
+            MarchScheme::MasslessContactTrapezoidal
+        } else {
+            MarchScheme::MOREAU_JEAN_DEFAULT
+        };
+        assert_eq!(marcher.scheme(), expected);
         assert!(counters.contact_solves > 100);
     }
 }

@@ -78,7 +78,9 @@
 //!   about 0.1 s at 2000 steps per period (release). The tip touches the gap exactly
 //!   (`tip max = 0.5`), the tip minimum is -0.5231507 (it varies by 2e-7 over 1000..8000
 //!   steps per period, without a clean order: contact onsets are quantised by the step),
-//!   the mean contact force -9.24379e-3 converges at order 2.2.
+//!   the mean contact force -9.24379e-3 converges at order 2.2. SSN-HB with `H = 40`
+//!   agrees with it to 1.3e-5 (tip minimum), 1.1e-4 (tip RMS) and 5.8e-4 (mean contact
+//!   force), relative.
 //! - Consistent mass (Moreau–Jean): the restitution changes the contact history (one
 //!   contact episode per period for `e = 0`, about five bounces for `e = 0.5`, 13 % less
 //!   time in contact) but the tip minimum only by ~1e-4 relative. The discrete map need
@@ -86,7 +88,9 @@
 //!   but jitters by 5e-4 to 1e-3 (relative, in the tip minimum) between periods at 2000 and
 //!   4000, and `e = 0.5` jitters at every step count tried (`O(h)`), so
 //!   [`march_to_steady_state`] can end with [`MarchError::NotSteady`], which still carries
-//!   the last period.
+//!   the last period. Against SSN-HB (`H = 40`) the mean contact force differs by 1.2 to
+//!   1.3 % and the tip minimum by 0.6e-3 to 2e-3: harmonic balance imposes no impact law,
+//!   so it cannot be expected to converge to a Moreau–Jean answer here.
 //!
 //! # Options (defaults)
 //! - `steps_per_period`: 2000, `max_periods`: 2000, `tolerance`: 1e-8,
