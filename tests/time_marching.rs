@@ -652,14 +652,41 @@ fn report_canonical_modified_mass_refinement_table() {
     }
 }
 
+/// SSN-HB from zero with the structured solver (up to 1000 Newton iterations): the Newton
+/// report and the tip summary on 4096 points.
+fn ssn_hb_tip(
+    model: &StructuralModel,
+    harmonics: usize,
+    tip: usize,
+) -> (
+    semismooth::newton::NewtonReport,
+    semismooth_problems::hb::ResponseSummary,
+) {
+    use semismooth::newton::{solve, NewtonOptions};
+    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+    let mut hb = SsnHb::new(
+        model,
+        &HbOptions {
+            harmonics,
+            ..HbOptions::default()
+        },
+    )
+    .unwrap();
+    let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
+    let options = NewtonOptions {
+        max_iterations: 1000,
+        ..NewtonOptions::default()
+    };
+    let report = solve(&mut hb, &mut StructuredHbSolver::new(), &mut x, &options).unwrap();
+    (report, hb.summary(&x, tip, 4096).unwrap())
+}
+
 /// Cross-check for the report: SSN-HB (H = 10, 20, 40, from zero, structured solver)
 /// against this reference at 8000 steps per period on the canonical modified-mass case.
 /// `cargo test --release --test time_marching -- --ignored --nocapture`
 #[test]
 #[ignore]
 fn report_harmonic_balance_against_the_reference() {
-    use semismooth::newton::{solve, NewtonOptions};
-    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
     let rod = modified_rod();
     let tip = rod.tip_dof();
     let (period, _) = canonical_modified_period(8000, 1e-10);
@@ -669,18 +696,7 @@ fn report_harmonic_balance_against_the_reference() {
     let reference_mean = period_mean(&period.contact_forces[0]);
     println!("reference: tip min {reference_min:.9} rms {reference_rms:.9} mean lambda {reference_mean:.9e}");
     for harmonics in [10, 20, 40] {
-        let mut hb = SsnHb::new(
-            &rod.model,
-            &HbOptions {
-                harmonics,
-                ..HbOptions::default()
-            },
-        )
-        .unwrap();
-        let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
-        let mut solver = StructuredHbSolver::new();
-        let report = solve(&mut hb, &mut solver, &mut x, &NewtonOptions::default()).unwrap();
-        let s = hb.summary(&x, tip, 4096).unwrap();
+        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
         println!(
             "H {harmonics}: converged {} in {} iterations; tip min {:.9} ({:.2e} rel), rms {:.9} \
              ({:.2e} rel), mean lambda {:.9e} ({:.2e} rel)",
@@ -702,32 +718,11 @@ fn report_harmonic_balance_against_the_reference() {
 #[test]
 #[ignore]
 fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
-    use semismooth::newton::{solve, NewtonOptions};
-    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
     let rod = build_rod(&RodSpec::canonical()).unwrap();
     let tip = rod.tip_dof();
     let mut summaries = Vec::new();
     for harmonics in [20, 40] {
-        let mut hb = SsnHb::new(
-            &rod.model,
-            &HbOptions {
-                harmonics,
-                ..HbOptions::default()
-            },
-        )
-        .unwrap();
-        let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
-        let report = solve(
-            &mut hb,
-            &mut StructuredHbSolver::new(),
-            &mut x,
-            &NewtonOptions {
-                max_iterations: 1000,
-                ..NewtonOptions::default()
-            },
-        )
-        .unwrap();
-        let s = hb.summary(&x, tip, 4096).unwrap();
+        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
         println!(
             "SSN-HB H {harmonics} ({:?} after {} iterations, |F| {:.1e}): tip min {:.7} rms {:.7} \
              mean lambda {:.6e}",
