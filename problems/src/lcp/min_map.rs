@@ -334,15 +334,8 @@ mod tests {
 
     #[test]
     fn singular_active_block_is_a_typed_error() {
-        let a = Mat::from_fn(3, 3, |i, j| {
-            if i < 2 && j < 2 {
-                1.0
-            } else if i == j {
-                1.0
-            } else {
-                0.0
-            }
-        });
+        // Rows 0 and 1 of the active block are equal: A_II = [[1, 1], [1, 1]].
+        let a = Mat::from_fn(3, 3, |i, j| f64::from(i == j || (i < 2 && j < 2)));
         let jac = MinMapJacobian::new(a.as_ref(), vec![true, true, false]).unwrap();
         let mut solver = ActiveSetSolver::new();
         assert!(matches!(

@@ -449,7 +449,7 @@ impl PeriodicLcp {
             let b = rhs.clone();
             lu.solve_in_place(rhs.as_mut());
             let relative_residual = bin_residual(&union.pattern, &rhs, &b, stiffness_max);
-            if !(relative_residual <= BIN_RESIDUAL_TOLERANCE) {
+            if relative_residual.is_nan() || relative_residual > BIN_RESIDUAL_TOLERANCE {
                 return Err(LcpError::SingularBin {
                     bin: k,
                     frequency: sigma,
