@@ -11,4 +11,5 @@ pub mod march;
 pub mod model;
 pub mod output;
 pub mod rod;
+pub mod runner;
 pub mod scene;

@@ -1,1 +1,361 @@
-//! (in progress)
+//! Outputs: CSV tables, SVG line plots and files written atomically (a temporary name in the
+//! same directory, then a rename), so a failed run never leaves a half-written file.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+/// Why an output could not be produced.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// A file or directory could not be written.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The target path.
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// The plot could not be drawn.
+    #[error("cannot draw plot {title:?}: {reason}")]
+    Plot {
+        /// The plot's title.
+        title: String,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename:
+/// readers see either the old file or the whole new one.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let io = |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "output".into());
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io)
+}
+
+/// Creates `dir` (and parents) and checks that a file can be created in it.
+pub fn prepare_directory(dir: &Path) -> Result<(), OutputError> {
+    let io = |source| OutputError::Io {
+        path: dir.to_path_buf(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let probe = dir.join(format!(".ssn-write-probe-{}", std::process::id()));
+    std::fs::File::create(&probe).map_err(io)?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// A CSV table from named columns of equal length (shorter columns are padded with empty
+/// cells). Numbers are written with full precision.
+pub fn csv_table(headers: &[&str], columns: &[&[f64]]) -> String {
+    let rows = columns.iter().map(|c| c.len()).max().unwrap_or(0);
+    let mut out = headers.join(",");
+    out.push('\n');
+    for r in 0..rows {
+        let cells: Vec<String> = columns
+            .iter()
+            .map(|c| c.get(r).map(|v| format!("{v:e}")).unwrap_or_default())
+            .collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// One curve of a line plot.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Ordinates.
+    pub y: Vec<f64>,
+    /// Draw dashed (reference curves).
+    pub dashed: bool,
+}
+
+impl Series {
+    /// A solid curve.
+    pub fn new(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series {
+            label: label.into(),
+            x,
+            y,
+            dashed: false,
+        }
+    }
+
+    /// A dashed curve.
+    pub fn dashed(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series {
+            dashed: true,
+            ..Series::new(label, x, y)
+        }
+    }
+}
+
+/// Axes of a plot.
+#[derive(Debug, Clone)]
+pub struct PlotSpec {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the horizontal axis.
+    pub x_label: String,
+    /// Label of the vertical axis.
+    pub y_label: String,
+    /// Plot log10 of both coordinates (non-positive values are dropped).
+    pub log_log: bool,
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(0, 0, 0),
+];
+
+/// Draws the series as an SVG document (840 x 520 px) and returns it as a string.
+pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, OutputError> {
+    let fail = |reason: String| OutputError::Plot {
+        title: spec.title.clone(),
+        reason,
+    };
+    let transform = |v: f64| if spec.log_log { v.log10() } else { v };
+    let curves: Vec<(&Series, Vec<(f64, f64)>)> = series
+        .iter()
+        .map(|s| {
+            let pts = s
+                .x
+                .iter()
+                .zip(&s.y)
+                .filter(|(x, y)| {
+                    x.is_finite() && y.is_finite() && (!spec.log_log || (**x > 0.0 && **y > 0.0))
+                })
+                .map(|(x, y)| (transform(*x), transform(*y)))
+                .collect();
+            (s, pts)
+        })
+        .collect();
+    let all = curves.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return Err(fail("no finite points to plot".into()));
+    }
+    let pad = |a: f64, b: f64| {
+        let d = if b > a {
+            0.05 * (b - a)
+        } else {
+            0.5 * a.abs().max(1.0)
+        };
+        (a - d, b + d)
+    };
+    let (x0, x1) = pad(x0, x1);
+    let (y0, y1) = pad(y0, y1);
+    let (xl, yl) = if spec.log_log {
+        (
+            format!("log10 {}", spec.x_label),
+            format!("log10 {}", spec.y_label),
+        )
+    } else {
+        (spec.x_label.clone(), spec.y_label.clone())
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (840, 520)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&spec.title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| fail(e.to_string()))?;
+        chart
+            .configure_mesh()
+            .x_desc(xl)
+            .y_desc(yl)
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(|e| fail(e.to_string()))?;
+        for (i, (s, pts)) in curves.into_iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let style = ShapeStyle {
+                color: color.to_rgba(),
+                filled: false,
+                stroke_width: 2,
+            };
+            let anno = if s.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(pts, 6, 4, style))
+                    .map_err(|e| fail(e.to_string()))?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(pts, style))
+                    .map_err(|e| fail(e.to_string()))?
+            };
+            anno.label(s.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| fail(e.to_string()))?;
+        root.present().map_err(|e| fail(e.to_string()))?;
+    }
+    Ok(svg)
+}
+
+/// Draws and writes an SVG plot atomically.
+pub fn write_line_plot(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<(), OutputError> {
+    let svg = line_plot_svg(spec, series)?;
+    write_atomically(path, svg.as_bytes())
+}
+
+/// Summary of one period of a contact response, from samples at equal time steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PeriodStatistics {
+    /// Largest displacement of the observed dof.
+    pub max: f64,
+    /// Smallest displacement.
+    pub min: f64,
+    /// Largest penetration `max(0, u - gap)` (0 without contact).
+    pub max_penetration: f64,
+    /// Mean contact force over the period (<= 0 with the sign convention; 0 without contact).
+    pub mean_contact_force: f64,
+}
+
+/// Statistics of a displacement series (and, with contact, its gap and force series).
+pub fn period_statistics(displacement: &[f64], contact: Option<(f64, &[f64])>) -> PeriodStatistics {
+    let max = displacement
+        .iter()
+        .cloned()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let min = displacement.iter().cloned().fold(f64::INFINITY, f64::min);
+    let (max_penetration, mean_contact_force) = match contact {
+        Some((gap, force)) => (
+            displacement
+                .iter()
+                .map(|u| (u - gap).max(0.0))
+                .fold(0.0, f64::max),
+            if force.is_empty() {
+                0.0
+            } else {
+                force.iter().sum::<f64>() / force.len() as f64
+            },
+        ),
+        None => (0.0, 0.0),
+    };
+    PeriodStatistics {
+        max,
+        min,
+        max_penetration,
+        mean_contact_force,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_leaves_no_temporary_file_and_replaces_content() {
+        let dir = std::env::temp_dir().join(format!("ssn-out-test-{}", std::process::id()));
+        prepare_directory(&dir).unwrap();
+        let path = dir.join("a.csv");
+        write_atomically(&path, b"one").unwrap();
+        write_atomically(&path, b"two").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "two");
+        let names: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(names.len(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn atomic_write_into_a_missing_directory_fails_with_the_path() {
+        let path = Path::new("/nonexistent-dir-ssn/x.csv");
+        let err = write_atomically(path, b"x").unwrap_err().to_string();
+        assert!(err.contains("/nonexistent-dir-ssn/x.csv"), "{err}");
+    }
+
+    #[test]
+    fn csv_table_round_trips_numbers_exactly() {
+        let a = [0.1, 1.0 / 3.0];
+        let b = [2.0];
+        let text = csv_table(&["a", "b"], &[&a, &b]);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "a,b");
+        let v: f64 = lines[2].split(',').next().unwrap().parse().unwrap();
+        assert_eq!(v, 1.0 / 3.0);
+        assert!(lines[2].ends_with(','));
+    }
+
+    #[test]
+    fn svg_plot_contains_every_label() {
+        let spec = PlotSpec {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_log: false,
+        };
+        let svg = line_plot_svg(
+            &spec,
+            &[
+                Series::new("first", vec![0.0, 1.0], vec![0.0, 1.0]),
+                Series::dashed("second", vec![0.0, 1.0], vec![1.0, 0.0]),
+            ],
+        )
+        .unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("first") && svg.contains("second"));
+    }
+
+    #[test]
+    fn period_statistics_of_a_clipped_cosine() {
+        let u: Vec<f64> = (0..100)
+            .map(|n| (2.0 * std::f64::consts::PI * n as f64 / 100.0).cos())
+            .collect();
+        let force = vec![-1.0; 100];
+        let s = period_statistics(&u, Some((0.5, &force)));
+        assert_eq!(s.max, 1.0);
+        assert!((s.min + 1.0).abs() < 1e-3);
+        assert!((s.max_penetration - 0.5).abs() < 1e-15);
+        assert_eq!(s.mean_contact_force, -1.0);
+    }
+}

@@ -1,1 +1,673 @@
-//! (in progress)
+//! Scenes: TOML problem descriptions, validated into a rod spec and solver settings.
+//!
+//! Only what a scene declares is simulated: no `[damping]` section means no damping matrix,
+//! no `[contact]` section means a linear problem. Every key, its unit, default and allowed
+//! values are listed in README.md ("Scene format"); unknown keys are errors.
+//!
+//! ```toml
+//! [rod]
+//! elements = 20              # required, integer >= 1
+//! mass = "modified"          # consistent | lumped | modified (default consistent)
+//! [damping]
+//! zeta = 0.01                # or alpha/beta (Rayleigh)
+//! [forcing]
+//! amplitude = 0.04
+//! omega_ratio = 1.0          # or omega (absolute)
+//! [contact]
+//! gap = 0.5                  # tip contact; or [[contact.point]] node/gap entries
+//! [solver]
+//! method = "ssn-hb"
+//! harmonics = 20
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::rod::{DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec};
+
+/// Why a scene could not be used. Every variant names the file; `Invalid` also names the
+/// key, the value found and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scene: {source}")]
+    Io {
+        /// The scene file.
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// Malformed TOML, an unknown key, a wrong type or a missing required key.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The scene file.
+        path: PathBuf,
+        /// The parser's message (with line and column, key and expected type).
+        message: String,
+    },
+    /// A value of the right type outside its allowed range, or conflicting keys.
+    #[error("{path}: invalid `{key}` = {value}: allowed {allowed}")]
+    Invalid {
+        /// The scene file.
+        path: PathBuf,
+        /// The offending key, as `section.key`.
+        key: String,
+        /// The value found.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+}
+
+/// Solution method of a scene (`[solver] method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Harmonic balance with exact contact as the Lipschitz equation, semismooth Newton
+    /// (the paper).
+    #[default]
+    SsnHb,
+    /// Harmonic balance with a penalty contact law `lambda = -k_p max(0, G u - g)`.
+    PenaltyHb,
+    /// Periodic time-domain LCP solved by Lemke's algorithm.
+    LcpLemke,
+    /// Periodic time-domain LCP `min(z, q + A z) = 0` solved by semismooth Newton.
+    LcpSsn,
+    /// Time marching to the steady state (the reference).
+    March,
+}
+
+impl Method {
+    /// The scene spelling of the method.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::SsnHb => "ssn-hb",
+            Method::PenaltyHb => "penalty-hb",
+            Method::LcpLemke => "lcp-lemke",
+            Method::LcpSsn => "lcp-ssn",
+            Method::March => "march",
+        }
+    }
+
+    /// Whether the method represents the response by harmonics.
+    pub fn is_harmonic_balance(self) -> bool {
+        matches!(self, Method::SsnHb | Method::PenaltyHb)
+    }
+}
+
+/// Linear solver for the Newton systems of the harmonic-balance methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LinearSolverChoice {
+    /// Condensation onto the contact unknowns (per-harmonic sparse factorizations).
+    #[default]
+    Structured,
+    /// Dense LU of the full Jacobian (for checking; cubic in the model size).
+    Dense,
+}
+
+/// Globalization of the Newton iterations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum GlobalizationChoice {
+    /// Full Newton steps.
+    None,
+    /// Armijo backtracking on `0.5 |F|^2`.
+    Armijo,
+    /// Non-monotone (Grippo–Lampariello–Lucidi) line search.
+    #[default]
+    Nonmonotone,
+}
+
+/// Default number of harmonics.
+pub const DEFAULT_HARMONICS: usize = 20;
+/// Default number of LCP time steps per period.
+pub const DEFAULT_LCP_TIME_SAMPLES: usize = 256;
+/// Default penalty stiffness, relative to the contact stiffness scale `K[tip, tip]`.
+pub const DEFAULT_RELATIVE_PENALTY: f64 = 1e5;
+
+/// Default AFT sample count for `H` harmonics: the next power of two >= max(64, 4 (2H + 1)).
+pub fn default_hb_time_samples(harmonics: usize) -> usize {
+    (4 * (2 * harmonics + 1)).max(64).next_power_of_two()
+}
+
+/// Validated solver settings (`[solver]`), defaults filled in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverSettings {
+    /// Method.
+    pub method: Method,
+    /// Number of harmonics `H` (harmonic-balance methods).
+    pub harmonics: usize,
+    /// AFT samples (HB) or time steps per period (LCP).
+    pub time_samples: usize,
+    /// Complementarity constant `c`; `None`: the contact stiffness scale.
+    pub c: Option<f64>,
+    /// Penalty stiffness `k_p` (absolute); `None`: 1e5 times the contact stiffness scale.
+    pub penalty_stiffness: Option<f64>,
+    /// Linear solver for HB Newton systems.
+    pub linear_solver: LinearSolverChoice,
+    /// Newton iteration limit.
+    pub max_iterations: usize,
+    /// Newton globalization.
+    pub globalization: GlobalizationChoice,
+    /// Absolute tolerance on the residual 2-norm (Newton methods).
+    pub tolerance: f64,
+    /// Time-marching steps per period.
+    pub steps_per_period: usize,
+    /// Time-marching period limit.
+    pub max_periods: usize,
+    /// Time-marching period-to-period tolerance.
+    pub march_tolerance: f64,
+    /// Restitution coefficient of the Moreau–Jean scheme (massive contact nodes).
+    pub restitution: f64,
+}
+
+/// Validated sweep settings (`[sweep]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSettings {
+    /// Start of the sweep, in units of omega_1.
+    pub omega_ratio_from: f64,
+    /// End of the sweep, in units of omega_1.
+    pub omega_ratio_to: f64,
+    /// Initial arclength step.
+    pub step: f64,
+    /// Smallest step before giving up.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Point limit.
+    pub max_points: usize,
+}
+
+/// A validated scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// Where it came from (`<built-in>` for scenes built in code).
+    pub path: PathBuf,
+    /// Optional title (`title = "..."`).
+    pub title: Option<String>,
+    /// The rod.
+    pub rod: RodSpec,
+    /// Solver settings.
+    pub solver: SolverSettings,
+    /// Frequency sweep, if declared.
+    pub sweep: Option<SweepSettings>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    title: Option<String>,
+    rod: RawRod,
+    damping: Option<RawDamping>,
+    forcing: RawForcing,
+    contact: Option<RawContact>,
+    #[serde(default)]
+    solver: RawSolver,
+    sweep: Option<RawSweep>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRod {
+    elements: i64,
+    length: Option<f64>,
+    axial_stiffness: Option<f64>,
+    mass_per_length: Option<f64>,
+    #[serde(default)]
+    mass: RawMass,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawMass {
+    #[default]
+    Consistent,
+    Lumped,
+    Modified,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDamping {
+    zeta: Option<f64>,
+    alpha: Option<f64>,
+    beta: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawLoad {
+    #[default]
+    Distributed,
+    Tip,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawForcing {
+    #[serde(default)]
+    load: RawLoad,
+    amplitude: f64,
+    omega_ratio: Option<f64>,
+    omega: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContact {
+    gap: Option<f64>,
+    node: Option<i64>,
+    point: Option<Vec<RawContactPoint>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContactPoint {
+    node: i64,
+    gap: f64,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSolver {
+    #[serde(default)]
+    method: Method,
+    harmonics: Option<i64>,
+    time_samples: Option<i64>,
+    c: Option<f64>,
+    penalty_stiffness: Option<f64>,
+    #[serde(default)]
+    linear_solver: LinearSolverChoice,
+    max_iterations: Option<i64>,
+    #[serde(default)]
+    globalization: GlobalizationChoice,
+    tolerance: Option<f64>,
+    steps_per_period: Option<i64>,
+    max_periods: Option<i64>,
+    march_tolerance: Option<f64>,
+    restitution: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSweep {
+    omega_ratio_from: f64,
+    omega_ratio_to: f64,
+    step: Option<f64>,
+    min_step: Option<f64>,
+    max_step: Option<f64>,
+    max_points: Option<i64>,
+}
+
+/// Largest harmonic count accepted.
+pub const MAX_HARMONICS: usize = 2000;
+/// Largest sample / step count accepted.
+pub const MAX_TIME_SAMPLES: usize = 1 << 20;
+
+struct Check<'a> {
+    path: &'a Path,
+}
+
+impl Check<'_> {
+    fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_path_buf(),
+            key: key.to_string(),
+            value: value.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+
+    fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, v, "a finite number > 0"))
+        }
+    }
+
+    fn non_negative(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, v, "a finite number >= 0"))
+        }
+    }
+
+    fn finite(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, v, "a finite number"))
+        }
+    }
+
+    fn count(&self, key: &str, v: i64, min: usize, max: usize) -> Result<usize, SceneError> {
+        if v >= min as i64 && v <= max as i64 {
+            Ok(v as usize)
+        } else {
+            Err(self.invalid(key, v, &format!("an integer in {min}..={max}")))
+        }
+    }
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Scene::from_toml(&text, path)
+    }
+
+    /// Parses and validates scene text; `path` is only used in messages.
+    pub fn from_toml(text: &str, path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        resolve(raw, path)
+    }
+}
+
+fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
+    let ck = Check { path };
+    let elements = ck.count(
+        "rod.elements",
+        raw.rod.elements,
+        1,
+        crate::rod::MAX_ELEMENTS,
+    )?;
+    let length = ck.positive("rod.length", raw.rod.length.unwrap_or(1.0))?;
+    let axial_stiffness = ck.positive(
+        "rod.axial_stiffness",
+        raw.rod.axial_stiffness.unwrap_or(1.0),
+    )?;
+    let mass_per_length = ck.positive(
+        "rod.mass_per_length",
+        raw.rod.mass_per_length.unwrap_or(1.0),
+    )?;
+    let mass = match raw.rod.mass {
+        RawMass::Consistent => MassModel::Consistent,
+        RawMass::Lumped => MassModel::Lumped,
+        RawMass::Modified => MassModel::Modified,
+    };
+
+    let damping =
+        match raw.damping {
+            None => None,
+            Some(d) => match (d.zeta, d.alpha, d.beta) {
+                (Some(zeta), None, None) => Some(DampingSpec::StiffnessProportional {
+                    zeta: ck.non_negative("damping.zeta", zeta)?,
+                }),
+                (None, alpha, beta) if alpha.is_some() || beta.is_some() => {
+                    Some(DampingSpec::Rayleigh {
+                        alpha: ck.non_negative("damping.alpha", alpha.unwrap_or(0.0))?,
+                        beta: ck.non_negative("damping.beta", beta.unwrap_or(0.0))?,
+                    })
+                }
+                (None, None, None) => return Err(ck.invalid(
+                    "damping",
+                    "an empty section",
+                    "`zeta` (mode-1 ratio) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
+                )),
+                _ => {
+                    return Err(ck.invalid(
+                        "damping.zeta",
+                        "given together with alpha/beta",
+                        "either `zeta` or `alpha`/`beta`, not both",
+                    ))
+                }
+            },
+        };
+
+    let amplitude = ck.finite("forcing.amplitude", raw.forcing.amplitude)?;
+    let frequency = match (raw.forcing.omega_ratio, raw.forcing.omega) {
+        (Some(r), None) => FrequencySpec::Ratio(ck.positive("forcing.omega_ratio", r)?),
+        (None, Some(w)) => FrequencySpec::Absolute(ck.positive("forcing.omega", w)?),
+        (None, None) => FrequencySpec::Ratio(1.0),
+        (Some(_), Some(_)) => {
+            return Err(ck.invalid(
+                "forcing.omega",
+                "given together with omega_ratio",
+                "either `omega_ratio` (units of omega_1) or `omega` (rad per unit time)",
+            ))
+        }
+    };
+    let load = match raw.forcing.load {
+        RawLoad::Distributed => LoadKind::Distributed,
+        RawLoad::Tip => LoadKind::Tip,
+    };
+
+    let mut contacts = Vec::new();
+    if let Some(c) = raw.contact {
+        match (c.gap, c.point) {
+            (Some(gap), None) => {
+                let node = match c.node {
+                    Some(n) => ck.count("contact.node", n, 1, elements)?,
+                    None => elements,
+                };
+                contacts.push(RodContact {
+                    node,
+                    gap: ck.finite("contact.gap", gap)?,
+                });
+            }
+            (None, Some(points)) if c.node.is_none() => {
+                if points.is_empty() {
+                    return Err(ck.invalid(
+                        "contact.point",
+                        "an empty list",
+                        "at least one [[contact.point]] with node and gap",
+                    ));
+                }
+                for p in points {
+                    let node = ck.count("contact.point.node", p.node, 1, elements)?;
+                    if contacts.iter().any(|c: &RodContact| c.node == node) {
+                        return Err(ck.invalid(
+                            "contact.point.node",
+                            node,
+                            "distinct nodes (one contact per node)",
+                        ));
+                    }
+                    contacts.push(RodContact {
+                        node,
+                        gap: ck.finite("contact.point.gap", p.gap)?,
+                    });
+                }
+            }
+            (None, None) => {
+                return Err(ck.invalid(
+                    "contact",
+                    "a section without gap",
+                    "`gap` (and optional `node`) or [[contact.point]] entries; omit [contact] for a linear problem",
+                ))
+            }
+            _ => {
+                return Err(ck.invalid(
+                    "contact.gap",
+                    "given together with [[contact.point]] or node",
+                    "either `gap` (+ optional `node`) or [[contact.point]] entries",
+                ))
+            }
+        }
+    }
+
+    let s = raw.solver;
+    let method = s.method;
+    let harmonics = match s.harmonics {
+        Some(h) => ck.count("solver.harmonics", h, 1, MAX_HARMONICS)?,
+        None => DEFAULT_HARMONICS,
+    };
+    let time_samples = match (s.time_samples, method) {
+        (Some(n), m) if m.is_harmonic_balance() => {
+            let n = ck.count("solver.time_samples", n, 1, MAX_TIME_SAMPLES)?;
+            if n <= 2 * harmonics {
+                return Err(ck.invalid(
+                    "solver.time_samples",
+                    n,
+                    &format!(
+                        "an integer > 2 * harmonics = {} (the AFT needs more samples than basis functions)",
+                        2 * harmonics
+                    ),
+                ));
+            }
+            n
+        }
+        (Some(n), _) => ck.count("solver.time_samples", n, 8, MAX_TIME_SAMPLES)?,
+        (None, m) if m.is_harmonic_balance() => default_hb_time_samples(harmonics),
+        (None, _) => DEFAULT_LCP_TIME_SAMPLES,
+    };
+    let c = s.c.map(|c| ck.positive("solver.c", c)).transpose()?;
+    let penalty_stiffness = s
+        .penalty_stiffness
+        .map(|k| ck.positive("solver.penalty_stiffness", k))
+        .transpose()?;
+    let max_iterations = match s.max_iterations {
+        Some(n) => ck.count("solver.max_iterations", n, 1, 100_000)?,
+        None => 200,
+    };
+    let tolerance = ck.positive("solver.tolerance", s.tolerance.unwrap_or(1e-10))?;
+    let steps_per_period = match s.steps_per_period {
+        Some(n) => ck.count("solver.steps_per_period", n, 8, MAX_TIME_SAMPLES)?,
+        None => 2000,
+    };
+    let max_periods = match s.max_periods {
+        Some(n) => ck.count("solver.max_periods", n, 1, 1_000_000)?,
+        None => 2000,
+    };
+    let march_tolerance =
+        ck.positive("solver.march_tolerance", s.march_tolerance.unwrap_or(1e-8))?;
+    let restitution = s.restitution.unwrap_or(0.0);
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(ck.invalid("solver.restitution", restitution, "a number in [0, 1]"));
+    }
+    if contacts.is_empty() && matches!(method, Method::LcpLemke | Method::LcpSsn) {
+        // An LCP without contact is empty; allowed, solved as the linear response.
+    }
+
+    let sweep = match raw.sweep {
+        None => None,
+        Some(sw) => {
+            let from = ck.positive("sweep.omega_ratio_from", sw.omega_ratio_from)?;
+            let to = ck.positive("sweep.omega_ratio_to", sw.omega_ratio_to)?;
+            if to == from {
+                return Err(ck.invalid(
+                    "sweep.omega_ratio_to",
+                    to,
+                    "a value different from omega_ratio_from",
+                ));
+            }
+            let step = ck.positive("sweep.step", sw.step.unwrap_or(0.01))?;
+            let min_step = ck.positive("sweep.min_step", sw.min_step.unwrap_or(1e-5))?;
+            let max_step = ck.positive("sweep.max_step", sw.max_step.unwrap_or(0.05))?;
+            if step < min_step || step > max_step {
+                return Err(ck.invalid(
+                    "sweep.step",
+                    step,
+                    &format!("min_step ({min_step}) <= step <= max_step ({max_step})"),
+                ));
+            }
+            let max_points = match sw.max_points {
+                Some(n) => ck.count("sweep.max_points", n, 2, 1_000_000)?,
+                None => 2000,
+            };
+            Some(SweepSettings {
+                omega_ratio_from: from,
+                omega_ratio_to: to,
+                step,
+                min_step,
+                max_step,
+                max_points,
+            })
+        }
+    };
+
+    Ok(Scene {
+        path: path.to_path_buf(),
+        title: raw.title,
+        rod: RodSpec {
+            elements,
+            length,
+            axial_stiffness,
+            mass_per_length,
+            mass,
+            damping,
+            load,
+            amplitude,
+            frequency,
+            contacts,
+        },
+        solver: SolverSettings {
+            method,
+            harmonics,
+            time_samples,
+            c,
+            penalty_stiffness,
+            linear_solver: s.linear_solver,
+            max_iterations,
+            globalization: s.globalization,
+            tolerance,
+            steps_per_period,
+            max_periods,
+            march_tolerance,
+            restitution,
+        },
+        sweep,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CANONICAL: &str = r#"
+[rod]
+elements = 20
+[damping]
+zeta = 0.01
+[forcing]
+amplitude = 0.04
+omega_ratio = 1.0
+[contact]
+gap = 0.5
+"#;
+
+    #[test]
+    fn canonical_scene_resolves_to_the_canonical_rod() {
+        let scene = Scene::from_toml(CANONICAL, "canonical.toml").unwrap();
+        assert_eq!(scene.rod, RodSpec::canonical());
+        assert_eq!(scene.solver.method, Method::SsnHb);
+        assert_eq!(scene.solver.harmonics, 20);
+        assert_eq!(scene.solver.time_samples, 256);
+    }
+
+    #[test]
+    fn hb_time_sample_default_is_a_power_of_two_of_at_least_four_per_basis_function() {
+        assert_eq!(default_hb_time_samples(1), 64);
+        assert_eq!(default_hb_time_samples(5), 64);
+        assert_eq!(default_hb_time_samples(10), 128);
+        assert_eq!(default_hb_time_samples(100), 1024);
+    }
+
+    #[test]
+    fn unknown_key_is_named() {
+        let text = CANONICAL.replace("gap = 0.5", "gap = 0.5\ngapp = 1");
+        let err = Scene::from_toml(&text, "x.toml").unwrap_err().to_string();
+        assert!(err.contains("x.toml") && err.contains("gapp"), "{err}");
+    }
+
+    #[test]
+    fn too_few_time_samples_for_the_harmonics_are_rejected() {
+        let text = format!("{CANONICAL}\n[solver]\nharmonics = 20\ntime_samples = 40\n");
+        let err = Scene::from_toml(&text, "x.toml").unwrap_err().to_string();
+        assert!(
+            err.contains("solver.time_samples") && err.contains("40"),
+            "{err}"
+        );
+    }
+}

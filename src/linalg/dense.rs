@@ -1,8 +1,11 @@
-//! Dense LU with partial pivoting (faer).
+//! Dense LU with partial pivoting (faer), factored in place into storage that is reused
+//! from one factorization to the next.
 
-use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::{Mat, MatMut};
+use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve};
+use faer::perm::PermRef;
+use faer::{Mat, MatMut, Par};
 
+use super::scratch::Scratch;
 use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::LinearSolve;
 
@@ -38,31 +41,151 @@ impl DenseAssemble for nalgebra::DMatrix<f64> {
     }
 }
 
-/// faer dense LU with partial pivoting, with a relative pivot check
+/// Returns the first non-finite entry of a dense matrix as a typed error.
+pub(crate) fn check_finite_dense(
+    nrows: usize,
+    ncols: usize,
+    entry: impl Fn(usize, usize) -> f64,
+) -> Result<(), LinearSolveError> {
+    for col in 0..ncols {
+        for row in 0..nrows {
+            let value = entry(row, col);
+            if !value.is_finite() {
+                return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// faer dense LU with partial pivoting, `P A = L U`, with a relative pivot check
 /// (faer itself divides by zero pivots silently).
+///
+/// The factors overwrite a matrix kept by the solver; the row permutation and the
+/// scratch memory are kept as well, so repeated [`factor`](FaerDenseLu::factor) /
+/// [`solve_in_place`](FaerDenseLu::solve_in_place) calls of one size allocate nothing.
+///
+/// Both operations exist as inherent methods (usable without importing
+/// [`LinearSolve`] and without naming the Jacobian type) and through the
+/// [`LinearSolve<J>`] trait for every `J: DenseAssemble`, which is what the Newton
+/// driver uses.
+///
+/// ```
+/// use faer::Mat;
+/// use semismooth::linalg::FaerDenseLu;
+/// let a = Mat::from_fn(2, 2, |i, j| [[4.0, 1.0], [2.0, 3.0]][i][j]);
+/// let mut lu = FaerDenseLu::new();
+/// lu.factor(&a).unwrap();
+/// let mut x = [6.0, 8.0]; // A [1, 2]^T
+/// lu.solve_in_place(&mut x).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
+/// ```
 #[derive(Debug)]
 pub struct FaerDenseLu {
-    matrix: Mat<f64>,
-    lu: Option<PartialPivLu<f64>>,
-    pivot_threshold: Option<f64>,
+    /// Packed factors: strictly lower part = L (unit diagonal implied), upper part = U.
+    factors: Mat<f64>,
+    perm_fwd: Vec<usize>,
+    perm_inv: Vec<usize>,
+    scratch: Scratch,
+    factored: bool,
+    pivot_threshold: f64,
+    parallelism: Option<Par>,
 }
 
 impl FaerDenseLu {
     /// A solver with the default pivot threshold [`DEFAULT_PIVOT_THRESHOLD`].
     pub fn new() -> Self {
         Self {
-            matrix: Mat::zeros(0, 0),
-            lu: None,
-            pivot_threshold: None,
+            factors: Mat::zeros(0, 0),
+            perm_fwd: Vec::new(),
+            perm_inv: Vec::new(),
+            scratch: Scratch::new(),
+            factored: false,
+            pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
+            parallelism: None,
         }
     }
 
     /// A solver that treats `|u_ii| <= threshold * max |u_jj|` as a zero pivot.
     pub fn with_pivot_threshold(threshold: f64) -> Self {
         Self {
-            pivot_threshold: Some(threshold),
+            pivot_threshold: threshold,
             ..Self::new()
         }
+    }
+
+    /// Uses `par` for the factorization and solves instead of faer's global setting
+    /// (`faer::get_global_parallelism()`).
+    pub fn with_parallelism(mut self, par: Par) -> Self {
+        self.parallelism = Some(par);
+        self
+    }
+
+    /// Dimension of the last factored matrix.
+    pub fn dim(&self) -> usize {
+        self.factors.nrows()
+    }
+
+    fn par(&self) -> Par {
+        self.parallelism
+            .unwrap_or_else(faer::get_global_parallelism)
+    }
+
+    /// Factors `jac` (`P A = L U`, partial pivoting). Errors: a non-finite entry
+    /// ([`LinearSolveError::NonFiniteEntry`]) or a pivot `|u_ii| <= threshold * max |u_jj|`
+    /// ([`LinearSolveError::Singular`]); after an error the solver is unfactored.
+    pub fn factor<J: DenseAssemble + ?Sized>(&mut self, jac: &J) -> Result<(), LinearSolveError> {
+        let n = jac.dim();
+        self.factored = false;
+        if self.factors.nrows() != n {
+            self.factors = Mat::zeros(n, n);
+            self.perm_fwd.resize(n, 0);
+            self.perm_inv.resize(n, 0);
+        }
+        jac.assemble_dense(self.factors.as_mut());
+        check_finite_dense(n, n, |i, j| self.factors[(i, j)])?;
+        let par = self.par();
+        let req = lu_factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default());
+        let stack = self.scratch.stack(req);
+        lu_factor::lu_in_place(
+            self.factors.as_mut(),
+            &mut self.perm_fwd,
+            &mut self.perm_inv,
+            par,
+            stack,
+            Default::default(),
+        );
+        let factors = &self.factors;
+        check_pivots((0..n).map(|i| factors[(i, i)]), self.pivot_threshold)?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        if !self.factored {
+            return Err(LinearSolveError::NotFactored);
+        }
+        let n = self.factors.nrows();
+        if rhs.len() != n {
+            return Err(LinearSolveError::DimensionMismatch {
+                expected: n,
+                found: rhs.len(),
+            });
+        }
+        let par = self.par();
+        let req = lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, par);
+        let stack = self.scratch.stack(req);
+        let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
+        lu_solve::solve_in_place(
+            self.factors.as_ref(),
+            self.factors.as_ref(),
+            perm,
+            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            par,
+            stack,
+        );
+        Ok(())
     }
 }
 
@@ -74,44 +197,10 @@ impl Default for FaerDenseLu {
 
 impl<J: DenseAssemble + ?Sized> LinearSolve<J> for FaerDenseLu {
     fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
-        let n = jac.dim();
-        self.lu = None;
-        if self.matrix.nrows() != n {
-            self.matrix = Mat::zeros(n, n);
-        }
-        jac.assemble_dense(self.matrix.as_mut());
-        for j in 0..n {
-            for i in 0..n {
-                let value = self.matrix[(i, j)];
-                if !value.is_finite() {
-                    return Err(LinearSolveError::NonFiniteEntry {
-                        row: i,
-                        col: j,
-                        value,
-                    });
-                }
-            }
-        }
-        let lu = PartialPivLu::new(self.matrix.as_ref());
-        let u = lu.U();
-        check_pivots(
-            (0..n).map(|i| u[(i, i)]),
-            self.pivot_threshold.unwrap_or(DEFAULT_PIVOT_THRESHOLD),
-        )?;
-        self.lu = Some(lu);
-        Ok(())
+        FaerDenseLu::factor(self, jac)
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        let lu = self.lu.as_ref().ok_or(LinearSolveError::NotFactored)?;
-        let n = self.matrix.nrows();
-        if rhs.len() != n {
-            return Err(LinearSolveError::DimensionMismatch {
-                expected: n,
-                found: rhs.len(),
-            });
-        }
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
-        Ok(())
+        FaerDenseLu::solve_in_place(self, rhs)
     }
 }

@@ -5,8 +5,13 @@
 //! generalized Jacobian is an expected event in semismooth Newton, not a bug.
 
 mod dense;
+mod nalgebra_lu;
+mod scratch;
+mod sparse;
 
 pub use dense::{DenseAssemble, FaerDenseLu};
+pub use nalgebra_lu::NalgebraLu;
+pub use sparse::FaerSparseLu;
 
 /// Default relative pivot threshold: a pivot `|u_ii| <= threshold * max_j |u_jj|` is
 /// treated as zero.

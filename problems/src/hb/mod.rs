@@ -1,0 +1,430 @@
+//! Harmonic balance for periodic contact problems: the semismooth formulation of Shi &
+//! Legrand (SSN-HB, their equations (5)-(6)) and penalty harmonic balance.
+//!
+//! Both expand the displacements of the [`StructuralModel`] with `H` harmonics in the real
+//! basis of [`semismooth::harmonic`] (`u(t) = u_0 + sum_k u_ck cos(k w t) + u_sk sin(k w t)`),
+//! harmonic-major: unknown `j * N + dof` is coefficient `j` of `dof`. The linear dynamics
+//! `M u'' + D u' + K u` become the block-diagonal `A(w) U` with, for harmonic `k` on
+//! `(u_ck, u_sk)`,
+//!
+//! `[[K - (k w)^2 M,  k w D], [-k w D,  K - (k w)^2 M]]`
+//!
+//! (from `d/dt (a cos + b sin) = k w (b cos - a sin)`), and `K` alone on `u_0`.
+//!
+//! - [`SsnHb`]: unknowns `X = [U; Lambda]`, `Lambda` the contact-force coefficients (index
+//!   `j * m + contact`), residual `R_u = A(w) U - F - G^T Lambda`,
+//!   `R_lambda = Lambda + P max(0, c (G E U - g) - E Lambda)` through AFT with `Nt` samples.
+//! - [`PenaltyHb`]: unknowns `U` only, `lambda(t) = -k_p max(0, G u(t) - g)`,
+//!   residual `R = A(w) U - F - G^T P lambda(E U)`.
+//!
+//! Both write their generalized Jacobian into an [`HbJacobian`] (dynamic blocks shared, not
+//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact). It can be
+//! assembled densely ([`semismooth::linalg::DenseAssemble`], for the dense LU solvers) or
+//! solved by [`StructuredHbSolver`], which factors each harmonic's dynamic block once per
+//! frequency (sparse complex LU) and solves the Newton system on the `m (2H + 1)` contact
+//! unknowns (receptance / Schur-complement condensation).
+//!
+//! Without contacts (`m = 0`) both problems are linear and no FFT is performed.
+
+mod jacobian;
+mod penalty;
+mod ssn;
+mod structured;
+
+use std::sync::Arc;
+
+use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
+
+use crate::model::{SparseMatrix, StructuralModel};
+
+pub use jacobian::{ContactCoupling, HbJacobian};
+pub use penalty::{PenaltyHb, PenaltyHbOptions};
+pub use ssn::{HbOptions, SsnHb};
+pub use structured::StructuredHbSolver;
+
+/// Why a harmonic-balance problem could not be built or a reconstruction not made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HbError {
+    /// An option or parameter is outside its allowed range.
+    #[error("invalid {name} = {value}: allowed {allowed}")]
+    InvalidOption {
+        /// Which option (field name).
+        name: &'static str,
+        /// The value received.
+        value: f64,
+        /// The allowed range, in words.
+        allowed: &'static str,
+    },
+    /// The model's parts have inconsistent sizes.
+    #[error("model {what}: expected {expected}, found {found}")]
+    InconsistentModel {
+        /// Which part of the model.
+        what: &'static str,
+        /// Expected size.
+        expected: usize,
+        /// Size found.
+        found: usize,
+    },
+    /// A model entry is NaN or infinite.
+    #[error("model {what} holds a non-finite value {value}")]
+    NonFiniteModel {
+        /// Which part of the model.
+        what: &'static str,
+        /// The value found.
+        value: f64,
+    },
+    /// A degree of freedom or contact index is out of range.
+    #[error("{what} index {index} is out of range: allowed 0..{count}")]
+    IndexOutOfRange {
+        /// What the index refers to.
+        what: &'static str,
+        /// The index received.
+        index: usize,
+        /// Number of items.
+        count: usize,
+    },
+    /// A vector has the wrong length.
+    #[error("{what}: expected length {expected}, found {found}")]
+    DimensionMismatch {
+        /// Which vector.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length received.
+        found: usize,
+    },
+    /// The Fourier basis could not be built.
+    #[error(transparent)]
+    Harmonic(#[from] HarmonicError),
+}
+
+/// Extremes and contact diagnostics of a harmonic-balance solution over one period,
+/// reconstructed on `points` equally spaced times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResponseSummary {
+    /// Degree of freedom whose extremes are reported.
+    pub dof: usize,
+    /// Number of reconstruction points per period.
+    pub points: usize,
+    /// Maximum of `u_dof(t)` over the period.
+    pub displacement_max: f64,
+    /// Minimum of `u_dof(t)` over the period.
+    pub displacement_min: f64,
+    /// Root mean square of `u_dof(t)` over the period (exact, by Parseval).
+    pub displacement_rms: f64,
+    /// `max_t max_contacts (G u(t) - g)`, clipped at 0 (0 when there is no contact).
+    pub max_penetration: f64,
+    /// Mean of `lambda_i(t)` over the period for each contact (`<= 0` at a solution).
+    pub contact_force_mean: Vec<f64>,
+}
+
+/// The linear data shared by the formulations and their Jacobians (immutable, behind an
+/// `Arc`): matrices, forcing, contact rows and the Fourier basis.
+#[derive(Debug)]
+pub(crate) struct LinearData {
+    pub(crate) dofs: usize,
+    pub(crate) basis: FourierBasis,
+    pub(crate) mass: SparseMatrix,
+    pub(crate) damping: Option<SparseMatrix>,
+    pub(crate) stiffness: SparseMatrix,
+    pub(crate) forcing: Vec<f64>,
+    pub(crate) contact_dofs: Vec<usize>,
+    pub(crate) gaps: Vec<f64>,
+}
+
+impl LinearData {
+    /// Validates the model and the basis parameters and copies what HB needs.
+    pub(crate) fn new(
+        model: &StructuralModel,
+        harmonics: usize,
+        time_samples: Option<usize>,
+    ) -> Result<Self, HbError> {
+        validate_model(model)?;
+        if harmonics == 0 {
+            return Err(HbError::InvalidOption {
+                name: "harmonics",
+                value: 0.0,
+                allowed: "an integer >= 1 (the forcing is harmonic 1)",
+            });
+        }
+        let basis = match time_samples {
+            Some(nt) => FourierBasis::new(harmonics, nt)?,
+            None => FourierBasis::with_default_samples(harmonics),
+        };
+        Ok(Self {
+            dofs: model.dofs(),
+            basis,
+            mass: model.mass.clone(),
+            damping: model.damping.clone(),
+            stiffness: model.stiffness.clone(),
+            forcing: model.forcing.amplitude.clone(),
+            contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
+            gaps: model.contacts.iter().map(|c| c.gap).collect(),
+        })
+    }
+
+    pub(crate) fn contacts(&self) -> usize {
+        self.contact_dofs.len()
+    }
+
+    pub(crate) fn size(&self) -> usize {
+        self.basis.basis_size()
+    }
+
+    /// `out = A(w) U - F`.
+    pub(crate) fn dynamic_residual(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        self.apply_dynamic(omega, u, out);
+        let n = self.dofs;
+        for (o, f) in out[n..2 * n].iter_mut().zip(&self.forcing) {
+            *o -= f;
+        }
+    }
+
+    /// `out = A(w) U`.
+    pub(crate) fn apply_dynamic(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        let n = self.dofs;
+        out.fill(0.0);
+        spmv_add(&self.stiffness, &u[..n], &mut out[..n], 1.0);
+        for k in 1..=self.basis.harmonics() {
+            let kw = k as f64 * omega;
+            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+            let (a, b) = (&u[c..c + n], &u[s..s + n]);
+            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
+            spmv_add(&self.stiffness, a, out_c, 1.0);
+            spmv_add(&self.mass, a, out_c, -kw * kw);
+            spmv_add(&self.stiffness, b, out_s, 1.0);
+            spmv_add(&self.mass, b, out_s, -kw * kw);
+            if let Some(d) = &self.damping {
+                spmv_add(d, b, out_c, kw);
+                spmv_add(d, a, out_s, -kw);
+            }
+        }
+    }
+
+    /// `out = dA/dw (w) U`: for harmonic `k`, `-2 k^2 w M` on the diagonal blocks and
+    /// `+-k D` off the diagonal.
+    pub(crate) fn dynamic_omega_derivative(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        let n = self.dofs;
+        out.fill(0.0);
+        for k in 1..=self.basis.harmonics() {
+            let kf = k as f64;
+            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+            let (a, b) = (&u[c..c + n], &u[s..s + n]);
+            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
+            spmv_add(&self.mass, a, out_c, -2.0 * kf * kf * omega);
+            spmv_add(&self.mass, b, out_s, -2.0 * kf * kf * omega);
+            if let Some(d) = &self.damping {
+                spmv_add(d, b, out_c, kf);
+                spmv_add(d, a, out_s, -kf);
+            }
+        }
+    }
+
+    /// Coefficients (length `2H + 1`) of `dof` from a harmonic-major vector.
+    pub(crate) fn gather(&self, u: &[f64], dof: usize, out: &mut [f64]) {
+        let n = self.dofs;
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = u[j * n + dof];
+        }
+    }
+
+    pub(crate) fn check_dof(&self, dof: usize) -> Result<(), HbError> {
+        if dof >= self.dofs {
+            return Err(HbError::IndexOutOfRange {
+                what: "dof",
+                index: dof,
+                count: self.dofs,
+            });
+        }
+        Ok(())
+    }
+
+    pub(crate) fn check_contact(&self, contact: usize) -> Result<(), HbError> {
+        if contact >= self.contacts() {
+            return Err(HbError::IndexOutOfRange {
+                what: "contact",
+                index: contact,
+                count: self.contacts(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// `y += alpha A x` for a column-compressed `A`.
+pub(crate) fn spmv_add(a: &SparseMatrix, x: &[f64], y: &mut [f64], alpha: f64) {
+    let a = a.as_ref();
+    let symbolic = a.symbolic();
+    let rows = symbolic.row_idx();
+    let values = a.val();
+    for (j, &xj) in x.iter().enumerate() {
+        if xj == 0.0 {
+            continue;
+        }
+        let scaled = alpha * xj;
+        for p in symbolic.col_range(j) {
+            y[rows[p]] += values[p] * scaled;
+        }
+    }
+}
+
+fn validate_model(model: &StructuralModel) -> Result<(), HbError> {
+    let n = model.dofs();
+    let square = |what: &'static str, m: &SparseMatrix| -> Result<(), HbError> {
+        for found in [m.nrows(), m.ncols()] {
+            if found != n {
+                return Err(HbError::InconsistentModel {
+                    what,
+                    expected: n,
+                    found,
+                });
+            }
+        }
+        if let Some(&value) = m.as_ref().val().iter().find(|v| !v.is_finite()) {
+            return Err(HbError::NonFiniteModel { what, value });
+        }
+        Ok(())
+    };
+    square("stiffness matrix size", &model.stiffness)?;
+    square("mass matrix size", &model.mass)?;
+    if let Some(d) = &model.damping {
+        square("damping matrix size", d)?;
+    }
+    if model.forcing.amplitude.len() != n {
+        return Err(HbError::InconsistentModel {
+            what: "forcing amplitude length",
+            expected: n,
+            found: model.forcing.amplitude.len(),
+        });
+    }
+    if let Some(&value) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
+        return Err(HbError::NonFiniteModel {
+            what: "forcing amplitude",
+            value,
+        });
+    }
+    check_omega(model.forcing.omega)?;
+    for contact in &model.contacts {
+        if contact.dof >= n {
+            return Err(HbError::IndexOutOfRange {
+                what: "contact dof",
+                index: contact.dof,
+                count: n,
+            });
+        }
+        if !contact.gap.is_finite() {
+            return Err(HbError::NonFiniteModel {
+                what: "contact gap",
+                value: contact.gap,
+            });
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(HbError::InvalidOption {
+            name: "omega",
+            value: omega,
+            allowed: "a finite angular frequency > 0",
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {
+    if expected != found {
+        return Err(HbError::DimensionMismatch {
+            what,
+            expected,
+            found,
+        });
+    }
+    Ok(())
+}
+
+/// Samples of one dof over a period at `points` equally spaced times `t_n = n T / points`
+/// (a finer AFT grid than the solver's when `points > Nt`).
+pub(crate) fn fine_samples(
+    lin: &LinearData,
+    u: &[f64],
+    dof: usize,
+    points: usize,
+) -> Result<Vec<f64>, HbError> {
+    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
+    let mut aft = Aft::new(basis);
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let mut samples = vec![0.0; points];
+    aft.to_time(&coeffs, &mut samples)?;
+    Ok(samples)
+}
+
+/// Displacement extremes, RMS and penetration from the displacement coefficients `u`.
+pub(crate) fn displacement_summary(
+    lin: &LinearData,
+    u: &[f64],
+    dof: usize,
+    points: usize,
+    contact_force_mean: Vec<f64>,
+) -> Result<ResponseSummary, HbError> {
+    lin.check_dof(dof)?;
+    let samples = fine_samples(lin, u, dof, points)?;
+    let displacement_max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let displacement_min = samples.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let displacement_rms = lin.basis.mean_square(&coeffs)?.sqrt();
+    let mut max_penetration = 0.0f64;
+    for (&cdof, &gap) in lin.contact_dofs.iter().zip(&lin.gaps) {
+        let s = fine_samples(lin, u, cdof, points)?;
+        for x in s {
+            max_penetration = max_penetration.max(x - gap);
+        }
+    }
+    Ok(ResponseSummary {
+        dof,
+        points,
+        displacement_max,
+        displacement_min,
+        displacement_rms,
+        max_penetration,
+        contact_force_mean,
+    })
+}
+
+/// `u_dof(t)` at arbitrary times from harmonic-major coefficients.
+pub(crate) fn displacement_at(
+    lin: &LinearData,
+    omega: f64,
+    u: &[f64],
+    dof: usize,
+    times: &[f64],
+) -> Result<Vec<f64>, HbError> {
+    lin.check_dof(dof)?;
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let mut out = vec![0.0; times.len()];
+    lin.basis.evaluate_many(&coeffs, omega, times, &mut out)?;
+    Ok(out)
+}
+
+/// Shared state of both formulations at the current frequency.
+#[derive(Debug)]
+pub(crate) struct HbState {
+    pub(crate) linear: Arc<LinearData>,
+    pub(crate) omega: f64,
+    pub(crate) aft: Aft,
+}
+
+impl HbState {
+    pub(crate) fn new(linear: LinearData, omega: f64) -> Self {
+        let aft = Aft::new(linear.basis);
+        Self {
+            linear: Arc::new(linear),
+            omega,
+            aft,
+        }
+    }
+}

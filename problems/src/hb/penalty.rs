@@ -1,0 +1,266 @@
+//! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
+
+use semismooth::harmonic::FourierBasis;
+use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+
+use super::jacobian::{ContactCoupling, HbJacobian};
+use super::{
+    check_len, check_omega, displacement_at, displacement_summary, fine_samples, HbError, HbState,
+    LinearData, ResponseSummary,
+};
+use crate::model::StructuralModel;
+
+/// Options of [`PenaltyHb`].
+///
+/// | field | default | allowed |
+/// |---|---|---|
+/// | `harmonics` (`H`) | 20 | `>= 1` |
+/// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` | `> 2H` |
+/// | `penalty_stiffness` (`k_p`) | `1e3` | finite, `> 0` |
+///
+/// `penalty_stiffness` is **absolute** (force per length). Issue 5 and the scenes speak of
+/// `k_p` relative to the contact stiffness scale: multiply by
+/// [`StructuralModel::contact_stiffness_scale`] (e.g. `1e5 * scale`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PenaltyHbOptions {
+    /// Number of harmonics `H`.
+    pub harmonics: usize,
+    /// AFT samples per period `Nt`.
+    pub time_samples: Option<usize>,
+    /// Penalty stiffness `k_p` (absolute).
+    pub penalty_stiffness: f64,
+}
+
+impl Default for PenaltyHbOptions {
+    fn default() -> Self {
+        Self {
+            harmonics: 20,
+            time_samples: None,
+            penalty_stiffness: 1e3,
+        }
+    }
+}
+
+/// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),
+/// residual `R = A(w) U - F - G^T P lambda(E U)` with
+/// `lambda_i(t_n) = -k_p max(0, u_{dof_i}(t_n) - g_i)`, generalized Jacobian
+/// `A(w) + k_p G^T P diag(h) G E`, `h_n = 1` where `G u_n - g > 0`.
+#[derive(Debug)]
+pub struct PenaltyHb {
+    state: HbState,
+    stiffness: f64,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+}
+
+impl PenaltyHb {
+    /// Builds the problem; validates the model and the options.
+    pub fn new(model: &StructuralModel, options: &PenaltyHbOptions) -> Result<Self, HbError> {
+        let kp = options.penalty_stiffness;
+        if !(kp.is_finite() && kp > 0.0) {
+            return Err(HbError::InvalidOption {
+                name: "penalty_stiffness",
+                value: kp,
+                allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
+            });
+        }
+        let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
+        let size = linear.size();
+        let nt = linear.basis.time_samples();
+        Ok(Self {
+            state: HbState::new(linear, model.forcing.omega),
+            stiffness: kp,
+            coeffs: vec![0.0; size],
+            samples: vec![0.0; nt],
+        })
+    }
+
+    /// The Fourier basis (`H`, `Nt`).
+    pub fn basis(&self) -> FourierBasis {
+        self.state.linear.basis
+    }
+
+    /// Number of degrees of freedom `N`.
+    pub fn dofs(&self) -> usize {
+        self.state.linear.dofs
+    }
+
+    /// Number of contacts `m`.
+    pub fn contacts(&self) -> usize {
+        self.state.linear.contacts()
+    }
+
+    /// The penalty stiffness `k_p` in use.
+    pub fn penalty_stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    /// Current angular frequency `w`.
+    pub fn omega(&self) -> f64 {
+        self.state.omega
+    }
+
+    /// Sets `w` (finite, `> 0`).
+    pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
+        check_omega(omega)?;
+        self.state.omega = omega;
+        Ok(())
+    }
+
+    /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
+    pub fn displacement_samples(
+        &self,
+        u: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        self.state.linear.check_dof(dof)?;
+        fine_samples(&self.state.linear, u, dof, points)
+    }
+
+    /// `u_dof(t)` at arbitrary times.
+    pub fn displacement_at(
+        &self,
+        u: &[f64],
+        dof: usize,
+        times: &[f64],
+    ) -> Result<Vec<f64>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        displacement_at(&self.state.linear, self.state.omega, u, dof, times)
+    }
+
+    /// Penalty force `lambda_i(t_n) = -k_p max(0, u(t_n) - g_i)` at `points` equally spaced
+    /// times (evaluated pointwise on the fine grid, not through the `H`-harmonic projection).
+    pub fn contact_force_samples(
+        &self,
+        u: &[f64],
+        contact: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let lin = &self.state.linear;
+        lin.check_contact(contact)?;
+        let gap = lin.gaps[contact];
+        let samples = fine_samples(lin, u, lin.contact_dofs[contact], points)?;
+        Ok(samples
+            .into_iter()
+            .map(|x| -self.stiffness * (x - gap).max(0.0))
+            .collect())
+    }
+
+    /// Extremes of `u_dof`, penetration and mean penalty forces over a period reconstructed
+    /// on `points` times (the mean force is the period mean of the pointwise penalty force).
+    pub fn summary(
+        &self,
+        u: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<ResponseSummary, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let means = (0..self.contacts())
+            .map(|i| {
+                self.contact_force_samples(u, i, points)
+                    .map(|f| f.iter().sum::<f64>() / points as f64)
+            })
+            .collect::<Result<Vec<f64>, HbError>>()?;
+        displacement_summary(&self.state.linear, u, dof, points, means)
+    }
+
+    /// Samples `G u_n - g` of contact `i` into `self.samples`.
+    fn gap_samples(&mut self, u: &[f64], i: usize) {
+        let lin = &self.state.linear;
+        lin.gather(u, lin.contact_dofs[i], &mut self.coeffs);
+        self.coeffs[0] -= lin.gaps[i];
+        // Lengths are fixed at construction: the transform cannot fail.
+        let _ = self.state.aft.to_time(&self.coeffs, &mut self.samples);
+    }
+}
+
+impl Residual for PenaltyHb {
+    fn dim(&self) -> usize {
+        self.state.linear.dofs * self.state.linear.size()
+    }
+
+    fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+        let lin = self.state.linear.clone();
+        let (n, size) = (lin.dofs, lin.size());
+        lin.dynamic_residual(self.state.omega, u, out);
+        for i in 0..lin.contacts() {
+            self.gap_samples(u, i);
+            for s in &mut self.samples {
+                *s = self.stiffness * s.max(0.0);
+            }
+            let _ = self
+                .state
+                .aft
+                .to_coefficients(&self.samples, &mut self.coeffs);
+            // - G^T P lambda = + k_p G^T P max(0, G u - g).
+            let dof = lin.contact_dofs[i];
+            for j in 0..size {
+                out[j * n + dof] += self.coeffs[j];
+            }
+        }
+    }
+
+    fn fft_count(&self) -> u64 {
+        self.state.aft.fft_count()
+    }
+}
+
+impl GeneralizedJacobian for PenaltyHb {
+    type Jacobian = HbJacobian;
+
+    fn new_jacobian(&self) -> HbJacobian {
+        HbJacobian::new(
+            self.state.linear.clone(),
+            self.state.omega,
+            ContactCoupling::Penalty {
+                stiffness: self.stiffness,
+            },
+        )
+    }
+
+    fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) {
+        if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
+            *jac = self.new_jacobian();
+        }
+        jac.omega = self.state.omega;
+        jac.coupling = ContactCoupling::Penalty {
+            stiffness: self.stiffness,
+        };
+        let size = self.state.linear.size();
+        for i in 0..self.contacts() {
+            self.gap_samples(u, i);
+            let mut active = 0;
+            for s in &mut self.samples {
+                *s = if *s > 0.0 {
+                    active += 1;
+                    1.0
+                } else {
+                    0.0
+                };
+            }
+            jac.active[i] = active;
+            let block = jac.q.as_mut().subcols_mut(i * size, size);
+            let _ = self.state.aft.multiplication_matrix(&self.samples, block);
+        }
+    }
+}
+
+impl ParameterDependent for PenaltyHb {
+    fn parameter(&self) -> f64 {
+        self.state.omega
+    }
+
+    fn set_parameter(&mut self, p: f64) {
+        self.state.omega = p;
+    }
+
+    /// `dR/dw = dA/dw U` (the penalty term does not depend on `w`).
+    fn residual_parameter_derivative(&mut self, u: &[f64], out: &mut [f64]) {
+        self.state
+            .linear
+            .dynamic_omega_derivative(self.state.omega, u, out);
+    }
+}

@@ -1,0 +1,321 @@
+//! SSN-HB: harmonic balance with the contact law as a semismooth equation (Shi & Legrand,
+//! equations (5)-(6)).
+
+use semismooth::harmonic::FourierBasis;
+use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+
+use super::jacobian::{ContactCoupling, HbJacobian};
+use super::{
+    check_len, check_omega, displacement_at, displacement_summary, fine_samples, HbError, HbState,
+    LinearData, ResponseSummary,
+};
+use crate::model::StructuralModel;
+
+/// Options of [`SsnHb`].
+///
+/// | field | default | allowed |
+/// |---|---|---|
+/// | `harmonics` (`H`) | 20 | `>= 1` |
+/// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` (256 for `H = 20`) | `> 2H` |
+/// | `c` | `None`: [`StructuralModel::contact_stiffness_scale`] | finite, `> 0` |
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HbOptions {
+    /// Number of harmonics `H`.
+    pub harmonics: usize,
+    /// AFT samples per period `Nt` (the quadrature of the nonsmooth terms).
+    pub time_samples: Option<usize>,
+    /// Complementarity constant `c` in `lambda + max(0, c (G u - g) - lambda) = 0`.
+    pub c: Option<f64>,
+}
+
+impl Default for HbOptions {
+    fn default() -> Self {
+        Self {
+            harmonics: 20,
+            time_samples: None,
+            c: None,
+        }
+    }
+}
+
+/// SSN-HB on a [`StructuralModel`] with `m >= 0` contacts.
+///
+/// Unknowns `X = [U; Lambda]`: `U` of length `N (2H + 1)` (index `j N + dof`), `Lambda` of
+/// length `m (2H + 1)` (index `j m + contact`), the Fourier coefficients of the contact
+/// forces `lambda(t) <= 0`. Residual
+///
+/// - `R_u = A(w) U - F - G^T Lambda` (Galerkin projection of the equation of motion),
+/// - `R_lambda = Lambda + P max(0, c (G E U - g) - E Lambda)` (Galerkin projection of the
+///   complementarity function, `Nt`-point quadrature).
+///
+/// Generalized Jacobian: `dR_lambda/dU = c P diag(h) G E`, `dR_lambda/dLambda = I - P diag(h) E`,
+/// `h_n = 1` where `s_n = c (G u_n - g) - lambda_n > 0` (else 0). The parameter of
+/// [`ParameterDependent`] is `w`; only `A(w)` depends on it.
+#[derive(Debug)]
+pub struct SsnHb {
+    state: HbState,
+    c: f64,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+}
+
+impl SsnHb {
+    /// Builds the problem; validates the model and the options.
+    pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
+        let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
+        let c = match options.c {
+            Some(c) => c,
+            None => model.contact_stiffness_scale(),
+        };
+        if !(c.is_finite() && c > 0.0) {
+            return Err(HbError::InvalidOption {
+                name: "c",
+                value: c,
+                allowed: "a finite complementarity constant > 0 (force per length)",
+            });
+        }
+        let size = linear.size();
+        let nt = linear.basis.time_samples();
+        Ok(Self {
+            state: HbState::new(linear, model.forcing.omega),
+            c,
+            coeffs: vec![0.0; size],
+            samples: vec![0.0; nt],
+        })
+    }
+
+    /// The Fourier basis (`H`, `Nt`).
+    pub fn basis(&self) -> FourierBasis {
+        self.state.linear.basis
+    }
+
+    /// Number of degrees of freedom `N`.
+    pub fn dofs(&self) -> usize {
+        self.state.linear.dofs
+    }
+
+    /// Number of contacts `m`.
+    pub fn contacts(&self) -> usize {
+        self.state.linear.contacts()
+    }
+
+    /// The complementarity constant `c` in use.
+    pub fn c(&self) -> f64 {
+        self.c
+    }
+
+    /// Current angular frequency `w`.
+    pub fn omega(&self) -> f64 {
+        self.state.omega
+    }
+
+    /// Sets `w` (finite, `> 0`).
+    pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
+        check_omega(omega)?;
+        self.state.omega = omega;
+        Ok(())
+    }
+
+    /// Length of `U`, `N (2H + 1)`; `Lambda` starts here in `X`.
+    pub fn displacement_len(&self) -> usize {
+        self.dofs() * self.state.linear.size()
+    }
+
+    /// `U` part of `X`.
+    pub fn displacement_coefficients<'a>(&self, x: &'a [f64]) -> Result<&'a [f64], HbError> {
+        check_len("HB unknowns", self.dim(), x.len())?;
+        Ok(&x[..self.displacement_len()])
+    }
+
+    /// `Lambda` part of `X`.
+    pub fn force_coefficients<'a>(&self, x: &'a [f64]) -> Result<&'a [f64], HbError> {
+        check_len("HB unknowns", self.dim(), x.len())?;
+        Ok(&x[self.displacement_len()..])
+    }
+
+    /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
+    pub fn displacement_samples(
+        &self,
+        x: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        let u = self.displacement_coefficients(x)?;
+        self.state.linear.check_dof(dof)?;
+        fine_samples(&self.state.linear, u, dof, points)
+    }
+
+    /// `u_dof(t)` at arbitrary times.
+    pub fn displacement_at(
+        &self,
+        x: &[f64],
+        dof: usize,
+        times: &[f64],
+    ) -> Result<Vec<f64>, HbError> {
+        let u = self.displacement_coefficients(x)?;
+        displacement_at(&self.state.linear, self.state.omega, u, dof, times)
+    }
+
+    /// `lambda_i(t_n) = (E Lambda_i)_n` at `points` equally spaced times over one period.
+    pub fn contact_force_samples(
+        &self,
+        x: &[f64],
+        contact: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        let lambda = self.force_coefficients(x)?;
+        let lin = &self.state.linear;
+        lin.check_contact(contact)?;
+        let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
+        let coeffs = self.contact_coefficients(lambda, contact);
+        let mut aft = semismooth::harmonic::Aft::new(basis);
+        let mut out = vec![0.0; points];
+        aft.to_time(&coeffs, &mut out)?;
+        Ok(out)
+    }
+
+    /// `lambda_i(t)` at arbitrary times.
+    pub fn contact_force_at(
+        &self,
+        x: &[f64],
+        contact: usize,
+        times: &[f64],
+    ) -> Result<Vec<f64>, HbError> {
+        let lambda = self.force_coefficients(x)?;
+        self.state.linear.check_contact(contact)?;
+        let coeffs = self.contact_coefficients(lambda, contact);
+        let mut out = vec![0.0; times.len()];
+        self.state
+            .linear
+            .basis
+            .evaluate_many(&coeffs, self.state.omega, times, &mut out)?;
+        Ok(out)
+    }
+
+    /// Extremes of `u_dof`, penetration and mean contact forces (`Lambda_0`) over a period
+    /// reconstructed on `points` times.
+    pub fn summary(
+        &self,
+        x: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<ResponseSummary, HbError> {
+        let u = self.displacement_coefficients(x)?;
+        let lambda = self.force_coefficients(x)?;
+        let means = lambda[..self.contacts()].to_vec();
+        displacement_summary(&self.state.linear, u, dof, points, means)
+    }
+
+    fn contact_coefficients(&self, lambda: &[f64], contact: usize) -> Vec<f64> {
+        let m = self.contacts();
+        (0..self.state.linear.size())
+            .map(|j| lambda[j * m + contact])
+            .collect()
+    }
+
+    /// Samples `s_n = c (G u_n - g) - lambda_n` of contact `i` into `self.samples`.
+    fn switching_samples(&mut self, x: &[f64], i: usize) {
+        let lin = &self.state.linear;
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let offset = n * size;
+        let dof = lin.contact_dofs[i];
+        for j in 0..size {
+            self.coeffs[j] = self.c * x[j * n + dof] - x[offset + j * m + i];
+        }
+        self.coeffs[0] -= self.c * lin.gaps[i];
+        // Lengths are fixed at construction: the transform cannot fail.
+        let _ = self.state.aft.to_time(&self.coeffs, &mut self.samples);
+    }
+}
+
+impl Residual for SsnHb {
+    fn dim(&self) -> usize {
+        let lin = &self.state.linear;
+        (lin.dofs + lin.contacts()) * lin.size()
+    }
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        let lin = self.state.linear.clone();
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let offset = n * size;
+        let (out_u, out_l) = out.split_at_mut(offset);
+        lin.dynamic_residual(self.state.omega, &x[..offset], out_u);
+        for i in 0..m {
+            let dof = lin.contact_dofs[i];
+            for j in 0..size {
+                out_u[j * n + dof] -= x[offset + j * m + i];
+            }
+            self.switching_samples(x, i);
+            for s in &mut self.samples {
+                *s = s.max(0.0);
+            }
+            let _ = self
+                .state
+                .aft
+                .to_coefficients(&self.samples, &mut self.coeffs);
+            for j in 0..size {
+                out_l[j * m + i] = x[offset + j * m + i] + self.coeffs[j];
+            }
+        }
+    }
+
+    fn fft_count(&self) -> u64 {
+        self.state.aft.fft_count()
+    }
+}
+
+impl GeneralizedJacobian for SsnHb {
+    type Jacobian = HbJacobian;
+
+    fn new_jacobian(&self) -> HbJacobian {
+        HbJacobian::new(
+            self.state.linear.clone(),
+            self.state.omega,
+            ContactCoupling::Complementarity { c: self.c },
+        )
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) {
+        if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
+            *jac = self.new_jacobian();
+        }
+        jac.omega = self.state.omega;
+        jac.coupling = ContactCoupling::Complementarity { c: self.c };
+        let size = self.state.linear.size();
+        for i in 0..self.contacts() {
+            self.switching_samples(x, i);
+            let mut active = 0;
+            for s in &mut self.samples {
+                *s = if *s > 0.0 {
+                    active += 1;
+                    1.0
+                } else {
+                    0.0
+                };
+            }
+            jac.active[i] = active;
+            let block = jac.q.as_mut().subcols_mut(i * size, size);
+            let _ = self.state.aft.multiplication_matrix(&self.samples, block);
+        }
+    }
+}
+
+impl ParameterDependent for SsnHb {
+    fn parameter(&self) -> f64 {
+        self.state.omega
+    }
+
+    fn set_parameter(&mut self, p: f64) {
+        self.state.omega = p;
+    }
+
+    /// `dR/dw = [dA/dw U; 0]`.
+    fn residual_parameter_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+        let offset = self.displacement_len();
+        let (out_u, out_l) = out.split_at_mut(offset);
+        self.state
+            .linear
+            .dynamic_omega_derivative(self.state.omega, &x[..offset], out_u);
+        out_l.fill(0.0);
+    }
+}

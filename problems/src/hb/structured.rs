@@ -1,0 +1,681 @@
+//! Structured solver for [`HbJacobian`]: per-harmonic sparse LU of the dynamic blocks,
+//! condensation onto the `m (2H + 1)` contact unknowns (receptance / Schur complement).
+//!
+//! For harmonic `k >= 1` the real `2N x 2N` block on `(u_ck, u_sk)` is equivalent to the
+//! complex `N x N` matrix `Z_k = K - (k w)^2 M + i k w D` acting on `z = u_c - i u_s`
+//! (`k = 0`: `K` on `u_0`). Each `Z_k` is factored once per frequency by faer's sparse LU
+//! (symbolic analysis once per sparsity pattern), so the cost is linear in `N` for banded
+//! models. The receptance `R_k = G Z_k^{-1} G^T` (`m x m` complex) maps contact-force
+//! coefficients to contact-displacement coefficients.
+//!
+//! SSN-HB, `J = [[A, -G^T], [c Q G, I - Q]]`: with `w = A^{-1} r_u` and `y = G w`,
+//! `(I - Q + c Q R) dLambda = r_lambda - c Q y`, then `dU = w + A^{-1} G^T dLambda`.
+//! Penalty HB, `J = A + k_p G^T Q G`: `(I + k_p R Q) y = G A^{-1} r`, then
+//! `dU = A^{-1} (r - k_p G^T Q y)`. The dense Schur matrix (`m (2H + 1)` square) is
+//! refactored each Newton iteration; the sparse factors only when `w` or the model change.
+
+use std::sync::Arc;
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solve};
+use faer::perm::PermRef;
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
+use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
+use faer::{c64, Conj, Mat, MatMut, Par};
+use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use semismooth::LinearSolve;
+
+use super::jacobian::{ContactCoupling, HbJacobian};
+use super::LinearData;
+use crate::model::SparseMatrix;
+
+/// Sparsity pattern of `K + M + D` with the positions of each matrix's entries in it, and
+/// its symbolic LU (computed once per model).
+struct Pattern {
+    union: SparseColMat<usize, f64>,
+    stiffness_pos: Vec<usize>,
+    mass_pos: Vec<usize>,
+    damping_pos: Vec<usize>,
+    symbolic: SymbolicLu<usize>,
+}
+
+impl Pattern {
+    fn new(lin: &LinearData) -> Result<Self, LinearSolveError> {
+        let n = lin.dofs;
+        let mut triplets = Vec::new();
+        let mut push = |m: &SparseMatrix| {
+            let m = m.as_ref();
+            let symbolic = m.symbolic();
+            for j in 0..n {
+                for p in symbolic.col_range(j) {
+                    triplets.push(Triplet::new(symbolic.row_idx()[p], j, 0.0));
+                }
+            }
+        };
+        push(&lin.stiffness);
+        push(&lin.mass);
+        if let Some(d) = &lin.damping {
+            push(d);
+        }
+        for j in 0..n {
+            triplets.push(Triplet::new(j, j, 0.0));
+        }
+        let union =
+            SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).map_err(|e| {
+                LinearSolveError::Sparse {
+                    reason: format!("building the union sparsity pattern: {e:?}"),
+                }
+            })?;
+        let positions = |m: &SparseMatrix| -> Vec<usize> {
+            let m = m.as_ref();
+            let sm = m.symbolic();
+            let su = union.symbolic();
+            let mut out = Vec::with_capacity(m.val().len());
+            for j in 0..n {
+                let range = su.col_range(j);
+                let rows = &su.row_idx()[range.clone()];
+                for p in sm.col_range(j) {
+                    let r = sm.row_idx()[p];
+                    // The union contains every entry of m by construction.
+                    let offset = rows.binary_search(&r).unwrap_or(0);
+                    out.push(range.start + offset);
+                }
+            }
+            out
+        };
+        let stiffness_pos = positions(&lin.stiffness);
+        let mass_pos = positions(&lin.mass);
+        let damping_pos = lin.damping.as_ref().map(positions).unwrap_or_default();
+        let symbolic =
+            factorize_symbolic_lu(union.symbolic(), Default::default()).map_err(|e| {
+                LinearSolveError::Sparse {
+                    reason: format!("symbolic LU of the dynamic blocks: {e:?}"),
+                }
+            })?;
+        Ok(Self {
+            union,
+            stiffness_pos,
+            mass_pos,
+            damping_pos,
+            symbolic,
+        })
+    }
+}
+
+/// Structured [`LinearSolve`] for [`HbJacobian`] (SSN-HB and penalty HB): see the module
+/// documentation of this file for the algebra.
+///
+/// Work per Newton iteration at fixed `w`: one dense LU of size `m (2H + 1)`, `H + 1`
+/// sparse complex solves per right-hand side; no allocation once the sizes are set.
+/// The per-harmonic sparse factorizations are redone only when the Jacobian's dynamic part
+/// changes ([`HbJacobian::same_dynamic_part`]), which
+/// [`StructuredHbSolver::dynamic_factorizations`] counts.
+pub struct StructuredHbSolver {
+    pattern: Option<(Arc<LinearData>, Pattern)>,
+    /// Jacobian whose dynamic part is currently factored (only its `linear` and `omega`
+    /// matter).
+    factored_for: Option<(Arc<LinearData>, f64)>,
+    numeric: Vec<NumericLu<usize, c64>>,
+    values: Vec<c64>,
+    /// `Z_k^{-1} G^T` (N x m) per harmonic `k = 0..=H`.
+    response: Vec<Mat<c64>>,
+    /// `R_k = G Z_k^{-1} G^T` (m x m) per harmonic.
+    receptance: Vec<Mat<c64>>,
+    coupling: ContactCoupling,
+    q: Mat<f64>,
+    schur: Mat<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    schur_ready: bool,
+    complex_rhs: Mat<c64>,
+    work_u: Vec<f64>,
+    work_a: Vec<f64>,
+    work_b: Mat<f64>,
+    work_c: Vec<f64>,
+    work_d: Vec<f64>,
+    work_rhs: Vec<f64>,
+    work_res: Vec<f64>,
+    refinement_steps: usize,
+    mem: MemBuffer,
+    pivot_threshold: f64,
+    dynamic_factorizations: u64,
+    schur_factorizations: u64,
+}
+
+impl std::fmt::Debug for StructuredHbSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StructuredHbSolver")
+            .field("dynamic_factorizations", &self.dynamic_factorizations)
+            .field("schur_factorizations", &self.schur_factorizations)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Default for StructuredHbSolver {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl StructuredHbSolver {
+    /// A solver with the default relative pivot threshold for the condensed system.
+    pub fn new() -> Self {
+        Self {
+            pattern: None,
+            factored_for: None,
+            numeric: Vec::new(),
+            values: Vec::new(),
+            response: Vec::new(),
+            receptance: Vec::new(),
+            coupling: ContactCoupling::Complementarity { c: 1.0 },
+            q: Mat::zeros(0, 0),
+            schur: Mat::zeros(0, 0),
+            perm: Vec::new(),
+            perm_inv: Vec::new(),
+            schur_ready: false,
+            complex_rhs: Mat::zeros(0, 0),
+            work_u: Vec::new(),
+            work_a: Vec::new(),
+            work_b: Mat::zeros(0, 0),
+            work_c: Vec::new(),
+            work_d: Vec::new(),
+            work_rhs: Vec::new(),
+            work_res: Vec::new(),
+            refinement_steps: 1,
+            mem: MemBuffer::new(StackReq::EMPTY),
+            pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
+            dynamic_factorizations: 0,
+            schur_factorizations: 0,
+        }
+    }
+
+    /// Sets the number of iterative-refinement steps after each solve (default 1; 0 gives
+    /// the bare condensed solve). Each step costs one structured product and one solve.
+    pub fn with_refinement_steps(mut self, steps: usize) -> Self {
+        self.refinement_steps = steps;
+        self
+    }
+
+    /// Number of times the per-harmonic dynamic blocks were factored (once per frequency).
+    pub fn dynamic_factorizations(&self) -> u64 {
+        self.dynamic_factorizations
+    }
+
+    /// Number of condensed (Schur) factorizations (once per Newton iteration).
+    pub fn schur_factorizations(&self) -> u64 {
+        self.schur_factorizations
+    }
+
+    /// Receptance `R_k = G (K - (k w)^2 M + i k w D)^{-1} G^T` of harmonic `k` (m x m,
+    /// complex) at the last factored frequency.
+    pub fn receptance(&self, k: usize) -> Option<&Mat<c64>> {
+        self.receptance.get(k)
+    }
+
+    fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
+        let lin = jac.linear.clone();
+        let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
+        let same_model = matches!(&self.pattern, Some((l, _)) if Arc::ptr_eq(l, &lin));
+        if !same_model {
+            self.pattern = Some((lin.clone(), Pattern::new(&lin)?));
+            self.numeric = (0..=h).map(|_| NumericLu::new()).collect();
+        }
+        let Some((_, pattern)) = &self.pattern else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let size = 2 * h + 1;
+        let nc = m * size;
+        let req = StackReq::any_of(&[
+            pattern
+                .symbolic
+                .factorize_numeric_lu_scratch::<c64>(Par::Seq, Default::default()),
+            pattern
+                .symbolic
+                .solve_in_place_scratch::<c64>(m.max(1), Par::Seq),
+            dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
+            dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
+        ]);
+        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::Sparse {
+            reason: "out of memory for the LU workspace".into(),
+        })?;
+        self.values
+            .resize(pattern.union.val().len(), c64::new(0.0, 0.0));
+        self.response.resize_with(h + 1, || Mat::zeros(n, m));
+        self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
+        let stack = MemStack::new(&mut self.mem);
+        for k in 0..=h {
+            let kw = k as f64 * jac.omega;
+            self.values.fill(c64::new(0.0, 0.0));
+            let add = |values: &mut [c64], mat: &SparseMatrix, pos: &[usize], scale: c64| {
+                for (&p, &v) in pos.iter().zip(mat.as_ref().val()) {
+                    values[p] += scale * v;
+                }
+            };
+            add(
+                &mut self.values,
+                &lin.stiffness,
+                &pattern.stiffness_pos,
+                c64::new(1.0, 0.0),
+            );
+            add(
+                &mut self.values,
+                &lin.mass,
+                &pattern.mass_pos,
+                c64::new(-kw * kw, 0.0),
+            );
+            if let Some(d) = &lin.damping {
+                add(&mut self.values, d, &pattern.damping_pos, c64::new(0.0, kw));
+            }
+            let matrix = SparseColMatRef::new(pattern.union.symbolic(), &self.values);
+            let lu = pattern
+                .symbolic
+                .factorize_numeric_lu(
+                    &mut self.numeric[k],
+                    matrix,
+                    Par::Seq,
+                    stack,
+                    Default::default(),
+                )
+                .map_err(|e| LinearSolveError::Sparse {
+                    reason: format!("harmonic {k} dynamic block: {e:?}"),
+                })?;
+            let z = &mut self.response[k];
+            if z.nrows() != n || z.ncols() != m {
+                *z = Mat::zeros(n, m);
+            }
+            z.fill(c64::new(0.0, 0.0));
+            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                z[(dof, i)] = c64::new(1.0, 0.0);
+            }
+            lu.solve_in_place_with_conj(Conj::No, z.as_mut(), Par::Seq, stack);
+            let r = &mut self.receptance[k];
+            if r.nrows() != m {
+                *r = Mat::zeros(m, m);
+            }
+            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                for ip in 0..m {
+                    let value = z[(dof, ip)];
+                    if !(value.re.is_finite() && value.im.is_finite()) {
+                        return Err(LinearSolveError::Singular {
+                            index: k,
+                            pivot: 0.0,
+                            max_pivot: f64::NAN,
+                        });
+                    }
+                    r[(i, ip)] = value;
+                }
+            }
+            // Without contacts, detect a singular block from a probe solve instead.
+            if m == 0 {
+                let probe = &mut self.complex_rhs;
+                *probe = Mat::from_fn(n, 1, |_, _| c64::new(1.0, 0.0));
+                lu.solve_in_place_with_conj(Conj::No, probe.as_mut(), Par::Seq, stack);
+                if (0..n).any(|r| !(probe[(r, 0)].re.is_finite() && probe[(r, 0)].im.is_finite())) {
+                    return Err(LinearSolveError::Singular {
+                        index: k,
+                        pivot: 0.0,
+                        max_pivot: f64::NAN,
+                    });
+                }
+            }
+        }
+        self.complex_rhs = Mat::zeros(n, 1);
+        self.work_u.resize(n * size, 0.0);
+        self.work_a.resize(nc, 0.0);
+        self.work_c.resize(nc, 0.0);
+        self.work_d.resize(nc, 0.0);
+        self.work_rhs.reserve(n * size + nc);
+        self.work_res.reserve(n * size + nc);
+        self.work_b = Mat::zeros(nc, 1);
+        self.schur = Mat::zeros(nc, nc);
+        self.perm.resize(nc, 0);
+        self.perm_inv.resize(nc, 0);
+        self.q = Mat::zeros(size, nc);
+        self.factored_for = Some((lin, jac.omega));
+        self.dynamic_factorizations += 1;
+        Ok(())
+    }
+
+    /// `u <- A(w)^{-1} u` harmonic by harmonic (complex form).
+    fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
+        let (Some((_, pattern)), Some((lin, _))) = (&self.pattern, &self.factored_for) else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let n = lin.dofs;
+        let stack = MemStack::new(&mut self.mem);
+        for k in 0..=lin.basis.harmonics() {
+            let rhs = &mut self.complex_rhs;
+            if k == 0 {
+                for r in 0..n {
+                    rhs[(r, 0)] = c64::new(u[r], 0.0);
+                }
+            } else {
+                let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+                for r in 0..n {
+                    rhs[(r, 0)] = c64::new(u[c + r], -u[s + r]);
+                }
+            }
+            LuRef::new_unchecked(&pattern.symbolic, &self.numeric[k]).solve_in_place_with_conj(
+                Conj::No,
+                rhs.as_mut(),
+                Par::Seq,
+                stack,
+            );
+            if k == 0 {
+                for r in 0..n {
+                    u[r] = rhs[(r, 0)].re;
+                }
+            } else {
+                let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+                for r in 0..n {
+                    u[c + r] = rhs[(r, 0)].re;
+                    u[s + r] = -rhs[(r, 0)].im;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `u += alpha A^{-1} G^T p` for contact coefficients `p` (index `j m + i`).
+    fn add_response(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
+        let Some((lin, _)) = &self.factored_for else {
+            return;
+        };
+        let (n, m) = (lin.dofs, lin.contacts());
+        for k in 0..=lin.basis.harmonics() {
+            let z = &self.response[k];
+            for i in 0..m {
+                if k == 0 {
+                    let pi = alpha * p[i];
+                    for r in 0..n {
+                        u[r] += z[(r, i)].re * pi;
+                    }
+                } else {
+                    // Load pc cos + ps sin -> complex pc - i ps.
+                    let q = c64::new(p[(2 * k - 1) * m + i], -p[2 * k * m + i]) * alpha;
+                    let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+                    for r in 0..n {
+                        let v = z[(r, i)] * q;
+                        u[c + r] += v.re;
+                        u[s + r] -= v.im;
+                    }
+                }
+            }
+        }
+    }
+
+    /// `out = R p`: contact-displacement coefficients from contact-force coefficients.
+    fn apply_receptance(receptance: &[Mat<c64>], m: usize, p: &[f64], out: &mut [f64]) {
+        for (k, r) in receptance.iter().enumerate() {
+            for i in 0..m {
+                if k == 0 {
+                    out[i] = (0..m).map(|ip| r[(i, ip)].re * p[ip]).sum();
+                } else {
+                    let (c, s) = ((2 * k - 1) * m, 2 * k * m);
+                    let (mut a, mut b) = (0.0, 0.0);
+                    for ip in 0..m {
+                        let (cr, ci) = (r[(i, ip)].re, r[(i, ip)].im);
+                        let (pc, ps) = (p[c + ip], p[s + ip]);
+                        a += cr * pc + ci * ps;
+                        b += -ci * pc + cr * ps;
+                    }
+                    out[c + i] = a;
+                    out[s + i] = b;
+                }
+            }
+        }
+    }
+
+    /// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
+    fn apply_coupling(q: &Mat<f64>, m: usize, p: &[f64], out: &mut [f64]) {
+        let size = q.nrows();
+        for i in 0..m {
+            for j in 0..size {
+                let mut sum = 0.0;
+                for l in 0..size {
+                    sum += q[(j, i * size + l)] * p[l * m + i];
+                }
+                out[j * m + i] = sum;
+            }
+        }
+    }
+}
+
+impl LinearSolve<HbJacobian> for StructuredHbSolver {
+    fn factor(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
+        self.schur_ready = false;
+        let reuse = matches!(&self.factored_for,
+            Some((lin, omega)) if Arc::ptr_eq(lin, &jac.linear) && omega.to_bits() == jac.omega.to_bits());
+        if !reuse {
+            self.factored_for = None;
+            self.factor_dynamic(jac)?;
+        }
+        let lin = jac.linear.clone();
+        let (m, size) = (lin.contacts(), lin.size());
+        let nc = m * size;
+        self.coupling = jac.coupling;
+        self.q.copy_from(&jac.q);
+        if let Some((row, col, value)) = (0..nc)
+            .flat_map(|c| (0..size).map(move |r| (r, c)))
+            .map(|(r, c)| (r, c, jac.q[(r, c)]))
+            .find(|(_, _, v)| !v.is_finite())
+        {
+            return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+        }
+        // Build the condensed matrix column by column.
+        for col in 0..nc {
+            self.work_a.fill(0.0);
+            self.work_a[col] = 1.0;
+            match self.coupling {
+                ContactCoupling::Complementarity { c } => {
+                    // S = I - Q + c Q R.
+                    Self::apply_receptance(&self.receptance, m, &self.work_a, &mut self.work_c);
+                    for v in self.work_c.iter_mut() {
+                        *v *= c;
+                    }
+                    self.work_c[col] -= 1.0;
+                    // work_c = c R e - e; S e = e + Q (c R e - e).
+                    let (work_c, work_a) = (&self.work_c, &mut self.work_a);
+                    Self::apply_coupling(&self.q, m, work_c, work_a);
+                    for r in 0..nc {
+                        self.schur[(r, col)] = self.work_a[r] + if r == col { 1.0 } else { 0.0 };
+                    }
+                }
+                ContactCoupling::Penalty { stiffness } => {
+                    // S = I + k_p R Q.
+                    Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                    Self::apply_receptance(&self.receptance, m, &self.work_c, &mut self.work_a);
+                    for r in 0..nc {
+                        self.schur[(r, col)] =
+                            stiffness * self.work_a[r] + if r == col { 1.0 } else { 0.0 };
+                    }
+                }
+            }
+        }
+        if nc > 0 {
+            let stack = MemStack::new(&mut self.mem);
+            dense_lu::lu_in_place(
+                self.schur.as_mut(),
+                &mut self.perm,
+                &mut self.perm_inv,
+                Par::Seq,
+                stack,
+                Default::default(),
+            );
+            check_pivots((0..nc).map(|i| self.schur[(i, i)]), self.pivot_threshold).map_err(
+                |e| match e {
+                    LinearSolveError::Singular {
+                        index,
+                        pivot,
+                        max_pivot,
+                    } => LinearSolveError::Singular {
+                        index: lin.dofs * size + index,
+                        pivot,
+                        max_pivot,
+                    },
+                    other => other,
+                },
+            )?;
+        }
+        self.schur_factorizations += 1;
+        self.schur_ready = true;
+        Ok(())
+    }
+
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        self.work_rhs.clear();
+        self.work_rhs.extend_from_slice(rhs);
+        self.solve_once(rhs)?;
+        // Iterative refinement with the exact structured operator: the condensation
+        // subtracts large terms when A(w) is ill-conditioned (near resonance, stiff
+        // penalties); a correction step restores dense-LU accuracy.
+        for _ in 0..self.refinement_steps {
+            let mut correction = std::mem::take(&mut self.work_res);
+            correction.resize(rhs.len(), 0.0);
+            self.apply_jacobian(rhs, &mut correction);
+            for (c, o) in correction.iter_mut().zip(&self.work_rhs) {
+                *c = *o - *c;
+            }
+            let solved = self.solve_once(&mut correction);
+            if solved.is_ok() {
+                for (x, c) in rhs.iter_mut().zip(&correction) {
+                    *x += c;
+                }
+            }
+            self.work_res = correction;
+            solved?;
+        }
+        Ok(())
+    }
+}
+
+impl StructuredHbSolver {
+    fn solve_once(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        if !self.schur_ready {
+            return Err(LinearSolveError::NotFactored);
+        }
+        let Some((lin, _)) = self.factored_for.clone() else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let nu = n * size;
+        let nc = m * size;
+        let expected = match self.coupling {
+            ContactCoupling::Complementarity { .. } => nu + nc,
+            ContactCoupling::Penalty { .. } => nu,
+        };
+        if rhs.len() != expected {
+            return Err(LinearSolveError::DimensionMismatch {
+                expected,
+                found: rhs.len(),
+            });
+        }
+        let mut w = std::mem::take(&mut self.work_u);
+        w.copy_from_slice(&rhs[..nu]);
+        self.apply_dynamic_inverse(&mut w)?;
+        // y = G w.
+        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            for j in 0..size {
+                self.work_a[j * m + i] = w[j * n + dof];
+            }
+        }
+        match self.coupling {
+            ContactCoupling::Complementarity { c } => {
+                // b = r_lambda - c Q y.
+                Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                for r in 0..nc {
+                    self.work_b[(r, 0)] = rhs[nu + r] - c * self.work_c[r];
+                }
+                self.solve_schur();
+                for r in 0..nc {
+                    self.work_a[r] = self.work_b[(r, 0)];
+                }
+                // dU = w + A^{-1} G^T dLambda.
+                self.add_response(&self.work_a, 1.0, &mut w);
+                rhs[..nu].copy_from_slice(&w);
+                rhs[nu..].copy_from_slice(&self.work_a);
+            }
+            ContactCoupling::Penalty { stiffness } => {
+                for r in 0..nc {
+                    self.work_b[(r, 0)] = self.work_a[r];
+                }
+                self.solve_schur();
+                for r in 0..nc {
+                    self.work_a[r] = self.work_b[(r, 0)];
+                }
+                // dU = w - k_p A^{-1} G^T Q y.
+                Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                self.add_response(&self.work_c, -stiffness, &mut w);
+                rhs.copy_from_slice(&w);
+            }
+        }
+        self.work_u = w;
+        if let Some(&value) = rhs.iter().find(|v| !v.is_finite()) {
+            return Err(LinearSolveError::NonFiniteEntry {
+                row: 0,
+                col: 0,
+                value,
+            });
+        }
+        Ok(())
+    }
+}
+
+impl StructuredHbSolver {
+    /// `out = J x` with the Jacobian last factored (structured product, no assembly).
+    fn apply_jacobian(&mut self, x: &[f64], out: &mut [f64]) {
+        let Some((lin, omega)) = self.factored_for.clone() else {
+            return;
+        };
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let nu = n * size;
+        lin.apply_dynamic(omega, &x[..nu], &mut out[..nu]);
+        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            for j in 0..size {
+                self.work_a[j * m + i] = x[j * n + dof];
+            }
+        }
+        Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        match self.coupling {
+            ContactCoupling::Complementarity { c } => {
+                let (out_u, out_l) = out.split_at_mut(nu);
+                let x_l = &x[nu..];
+                Self::apply_coupling(&self.q, m, x_l, &mut self.work_d);
+                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    for j in 0..size {
+                        let r = j * m + i;
+                        out_u[j * n + dof] -= x_l[r];
+                        out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
+                    }
+                }
+            }
+            ContactCoupling::Penalty { stiffness } => {
+                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    for j in 0..size {
+                        out[j * n + dof] += stiffness * self.work_c[j * m + i];
+                    }
+                }
+            }
+        }
+    }
+
+    /// `work_b <- S^{-1} work_b` with the factored condensed matrix.
+    fn solve_schur(&mut self) {
+        let nc = self.schur.nrows();
+        if nc == 0 {
+            return;
+        }
+        let stack = MemStack::new(&mut self.mem);
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, nc);
+        let rhs: MatMut<'_, f64> = self.work_b.as_mut();
+        dense_solve::solve_in_place_with_conj(
+            self.schur.as_ref(),
+            self.schur.as_ref(),
+            perm,
+            Conj::No,
+            rhs,
+            Par::Seq,
+            stack,
+        );
+    }
+}

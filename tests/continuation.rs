@@ -1,0 +1,1017 @@
+//! Pseudo-arclength continuation on problems whose branches are known independently:
+//! closed forms (circle, S-curve, piecewise-linear kink, plateau), an implicit frequency
+//! response (Duffing first-harmonic balance) whose folds are located by the cubic's
+//! discriminant, and a natural-parameter sweep that jumps where the arclength follows.
+
+use faer::Mat;
+use semismooth::continuation::{
+    natural_sweep, Branch, Continuation, ContinuationError, ContinuationEvent, ContinuationOptions,
+    ContinuationTermination, CorrectorFailure, Direction, Predictor,
+};
+use semismooth::linalg::{FaerDenseLu, LinearSolveError};
+use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+
+type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
+type JacobianFn = Box<dyn Fn(&[f64], f64, &mut Mat<f64>)>;
+
+/// A test problem `F(x, p)` from closures, with an analytic `F_p` when given (the trait's
+/// central difference otherwise), counting `set_parameter` calls.
+struct Closure {
+    n: usize,
+    p: f64,
+    f: ResidualFn,
+    j: JacobianFn,
+    fp: Option<ResidualFn>,
+}
+
+impl Residual for Closure {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        (self.f)(x, self.p, out)
+    }
+}
+
+impl GeneralizedJacobian for Closure {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.n, self.n)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+        (self.j)(x, self.p, jac)
+    }
+}
+
+impl ParameterDependent for Closure {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+    }
+    fn residual_parameter_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+        match &self.fp {
+            Some(fp) => fp(x, self.p, out),
+            None => {
+                let p = self.p;
+                let h = 1e-7 * (1.0 + p.abs());
+                let mut minus = vec![0.0; out.len()];
+                (self.f)(x, p + h, out);
+                (self.f)(x, p - h, &mut minus);
+                for (o, m) in out.iter_mut().zip(&minus) {
+                    *o = (*o - m) / (2.0 * h);
+                }
+            }
+        }
+    }
+}
+
+/// `x^3 - x - p = 0`: folds at `x = ±1/√3`, `p = ∓2/(3√3)`.
+fn s_curve() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0].powi(3) - x[0] - p),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = 3.0 * x[0] * x[0] - 1.0),
+        fp: Some(Box::new(|_, _, out| out[0] = -1.0)),
+    }
+}
+
+/// `x^2 + p^2 - 1 = 0`: folds at `p = ±1`.
+fn circle() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0] * x[0] + p * p - 1.0),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = 2.0 * x[0]),
+        fp: Some(Box::new(|_, p, out| out[0] = 2.0 * p)),
+    }
+}
+
+/// Duffing `u'' + 2 ζ u' + u + γ u^3 = f cos(ω t)`, one harmonic `u = a cos + b sin`,
+/// parameter `ω`; `F_p` by the trait's central difference.
+const ZETA: f64 = 0.05;
+const GAMMA: f64 = 1.0;
+const FORCE: f64 = 0.1;
+fn duffing() -> Closure {
+    Closure {
+        n: 2,
+        p: 0.0,
+        f: Box::new(|x, w, out| {
+            let k = 1.0 - w * w + 0.75 * GAMMA * (x[0] * x[0] + x[1] * x[1]);
+            out[0] = k * x[0] + 2.0 * ZETA * w * x[1] - FORCE;
+            out[1] = -2.0 * ZETA * w * x[0] + k * x[1];
+        }),
+        j: Box::new(|x, w, jac| {
+            let (a, b) = (x[0], x[1]);
+            let k = 1.0 - w * w + 0.75 * GAMMA * (a * a + b * b);
+            let c = 1.5 * GAMMA;
+            jac[(0, 0)] = k + c * a * a;
+            jac[(0, 1)] = c * a * b + 2.0 * ZETA * w;
+            jac[(1, 0)] = c * a * b - 2.0 * ZETA * w;
+            jac[(1, 1)] = k + c * b * b;
+        }),
+        fp: None,
+    }
+}
+
+/// `x + k max(0, x - 1) - p = 0`: slope 1 below the kink at `x = 1`, `1/(1+k)` above.
+const KINK: f64 = 4.0;
+fn kink() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0] + KINK * (x[0] - 1.0).max(0.0) - p),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = 1.0 + if x[0] > 1.0 { KINK } else { 0.0 }),
+        fp: Some(Box::new(|_, _, out| out[0] = -1.0)),
+    }
+}
+
+fn kink_closed_form(p: f64) -> f64 {
+    if p <= 1.0 {
+        p
+    } else {
+        1.0 + (p - 1.0) / (1.0 + KINK)
+    }
+}
+
+/// `p - min(max(x, 0), 1) = 0`: `x = p` on `(0, 1)`, then the vertical segment `p = 1`,
+/// `x > 1`, where the Jacobian is exactly zero (singular) and only the bordered system is
+/// regular.
+fn plateau() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = p - x[0].clamp(0.0, 1.0)),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = if x[0] > 0.0 && x[0] < 1.0 { -1.0 } else { 0.0 }),
+        fp: Some(Box::new(|_, _, out| out[0] = 1.0)),
+    }
+}
+
+/// `x - p = 0`, but the residual is NaN for `p > 1` (a model outside its domain).
+fn ends_at_one() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = if p > 1.0 { f64::NAN } else { x[0] - p }),
+        j: Box::new(|_, _, jac| jac[(0, 0)] = 1.0),
+        fp: Some(Box::new(|_, _, out| out[0] = -1.0)),
+    }
+}
+
+fn fold_count(branch: &Branch) -> usize {
+    branch
+        .events
+        .iter()
+        .filter(|e| matches!(e, ContinuationEvent::Fold { .. }))
+        .count()
+}
+
+/// The counters identity of the block elimination: one Jacobian and one factorization per
+/// corrector iteration, two solves (`J a = F_p`, `J b = F`) per factorization.
+fn assert_one_factorization_per_iteration(branch: &Branch) {
+    let c = branch.counters;
+    let accepted: u64 = branch.points.iter().map(|q| q.iterations as u64).sum();
+    assert_eq!(c.corrector_iterations, accepted + c.rejected_iterations);
+    assert_eq!(c.factorizations, c.corrector_iterations);
+    assert_eq!(c.jacobian_evaluations, c.corrector_iterations);
+    assert_eq!(c.parameter_derivative_evaluations, c.corrector_iterations);
+    assert_eq!(c.linear_solves, 2 * c.factorizations);
+    assert_eq!(c.dense_bordered_factorizations, 0);
+}
+
+const FOLD_S: f64 = 0.384_900_179_459_750_5; // 2 / (3 √3)
+
+#[test]
+fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options.clone())
+        .unwrap()
+        .run()
+        .unwrap();
+    // Every point is on the curve (the corrector's tolerance on |F|).
+    for q in &branch.points {
+        let x = q.state[0];
+        assert!((x.powi(3) - x - q.parameter).abs() <= 1e-10);
+    }
+    // Two folds, first the upper one (p = +2/(3√3)), then the lower one. The cubic Hermite
+    // interpolant of p(σ) over one chord (θ = 1/2, n = 1: |y|_θ = |y|/√2, so a Euclidean
+    // chord σ <= √2 max_step ≈ 0.07) has error
+    // ~ σ^4 |p''''| / 384 with |p''''| ~ 10 κ^3 at a fold of curvature κ = 6/√3 ≈ 3.5:
+    // about 3e-5; 1e-4 bounds it (measured 1.4e-5).
+    let folds = branch.fold_parameters();
+    println!("S-curve folds {folds:?}, {} points", branch.points.len());
+    assert_eq!(folds.len(), 2);
+    assert!((folds[0] - FOLD_S).abs() < 1e-4, "{}", folds[0] - FOLD_S);
+    assert!((folds[1] + FOLD_S).abs() < 1e-4, "{}", folds[1] + FOLD_S);
+    // The fold event sits between the two points whose tangents have opposite signs.
+    for e in &branch.events {
+        let ContinuationEvent::Fold { index, .. } = e else {
+            continue;
+        };
+        let (a, b) = (&branch.points[index - 1], &branch.points[*index]);
+        assert!(a.tangent_parameter * b.tangent_parameter < 0.0);
+    }
+    // The run ends on the bound p = 1, at the real root of x^3 - x - 1 (the plastic number,
+    // Cardano: ((9 + √69)/18)^(1/3) + ((9 - √69)/18)^(1/3)).
+    let s69 = 69f64.sqrt();
+    let plastic = ((9.0 + s69) / 18.0).cbrt() + ((9.0 - s69) / 18.0).cbrt();
+    let last = branch.points.last().unwrap();
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::ReachedBound {
+            parameter: 1.0,
+            bound: 1.0
+        }
+    );
+    assert!((last.state[0] - plastic).abs() < 1e-10);
+    assert_one_factorization_per_iteration(&branch);
+    // Without refinement the fold is reported at the point after the sign change, which is
+    // within one step of the fold in the parameter.
+    let mut problem = s_curve();
+    let coarse = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &[-1.3],
+        -1.0,
+        ContinuationOptions {
+            refine_folds: false,
+            ..options
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    let folds = coarse.fold_parameters();
+    assert_eq!(folds.len(), 2);
+    assert!((folds[0] - FOLD_S).abs() < 0.05 && (folds[1] + FOLD_S).abs() < 0.05);
+}
+
+#[test]
+fn s_curve_followed_downwards_ends_at_the_lower_root() {
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        direction: Direction::Decreasing,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[1.3], 1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    let folds = branch.fold_parameters();
+    assert_eq!(folds.len(), 2);
+    // Same interpolation bound as upwards.
+    assert!((folds[0] + FOLD_S).abs() < 1e-4 && (folds[1] - FOLD_S).abs() < 1e-4);
+    let last = branch.points.last().unwrap();
+    assert_eq!(last.parameter, -1.0);
+    let s69 = 69f64.sqrt();
+    let plastic = ((9.0 + s69) / 18.0).cbrt() + ((9.0 - s69) / 18.0).cbrt();
+    // x^3 - x + 1 = 0 has the root -plastic.
+    assert!((last.state[0] + plastic).abs() < 1e-10);
+    assert_eq!(problem.parameter(), -1.0);
+
+    // Started on the lower bound heading down: the start is the whole branch.
+    let mut problem = s_curve();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        direction: Direction::Decreasing,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(branch.points.len(), 1);
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::ReachedBound {
+            parameter: -1.0,
+            bound: -1.0
+        }
+    );
+}
+
+/// Follows the circle from (x, p) = (1, 0) once around (unwrapped polar angle 2π), using
+/// the iterator directly.
+fn once_around_the_circle(predictor: Predictor) -> (Vec<(f64, f64)>, Vec<f64>) {
+    let mut problem = circle();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        predictor,
+        ..Default::default()
+    };
+    let mut continuation =
+        Continuation::new(&mut problem, &mut solver, &[1.05], 0.0, options).unwrap();
+    let mut points = Vec::new();
+    let mut angle = 0.0_f64;
+    for item in continuation.by_ref() {
+        let q = item.unwrap();
+        let phi = q.parameter.atan2(q.state[0]);
+        // Unwrap: the increment between consecutive points is small and positive.
+        let mut d = phi - angle.rem_euclid(2.0 * std::f64::consts::PI);
+        if d < -std::f64::consts::PI {
+            d += 2.0 * std::f64::consts::PI;
+        }
+        assert!((0.0..0.2).contains(&d), "angle increment {d}");
+        angle += d;
+        points.push((q.state[0], q.parameter));
+        if angle > 2.0 * std::f64::consts::PI {
+            break;
+        }
+    }
+    let folds = continuation
+        .events()
+        .iter()
+        .map(|e| match e {
+            ContinuationEvent::Fold { parameter, .. } => *parameter,
+            _ => f64::NAN,
+        })
+        .collect();
+    (points, folds)
+}
+
+#[test]
+fn circle_branch_goes_once_around_through_both_folds() {
+    for predictor in [Predictor::Secant, Predictor::Tangent] {
+        let (points, folds) = once_around_the_circle(predictor);
+        // On the unit circle: the radius is 1 to the corrector's tolerance (|F| <= 1e-10
+        // and F = r^2 - 1, so |r - 1| <= 1e-10 / 2).
+        for (x, p) in &points {
+            assert!((x.hypot(*p) - 1.0).abs() <= 1e-10);
+        }
+        // Folds at p = +1 then p = -1. Hermite interpolation of p = sin(σ) over a chord of
+        // Euclidean length <= 0.05/√0.5: error <= h^4/384 ≈ 7e-8.
+        println!("{predictor:?}: {} points, folds {folds:?}", points.len());
+        assert_eq!(folds.len(), 2);
+        assert!((folds[0] - 1.0).abs() < 1e-6 && (folds[1] + 1.0).abs() < 1e-6);
+    }
+}
+
+/// Discriminant of the cubic in `u = A^2` whose positive roots are the Duffing response
+/// amplitudes at `ω`: `c^2 u^3 + 2 c (1 - ω^2) u^2 + ((1 - ω^2)^2 + 4 ζ^2 ω^2) u - f^2`.
+/// Positive: three real roots (inside the overhang); negative: one.
+fn duffing_discriminant(w: f64) -> f64 {
+    let c = 0.75 * GAMMA;
+    let s = 1.0 - w * w;
+    let (a, b, cc, d) = (
+        c * c,
+        2.0 * c * s,
+        s * s + 4.0 * ZETA * ZETA * w * w,
+        -FORCE * FORCE,
+    );
+    18.0 * a * b * cc * d - 4.0 * b.powi(3) * d + b * b * cc * cc
+        - 4.0 * a * cc.powi(3)
+        - 27.0 * a * a * d * d
+}
+
+/// Frequencies where the discriminant changes sign (the folds), by a grid scan and bisection.
+fn duffing_folds_by_discriminant() -> Vec<f64> {
+    let mut folds = Vec::new();
+    let grid: Vec<f64> = (0..=3000).map(|i| 0.5 + 1.5 * i as f64 / 3000.0).collect();
+    for pair in grid.windows(2) {
+        let (mut lo, mut hi) = (pair[0], pair[1]);
+        if duffing_discriminant(lo).signum() == duffing_discriminant(hi).signum() {
+            continue;
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if duffing_discriminant(mid).signum() == duffing_discriminant(lo).signum() {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        folds.push(0.5 * (lo + hi));
+    }
+    folds
+}
+
+fn duffing_branch() -> Branch {
+    let mut problem = duffing();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: 0.5,
+        parameter_max: 2.0,
+        ..Default::default()
+    };
+    Continuation::new(&mut problem, &mut solver, &[0.13, 0.0], 0.5, options)
+        .unwrap()
+        .run()
+        .unwrap()
+}
+
+#[test]
+fn duffing_frequency_response_satisfies_the_implicit_amplitude_equation_through_two_folds() {
+    let branch = duffing_branch();
+    // Every point satisfies A^2 [(1 - ω^2 + 3/4 γ A^2)^2 + (2 ζ ω)^2] = f^2: this is
+    // |M(A, ω) (a, b)|^2 = f^2 for the residual F = M (a, b) - (f, 0), so it holds to about
+    // 2 f |F| <= 2e-11 absolute; relative to f^2 = 1e-2 that is 2e-9.
+    for q in &branch.points {
+        let (a, b, w) = (q.state[0], q.state[1], q.parameter);
+        let u = a * a + b * b;
+        let k = 1.0 - w * w + 0.75 * GAMMA * u;
+        let lhs = u * (k * k + 4.0 * ZETA * ZETA * w * w);
+        assert!(
+            ((lhs - FORCE * FORCE) / (FORCE * FORCE)).abs() < 1e-8,
+            "ω = {w}: {lhs}"
+        );
+    }
+    // The branch overhangs: ω increases to the jump-down fold, decreases to the jump-up
+    // fold, then increases to the bound.
+    let reference = duffing_folds_by_discriminant();
+    let folds = branch.fold_parameters();
+    println!(
+        "Duffing: {} points, folds {folds:?}, discriminant {reference:?}, counters {:?}",
+        branch.points.len(),
+        branch.counters
+    );
+    assert_eq!(reference.len(), 2);
+    assert_eq!(folds.len(), 2);
+    // First fold met is the upper (jump-down) frequency. Tolerance: Hermite interpolation
+    // error over steps <= 0.05 (θ-norm), p'''' of order 10^2 at a sharp fold: < 1e-4.
+    assert!(
+        (folds[0] - reference[1]).abs() < 1e-4,
+        "{}",
+        folds[0] - reference[1]
+    );
+    assert!(
+        (folds[1] - reference[0]).abs() < 1e-4,
+        "{}",
+        folds[1] - reference[0]
+    );
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::ReachedBound {
+            parameter: 2.0,
+            bound: 2.0
+        }
+    );
+    assert_one_factorization_per_iteration(&branch);
+    assert!(branch.counters.rejected_steps == 0);
+    // Peak amplitude on the backbone ω^2 = 1 + 3/4 γ A^2 with A = f/(2ζω): the maximum of
+    // the computed amplitudes is within a few percent of it (the sampled branch may miss
+    // the exact peak by one step).
+    let amplitudes = branch.measure(|q| q.state[0].hypot(q.state[1]));
+    let peak = amplitudes.iter().cloned().fold(0.0, f64::max);
+    // Solve A = f / (2 ζ sqrt(1 + 3/4 γ A^2)) by fixed point.
+    let mut a_peak = 1.0;
+    for _ in 0..200 {
+        a_peak = FORCE / (2.0 * ZETA * (1.0 + 0.75 * GAMMA * a_peak * a_peak).sqrt());
+    }
+    println!("peak amplitude {peak} vs backbone estimate {a_peak}");
+    assert!((peak - a_peak).abs() / a_peak < 0.02);
+}
+
+#[test]
+fn kinked_piecewise_linear_branch_is_followed_through_the_kink() {
+    let mut problem = kink();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: 0.0,
+        parameter_max: 3.0,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[0.2], 0.2, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    // Piecewise linear: Newton with the generalized Jacobian is exact on each piece, so
+    // every point matches the closed form to rounding (1e-12 on O(1) values).
+    for q in &branch.points {
+        assert!((q.state[0] - kink_closed_form(q.parameter)).abs() < 1e-12);
+    }
+    assert!(branch.points.iter().any(|q| q.state[0] < 1.0));
+    assert!(branch.points.iter().any(|q| q.state[0] > 1.0));
+    assert_eq!(fold_count(&branch), 0);
+    assert_eq!(branch.points.last().unwrap().parameter, 3.0);
+    // The parameter increases monotonically along this branch.
+    assert!(branch
+        .points
+        .windows(2)
+        .all(|w| w[1].parameter > w[0].parameter));
+    assert_one_factorization_per_iteration(&branch);
+}
+
+#[test]
+fn singular_jacobian_plateau_needs_the_dense_bordered_fallback() {
+    let options = ContinuationOptions {
+        parameter_min: 0.0,
+        parameter_max: 2.0,
+        max_points: 80,
+        ..Default::default()
+    };
+    // With the fallback the branch turns the corner (1, 1) and runs along p = 1, x > 1,
+    // where J = 0 exactly and only the bordered matrix [[0, 1], [w_x, w_p]] is regular.
+    let mut problem = plateau();
+    let mut solver = FaerDenseLu::new();
+    let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options.clone())
+        .unwrap()
+        .with_dense_fallback()
+        .run()
+        .unwrap();
+    for q in &branch.points {
+        assert!((q.parameter - q.state[0].clamp(0.0, 1.0)).abs() < 1e-12);
+    }
+    let last = branch.points.last().unwrap();
+    assert!(last.state[0] > 2.0 && last.parameter == 1.0, "{last:?}");
+    assert!(branch.counters.dense_bordered_factorizations > 0);
+    // Each corrector iteration still calls `factor` once (it fails on the plateau, then the
+    // dense bordered LU takes over).
+    assert_eq!(
+        branch.counters.factorizations,
+        branch.counters.corrector_iterations
+    );
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::MaxPoints { points: 80 }
+    );
+
+    // Without it the factorization reports the singular Jacobian and the run stops at the
+    // corner with the solver's error in the termination.
+    let mut problem = plateau();
+    let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    let last = branch.points.last().unwrap();
+    println!("without fallback: {:?}", branch.termination);
+    assert!(last.state[0] <= 1.0 + 1e-12 && last.state[0] > 0.9);
+    let failure = match &branch.termination {
+        ContinuationTermination::StepTooSmall { failure, .. }
+        | ContinuationTermination::TooManyFailures { failure, .. } => failure.clone(),
+        other => panic!("unexpected termination {other:?}"),
+    };
+    assert!(matches!(
+        failure,
+        CorrectorFailure::LinearSolve {
+            error: LinearSolveError::Singular { .. },
+            ..
+        }
+    ));
+    assert_eq!(problem.parameter(), last.parameter);
+}
+
+#[test]
+fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
+    let mut problem = ends_at_one();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        max_consecutive_failures: 100,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options.clone())
+        .unwrap()
+        .run()
+        .unwrap();
+    println!("{}", branch.termination);
+    assert!(branch.termination.to_string().contains("step too small"));
+    let ContinuationTermination::StepTooSmall {
+        parameter,
+        step,
+        residual_norm,
+        failure,
+    } = branch.termination.clone()
+    else {
+        panic!("{:?}", branch.termination);
+    };
+    // The last accepted point is below 1 and closer to it than one minimum step (measured
+    // in the θ-norm: a parameter change of min_step/sqrt(θ (1 + 1)) per unit step along x = p).
+    let last = branch.points.last().unwrap();
+    assert_eq!(parameter, last.parameter);
+    assert!(
+        parameter <= 1.0 && parameter > 1.0 - options.min_step,
+        "{parameter}"
+    );
+    assert_eq!(step, options.min_step);
+    assert_eq!(residual_norm, f64::INFINITY);
+    assert_eq!(failure, CorrectorFailure::NonFinite { iteration: 0 });
+    assert!(branch.counters.rejected_steps > 0);
+    // Rolled back: the problem's parameter is the last accepted one, not the rejected one.
+    assert_eq!(problem.parameter(), last.parameter);
+    for q in &branch.points {
+        assert!((q.state[0] - q.parameter).abs() < 1e-12);
+    }
+
+    // Started exactly at the end of the domain, every step fails. Halving from the initial
+    // 0.01: 0.005, 0.0025, then 0.00125 is clamped to min_step = 0.002; the attempt at
+    // 0.002 fails too: four rejected steps, StepTooSmall at 0.002.
+    let mut problem = ends_at_one();
+    let branch = Continuation::new(&mut problem, &mut solver, &[1.0], 1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(branch.points.len(), 1);
+    assert_eq!(branch.counters.rejected_steps, 4);
+    assert!(matches!(
+        branch.termination,
+        ContinuationTermination::StepTooSmall { parameter, step, .. } if parameter == 1.0 && step == 0.002
+    ));
+    // With the default (NLvib) limit of 3 failures in a row: 0.01, 0.005, 0.0025 fail and
+    // the run stops with TooManyFailures at step 0.0025.
+    let mut problem = ends_at_one();
+    let branch = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &[1.0],
+        1.0,
+        ContinuationOptions::default(),
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::TooManyFailures {
+            parameter: 1.0,
+            step: 0.0025,
+            failures: 3,
+            residual_norm: f64::INFINITY,
+            failure: CorrectorFailure::NonFinite { iteration: 0 },
+        }
+    );
+    assert_eq!(problem.parameter(), 1.0);
+}
+
+#[test]
+fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
+    // Sweep p on the S-curve from the lower branch: past the fold p = 2/(3√3) the lower
+    // branch no longer exists and Newton from the previous solution lands on the upper one.
+    let parameters: Vec<f64> = (0..=40).map(|i| -1.0 + 0.05 * i as f64).collect();
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let sweep = natural_sweep(
+        &mut problem,
+        &mut solver,
+        &[-1.3],
+        &parameters,
+        &Default::default(),
+    )
+    .unwrap();
+    let xs: Vec<f64> = sweep.points.iter().map(|q| q.state[0]).collect();
+    let jumps: Vec<usize> = (1..xs.len())
+        .filter(|&i| (xs[i] - xs[i - 1]).abs() > 0.5)
+        .collect();
+    println!(
+        "sweep: {} points, jumps at {jumps:?}, failure {:?}",
+        xs.len(),
+        sweep.failure
+    );
+    // Either it failed at the fold, or it jumped exactly once, between the parameters that
+    // bracket the fold, from x < -1/√3 to x > 1/√3.
+    if let Some(f) = &sweep.failure {
+        // It failed at the first grid parameter past the fold, after following the lower
+        // branch up to the last one before it.
+        assert!(jumps.is_empty());
+        assert!(f.parameter > FOLD_S && f.parameter - 0.05 < FOLD_S, "{f:?}");
+        assert!(xs.iter().all(|&x| x < -1.0 / 3f64.sqrt()));
+    } else {
+        assert_eq!(jumps.len(), 1);
+        let i = jumps[0];
+        assert!(parameters[i - 1] < FOLD_S && parameters[i] > FOLD_S);
+        assert!(xs[i - 1] < -1.0 / 3f64.sqrt() && xs[i] > 1.0 / 3f64.sqrt());
+    }
+    // The pseudo-arclength branch over the same range moves continuously: the predictor
+    // moves at most max_step = 0.05 in the θ-norm (0.071 Euclidean for θ = 1/2, n = 1) and
+    // the corrector moves orthogonally to it by much less, so 0.1 bounds the Euclidean
+    // distance between consecutive points.
+    let mut problem = s_curve();
+    let branch = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &[-1.3],
+        -1.0,
+        ContinuationOptions {
+            parameter_min: -1.0,
+            parameter_max: 1.0,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    for w in branch.points.windows(2) {
+        let d = (w[1].state[0] - w[0].state[0]).hypot(w[1].parameter - w[0].parameter);
+        assert!(d < 0.1, "{d}");
+    }
+    assert_eq!(fold_count(&branch), 2);
+}
+
+#[test]
+fn every_continuation_point_resolved_by_plain_newton_stays_put() {
+    // Re-solve each point at its own parameter, from itself, with a tolerance 100x tighter
+    // than the continuation's so that at least one Newton step is taken.
+    let strict = semismooth::continuation::NaturalSweepOptions {
+        tolerance: 1e-12,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    let branch = duffing_branch();
+    let mut problem = duffing();
+    let mut worst = 0.0_f64;
+    for q in &branch.points {
+        let sweep =
+            natural_sweep(&mut problem, &mut solver, &q.state, &[q.parameter], &strict).unwrap();
+        assert!(sweep.failure.is_none());
+        let r = &sweep.points[0];
+        let moved = (r.state[0] - q.state[0]).hypot(r.state[1] - q.state[1]);
+        worst = worst.max(moved);
+        assert!(moved < 1e-8, "ω = {}: moved {moved}", q.parameter);
+    }
+    println!("Duffing: largest move under re-solve {worst:e}");
+}
+
+#[test]
+fn bad_input_is_a_typed_error_with_the_numbers() {
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let bad = |o: ContinuationOptions| o.validate().unwrap_err();
+    assert!(matches!(
+        bad(ContinuationOptions { theta: 1.0, ..Default::default() }),
+        ContinuationError::InvalidOption { name: "theta", value, .. } if value == 1.0
+    ));
+    assert!(matches!(
+        bad(ContinuationOptions {
+            initial_step: 1.0,
+            ..Default::default()
+        }),
+        ContinuationError::InvalidOption {
+            name: "initial_step",
+            ..
+        }
+    ));
+    assert!(matches!(
+        bad(ContinuationOptions {
+            min_step: f64::NAN,
+            ..Default::default()
+        }),
+        ContinuationError::InvalidOption {
+            name: "min_step",
+            ..
+        }
+    ));
+    assert!(matches!(
+        bad(ContinuationOptions {
+            parameter_min: 2.0,
+            parameter_max: 1.0,
+            ..Default::default()
+        }),
+        ContinuationError::InvalidOption {
+            name: "parameter_max",
+            ..
+        }
+    ));
+    assert!(matches!(
+        bad(ContinuationOptions {
+            max_points: 0,
+            ..Default::default()
+        }),
+        ContinuationError::InvalidOption {
+            name: "max_points",
+            ..
+        }
+    ));
+    assert!(ContinuationOptions::with_step(0.1).validate().is_ok());
+    assert!(matches!(
+        Continuation::new(
+            &mut problem,
+            &mut solver,
+            &[1.0, 2.0],
+            0.0,
+            Default::default()
+        )
+        .err(),
+        Some(ContinuationError::DimensionMismatch {
+            expected: 1,
+            found: 2
+        })
+    ));
+    let bounded = ContinuationOptions {
+        parameter_min: 0.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    assert!(matches!(
+        Continuation::new(&mut problem, &mut solver, &[1.0], 1.5, bounded).err(),
+        Some(ContinuationError::InvalidStart { parameter, .. }) if parameter == 1.5
+    ));
+    // x^2 + 1 + p^2 has no real root: the start cannot be corrected; the iterator yields
+    // one Err and then stops.
+    let mut none = Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0] * x[0] + 1.0 + p * p),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = 2.0 * x[0]),
+        fp: None,
+    };
+    let mut it =
+        Continuation::new(&mut none, &mut solver, &[1.0], 0.0, Default::default()).unwrap();
+    assert!(matches!(
+        it.next(),
+        Some(Err(ContinuationError::StartNotConverged { parameter, .. })) if parameter == 0.0
+    ));
+    assert!(it.next().is_none());
+}
+
+/// A structured (diagonal) Jacobian that cannot be assembled densely, with its own solver:
+/// the continuation must work through `LinearSolve` alone.
+struct Diagonal(Vec<f64>);
+
+struct DiagonalSolver {
+    diagonal: Vec<f64>,
+}
+
+impl semismooth::LinearSolve<Diagonal> for DiagonalSolver {
+    fn factor(&mut self, jac: &Diagonal) -> Result<(), LinearSolveError> {
+        let max_pivot = jac.0.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        if let Some(index) = jac.0.iter().position(|d| *d == 0.0 || !d.is_finite()) {
+            return Err(LinearSolveError::Singular {
+                index,
+                pivot: jac.0[index].abs(),
+                max_pivot,
+            });
+        }
+        self.diagonal.clone_from(&jac.0);
+        Ok(())
+    }
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        for (r, d) in rhs.iter_mut().zip(&self.diagonal) {
+            *r /= d;
+        }
+        Ok(())
+    }
+}
+
+/// `F_0 = x_0^3 - x_0 - p` (the S-curve, which makes the folds) and, for `i >= 1`,
+/// `F_i = x_i^3 + (1 + i/n) x_i - p` (monotone in `x_i`, one root for every `p`).
+struct DecoupledCurves {
+    n: usize,
+    p: f64,
+}
+
+impl DecoupledCurves {
+    fn coefficient(&self, i: usize) -> f64 {
+        if i == 0 {
+            -1.0
+        } else {
+            1.0 + i as f64 / self.n as f64
+        }
+    }
+}
+
+impl Residual for DecoupledCurves {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
+            *o = xi.powi(3) + self.coefficient(i) * xi - self.p;
+        }
+    }
+}
+
+impl ParameterDependent for DecoupledCurves {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+    }
+}
+
+impl GeneralizedJacobian for DecoupledCurves {
+    type Jacobian = Diagonal;
+    fn new_jacobian(&self) -> Diagonal {
+        Diagonal(vec![0.0; self.n])
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Diagonal) {
+        for (i, (d, xi)) in jac.0.iter_mut().zip(x).enumerate() {
+            *d = 3.0 * xi * xi + self.coefficient(i);
+        }
+    }
+}
+
+/// The same problem with a dense Jacobian, to solve with the dense LU.
+struct DenseDecoupled(DecoupledCurves);
+
+impl Residual for DenseDecoupled {
+    fn dim(&self) -> usize {
+        self.0.n
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        self.0.residual(x, out)
+    }
+}
+
+impl ParameterDependent for DenseDecoupled {
+    fn parameter(&self) -> f64 {
+        self.0.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.0.p = p;
+    }
+}
+
+impl GeneralizedJacobian for DenseDecoupled {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.0.n, self.0.n)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+        let mut d = self.0.new_jacobian();
+        self.0.jacobian(x, &mut d);
+        for i in 0..self.0.n {
+            for j in 0..self.0.n {
+                jac[(i, j)] = if i == j { d.0[i] } else { 0.0 };
+            }
+        }
+    }
+}
+
+#[test]
+fn structured_jacobian_branch_equals_the_dense_one_and_passes_the_folds() {
+    let n = 40;
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    // Start at p = -1: x_0 on the lower branch; x_i (i >= 1) from Newton-free bisection.
+    let root = |c: f64, p: f64| {
+        let (mut lo, mut hi) = (-2.0_f64, 2.0_f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if mid.powi(3) + c * mid - p > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let mut structured = DecoupledCurves { n, p: -1.0 };
+    let x0: Vec<f64> = (0..n)
+        .map(|i| {
+            if i == 0 {
+                -1.3
+            } else {
+                root(structured.coefficient(i), -1.0)
+            }
+        })
+        .collect();
+    let mut diagonal_solver = DiagonalSolver {
+        diagonal: Vec::new(),
+    };
+    let branch = Continuation::new(
+        &mut structured,
+        &mut diagonal_solver,
+        &x0,
+        -1.0,
+        options.clone(),
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    let mut dense = DenseDecoupled(DecoupledCurves { n, p: -1.0 });
+    let mut lu = FaerDenseLu::new();
+    let reference = Continuation::new(&mut dense, &mut lu, &x0, -1.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    // Same arithmetic up to the LU's rounding on a diagonal matrix: the branches agree
+    // point by point to 1e-12 (on O(1) values).
+    assert_eq!(branch.points.len(), reference.points.len());
+    for (a, b) in branch.points.iter().zip(&reference.points) {
+        assert!((a.parameter - b.parameter).abs() < 1e-12);
+        for (u, v) in a.state.iter().zip(&b.state) {
+            assert!((u - v).abs() < 1e-12);
+        }
+    }
+    // Components i >= 1 are the unique real roots of their cubics (bisection, 1e-12 after
+    // 200 halvings of [-2, 2]; corrector residual 1e-10 over slope >= 1 gives 1e-10).
+    let probe = DecoupledCurves { n, p: 0.0 };
+    for q in &branch.points {
+        for i in 1..n {
+            let exact = root(probe.coefficient(i), q.parameter);
+            assert!((q.state[i] - exact).abs() < 1e-9);
+        }
+    }
+    let folds = branch.fold_parameters();
+    println!(
+        "structured n = {n}: {} points, folds {folds:?}",
+        branch.points.len()
+    );
+    assert_eq!(folds.len(), 2);
+    // Fold tolerance as for the scalar S-curve (the x_0 component dominates p(s) there).
+    assert!((folds[0] - FOLD_S).abs() < 1e-4 && (folds[1] + FOLD_S).abs() < 1e-4);
+    assert_one_factorization_per_iteration(&branch);
+}

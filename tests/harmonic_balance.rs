@@ -1,0 +1,699 @@
+//! Harmonic balance (SSN-HB and penalty HB): residuals and Jacobians against independent
+//! evaluations, the linear case against the exact frequency response, and the structured
+//! (condensed) solver against the dense LU.
+
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Mat;
+use nalgebra::{Complex, DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use semismooth::harmonic::{Aft, FourierBasis};
+use semismooth::linalg::{DenseAssemble, FaerDenseLu};
+use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth_problems::hb::{
+    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+};
+use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel};
+use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
+
+/// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
+/// `D = beta K` (or none), forcing `amplitude` on every dof at `omega`.
+fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -> StructuralModel {
+    let k = [3.0, 2.0, 1.5, 1.2, 1.0];
+    let mass = [1.0, 0.7, 0.5, 0.4, 0.3];
+    let mut kt = Vec::new();
+    let mut mt = Vec::new();
+    for i in 0..n {
+        // Spring i connects dof i-1 (or the wall) to dof i.
+        kt.push(Triplet::new(i, i, k[i % 5]));
+        if i + 1 < n {
+            kt.push(Triplet::new(i, i, k[(i + 1) % 5]));
+            kt.push(Triplet::new(i, i + 1, -k[(i + 1) % 5]));
+            kt.push(Triplet::new(i + 1, i, -k[(i + 1) % 5]));
+        }
+        mt.push(Triplet::new(i, i, mass[i % 5]));
+    }
+    let stiffness = SparseColMat::try_new_from_triplets(n, n, &kt).unwrap();
+    let mass = SparseColMat::try_new_from_triplets(n, n, &mt).unwrap();
+    let damping = beta.map(|b| {
+        let dt: Vec<_> = kt
+            .iter()
+            .map(|t| Triplet::new(t.row, t.col, b * t.val))
+            .collect();
+        SparseColMat::try_new_from_triplets(n, n, &dt).unwrap()
+    });
+    StructuralModel {
+        mass,
+        damping,
+        stiffness,
+        forcing: HarmonicForcing {
+            amplitude: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
+            omega,
+        },
+        contacts,
+    }
+}
+
+fn dense(m: &SparseColMat<usize, f64>) -> DMatrix<f64> {
+    let d = m.to_dense();
+    DMatrix::from_fn(d.nrows(), d.ncols(), |i, j| d[(i, j)])
+}
+
+fn random_vector(rng: &mut ChaCha8Rng, len: usize, scale: f64) -> Vec<f64> {
+    (0..len)
+        .map(|_| scale * rng.random_range(-1.0..1.0))
+        .collect()
+}
+
+fn assemble(jac: &HbJacobian) -> Mat<f64> {
+    let n = jac.dim();
+    let mut out = Mat::zeros(n, n);
+    jac.assemble_dense(out.as_mut());
+    out
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Central finite-difference Jacobian of `problem` at `x` (step `h`).
+fn fd_jacobian<P: Residual>(problem: &mut P, x: &[f64], h: f64) -> Mat<f64> {
+    let n = problem.dim();
+    let mut out = Mat::zeros(n, n);
+    let mut xp = x.to_vec();
+    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+    for col in 0..n {
+        xp[col] = x[col] + h;
+        problem.residual(&xp, &mut fp);
+        xp[col] = x[col] - h;
+        problem.residual(&xp, &mut fm);
+        xp[col] = x[col];
+        for r in 0..n {
+            out[(r, col)] = (fp[r] - fm[r]) / (2.0 * h);
+        }
+    }
+    out
+}
+
+fn max_abs(m: &Mat<f64>) -> f64 {
+    let mut best = 0.0f64;
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            best = best.max(m[(i, j)].abs());
+        }
+    }
+    best
+}
+
+#[test]
+fn dynamic_blocks_match_time_domain_equation_of_motion() {
+    // R = A(w) U - F with F = 0 and no contact, against M u'' + D u' + K u evaluated at
+    // the samples (derivatives from the coefficient-space operator) and projected by P.
+    let mut model = chain(3, Some(0.05), 1.3, vec![]);
+    model.forcing.amplitude = vec![0.0; 3];
+    let options = HbOptions {
+        harmonics: 4,
+        time_samples: Some(32),
+        c: None,
+    };
+    let mut hb = SsnHb::new(&model, &options).unwrap();
+    let basis = FourierBasis::new(4, 32).unwrap();
+    let size = basis.basis_size();
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let u = random_vector(&mut rng, 3 * size, 1.0);
+    let mut r = vec![0.0; hb.dim()];
+    hb.residual(&u, &mut r);
+
+    let (m, d, k) = (
+        dense(&model.mass),
+        dense(model.damping.as_ref().unwrap()),
+        dense(&model.stiffness),
+    );
+    let mut aft = Aft::new(basis);
+    let omega = 1.3;
+    // Samples of u, u', u'' per dof.
+    let mut series = vec![vec![vec![0.0; 32]; 3]; 3];
+    for dof in 0..3 {
+        let c0: Vec<f64> = (0..size).map(|j| u[j * 3 + dof]).collect();
+        let mut c1 = vec![0.0; size];
+        let mut c2 = vec![0.0; size];
+        basis.differentiate(&c0, omega, &mut c1).unwrap();
+        basis.differentiate(&c1, omega, &mut c2).unwrap();
+        for (order, c) in [c0, c1, c2].iter().enumerate() {
+            aft.to_time(c, &mut series[order][dof]).unwrap();
+        }
+    }
+    let mut force = vec![vec![0.0; 32]; 3];
+    for n in 0..32 {
+        for i in 0..3 {
+            for j in 0..3 {
+                force[i][n] += m[(i, j)] * series[2][j][n]
+                    + d[(i, j)] * series[1][j][n]
+                    + k[(i, j)] * series[0][j][n];
+            }
+        }
+    }
+    let scale = norm(&r);
+    for (i, f) in force.iter().enumerate() {
+        let mut coeffs = vec![0.0; size];
+        aft.to_coefficients(f, &mut coeffs).unwrap();
+        for j in 0..size {
+            // Both sides are exact for trigonometric polynomials: only rounding remains.
+            assert!(
+                (coeffs[j] - r[j * 3 + i]).abs() < 1e-13 * scale,
+                "dof {i} coefficient {j}: time domain {} vs HB {}",
+                coeffs[j],
+                r[j * 3 + i]
+            );
+        }
+    }
+}
+
+/// A point whose switching samples all stay at least `margin` away from 0, with some
+/// samples active and some inactive (so the Jacobian has a nontrivial contact part).
+fn point_away_from_kinks<F: FnMut(&[f64]) -> (f64, usize, usize)>(
+    len: usize,
+    scale: f64,
+    mut probe: F,
+) -> Vec<f64> {
+    for seed in 0..1000 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, len, scale);
+        let (min_abs, active, total) = probe(&x);
+        if min_abs > 1e-3 && active > 0 && active < total {
+            return x;
+        }
+    }
+    panic!("no point away from kinks found");
+}
+
+fn ssn_switching(
+    model: &StructuralModel,
+    c: f64,
+    x: &[f64],
+    h: usize,
+    nt: usize,
+) -> (f64, usize, usize) {
+    let n = model.dofs();
+    let m = model.contact_count();
+    let size = 2 * h + 1;
+    let basis = FourierBasis::new(h, nt).unwrap();
+    let mut aft = Aft::new(basis);
+    let mut s = vec![0.0; nt];
+    let (mut min_abs, mut active) = (f64::INFINITY, 0);
+    for (i, cp) in model.contacts.iter().enumerate() {
+        let mut coeffs: Vec<f64> = (0..size)
+            .map(|j| c * x[j * n + cp.dof] - x[n * size + j * m + i])
+            .collect();
+        coeffs[0] -= c * cp.gap;
+        aft.to_time(&coeffs, &mut s).unwrap();
+        for v in &s {
+            min_abs = min_abs.min(v.abs());
+            active += usize::from(*v > 0.0);
+        }
+    }
+    (min_abs, active, nt * m)
+}
+
+#[test]
+fn ssn_jacobian_matches_central_differences_away_from_kinks() {
+    let contacts = vec![
+        ContactPoint { dof: 1, gap: 0.2 },
+        ContactPoint { dof: 2, gap: 0.1 },
+    ];
+    let model = chain(3, Some(0.02), 0.9, contacts);
+    let (h, nt) = (3, 16);
+    let options = HbOptions {
+        harmonics: h,
+        time_samples: Some(nt),
+        c: Some(2.0),
+    };
+    let mut hb = SsnHb::new(&model, &options).unwrap();
+    let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
+    let mut jac = hb.new_jacobian();
+    hb.jacobian(&x, &mut jac);
+    let analytic = assemble(&jac);
+    // Step 1e-6: the switching samples move by at most c * h * 2 = 4e-6 < margin 1e-3, so no
+    // kink is crossed and the residual is smooth (quadratic pieces: FD error ~ rounding
+    // 1e-16 / 1e-6 = 1e-10 relative).
+    let fd = fd_jacobian(&mut hb, &x, 1e-6);
+    let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
+    assert!(err < 1e-6, "relative Jacobian error {err:e}");
+}
+
+#[test]
+fn penalty_jacobian_matches_central_differences_away_from_kinks() {
+    let contacts = vec![
+        ContactPoint { dof: 0, gap: 0.05 },
+        ContactPoint { dof: 2, gap: 0.1 },
+    ];
+    let model = chain(3, Some(0.02), 0.9, contacts);
+    let (h, nt) = (3, 16);
+    let options = PenaltyHbOptions {
+        harmonics: h,
+        time_samples: Some(nt),
+        penalty_stiffness: 50.0,
+    };
+    let mut hb = PenaltyHb::new(&model, &options).unwrap();
+    let x = point_away_from_kinks(hb.dim(), 0.3, |x| {
+        // Penalty switching function: G u - g (c = 1, no force unknowns).
+        let mut padded = x.to_vec();
+        padded.extend(std::iter::repeat_n(0.0, 2 * (2 * h + 1)));
+        ssn_switching(&model, 1.0, &padded, h, nt)
+    });
+    let mut jac = hb.new_jacobian();
+    hb.jacobian(&x, &mut jac);
+    let analytic = assemble(&jac);
+    let fd = fd_jacobian(&mut hb, &x, 1e-6);
+    let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
+    assert!(err < 1e-6, "relative Jacobian error {err:e}");
+}
+
+#[test]
+fn omega_derivative_matches_central_differences() {
+    let model = chain(3, Some(0.03), 1.1, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let mut hb = SsnHb::new(
+        &model,
+        &HbOptions {
+            harmonics: 3,
+            time_samples: Some(16),
+            c: None,
+        },
+    )
+    .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let x = random_vector(&mut rng, hb.dim(), 0.5);
+    let mut analytic = vec![0.0; hb.dim()];
+    hb.residual_parameter_derivative(&x, &mut analytic);
+    let (mut fp, mut fm) = (vec![0.0; hb.dim()], vec![0.0; hb.dim()]);
+    let step = 1e-5;
+    hb.set_parameter(1.1 + step);
+    hb.residual(&x, &mut fp);
+    hb.set_parameter(1.1 - step);
+    hb.residual(&x, &mut fm);
+    hb.set_parameter(1.1);
+    // A(w) is quadratic in w: the central difference is exact up to rounding.
+    let fd: Vec<f64> = fp
+        .iter()
+        .zip(&fm)
+        .map(|(a, b)| (a - b) / (2.0 * step))
+        .collect();
+    let diff: Vec<f64> = analytic.iter().zip(&fd).map(|(a, b)| a - b).collect();
+    assert!(
+        norm(&diff) < 1e-8 * norm(&analytic),
+        "{:e}",
+        norm(&diff) / norm(&analytic)
+    );
+}
+
+/// Exact linear response `u(t) = Re(z e^{i w t})`, `(K - w^2 M + i w D) z = f`.
+fn exact_linear_response(model: &StructuralModel) -> (Vec<f64>, Vec<f64>) {
+    let w = model.forcing.omega;
+    let (m, k) = (dense(&model.mass), dense(&model.stiffness));
+    let d = model
+        .damping
+        .as_ref()
+        .map(dense)
+        .unwrap_or_else(|| DMatrix::zeros(m.nrows(), m.ncols()));
+    let n = m.nrows();
+    let a = DMatrix::from_fn(n, n, |i, j| {
+        Complex::new(k[(i, j)] - w * w * m[(i, j)], w * d[(i, j)])
+    });
+    let f = DVector::from_fn(n, |i, _| Complex::new(model.forcing.amplitude[i], 0.0));
+    let z = a.lu().solve(&f).unwrap();
+    // u = Re z cos(wt) - Im z sin(wt).
+    (
+        z.iter().map(|c| c.re).collect(),
+        z.iter().map(|c| -c.im).collect(),
+    )
+}
+
+#[test]
+fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
+    for damping in [Some(0.04), None] {
+        let model = chain(4, damping, 1.7, vec![]);
+        let mut hb = SsnHb::new(&model, &HbOptions::default()).unwrap();
+        let mut x = vec![0.0; hb.dim()];
+        let mut r = vec![0.0; hb.dim()];
+        hb.residual(&x, &mut r);
+        let mut jac = hb.new_jacobian();
+        hb.jacobian(&x, &mut jac);
+        let mut solver = StructuredHbSolver::new();
+        solver.factor(&jac).unwrap();
+        // One Newton step solves the linear problem: x = -J^{-1} R(0).
+        for v in &mut r {
+            *v = -*v;
+        }
+        solver.solve_in_place(&mut r).unwrap();
+        x.copy_from_slice(&r);
+        let (cos, sin) = exact_linear_response(&model);
+        let n = model.dofs();
+        let scale = norm(&cos).max(norm(&sin));
+        for dof in 0..n {
+            // Both are direct solves of the same 4 x 4 complex system: 1e-12 relative.
+            assert!((x[n + dof] - cos[dof]).abs() < 1e-12 * scale);
+            assert!((x[2 * n + dof] - sin[dof]).abs() < 1e-12 * scale);
+        }
+        for (j, v) in x.iter().enumerate() {
+            if !(n..3 * n).contains(&j) {
+                assert!(v.abs() < 1e-14 * scale, "coefficient {j} = {v}");
+            }
+        }
+        hb.residual(&x, &mut r);
+        assert!(norm(&r) < 1e-12 * norm(&model.forcing.amplitude));
+        assert_eq!(hb.fft_count(), 0, "no contact: no FFT");
+    }
+}
+
+fn structured_vs_dense_step<P>(problem: &mut P, x: &[f64]) -> f64
+where
+    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+{
+    let n = problem.dim();
+    let mut r = vec![0.0; n];
+    problem.residual(x, &mut r);
+    let mut jac = problem.new_jacobian();
+    problem.jacobian(x, &mut jac);
+    let mut structured = StructuredHbSolver::new();
+    let mut dense = FaerDenseLu::new();
+    structured.factor(&jac).unwrap();
+    dense.factor(&jac).unwrap();
+    let mut ds = r.clone();
+    let mut dd = r.clone();
+    structured.solve_in_place(&mut ds).unwrap();
+    LinearSolve::<HbJacobian>::solve_in_place(&mut dense, &mut dd).unwrap();
+    let diff: Vec<f64> = ds.iter().zip(&dd).map(|(a, b)| a - b).collect();
+    norm(&diff) / norm(&dd)
+}
+
+#[test]
+fn structured_and_dense_newton_steps_agree_ssn() {
+    let contacts = vec![
+        ContactPoint { dof: 1, gap: 0.2 },
+        ContactPoint { dof: 3, gap: 0.1 },
+    ];
+    let model = chain(5, Some(0.02), 1.2, contacts);
+    let mut hb = SsnHb::new(
+        &model,
+        &HbOptions {
+            harmonics: 6,
+            time_samples: None,
+            c: Some(3.0),
+        },
+    )
+    .unwrap();
+    for seed in 0..3 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, hb.dim(), 0.3);
+        let err = structured_vs_dense_step(&mut hb, &x);
+        // Two backward-stable solves of a well-conditioned system: agreement to ~1e-13.
+        assert!(err < 1e-10, "seed {seed}: relative step difference {err:e}");
+    }
+}
+
+#[test]
+fn structured_and_dense_newton_steps_agree_penalty() {
+    let contacts = vec![
+        ContactPoint { dof: 1, gap: 0.05 },
+        ContactPoint { dof: 3, gap: 0.02 },
+    ];
+    let model = chain(5, Some(0.02), 1.2, contacts);
+    let mut hb = PenaltyHb::new(
+        &model,
+        &PenaltyHbOptions {
+            harmonics: 6,
+            time_samples: None,
+            penalty_stiffness: 100.0,
+        },
+    )
+    .unwrap();
+    for seed in 0..3 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, hb.dim(), 0.3);
+        let err = structured_vs_dense_step(&mut hb, &x);
+        assert!(err < 1e-10, "seed {seed}: relative step difference {err:e}");
+    }
+}
+
+#[test]
+fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
+    let model = chain(3, Some(0.02), 1.2, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let mut hb = SsnHb::new(
+        &model,
+        &HbOptions {
+            harmonics: 4,
+            ..HbOptions::default()
+        },
+    )
+    .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let mut jac = hb.new_jacobian();
+    let mut solver = StructuredHbSolver::new();
+    for _ in 0..3 {
+        let x = random_vector(&mut rng, hb.dim(), 0.3);
+        hb.jacobian(&x, &mut jac);
+        solver.factor(&jac).unwrap();
+    }
+    assert_eq!(solver.dynamic_factorizations(), 1);
+    assert_eq!(solver.schur_factorizations(), 3);
+    hb.set_omega(1.3).unwrap();
+    let x = random_vector(&mut rng, hb.dim(), 0.3);
+    hb.jacobian(&x, &mut jac);
+    solver.factor(&jac).unwrap();
+    assert_eq!(solver.dynamic_factorizations(), 2);
+    // And the refactored solver still agrees with the dense one.
+    assert!(structured_vs_dense_step(&mut hb, &x) < 1e-10);
+}
+
+#[test]
+fn bad_options_are_typed_errors_with_the_numbers() {
+    let model = chain(3, None, 1.0, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let err = SsnHb::new(
+        &model,
+        &HbOptions {
+            harmonics: 10,
+            time_samples: Some(20),
+            c: None,
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(
+        err,
+        HbError::Harmonic(semismooth::harmonic::HarmonicError::TooFewSamples {
+            harmonics: 10,
+            time_samples: 20,
+            minimum: 21
+        })
+    ));
+    let err = SsnHb::new(
+        &model,
+        &HbOptions {
+            c: Some(-1.0),
+            ..HbOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
+    let err = SsnHb::new(
+        &model,
+        &HbOptions {
+            harmonics: 0,
+            ..HbOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(
+        err,
+        HbError::InvalidOption {
+            name: "harmonics",
+            ..
+        }
+    ));
+    let err = PenaltyHb::new(
+        &model,
+        &PenaltyHbOptions {
+            penalty_stiffness: f64::NAN,
+            ..PenaltyHbOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(
+        err,
+        HbError::InvalidOption {
+            name: "penalty_stiffness",
+            ..
+        }
+    ));
+    let bad = chain(3, None, 1.0, vec![ContactPoint { dof: 7, gap: 0.1 }]);
+    let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
+    assert!(matches!(
+        err,
+        HbError::IndexOutOfRange {
+            index: 7,
+            count: 3,
+            ..
+        }
+    ));
+    let mut bad = chain(3, None, 1.0, vec![]);
+    bad.forcing.omega = 0.0;
+    assert!(matches!(
+        SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
+        HbError::InvalidOption { name: "omega", .. }
+    ));
+}
+
+fn canonical_modified_rod() -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = MassModel::Modified;
+    build_rod(&spec).unwrap().model
+}
+
+#[test]
+fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(
+        &model,
+        &PenaltyHbOptions {
+            penalty_stiffness: 1e3 * model.contact_stiffness_scale(),
+            ..PenaltyHbOptions::default()
+        },
+    )
+    .unwrap();
+    // A point where the tip overshoots the gap over part of the period: the constant
+    // coefficient of every dof is 0.45 * (position along the rod), first cosine 0.3 * x.
+    let (n, size) = (model.dofs(), 41);
+    let mut u = vec![0.0; n * size];
+    for dof in 0..n {
+        let x = (dof + 1) as f64 / n as f64;
+        u[dof] = 0.45 * x;
+        u[n + dof] = 0.3 * x;
+        u[4 * n + dof] = 0.02 * x;
+    }
+    let mut x = u.clone();
+    x.extend((0..size).map(|j| if j == 0 { -0.1 } else { 0.01 }));
+    let err = structured_vs_dense_step(&mut ssn, &x);
+    assert!(err < 1e-10, "SSN-HB: relative step difference {err:e}");
+    let err = structured_vs_dense_step(&mut penalty, &u);
+    assert!(err < 1e-10, "penalty HB: relative step difference {err:e}");
+}
+
+/// The condensed (Woodbury) solve subtracts large terms when the penalty is stiff; with
+/// one refinement step its residual `|J d - r| / |r|` stays at rounding level, like the
+/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (issue 5's finest setting).
+#[test]
+fn structured_solve_stays_backward_stable_for_stiff_penalties() {
+    let model = canonical_modified_rod();
+    let (n, size) = (model.dofs(), 41);
+    let mut u = vec![0.0; n * size];
+    for dof in 0..n {
+        let x = (dof + 1) as f64 / n as f64;
+        u[dof] = 0.45 * x;
+        u[n + dof] = 0.3 * x;
+        u[4 * n + dof] = 0.02 * x;
+    }
+    for relative in [1e1, 1e3, 1e5] {
+        let mut penalty = PenaltyHb::new(
+            &model,
+            &PenaltyHbOptions {
+                penalty_stiffness: relative * model.contact_stiffness_scale(),
+                ..PenaltyHbOptions::default()
+            },
+        )
+        .unwrap();
+        let mut r = vec![0.0; u.len()];
+        penalty.residual(&u, &mut r);
+        let mut jac = penalty.new_jacobian();
+        penalty.jacobian(&u, &mut jac);
+        let dense_j = assemble(&jac);
+        let mut solver = StructuredHbSolver::new();
+        solver.factor(&jac).unwrap();
+        let mut d = r.clone();
+        solver.solve_in_place(&mut d).unwrap();
+        let mut sum = 0.0;
+        for i in 0..r.len() {
+            let mut acc = -r[i];
+            for (j, dj) in d.iter().enumerate() {
+                acc += dense_j[(i, j)] * dj;
+            }
+            sum += acc * acc;
+        }
+        let backward = sum.sqrt() / norm(&r);
+        assert!(
+            backward < 1e-12,
+            "k_p = {relative:e} x scale: |J d - r| / |r| = {backward:e}"
+        );
+    }
+}
+
+/// Counts allocations made by the current thread (tests run in parallel threads).
+mod counting {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    pub struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    pub fn allocations() -> u64 {
+        ALLOCATIONS.with(|c| c.get())
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: counting::Counting = counting::Counting;
+
+/// One Newton iteration's work (residual, Jacobian, structured factor, solve) at a fixed
+/// frequency allocates nothing once the workspaces exist.
+#[test]
+fn newton_iteration_work_is_allocation_free() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::default()).unwrap();
+    fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x = random_vector(&mut rng, p.dim(), 0.5);
+        let mut r = vec![0.0; p.dim()];
+        let mut jac = p.new_jacobian();
+        let mut solver = StructuredHbSolver::new();
+        // Warm-up: builds the plans' scratch, the sparse factors and the workspaces.
+        p.residual(&x, &mut r);
+        p.jacobian(&x, &mut jac);
+        solver.factor(&jac).unwrap();
+        solver.solve_in_place(&mut r).unwrap();
+        let before = counting::allocations();
+        for _ in 0..3 {
+            p.residual(&x, &mut r);
+            p.jacobian(&x, &mut jac);
+            solver.factor(&jac).unwrap();
+            solver.solve_in_place(&mut r).unwrap();
+        }
+        counting::allocations() - before
+    }
+    // The counter sees allocations at all.
+    let before = counting::allocations();
+    let probe = std::hint::black_box(vec![1u8; 16]);
+    assert!(counting::allocations() > before && probe.len() == 16);
+    assert_eq!(iterate(&mut ssn, 1), 0, "SSN-HB iteration allocated");
+    assert_eq!(
+        iterate(&mut penalty, 2),
+        0,
+        "penalty HB iteration allocated"
+    );
+}
