@@ -4,7 +4,9 @@
 //! solvers against each other.
 
 use nalgebra::{Complex, DMatrix, DVector};
-use semismooth_problems::lcp::{LcpError, PeriodicLcp, PeriodicLcpOptions};
+use semismooth::lemke::{Lemke, LemkeOptions};
+use semismooth::newton::{self, NewtonOptions};
+use semismooth_problems::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
 use semismooth_problems::model::{SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 
@@ -370,4 +372,116 @@ fn bad_options_and_models_are_typed_errors() {
             found: 3
         }
     );
+}
+
+fn lemke_solution(lcp: &PeriodicLcp) -> semismooth::lemke::LemkeReport {
+    let mut lemke = Lemke::new(lcp.dim());
+    lcp.solve_with_lemke(&mut lemke, &LemkeOptions::default())
+        .unwrap()
+}
+
+fn ssn_solution(lcp: &PeriodicLcp) -> (Vec<f64>, newton::NewtonReport) {
+    ssn_from(lcp, vec![0.0; lcp.dim()])
+}
+
+fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonReport) {
+    let mut problem = lcp.min_map();
+    let mut solver = ActiveSetSolver::new();
+    let report =
+        newton::solve(&mut problem, &mut solver, &mut z, &NewtonOptions::default()).unwrap();
+    (z, report)
+}
+
+/// Numbers for the report (run with `--ignored --nocapture`); nothing asserted on time.
+#[test]
+#[ignore]
+fn report_lcp_numbers() {
+    for mass in [
+        MassModel::Modified,
+        MassModel::Consistent,
+        MassModel::Lumped,
+    ] {
+        let model = rod(mass, true);
+        for nt in [128usize, 256, 512, 1024, 2048] {
+            let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+            let (lo, hi) = lcp.symmetric_part_spectrum();
+            let start = std::time::Instant::now();
+            let lemke = lemke_solution(&lcp);
+            let lemke_time = start.elapsed().as_secs_f64();
+            let start = std::time::Instant::now();
+            let (z, ssn) = ssn_solution(&lcp);
+            let ssn_time = start.elapsed().as_secs_f64();
+            let tip_lemke = lcp.contact_displacements(&lemke.z).unwrap()[0]
+                .iter()
+                .cloned()
+                .fold(f64::INFINITY, f64::min);
+            let u = &lcp.contact_displacements(&z).unwrap()[0];
+            let tip_min = u.iter().cloned().fold(f64::INFINITY, f64::min);
+            let tip_max = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let dz = max_abs_diff(&lemke.z, &z);
+            let zmax = z.iter().cloned().fold(0.0, f64::max);
+            println!(
+                "{mass:?} Nt={nt}: sym eig [{lo:.4e}, {hi:.4e}] lemke {:?} pivots {} err {:.1e} {:.3}s tip_min {tip_lemke:.10} | ssn {:?} it {} res {:.1e} {:.3}s tip_min {tip_min:.10} tip_max {tip_max:.10} | |dz| {dz:.2e} zmax {zmax:.4e}",
+                lemke.termination, lemke.pivots, lemke.complementarity_error, lemke_time,
+                ssn.termination, ssn.iterations, ssn.residual_norm(), ssn_time
+            );
+        }
+    }
+}
+
+#[test]
+fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass() {
+    let model = rod(MassModel::Modified, true);
+    // Semismooth Newton by mesh sequencing 256 -> 512 -> 1024 (each level warm-started by
+    // interpolating the previous Newton solution); Lemke independently at 256 and 1024.
+    let mut previous: Option<Vec<f64>> = None;
+    for nt in [256usize, 512, 1024] {
+        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let start = match &previous {
+            None => vec![0.0; lcp.dim()],
+            Some(z) => lcp.interpolate_forces(z).unwrap(),
+        };
+        let (z, report) = ssn_from(&lcp, start);
+        assert!(report.converged(), "Nt = {nt}: {:?}", report.termination);
+        if nt != 512 {
+            let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
+            // Lemke's basic solution is exact up to the round-off of a solve with the
+            // active block (~1e-16 relative, errors measured 1e-17); Newton stops at
+            // |F| <= 1e-10 but ends with an exact active-set solve, so both are the unique
+            // solution of the same linear system: agreement to round-off, asserted at 1e-9.
+            let zmax = z.iter().cloned().fold(0.0, f64::max);
+            assert!(lemke.complementarity_error < 1e-12 * zmax);
+            assert!(max_abs_diff(&lemke.z, &z) < 1e-9 * zmax, "Nt = {nt}");
+            let w = lcp.gap(&z).unwrap();
+            assert!(max_abs_diff(&lemke.w, &w) < 1e-9);
+            // Contact happens: some nodes carry force, and the tip reaches the gap there.
+            assert!(zmax > 0.1);
+        }
+        previous = Some(z);
+    }
+}
+
+#[test]
+fn consistent_mass_makes_the_lcp_indefinite_and_lemke_stops_without_a_solution() {
+    let model = rod(MassModel::Consistent, true);
+    let lcp = PeriodicLcp::new(&model, options(256, vec![])).unwrap();
+    // The symmetric part of A is indefinite (its eigenvalues are Re H_k: negative above
+    // a resonance), here by much more than with the modified mass.
+    let (lo, hi) = lcp.symmetric_part_spectrum();
+    assert!(lo < -1e-2 && hi > 0.0, "[{lo}, {hi}]");
+    let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
+    assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
+    let report = lemke_solution(&lcp);
+    assert!(!report.solved());
+    match lcp.check_lemke(report.clone()) {
+        Err(LcpError::LemkeNotSolved {
+            pivots,
+            symmetric_part_min_eigenvalue,
+            ..
+        }) => {
+            assert_eq!(pivots, report.pivots);
+            assert_eq!(symmetric_part_min_eigenvalue, lo);
+        }
+        other => panic!("{other:?}"),
+    }
 }
