@@ -827,7 +827,11 @@ where
         last_step_norm = alpha * ws.norm(&ws.b, dp);
         debug_assert_eq!(ws.tangent.len(), n + 1);
     }
-    unreachable!("the loop returns at k == max_corrector_iterations")
+    // Not reached: the loop returns at k == max_corrector_iterations.
+    Err(CorrectorFailure::MaxIterations {
+        iterations: options.max_corrector_iterations,
+        residual_norm: *smallest,
+    })
 }
 
 enum BlockOutcome {
@@ -1607,4 +1611,20 @@ where
         failure,
         counters,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hermite_fold;
+
+    #[test]
+    fn hermite_fold_is_exact_for_a_quadratic_turn() {
+        // p(s) = 1 - (s - 0.3)^2 / 2 on [0, h] with h = 0.8: values and slopes at both ends;
+        // a cubic Hermite interpolant reproduces a quadratic, so the maximum 1 is exact.
+        let p = |s: f64| 1.0 - 0.5 * (s - 0.3) * (s - 0.3);
+        let dp = |s: f64| -(s - 0.3);
+        let h = 0.8;
+        let fold = hermite_fold(p(0.0), dp(0.0), p(h), dp(h), h);
+        assert!((fold - 1.0).abs() < 1e-15, "{fold}");
+    }
 }
