@@ -24,7 +24,9 @@
 //! solves, `J a = F_p` and `J b = F`: `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`.
 //! The bordered matrix is never assembled, so structured Jacobians (sparse, condensed)
 //! keep their structure. The tangent at the converged point comes for free from the last
-//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`).
+//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`), with `J` and `F_p` from
+//! the last corrector iteration, i.e. at the iterate before the converged one (an error
+//! of the size of the last correction; the corrector always takes at least one step).
 //!
 //! # Folds and the dense fallback
 //!
