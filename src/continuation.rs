@@ -24,7 +24,9 @@
 //! solves, `J a = F_p` and `J b = F`: `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`.
 //! The bordered matrix is never assembled, so structured Jacobians (sparse, condensed)
 //! keep their structure. The tangent at the converged point comes for free from the last
-//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`).
+//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`), with `J` and `F_p` from
+//! the last corrector iteration, i.e. at the iterate before the converged one (an error
+//! of the size of the last correction; the corrector always takes at least one step).
 //!
 //! # Folds and the dense fallback
 //!
@@ -827,7 +829,11 @@ where
         last_step_norm = alpha * ws.norm(&ws.b, dp);
         debug_assert_eq!(ws.tangent.len(), n + 1);
     }
-    unreachable!("the loop returns at k == max_corrector_iterations")
+    // Not reached: the loop returns at k == max_corrector_iterations.
+    Err(CorrectorFailure::MaxIterations {
+        iterations: options.max_corrector_iterations,
+        residual_norm: *smallest,
+    })
 }
 
 enum BlockOutcome {
@@ -1607,4 +1613,20 @@ where
         failure,
         counters,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hermite_fold;
+
+    #[test]
+    fn hermite_fold_is_exact_for_a_quadratic_turn() {
+        // p(s) = 1 - (s - 0.3)^2 / 2 on [0, h] with h = 0.8: values and slopes at both ends;
+        // a cubic Hermite interpolant reproduces a quadratic, so the maximum 1 is exact.
+        let p = |s: f64| 1.0 - 0.5 * (s - 0.3) * (s - 0.3);
+        let dp = |s: f64| -(s - 0.3);
+        let h = 0.8;
+        let fold = hermite_fold(p(0.0), dp(0.0), p(h), dp(h), h);
+        assert!((fold - 1.0).abs() < 1e-15, "{fold}");
+    }
 }
