@@ -142,6 +142,7 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
         GlobalizationChoice::None => Globalization::None,
         GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
         GlobalizationChoice::Nonmonotone => NewtonOptions::default().globalization,
+        GlobalizationChoice::Hybrid => Globalization::hybrid(),
     };
     NewtonOptions {
         absolute_tolerance: settings.tolerance,
