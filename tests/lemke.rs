@@ -700,17 +700,18 @@ fn thread_cpu_seconds() -> f64 {
 #[test]
 #[ignore]
 fn timing_n2048() {
+    use semismooth_problems::lcp::{PeriodicLcp, PeriodicLcpOptions};
+    use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
     let n = 2048;
     let mut lemke = Lemke::new(n);
-    let mut timed = |label: &str, m: &Mat<f64>, q: &[f64]| {
+    let mut timed = |label: &str, m: faer::MatRef<'_, f64>, q: &[f64]| {
         let start = std::time::Instant::now();
         let cpu = thread_cpu_seconds();
-        let report = lemke
-            .solve(m.as_ref(), q, &LemkeOptions::default())
-            .unwrap();
+        let report = lemke.solve(m, q, &LemkeOptions::default()).unwrap();
         let cpu = thread_cpu_seconds() - cpu;
         println!(
-            "{label} n={n}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            "{label} n={}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            q.len(),
             report.termination,
             report.pivots,
             report.z.iter().filter(|&&z| z > 0.0).count(),
@@ -718,11 +719,28 @@ fn timing_n2048() {
             start.elapsed().as_secs_f64()
         );
     };
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        let spec = RodSpec {
+            mass,
+            ..RodSpec::canonical()
+        };
+        let rod = build_rod(&spec).unwrap();
+        let options = PeriodicLcpOptions {
+            time_samples: n,
+            ..PeriodicLcpOptions::default()
+        };
+        let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
+        timed(
+            &format!("canonical rod, {mass:?} mass"),
+            lcp.matrix(),
+            lcp.q(),
+        );
+    }
     let (m, q) = circulant_case(n);
-    timed("circulant", &m, &q);
-    timed("circulant (reused workspace)", &m, &q);
+    timed("circulant", m.as_ref(), &q);
+    timed("circulant (reused workspace)", m.as_ref(), &q);
     let mut r = rng(7);
     let m = spd_matrix(n, 1.0, &mut r);
     let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
-    timed("random SPD", &m, &q);
+    timed("random SPD", m.as_ref(), &q);
 }
