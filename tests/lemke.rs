@@ -231,6 +231,30 @@ fn solve_allocates_only_the_report_whatever_the_pivot_count() {
     }
 }
 
+/// A row-major view (`M^T` of a column-major matrix) goes through the strided column
+/// path; it must give exactly what the contiguous copy gives.
+#[test]
+fn strided_matrix_view_gives_the_same_report_as_a_contiguous_copy() {
+    let mut r = rng(31);
+    let n = 9;
+    let a = pd_nonsymmetric(n, &mut r);
+    let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
+    let view = a.transpose();
+    let copy = view.to_owned();
+    let strided = solve_lcp(view, &q, &LemkeOptions::default()).unwrap();
+    let contiguous = solve_lcp(copy.as_ref(), &q, &LemkeOptions::default()).unwrap();
+    assert!(strided.solved());
+    assert_eq!(strided, contiguous);
+}
+
+#[test]
+fn empty_lcp_is_solved_trivially() {
+    let m = Mat::<f64>::zeros(0, 0);
+    let report = solve_lcp(m.as_ref(), &[], &LemkeOptions::default()).unwrap();
+    assert_eq!(report.termination, LemkeTermination::Solved);
+    assert_eq!((report.pivots, report.z.len()), (0, 0));
+}
+
 #[test]
 fn q_nonnegative_is_solved_by_zero_without_pivots() {
     let mut r = rng(5);
