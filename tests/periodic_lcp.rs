@@ -23,6 +23,31 @@ fn dense(m: &SparseMatrix) -> DMatrix<f64> {
     d
 }
 
+/// Dense `K`, `M`, `D` (zero when undamped).
+fn dense_kmd(model: &StructuralModel) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let k = dense(&model.stiffness);
+    let d = model
+        .damping
+        .as_ref()
+        .map(dense)
+        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
+    (k, dense(&model.mass), d)
+}
+
+/// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
+fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = mass;
+    spec.contacts = vec![
+        RodContact {
+            node: inner,
+            gap: 0.3,
+        },
+        RodContact { node: 20, gap: 0.5 },
+    ];
+    build_rod(&spec).unwrap().model
+}
+
 fn rod(mass: MassModel, damped: bool) -> StructuralModel {
     let mut spec = RodSpec::canonical();
     spec.mass = mass;
@@ -41,13 +66,7 @@ fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
 
 /// `Re((K + i s D - s^2 M)^{-1} a e^{i 2 pi n / Nt})` at the nodes, by a dense complex solve.
 fn frequency_response(model: &StructuralModel, s: f64, nt: usize) -> Vec<Vec<f64>> {
-    let k = dense(&model.stiffness);
-    let m = dense(&model.mass);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
+    let (k, m, d) = dense_kmd(model);
     let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
         Complex::new(k[(i, j)] - s * s * m[(i, j)], s * d[(i, j)])
     });
@@ -115,13 +134,7 @@ fn linear_response_is_the_frequency_response_at_the_warped_frequency_with_second
 fn block_row_sums_of_a_are_the_static_compliance_of_the_contacts() {
     // Two contacts (mid-rod and tip): exercises the m x m blocks.
     for mass in [MassModel::Modified, MassModel::Consistent] {
-        let mut spec = RodSpec::canonical();
-        spec.mass = mass;
-        spec.contacts = vec![
-            RodContact { node: 10, gap: 0.3 },
-            RodContact { node: 20, gap: 0.5 },
-        ];
-        let model = build_rod(&spec).unwrap().model;
+        let model = two_contact_rod(mass, 10);
         let nt = 64;
         let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
@@ -164,13 +177,7 @@ fn trapezoidal_contact_displacement(
     lambda: &[f64],
 ) -> Vec<f64> {
     let n = model.dofs();
-    let k = dense(&model.stiffness);
-    let m = dense(&model.mass);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(n, n));
+    let (k, m, d) = dense_kmd(model);
     let dt = 2.0 * std::f64::consts::PI / model.forcing.omega / nt as f64;
     let size = 2 * n * nt;
     let u = |step: usize, i: usize| (step % nt) * 2 * n + i;
@@ -292,13 +299,7 @@ fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem
 
 #[test]
 fn symmetric_part_spectrum_from_the_bins_matches_a_dense_eigensolver() {
-    let mut spec = RodSpec::canonical();
-    spec.mass = MassModel::Consistent;
-    spec.contacts = vec![
-        RodContact { node: 12, gap: 0.3 },
-        RodContact { node: 20, gap: 0.5 },
-    ];
-    let model = build_rod(&spec).unwrap().model;
+    let model = two_contact_rod(MassModel::Consistent, 12);
     for nt in [16usize, 21] {
         let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
@@ -570,13 +571,7 @@ fn lcp_solution_is_the_steady_state_of_the_massless_contact_trapezoidal_march_wi
 
 #[test]
 fn force_interpolation_reproduces_periodic_piecewise_linear_histories() {
-    let mut spec = RodSpec::canonical();
-    spec.mass = MassModel::Modified;
-    spec.contacts = vec![
-        RodContact { node: 10, gap: 0.3 },
-        RodContact { node: 20, gap: 0.5 },
-    ];
-    let model = build_rod(&spec).unwrap().model;
+    let model = two_contact_rod(MassModel::Modified, 10);
     let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
     // A coarse history of 4 nodes, 2 contacts (time-major): a triangle wave per contact.
     let coarse = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 2.0, 3.0];
