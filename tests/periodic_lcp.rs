@@ -409,6 +409,20 @@ fn thread_cpu_seconds() -> f64 {
 #[ignore]
 fn report_lcp_numbers() {
     let minimum = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        for nt in [256usize, 1024] {
+            let lcp = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+            let (lo, hi) = lcp.symmetric_part_spectrum();
+            let lemke = lemke_solution(&lcp);
+            println!(
+                "undamped {mass:?} Nt={nt}: eig(A) in [{lo:.4e}, {hi:.4e}] lemke {:?} pivots {}",
+                lemke.termination, lemke.pivots
+            );
+        }
+    }
+    if std::env::var_os("LCP_REPORT_UNDAMPED_ONLY").is_some() {
+        return;
+    }
     for mass in [
         MassModel::Modified,
         MassModel::Consistent,
@@ -591,4 +605,31 @@ fn force_interpolation_reproduces_periodic_piecewise_linear_histories() {
         lcp.interpolate_forces(&[1.0; 3]),
         Err(LcpError::WrongLength { found: 3, .. })
     ));
+}
+
+#[test]
+fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers() {
+    // Without damping, forcing at omega_1 puts bin 1 (warped just above omega_1) next to
+    // the resonance: H_1 is large and negative, so the symmetric part of A (eigenvalues
+    // Re H_k) is strongly indefinite; Lemke's method ends on a secondary ray.
+    let lcp = PeriodicLcp::new(&rod(MassModel::Modified, false), options(256, vec![])).unwrap();
+    let (lo, _) = lcp.symmetric_part_spectrum();
+    let h1 = lcp.receptance(1)[0];
+    assert_eq!(h1.im, 0.0);
+    assert_eq!(lo, h1.re);
+    assert!(lo < -1e3, "{lo}");
+    let report = lemke_solution(&lcp);
+    assert_eq!(report.termination, LemkeTermination::Ray);
+    match lcp.check_lemke(report.clone()) {
+        Err(LcpError::LemkeNotSolved {
+            termination: LemkeTermination::Ray,
+            pivots,
+            symmetric_part_min_eigenvalue,
+            ..
+        }) => {
+            assert_eq!(pivots, report.pivots);
+            assert_eq!(symmetric_part_min_eigenvalue, lo);
+        }
+        other => panic!("{other:?}"),
+    }
 }
