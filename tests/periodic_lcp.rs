@@ -395,6 +395,29 @@ fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonRepo
     (z, report)
 }
 
+/// Lemke (default options) ends with `expected`, and `check_lemke` turns the report into
+/// `LemkeNotSolved` carrying its pivots and the smallest eigenvalue of `(A + A^T)/2`.
+fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
+    let report = lemke_solution(lcp);
+    assert_eq!(report.termination, expected);
+    match lcp.check_lemke(report.clone()) {
+        Err(LcpError::LemkeNotSolved {
+            termination,
+            pivots,
+            symmetric_part_min_eigenvalue,
+            ..
+        }) => {
+            assert_eq!(termination, expected);
+            assert_eq!(pivots, report.pivots);
+            assert_eq!(
+                symmetric_part_min_eigenvalue,
+                lcp.symmetric_part_spectrum().0
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
 /// CPU time of this thread (from /proc; 0 where unavailable), for timings on a shared
 /// machine.
 fn thread_cpu_seconds() -> f64 {
@@ -515,19 +538,7 @@ fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much
     let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
     assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
     // With the default pivot limit 50 n + 100 Lemke stops without a solution (no ray):
-    let report = lemke_solution(&lcp);
-    assert_eq!(report.termination, LemkeTermination::PivotLimit);
-    match lcp.check_lemke(report.clone()) {
-        Err(LcpError::LemkeNotSolved {
-            pivots,
-            symmetric_part_min_eigenvalue,
-            ..
-        }) => {
-            assert_eq!(pivots, report.pivots);
-            assert_eq!(symmetric_part_min_eigenvalue, lo);
-        }
-        other => panic!("{other:?}"),
-    }
+    assert_not_solved(&lcp, LemkeTermination::PivotLimit);
     // ... but with 100 n pivots it solves this one (25369 pivots measured, against 172 for
     // the modified mass): the path is long, not a ray. At Nt >= 512 it had not finished
     // after 1000 n pivots.
@@ -618,18 +629,5 @@ fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers()
     assert_eq!(h1.im, 0.0);
     assert_eq!(lo, h1.re);
     assert!(lo < -1e3, "{lo}");
-    let report = lemke_solution(&lcp);
-    assert_eq!(report.termination, LemkeTermination::Ray);
-    match lcp.check_lemke(report.clone()) {
-        Err(LcpError::LemkeNotSolved {
-            termination: LemkeTermination::Ray,
-            pivots,
-            symmetric_part_min_eigenvalue,
-            ..
-        }) => {
-            assert_eq!(pivots, report.pivots);
-            assert_eq!(symmetric_part_min_eigenvalue, lo);
-        }
-        other => panic!("{other:?}"),
-    }
+    assert_not_solved(&lcp, LemkeTermination::Ray);
 }
