@@ -24,8 +24,11 @@ use crate::scene::{
     GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
 };
 
+/// Ratio between successive penalty stiffnesses of the penalty homotopy.
+pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
+
 /// Number of reconstruction points per period for harmonic-balance outputs.
-pub const HB_OUTPUT_POINTS: usize = 512;
+pub const HB_OUTPUT_POINTS: usize = 1024;
 
 /// Why a run could not be carried out.
 #[derive(Debug, thiserror::Error)]
@@ -102,6 +105,8 @@ pub struct Solution {
     pub harmonics: Option<usize>,
     /// AFT samples (HB), time steps per period (LCP, time marching).
     pub time_samples: usize,
+    /// Complementarity constant `c` (SSN-HB only).
+    pub c: Option<f64>,
     /// Forcing frequency.
     pub omega: f64,
     /// First natural frequency of the rod.
@@ -205,6 +210,7 @@ fn hb_solution(
         method: settings.method,
         harmonics: Some(settings.harmonics),
         time_samples: settings.time_samples,
+        c: None,
         omega,
         omega_1: rod.omega_1,
         converged: report.converged(),
@@ -283,20 +289,46 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            sol.c = (problem.contacts() > 0).then(|| problem.c());
             Ok(sol)
         }
         Method::PenaltyHb => {
+            let target = settings
+                .penalty_stiffness
+                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
             let options = PenaltyHbOptions {
                 harmonics: settings.harmonics,
                 time_samples: Some(settings.time_samples),
-                penalty_stiffness: settings
-                    .penalty_stiffness
-                    .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale),
+                penalty_stiffness: target,
             };
             let mut problem = PenaltyHb::new(model, &options)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
-            let report = newton_hb(&mut problem, &mut x, settings)?;
+            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+            // is the linear response, deep in the obstacle), so without a warm start the
+            // stiffness is raised from the contact scale by factors of 10, each stage
+            // starting from the previous answer.
+            let mut counters = WorkCounters::default();
+            if warm_start.is_none() {
+                let mut k = scale;
+                while k < target {
+                    let stage_options = PenaltyHbOptions {
+                        penalty_stiffness: k,
+                        ..options
+                    };
+                    let mut stage = PenaltyHb::new(model, &stage_options)?;
+                    let mut trial = x.clone();
+                    let report = newton_hb(&mut stage, &mut trial, settings)?;
+                    counters += report.counters;
+                    if report.converged() {
+                        x = trial;
+                    }
+                    k *= PENALTY_HOMOTOPY_FACTOR;
+                }
+            }
+            let mut report = newton_hb(&mut problem, &mut x, settings)?;
+            counters += report.counters;
+            report.counters = counters;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let tip_series = problem.displacement_samples(&x, tip, points)?;
@@ -405,6 +437,7 @@ fn solve_lcp(
         method,
         harmonics: None,
         time_samples: settings.time_samples,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged,
@@ -459,6 +492,7 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         method: Method::March,
         harmonics: None,
         time_samples: settings.steps_per_period,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged: true,

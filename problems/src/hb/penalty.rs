@@ -149,8 +149,11 @@ impl PenaltyHb {
             .collect())
     }
 
-    /// Extremes of `u_dof`, penetration and mean penalty forces over a period reconstructed
-    /// on `points` times (the mean force is the period mean of the pointwise penalty force).
+    /// Extremes of `u_dof` and penetration over a period reconstructed on `points` times,
+    /// and the mean penalty force of each contact as the equations see it: the mean over
+    /// the `Nt` AFT samples, `(P lambda)_0` (the static balance `K u_0 = f_0 + G^T Lambda_0`).
+    /// A finer grid would resolve a stiff penalty's narrow force peaks that the `Nt`-point
+    /// quadrature does not, and give a mean inconsistent with the solution.
     pub fn summary(
         &self,
         u: &[f64],
@@ -158,10 +161,11 @@ impl PenaltyHb {
         points: usize,
     ) -> Result<ResponseSummary, HbError> {
         check_len("HB unknowns", self.dim(), u.len())?;
+        let nt = self.state.linear.basis.time_samples();
         let means = (0..self.contacts())
             .map(|i| {
-                self.contact_force_samples(u, i, points)
-                    .map(|f| f.iter().sum::<f64>() / points as f64)
+                self.contact_force_samples(u, i, nt)
+                    .map(|f| f.iter().sum::<f64>() / nt as f64)
             })
             .collect::<Result<Vec<f64>, HbError>>()?;
         displacement_summary(&self.state.linear, u, dof, points, means)
