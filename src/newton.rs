@@ -262,7 +262,8 @@ pub struct NewtonReport {
     /// Accepted step norms `alpha_k |d_k|_2` (`iterations` values).
     pub step_norms: Vec<f64>,
     /// Estimated order `q` from the last three residual norms,
-    /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})`; `None` with fewer than three norms, when
+    /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})` (also for runs that did not converge: a
+    /// stalled or capped run shows its rate); `None` with fewer than three norms, when
     /// one of them is below `1e-300` (exact termination, e.g. the active set was found
     /// and the remaining system was linear), or when the estimate is undefined.
     pub observed_order: Option<f64>,
@@ -614,11 +615,7 @@ impl<J> NewtonSolver<J> {
         }
         counters.ffts = problem.fft_count().saturating_sub(fft_start);
         Ok(NewtonReport {
-            observed_order: if termination == Termination::Converged {
-                observed_order(&residual_norms)
-            } else {
-                None
-            },
+            observed_order: observed_order(&residual_norms),
             termination,
             iterations,
             residual_norms,
