@@ -411,18 +411,48 @@ fn solve_lcp(
             )
         }
         _ => {
-            let mut problem = lcp.min_map();
-            let mut z = initial_state(problem.dim(), warm_start);
-            let mut solver = ActiveSetSolver::new();
-            let report =
-                newton::solve(&mut problem, &mut solver, &mut z, &newton_options(settings))?;
+            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+            // creeps one time node per iteration.
+            let options = newton_options(settings);
+            let (z, report_list) = match warm_start {
+                Some(w) if w.len() == lcp.dim() => {
+                    let mut problem = lcp.min_map();
+                    let mut z = w.to_vec();
+                    let mut solver = ActiveSetSolver::new();
+                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)?;
+                    (z, vec![report])
+                }
+                _ => {
+                    let sequenced = crate::lcp::solve_min_map_sequenced(
+                        model,
+                        PeriodicLcpOptions {
+                            time_samples: settings.time_samples,
+                            observed_dofs: Vec::new(),
+                        },
+                        &options,
+                    )?;
+                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                    (sequenced.z, reports)
+                }
+            };
+            let last = report_list.last().expect("at least one level");
+            let mut counters = RunCounters::default();
+            for r in &report_list {
+                let c: RunCounters = r.counters.into();
+                counters.residual_evaluations += c.residual_evaluations;
+                counters.jacobian_evaluations += c.jacobian_evaluations;
+                counters.factorizations += c.factorizations;
+                counters.linear_solves += c.linear_solves;
+                counters.line_search_backtracks += c.line_search_backtracks;
+            }
             (
                 z,
-                report.converged(),
-                termination_name(&report),
-                report.iterations,
-                report.residual_norm(),
-                report.counters.into(),
+                last.converged(),
+                termination_name(last),
+                report_list.iter().map(|r| r.iterations).sum(),
+                last.residual_norm(),
+                counters,
             )
         }
     };
