@@ -310,6 +310,7 @@ pub fn solve_rod(
             // stiffness is raised from the contact scale by factors of 10, each stage
             // starting from the previous answer.
             let mut counters = WorkCounters::default();
+            let mut homotopy_iterations = 0;
             if warm_start.is_none() {
                 let mut k = scale;
                 while k < target {
@@ -321,6 +322,7 @@ pub fn solve_rod(
                     let mut trial = x.clone();
                     let report = newton_hb(&mut stage, &mut trial, settings)?;
                     counters += report.counters;
+                    homotopy_iterations += report.iterations;
                     if report.converged() {
                         x = trial;
                     }
@@ -330,6 +332,8 @@ pub fn solve_rod(
             let mut report = newton_hb(&mut problem, &mut x, settings)?;
             counters += report.counters;
             report.counters = counters;
+            // Iterations of the whole homotopy, so that costs compare across methods.
+            report.iterations += homotopy_iterations;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let tip_series = problem.displacement_samples(&x, tip, points)?;
@@ -343,6 +347,17 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            // The mean penalty force as the equations see it: over the Nt AFT samples (a
+            // finer grid resolves narrow force peaks the quadrature does not).
+            if problem.contacts() > 0 {
+                let summary = problem.summary(&sol.state, tip, points)?;
+                let tip_contact = model
+                    .contacts
+                    .iter()
+                    .position(|c| c.dof == tip)
+                    .unwrap_or(0);
+                sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
+            }
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
