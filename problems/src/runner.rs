@@ -120,6 +120,10 @@ pub struct Solution {
     /// Final residual norm (Newton methods), complementarity error (Lemke), period change
     /// (time marching).
     pub residual_norm: f64,
+    /// Convergence order observed over the last Newton iterations (Newton methods).
+    pub observed_order: Option<f64>,
+    /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
+    pub residual_history: Vec<f64>,
     /// Wall time of the solve (not the set-up of the rod).
     pub solve_seconds: f64,
     /// Times over one period, `[0, T)` (the forcing is `cos(omega t)`).
@@ -218,6 +222,8 @@ fn hb_solution(
         termination: termination_name(report),
         iterations: report.iterations,
         residual_norm: report.residual_norm(),
+        observed_order: report.observed_order,
+        residual_history: report.residual_norms.clone(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip, &contact_forces, None),
         times,
@@ -490,6 +496,8 @@ fn solve_lcp(
         termination,
         iterations,
         residual_norm: residual,
+        observed_order: None,
+        residual_history: Vec::new(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
         times,
@@ -545,6 +553,8 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         termination: "converged".into(),
         iterations: period.periods,
         residual_norm: period.period_change,
+        observed_order: None,
+        residual_history: Vec::new(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
         times,
