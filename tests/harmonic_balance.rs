@@ -950,3 +950,46 @@ fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
     let d: Vec<f64> = xs.iter().zip(&xd).map(|(a, b)| a - b).collect();
     assert!(norm(&d) < 1e-10 * norm(&xd));
 }
+
+/// Measurement, not a claim (run with `--ignored --nocapture`): SSN-HB from zero on the
+/// modified-mass rod at H = 20 for growing element counts and two values of c. Prints the
+/// Newton iterations, the time per solve and per iteration, and the tip minimum.
+#[test]
+#[ignore]
+fn report_iterations_and_time_versus_elements() {
+    for elements in [20usize, 200, 1000, 10000] {
+        let mut spec = RodSpec::canonical();
+        spec.mass = MassModel::Modified;
+        spec.elements = elements;
+        spec.contacts[0].node = elements;
+        let rod = build_rod(&spec).unwrap();
+        let scale = rod.model.contact_stiffness_scale();
+        for c in [1.0, scale] {
+            let options = HbOptions {
+                c: Some(c),
+                ..HbOptions::default()
+            };
+            let mut hb = SsnHb::new(&rod.model, &options).unwrap();
+            let mut x = vec![0.0; hb.dim()];
+            let start = std::time::Instant::now();
+            let report = newton::solve(
+                &mut hb,
+                &mut StructuredHbSolver::new(),
+                &mut x,
+                &newton_options(),
+            )
+            .unwrap();
+            let elapsed = start.elapsed();
+            let s = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
+            println!(
+                "elements {elements}, c = {c}: {:?} after {} iterations, {} residual evaluations, \
+                 {elapsed:?} ({:?} per iteration), tip min {:.6}",
+                report.termination,
+                report.iterations,
+                report.counters.residual_evaluations,
+                elapsed / report.iterations.max(1) as u32,
+                s.displacement_min
+            );
+        }
+    }
+}

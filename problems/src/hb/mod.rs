@@ -140,13 +140,7 @@ impl LinearData {
         time_samples: Option<usize>,
     ) -> Result<Self, HbError> {
         validate_model(model)?;
-        if harmonics == 0 {
-            return Err(HbError::InvalidOption {
-                name: "harmonics",
-                value: 0.0,
-                allowed: "an integer >= 1 (the forcing is harmonic 1)",
-            });
-        }
+        validate_basis(harmonics, time_samples)?;
         let basis = match time_samples {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
             None => FourierBasis::with_default_samples(harmonics),
@@ -318,6 +312,21 @@ fn validate_model(model: &StructuralModel) -> Result<(), HbError> {
                 value: contact.gap,
             });
         }
+    }
+    Ok(())
+}
+
+/// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
+pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> Result<(), HbError> {
+    if harmonics == 0 {
+        return Err(HbError::InvalidOption {
+            name: "harmonics",
+            value: 0.0,
+            allowed: "an integer >= 1 (the forcing is harmonic 1)",
+        });
+    }
+    if let Some(nt) = time_samples {
+        FourierBasis::new(harmonics, nt)?;
     }
     Ok(())
 }
