@@ -5,10 +5,12 @@
 //! contact `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, the finite-element rod of
 //! Shi & Legrand, and the formulations that solve it.
 
+pub mod cli;
 pub mod hb;
 pub mod lcp;
 pub mod march;
 pub mod model;
 pub mod output;
 pub mod rod;
+pub mod runner;
 pub mod scene;

@@ -1,0 +1,514 @@
+//! Runs a scene's method on a rod: builds the formulation, drives it with the core's solvers
+//! and reduces the answer to what users compare (the tip over one period, contact
+//! diagnostics, work counters).
+//!
+//! A run that could not start (bad settings, a singular model) is an [`RunError`]; a run that
+//! started but did not converge is an `Ok` [`Solution`] with `converged = false` and the
+//! termination reason, so callers can still print what happened.
+
+use std::time::Instant;
+
+use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::{self, Globalization, NewtonOptions, NewtonReport, WorkCounters};
+use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+
+use crate::hb::{
+    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+};
+use crate::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
+use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
+use crate::output::{period_statistics, PeriodStatistics};
+use crate::rod::{ModelError, RodModel};
+use crate::scene::{
+    GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
+};
+
+/// Ratio between successive penalty stiffnesses of the penalty homotopy.
+pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
+
+/// Number of reconstruction points per period for harmonic-balance outputs.
+pub const HB_OUTPUT_POINTS: usize = 1024;
+
+/// Why a run could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The rod could not be built.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The harmonic-balance problem could not be built.
+    #[error(transparent)]
+    HarmonicBalance(#[from] HbError),
+    /// The periodic LCP could not be built.
+    #[error(transparent)]
+    Lcp(#[from] LcpError),
+    /// Lemke's algorithm could not run.
+    #[error(transparent)]
+    Lemke(#[from] semismooth::lemke::LemkeError),
+    /// Newton's method could not run.
+    #[error(transparent)]
+    Newton(#[from] newton::NewtonError),
+    /// Time marching could not run (or did not reach a steady state).
+    #[error(transparent)]
+    March(#[from] MarchError),
+    /// The method needs something the scene does not declare.
+    #[error("method {method} needs {what}")]
+    Unsupported {
+        /// The method.
+        method: &'static str,
+        /// What is missing.
+        what: &'static str,
+    },
+}
+
+/// Work done by a run (the JSON `counters` object).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunCounters {
+    /// Residual evaluations.
+    pub residual_evaluations: u64,
+    /// Generalized Jacobian evaluations.
+    pub jacobian_evaluations: u64,
+    /// Factorizations requested from the linear solver.
+    pub factorizations: u64,
+    /// Linear solves.
+    pub linear_solves: u64,
+    /// Line-search backtracks.
+    pub line_search_backtracks: u64,
+    /// Fast Fourier transforms in the residual/Jacobian evaluations.
+    pub ffts: u64,
+    /// Lemke pivots (LCP by Lemke).
+    pub lemke_pivots: u64,
+    /// Time steps (time marching).
+    pub time_steps: u64,
+}
+
+impl From<WorkCounters> for RunCounters {
+    fn from(c: WorkCounters) -> Self {
+        RunCounters {
+            residual_evaluations: c.residual_evaluations,
+            jacobian_evaluations: c.jacobian_evaluations,
+            factorizations: c.factorizations,
+            linear_solves: c.linear_solves,
+            line_search_backtracks: c.line_search_backtracks,
+            ffts: c.ffts,
+            ..RunCounters::default()
+        }
+    }
+}
+
+/// The answer of one run, reduced to one period of the tip.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Method used.
+    pub method: Method,
+    /// Harmonics (HB methods only).
+    pub harmonics: Option<usize>,
+    /// AFT samples (HB), time steps per period (LCP, time marching).
+    pub time_samples: usize,
+    /// Complementarity constant `c` (SSN-HB only).
+    pub c: Option<f64>,
+    /// Forcing frequency.
+    pub omega: f64,
+    /// First natural frequency of the rod.
+    pub omega_1: f64,
+    /// Whether the method converged.
+    pub converged: bool,
+    /// Termination reason in words (`converged`, `max-iterations`, `ray`, ...).
+    pub termination: String,
+    /// Newton iterations or Lemke pivots or periods marched.
+    pub iterations: usize,
+    /// Final residual norm (Newton methods), complementarity error (Lemke), period change
+    /// (time marching).
+    pub residual_norm: f64,
+    /// Wall time of the solve (not the set-up of the rod).
+    pub solve_seconds: f64,
+    /// Times over one period, `[0, T)` (the forcing is `cos(omega t)`).
+    pub times: Vec<f64>,
+    /// Tip displacement at `times`.
+    pub tip: Vec<f64>,
+    /// Contact forces at `times`, one series per contact.
+    pub contact_forces: Vec<Vec<f64>>,
+    /// Tip statistics (penetration over all contacts, mean force of the first contact).
+    pub stats: PeriodStatistics,
+    /// Work counters.
+    pub counters: RunCounters,
+    /// The method's unknowns (HB coefficients, LCP z), for warm starts.
+    pub state: Vec<f64>,
+}
+
+/// Newton options from scene settings.
+pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
+    let globalization = match settings.globalization {
+        GlobalizationChoice::None => Globalization::None,
+        GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
+        GlobalizationChoice::Nonmonotone => NewtonOptions::default().globalization,
+    };
+    NewtonOptions {
+        absolute_tolerance: settings.tolerance,
+        max_iterations: settings.max_iterations,
+        globalization,
+        ..NewtonOptions::default()
+    }
+}
+
+fn termination_name(report: &NewtonReport) -> String {
+    use newton::Termination as T;
+    match &report.termination {
+        T::Converged => "converged".into(),
+        T::MaxIterations => "max-iterations".into(),
+        T::Stalled => "stalled".into(),
+        T::LineSearchFailed => "line-search-failed".into(),
+        T::SingularJacobian(e) => format!("singular-jacobian: {e}"),
+        T::NonFinite => "non-finite".into(),
+    }
+}
+
+/// A Newton solve with the linear solver chosen by the settings.
+fn newton_hb<P>(
+    problem: &mut P,
+    x: &mut [f64],
+    settings: &SolverSettings,
+) -> Result<NewtonReport, RunError>
+where
+    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+{
+    let options = newton_options(settings);
+    let report = match settings.linear_solver {
+        LinearSolverChoice::Structured => {
+            let mut solver = StructuredHbSolver::new();
+            newton::solve(problem, &mut solver, x, &options)?
+        }
+        LinearSolverChoice::Dense => {
+            let mut solver = FaerDenseLu::new();
+            newton::solve(
+                problem,
+                &mut solver as &mut dyn LinearSolve<HbJacobian>,
+                x,
+                &options,
+            )?
+        }
+    };
+    Ok(report)
+}
+
+fn hb_solution(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    report: &NewtonReport,
+    seconds: f64,
+    tip: Vec<f64>,
+    contact_forces: Vec<Vec<f64>>,
+    state: Vec<f64>,
+) -> Solution {
+    let omega = rod.model.forcing.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let points = tip.len();
+    let times = (0..points)
+        .map(|n| period * n as f64 / points as f64)
+        .collect();
+    Solution {
+        method: settings.method,
+        harmonics: Some(settings.harmonics),
+        time_samples: settings.time_samples,
+        c: None,
+        omega,
+        omega_1: rod.omega_1,
+        converged: report.converged(),
+        termination: termination_name(report),
+        iterations: report.iterations,
+        residual_norm: report.residual_norm(),
+        solve_seconds: seconds,
+        stats: statistics(rod, &tip, &contact_forces, None),
+        times,
+        tip,
+        contact_forces,
+        counters: report.counters.into(),
+        state,
+    }
+}
+
+/// Tip statistics; the penetration is the largest over all contacts when their
+/// displacement series are given, else over the tip's contact.
+fn statistics(
+    rod: &RodModel,
+    tip: &[f64],
+    forces: &[Vec<f64>],
+    contact_displacements: Option<&[Vec<f64>]>,
+) -> PeriodStatistics {
+    let tip_dof = rod.tip_dof();
+    let contacts = &rod.model.contacts;
+    let tip_contact = contacts.iter().position(|c| c.dof == tip_dof);
+    let mut stats = match (tip_contact, forces.first()) {
+        (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
+        (None, Some(f)) => {
+            let mut s = period_statistics(tip, None);
+            s.mean_contact_force = f.iter().sum::<f64>() / f.len().max(1) as f64;
+            s
+        }
+        _ => period_statistics(tip, None),
+    };
+    if let Some(series) = contact_displacements {
+        for (c, u) in contacts.iter().zip(series) {
+            let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
+            stats.max_penetration = stats.max_penetration.max(p);
+        }
+    }
+    stats
+}
+
+/// Solves the rod with the scene's method, from a zero initial guess (or `warm_start`).
+pub fn solve_rod(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let tip = rod.tip_dof();
+    let scale = model.contact_stiffness_scale();
+    match settings.method {
+        Method::SsnHb => {
+            let options = HbOptions {
+                harmonics: settings.harmonics,
+                time_samples: Some(settings.time_samples),
+                c: settings.c,
+            };
+            let mut problem = SsnHb::new(model, &options)?;
+            let mut x = initial_state(problem.dim(), warm_start);
+            let start = Instant::now();
+            let report = newton_hb(&mut problem, &mut x, settings)?;
+            let seconds = start.elapsed().as_secs_f64();
+            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+            let tip_series = problem.displacement_samples(&x, tip, points)?;
+            let forces = (0..problem.contacts())
+                .map(|i| problem.contact_force_samples(&x, i, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let contact_u = model
+                .contacts
+                .iter()
+                .map(|c| problem.displacement_samples(&x, c.dof, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
+            sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            sol.c = (problem.contacts() > 0).then(|| problem.c());
+            Ok(sol)
+        }
+        Method::PenaltyHb => {
+            let target = settings
+                .penalty_stiffness
+                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
+            let options = PenaltyHbOptions {
+                harmonics: settings.harmonics,
+                time_samples: Some(settings.time_samples),
+                penalty_stiffness: target,
+            };
+            let mut problem = PenaltyHb::new(model, &options)?;
+            let mut x = initial_state(problem.dim(), warm_start);
+            let start = Instant::now();
+            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+            // is the linear response, deep in the obstacle), so without a warm start the
+            // stiffness is raised from the contact scale by factors of 10, each stage
+            // starting from the previous answer.
+            let mut counters = WorkCounters::default();
+            if warm_start.is_none() {
+                let mut k = scale;
+                while k < target {
+                    let stage_options = PenaltyHbOptions {
+                        penalty_stiffness: k,
+                        ..options
+                    };
+                    let mut stage = PenaltyHb::new(model, &stage_options)?;
+                    let mut trial = x.clone();
+                    let report = newton_hb(&mut stage, &mut trial, settings)?;
+                    counters += report.counters;
+                    if report.converged() {
+                        x = trial;
+                    }
+                    k *= PENALTY_HOMOTOPY_FACTOR;
+                }
+            }
+            let mut report = newton_hb(&mut problem, &mut x, settings)?;
+            counters += report.counters;
+            report.counters = counters;
+            let seconds = start.elapsed().as_secs_f64();
+            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+            let tip_series = problem.displacement_samples(&x, tip, points)?;
+            let forces = (0..problem.contacts())
+                .map(|i| problem.contact_force_samples(&x, i, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let contact_u = model
+                .contacts
+                .iter()
+                .map(|c| problem.displacement_samples(&x, c.dof, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
+            sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            Ok(sol)
+        }
+        Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
+        Method::March => solve_march(rod, settings),
+    }
+}
+
+fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
+    match warm_start {
+        Some(w) if w.len() == dim => w.to_vec(),
+        _ => vec![0.0; dim],
+    }
+}
+
+fn solve_lcp(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let method = settings.method;
+    if model.contacts.is_empty() {
+        return Err(RunError::Unsupported {
+            method: method.name(),
+            what: "a [contact] section (the periodic LCP is posed on the contact forces)",
+        });
+    }
+    let tip = rod.tip_dof();
+    let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
+    let options = PeriodicLcpOptions {
+        time_samples: settings.time_samples,
+        observed_dofs: if tip_contact.is_some() {
+            Vec::new()
+        } else {
+            vec![tip]
+        },
+    };
+    let start = Instant::now();
+    let lcp = PeriodicLcp::new(model, options)?;
+    let (z, converged, termination, iterations, residual, counters) = match method {
+        Method::LcpLemke => {
+            let mut lemke = Lemke::new(lcp.dim());
+            let report = lemke.solve(lcp.matrix(), lcp.q(), &LemkeOptions::default())?;
+            let termination = match report.termination {
+                LemkeTermination::Solved => "converged".to_string(),
+                LemkeTermination::Ray => {
+                    let (min_eig, _) = lcp.symmetric_part_spectrum();
+                    format!(
+                        "ray after {} pivots (smallest eigenvalue of the symmetric part of A: {min_eig:e})",
+                        report.pivots
+                    )
+                }
+                LemkeTermination::PivotLimit => format!("pivot-limit ({})", report.pivots),
+            };
+            let counters = RunCounters {
+                lemke_pivots: report.pivots as u64,
+                ..RunCounters::default()
+            };
+            (
+                report.z.clone(),
+                report.solved(),
+                termination,
+                report.pivots,
+                report.complementarity_error,
+                counters,
+            )
+        }
+        _ => {
+            let mut problem = lcp.min_map();
+            let mut z = initial_state(problem.dim(), warm_start);
+            let mut solver = ActiveSetSolver::new();
+            let report =
+                newton::solve(&mut problem, &mut solver, &mut z, &newton_options(settings))?;
+            (
+                z,
+                report.converged(),
+                termination_name(&report),
+                report.iterations,
+                report.residual_norm(),
+                report.counters.into(),
+            )
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    let contact_u = lcp.contact_displacements(&z)?;
+    let forces = lcp.contact_forces(&z)?;
+    let tip_series = match tip_contact {
+        Some(i) => contact_u[i].clone(),
+        None => lcp.displacements(&z)?.remove(0),
+    };
+    let times = lcp.times();
+    let mut sol = Solution {
+        method,
+        harmonics: None,
+        time_samples: settings.time_samples,
+        c: None,
+        omega: model.forcing.omega,
+        omega_1: rod.omega_1,
+        converged,
+        termination,
+        iterations,
+        residual_norm: residual,
+        solve_seconds: seconds,
+        stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
+        times,
+        tip: tip_series,
+        contact_forces: forces,
+        counters,
+        state: z,
+    };
+    sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
+    Ok(sol)
+}
+
+fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let tip = rod.tip_dof();
+    let options = MarchOptions {
+        steps_per_period: settings.steps_per_period,
+        max_periods: settings.max_periods,
+        tolerance: settings.march_tolerance,
+        scheme: if settings.restitution > 0.0 {
+            MarchScheme::MoreauJean {
+                theta: 0.5,
+                restitution: settings.restitution,
+            }
+        } else {
+            MarchScheme::Auto
+        },
+    };
+    let mut observed = vec![tip];
+    observed.extend(model.contacts.iter().map(|c| c.dof));
+    let start = Instant::now();
+    let period = march_to_steady_state(model, &options, &observed)?;
+    let seconds = start.elapsed().as_secs_f64();
+    // Drop the closing sample (t = T repeats t = 0).
+    let keep = period.times.len().saturating_sub(1).max(1);
+    let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
+    let tip_series = cut(&period.displacements[0]);
+    let contact_u: Vec<Vec<f64>> = period.displacements[1..].iter().map(cut).collect();
+    let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
+    let start_time = period.times[0];
+    let times = period.times[..keep]
+        .iter()
+        .map(|t| t - start_time)
+        .collect();
+    Ok(Solution {
+        method: Method::March,
+        harmonics: None,
+        time_samples: settings.steps_per_period,
+        c: None,
+        omega: model.forcing.omega,
+        omega_1: rod.omega_1,
+        converged: true,
+        termination: "converged".into(),
+        iterations: period.periods,
+        residual_norm: period.period_change,
+        solve_seconds: seconds,
+        stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
+        times,
+        tip: tip_series,
+        contact_forces: forces,
+        counters: RunCounters {
+            time_steps: period.counters.steps,
+            factorizations: period.counters.factorizations,
+            ..RunCounters::default()
+        },
+        state: Vec::new(),
+    })
+}
