@@ -24,8 +24,14 @@
 //! frequency (sparse complex LU) and solves the Newton system on the `m (2H + 1)` contact
 //! unknowns (receptance / Schur-complement condensation).
 //!
+//! [`CondensedSsnHb`] eliminates `U` once and for all (`G U = G A^{-1} F + R Lambda`) and
+//! runs Newton on the `m (2H + 1)` force coefficients alone: the same Newton direction as
+//! the full problem once `R_u = 0`, but a residual that costs `O(m^2 H + m Nt log Nt)`,
+//! independent of `N`, and a merit function that sees only the contact equations.
+//!
 //! Without contacts (`m = 0`) both problems are linear and no FFT is performed.
 
+mod condensed;
 mod jacobian;
 mod penalty;
 mod ssn;
@@ -37,6 +43,7 @@ use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 
 use crate::model::{SparseMatrix, StructuralModel};
 
+pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use penalty::{PenaltyHb, PenaltyHbOptions};
 pub use ssn::{HbOptions, SsnHb};
@@ -96,6 +103,9 @@ pub enum HbError {
     /// The Fourier basis could not be built.
     #[error(transparent)]
     Harmonic(#[from] HarmonicError),
+    /// The dynamic blocks `A(w)` could not be factored (e.g. an undamped resonance).
+    #[error("dynamic blocks: {0}")]
+    Linear(#[from] semismooth::linalg::LinearSolveError),
 }
 
 /// Extremes and contact diagnostics of a harmonic-balance solution over one period,

@@ -71,7 +71,7 @@ impl HbOptions {
 /// [`ParameterDependent`] is `w`; only `A(w)` depends on it.
 #[derive(Debug)]
 pub struct SsnHb {
-    state: HbState,
+    pub(crate) state: HbState,
     c: f64,
     coeffs: Vec<f64>,
     samples: Vec<f64>,
@@ -126,6 +126,17 @@ impl SsnHb {
     /// Current angular frequency `w`.
     pub fn omega(&self) -> f64 {
         self.state.omega
+    }
+
+    /// Sets the complementarity constant `c` (finite, `> 0`).
+    pub fn set_c(&mut self, c: f64) -> Result<(), HbError> {
+        HbOptions {
+            c: Some(c),
+            ..HbOptions::default()
+        }
+        .validate()?;
+        self.c = c;
+        Ok(())
     }
 
     /// Sets `w` (finite, `> 0`).
