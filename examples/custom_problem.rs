@@ -8,7 +8,8 @@
 //! Newton driver, then checked against Lemke on the condensed LCP in `z = (l_l, l_r)`:
 //! `w = g + C K^{-1} (f + C^T z)`, `C = [e_0^T; -e_{N-1}^T]`.
 //!
-//! Run: `cargo run --release --example custom_problem`.
+//! Run: `cargo run --release --example custom_problem` (exits non-zero if the two
+//! answers differ by more than 1e-9; `tests/lemke.rs` runs the same comparison).
 
 use faer::Mat;
 use semismooth::complementarity::min_function;

@@ -231,6 +231,30 @@ fn solve_allocates_only_the_report_whatever_the_pivot_count() {
     }
 }
 
+/// A row-major view (`M^T` of a column-major matrix) goes through the strided column
+/// path; it must give exactly what the contiguous copy gives.
+#[test]
+fn strided_matrix_view_gives_the_same_report_as_a_contiguous_copy() {
+    let mut r = rng(31);
+    let n = 9;
+    let a = pd_nonsymmetric(n, &mut r);
+    let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
+    let view = a.transpose();
+    let copy = view.to_owned();
+    let strided = solve_lcp(view, &q, &LemkeOptions::default()).unwrap();
+    let contiguous = solve_lcp(copy.as_ref(), &q, &LemkeOptions::default()).unwrap();
+    assert!(strided.solved());
+    assert_eq!(strided, contiguous);
+}
+
+#[test]
+fn empty_lcp_is_solved_trivially() {
+    let m = Mat::<f64>::zeros(0, 0);
+    let report = solve_lcp(m.as_ref(), &[], &LemkeOptions::default()).unwrap();
+    assert_eq!(report.termination, LemkeTermination::Solved);
+    assert_eq!((report.pivots, report.z.len()), (0, 0));
+}
+
 #[test]
 fn q_nonnegative_is_solved_by_zero_without_pivots() {
     let mut r = rng(5);
@@ -700,17 +724,18 @@ fn thread_cpu_seconds() -> f64 {
 #[test]
 #[ignore]
 fn timing_n2048() {
+    use semismooth_problems::lcp::{PeriodicLcp, PeriodicLcpOptions};
+    use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
     let n = 2048;
     let mut lemke = Lemke::new(n);
-    let mut timed = |label: &str, m: &Mat<f64>, q: &[f64]| {
+    let mut timed = |label: &str, m: faer::MatRef<'_, f64>, q: &[f64]| {
         let start = std::time::Instant::now();
         let cpu = thread_cpu_seconds();
-        let report = lemke
-            .solve(m.as_ref(), q, &LemkeOptions::default())
-            .unwrap();
+        let report = lemke.solve(m, q, &LemkeOptions::default()).unwrap();
         let cpu = thread_cpu_seconds() - cpu;
         println!(
-            "{label} n={n}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            "{label} n={}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            q.len(),
             report.termination,
             report.pivots,
             report.z.iter().filter(|&&z| z > 0.0).count(),
@@ -718,11 +743,28 @@ fn timing_n2048() {
             start.elapsed().as_secs_f64()
         );
     };
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        let spec = RodSpec {
+            mass,
+            ..RodSpec::canonical()
+        };
+        let rod = build_rod(&spec).unwrap();
+        let options = PeriodicLcpOptions {
+            time_samples: n,
+            ..PeriodicLcpOptions::default()
+        };
+        let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
+        timed(
+            &format!("canonical rod, {mass:?} mass"),
+            lcp.matrix(),
+            lcp.q(),
+        );
+    }
     let (m, q) = circulant_case(n);
-    timed("circulant", &m, &q);
-    timed("circulant (reused workspace)", &m, &q);
+    timed("circulant", m.as_ref(), &q);
+    timed("circulant (reused workspace)", m.as_ref(), &q);
     let mut r = rng(7);
     let m = spd_matrix(n, 1.0, &mut r);
     let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
-    timed("random SPD", &m, &q);
+    timed("random SPD", m.as_ref(), &q);
 }

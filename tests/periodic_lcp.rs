@@ -4,9 +4,11 @@
 //! solvers against each other.
 
 use nalgebra::{Complex, DMatrix, DVector};
-use semismooth::lemke::{Lemke, LemkeOptions};
+use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions};
-use semismooth_problems::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
+use semismooth_problems::lcp::{
+    solve_min_map_sequenced, ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions,
+};
 use semismooth_problems::model::{SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 
@@ -19,6 +21,31 @@ fn dense(m: &SparseMatrix) -> DMatrix<f64> {
         }
     }
     d
+}
+
+/// Dense `K`, `M`, `D` (zero when undamped).
+fn dense_kmd(model: &StructuralModel) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let k = dense(&model.stiffness);
+    let d = model
+        .damping
+        .as_ref()
+        .map(dense)
+        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
+    (k, dense(&model.mass), d)
+}
+
+/// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
+fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = mass;
+    spec.contacts = vec![
+        RodContact {
+            node: inner,
+            gap: 0.3,
+        },
+        RodContact { node: 20, gap: 0.5 },
+    ];
+    build_rod(&spec).unwrap().model
 }
 
 fn rod(mass: MassModel, damped: bool) -> StructuralModel {
@@ -39,13 +66,7 @@ fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
 
 /// `Re((K + i s D - s^2 M)^{-1} a e^{i 2 pi n / Nt})` at the nodes, by a dense complex solve.
 fn frequency_response(model: &StructuralModel, s: f64, nt: usize) -> Vec<Vec<f64>> {
-    let k = dense(&model.stiffness);
-    let m = dense(&model.mass);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
+    let (k, m, d) = dense_kmd(model);
     let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
         Complex::new(k[(i, j)] - s * s * m[(i, j)], s * d[(i, j)])
     });
@@ -113,13 +134,7 @@ fn linear_response_is_the_frequency_response_at_the_warped_frequency_with_second
 fn block_row_sums_of_a_are_the_static_compliance_of_the_contacts() {
     // Two contacts (mid-rod and tip): exercises the m x m blocks.
     for mass in [MassModel::Modified, MassModel::Consistent] {
-        let mut spec = RodSpec::canonical();
-        spec.mass = mass;
-        spec.contacts = vec![
-            RodContact { node: 10, gap: 0.3 },
-            RodContact { node: 20, gap: 0.5 },
-        ];
-        let model = build_rod(&spec).unwrap().model;
+        let model = two_contact_rod(mass, 10);
         let nt = 64;
         let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
@@ -162,13 +177,7 @@ fn trapezoidal_contact_displacement(
     lambda: &[f64],
 ) -> Vec<f64> {
     let n = model.dofs();
-    let k = dense(&model.stiffness);
-    let m = dense(&model.mass);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(n, n));
+    let (k, m, d) = dense_kmd(model);
     let dt = 2.0 * std::f64::consts::PI / model.forcing.omega / nt as f64;
     let size = 2 * n * nt;
     let u = |step: usize, i: usize| (step % nt) * 2 * n + i;
@@ -290,13 +299,7 @@ fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem
 
 #[test]
 fn symmetric_part_spectrum_from_the_bins_matches_a_dense_eigensolver() {
-    let mut spec = RodSpec::canonical();
-    spec.mass = MassModel::Consistent;
-    spec.contacts = vec![
-        RodContact { node: 12, gap: 0.3 },
-        RodContact { node: 20, gap: 0.5 },
-    ];
-    let model = build_rod(&spec).unwrap().model;
+    let model = two_contact_rod(MassModel::Consistent, 12);
     for nt in [16usize, 21] {
         let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
@@ -392,39 +395,98 @@ fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonRepo
     (z, report)
 }
 
+/// Lemke (default options) ends with `expected`, and `check_lemke` turns the report into
+/// `LemkeNotSolved` carrying its pivots and the smallest eigenvalue of `(A + A^T)/2`.
+fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
+    let report = lemke_solution(lcp);
+    assert_eq!(report.termination, expected);
+    match lcp.check_lemke(report.clone()) {
+        Err(LcpError::LemkeNotSolved {
+            termination,
+            pivots,
+            symmetric_part_min_eigenvalue,
+            ..
+        }) => {
+            assert_eq!(termination, expected);
+            assert_eq!(pivots, report.pivots);
+            assert_eq!(
+                symmetric_part_min_eigenvalue,
+                lcp.symmetric_part_spectrum().0
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// CPU time of this thread (from /proc; 0 where unavailable), for timings on a shared
+/// machine.
+fn thread_cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(0.0, |ns| ns * 1e-9)
+}
+
 /// Numbers for the report (run with `--ignored --nocapture`); nothing asserted on time.
 #[test]
 #[ignore]
 fn report_lcp_numbers() {
+    let minimum = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        for nt in [256usize, 1024] {
+            let lcp = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+            let (lo, hi) = lcp.symmetric_part_spectrum();
+            let lemke = lemke_solution(&lcp);
+            println!(
+                "undamped {mass:?} Nt={nt}: eig(A) in [{lo:.4e}, {hi:.4e}] lemke {:?} pivots {}",
+                lemke.termination, lemke.pivots
+            );
+        }
+    }
+    if std::env::var_os("LCP_REPORT_UNDAMPED_ONLY").is_some() {
+        return;
+    }
     for mass in [
         MassModel::Modified,
         MassModel::Consistent,
         MassModel::Lumped,
     ] {
         let model = rod(mass, true);
+        let mut previous: Option<Vec<f64>> = None;
         for nt in [128usize, 256, 512, 1024, 2048] {
+            let start = std::time::Instant::now();
             let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+            let build = start.elapsed().as_secs_f64();
             let (lo, hi) = lcp.symmetric_part_spectrum();
             let start = std::time::Instant::now();
-            let lemke = lemke_solution(&lcp);
+            let cpu = thread_cpu_seconds();
+            let mut workspace = Lemke::new(lcp.dim());
+            let generous = LemkeOptions {
+                max_pivots: Some(100 * lcp.dim()),
+                ..LemkeOptions::default()
+            };
+            let lemke = lcp.solve_with_lemke(&mut workspace, &generous).unwrap();
+            let lemke_cpu = thread_cpu_seconds() - cpu;
             let lemke_time = start.elapsed().as_secs_f64();
+            let tip_lemke = minimum(&lcp.contact_displacements(&lemke.z).unwrap()[0]);
             let start = std::time::Instant::now();
-            let (z, ssn) = ssn_solution(&lcp);
-            let ssn_time = start.elapsed().as_secs_f64();
-            let tip_lemke = lcp.contact_displacements(&lemke.z).unwrap()[0]
-                .iter()
-                .cloned()
-                .fold(f64::INFINITY, f64::min);
-            let u = &lcp.contact_displacements(&z).unwrap()[0];
-            let tip_min = u.iter().cloned().fold(f64::INFINITY, f64::min);
-            let tip_max = u.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            let dz = max_abs_diff(&lemke.z, &z);
-            let zmax = z.iter().cloned().fold(0.0, f64::max);
+            let (z0, cold) = ssn_solution(&lcp);
+            let cold_time = start.elapsed().as_secs_f64();
+            let warm_start = match &previous {
+                Some(z) => lcp.interpolate_forces(z).unwrap(),
+                None => vec![0.0; lcp.dim()],
+            };
+            let start = std::time::Instant::now();
+            let (z, warm) = ssn_from(&lcp, warm_start);
+            let warm_time = start.elapsed().as_secs_f64();
+            let tip_ssn = minimum(&lcp.contact_displacements(&z).unwrap()[0]);
             println!(
-                "{mass:?} Nt={nt}: sym eig [{lo:.4e}, {hi:.4e}] lemke {:?} pivots {} err {:.1e} {:.3}s tip_min {tip_lemke:.10} | ssn {:?} it {} res {:.1e} {:.3}s tip_min {tip_min:.10} tip_max {tip_max:.10} | |dz| {dz:.2e} zmax {zmax:.4e}",
-                lemke.termination, lemke.pivots, lemke.complementarity_error, lemke_time,
-                ssn.termination, ssn.iterations, ssn.residual_norm(), ssn_time
+                "{mass:?} Nt={nt}: build {build:.3}s sym eig [{lo:.4e}, {hi:.4e}] | lemke {:?} pivots {} err {:.1e} {lemke_time:.3}s (cpu {lemke_cpu:.3}s) tip_min {tip_lemke:.10} | ssn cold {:?} it {} {cold_time:.3}s | ssn sequenced {:?} it {} {warm_time:.3}s tip_min {tip_ssn:.10} | |z_lemke - z_ssn| {:.1e} |z_cold - z_ssn| {:.1e}",
+                lemke.termination, lemke.pivots, lemke.complementarity_error,
+                cold.termination, cold.iterations, warm.termination, warm.iterations,
+                max_abs_diff(&lemke.z, &z), max_abs_diff(&z0, &z)
             );
+            previous = Some(z);
         }
     }
 }
@@ -432,37 +494,41 @@ fn report_lcp_numbers() {
 #[test]
 fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass() {
     let model = rod(MassModel::Modified, true);
-    // Semismooth Newton by mesh sequencing 256 -> 512 -> 1024 (each level warm-started by
-    // interpolating the previous Newton solution); Lemke independently at 256 and 1024.
-    let mut previous: Option<Vec<f64>> = None;
-    for nt in [256usize, 512, 1024] {
-        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
-        let start = match &previous {
-            None => vec![0.0; lcp.dim()],
-            Some(z) => lcp.interpolate_forces(z).unwrap(),
-        };
-        let (z, report) = ssn_from(&lcp, start);
-        assert!(report.converged(), "Nt = {nt}: {:?}", report.termination);
-        if nt != 512 {
-            let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
-            // Lemke's basic solution is exact up to the round-off of a solve with the
-            // active block (~1e-16 relative, errors measured 1e-17); Newton stops at
-            // |F| <= 1e-10 but ends with an exact active-set solve, so both are the unique
-            // solution of the same linear system: agreement to round-off, asserted at 1e-9.
-            let zmax = z.iter().cloned().fold(0.0, f64::max);
-            assert!(lemke.complementarity_error < 1e-12 * zmax);
-            assert!(max_abs_diff(&lemke.z, &z) < 1e-9 * zmax, "Nt = {nt}");
-            let w = lcp.gap(&z).unwrap();
-            assert!(max_abs_diff(&lemke.w, &w) < 1e-9);
-            // Contact happens: some nodes carry force, and the tip reaches the gap there.
-            assert!(zmax > 0.1);
+    for nt in [256usize, 1024] {
+        // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
+        // interpolated previous Newton solution); Lemke independently on the finest LCP.
+        let sequenced =
+            solve_min_map_sequenced(&model, options(nt, vec![]), &NewtonOptions::default())
+                .unwrap();
+        assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
+        assert_eq!(
+            sequenced.levels.len(),
+            1 + (nt / 128).trailing_zeros() as usize
+        );
+        let lcp = &sequenced.lcp;
+        let z = &sequenced.z;
+        let lemke = lcp.check_lemke(lemke_solution(lcp)).unwrap();
+        // Lemke's basic solution is exact up to the round-off of a solve with the final
+        // basis (errors measured 1e-17); Newton ends with an exact solve on the same
+        // active set. Both are then the solution of one linear system with A_II
+        // (condition ~1e5 here): agreement to ~1e-13 measured, asserted at 1e-9.
+        let zmax = z.iter().cloned().fold(0.0, f64::max);
+        assert!(zmax > 0.1, "contact carries force");
+        assert!(lemke.complementarity_error < 1e-12 * zmax);
+        assert!(max_abs_diff(&lemke.z, z) < 1e-9 * zmax, "Nt = {nt}");
+        let w = lcp.gap(z).unwrap();
+        assert!(max_abs_diff(&lemke.w, &w) < 1e-9);
+        if nt == 256 {
+            // From z = 0 directly (no sequencing) Newton reaches the same solution.
+            let (cold, report) = ssn_solution(lcp);
+            assert!(report.converged());
+            assert!(max_abs_diff(&cold, z) < 1e-9 * zmax);
         }
-        previous = Some(z);
     }
 }
 
 #[test]
-fn consistent_mass_makes_the_lcp_indefinite_and_lemke_stops_without_a_solution() {
+fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much_longer() {
     let model = rod(MassModel::Consistent, true);
     let lcp = PeriodicLcp::new(&model, options(256, vec![])).unwrap();
     // The symmetric part of A is indefinite (its eigenvalues are Re H_k: negative above
@@ -471,19 +537,25 @@ fn consistent_mass_makes_the_lcp_indefinite_and_lemke_stops_without_a_solution()
     assert!(lo < -1e-2 && hi > 0.0, "[{lo}, {hi}]");
     let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
     assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
-    let report = lemke_solution(&lcp);
-    assert!(!report.solved());
-    match lcp.check_lemke(report.clone()) {
-        Err(LcpError::LemkeNotSolved {
-            pivots,
-            symmetric_part_min_eigenvalue,
-            ..
-        }) => {
-            assert_eq!(pivots, report.pivots);
-            assert_eq!(symmetric_part_min_eigenvalue, lo);
-        }
-        other => panic!("{other:?}"),
-    }
+    // With the default pivot limit 50 n + 100 Lemke stops without a solution (no ray):
+    assert_not_solved(&lcp, LemkeTermination::PivotLimit);
+    // ... but with 100 n pivots it solves this one (25369 pivots measured, against 172 for
+    // the modified mass): the path is long, not a ray. At Nt >= 512 it had not finished
+    // after 1000 n pivots.
+    let mut lemke = Lemke::new(lcp.dim());
+    let generous = LemkeOptions {
+        max_pivots: Some(100 * lcp.dim()),
+        ..LemkeOptions::default()
+    };
+    let solved = lcp.solve_with_lemke(&mut lemke, &generous).unwrap();
+    assert!(
+        solved.solved(),
+        "{:?} after {}",
+        solved.termination,
+        solved.pivots
+    );
+    assert!(solved.complementarity_error < 1e-12);
+    assert!(solved.pivots > 50 * lcp.dim());
 }
 
 #[test]
@@ -520,4 +592,42 @@ fn lcp_solution_is_the_steady_state_of_the_massless_contact_trapezoidal_march_wi
         assert!(du < 1e-9, "Nt = {nt}: {du:e}");
         assert!(dl < 1e-8, "Nt = {nt}: {dl:e}");
     }
+}
+
+#[test]
+fn force_interpolation_reproduces_periodic_piecewise_linear_histories() {
+    let model = two_contact_rod(MassModel::Modified, 10);
+    let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
+    // A coarse history of 4 nodes, 2 contacts (time-major): a triangle wave per contact.
+    let coarse = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 2.0, 3.0];
+    let fine = lcp.interpolate_forces(&coarse).unwrap();
+    for n in 0..16 {
+        // Fine node n sits at coarse position n / 4; linear between coarse nodes, and
+        // periodic (node 3 -> node 0) at the end. Exact in binary arithmetic.
+        let position = n as f64 / 4.0;
+        let left = position.floor() as usize;
+        let f = position - left as f64;
+        for c in 0..2 {
+            let expected = (1.0 - f) * coarse[left * 2 + c] + f * coarse[((left + 1) % 4) * 2 + c];
+            assert_eq!(fine[n * 2 + c], expected);
+        }
+    }
+    assert!(matches!(
+        lcp.interpolate_forces(&[1.0; 3]),
+        Err(LcpError::WrongLength { found: 3, .. })
+    ));
+}
+
+#[test]
+fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers() {
+    // Without damping, forcing at omega_1 puts bin 1 (warped just above omega_1) next to
+    // the resonance: H_1 is large and negative, so the symmetric part of A (eigenvalues
+    // Re H_k) is strongly indefinite; Lemke's method ends on a secondary ray.
+    let lcp = PeriodicLcp::new(&rod(MassModel::Modified, false), options(256, vec![])).unwrap();
+    let (lo, _) = lcp.symmetric_part_spectrum();
+    let h1 = lcp.receptance(1)[0];
+    assert_eq!(h1.im, 0.0);
+    assert_eq!(lo, h1.re);
+    assert!(lo < -1e3, "{lo}");
+    assert_not_solved(&lcp, LemkeTermination::Ray);
 }

@@ -142,6 +142,7 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
         GlobalizationChoice::None => Globalization::None,
         GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
         GlobalizationChoice::Nonmonotone => NewtonOptions::default().globalization,
+        GlobalizationChoice::Hybrid => Globalization::hybrid(),
     };
     NewtonOptions {
         absolute_tolerance: settings.tolerance,
@@ -309,6 +310,7 @@ pub fn solve_rod(
             // stiffness is raised from the contact scale by factors of 10, each stage
             // starting from the previous answer.
             let mut counters = WorkCounters::default();
+            let mut homotopy_iterations = 0;
             if warm_start.is_none() {
                 let mut k = scale;
                 while k < target {
@@ -320,6 +322,7 @@ pub fn solve_rod(
                     let mut trial = x.clone();
                     let report = newton_hb(&mut stage, &mut trial, settings)?;
                     counters += report.counters;
+                    homotopy_iterations += report.iterations;
                     if report.converged() {
                         x = trial;
                     }
@@ -329,6 +332,8 @@ pub fn solve_rod(
             let mut report = newton_hb(&mut problem, &mut x, settings)?;
             counters += report.counters;
             report.counters = counters;
+            // Iterations of the whole homotopy, so that costs compare across methods.
+            report.iterations += homotopy_iterations;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let tip_series = problem.displacement_samples(&x, tip, points)?;
@@ -342,6 +347,17 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            // The mean penalty force as the equations see it: over the Nt AFT samples (a
+            // finer grid resolves narrow force peaks the quadrature does not).
+            if problem.contacts() > 0 {
+                let summary = problem.summary(&sol.state, tip, points)?;
+                let tip_contact = model
+                    .contacts
+                    .iter()
+                    .position(|c| c.dof == tip)
+                    .unwrap_or(0);
+                sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
+            }
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
@@ -410,18 +426,48 @@ fn solve_lcp(
             )
         }
         _ => {
-            let mut problem = lcp.min_map();
-            let mut z = initial_state(problem.dim(), warm_start);
-            let mut solver = ActiveSetSolver::new();
-            let report =
-                newton::solve(&mut problem, &mut solver, &mut z, &newton_options(settings))?;
+            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+            // creeps one time node per iteration.
+            let options = newton_options(settings);
+            let (z, report_list) = match warm_start {
+                Some(w) if w.len() == lcp.dim() => {
+                    let mut problem = lcp.min_map();
+                    let mut z = w.to_vec();
+                    let mut solver = ActiveSetSolver::new();
+                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)?;
+                    (z, vec![report])
+                }
+                _ => {
+                    let sequenced = crate::lcp::solve_min_map_sequenced(
+                        model,
+                        PeriodicLcpOptions {
+                            time_samples: settings.time_samples,
+                            observed_dofs: Vec::new(),
+                        },
+                        &options,
+                    )?;
+                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                    (sequenced.z, reports)
+                }
+            };
+            let last = report_list.last().expect("at least one level");
+            let mut counters = RunCounters::default();
+            for r in &report_list {
+                let c: RunCounters = r.counters.into();
+                counters.residual_evaluations += c.residual_evaluations;
+                counters.jacobian_evaluations += c.jacobian_evaluations;
+                counters.factorizations += c.factorizations;
+                counters.linear_solves += c.linear_solves;
+                counters.line_search_backtracks += c.line_search_backtracks;
+            }
             (
                 z,
-                report.converged(),
-                termination_name(&report),
-                report.iterations,
-                report.residual_norm(),
-                report.counters.into(),
+                last.converged(),
+                termination_name(last),
+                report_list.iter().map(|r| r.iterations).sum(),
+                last.residual_norm(),
+                counters,
             )
         }
     };

@@ -116,8 +116,11 @@ pub enum GlobalizationChoice {
     /// Armijo backtracking on `0.5 |F|^2`.
     Armijo,
     /// Non-monotone (Grippo–Lampariello–Lucidi) line search.
-    #[default]
     Nonmonotone,
+    /// Full steps for 30 iterations (active-set behaviour), then the non-monotone line
+    /// search from the best iterate.
+    #[default]
+    Hybrid,
 }
 
 /// Default number of harmonics.
