@@ -12,7 +12,8 @@ use semismooth::linalg::{DenseAssemble, FaerDenseLu};
 use semismooth::newton::{self, NewtonOptions, NewtonReport};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use semismooth_problems::hb::{
-    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+    CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
+    StructuredHbSolver,
 };
 use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
@@ -949,4 +950,138 @@ fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
     assert_eq!(rs.iterations, rd.iterations);
     let d: Vec<f64> = xs.iter().zip(&xd).map(|(a, b)| a - b).collect();
     assert!(norm(&d) < 1e-10 * norm(&xd));
+}
+
+/// Measurement, not a claim (run with `--ignored --nocapture`): SSN-HB from zero on the
+/// modified-mass rod at H = 20 for growing element counts and two values of c. Prints the
+/// Newton iterations, the time per solve and per iteration, and the tip minimum.
+#[test]
+#[ignore]
+fn report_iterations_and_time_versus_elements() {
+    for elements in [20usize, 1000, 10000, 100000] {
+        let mut spec = RodSpec::canonical();
+        spec.mass = MassModel::Modified;
+        spec.elements = elements;
+        spec.contacts[0].node = elements;
+        let rod = build_rod(&spec).unwrap();
+        let scale = rod.model.contact_stiffness_scale();
+        for c in [1.0, scale] {
+            let options = HbOptions {
+                c: Some(c),
+                ..HbOptions::default()
+            };
+            let mut hb = SsnHb::new(&rod.model, &options).unwrap();
+            let mut x = vec![0.0; hb.dim()];
+            let start = std::time::Instant::now();
+            if elements > 1000 {
+                let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
+                let mut lambda = vec![0.0; condensed.dim()];
+                let reduced = newton::solve(
+                    &mut condensed,
+                    &mut FaerDenseLu::new(),
+                    &mut lambda,
+                    &newton_options(),
+                )
+                .unwrap();
+                let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
+                println!(
+                    "elements {elements}, c = {c}, condensed (incl. factorization): {:?} after {} iterations, {:?}, tip min {:.6}",
+                    reduced.termination,
+                    reduced.iterations,
+                    start.elapsed(),
+                    sc.displacement_min
+                );
+                continue;
+            }
+            let report = newton::solve(
+                &mut hb,
+                &mut StructuredHbSolver::new(),
+                &mut x,
+                &newton_options(),
+            )
+            .unwrap();
+            let elapsed = start.elapsed();
+            let s = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
+            let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
+            let mut lambda = vec![0.0; condensed.dim()];
+            let start = std::time::Instant::now();
+            let reduced = newton::solve(
+                &mut condensed,
+                &mut FaerDenseLu::new(),
+                &mut lambda,
+                &newton_options(),
+            )
+            .unwrap();
+            let reduced_time = start.elapsed();
+            let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
+            println!(
+                "elements {elements}, c = {c}, condensed: {:?} after {} iterations, {reduced_time:?}, tip min {:.6}",
+                reduced.termination, reduced.iterations, sc.displacement_min
+            );
+            println!(
+                "elements {elements}, c = {c}: {:?} after {} iterations, {} residual evaluations, \
+                 {elapsed:?} ({:?} per iteration), tip min {:.6}",
+                report.termination,
+                report.iterations,
+                report.counters.residual_evaluations,
+                elapsed / report.iterations.max(1) as u32,
+                s.displacement_min
+            );
+        }
+    }
+}
+
+/// Newton on the condensed problem (force coefficients only) from zero: converges, and the
+/// expanded solution is a root of the full SSN-HB residual and equals the full solve's
+/// answer (both satisfy |F| <= 1e-10; the root is isolated, so they agree to ~1e-10).
+#[test]
+fn condensed_ssn_hb_matches_the_full_problem_on_the_canonical_rod() {
+    let model = canonical_modified_rod();
+    let options = HbOptions::default();
+    let (mut full, x_full, full_report) = solve_ssn(&model, &options);
+    let mut condensed = CondensedSsnHb::new(&model, &options).unwrap();
+    let mut lambda = vec![0.0; condensed.dim()];
+    let report = newton::solve(
+        &mut condensed,
+        &mut FaerDenseLu::new(),
+        &mut lambda,
+        &newton_options(),
+    )
+    .unwrap();
+    assert!(report.converged(), "{:?}", report.termination);
+    let x = condensed.expand(&lambda).unwrap();
+    let mut r = vec![0.0; full.dim()];
+    full.residual(&x, &mut r);
+    let d: Vec<f64> = x.iter().zip(&x_full).map(|(a, b)| a - b).collect();
+    let s = condensed.summary(&lambda, 19, 1024).unwrap();
+    println!(
+        "condensed: {} iterations (full: {}), |F_full(expand)| = {:.1e}, |x - x_full| / |x_full| = {:.1e}, tip min {:.6}",
+        report.iterations,
+        full_report.iterations,
+        norm(&r),
+        norm(&d) / norm(&x_full),
+        s.displacement_min
+    );
+    assert!(
+        norm(&r) < 1e-9,
+        "full residual of the expanded solution {:e}",
+        norm(&r)
+    );
+    assert!(norm(&d) < 1e-8 * norm(&x_full));
+}
+
+/// The static contact stiffness of the clamped-free rod at its tip is `EA / L = 1`
+/// whatever the mesh (closed form), unlike `K[tip, tip] = EA / h`.
+#[test]
+fn static_contact_stiffness_of_the_rod_is_ea_over_l_for_any_mesh() {
+    for elements in [5, 20, 300] {
+        let mut spec = RodSpec::canonical();
+        spec.elements = elements;
+        spec.contacts[0].node = elements;
+        let rod = build_rod(&spec).unwrap();
+        let condensed = CondensedSsnHb::new(&rod.model, &HbOptions::default()).unwrap();
+        let k = condensed.static_contact_stiffness();
+        assert!((k - 1.0).abs() < 1e-12, "{elements} elements: {k}");
+        assert!((rod.model.contact_stiffness_scale() - elements as f64).abs() < 1e-9);
+    }
 }

@@ -21,7 +21,7 @@ use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solv
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{c64, Conj, Mat, MatMut, Par};
+use faer::{c64, Conj, Mat, MatMut, MatRef, Par};
 use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::LinearSolve;
 
@@ -341,7 +341,7 @@ impl StructuredHbSolver {
     }
 
     /// `u <- A(w)^{-1} u` harmonic by harmonic (complex form).
-    fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
+    pub(crate) fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
         let (Some((_, pattern)), Some((lin, _))) = (&self.pattern, &self.factored_for) else {
             return Err(LinearSolveError::NotFactored);
         };
@@ -381,7 +381,7 @@ impl StructuredHbSolver {
     }
 
     /// `u += alpha A^{-1} G^T p` for contact coefficients `p` (index `j m + i`).
-    fn add_response(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
+    pub(crate) fn add_response(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
         let Some((lin, _)) = &self.factored_for else {
             return;
         };
@@ -444,7 +444,13 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
         {
             return Err(LinearSolveError::NonFiniteEntry { row, col, value });
         }
-        self.build_schur(m, size);
+        condensed_matrix(
+            &self.receptance,
+            self.q.as_ref(),
+            self.coupling,
+            m,
+            self.schur.as_mut(),
+        );
         if nc > 0 {
             let stack = MemStack::new(&mut self.mem);
             dense_lu::lu_in_place(
@@ -584,76 +590,6 @@ impl StructuredHbSolver {
 }
 
 impl StructuredHbSolver {
-    /// Receptance entries of column `(l, i')`: `R e_(l, i')` is nonzero only on the
-    /// basis functions of harmonic `k(l)`; returns `(rho_cos_or_const, rho_sin)` for row
-    /// contact `i` (`rho_sin` is 0 for `k = 0`).
-    #[inline]
-    fn receptance_column(&self, l: usize, i: usize, ip: usize) -> (f64, f64) {
-        let k = l.div_ceil(2);
-        let r = self.receptance[k][(i, ip)];
-        if k == 0 {
-            (r.re, 0.0)
-        } else if l % 2 == 1 {
-            // Unit cosine load: a = Cr, b = -Ci.
-            (r.re, -r.im)
-        } else {
-            // Unit sine load: a = Ci, b = Cr.
-            (r.im, r.re)
-        }
-    }
-
-    /// Builds the condensed matrix: `I - Q + c Q R` (SSN-HB) or `I + k_p R Q` (penalty),
-    /// using that `R` only couples the two basis functions of one harmonic (cost
-    /// `O(m^2 (2H + 1)^2)`).
-    fn build_schur(&mut self, m: usize, size: usize) {
-        let nc = m * size;
-        self.schur.fill(0.0);
-        for l in 0..size {
-            let k = l.div_ceil(2);
-            // Basis functions of harmonic k: (first, count).
-            let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
-            for ip in 0..m {
-                let col = l * m + ip;
-                match self.coupling {
-                    ContactCoupling::Complementarity { c } => {
-                        for i in 0..m {
-                            let (rho0, rho1) = self.receptance_column(l, i, ip);
-                            let qi = i * size;
-                            for j in 0..size {
-                                let mut value = c * rho0 * self.q[(j, qi + first)];
-                                if count == 2 {
-                                    value += c * rho1 * self.q[(j, qi + first + 1)];
-                                }
-                                if i == ip {
-                                    value -= self.q[(j, qi + l)];
-                                }
-                                self.schur[(j * m + i, col)] = value;
-                            }
-                        }
-                    }
-                    ContactCoupling::Penalty { stiffness } => {
-                        // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
-                        let qp = ip * size;
-                        for i in 0..m {
-                            let r0 = self.receptance[0][(i, ip)].re;
-                            self.schur[(i, col)] = stiffness * r0 * self.q[(0, qp + l)];
-                            for kk in 1..size.div_ceil(2) {
-                                let (jc, js) = (2 * kk - 1, 2 * kk);
-                                let r = self.receptance[kk][(i, ip)];
-                                let (pc, ps) = (self.q[(jc, qp + l)], self.q[(js, qp + l)]);
-                                self.schur[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
-                                self.schur[(js * m + i, col)] =
-                                    stiffness * (-r.im * pc + r.re * ps);
-                            }
-                        }
-                    }
-                }
-                self.schur[(col, col)] += 1.0;
-            }
-        }
-        debug_assert_eq!(self.schur.nrows(), nc);
-    }
-
     /// `out = J x` with the Jacobian last factored (structured product, no assembly).
     fn apply_jacobian(&mut self, x: &[f64], out: &mut [f64]) {
         let Some((lin, omega)) = self.factored_for.clone() else {
@@ -709,5 +645,79 @@ impl StructuredHbSolver {
             Par::Seq,
             stack,
         );
+    }
+}
+
+/// Receptance entries of column `(l, i')`: `R e_(l, i')` is nonzero only on the basis
+/// functions of harmonic `k(l)`; returns `(rho_cos_or_const, rho_sin)` for row contact `i`
+/// (`rho_sin` is 0 for `k = 0`).
+#[inline]
+fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> (f64, f64) {
+    let k = l.div_ceil(2);
+    let r = receptance[k][(i, ip)];
+    if k == 0 {
+        (r.re, 0.0)
+    } else if l % 2 == 1 {
+        // Unit cosine load: a = Cr, b = -Ci.
+        (r.re, -r.im)
+    } else {
+        // Unit sine load: a = Ci, b = Cr.
+        (r.im, r.re)
+    }
+}
+
+/// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R`
+/// (SSN-HB) or `I + k_p R Q` (penalty), using that `R` only couples the two basis
+/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` in column blocks.
+pub(crate) fn condensed_matrix(
+    receptance: &[Mat<c64>],
+    q: MatRef<'_, f64>,
+    coupling: ContactCoupling,
+    m: usize,
+    mut out: MatMut<'_, f64>,
+) {
+    let size = q.nrows();
+    out.fill(0.0);
+    for l in 0..size {
+        let k = l.div_ceil(2);
+        // Basis functions of harmonic k: (first, count).
+        let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
+        for ip in 0..m {
+            let col = l * m + ip;
+            match coupling {
+                ContactCoupling::Complementarity { c } => {
+                    for i in 0..m {
+                        let (rho0, rho1) = receptance_column(receptance, l, i, ip);
+                        let qi = i * size;
+                        for j in 0..size {
+                            let mut value = c * rho0 * q[(j, qi + first)];
+                            if count == 2 {
+                                value += c * rho1 * q[(j, qi + first + 1)];
+                            }
+                            if i == ip {
+                                value -= q[(j, qi + l)];
+                            }
+                            out[(j * m + i, col)] = value;
+                        }
+                    }
+                }
+                ContactCoupling::Penalty { stiffness } => {
+                    // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
+                    let qp = ip * size;
+                    for i in 0..m {
+                        let r0 = receptance[0][(i, ip)].re;
+                        out[(i, col)] = stiffness * r0 * q[(0, qp + l)];
+                        for (kk, rk) in receptance.iter().enumerate().skip(1) {
+                            let (jc, js) = (2 * kk - 1, 2 * kk);
+                            let r = rk[(i, ip)];
+                            let (pc, ps) = (q[(jc, qp + l)], q[(js, qp + l)]);
+                            out[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
+                            out[(js * m + i, col)] = stiffness * (-r.im * pc + r.re * ps);
+                        }
+                    }
+                }
+            }
+            out[(col, col)] += 1.0;
+        }
     }
 }
