@@ -13,3 +13,4 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod sweep;
