@@ -14,3 +14,4 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod sweep;

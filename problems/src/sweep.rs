@@ -1,0 +1,1111 @@
+//! Frequency-response curves: pseudo-arclength continuation in the forcing frequency of a
+//! scene's periodic problem (issue 6).
+//!
+//! [`frequency_response`] solves at `omega_from = omega_ratio_from * omega_1` by globalized
+//! Newton from zero, then follows the branch with [`semismooth::continuation`] until the
+//! frequency leaves `[omega_from, omega_to]` (through folds, where the frequency turns back).
+//! Each point is reduced to the tip over one period: `tip_max`, `tip_min` and the amplitude
+//! `max_t |u_tip(t)|` (with contact the maximum sits at the gap along the contact branch, so
+//! the negative excursion carries the information).
+//!
+//! # What a step length means
+//!
+//! The continuation measures steps in a θ-weighted norm of its unknowns. It runs here on
+//! scaled unknowns (the problem is wrapped, the core is untouched), chosen so that with
+//! `θ = 1/2` a step `ds` is the Euclidean arclength in the plane
+//!
+//! ```text
+//! ds² = (Δω / ω_1)² + |ΔX|² / (N u_ref²),
+//! ```
+//!
+//! `N` the number of dofs, `|ΔX|` the 2-norm of the change of all displacement coefficients
+//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by the contact
+//! stiffness scale), and `u_ref` the root-mean-square over the dofs of the linear response
+//! (contacts removed) at `ω_1` ([`FrequencyResponse::reference_amplitude`]). The linear
+//! resonance is thus at distance about 1 from zero in both directions, whatever `H`, `Nt`
+//! or the mesh: `[sweep] step = 0.01` means about one percent of `ω_1` on flat parts of the
+//! curve and one percent of the resonant amplitude on steep ones, for `H = 5` as for
+//! `H = 50`.
+//!
+//! # Methods
+//!
+//! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
+//!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
+//! - `lcp-ssn`: the periodic LCP `min(z, q(ω) + A(ω) z) = 0` ([`PeriodicLcp`]), rebuilt when
+//!   `ω` changes, dense Jacobian and [`FaerDenseLu`]; `dF/dω` by central differences.
+//! - `lcp-lemke`, `march`: [`RunError::Unsupported`] (neither is a smooth-enough equation in
+//!   `ω` to continue; use natural steps, one `ssn solve` per frequency).
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::time::Instant;
+
+use faer::Mat;
+use semismooth::continuation::{
+    Continuation, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
+    ContinuationTermination, Direction, Predictor,
+};
+use semismooth::harmonic::{Aft, FourierBasis};
+use semismooth::linalg::{FaerDenseLu, LinearSolveError};
+use semismooth::newton::{self, NewtonReport};
+use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use serde_json::json;
+
+use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
+use crate::lcp::{PeriodicLcp, PeriodicLcpOptions};
+use crate::model::StructuralModel;
+use crate::rod::RodModel;
+use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
+use crate::scene::{
+    LinearSolverChoice, Method, SolverSettings, SweepSettings, DEFAULT_RELATIVE_PENALTY,
+};
+
+/// Weight `θ` of the state in the arclength (see the module documentation: with the scaling
+/// used here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the
+/// θ-norm of order one).
+pub const THETA: f64 = 0.5;
+
+/// Largest number of corrector iterations per attempted step.
+pub const MAX_CORRECTOR_ITERATIONS: usize = 12;
+
+/// Corrector iterations the step control aims at.
+pub const TARGET_ITERATIONS: usize = 4;
+
+/// The corrector may not leave the θ-ball of radius `TRUST_FACTOR * ds_max` around the last
+/// accepted point, `ds_max` the largest step the next attempt can take (see `Trust`).
+pub const TRUST_FACTOR: f64 = 3.0;
+
+/// `θ` of the short segments restarted after a failed step: nearly all weight on the state,
+/// so that the arclength constraint still cuts a branch that reverses in `ω` at a corner
+/// (a fold where the contact's active set changes) while its state moves on.
+pub const THETA_RESTART: f64 = 0.95;
+
+/// Points of a restarted segment before the main metric is taken again.
+pub const RESTART_POINTS: usize = 4;
+
+/// Restarts allowed per sweep.
+pub const MAX_RESTARTS: usize = 20;
+
+/// A frequency-response curve: one entry per branch point, in branch order (the frequency
+/// is not monotone across folds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrequencyResponse {
+    /// Method used.
+    pub method: Method,
+    /// First natural frequency of the rod (the curve's frequency unit).
+    pub omega_1: f64,
+    /// Forcing frequency `ω` of each point (absolute).
+    pub omega: Vec<f64>,
+    /// `max_t u_tip(t)` over one period.
+    pub tip_max: Vec<f64>,
+    /// `min_t u_tip(t)` over one period.
+    pub tip_min: Vec<f64>,
+    /// `max_t |u_tip(t)|` over one period.
+    pub amplitude: Vec<f64>,
+    /// Corrector iterations of each point (the first: those of the start correction).
+    pub iterations: Vec<usize>,
+    /// Frequencies `ω` (absolute) where the branch turns back, in branch order.
+    pub folds: Vec<f64>,
+    /// Index of the extreme point at each fold (same order as `folds`).
+    pub fold_indices: Vec<usize>,
+    /// Whether the branch reached `omega_ratio_to` (the bound at the end of the sweep).
+    pub converged: bool,
+    /// Why the continuation stopped, in words.
+    pub termination: String,
+    /// Wall time of the whole computation after the rod was built (reference amplitude,
+    /// initial Newton solve, continuation, tip reconstructions).
+    pub solve_seconds: f64,
+    /// Work counters (initial Newton solve + continuation).
+    pub counters: RunCounters,
+    /// The continuation's own counters (corrector iterations, rejected steps).
+    pub continuation: ContinuationCounters,
+    /// Iterations of the initial globalized Newton solve at `omega_from`.
+    pub initial_iterations: usize,
+    /// Continuation restarts after failed steps (module documentation).
+    pub restarts: usize,
+    /// `u_ref` of the step scaling (module documentation).
+    pub reference_amplitude: f64,
+    /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
+    pub output_points: usize,
+    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP `z`),
+    /// unscaled, for warm starts and re-solves.
+    pub states: Vec<Vec<f64>>,
+}
+
+impl FrequencyResponse {
+    /// Number of branch points.
+    pub fn points(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// `ω / ω_1` of each point.
+    pub fn omega_ratio(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / self.omega_1).collect()
+    }
+
+    /// Index and value of the largest amplitude (`None` for an empty curve).
+    pub fn peak(&self) -> Option<(usize, f64)> {
+        self.amplitude
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(None, |best, (i, a)| match best {
+                Some((_, b)) if b >= a => best,
+                _ => Some((i, a)),
+            })
+    }
+
+    /// The JSON object of `ssn sweep --json` (issue 6): `points`, `omega`, `tip_max`,
+    /// `tip_min`, `amplitude`, `folds`, `converged`, `solve_seconds`, `termination`,
+    /// `counters`. Non-finite numbers (never produced by a converged branch) become `null`.
+    pub fn to_json(&self) -> serde_json::Value {
+        let c = &self.counters;
+        json!({
+            "points": self.points(),
+            "omega": self.omega,
+            "tip_max": self.tip_max,
+            "tip_min": self.tip_min,
+            "amplitude": self.amplitude,
+            "folds": self.folds,
+            "converged": self.converged,
+            "solve_seconds": self.solve_seconds,
+            "termination": self.termination,
+            "counters": {
+                "residual_evaluations": c.residual_evaluations,
+                "jacobian_evaluations": c.jacobian_evaluations,
+                "factorizations": c.factorizations,
+                "linear_solves": c.linear_solves,
+                "line_search_backtracks": c.line_search_backtracks,
+                "ffts": c.ffts,
+                "corrector_iterations": self.continuation.corrector_iterations,
+                "rejected_steps": self.continuation.rejected_steps,
+            },
+        })
+    }
+}
+
+/// The ball around the last accepted point outside which the scaled problem refuses to
+/// evaluate (its residual is NaN there, which makes the corrector fail and the step halve).
+///
+/// Pseudo-arclength lands at θ-distance about `ds` from the last point; a corrector that
+/// wanders much farther has left for another part of the branch (on these piecewise-smooth
+/// problems Newton can converge on the far side of an overhang, skipping the folds).
+#[derive(Debug, Default)]
+struct Trust {
+    center: Vec<f64>,
+    center_q: f64,
+    radius: f64,
+}
+
+/// `F(s ⊙ y, ω_unit q)`: the problem in scaled unknowns `y` and parameter `q`.
+struct Scaled<'a, P: ?Sized> {
+    inner: &'a mut P,
+    scale: &'a [f64],
+    omega_unit: f64,
+    x: Vec<f64>,
+    trust: Rc<RefCell<Trust>>,
+}
+
+impl<P: ParameterDependent + ?Sized> Scaled<'_, P> {
+    fn unscale(&mut self, y: &[f64]) {
+        for ((x, y), s) in self.x.iter_mut().zip(y).zip(self.scale) {
+            *x = y * s;
+        }
+    }
+
+    /// θ-distance of `(y, q)` from the trust center, within the radius.
+    fn trusted(&self, y: &[f64]) -> bool {
+        let trust = self.trust.borrow();
+        if trust.center.len() != y.len() {
+            return true;
+        }
+        let q = self.inner.parameter() / self.omega_unit;
+        let dy: f64 = y
+            .iter()
+            .zip(&trust.center)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum();
+        let dq = q - trust.center_q;
+        let d2 = THETA / y.len() as f64 * dy + (1.0 - THETA) * dq * dq;
+        d2 <= trust.radius * trust.radius
+    }
+}
+
+impl<P: ParameterDependent + ?Sized> Residual for Scaled<'_, P> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn residual(&mut self, y: &[f64], out: &mut [f64]) {
+        if !self.trusted(y) {
+            out.fill(f64::NAN);
+            return;
+        }
+        self.unscale(y);
+        self.inner.residual(&self.x, out);
+    }
+    fn fft_count(&self) -> u64 {
+        self.inner.fft_count()
+    }
+}
+
+impl<P: GeneralizedJacobian + ParameterDependent + ?Sized> GeneralizedJacobian for Scaled<'_, P> {
+    type Jacobian = P::Jacobian;
+    fn new_jacobian(&self) -> P::Jacobian {
+        self.inner.new_jacobian()
+    }
+    /// The Jacobian in `y` is `J(x) diag(s)`; the column scaling is applied by
+    /// [`ScaledSolver`], so `J(x)` itself is stored.
+    fn jacobian(&mut self, y: &[f64], jac: &mut P::Jacobian) {
+        self.unscale(y);
+        self.inner.jacobian(&self.x, jac);
+    }
+}
+
+impl<P: ParameterDependent + ?Sized> ParameterDependent for Scaled<'_, P> {
+    fn parameter(&self) -> f64 {
+        self.inner.parameter() / self.omega_unit
+    }
+    fn set_parameter(&mut self, q: f64) {
+        self.inner.set_parameter(q * self.omega_unit);
+    }
+    /// `dF/dq = ω_unit dF/dω`.
+    fn residual_parameter_derivative(&mut self, y: &[f64], out: &mut [f64]) {
+        self.unscale(y);
+        self.inner.residual_parameter_derivative(&self.x, out);
+        for o in out.iter_mut() {
+            *o *= self.omega_unit;
+        }
+    }
+}
+
+/// Solves `J diag(s) dy = r` as `dy = (J^{-1} r) / s` with the inner solver's factorization.
+struct ScaledSolver<'a, S: ?Sized> {
+    inner: &'a mut S,
+    scale: &'a [f64],
+}
+
+impl<J: ?Sized, S: LinearSolve<J> + ?Sized> LinearSolve<J> for ScaledSolver<'_, S> {
+    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
+        self.inner.factor(jac)
+    }
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        self.inner.solve_in_place(rhs)?;
+        for (r, s) in rhs.iter_mut().zip(self.scale) {
+            *r /= s;
+        }
+        Ok(())
+    }
+}
+
+/// The periodic LCP `min(z, q(ω) + A(ω) z) = 0` as a problem owning its data, rebuilt when
+/// `ω` changes (method `lcp-ssn` in a sweep). A failed rebuild makes the residual NaN, which
+/// the continuation treats as a failed step.
+struct OwnedLcp {
+    model: StructuralModel,
+    options: PeriodicLcpOptions,
+    lcp: Option<PeriodicLcp>,
+    omega: f64,
+    built_for: f64,
+    w: Vec<f64>,
+    n: usize,
+}
+
+impl OwnedLcp {
+    fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, RunError> {
+        let lcp = PeriodicLcp::new(model, options.clone())?;
+        let n = lcp.dim();
+        let omega = model.forcing.omega;
+        Ok(Self {
+            model: model.clone(),
+            options,
+            lcp: Some(lcp),
+            omega,
+            built_for: omega,
+            w: vec![0.0; n],
+            n,
+        })
+    }
+
+    fn ensure(&mut self) {
+        if self.built_for.to_bits() != self.omega.to_bits() {
+            self.model.forcing.omega = self.omega;
+            self.lcp = PeriodicLcp::new(&self.model, self.options.clone()).ok();
+            self.built_for = self.omega;
+        }
+    }
+
+    /// `w = q + A z`; false when the LCP could not be built at this `ω`.
+    fn gap(&mut self, z: &[f64]) -> bool {
+        self.ensure();
+        let Some(lcp) = self.lcp.as_ref() else {
+            return false;
+        };
+        let (a, q) = (lcp.matrix(), lcp.q());
+        self.w.copy_from_slice(q);
+        for (j, zj) in z.iter().enumerate() {
+            if *zj != 0.0 {
+                for (i, wi) in self.w.iter_mut().enumerate() {
+                    *wi += a[(i, j)] * zj;
+                }
+            }
+        }
+        true
+    }
+}
+
+impl Residual for OwnedLcp {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+        if !self.gap(z) {
+            out.fill(f64::NAN);
+            return;
+        }
+        for ((o, z), w) in out.iter_mut().zip(z).zip(&self.w) {
+            *o = z.min(*w);
+        }
+    }
+}
+
+impl GeneralizedJacobian for OwnedLcp {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.n, self.n)
+    }
+    /// Row `i` of `A` where `(q + A z)_i < z_i`, else `e_i` (as [`crate::lcp::MinMapLcp`]).
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+        if !self.gap(z) {
+            jac.fill(f64::NAN);
+            return;
+        }
+        let Some(lcp) = self.lcp.as_ref() else {
+            return;
+        };
+        let a = lcp.matrix();
+        for i in 0..self.n {
+            let active = self.w[i] < z[i];
+            for j in 0..self.n {
+                jac[(i, j)] = if active {
+                    a[(i, j)]
+                } else if i == j {
+                    1.0
+                } else {
+                    0.0
+                };
+            }
+        }
+    }
+}
+
+impl ParameterDependent for OwnedLcp {
+    fn parameter(&self) -> f64 {
+        self.omega
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.omega = p;
+    }
+}
+
+/// Root mean square over the dofs of the linear response (contacts removed) at `ω_1`
+/// (`0.95 ω_1`, then `0.5 ω_1` if that is singular, e.g. undamped); `1` if all fail.
+fn reference_amplitude(rod: &RodModel) -> f64 {
+    let mut model = rod.model.clone();
+    model.contacts.clear();
+    let dofs = model.dofs().max(1);
+    for ratio in [1.0, 0.95, 0.5] {
+        model.forcing.omega = ratio * rod.omega_1;
+        let options = PenaltyHbOptions {
+            harmonics: 1,
+            time_samples: None,
+            penalty_stiffness: 1.0,
+        };
+        let Ok(mut problem) = PenaltyHb::new(&model, &options) else {
+            continue;
+        };
+        let n = problem.dim();
+        let x = vec![0.0; n];
+        let mut r = vec![0.0; n];
+        let mut jac = problem.new_jacobian();
+        problem.jacobian(&x, &mut jac);
+        problem.residual(&x, &mut r);
+        let mut solver = StructuredHbSolver::new();
+        if solver.factor(&jac).is_err() || solver.solve_in_place(&mut r).is_err() {
+            continue;
+        }
+        let rms = (r.iter().map(|v| v * v).sum::<f64>() / dofs as f64).sqrt();
+        if rms.is_finite() && rms > 0.0 {
+            return rms;
+        }
+    }
+    1.0
+}
+
+fn invalid(name: &'static str, value: f64, allowed: &'static str) -> RunError {
+    RunError::HarmonicBalance(HbError::InvalidOption {
+        name,
+        value,
+        allowed,
+    })
+}
+
+fn check_sweep(sweep: &SweepSettings) -> Result<(), RunError> {
+    for (name, value) in [
+        ("sweep.omega_ratio_from", sweep.omega_ratio_from),
+        ("sweep.omega_ratio_to", sweep.omega_ratio_to),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(invalid(name, value, "finite and > 0"));
+        }
+    }
+    if sweep.omega_ratio_to == sweep.omega_ratio_from {
+        return Err(invalid(
+            "sweep.omega_ratio_to",
+            sweep.omega_ratio_to,
+            "a value different from omega_ratio_from",
+        ));
+    }
+    Ok(())
+}
+
+/// Maps the sweep settings onto continuation options in the scaled unknowns.
+fn continuation_options(
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    q_unit: f64,
+) -> Result<ContinuationOptions, RunError> {
+    let (lo, hi) = if sweep.omega_ratio_to > sweep.omega_ratio_from {
+        (sweep.omega_ratio_from, sweep.omega_ratio_to)
+    } else {
+        (sweep.omega_ratio_to, sweep.omega_ratio_from)
+    };
+    // Halving from max_step down to min_step, plus one attempt at min_step.
+    let halvings = (sweep.max_step / sweep.min_step).log2().ceil().max(0.0) as usize + 2;
+    let options = ContinuationOptions {
+        initial_step: sweep.step,
+        min_step: sweep.min_step,
+        max_step: sweep.max_step,
+        target_iterations: TARGET_ITERATIONS,
+        max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
+        corrector_tolerance: settings.tolerance,
+        parameter_min: lo / q_unit,
+        parameter_max: hi / q_unit,
+        max_points: sweep.max_points,
+        max_consecutive_failures: halvings.clamp(3, 64),
+        theta: THETA,
+        direction: if sweep.omega_ratio_to > sweep.omega_ratio_from {
+            Direction::Increasing
+        } else {
+            Direction::Decreasing
+        },
+        predictor: Predictor::Secant,
+        refine_folds: true,
+        ..ContinuationOptions::default()
+    };
+    options.validate().map_err(continuation_error)?;
+    Ok(options)
+}
+
+fn continuation_error(e: ContinuationError) -> RunError {
+    match e {
+        ContinuationError::InvalidOption {
+            name,
+            value,
+            allowed,
+        } => {
+            let name = match name {
+                "initial_step" => "sweep.step",
+                "min_step" => "sweep.min_step",
+                "max_step" => "sweep.max_step",
+                "max_points" => "sweep.max_points",
+                "corrector_tolerance" => "solver.tolerance",
+                "parameter_max" | "parameter_min" => "sweep.omega_ratio_to",
+                other => other,
+            };
+            invalid(name, value, allowed)
+        }
+        ContinuationError::DimensionMismatch { expected, found } => {
+            RunError::HarmonicBalance(HbError::DimensionMismatch {
+                what: "continuation state",
+                expected,
+                found,
+            })
+        }
+        ContinuationError::InvalidStart { parameter, .. } => invalid(
+            "sweep.omega_ratio_from",
+            parameter,
+            "within the sweep interval",
+        ),
+        // Handled by the caller (a non-converged curve); kept total here.
+        ContinuationError::StartNotConverged { parameter, .. } => invalid(
+            "sweep.omega_ratio_from",
+            parameter,
+            "a frequency where the start point can be corrected",
+        ),
+    }
+}
+
+fn newton_termination(report: &NewtonReport) -> String {
+    use newton::Termination as T;
+    match &report.termination {
+        T::Converged => "converged".into(),
+        T::MaxIterations => "max-iterations".into(),
+        T::Stalled => "stalled".into(),
+        T::LineSearchFailed => "line-search-failed".into(),
+        T::SingularJacobian(e) => format!("singular-jacobian: {e}"),
+        T::NonFinite => "non-finite".into(),
+    }
+}
+
+/// Reduces a state to `(tip_max, tip_min)` over one period.
+type TipMeasure<'m, P> = dyn FnMut(&P, &[f64]) -> Result<(f64, f64), RunError> + 'm;
+
+/// Everything `follow` needs besides the problem and the solver.
+struct Setup<'a> {
+    settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    omega_1: f64,
+    u_ref: f64,
+    dofs: usize,
+    /// Per unknown: 1 for displacements, the force unit for forces.
+    units: Vec<f64>,
+    output_points: usize,
+    started: Instant,
+}
+
+fn follow<P, S>(
+    problem: &mut P,
+    solver: &mut S,
+    setup: Setup<'_>,
+    measure: &mut TipMeasure<'_, P>,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError>
+where
+    P: GeneralizedJacobian + ParameterDependent,
+    S: LinearSolve<P::Jacobian>,
+{
+    let Setup {
+        settings,
+        sweep,
+        omega_1,
+        u_ref,
+        dofs,
+        units,
+        output_points,
+        started,
+    } = setup;
+    let n = problem.dim();
+    // q = (ω/ω_1) / sqrt(1 - θ): (1 - θ) Δq² = Δ(ω/ω_1)².
+    let q_unit = (1.0 - THETA).sqrt();
+    let omega_unit = q_unit * omega_1;
+    let options = continuation_options(settings, sweep, q_unit)?;
+    // x = s ⊙ y with s² = θ N u_ref² / n: (θ/n)|Δy|² = |ΔX|² / (N u_ref²).
+    let base = (THETA * dofs as f64 / n as f64).sqrt() * u_ref;
+    let scale: Vec<f64> = units.iter().map(|u| u * base).collect();
+
+    let omega_from = sweep.omega_ratio_from * omega_1;
+    problem.set_parameter(omega_from);
+    let mut x = vec![0.0; n];
+    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
+    let mut counters = RunCounters::from(report.counters);
+    let mut response = FrequencyResponse {
+        method: settings.method,
+        omega_1,
+        omega: Vec::new(),
+        tip_max: Vec::new(),
+        tip_min: Vec::new(),
+        amplitude: Vec::new(),
+        iterations: Vec::new(),
+        folds: Vec::new(),
+        fold_indices: Vec::new(),
+        converged: false,
+        termination: String::new(),
+        solve_seconds: 0.0,
+        counters,
+        continuation: ContinuationCounters::default(),
+        initial_iterations: report.iterations,
+        restarts: 0,
+        reference_amplitude: u_ref,
+        output_points,
+        states: Vec::new(),
+    };
+    if !report.converged() {
+        response.termination = format!(
+            "the start at omega_ratio {} did not converge: {} after {} iterations (|F| = {:e})",
+            sweep.omega_ratio_from,
+            newton_termination(&report),
+            report.iterations,
+            report.residual_norm()
+        );
+        response.solve_seconds = started.elapsed().as_secs_f64();
+        return Ok(response);
+    }
+
+    let y0: Vec<f64> = x.iter().zip(&scale).map(|(x, s)| x / s).collect();
+    let max_step = options.max_step;
+    let trust = Rc::new(RefCell::new(Trust::default()));
+    let mut scaled = Scaled {
+        inner: problem,
+        scale: &scale,
+        omega_unit,
+        x: vec![0.0; n],
+        trust: trust.clone(),
+    };
+    let mut scaled_solver = ScaledSolver {
+        inner: solver,
+        scale: &scale,
+    };
+    let q0 = omega_from / omega_unit;
+    let base_points = options.max_points;
+    // Segments: the main continuation, and after a failure a short one with the state-heavy
+    // metric (THETA_RESTART) from the last accepted point, then the main one again.
+    let mut start_y = y0;
+    let mut start_q = q0;
+    let mut direction = options.direction;
+    let mut restart = false;
+    let mut restarts = 0;
+    let mut raw_events: Vec<(usize, f64)> = Vec::new();
+    let mut c = ContinuationCounters::default();
+    let mut start_failure = None;
+    let mut last_tangent_parameter = 0.0;
+    let termination = loop {
+        let offset = response.omega.len();
+        let remaining = base_points.saturating_sub(offset);
+        let segment_options = ContinuationOptions {
+            theta: if restart { THETA_RESTART } else { THETA },
+            max_points: if restart {
+                RESTART_POINTS + 1
+            } else {
+                remaining + usize::from(offset > 0)
+            }
+            .min(remaining + usize::from(offset > 0))
+            .max(1),
+            direction,
+            ..options.clone()
+        };
+        let mut cont = Continuation::new(
+            &mut scaled,
+            &mut scaled_solver,
+            &start_y,
+            start_q,
+            segment_options,
+        )
+        .map_err(continuation_error)?;
+        let mut first = true;
+        while let Some(item) = cont.next() {
+            let point = match item {
+                Ok(point) => point,
+                Err(ContinuationError::StartNotConverged { failure, .. }) => {
+                    start_failure = Some(failure);
+                    break;
+                }
+                Err(e) => return Err(continuation_error(e)),
+            };
+            {
+                // Next attempts: at most 2 * this step (the step control's growth bound).
+                let mut t = trust.borrow_mut();
+                t.center.clone_from(&point.state);
+                t.center_q = point.parameter;
+                let next = if point.step > 0.0 {
+                    (2.0 * point.step).min(max_step)
+                } else {
+                    max_step
+                };
+                t.radius = TRUST_FACTOR * next;
+            }
+            // The start of a restarted segment repeats the last point.
+            if std::mem::take(&mut first) && offset > 0 {
+                continue;
+            }
+            last_tangent_parameter = point.tangent_parameter;
+            let state: Vec<f64> = point.state.iter().zip(&scale).map(|(y, s)| y * s).collect();
+            let omega = point.parameter * omega_unit;
+            let (max, min) = measure(&*cont.problem().inner, &state)?;
+            response.omega.push(omega);
+            response.tip_max.push(max);
+            response.tip_min.push(min);
+            response.amplitude.push(max.abs().max(min.abs()));
+            response.iterations.push(point.iterations);
+            response.states.push(state);
+            start_y = point.state;
+            start_q = point.parameter;
+            if let Some(report) = progress {
+                report(response.omega.len() - 1, omega / omega_1);
+            }
+        }
+        let shift = offset.saturating_sub(1);
+        for event in cont.events() {
+            if let ContinuationEvent::Fold { index, parameter } = event {
+                raw_events.push((index + shift, parameter * omega_unit));
+            }
+        }
+        add_counters(&mut c, &cont.counters());
+        let termination = cont.termination().cloned();
+        drop(cont);
+        if start_failure.is_some() {
+            break termination;
+        }
+        let failed = matches!(
+            termination,
+            Some(
+                ContinuationTermination::StepTooSmall { .. }
+                    | ContinuationTermination::TooManyFailures { .. }
+            )
+        );
+        let short_done =
+            restart && matches!(termination, Some(ContinuationTermination::MaxPoints { .. }));
+        if response.omega.len() >= base_points {
+            break termination;
+        }
+        if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
+            restarts += 1;
+            restart = true;
+        } else if short_done {
+            restart = false;
+        } else {
+            break termination;
+        }
+        direction = if last_tangent_parameter > 0.0 {
+            Direction::Increasing
+        } else {
+            Direction::Decreasing
+        };
+    };
+    let (folds, indices) = folds_from_branch(&response.omega, &raw_events);
+    response.folds = folds;
+    response.fold_indices = indices;
+    response.restarts = restarts;
+    counters.residual_evaluations += c.residual_evaluations;
+    counters.jacobian_evaluations += c.jacobian_evaluations;
+    counters.factorizations += c.factorizations + c.dense_bordered_factorizations;
+    counters.linear_solves += c.linear_solves;
+    counters.ffts += c.ffts;
+    response.counters = counters;
+    response.continuation = c;
+    let to_q = sweep.omega_ratio_to / q_unit;
+    let ratio = |q: f64| q * q_unit;
+    let (converged, words) = match (&termination, start_failure) {
+        (_, Some(failure)) => (
+            false,
+            format!("the start point could not be corrected: {failure}"),
+        ),
+        (Some(ContinuationTermination::ReachedBound { parameter, bound }), None) => {
+            let reached_end = *bound == to_q;
+            let at_bound = *parameter == *bound;
+            (
+                reached_end,
+                format!(
+                    "reached omega_ratio {}{}",
+                    ratio(*bound),
+                    if reached_end {
+                        if at_bound {
+                            " (the end of the sweep)".to_string()
+                        } else {
+                            format!(
+                                " (the end of the sweep; last point at {} not re-solved on it)",
+                                ratio(*parameter)
+                            )
+                        }
+                    } else {
+                        " (the start of the sweep: the branch turned back)".to_string()
+                    }
+                ),
+            )
+        }
+        (Some(ContinuationTermination::MaxPoints { points }), None) => (
+            false,
+            format!(
+                "point limit ({points} points) at omega_ratio {}",
+                response.omega.last().map_or(f64::NAN, |w| w / omega_1)
+            ),
+        ),
+        (
+            Some(ContinuationTermination::StepTooSmall {
+                parameter,
+                step,
+                failure,
+                ..
+            }),
+            None,
+        ) => (
+            false,
+            format!(
+                "step too small at omega_ratio {}: the attempt with step {step:e} failed: {failure}",
+                ratio(*parameter)
+            ),
+        ),
+        (
+            Some(ContinuationTermination::TooManyFailures {
+                parameter,
+                failures,
+                failure,
+                ..
+            }),
+            None,
+        ) => (
+            false,
+            format!(
+                "{failures} failed steps in a row at omega_ratio {}: {failure}",
+                ratio(*parameter)
+            ),
+        ),
+        (None, None) => (false, "stopped without a reason".to_string()),
+    };
+    response.converged = converged;
+    response.termination = words;
+    response.solve_seconds = started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
+    total.residual_evaluations += c.residual_evaluations;
+    total.jacobian_evaluations += c.jacobian_evaluations;
+    total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
+    total.factorizations += c.factorizations;
+    total.linear_solves += c.linear_solves;
+    total.dense_bordered_factorizations += c.dense_bordered_factorizations;
+    total.ffts += c.ffts;
+    total.corrector_iterations += c.corrector_iterations;
+    total.rejected_iterations += c.rejected_iterations;
+    total.rejected_steps += c.rejected_steps;
+}
+
+/// Folds as the local extrema of `ω` along the branch (sign changes of its increments).
+/// Each is reported at the interpolated fold of a continuation event within one point of
+/// it when that lies beyond the extreme point (cubic Hermite refinement), else at the
+/// extreme point. Events without a reversal of `ω` (a tangent orientation flipped on a
+/// sharply turning branch) are dropped.
+fn folds_from_branch(omega: &[f64], events: &[(usize, f64)]) -> (Vec<f64>, Vec<usize>) {
+    let mut folds = Vec::new();
+    let mut indices = Vec::new();
+    let mut last_sign = 0.0;
+    let mut last_index = 0;
+    for i in 1..omega.len() {
+        let inc = omega[i] - omega[i - 1];
+        if inc == 0.0 {
+            continue;
+        }
+        let sign = inc.signum();
+        if last_sign != 0.0 && sign != last_sign {
+            // The extreme is the point before this increment.
+            let k = i - 1;
+            let w = omega[k];
+            let reach = (omega[k] - omega[last_index]).abs().max(inc.abs());
+            let refined = events
+                .iter()
+                .filter(|(index, _)| index.abs_diff(k) <= 2)
+                .map(|(_, p)| *p)
+                .filter(|p| (p - w) * last_sign >= 0.0 && (p - w).abs() <= reach)
+                .fold(w, |best, p| {
+                    if (p - best) * last_sign > 0.0 {
+                        p
+                    } else {
+                        best
+                    }
+                });
+            folds.push(refined);
+            indices.push(k);
+        }
+        last_sign = sign;
+        last_index = i - 1;
+    }
+    (folds, indices)
+}
+
+/// Reconstructs one dof over a period from HB coefficients (index `j N + dof`).
+struct HbTip {
+    aft: Aft,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+    dofs: usize,
+    dof: usize,
+}
+
+impl HbTip {
+    fn new(harmonics: usize, points: usize, dofs: usize, dof: usize) -> Result<Self, RunError> {
+        let basis = FourierBasis::new(harmonics, points).map_err(HbError::from)?;
+        Ok(Self {
+            aft: Aft::new(basis),
+            coeffs: vec![0.0; 2 * harmonics + 1],
+            samples: vec![0.0; points],
+            dofs,
+            dof,
+        })
+    }
+
+    fn extremes(&mut self, x: &[f64]) -> Result<(f64, f64), RunError> {
+        for (j, c) in self.coeffs.iter_mut().enumerate() {
+            *c = x[j * self.dofs + self.dof];
+        }
+        self.aft
+            .to_time(&self.coeffs, &mut self.samples)
+            .map_err(HbError::from)?;
+        Ok(extremes(&self.samples))
+    }
+}
+
+fn extremes(samples: &[f64]) -> (f64, f64) {
+    samples
+        .iter()
+        .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), v| {
+            (hi.max(*v), lo.min(*v))
+        })
+}
+
+/// Frequency-response curve of the rod with the scene's method (module documentation):
+/// globalized Newton at `omega_ratio_from`, then pseudo-arclength continuation in `ω` up to
+/// `omega_ratio_to`. `progress(index, omega_ratio)` is called after each accepted point.
+///
+/// `Err` when the sweep could not start (bad settings, unsupported method, a model the
+/// method cannot build); a branch that stopped early is an `Ok` curve with
+/// `converged = false` and the reason in `termination`.
+pub fn frequency_response(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    check_sweep(sweep)?;
+    let started = Instant::now();
+    let model = &rod.model;
+    let tip = rod.tip_dof();
+    let dofs = model.dofs();
+    let omega_1 = rod.omega_1;
+    let u_ref = reference_amplitude(rod);
+    let output_points = HB_OUTPUT_POINTS.max(settings.time_samples);
+    let setup = |units: Vec<f64>, output_points: usize| Setup {
+        settings,
+        sweep,
+        omega_1,
+        u_ref,
+        dofs,
+        units,
+        output_points,
+        started,
+    };
+    match settings.method {
+        Method::SsnHb => {
+            let options = HbOptions {
+                harmonics: settings.harmonics,
+                time_samples: Some(settings.time_samples),
+                c: settings.c,
+            };
+            let mut problem = SsnHb::new(model, &options)?;
+            let split = problem.displacement_len();
+            let c = problem.c();
+            let units = (0..problem.dim())
+                .map(|i| if i < split { 1.0 } else { c })
+                .collect();
+            let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
+            let mut measure = |_: &SsnHb, x: &[f64]| tip_rec.extremes(x);
+            let setup = setup(units, output_points);
+            match settings.linear_solver {
+                LinearSolverChoice::Structured => follow(
+                    &mut problem,
+                    &mut StructuredHbSolver::new(),
+                    setup,
+                    &mut measure,
+                    progress,
+                ),
+                LinearSolverChoice::Dense => follow(
+                    &mut problem,
+                    &mut FaerDenseLu::new(),
+                    setup,
+                    &mut measure,
+                    progress,
+                ),
+            }
+        }
+        Method::PenaltyHb => {
+            let options = PenaltyHbOptions {
+                harmonics: settings.harmonics,
+                time_samples: Some(settings.time_samples),
+                penalty_stiffness: settings
+                    .penalty_stiffness
+                    .unwrap_or(DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()),
+            };
+            let mut problem = PenaltyHb::new(model, &options)?;
+            let units = vec![1.0; problem.dim()];
+            let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
+            let mut measure = |_: &PenaltyHb, x: &[f64]| tip_rec.extremes(x);
+            let setup = setup(units, output_points);
+            match settings.linear_solver {
+                LinearSolverChoice::Structured => follow(
+                    &mut problem,
+                    &mut StructuredHbSolver::new(),
+                    setup,
+                    &mut measure,
+                    progress,
+                ),
+                LinearSolverChoice::Dense => follow(
+                    &mut problem,
+                    &mut FaerDenseLu::new(),
+                    setup,
+                    &mut measure,
+                    progress,
+                ),
+            }
+        }
+        Method::LcpSsn => {
+            if model.contacts.is_empty() {
+                return Err(RunError::Unsupported {
+                    method: "lcp-ssn",
+                    what: "a [contact] section (the periodic LCP is posed on the contact \
+                           forces); sweep the linear rod with ssn-hb or penalty-hb",
+                });
+            }
+            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
+            let options = PeriodicLcpOptions {
+                time_samples: settings.time_samples,
+                observed_dofs: if tip_contact.is_some() {
+                    Vec::new()
+                } else {
+                    vec![tip]
+                },
+            };
+            let mut start_model = model.clone();
+            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
+            let mut problem = OwnedLcp::new(&start_model, options)?;
+            // z are contact forces: divide by the contact stiffness scale to get lengths.
+            let units = vec![model.contact_stiffness_scale(); problem.dim()];
+            let output_points = settings.time_samples;
+            let mut measure = |p: &OwnedLcp, z: &[f64]| -> Result<(f64, f64), RunError> {
+                // The stored LCP is normally the one of the accepted point; rebuild if not.
+                let rebuilt;
+                let lcp = match p.lcp.as_ref() {
+                    Some(lcp) if p.built_for.to_bits() == p.omega.to_bits() => lcp,
+                    _ => {
+                        let mut m = p.model.clone();
+                        m.forcing.omega = p.omega;
+                        rebuilt = PeriodicLcp::new(&m, p.options.clone())?;
+                        &rebuilt
+                    }
+                };
+                let series = match tip_contact {
+                    Some(i) => lcp.contact_displacements(z)?.swap_remove(i),
+                    None => lcp.displacements(z)?.swap_remove(0),
+                };
+                Ok(extremes(&series))
+            };
+            follow(
+                &mut problem,
+                &mut FaerDenseLu::new(),
+                setup(units, output_points),
+                &mut measure,
+                progress,
+            )
+        }
+        Method::LcpLemke => Err(RunError::Unsupported {
+            method: "lcp-lemke",
+            what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
+                   sweep with ssn-hb, penalty-hb or lcp-ssn, or solve frequency by frequency \
+                   with `ssn solve`",
+        }),
+        Method::March => Err(RunError::Unsupported {
+            method: "march",
+            what: "a method continuable in omega (time marching has no equation to continue): \
+                   sweep with ssn-hb, penalty-hb or lcp-ssn, or march frequency by frequency \
+                   with `ssn solve`",
+        }),
+    }
+}
