@@ -179,6 +179,124 @@ fn print_solution(s: &Solution) {
     );
 }
 
+/// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
+/// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
+pub fn sweep(
+    path: &Path,
+    as_json: bool,
+    csv: Option<&Path>,
+    svg: Option<&Path>,
+    quiet: bool,
+) -> Result<(), CliError> {
+    let (scene, rod) = load(path)?;
+    let Some(settings) = scene.sweep.as_ref() else {
+        return Err(CliError::BadInput(format!(
+            "{}: no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
+            path.display()
+        )));
+    };
+    let bar = progress_spinner("sweep", quiet);
+    let progress = |points: usize, omega: f64| {
+        bar.set_message(format!(
+            "sweep: {points} points, omega/omega_1 = {:.4}",
+            omega / rod.omega_1
+        ));
+        bar.tick();
+    };
+    let response = crate::sweep::frequency_response(&rod, &scene.solver, settings, Some(&progress))
+        .map_err(|e| run_error(path, e))?;
+    bar.finish_and_clear();
+    let ratio = response.omega_ratio();
+    if let Some(csv) = csv {
+        let text = csv_table(
+            &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
+            &[
+                &response.omega,
+                &ratio,
+                &response.tip_max,
+                &response.tip_min,
+                &response.amplitude,
+            ],
+        );
+        write_atomically(csv, text.as_bytes())?;
+    }
+    if let Some(svg) = svg {
+        write_line_plot(
+            svg,
+            &PlotSpec {
+                title: scene
+                    .title
+                    .clone()
+                    .unwrap_or_else(|| "frequency response".into()),
+                x_label: "omega / omega_1".into(),
+                y_label: "max |u_tip|".into(),
+                log_log: false,
+            },
+            &[Series::new(
+                format!(
+                    "{} H = {}",
+                    scene.solver.method.name(),
+                    scene.solver.harmonics
+                ),
+                ratio.clone(),
+                response.amplitude.clone(),
+            )],
+        )?;
+    }
+    if as_json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&response.to_json()).expect("JSON of plain values")
+        );
+    } else {
+        println!(
+            "sweep             {} points, omega/omega_1 from {:.4} to {:.4}",
+            response.points(),
+            ratio.first().copied().unwrap_or(f64::NAN),
+            ratio.last().copied().unwrap_or(f64::NAN)
+        );
+        if let Some((i, a)) = response.peak() {
+            println!(
+                "peak amplitude    {a:.6} at omega/omega_1 = {:.4}",
+                ratio[i]
+            );
+        }
+        let folds: Vec<String> = response
+            .folds
+            .iter()
+            .map(|w| format!("{:.4}", w / rod.omega_1))
+            .collect();
+        println!(
+            "folds             {}",
+            if folds.is_empty() {
+                "none".into()
+            } else {
+                folds.join(", ")
+            }
+        );
+        println!(
+            "converged         {} ({}), {:.3} s",
+            response.converged, response.termination, response.solve_seconds
+        );
+    }
+    if response.converged {
+        Ok(())
+    } else {
+        Err(CliError::NotConverged)
+    }
+}
+
+/// A spinner on stderr when it is a terminal and not `quiet`.
+pub fn progress_spinner(message: &str, quiet: bool) -> indicatif::ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_message(message.to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
 /// The resolved model of a scene, in words (`ssn scene-check`).
 pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
     use crate::rod::{DampingSpec, FrequencySpec, LoadKind};

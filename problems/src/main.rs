@@ -63,6 +63,27 @@ enum Command {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+    /// Follow the response in frequency (pseudo-arclength continuation) over the scene's
+    /// [sweep] range.
+    #[command(
+        after_help = "Examples:\n  ssn sweep problems/scenes/paper_fig2.toml\n  \
+        ssn sweep problems/scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
+        JSON fields: points, omega, tip_max, tip_min, amplitude (arrays in branch order),\n  \
+        folds (omega where the branch turns), converged, termination, solve_seconds, counters\n\n"
+    )]
+    Sweep {
+        /// Scene file (TOML) with a [sweep] section.
+        scene: PathBuf,
+        /// Print the branch as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+        /// Write the branch as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Write the frequency response as SVG.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
     /// Validate a scene and print the resolved model (natural frequencies, effects present).
     #[command(after_help = "Example:\n  ssn scene-check problems/scenes/two_contacts.toml\n\n")]
     SceneCheck {
@@ -89,6 +110,14 @@ fn main() -> ExitCode {
             csv,
             svg,
         }) => semismooth_problems::cli::solve(scene, *json, csv.as_deref(), svg.as_deref()),
+        Some(Command::Sweep {
+            scene,
+            json,
+            csv,
+            svg,
+        }) => {
+            semismooth_problems::cli::sweep(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
+        }
     }
     .map_err(|e| match e {
         semismooth_problems::cli::CliError::NotConverged => Failure::NotConverged,
