@@ -291,6 +291,19 @@ fn cross_check(case: &str, outcomes: &[Outcome], methods: &[Method]) {
             lcp.stats.min
         );
     }
+    if let (Some(e), Some(p)) = (find(Method::SsnHb), find(Method::PenaltyHb)) {
+        // Same harmonics and quadrature; both within the truncation bound of the exact
+        // periodic answer, the penalty also within its own penetration max|λ| / k_p.
+        let tol = hb_penetration_bound(e) + hb_penetration_bound(p) + p.stats.max_penetration;
+        let diff = (e.stats.min - p.stats.min).abs();
+        println!("HARD | {case:<34} | cross-check ssn-hb vs penalty-hb tip min: diff {diff:.2e} (tol {tol:.2e})");
+        assert!(
+            diff <= tol,
+            "{case}: SSN-HB tip min {} vs penalty {}",
+            e.stats.min,
+            p.stats.min
+        );
+    }
     if let (Some(a), Some(b)) = (find(Method::LcpLemke), find(Method::LcpSsn)) {
         // Same LCP, two solvers: the solution of a P-matrix LCP is unique; 1e-8 of the
         // amplitude covers the Newton tolerance 1e-10 on the forces times the compliance.
@@ -334,6 +347,7 @@ fn preloaded_contact_negative_gap() {
     // Lemke is checked separately below (its accuracy here is the open question).
     let methods = [Method::SsnHb, Method::PenaltyHb, Method::LcpSsn];
     let out = run_all("gap = -0.1 (preload)", &with_gap(-0.1), &hb(20), &methods);
+    cross_check("gap = -0.1 (preload)", &out, &methods);
     // Preloaded: the mean contact force is strictly compressive, and at least the static
     // preload: the rod pushed back by 0.1 over its length needs EA/L * 0.1 = 0.1.
     for s in out.iter().filter_map(Outcome::converged) {
@@ -413,7 +427,8 @@ fn many_harmonics_h100_nt4096() {
     let mut s = hb(100);
     s.time_samples = 4096;
     // The periodic LCP at 4096 steps is a dense 4096 x 4096 problem: not run here.
-    run_all("H = 100, Nt = 4096", &canonical(), &s, &HB_ONLY);
+    let out = run_all("H = 100, Nt = 4096", &canonical(), &s, &HB_ONLY);
+    cross_check("H = 100, Nt = 4096", &out, &HB_ONLY);
 }
 
 fn two_thousand_element_rod() -> RodSpec {
