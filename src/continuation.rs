@@ -10,6 +10,7 @@
 //! <(a, α), (b, β)>_θ = (θ / n) a·b + (1 - θ) α β,        |y|_θ = sqrt(<y, y>_θ),
 //! ```
 //!
+//! (with [`ContinuationOptions::state_scale`] `s`, `a·b` becomes `Σ a_i b_i / s_i^2`),
 //! and step lengths `ds` are lengths in that norm. From an accepted point `y0` with unit
 //! direction `t` (tangent for the first step, secant afterwards by default) the predictor is
 //! `y0 + ds t`; the corrector is Newton on the bordered system
@@ -23,7 +24,9 @@
 //! solves, `J a = F_p` and `J b = F`: `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`.
 //! The bordered matrix is never assembled, so structured Jacobians (sparse, condensed)
 //! keep their structure. The tangent at the converged point comes for free from the last
-//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`).
+//! `a`: it is `±(-a, 1)` normalised (the kernel of `[J, F_p]`), with `J` and `F_p` from
+//! the last corrector iteration, i.e. at the iterate before the converged one (an error
+//! of the size of the last correction; the corrector always takes at least one step).
 //!
 //! # Folds and the dense fallback
 //!
@@ -54,11 +57,21 @@
 //! between consecutive accepted points, and located by cubic Hermite interpolation of
 //! `p(s)` (values and slopes `dp/ds = t_p` at both points).
 //!
+//! The corrector takes full Newton steps unless
+//! [`ContinuationOptions::corrector_line_search`] asks for Armijo backtracking on
+//! `(|F|^2 + N^2) / 2` ([`crate::linesearch::backtrack`]).
+//!
 //! # Style
 //!
 //! [`Continuation`] is an [`Iterator`] over accepted points (BifurcationKit's style); the
 //! first item is the starting point corrected at fixed `p0`. [`Continuation::run`] collects a
-//! whole [`Branch`].
+//! whole [`Branch`]. [`natural_sweep`] solves at a list of parameters with
+//! [`crate::newton`] from the previous solution, for comparison: it fails or jumps at folds.
+//!
+//! References: H. B. Keller, *Numerical solution of bifurcation and nonlinear eigenvalue
+//! problems* (1977); E. Allgower & K. Georg, *Numerical Continuation Methods* (1990), for
+//! the bordered system and its block elimination; BifurcationKit.jl (`Palc`) for the
+//! θ-weighted arclength and the iterator; NLvib for the step bounds.
 //!
 //! ```
 //! use faer::Mat;
@@ -97,6 +110,8 @@ use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut};
 
 use crate::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use crate::linesearch::{backtrack, LineSearchOptions};
+use crate::newton::{NewtonError, NewtonOptions, NewtonSolver, Termination, WorkCounters};
 use crate::{GeneralizedJacobian, LinearSolve, ParameterDependent};
 
 /// Relative size below which the block-elimination pivot `w_p - w_x·a` is treated as zero:
@@ -173,10 +188,19 @@ pub struct ContinuationOptions {
     /// Weight `θ` in `(0, 1)` between the state (`θ/n` per component) and the parameter
     /// (`1 - θ`) in the arclength. Default `0.5`.
     pub theta: f64,
+    /// Typical magnitude `s_i > 0` of each unknown (length `n`): the state part of the
+    /// inner product becomes `(θ/n) Σ a_i b_i / s_i^2`, so that unknowns of different
+    /// units (displacements and contact forces) weigh alike. Default `None` (all `1`).
+    pub state_scale: Option<Vec<f64>>,
     /// Direction of the parameter on the first step. Default [`Direction::Increasing`].
     pub direction: Direction,
     /// Predictor after the first step. Default [`Predictor::Secant`].
     pub predictor: Predictor,
+    /// Backtracking (Armijo) on the corrector's merit `(|F|^2 + N^2) / 2` along each
+    /// bordered Newton correction; `None` takes full steps. Default `None` (the predictor
+    /// is usually close enough; a line search helps nonsmooth problems whose full steps
+    /// jump between active sets, and a poor starting guess).
+    pub corrector_line_search: Option<LineSearchOptions>,
     /// Locate folds by cubic Hermite interpolation of `p(s)` between the two points that
     /// bracket the sign change (otherwise the fold is reported at the parameter of the
     /// point after the sign change). Default `true`.
@@ -198,8 +222,10 @@ impl Default for ContinuationOptions {
             max_points: 1000,
             max_consecutive_failures: 3,
             theta: 0.5,
+            state_scale: None,
             direction: Direction::Increasing,
             predictor: Predictor::Secant,
+            corrector_line_search: None,
             refine_folds: true,
         }
     }
@@ -290,6 +316,21 @@ impl ContinuationOptions {
         if !(self.theta > 0.0 && self.theta < 1.0) {
             return Err(invalid("theta", self.theta, "in the open interval (0, 1)"));
         }
+        if let Some(scale) = &self.state_scale {
+            if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+                return Err(invalid("state_scale", bad, "finite and > 0 entries"));
+            }
+        }
+        if let Some(ls) = &self.corrector_line_search {
+            ls.validate().map_err(|e| {
+                let name = match e.name {
+                    "sufficient_decrease" => "corrector_line_search.sufficient_decrease",
+                    "shrink" => "corrector_line_search.shrink",
+                    _ => "corrector_line_search.min_step",
+                };
+                invalid(name, e.value, e.allowed)
+            })?;
+        }
         Ok(())
     }
 }
@@ -364,6 +405,16 @@ pub enum CorrectorFailure {
         iteration: usize,
         /// The solver's error.
         error: LinearSolveError,
+    },
+    /// The corrector's line search found no step with sufficient decrease.
+    #[error("line search failed at iteration {iteration} (|F| = {residual_norm:e}, last step {last_step:e})")]
+    LineSearchFailed {
+        /// Iteration at which it happened.
+        iteration: usize,
+        /// `|F|` at the iterate.
+        residual_norm: f64,
+        /// The last step length tried.
+        last_step: f64,
     },
     /// The block-elimination pivot `w_p - w_x·a` vanished and no dense fallback is set.
     #[error("bordered system singular at iteration {iteration}: pivot w_p - w_x·a = {pivot:e}")]
@@ -455,20 +506,16 @@ impl std::fmt::Display for ContinuationTermination {
 /// Work done by a continuation run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ContinuationCounters {
-    /// Evaluations of `F`.
-    pub residual_evaluations: u64,
-    /// Evaluations of the Jacobian.
-    pub jacobian_evaluations: u64,
-    /// Evaluations of `F_p` (each may cost residual evaluations inside the problem).
+    /// The Newton-style counters: residual evaluations (line-search trials included),
+    /// Jacobian evaluations and `factor` calls (one each per corrector iteration), solves
+    /// (two per corrector iteration with block elimination), corrector line-search
+    /// backtracks, and the FFTs the problem counted during the run.
+    pub work: WorkCounters,
+    /// Evaluations of `F_p` (each may cost residual evaluations inside the problem, which
+    /// are not counted in `work`).
     pub parameter_derivative_evaluations: u64,
-    /// Calls of the linear solver's `factor` (one per corrector iteration).
-    pub factorizations: u64,
-    /// Calls of the linear solver's `solve_in_place` (two per corrector iteration).
-    pub linear_solves: u64,
     /// Dense LU factorizations of the assembled bordered matrix (fallback).
     pub dense_bordered_factorizations: u64,
-    /// FFTs counted by the problem during the run.
-    pub ffts: u64,
     /// Corrector iterations of all attempts, accepted or not, start and bound landing
     /// included.
     pub corrector_iterations: u64,
@@ -544,6 +591,10 @@ pub enum ContinuationError {
         /// Upper bound.
         max: f64,
     },
+    /// The Newton options of a natural sweep are invalid (or the state has the wrong
+    /// length).
+    #[error(transparent)]
+    Newton(#[from] NewtonError),
     /// The starting point could not be corrected at fixed parameter.
     #[error("the starting point could not be corrected at p = {parameter}: {failure}")]
     StartNotConverged {
@@ -561,11 +612,15 @@ type DenseAssembler<J> = fn(&J, MatMut<'_, f64>);
 struct Work<J> {
     n: usize,
     theta: f64,
+    /// `1 / s_i^2` from [`ContinuationOptions::state_scale`] (empty: all ones).
+    weights: Vec<f64>,
     jac: J,
     f: Vec<f64>,
     fp: Vec<f64>,
     a: Vec<f64>,
     b: Vec<f64>,
+    /// Line-search trial state.
+    trial: Vec<f64>,
     /// θ-weighted constraint row `w_x`.
     w: Vec<f64>,
     /// Raw (unnormalised) tangent from the last iteration, length `n + 1`, with positive
@@ -576,15 +631,19 @@ struct Work<J> {
 }
 
 impl<J> Work<J> {
-    fn new(n: usize, theta: f64, jac: J) -> Self {
+    fn new(n: usize, theta: f64, scale: Option<&[f64]>, jac: J) -> Self {
         Self {
             n,
             theta,
+            weights: scale
+                .map(|s| s.iter().map(|v| 1.0 / (v * v)).collect())
+                .unwrap_or_default(),
             jac,
             f: vec![0.0; n],
             fp: vec![0.0; n],
             a: vec![0.0; n],
             b: vec![0.0; n],
+            trial: vec![0.0; n],
             w: vec![0.0; n],
             tangent: vec![0.0; n + 1],
             dense: None,
@@ -593,7 +652,15 @@ impl<J> Work<J> {
 
     /// `<(ax, ap), (bx, bp)>_θ`.
     fn dot(&self, ax: &[f64], ap: f64, bx: &[f64], bp: f64) -> f64 {
-        let s: f64 = ax.iter().zip(bx).map(|(u, v)| u * v).sum();
+        let s: f64 = if self.weights.is_empty() {
+            ax.iter().zip(bx).map(|(u, v)| u * v).sum()
+        } else {
+            ax.iter()
+                .zip(bx)
+                .zip(&self.weights)
+                .map(|((u, v), w)| u * v * w)
+                .sum()
+        };
         self.theta / self.n as f64 * s + (1.0 - self.theta) * ap * bp
     }
     fn norm(&self, x: &[f64], p: f64) -> f64 {
@@ -646,10 +713,15 @@ where
     let n = ws.n;
     *smallest = f64::INFINITY;
     let mut last_step_norm = f64::INFINITY;
+    // Whether ws.f already holds F at (x, p) (the line search's accepted trial).
+    let mut fresh = false;
     for k in 0..=options.max_corrector_iterations {
         problem.set_parameter(*p);
-        problem.residual(x, &mut ws.f);
-        counters.residual_evaluations += 1;
+        if !fresh {
+            problem.residual(x, &mut ws.f);
+            counters.work.residual_evaluations += 1;
+        }
+        fresh = false;
         if !all_finite(&ws.f) {
             return Err(CorrectorFailure::NonFinite { iteration: k });
         }
@@ -682,7 +754,7 @@ where
         let n_value = w_x_dot_x + constraint.w_p * *p - constraint.target;
 
         problem.jacobian(x, &mut ws.jac);
-        counters.jacobian_evaluations += 1;
+        counters.work.jacobian_evaluations += 1;
         problem.residual_parameter_derivative(x, &mut ws.fp);
         counters.parameter_derivative_evaluations += 1;
         // The default F_p moves the parameter and restores it; make sure it is ours.
@@ -691,7 +763,7 @@ where
             return Err(CorrectorFailure::NonFinite { iteration: k });
         }
         counters.corrector_iterations += 1;
-        counters.factorizations += 1;
+        counters.work.factorizations += 1;
         let block = match solver.factor(&ws.jac) {
             Ok(()) => block_elimination(solver, ws, constraint, n_value, counters, k)?,
             Err(error) => BlockOutcome::NeedsFallback(CorrectorFailure::LinearSolve {
@@ -718,14 +790,50 @@ where
         if !all_finite(&ws.b) || !dp.is_finite() || !all_finite(&ws.tangent) {
             return Err(CorrectorFailure::NonFinite { iteration: k });
         }
-        for (xi, di) in x.iter_mut().zip(&ws.b) {
-            *xi += di;
+        let mut alpha = 1.0;
+        if let Some(ls) = &options.corrector_line_search {
+            let merit0 = 0.5 * (r * r + n_value * n_value);
+            let mut evaluations = 0;
+            let searched = backtrack(merit0, -2.0 * merit0, ls, |t| {
+                for ((yi, xi), di) in ws.trial.iter_mut().zip(x.iter()).zip(&ws.b) {
+                    *yi = xi + t * di;
+                }
+                problem.set_parameter(*p + t * dp);
+                problem.residual(&ws.trial, &mut ws.f);
+                evaluations += 1;
+                // N is linear: after a fraction t of the correction it is (1 - t) N.
+                let nt = (1.0 - t) * n_value;
+                0.5 * (ws.f.iter().map(|v| v * v).sum::<f64>() + nt * nt)
+            });
+            counters.work.residual_evaluations += evaluations;
+            match searched {
+                Ok(accepted) => {
+                    counters.work.line_search_backtracks += accepted.backtracks;
+                    alpha = accepted.step;
+                    fresh = true;
+                }
+                Err(failed) => {
+                    counters.work.line_search_backtracks += failed.backtracks;
+                    return Err(CorrectorFailure::LineSearchFailed {
+                        iteration: k,
+                        residual_norm: r,
+                        last_step: failed.last_step,
+                    });
+                }
+            }
         }
-        *p += dp;
-        last_step_norm = ws.norm(&ws.b, dp);
+        for (xi, di) in x.iter_mut().zip(&ws.b) {
+            *xi += alpha * di;
+        }
+        *p += alpha * dp;
+        last_step_norm = alpha * ws.norm(&ws.b, dp);
         debug_assert_eq!(ws.tangent.len(), n + 1);
     }
-    unreachable!("the loop returns at k == max_corrector_iterations")
+    // Not reached: the loop returns at k == max_corrector_iterations.
+    Err(CorrectorFailure::MaxIterations {
+        iterations: options.max_corrector_iterations,
+        residual_norm: *smallest,
+    })
 }
 
 enum BlockOutcome {
@@ -751,7 +859,7 @@ where
     let n = ws.n;
     ws.a.copy_from_slice(&ws.fp);
     ws.b.copy_from_slice(&ws.f);
-    counters.linear_solves += 2;
+    counters.work.linear_solves += 2;
     for rhs in [&mut ws.a, &mut ws.b] {
         if let Err(error) = solver.solve_in_place(rhs) {
             return Ok(BlockOutcome::NeedsFallback(CorrectorFailure::LinearSolve {
@@ -882,8 +990,10 @@ enum Phase {
 
 /// Pseudo-arclength continuation as an iterator over accepted [`BranchPoint`]s.
 ///
-/// The first item is the starting point corrected at fixed `p0` (plain Newton, no line
-/// search: start close to a solution, e.g. from a [`crate::newton`] solve). An `Err` item
+/// The first item is the starting point corrected at fixed `p0` by the continuation's own
+/// corrector (Newton, with the line search of
+/// [`ContinuationOptions::corrector_line_search`] if set; from a poor guess, solve first
+/// with [`crate::newton`]). An `Err` item
 /// (the start could not be corrected) ends the iteration. When the iteration ends,
 /// [`Continuation::termination`] says why, [`Continuation::events`] lists the folds and the
 /// problem's parameter is that of the last accepted point.
@@ -945,7 +1055,21 @@ where
                 max: options.parameter_max,
             });
         }
-        let ws = Work::new(n, options.theta, problem.new_jacobian());
+        if let Some(scale) = &options.state_scale {
+            if scale.len() != n {
+                return Err(ContinuationError::InvalidOption {
+                    name: "state_scale",
+                    value: scale.len() as f64,
+                    allowed: "one entry per unknown (the problem's dimension)",
+                });
+            }
+        }
+        let ws = Work::new(
+            n,
+            options.theta,
+            options.state_scale.as_deref(),
+            problem.new_jacobian(),
+        );
         let fft_start = problem.fft_count();
         Ok(Self {
             problem,
@@ -984,7 +1108,7 @@ where
     /// Work done so far.
     pub fn counters(&self) -> ContinuationCounters {
         let mut c = self.counters;
-        c.ffts = self.problem.fft_count().saturating_sub(self.fft_start);
+        c.work.ffts = self.problem.fft_count().saturating_sub(self.fft_start);
         c
     }
 
@@ -1116,6 +1240,11 @@ where
             {
                 *xi = si + ds * di;
                 *wi = theta_x * di;
+            }
+            if !self.ws.weights.is_empty() {
+                for (wi, v) in self.ws.w.iter_mut().zip(&self.ws.weights) {
+                    *wi *= v;
+                }
             }
             let mut p = last.parameter + ds * self.direction[n];
             let w_p = (1.0 - self.options.theta) * self.direction[n];
@@ -1379,25 +1508,6 @@ where
     Continuation::new(problem, solver, x0, p0, options)?.run()
 }
 
-/// Options of [`natural_sweep`] (a plain Newton at each parameter, no line search).
-#[derive(Clone, Debug, PartialEq)]
-pub struct NaturalSweepOptions {
-    /// Converged when the 2-norm `|F| <= tolerance` (after at least one step). Default
-    /// `1e-10`.
-    pub tolerance: f64,
-    /// Newton iterations allowed per parameter. Default `50`.
-    pub max_iterations: usize,
-}
-
-impl Default for NaturalSweepOptions {
-    fn default() -> Self {
-        Self {
-            tolerance: 1e-10,
-            max_iterations: 50,
-        }
-    }
-}
-
 /// One solved point of a natural-parameter sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SweepPoint {
@@ -1418,8 +1528,12 @@ pub struct SweepFailure {
     pub index: usize,
     /// The parameter.
     pub parameter: f64,
-    /// Why Newton failed.
-    pub failure: CorrectorFailure,
+    /// Why Newton stopped.
+    pub termination: Termination,
+    /// Newton iterations spent there.
+    pub iterations: usize,
+    /// `|F|` at Newton's best iterate there.
+    pub residual_norm: f64,
 }
 
 /// Result of a natural-parameter sweep: the solved points in order, and the first failure
@@ -1430,48 +1544,29 @@ pub struct NaturalSweep {
     pub points: Vec<SweepPoint>,
     /// The first failure, if any.
     pub failure: Option<SweepFailure>,
-    /// Work done.
-    pub counters: ContinuationCounters,
+    /// Work done (summed over the Newton solves).
+    pub counters: WorkCounters,
 }
 
-/// Natural-parameter continuation: for each `p` in `parameters`, Newton at fixed `p` from
-/// the previous solution (`x0` for the first). At a fold it fails or jumps to another
-/// branch; it exists to be compared with the pseudo-arclength [`Continuation`]. The
-/// problem's parameter is left at the last solved point (or `parameters[0]`'s start).
+/// Natural-parameter continuation: for each `p` in `parameters`, semismooth Newton
+/// ([`crate::newton`], with `options`) at fixed `p` from the previous solution (`x0` for
+/// the first). At a fold it fails or jumps to another branch; it exists to be compared with
+/// the pseudo-arclength [`Continuation`]. Stops at the first failure; the problem's
+/// parameter is then left at the last solved point.
 pub fn natural_sweep<P, S>(
     problem: &mut P,
     solver: &mut S,
     x0: &[f64],
     parameters: &[f64],
-    options: &NaturalSweepOptions,
+    options: &NewtonOptions,
 ) -> Result<NaturalSweep, ContinuationError>
 where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: LinearSolve<P::Jacobian> + ?Sized,
 {
-    let corrector = ContinuationOptions {
-        corrector_tolerance: options.tolerance,
-        max_corrector_iterations: options.max_iterations,
-        ..ContinuationOptions::default()
-    };
-    corrector.validate().map_err(|e| match e {
-        ContinuationError::InvalidOption {
-            name,
-            value,
-            allowed,
-        } => ContinuationError::InvalidOption {
-            name: match name {
-                "corrector_tolerance" => "tolerance",
-                "max_corrector_iterations" => "max_iterations",
-                other => other,
-            },
-            value,
-            allowed,
-        },
-        other => other,
-    })?;
+    let mut newton = NewtonSolver::<P::Jacobian>::new(*options)?;
     let n = problem.dim();
-    if n == 0 || x0.len() != n {
+    if x0.len() != n {
         return Err(ContinuationError::DimensionMismatch {
             expected: n,
             found: x0.len(),
@@ -1484,58 +1579,54 @@ where
             max: f64::INFINITY,
         });
     }
-    let mut ws = Work::new(n, corrector.theta, problem.new_jacobian());
-    let fft_start = problem.fft_count();
-    let mut counters = ContinuationCounters::default();
+    let mut counters = WorkCounters::default();
     let mut points: Vec<SweepPoint> = Vec::with_capacity(parameters.len());
     let mut x = x0.to_vec();
     let mut failure = None;
     for (index, &parameter) in parameters.iter().enumerate() {
-        let mut p = parameter;
-        let mut smallest = f64::INFINITY;
-        let constraint = Constraint {
-            arclength: false,
-            w_p: 1.0,
-            target: parameter,
-        };
-        let before = counters.corrector_iterations;
-        match correct(
-            problem,
-            solver,
-            &mut ws,
-            None,
-            &corrector,
-            &mut x,
-            &mut p,
-            constraint,
-            &mut counters,
-            &mut smallest,
-        ) {
-            Ok(c) => points.push(SweepPoint {
+        problem.set_parameter(parameter);
+        let report = newton.solve(problem, solver, &mut x)?;
+        counters += report.counters;
+        if report.converged() {
+            points.push(SweepPoint {
                 state: x.clone(),
-                parameter: p,
-                iterations: c.iterations,
-                residual_norm: c.residual_norm,
-            }),
-            Err(f) => {
-                counters.rejected_steps += 1;
-                counters.rejected_iterations += counters.corrector_iterations - before;
-                if let Some(last) = points.last() {
-                    problem.set_parameter(last.parameter);
-                }
-                failure = Some(SweepFailure {
-                    index,
-                    parameter,
-                    failure: f,
-                });
-                break;
+                parameter,
+                iterations: report.iterations,
+                residual_norm: report.residual_norm(),
+            });
+        } else {
+            if let Some(last) = points.last() {
+                problem.set_parameter(last.parameter);
             }
+            failure = Some(SweepFailure {
+                index,
+                parameter,
+                residual_norm: report.residual_norm(),
+                iterations: report.iterations,
+                termination: report.termination,
+            });
+            break;
         }
     }
-    counters.ffts = problem.fft_count().saturating_sub(fft_start);
     Ok(NaturalSweep {
         points,
         failure,
         counters,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hermite_fold;
+
+    #[test]
+    fn hermite_fold_is_exact_for_a_quadratic_turn() {
+        // p(s) = 1 - (s - 0.3)^2 / 2 on [0, h] with h = 0.8: values and slopes at both ends;
+        // a cubic Hermite interpolant reproduces a quadratic, so the maximum 1 is exact.
+        let p = |s: f64| 1.0 - 0.5 * (s - 0.3) * (s - 0.3);
+        let dp = |s: f64| -(s - 0.3);
+        let h = 0.8;
+        let fold = hermite_fold(p(0.0), dp(0.0), p(h), dp(h), h);
+        assert!((fold - 1.0).abs() < 1e-15, "{fold}");
+    }
 }

@@ -67,7 +67,11 @@ const REFINEMENT_STEPS: usize = 2;
 #[derive(Clone, Debug, PartialEq)]
 pub struct LemkeOptions {
     /// Maximum number of pivots, the initial pivot on `z0` included.
-    /// `None` (default) means `50 n + 100`.
+    /// `None` (default) means `50 n + 100`. Lemke's path is short for P-matrices met in
+    /// practice but can be very long otherwise (measured: the periodic LCP of a rod with
+    /// a massive contact node, `n = 512`, still running after 5 million pivots while `z0`
+    /// decreased slowly and steadily, no cycling); the limit turns that into
+    /// [`LemkeTermination::PivotLimit`].
     pub max_pivots: Option<usize>,
     /// Relative tolerance, in `(0, 1)`; default `1e-12`. An entering-column entry `t_i`
     /// can block only if `t_i > tolerance * max_j |t_j|`; two ratios `x_i / t_i` count as
@@ -430,15 +434,7 @@ impl Lemke {
         let artificial = 2 * n;
         self.ties.clear();
         self.ties.extend(0..n);
-        let r = lex_min_ratio(
-            &mut self.ties,
-            &self.x,
-            &self.binv,
-            n,
-            &self.d,
-            tol,
-            NONBASIC,
-        );
+        let r = self.leaving_row(true, tol, NONBASIC);
         for (c, d) in self.col.iter_mut().zip(&self.d) {
             *c = -d;
         }
@@ -470,15 +466,7 @@ impl Lemke {
                 let variable = variable(entering, n);
                 return Ok(self.finish(m, q, LemkeTermination::Ray, pivots, Some(variable)));
             }
-            let r = lex_min_ratio(
-                &mut self.ties,
-                &self.x,
-                &self.binv,
-                n,
-                &self.col,
-                tol,
-                self.row_of[artificial],
-            );
+            let r = self.leaving_row(false, tol, self.row_of[artificial]);
             (leaving, ready) = self.pivot(m, r, entering);
             pivots += 1;
             if let Some(row) = self.x.iter().position(|v| !v.is_finite()) {
@@ -489,6 +477,22 @@ impl Lemke {
                 return Ok(self.finish(m, q, LemkeTermination::Solved, pivots, None));
             }
         }
+    }
+
+    /// The lexicographic minimum-ratio test over the candidate rows in `self.ties`:
+    /// for the initial pivot on `z0` (`initial`), divisor `d` and raw `x = q`; otherwise
+    /// divisor the entering column and `x` clamped at 0. See [`lex_min_ratio`].
+    fn leaving_row(&mut self, initial: bool, tol: f64, prefer: usize) -> usize {
+        let ratio = RatioTest {
+            x: &self.x,
+            binv: &self.binv,
+            n: self.n,
+            divisor: if initial { &self.d } else { &self.col },
+            tol,
+            prefer,
+            clamp: !initial,
+        };
+        lex_min_ratio(&mut self.ties, &ratio)
     }
 
     /// Writes `B^{-1} a_e` into `self.col` for the entering variable `e` (`w_i` or `z_j`).
@@ -779,22 +783,40 @@ fn copy_column(m: MatRef<'_, f64>, j: usize, out: &mut [f64]) {
     }
 }
 
+/// Data of one lexicographic minimum-ratio test.
+struct RatioTest<'a> {
+    x: &'a [f64],
+    binv: &'a [f64],
+    n: usize,
+    divisor: &'a [f64],
+    tol: f64,
+    prefer: usize,
+    clamp: bool,
+}
+
 /// Lexicographic minimum-ratio test over the candidate rows in `ties` (each with
 /// `divisor[i] > 0`): minimise `x_i / divisor_i`, then break ties on
 /// `B^{-1}[i, c] / divisor_i` for `c = 0, 1, ...`. A row equal to `prefer` among the rows
-/// tied on the ratio wins at once. `ties` is used as scratch.
-fn lex_min_ratio(
-    ties: &mut Vec<usize>,
-    x: &[f64],
-    binv: &[f64],
-    n: usize,
-    divisor: &[f64],
-    tol: f64,
-    prefer: usize,
-) -> usize {
+/// tied on the ratio wins at once. With `clamp`, a basic value made slightly negative by
+/// rounding counts as 0 (a degenerate step, never a step backwards along the path).
+/// `ties` is used as scratch.
+fn lex_min_ratio(ties: &mut Vec<usize>, test: &RatioTest<'_>) -> usize {
+    let RatioTest {
+        x,
+        binv,
+        n,
+        divisor,
+        tol,
+        prefer,
+        clamp,
+    } = *test;
     debug_assert!(!ties.is_empty());
     let xscale = x.iter().fold(0.0_f64, |a, &v| a.max(v.abs()));
-    keep_minimal(ties, |i| x[i] / divisor[i], xscale, divisor, tol);
+    if clamp {
+        keep_minimal(ties, |i| x[i].max(0.0) / divisor[i], xscale, divisor, tol);
+    } else {
+        keep_minimal(ties, |i| x[i] / divisor[i], xscale, divisor, tol);
+    }
     if ties.len() == 1 {
         return ties[0];
     }

@@ -89,6 +89,30 @@ pub enum Globalization {
         /// Backtracking options.
         line_search: LineSearchOptions,
     },
+    /// Full steps first, then the non-monotone line search: the first `full_steps`
+    /// iterations take `alpha = 1` whenever `F` stays finite (semismooth Newton on
+    /// complementarity systems then behaves as a primal-dual active-set method, which
+    /// may cross regions of large residual on its way to the solution); if it has not
+    /// converged by then, it restarts from the best iterate with the GLL line search.
+    Hybrid {
+        /// Iterations of the full-step phase.
+        full_steps: usize,
+        /// Memory of the non-monotone phase (`>= 1`).
+        memory: usize,
+        /// Backtracking options of the non-monotone phase.
+        line_search: LineSearchOptions,
+    },
+}
+
+impl Globalization {
+    /// [`Globalization::Hybrid`] with 30 full steps, then GLL with memory 10.
+    pub fn hybrid() -> Self {
+        Self::Hybrid {
+            full_steps: 30,
+            memory: 10,
+            line_search: LineSearchOptions::default(),
+        }
+    }
 }
 
 impl Default for Globalization {
@@ -153,6 +177,11 @@ impl NewtonOptions {
             Globalization::NonMonotone {
                 memory,
                 line_search,
+            }
+            | Globalization::Hybrid {
+                memory,
+                line_search,
+                ..
             } => {
                 if memory == 0 {
                     return Err(invalid("globalization.memory", 0.0, ">= 1"));
@@ -233,7 +262,8 @@ pub struct NewtonReport {
     /// Accepted step norms `alpha_k |d_k|_2` (`iterations` values).
     pub step_norms: Vec<f64>,
     /// Estimated order `q` from the last three residual norms,
-    /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})`; `None` with fewer than three norms, when
+    /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})` (also for runs that did not converge: a
+    /// stalled or capped run shows its rate); `None` with fewer than three norms, when
     /// one of them is below `1e-300` (exact termination, e.g. the active set was found
     /// and the remaining system was linear), or when the estimate is undefined.
     pub observed_order: Option<f64>,
@@ -454,13 +484,18 @@ impl<J> NewtonSolver<J> {
         let tolerance = options
             .absolute_tolerance
             .max(options.relative_tolerance * norm);
-        let (memory, line_search) = match options.globalization {
-            Globalization::None => (1, None),
-            Globalization::Armijo(ls) => (1, Some(ls)),
+        let (memory, line_search, mut full_steps) = match options.globalization {
+            Globalization::None => (1, None, 0),
+            Globalization::Armijo(ls) => (1, Some(ls), 0),
             Globalization::NonMonotone {
                 memory,
                 line_search,
-            } => (memory, Some(line_search)),
+            } => (memory, Some(line_search), 0),
+            Globalization::Hybrid {
+                full_steps,
+                memory,
+                line_search,
+            } => (memory, Some(line_search), full_steps),
         };
         self.history.reset(memory);
         self.history.push(0.5 * norm * norm);
@@ -477,6 +512,18 @@ impl<J> NewtonSolver<J> {
             }
             let jac = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
             while iterations < options.max_iterations {
+                if full_steps > 0 && iterations == full_steps {
+                    // End of the full-step phase: restart from the best iterate.
+                    full_steps = 0;
+                    if best_norm < norm {
+                        x.copy_from_slice(&self.best_x);
+                        problem.residual(x, &mut self.f);
+                        counters.residual_evaluations += 1;
+                        norm = norm2(&self.f);
+                    }
+                    self.history.reset(memory);
+                    self.history.push(0.5 * norm * norm);
+                }
                 problem.jacobian(x, jac);
                 counters.jacobian_evaluations += 1;
                 counters.factorizations += 1;
@@ -510,26 +557,31 @@ impl<J> NewtonSolver<J> {
                         f64::INFINITY
                     }
                 };
-                let alpha = match line_search {
-                    None => {
-                        if !merit(1.0).is_finite() {
-                            break 'newton Termination::NonFinite;
-                        }
-                        1.0
+                let mut alpha_taken = 1.0;
+                let full_step_phase = iterations < full_steps;
+                if full_step_phase && merit(1.0).is_finite() {
+                    // Full step accepted without a merit test.
+                } else if let Some(ls) = line_search {
+                    if full_step_phase {
+                        // A non-finite full step ends the full-step phase.
+                        full_steps = 0;
+                        self.history.reset(memory);
+                        self.history.push(merit0);
                     }
-                    Some(ls) => {
-                        match backtrack(self.history.reference(), -2.0 * merit0, &ls, merit) {
-                            Ok(step) => {
-                                counters.line_search_backtracks += step.backtracks;
-                                step.step
-                            }
-                            Err(fail) => {
-                                counters.line_search_backtracks += fail.backtracks;
-                                break 'newton Termination::LineSearchFailed;
-                            }
+                    match backtrack(self.history.reference(), -2.0 * merit0, &ls, &mut merit) {
+                        Ok(step) => {
+                            counters.line_search_backtracks += step.backtracks;
+                            alpha_taken = step.step;
+                        }
+                        Err(fail) => {
+                            counters.line_search_backtracks += fail.backtracks;
+                            break 'newton Termination::LineSearchFailed;
                         }
                     }
-                };
+                } else if !merit(1.0).is_finite() {
+                    break 'newton Termination::NonFinite;
+                }
+                let alpha = alpha_taken;
 
                 // Accept: x <- trial, F <- F(trial).
                 x.copy_from_slice(&self.trial);
@@ -563,11 +615,7 @@ impl<J> NewtonSolver<J> {
         }
         counters.ffts = problem.fft_count().saturating_sub(fft_start);
         Ok(NewtonReport {
-            observed_order: if termination == Termination::Converged {
-                observed_order(&residual_norms)
-            } else {
-                None
-            },
+            observed_order: observed_order(&residual_norms),
             termination,
             iterations,
             residual_norms,

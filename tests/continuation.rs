@@ -9,6 +9,7 @@ use semismooth::continuation::{
     ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
+use semismooth::newton::{self, Globalization, NewtonOptions};
 use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
 
 type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
@@ -174,10 +175,13 @@ fn assert_one_factorization_per_iteration(branch: &Branch) {
     let c = branch.counters;
     let accepted: u64 = branch.points.iter().map(|q| q.iterations as u64).sum();
     assert_eq!(c.corrector_iterations, accepted + c.rejected_iterations);
-    assert_eq!(c.factorizations, c.corrector_iterations);
-    assert_eq!(c.jacobian_evaluations, c.corrector_iterations);
+    assert_eq!(c.work.factorizations, c.corrector_iterations);
+    assert_eq!(c.work.jacobian_evaluations, c.corrector_iterations);
     assert_eq!(c.parameter_derivative_evaluations, c.corrector_iterations);
-    assert_eq!(c.linear_solves, 2 * c.factorizations);
+    assert_eq!(c.work.linear_solves, 2 * c.work.factorizations);
+    // Without line search: one residual per iteration plus the final convergence check of
+    // each attempt that did not stop on a non-finite value.
+    assert!(c.work.residual_evaluations >= c.corrector_iterations);
     assert_eq!(c.dense_bordered_factorizations, 0);
 }
 
@@ -185,17 +189,7 @@ const FOLD_S: f64 = 0.384_900_179_459_750_5; // 2 / (3 √3)
 
 #[test]
 fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
-    let mut problem = s_curve();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: -1.0,
-        parameter_max: 1.0,
-        ..Default::default()
-    };
-    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options.clone())
-        .unwrap()
-        .run()
-        .unwrap();
+    let branch = s_curve_branch();
     // Every point is on the curve (the corrector's tolerance on |F|).
     for q in &branch.points {
         let x = q.state[0];
@@ -236,14 +230,17 @@ fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
     // Without refinement the fold is reported at the point after the sign change, which is
     // within one step of the fold in the parameter.
     let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
     let coarse = Continuation::new(
         &mut problem,
         &mut solver,
         &[-1.3],
         -1.0,
         ContinuationOptions {
+            parameter_min: -1.0,
+            parameter_max: 1.0,
             refine_folds: false,
-            ..options
+            ..Default::default()
         },
     )
     .unwrap()
@@ -396,6 +393,20 @@ fn duffing_folds_by_discriminant() -> Vec<f64> {
     folds
 }
 
+fn s_curve_branch() -> Branch {
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
+        .unwrap()
+        .run()
+        .unwrap()
+}
+
 fn duffing_branch() -> Branch {
     let mut problem = duffing();
     let mut solver = FaerDenseLu::new();
@@ -528,7 +539,7 @@ fn singular_jacobian_plateau_needs_the_dense_bordered_fallback() {
     // Each corrector iteration still calls `factor` once (it fails on the plateau, then the
     // dense bordered LU takes over).
     assert_eq!(
-        branch.counters.factorizations,
+        branch.counters.work.factorizations,
         branch.counters.corrector_iterations
     );
     assert_eq!(
@@ -645,40 +656,51 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
 #[test]
 fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
     // Sweep p on the S-curve from the lower branch: past the fold p = 2/(3√3) the lower
-    // branch no longer exists and Newton from the previous solution lands on the upper one.
+    // branch no longer exists. Newton from the previous solution either stalls near the
+    // local minimum of |F|^2 at the fold x = -1/√3 (the line search cannot leave it; full
+    // steps cycle around it) or overshoots through the near-zero slope and lands on the
+    // upper branch. Which one happens depends on rounding-level details of the previous
+    // point (full-step Newton on a cubic is chaotic there), so both are accepted; neither
+    // follows the branch around the fold.
     let parameters: Vec<f64> = (0..=40).map(|i| -1.0 + 0.05 * i as f64).collect();
-    let mut problem = s_curve();
     let mut solver = FaerDenseLu::new();
-    let sweep = natural_sweep(
-        &mut problem,
-        &mut solver,
-        &[-1.3],
-        &parameters,
-        &Default::default(),
-    )
-    .unwrap();
-    let xs: Vec<f64> = sweep.points.iter().map(|q| q.state[0]).collect();
-    let jumps: Vec<usize> = (1..xs.len())
-        .filter(|&i| (xs[i] - xs[i - 1]).abs() > 0.5)
-        .collect();
-    println!(
-        "sweep: {} points, jumps at {jumps:?}, failure {:?}",
-        xs.len(),
-        sweep.failure
-    );
-    // Either it failed at the fold, or it jumped exactly once, between the parameters that
-    // bracket the fold, from x < -1/√3 to x > 1/√3.
-    if let Some(f) = &sweep.failure {
-        // It failed at the first grid parameter past the fold, after following the lower
-        // branch up to the last one before it.
-        assert!(jumps.is_empty());
-        assert!(f.parameter > FOLD_S && f.parameter - 0.05 < FOLD_S, "{f:?}");
-        assert!(xs.iter().all(|&x| x < -1.0 / 3f64.sqrt()));
-    } else {
-        assert_eq!(jumps.len(), 1);
-        let i = jumps[0];
-        assert!(parameters[i - 1] < FOLD_S && parameters[i] > FOLD_S);
-        assert!(xs[i - 1] < -1.0 / 3f64.sqrt() && xs[i] > 1.0 / 3f64.sqrt());
+    let below = -1.0 / 3f64.sqrt();
+    for globalization in [Globalization::None, Globalization::default()] {
+        let mut problem = s_curve();
+        let options = NewtonOptions {
+            globalization,
+            ..Default::default()
+        };
+        let sweep =
+            natural_sweep(&mut problem, &mut solver, &[-1.3], &parameters, &options).unwrap();
+        let xs: Vec<f64> = sweep.points.iter().map(|q| q.state[0]).collect();
+        let jumps: Vec<usize> = (1..xs.len())
+            .filter(|&i| (xs[i] - xs[i - 1]).abs() > 0.5)
+            .collect();
+        println!(
+            "sweep ({globalization:?}): {} points, jumps at {jumps:?}, failure {:?}",
+            xs.len(),
+            sweep.failure
+        );
+        // Every solved point is a root (Newton's tolerance 1e-10 on |F|).
+        for q in &sweep.points {
+            let x = q.state[0];
+            assert!((x.powi(3) - x - q.parameter).abs() <= 1e-10);
+        }
+        if let Some(f) = &sweep.failure {
+            // Failed at the first grid parameter past the fold, after following the lower
+            // branch up to the last one before it.
+            assert!(jumps.is_empty());
+            assert!(f.parameter > FOLD_S && f.parameter - 0.05 < FOLD_S, "{f:?}");
+            assert!(xs.iter().all(|&x| x < below));
+        } else {
+            // Jumped exactly once, between the parameters that bracket the fold, from the
+            // lower branch (x < -1/√3) to the upper one (x > 1/√3).
+            assert_eq!(jumps.len(), 1);
+            let i = jumps[0];
+            assert!(parameters[i - 1] < FOLD_S && parameters[i] > FOLD_S);
+            assert!(xs[i - 1] < below && xs[i] > -below);
+        }
     }
     // The pseudo-arclength branch over the same range moves continuously: the predictor
     // moves at most max_step = 0.05 in the θ-norm (0.071 Euclidean for θ = 1/2, n = 1) and
@@ -708,26 +730,105 @@ fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
 
 #[test]
 fn every_continuation_point_resolved_by_plain_newton_stays_put() {
-    // Re-solve each point at its own parameter, from itself, with a tolerance 100x tighter
-    // than the continuation's so that at least one Newton step is taken.
-    let strict = semismooth::continuation::NaturalSweepOptions {
-        tolerance: 1e-12,
+    // Re-solve each point at its own parameter, from itself, with the library's Newton
+    // driver and a tolerance 100x tighter than the continuation's, so that a Newton step is
+    // taken: the correction is about |J^{-1}| |F| <= 1e-10 / σ_min(J).
+    let strict = NewtonOptions {
+        absolute_tolerance: 1e-12,
         ..Default::default()
     };
     let mut solver = FaerDenseLu::new();
-    let branch = duffing_branch();
-    let mut problem = duffing();
-    let mut worst = 0.0_f64;
-    for q in &branch.points {
-        let sweep =
-            natural_sweep(&mut problem, &mut solver, &q.state, &[q.parameter], &strict).unwrap();
-        assert!(sweep.failure.is_none());
-        let r = &sweep.points[0];
-        let moved = (r.state[0] - q.state[0]).hypot(r.state[1] - q.state[1]);
-        worst = worst.max(moved);
-        assert!(moved < 1e-8, "ω = {}: moved {moved}", q.parameter);
+    let mut worst = [0.0_f64; 2];
+    for (k, (branch, mut problem)) in [(duffing_branch(), duffing()), (s_curve_branch(), s_curve())]
+        .into_iter()
+        .enumerate()
+    {
+        for q in &branch.points {
+            let mut x = q.state.clone();
+            problem.set_parameter(q.parameter);
+            let report = newton::solve(&mut problem, &mut solver, &mut x, &strict).unwrap();
+            assert!(
+                report.converged(),
+                "p = {}: {:?}",
+                q.parameter,
+                report.termination
+            );
+            // A step is taken wherever the point's |F| exceeds 1e-12.
+            assert!(report.iterations >= 1 || q.residual_norm <= 1e-12);
+            let moved = x
+                .iter()
+                .zip(&q.state)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst[k] = worst[k].max(moved);
+            assert!(moved < 1e-8, "p = {}: moved {moved}", q.parameter);
+        }
     }
-    println!("Duffing: largest move under re-solve {worst:e}");
+    println!(
+        "largest move under re-solve: Duffing {:e}, S-curve {:e}",
+        worst[0], worst[1]
+    );
+}
+
+/// `atan(x) - p = 0`: plain Newton from |x - tan p| large overshoots and diverges (the
+/// classic example); the branch is x = tan(p).
+fn arctangent() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0].atan() - p),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = 1.0 / (1.0 + x[0] * x[0])),
+        fp: Some(Box::new(|_, _, out| out[0] = -1.0)),
+    }
+}
+
+#[test]
+fn corrector_line_search_rescues_a_far_start_that_full_steps_cannot() {
+    let options = ContinuationOptions {
+        parameter_min: 0.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    // Full Newton steps from x = 3 at p = 0 diverge (|x| grows each step and overflows).
+    let mut problem = arctangent();
+    let start = Continuation::new(&mut problem, &mut solver, &[3.0], 0.0, options.clone())
+        .unwrap()
+        .next();
+    assert!(
+        matches!(
+            start,
+            Some(Err(ContinuationError::StartNotConverged { .. }))
+        ),
+        "{start:?}"
+    );
+    // With backtracking the start converges to x = 0 and the branch follows x = tan(p).
+    let mut problem = arctangent();
+    let branch = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &[3.0],
+        0.0,
+        ContinuationOptions {
+            corrector_line_search: Some(Default::default()),
+            ..options
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    // |F| <= 1e-10 and |dF/dx| = 1/(1 + x^2) >= 1/(1 + tan(1)^2) ≈ 0.29: |x - tan p| < 4e-10.
+    for q in &branch.points {
+        assert!((q.state[0] - q.parameter.tan()).abs() < 4e-10);
+    }
+    assert_eq!(branch.points.last().unwrap().parameter, 1.0);
+    assert!(branch.counters.work.line_search_backtracks > 0);
+    println!(
+        "atan: {} points, counters {:?}",
+        branch.points.len(),
+        branch.counters
+    );
 }
 
 #[test]
@@ -1014,4 +1115,89 @@ fn structured_jacobian_branch_equals_the_dense_one_and_passes_the_folds() {
     // Fold tolerance as for the scalar S-curve (the x_0 component dominates p(s) there).
     assert!((folds[0] - FOLD_S).abs() < 1e-4 && (folds[1] + FOLD_S).abs() < 1e-4);
     assert_one_factorization_per_iteration(&branch);
+}
+
+#[test]
+fn state_scale_equals_continuing_the_rescaled_problem() {
+    // With x = S z, the θ-product Σ a_i b_i / s_i^2 on x is the plain product on z: the
+    // branch of F with state_scale S must be the branch of G(z, ω) = F(S z, ω) without
+    // scale, mapped by x = S z. S = (0.3, 3) makes the two unknowns differ by 100 in
+    // weight, so a wrong weighting would change the steps and the points.
+    let scale = [0.3, 3.0];
+    let residual = duffing().f;
+    let jacobian = duffing().j;
+    let mut rescaled = Closure {
+        n: 2,
+        p: 0.0,
+        f: Box::new(move |z, w, out| residual(&[scale[0] * z[0], scale[1] * z[1]], w, out)),
+        j: Box::new(move |z, w, jac| {
+            jacobian(&[scale[0] * z[0], scale[1] * z[1]], w, jac);
+            for i in 0..2 {
+                for (j, s) in scale.iter().enumerate() {
+                    jac[(i, j)] *= s;
+                }
+            }
+        }),
+        fp: None,
+    };
+    let options = ContinuationOptions {
+        parameter_min: 0.5,
+        parameter_max: 2.0,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    let x0 = [0.13, 0.0];
+    let z0 = [x0[0] / scale[0], x0[1] / scale[1]];
+    let reference = Continuation::new(&mut rescaled, &mut solver, &z0, 0.5, options.clone())
+        .unwrap()
+        .run()
+        .unwrap();
+    let mut problem = duffing();
+    let branch = Continuation::new(
+        &mut problem,
+        &mut solver,
+        &x0,
+        0.5,
+        ContinuationOptions {
+            state_scale: Some(scale.to_vec()),
+            ..options
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    assert_eq!(branch.points.len(), reference.points.len());
+    // The same Newton iterates in both coordinates up to the rounding of S z: the points
+    // agree to rounding, amplified by at most the corrector's conditioning; 1e-10 leaves
+    // room (measured 1e-14).
+    let mut worst = 0.0_f64;
+    for (a, b) in branch.points.iter().zip(&reference.points) {
+        worst = worst.max((a.parameter - b.parameter).abs());
+        for ((x, z), s) in a.state.iter().zip(&b.state).zip(&scale) {
+            worst = worst.max((x - s * z).abs());
+        }
+    }
+    println!(
+        "scaled vs rescaled: {} points, largest difference {worst:e}",
+        branch.points.len()
+    );
+    assert!(worst < 1e-10);
+    println!("{}", branch.termination);
+    assert_eq!(branch.fold_parameters().len(), 2);
+    // A scale of the wrong length is refused with the numbers.
+    let mut problem = duffing();
+    assert!(matches!(
+        Continuation::new(
+            &mut problem,
+            &mut solver,
+            &x0,
+            0.5,
+            ContinuationOptions {
+                state_scale: Some(vec![1.0; 3]),
+                ..Default::default()
+            }
+        )
+        .err(),
+        Some(ContinuationError::InvalidOption { name: "state_scale", value, .. }) if value == 3.0
+    ));
 }

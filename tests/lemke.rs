@@ -10,6 +10,9 @@ use semismooth::lemke::{
     complementarity_error, solve_lcp, LcpVariable, Lemke, LemkeError, LemkeOptions,
     LemkeTermination,
 };
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::{solve, NewtonOptions};
+use semismooth::{GeneralizedJacobian, Residual};
 
 /// Counts heap allocations made by the current thread (tests run on parallel threads,
 /// so the count is per thread).
@@ -226,6 +229,30 @@ fn solve_allocates_only_the_report_whatever_the_pivot_count() {
         );
         assert_eq!(count, 2, "{count} allocations for {} pivots", report.pivots);
     }
+}
+
+/// A row-major view (`M^T` of a column-major matrix) goes through the strided column
+/// path; it must give exactly what the contiguous copy gives.
+#[test]
+fn strided_matrix_view_gives_the_same_report_as_a_contiguous_copy() {
+    let mut r = rng(31);
+    let n = 9;
+    let a = pd_nonsymmetric(n, &mut r);
+    let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
+    let view = a.transpose();
+    let copy = view.to_owned();
+    let strided = solve_lcp(view, &q, &LemkeOptions::default()).unwrap();
+    let contiguous = solve_lcp(copy.as_ref(), &q, &LemkeOptions::default()).unwrap();
+    assert!(strided.solved());
+    assert_eq!(strided, contiguous);
+}
+
+#[test]
+fn empty_lcp_is_solved_trivially() {
+    let m = Mat::<f64>::zeros(0, 0);
+    let report = solve_lcp(m.as_ref(), &[], &LemkeOptions::default()).unwrap();
+    assert_eq!(report.termination, LemkeTermination::Solved);
+    assert_eq!((report.pivots, report.z.len()), (0, 0));
 }
 
 #[test]
@@ -548,6 +575,123 @@ fn large_spd_lcp_n1024_has_small_complementarity_error() {
     assert!(active > n / 8, "only {active} active");
 }
 
+/// `F(z) = min(z, q + M z)`: its zeros are the solutions of the LCP.
+struct MinMap<'a> {
+    m: &'a Mat<f64>,
+    q: &'a [f64],
+}
+
+impl Residual for MinMap<'_> {
+    fn dim(&self) -> usize {
+        self.q.len()
+    }
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+        let w = residual(self.m, self.q, z);
+        for i in 0..z.len() {
+            out[i] = z[i].min(w[i]);
+        }
+    }
+}
+
+impl GeneralizedJacobian for MinMap<'_> {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.q.len(), self.q.len())
+    }
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+        let n = z.len();
+        let w = residual(self.m, self.q, z);
+        for i in 0..n {
+            for j in 0..n {
+                // Row of I where z_i <= w_i, row of M otherwise.
+                jac[(i, j)] = if z[i] <= w[i] {
+                    (i == j) as u8 as f64
+                } else {
+                    self.m[(i, j)]
+                };
+            }
+        }
+    }
+}
+
+/// Issue 3: Lemke and the semismooth Newton method on `min(z, q + M z) = 0` give the same
+/// solution. Newton stops at `|F|_2 <= 1e-13`; for these well-conditioned P-matrices (and
+/// once the active set is right Newton is exact up to rounding) the distance to the
+/// solution is of the same order, far below the 1e-10 agreement tolerance.
+#[test]
+fn lemke_agrees_with_semismooth_newton_on_the_min_map() {
+    let options = NewtonOptions {
+        absolute_tolerance: 1e-13,
+        ..NewtonOptions::default()
+    };
+    let mut lemke = Lemke::new(8);
+    for seed in 0..60u64 {
+        let mut r = rng(4242 + seed);
+        let n = [1usize, 2, 3, 5, 8, 20, 60][seed as usize % 7];
+        let m = if seed % 2 == 0 {
+            dominant_p_matrix(n, &mut r)
+        } else {
+            spd_matrix(n, 0.5, &mut r)
+        };
+        let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
+        let report = lemke
+            .solve(m.as_ref(), &q, &LemkeOptions::default())
+            .unwrap();
+        assert!(report.solved());
+        let mut z = vec![0.0; n];
+        let newton = solve(
+            &mut MinMap { m: &m, q: &q },
+            &mut FaerDenseLu::new(),
+            &mut z,
+            &options,
+        )
+        .unwrap();
+        assert!(newton.converged(), "seed {seed}: {:?}", newton.termination);
+        let diff = max_abs_diff(&report.z, &z);
+        assert!(
+            diff <= AGREEMENT * (1.0 + max_abs(&z)),
+            "seed {seed} n {n}: diff {diff:e}"
+        );
+    }
+}
+
+#[allow(dead_code)]
+#[path = "../examples/custom_problem.rs"]
+mod custom_problem;
+
+/// The example `custom_problem` (spring chain between two walls) run as a test: the
+/// Newton solution of the full problem and Lemke on the condensed LCP agree to 1e-9 (the
+/// example's own exit criterion), the Lemke answer satisfies the full residual, and the
+/// three loads give the three contact states.
+#[test]
+fn custom_problem_newton_agrees_with_lemke_in_every_contact_state() {
+    for (load, closed) in [
+        (0.1, [false, false]),
+        (0.3, [false, true]),
+        (2.0, [true, true]),
+    ] {
+        let mut chain = custom_problem::SpringChain::new(12, 100.0, 1.0, load, [0.02, 0.05]);
+        let [x, y] = custom_problem::newton_and_lemke(&mut chain).unwrap();
+        let diff = max_abs_diff(&x, &y);
+        assert!(diff <= 1e-9, "load {load}: difference {diff:e}");
+        let mut f = vec![0.0; y.len()];
+        chain.residual(&y, &mut f);
+        // Forces of order 1, stiffness 100: rounding leaves residuals ~1e-14.
+        assert!(
+            max_abs(&f) <= 1e-10,
+            "load {load}: residual {:e}",
+            max_abs(&f)
+        );
+        let n = y.len() - 2;
+        assert_eq!(
+            [y[n] > 0.0, y[n + 1] > 0.0],
+            closed,
+            "load {load}: {:?}",
+            &y[n..]
+        );
+    }
+}
+
 /// Periodic-LCP stand-in for timing: a symmetric positive definite circulant matrix
 /// (exponential kernel plus identity) and `q_i = 0.5 - cos(2 pi i / n)` (a gap of 0.5
 /// closed by a harmonic motion of amplitude 1: about a third of the period in contact).
@@ -580,17 +724,18 @@ fn thread_cpu_seconds() -> f64 {
 #[test]
 #[ignore]
 fn timing_n2048() {
+    use semismooth_problems::lcp::{PeriodicLcp, PeriodicLcpOptions};
+    use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
     let n = 2048;
     let mut lemke = Lemke::new(n);
-    let mut timed = |label: &str, m: &Mat<f64>, q: &[f64]| {
+    let mut timed = |label: &str, m: faer::MatRef<'_, f64>, q: &[f64]| {
         let start = std::time::Instant::now();
         let cpu = thread_cpu_seconds();
-        let report = lemke
-            .solve(m.as_ref(), q, &LemkeOptions::default())
-            .unwrap();
+        let report = lemke.solve(m, q, &LemkeOptions::default()).unwrap();
         let cpu = thread_cpu_seconds() - cpu;
         println!(
-            "{label} n={n}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            "{label} n={}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
+            q.len(),
             report.termination,
             report.pivots,
             report.z.iter().filter(|&&z| z > 0.0).count(),
@@ -598,11 +743,28 @@ fn timing_n2048() {
             start.elapsed().as_secs_f64()
         );
     };
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        let spec = RodSpec {
+            mass,
+            ..RodSpec::canonical()
+        };
+        let rod = build_rod(&spec).unwrap();
+        let options = PeriodicLcpOptions {
+            time_samples: n,
+            ..PeriodicLcpOptions::default()
+        };
+        let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
+        timed(
+            &format!("canonical rod, {mass:?} mass"),
+            lcp.matrix(),
+            lcp.q(),
+        );
+    }
     let (m, q) = circulant_case(n);
-    timed("circulant", &m, &q);
-    timed("circulant (reused workspace)", &m, &q);
+    timed("circulant", m.as_ref(), &q);
+    timed("circulant (reused workspace)", m.as_ref(), &q);
     let mut r = rng(7);
     let m = spd_matrix(n, 1.0, &mut r);
     let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
-    timed("random SPD", &m, &q);
+    timed("random SPD", m.as_ref(), &q);
 }

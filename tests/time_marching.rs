@@ -3,6 +3,8 @@
 //! convergence under step refinement, the energy balance of the trapezoidal scheme, the
 //! restitution dependence of Moreau–Jean, and typed errors for bad input.
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::time::Instant;
 
 use nalgebra::{DMatrix, DVector};
@@ -14,6 +16,35 @@ use semismooth_problems::model::{SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{
     build_rod, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
 };
+
+/// Counts heap allocations per thread (tests run on parallel threads), to check that
+/// stepping does not allocate.
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(|c| c.get())
+}
 
 fn dense(m: &SparseMatrix) -> DMatrix<f64> {
     let r = m.as_ref();
@@ -233,6 +264,44 @@ fn modified_mass_steady_period_converges_under_step_refinement() {
         assert!(((w[0] - w[1]) / w[1]).abs() < 1e-5, "{minima:?}");
     }
     println!("tip minima (parabola) {minima:?}");
+}
+
+#[test]
+fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
+    // Free steps allocate nothing (buffers and the sparse-LU scratch are kept); a step
+    // with a closed contact allocates only the two vectors of Lemke's report.
+    for spec in [
+        RodSpec {
+            mass: MassModel::Modified,
+            ..RodSpec::canonical()
+        },
+        RodSpec::canonical(),
+    ] {
+        let rod = build_rod(&spec).unwrap();
+        let options = MarchOptions {
+            steps_per_period: 500,
+            ..MarchOptions::default()
+        };
+        let mut marcher =
+            TimeMarcher::new(&rod.model, &options, &MarchState::rest(&rod.model)).unwrap();
+        for _ in 0..20 * 500 {
+            let (before, solves) = (allocations(), marcher.counters().contact_solves);
+            marcher.step().unwrap();
+            let allocated = allocations() - before;
+            let lcp = marcher.counters().contact_solves - solves;
+            assert!(allocated <= 2 * lcp, "{allocated} allocations, {lcp} LCPs");
+        }
+        let counters = marcher.counters();
+        println!("{:?}: {counters:?}", marcher.scheme());
+        // Auto: trapezoidal for the massless tip, Moreau–Jean (theta 1/2, e = 0) otherwise.
+        let expected = if spec.mass == MassModel::Modified {
+            MarchScheme::MasslessContactTrapezoidal
+        } else {
+            MarchScheme::MOREAU_JEAN_DEFAULT
+        };
+        assert_eq!(marcher.scheme(), expected);
+        assert!(counters.contact_solves > 100);
+    }
 }
 
 #[test]
@@ -543,9 +612,16 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         ..MarchOptions::default()
     };
     match march_to_steady_state(model, &options, &[19]).unwrap_err() {
-        MarchError::NotSteady { periods, change } => {
+        MarchError::NotSteady {
+            periods,
+            change,
+            last_period,
+        } => {
             assert_eq!(periods, 3);
             assert!(change.is_finite() && change > options.tolerance);
+            assert_eq!(last_period.period_change, change);
+            assert_eq!(last_period.displacements[0].len(), 101);
+            assert!(last_period.displacements[0].iter().all(|u| u.is_finite()));
         }
         other => panic!("{other}"),
     }
@@ -571,6 +647,123 @@ fn report_canonical_modified_mass_refinement_table() {
                 "{spp} | {} | {hi:.10} | {lo:.10} | {refined:.10} | {mean:.10e} | {} | \
                  {seconds:.3}",
                 period.periods, period.counters.active_steps
+            );
+        }
+    }
+}
+
+/// SSN-HB from zero with the structured solver (up to 1000 Newton iterations): the Newton
+/// report and the tip summary on 4096 points.
+fn ssn_hb_tip(
+    model: &StructuralModel,
+    harmonics: usize,
+    tip: usize,
+) -> (
+    semismooth::newton::NewtonReport,
+    semismooth_problems::hb::ResponseSummary,
+) {
+    use semismooth::newton::{solve, NewtonOptions};
+    use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+    let mut hb = SsnHb::new(
+        model,
+        &HbOptions {
+            harmonics,
+            ..HbOptions::default()
+        },
+    )
+    .unwrap();
+    let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
+    let options = NewtonOptions {
+        max_iterations: 1000,
+        ..NewtonOptions::default()
+    };
+    let report = solve(&mut hb, &mut StructuredHbSolver::new(), &mut x, &options).unwrap();
+    (report, hb.summary(&x, tip, 4096).unwrap())
+}
+
+/// Cross-check for the report: SSN-HB (H = 10, 20, 40, from zero, structured solver)
+/// against this reference at 8000 steps per period on the canonical modified-mass case.
+/// `cargo test --release --test time_marching -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn report_harmonic_balance_against_the_reference() {
+    let rod = modified_rod();
+    let tip = rod.tip_dof();
+    let (period, _) = canonical_modified_period(8000, 1e-10);
+    let u = &period.displacements[0];
+    let reference_min = parabolic_min(u);
+    let reference_rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
+    let reference_mean = period_mean(&period.contact_forces[0]);
+    println!("reference: tip min {reference_min:.9} rms {reference_rms:.9} mean lambda {reference_mean:.9e}");
+    for harmonics in [10, 20, 40] {
+        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
+        println!(
+            "H {harmonics}: converged {} in {} iterations; tip min {:.9} ({:.2e} rel), rms {:.9} \
+             ({:.2e} rel), mean lambda {:.9e} ({:.2e} rel)",
+            report.converged(),
+            report.iterations,
+            s.displacement_min,
+            ((s.displacement_min - reference_min) / reference_min).abs(),
+            s.displacement_rms,
+            ((s.displacement_rms - reference_rms) / reference_rms).abs(),
+            s.contact_force_mean[0],
+            ((s.contact_force_mean[0] - reference_mean) / reference_mean).abs()
+        );
+    }
+}
+
+/// Consistent mass, for the report: SSN-HB (H = 40) against Moreau–Jean (e = 0 and 0.5, at
+/// 1000 and 4000 steps per period; the last period when the march does not lock onto the
+/// forcing period). `cargo test --release --test time_marching -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
+    let rod = build_rod(&RodSpec::canonical()).unwrap();
+    let tip = rod.tip_dof();
+    let mut summaries = Vec::new();
+    for harmonics in [20, 40] {
+        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
+        println!(
+            "SSN-HB H {harmonics} ({:?} after {} iterations, |F| {:.1e}): tip min {:.7} rms {:.7} \
+             mean lambda {:.6e}",
+            report.termination,
+            report.iterations,
+            report.residual_norm(),
+            s.displacement_min,
+            s.displacement_rms,
+            s.contact_force_mean[0]
+        );
+        summaries.push(s);
+    }
+    let s = summaries.pop().unwrap();
+    for e in [0.0, 0.5] {
+        for spp in [1000, 4000] {
+            let options = MarchOptions {
+                steps_per_period: spp,
+                max_periods: 400,
+                scheme: MarchScheme::MoreauJean {
+                    theta: 0.5,
+                    restitution: e,
+                },
+                ..MarchOptions::default()
+            };
+            let period = match march_to_steady_state(&rod.model, &options, &[tip]) {
+                Ok(p) => p,
+                Err(MarchError::NotSteady { last_period, .. }) => *last_period,
+                Err(other) => panic!("{other}"),
+            };
+            let u = &period.displacements[0];
+            let min = parabolic_min(u);
+            let rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
+            let mean = period_mean(&period.contact_forces[0]);
+            println!(
+                "MJ e {e} spp {spp}: periods {} change {:.1e}; tip min {min:.7} ({:.2e} rel to HB) \
+                 rms {rms:.7} ({:.2e}) mean lambda {mean:.6e} ({:.2e})",
+                period.periods,
+                period.period_change,
+                ((min - s.displacement_min) / s.displacement_min).abs(),
+                ((rms - s.displacement_rms) / s.displacement_rms).abs(),
+                ((mean - s.contact_force_mean[0]) / s.contact_force_mean[0]).abs()
             );
         }
     }

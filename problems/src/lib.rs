@@ -5,6 +5,7 @@
 //! contact `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, the finite-element rod of
 //! Shi & Legrand, and the formulations that solve it.
 
+pub mod cli;
 pub mod hb;
 pub mod lcp;
 pub mod march;

@@ -24,8 +24,11 @@ use crate::scene::{
     GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
 };
 
+/// Ratio between successive penalty stiffnesses of the penalty homotopy.
+pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
+
 /// Number of reconstruction points per period for harmonic-balance outputs.
-pub const HB_OUTPUT_POINTS: usize = 512;
+pub const HB_OUTPUT_POINTS: usize = 1024;
 
 /// Why a run could not be carried out.
 #[derive(Debug, thiserror::Error)]
@@ -102,6 +105,8 @@ pub struct Solution {
     pub harmonics: Option<usize>,
     /// AFT samples (HB), time steps per period (LCP, time marching).
     pub time_samples: usize,
+    /// Complementarity constant `c` (SSN-HB only).
+    pub c: Option<f64>,
     /// Forcing frequency.
     pub omega: f64,
     /// First natural frequency of the rod.
@@ -115,6 +120,10 @@ pub struct Solution {
     /// Final residual norm (Newton methods), complementarity error (Lemke), period change
     /// (time marching).
     pub residual_norm: f64,
+    /// Convergence order observed over the last Newton iterations (Newton methods).
+    pub observed_order: Option<f64>,
+    /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
+    pub residual_history: Vec<f64>,
     /// Wall time of the solve (not the set-up of the rod).
     pub solve_seconds: f64,
     /// Times over one period, `[0, T)` (the forcing is `cos(omega t)`).
@@ -137,6 +146,7 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
         GlobalizationChoice::None => Globalization::None,
         GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
         GlobalizationChoice::Nonmonotone => NewtonOptions::default().globalization,
+        GlobalizationChoice::Hybrid => Globalization::hybrid(),
     };
     NewtonOptions {
         absolute_tolerance: settings.tolerance,
@@ -205,12 +215,15 @@ fn hb_solution(
         method: settings.method,
         harmonics: Some(settings.harmonics),
         time_samples: settings.time_samples,
+        c: None,
         omega,
         omega_1: rod.omega_1,
         converged: report.converged(),
         termination: termination_name(report),
         iterations: report.iterations,
         residual_norm: report.residual_norm(),
+        observed_order: report.observed_order,
+        residual_history: report.residual_norms.clone(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip, &contact_forces, None),
         times,
@@ -283,20 +296,50 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            sol.c = (problem.contacts() > 0).then(|| problem.c());
             Ok(sol)
         }
         Method::PenaltyHb => {
+            let target = settings
+                .penalty_stiffness
+                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
             let options = PenaltyHbOptions {
                 harmonics: settings.harmonics,
                 time_samples: Some(settings.time_samples),
-                penalty_stiffness: settings
-                    .penalty_stiffness
-                    .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale),
+                penalty_stiffness: target,
             };
             let mut problem = PenaltyHb::new(model, &options)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
-            let report = newton_hb(&mut problem, &mut x, settings)?;
+            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+            // is the linear response, deep in the obstacle), so without a warm start the
+            // stiffness is raised from the contact scale by factors of 10, each stage
+            // starting from the previous answer.
+            let mut counters = WorkCounters::default();
+            let mut homotopy_iterations = 0;
+            if warm_start.is_none() {
+                let mut k = scale;
+                while k < target {
+                    let stage_options = PenaltyHbOptions {
+                        penalty_stiffness: k,
+                        ..options
+                    };
+                    let mut stage = PenaltyHb::new(model, &stage_options)?;
+                    let mut trial = x.clone();
+                    let report = newton_hb(&mut stage, &mut trial, settings)?;
+                    counters += report.counters;
+                    homotopy_iterations += report.iterations;
+                    if report.converged() {
+                        x = trial;
+                    }
+                    k *= PENALTY_HOMOTOPY_FACTOR;
+                }
+            }
+            let mut report = newton_hb(&mut problem, &mut x, settings)?;
+            counters += report.counters;
+            report.counters = counters;
+            // Iterations of the whole homotopy, so that costs compare across methods.
+            report.iterations += homotopy_iterations;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let tip_series = problem.displacement_samples(&x, tip, points)?;
@@ -310,6 +353,17 @@ pub fn solve_rod(
                 .collect::<Result<Vec<_>, _>>()?;
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            // The mean penalty force as the equations see it: over the Nt AFT samples (a
+            // finer grid resolves narrow force peaks the quadrature does not).
+            if problem.contacts() > 0 {
+                let summary = problem.summary(&sol.state, tip, points)?;
+                let tip_contact = model
+                    .contacts
+                    .iter()
+                    .position(|c| c.dof == tip)
+                    .unwrap_or(0);
+                sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
+            }
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
@@ -378,18 +432,48 @@ fn solve_lcp(
             )
         }
         _ => {
-            let mut problem = lcp.min_map();
-            let mut z = initial_state(problem.dim(), warm_start);
-            let mut solver = ActiveSetSolver::new();
-            let report =
-                newton::solve(&mut problem, &mut solver, &mut z, &newton_options(settings))?;
+            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+            // creeps one time node per iteration.
+            let options = newton_options(settings);
+            let (z, report_list) = match warm_start {
+                Some(w) if w.len() == lcp.dim() => {
+                    let mut problem = lcp.min_map();
+                    let mut z = w.to_vec();
+                    let mut solver = ActiveSetSolver::new();
+                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)?;
+                    (z, vec![report])
+                }
+                _ => {
+                    let sequenced = crate::lcp::solve_min_map_sequenced(
+                        model,
+                        PeriodicLcpOptions {
+                            time_samples: settings.time_samples,
+                            observed_dofs: Vec::new(),
+                        },
+                        &options,
+                    )?;
+                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                    (sequenced.z, reports)
+                }
+            };
+            let last = report_list.last().expect("at least one level");
+            let mut counters = RunCounters::default();
+            for r in &report_list {
+                let c: RunCounters = r.counters.into();
+                counters.residual_evaluations += c.residual_evaluations;
+                counters.jacobian_evaluations += c.jacobian_evaluations;
+                counters.factorizations += c.factorizations;
+                counters.linear_solves += c.linear_solves;
+                counters.line_search_backtracks += c.line_search_backtracks;
+            }
             (
                 z,
-                report.converged(),
-                termination_name(&report),
-                report.iterations,
-                report.residual_norm(),
-                report.counters.into(),
+                last.converged(),
+                termination_name(last),
+                report_list.iter().map(|r| r.iterations).sum(),
+                last.residual_norm(),
+                counters,
             )
         }
     };
@@ -405,12 +489,15 @@ fn solve_lcp(
         method,
         harmonics: None,
         time_samples: settings.time_samples,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged,
         termination,
         iterations,
         residual_norm: residual,
+        observed_order: None,
+        residual_history: Vec::new(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
         times,
@@ -459,12 +546,15 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         method: Method::March,
         harmonics: None,
         time_samples: settings.steps_per_period,
+        c: None,
         omega: model.forcing.omega,
         omega_1: rod.omega_1,
         converged: true,
         termination: "converged".into(),
         iterations: period.periods,
         residual_norm: period.period_change,
+        observed_order: None,
+        residual_history: Vec::new(),
         solve_seconds: seconds,
         stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
         times,

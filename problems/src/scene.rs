@@ -116,8 +116,11 @@ pub enum GlobalizationChoice {
     /// Armijo backtracking on `0.5 |F|^2`.
     Armijo,
     /// Non-monotone (Grippo–Lampariello–Lucidi) line search.
-    #[default]
     Nonmonotone,
+    /// Full steps for 30 iterations (active-set behaviour), then the non-monotone line
+    /// search from the best iterate.
+    #[default]
+    Hybrid,
 }
 
 /// Default number of harmonics.
@@ -231,9 +234,17 @@ enum RawMass {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawDamping {
+    model: Option<RawDampingModel>,
     zeta: Option<f64>,
     alpha: Option<f64>,
     beta: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum RawDampingModel {
+    StiffnessProportional,
+    Rayleigh,
 }
 
 #[derive(Debug, Deserialize, Default, Clone, Copy)]
@@ -398,33 +409,64 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         RawMass::Modified => MassModel::Modified,
     };
 
-    let damping =
-        match raw.damping {
-            None => None,
-            Some(d) => match (d.zeta, d.alpha, d.beta) {
-                (Some(zeta), None, None) => Some(DampingSpec::StiffnessProportional {
-                    zeta: ck.non_negative("damping.zeta", zeta)?,
-                }),
-                (None, alpha, beta) if alpha.is_some() || beta.is_some() => {
-                    Some(DampingSpec::Rayleigh {
-                        alpha: ck.non_negative("damping.alpha", alpha.unwrap_or(0.0))?,
-                        beta: ck.non_negative("damping.beta", beta.unwrap_or(0.0))?,
-                    })
+    let damping = match raw.damping {
+        None => None,
+        Some(d) => {
+            let model = match (d.model, d.zeta, d.alpha, d.beta) {
+                (Some(m), _, _, _) => m,
+                (None, Some(_), None, None) => RawDampingModel::StiffnessProportional,
+                (None, None, a, b) if a.is_some() || b.is_some() => RawDampingModel::Rayleigh,
+                (None, None, None, None) => {
+                    return Err(ck.invalid(
+                        "damping",
+                        "an empty section",
+                        "`zeta` (stiffness-proportional) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
+                    ))
                 }
-                (None, None, None) => return Err(ck.invalid(
-                    "damping",
-                    "an empty section",
-                    "`zeta` (mode-1 ratio) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
-                )),
                 _ => {
                     return Err(ck.invalid(
                         "damping.zeta",
                         "given together with alpha/beta",
-                        "either `zeta` or `alpha`/`beta`, not both",
+                        "either `zeta` (model = \"stiffness-proportional\") or `alpha`/`beta` (model = \"rayleigh\")",
                     ))
                 }
-            },
-        };
+            };
+            match model {
+                RawDampingModel::StiffnessProportional => {
+                    if d.alpha.is_some() || d.beta.is_some() {
+                        return Err(ck.invalid(
+                            "damping.alpha",
+                            "given with model = \"stiffness-proportional\"",
+                            "only `zeta` for this model",
+                        ));
+                    }
+                    let zeta = d.zeta.ok_or_else(|| {
+                        ck.invalid(
+                            "damping.zeta",
+                            "missing",
+                            "a finite number >= 0 (required by model = \"stiffness-proportional\")",
+                        )
+                    })?;
+                    Some(DampingSpec::StiffnessProportional {
+                        zeta: ck.non_negative("damping.zeta", zeta)?,
+                    })
+                }
+                RawDampingModel::Rayleigh => {
+                    if d.zeta.is_some() {
+                        return Err(ck.invalid(
+                            "damping.zeta",
+                            "given with model = \"rayleigh\"",
+                            "only `alpha` and `beta` for this model",
+                        ));
+                    }
+                    Some(DampingSpec::Rayleigh {
+                        alpha: ck.non_negative("damping.alpha", d.alpha.unwrap_or(0.0))?,
+                        beta: ck.non_negative("damping.beta", d.beta.unwrap_or(0.0))?,
+                    })
+                }
+            }
+        }
+    };
 
     let amplitude = ck.finite("forcing.amplitude", raw.forcing.amplitude)?;
     let frequency = match (raw.forcing.omega_ratio, raw.forcing.omega) {

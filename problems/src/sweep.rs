@@ -536,6 +536,7 @@ fn continuation_error(e: ContinuationError) -> RunError {
                 found,
             })
         }
+        ContinuationError::Newton(e) => RunError::Newton(e),
         ContinuationError::InvalidStart { parameter, .. } => invalid(
             "sweep.omega_ratio_from",
             parameter,
@@ -788,11 +789,11 @@ where
     response.folds = folds;
     response.fold_indices = indices;
     response.restarts = restarts;
-    counters.residual_evaluations += c.residual_evaluations;
-    counters.jacobian_evaluations += c.jacobian_evaluations;
-    counters.factorizations += c.factorizations + c.dense_bordered_factorizations;
-    counters.linear_solves += c.linear_solves;
-    counters.ffts += c.ffts;
+    counters.residual_evaluations += c.work.residual_evaluations;
+    counters.jacobian_evaluations += c.work.jacobian_evaluations;
+    counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
+    counters.linear_solves += c.work.linear_solves;
+    counters.ffts += c.work.ffts;
     response.counters = counters;
     response.continuation = c;
     let to_q = sweep.omega_ratio_to / q_unit;
@@ -871,13 +872,9 @@ where
 }
 
 fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
-    total.residual_evaluations += c.residual_evaluations;
-    total.jacobian_evaluations += c.jacobian_evaluations;
+    total.work += c.work;
     total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
-    total.factorizations += c.factorizations;
-    total.linear_solves += c.linear_solves;
     total.dense_bordered_factorizations += c.dense_bordered_factorizations;
-    total.ffts += c.ffts;
     total.corrector_iterations += c.corrector_iterations;
     total.rejected_iterations += c.rejected_iterations;
     total.rejected_steps += c.rejected_steps;

@@ -115,7 +115,8 @@ impl FaerDenseLu {
     }
 
     /// Uses `par` for the factorization and solves instead of faer's global setting
-    /// (`faer::get_global_parallelism()`).
+    /// (`faer::get_global_parallelism()`, which panics if a program called
+    /// `faer::disable_global_parallelism()`: such programs must set `par` here).
     pub fn with_parallelism(mut self, par: Par) -> Self {
         self.parallelism = Some(par);
         self

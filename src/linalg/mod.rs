@@ -3,6 +3,18 @@
 //! Every implementation checks its pivots against a relative threshold and returns
 //! [`LinearSolveError::Singular`] instead of dividing by a (near) zero pivot: a singular
 //! generalized Jacobian is an expected event in semismooth Newton, not a bug.
+//!
+//! | solver | matrix types | storage between factorizations |
+//! |---|---|---|
+//! | [`FaerDenseLu`] | any [`DenseAssemble`] (`faer::Mat`, `nalgebra::DMatrix`, structured types) | reused: no allocation after the first call of a size |
+//! | [`NalgebraLu`] | any [`DenseAssemble`] | matrix reused; nalgebra allocates its permutation and the U copy for the pivot check |
+//! | [`FaerSparseLu`] | `faer::sparse::SparseColMat<usize, f64>` | column ordering once per pattern, factor storage reused |
+//!
+//! Each solver has inherent `factor` and `solve_in_place` methods with the same meaning
+//! as the [`LinearSolve`](crate::LinearSolve) trait methods, so direct use needs neither
+//! the trait in scope nor an annotation of the Jacobian type (the dense solvers implement
+//! `LinearSolve<J>` for every `J: DenseAssemble`, which would otherwise make
+//! `lu.solve_in_place(..)` ambiguous). Generic code (the Newton driver) uses the trait.
 
 mod dense;
 mod nalgebra_lu;

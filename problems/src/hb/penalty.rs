@@ -5,8 +5,8 @@ use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_omega, displacement_at, displacement_summary, fine_samples, HbError, HbState,
-    LinearData, ResponseSummary,
+    check_len, check_omega, displacement_at, displacement_summary, fine_samples, validate_basis,
+    HbError, HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -41,6 +41,22 @@ impl Default for PenaltyHbOptions {
     }
 }
 
+impl PenaltyHbOptions {
+    /// Checks `harmonics >= 1`, `time_samples > 2H`, `penalty_stiffness` finite and `> 0`.
+    pub fn validate(&self) -> Result<(), HbError> {
+        validate_basis(self.harmonics, self.time_samples)?;
+        let kp = self.penalty_stiffness;
+        if !(kp.is_finite() && kp > 0.0) {
+            return Err(HbError::InvalidOption {
+                name: "penalty_stiffness",
+                value: kp,
+                allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),
 /// residual `R = A(w) U - F - G^T P lambda(E U)` with
 /// `lambda_i(t_n) = -k_p max(0, u_{dof_i}(t_n) - g_i)`, generalized Jacobian
@@ -56,14 +72,8 @@ pub struct PenaltyHb {
 impl PenaltyHb {
     /// Builds the problem; validates the model and the options.
     pub fn new(model: &StructuralModel, options: &PenaltyHbOptions) -> Result<Self, HbError> {
+        options.validate()?;
         let kp = options.penalty_stiffness;
-        if !(kp.is_finite() && kp > 0.0) {
-            return Err(HbError::InvalidOption {
-                name: "penalty_stiffness",
-                value: kp,
-                allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
-            });
-        }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let size = linear.size();
         let nt = linear.basis.time_samples();
@@ -149,8 +159,11 @@ impl PenaltyHb {
             .collect())
     }
 
-    /// Extremes of `u_dof`, penetration and mean penalty forces over a period reconstructed
-    /// on `points` times (the mean force is the period mean of the pointwise penalty force).
+    /// Extremes of `u_dof` and penetration over a period reconstructed on `points` times,
+    /// and the mean penalty force of each contact as the equations see it: the mean over
+    /// the `Nt` AFT samples, `(P lambda)_0` (the static balance `K u_0 = f_0 + G^T Lambda_0`).
+    /// A finer grid would resolve a stiff penalty's narrow force peaks that the `Nt`-point
+    /// quadrature does not, and give a mean inconsistent with the solution.
     pub fn summary(
         &self,
         u: &[f64],
@@ -158,10 +171,11 @@ impl PenaltyHb {
         points: usize,
     ) -> Result<ResponseSummary, HbError> {
         check_len("HB unknowns", self.dim(), u.len())?;
+        let nt = self.state.linear.basis.time_samples();
         let means = (0..self.contacts())
             .map(|i| {
-                self.contact_force_samples(u, i, points)
-                    .map(|f| f.iter().sum::<f64>() / points as f64)
+                self.contact_force_samples(u, i, nt)
+                    .map(|f| f.iter().sum::<f64>() / nt as f64)
             })
             .collect::<Result<Vec<f64>, HbError>>()?;
         displacement_summary(&self.state.linear, u, dof, points, means)

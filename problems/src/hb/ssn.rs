@@ -6,8 +6,8 @@ use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_omega, displacement_at, displacement_summary, fine_samples, HbError, HbState,
-    LinearData, ResponseSummary,
+    check_len, check_omega, displacement_at, displacement_summary, fine_samples, validate_basis,
+    HbError, HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -38,6 +38,24 @@ impl Default for HbOptions {
     }
 }
 
+impl HbOptions {
+    /// Checks what can be checked without a model: `harmonics >= 1`, `time_samples > 2H`,
+    /// `c` finite and `> 0` when given.
+    pub fn validate(&self) -> Result<(), HbError> {
+        validate_basis(self.harmonics, self.time_samples)?;
+        if let Some(c) = self.c {
+            if !(c.is_finite() && c > 0.0) {
+                return Err(HbError::InvalidOption {
+                    name: "c",
+                    value: c,
+                    allowed: "a finite complementarity constant > 0 (force per length)",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// SSN-HB on a [`StructuralModel`] with `m >= 0` contacts.
 ///
 /// Unknowns `X = [U; Lambda]`: `U` of length `N (2H + 1)` (index `j N + dof`), `Lambda` of
@@ -53,7 +71,7 @@ impl Default for HbOptions {
 /// [`ParameterDependent`] is `w`; only `A(w)` depends on it.
 #[derive(Debug)]
 pub struct SsnHb {
-    state: HbState,
+    pub(crate) state: HbState,
     c: f64,
     coeffs: Vec<f64>,
     samples: Vec<f64>,
@@ -62,6 +80,7 @@ pub struct SsnHb {
 impl SsnHb {
     /// Builds the problem; validates the model and the options.
     pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
+        options.validate()?;
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let c = match options.c {
             Some(c) => c,
@@ -107,6 +126,17 @@ impl SsnHb {
     /// Current angular frequency `w`.
     pub fn omega(&self) -> f64 {
         self.state.omega
+    }
+
+    /// Sets the complementarity constant `c` (finite, `> 0`).
+    pub fn set_c(&mut self, c: f64) -> Result<(), HbError> {
+        HbOptions {
+            c: Some(c),
+            ..HbOptions::default()
+        }
+        .validate()?;
+        self.c = c;
+        Ok(())
     }
 
     /// Sets `w` (finite, `> 0`).

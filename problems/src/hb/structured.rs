@@ -21,13 +21,16 @@ use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solv
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{c64, Conj, Mat, MatMut, Par};
+use faer::{c64, Conj, Mat, MatMut, MatRef, Par};
 use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::LinearSolve;
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::LinearData;
 use crate::model::SparseMatrix;
+
+/// Relative residual `|J x - b| / |b|` below which iterative refinement stops.
+const REFINEMENT_TARGET: f64 = 1e-14;
 
 /// Sparsity pattern of `K + M + D` with the positions of each matrix's entries in it, and
 /// its symbolic LU (computed once per model).
@@ -189,8 +192,9 @@ impl StructuredHbSolver {
         }
     }
 
-    /// Sets the number of iterative-refinement steps after each solve (default 1; 0 gives
-    /// the bare condensed solve). Each step costs one structured product and one solve.
+    /// Sets the maximum number of iterative-refinement steps after each solve (default 1;
+    /// 0 gives the bare condensed solve). Each step costs one structured product, and one
+    /// more solve unless the relative residual is already below `1e-14`.
     pub fn with_refinement_steps(mut self, steps: usize) -> Self {
         self.refinement_steps = steps;
         self
@@ -337,7 +341,7 @@ impl StructuredHbSolver {
     }
 
     /// `u <- A(w)^{-1} u` harmonic by harmonic (complex form).
-    fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
+    pub(crate) fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
         let (Some((_, pattern)), Some((lin, _))) = (&self.pattern, &self.factored_for) else {
             return Err(LinearSolveError::NotFactored);
         };
@@ -377,7 +381,7 @@ impl StructuredHbSolver {
     }
 
     /// `u += alpha A^{-1} G^T p` for contact coefficients `p` (index `j m + i`).
-    fn add_response(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
+    pub(crate) fn add_response(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
         let Some((lin, _)) = &self.factored_for else {
             return;
         };
@@ -399,28 +403,6 @@ impl StructuredHbSolver {
                         u[c + r] += v.re;
                         u[s + r] -= v.im;
                     }
-                }
-            }
-        }
-    }
-
-    /// `out = R p`: contact-displacement coefficients from contact-force coefficients.
-    fn apply_receptance(receptance: &[Mat<c64>], m: usize, p: &[f64], out: &mut [f64]) {
-        for (k, r) in receptance.iter().enumerate() {
-            for i in 0..m {
-                if k == 0 {
-                    out[i] = (0..m).map(|ip| r[(i, ip)].re * p[ip]).sum();
-                } else {
-                    let (c, s) = ((2 * k - 1) * m, 2 * k * m);
-                    let (mut a, mut b) = (0.0, 0.0);
-                    for ip in 0..m {
-                        let (cr, ci) = (r[(i, ip)].re, r[(i, ip)].im);
-                        let (pc, ps) = (p[c + ip], p[s + ip]);
-                        a += cr * pc + ci * ps;
-                        b += -ci * pc + cr * ps;
-                    }
-                    out[c + i] = a;
-                    out[s + i] = b;
                 }
             }
         }
@@ -462,36 +444,13 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
         {
             return Err(LinearSolveError::NonFiniteEntry { row, col, value });
         }
-        // Build the condensed matrix column by column.
-        for col in 0..nc {
-            self.work_a.fill(0.0);
-            self.work_a[col] = 1.0;
-            match self.coupling {
-                ContactCoupling::Complementarity { c } => {
-                    // S = I - Q + c Q R.
-                    Self::apply_receptance(&self.receptance, m, &self.work_a, &mut self.work_c);
-                    for v in self.work_c.iter_mut() {
-                        *v *= c;
-                    }
-                    self.work_c[col] -= 1.0;
-                    // work_c = c R e - e; S e = e + Q (c R e - e).
-                    let (work_c, work_a) = (&self.work_c, &mut self.work_a);
-                    Self::apply_coupling(&self.q, m, work_c, work_a);
-                    for r in 0..nc {
-                        self.schur[(r, col)] = self.work_a[r] + if r == col { 1.0 } else { 0.0 };
-                    }
-                }
-                ContactCoupling::Penalty { stiffness } => {
-                    // S = I + k_p R Q.
-                    Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
-                    Self::apply_receptance(&self.receptance, m, &self.work_c, &mut self.work_a);
-                    for r in 0..nc {
-                        self.schur[(r, col)] =
-                            stiffness * self.work_a[r] + if r == col { 1.0 } else { 0.0 };
-                    }
-                }
-            }
-        }
+        condensed_matrix(
+            &self.receptance,
+            self.q.as_ref(),
+            self.coupling,
+            m,
+            self.schur.as_mut(),
+        );
         if nc > 0 {
             let stack = MemStack::new(&mut self.mem);
             dense_lu::lu_in_place(
@@ -533,8 +492,17 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
             let mut correction = std::mem::take(&mut self.work_res);
             correction.resize(rhs.len(), 0.0);
             self.apply_jacobian(rhs, &mut correction);
+            let mut residual_sq = 0.0;
+            let mut rhs_sq = 0.0;
             for (c, o) in correction.iter_mut().zip(&self.work_rhs) {
                 *c = *o - *c;
+                residual_sq += *c * *c;
+                rhs_sq += o * o;
+            }
+            // Already at rounding level: a correction would not change the answer.
+            if residual_sq <= REFINEMENT_TARGET * REFINEMENT_TARGET * rhs_sq {
+                self.work_res = correction;
+                break;
             }
             let solved = self.solve_once(&mut correction);
             if solved.is_ok() {
@@ -677,5 +645,79 @@ impl StructuredHbSolver {
             Par::Seq,
             stack,
         );
+    }
+}
+
+/// Receptance entries of column `(l, i')`: `R e_(l, i')` is nonzero only on the basis
+/// functions of harmonic `k(l)`; returns `(rho_cos_or_const, rho_sin)` for row contact `i`
+/// (`rho_sin` is 0 for `k = 0`).
+#[inline]
+fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> (f64, f64) {
+    let k = l.div_ceil(2);
+    let r = receptance[k][(i, ip)];
+    if k == 0 {
+        (r.re, 0.0)
+    } else if l % 2 == 1 {
+        // Unit cosine load: a = Cr, b = -Ci.
+        (r.re, -r.im)
+    } else {
+        // Unit sine load: a = Ci, b = Cr.
+        (r.im, r.re)
+    }
+}
+
+/// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R`
+/// (SSN-HB) or `I + k_p R Q` (penalty), using that `R` only couples the two basis
+/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` in column blocks.
+pub(crate) fn condensed_matrix(
+    receptance: &[Mat<c64>],
+    q: MatRef<'_, f64>,
+    coupling: ContactCoupling,
+    m: usize,
+    mut out: MatMut<'_, f64>,
+) {
+    let size = q.nrows();
+    out.fill(0.0);
+    for l in 0..size {
+        let k = l.div_ceil(2);
+        // Basis functions of harmonic k: (first, count).
+        let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
+        for ip in 0..m {
+            let col = l * m + ip;
+            match coupling {
+                ContactCoupling::Complementarity { c } => {
+                    for i in 0..m {
+                        let (rho0, rho1) = receptance_column(receptance, l, i, ip);
+                        let qi = i * size;
+                        for j in 0..size {
+                            let mut value = c * rho0 * q[(j, qi + first)];
+                            if count == 2 {
+                                value += c * rho1 * q[(j, qi + first + 1)];
+                            }
+                            if i == ip {
+                                value -= q[(j, qi + l)];
+                            }
+                            out[(j * m + i, col)] = value;
+                        }
+                    }
+                }
+                ContactCoupling::Penalty { stiffness } => {
+                    // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
+                    let qp = ip * size;
+                    for i in 0..m {
+                        let r0 = receptance[0][(i, ip)].re;
+                        out[(i, col)] = stiffness * r0 * q[(0, qp + l)];
+                        for (kk, rk) in receptance.iter().enumerate().skip(1) {
+                            let (jc, js) = (2 * kk - 1, 2 * kk);
+                            let r = rk[(i, ip)];
+                            let (pc, ps) = (q[(jc, qp + l)], q[(js, qp + l)]);
+                            out[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
+                            out[(js * m + i, col)] = stiffness * (-r.im * pc + r.re * ps);
+                        }
+                    }
+                }
+            }
+            out[(col, col)] += 1.0;
+        }
     }
 }

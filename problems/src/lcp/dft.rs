@@ -54,8 +54,7 @@ impl Dft {
         assert_eq!(x.len(), self.n, "DFT length");
         match &self.bit_reverse {
             Some(rev) => {
-                for i in 0..self.n {
-                    let j = rev[i];
+                for (i, &j) in rev.iter().enumerate() {
                     if i < j {
                         x.swap(i, j);
                     }

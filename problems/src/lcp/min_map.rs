@@ -11,6 +11,7 @@
 
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
+use semismooth::complementarity::min_function;
 use semismooth::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
 
@@ -83,7 +84,7 @@ impl Residual for MinMapLcp<'_> {
     fn residual(&mut self, x: &[f64], out: &mut [f64]) {
         self.gap(x);
         for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
-            *o = z.min(*w);
+            *o = min_function(*z, *w).value;
         }
     }
 }
@@ -101,7 +102,8 @@ impl<'a> GeneralizedJacobian for MinMapLcp<'a> {
     fn jacobian(&mut self, x: &[f64], jac: &mut MinMapJacobian<'a>) {
         self.gap(x);
         for ((a, z), w) in jac.active.iter_mut().zip(x).zip(&self.w) {
-            *a = w < z;
+            // min_function's gradient is (0, 1) exactly where w < z (tie: (1, 0)).
+            *a = min_function(*z, *w).db == 1.0;
         }
     }
 }
@@ -334,15 +336,8 @@ mod tests {
 
     #[test]
     fn singular_active_block_is_a_typed_error() {
-        let a = Mat::from_fn(3, 3, |i, j| {
-            if i < 2 && j < 2 {
-                1.0
-            } else if i == j {
-                1.0
-            } else {
-                0.0
-            }
-        });
+        // Rows 0 and 1 of the active block are equal: A_II = [[1, 1], [1, 1]].
+        let a = Mat::from_fn(3, 3, |i, j| f64::from(i == j || (i < 2 && j < 2)));
         let jac = MinMapJacobian::new(a.as_ref(), vec![true, true, false]).unwrap();
         let mut solver = ActiveSetSolver::new();
         assert!(matches!(

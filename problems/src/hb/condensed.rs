@@ -1,0 +1,241 @@
+//! SSN-HB condensed onto the contact-force coefficients.
+
+use faer::{c64, Mat};
+use semismooth::harmonic::{Aft, FourierBasis};
+use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+
+use super::jacobian::ContactCoupling;
+use super::ssn::{HbOptions, SsnHb};
+use super::structured::{condensed_matrix, StructuredHbSolver};
+use super::{check_len, HbError, ResponseSummary};
+use crate::model::StructuralModel;
+
+/// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
+/// index `j m + contact`).
+///
+/// At fixed `w` the equation of motion `A(w) U = F + G^T Lambda` gives
+/// `G U = y_lin + R Lambda` with `y_lin = G A^{-1} F` and the receptance
+/// `R = G A^{-1} G^T` (block diagonal per harmonic), both computed once per frequency by the
+/// per-harmonic sparse LU of [`StructuredHbSolver`]. The residual is
+/// `Lambda + P max(0, c (E (y_lin + R Lambda) - g) - E Lambda)` and its generalized Jacobian
+/// the dense `I - Q + c Q R` (`Q = P diag(h) E` per contact): solve it with a dense LU
+/// (`semismooth::linalg::FaerDenseLu`). The full solution `[U; Lambda]` of [`SsnHb`] is
+/// recovered by [`CondensedSsnHb::expand`], and is a root of the full residual.
+#[derive(Debug)]
+pub struct CondensedSsnHb {
+    full: SsnHb,
+    receptance: Vec<Mat<c64>>,
+    solver: StructuredHbSolver,
+    linear_response: Vec<f64>,
+    contact_linear: Vec<f64>,
+    y: Vec<f64>,
+    q: Mat<f64>,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+    aft: Aft,
+}
+
+impl CondensedSsnHb {
+    /// Builds the problem and factors `A(w)` (validates like [`SsnHb::new`]; a singular
+    /// dynamic block is [`HbError::Linear`]).
+    pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
+        let full = SsnHb::new(model, options)?;
+        let basis = full.basis();
+        let (m, size) = (full.contacts(), basis.basis_size());
+        let mut this = Self {
+            receptance: Vec::new(),
+            solver: StructuredHbSolver::new(),
+            linear_response: vec![0.0; full.displacement_len()],
+            contact_linear: vec![0.0; m * size],
+            y: vec![0.0; m * size],
+            q: Mat::zeros(size, m * size),
+            coeffs: vec![0.0; size],
+            samples: vec![0.0; basis.time_samples()],
+            aft: Aft::new(basis),
+            full,
+        };
+        this.refactor()?;
+        Ok(this)
+    }
+
+    /// Factors `A(w)` at the current `w`, then `A^{-1} F`, `G A^{-1} F` and `R`.
+    fn refactor(&mut self) -> Result<(), HbError> {
+        let jac = self.full.new_jacobian();
+        self.solver.factor(&jac)?;
+        let lin = self.full.state.linear.clone();
+        let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
+        self.linear_response.fill(0.0);
+        self.linear_response[n..2 * n].copy_from_slice(&lin.forcing);
+        self.solver
+            .apply_dynamic_inverse(&mut self.linear_response)?;
+        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            for j in 0..lin.size() {
+                self.contact_linear[j * m + i] = self.linear_response[j * n + dof];
+            }
+        }
+        self.receptance = (0..=h)
+            .map(|k| {
+                self.solver
+                    .receptance(k)
+                    .cloned()
+                    .unwrap_or_else(|| Mat::zeros(m, m))
+            })
+            .collect();
+        Ok(())
+    }
+
+    /// The full SSN-HB problem (for reconstruction and summaries of expanded solutions).
+    pub fn full_problem(&self) -> &SsnHb {
+        &self.full
+    }
+
+    /// The Fourier basis (`H`, `Nt`).
+    pub fn basis(&self) -> FourierBasis {
+        self.full.basis()
+    }
+
+    /// The complementarity constant `c`.
+    pub fn c(&self) -> f64 {
+        self.full.c()
+    }
+
+    /// Sets the complementarity constant `c` (finite, `> 0`).
+    pub fn set_c(&mut self, c: f64) -> Result<(), HbError> {
+        self.full.set_c(c)
+    }
+
+    /// Static stiffness seen by the contacts: the mean over contacts of
+    /// `1 / (G K^{-1} G^T)_ii` (for the rod, `EA / L` whatever the mesh). A mesh-independent
+    /// scale for `c`, unlike `K[dof, dof]` (which grows like the element count); see
+    /// [`CondensedSsnHb::set_c`].
+    pub fn static_contact_stiffness(&self) -> f64 {
+        let m = self.full.contacts();
+        if m == 0 {
+            return 1.0;
+        }
+        let r0 = &self.receptance[0];
+        (0..m).map(|i| 1.0 / r0[(i, i)].re).sum::<f64>() / m as f64
+    }
+
+    /// Current angular frequency `w`.
+    pub fn omega(&self) -> f64 {
+        self.full.omega()
+    }
+
+    /// Sets `w` and refactors the dynamic blocks.
+    pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
+        self.full.set_omega(omega)?;
+        self.refactor()
+    }
+
+    /// The full unknowns `[U; Lambda]` of [`SsnHb`] from `Lambda`:
+    /// `U = A^{-1} (F + G^T Lambda)`.
+    pub fn expand(&self, lambda: &[f64]) -> Result<Vec<f64>, HbError> {
+        check_len("contact-force coefficients", self.dim(), lambda.len())?;
+        let mut x = self.linear_response.clone();
+        self.solver.add_response(lambda, 1.0, &mut x);
+        x.extend_from_slice(lambda);
+        Ok(x)
+    }
+
+    /// [`SsnHb::summary`] of the expanded solution.
+    pub fn summary(
+        &self,
+        lambda: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<ResponseSummary, HbError> {
+        let x = self.expand(lambda)?;
+        self.full.summary(&x, dof, points)
+    }
+
+    /// `self.y = y_lin + R Lambda` (contact-displacement coefficients).
+    fn contact_displacements(&mut self, lambda: &[f64]) {
+        let m = self.full.contacts();
+        self.y.copy_from_slice(&self.contact_linear);
+        for (k, r) in self.receptance.iter().enumerate() {
+            for i in 0..m {
+                for ip in 0..m {
+                    let (cr, ci) = (r[(i, ip)].re, r[(i, ip)].im);
+                    if k == 0 {
+                        self.y[i] += cr * lambda[ip];
+                    } else {
+                        let (c, s) = ((2 * k - 1) * m, 2 * k * m);
+                        let (pc, ps) = (lambda[c + ip], lambda[s + ip]);
+                        self.y[c + i] += cr * pc + ci * ps;
+                        self.y[s + i] += -ci * pc + cr * ps;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Samples of `s = c (G u - g) - lambda` of contact `i` into `self.samples`.
+    fn switching_samples(&mut self, lambda: &[f64], i: usize) {
+        let lin = &self.full.state.linear;
+        let m = lin.contacts();
+        let c = self.full.c();
+        for j in 0..lin.size() {
+            self.coeffs[j] = c * self.y[j * m + i] - lambda[j * m + i];
+        }
+        self.coeffs[0] -= c * lin.gaps[i];
+        // Lengths are fixed at construction: the transform cannot fail.
+        let _ = self.aft.to_time(&self.coeffs, &mut self.samples);
+    }
+}
+
+impl Residual for CondensedSsnHb {
+    fn dim(&self) -> usize {
+        self.full.contacts() * self.full.basis().basis_size()
+    }
+
+    fn residual(&mut self, lambda: &[f64], out: &mut [f64]) {
+        let m = self.full.contacts();
+        let size = self.full.basis().basis_size();
+        self.contact_displacements(lambda);
+        for i in 0..m {
+            self.switching_samples(lambda, i);
+            for s in &mut self.samples {
+                *s = s.max(0.0);
+            }
+            let _ = self.aft.to_coefficients(&self.samples, &mut self.coeffs);
+            for j in 0..size {
+                out[j * m + i] = lambda[j * m + i] + self.coeffs[j];
+            }
+        }
+    }
+
+    fn fft_count(&self) -> u64 {
+        self.aft.fft_count()
+    }
+}
+
+impl GeneralizedJacobian for CondensedSsnHb {
+    type Jacobian = Mat<f64>;
+
+    fn new_jacobian(&self) -> Mat<f64> {
+        let n = self.dim();
+        Mat::zeros(n, n)
+    }
+
+    fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) {
+        let m = self.full.contacts();
+        let size = self.full.basis().basis_size();
+        self.contact_displacements(lambda);
+        for i in 0..m {
+            self.switching_samples(lambda, i);
+            for s in &mut self.samples {
+                *s = if *s > 0.0 { 1.0 } else { 0.0 };
+            }
+            let block = self.q.as_mut().subcols_mut(i * size, size);
+            let _ = self.aft.multiplication_matrix(&self.samples, block);
+        }
+        condensed_matrix(
+            &self.receptance,
+            self.q.as_ref(),
+            ContactCoupling::Complementarity { c: self.full.c() },
+            m,
+            jac.as_mut(),
+        );
+    }
+}

@@ -1,0 +1,943 @@
+//! The semismooth Newton driver on problems with known answers: convergence order on
+//! smooth and nonsmooth problems, globalization, exact work counters, every termination.
+
+use std::cell::Cell;
+
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Mat;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use semismooth::complementarity::{fischer_burmeister, max_form, min_function, PhiValue};
+use semismooth::linalg::{FaerDenseLu, FaerSparseLu, LinearSolveError, NalgebraLu};
+use semismooth::newton::{
+    solve, Globalization, LineSearchOptions, NewtonError, NewtonOptions, NewtonSolver, Termination,
+    WorkCounters,
+};
+use semismooth::{GeneralizedJacobian, Residual};
+
+fn options(globalization: Globalization) -> NewtonOptions {
+    NewtonOptions {
+        globalization,
+        ..Default::default()
+    }
+}
+
+fn armijo() -> Globalization {
+    Globalization::Armijo(LineSearchOptions::default())
+}
+
+/// A scalar problem from closures: F(x) = f(x), J = df(x).
+struct Scalar<F, D> {
+    f: F,
+    df: D,
+}
+impl<F: Fn(f64) -> f64, D: Fn(f64) -> f64> Residual for Scalar<F, D> {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        out[0] = (self.f)(x[0]);
+    }
+}
+impl<F: Fn(f64) -> f64, D: Fn(f64) -> f64> GeneralizedJacobian for Scalar<F, D> {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(1, 1)
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+        jac[(0, 0)] = (self.df)(x[0]);
+    }
+}
+
+fn scalar(
+    f: impl Fn(f64) -> f64,
+    df: impl Fn(f64) -> f64,
+) -> Scalar<impl Fn(f64) -> f64, impl Fn(f64) -> f64> {
+    Scalar { f, df }
+}
+
+/// F(x) = x^3: root 0 with a singular Jacobian; Newton gives x_{k+1} = 2/3 x_k.
+fn cube() -> Scalar<impl Fn(f64) -> f64, impl Fn(f64) -> f64> {
+    scalar(|x| x * x * x, |x| 3.0 * x * x)
+}
+
+/// Newton on [`cube`] from x0 = 1 with the dense LU: the report and the final x.
+fn newton_on_cube(opts: &NewtonOptions) -> (semismooth::newton::NewtonReport, [f64; 1]) {
+    let mut x = [1.0];
+    let report = solve(&mut cube(), &mut FaerDenseLu::new(), &mut x, opts).unwrap();
+    (report, x)
+}
+
+/// Gradient of Rosenbrock's function f = (1 - x)^2 + 100 (y - x^2)^2; its only root is
+/// the minimizer (1, 1), where the Hessian [[802, -400], [-400, 200]] is regular.
+struct RosenbrockGradient;
+impl Residual for RosenbrockGradient {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn residual(&mut self, v: &[f64], out: &mut [f64]) {
+        let (x, y) = (v[0], v[1]);
+        out[0] = -2.0 * (1.0 - x) - 400.0 * x * (y - x * x);
+        out[1] = 200.0 * (y - x * x);
+    }
+}
+impl GeneralizedJacobian for RosenbrockGradient {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(2, 2)
+    }
+    fn jacobian(&mut self, v: &[f64], jac: &mut Mat<f64>) {
+        let (x, y) = (v[0], v[1]);
+        jac[(0, 0)] = 2.0 - 400.0 * (y - 3.0 * x * x);
+        jac[(0, 1)] = -400.0 * x;
+        jac[(1, 0)] = -400.0 * x;
+        jac[(1, 1)] = 200.0;
+    }
+}
+
+/// Coupled squares F(x) = B (x o x) - B (s o s) with B well conditioned: the root x = s
+/// (all s_i > 0) is regular (J = 2 B diag(x)).
+struct CoupledSquares {
+    b: Mat<f64>,
+    target: Vec<f64>,
+}
+impl CoupledSquares {
+    fn new(n: usize) -> Self {
+        let b = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                4.0
+            } else {
+                1.0 / (1.0 + (i + j) as f64)
+            }
+        });
+        let target = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
+        Self { b, target }
+    }
+}
+impl Residual for CoupledSquares {
+    fn dim(&self) -> usize {
+        self.target.len()
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+        let n = self.dim();
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = (0..n)
+                .map(|j| self.b[(i, j)] * (x[j] * x[j] - self.target[j] * self.target[j]))
+                .sum();
+        }
+    }
+}
+impl GeneralizedJacobian for CoupledSquares {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.dim(), self.dim())
+    }
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+        let n = self.dim();
+        for i in 0..n {
+            for j in 0..n {
+                jac[(i, j)] = 2.0 * self.b[(i, j)] * x[j];
+            }
+        }
+    }
+}
+
+/// On smooth systems with a regular root, the observed order over the last three
+/// residuals is >= 1.8 (theory: 2; measured 2.0) and the root matches the closed form.
+/// The absolute tolerance 1e-9 stops before the residual reaches round-off (~1e-13
+/// here), which would corrupt the order estimate.
+#[test]
+fn smooth_regular_root_converges_with_order_at_least_1_8() {
+    let opts = NewtonOptions {
+        absolute_tolerance: 1e-9,
+        ..options(Globalization::None)
+    };
+    let mut problem = CoupledSquares::new(6);
+    let mut x: Vec<f64> = problem.target.iter().map(|s| s * 1.3).collect();
+    let report = solve(&mut problem, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
+    println!("coupled squares: {:?}", report.residual_norms);
+    assert!(report.converged());
+    let q = report.observed_order.unwrap();
+    assert!(q >= 1.8, "order {q}");
+    for (xi, si) in x.iter().zip(&problem.target) {
+        assert!((xi - si).abs() < 1e-10);
+    }
+
+    // Rosenbrock's gradient from the classical start (-1.2, 1), full steps (the merit
+    // |grad f|^2 has a curved valley where Armijo takes tiny steps; Newton's iteration
+    // itself reaches the quadratic region within a few steps from here).
+    let opts = NewtonOptions {
+        absolute_tolerance: 1e-11,
+        ..options(Globalization::None)
+    };
+    let mut x = [-1.2, 1.0];
+    let report = solve(
+        &mut RosenbrockGradient,
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &opts,
+    )
+    .unwrap();
+    println!(
+        "rosenbrock: {:?} steps {:?}",
+        report.residual_norms, report.step_lengths
+    );
+    assert!(report.converged());
+    // The run ends exactly at 0 (measured: 25, 8.6e-6, 8.3e-9, 0), too short a tail for
+    // an order estimate; check the superlinear contraction r_{k+1} <= 1e-2 r_k over the
+    // last two nonzero steps instead.
+    let tail: Vec<f64> = report
+        .residual_norms
+        .iter()
+        .copied()
+        .filter(|&r| r > 0.0)
+        .collect();
+    let t = tail.len();
+    assert!(tail[t - 1] <= 1e-2 * tail[t - 2] && tail[t - 2] <= 1e-2 * tail[t - 3]);
+    assert!(
+        (x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12,
+        "{x:?}"
+    );
+}
+
+/// The order estimate tells linear from quadratic convergence: F(x) = x^3 has a
+/// singular Jacobian at its root, Newton gives x_{k+1} = 2/3 x_k and r_k = x_k^3, so
+/// the estimate is 1 (to round-off).
+#[test]
+fn singular_root_is_reported_with_order_one() {
+    let (report, _) = newton_on_cube(&NewtonOptions {
+        absolute_tolerance: 1e-12,
+        ..options(Globalization::None)
+    });
+    assert!(report.converged());
+    let q = report.observed_order.unwrap();
+    assert!((q - 1.0).abs() < 1e-6, "order {q}");
+    // Closed form: x_k = (2/3)^k and r_k = (2/3)^(3k) until r_k <= 1e-12.
+    let k = (0..)
+        .find(|&k| (2.0f64 / 3.0).powi(3 * k) <= 1e-12)
+        .unwrap() as usize;
+    assert_eq!(report.iterations, k);
+}
+
+/// An LCP `w = A z + q, z, w >= 0, z . w = 0` with a P-matrix, written with a
+/// complementarity function `phi(z_i, w_i) = 0`.
+#[derive(Clone, Copy, Debug)]
+enum Phi {
+    Min,
+    /// The paper's max form in the sign convention `-z, -w <= 0`, with constant c.
+    Max(f64),
+    FischerBurmeister,
+}
+
+struct Lcp {
+    a: Mat<f64>,
+    q: Vec<f64>,
+    phi: Phi,
+    w: Vec<f64>,
+}
+impl Lcp {
+    fn eval(&mut self, z: &[f64]) {
+        let n = self.q.len();
+        for i in 0..n {
+            self.w[i] = self.q[i] + (0..n).map(|j| self.a[(i, j)] * z[j]).sum::<f64>();
+        }
+    }
+    fn phi(&self, z: f64, w: f64) -> PhiValue {
+        match self.phi {
+            Phi::Min => min_function(z, w),
+            Phi::Max(c) => {
+                // phi(-z, -w): d/dz = -da, d/dw = -db.
+                let v = max_form(-z, -w, c);
+                PhiValue {
+                    value: v.value,
+                    da: -v.da,
+                    db: -v.db,
+                }
+            }
+            Phi::FischerBurmeister => fischer_burmeister(z, w),
+        }
+    }
+}
+impl Residual for Lcp {
+    fn dim(&self) -> usize {
+        self.q.len()
+    }
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+        self.eval(z);
+        for i in 0..self.dim() {
+            out[i] = self.phi(z[i], self.w[i]).value;
+        }
+    }
+}
+impl GeneralizedJacobian for Lcp {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.dim(), self.dim())
+    }
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+        self.eval(z);
+        let n = self.dim();
+        for i in 0..n {
+            let g = self.phi(z[i], self.w[i]);
+            for j in 0..n {
+                jac[(i, j)] = g.db * self.a[(i, j)] + if i == j { g.da } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// Brute force: for each of the 2^n index sets S, solve A_SS z_S = -q_S with z = 0
+/// off S, keep the z with z >= 0 and w = A z + q >= 0 (unique for a P-matrix).
+fn lcp_by_enumeration(a: &Mat<f64>, q: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let mut found = Vec::new();
+    for mask in 0u32..(1 << n) {
+        let s: Vec<usize> = (0..n).filter(|i| mask & (1 << i) != 0).collect();
+        let sub = Mat::from_fn(s.len(), s.len(), |i, j| a[(s[i], s[j])]);
+        let mut rhs: Vec<f64> = s.iter().map(|&i| -q[i]).collect();
+        let mut lu = NalgebraLu::new();
+        if lu.factor(&sub).is_err() || lu.solve_in_place(&mut rhs).is_err() {
+            continue;
+        }
+        let mut z = vec![0.0; n];
+        for (k, &i) in s.iter().enumerate() {
+            z[i] = rhs[k];
+        }
+        let w: Vec<f64> = (0..n)
+            .map(|i| q[i] + (0..n).map(|j| a[(i, j)] * z[j]).sum::<f64>())
+            .collect();
+        if z.iter().all(|&v| v >= -1e-12) && w.iter().all(|&v| v >= -1e-12) {
+            found.push(z);
+        }
+    }
+    assert_eq!(found.len(), 1, "a P-matrix LCP has exactly one solution");
+    found.pop().unwrap()
+}
+
+/// A seeded 8x8 LCP with a strictly diagonally dominant, positive-diagonal (hence P-)
+/// matrix, and q built from a chosen strictly complementary pair (z*, w*):
+/// q = w* - A z*, with z*_i = 0.5 + i/8 on even i and w*_i = 1 on odd i.
+fn strictly_complementary_lcp(phi: Phi) -> (Lcp, Vec<f64>) {
+    let n = 8;
+    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    let mut a = Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0));
+    for i in 0..n {
+        a[(i, i)] = n as f64 + rng.random_range(0.0..1.0);
+    }
+    let z_star: Vec<f64> = (0..n)
+        .map(|i| {
+            if i % 2 == 0 {
+                0.5 + i as f64 / 8.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let w_star: Vec<f64> = (0..n).map(|i| if i % 2 == 1 { 1.0 } else { 0.0 }).collect();
+    let q: Vec<f64> = (0..n)
+        .map(|i| w_star[i] - (0..n).map(|j| a[(i, j)] * z_star[j]).sum::<f64>())
+        .collect();
+    let lcp = Lcp {
+        a,
+        q,
+        phi,
+        w: vec![0.0; n],
+    };
+    (lcp, z_star)
+}
+
+/// Semismooth Newton on the LCP with a strictly complementary solution:
+/// - min and max form are piecewise linear, so once the iterate's active pieces are the
+///   solution's, one step solves the (linear) system: finite termination. The test
+///   measures it: the last step lands at round-off (|F| <= 1e-13, a backward error of a
+///   few eps times |A||z| ~ 10) from a residual >= 1e-6, i.e. no quadratic tail, and the
+///   estimated order is therefore far above 2.
+/// - Fischer–Burmeister is smooth near a strictly complementary solution (away from the
+///   kink at (0, 0)), so it converges Q-quadratically: observed order >= 1.8.
+///
+/// All agree with the brute-force enumeration to 1e-12 (the LCP is well conditioned:
+/// cond(A_SS) < 3).
+#[test]
+fn nonsmooth_lcp_terminates_finitely_with_min_and_max_form_and_quadratically_with_fb() {
+    for phi in [
+        Phi::Min,
+        Phi::Max(1.0),
+        Phi::Max(10.0),
+        Phi::FischerBurmeister,
+    ] {
+        let (mut lcp, z_star) = strictly_complementary_lcp(phi);
+        let z_enum = lcp_by_enumeration(&lcp.a, &lcp.q);
+        for (a, b) in z_enum.iter().zip(&z_star) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        let mut z = vec![1.0; 8];
+        let opts = NewtonOptions {
+            absolute_tolerance: 1e-10,
+            ..Default::default()
+        };
+        let report = solve(&mut lcp, &mut FaerDenseLu::new(), &mut z, &opts).unwrap();
+        println!(
+            "{phi:?}: iterations {} norms {:?} order {:?}",
+            report.iterations, report.residual_norms, report.observed_order
+        );
+        assert!(report.converged(), "{phi:?}: {:?}", report.termination);
+        for (a, b) in z.iter().zip(&z_enum) {
+            assert!((a - b).abs() < 1e-12, "{phi:?}: {z:?}");
+        }
+        let norms = &report.residual_norms;
+        let last = norms[norms.len() - 1];
+        let before = norms[norms.len() - 2];
+        match phi {
+            Phi::Min | Phi::Max(_) => {
+                let exact = last < 1e-300;
+                if exact {
+                    assert_eq!(report.observed_order, None);
+                } else {
+                    assert!(
+                        last <= 1e-13 && before >= 1e-6,
+                        "{phi:?}: {before:e} -> {last:e}"
+                    );
+                    assert!(report.observed_order.is_none_or(|q| q > 2.0));
+                }
+            }
+            Phi::FischerBurmeister => {
+                // The run may end exactly at 0 (then `observed_order` is None by
+                // definition): measure the order on the last three norms above the
+                // round-off floor 1e-13.
+                let tail: Vec<f64> = norms.iter().copied().filter(|&r| r > 1e-13).collect();
+                let [r1, r2, r3] = tail[tail.len() - 3..] else {
+                    unreachable!()
+                };
+                let q = (r3 / r2).ln() / (r2 / r1).ln();
+                assert!(q >= 1.8, "FB order {q}");
+                assert!(report.observed_order.is_none_or(|q| q >= 1.8));
+            }
+        }
+    }
+}
+
+/// atan(x) = 0 from x0 = 10: the full Newton step overshoots ever further
+/// (x_{k+1} = x_k - (1 + x_k^2) atan(x_k)) and the local method fails (reported, not
+/// converged, x left at the best iterate 10); Armijo and the non-monotone rule converge
+/// to the root 0.
+#[test]
+fn atan_from_10_fails_without_globalization_and_converges_with_line_search() {
+    let problem = || scalar(f64::atan, |x| 1.0 / (1.0 + x * x));
+    let mut x = [10.0];
+    let report = solve(
+        &mut problem(),
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &options(Globalization::None),
+    )
+    .unwrap();
+    println!(
+        "none: {:?} after {} iterations",
+        report.termination, report.iterations
+    );
+    assert!(!report.converged());
+    assert!(report.clone().into_result().is_err());
+    assert_eq!(x, [10.0], "best iterate is the initial guess");
+    assert!(report.residual_norms.iter().skip(1).all(|&r| r > 1.47));
+
+    for globalization in [armijo(), Globalization::default()] {
+        let mut x = [10.0];
+        let report = solve(
+            &mut problem(),
+            &mut FaerDenseLu::new(),
+            &mut x,
+            &options(globalization),
+        )
+        .unwrap();
+        println!(
+            "{globalization:?}: {} iterations, {} backtracks, steps {:?}",
+            report.iterations, report.counters.line_search_backtracks, report.step_lengths
+        );
+        assert!(report.converged());
+        assert!(x[0].abs() < 1e-10);
+        assert!(report.counters.line_search_backtracks > 0);
+    }
+}
+
+/// A linear problem F(x) = A x - b with a counted fake FFT (2 per evaluation): one
+/// Newton step solves it, so exactly 2 residual evaluations, 1 Jacobian, 1
+/// factorization, 1 solve, 0 backtracks, 4 FFTs; the same again on a second solve with
+/// a reused `NewtonSolver`, which creates the Jacobian only once.
+#[test]
+fn counters_are_exact_on_a_linear_problem_and_jacobian_is_reused() {
+    struct Linear {
+        ffts: u64,
+        jacobians_created: Cell<u32>,
+    }
+    const A: [[f64; 2]; 2] = [[3.0, 1.0], [1.0, 2.0]];
+    impl Residual for Linear {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+            self.ffts += 2;
+            out[0] = A[0][0] * x[0] + A[0][1] * x[1] - 5.0;
+            out[1] = A[1][0] * x[0] + A[1][1] * x[1] - 5.0;
+        }
+        fn fft_count(&self) -> u64 {
+            self.ffts
+        }
+    }
+    impl GeneralizedJacobian for Linear {
+        type Jacobian = nalgebra::DMatrix<f64>;
+        fn new_jacobian(&self) -> Self::Jacobian {
+            self.jacobians_created.set(self.jacobians_created.get() + 1);
+            nalgebra::DMatrix::zeros(2, 2)
+        }
+        fn jacobian(&mut self, _: &[f64], jac: &mut Self::Jacobian) {
+            *jac = nalgebra::DMatrix::from_row_slice(2, 2, &[3.0, 1.0, 1.0, 2.0]);
+        }
+    }
+    let mut problem = Linear {
+        ffts: 7,
+        jacobians_created: Cell::new(0),
+    };
+    let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let mut lu = NalgebraLu::new();
+    let expected = WorkCounters {
+        residual_evaluations: 2,
+        jacobian_evaluations: 1,
+        factorizations: 1,
+        linear_solves: 1,
+        line_search_backtracks: 0,
+        ffts: 4,
+    };
+    let mut total = WorkCounters::default();
+    for start in [[0.0, 0.0], [-4.0, 9.0]] {
+        let mut x = start;
+        let report = newton.solve(&mut problem, &mut lu, &mut x).unwrap();
+        assert!(report.converged());
+        assert_eq!(report.iterations, 1);
+        assert_eq!(report.counters, expected);
+        // Solution of [[3, 1], [1, 2]] x = [5, 5]: x = [1, 2].
+        assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
+        assert_eq!(report.step_lengths, vec![1.0]);
+        total += report.counters;
+    }
+    assert_eq!(total.residual_evaluations, 4);
+    assert_eq!(total.ffts, 8);
+    assert_eq!(problem.jacobians_created.get(), 1);
+    // Already at the solution: converged with 0 iterations and one evaluation.
+    let mut x = [1.0, 2.0];
+    let report = newton.solve(&mut problem, &mut lu, &mut x).unwrap();
+    assert_eq!(
+        (report.iterations, report.counters.residual_evaluations),
+        (0, 1)
+    );
+}
+
+/// A wrong-sign Jacobian gives an ascent direction: every trial increases the merit.
+/// Trials alpha = 2^-k for k = 0..=33 (2^-33 ~ 1.2e-10 >= min_step = 1e-10, 2^-34 < it):
+/// 34 rejections, 35 residual evaluations, x unchanged.
+#[test]
+fn line_search_failure_is_reported_with_exact_trial_count() {
+    let mut p = scalar(|x| x, |_| -1.0);
+    let mut x = [1.0];
+    let report = solve(&mut p, &mut FaerDenseLu::new(), &mut x, &options(armijo())).unwrap();
+    assert_eq!(report.termination, Termination::LineSearchFailed);
+    assert_eq!(report.counters.line_search_backtracks, 34);
+    assert_eq!(report.counters.residual_evaluations, 35);
+    assert_eq!(x, [1.0]);
+    match report.into_result() {
+        Err(NewtonError::NotConverged {
+            termination,
+            iterations,
+            residual_norm,
+            initial_residual_norm,
+        }) => {
+            assert_eq!(termination, Termination::LineSearchFailed);
+            assert_eq!(
+                (iterations, residual_norm, initial_residual_norm),
+                (0, 1.0, 1.0)
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// F(x) = x^2 + 1 at x0 = 0 has J = 0: SingularJacobian carrying the solver's error.
+#[test]
+fn singular_jacobian_is_a_termination_carrying_the_linear_solver_error() {
+    let mut p = scalar(|x| x * x + 1.0, |x| 2.0 * x);
+    let mut x = [0.0];
+    let report = solve(
+        &mut p,
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &NewtonOptions::default(),
+    )
+    .unwrap();
+    assert!(matches!(
+        report.termination,
+        Termination::SingularJacobian(LinearSolveError::Singular { index: 0, .. })
+    ));
+    assert_eq!(x, [0.0]);
+}
+
+/// A NaN residual at the start (sqrt of a negative number) is NonFinite with x
+/// unchanged; the reported norm is infinite, not NaN.
+#[test]
+fn non_finite_residual_is_reported_and_x_kept() {
+    let mut p = scalar(|x: f64| x.sqrt() - 1.0, |x: f64| 0.5 / x.sqrt());
+    let mut x = [-1.0];
+    let report = solve(
+        &mut p,
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &NewtonOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(report.termination, Termination::NonFinite);
+    assert_eq!(report.iterations, 0);
+    assert_eq!(x, [-1.0]);
+    assert_eq!(report.residual_norm(), f64::INFINITY);
+}
+
+/// F(x) = x^3 converges linearly with steps x_k / 3; with step_tolerance 0.01 the run
+/// stops as Stalled at the first k with x_k / 3 <= 0.01 (1 + x_{k+1}), x_k = (2/3)^k,
+/// and the report still carries the observed (linear) order.
+#[test]
+fn small_steps_without_convergence_are_reported_as_stalled() {
+    let (report, x) = newton_on_cube(&NewtonOptions {
+        absolute_tolerance: 1e-300,
+        step_tolerance: 0.01,
+        ..options(Globalization::None)
+    });
+    assert_eq!(report.termination, Termination::Stalled);
+    let r = 2.0f64 / 3.0;
+    let k = (0..)
+        .find(|&k| r.powi(k) / 3.0 <= 0.01 * (1.0 + r.powi(k + 1)))
+        .unwrap();
+    assert_eq!(report.iterations, k as usize + 1);
+    assert!((x[0] - r.powi(k + 1)).abs() < 1e-14);
+    // Not converged, but the rate is still estimated: linear, r_{k+1}/r_k = 8/27.
+    let q = report.observed_order.unwrap();
+    assert!((q - 1.0).abs() < 1e-9, "order {q}");
+}
+
+#[test]
+fn max_iterations_is_a_termination_not_an_error() {
+    let (report, x) = newton_on_cube(&NewtonOptions {
+        max_iterations: 3,
+        ..Default::default()
+    });
+    assert_eq!(report.termination, Termination::MaxIterations);
+    assert_eq!(report.iterations, 3);
+    assert_eq!(report.residual_norms.len(), 4);
+    assert!((x[0] - 8.0 / 27.0).abs() < 1e-15);
+}
+
+#[test]
+fn bad_options_and_dimensions_are_errors_before_any_evaluation() {
+    let mut p = scalar(|x| x, |_| 1.0);
+    let mut x = [1.0];
+    let opts = NewtonOptions {
+        step_tolerance: -1.0,
+        ..Default::default()
+    };
+    assert_eq!(
+        solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts),
+        Err(NewtonError::InvalidOption {
+            name: "step_tolerance",
+            value: -1.0,
+            allowed: "finite and >= 0"
+        })
+    );
+    let mut x2 = [1.0, 2.0];
+    assert_eq!(
+        solve(
+            &mut p,
+            &mut FaerDenseLu::new(),
+            &mut x2,
+            &NewtonOptions::default()
+        ),
+        Err(NewtonError::DimensionMismatch {
+            expected: 1,
+            found: 2
+        })
+    );
+}
+
+/// The relative tolerance stops at |F| <= rel |F(x0)|: for x^3 from 1 (|F0| = 1,
+/// r_k = (8/27)^k) and rel = 1e-3, at the first k with (8/27)^k <= 1e-3, i.e. k = 6.
+#[test]
+fn relative_tolerance_is_relative_to_initial_residual() {
+    let (report, _) = newton_on_cube(&NewtonOptions {
+        absolute_tolerance: 0.0,
+        relative_tolerance: 1e-3,
+        ..options(Globalization::None)
+    });
+    assert!(report.converged());
+    assert_eq!(report.iterations, 6);
+}
+
+/// An obstacle problem with a sparse Jacobian: min(u - psi, K u - f) = 0 with K the
+/// 1-D Laplacian tridiag(-1, 2, -1) (n = 200) and an obstacle psi that the unloaded
+/// solution would cross. Solved with the sparse LU and with the dense LU (the same
+/// Jacobian written densely), the solutions agree to 1e-12, and the complementarity
+/// conditions hold to 1e-12 (checked directly: u >= psi, K u - f >= 0, product 0).
+#[test]
+fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
+    struct Obstacle {
+        n: usize,
+        psi: Vec<f64>,
+        f: f64,
+    }
+    impl Obstacle {
+        fn ku(&self, u: &[f64], i: usize) -> f64 {
+            let left = if i > 0 { u[i - 1] } else { 0.0 };
+            let right = if i + 1 < self.n { u[i + 1] } else { 0.0 };
+            2.0 * u[i] - left - right - self.f
+        }
+        fn pattern(&self) -> Vec<Triplet<usize, usize, f64>> {
+            let mut t = Vec::new();
+            for j in 0..self.n {
+                for i in j.saturating_sub(1)..(j + 2).min(self.n) {
+                    t.push(Triplet::new(i, j, 0.0));
+                }
+            }
+            t
+        }
+    }
+    impl Residual for Obstacle {
+        fn dim(&self) -> usize {
+            self.n
+        }
+        fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+            for i in 0..self.n {
+                out[i] = min_function(u[i] - self.psi[i], self.ku(u, i)).value;
+            }
+        }
+    }
+    /// The same problem with two Jacobian types: a `SparseColMat` with a fixed pattern
+    /// (values overwritten in place) and a dense `Mat`.
+    struct Sparse(Obstacle);
+    struct Dense(Obstacle);
+    impl Residual for Sparse {
+        fn dim(&self) -> usize {
+            self.0.n
+        }
+        fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+            self.0.residual(u, out)
+        }
+    }
+    impl Residual for Dense {
+        fn dim(&self) -> usize {
+            self.0.n
+        }
+        fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+            self.0.residual(u, out)
+        }
+    }
+    fn entry(o: &Obstacle, u: &[f64], i: usize, j: usize) -> f64 {
+        let g = min_function(u[i] - o.psi[i], o.ku(u, i));
+        let k = match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        };
+        g.db * k + if i == j { g.da } else { 0.0 }
+    }
+    impl GeneralizedJacobian for Sparse {
+        type Jacobian = SparseColMat<usize, f64>;
+        fn new_jacobian(&self) -> Self::Jacobian {
+            SparseColMat::try_new_from_triplets(self.0.n, self.0.n, &self.0.pattern()).unwrap()
+        }
+        fn jacobian(&mut self, u: &[f64], jac: &mut Self::Jacobian) {
+            for j in 0..self.0.n {
+                let rows: Vec<usize> = jac.row_idx_of_col(j).collect();
+                let vals = jac.val_of_col_mut(j);
+                for (v, &i) in vals.iter_mut().zip(&rows) {
+                    *v = entry(&self.0, u, i, j);
+                }
+            }
+        }
+    }
+    impl GeneralizedJacobian for Dense {
+        type Jacobian = Mat<f64>;
+        fn new_jacobian(&self) -> Mat<f64> {
+            Mat::zeros(self.0.n, self.0.n)
+        }
+        fn jacobian(&mut self, u: &[f64], jac: &mut Mat<f64>) {
+            for j in 0..self.0.n {
+                for i in 0..self.0.n {
+                    jac[(i, j)] = entry(&self.0, u, i, j);
+                }
+            }
+        }
+    }
+    let n = 200;
+    let make = || Obstacle {
+        n,
+        // A tilted obstacle above zero in the middle, below the boundary values.
+        psi: (0..n)
+            .map(|i| {
+                let t = (i + 1) as f64 / (n + 1) as f64;
+                0.3 - 4.0 * (t - 0.4).powi(2)
+            })
+            .collect(),
+        f: -1e-5,
+    };
+    let mut sparse = Sparse(make());
+    let mut dense = Dense(make());
+    let opts = NewtonOptions {
+        absolute_tolerance: 1e-12,
+        ..Default::default()
+    };
+    let mut us = vec![0.0; n];
+    let mut slu = FaerSparseLu::new();
+    let rs = solve(&mut sparse, &mut slu, &mut us, &opts).unwrap();
+    let mut ud = vec![0.0; n];
+    let rd = solve(&mut dense, &mut FaerDenseLu::new(), &mut ud, &opts).unwrap();
+    println!(
+        "obstacle: sparse {} it, dense {} it, norms {:?}",
+        rs.iterations, rd.iterations, rs.residual_norms
+    );
+    assert!(rs.converged() && rd.converged());
+    assert_eq!(slu.symbolic_analyses(), 1, "one pattern, analysed once");
+    let o = &sparse.0;
+    let mut contacts = 0;
+    for i in 0..n {
+        assert!((us[i] - ud[i]).abs() < 1e-12);
+        let gap = us[i] - o.psi[i];
+        let w = o.ku(&us, i);
+        assert!(
+            gap >= -1e-12 && w >= -1e-12 && (gap * w).abs() < 1e-12,
+            "node {i}: {gap:e} {w:e}"
+        );
+        if gap.abs() < 1e-12 {
+            contacts += 1;
+        }
+    }
+    assert!(
+        contacts > 0 && contacts < n,
+        "the obstacle is partly active ({contacts} nodes)"
+    );
+}
+
+/// Counts heap allocations made by the current thread (tests run in parallel threads).
+struct CountingAllocator;
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, size) }
+    }
+}
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(Cell::get)
+}
+
+/// One warm-up solve (buffers, Jacobian, factor storage), then from each start: the
+/// solve converges in >= 3 iterations and makes exactly 3 allocations (the report's
+/// residual, step-length and step-norm histories).
+fn warm_then_count_allocations<P, S>(
+    newton: &mut NewtonSolver<P::Jacobian>,
+    problem: &mut P,
+    lu: &mut S,
+    x: &mut [f64],
+    starts: &[f64],
+) where
+    P: GeneralizedJacobian,
+    S: semismooth::LinearSolve<P::Jacobian>,
+{
+    newton.solve(problem, lu, x).unwrap();
+    for &start in starts {
+        x.fill(start);
+        let before = allocations();
+        let report = newton.solve(problem, lu, x).unwrap();
+        let made = allocations() - before;
+        assert!(
+            report.converged() && report.iterations >= 3,
+            "start {start}"
+        );
+        assert_eq!(
+            made, 3,
+            "start {start}: {made} allocations for {} iterations",
+            report.iterations
+        );
+    }
+}
+
+/// A reused `NewtonSolver` with a reused faer solver (dense or sparse) allocates only
+/// the report's three history vectors per solve, however many iterations it takes:
+/// nothing per iteration. Measured with a counting global allocator on this thread.
+#[test]
+fn repeated_solves_allocate_nothing_per_iteration() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let (mut lcp, _) = strictly_complementary_lcp(Phi::FischerBurmeister);
+    let mut lu = FaerDenseLu::new();
+    let mut z = vec![1.0; 8];
+    warm_then_count_allocations(&mut newton, &mut lcp, &mut lu, &mut z, &[1.0, 3.0, -2.0]);
+
+    let n = 200;
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push(Triplet::new(i, i, 0.0));
+        if i + 1 < n {
+            t.push(Triplet::new(i + 1, i, 0.0));
+            t.push(Triplet::new(i, i + 1, 0.0));
+        }
+    }
+    /// F(u) = K u + u^3 / 10 - 1 with K = tridiag(-1, 3, -1), sparse Jacobian.
+    struct Chain(SparseColMat<usize, f64>);
+    impl Residual for Chain {
+        fn dim(&self) -> usize {
+            self.0.nrows()
+        }
+        fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+            let n = u.len();
+            for i in 0..n {
+                let l = if i > 0 { u[i - 1] } else { 0.0 };
+                let r = if i + 1 < n { u[i + 1] } else { 0.0 };
+                out[i] = 3.0 * u[i] - l - r + u[i].powi(3) / 10.0 - 1.0;
+            }
+        }
+    }
+    impl GeneralizedJacobian for Chain {
+        type Jacobian = SparseColMat<usize, f64>;
+        fn new_jacobian(&self) -> Self::Jacobian {
+            self.0.clone()
+        }
+        fn jacobian(&mut self, u: &[f64], jac: &mut Self::Jacobian) {
+            for (j, uj) in u.iter().enumerate() {
+                let (symbolic, values) = jac.parts_mut();
+                let rows = symbolic.row_idx_of_col_raw(j);
+                let range = symbolic.col_range(j);
+                for (v, &i) in values[range].iter_mut().zip(rows) {
+                    *v = if i == j { 3.0 + 0.3 * uj * uj } else { -1.0 };
+                }
+            }
+        }
+    }
+    let mut chain = Chain(SparseColMat::try_new_from_triplets(n, n, &t).unwrap());
+    let mut slu = FaerSparseLu::new();
+    let mut u = vec![0.0; n];
+    let mut newton_sparse = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    warm_then_count_allocations(
+        &mut newton_sparse,
+        &mut chain,
+        &mut slu,
+        &mut u,
+        &[0.0, 5.0],
+    );
+    assert_eq!(slu.symbolic_analyses(), 1);
+}

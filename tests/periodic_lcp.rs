@@ -1,0 +1,633 @@
+//! The periodic time-domain LCP (issue 5): its matrix, vector and linear response checked
+//! against independent computations (the analytic frequency response, a direct static
+//! solve, the trapezoidal rule written out in the time domain, dense eigenvalues), and its
+//! solvers against each other.
+
+use nalgebra::{Complex, DMatrix, DVector};
+use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
+use semismooth::newton::{self, NewtonOptions};
+use semismooth_problems::lcp::{
+    solve_min_map_sequenced, ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions,
+};
+use semismooth_problems::model::{SparseMatrix, StructuralModel};
+use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
+
+fn dense(m: &SparseMatrix) -> DMatrix<f64> {
+    let r = m.as_ref();
+    let mut d = DMatrix::zeros(r.nrows(), r.ncols());
+    for j in 0..r.ncols() {
+        for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
+            d[(i, j)] += v;
+        }
+    }
+    d
+}
+
+/// Dense `K`, `M`, `D` (zero when undamped).
+fn dense_kmd(model: &StructuralModel) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let k = dense(&model.stiffness);
+    let d = model
+        .damping
+        .as_ref()
+        .map(dense)
+        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
+    (k, dense(&model.mass), d)
+}
+
+/// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
+fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = mass;
+    spec.contacts = vec![
+        RodContact {
+            node: inner,
+            gap: 0.3,
+        },
+        RodContact { node: 20, gap: 0.5 },
+    ];
+    build_rod(&spec).unwrap().model
+}
+
+fn rod(mass: MassModel, damped: bool) -> StructuralModel {
+    let mut spec = RodSpec::canonical();
+    spec.mass = mass;
+    if !damped {
+        spec.damping = None;
+    }
+    build_rod(&spec).unwrap().model
+}
+
+fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
+    PeriodicLcpOptions {
+        time_samples: nt,
+        observed_dofs: observed,
+    }
+}
+
+/// `Re((K + i s D - s^2 M)^{-1} a e^{i 2 pi n / Nt})` at the nodes, by a dense complex solve.
+fn frequency_response(model: &StructuralModel, s: f64, nt: usize) -> Vec<Vec<f64>> {
+    let (k, m, d) = dense_kmd(model);
+    let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
+        Complex::new(k[(i, j)] - s * s * m[(i, j)], s * d[(i, j)])
+    });
+    let a = DVector::from_fn(k.nrows(), |i, _| {
+        Complex::new(model.forcing.amplitude[i], 0.0)
+    });
+    let x = z.lu().solve(&a).unwrap();
+    (0..k.nrows())
+        .map(|dof| {
+            (0..nt)
+                .map(|n| {
+                    let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
+                    (x[dof] * Complex::new(phase.cos(), phase.sin())).re
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn linear_response_is_the_frequency_response_at_the_warped_frequency_with_second_order_error() {
+    let model = rod(MassModel::Consistent, true);
+    let dofs: Vec<usize> = (0..model.dofs()).collect();
+    let omega = model.forcing.omega;
+    let mut errors = Vec::new();
+    for nt in [32usize, 64, 128, 256, 512] {
+        let lcp = PeriodicLcp::new(&model, options(nt, dofs.clone())).unwrap();
+        let zero = vec![0.0; lcp.dim()];
+        let u = lcp.displacements(&zero).unwrap();
+        // The discrete answer is exactly the frequency response at the warped frequency
+        // (2/dt) tan(pi/Nt): equal up to the round-off of two O(N) complex solves.
+        let warped = frequency_response(&model, lcp.bin_frequency(1), nt);
+        let scale = warped.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+        for dof in 0..model.dofs() {
+            assert!(max_abs_diff(&u[dof], &warped[dof]) < 1e-11 * scale);
+        }
+        // q = g - u_lin at the tip.
+        let tip = model.dofs() - 1;
+        let gap = model.contacts[0].gap;
+        let from_q: Vec<f64> = lcp.q().iter().map(|q| gap - q).collect();
+        assert!(max_abs_diff(&from_q, &u[tip]) < 1e-12 * scale);
+        let exact = frequency_response(&model, omega, nt);
+        let error = (0..model.dofs())
+            .map(|dof| max_abs_diff(&u[dof], &exact[dof]))
+            .fold(0.0, f64::max);
+        errors.push(error / scale);
+    }
+    // Warping error: s_1 = omega (1 + (pi/Nt)^2 / 3 + ...). The forcing sits on the
+    // resonance (zeta = 0.01) so the response is sensitive to the frequency shift, but once
+    // the shift 0.82 / Nt^2 is well below zeta (Nt >= 32) the error falls by 4 per doubling.
+    for pair in errors.windows(2) {
+        let order = (pair[0] / pair[1]).log2();
+        assert!((1.9..2.1).contains(&order), "errors {errors:?}");
+    }
+}
+
+#[test]
+fn block_row_sums_of_a_are_the_static_compliance_of_the_contacts() {
+    // Two contacts (mid-rod and tip): exercises the m x m blocks.
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        let model = two_contact_rod(mass, 10);
+        let nt = 64;
+        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let a = lcp.matrix();
+        let m = 2;
+        let k = dense(&model.stiffness);
+        let dofs = [9usize, 19];
+        let lu = k.lu();
+        let mut compliance = [[0.0; 2]; 2];
+        for (c2, &d2) in dofs.iter().enumerate() {
+            let e = DVector::from_fn(model.dofs(), |i, _| if i == d2 { 1.0 } else { 0.0 });
+            let x = lu.solve(&e).unwrap();
+            for (c, &d) in dofs.iter().enumerate() {
+                compliance[c][c2] = x[d];
+            }
+        }
+        let scale = compliance[1][1];
+        for n in 0..nt {
+            for (c, row) in compliance.iter().enumerate() {
+                for (c2, expected) in row.iter().enumerate() {
+                    let sum: f64 = (0..nt).map(|j| a[(n * m + c, j * m + c2)]).sum();
+                    // Sum of Nt kernel values obtained by an FFT of O(1) receptances.
+                    assert!(
+                        (sum - expected).abs() < 1e-12 * scale * nt as f64,
+                        "{mass:?} row {n}, block ({c}, {c2}): {sum} vs {expected}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The periodic trapezoidal rule written out in the time domain (first-order form, all
+/// `2 N Nt` unknowns), solved densely for a given contact force history `lambda`:
+/// `u_{n+1} - u_n = dt/2 (v_{n+1} + v_n)`,
+/// `M (v_{n+1} - v_n) + dt/2 [D (v_{n+1} + v_n) + K (u_{n+1} + u_n)] = dt/2 (f_{n+1} + f_n + G^T (lambda_{n+1} + lambda_n))`.
+/// For odd `Nt` the system is regular (no Nyquist bin).
+fn trapezoidal_contact_displacement(
+    model: &StructuralModel,
+    nt: usize,
+    lambda: &[f64],
+) -> Vec<f64> {
+    let n = model.dofs();
+    let (k, m, d) = dense_kmd(model);
+    let dt = 2.0 * std::f64::consts::PI / model.forcing.omega / nt as f64;
+    let size = 2 * n * nt;
+    let u = |step: usize, i: usize| (step % nt) * 2 * n + i;
+    let v = |step: usize, i: usize| (step % nt) * 2 * n + n + i;
+    let mut a = DMatrix::<f64>::zeros(size, size);
+    let mut b = DVector::<f64>::zeros(size);
+    let tip = model.contacts[0].dof;
+    for step in 0..nt {
+        let row0 = step * 2 * n;
+        for i in 0..n {
+            let r = row0 + i;
+            a[(r, u(step + 1, i))] += 1.0;
+            a[(r, u(step, i))] -= 1.0;
+            a[(r, v(step + 1, i))] -= 0.5 * dt;
+            a[(r, v(step, i))] -= 0.5 * dt;
+            let r = row0 + n + i;
+            for j in 0..n {
+                a[(r, v(step + 1, j))] += m[(i, j)] + 0.5 * dt * d[(i, j)];
+                a[(r, v(step, j))] += -m[(i, j)] + 0.5 * dt * d[(i, j)];
+                a[(r, u(step + 1, j))] += 0.5 * dt * k[(i, j)];
+                a[(r, u(step, j))] += 0.5 * dt * k[(i, j)];
+            }
+            let t0 = step as f64 * dt;
+            let t1 = t0 + dt;
+            let w = model.forcing.omega;
+            let mut rhs = model.forcing.amplitude[i] * ((w * t0).cos() + (w * t1).cos());
+            if i == tip {
+                rhs += lambda[step] + lambda[(step + 1) % nt];
+            }
+            b[r] = 0.5 * dt * rhs;
+        }
+    }
+    let x = a.lu().solve(&b).unwrap();
+    (0..nt).map(|step| x[u(step, tip)]).collect()
+}
+
+#[test]
+fn lcp_gap_equals_the_time_domain_trapezoidal_rule_for_odd_nt() {
+    for mass in [MassModel::Consistent, MassModel::Modified] {
+        let mut spec = RodSpec::canonical();
+        spec.elements = 4;
+        spec.mass = mass;
+        spec.contacts = vec![RodContact { node: 4, gap: 0.5 }];
+        let model = build_rod(&spec).unwrap().model;
+        let nt = 15; // odd, not a power of two: the direct-DFT path
+        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let z: Vec<f64> = (0..nt)
+            .map(|n| (0.3 + (1.7 * n as f64).sin()).max(0.0) * 0.05)
+            .collect();
+        let lambda: Vec<f64> = z.iter().map(|v| -v).collect();
+        let reference = trapezoidal_contact_displacement(&model, nt, &lambda);
+        let from_lcp = &lcp.contact_displacements(&z).unwrap()[0];
+        let by_fft = &lcp.contact_displacements_by_fft(&z).unwrap()[0];
+        let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        // Two dense solves of well-conditioned systems of size <= 120: round-off.
+        assert!(
+            max_abs_diff(from_lcp, &reference) < 1e-11 * scale,
+            "{mass:?}"
+        );
+        assert!(max_abs_diff(by_fft, &reference) < 1e-11 * scale, "{mass:?}");
+    }
+}
+
+fn transpose_distance(a: faer::MatRef<'_, f64>, b: faer::MatRef<'_, f64>) -> f64 {
+    let n = a.nrows();
+    let mut worst = 0.0f64;
+    for i in 0..n {
+        for j in 0..n {
+            worst = worst.max((a[(i, j)] - b[(j, i)]).abs());
+        }
+    }
+    worst
+}
+
+fn max_entry(a: faer::MatRef<'_, f64>) -> f64 {
+    let mut worst = 0.0f64;
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            worst = worst.max(a[(i, j)].abs());
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem() {
+    let nt = 128;
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        // Undamped: every H_k = G (K - s_k^2 M)^{-1} G^T is real, the kernel is even in time.
+        let undamped = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+        let a = undamped.matrix();
+        assert!(transpose_distance(a, a) < 1e-13 * max_entry(a), "{mass:?}");
+
+        // Damped: H_k has an imaginary part, odd in k, so the kernel has an odd part.
+        let model = rod(mass, true);
+        let damped = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let a = damped.matrix();
+        let asymmetry = transpose_distance(a, a) / max_entry(a);
+        assert!(
+            asymmetry > 1e-2,
+            "{mass:?}: relative asymmetry {asymmetry:e}"
+        );
+        // Theory: A^T has the bins H_k^* = G Z(-s_k)^{-1} G^T, i.e. the LCP of the model
+        // with D replaced by -D (time reversal).
+        let mut reversed = model.clone();
+        let d = reversed.damping.take().unwrap();
+        let (symbolic, values) = d.into_parts();
+        reversed.damping = Some(SparseMatrix::new(
+            symbolic,
+            values.iter().map(|v| -v).collect(),
+        ));
+        let time_reversed = PeriodicLcp::new(&reversed, options(nt, vec![])).unwrap();
+        assert!(
+            transpose_distance(a, time_reversed.matrix()) < 1e-12 * max_entry(a),
+            "{mass:?}"
+        );
+    }
+}
+
+#[test]
+fn symmetric_part_spectrum_from_the_bins_matches_a_dense_eigensolver() {
+    let model = two_contact_rod(MassModel::Consistent, 12);
+    for nt in [16usize, 21] {
+        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let a = lcp.matrix();
+        let n = lcp.dim();
+        let s = DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+        let eig = nalgebra::SymmetricEigen::new(s).eigenvalues;
+        let lo = eig.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = eig.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let (blo, bhi) = lcp.symmetric_part_spectrum();
+        let scale = hi.abs().max(lo.abs());
+        // Dense symmetric eigenvalues are backward stable: error ~ n eps |S|.
+        assert!((lo - blo).abs() < 1e-12 * scale, "{lo} vs {blo}");
+        assert!((hi - bhi).abs() < 1e-12 * scale, "{hi} vs {bhi}");
+    }
+}
+
+#[test]
+fn nyquist_bin_is_the_static_receptance_of_the_massless_undamped_dofs() {
+    let nt = 64;
+    // Undamped modified mass: the tip has neither mass nor damping, H_{Nt/2} = 1 / K_tt.
+    let model = rod(MassModel::Modified, false);
+    let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+    assert_eq!(lcp.static_dof_count(), 1);
+    let h = lcp.receptance(nt / 2)[0];
+    let k_tt = dense(&model.stiffness)[(19, 19)];
+    assert!((h.re - 1.0 / k_tt).abs() < 1e-15 && h.im == 0.0);
+    // The bins approach that limit: H_k - 1/K_tt = O(1 / s_k^2) near Nyquist.
+    let near = lcp.receptance(nt / 2 - 1)[0];
+    assert!((near.re - 1.0 / k_tt).abs() < 0.05 / k_tt, "{near}");
+    // Damped (stiffness-proportional, the tip is damped) or massive tip: the limit is 0.
+    for (mass, damped) in [(MassModel::Modified, true), (MassModel::Consistent, false)] {
+        let lcp = PeriodicLcp::new(&rod(mass, damped), options(nt, vec![])).unwrap();
+        assert_eq!(lcp.static_dof_count(), 0);
+        assert_eq!(lcp.receptance(nt / 2)[0].norm(), 0.0);
+    }
+}
+
+#[test]
+fn bad_options_and_models_are_typed_errors() {
+    let model = rod(MassModel::Modified, true);
+    for nt in [0usize, 1, 7, 8193] {
+        match PeriodicLcp::new(&model, options(nt, vec![])) {
+            Err(LcpError::InvalidOption { name, value, .. }) => {
+                assert_eq!(name, "time_samples");
+                assert_eq!(value, nt as f64);
+            }
+            other => panic!("Nt = {nt}: {other:?}"),
+        }
+    }
+    assert!(PeriodicLcp::new(&model, options(8, vec![])).is_ok());
+    assert_eq!(
+        PeriodicLcp::new(&model, options(16, vec![20])).unwrap_err(),
+        LcpError::ObservedDofOutOfRange { dof: 20, dofs: 20 }
+    );
+    let mut free = model.clone();
+    free.contacts.clear();
+    assert_eq!(
+        PeriodicLcp::new(&free, options(16, vec![])).unwrap_err(),
+        LcpError::NoContacts
+    );
+    let mut bad = model.clone();
+    bad.forcing.omega = f64::NAN;
+    assert!(matches!(
+        PeriodicLcp::new(&bad, options(16, vec![])),
+        Err(LcpError::InvalidModel { name: "omega", .. })
+    ));
+    let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
+    assert_eq!(
+        lcp.gap(&[0.0; 3]).unwrap_err(),
+        LcpError::WrongLength {
+            what: "z",
+            expected: 16,
+            found: 3
+        }
+    );
+}
+
+fn lemke_solution(lcp: &PeriodicLcp) -> semismooth::lemke::LemkeReport {
+    let mut lemke = Lemke::new(lcp.dim());
+    lcp.solve_with_lemke(&mut lemke, &LemkeOptions::default())
+        .unwrap()
+}
+
+fn ssn_solution(lcp: &PeriodicLcp) -> (Vec<f64>, newton::NewtonReport) {
+    ssn_from(lcp, vec![0.0; lcp.dim()])
+}
+
+fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonReport) {
+    let mut problem = lcp.min_map();
+    let mut solver = ActiveSetSolver::new();
+    let report =
+        newton::solve(&mut problem, &mut solver, &mut z, &NewtonOptions::default()).unwrap();
+    (z, report)
+}
+
+/// Lemke (default options) ends with `expected`, and `check_lemke` turns the report into
+/// `LemkeNotSolved` carrying its pivots and the smallest eigenvalue of `(A + A^T)/2`.
+fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
+    let report = lemke_solution(lcp);
+    assert_eq!(report.termination, expected);
+    match lcp.check_lemke(report.clone()) {
+        Err(LcpError::LemkeNotSolved {
+            termination,
+            pivots,
+            symmetric_part_min_eigenvalue,
+            ..
+        }) => {
+            assert_eq!(termination, expected);
+            assert_eq!(pivots, report.pivots);
+            assert_eq!(
+                symmetric_part_min_eigenvalue,
+                lcp.symmetric_part_spectrum().0
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// CPU time of this thread (from /proc; 0 where unavailable), for timings on a shared
+/// machine.
+fn thread_cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(0.0, |ns| ns * 1e-9)
+}
+
+/// Numbers for the report (run with `--ignored --nocapture`); nothing asserted on time.
+#[test]
+#[ignore]
+fn report_lcp_numbers() {
+    let minimum = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
+    for mass in [MassModel::Modified, MassModel::Consistent] {
+        for nt in [256usize, 1024] {
+            let lcp = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+            let (lo, hi) = lcp.symmetric_part_spectrum();
+            let lemke = lemke_solution(&lcp);
+            println!(
+                "undamped {mass:?} Nt={nt}: eig(A) in [{lo:.4e}, {hi:.4e}] lemke {:?} pivots {}",
+                lemke.termination, lemke.pivots
+            );
+        }
+    }
+    if std::env::var_os("LCP_REPORT_UNDAMPED_ONLY").is_some() {
+        return;
+    }
+    for mass in [
+        MassModel::Modified,
+        MassModel::Consistent,
+        MassModel::Lumped,
+    ] {
+        let model = rod(mass, true);
+        let mut previous: Option<Vec<f64>> = None;
+        for nt in [128usize, 256, 512, 1024, 2048] {
+            let start = std::time::Instant::now();
+            let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+            let build = start.elapsed().as_secs_f64();
+            let (lo, hi) = lcp.symmetric_part_spectrum();
+            let start = std::time::Instant::now();
+            let cpu = thread_cpu_seconds();
+            let mut workspace = Lemke::new(lcp.dim());
+            let generous = LemkeOptions {
+                max_pivots: Some(100 * lcp.dim()),
+                ..LemkeOptions::default()
+            };
+            let lemke = lcp.solve_with_lemke(&mut workspace, &generous).unwrap();
+            let lemke_cpu = thread_cpu_seconds() - cpu;
+            let lemke_time = start.elapsed().as_secs_f64();
+            let tip_lemke = minimum(&lcp.contact_displacements(&lemke.z).unwrap()[0]);
+            let start = std::time::Instant::now();
+            let (z0, cold) = ssn_solution(&lcp);
+            let cold_time = start.elapsed().as_secs_f64();
+            let warm_start = match &previous {
+                Some(z) => lcp.interpolate_forces(z).unwrap(),
+                None => vec![0.0; lcp.dim()],
+            };
+            let start = std::time::Instant::now();
+            let (z, warm) = ssn_from(&lcp, warm_start);
+            let warm_time = start.elapsed().as_secs_f64();
+            let tip_ssn = minimum(&lcp.contact_displacements(&z).unwrap()[0]);
+            println!(
+                "{mass:?} Nt={nt}: build {build:.3}s sym eig [{lo:.4e}, {hi:.4e}] | lemke {:?} pivots {} err {:.1e} {lemke_time:.3}s (cpu {lemke_cpu:.3}s) tip_min {tip_lemke:.10} | ssn cold {:?} it {} {cold_time:.3}s | ssn sequenced {:?} it {} {warm_time:.3}s tip_min {tip_ssn:.10} | |z_lemke - z_ssn| {:.1e} |z_cold - z_ssn| {:.1e}",
+                lemke.termination, lemke.pivots, lemke.complementarity_error,
+                cold.termination, cold.iterations, warm.termination, warm.iterations,
+                max_abs_diff(&lemke.z, &z), max_abs_diff(&z0, &z)
+            );
+            previous = Some(z);
+        }
+    }
+}
+
+#[test]
+fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass() {
+    let model = rod(MassModel::Modified, true);
+    for nt in [256usize, 1024] {
+        // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
+        // interpolated previous Newton solution); Lemke independently on the finest LCP.
+        let sequenced =
+            solve_min_map_sequenced(&model, options(nt, vec![]), &NewtonOptions::default())
+                .unwrap();
+        assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
+        assert_eq!(
+            sequenced.levels.len(),
+            1 + (nt / 128).trailing_zeros() as usize
+        );
+        let lcp = &sequenced.lcp;
+        let z = &sequenced.z;
+        let lemke = lcp.check_lemke(lemke_solution(lcp)).unwrap();
+        // Lemke's basic solution is exact up to the round-off of a solve with the final
+        // basis (errors measured 1e-17); Newton ends with an exact solve on the same
+        // active set. Both are then the solution of one linear system with A_II
+        // (condition ~1e5 here): agreement to ~1e-13 measured, asserted at 1e-9.
+        let zmax = z.iter().cloned().fold(0.0, f64::max);
+        assert!(zmax > 0.1, "contact carries force");
+        assert!(lemke.complementarity_error < 1e-12 * zmax);
+        assert!(max_abs_diff(&lemke.z, z) < 1e-9 * zmax, "Nt = {nt}");
+        let w = lcp.gap(z).unwrap();
+        assert!(max_abs_diff(&lemke.w, &w) < 1e-9);
+        if nt == 256 {
+            // From z = 0 directly (no sequencing) Newton reaches the same solution.
+            let (cold, report) = ssn_solution(lcp);
+            assert!(report.converged());
+            assert!(max_abs_diff(&cold, z) < 1e-9 * zmax);
+        }
+    }
+}
+
+#[test]
+fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much_longer() {
+    let model = rod(MassModel::Consistent, true);
+    let lcp = PeriodicLcp::new(&model, options(256, vec![])).unwrap();
+    // The symmetric part of A is indefinite (its eigenvalues are Re H_k: negative above
+    // a resonance), here by much more than with the modified mass.
+    let (lo, hi) = lcp.symmetric_part_spectrum();
+    assert!(lo < -1e-2 && hi > 0.0, "[{lo}, {hi}]");
+    let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
+    assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
+    // With the default pivot limit 50 n + 100 Lemke stops without a solution (no ray):
+    assert_not_solved(&lcp, LemkeTermination::PivotLimit);
+    // ... but with 100 n pivots it solves this one (25369 pivots measured, against 172 for
+    // the modified mass): the path is long, not a ray. At Nt >= 512 it had not finished
+    // after 1000 n pivots.
+    let mut lemke = Lemke::new(lcp.dim());
+    let generous = LemkeOptions {
+        max_pivots: Some(100 * lcp.dim()),
+        ..LemkeOptions::default()
+    };
+    let solved = lcp.solve_with_lemke(&mut lemke, &generous).unwrap();
+    assert!(
+        solved.solved(),
+        "{:?} after {}",
+        solved.termination,
+        solved.pivots
+    );
+    assert!(solved.complementarity_error < 1e-12);
+    assert!(solved.pivots > 50 * lcp.dim());
+}
+
+#[test]
+fn lcp_solution_is_the_steady_state_of_the_massless_contact_trapezoidal_march_with_the_same_step() {
+    use semismooth_problems::march::{march_to_steady_state, MarchOptions, MarchScheme};
+    let model = rod(MassModel::Modified, true);
+    let tip = model.dofs() - 1;
+    for nt in [128usize, 512] {
+        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
+        let u = &lcp.contact_displacements(&lemke.z).unwrap()[0];
+        let lambda = &lcp.contact_forces(&lemke.z).unwrap()[0];
+        let march = march_to_steady_state(
+            &model,
+            &MarchOptions {
+                steps_per_period: nt,
+                max_periods: 5000,
+                tolerance: 1e-12,
+                scheme: MarchScheme::MasslessContactTrapezoidal,
+            },
+            &[tip],
+        )
+        .unwrap();
+        // Same discrete equations (trapezoidal rule, massless tip in equilibrium at every
+        // node, exact contact at the nodes): the periodic LCP solution is the march's limit
+        // cycle. The march stops at a period-to-period change of 1e-12; the remaining
+        // transient is about 16 times that (decay 0.94 per period).
+        let du = max_abs_diff(u, &march.displacements[0][..nt]);
+        let dl = max_abs_diff(lambda, &march.contact_forces[0][..nt]);
+        println!(
+            "Nt = {nt}: |du| = {du:.2e}, |dlambda| = {dl:.2e}, periods {}",
+            march.periods
+        );
+        assert!(du < 1e-9, "Nt = {nt}: {du:e}");
+        assert!(dl < 1e-8, "Nt = {nt}: {dl:e}");
+    }
+}
+
+#[test]
+fn force_interpolation_reproduces_periodic_piecewise_linear_histories() {
+    let model = two_contact_rod(MassModel::Modified, 10);
+    let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
+    // A coarse history of 4 nodes, 2 contacts (time-major): a triangle wave per contact.
+    let coarse = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 2.0, 3.0];
+    let fine = lcp.interpolate_forces(&coarse).unwrap();
+    for n in 0..16 {
+        // Fine node n sits at coarse position n / 4; linear between coarse nodes, and
+        // periodic (node 3 -> node 0) at the end. Exact in binary arithmetic.
+        let position = n as f64 / 4.0;
+        let left = position.floor() as usize;
+        let f = position - left as f64;
+        for c in 0..2 {
+            let expected = (1.0 - f) * coarse[left * 2 + c] + f * coarse[((left + 1) % 4) * 2 + c];
+            assert_eq!(fine[n * 2 + c], expected);
+        }
+    }
+    assert!(matches!(
+        lcp.interpolate_forces(&[1.0; 3]),
+        Err(LcpError::WrongLength { found: 3, .. })
+    ));
+}
+
+#[test]
+fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers() {
+    // Without damping, forcing at omega_1 puts bin 1 (warped just above omega_1) next to
+    // the resonance: H_1 is large and negative, so the symmetric part of A (eigenvalues
+    // Re H_k) is strongly indefinite; Lemke's method ends on a secondary ray.
+    let lcp = PeriodicLcp::new(&rod(MassModel::Modified, false), options(256, vec![])).unwrap();
+    let (lo, _) = lcp.symmetric_part_spectrum();
+    let h1 = lcp.receptance(1)[0];
+    assert_eq!(h1.im, 0.0);
+    assert_eq!(lo, h1.re);
+    assert!(lo < -1e3, "{lo}");
+    assert_not_solved(&lcp, LemkeTermination::Ray);
+}
