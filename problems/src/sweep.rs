@@ -31,16 +31,17 @@
 //!
 //! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
 //!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
-//! - `lcp-ssn`: the periodic LCP `min(z, q(ω) + A(ω) z) = 0` ([`PeriodicLcp`]), rebuilt when
-//!   `ω` changes, dense Jacobian and [`FaerDenseLu`]; `dF/dω` by central differences.
-//! - `lcp-lemke`, `march`: [`RunError::Unsupported`] (neither is a smooth-enough equation in
-//!   `ω` to continue; use natural steps, one `ssn solve` per frequency).
+//! - `lcp-ssn`, `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
+//!   marching are no equation in `ω` to continue. The min-map LCP is one, and was tried
+//!   (the LCP rebuilt at each `ω`, dense Jacobian): its unknowns are the contact forces,
+//!   identically zero below contact onset, and the branch has a corner there where the
+//!   corrector stalls; the free response is also invisible to the arclength. Use natural
+//!   steps instead, one `ssn solve` per frequency.
 
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
 
-use faer::Mat;
 use semismooth::continuation::{
     Continuation, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
     ContinuationTermination, Direction, Predictor,
@@ -52,8 +53,6 @@ use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual}
 use serde_json::json;
 
 use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
-use crate::lcp::{PeriodicLcp, PeriodicLcpOptions};
-use crate::model::StructuralModel;
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
 use crate::scene::{
@@ -299,116 +298,6 @@ impl<J: ?Sized, S: LinearSolve<J> + ?Sized> LinearSolve<J> for ScaledSolver<'_, 
             *r /= s;
         }
         Ok(())
-    }
-}
-
-/// The periodic LCP `min(z, q(ω) + A(ω) z) = 0` as a problem owning its data, rebuilt when
-/// `ω` changes (method `lcp-ssn` in a sweep). A failed rebuild makes the residual NaN, which
-/// the continuation treats as a failed step.
-struct OwnedLcp {
-    model: StructuralModel,
-    options: PeriodicLcpOptions,
-    lcp: Option<PeriodicLcp>,
-    omega: f64,
-    built_for: f64,
-    w: Vec<f64>,
-    n: usize,
-}
-
-impl OwnedLcp {
-    fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, RunError> {
-        let lcp = PeriodicLcp::new(model, options.clone())?;
-        let n = lcp.dim();
-        let omega = model.forcing.omega;
-        Ok(Self {
-            model: model.clone(),
-            options,
-            lcp: Some(lcp),
-            omega,
-            built_for: omega,
-            w: vec![0.0; n],
-            n,
-        })
-    }
-
-    fn ensure(&mut self) {
-        if self.built_for.to_bits() != self.omega.to_bits() {
-            self.model.forcing.omega = self.omega;
-            self.lcp = PeriodicLcp::new(&self.model, self.options.clone()).ok();
-            self.built_for = self.omega;
-        }
-    }
-
-    /// `w = q + A z`; false when the LCP could not be built at this `ω`.
-    fn gap(&mut self, z: &[f64]) -> bool {
-        self.ensure();
-        let Some(lcp) = self.lcp.as_ref() else {
-            return false;
-        };
-        let (a, q) = (lcp.matrix(), lcp.q());
-        self.w.copy_from_slice(q);
-        for (j, zj) in z.iter().enumerate() {
-            if *zj != 0.0 {
-                for (i, wi) in self.w.iter_mut().enumerate() {
-                    *wi += a[(i, j)] * zj;
-                }
-            }
-        }
-        true
-    }
-}
-
-impl Residual for OwnedLcp {
-    fn dim(&self) -> usize {
-        self.n
-    }
-    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
-        if !self.gap(z) {
-            out.fill(f64::NAN);
-            return;
-        }
-        for ((o, z), w) in out.iter_mut().zip(z).zip(&self.w) {
-            *o = z.min(*w);
-        }
-    }
-}
-
-impl GeneralizedJacobian for OwnedLcp {
-    type Jacobian = Mat<f64>;
-    fn new_jacobian(&self) -> Mat<f64> {
-        Mat::zeros(self.n, self.n)
-    }
-    /// Row `i` of `A` where `(q + A z)_i < z_i`, else `e_i` (as [`crate::lcp::MinMapLcp`]).
-    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
-        if !self.gap(z) {
-            jac.fill(f64::NAN);
-            return;
-        }
-        let Some(lcp) = self.lcp.as_ref() else {
-            return;
-        };
-        let a = lcp.matrix();
-        for i in 0..self.n {
-            let active = self.w[i] < z[i];
-            for j in 0..self.n {
-                jac[(i, j)] = if active {
-                    a[(i, j)]
-                } else if i == j {
-                    1.0
-                } else {
-                    0.0
-                };
-            }
-        }
-    }
-}
-
-impl ParameterDependent for OwnedLcp {
-    fn parameter(&self) -> f64 {
-        self.omega
-    }
-    fn set_parameter(&mut self, p: f64) {
-        self.omega = p;
     }
 }
 
@@ -763,6 +652,7 @@ where
         if response.omega.len() >= base_points {
             break termination;
         }
+        let stuck = failed && restart && response.omega.len() == offset;
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
             restart = true;
@@ -772,17 +662,23 @@ where
             break termination;
         }
         // Keep going the way the branch went (the last increment of ω; the tangent's sign
-        // can be flipped where the branch turns sharply).
+        // can be flipped where the branch turns sharply). A restart that could not make a
+        // single step tries the other orientation (a fold at a corner of the branch).
         let k = response.omega.len();
         let heading = if k >= 2 {
             response.omega[k - 1] - response.omega[k - 2]
         } else {
             last_tangent_parameter
         };
-        direction = if heading >= 0.0 {
+        let forward = if heading >= 0.0 {
             Direction::Increasing
         } else {
             Direction::Decreasing
+        };
+        direction = match (stuck, direction) {
+            (true, Direction::Increasing) => Direction::Decreasing,
+            (true, Direction::Decreasing) => Direction::Increasing,
+            _ => forward,
         };
     };
     let (folds, indices) = folds_from_branch(&response.omega, &raw_events);
@@ -1056,65 +952,23 @@ pub fn frequency_response(
                 ),
             }
         }
-        Method::LcpSsn => {
-            if model.contacts.is_empty() {
-                return Err(RunError::Unsupported {
-                    method: "lcp-ssn",
-                    what: "a [contact] section (the periodic LCP is posed on the contact \
-                           forces); sweep the linear rod with ssn-hb or penalty-hb",
-                });
-            }
-            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
-            let options = PeriodicLcpOptions {
-                time_samples: settings.time_samples,
-                observed_dofs: if tip_contact.is_some() {
-                    Vec::new()
-                } else {
-                    vec![tip]
-                },
-            };
-            let mut start_model = model.clone();
-            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
-            let mut problem = OwnedLcp::new(&start_model, options)?;
-            // z are contact forces: divide by the contact stiffness scale to get lengths.
-            let units = vec![model.contact_stiffness_scale(); problem.dim()];
-            let output_points = settings.time_samples;
-            let mut measure = |p: &OwnedLcp, z: &[f64]| -> Result<(f64, f64), RunError> {
-                // The stored LCP is normally the one of the accepted point; rebuild if not.
-                let rebuilt;
-                let lcp = match p.lcp.as_ref() {
-                    Some(lcp) if p.built_for.to_bits() == p.omega.to_bits() => lcp,
-                    _ => {
-                        let mut m = p.model.clone();
-                        m.forcing.omega = p.omega;
-                        rebuilt = PeriodicLcp::new(&m, p.options.clone())?;
-                        &rebuilt
-                    }
-                };
-                let series = match tip_contact {
-                    Some(i) => lcp.contact_displacements(z)?.swap_remove(i),
-                    None => lcp.displacements(z)?.swap_remove(0),
-                };
-                Ok(extremes(&series))
-            };
-            follow(
-                &mut problem,
-                &mut FaerDenseLu::new(),
-                setup(units, output_points),
-                &mut measure,
-                progress,
-            )
-        }
+        Method::LcpSsn => Err(RunError::Unsupported {
+            method: "lcp-ssn",
+            what: "a branch the continuation can follow: the periodic LCP's unknowns are the \
+                   contact forces, which leave zero at a corner of the branch (contact onset) \
+                   where the corrector stalls; sweep with ssn-hb or penalty-hb, or solve \
+                   frequency by frequency with `ssn solve`",
+        }),
         Method::LcpLemke => Err(RunError::Unsupported {
             method: "lcp-lemke",
             what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
-                   sweep with ssn-hb, penalty-hb or lcp-ssn, or solve frequency by frequency \
+                   sweep with ssn-hb or penalty-hb, or solve frequency by frequency \
                    with `ssn solve`",
         }),
         Method::March => Err(RunError::Unsupported {
             method: "march",
             what: "a method continuable in omega (time marching has no equation to continue): \
-                   sweep with ssn-hb, penalty-hb or lcp-ssn, or march frequency by frequency \
+                   sweep with ssn-hb or penalty-hb, or march frequency by frequency \
                    with `ssn solve`",
         }),
     }
