@@ -27,6 +27,28 @@
 //! curve and one percent of the resonant amplitude on steep ones, for `H = 5` as for
 //! `H = 50`.
 //!
+//! # Robustness on piecewise-smooth branches
+//!
+//! The contact branches are only piecewise smooth (the set of active AFT samples changes
+//! along them), with corners and folds at corners. Three measures on this side of the core:
+//!
+//! - a trust ball: the corrector may not leave the θ-ball of radius
+//!   [`TRUST_FACTOR`]` x` (largest next step) around the last point (outside it the residual
+//!   is NaN, so the attempt fails and the step is halved) — without it Newton sometimes
+//!   converged on the far side of an overhang and skipped both folds;
+//! - restarts: when the continuation stops on a failed step, it is restarted from the last
+//!   point for [`RESTART_POINTS`] points with `θ = `[`THETA_RESTART`] (the arclength then
+//!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
+//!   the constraint), heading the way `ω` last moved, or the other way when that restart
+//!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//! - folds are the reversals of `ω` along the accepted points (the core's fold events,
+//!   from sign changes of the tangent, also fire where a sharply turning branch flips the
+//!   tangent's orientation without any reversal); the core's interpolated fold frequency
+//!   is used when it lies beyond the extreme point.
+//!
+//! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
+//! tolerance, so each point is a fixed point of a Newton solve at that tolerance.
+//!
 //! # Methods
 //!
 //! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
@@ -183,6 +205,7 @@ impl FrequencyResponse {
                 "ffts": c.ffts,
                 "corrector_iterations": self.continuation.corrector_iterations,
                 "rejected_steps": self.continuation.rejected_steps,
+                "restarts": self.restarts,
             },
         })
     }
