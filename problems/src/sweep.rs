@@ -47,7 +47,14 @@
 //!   is used when it lies beyond the extreme point.
 //!
 //! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
-//! tolerance, so each point is a fixed point of a Newton solve at that tolerance.
+//! tolerance for SSN-HB, so each point is a fixed point of a Newton solve at that
+//! tolerance; for penalty HB it is the scene's tolerance itself (a stiff penalty puts the
+//! rounding floor of `|F|` within a decade of it).
+//!
+//! Known limit: penalty-HB branches with a stiff penalty (`k_p >= 1e3` times the contact
+//! stiffness scale, the scenes' default is `1e5`) reverse in `ω` many times by small amounts
+//! near the contact onset of the canonical rod, and the continuation stalls there
+//! (`converged = false`, the reason in `termination`); SSN-HB passes.
 //!
 //! # Methods
 //!
@@ -404,7 +411,11 @@ fn continuation_options(
         max_step: sweep.max_step,
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
-        corrector_tolerance: CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
+        corrector_tolerance: match settings.method {
+            // A stiff penalty puts the rounding floor of |F| near the tolerance itself.
+            Method::PenaltyHb => settings.tolerance,
+            _ => CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
+        },
         parameter_min: lo / q_unit,
         parameter_max: hi / q_unit,
         max_points: sweep.max_points,
