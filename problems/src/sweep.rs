@@ -68,6 +68,11 @@ pub const THETA: f64 = 0.5;
 /// Largest number of corrector iterations per attempted step.
 pub const MAX_CORRECTOR_ITERATIONS: usize = 12;
 
+/// The corrector's tolerance on `|F|` relative to the scene's Newton tolerance: one decade
+/// tighter, so that every branch point is a fixed point of a Newton solve at the scene's
+/// tolerance even where the Jacobian is ill-conditioned (near folds).
+pub const CORRECTOR_TOLERANCE_FACTOR: f64 = 0.1;
+
 /// Corrector iterations the step control aims at.
 pub const TARGET_ITERATIONS: usize = 4;
 
@@ -487,7 +492,7 @@ fn continuation_options(
         max_step: sweep.max_step,
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
-        corrector_tolerance: settings.tolerance,
+        corrector_tolerance: CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
         parameter_min: lo / q_unit,
         parameter_max: hi / q_unit,
         max_points: sweep.max_points,
@@ -766,7 +771,15 @@ where
         } else {
             break termination;
         }
-        direction = if last_tangent_parameter > 0.0 {
+        // Keep going the way the branch went (the last increment of ω; the tangent's sign
+        // can be flipped where the branch turns sharply).
+        let k = response.omega.len();
+        let heading = if k >= 2 {
+            response.omega[k - 1] - response.omega[k - 2]
+        } else {
+            last_tangent_parameter
+        };
+        direction = if heading >= 0.0 {
             Direction::Increasing
         } else {
             Direction::Decreasing
