@@ -180,7 +180,7 @@ fn contact_stiffens_the_resonance_bounds_the_peak_and_passes_folds() {
         // The tip stays behind the gap up to the resolution of the discretised contact law:
         // SSN-HB imposes it on the Galerkin projection onto 2H+1 harmonics (not sample by
         // sample), so the excess is a truncation effect that must shrink as H grows, and at
-        // H = 5 stays a small fraction of the gap.
+        // H = 5 stays a small fraction of the gap (5 % with the default c = 10 x static).
         let excess = |r: &FrequencyResponse| {
             r.tip_max
                 .iter()
@@ -190,7 +190,7 @@ fn contact_stiffens_the_resonance_bounds_the_peak_and_passes_folds() {
         let fine = curve(&rod, Method::SsnHb, 20, 0.5, 2.0);
         let (e5, e20) = (excess(&contact), excess(&fine));
         println!("{mass:?}: largest tip excess over the gap: H = 5 {e5:e}, H = 20 {e20:e}");
-        assert!(e5 <= 0.03 * gap, "{mass:?}: {e5:e}");
+        assert!(e5 <= 0.05 * gap, "{mass:?}: {e5:e}");
         assert!(
             e20 <= 0.5 * e5.max(0.0) + 1e-9,
             "{mass:?}: {e20:e} vs {e5:e}"
