@@ -143,7 +143,6 @@ fn program_help_exits_zero_and_documents_the_exit_codes() {
 /// What the issue asks: the program's own help shows an example command line too (today
 /// only the subcommands' help does).
 #[test]
-#[ignore = "reason: `ssn --help` shows the exit codes but no example command line (the subcommands' help does)"]
 fn program_help_shows_an_example() {
     let text = stdout(&ssn(&["--help"]));
     assert!(text.to_lowercase().contains("example"), "{text}");
@@ -534,7 +533,6 @@ fn scene_check_prints_frequencies_and_the_effects_present() {
 /// and time marching need an impact law (measured: Lemke ends at the pivot limit, 25,700
 /// pivots, on this scene), but scene-check only warns for non-modified mass models.
 #[test]
-#[ignore = "reason: scene-check warns about massive contact nodes only when mass != modified; two_contacts.toml has a massive interior contact node (10)"]
 fn scene_check_warns_about_a_massive_interior_contact_node() {
     let out = ssn(&[
         "scene-check",
