@@ -541,3 +541,67 @@ fn scene_check_warns_about_a_massive_interior_contact_node() {
     let text = stdout(&out);
     assert!(text.contains("note"), "{text}");
 }
+
+#[test]
+fn an_lcp_scene_prints_json_without_harmonics() {
+    let dir = TempDir::new("lcp");
+    let text = CANONICAL.replace(
+        "harmonics = 20",
+        "method = \"lcp-lemke\"\ntime_samples = 128",
+    );
+    let path = dir.write("lcp.toml", &text);
+    let (out, json) = solve_json(&path, &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert_eq!(json["method"], "lcp-lemke");
+    assert!(json.get("harmonics").is_none(), "{json}");
+    assert_eq!(json["time_samples"], 128);
+    assert!(
+        json["counters"]["lemke_pivots"].as_u64().unwrap() > 0,
+        "{json}"
+    );
+    // The LCP enforces contact at every time node: no penetration beyond rounding.
+    assert!(json["max_penetration"].as_f64().unwrap() <= 1e-9, "{json}");
+}
+
+#[test]
+fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
+    let fig2 = scenes_dir().join("paper_fig2.toml");
+    let out = ssn(&["sweep", "--json", fig2.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
+    assert_eq!(json["converged"], Value::Bool(true));
+    let omega = json["omega"].as_array().expect("omega array");
+    assert!(omega.len() >= 2 && json["points"] == omega.len());
+    for key in ["tip_max", "tip_min", "amplitude"] {
+        let v = json[key].as_array().expect("array");
+        assert_eq!(v.len(), omega.len(), "{key}");
+        assert!(
+            v.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)),
+            "{key}"
+        );
+    }
+
+    // No [sweep] section: bad input naming the file and the section.
+    let fig1 = scenes_dir().join("paper_fig1.toml");
+    let out = ssn(&["sweep", fig1.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("paper_fig1.toml") && stderr(&out).contains("[sweep]"),
+        "{}",
+        stderr(&out)
+    );
+
+    // Lemke cannot be continued in omega: bad input, saying which methods can.
+    let dir = TempDir::new("sweep");
+    let text = std::fs::read_to_string(&fig2)
+        .unwrap()
+        .replace("method = \"ssn-hb\"", "method = \"lcp-lemke\"");
+    let path = dir.write("lemke_sweep.toml", &text);
+    let out = ssn(&["sweep", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("lemke_sweep.toml") && stderr(&out).contains("lcp-lemke"),
+        "{}",
+        stderr(&out)
+    );
+}
