@@ -504,6 +504,28 @@ fn two_thousand_elements_converge_with_default_settings() {
     assert!(out.converged().is_some(), "{}", out.summary());
 }
 
+/// What the library should do: penalty HB converges on a refined rod with its default
+/// settings, as SSN-HB does. Measured (modified mass, gap 0.5, omega_1, H = 20, default
+/// penalty 1e5 K[tip, tip]): 100 elements converge in 33 iterations; 200 elements end
+/// line-search-failed after 918 iterations (residual 1.46e-3, tip at +-0.5); 500, 1000 and
+/// 2000 elements likewise (763, 603, 486 iterations), whatever k_p in 1e6..2e8. The penalty
+/// homotopy starts from `K[tip, tip] = EA / h`, which grows with the mesh (as the old default
+/// c did).
+#[test]
+#[ignore = "reason: penalty-HB with default settings ends line-search-failed on 200 elements (918 iterations, residual 1.46e-3) and beyond; converges on 100"]
+fn penalty_hb_converges_on_200_elements() {
+    let spec = RodSpec {
+        elements: 200,
+        contacts: vec![RodContact {
+            node: 200,
+            gap: 0.5,
+        }],
+        ..canonical()
+    };
+    let out = run("200 elements", &spec, &hb(20), Method::PenaltyHb);
+    assert!(out.converged().is_some(), "penalty-hb: {}", out.summary());
+}
+
 #[test]
 fn stiff_penalty_kp_1e8() {
     let mut s = hb(20);
