@@ -542,25 +542,38 @@ fn scene_check_warns_about_a_massive_interior_contact_node() {
     assert!(text.contains("note"), "{text}");
 }
 
+/// LCP and time marching: no `harmonics`, `time_samples` the steps per period, their own
+/// counters, contact exact at the time nodes; the tip minimum agrees with SSN-HB's on the
+/// same (modified-mass) scene within the HB truncation bound `4 A / (pi H)` (hard_cases.rs).
 #[test]
-fn an_lcp_scene_prints_json_without_harmonics() {
+fn lcp_and_march_scenes_print_json_without_harmonics() {
+    let (_, hb) = solve_json(&scenes_dir().join("paper_fig1_modified_mass.toml"), &[]);
+    let hb_min = hb["tip_min"].as_f64().unwrap();
+    let half_amplitude = 0.5 * (hb["tip_max"].as_f64().unwrap() - hb_min);
+    let bound = 4.0 * half_amplitude / (std::f64::consts::PI * 20.0);
     let dir = TempDir::new("lcp");
-    let text = CANONICAL.replace(
-        "harmonics = 20",
-        "method = \"lcp-lemke\"\ntime_samples = 128",
-    );
-    let path = dir.write("lcp.toml", &text);
-    let (out, json) = solve_json(&path, &[]);
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    assert_eq!(json["method"], "lcp-lemke");
-    assert!(json.get("harmonics").is_none(), "{json}");
-    assert_eq!(json["time_samples"], 128);
-    assert!(
-        json["counters"]["lemke_pivots"].as_u64().unwrap() > 0,
-        "{json}"
-    );
-    // The LCP enforces contact at every time node: no penetration beyond rounding.
-    assert!(json["max_penetration"].as_f64().unwrap() <= 1e-9, "{json}");
+    for (method, extra, counter) in [
+        ("lcp-lemke", "time_samples = 128", "lemke_pivots"),
+        ("march", "steps_per_period = 256", "time_steps"),
+    ] {
+        let text = CANONICAL.replace("harmonics = 20", &format!("method = \"{method}\"\n{extra}"));
+        let path = dir.write(&format!("{method}.toml"), &text);
+        let (out, json) = solve_json(&path, &[]);
+        assert_eq!(out.status.code(), Some(0), "{method}: {}", stderr(&out));
+        assert_eq!(json["method"], method);
+        assert!(json.get("harmonics").is_none(), "{json}");
+        assert!(
+            json["time_samples"] == 128 || json["time_samples"] == 256,
+            "{json}"
+        );
+        assert!(json["counters"][counter].as_u64().unwrap() > 0, "{json}");
+        assert!(json["max_penetration"].as_f64().unwrap() <= 1e-9, "{json}");
+        let diff = (json["tip_min"].as_f64().unwrap() - hb_min).abs();
+        assert!(
+            diff <= bound,
+            "{method}: tip min differs from SSN-HB by {diff} > {bound}"
+        );
+    }
 }
 
 #[test]
