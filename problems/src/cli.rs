@@ -357,7 +357,9 @@ pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
             ));
         }
         line(format!(
-            "contact scale     K[dof,dof] = {:.6e} (default c and penalty unit)",
+            "contact stiffness static {:.6e} (default c = 10 x static = {:.6e}), local K[dof,dof] = {:.6e} (penalty unit)",
+            rod.model.static_contact_stiffness().unwrap_or(f64::NAN),
+            rod.model.default_complementarity_constant(),
             rod.model.contact_stiffness_scale()
         ));
     }
@@ -392,13 +394,20 @@ pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
             sw.max_points
         ));
     }
-    if s.mass != MassModel::Modified && !s.contacts.is_empty() {
-        line(
-            "note              the contact node has mass: time marching needs an impact law and \
-             harmonic balance imposes none, so the two need not agree; mass = \"modified\" makes \
-             the problem well posed"
-                .into(),
-        );
+    let massive: Vec<String> = rod
+        .model
+        .contacts
+        .iter()
+        .filter(|c| crate::model::diagonal_entry(&rod.model.mass, c.dof) > 0.0)
+        .map(|c| (c.dof + 1).to_string())
+        .collect();
+    if !massive.is_empty() {
+        line(format!(
+            "note              contact node(s) {} carry mass: time marching then needs an impact \
+             law and harmonic balance imposes none, so the two need not agree, and the periodic \
+             LCP may be hard for Lemke; mass = \"modified\" makes the tip contact massless",
+            massive.join(", ")
+        ));
     }
     out
 }

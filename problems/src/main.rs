@@ -10,6 +10,13 @@ use semismooth_problems::rod::{build_rod, natural_frequencies};
 use semismooth_problems::scene::Scene;
 
 const EXIT_CODES: &str = "\
+Examples:
+  ssn                                         reproduce the paper's figures into ./out/
+  ssn solve problems/scenes/paper_fig1_modified_mass.toml --json
+  ssn sweep problems/scenes/paper_fig2.toml --csv fig2.csv --svg fig2.svg
+  ssn compare problems/scenes/paper_fig1_modified_mass.toml --out out/compare
+  ssn scene-check problems/scenes/two_contacts.toml
+
 Exit codes:
   0  converged (or, for scene-check, a valid scene)
   1  the solver ran but did not converge (its JSON is still printed, with converged = false)
