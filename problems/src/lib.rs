@@ -14,4 +14,5 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod study;
 pub mod sweep;

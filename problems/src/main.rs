@@ -91,6 +91,19 @@ enum Command {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+    /// Accuracy against cost: every method over its discretisation settings, error against a
+    /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
+    #[command(
+        after_help = "Example:\n  ssn compare problems/scenes/paper_fig1_modified_mass.toml --out out/compare\n\n"
+    )]
+    Compare {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Requested relative accuracy on the tip minimum: the cheapest setting of each
+        /// method reaching it is reported.
+        #[arg(long, default_value_t = 1e-3)]
+        accuracy: f64,
+    },
     /// Validate a scene and print the resolved model (natural frequencies, effects present).
     #[command(after_help = "Example:\n  ssn scene-check problems/scenes/two_contacts.toml\n\n")]
     SceneCheck {
@@ -124,6 +137,9 @@ fn main() -> ExitCode {
             svg,
         }) => {
             semismooth_problems::cli::sweep(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
+        }
+        Some(Command::Compare { scene, accuracy }) => {
+            semismooth_problems::cli::compare(scene, &cli.out, *accuracy, cli.quiet)
         }
     }
     .map_err(|e| match e {

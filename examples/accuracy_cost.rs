@@ -1,0 +1,59 @@
+//! Accuracy versus cost of every method on the canonical rod with the modified mass
+//! (massless contact node), or on a scene given as the first argument: the table, the
+//! cheapest setting of each method for 1e-3 and 1e-4 relative accuracy on the tip minimum,
+//! and `accuracy_cost.csv` / `accuracy_cost.svg` in `out/accuracy_cost/`.
+//!
+//! `cargo run --release --example accuracy_cost [SCENE.toml]`
+
+use std::path::PathBuf;
+
+use semismooth_problems::cli::default_settings;
+use semismooth_problems::output::{prepare_directory, write_atomically};
+use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
+use semismooth_problems::scene::Scene;
+use semismooth_problems::study::accuracy_cost;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let (spec, base) = match std::env::args().nth(1) {
+        Some(path) => {
+            let scene = Scene::from_path(&path)?;
+            (scene.rod, scene.solver)
+        }
+        None => (
+            RodSpec {
+                mass: MassModel::Modified,
+                ..RodSpec::canonical()
+            },
+            default_settings(20),
+        ),
+    };
+    let rod = build_rod(&spec)?;
+    let progress = |s: &str| eprintln!("  {s}");
+    let study = accuracy_cost(&rod, &base, Some(&progress))?;
+    println!("{}", study.table());
+    for accuracy in [1e-3, 1e-4] {
+        println!("cheapest setting for {accuracy:.0e} on the tip minimum:");
+        for (method, entry) in study.cheapest(accuracy) {
+            match entry {
+                Some(e) => println!(
+                    "  {:<11} {:<22} {:.3e} s (error {:.1e})",
+                    method.name(),
+                    e.setting,
+                    e.seconds,
+                    e.tip_min_error
+                ),
+                None => println!("  {:<11} not reached", method.name()),
+            }
+        }
+    }
+    let out = PathBuf::from("out/accuracy_cost");
+    prepare_directory(&out)?;
+    write_atomically(&out.join("accuracy_cost.csv"), study.to_csv().as_bytes())?;
+    study.write_svg(&out.join("accuracy_cost.svg"))?;
+    println!(
+        "\nWrote {0}/accuracy_cost.csv and {0}/accuracy_cost.svg",
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,451 @@
+//! Accuracy versus cost: every applicable method swept over its discretisation, its error
+//! against a converged reference plotted against its wall time.
+//!
+//! The quantity compared is the tip minimum `min_t u_tip(t)` over one period (the tip
+//! maximum is pinned at the gap by contact, so its error says little); the relative error
+//! is `|min - min_ref| / |min_ref|`. Secondary errors: the tip RMS over the period and, with
+//! contact, the mean contact force of the first contact.
+//!
+//! The reference is time marching with [`REFERENCE_STEPS`] steps per period and a
+//! period-to-period tolerance of 1e-10: its tip minimum converges monotonically-fast with the
+//! step (second order for a massless contact node), while harmonic balance converges
+//! slowly in `H` when the contact is non-smooth. Its own uncertainty is estimated as the
+//! change of the tip minimum from half the steps, and it is cross-checked against SSN-HB
+//! at [`REFERENCE_HARMONICS`] harmonics; both numbers are reported with the reference. An
+//! accuracy below the reference uncertainty cannot be resolved by the study.
+//!
+//! Wall times are medians of [`REPEATS`] runs when a run takes less than 50 ms, else one
+//! run; they include what the runner times (the solve, not the set-up of the rod).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::output::{write_line_plot, OutputError, PlotSpec, Series};
+use crate::rod::RodModel;
+use crate::runner::{solve_rod, RunError, Solution};
+use crate::scene::{default_hb_time_samples, Method, SolverSettings};
+
+/// Steps per period of the time-marching reference.
+pub const REFERENCE_STEPS: usize = 8000;
+/// Harmonics of the SSN-HB cross-check of the reference.
+pub const REFERENCE_HARMONICS: usize = 320;
+/// Repeats of a fast run (median taken).
+pub const REPEATS: usize = 3;
+/// Runs faster than this (seconds) are repeated [`REPEATS`] times.
+const REPEAT_BELOW_SECONDS: f64 = 0.05;
+
+/// The converged reference of a study.
+#[derive(Debug, Clone)]
+pub struct Reference {
+    /// How it was computed.
+    pub description: String,
+    /// Tip minimum over one period.
+    pub tip_min: f64,
+    /// Tip RMS over one period.
+    pub tip_rms: f64,
+    /// Mean contact force of the first contact (0 without contact).
+    pub mean_force: f64,
+    /// Relative change of the tip minimum from half the steps (the reference's own
+    /// uncertainty).
+    pub uncertainty: f64,
+    /// Relative difference of the tip minimum to SSN-HB at [`REFERENCE_HARMONICS`]
+    /// harmonics (`None` if that run failed or did not converge).
+    pub cross_check: Option<f64>,
+    /// Wall time of the reference run.
+    pub seconds: f64,
+}
+
+/// One run of the study.
+#[derive(Debug, Clone)]
+pub struct Entry {
+    /// Method.
+    pub method: Method,
+    /// The discretisation in words (`H=20 Nt=256`, `Nt=512`, `steps=2000`, ...).
+    pub setting: String,
+    /// Relative error of the tip minimum.
+    pub tip_min_error: f64,
+    /// Relative error of the tip RMS.
+    pub tip_rms_error: f64,
+    /// Relative error of the mean contact force (`None` without contact).
+    pub mean_force_error: Option<f64>,
+    /// Wall time of the solve (median of the repeats), seconds.
+    pub seconds: f64,
+    /// Newton iterations, Lemke pivots or periods marched.
+    pub iterations: usize,
+    /// Whether the method converged.
+    pub converged: bool,
+}
+
+/// Result of [`accuracy_cost`].
+#[derive(Debug, Clone)]
+pub struct AccuracyCost {
+    /// The reference all errors are measured against.
+    pub reference: Reference,
+    /// Every run, grouped by method in the order they ran.
+    pub entries: Vec<Entry>,
+}
+
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn relative(value: f64, reference: f64) -> f64 {
+    (value - reference).abs() / reference.abs().max(f64::MIN_POSITIVE)
+}
+
+/// Methods in plotting order.
+const METHODS: [Method; 5] = [
+    Method::SsnHb,
+    Method::PenaltyHb,
+    Method::LcpLemke,
+    Method::LcpSsn,
+    Method::March,
+];
+
+impl AccuracyCost {
+    /// For each method of the study, its cheapest converged entry whose tip-minimum error is
+    /// at most `accuracy` (`None` if no setting reached it).
+    pub fn cheapest(&self, accuracy: f64) -> Vec<(Method, Option<Entry>)> {
+        METHODS
+            .iter()
+            .filter(|m| self.entries.iter().any(|e| e.method == **m))
+            .map(|&m| {
+                let best = self
+                    .entries
+                    .iter()
+                    .filter(|e| e.method == m && e.converged && e.tip_min_error <= accuracy)
+                    .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+                    .cloned();
+                (m, best)
+            })
+            .collect()
+    }
+
+    /// CSV: one line per entry, the reference in a leading comment line.
+    pub fn to_csv(&self) -> String {
+        let r = &self.reference;
+        let mut s = format!(
+            "# reference: {}; tip_min={:e} tip_rms={:e} mean_force={:e} uncertainty={:e}\n",
+            r.description, r.tip_min, r.tip_rms, r.mean_force, r.uncertainty
+        );
+        s.push_str(
+            "method,setting,tip_min_error,tip_rms_error,mean_force_error,seconds,iterations,converged\n",
+        );
+        for e in &self.entries {
+            let _ = writeln!(
+                s,
+                "{},{},{:e},{:e},{},{:e},{},{}",
+                e.method.name(),
+                e.setting,
+                e.tip_min_error,
+                e.tip_rms_error,
+                e.mean_force_error
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default(),
+                e.seconds,
+                e.iterations,
+                e.converged
+            );
+        }
+        s
+    }
+
+    /// A printable table (reference first, then one line per entry).
+    pub fn table(&self) -> String {
+        let r = &self.reference;
+        let mut s = String::new();
+        let _ = writeln!(s, "reference: {}", r.description);
+        let _ = writeln!(
+            s,
+            "  tip min {:.10}  tip rms {:.10}  mean force {:.6e}  ({:.3} s)",
+            r.tip_min, r.tip_rms, r.mean_force, r.seconds
+        );
+        let _ = writeln!(
+            s,
+            "  uncertainty (vs half the steps) {:.1e}; SSN-HB H={} differs by {}",
+            r.uncertainty,
+            REFERENCE_HARMONICS,
+            r.cross_check
+                .map(|v| format!("{v:.1e}"))
+                .unwrap_or_else(|| "n/a".into())
+        );
+        let _ = writeln!(
+            s,
+            "{:<11} {:<22} {:>10} {:>10} {:>10} {:>11} {:>6} {:>5}",
+            "method", "setting", "err(min)", "err(rms)", "err(F)", "time [s]", "iter", "conv"
+        );
+        for e in &self.entries {
+            let _ = writeln!(
+                s,
+                "{:<11} {:<22} {:>10.2e} {:>10.2e} {:>10} {:>11.3e} {:>6} {:>5}",
+                e.method.name(),
+                e.setting,
+                e.tip_min_error,
+                e.tip_rms_error,
+                e.mean_force_error
+                    .map(|v| format!("{v:.2e}"))
+                    .unwrap_or_else(|| "-".into()),
+                e.seconds,
+                e.iterations,
+                if e.converged { "yes" } else { "no" }
+            );
+        }
+        s
+    }
+
+    /// Log-log plot of the tip-minimum error against wall time, one curve per method
+    /// (converged entries only).
+    pub fn write_svg(&self, path: &Path) -> Result<(), OutputError> {
+        let series: Vec<Series> = METHODS
+            .iter()
+            .filter_map(|&m| {
+                let mut points: Vec<(f64, f64)> = self
+                    .entries
+                    .iter()
+                    .filter(|e| e.method == m && e.converged)
+                    .map(|e| (e.seconds, e.tip_min_error.max(1e-16)))
+                    .collect();
+                if points.is_empty() {
+                    return None;
+                }
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let (x, y) = points.into_iter().unzip();
+                Some(Series::new(m.name(), x, y))
+            })
+            .collect();
+        let spec = PlotSpec {
+            title: "Accuracy vs cost (tip minimum)".into(),
+            x_label: "wall time [s]".into(),
+            y_label: "relative error of the tip minimum".into(),
+            log_log: true,
+        };
+        write_line_plot(path, &spec, &series)
+    }
+}
+
+/// Runs `settings`, repeating fast runs and keeping the median wall time.
+fn timed(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, RunError> {
+    let first = solve_rod(rod, settings, None)?;
+    if first.solve_seconds >= REPEAT_BELOW_SECONDS {
+        return Ok(first);
+    }
+    let mut times = vec![first.solve_seconds];
+    for _ in 1..REPEATS {
+        times.push(solve_rod(rod, settings, None)?.solve_seconds);
+    }
+    times.sort_by(f64::total_cmp);
+    let mut sol = first;
+    sol.solve_seconds = times[times.len() / 2];
+    Ok(sol)
+}
+
+fn tip_contact_force(sol: &Solution) -> f64 {
+    sol.stats.mean_contact_force
+}
+
+/// The discretisations swept for each method: `(method, description, settings)`.
+fn sweep_settings(rod: &RodModel, base: &SolverSettings) -> Vec<(Method, String, SolverSettings)> {
+    let contact = !rod.model.contacts.is_empty();
+    let scale = rod.model.contact_stiffness_scale();
+    let hb = |method: Method, h: usize, nt: usize| SolverSettings {
+        method,
+        harmonics: h,
+        time_samples: nt,
+        ..base.clone()
+    };
+    let mut out = Vec::new();
+    for h in [5, 10, 20, 40, 80, 160] {
+        let nt = default_hb_time_samples(h);
+        out.push((
+            Method::SsnHb,
+            format!("H={h} Nt={nt}"),
+            hb(Method::SsnHb, h, nt),
+        ));
+    }
+    // Nt at fixed H: the AFT sampling of the contact law.
+    for nt in [64, 1024] {
+        out.push((
+            Method::SsnHb,
+            format!("H=20 Nt={nt}"),
+            hb(Method::SsnHb, 20, nt),
+        ));
+    }
+    if contact {
+        for h in [20, 80] {
+            for relative in [1e1, 1e2, 1e3, 1e4] {
+                let nt = default_hb_time_samples(h);
+                let mut s = hb(Method::PenaltyHb, h, nt);
+                s.penalty_stiffness = Some(relative * scale);
+                out.push((Method::PenaltyHb, format!("H={h} kp={relative:.0e}K"), s));
+            }
+        }
+        for (method, nts) in [
+            (Method::LcpLemke, &[64usize, 128, 256, 512][..]),
+            (Method::LcpSsn, &[64usize, 128, 256, 512, 1024][..]),
+        ] {
+            for &nt in nts {
+                out.push((
+                    method,
+                    format!("Nt={nt}"),
+                    SolverSettings {
+                        method,
+                        time_samples: nt,
+                        ..base.clone()
+                    },
+                ));
+            }
+        }
+    }
+    for steps in [32, 64, 128, 250, 500, 1000, 2000, 4000] {
+        out.push((
+            Method::March,
+            format!("steps={steps}"),
+            SolverSettings {
+                method: Method::March,
+                steps_per_period: steps,
+                ..base.clone()
+            },
+        ));
+    }
+    out
+}
+
+/// The accuracy-vs-cost study of `rod`: the reference (see the module documentation), then
+/// every applicable method over its discretisation (LCP and penalty HB only with contact).
+/// `base` supplies the Newton tolerance, iteration limit, globalization, linear solver and
+/// time-marching limits; `progress` receives one line per run.
+///
+/// A run that fails to start is recorded as not converged with infinite errors; only a
+/// failure of the reference is an error.
+pub fn accuracy_cost(
+    rod: &RodModel,
+    base: &SolverSettings,
+    progress: Option<&dyn Fn(&str)>,
+) -> Result<AccuracyCost, RunError> {
+    let say = |s: &str| {
+        if let Some(p) = progress {
+            p(s)
+        }
+    };
+    let reference_settings = |steps: usize| SolverSettings {
+        method: Method::March,
+        steps_per_period: steps,
+        march_tolerance: 1e-10,
+        max_periods: base.max_periods.max(5000),
+        ..base.clone()
+    };
+    say(&format!(
+        "reference: time marching, {REFERENCE_STEPS} steps per period"
+    ));
+    let fine = solve_rod(rod, &reference_settings(REFERENCE_STEPS), None)?;
+    let half = solve_rod(rod, &reference_settings(REFERENCE_STEPS / 2), None)?;
+    let tip_min = fine.stats.min;
+    say(&format!(
+        "cross-check: SSN-HB, {REFERENCE_HARMONICS} harmonics"
+    ));
+    let cross_check = solve_rod(
+        rod,
+        &SolverSettings {
+            method: Method::SsnHb,
+            harmonics: REFERENCE_HARMONICS,
+            time_samples: default_hb_time_samples(REFERENCE_HARMONICS),
+            ..base.clone()
+        },
+        None,
+    )
+    .ok()
+    .filter(|s| s.converged)
+    .map(|s| relative(s.stats.min, tip_min));
+    let contact = !rod.model.contacts.is_empty();
+    let reference = Reference {
+        description: format!(
+            "time marching, {REFERENCE_STEPS} steps per period, period-to-period tolerance 1e-10"
+        ),
+        tip_min,
+        tip_rms: rms(&fine.tip),
+        mean_force: tip_contact_force(&fine),
+        uncertainty: relative(half.stats.min, tip_min),
+        cross_check,
+        seconds: fine.solve_seconds,
+    };
+    let mut entries = Vec::new();
+    for (method, setting, settings) in sweep_settings(rod, base) {
+        say(&format!("{} {setting}", method.name()));
+        let entry = match timed(rod, &settings) {
+            Ok(sol) => Entry {
+                method,
+                setting,
+                tip_min_error: relative(sol.stats.min, reference.tip_min),
+                tip_rms_error: relative(rms(&sol.tip), reference.tip_rms),
+                mean_force_error: contact
+                    .then(|| relative(tip_contact_force(&sol), reference.mean_force)),
+                seconds: sol.solve_seconds,
+                iterations: sol.iterations,
+                converged: sol.converged,
+            },
+            Err(_) => Entry {
+                method,
+                setting,
+                tip_min_error: f64::INFINITY,
+                tip_rms_error: f64::INFINITY,
+                mean_force_error: None,
+                seconds: f64::NAN,
+                iterations: 0,
+                converged: false,
+            },
+        };
+        entries.push(entry);
+    }
+    Ok(AccuracyCost { reference, entries })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(method: Method, err: f64, seconds: f64, converged: bool) -> Entry {
+        Entry {
+            method,
+            setting: String::new(),
+            tip_min_error: err,
+            tip_rms_error: err,
+            mean_force_error: None,
+            seconds,
+            iterations: 1,
+            converged,
+        }
+    }
+
+    #[test]
+    fn cheapest_picks_the_fastest_converged_entry_within_the_accuracy() {
+        let study = AccuracyCost {
+            reference: Reference {
+                description: String::new(),
+                tip_min: -1.0,
+                tip_rms: 1.0,
+                mean_force: 0.0,
+                uncertainty: 0.0,
+                cross_check: None,
+                seconds: 0.0,
+            },
+            entries: vec![
+                entry(Method::SsnHb, 1e-2, 0.001, true),
+                entry(Method::SsnHb, 1e-4, 0.003, true),
+                entry(Method::SsnHb, 1e-5, 0.002, false),
+                entry(Method::SsnHb, 1e-6, 0.010, true),
+                entry(Method::March, 1e-2, 0.1, true),
+            ],
+        };
+        let best = study.cheapest(1e-3);
+        assert_eq!(best.len(), 2);
+        assert_eq!(best[0].0, Method::SsnHb);
+        assert_eq!(best[0].1.as_ref().map(|e| e.seconds), Some(0.003));
+        assert_eq!(best[1].0, Method::March);
+        assert!(best[1].1.is_none());
+        let csv = study.to_csv();
+        assert_eq!(csv.lines().count(), 2 + study.entries.len());
+    }
+}
