@@ -393,8 +393,20 @@ fn an_unwritable_output_exits_3_and_leaves_no_file() {
         );
         assert!(!Path::new("/nonexistent/dir/x.out").exists());
     }
-    // The target is an existing directory: the write fails and no temporary file is left.
+    // A parent that is a regular file: cannot be created even by root (where
+    // /nonexistent/dir could be), so the write must fail and leave nothing.
     let dir = TempDir::new("out");
+    let file = dir.write("a-file", "x");
+    let under_file = file.join("x.csv");
+    let out = ssn(&["solve", scene, "--csv", under_file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3), "stderr {}", stderr(&out));
+    assert_eq!(
+        dir.entries(),
+        vec!["a-file".to_string()],
+        "something was left behind"
+    );
+    std::fs::remove_file(&file).unwrap();
+    // The target is an existing directory: the write fails and no temporary file is left.
     let sub = dir.0.join("a-directory");
     std::fs::create_dir(&sub).unwrap();
     let out = ssn(&["solve", scene, "--csv", sub.to_str().unwrap()]);
@@ -635,4 +647,38 @@ fn scene_check_accepts_a_two_element_modified_mass_rod() {
     let out = ssn(&["scene-check", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "scene-check: {}", stderr(&out));
     assert_eq!(natural_frequencies_line(&stdout(&out)).len(), 1);
+}
+
+#[test]
+fn compare_writes_its_table_and_refuses_an_unwritable_directory() {
+    let scene = scenes_dir().join("paper_fig1_modified_mass.toml");
+    let scene = scene.to_str().unwrap();
+    let dir = TempDir::new("compare");
+    let out_dir = dir.0.join("cmp");
+    let out = ssn(&["compare", scene, "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let mut written: Vec<String> = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(written, vec!["accuracy_cost.csv", "accuracy_cost.svg"]);
+    for method in ["ssn-hb", "penalty-hb", "lcp-lemke", "lcp-ssn", "march"] {
+        assert!(
+            stdout(&out).contains(method),
+            "{method} missing from the table"
+        );
+    }
+
+    // Output directory under a regular file: exit 3, nothing created.
+    let file = dir.write("a-file", "x");
+    let out = ssn(&[
+        "compare",
+        scene,
+        "--out",
+        file.join("sub").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a-file"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
