@@ -543,6 +543,28 @@ fn two_thousand_elements() {
     );
 }
 
+/// What the library should do: the periodic LCP (Nt = 256) solves the 2,000-element rod as
+/// it solves the 20-element one. Measured: LCP-SSN ends max-iterations (400 over the mesh
+/// sequence, residual 1.87, tip min -0.807, penetration 0.267); Lemke ends at its pivot
+/// limit (12,900); the symmetric part of A has smallest eigenvalue -7.4e-3.
+#[test]
+#[ignore = "reason: on 2000 elements (Nt = 256) LCP-SSN ends max-iterations (residual 1.87) and Lemke at the pivot limit (12900); SSN-HB converges (tip min -0.52378)"]
+fn two_thousand_elements_lcp_converges() {
+    let spec = two_thousand_element_rod();
+    let e = run("2000 elements", &spec, &hb(20), Method::SsnHb);
+    let l = run("2000 elements", &spec, &hb(20), Method::LcpSsn);
+    let e = e.converged().expect("SSN-HB converges");
+    let l = l.converged().expect("LCP-SSN converges on 2000 elements");
+    let tol = hb_penetration_bound(e)
+        + 2.0 * std::f64::consts::PI * 0.5 * (e.stats.max - e.stats.min) / 256.0;
+    assert!(
+        (e.stats.min - l.stats.min).abs() <= tol,
+        "SSN-HB {} vs LCP-SSN {}",
+        e.stats.min,
+        l.stats.min
+    );
+}
+
 /// SSN-HB converges on 2,000 elements with its default settings (mesh-independent default
 /// `c`, 10 times the static contact stiffness `1 / (G K^-1 G^T)`).
 #[test]
