@@ -586,7 +586,6 @@ fn two_thousand_elements_converge_with_default_settings() {
 /// homotopy starts from `K[tip, tip] = EA / h`, which grows with the mesh (as the old default
 /// c did).
 #[test]
-#[ignore = "reason: penalty-HB with default settings ends line-search-failed on 200 elements (918 iterations, residual 1.46e-3) and beyond; converges on 100"]
 fn penalty_hb_converges_on_200_elements() {
     let spec = RodSpec {
         elements: 200,

@@ -637,7 +637,6 @@ fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
 /// frequencies requested, the model has 1 finite ones" (`ssn solve` on the same scene
 /// converges).
 #[test]
-#[ignore = "reason: scene-check on a 2-element modified-mass rod exits 2: '2 natural frequencies requested, the model has 1 finite ones'"]
 fn scene_check_accepts_a_two_element_modified_mass_rod() {
     let dir = TempDir::new("two-el");
     let text = CANONICAL.replace("elements = 20", "elements = 2");
