@@ -18,6 +18,7 @@ use crate::hb::{
 };
 use crate::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
 use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
+use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
 use crate::rod::{ModelError, RodModel};
 use crate::scene::{
@@ -200,20 +201,30 @@ where
 /// `100 eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
 /// the iterate) below it has converged as far as floating point allows: large models
 /// (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
-fn roundoff_floor(model: &crate::model::StructuralModel, dim: usize, u_max: f64) -> f64 {
+fn roundoff_floor(
+    model: &crate::model::StructuralModel,
+    dim: usize,
+    u_max: f64,
+    extra_stiffness: f64,
+) -> f64 {
     let k_max = (0..model.dofs())
         .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
-        .fold(0.0, f64::max);
+        .fold(extra_stiffness, f64::max);
     100.0 * f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
 }
 
-/// Marks a stalled run below the round-off floor as converged.
-fn accept_roundoff(sol: &mut Solution, model: &crate::model::StructuralModel) {
+/// Marks a stalled run below the round-off floor as converged (`extra_stiffness`: a
+/// penalty stiffness, which enters the residual like `K`).
+fn accept_roundoff(
+    sol: &mut Solution,
+    model: &crate::model::StructuralModel,
+    extra_stiffness: f64,
+) {
     if sol.converged || !sol.termination.starts_with("stalled") {
         return;
     }
     let u_max = sol.tip.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let floor = roundoff_floor(model, sol.state.len(), u_max);
+    let floor = roundoff_floor(model, sol.state.len(), u_max, extra_stiffness);
     if sol.residual_norm <= floor {
         sol.converged = true;
         sol.termination =
@@ -328,7 +339,7 @@ pub fn solve_rod(
             let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
             sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
             sol.c = (problem.contacts() > 0).then(|| problem.c());
-            accept_roundoff(&mut sol, model);
+            accept_roundoff(&mut sol, model, 0.0);
             Ok(sol)
         }
         Method::PenaltyHb => {
@@ -350,10 +361,17 @@ pub fn solve_rod(
             let mut counters = WorkCounters::default();
             let mut homotopy_iterations = 0;
             if warm_start.is_none() {
-                // From the static contact stiffness (mesh-independent; the local one grows
+                // From 10 x the static contact stiffness (mesh-independent; the local one grows
                 // with the mesh and is already too stiff a start on fine meshes).
-                let mut k = model.static_contact_stiffness().unwrap_or(scale);
-                while k < target {
+                let mut k = model
+                    .static_contact_stiffness()
+                    .map(|s| DEFAULT_C_FACTOR * s)
+                    .unwrap_or(scale);
+                // Adaptive steps in log k_p: a failed stage goes back to the last converged
+                // stiffness and takes the square root of the factor (10, 3.2, 1.8, ...).
+                let mut factor = PENALTY_HOMOTOPY_FACTOR;
+                let mut last_converged: Option<f64> = None;
+                while k < target && factor > 1.05 {
                     let stage_options = PenaltyHbOptions {
                         penalty_stiffness: k,
                         ..options
@@ -365,8 +383,12 @@ pub fn solve_rod(
                     homotopy_iterations += report.iterations;
                     if report.converged() {
                         x = trial;
+                        last_converged = Some(k);
+                        k *= factor;
+                    } else {
+                        factor = factor.sqrt();
+                        k = last_converged.map_or(k / factor, |kc| kc * factor);
                     }
-                    k *= PENALTY_HOMOTOPY_FACTOR;
                 }
             }
             let mut report = newton_hb(&mut problem, &mut x, settings)?;
@@ -398,7 +420,7 @@ pub fn solve_rod(
                     .unwrap_or(0);
                 sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
             }
-            accept_roundoff(&mut sol, model);
+            accept_roundoff(&mut sol, model, target);
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
