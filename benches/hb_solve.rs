@@ -44,18 +44,19 @@ fn rod(mass: MassModel, elements: usize) -> RodModel {
     .expect("valid rod")
 }
 
-fn hb_options(h: usize) -> HbOptions {
+fn hb_options(h: usize, c: Option<f64>) -> HbOptions {
     HbOptions {
         harmonics: h,
         time_samples: Some(default_hb_time_samples(h)),
-        c: None,
+        c,
     }
 }
 
-/// One SSN-HB solve from zero with the structured solver; returns the iterations.
-fn solve_structured(rod: &RodModel, h: usize) -> usize {
+/// One SSN-HB solve from zero with the structured solver (`c`: `None` for the default
+/// `K[tip, tip]`); returns the iterations.
+fn solve_structured(rod: &RodModel, h: usize, c: Option<f64>) -> usize {
     let options = newton_options(&default_settings(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = StructuredHbSolver::new();
     let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
@@ -65,7 +66,7 @@ fn solve_structured(rod: &RodModel, h: usize) -> usize {
 
 fn solve_dense(rod: &RodModel, h: usize) -> usize {
     let options = newton_options(&default_settings(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(h, None)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = FaerDenseLu::new();
     let report = newton::solve(
@@ -90,7 +91,9 @@ fn canonical(c: &mut Criterion) {
         ("consistent", MassModel::Consistent),
     ] {
         let rod = rod(mass, 20);
-        group.bench_function(name, |b| b.iter(|| black_box(solve_structured(&rod, H))));
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(solve_structured(&rod, H, None)))
+        });
     }
     group.finish();
 }
@@ -104,14 +107,14 @@ fn newton_solver(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(4));
     group.bench_function("structured", |b| {
-        b.iter(|| black_box(solve_structured(&rod, H)))
+        b.iter(|| black_box(solve_structured(&rod, H, None)))
     });
     group.bench_function("dense", |b| b.iter(|| black_box(solve_dense(&rod, H))));
     group.finish();
 
     // One Newton system at the converged state (an active set with contact).
     let options = newton_options(&default_settings(H));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(H)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(H, None)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = StructuredHbSolver::new();
     newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
@@ -166,8 +169,11 @@ fn elements(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     for n in [1000, 10_000] {
         let rod = rod(MassModel::Modified, n);
+        // c = EA / L, the static tip stiffness (see examples/scaling.rs: the default
+        // K[tip, tip] grows with n and Newton from zero then cycles).
+        let c = rod.spec.axial_stiffness / rod.spec.length;
         group.bench_function(n.to_string(), |b| {
-            b.iter(|| black_box(solve_structured(&rod, H)))
+            b.iter(|| black_box(solve_structured(&rod, H, Some(c))))
         });
     }
     group.finish();
