@@ -8,7 +8,8 @@
 //! - `linear_solve/{structured_iteration,structured_fresh,dense}`: one factor + solve of the
 //!   Newton system at the converged state (`structured_iteration` reuses the per-harmonic
 //!   factorizations as the Newton iterations at fixed omega do, `structured_fresh` redoes
-//!   them);
+//!   them), and the parts of one iteration: `part_{residual,jacobian,factor,solve}`
+//!   (structured factor with the per-harmonic factorizations reused);
 //! - `elements/{1000,10000}`: the modified-mass rod with that many elements (contact at the
 //!   tip), H = 20, from zero (target: 10,000 under 1 s; the full scan up to 100,000 with the
 //!   fitted exponent is `cargo run --release --example scaling`);
@@ -145,6 +146,30 @@ fn newton_solver(c: &mut Criterion) {
             s.factor(&jac).expect("factors");
             work.copy_from_slice(&rhs);
             s.solve_in_place(&mut work).expect("solves");
+            black_box(work[0])
+        })
+    });
+    // The parts of one Newton iteration (profile of the canonical H = 20 solve).
+    let mut f = vec![0.0; problem.dim()];
+    group.bench_function("part_residual", |b| {
+        b.iter(|| {
+            problem.residual(&x, &mut f);
+            black_box(f[0])
+        })
+    });
+    group.bench_function("part_jacobian", |b| {
+        b.iter(|| {
+            problem.jacobian(&x, &mut jac);
+            black_box(jac.harmonics())
+        })
+    });
+    group.bench_function("part_factor", |b| {
+        b.iter(|| structured.factor(&jac).expect("factors"))
+    });
+    group.bench_function("part_solve", |b| {
+        b.iter(|| {
+            work.copy_from_slice(&rhs);
+            structured.solve_in_place(&mut work).expect("solves");
             black_box(work[0])
         })
     });
