@@ -93,7 +93,8 @@ pub enum Globalization {
     /// iterations take `alpha = 1` whenever `F` stays finite (semismooth Newton on
     /// complementarity systems then behaves as a primal-dual active-set method, which
     /// may cross regions of large residual on its way to the solution); if it has not
-    /// converged by then, it restarts from the best iterate with the GLL line search.
+    /// converged by then, it restarts from the initial guess with the GLL line search
+    /// (the best iterate of both phases is returned).
     Hybrid {
         /// Iterations of the full-step phase.
         full_steps: usize,
@@ -388,6 +389,7 @@ pub struct NewtonSolver<J> {
     direction: Vec<f64>,
     trial: Vec<f64>,
     best_x: Vec<f64>,
+    start_x: Vec<f64>,
     history: NonMonotoneHistory,
 }
 
@@ -404,6 +406,7 @@ impl<J> NewtonSolver<J> {
             direction: Vec::new(),
             trial: Vec::new(),
             best_x: Vec::new(),
+            start_x: Vec::new(),
             history: NonMonotoneHistory::new(1),
         })
     }
@@ -441,6 +444,7 @@ impl<J> NewtonSolver<J> {
             &mut self.direction,
             &mut self.trial,
             &mut self.best_x,
+            &mut self.start_x,
         ] {
             v.resize(n, 0.0);
         }
@@ -500,6 +504,7 @@ impl<J> NewtonSolver<J> {
         self.history.reset(memory);
         self.history.push(0.5 * norm * norm);
         self.best_x.copy_from_slice(x);
+        self.start_x.copy_from_slice(x);
         let mut best_norm = norm;
         let mut iterations = 0;
 
@@ -513,14 +518,15 @@ impl<J> NewtonSolver<J> {
             let jac = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
             while iterations < options.max_iterations {
                 if full_steps > 0 && iterations == full_steps {
-                    // End of the full-step phase: restart from the best iterate.
+                    // End of the full-step phase: start again from the initial guess with
+                    // the line search (the full steps may have wandered into a region where
+                    // descent stalls; the best iterate so far is still kept and returned if
+                    // nothing better is found).
                     full_steps = 0;
-                    if best_norm < norm {
-                        x.copy_from_slice(&self.best_x);
-                        problem.residual(x, &mut self.f);
-                        counters.residual_evaluations += 1;
-                        norm = norm2(&self.f);
-                    }
+                    x.copy_from_slice(&self.start_x);
+                    problem.residual(x, &mut self.f);
+                    counters.residual_evaluations += 1;
+                    norm = norm2(&self.f);
                     self.history.reset(memory);
                     self.history.push(0.5 * norm * norm);
                 }

@@ -10,6 +10,13 @@ use semismooth_problems::rod::{build_rod, natural_frequencies};
 use semismooth_problems::scene::Scene;
 
 const EXIT_CODES: &str = "\
+Examples:
+  ssn                                         reproduce the paper's figures into ./out/
+  ssn solve problems/scenes/paper_fig1_modified_mass.toml --json
+  ssn sweep problems/scenes/paper_fig2.toml --csv fig2.csv --svg fig2.svg
+  ssn compare problems/scenes/paper_fig1_modified_mass.toml --out out/compare
+  ssn scene-check problems/scenes/two_contacts.toml
+
 Exit codes:
   0  converged (or, for scene-check, a valid scene)
   1  the solver ran but did not converge (its JSON is still printed, with converged = false)
@@ -84,6 +91,19 @@ enum Command {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+    /// Accuracy against cost: every method over its discretisation settings, error against a
+    /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
+    #[command(
+        after_help = "Example:\n  ssn compare problems/scenes/paper_fig1_modified_mass.toml --out out/compare\n\n"
+    )]
+    Compare {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Requested relative accuracy on the tip minimum: the cheapest setting of each
+        /// method reaching it is reported.
+        #[arg(long, default_value_t = 1e-3)]
+        accuracy: f64,
+    },
     /// Validate a scene and print the resolved model (natural frequencies, effects present).
     #[command(after_help = "Example:\n  ssn scene-check problems/scenes/two_contacts.toml\n\n")]
     SceneCheck {
@@ -117,6 +137,9 @@ fn main() -> ExitCode {
             svg,
         }) => {
             semismooth_problems::cli::sweep(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
+        }
+        Some(Command::Compare { scene, accuracy }) => {
+            semismooth_problems::cli::compare(scene, &cli.out, *accuracy, cli.quiet)
         }
     }
     .map_err(|e| match e {

@@ -71,6 +71,50 @@ impl StructuralModel {
     }
 }
 
+impl StructuralModel {
+    /// Static stiffness seen by the contacts: the mean over the contacts of
+    /// `1 / (G K^{-1} G^T)_ii`, the force that moves contact `i` by a unit length with the
+    /// rest of the structure free. Independent of the mesh (for the rod: `EA / x_node`);
+    /// `None` without contacts or when `K` cannot be factored.
+    pub fn static_contact_stiffness(&self) -> Option<f64> {
+        if self.contacts.is_empty() {
+            return None;
+        }
+        let mut lu = semismooth::linalg::FaerSparseLu::new();
+        lu.factor(&self.stiffness).ok()?;
+        let mut sum = 0.0;
+        let mut rhs = vec![0.0; self.dofs()];
+        for c in &self.contacts {
+            rhs.iter_mut().for_each(|v| *v = 0.0);
+            rhs[c.dof] = 1.0;
+            lu.solve_in_place(&mut rhs).ok()?;
+            let compliance = rhs[c.dof];
+            if !(compliance.is_finite() && compliance > 0.0) {
+                return None;
+            }
+            sum += 1.0 / compliance;
+        }
+        Some(sum / self.contacts.len() as f64)
+    }
+
+    /// Default complementarity constant `c` of SSN-HB: ten times the static contact
+    /// stiffness (the contact stiffness scale when `K` cannot be factored).
+    ///
+    /// `c` converts a length into a force. Measured on the canonical rod (H = 20): with
+    /// `c` between 1 and 30 times the static stiffness Newton converges from zero in 7-14
+    /// iterations for 20 to 100,000 elements, and 10 gives the smallest truncation error;
+    /// the local stiffness `K[tip, tip] = EA/h` grows with the mesh and from 200 elements on
+    /// Newton no longer converges with it.
+    pub fn default_complementarity_constant(&self) -> f64 {
+        self.static_contact_stiffness()
+            .map(|k| DEFAULT_C_FACTOR * k)
+            .unwrap_or_else(|| self.contact_stiffness_scale())
+    }
+}
+
+/// Ratio of the default complementarity constant `c` to the static contact stiffness.
+pub const DEFAULT_C_FACTOR: f64 = 10.0;
+
 /// Entry `(i, i)` of a column-compressed matrix (0 when not stored).
 pub fn diagonal_entry(matrix: &SparseMatrix, i: usize) -> f64 {
     let m = matrix.as_ref();

@@ -27,20 +27,50 @@
 //! curve and one percent of the resonant amplitude on steep ones, for `H = 5` as for
 //! `H = 50`.
 //!
+//! # Robustness on piecewise-smooth branches
+//!
+//! The contact branches are only piecewise smooth (the set of active AFT samples changes
+//! along them), with corners and folds at corners. Three measures on this side of the core:
+//!
+//! - a trust ball: the corrector may not leave the θ-ball of radius
+//!   [`TRUST_FACTOR`]` x` (largest next step) around the last point (outside it the residual
+//!   is NaN, so the attempt fails and the step is halved) — without it Newton sometimes
+//!   converged on the far side of an overhang and skipped both folds;
+//! - restarts: when the continuation stops on a failed step, it is restarted from the last
+//!   point for [`RESTART_POINTS`] points with `θ = `[`THETA_RESTART`] (the arclength then
+//!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
+//!   the constraint), heading the way `ω` last moved, or the other way when that restart
+//!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//! - folds are the reversals of `ω` along the accepted points (the core's fold events,
+//!   from sign changes of the tangent, also fire where a sharply turning branch flips the
+//!   tangent's orientation without any reversal); the core's interpolated fold frequency
+//!   is used when it lies beyond the extreme point.
+//!
+//! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
+//! tolerance for SSN-HB, so each point is a fixed point of a Newton solve at that
+//! tolerance; for penalty HB it is the scene's tolerance itself (a stiff penalty puts the
+//! rounding floor of `|F|` within a decade of it).
+//!
+//! Known limit: penalty-HB branches with a stiff penalty (`k_p >= 1e3` times the contact
+//! stiffness scale, the scenes' default is `1e5`) reverse in `ω` many times by small amounts
+//! near the contact onset of the canonical rod, and the continuation stalls there
+//! (`converged = false`, the reason in `termination`); SSN-HB passes.
+//!
 //! # Methods
 //!
 //! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
 //!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
-//! - `lcp-ssn`: the periodic LCP `min(z, q(ω) + A(ω) z) = 0` ([`PeriodicLcp`]), rebuilt when
-//!   `ω` changes, dense Jacobian and [`FaerDenseLu`]; `dF/dω` by central differences.
-//! - `lcp-lemke`, `march`: [`RunError::Unsupported`] (neither is a smooth-enough equation in
-//!   `ω` to continue; use natural steps, one `ssn solve` per frequency).
+//! - `lcp-ssn`, `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
+//!   marching are no equation in `ω` to continue. The min-map LCP is one, and was tried
+//!   (the LCP rebuilt at each `ω`, dense Jacobian): its unknowns are the contact forces,
+//!   identically zero below contact onset, and the branch has a corner there where the
+//!   corrector stalls; the free response is also invisible to the arclength. Use natural
+//!   steps instead, one `ssn solve` per frequency.
 
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
 
-use faer::Mat;
 use semismooth::continuation::{
     Continuation, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
     ContinuationTermination, Direction, Predictor,
@@ -52,8 +82,6 @@ use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual}
 use serde_json::json;
 
 use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
-use crate::lcp::{PeriodicLcp, PeriodicLcpOptions};
-use crate::model::StructuralModel;
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
 use crate::scene::{
@@ -67,6 +95,11 @@ pub const THETA: f64 = 0.5;
 
 /// Largest number of corrector iterations per attempted step.
 pub const MAX_CORRECTOR_ITERATIONS: usize = 12;
+
+/// The corrector's tolerance on `|F|` relative to the scene's Newton tolerance: one decade
+/// tighter, so that every branch point is a fixed point of a Newton solve at the scene's
+/// tolerance even where the Jacobian is ill-conditioned (near folds).
+pub const CORRECTOR_TOLERANCE_FACTOR: f64 = 0.1;
 
 /// Corrector iterations the step control aims at.
 pub const TARGET_ITERATIONS: usize = 4;
@@ -179,6 +212,7 @@ impl FrequencyResponse {
                 "ffts": c.ffts,
                 "corrector_iterations": self.continuation.corrector_iterations,
                 "rejected_steps": self.continuation.rejected_steps,
+                "restarts": self.restarts,
             },
         })
     }
@@ -297,116 +331,6 @@ impl<J: ?Sized, S: LinearSolve<J> + ?Sized> LinearSolve<J> for ScaledSolver<'_, 
     }
 }
 
-/// The periodic LCP `min(z, q(ω) + A(ω) z) = 0` as a problem owning its data, rebuilt when
-/// `ω` changes (method `lcp-ssn` in a sweep). A failed rebuild makes the residual NaN, which
-/// the continuation treats as a failed step.
-struct OwnedLcp {
-    model: StructuralModel,
-    options: PeriodicLcpOptions,
-    lcp: Option<PeriodicLcp>,
-    omega: f64,
-    built_for: f64,
-    w: Vec<f64>,
-    n: usize,
-}
-
-impl OwnedLcp {
-    fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, RunError> {
-        let lcp = PeriodicLcp::new(model, options.clone())?;
-        let n = lcp.dim();
-        let omega = model.forcing.omega;
-        Ok(Self {
-            model: model.clone(),
-            options,
-            lcp: Some(lcp),
-            omega,
-            built_for: omega,
-            w: vec![0.0; n],
-            n,
-        })
-    }
-
-    fn ensure(&mut self) {
-        if self.built_for.to_bits() != self.omega.to_bits() {
-            self.model.forcing.omega = self.omega;
-            self.lcp = PeriodicLcp::new(&self.model, self.options.clone()).ok();
-            self.built_for = self.omega;
-        }
-    }
-
-    /// `w = q + A z`; false when the LCP could not be built at this `ω`.
-    fn gap(&mut self, z: &[f64]) -> bool {
-        self.ensure();
-        let Some(lcp) = self.lcp.as_ref() else {
-            return false;
-        };
-        let (a, q) = (lcp.matrix(), lcp.q());
-        self.w.copy_from_slice(q);
-        for (j, zj) in z.iter().enumerate() {
-            if *zj != 0.0 {
-                for (i, wi) in self.w.iter_mut().enumerate() {
-                    *wi += a[(i, j)] * zj;
-                }
-            }
-        }
-        true
-    }
-}
-
-impl Residual for OwnedLcp {
-    fn dim(&self) -> usize {
-        self.n
-    }
-    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
-        if !self.gap(z) {
-            out.fill(f64::NAN);
-            return;
-        }
-        for ((o, z), w) in out.iter_mut().zip(z).zip(&self.w) {
-            *o = z.min(*w);
-        }
-    }
-}
-
-impl GeneralizedJacobian for OwnedLcp {
-    type Jacobian = Mat<f64>;
-    fn new_jacobian(&self) -> Mat<f64> {
-        Mat::zeros(self.n, self.n)
-    }
-    /// Row `i` of `A` where `(q + A z)_i < z_i`, else `e_i` (as [`crate::lcp::MinMapLcp`]).
-    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
-        if !self.gap(z) {
-            jac.fill(f64::NAN);
-            return;
-        }
-        let Some(lcp) = self.lcp.as_ref() else {
-            return;
-        };
-        let a = lcp.matrix();
-        for i in 0..self.n {
-            let active = self.w[i] < z[i];
-            for j in 0..self.n {
-                jac[(i, j)] = if active {
-                    a[(i, j)]
-                } else if i == j {
-                    1.0
-                } else {
-                    0.0
-                };
-            }
-        }
-    }
-}
-
-impl ParameterDependent for OwnedLcp {
-    fn parameter(&self) -> f64 {
-        self.omega
-    }
-    fn set_parameter(&mut self, p: f64) {
-        self.omega = p;
-    }
-}
-
 /// Root mean square over the dofs of the linear response (contacts removed) at `ω_1`
 /// (`0.95 ω_1`, then `0.5 ω_1` if that is singular, e.g. undamped); `1` if all fail.
 fn reference_amplitude(rod: &RodModel) -> f64 {
@@ -487,7 +411,11 @@ fn continuation_options(
         max_step: sweep.max_step,
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
-        corrector_tolerance: settings.tolerance,
+        corrector_tolerance: match settings.method {
+            // A stiff penalty puts the rounding floor of |F| near the tolerance itself.
+            Method::PenaltyHb => settings.tolerance,
+            _ => CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
+        },
         parameter_min: lo / q_unit,
         parameter_max: hi / q_unit,
         max_points: sweep.max_points,
@@ -758,6 +686,7 @@ where
         if response.omega.len() >= base_points {
             break termination;
         }
+        let stuck = failed && restart && response.omega.len() == offset;
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
             restart = true;
@@ -766,10 +695,24 @@ where
         } else {
             break termination;
         }
-        direction = if last_tangent_parameter > 0.0 {
+        // Keep going the way the branch went (the last increment of ω; the tangent's sign
+        // can be flipped where the branch turns sharply). A restart that could not make a
+        // single step tries the other orientation (a fold at a corner of the branch).
+        let k = response.omega.len();
+        let heading = if k >= 2 {
+            response.omega[k - 1] - response.omega[k - 2]
+        } else {
+            last_tangent_parameter
+        };
+        let forward = if heading >= 0.0 {
             Direction::Increasing
         } else {
             Direction::Decreasing
+        };
+        direction = match (stuck, direction) {
+            (true, Direction::Increasing) => Direction::Decreasing,
+            (true, Direction::Decreasing) => Direction::Increasing,
+            _ => forward,
         };
     };
     let (folds, indices) = folds_from_branch(&response.omega, &raw_events);
@@ -1043,65 +986,23 @@ pub fn frequency_response(
                 ),
             }
         }
-        Method::LcpSsn => {
-            if model.contacts.is_empty() {
-                return Err(RunError::Unsupported {
-                    method: "lcp-ssn",
-                    what: "a [contact] section (the periodic LCP is posed on the contact \
-                           forces); sweep the linear rod with ssn-hb or penalty-hb",
-                });
-            }
-            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
-            let options = PeriodicLcpOptions {
-                time_samples: settings.time_samples,
-                observed_dofs: if tip_contact.is_some() {
-                    Vec::new()
-                } else {
-                    vec![tip]
-                },
-            };
-            let mut start_model = model.clone();
-            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
-            let mut problem = OwnedLcp::new(&start_model, options)?;
-            // z are contact forces: divide by the contact stiffness scale to get lengths.
-            let units = vec![model.contact_stiffness_scale(); problem.dim()];
-            let output_points = settings.time_samples;
-            let mut measure = |p: &OwnedLcp, z: &[f64]| -> Result<(f64, f64), RunError> {
-                // The stored LCP is normally the one of the accepted point; rebuild if not.
-                let rebuilt;
-                let lcp = match p.lcp.as_ref() {
-                    Some(lcp) if p.built_for.to_bits() == p.omega.to_bits() => lcp,
-                    _ => {
-                        let mut m = p.model.clone();
-                        m.forcing.omega = p.omega;
-                        rebuilt = PeriodicLcp::new(&m, p.options.clone())?;
-                        &rebuilt
-                    }
-                };
-                let series = match tip_contact {
-                    Some(i) => lcp.contact_displacements(z)?.swap_remove(i),
-                    None => lcp.displacements(z)?.swap_remove(0),
-                };
-                Ok(extremes(&series))
-            };
-            follow(
-                &mut problem,
-                &mut FaerDenseLu::new(),
-                setup(units, output_points),
-                &mut measure,
-                progress,
-            )
-        }
+        Method::LcpSsn => Err(RunError::Unsupported {
+            method: "lcp-ssn",
+            what: "a branch the continuation can follow: the periodic LCP's unknowns are the \
+                   contact forces, which leave zero at a corner of the branch (contact onset) \
+                   where the corrector stalls; sweep with ssn-hb or penalty-hb, or solve \
+                   frequency by frequency with `ssn solve`",
+        }),
         Method::LcpLemke => Err(RunError::Unsupported {
             method: "lcp-lemke",
             what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
-                   sweep with ssn-hb, penalty-hb or lcp-ssn, or solve frequency by frequency \
+                   sweep with ssn-hb or penalty-hb, or solve frequency by frequency \
                    with `ssn solve`",
         }),
         Method::March => Err(RunError::Unsupported {
             method: "march",
             what: "a method continuable in omega (time marching has no equation to continue): \
-                   sweep with ssn-hb, penalty-hb or lcp-ssn, or march frequency by frequency \
+                   sweep with ssn-hb or penalty-hb, or march frequency by frequency \
                    with `ssn solve`",
         }),
     }

@@ -17,7 +17,7 @@ use crate::model::StructuralModel;
 /// |---|---|---|
 /// | `harmonics` (`H`) | 20 | `>= 1` |
 /// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` (256 for `H = 20`) | `> 2H` |
-/// | `c` | `None`: [`StructuralModel::contact_stiffness_scale`] | finite, `> 0` |
+/// | `c` | `None`: [`StructuralModel::default_complementarity_constant`] (10 x the static contact stiffness) | finite, `> 0` |
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HbOptions {
     /// Number of harmonics `H`.
@@ -84,7 +84,7 @@ impl SsnHb {
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let c = match options.c {
             Some(c) => c,
-            None => model.contact_stiffness_scale(),
+            None => model.default_complementarity_constant(),
         };
         if !(c.is_finite() && c > 0.0) {
             return Err(HbError::InvalidOption {

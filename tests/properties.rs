@@ -1,0 +1,256 @@
+//! Property tests (issue 9), modest case counts so the file runs in seconds in release mode:
+//!
+//! - random P-matrix LCPs (`n <= 12`): Lemke and the semismooth Newton method on the min
+//!   map (dense LU) find the same, unique, solution within an a-posteriori error bound;
+//! - random valid scenes within the documented ranges, every method: no panic, and either a
+//!   converged answer or a cleanly reported non-convergence / error, never NaN.
+
+use faer::Mat;
+use proptest::prelude::*;
+
+use semismooth::lemke::{Lemke, LemkeOptions};
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::{self, NewtonOptions};
+use semismooth::{GeneralizedJacobian, Residual};
+use semismooth_problems::rod::build_rod;
+use semismooth_problems::runner::solve_rod;
+use semismooth_problems::scene::Scene;
+
+/// `F(z) = min(z, q + M z)`; generalized Jacobian row `i` is `e_i` where `z_i <= w_i`, else
+/// row `i` of `M`.
+struct MinMap {
+    m: Mat<f64>,
+    q: Vec<f64>,
+}
+
+impl MinMap {
+    fn w(&self, z: &[f64], i: usize) -> f64 {
+        self.q[i] + (0..z.len()).map(|j| self.m[(i, j)] * z[j]).sum::<f64>()
+    }
+
+    /// `max_i |min(z_i, w_i)|`, the infinity norm of the min map.
+    fn error(&self, z: &[f64]) -> f64 {
+        (0..z.len()).fold(0.0, |e: f64, i| e.max(z[i].min(self.w(z, i)).abs()))
+    }
+}
+
+impl Residual for MinMap {
+    fn dim(&self) -> usize {
+        self.q.len()
+    }
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = z[i].min(self.w(z, i));
+        }
+    }
+}
+
+impl GeneralizedJacobian for MinMap {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.q.len(), self.q.len())
+    }
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+        let n = z.len();
+        for i in 0..n {
+            let use_identity = z[i] <= self.w(z, i);
+            for j in 0..n {
+                jac[(i, j)] = if use_identity {
+                    if i == j {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                } else {
+                    self.m[(i, j)]
+                };
+            }
+        }
+    }
+}
+
+/// A strictly row-diagonally-dominant matrix with positive diagonal (hence a P-matrix, so
+/// the LCP has exactly one solution), not symmetric: off-diagonal entries `off` scaled so
+/// that row `i` sums to `(1 - margin) d_i` in absolute value.
+fn p_matrix(n: usize, diag: &[f64], off: &[f64], margin: f64) -> Mat<f64> {
+    Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            diag[i]
+        } else {
+            let row: f64 = (0..n)
+                .filter(|&k| k != i)
+                .map(|k| off[i * n + k].abs())
+                .sum();
+            if row == 0.0 {
+                0.0
+            } else {
+                off[i * n + j] * (1.0 - margin) * diag[i] / row
+            }
+        }
+    })
+}
+
+fn lcp_strategy() -> impl Strategy<Value = (Mat<f64>, Vec<f64>, f64)> {
+    (1usize..=12).prop_flat_map(|n| {
+        (
+            prop::collection::vec(0.1f64..10.0, n),
+            prop::collection::vec(-1.0f64..1.0, n * n),
+            0.05f64..0.9,
+            prop::collection::vec(-5.0f64..5.0, n),
+        )
+            .prop_map(move |(diag, off, margin, q)| {
+                let m = p_matrix(n, &diag, &off, margin);
+                // beta_i = m_ii - sum_{j != i} |m_ij| = margin d_i.
+                let beta = diag.iter().fold(f64::INFINITY, |b, d| b.min(margin * d));
+                (m, q, beta)
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// Error bound (García-Esnaola & Peña 2009, strictly diagonally dominant M with positive
+    /// diagonal): `|z - z*|_inf <= kappa |min(z, q + M z)|_inf` with
+    /// `kappa = max(1, 1 / min_i beta_i)`, `beta_i = m_ii - sum_{j != i} |m_ij|`. So the two
+    /// solvers agree within `kappa` times the sum of their min-map errors, plus rounding in
+    /// evaluating `w` (`1e-14 kappa (|q| + |M| |z|)`).
+    #[test]
+    fn lemke_and_semismooth_newton_agree_on_p_matrix_lcps((m, q, beta) in lcp_strategy()) {
+        let n = q.len();
+        let mut lemke = Lemke::new(n);
+        let report = lemke.solve(m.as_ref(), &q, &LemkeOptions::default()).unwrap();
+        prop_assert!(report.solved(), "Lemke on a P-matrix must solve: {:?}", report.termination);
+
+        let mut problem = MinMap { m: m.clone(), q: q.clone() };
+        let mut z = vec![0.0; n];
+        let mut solver = FaerDenseLu::new();
+        let options = NewtonOptions { max_iterations: 100, ..NewtonOptions::default() };
+        let newton = newton::solve(&mut problem, &mut solver, &mut z, &options).unwrap();
+        prop_assert!(newton.converged(), "SSN: {:?} after {} iterations", newton.termination, newton.iterations);
+
+        let kappa = (1.0 / beta).max(1.0);
+        let e_lemke = problem.error(&report.z);
+        let e_ssn = problem.error(&z);
+        let m_norm = (0..n).map(|i| (0..n).map(|j| m[(i, j)].abs()).sum::<f64>()).fold(0.0, f64::max);
+        let z_norm = report.z.iter().chain(&z).fold(0.0, |a: f64, b| a.max(b.abs()));
+        let q_norm = q.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
+        let tol = kappa * (e_lemke + e_ssn) + 1e-14 * kappa * (q_norm + m_norm * z_norm);
+        let diff = report.z.iter().zip(&z).fold(0.0, |a: f64, (x, y)| a.max((x - y).abs()));
+        prop_assert!(diff <= tol, "|z_lemke - z_ssn| = {diff:e} > {tol:e} (kappa {kappa})");
+    }
+}
+
+const METHODS: [&str; 4] = ["ssn-hb", "penalty-hb", "lcp-ssn", "lcp-lemke"];
+const MASSES: [&str; 3] = ["consistent", "lumped", "modified"];
+
+#[derive(Debug, Clone)]
+struct SceneParams {
+    elements: usize,
+    gap: f64,
+    amplitude: f64,
+    zeta: f64,
+    omega_ratio: f64,
+    harmonics: usize,
+    mass: &'static str,
+    method: &'static str,
+    lcp_samples: usize,
+}
+
+fn scene_strategy() -> impl Strategy<Value = SceneParams> {
+    (
+        1usize..=200,
+        // gap in [-0.2, 1], skewed towards small gaps so that most scenes have contact.
+        (0.0f64..1.0).prop_map(|u| -0.2 + 1.2 * u * u * u),
+        0.0f64..0.2,
+        0.0f64..0.1,
+        0.3f64..3.0,
+        1usize..=30,
+        0usize..3,
+        0usize..4,
+        prop::sample::select(vec![32usize, 64, 128]),
+    )
+        .prop_map(
+            |(
+                elements,
+                gap,
+                amplitude,
+                zeta,
+                omega_ratio,
+                harmonics,
+                mass,
+                method,
+                lcp_samples,
+            )| {
+                SceneParams {
+                    elements,
+                    gap,
+                    amplitude,
+                    zeta,
+                    omega_ratio,
+                    harmonics,
+                    mass: MASSES[mass],
+                    method: METHODS[method],
+                    lcp_samples,
+                }
+            },
+        )
+}
+
+fn scene_text(p: &SceneParams) -> String {
+    let samples = if p.method.starts_with("lcp") {
+        format!("time_samples = {}\n", p.lcp_samples)
+    } else {
+        String::new()
+    };
+    format!(
+        "[rod]\nelements = {}\nmass = \"{}\"\n[damping]\nzeta = {:?}\n[forcing]\namplitude = {:?}\n\
+         omega_ratio = {:?}\n[contact]\ngap = {:?}\n[solver]\nmethod = \"{}\"\nharmonics = {}\n\
+         max_iterations = 40\n{samples}",
+        p.elements, p.mass, p.zeta, p.amplitude, p.omega_ratio, p.gap, p.method, p.harmonics
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// Every valid scene either converges or says why not; no panic (proptest reports one as
+    /// a failure), no NaN in what is reported.
+    #[test]
+    fn random_valid_scenes_converge_or_report_cleanly(p in scene_strategy()) {
+        let text = scene_text(&p);
+        let scene = Scene::from_toml(&text, "random.toml")
+            .map_err(|e| TestCaseError::fail(format!("a valid scene was rejected: {e}\n{text}")))?;
+        let rod = match build_rod(&scene.rod) {
+            Ok(r) => r,
+            Err(e) => {
+                // Only a typed, explained refusal is acceptable.
+                prop_assert!(!e.to_string().is_empty());
+                return Ok(());
+            }
+        };
+        match solve_rod(&rod, &scene.solver, None) {
+            Err(e) => prop_assert!(!e.to_string().is_empty(), "an error without a message"),
+            Ok(s) => {
+                let st = &s.stats;
+                for (name, v) in [("tip max", st.max), ("tip min", st.min),
+                    ("penetration", st.max_penetration), ("mean force", st.mean_contact_force)] {
+                    prop_assert!(v.is_finite(), "{name} = {v} ({}, {})\n{text}", s.converged, s.termination);
+                }
+                prop_assert!(s.tip.iter().all(|v| v.is_finite()), "non-finite tip\n{text}");
+                for f in &s.contact_forces {
+                    prop_assert!(f.iter().all(|v| v.is_finite()), "non-finite force\n{text}");
+                }
+                prop_assert!(!s.termination.is_empty());
+                if s.converged {
+                    prop_assert!(s.residual_norm.is_finite(), "residual {}", s.residual_norm);
+                    let scale = s.contact_forces.iter().flatten().fold(0.0, |a: f64, b| a.max(b.abs()));
+                    prop_assert!(st.mean_contact_force <= 1e-9 * scale.max(1e-300),
+                        "mean contact force {} > 0\n{text}", st.mean_contact_force);
+                } else {
+                    prop_assert!(s.termination != "converged");
+                }
+            }
+        }
+    }
+}
