@@ -522,4 +522,49 @@ mod tests {
         let csv = study.to_csv();
         assert_eq!(csv.lines().count(), 2 + study.entries.len());
     }
+
+    /// The canonical modified-mass rod: the time-marching reference and SSN-HB at 320
+    /// harmonics are independent formulations and agree to 1e-5 on the tip minimum (measured
+    /// 2e-7; the HB truncation error at H = 320 is ~1e-6); the SSN-HB error falls as H grows
+    /// (5 -> 20 harmonics) and every method reaches 1e-3.
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "1.5 s in release, much slower in debug")]
+    fn canonical_study_reference_is_cross_checked_and_hb_error_falls_with_harmonics() {
+        use crate::rod::{build_rod, MassModel, RodSpec};
+        let rod = build_rod(&RodSpec {
+            mass: MassModel::Modified,
+            ..RodSpec::canonical()
+        })
+        .unwrap();
+        let study = accuracy_cost(&rod, &crate::cli::default_settings(20), None).unwrap();
+        let r = &study.reference;
+        assert!(
+            r.uncertainty < 1e-5,
+            "reference uncertainty {}",
+            r.uncertainty
+        );
+        let cross = r.cross_check.expect("SSN-HB H=320 converges");
+        assert!(cross < 1e-5, "cross-check {cross}");
+        let err = |setting: &str| {
+            study
+                .entries
+                .iter()
+                .find(|e| e.method == Method::SsnHb && e.setting.starts_with(setting))
+                .map(|e| e.tip_min_error)
+                .unwrap()
+        };
+        assert!(
+            err("H=20 ") < err("H=5 "),
+            "{} vs {}",
+            err("H=20 "),
+            err("H=5 ")
+        );
+        for (method, best) in study.cheapest(1e-3) {
+            assert!(best.is_some(), "{} does not reach 1e-3", method.name());
+        }
+        assert!(study
+            .entries
+            .iter()
+            .all(|e| !e.converged || e.seconds.is_finite()));
+    }
 }
