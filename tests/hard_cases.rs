@@ -23,6 +23,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use semismooth_problems::cli::default_settings;
+use semismooth_problems::hb::{HbOptions, SsnHb};
 use semismooth_problems::rod::{
     build_rod, DampingSpec, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
 };
@@ -83,6 +84,17 @@ enum Outcome {
 }
 
 impl Outcome {
+    /// One line: the termination and numbers, or the error (not the whole solution).
+    fn summary(&self) -> String {
+        match self {
+            Outcome::Converged(s) | Outcome::NotConverged(s) => format!(
+                "{} after {} iterations, residual {:e}, tip min {}",
+                s.termination, s.iterations, s.residual_norm, s.stats.min
+            ),
+            Outcome::Error(e) => format!("error: {e}"),
+        }
+    }
+
     fn converged(&self) -> Option<&Solution> {
         match self {
             Outcome::Converged(s) => Some(s),
@@ -327,12 +339,68 @@ fn light_damping_zeta_1e_4() {
     cross_check("zeta = 1e-4", &out, &ALL);
 }
 
+/// No damping at all, forced exactly at `omega_1`: the linear part is singular in the first
+/// harmonic, only the contact bounds the response. Any outcome is acceptable if clean (the
+/// table shows which); the messages carry no NaN.
+#[test]
+fn undamped_at_resonance() {
+    let spec = RodSpec {
+        damping: None,
+        ..canonical()
+    };
+    let out = run_all("undamped, omega_1", &spec, &hb(20), &ALL);
+    cross_check("undamped, omega_1", &out, &ALL);
+    for (m, o) in ALL.iter().zip(&out) {
+        assert!(
+            !o.summary().contains("NaN"),
+            "{}: {}",
+            m.name(),
+            o.summary()
+        );
+    }
+}
+
+/// What the library should do: SSN-HB solves the undamped resonant rod that LCP-SSN solves
+/// (tip min -0.529806, 22 iterations). From zero no contact is active, so the first
+/// Jacobian is the undamped dynamic stiffness at `omega_1`, singular in the first harmonic;
+/// SSN-HB (structured solver) stops after 1 iteration with `singular-jacobian` (pivot 5.7
+/// against 1.4e15, index 820), penalty HB likewise after 6. Lemke ends on a ray after 2
+/// pivots (A not copositive: symmetric-part eigenvalue -8.0e3).
+#[test]
+#[ignore = "reason: undamped canonical rod at omega_1: SSN-HB ends singular-jacobian after 1 iteration (the linear part is singular before contact activates); LCP-SSN converges to tip min -0.529806"]
+fn undamped_at_resonance_converges_with_ssn_hb() {
+    let spec = RodSpec {
+        damping: None,
+        ..canonical()
+    };
+    let hb_out = run("undamped, omega_1", &spec, &hb(20), Method::SsnHb);
+    let lcp_out = run("undamped, omega_1", &spec, &hb(20), Method::LcpSsn);
+    let e = hb_out
+        .converged()
+        .expect("SSN-HB converges undamped at omega_1");
+    let l = lcp_out
+        .converged()
+        .expect("LCP-SSN converges undamped at omega_1");
+    let a = 0.5 * (e.stats.max - e.stats.min);
+    let tol = hb_penetration_bound(e) + 2.0 * std::f64::consts::PI * a / l.time_samples as f64;
+    assert!(
+        (e.stats.min - l.stats.min).abs() <= tol,
+        "SSN-HB {} vs LCP-SSN {}",
+        e.stats.min,
+        l.stats.min
+    );
+}
+
 #[test]
 fn grazing_gap_zero() {
     let out = run_all("gap = 0", &with_gap(0.0), &hb(20), &ALL);
     cross_check("gap = 0", &out, &ALL);
     for o in &out {
-        assert!(o.converged().is_some(), "gap 0 should converge: {o:?}");
+        assert!(
+            o.converged().is_some(),
+            "gap 0 should converge: {}",
+            o.summary()
+        );
     }
 }
 
@@ -442,12 +510,12 @@ fn two_thousand_element_rod() -> RodSpec {
     }
 }
 
-/// 2,000 elements with the scene defaults: the default `c` is `K[tip, tip] = EA / h = 2000`
-/// (100 times the 20-element value); SSN-HB, penalty HB and LCP-SSN currently end
-/// non-converged (reported cleanly). With `c = EA / L = 1` (the mesh-independent static
-/// contact stiffness) SSN-HB converges, and its tip minimum agrees with the 20-element rod
+/// 2,000 elements. The default `c` was `K[tip, tip] = EA / h` (2000 here, 100 times the
+/// 20-element value), with which SSN-HB stopped at max-iterations (200, residual 4.6e-4);
+/// it is now 10 times the static contact stiffness `EA / L` whatever the mesh. With
+/// `c = EA / L = 1` SSN-HB converges too, and its tip minimum agrees with the 20-element rod
 /// within the HB truncation bound (the FE error of the smooth part, O(h²) = 2.5e-3 at 20
-/// elements, is below it).
+/// elements, is below it). Penalty HB and LCP-SSN may end non-converged (reported cleanly).
 #[test]
 fn two_thousand_elements() {
     let spec = two_thousand_element_rod();
@@ -475,10 +543,31 @@ fn two_thousand_elements() {
     );
 }
 
-/// What the library should do: converge on 2,000 elements with its default settings (a
-/// mesh-independent default `c`, e.g. the static contact stiffness `1 / (G K^-1 G^T)`).
+/// What the library should do: the periodic LCP (Nt = 256) solves the 2,000-element rod as
+/// it solves the 20-element one. Measured: LCP-SSN ends max-iterations (400 over the mesh
+/// sequence, residual 1.87, tip min -0.807, penetration 0.267); Lemke ends at its pivot
+/// limit (12,900); the symmetric part of A has smallest eigenvalue -7.4e-3.
 #[test]
-#[ignore = "reason: SSN-HB with default c = K[tip,tip] = 2000 stops at max-iterations (200, residual 4.6e-4) on 2000 elements; converges in 13 iterations with c = 1"]
+#[ignore = "reason: on 2000 elements (Nt = 256) LCP-SSN ends max-iterations (residual 1.87) and Lemke at the pivot limit (12900); SSN-HB converges (tip min -0.52378)"]
+fn two_thousand_elements_lcp_converges() {
+    let spec = two_thousand_element_rod();
+    let e = run("2000 elements", &spec, &hb(20), Method::SsnHb);
+    let l = run("2000 elements", &spec, &hb(20), Method::LcpSsn);
+    let e = e.converged().expect("SSN-HB converges");
+    let l = l.converged().expect("LCP-SSN converges on 2000 elements");
+    let tol = hb_penetration_bound(e)
+        + 2.0 * std::f64::consts::PI * 0.5 * (e.stats.max - e.stats.min) / 256.0;
+    assert!(
+        (e.stats.min - l.stats.min).abs() <= tol,
+        "SSN-HB {} vs LCP-SSN {}",
+        e.stats.min,
+        l.stats.min
+    );
+}
+
+/// SSN-HB converges on 2,000 elements with its default settings (mesh-independent default
+/// `c`, 10 times the static contact stiffness `1 / (G K^-1 G^T)`).
+#[test]
 fn two_thousand_elements_converge_with_default_settings() {
     let out = run(
         "2000 elements",
@@ -486,7 +575,28 @@ fn two_thousand_elements_converge_with_default_settings() {
         &hb(20),
         Method::SsnHb,
     );
-    assert!(out.converged().is_some(), "{out:?}");
+    assert!(out.converged().is_some(), "{}", out.summary());
+}
+
+/// What the library should do: penalty HB converges on a refined rod with its default
+/// settings, as SSN-HB does. Measured (modified mass, gap 0.5, omega_1, H = 20, default
+/// penalty 1e5 K[tip, tip]): 100 elements converge in 33 iterations; 200 elements end
+/// line-search-failed after 918 iterations (residual 1.46e-3, tip at +-0.5); 500, 1000 and
+/// 2000 elements likewise (763, 603, 486 iterations), whatever k_p in 1e6..2e8. The penalty
+/// homotopy starts from `K[tip, tip] = EA / h`, which grows with the mesh (as the old default
+/// c did).
+#[test]
+fn penalty_hb_converges_on_200_elements() {
+    let spec = RodSpec {
+        elements: 200,
+        contacts: vec![RodContact {
+            node: 200,
+            gap: 0.5,
+        }],
+        ..canonical()
+    };
+    let out = run("200 elements", &spec, &hb(20), Method::PenaltyHb);
+    assert!(out.converged().is_some(), "penalty-hb: {}", out.summary());
 }
 
 #[test]
@@ -512,10 +622,15 @@ fn stiff_penalty_kp_1e8() {
     }
 }
 
+/// The `c` SSN-HB uses on the canonical rod when the scene leaves it out.
+fn default_c() -> f64 {
+    let rod = build_rod(&canonical()).unwrap();
+    SsnHb::new(&rod.model, &HbOptions::default()).unwrap().c()
+}
+
 #[test]
 fn complementarity_constant_across_six_decades() {
-    let rod = build_rod(&canonical()).unwrap();
-    let c0 = rod.model.contact_stiffness_scale();
+    let c0 = default_c();
     let mut converged = Vec::new();
     for e in -3..=3 {
         let factor = 10f64.powi(e);
@@ -528,7 +643,7 @@ fn complementarity_constant_across_six_decades() {
     }
     // The Galerkin projection of the complementarity function vanishes, not the function at
     // every sample, so the zeros move with c -- within the HB truncation error (measured:
-    // tip minima within 4e-4 of each other, bound 1.4e-2).
+    // tip minima within 6e-4 of each other, bound 1.4e-2).
     let (_, reference) = converged
         .iter()
         .find(|(f, _)| *f == 1.0)
@@ -542,8 +657,8 @@ fn complementarity_constant_across_six_decades() {
             reference.stats.min
         );
     }
-    // Small c converges (measured: every factor <= 10).
-    for f in [1e-3, 1e-2, 1e-1, 1.0, 10.0] {
+    // Measured: every factor up to 1e2 converges (default c = 10 EA/L = 10 here).
+    for f in [1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0] {
         assert!(
             converged.iter().any(|(g, _)| *g == f),
             "c factor {f} did not converge"
@@ -552,23 +667,15 @@ fn complementarity_constant_across_six_decades() {
 }
 
 /// What the library should do: converge for large `c` too within the scene's 200
-/// iterations (measured: c = 100 x default needs 300 iterations).
+/// iterations (the default c is 10 EA/L = 10 on the canonical rod; measured: c = 2000
+/// converges after 300 iterations).
 #[test]
-#[ignore = "reason: SSN-HB with c = 1e2 and 1e3 x default stops at max-iterations (200, residual 4.5e-3); c = 2000 converges only after 300 iterations"]
+#[ignore = "reason: SSN-HB with c = 1e3 x default (c = 1e4) stops at max-iterations (200, best residual 4.51e-3, tip min -0.49998: stuck near the start)"]
 fn large_complementarity_constant_converges() {
-    let rod = build_rod(&canonical()).unwrap();
-    let c0 = rod.model.contact_stiffness_scale();
-    for f in [1e2, 1e3] {
-        let mut s = hb(20);
-        s.c = Some(c0 * f);
-        let out = run(
-            &format!("c = {f:e} x default"),
-            &canonical(),
-            &s,
-            Method::SsnHb,
-        );
-        assert!(out.converged().is_some(), "c factor {f}: {out:?}");
-    }
+    let mut s = hb(20);
+    s.c = Some(1e3 * default_c());
+    let out = run("c = 1e3 x default", &canonical(), &s, Method::SsnHb);
+    assert!(out.converged().is_some(), "c factor 1e3: {}", out.summary());
 }
 
 #[test]
@@ -600,6 +707,9 @@ fn third_omega_1() -> RodSpec {
 fn superharmonic_resonance_third_omega_1() {
     let out = run_all("omega_1/3, gap 0.01", &third_omega_1(), &hb(20), &ALL);
     cross_check("omega_1/3, gap 0.01", &out, &ALL);
+    // SSN-HB converges since the hybrid globalization restarts from the initial guess after
+    // its full-step phase (before: line-search-failed after 79 iterations).
+    assert!(out[0].converged().is_some(), "SSN-HB: {}", out[0].summary());
     // Lemke and penalty HB converge here (measured); they agree within the HB bound.
     let p = out[1]
         .converged()
@@ -614,16 +724,18 @@ fn superharmonic_resonance_third_omega_1() {
     );
 }
 
-/// What the library should do: SSN-HB and the semismooth LCP solve the superharmonic case
-/// that Lemke and penalty HB solve.
+/// What the library should do: the semismooth LCP solves the superharmonic case that
+/// Lemke solves (same LCP).
 #[test]
-#[ignore = "reason: at omega_1/3, gap 0.01, SSN-HB (H = 20) ends line-search-failed after 79 iterations (residual 1.3e-3) and LCP-SSN (Nt = 256) line-search-failed after 368 (residual 1.3e-2), while Lemke solves it"]
-fn superharmonic_third_converges_with_ssn() {
-    let spec = third_omega_1();
-    for m in [Method::SsnHb, Method::LcpSsn] {
-        let out = run("omega_1/3, gap 0.01", &spec, &hb(20), m);
-        assert!(out.converged().is_some(), "{}: {out:?}", m.name());
-    }
+#[ignore = "reason: at omega_1/3, gap 0.01, LCP-SSN (Nt = 256) ends line-search-failed after 368 iterations (residual 1.3e-2, tip min -0.02291), while Lemke solves the same LCP (269 pivots, tip min -0.028124)"]
+fn superharmonic_third_converges_with_lcp_ssn() {
+    let out = run(
+        "omega_1/3, gap 0.01",
+        &third_omega_1(),
+        &hb(20),
+        Method::LcpSsn,
+    );
+    assert!(out.converged().is_some(), "lcp-ssn: {}", out.summary());
 }
 
 #[test]

@@ -166,8 +166,14 @@ fn scene_check(path: &std::path::Path) -> Result<(), semismooth_problems::cli::C
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let rod = build_rod(&scene.rod)
         .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
-    let modes = natural_frequencies(&rod.model, 5.min(rod.model.dofs()))
-        .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
+    // Up to five modes; massless dofs have none (a modified-mass rod has one fewer).
+    let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
+        Err(semismooth_problems::rod::ModelError::TooManyModes { available, .. }) => {
+            natural_frequencies(&rod.model, available)
+        }
+        other => other,
+    }
+    .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
     print!(
         "{}",
         semismooth_problems::cli::describe(&scene, &rod, &modes)

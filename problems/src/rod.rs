@@ -363,6 +363,17 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         FrequencySpec::Ratio(r) => r * omega_1,
         FrequencySpec::Absolute(w) => w,
     };
+    if !model.forcing.omega.is_finite() {
+        let value = match spec.frequency {
+            FrequencySpec::Ratio(r) => r,
+            FrequencySpec::Absolute(w) => w,
+        };
+        return Err(ModelError::InvalidParameter {
+            name: "omega_ratio",
+            value,
+            allowed: "a ratio whose frequency omega_ratio * omega_1 is finite",
+        });
+    }
     Ok(RodModel {
         model,
         omega_1,

@@ -345,12 +345,14 @@ pub fn solve_rod(
             let start = Instant::now();
             // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
             // is the linear response, deep in the obstacle), so without a warm start the
-            // stiffness is raised from the contact scale by factors of 10, each stage
-            // starting from the previous answer.
+            // stiffness is raised from the static contact stiffness by factors of 10, each
+            // stage starting from the previous answer.
             let mut counters = WorkCounters::default();
             let mut homotopy_iterations = 0;
             if warm_start.is_none() {
-                let mut k = scale;
+                // From the static contact stiffness (mesh-independent; the local one grows
+                // with the mesh and is already too stiff a start on fine meshes).
+                let mut k = model.static_contact_stiffness().unwrap_or(scale);
                 while k < target {
                     let stage_options = PenaltyHbOptions {
                         penalty_stiffness: k,

@@ -393,8 +393,20 @@ fn an_unwritable_output_exits_3_and_leaves_no_file() {
         );
         assert!(!Path::new("/nonexistent/dir/x.out").exists());
     }
-    // The target is an existing directory: the write fails and no temporary file is left.
+    // A parent that is a regular file: cannot be created even by root (where
+    // /nonexistent/dir could be), so the write must fail and leave nothing.
     let dir = TempDir::new("out");
+    let file = dir.write("a-file", "x");
+    let under_file = file.join("x.csv");
+    let out = ssn(&["solve", scene, "--csv", under_file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3), "stderr {}", stderr(&out));
+    assert_eq!(
+        dir.entries(),
+        vec!["a-file".to_string()],
+        "something was left behind"
+    );
+    std::fs::remove_file(&file).unwrap();
+    // The target is an existing directory: the write fails and no temporary file is left.
     let sub = dir.0.join("a-directory");
     std::fs::create_dir(&sub).unwrap();
     let out = ssn(&["solve", scene, "--csv", sub.to_str().unwrap()]);
@@ -540,4 +552,132 @@ fn scene_check_warns_about_a_massive_interior_contact_node() {
     ]);
     let text = stdout(&out);
     assert!(text.contains("note"), "{text}");
+}
+
+/// LCP and time marching: no `harmonics`, `time_samples` the steps per period, their own
+/// counters, contact exact at the time nodes; the tip minimum agrees with SSN-HB's on the
+/// same (modified-mass) scene within the HB truncation bound `4 A / (pi H)` (hard_cases.rs).
+#[test]
+fn lcp_and_march_scenes_print_json_without_harmonics() {
+    let (_, hb) = solve_json(&scenes_dir().join("paper_fig1_modified_mass.toml"), &[]);
+    let hb_min = hb["tip_min"].as_f64().unwrap();
+    let half_amplitude = 0.5 * (hb["tip_max"].as_f64().unwrap() - hb_min);
+    let bound = 4.0 * half_amplitude / (std::f64::consts::PI * 20.0);
+    let dir = TempDir::new("lcp");
+    for (method, extra, counter) in [
+        ("lcp-lemke", "time_samples = 128", "lemke_pivots"),
+        ("march", "steps_per_period = 256", "time_steps"),
+    ] {
+        let text = CANONICAL.replace("harmonics = 20", &format!("method = \"{method}\"\n{extra}"));
+        let path = dir.write(&format!("{method}.toml"), &text);
+        let (out, json) = solve_json(&path, &[]);
+        assert_eq!(out.status.code(), Some(0), "{method}: {}", stderr(&out));
+        assert_eq!(json["method"], method);
+        assert!(json.get("harmonics").is_none(), "{json}");
+        assert!(
+            json["time_samples"] == 128 || json["time_samples"] == 256,
+            "{json}"
+        );
+        assert!(json["counters"][counter].as_u64().unwrap() > 0, "{json}");
+        assert!(json["max_penetration"].as_f64().unwrap() <= 1e-9, "{json}");
+        let diff = (json["tip_min"].as_f64().unwrap() - hb_min).abs();
+        assert!(
+            diff <= bound,
+            "{method}: tip min differs from SSN-HB by {diff} > {bound}"
+        );
+    }
+}
+
+#[test]
+fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
+    let fig2 = scenes_dir().join("paper_fig2.toml");
+    let out = ssn(&["sweep", "--json", fig2.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
+    assert_eq!(json["converged"], Value::Bool(true));
+    let omega = json["omega"].as_array().expect("omega array");
+    assert!(omega.len() >= 2 && json["points"] == omega.len());
+    for key in ["tip_max", "tip_min", "amplitude"] {
+        let v = json[key].as_array().expect("array");
+        assert_eq!(v.len(), omega.len(), "{key}");
+        assert!(
+            v.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)),
+            "{key}"
+        );
+    }
+
+    // No [sweep] section: bad input naming the file and the section.
+    let fig1 = scenes_dir().join("paper_fig1.toml");
+    let out = ssn(&["sweep", fig1.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("paper_fig1.toml") && stderr(&out).contains("[sweep]"),
+        "{}",
+        stderr(&out)
+    );
+
+    // Lemke cannot be continued in omega: bad input, saying which methods can.
+    let dir = TempDir::new("sweep");
+    let text = std::fs::read_to_string(&fig2)
+        .unwrap()
+        .replace("method = \"ssn-hb\"", "method = \"lcp-lemke\"");
+    let path = dir.write("lemke_sweep.toml", &text);
+    let out = ssn(&["sweep", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("lemke_sweep.toml") && stderr(&out).contains("lcp-lemke"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// What the library should do: scene-check prints the finite natural frequencies of a
+/// valid small rod. With 2 elements and the modified mass (massless tip) the model has one
+/// finite frequency, scene-check asks for min(5, dofs) = 2 and exits 2: "2 natural
+/// frequencies requested, the model has 1 finite ones" (`ssn solve` on the same scene
+/// converges).
+#[test]
+fn scene_check_accepts_a_two_element_modified_mass_rod() {
+    let dir = TempDir::new("two-el");
+    let text = CANONICAL.replace("elements = 20", "elements = 2");
+    let path = dir.write("two_elements.toml", &text);
+    let out = ssn(&["solve", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "solve: {}", stderr(&out));
+    let out = ssn(&["scene-check", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "scene-check: {}", stderr(&out));
+    assert_eq!(natural_frequencies_line(&stdout(&out)).len(), 1);
+}
+
+#[test]
+fn compare_writes_its_table_and_refuses_an_unwritable_directory() {
+    let scene = scenes_dir().join("paper_fig1_modified_mass.toml");
+    let scene = scene.to_str().unwrap();
+    let dir = TempDir::new("compare");
+    let out_dir = dir.0.join("cmp");
+    let out = ssn(&["compare", scene, "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let mut written: Vec<String> = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(written, vec!["accuracy_cost.csv", "accuracy_cost.svg"]);
+    for method in ["ssn-hb", "penalty-hb", "lcp-lemke", "lcp-ssn", "march"] {
+        assert!(
+            stdout(&out).contains(method),
+            "{method} missing from the table"
+        );
+    }
+
+    // Output directory under a regular file: exit 3, nothing created.
+    let file = dir.write("a-file", "x");
+    let out = ssn(&[
+        "compare",
+        scene,
+        "--out",
+        file.join("sub").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(stderr(&out).contains("a-file"), "{}", stderr(&out));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
