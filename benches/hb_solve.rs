@@ -8,7 +8,8 @@
 //! - `linear_solve/{structured_iteration,structured_fresh,dense}`: one factor + solve of the
 //!   Newton system at the converged state (`structured_iteration` reuses the per-harmonic
 //!   factorizations as the Newton iterations at fixed omega do, `structured_fresh` redoes
-//!   them);
+//!   them), and the parts of one iteration: `part_{residual,jacobian,factor,solve}`
+//!   (structured factor with the per-harmonic factorizations reused);
 //! - `elements/{1000,10000}`: the modified-mass rod with that many elements (contact at the
 //!   tip), H = 20, from zero (target: 10,000 under 1 s; the full scan up to 100,000 with the
 //!   fitted exponent is `cargo run --release --example scaling`);
@@ -44,18 +45,19 @@ fn rod(mass: MassModel, elements: usize) -> RodModel {
     .expect("valid rod")
 }
 
-fn hb_options(h: usize) -> HbOptions {
+fn hb_options(h: usize, c: Option<f64>) -> HbOptions {
     HbOptions {
         harmonics: h,
         time_samples: Some(default_hb_time_samples(h)),
-        c: None,
+        c,
     }
 }
 
-/// One SSN-HB solve from zero with the structured solver; returns the iterations.
-fn solve_structured(rod: &RodModel, h: usize) -> usize {
+/// One SSN-HB solve from zero with the structured solver (`c`: `None` for the default
+/// `K[tip, tip]`); returns the iterations.
+fn solve_structured(rod: &RodModel, h: usize, c: Option<f64>) -> usize {
     let options = newton_options(&default_settings(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = StructuredHbSolver::new();
     let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
@@ -65,7 +67,7 @@ fn solve_structured(rod: &RodModel, h: usize) -> usize {
 
 fn solve_dense(rod: &RodModel, h: usize) -> usize {
     let options = newton_options(&default_settings(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(h, None)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = FaerDenseLu::new();
     let report = newton::solve(
@@ -90,7 +92,9 @@ fn canonical(c: &mut Criterion) {
         ("consistent", MassModel::Consistent),
     ] {
         let rod = rod(mass, 20);
-        group.bench_function(name, |b| b.iter(|| black_box(solve_structured(&rod, H))));
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(solve_structured(&rod, H, None)))
+        });
     }
     group.finish();
 }
@@ -104,14 +108,14 @@ fn newton_solver(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(4));
     group.bench_function("structured", |b| {
-        b.iter(|| black_box(solve_structured(&rod, H)))
+        b.iter(|| black_box(solve_structured(&rod, H, None)))
     });
     group.bench_function("dense", |b| b.iter(|| black_box(solve_dense(&rod, H))));
     group.finish();
 
     // One Newton system at the converged state (an active set with contact).
     let options = newton_options(&default_settings(H));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(H)).expect("valid HB problem");
+    let mut problem = SsnHb::new(&rod.model, &hb_options(H, None)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = StructuredHbSolver::new();
     newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
@@ -145,6 +149,30 @@ fn newton_solver(c: &mut Criterion) {
             black_box(work[0])
         })
     });
+    // The parts of one Newton iteration (profile of the canonical H = 20 solve).
+    let mut f = vec![0.0; problem.dim()];
+    group.bench_function("part_residual", |b| {
+        b.iter(|| {
+            problem.residual(&x, &mut f);
+            black_box(f[0])
+        })
+    });
+    group.bench_function("part_jacobian", |b| {
+        b.iter(|| {
+            problem.jacobian(&x, &mut jac);
+            black_box(jac.harmonics())
+        })
+    });
+    group.bench_function("part_factor", |b| {
+        b.iter(|| structured.factor(&jac).expect("factors"))
+    });
+    group.bench_function("part_solve", |b| {
+        b.iter(|| {
+            work.copy_from_slice(&rhs);
+            structured.solve_in_place(&mut work).expect("solves");
+            black_box(work[0])
+        })
+    });
     let mut dense = FaerDenseLu::new();
     group.bench_function("dense", |b| {
         b.iter(|| {
@@ -166,8 +194,11 @@ fn elements(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     for n in [1000, 10_000] {
         let rod = rod(MassModel::Modified, n);
+        // c = EA / L, the static tip stiffness (see examples/scaling.rs: the default
+        // K[tip, tip] grows with n and Newton from zero then cycles).
+        let c = rod.spec.axial_stiffness / rod.spec.length;
         group.bench_function(n.to_string(), |b| {
-            b.iter(|| black_box(solve_structured(&rod, H)))
+            b.iter(|| black_box(solve_structured(&rod, H, Some(c))))
         });
     }
     group.finish();

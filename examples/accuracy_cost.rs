@@ -13,7 +13,17 @@ use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::scene::Scene;
 use semismooth_problems::study::accuracy_cost;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
     faer::set_global_parallelism(faer::Par::Seq);
     let (spec, base) = match std::env::args().nth(1) {
         Some(path) => {
