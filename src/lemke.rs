@@ -715,7 +715,22 @@ impl Lemke {
                 }
             }
         }
-        let complementarity_error = complementarity_error(&z, &w);
+        let mut complementarity_error = complementarity_error(&z, &w);
+        if termination == LemkeTermination::Solved {
+            let scale = q
+                .iter()
+                .fold(0.0_f64, |a, v| a.max(v.abs()))
+                .max(f64::MIN_POSITIVE);
+            if complementarity_error > POLISH_THRESHOLD * scale {
+                if let Some((zp, wp, error)) = polish(m, q, &z) {
+                    if error < complementarity_error {
+                        z = zp;
+                        w = wp;
+                        complementarity_error = error;
+                    }
+                }
+            }
+        }
         let artificial = match self.row_of.get(2 * n) {
             Some(&row) if row != NONBASIC => self.x[row],
             _ => 0.0,
@@ -730,6 +745,43 @@ impl Lemke {
             ray_entering,
         }
     }
+}
+
+/// Relative complementarity error (against `max |q|`) above which a solved LCP is polished.
+const POLISH_THRESHOLD: f64 = 1e-12;
+
+/// Active-set polish of a solution found along a long pivot path (where the explicit basis
+/// inverse has accumulated rounding): with `A = {j : z_j > 0}`, solve `M_AA z_A = -q_A` by a
+/// fresh LU and keep the result if it is feasible (`z_A >= 0`, `w = q + M z >= 0` up to
+/// rounding). Returns `(z, w, complementarity error)`; allocates (only on this path).
+fn polish(m: MatRef<'_, f64>, q: &[f64], z: &[f64]) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    use faer::linalg::solvers::{PartialPivLu, Solve};
+    let active: Vec<usize> = (0..z.len()).filter(|&j| z[j] > 0.0).collect();
+    if active.is_empty() {
+        return None;
+    }
+    let k = active.len();
+    let block = faer::Mat::from_fn(k, k, |a, b| m[(active[a], active[b])]);
+    let mut rhs = faer::Mat::from_fn(k, 1, |a, _| -q[active[a]]);
+    let lu = PartialPivLu::new(block.as_ref());
+    lu.solve_in_place(rhs.as_mut());
+    let mut zp = vec![0.0; z.len()];
+    for (a, &j) in active.iter().enumerate() {
+        let v = rhs[(a, 0)];
+        if !(v.is_finite() && v >= 0.0) {
+            return None;
+        }
+        zp[j] = v;
+    }
+    let mut w = q.to_vec();
+    for &j in &active {
+        let mcol = m.col(j);
+        for (i, wi) in w.iter_mut().enumerate() {
+            *wi += zp[j] * mcol[i];
+        }
+    }
+    let error = complementarity_error(&zp, &w);
+    Some((zp, w, error))
 }
 
 /// One-shot convenience: `Lemke::new(n).solve(m, q, options)` (allocates a workspace;

@@ -437,7 +437,6 @@ fn preloaded_contact_negative_gap() {
 /// semismooth Newton on the same LCP reaches 2.6e-14: accuracy is lost along the long
 /// pivot path.
 #[test]
-#[ignore = "reason: Lemke solves the preloaded periodic LCP (Nt = 256) with complementarity error 2.06e-9 > 1e-9 (LCP-SSN: 2.6e-14)"]
 fn preloaded_contact_lemke_is_accurate() {
     let out = run(
         "gap = -0.1 (preload)",
