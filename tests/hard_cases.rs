@@ -460,7 +460,6 @@ fn preloaded_contact_lemke_is_accurate() {
 /// `Nt = 128, 256` both converge. The semismooth solver should not give up on a singular
 /// first Jacobian when the LCP has a solution.
 #[test]
-#[ignore = "reason: LCP-SSN ends singular-jacobian at iteration 0 on gap -0.1, omega 2 omega_1, Nt = 32 (and 64), where Lemke solves in 25 pivots"]
 fn preloaded_lcp_ssn_survives_a_singular_first_jacobian() {
     let spec = RodSpec {
         frequency: FrequencySpec::Ratio(2.0),

@@ -173,6 +173,7 @@ pub struct ActiveSetSolver {
     lu: Option<PartialPivLu<f64>>,
     rhs: Mat<f64>,
     pivot_threshold: f64,
+    regularize: bool,
 }
 
 impl Default for ActiveSetSolver {
@@ -197,7 +198,15 @@ impl ActiveSetSolver {
             lu: None,
             rhs: Mat::zeros(0, 1),
             pivot_threshold: threshold,
+            regularize: true,
         }
+    }
+
+    /// Reports a singular active block as [`LinearSolveError::Singular`] instead of
+    /// shifting its diagonal (the default regularises it, see `factor`).
+    pub fn without_regularization(mut self) -> Self {
+        self.regularize = false;
+        self
     }
 
     /// Size of the active block of the last factorization.
@@ -205,6 +214,9 @@ impl ActiveSetSolver {
         self.active.len()
     }
 }
+
+/// Relative diagonal shift applied to a singular active block (see `factor`).
+const REGULARIZATION: f64 = 1e-8;
 
 impl LinearSolve<MinMapJacobian<'_>> for ActiveSetSolver {
     fn factor(&mut self, jac: &MinMapJacobian<'_>) -> Result<(), LinearSolveError> {
@@ -247,8 +259,32 @@ impl LinearSolve<MinMapJacobian<'_>> for ActiveSetSolver {
         if k > 0 {
             let lu = PartialPivLu::new(block.as_ref());
             let u = lu.U();
-            check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold)?;
-            self.lu = Some(lu);
+            match check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold) {
+                Ok(()) => self.lu = Some(lu),
+                Err(singular) if !self.regularize => return Err(singular),
+                Err(singular) => {
+                    // A singular active block (e.g. at z = 0 when every time node is in
+                    // contact and A has a null vector): shift the diagonal by 1e-8 of the
+                    // largest entry (a Levenberg–Marquardt-like regularised Newton step,
+                    // still a descent direction for the merit), or report the singularity.
+                    let largest = (0..k)
+                        .flat_map(|r| (0..k).map(move |c| (r, c)))
+                        .fold(0.0_f64, |m, (r, c)| m.max(block[(r, c)].abs()));
+                    let shift = REGULARIZATION * largest;
+                    for d in 0..k {
+                        block[(d, d)] += shift;
+                    }
+                    let lu = PartialPivLu::new(block.as_ref());
+                    let u = lu.U();
+                    if shift > 0.0
+                        && check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold).is_ok()
+                    {
+                        self.lu = Some(lu);
+                    } else {
+                        return Err(singular);
+                    }
+                }
+            }
         }
         self.rhs = Mat::zeros(k, 1);
         Ok(())
@@ -339,7 +375,13 @@ mod tests {
         // Rows 0 and 1 of the active block are equal: A_II = [[1, 1], [1, 1]].
         let a = Mat::from_fn(3, 3, |i, j| f64::from(i == j || (i < 2 && j < 2)));
         let jac = MinMapJacobian::new(a.as_ref(), vec![true, true, false]).unwrap();
-        let mut solver = ActiveSetSolver::new();
+        // By default the block is regularised and the solve is finite.
+        let mut regularised = ActiveSetSolver::new();
+        regularised.factor(&jac).unwrap();
+        let mut x = vec![1.0; 3];
+        regularised.solve_in_place(&mut x).unwrap();
+        assert!(x.iter().all(|v| v.is_finite()));
+        let mut solver = ActiveSetSolver::new().without_regularization();
         assert!(matches!(
             solver.factor(&jac),
             Err(LinearSolveError::Singular { .. })
