@@ -11,7 +11,7 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::cli::{default_settings, figure_1};
+use semismooth_problems::cli::{default_settings, fig1_table, figure_1};
 use semismooth_problems::output::{prepare_directory, write_line_plot, PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::runner::solve_rod;
@@ -26,26 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let map = |e: semismooth_problems::cli::CliError| format!("{e:?}");
     let mut rows = figure_1(&out, MassModel::Modified, quiet).map_err(map)?;
     rows.extend(figure_1(&out, MassModel::Consistent, quiet).map_err(map)?);
-    println!("Fig. 1 (20 elements, gap 0.5, omega = omega_1, zeta = 0.01, p0 = 0.04)");
-    println!(
-        "{:<11} {:<10} {:>6} {:>9} {:>11} {:>11} {:>12}",
-        "mass", "method", "iter", "ms", "tip max", "tip min", "diff to ref"
-    );
-    for r in &rows {
-        println!(
-            "{:<11} {:<10} {:>6} {:>9.2} {:>11.6} {:>11.6} {:>12.2e}",
-            format!("{:?}", r.mass).to_lowercase(),
-            r.harmonics
-                .map(|h| format!("H = {h}"))
-                .unwrap_or_else(|| "reference".into()),
-            r.iterations,
-            1e3 * r.seconds,
-            r.tip_max,
-            r.tip_min,
-            r.difference
-        );
-    }
-
+    print!("{}", fig1_table(&rows));
     println!("\nNewton from zero, H = 5..40 (hybrid globalization, structured solver)");
     println!(
         "{:<11} {:>4} {:>5} {:>11} {:>11}  last residual norms",

@@ -245,6 +245,62 @@ fn accept_roundoff(
     }
 }
 
+/// Reconstruction a harmonic-balance problem offers for the outputs.
+trait HbReconstruction {
+    fn contact_count(&self) -> usize;
+    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+}
+
+impl HbReconstruction for SsnHb {
+    fn contact_count(&self) -> usize {
+        self.contacts()
+    }
+    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError> {
+        self.displacement_samples(x, dof, points)
+    }
+    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
+        self.contact_force_samples(x, i, points)
+    }
+}
+
+impl HbReconstruction for PenaltyHb {
+    fn contact_count(&self) -> usize {
+        self.contacts()
+    }
+    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError> {
+        self.displacement_samples(x, dof, points)
+    }
+    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
+        self.contact_force_samples(x, i, points)
+    }
+}
+
+/// The tip, the contact forces and the statistics of an HB solution on `points` times.
+fn hb_outputs(
+    problem: &impl HbReconstruction,
+    rod: &RodModel,
+    settings: &SolverSettings,
+    report: &NewtonReport,
+    seconds: f64,
+    x: Vec<f64>,
+    points: usize,
+) -> Result<Solution, RunError> {
+    let tip_series = problem.displacement(&x, rod.tip_dof(), points)?;
+    let forces = (0..problem.contact_count())
+        .map(|i| problem.contact_force(&x, i, points))
+        .collect::<Result<Vec<_>, _>>()?;
+    let contact_u = rod
+        .model
+        .contacts
+        .iter()
+        .map(|c| problem.displacement(&x, c.dof, points))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut sol = hb_solution(rod, settings, report, seconds, tip_series, forces, x);
+    sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+    Ok(sol)
+}
+
 fn hb_solution(
     rod: &RodModel,
     settings: &SolverSettings,
@@ -340,17 +396,7 @@ pub fn solve_rod(
             let report = newton_hb(&mut problem, &mut x, settings, model, 0.0)?;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let tip_series = problem.displacement_samples(&x, tip, points)?;
-            let forces = (0..problem.contacts())
-                .map(|i| problem.contact_force_samples(&x, i, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let contact_u = model
-                .contacts
-                .iter()
-                .map(|c| problem.displacement_samples(&x, c.dof, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
-            sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            let mut sol = hb_outputs(&problem, rod, settings, &report, seconds, x, points)?;
             sol.c = (problem.contacts() > 0).then(|| problem.c());
             accept_roundoff(&mut sol, model, 0.0);
             Ok(sol)
@@ -411,17 +457,7 @@ pub fn solve_rod(
             report.iterations += homotopy_iterations;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let tip_series = problem.displacement_samples(&x, tip, points)?;
-            let forces = (0..problem.contacts())
-                .map(|i| problem.contact_force_samples(&x, i, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let contact_u = model
-                .contacts
-                .iter()
-                .map(|c| problem.displacement_samples(&x, c.dof, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let mut sol = hb_solution(rod, settings, &report, seconds, tip_series, forces, x);
-            sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
+            let mut sol = hb_outputs(&problem, rod, settings, &report, seconds, x, points)?;
             // The mean penalty force as the equations see it: over the Nt AFT samples (a
             // finer grid resolves narrow force peaks the quadrature does not).
             if problem.contacts() > 0 {
