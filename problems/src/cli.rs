@@ -100,9 +100,17 @@ pub fn solve(
     as_json: bool,
     csv: Option<&Path>,
     svg: Option<&Path>,
+    quiet: bool,
 ) -> Result<(), CliError> {
     let (scene, rod) = load(path)?;
+    // Time marching to a steady state is the long one: a spinner while it runs.
+    let bar = if scene.solver.method == Method::March {
+        progress_spinner("time marching to a steady state", quiet)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
     let solution = solve_rod(&rod, &scene.solver, None).map_err(|e| run_error(path, e))?;
+    bar.finish_and_clear();
     if let Some(csv) = csv {
         let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
         let mut headers = vec!["t".to_string(), "u_tip".to_string()];

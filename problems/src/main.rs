@@ -129,7 +129,9 @@ fn main() -> ExitCode {
             json,
             csv,
             svg,
-        }) => semismooth_problems::cli::solve(scene, *json, csv.as_deref(), svg.as_deref()),
+        }) => {
+            semismooth_problems::cli::solve(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
+        }
         Some(Command::Sweep {
             scene,
             json,
