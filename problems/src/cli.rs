@@ -500,6 +500,24 @@ pub struct Fig1Row {
     pub difference: f64,
 }
 
+/// Writes `<stem>.svg` (the series) and `<stem>.csv` (the named columns) into `out`.
+fn write_figure(
+    out: &Path,
+    stem: &str,
+    plot: &PlotSpec,
+    series: &[Series],
+    columns: &[(String, Vec<f64>)],
+) -> Result<(), CliError> {
+    write_line_plot(&out.join(format!("{stem}.svg")), plot, series)?;
+    let headers: Vec<&str> = columns.iter().map(|(h, _)| h.as_str()).collect();
+    let data: Vec<&[f64]> = columns.iter().map(|(_, c)| c.as_slice()).collect();
+    write_atomically(
+        &out.join(format!("{stem}.csv")),
+        csv_table(&headers, &data).as_bytes(),
+    )?;
+    Ok(())
+}
+
 /// Fig. 1 of the paper for one mass model: SSN-HB at H = 10, 15, 20 against the time-marching
 /// reference; writes `fig1_<mass>.svg` and `.csv` into `out`.
 pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>, CliError> {
@@ -577,8 +595,9 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         difference: 0.0,
     });
     bar.finish_and_clear();
-    write_line_plot(
-        &out.join(format!("fig1_{name}_mass.svg")),
+    write_figure(
+        out,
+        &format!("fig1_{name}_mass"),
         &PlotSpec {
             title: format!(
                 "Fig. 1: rod tip over one period, gap 0.5, omega = omega_1 ({name} mass)"
@@ -588,12 +607,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
             log_log: false,
         },
         &series,
-    )?;
-    let headers: Vec<&str> = csv_columns.iter().map(|(h, _)| h.as_str()).collect();
-    let columns: Vec<&[f64]> = csv_columns.iter().map(|(_, c)| c.as_slice()).collect();
-    write_atomically(
-        &out.join(format!("fig1_{name}_mass.csv")),
-        csv_table(&headers, &columns).as_bytes(),
+        &csv_columns,
     )?;
     Ok(rows)
 }
@@ -716,8 +730,9 @@ pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Cur
         });
     }
     bar.finish_and_clear();
-    write_line_plot(
-        &out.join(format!("fig2_H{harmonics}.svg")),
+    write_figure(
+        out,
+        &format!("fig2_H{harmonics}"),
         &PlotSpec {
             title: format!("Fig. 2: frequency response of the rod tip, H = {harmonics}"),
             x_label: "omega / omega_1".into(),
@@ -725,12 +740,7 @@ pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Cur
             log_log: false,
         },
         &series,
-    )?;
-    let headers: Vec<&str> = columns.iter().map(|(h, _)| h.as_str()).collect();
-    let data: Vec<&[f64]> = columns.iter().map(|(_, c)| c.as_slice()).collect();
-    write_atomically(
-        &out.join(format!("fig2_H{harmonics}.csv")),
-        csv_table(&headers, &data).as_bytes(),
+        &columns,
     )?;
     Ok(curves)
 }

@@ -469,6 +469,30 @@ pub(crate) struct HbState {
 }
 
 impl HbState {
+    /// Turns the switching samples of contact `i` into the indicator `h_n = [s_n > 0]` (in
+    /// place) and writes the block `P diag(h) E` of the Jacobian; records the active count.
+    pub(crate) fn write_contact_block(
+        &mut self,
+        samples: &mut [f64],
+        jac: &mut jacobian::HbJacobian,
+        i: usize,
+    ) {
+        let mut active = 0;
+        for s in samples.iter_mut() {
+            *s = if *s > 0.0 {
+                active += 1;
+                1.0
+            } else {
+                0.0
+            };
+        }
+        jac.active[i] = active;
+        let size = self.linear.size();
+        let block = jac.q.as_mut().subcols_mut(i * size, size);
+        // Lengths are fixed at construction: the product cannot fail.
+        let _ = self.aft.multiplication_matrix(samples, block);
+    }
+
     pub(crate) fn new(linear: LinearData, omega: f64) -> Self {
         let aft = Aft::new(linear.basis);
         Self {

@@ -243,21 +243,9 @@ impl GeneralizedJacobian for PenaltyHb {
         jac.coupling = ContactCoupling::Penalty {
             stiffness: self.stiffness,
         };
-        let size = self.state.linear.size();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
-            let mut active = 0;
-            for s in &mut self.samples {
-                *s = if *s > 0.0 {
-                    active += 1;
-                    1.0
-                } else {
-                    0.0
-                };
-            }
-            jac.active[i] = active;
-            let block = jac.q.as_mut().subcols_mut(i * size, size);
-            let _ = self.state.aft.multiplication_matrix(&self.samples, block);
+            self.state.write_contact_block(&mut self.samples, jac, i);
         }
     }
 }
