@@ -53,9 +53,26 @@
 //! `[parameter_min, parameter_max]` (the last point is then re-solved at the bound), or after
 //! `max_points` points.
 //!
-//! Folds are detected as sign changes of the parameter component of the oriented tangent
-//! between consecutive accepted points, and located by cubic Hermite interpolation of
-//! `p(s)` (values and slopes `dp/ds = t_p` at both points).
+//! Folds are detected as sign changes of the parameter component of the tangent, oriented
+//! along the step just taken, confirmed by a reversal of the parameter's increments between
+//! accepted points, and located by cubic Hermite interpolation of `p(s)` (values and slopes
+//! `dp/ds = t_p` at both points); a reversal at a corner of a piecewise-smooth branch (no
+//! sign change of `t_p`) is a fold at the extreme point ([`FoldDetector`], also usable on
+//! branches stitched together from several runs).
+//!
+//! # Corners
+//!
+//! Branches of semismooth problems are only piecewise smooth. Where the branch turns by
+//! more than 90° in the θ-norm at a corner, the pseudo-arclength hyperplane (normal to the
+//! incoming direction `d`) no longer cuts the far piece, whatever the step: halving ends
+//! the run there. Before giving up ([`ContinuationOptions::pass_corners`]), the step that
+//! failed last is tried twice more from the last point: on the hyperplane normal to `d`'s
+//! state part only, `d_x · (x - x_k) = ds |d_x|²` (cuts a far piece along which the state
+//! keeps moving forward, e.g. a fold at a corner), then at the next parameter
+//! `p_k + sign(d_p) ds / sqrt(1 - θ)` (cuts a far piece along which the parameter keeps
+//! moving). A point found this way ([`ContinuationCounters::corner_passes`]) is accepted
+//! with its tangent oriented along that constraint's normal, and the next predictor
+//! follows that tangent (the chord across the corner is no direction for the far piece).
 //!
 //! The corrector takes full Newton steps unless
 //! [`ContinuationOptions::corrector_line_search`] asks for Armijo backtracking on
@@ -205,6 +222,10 @@ pub struct ContinuationOptions {
     /// bracket the sign change (otherwise the fold is reported at the parameter of the
     /// point after the sign change). Default `true`.
     pub refine_folds: bool,
+    /// When the step has been halved to its end (the run would stop), try once to pass a
+    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
+    /// before giving up. Default `true`.
+    pub pass_corners: bool,
 }
 
 impl Default for ContinuationOptions {
@@ -227,6 +248,7 @@ impl Default for ContinuationOptions {
             predictor: Predictor::Secant,
             corrector_line_search: None,
             refine_folds: true,
+            pass_corners: true,
         }
     }
 }
@@ -358,9 +380,12 @@ pub struct BranchPoint {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum ContinuationEvent {
-    /// The parameter turns back: `t_p` changed sign between points `index - 1` and `index`.
+    /// The parameter turns back (see [`FoldDetector`]): on a smooth branch `t_p` changed
+    /// sign between points `index - 1` and `index`; at a corner of a piecewise-smooth branch
+    /// `index` is the extreme point itself.
     Fold {
-        /// Index (in the branch) of the first point after the sign change.
+        /// Index (in the branch) of the first point after the sign change of `t_p`, or of
+        /// the extreme point where `t_p` did not change sign.
         index: usize,
         /// Parameter at the fold (refined by interpolation when
         /// [`ContinuationOptions::refine_folds`] is set).
@@ -523,6 +548,8 @@ pub struct ContinuationCounters {
     pub rejected_iterations: u64,
     /// Rejected attempts.
     pub rejected_steps: u64,
+    /// Points accepted by a corner pass (module documentation, *Corners*).
+    pub corner_passes: u64,
 }
 
 /// A computed branch.
@@ -982,6 +1009,130 @@ fn hermite_fold(p0: f64, m0: f64, p1: f64, m1: f64, h: f64) -> f64 {
     }
 }
 
+/// One accepted point as the fold detector sees it.
+#[derive(Clone, Copy, Debug)]
+struct FoldSample {
+    parameter: f64,
+    tangent_parameter: f64,
+    /// θ-length of the chord from the previous point.
+    chord: f64,
+}
+
+/// Fold detection along a sequence of accepted points.
+///
+/// A fold is a local extremum of the parameter along the branch: the increments
+/// `p_k - p_{k-1}` change sign at the extreme point `k`. On a smooth branch the tangent's
+/// parameter component `t_p` changes sign between `k - 1` and `k` or between `k` and `k + 1`;
+/// the fold is then located by cubic Hermite interpolation of `p(s)` on that interval (when
+/// refinement is asked for and the interpolated extremum lies beyond `p_k`, within the
+/// reach of the neighbouring steps), otherwise reported at the point after the sign change
+/// (unrefined) or at `p_k`. A reversal without such a sign change (a fold at a corner of a
+/// piecewise-smooth branch) is reported at `p_k`. A sign change of `t_p` without a reversal
+/// of the increments (a generalized Jacobian taken on the other side of a corner, where
+/// the tangent of the neighbouring piece points backwards) is no fold.
+///
+/// A fold is confirmed by the first point after the extremum, so it is reported one point
+/// late; a fold at the last point of a branch is not reported.
+#[derive(Clone, Debug)]
+pub struct FoldDetector {
+    refine: bool,
+    /// The last three points (oldest first).
+    recent: Vec<FoldSample>,
+    /// Index of the newest point in `recent`.
+    newest: usize,
+    /// Sign of the last non-zero parameter increment.
+    increment_sign: f64,
+}
+
+impl FoldDetector {
+    /// A detector; `refine` locates folds by Hermite interpolation.
+    pub fn new(refine: bool) -> Self {
+        Self {
+            refine,
+            recent: Vec::with_capacity(3),
+            newest: 0,
+            increment_sign: 0.0,
+        }
+    }
+
+    /// Adds the next accepted point: its parameter, the parameter component of its unit
+    /// tangent oriented along the branch, and the θ-length of the chord from the previous
+    /// point (ignored for the first). Returns the fold this point confirms, if any; its
+    /// `index` counts the points pushed (from 0).
+    pub fn push(
+        &mut self,
+        parameter: f64,
+        tangent_parameter: f64,
+        chord: f64,
+    ) -> Option<ContinuationEvent> {
+        let sample = FoldSample {
+            parameter,
+            tangent_parameter,
+            chord,
+        };
+        if self.recent.is_empty() {
+            self.recent.push(sample);
+            self.newest = 0;
+            return None;
+        }
+        self.newest += 1;
+        if self.recent.len() == 3 {
+            self.recent.remove(0);
+        }
+        self.recent.push(sample);
+        let m = self.recent.len();
+        let increment = parameter - self.recent[m - 2].parameter;
+        if increment == 0.0 {
+            return None;
+        }
+        let sign = increment.signum();
+        let previous = std::mem::replace(&mut self.increment_sign, sign);
+        if previous == 0.0 || previous == sign {
+            return None;
+        }
+        // The extreme point is the one before this increment.
+        let extreme = self.recent[m - 2];
+        let extreme_index = self.newest - 1;
+        // Intervals [k-1, k] and [k, k+1] around the extreme k, as (left, right, index of
+        // right); a sign change of t_p from `previous` to `sign` brackets a smooth fold.
+        let mut brackets = Vec::with_capacity(2);
+        if m == 3 {
+            brackets.push((self.recent[0], self.recent[1], extreme_index));
+        }
+        brackets.push((self.recent[m - 2], self.recent[m - 1], self.newest));
+        let bracket = brackets.into_iter().find(|(a, b, _)| {
+            a.tangent_parameter.signum() == previous && b.tangent_parameter.signum() == sign
+        });
+        let reach = if m == 3 {
+            (extreme.parameter - self.recent[0].parameter)
+                .abs()
+                .max(increment.abs())
+        } else {
+            increment.abs()
+        };
+        let (index, parameter) = match bracket {
+            Some((a, b, index)) if self.refine && b.chord > 0.0 => {
+                let p = hermite_fold(
+                    a.parameter,
+                    a.tangent_parameter,
+                    b.parameter,
+                    b.tangent_parameter,
+                    b.chord,
+                );
+                let beyond = (p - extreme.parameter) * previous;
+                if beyond >= 0.0 && beyond <= reach {
+                    (index, p)
+                } else {
+                    (index, extreme.parameter)
+                }
+            }
+            Some((_, b, index)) => (index, b.parameter),
+            None => (extreme_index, extreme.parameter),
+        };
+        Some(ContinuationEvent::Fold { index, parameter })
+    }
+}
+
 enum Phase {
     NotStarted { x0: Vec<f64>, p0: f64 },
     Running,
@@ -1018,7 +1169,7 @@ where
     points: usize,
     consecutive_failures: usize,
     /// Sign of the last non-zero tangent parameter component.
-    last_sign: f64,
+    folds: FoldDetector,
     events: Vec<ContinuationEvent>,
     termination: Option<ContinuationTermination>,
     counters: ContinuationCounters,
@@ -1071,6 +1222,7 @@ where
             problem.new_jacobian(),
         );
         let fft_start = problem.fft_count();
+        let folds = FoldDetector::new(options.refine_folds);
         Ok(Self {
             problem,
             solver,
@@ -1087,7 +1239,7 @@ where
             direction: vec![0.0; n + 1],
             points: 0,
             consecutive_failures: 0,
-            last_sign: 0.0,
+            folds,
             events: Vec::new(),
             termination: None,
             counters: ContinuationCounters::default(),
@@ -1209,10 +1361,8 @@ where
             step: 0.0,
             tangent_parameter: self.tangent[n],
         };
-        self.last_sign = point.tangent_parameter.signum();
-        if point.tangent_parameter == 0.0 {
-            self.last_sign = 0.0;
-        }
+        self.folds
+            .push(point.parameter, point.tangent_parameter, 0.0);
         self.last = Some(point.clone());
         self.points = 1;
         self.phase = Phase::Running;
@@ -1276,13 +1426,20 @@ where
                 &mut smallest,
             );
             match corrected {
-                Ok(c) => return self.accept(&last, x, p, ds, c),
+                Ok(c) => return self.accept(&last, x, p, ds, c, None),
                 Err(failure) => {
                     self.counters.rejected_steps += 1;
                     self.counters.rejected_iterations +=
                         self.counters.corrector_iterations - before;
                     self.problem.set_parameter(last.parameter);
                     self.consecutive_failures += 1;
+                    let ending = ds <= self.options.min_step
+                        || self.consecutive_failures >= self.options.max_consecutive_failures;
+                    if ending && self.options.pass_corners {
+                        if let Some(point) = self.pass_corner(&last, ds) {
+                            return point;
+                        }
+                    }
                     if ds <= self.options.min_step {
                         self.finish(ContinuationTermination::StepTooSmall {
                             parameter: last.parameter,
@@ -1308,6 +1465,97 @@ where
         }
     }
 
+    /// The corner passes of the module documentation (*Corners*), with step `ds` from
+    /// `last` along the current direction: first on the hyperplane normal to the direction's
+    /// state part, then at the next parameter `p + ds / sqrt(1 - θ)` (sign of the direction's
+    /// parameter component). `Some(result of accept)` when one converged.
+    fn pass_corner(&mut self, last: &BranchPoint, ds: f64) -> Option<Option<BranchPoint>> {
+        let n = self.ws.n;
+        let theta_x = self.options.theta / n as f64;
+        let d = self.direction.clone();
+        let state_part = self.ws.dot(&d[..n], 0.0, &d[..n], 0.0);
+        let parameter_part = (1.0 - self.options.theta) * d[n] * d[n];
+        for on_state in [true, false] {
+            let (scale, along, constraint) = if on_state {
+                if state_part < 1e-6 {
+                    continue;
+                }
+                for (i, (wi, di)) in self.ws.w.iter_mut().zip(&d).enumerate() {
+                    *wi = theta_x * di * self.ws.weights.get(i).copied().unwrap_or(1.0);
+                }
+                let mut along = d.clone();
+                along[n] = 0.0;
+                let target: f64 = self
+                    .ws
+                    .w
+                    .iter()
+                    .zip(&last.state)
+                    .zip(&d)
+                    .map(|((w, x), di)| w * (x + ds * di))
+                    .sum();
+                let constraint = Constraint {
+                    arclength: true,
+                    w_p: 0.0,
+                    target,
+                };
+                (ds, along, constraint)
+            } else {
+                if parameter_part < 1e-6 {
+                    continue;
+                }
+                let step_p = ds / (1.0 - self.options.theta).sqrt() * d[n].signum();
+                let mut along = vec![0.0; n + 1];
+                along[n] = d[n].signum();
+                let constraint = Constraint {
+                    arclength: false,
+                    w_p: 1.0,
+                    target: last.parameter + step_p,
+                };
+                (step_p / d[n], along, constraint)
+            };
+            let mut x: Vec<f64> = last
+                .state
+                .iter()
+                .zip(&d)
+                .map(|(x, di)| x + scale * di)
+                .collect();
+            let mut p = last.parameter + scale * d[n];
+            let mut smallest = f64::INFINITY;
+            let before = self.counters.corrector_iterations;
+            match correct(
+                &mut *self.problem,
+                &mut *self.solver,
+                &mut self.ws,
+                self.fallback,
+                &self.options,
+                &mut x,
+                &mut p,
+                constraint,
+                &mut self.counters,
+                &mut smallest,
+            ) {
+                Ok(c) => {
+                    self.counters.corner_passes += 1;
+                    let step = self.ws.norm(
+                        &x.iter()
+                            .zip(&last.state)
+                            .map(|(a, b)| a - b)
+                            .collect::<Vec<_>>(),
+                        p - last.parameter,
+                    );
+                    return Some(self.accept(last, x, p, step, c, Some(&along)));
+                }
+                Err(_) => {
+                    self.counters.rejected_steps += 1;
+                    self.counters.rejected_iterations +=
+                        self.counters.corrector_iterations - before;
+                    self.problem.set_parameter(last.parameter);
+                }
+            }
+        }
+        None
+    }
+
     fn accept(
         &mut self,
         last: &BranchPoint,
@@ -1315,6 +1563,7 @@ where
         mut p: f64,
         ds: f64,
         corrected: Corrected,
+        along: Option<&[f64]>,
     ) -> Option<BranchPoint> {
         let n = self.ws.n;
         self.consecutive_failures = 0;
@@ -1389,30 +1638,33 @@ where
         let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
         let dpar = p - last.parameter;
         let chord = self.ws.norm(&dx, dpar);
+        // Orient the tangent along the step just taken: where the branch turns sharply the
+        // predictor's direction can make an obtuse angle with the new tangent, and orienting
+        // by it would reverse the tangent (a spurious fold, and a tangent predictor heading
+        // back along the branch). The secant always has a positive component along the
+        // predictor (the arclength constraint), so it is the forward direction here.
+        let forward = match along {
+            Some(a) => self
+                .ws
+                .dot(&self.tangent[..n], self.tangent[n], &a[..n], a[n]),
+            None if chord > 0.0 => self.ws.dot(&self.tangent[..n], self.tangent[n], &dx, dpar),
+            None => 0.0,
+        };
+        if forward < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
 
         // Fold detection.
         let tp = self.tangent[n];
-        let index = self.points;
-        let sign = if tp == 0.0 { 0.0 } else { tp.signum() };
-        if sign != 0.0 && self.last_sign != 0.0 && sign != self.last_sign {
-            let parameter = if last.tangent_parameter != 0.0 && chord > 0.0 {
-                if self.options.refine_folds {
-                    hermite_fold(last.parameter, last.tangent_parameter, p, tp, chord)
-                } else {
-                    p
-                }
-            } else {
-                last.parameter
-            };
-            self.events
-                .push(ContinuationEvent::Fold { index, parameter });
-        }
-        if sign != 0.0 {
-            self.last_sign = sign;
+        if let Some(event) = self.folds.push(p, tp, chord) {
+            self.events.push(event);
         }
 
         match self.options.predictor {
-            Predictor::Secant if chord > 0.0 => {
+            // After a corner the chord cuts across it: the new piece's tangent is the way on.
+            Predictor::Secant if chord > 0.0 && along.is_none() => {
                 for (d, v) in self.direction.iter_mut().zip(&dx) {
                     *d = v / chord;
                 }

@@ -414,3 +414,62 @@ fn json_has_the_issue_fields_one_entry_per_point() {
     assert_eq!(v["folds"].as_array().unwrap().len(), r.folds.len());
     assert_eq!(v["converged"].as_bool(), Some(true));
 }
+
+#[test]
+fn invalid_sweep_settings_are_typed_errors_naming_the_field() {
+    let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
+    let base = sweep(0.5, 2.0);
+    let cases = [
+        (
+            SweepSettings {
+                omega_ratio_from: f64::NAN,
+                ..base.clone()
+            },
+            "sweep.omega_ratio_from",
+        ),
+        (
+            SweepSettings {
+                omega_ratio_to: -1.0,
+                ..base.clone()
+            },
+            "sweep.omega_ratio_to",
+        ),
+        (
+            SweepSettings {
+                omega_ratio_to: 0.5,
+                ..base.clone()
+            },
+            "sweep.omega_ratio_to",
+        ),
+        (
+            SweepSettings {
+                step: -0.01,
+                ..base.clone()
+            },
+            "sweep.step",
+        ),
+        (
+            SweepSettings {
+                min_step: 0.1,
+                ..base.clone()
+            },
+            // Reported on the bound it violates: max_step (0.05) below min_step.
+            "sweep.max_step",
+        ),
+        (
+            SweepSettings {
+                max_points: 0,
+                ..base.clone()
+            },
+            "sweep.max_points",
+        ),
+    ];
+    for (bad, field) in cases {
+        let err = frequency_response(&rod, &settings(Method::SsnHb, 5), &bad, None).unwrap_err();
+        let RunError::InvalidSetting { name, .. } = &err else {
+            panic!("{field}: {err:?}");
+        };
+        assert_eq!(*name, field, "{err}");
+        assert!(err.to_string().contains(field), "{err}");
+    }
+}

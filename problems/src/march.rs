@@ -6,7 +6,7 @@
 //!
 //! Two schemes that never let the contacts penetrate at the step level (each step's contact
 //! problem is a small linear complementarity problem solved by the core's
-//! [`Lemke`](semismooth::lemke::Lemke)):
+//! [`Lemke`]):
 //!
 //! - [`MarchScheme::MasslessContactTrapezoidal`] for the *modified* mass (every contact dof
 //!   has a zero mass row). Trapezoidal rule (Newmark average acceleration,

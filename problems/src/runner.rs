@@ -52,6 +52,16 @@ pub enum RunError {
     /// Time marching could not run (or did not reach a steady state).
     #[error(transparent)]
     March(#[from] MarchError),
+    /// A run setting (e.g. a `sweep.*` field) is outside its allowed range.
+    #[error("invalid {name} = {value}: allowed {allowed}")]
+    InvalidSetting {
+        /// Which setting (the scene's field name).
+        name: &'static str,
+        /// The value received.
+        value: f64,
+        /// The allowed range, in words.
+        allowed: &'static str,
+    },
     /// The method needs something the scene does not declare.
     #[error("method {method} needs {what}")]
     Unsupported {

@@ -41,10 +41,14 @@
 //!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
 //!   the constraint), heading the way `ω` last moved, or the other way when that restart
 //!   cannot make a single step; at most [`MAX_RESTARTS`] times;
-//! - folds are the reversals of `ω` along the accepted points (the core's fold events,
-//!   from sign changes of the tangent, also fire where a sharply turning branch flips the
-//!   tangent's orientation without any reversal); the core's interpolated fold frequency
-//!   is used when it lies beyond the extreme point.
+//! - folds are found by the core's [`FoldDetector`] over the whole stitched branch (a fold
+//!   can fall between two segments): reversals of `ω` along the accepted points, located by
+//!   Hermite interpolation where the tangent's `ω` component changes sign across them; a
+//!   sign change of the tangent alone (a generalized Jacobian from the far side of a
+//!   corner) is no fold.
+//!
+//! The core's own corner passes ([`ContinuationOptions::pass_corners`]) are tried first,
+//! before a segment gives up; the restarts above come after them.
 //!
 //! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
 //! tolerance for SSN-HB, so each point is a fixed point of a Newton solve at that
@@ -73,7 +77,7 @@ use std::time::Instant;
 
 use semismooth::continuation::{
     Continuation, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
-    ContinuationTermination, Direction, Predictor,
+    ContinuationTermination, Direction, FoldDetector, Predictor,
 };
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
@@ -366,11 +370,11 @@ fn reference_amplitude(rod: &RodModel) -> f64 {
 }
 
 fn invalid(name: &'static str, value: f64, allowed: &'static str) -> RunError {
-    RunError::HarmonicBalance(HbError::InvalidOption {
+    RunError::InvalidSetting {
         name,
         value,
         allowed,
-    })
+    }
 }
 
 fn check_sweep(sweep: &SweepSettings) -> Result<(), RunError> {
@@ -593,7 +597,8 @@ where
     let mut direction = options.direction;
     let mut restart = false;
     let mut restarts = 0;
-    let mut raw_events: Vec<(usize, f64)> = Vec::new();
+    // Folds along the whole stitched branch (a fold can fall between two segments).
+    let mut fold_detector = FoldDetector::new(true);
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
@@ -656,16 +661,16 @@ where
             response.amplitude.push(max.abs().max(min.abs()));
             response.iterations.push(point.iterations);
             response.states.push(state);
+            if let Some(ContinuationEvent::Fold { index, parameter }) =
+                fold_detector.push(point.parameter, point.tangent_parameter, point.step)
+            {
+                response.folds.push(parameter * omega_unit);
+                response.fold_indices.push(index);
+            }
             start_y = point.state;
             start_q = point.parameter;
             if let Some(report) = progress {
                 report(response.omega.len() - 1, omega / omega_1);
-            }
-        }
-        let shift = offset.saturating_sub(1);
-        for event in cont.events() {
-            if let ContinuationEvent::Fold { index, parameter } = event {
-                raw_events.push((index + shift, parameter * omega_unit));
             }
         }
         add_counters(&mut c, &cont.counters());
@@ -715,9 +720,6 @@ where
             _ => forward,
         };
     };
-    let (folds, indices) = folds_from_branch(&response.omega, &raw_events);
-    response.folds = folds;
-    response.fold_indices = indices;
     response.restarts = restarts;
     counters.residual_evaluations += c.work.residual_evaluations;
     counters.jacobian_evaluations += c.work.jacobian_evaluations;
@@ -808,48 +810,7 @@ fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
     total.corrector_iterations += c.corrector_iterations;
     total.rejected_iterations += c.rejected_iterations;
     total.rejected_steps += c.rejected_steps;
-}
-
-/// Folds as the local extrema of `ω` along the branch (sign changes of its increments).
-/// Each is reported at the interpolated fold of a continuation event within one point of
-/// it when that lies beyond the extreme point (cubic Hermite refinement), else at the
-/// extreme point. Events without a reversal of `ω` (a tangent orientation flipped on a
-/// sharply turning branch) are dropped.
-fn folds_from_branch(omega: &[f64], events: &[(usize, f64)]) -> (Vec<f64>, Vec<usize>) {
-    let mut folds = Vec::new();
-    let mut indices = Vec::new();
-    let mut last_sign = 0.0;
-    let mut last_index = 0;
-    for i in 1..omega.len() {
-        let inc = omega[i] - omega[i - 1];
-        if inc == 0.0 {
-            continue;
-        }
-        let sign = inc.signum();
-        if last_sign != 0.0 && sign != last_sign {
-            // The extreme is the point before this increment.
-            let k = i - 1;
-            let w = omega[k];
-            let reach = (omega[k] - omega[last_index]).abs().max(inc.abs());
-            let refined = events
-                .iter()
-                .filter(|(index, _)| index.abs_diff(k) <= 2)
-                .map(|(_, p)| *p)
-                .filter(|p| (p - w) * last_sign >= 0.0 && (p - w).abs() <= reach)
-                .fold(w, |best, p| {
-                    if (p - best) * last_sign > 0.0 {
-                        p
-                    } else {
-                        best
-                    }
-                });
-            folds.push(refined);
-            indices.push(k);
-        }
-        last_sign = sign;
-        last_index = i - 1;
-    }
-    (folds, indices)
+    total.corner_passes += c.corner_passes;
 }
 
 /// Reconstructs one dof over a period from HB coefficients (index `j N + dof`).
