@@ -1318,6 +1318,28 @@ where
         self.tangent = t;
     }
 
+    /// [`correct`] on this run's problem, solver, workspace and counters.
+    fn correct_at(
+        &mut self,
+        x: &mut [f64],
+        p: &mut f64,
+        constraint: Constraint,
+        smallest: &mut f64,
+    ) -> Result<Corrected, CorrectorFailure> {
+        correct(
+            &mut *self.problem,
+            &mut *self.solver,
+            &mut self.ws,
+            self.fallback,
+            &self.options,
+            x,
+            p,
+            constraint,
+            &mut self.counters,
+            smallest,
+        )
+    }
+
     fn start(&mut self, x0: Vec<f64>, p0: f64) -> Result<BranchPoint, ContinuationError> {
         let mut x = x0;
         let mut p = p0;
@@ -1327,18 +1349,7 @@ where
             w_p: 1.0,
             target: p0,
         };
-        let corrected = correct(
-            &mut *self.problem,
-            &mut *self.solver,
-            &mut self.ws,
-            self.fallback,
-            &self.options,
-            &mut x,
-            &mut p,
-            constraint,
-            &mut self.counters,
-            &mut smallest,
-        );
+        let corrected = self.correct_at(&mut x, &mut p, constraint, &mut smallest);
         let corrected = match corrected {
             Ok(c) => c,
             Err(failure) => {
@@ -1413,18 +1424,7 @@ where
             };
             let mut smallest = f64::INFINITY;
             let before = self.counters.corrector_iterations;
-            let corrected = correct(
-                &mut *self.problem,
-                &mut *self.solver,
-                &mut self.ws,
-                self.fallback,
-                &self.options,
-                &mut x,
-                &mut p,
-                constraint,
-                &mut self.counters,
-                &mut smallest,
-            );
+            let corrected = self.correct_at(&mut x, &mut p, constraint, &mut smallest);
             match corrected {
                 Ok(c) => return self.accept(&last, x, p, ds, c, None),
                 Err(failure) => {
@@ -1522,18 +1522,7 @@ where
             let mut p = last.parameter + scale * d[n];
             let mut smallest = f64::INFINITY;
             let before = self.counters.corrector_iterations;
-            match correct(
-                &mut *self.problem,
-                &mut *self.solver,
-                &mut self.ws,
-                self.fallback,
-                &self.options,
-                &mut x,
-                &mut p,
-                constraint,
-                &mut self.counters,
-                &mut smallest,
-            ) {
+            match self.correct_at(&mut x, &mut p, constraint, &mut smallest) {
                 Ok(c) => {
                     self.counters.corner_passes += 1;
                     let step = self.ws.norm(
@@ -1606,18 +1595,7 @@ where
                 target: pb,
             };
             let saved_tangent = self.tangent.clone();
-            match correct(
-                &mut *self.problem,
-                &mut *self.solver,
-                &mut self.ws,
-                self.fallback,
-                &self.options,
-                &mut xb,
-                &mut pbv,
-                constraint,
-                &mut self.counters,
-                &mut smallest,
-            ) {
+            match self.correct_at(&mut xb, &mut pbv, constraint, &mut smallest) {
                 Ok(c) => {
                     self.take_tangent(Some(&direction), 0.0);
                     x = xb;
