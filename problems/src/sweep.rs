@@ -216,6 +216,7 @@ impl FrequencyResponse {
                 "ffts": c.ffts,
                 "corrector_iterations": self.continuation.corrector_iterations,
                 "rejected_steps": self.continuation.rejected_steps,
+                "corner_passes": self.continuation.corner_passes,
                 "restarts": self.restarts,
             },
         })
