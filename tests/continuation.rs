@@ -1258,6 +1258,12 @@ fn corner_fold_of_a_piecewise_linear_branch_is_reported_within_one_step_of_the_c
         assert!((point.parameter + point.state[0].abs()).abs() < 1e-10);
     }
     let folds = branch.fold_parameters();
+    println!(
+        "roof: {} points, folds {folds:?}, corner passes {}, rejected steps {}",
+        branch.points.len(),
+        branch.counters.corner_passes,
+        branch.counters.rejected_steps
+    );
     assert_eq!(folds.len(), 1, "{folds:?}");
     // The fold is at p = 0; the neighbouring points are within one (θ-norm) step, i.e.
     // |Δp| <= max_step / sqrt(1 - θ), of it, and the report is never past the corner.
@@ -1295,13 +1301,10 @@ fn sharp_corner_of_a_graph_over_the_parameter_is_passed_without_a_fold() {
             .unwrap();
         let parameters = branch.parameters();
         println!(
-            "{predictor:?}: {} points, t_p signs {:?}",
+            "{predictor:?}: {} points, corner passes {}, rejected steps {}",
             parameters.len(),
-            branch
-                .points
-                .iter()
-                .map(|q| q.tangent_parameter.signum() as i8)
-                .collect::<Vec<_>>()
+            branch.counters.corner_passes,
+            branch.counters.rejected_steps
         );
         // The branch is a graph over p: p increases at every point, to the bound p = 1.
         assert!(parameters.windows(2).all(|w| w[1] > w[0]));
