@@ -81,7 +81,13 @@ use semismooth::newton::{self, NewtonReport};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use serde_json::json;
 
-use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
+mod corners;
+
+use corners::{Corners, PenaltyCorners};
+
+use crate::hb::{
+    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+};
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
 use crate::scene::{
@@ -118,6 +124,10 @@ pub const RESTART_POINTS: usize = 4;
 
 /// Restarts allowed per sweep.
 pub const MAX_RESTARTS: usize = 20;
+
+/// Failed steps in a row (each halving the step) after which a penalty-HB continuation
+/// segment stops and the corner ahead is crossed explicitly (module documentation).
+pub const PENALTY_MAX_FAILURES: usize = 3;
 
 /// A frequency-response curve: one entry per branch point, in branch order (the frequency
 /// is not monotone across folds).
@@ -156,6 +166,8 @@ pub struct FrequencyResponse {
     pub initial_iterations: usize,
     /// Continuation restarts after failed steps (module documentation).
     pub restarts: usize,
+    /// Corners of a penalty branch stepped over explicitly (module documentation).
+    pub corners: usize,
     /// `u_ref` of the step scaling (module documentation).
     pub reference_amplitude: f64,
     /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
@@ -166,6 +178,15 @@ pub struct FrequencyResponse {
 }
 
 impl FrequencyResponse {
+    fn push(&mut self, omega: f64, max: f64, min: f64, iterations: usize, state: Vec<f64>) {
+        self.omega.push(omega);
+        self.tip_max.push(max);
+        self.tip_min.push(min);
+        self.amplitude.push(max.abs().max(min.abs()));
+        self.iterations.push(iterations);
+        self.states.push(state);
+    }
+
     /// Number of branch points.
     pub fn points(&self) -> usize {
         self.omega.len()
@@ -397,6 +418,7 @@ fn continuation_options(
     settings: &SolverSettings,
     sweep: &SweepSettings,
     q_unit: f64,
+    residual_floor: f64,
 ) -> Result<ContinuationOptions, RunError> {
     let (lo, hi) = if sweep.omega_ratio_to > sweep.omega_ratio_from {
         (sweep.omega_ratio_from, sweep.omega_ratio_to)
@@ -412,14 +434,19 @@ fn continuation_options(
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
         corrector_tolerance: match settings.method {
-            // A stiff penalty puts the rounding floor of |F| near the tolerance itself.
-            Method::PenaltyHb => settings.tolerance,
+            // |F| cannot be computed below its rounding floor (a stiff penalty puts it
+            // near the scene's tolerance).
+            Method::PenaltyHb => settings.tolerance.max(residual_floor),
             _ => CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
         },
         parameter_min: lo / q_unit,
         parameter_max: hi / q_unit,
         max_points: sweep.max_points,
-        max_consecutive_failures: halvings.clamp(3, 64),
+        max_consecutive_failures: match settings.method {
+            // A failed step on a penalty branch is a corner, crossed explicitly.
+            Method::PenaltyHb => PENALTY_MAX_FAILURES,
+            _ => halvings.clamp(3, 64),
+        },
         theta: THETA,
         direction: if sweep.omega_ratio_to > sweep.omega_ratio_from {
             Direction::Increasing
@@ -500,6 +527,8 @@ struct Setup<'a> {
     units: Vec<f64>,
     output_points: usize,
     started: Instant,
+    /// Rounding floor of `|F|` (0 where negligible): the corrector tolerance is at least this.
+    residual_floor: f64,
 }
 
 fn follow<P, S>(
@@ -507,6 +536,7 @@ fn follow<P, S>(
     solver: &mut S,
     setup: Setup<'_>,
     measure: &mut TipMeasure<'_, P>,
+    mut corners: Option<&mut dyn Corners>,
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError>
 where
@@ -522,12 +552,13 @@ where
         units,
         output_points,
         started,
+        residual_floor,
     } = setup;
     let n = problem.dim();
     // q = (ω/ω_1) / sqrt(1 - θ): (1 - θ) Δq² = Δ(ω/ω_1)².
     let q_unit = (1.0 - THETA).sqrt();
     let omega_unit = q_unit * omega_1;
-    let options = continuation_options(settings, sweep, q_unit)?;
+    let options = continuation_options(settings, sweep, q_unit, residual_floor)?;
     // x = s ⊙ y with s² = θ N u_ref² / n: (θ/n)|Δy|² = |ΔX|² / (N u_ref²).
     let base = (THETA * dofs as f64 / n as f64).sqrt() * u_ref;
     let scale: Vec<f64> = units.iter().map(|u| u * base).collect();
@@ -554,6 +585,7 @@ where
         continuation: ContinuationCounters::default(),
         initial_iterations: report.iterations,
         restarts: 0,
+        corners: 0,
         reference_amplitude: u_ref,
         output_points,
         states: Vec::new(),
@@ -597,17 +629,25 @@ where
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
+    // After a corner the segment starts at a new point (otherwise at the last one).
+    let mut new_start = false;
+    let mut crossed = 0;
+    let mut corner_work = newton::WorkCounters::default();
+    // Penalty: the smooth piece of the last recorded point and the way ω goes along it.
+    let mut piece: Option<Vec<bool>> = None;
+    let mut travel = direction_sign(direction);
     let termination = loop {
         let offset = response.omega.len();
         let remaining = base_points.saturating_sub(offset);
+        let repeat = usize::from(offset > 0 && !new_start);
         let segment_options = ContinuationOptions {
             theta: if restart { THETA_RESTART } else { THETA },
             max_points: if restart {
                 RESTART_POINTS + 1
             } else {
-                remaining + usize::from(offset > 0)
+                remaining + repeat
             }
-            .min(remaining + usize::from(offset > 0))
+            .min(remaining + repeat)
             .max(1),
             direction,
             ..options.clone()
@@ -620,7 +660,10 @@ where
             segment_options,
         )
         .map_err(continuation_error)?;
-        let mut first = true;
+        // Index in `response` of each point of the segment (for the core's fold events),
+        // and where the segment stopped to let the next one start after a corner.
+        let mut index_map: Vec<usize> = Vec::new();
+        let mut next: Option<(Vec<f64>, f64, Direction, bool)> = None;
         while let Some(item) = cont.next() {
             let point = match item {
                 Ok(point) => point,
@@ -643,29 +686,80 @@ where
                 t.radius = TRUST_FACTOR * next;
             }
             // The start of a restarted segment repeats the last point.
-            if std::mem::take(&mut first) && offset > 0 {
+            if index_map.is_empty() && repeat > 0 {
+                index_map.push(offset - 1);
                 continue;
             }
-            last_tangent_parameter = point.tangent_parameter;
             let state: Vec<f64> = point.state.iter().zip(&scale).map(|(y, s)| y * s).collect();
             let omega = point.parameter * omega_unit;
+            // Penalty: a point on another piece means a corner was passed. It is located
+            // and recorded; the continuation goes on unless it would head back to it.
+            let mut corner_points = Vec::new();
+            if let Some(c) = corners.as_mut() {
+                let mut label = c.piece(&state);
+                let k = response.omega.len();
+                match piece.as_ref() {
+                    Some(last) if *last != label && k > 0 => {
+                        let walk = c.cross(
+                            &response.states[k - 1],
+                            response.omega[k - 1],
+                            travel,
+                            remaining,
+                            &mut corner_work,
+                        );
+                        if let Some(walk) = walk {
+                            crossed += walk.corners.len();
+                            let along = direction_sign(walk.direction);
+                            let start_label = c.piece(&walk.start);
+                            if walk.corners.len() > 1 || start_label != label {
+                                // Several corners passed: go on after the last.
+                                label = start_label;
+                                next = Some((walk.start, walk.start_omega, walk.direction, true));
+                            } else if (omega - response.omega[k - 1]) * along < 0.0 {
+                                // The continuation would head back to the corner.
+                                next = Some((state.clone(), omega, walk.direction, false));
+                            }
+                            corner_points = walk.corners;
+                            travel = along;
+                        } else {
+                            travel = (omega - response.omega[k - 1]).signum();
+                        }
+                    }
+                    Some(_) if k > 0 && omega != response.omega[k - 1] => {
+                        travel = (omega - response.omega[k - 1]).signum();
+                    }
+                    _ => {}
+                }
+                piece = Some(label);
+            }
+            for (x, w) in corner_points {
+                let (max, min) = measure(&*cont.problem().inner, &x)?;
+                response.push(w, max, min, 0, x);
+                if let Some(report) = progress {
+                    report(response.omega.len() - 1, w / omega_1);
+                }
+            }
+            if matches!(next, Some((_, _, _, true))) {
+                break;
+            }
+            last_tangent_parameter = point.tangent_parameter;
             let (max, min) = measure(&*cont.problem().inner, &state)?;
-            response.omega.push(omega);
-            response.tip_max.push(max);
-            response.tip_min.push(min);
-            response.amplitude.push(max.abs().max(min.abs()));
-            response.iterations.push(point.iterations);
-            response.states.push(state);
+            response.push(omega, max, min, point.iterations, state);
+            index_map.push(response.omega.len() - 1);
             start_y = point.state;
             start_q = point.parameter;
             if let Some(report) = progress {
                 report(response.omega.len() - 1, omega / omega_1);
             }
+            if next.is_some() {
+                break;
+            }
         }
-        let shift = offset.saturating_sub(1);
         for event in cont.events() {
             if let ContinuationEvent::Fold { index, parameter } = event {
-                raw_events.push((index + shift, parameter * omega_unit));
+                if let Some(&i) = index_map.get(*index) {
+                    raw_events.push((i, parameter * omega_unit));
+                }
             }
         }
         add_counters(&mut c, &cont.counters());
@@ -686,6 +780,43 @@ where
         if response.omega.len() >= base_points {
             break termination;
         }
+        // Penalty: a failed step at a corner (one the arclength cannot turn, e.g. a fold
+        // where the next piece leaves at more than a right angle) is crossed explicitly.
+        if let (true, None, Some(c)) = (failed, &next, corners.as_mut()) {
+            let k = response.omega.len();
+            if let Some(walk) = c.cross(
+                &response.states[k - 1],
+                response.omega[k - 1],
+                travel,
+                base_points.saturating_sub(k),
+                &mut corner_work,
+            ) {
+                crossed += walk.corners.len();
+                for (x, w) in walk.corners {
+                    let (max, min) = measure(&*scaled.inner, &x)?;
+                    response.push(w, max, min, 0, x);
+                    if let Some(report) = progress {
+                        report(response.omega.len() - 1, w / omega_1);
+                    }
+                }
+                piece = Some(c.piece(&walk.start));
+                travel = direction_sign(walk.direction);
+                next = Some((walk.start, walk.start_omega, walk.direction, true));
+            }
+        }
+        if let Some((x, w, d, fresh)) = next {
+            start_y = x.iter().zip(&scale).map(|(x, s)| x / s).collect();
+            start_q = w / omega_unit;
+            direction = d;
+            restart = false;
+            new_start = fresh;
+            let mut t = trust.borrow_mut();
+            t.center.clone_from(&start_y);
+            t.center_q = start_q;
+            t.radius = TRUST_FACTOR * max_step;
+            continue;
+        }
+        new_start = false;
         let stuck = failed && restart && response.omega.len() == offset;
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
@@ -714,11 +845,17 @@ where
             (true, Direction::Decreasing) => Direction::Increasing,
             _ => forward,
         };
+        travel = direction_sign(direction);
     };
     let (folds, indices) = folds_from_branch(&response.omega, &raw_events);
     response.folds = folds;
     response.fold_indices = indices;
     response.restarts = restarts;
+    response.corners = crossed;
+    if let Some(c) = corners.as_ref() {
+        corner_work.ffts += c.ffts();
+    }
+    c.work += corner_work;
     counters.residual_evaluations += c.work.residual_evaluations;
     counters.jacobian_evaluations += c.work.jacobian_evaluations;
     counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
@@ -799,6 +936,13 @@ where
     response.termination = words;
     response.solve_seconds = started.elapsed().as_secs_f64();
     Ok(response)
+}
+
+fn direction_sign(direction: Direction) -> f64 {
+    match direction {
+        Direction::Increasing => 1.0,
+        Direction::Decreasing => -1.0,
+    }
 }
 
 fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
@@ -913,7 +1057,7 @@ pub fn frequency_response(
     let omega_1 = rod.omega_1;
     let u_ref = reference_amplitude(rod);
     let output_points = HB_OUTPUT_POINTS.max(settings.time_samples);
-    let setup = |units: Vec<f64>, output_points: usize| Setup {
+    let setup = |units: Vec<f64>, output_points: usize, residual_floor: f64| Setup {
         settings,
         sweep,
         omega_1,
@@ -922,6 +1066,7 @@ pub fn frequency_response(
         units,
         output_points,
         started,
+        residual_floor,
     };
     match settings.method {
         Method::SsnHb => {
@@ -938,13 +1083,14 @@ pub fn frequency_response(
                 .collect();
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64]| tip_rec.extremes(x);
-            let setup = setup(units, output_points);
+            let setup = setup(units, output_points, 0.0);
             match settings.linear_solver {
                 LinearSolverChoice::Structured => follow(
                     &mut problem,
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -952,6 +1098,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
             }
@@ -968,13 +1115,37 @@ pub fn frequency_response(
             let units = vec![1.0; problem.dim()];
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64]| tip_rec.extremes(x);
-            let setup = setup(units, output_points);
+            // The penalty force is k_p times gaps computed to ε |u| (|u| ~ the gap in contact).
+            let gap = model
+                .contacts
+                .iter()
+                .map(|c| c.gap.abs())
+                .fold(u_ref, f64::max);
+            let floor = f64::EPSILON * options.penalty_stiffness * gap;
+            let setup = setup(units, output_points, floor);
+            // A corner is searched within one largest step of the last point, and the next
+            // piece is entered at most a quarter of the first step from it (in ω).
+            let limits = (sweep.max_step * omega_1, 0.25 * sweep.step * omega_1);
+            let solver: Box<dyn LinearSolve<HbJacobian>> = match settings.linear_solver {
+                LinearSolverChoice::Structured => Box::new(StructuredHbSolver::new()),
+                LinearSolverChoice::Dense => Box::new(FaerDenseLu::new()),
+            };
+            let mut corners = PenaltyCorners {
+                problem: PenaltyHb::new(model, &options)?,
+                solver,
+                reach: limits.0,
+                shift: limits.1,
+                walk: sweep.max_step,
+                omega_1,
+                unit: (dofs as f64).sqrt() * u_ref,
+            };
             match settings.linear_solver {
                 LinearSolverChoice::Structured => follow(
                     &mut problem,
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    Some(&mut corners),
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -982,6 +1153,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    Some(&mut corners),
                     progress,
                 ),
             }
