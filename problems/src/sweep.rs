@@ -30,7 +30,7 @@
 //! # Robustness on piecewise-smooth branches
 //!
 //! The contact branches are only piecewise smooth (the set of active AFT samples changes
-//! along them), with corners and folds at corners. Three measures on this side of the core:
+//! along them), with corners and folds at corners. Four measures on this side of the core:
 //!
 //! - a trust ball: the corrector may not leave the θ-ball of radius
 //!   [`TRUST_FACTOR`]` x` (largest next step) around the last point (outside it the residual
@@ -41,6 +41,7 @@
 //!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
 //!   the constraint), heading the way `ω` last moved, or the other way when that restart
 //!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//! - penalty HB: corners crossed explicitly (below);
 //! - folds are the reversals of `ω` along the accepted points (the core's fold events,
 //!   from sign changes of the tangent, also fire where a sharply turning branch flips the
 //!   tangent's orientation without any reversal); the core's interpolated fold frequency
@@ -48,13 +49,52 @@
 //!
 //! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
 //! tolerance for SSN-HB, so each point is a fixed point of a Newton solve at that
-//! tolerance; for penalty HB it is the scene's tolerance itself (a stiff penalty puts the
-//! rounding floor of `|F|` within a decade of it).
+//! tolerance. For penalty HB it is the scene's tolerance or the rounding floor of `|F|`,
+//! `ε k_p max(|g|, u_ref)` (the penalty force is `k_p` times gaps computed to `ε |u|`),
+//! whichever is larger: at the default penalty on the canonical rod the floor is 3.3e-10
+//! and a solution's `|F|` measures 1.5e-11 to 4.4e-11; from `k_p = 1e6 x` on, a fixed
+//! tolerance of 1e-10 is below the floor and the corrector stalls (measured: `|F| = 2.1e-10`
+//! at `k_p = 1e6 x`, `H = 5`).
 //!
-//! Known limit: penalty-HB branches with a stiff penalty (`k_p >= 1e3` times the contact
-//! stiffness scale, the scenes' default is `1e5`) reverse in `ω` many times by small amounts
-//! near the contact onset of the canonical rod, and the continuation stalls there
-//! (`converged = false`, the reason in `termination`); SSN-HB passes.
+//! ## Penalty-HB branches: corners crossed explicitly
+//!
+//! With the active samples fixed, the penalty residual is affine in `U`: the branch is a
+//! chain of pieces, each a graph over `ω`, joined at corners where a sample's gap changes
+//! sign, and every fold of a penalty branch is a corner. With a stiff penalty the contact
+//! moves from sample to sample as `ω` changes and the branch zigzags: on the canonical rod
+//! (gap 0.5, default `k_p = 1e5 x` the contact stiffness scale) 48 corners and 44 folds at
+//! `H = 5`, 670 and 646 at `H = 20` (1570 and 1510 with gap 0.25). They are features of
+//! the penalty branch, not corrector artefacts: before corners were crossed explicitly,
+//! `max_step = 2e-3` and `5e-4` (instead of `5e-2`) stalled after the same reversals at
+//! the same frequencies (1.00448 -> 1.00350 and 1.00977 -> 1.00767 `ω_1`, then 1.01447);
+//! now any `max_step` gives the same folds (44 to 6e-10 with `5e-2`, `2e-3` and `5e-4`;
+//! 646 at `H = 20` to 1.3e-10 with `5e-2`, `1e-2` and `2e-3`). Some corners turn by more
+//! than a right angle in the arclength metric (93.6° at `ω = 1.01447 ω_1`, `H = 5`, where
+//! the two-sample piece meets the one-sample piece going back): the arclength constraint
+//! then has no solution on the next piece at any step, and the sweep used to end there
+//! with `converged = false` (after 20 restarts, or retracing the branch back to
+//! `omega_from`). Scaling the force harmonics into the metric does not help (the turn
+//! stays above 90°, 108° at weight 100).
+//!
+//! So a penalty sweep watches the active samples of each accepted point (`corners.rs`):
+//! when they change, or when a segment stops on failed steps (after
+//! [`PENALTY_MAX_FAILURES`] halvings), the corner ahead is located exactly on the current
+//! piece (Newton in `ω` on the crossing sample's gap, each iterate one linear solve of the
+//! affine piece), the sample is flipped, and the branch goes on along the new piece in the
+//! `ω` direction where it is consistent — walking on from corner to corner while they are
+//! closer than one largest step, then restarting the continuation a short way along the
+//! first long piece (or from the continuation's own point when it already lies there,
+//! heading away from the corner). Corners are branch points (`iterations = 0`), and the
+//! folds of a penalty branch are its extreme corners (the core's interpolated fold, which
+//! assumes a smooth turn, is not used). Measured with the sweep settings of
+//! `tests/frequency_response.rs` (release, 2 shared cores): the four canonical cases above
+//! reach `omega_ratio_to = 2` in 0.05-0.1, 0.1-0.2, 0.4-0.7 and 1.0 s (1356, 3260, 2777 and
+//! 6185 factorizations), and the branch converges like `1/k_p` (jump-down frequency and
+//! peak change by 4e-4 and 7e-4 from `k_p = 1e3` to `1e4 x`, by 4e-5 and 7e-5 from `1e4`
+//! to `1e5 x`). Its limit is not the SSN-HB branch at the same `H` (contact imposed at the
+//! `Nt` samples instead of on the `2H + 1`-term projection): jump-down 1.0518 against
+//! 1.0414 `ω_1` at `H = 5`, 1.0293 against 1.0276 at `H = 20`, both approaching SSN-HB at
+//! `H = 40` (1.0278).
 //!
 //! # Methods
 //!
@@ -234,6 +274,7 @@ impl FrequencyResponse {
                 "corrector_iterations": self.continuation.corrector_iterations,
                 "rejected_steps": self.continuation.rejected_steps,
                 "restarts": self.restarts,
+                "corners": self.corners,
             },
         })
     }
@@ -755,7 +796,9 @@ where
                 break;
             }
         }
-        for event in cont.events() {
+        // Penalty: every fold is a corner, recorded exactly (the core's interpolation
+        // assumes a smooth turn and would place it beyond).
+        for event in cont.events().iter().filter(|_| corners.is_none()) {
             if let ContinuationEvent::Fold { index, parameter } = event {
                 if let Some(&i) = index_map.get(*index) {
                     raw_events.push((i, parameter * omega_unit));

@@ -65,7 +65,7 @@ impl PenaltyHbOptions {
 /// With the activity `h` held fixed the residual is affine in `U`: the branch of solutions
 /// in `w` is made of pieces `U_h(w)` (one per set of active samples), each a graph over
 /// `w`, joined at corners where one sample's gap changes sign. [`crate::sweep`] steps over
-/// such corners with the crate-internal frozen activity ([`PenaltyHb::freeze_activity`]).
+/// such corners with the pieces themselves (a crate-internal frozen activity).
 #[derive(Debug)]
 pub struct PenaltyHb {
     state: HbState,
