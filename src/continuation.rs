@@ -219,8 +219,8 @@ pub struct ContinuationOptions {
     /// jump between active sets, and a poor starting guess).
     pub corrector_line_search: Option<LineSearchOptions>,
     /// Locate folds by cubic Hermite interpolation of `p(s)` between the two points that
-    /// bracket the sign change (otherwise the fold is reported at the parameter of the
-    /// point after the sign change). Default `true`.
+    /// bracket the sign change (otherwise the fold is reported at the extreme point of the
+    /// accepted points). Default `true`.
     pub refine_folds: bool,
     /// When the step has been halved to its end (the run would stop), try once to pass a
     /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
@@ -1025,8 +1025,7 @@ struct FoldSample {
 /// parameter component `t_p` changes sign between `k - 1` and `k` or between `k` and `k + 1`;
 /// the fold is then located by cubic Hermite interpolation of `p(s)` on that interval (when
 /// refinement is asked for and the interpolated extremum lies beyond `p_k`, within the
-/// reach of the neighbouring steps), otherwise reported at the point after the sign change
-/// (unrefined) or at `p_k`. A reversal without such a sign change (a fold at a corner of a
+/// reach of the neighbouring steps), otherwise reported at the extreme point `p_k`. A reversal without such a sign change (a fold at a corner of a
 /// piecewise-smooth branch) is reported at `p_k`. A sign change of `t_p` without a reversal
 /// of the increments (a generalized Jacobian taken on the other side of a corner, where
 /// the tangent of the neighbouring piece points backwards) is no fold.
@@ -1126,8 +1125,7 @@ impl FoldDetector {
                     (index, extreme.parameter)
                 }
             }
-            Some((_, b, index)) => (index, b.parameter),
-            None => (extreme_index, extreme.parameter),
+            _ => (extreme_index, extreme.parameter),
         };
         Some(ContinuationEvent::Fold { index, parameter })
     }

@@ -227,7 +227,7 @@ fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
     );
     assert!((last.state[0] - plastic).abs() < 1e-10);
     assert_one_factorization_per_iteration(&branch);
-    // Without refinement the fold is reported at the point after the sign change, which is
+    // Without refinement the fold is reported at the extreme point of the branch, which is
     // within one step of the fold in the parameter.
     let mut problem = s_curve();
     let mut solver = FaerDenseLu::new();

@@ -1,20 +1,21 @@
 //! Frequency-response curves by pseudo-arclength continuation (issue 6), checked against
 //! independent references: the exact linear response (complex dense solve), plain Newton
-//! re-solves at every branch point, the natural-parameter sweep, and the penalty
-//! formulation.
+//! re-solves at every branch point, the natural-parameter sweep, the penalty formulation
+//! (its own residual at every point, its convergence in the penalty) and SSN-HB at a higher
+//! `H`.
 
 use faer::sparse::SparseColMat;
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::continuation::natural_sweep;
 use semismooth::newton::{self, Globalization, NewtonOptions};
-use semismooth::ParameterDependent;
-use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth_problems::hb::{HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::model::StructuralModel;
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::RunError;
 use semismooth_problems::scene::{
     default_hb_time_samples, GlobalizationChoice, LinearSolverChoice, Method, SolverSettings,
-    SweepSettings,
+    SweepSettings, DEFAULT_RELATIVE_PENALTY,
 };
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
 
@@ -334,43 +335,163 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
     assert!((arc.omega.last().unwrap() / rod.omega_1 - 1.2).abs() < 1e-12);
 }
 
-/// Penalty HB against SSN-HB where both branches are single-valued in omega (up to
-/// omega_1, past the onset of contact near 0.98 omega_1): the end point at omega_to is the
-/// same frequency for both, so the states compare directly. (Beyond, stiff-penalty branches
-/// reverse in omega many times by small amounts and the sweeps stall: see `sweep`'s docs.)
+/// The frequency where the branch turns back last (the jump-down frequency of an upward
+/// sweep) and the largest amplitude.
+fn jump_down_and_peak(r: &FrequencyResponse) -> (f64, f64) {
+    let fold = r.folds.iter().copied().fold(f64::NAN, f64::max) / r.omega_1;
+    (fold, r.peak().unwrap().1)
+}
+
+/// Penalty HB at the scenes' default penalty (`1e5` x the contact stiffness scale) on the
+/// canonical rod: the branch zigzags in omega (the contact moves from AFT sample to AFT
+/// sample, every change of the active samples is a corner, many are folds), and the sweep
+/// crosses these corners to the end of [0.5, 2]. Every point, corners included, is checked
+/// on the penalty problem itself: its residual is at the corrector's tolerance and a plain
+/// Newton step from it (exact on the affine piece it lies on) moves it by round-off only.
 #[test]
-fn penalty_branch_approaches_the_exact_contact_branch_for_a_stiff_penalty() {
-    let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
-    let h = 5;
-    let (from, to) = (0.5, 1.0);
-    let ssn = curve(&rod, Method::SsnHb, h, from, to);
-    let mut s = settings(Method::PenaltyHb, h);
-    let scale = rod.model.contact_stiffness_scale();
-    let reference = *ssn.tip_min.last().unwrap();
-    let mut values = Vec::new();
-    for relative in [1e2, 1e3, 1e4] {
-        s.penalty_stiffness = Some(relative * scale);
-        let pen = frequency_response(&rod, &s, &sweep(from, to), None).unwrap();
-        assert!(pen.converged, "{}", pen.termination);
-        let value = *pen.tip_min.last().unwrap();
-        let diff = (value - reference).abs() / reference.abs();
+fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
+    for (gap, h) in [(0.5, 5), (0.25, 5), (0.5, 20), (0.25, 20)] {
+        let rod = rod(Some(gap), 0.04, MassModel::Consistent);
+        let s = settings(Method::PenaltyHb, h);
+        let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
+        assert!(r.converged, "gap {gap}, H = {h}: {}", r.termination);
+        assert!((r.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
+        let (fold, peak) = jump_down_and_peak(&r);
         println!(
-            "k_p = {relative:e} K: tip min at omega_to {value} vs {reference}, relative {diff:e}, \
-             tip max {} (gap 0.5)",
-            pen.tip_max.last().unwrap()
+            "gap {gap}, H = {h}: {} points, {} corners, {} folds, jump-down {fold}, peak {peak}, \
+             {} factorizations, {:.3} s",
+            r.points(),
+            r.corners,
+            r.folds.len(),
+            r.counters.factorizations,
+            r.solve_seconds
         );
-        // The two formulations discretise the contact law differently (penalty on the AFT
-        // samples, complementarity on the Galerkin projection): at H = 5 they agree to the
-        // contact resolution measured above (3% of the gap).
-        assert!(diff < 0.03, "k_p = {relative:e}: {diff:e}");
-        values.push(value);
+        assert!(r.corners > 0 && r.folds.len() > 2, "gap {gap}, H = {h}");
+        let kp = DEFAULT_RELATIVE_PENALTY * rod.model.contact_stiffness_scale();
+        let options = PenaltyHbOptions {
+            harmonics: h,
+            time_samples: Some(default_hb_time_samples(h)),
+            penalty_stiffness: kp,
+        };
+        let mut problem = PenaltyHb::new(&rod.model, &options).unwrap();
+        let mut solver = StructuredHbSolver::new();
+        let mut jac = problem.new_jacobian();
+        let mut f = vec![0.0; problem.dim()];
+        // The corrector's tolerance: the scene's, or the rounding floor of the penalty force
+        // (k_p times gaps computed to eps |u|), whichever is larger.
+        let tolerance = s
+            .tolerance
+            .max(f64::EPSILON * kp * gap.max(r.reference_amplitude));
+        let (mut worst_f, mut worst_step): (f64, f64) = (0.0, 0.0);
+        for (x, &w) in r.states.iter().zip(&r.omega) {
+            problem.set_parameter(w);
+            problem.residual(x, &mut f);
+            let fnorm = norm(&f);
+            problem.jacobian(x, &mut jac);
+            solver.factor(&jac).unwrap();
+            solver.solve_in_place(&mut f).unwrap();
+            let step = norm(&f) / norm(x);
+            assert!(
+                fnorm <= tolerance,
+                "w = {w}: |F| = {fnorm:e} > {tolerance:e}"
+            );
+            assert!(step <= 1e-6, "w = {w}: Newton step {step:e}");
+            worst_f = worst_f.max(fnorm);
+            worst_step = worst_step.max(step);
+        }
+        println!("  largest |F| {worst_f:e} (tolerance {tolerance:e}), Newton step {worst_step:e}");
     }
-    // The penalty solution converges as k_p grows (changes shrink like 1/k_p: measured
-    // 1.4e-4 then 1.4e-5 per decade) to a limit within the formulations' H = 5 difference
-    // of the SSN-HB one (measured 1.05%).
-    let (d1, d2) = ((values[1] - values[0]).abs(), (values[2] - values[1]).abs());
-    println!("penalty changes per decade of k_p: {d1:e}, {d2:e}");
-    assert!(d2 < 0.2 * d1, "{d1:e} {d2:e}");
+}
+
+/// The folds of a penalty branch are corners (changes of the active AFT samples), located
+/// exactly whatever path the continuation takes between them: a sweep with a largest step
+/// 25 times smaller (twelve times more points) finds the same folds to round-off.
+#[test]
+fn penalty_folds_do_not_depend_on_the_continuation_step() {
+    let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
+    let s = settings(Method::PenaltyHb, 5);
+    let coarse = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
+    let fine_steps = SweepSettings {
+        step: 0.002,
+        max_step: 0.002,
+        max_points: 5000,
+        ..sweep(0.5, 2.0)
+    };
+    let fine = frequency_response(&rod, &s, &fine_steps, None).unwrap();
+    assert!(coarse.converged, "{}", coarse.termination);
+    assert!(fine.converged, "{}", fine.termination);
+    assert!(fine.points() > 10 * coarse.points());
+    assert_eq!(coarse.folds.len(), fine.folds.len());
+    let worst = coarse
+        .folds
+        .iter()
+        .zip(&fine.folds)
+        .map(|(a, b)| (a - b).abs() / rod.omega_1)
+        .fold(0.0, f64::max);
+    println!(
+        "{} folds, {} and {} points: largest difference {worst:e} omega_1",
+        coarse.folds.len(),
+        coarse.points(),
+        fine.points()
+    );
+    // Corners are located to 1e-10 omega (or the rounding of a slowly crossing gap).
+    assert!(worst < 1e-8, "{worst:e}");
+}
+
+/// The penalty branch converges as `k_p` grows, its error (the penetration, force / k_p)
+/// shrinking like `1 / k_p`: the jump-down frequency and the peak change ten times less per
+/// decade of `k_p` at each decade. Its limit is not the SSN-HB branch at the same `H`: the
+/// penalty imposes contact at the `Nt` AFT samples, SSN-HB on the Galerkin projection onto
+/// `2H + 1` harmonics. The two are truncations of the same contact problem, so they approach
+/// each other as `H` grows: against SSN-HB at `H = 40`, both formulations' errors shrink by
+/// more than four from `H = 5` to `H = 20`.
+#[test]
+fn penalty_branch_converges_like_one_over_the_penalty_and_meets_ssn_as_h_grows() {
+    let gap = 0.5;
+    let rod = rod(Some(gap), 0.04, MassModel::Consistent);
+    let scale = rod.model.contact_stiffness_scale();
+    let penalty = |h: usize, relative: f64| {
+        let mut s = settings(Method::PenaltyHb, h);
+        s.penalty_stiffness = Some(relative * scale);
+        let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
+        assert!(
+            r.converged,
+            "H = {h}, k_p = {relative:e}: {}",
+            r.termination
+        );
+        jump_down_and_peak(&r)
+    };
+    let values: Vec<(f64, f64)> = [1e3, 1e4, DEFAULT_RELATIVE_PENALTY]
+        .iter()
+        .map(|&k| penalty(5, k))
+        .collect();
+    let change = |i: usize| {
+        (
+            (values[i + 1].0 - values[i].0).abs(),
+            (values[i + 1].1 - values[i].1).abs(),
+        )
+    };
+    let (first, second) = (change(0), change(1));
+    println!("H = 5, k_p = 1e3, 1e4, 1e5 x: {values:?}; changes per decade {first:?} {second:?}");
+    assert!(second.0 < 0.2 * first.0, "jump-down: {first:?} {second:?}");
+    assert!(second.1 < 0.2 * first.1, "peak: {first:?} {second:?}");
+
+    let ssn = |h: usize| jump_down_and_peak(&curve(&rod, Method::SsnHb, h, 0.5, 2.0));
+    let reference = ssn(40);
+    let error = |v: (f64, f64)| ((v.0 - reference.0).abs(), (v.1 - reference.1).abs());
+    let (pen5, pen20) = (
+        error(values[2]),
+        error(penalty(20, DEFAULT_RELATIVE_PENALTY)),
+    );
+    let (ssn5, ssn20) = (error(ssn(5)), error(ssn(20)));
+    println!(
+        "against SSN-HB at H = 40 {reference:?}: penalty H = 5 {pen5:?}, H = 20 {pen20:?}; \
+         SSN-HB H = 5 {ssn5:?}, H = 20 {ssn20:?}"
+    );
+    for (name, e5, e20) in [("penalty", pen5, pen20), ("ssn-hb", ssn5, ssn20)] {
+        assert!(e20.0 < 0.25 * e5.0, "{name} jump-down: {e5:?} {e20:?}");
+        assert!(e20.1 < 0.25 * e5.1, "{name} peak: {e5:?} {e20:?}");
+    }
 }
 
 #[test]

@@ -30,7 +30,7 @@
 //! # Robustness on piecewise-smooth branches
 //!
 //! The contact branches are only piecewise smooth (the set of active AFT samples changes
-//! along them), with corners and folds at corners. Three measures on this side of the core:
+//! along them), with corners and folds at corners. Four measures on this side of the core:
 //!
 //! - a trust ball: the corrector may not leave the θ-ball of radius
 //!   [`TRUST_FACTOR`]` x` (largest next step) around the last point (outside it the residual
@@ -41,24 +41,65 @@
 //!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
 //!   the constraint), heading the way `ω` last moved, or the other way when that restart
 //!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//! - penalty HB: corners crossed explicitly (below);
 //! - folds are found by the core's [`FoldDetector`] over the whole stitched branch (a fold
 //!   can fall between two segments): reversals of `ω` along the accepted points, located by
 //!   Hermite interpolation where the tangent's `ω` component changes sign across them; a
 //!   sign change of the tangent alone (a generalized Jacobian from the far side of a
-//!   corner) is no fold.
+//!   corner) is no fold. Corners recorded by the penalty path carry no tangent, so a fold
+//!   there is the corner itself.
 //!
 //! The core's own corner passes ([`ContinuationOptions::pass_corners`]) are tried first,
 //! before a segment gives up; the restarts above come after them.
 //!
 //! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
 //! tolerance for SSN-HB, so each point is a fixed point of a Newton solve at that
-//! tolerance; for penalty HB it is the scene's tolerance itself (a stiff penalty puts the
-//! rounding floor of `|F|` within a decade of it).
+//! tolerance. For penalty HB it is the scene's tolerance or the rounding floor of `|F|`,
+//! `ε k_p max(|g|, u_ref)` (the penalty force is `k_p` times gaps computed to `ε |u|`),
+//! whichever is larger: at the default penalty on the canonical rod the floor is 3.3e-10
+//! and a solution's `|F|` measures 1.5e-11 to 4.4e-11; from `k_p = 1e6 x` on, a fixed
+//! tolerance of 1e-10 is below the floor and the corrector stalls (measured: `|F| = 2.1e-10`
+//! at `k_p = 1e6 x`, `H = 5`).
 //!
-//! Known limit: penalty-HB branches with a stiff penalty (`k_p >= 1e3` times the contact
-//! stiffness scale, the scenes' default is `1e5`) reverse in `ω` many times by small amounts
-//! near the contact onset of the canonical rod, and the continuation stalls there
-//! (`converged = false`, the reason in `termination`); SSN-HB passes.
+//! ## Penalty-HB branches: corners crossed explicitly
+//!
+//! With the active samples fixed, the penalty residual is affine in `U`: the branch is a
+//! chain of pieces, each a graph over `ω`, joined at corners where a sample's gap changes
+//! sign, and every fold of a penalty branch is a corner. With a stiff penalty the contact
+//! moves from sample to sample as `ω` changes and the branch zigzags: on the canonical rod
+//! (gap 0.5, default `k_p = 1e5 x` the contact stiffness scale) 48 corners and 44 folds at
+//! `H = 5`, 670 and 646 at `H = 20` (1570 and 1510 with gap 0.25). They are features of
+//! the penalty branch, not corrector artefacts: before corners were crossed explicitly,
+//! `max_step = 2e-3` and `5e-4` (instead of `5e-2`) stalled after the same reversals at
+//! the same frequencies (1.00448 -> 1.00350 and 1.00977 -> 1.00767 `ω_1`, then 1.01447);
+//! now any `max_step` gives the same folds (44 to 6e-10 with `5e-2`, `2e-3` and `5e-4`;
+//! 646 at `H = 20` to 1.3e-10 with `5e-2`, `1e-2` and `2e-3`). Some corners turn by more
+//! than a right angle in the arclength metric (93.6° at `ω = 1.01447 ω_1`, `H = 5`, where
+//! the two-sample piece meets the one-sample piece going back): the arclength constraint
+//! then has no solution on the next piece at any step, and the sweep used to end there
+//! with `converged = false` (after 20 restarts, or retracing the branch back to
+//! `omega_from`). Scaling the force harmonics into the metric does not help (the turn
+//! stays above 90°, 108° at weight 100).
+//!
+//! So a penalty sweep watches the active samples of each accepted point (`corners.rs`):
+//! when they change, or when a segment stops on failed steps (after
+//! [`PENALTY_MAX_FAILURES`] halvings), the corner ahead is located exactly on the current
+//! piece (Newton in `ω` on the crossing sample's gap, each iterate one linear solve of the
+//! affine piece), the sample is flipped, and the branch goes on along the new piece in the
+//! `ω` direction where it is consistent — walking on from corner to corner while they are
+//! closer than one largest step, then restarting the continuation a short way along the
+//! first long piece (or from the continuation's own point when it already lies there,
+//! heading away from the corner). Corners are branch points (`iterations = 0`), and the
+//! folds of a penalty branch are its extreme corners (the core's interpolated fold, which
+//! assumes a smooth turn, is not used). Measured with the sweep settings of
+//! `tests/frequency_response.rs` (release, 2 shared cores): the four canonical cases above
+//! reach `omega_ratio_to = 2` in 0.05-0.1, 0.1-0.2, 0.4-0.7 and 1.0 s (1356, 3260, 2777 and
+//! 6185 factorizations), and the branch converges like `1/k_p` (jump-down frequency and
+//! peak change by 4e-4 and 7e-4 from `k_p = 1e3` to `1e4 x`, by 4e-5 and 7e-5 from `1e4`
+//! to `1e5 x`). Its limit is not the SSN-HB branch at the same `H` (contact imposed at the
+//! `Nt` samples instead of on the `2H + 1`-term projection): jump-down 1.0518 against
+//! 1.0414 `ω_1` at `H = 5`, 1.0293 against 1.0276 at `H = 20`, both approaching SSN-HB at
+//! `H = 40` (1.0278).
 //!
 //! # Methods
 //!
@@ -85,7 +126,13 @@ use semismooth::newton::{self, NewtonReport};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use serde_json::json;
 
-use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
+mod corners;
+
+use corners::{Corners, PenaltyCorners};
+
+use crate::hb::{
+    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+};
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
 use crate::scene::{
@@ -122,6 +169,10 @@ pub const RESTART_POINTS: usize = 4;
 
 /// Restarts allowed per sweep.
 pub const MAX_RESTARTS: usize = 20;
+
+/// Failed steps in a row (each halving the step) after which a penalty-HB continuation
+/// segment stops and the corner ahead is crossed explicitly (module documentation).
+pub const PENALTY_MAX_FAILURES: usize = 3;
 
 /// A frequency-response curve: one entry per branch point, in branch order (the frequency
 /// is not monotone across folds).
@@ -160,6 +211,8 @@ pub struct FrequencyResponse {
     pub initial_iterations: usize,
     /// Continuation restarts after failed steps (module documentation).
     pub restarts: usize,
+    /// Corners of a penalty branch stepped over explicitly (module documentation).
+    pub corners: usize,
     /// `u_ref` of the step scaling (module documentation).
     pub reference_amplitude: f64,
     /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
@@ -170,6 +223,15 @@ pub struct FrequencyResponse {
 }
 
 impl FrequencyResponse {
+    fn push(&mut self, omega: f64, max: f64, min: f64, iterations: usize, state: Vec<f64>) {
+        self.omega.push(omega);
+        self.tip_max.push(max);
+        self.tip_min.push(min);
+        self.amplitude.push(max.abs().max(min.abs()));
+        self.iterations.push(iterations);
+        self.states.push(state);
+    }
+
     /// Number of branch points.
     pub fn points(&self) -> usize {
         self.omega.len()
@@ -218,6 +280,7 @@ impl FrequencyResponse {
                 "rejected_steps": self.continuation.rejected_steps,
                 "corner_passes": self.continuation.corner_passes,
                 "restarts": self.restarts,
+                "corners": self.corners,
             },
         })
     }
@@ -402,6 +465,7 @@ fn continuation_options(
     settings: &SolverSettings,
     sweep: &SweepSettings,
     q_unit: f64,
+    residual_floor: f64,
 ) -> Result<ContinuationOptions, RunError> {
     let (lo, hi) = if sweep.omega_ratio_to > sweep.omega_ratio_from {
         (sweep.omega_ratio_from, sweep.omega_ratio_to)
@@ -417,14 +481,19 @@ fn continuation_options(
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
         corrector_tolerance: match settings.method {
-            // A stiff penalty puts the rounding floor of |F| near the tolerance itself.
-            Method::PenaltyHb => settings.tolerance,
+            // |F| cannot be computed below its rounding floor (a stiff penalty puts it
+            // near the scene's tolerance).
+            Method::PenaltyHb => settings.tolerance.max(residual_floor),
             _ => CORRECTOR_TOLERANCE_FACTOR * settings.tolerance,
         },
         parameter_min: lo / q_unit,
         parameter_max: hi / q_unit,
         max_points: sweep.max_points,
-        max_consecutive_failures: halvings.clamp(3, 64),
+        max_consecutive_failures: match settings.method {
+            // A failed step on a penalty branch is a corner, crossed explicitly.
+            Method::PenaltyHb => PENALTY_MAX_FAILURES,
+            _ => halvings.clamp(3, 64),
+        },
         theta: THETA,
         direction: if sweep.omega_ratio_to > sweep.omega_ratio_from {
             Direction::Increasing
@@ -505,6 +574,8 @@ struct Setup<'a> {
     units: Vec<f64>,
     output_points: usize,
     started: Instant,
+    /// Rounding floor of `|F|` (0 where negligible): the corrector tolerance is at least this.
+    residual_floor: f64,
 }
 
 fn follow<P, S>(
@@ -512,6 +583,7 @@ fn follow<P, S>(
     solver: &mut S,
     setup: Setup<'_>,
     measure: &mut TipMeasure<'_, P>,
+    mut corners: Option<&mut dyn Corners>,
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError>
 where
@@ -527,12 +599,13 @@ where
         units,
         output_points,
         started,
+        residual_floor,
     } = setup;
     let n = problem.dim();
     // q = (ω/ω_1) / sqrt(1 - θ): (1 - θ) Δq² = Δ(ω/ω_1)².
     let q_unit = (1.0 - THETA).sqrt();
     let omega_unit = q_unit * omega_1;
-    let options = continuation_options(settings, sweep, q_unit)?;
+    let options = continuation_options(settings, sweep, q_unit, residual_floor)?;
     // x = s ⊙ y with s² = θ N u_ref² / n: (θ/n)|Δy|² = |ΔX|² / (N u_ref²).
     let base = (THETA * dofs as f64 / n as f64).sqrt() * u_ref;
     let scale: Vec<f64> = units.iter().map(|u| u * base).collect();
@@ -559,6 +632,7 @@ where
         continuation: ContinuationCounters::default(),
         initial_iterations: report.iterations,
         restarts: 0,
+        corners: 0,
         reference_amplitude: u_ref,
         output_points,
         states: Vec::new(),
@@ -599,21 +673,30 @@ where
     let mut restart = false;
     let mut restarts = 0;
     // Folds along the whole stitched branch (a fold can fall between two segments).
-    let mut fold_detector = FoldDetector::new(true);
+    // Penalty folds are corners, recorded exactly: no smooth-turn interpolation there.
+    let mut fold_detector = FoldDetector::new(corners.is_none());
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
+    // After a corner the segment starts at a new point (otherwise at the last one).
+    let mut new_start = false;
+    let mut crossed = 0;
+    let mut corner_work = newton::WorkCounters::default();
+    // Penalty: the smooth piece of the last recorded point and the way ω goes along it.
+    let mut piece: Option<Vec<bool>> = None;
+    let mut travel = direction_sign(direction);
     let termination = loop {
         let offset = response.omega.len();
         let remaining = base_points.saturating_sub(offset);
+        let repeat = usize::from(offset > 0 && !new_start);
         let segment_options = ContinuationOptions {
             theta: if restart { THETA_RESTART } else { THETA },
             max_points: if restart {
                 RESTART_POINTS + 1
             } else {
-                remaining + usize::from(offset > 0)
+                remaining + repeat
             }
-            .min(remaining + usize::from(offset > 0))
+            .min(remaining + repeat)
             .max(1),
             direction,
             ..options.clone()
@@ -626,7 +709,10 @@ where
             segment_options,
         )
         .map_err(continuation_error)?;
-        let mut first = true;
+        // Index in `response` of each point of the segment (for the core's fold events),
+        // and where the segment stopped to let the next one start after a corner.
+        let mut index_map: Vec<usize> = Vec::new();
+        let mut next: Option<(Vec<f64>, f64, Direction, bool)> = None;
         while let Some(item) = cont.next() {
             let point = match item {
                 Ok(point) => point,
@@ -649,29 +735,82 @@ where
                 t.radius = TRUST_FACTOR * next;
             }
             // The start of a restarted segment repeats the last point.
-            if std::mem::take(&mut first) && offset > 0 {
+            if index_map.is_empty() && repeat > 0 {
+                index_map.push(offset - 1);
                 continue;
             }
-            last_tangent_parameter = point.tangent_parameter;
             let state: Vec<f64> = point.state.iter().zip(&scale).map(|(y, s)| y * s).collect();
             let omega = point.parameter * omega_unit;
-            let (max, min) = measure(&*cont.problem().inner, &state)?;
-            response.omega.push(omega);
-            response.tip_max.push(max);
-            response.tip_min.push(min);
-            response.amplitude.push(max.abs().max(min.abs()));
-            response.iterations.push(point.iterations);
-            response.states.push(state);
-            if let Some(ContinuationEvent::Fold { index, parameter }) =
-                fold_detector.push(point.parameter, point.tangent_parameter, point.step)
-            {
-                response.folds.push(parameter * omega_unit);
-                response.fold_indices.push(index);
+            // Penalty: a point on another piece means a corner was passed. It is located
+            // and recorded; the continuation goes on unless it would head back to it.
+            let mut corner_points = Vec::new();
+            if let Some(c) = corners.as_mut() {
+                let mut label = c.piece(&state);
+                let k = response.omega.len();
+                match piece.as_ref() {
+                    Some(last) if *last != label && k > 0 => {
+                        let walk = c.cross(
+                            &response.states[k - 1],
+                            response.omega[k - 1],
+                            travel,
+                            remaining,
+                            &mut corner_work,
+                        );
+                        if let Some(walk) = walk {
+                            crossed += walk.corners.len();
+                            let along = direction_sign(walk.direction);
+                            let start_label = c.piece(&walk.start);
+                            if walk.corners.len() > 1 || start_label != label {
+                                // Several corners passed: go on after the last.
+                                label = start_label;
+                                next = Some((walk.start, walk.start_omega, walk.direction, true));
+                            } else if (omega - response.omega[k - 1]) * along < 0.0 {
+                                // The continuation would head back to the corner.
+                                next = Some((state.clone(), omega, walk.direction, false));
+                            }
+                            corner_points = walk.corners;
+                            travel = along;
+                        } else {
+                            travel = (omega - response.omega[k - 1]).signum();
+                        }
+                    }
+                    Some(_) if k > 0 && omega != response.omega[k - 1] => {
+                        travel = (omega - response.omega[k - 1]).signum();
+                    }
+                    _ => {}
+                }
+                piece = Some(label);
             }
+            for (x, w) in corner_points {
+                let (max, min) = measure(&*cont.problem().inner, &x)?;
+                response.push(w, max, min, 0, x);
+                record_fold(&mut response, &mut fold_detector, w, 0.0, 0.0, omega_unit);
+                if let Some(report) = progress {
+                    report(response.omega.len() - 1, w / omega_1);
+                }
+            }
+            if matches!(next, Some((_, _, _, true))) {
+                break;
+            }
+            last_tangent_parameter = point.tangent_parameter;
+            let (max, min) = measure(&*cont.problem().inner, &state)?;
+            response.push(omega, max, min, point.iterations, state);
+            index_map.push(response.omega.len() - 1);
+            record_fold(
+                &mut response,
+                &mut fold_detector,
+                omega,
+                point.tangent_parameter,
+                point.step,
+                omega_unit,
+            );
             start_y = point.state;
             start_q = point.parameter;
             if let Some(report) = progress {
                 report(response.omega.len() - 1, omega / omega_1);
+            }
+            if next.is_some() {
+                break;
             }
         }
         add_counters(&mut c, &cont.counters());
@@ -692,6 +831,44 @@ where
         if response.omega.len() >= base_points {
             break termination;
         }
+        // Penalty: a failed step at a corner (one the arclength cannot turn, e.g. a fold
+        // where the next piece leaves at more than a right angle) is crossed explicitly.
+        if let (true, None, Some(c)) = (failed, &next, corners.as_mut()) {
+            let k = response.omega.len();
+            if let Some(walk) = c.cross(
+                &response.states[k - 1],
+                response.omega[k - 1],
+                travel,
+                base_points.saturating_sub(k),
+                &mut corner_work,
+            ) {
+                crossed += walk.corners.len();
+                for (x, w) in walk.corners {
+                    let (max, min) = measure(&*scaled.inner, &x)?;
+                    response.push(w, max, min, 0, x);
+                    record_fold(&mut response, &mut fold_detector, w, 0.0, 0.0, omega_unit);
+                    if let Some(report) = progress {
+                        report(response.omega.len() - 1, w / omega_1);
+                    }
+                }
+                piece = Some(c.piece(&walk.start));
+                travel = direction_sign(walk.direction);
+                next = Some((walk.start, walk.start_omega, walk.direction, true));
+            }
+        }
+        if let Some((x, w, d, fresh)) = next {
+            start_y = x.iter().zip(&scale).map(|(x, s)| x / s).collect();
+            start_q = w / omega_unit;
+            direction = d;
+            restart = false;
+            new_start = fresh;
+            let mut t = trust.borrow_mut();
+            t.center.clone_from(&start_y);
+            t.center_q = start_q;
+            t.radius = TRUST_FACTOR * max_step;
+            continue;
+        }
+        new_start = false;
         let stuck = failed && restart && response.omega.len() == offset;
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
@@ -720,8 +897,14 @@ where
             (true, Direction::Decreasing) => Direction::Increasing,
             _ => forward,
         };
+        travel = direction_sign(direction);
     };
     response.restarts = restarts;
+    response.corners = crossed;
+    if let Some(c) = corners.as_ref() {
+        corner_work.ffts += c.ffts();
+    }
+    c.work += corner_work;
     counters.residual_evaluations += c.work.residual_evaluations;
     counters.jacobian_evaluations += c.work.jacobian_evaluations;
     counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
@@ -804,6 +987,32 @@ where
     Ok(response)
 }
 
+fn direction_sign(direction: Direction) -> f64 {
+    match direction {
+        Direction::Increasing => 1.0,
+        Direction::Decreasing => -1.0,
+    }
+}
+
+/// Feeds the point just pushed (at `omega`, with the tangent's scaled-parameter component
+/// and the chord from the previous point; both 0 for a corner, which has no tangent) to the
+/// fold detector, recording a fold it confirms.
+fn record_fold(
+    response: &mut FrequencyResponse,
+    detector: &mut FoldDetector,
+    omega: f64,
+    tangent_parameter: f64,
+    chord: f64,
+    omega_unit: f64,
+) {
+    if let Some(ContinuationEvent::Fold { index, parameter }) =
+        detector.push(omega / omega_unit, tangent_parameter, chord)
+    {
+        response.folds.push(parameter * omega_unit);
+        response.fold_indices.push(index);
+    }
+}
+
 fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
     total.work += c.work;
     total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
@@ -875,7 +1084,7 @@ pub fn frequency_response(
     let omega_1 = rod.omega_1;
     let u_ref = reference_amplitude(rod);
     let output_points = HB_OUTPUT_POINTS.max(settings.time_samples);
-    let setup = |units: Vec<f64>, output_points: usize| Setup {
+    let setup = |units: Vec<f64>, output_points: usize, residual_floor: f64| Setup {
         settings,
         sweep,
         omega_1,
@@ -884,6 +1093,7 @@ pub fn frequency_response(
         units,
         output_points,
         started,
+        residual_floor,
     };
     match settings.method {
         Method::SsnHb => {
@@ -900,13 +1110,14 @@ pub fn frequency_response(
                 .collect();
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64]| tip_rec.extremes(x);
-            let setup = setup(units, output_points);
+            let setup = setup(units, output_points, 0.0);
             match settings.linear_solver {
                 LinearSolverChoice::Structured => follow(
                     &mut problem,
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -914,6 +1125,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
             }
@@ -930,13 +1142,37 @@ pub fn frequency_response(
             let units = vec![1.0; problem.dim()];
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64]| tip_rec.extremes(x);
-            let setup = setup(units, output_points);
+            // The penalty force is k_p times gaps computed to ε |u| (|u| ~ the gap in contact).
+            let gap = model
+                .contacts
+                .iter()
+                .map(|c| c.gap.abs())
+                .fold(u_ref, f64::max);
+            let floor = f64::EPSILON * options.penalty_stiffness * gap;
+            let setup = setup(units, output_points, floor);
+            // A corner is searched within one largest step of the last point, and the next
+            // piece is entered at most a quarter of the first step from it (in ω).
+            let limits = (sweep.max_step * omega_1, 0.25 * sweep.step * omega_1);
+            let solver: Box<dyn LinearSolve<HbJacobian>> = match settings.linear_solver {
+                LinearSolverChoice::Structured => Box::new(StructuredHbSolver::new()),
+                LinearSolverChoice::Dense => Box::new(FaerDenseLu::new()),
+            };
+            let mut corners = PenaltyCorners {
+                problem: PenaltyHb::new(model, &options)?,
+                solver,
+                reach: limits.0,
+                shift: limits.1,
+                walk: sweep.max_step,
+                omega_1,
+                unit: (dofs as f64).sqrt() * u_ref,
+            };
             match settings.linear_solver {
                 LinearSolverChoice::Structured => follow(
                     &mut problem,
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    Some(&mut corners),
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -944,6 +1180,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    Some(&mut corners),
                     progress,
                 ),
             }

@@ -61,12 +61,20 @@ impl PenaltyHbOptions {
 /// residual `R = A(w) U - F - G^T P lambda(E U)` with
 /// `lambda_i(t_n) = -k_p max(0, u_{dof_i}(t_n) - g_i)`, generalized Jacobian
 /// `A(w) + k_p G^T P diag(h) G E`, `h_n = 1` where `G u_n - g > 0`.
+///
+/// With the activity `h` held fixed the residual is affine in `U`: the branch of solutions
+/// in `w` is made of pieces `U_h(w)` (one per set of active samples), each a graph over
+/// `w`, joined at corners where one sample's gap changes sign. [`crate::sweep`] steps over
+/// such corners with the pieces themselves (a crate-internal frozen activity).
 #[derive(Debug)]
 pub struct PenaltyHb {
     state: HbState,
     stiffness: f64,
     coeffs: Vec<f64>,
     samples: Vec<f64>,
+    /// Frozen activity `h` (contact-major, `m Nt` entries): while `Some`, the penalty force
+    /// is `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
+    frozen: Option<Vec<bool>>,
 }
 
 impl PenaltyHb {
@@ -82,6 +90,7 @@ impl PenaltyHb {
             stiffness: kp,
             coeffs: vec![0.0; size],
             samples: vec![0.0; nt],
+            frozen: None,
         })
     }
 
@@ -181,6 +190,48 @@ impl PenaltyHb {
         displacement_summary(&self.state.linear, u, dof, points, means)
     }
 
+    /// Gaps `G u(t_n) - g` at the `Nt` AFT samples, contact-major (`i Nt + n`): the numbers
+    /// whose signs decide which samples carry penalty force.
+    pub(crate) fn gap_samples_all(&mut self, u: &[f64]) -> Vec<f64> {
+        let nt = self.samples.len();
+        let mut out = Vec::with_capacity(self.contacts() * nt);
+        for i in 0..self.contacts() {
+            self.gap_samples(u, i);
+            out.extend_from_slice(&self.samples);
+        }
+        out
+    }
+
+    /// Freezes the activity (`Some(h)`, contact-major, `m Nt` entries): residual and
+    /// Jacobian become those of the affine piece with penalty force `k_p h_n (G u_n - g)`,
+    /// whatever the signs of the gaps. `None` restores `k_p max(0, G u_n - g)`.
+    pub(crate) fn freeze_activity(&mut self, activity: Option<Vec<bool>>) {
+        debug_assert!(activity
+            .as_ref()
+            .is_none_or(|h| h.len() == self.contacts() * self.samples.len()));
+        self.frozen = activity;
+    }
+
+    /// Replaces the gap samples of contact `i` in `self.samples` by the penalty
+    /// "activity-weighted gaps": `max(0, s_n)`, or `h_n s_n` when the activity is frozen.
+    fn penetrations(&mut self, i: usize) {
+        let nt = self.samples.len();
+        match &self.frozen {
+            Some(h) => {
+                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                    if !on {
+                        *s = 0.0;
+                    }
+                }
+            }
+            None => {
+                for s in &mut self.samples {
+                    *s = s.max(0.0);
+                }
+            }
+        }
+    }
+
     /// Samples `G u_n - g` of contact `i` into `self.samples`.
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
@@ -202,8 +253,9 @@ impl Residual for PenaltyHb {
         lin.dynamic_residual(self.state.omega, u, out);
         for i in 0..lin.contacts() {
             self.gap_samples(u, i);
+            self.penetrations(i);
             for s in &mut self.samples {
-                *s = self.stiffness * s.max(0.0);
+                *s *= self.stiffness;
             }
             let _ = self
                 .state
@@ -243,8 +295,15 @@ impl GeneralizedJacobian for PenaltyHb {
         jac.coupling = ContactCoupling::Penalty {
             stiffness: self.stiffness,
         };
+        let nt = self.samples.len();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
+            if let Some(h) = &self.frozen {
+                // The indicator is the sign of the sample: impose the frozen one.
+                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                    *s = if on { 1.0 } else { 0.0 };
+                }
+            }
             self.state.write_contact_block(&mut self.samples, jac, i);
         }
     }
