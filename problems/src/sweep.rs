@@ -81,6 +81,9 @@ use semismooth::newton::{self, NewtonReport};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use serde_json::json;
 
+use crate::lcp::{
+    solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver, PeriodicLcp, PeriodicLcpOptions,
+};
 use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
@@ -500,6 +503,9 @@ struct Setup<'a> {
     units: Vec<f64>,
     output_points: usize,
     started: Instant,
+    /// Starting guess of the Newton solve at `omega_from` (zero when `None`) and the work
+    /// spent computing it.
+    start: Option<(Vec<f64>, RunCounters)>,
 }
 
 fn follow<P, S>(
@@ -522,6 +528,7 @@ where
         units,
         output_points,
         started,
+        start,
     } = setup;
     let n = problem.dim();
     // q = (ω/ω_1) / sqrt(1 - θ): (1 - θ) Δq² = Δ(ω/ω_1)².
@@ -534,9 +541,10 @@ where
 
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
-    let mut x = vec![0.0; n];
+    let (mut x, start_counters) = start.unwrap_or_else(|| (vec![0.0; n], RunCounters::default()));
     let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
     let mut counters = RunCounters::from(report.counters);
+    add_run_counters(&mut counters, &start_counters);
     let mut response = FrequencyResponse {
         method: settings.method,
         omega_1,
@@ -801,6 +809,15 @@ where
     Ok(response)
 }
 
+fn add_run_counters(total: &mut RunCounters, c: &RunCounters) {
+    total.residual_evaluations += c.residual_evaluations;
+    total.jacobian_evaluations += c.jacobian_evaluations;
+    total.factorizations += c.factorizations;
+    total.linear_solves += c.linear_solves;
+    total.line_search_backtracks += c.line_search_backtracks;
+    total.ffts += c.ffts;
+}
+
 fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
     total.work += c.work;
     total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
@@ -922,6 +939,7 @@ pub fn frequency_response(
         units,
         output_points,
         started,
+        start: None,
     };
     match settings.method {
         Method::SsnHb => {
@@ -986,13 +1004,77 @@ pub fn frequency_response(
                 ),
             }
         }
-        Method::LcpSsn => Err(RunError::Unsupported {
-            method: "lcp-ssn",
-            what: "a branch the continuation can follow: the periodic LCP's unknowns are the \
-                   contact forces, which leave zero at a corner of the branch (contact onset) \
-                   where the corrector stalls; sweep with ssn-hb or penalty-hb, or solve \
-                   frequency by frequency with `ssn solve`",
-        }),
+        Method::LcpSsn => {
+            if model.contacts.is_empty() {
+                return Err(RunError::Unsupported {
+                    method: "lcp-ssn",
+                    what: "a [contact] section (the periodic LCP is posed on the contact \
+                           forces; sweep a linear scene with ssn-hb or penalty-hb)",
+                });
+            }
+            let kappa = settings.c.unwrap_or(model.contact_stiffness_scale());
+            let lcp_options = PeriodicLcpOptions {
+                time_samples: settings.time_samples,
+                observed_dofs: Vec::new(),
+            };
+            // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
+            let mut start_model = model.clone();
+            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
+            let sequenced = solve_min_map_sequenced(
+                &start_model,
+                lcp_options.clone(),
+                &newton_options(settings),
+            )?;
+            let mut start_counters = RunCounters::default();
+            for level in &sequenced.levels {
+                add_run_counters(&mut start_counters, &level.report.counters.into());
+            }
+            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
+            let y0 = problem.state_from_forces(&sequenced.z)?;
+            let half = problem.half();
+            let units = (0..problem.dim())
+                .map(|i| if i < half { 1.0 } else { kappa })
+                .collect();
+            // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip's
+            // history from an LCP at the point's frequency with the tip observed.
+            let contacts = model.contact_count();
+            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
+            let gap = tip_contact.map_or(0.0, |c| model.contacts[c].gap);
+            let time_samples = settings.time_samples;
+            let mut measure = |p: &FrequencyLcp, y: &[f64]| -> Result<(f64, f64), RunError> {
+                let half = p.half();
+                match tip_contact {
+                    Some(c) => {
+                        let tip: Vec<f64> = (0..time_samples)
+                            .map(|n| gap - y[n * contacts + c])
+                            .collect();
+                        Ok(extremes(&tip))
+                    }
+                    None => {
+                        let mut m = model.clone();
+                        m.forcing.omega = p.parameter();
+                        let options = PeriodicLcpOptions {
+                            time_samples,
+                            observed_dofs: vec![tip],
+                        };
+                        let lcp = PeriodicLcp::new(&m, options)?;
+                        let u = lcp.displacements(&y[half..])?;
+                        Ok(extremes(&u[0]))
+                    }
+                }
+            };
+            let setup = Setup {
+                start: Some((y0, start_counters)),
+                ..setup(units, settings.time_samples)
+            };
+            follow(
+                &mut problem,
+                &mut FrequencyLcpSolver::new(),
+                setup,
+                &mut measure,
+                progress,
+            )
+        }
         Method::LcpLemke => Err(RunError::Unsupported {
             method: "lcp-lemke",
             what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \

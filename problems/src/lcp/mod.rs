@@ -630,12 +630,24 @@ impl PeriodicLcp {
             }
         }
         let size = m * nt;
-        let matrix = Mat::from_fn(size, size, |i, j| {
-            let (ni, ci) = (i / m, i % m);
-            let (nj, cj) = (j / m, j % m);
-            let p = (ni + nt - nj) % nt;
-            kernel[(p * m + ci) * m + cj]
-        });
+        // A[(ni, ci), (nj, cj)] = a_{ni - nj}[ci, cj]: column (nj, cj) is the column cj of
+        // the kernel blocks, rotated down by nj nodes (filled by contiguous copies).
+        let mut matrix = Mat::<f64>::zeros(size, size);
+        let mut column0 = vec![0.0; size];
+        for cj in 0..m {
+            for p in 0..nt {
+                for ci in 0..m {
+                    column0[p * m + ci] = kernel[(p * m + ci) * m + cj];
+                }
+            }
+            for nj in 0..nt {
+                let shift = nj * m;
+                let col = matrix.col_mut(nj * m + cj).try_as_col_major_mut();
+                let col = col.expect("a freshly allocated Mat is column-major").as_slice_mut();
+                col[shift..].copy_from_slice(&column0[..size - shift]);
+                col[..shift].copy_from_slice(&column0[size - shift..]);
+            }
+        }
         let mut q = vec![0.0; size];
         for node in 0..nt {
             let phase = 2.0 * std::f64::consts::PI * node as f64 / nt as f64;
@@ -1106,7 +1118,9 @@ fn fill_spectrum(spectrum: &mut [c64], bin: impl Fn(usize) -> c64) {
 fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale: f64) -> f64 {
     let n = z.nrows();
     let zr = z.as_ref();
-    let z_max = z.val().iter().fold(scale, |a, v| a.max(v.norm()));
+    // Largest moduli through squared moduli (one square root each, no hypot per entry).
+    let max_norm = |it: &mut dyn Iterator<Item = c64>| it.fold(0.0f64, |a, v| a.max(v.norm_sqr())).sqrt();
+    let z_max = scale.max(max_norm(&mut z.val().iter().copied()));
     let mut worst = 0.0f64;
     for col in 0..x.ncols() {
         let mut r: Vec<c64> = (0..n).map(|i| -b[(i, col)]).collect();
@@ -1116,9 +1130,9 @@ fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale:
                 r[i] += *v * xj;
             }
         }
-        let x_max = (0..n).fold(0.0f64, |a, i| a.max(x[(i, col)].norm()));
-        let b_max = (0..n).fold(0.0f64, |a, i| a.max(b[(i, col)].norm()));
-        let r_max = r.iter().fold(0.0f64, |a, v| a.max(v.norm()));
+        let x_max = max_norm(&mut (0..n).map(|i| x[(i, col)]));
+        let b_max = max_norm(&mut (0..n).map(|i| b[(i, col)]));
+        let r_max = max_norm(&mut r.iter().copied());
         let denominator = z_max * x_max + b_max;
         let rel = if denominator > 0.0 {
             r_max / denominator
