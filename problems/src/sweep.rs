@@ -19,8 +19,8 @@
 //! ```
 //!
 //! `N` the number of dofs, `|ΔX|` the 2-norm of the change of all displacement coefficients
-//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by the contact
-//! stiffness scale), and `u_ref` the root-mean-square over the dofs of the linear response
+//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by `κ`, LCP gaps
+//! as displacements), and `u_ref` the root-mean-square over the dofs of the linear response
 //! (contacts removed) at `ω_1` ([`FrequencyResponse::reference_amplitude`]). The linear
 //! resonance is thus at distance about 1 from zero in both directions, whatever `H`, `Nt`
 //! or the mesh: `[sweep] step = 0.01` means about one percent of `ω_1` on flat parts of the
@@ -60,12 +60,37 @@
 //!
 //! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
 //!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
-//! - `lcp-ssn`, `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
-//!   marching are no equation in `ω` to continue. The min-map LCP is one, and was tried
-//!   (the LCP rebuilt at each `ω`, dense Jacobian): its unknowns are the contact forces,
-//!   identically zero below contact onset, and the branch has a corner there where the
-//!   corrector stalls; the free response is also invisible to the arclength. Use natural
-//!   steps instead, one `ssn solve` per frequency.
+//! - `lcp-ssn`: the periodic LCP as the equation [`FrequencyLcp`] in the gaps and forces
+//!   `y = (w, z)` at the `Nt` time nodes, `w - q(ω) - A(ω) z = 0`, `min(z, κ w) = 0`
+//!   (`κ` = the scene's `c`, default the contact stiffness scale; the force unit of the
+//!   arclength), with the active-block solver [`FrequencyLcpSolver`] and the analytic
+//!   `dF/dω`; the LCP is rebuilt at each new `ω` (`Nt/2 + 1` sparse LUs, two cached). It
+//!   starts from the runner's mesh-sequenced min-map solve at `omega_from`. The tip
+//!   extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a contact).
+//!   (An earlier attempt on the min-map in `z` alone stalled at the contact onset, where
+//!   `z` leaves zero at a corner and the free response is invisible to the arclength; in
+//!   `(w, z)` the free response moves `w` and the onset is an ordinary switch of the min.)
+//!
+//!   The discrete LCP branch has a small fold at many changes of the active set (a node
+//!   entering or leaving contact): on the canonical rod with the modified mass the
+//!   overhang carries 34 / 60 / 66 reversals of `ω` at `Nt = 128 / 256 / 512`, of width
+//!   about 1e-3 / 3e-4 / 1e-4 `ω_1`, all reported in `folds` (every point is a solution
+//!   of the LCP at its `ω`, checked in tests/lcp_sweep.rs). The outermost folds and the
+//!   peak converge at second order to SSN-HB at high `H` (highest fold 1.03059 / 1.02965 /
+//!   1.02942 `ω_1` against 1.02935 at `H = 40`; peak 0.54519 / 0.54342 / 0.54302 against
+//!   0.54305).
+//!
+//!   Measured (canonical rod, modified mass, `[0.5, 2] ω_1`, one run of
+//!   `cargo run --release --example lcp_sweep -- 256 512`): ssn-hb `H = 20` 73 points in
+//!   0.04 s; lcp-ssn `Nt = 256` 324 points, 1224 corrector iterations, 1.07 s; `Nt = 512`
+//!   762 points, 3286 iterations, 7.3 s (about 2.2 ms per iteration, 1.3 ms of which
+//!   rebuild the LCP). Known limits: at `Nt = 1024` the continuation returned to
+//!   `omega_from` after 4068 points (208 s); with the consistent mass (massive contact
+//!   node) it leaves the branch right after the contact onset and retraces the free
+//!   response back to `omega_from` (`converged = false`).
+//! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
+//!   marching are no equation in `ω` to continue; solve frequency by frequency with
+//!   `ssn solve`.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -81,10 +106,10 @@ use semismooth::newton::{self, NewtonReport};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use serde_json::json;
 
+use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{
     solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver, PeriodicLcp, PeriodicLcpOptions,
 };
-use crate::hb::{HbError, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
 use crate::scene::{
@@ -163,8 +188,8 @@ pub struct FrequencyResponse {
     pub reference_amplitude: f64,
     /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
     pub output_points: usize,
-    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP `z`),
-    /// unscaled, for warm starts and re-solves.
+    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
+    /// `[w; z]`), unscaled, for warm starts and re-solves.
     pub states: Vec<Vec<f64>>,
 }
 

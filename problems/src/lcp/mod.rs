@@ -643,7 +643,9 @@ impl PeriodicLcp {
             for nj in 0..nt {
                 let shift = nj * m;
                 let col = matrix.col_mut(nj * m + cj).try_as_col_major_mut();
-                let col = col.expect("a freshly allocated Mat is column-major").as_slice_mut();
+                let col = col
+                    .expect("a freshly allocated Mat is column-major")
+                    .as_slice_mut();
                 col[shift..].copy_from_slice(&column0[..size - shift]);
                 col[..shift].copy_from_slice(&column0[size - shift..]);
             }
@@ -1119,7 +1121,8 @@ fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale:
     let n = z.nrows();
     let zr = z.as_ref();
     // Largest moduli through squared moduli (one square root each, no hypot per entry).
-    let max_norm = |it: &mut dyn Iterator<Item = c64>| it.fold(0.0f64, |a, v| a.max(v.norm_sqr())).sqrt();
+    let max_norm =
+        |it: &mut dyn Iterator<Item = c64>| it.fold(0.0f64, |a, v| a.max(v.norm_sqr())).sqrt();
     let z_max = scale.max(max_norm(&mut z.val().iter().copied()));
     let mut worst = 0.0f64;
     for col in 0..x.ncols() {
