@@ -147,6 +147,11 @@ pub const RESTART_POINTS: usize = 4;
 /// Restarts allowed per sweep.
 pub const MAX_RESTARTS: usize = 20;
 
+/// Restarts past a corner (problems with a corner step, see `follow`) allowed per sweep,
+/// counted apart from [`MAX_RESTARTS`]: fine LCP meshes have a sharp corner every few
+/// points of their overhang.
+pub const MAX_CORNER_STEPS: usize = 200;
+
 /// A frequency-response curve: one entry per branch point, in branch order (the frequency
 /// is not monotone across folds).
 #[derive(Debug, Clone, PartialEq)]
@@ -517,6 +522,12 @@ fn newton_termination(report: &NewtonReport) -> String {
 /// Reduces a state to `(tip_max, tip_min)` over one period.
 type TipMeasure<'m, P> = dyn FnMut(&P, &[f64]) -> Result<(f64, f64), RunError> + 'm;
 
+/// A start on the next piece of a piecewise-smooth branch past a corner ahead of the last
+/// point `(x, ω)` reached from `(x_prev, ω_prev)` (unscaled): `(x', ω', increasing)`.
+/// Called after a failed step (see [`FrequencyLcp::corner_step`]).
+type CornerStep<'m, P> =
+    dyn FnMut(&mut P, &[f64], f64, &[f64], f64) -> Option<(Vec<f64>, f64, bool)> + 'm;
+
 /// Everything `follow` needs besides the problem and the solver.
 struct Setup<'a> {
     settings: &'a SolverSettings,
@@ -538,6 +549,7 @@ fn follow<P, S>(
     solver: &mut S,
     setup: Setup<'_>,
     measure: &mut TipMeasure<'_, P>,
+    mut corner: Option<&mut CornerStep<'_, P>>,
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError>
 where
@@ -630,6 +642,7 @@ where
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
+    let mut corner_starts: Vec<(Vec<f64>, f64)> = Vec::new();
     let termination = loop {
         let offset = response.omega.len();
         let remaining = base_points.saturating_sub(offset);
@@ -720,7 +733,52 @@ where
             break termination;
         }
         let stuck = failed && restart && response.omega.len() == offset;
-        if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
+        // A corner just ahead where the branch turns by more than 90 degrees (no arclength
+        // hyperplane cuts the outgoing piece): restart on the outgoing piece when the
+        // problem can tell (the LCP) and the start is within one largest step.
+        let k = response.omega.len();
+        if let (true, true, Some(step), 2..) = (
+            failed,
+            corner_starts.len() < MAX_CORNER_STEPS,
+            corner.as_mut(),
+            k,
+        ) {
+            let found = step(
+                &mut *scaled.inner,
+                &response.states[k - 1],
+                response.omega[k - 1],
+                &response.states[k - 2],
+                response.omega[k - 2],
+            );
+            if let Some((x, w, increasing)) = found {
+                let y: Vec<f64> = x.iter().zip(&scale).map(|(x, s)| x / s).collect();
+                let q = w / omega_unit;
+                let dy: f64 = y.iter().zip(&start_y).map(|(a, b)| (a - b) * (a - b)).sum();
+                let d2 = THETA / n as f64 * dy + (1.0 - THETA) * (q - start_q).powi(2);
+                // A corner start within one smallest step of an earlier one: the pieces
+                // form a cycle, stop stepping.
+                let min_step = options.min_step;
+                let repeated = corner_starts.iter().any(|(y0, q0): &(Vec<f64>, f64)| {
+                    let dy: f64 = y.iter().zip(y0).map(|(a, b)| (a - b) * (a - b)).sum();
+                    THETA / n as f64 * dy + (1.0 - THETA) * (q - q0).powi(2) <= min_step * min_step
+                });
+                if d2.is_finite() && d2 <= max_step * max_step && !repeated {
+                    corner_starts.push((y.clone(), q));
+                    restarts += 1;
+                    restart = true;
+                    start_y = y;
+                    start_q = q;
+                    direction = if increasing {
+                        Direction::Increasing
+                    } else {
+                        Direction::Decreasing
+                    };
+                    continue;
+                }
+            }
+        }
+        if failed && restarts - corner_starts.len() < MAX_RESTARTS && last_tangent_parameter != 0.0
+        {
             restarts += 1;
             restart = true;
         } else if short_done {
@@ -988,6 +1046,7 @@ pub fn frequency_response(
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -995,6 +1054,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
             }
@@ -1018,6 +1078,7 @@ pub fn frequency_response(
                     &mut StructuredHbSolver::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
                 LinearSolverChoice::Dense => follow(
@@ -1025,6 +1086,7 @@ pub fn frequency_response(
                     &mut FaerDenseLu::new(),
                     setup,
                     &mut measure,
+                    None,
                     progress,
                 ),
             }
@@ -1088,6 +1150,10 @@ pub fn frequency_response(
                     }
                 }
             };
+            let mut corner_step =
+                |p: &mut FrequencyLcp, y: &[f64], omega: f64, y_prev: &[f64], omega_prev: f64| {
+                    p.corner_step(y, omega, y_prev, omega_prev)
+                };
             let setup = Setup {
                 start: Some((y0, start_counters)),
                 ..setup(units, settings.time_samples)
@@ -1097,6 +1163,7 @@ pub fn frequency_response(
                 &mut FrequencyLcpSolver::new(),
                 setup,
                 &mut measure,
+                Some(&mut corner_step),
                 progress,
             )
         }
