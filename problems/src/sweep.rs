@@ -41,6 +41,15 @@
 //!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
 //!   the constraint), heading the way `ω` last moved, or the other way when that restart
 //!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//! - corner steps (lcp-ssn only, before the restart): where the branch turns by more than
+//!   90 degrees at a corner, no arclength hyperplane normal to the incoming direction cuts
+//!   the outgoing piece, so every step length fails and a plain restart retraces the
+//!   incoming piece. The problem then extrapolates its current piece to the first switch
+//!   of the min ahead, and the continuation restarts just past that corner on the
+//!   outgoing piece ([`FrequencyLcp::corner_step`]), when that start is within one largest
+//!   step, inside the sweep interval, and not within one smallest step of an earlier
+//!   corner start (a cycle of pieces); at most [`MAX_CORNER_STEPS`] times, counted in
+//!   `restarts` but not against [`MAX_RESTARTS`];
 //! - folds are the reversals of `ω` along the accepted points (the core's fold events,
 //!   from sign changes of the tangent, also fire where a sharply turning branch flips the
 //!   tangent's orientation without any reversal); the core's interpolated fold frequency
@@ -187,7 +196,8 @@ pub struct FrequencyResponse {
     pub continuation: ContinuationCounters,
     /// Iterations of the initial globalized Newton solve at `omega_from`.
     pub initial_iterations: usize,
-    /// Continuation restarts after failed steps (module documentation).
+    /// Continuation restarts after failed steps, corner steps included (module
+    /// documentation).
     pub restarts: usize,
     /// `u_ref` of the step scaling (module documentation).
     pub reference_amplitude: f64,
@@ -762,7 +772,8 @@ where
                     let dy: f64 = y.iter().zip(y0).map(|(a, b)| (a - b) * (a - b)).sum();
                     THETA / n as f64 * dy + (1.0 - THETA) * (q - q0).powi(2) <= min_step * min_step
                 });
-                if d2.is_finite() && d2 <= max_step * max_step && !repeated {
+                let inside = q >= options.parameter_min && q <= options.parameter_max;
+                if d2.is_finite() && d2 <= max_step * max_step && !repeated && inside {
                     corner_starts.push((y.clone(), q));
                     restarts += 1;
                     restart = true;

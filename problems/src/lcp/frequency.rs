@@ -609,8 +609,7 @@ mod tests {
             max_iterations: 200,
             ..Default::default()
         };
-        let s = super::super::solve_min_map_sequenced(&model, p.options.clone(), &options)
-            .unwrap();
+        let s = super::super::solve_min_map_sequenced(&model, p.options.clone(), &options).unwrap();
         assert!(s.converged());
         p.set_parameter(omega);
         p.state_from_forces(&s.z).unwrap()
@@ -649,7 +648,10 @@ mod tests {
         let (a1, a) = (active_rows(&p, &y1), active_rows(&p, &y));
         let switched: Vec<usize> = (0..a.len()).filter(|&i| a[i] != a1[i]).collect();
         assert_eq!(switched.len(), 1, "{switched:?}");
-        let moved = y.iter().zip(&start).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let moved = y
+            .iter()
+            .zip(&start)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         let size = y1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         println!(
             "switched row {switched:?}, omega {} -> {}, corrected by {moved:e} (state {size:e})",
