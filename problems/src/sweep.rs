@@ -90,13 +90,20 @@
 //!   0.54305).
 //!
 //!   Measured (canonical rod, modified mass, `[0.5, 2] ω_1`, one run of
-//!   `cargo run --release --example lcp_sweep -- 256 512`): ssn-hb `H = 20` 73 points in
-//!   0.04 s; lcp-ssn `Nt = 256` 324 points, 1224 corrector iterations, 1.07 s; `Nt = 512`
-//!   762 points, 3286 iterations, 7.3 s (about 2.2 ms per iteration, 1.3 ms of which
-//!   rebuild the LCP). Known limits: at `Nt = 1024` the continuation returned to
-//!   `omega_from` after 4068 points (208 s); with the consistent mass (massive contact
-//!   node) it leaves the branch right after the contact onset and retraces the free
-//!   response back to `omega_from` (`converged = false`).
+//!   `cargo run --release --example lcp_sweep -- 128 256 512`): ssn-hb `H = 20` 73 points,
+//!   225 corrector iterations, 0.033 s (`H = 40`: 0.069 s); lcp-ssn `Nt = 128` 175 points,
+//!   618 iterations, 0.25 s; `Nt = 256` 324 points, 1224 iterations, 1.02 s; `Nt = 512`
+//!   762 points, 3286 iterations, 6.7 s (about 2 ms per corrector iteration, 1.3 ms of
+//!   which rebuild the LCP at the new `ω`: `Nt/2 + 1` sparse LUs and the dense `A`).
+//!
+//!   Known limits (`converged = false`, the reason in `termination`): at `Nt = 1024` the
+//!   overhang has a corner every few points where the branch turns by more than 90
+//!   degrees; corner steps carry it from 1.0167 to 1.0270 `ω_1` (106 of them on
+//!   `[1, 1.04] ω_1`), where the pieces met by the first switch ahead close into a cycle
+//!   (two nodes switching almost together) and the sweep stops. With the consistent mass
+//!   (massive contact node) the first sharp corner comes right after the contact onset
+//!   (0.9825 `ω_1` at `Nt = 128`) and the pieces cycle near 0.9886 `ω_1`, where the sweep
+//!   stops.
 //! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
 //!   marching are no equation in `ω` to continue; solve frequency by frequency with
 //!   `ssn solve`.
