@@ -103,7 +103,10 @@
 //!   (two nodes switching almost together) and the sweep stops. With the consistent mass
 //!   (massive contact node) the first sharp corner comes right after the contact onset
 //!   (0.9825 `ω_1` at `Nt = 128`) and the pieces cycle near 0.9886 `ω_1`, where the sweep
-//!   stops.
+//!   stops; likewise for any contact on a node with mass (mid-span node 10 of the modified
+//!   mass rod, alone or with the tip as in `two_contacts.toml`: stops at 0.981 / 0.980
+//!   `ω_1`, where SSN-HB `H = 20` passes). Without an impact law the trapezoidal periodic
+//!   LCP of a massive contact node is the ill-posed case (module `lcp`).
 //! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
 //!   marching are no equation in `ω` to continue; solve frequency by frequency with
 //!   `ssn solve`.
