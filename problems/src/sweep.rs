@@ -105,8 +105,12 @@
 //!   (0.9825 `ω_1` at `Nt = 128`) and the pieces cycle near 0.9886 `ω_1`, where the sweep
 //!   stops; likewise for any contact on a node with mass (mid-span node 10 of the modified
 //!   mass rod, alone or with the tip as in `two_contacts.toml`: stops at 0.981 / 0.980
-//!   `ω_1`, where SSN-HB `H = 20` passes). Without an impact law the trapezoidal periodic
-//!   LCP of a massive contact node is the ill-posed case (module `lcp`).
+//!   `ω_1`, where SSN-HB `H = 20` passes). There several nodes graze almost together at
+//!   the onset (node 10, `Nt = 128`: gaps 8e-5, 1.5e-4, 7e-4 at nodes 8, 9, 7), and the
+//!   corrector's first contact point already has node 7 in contact, not node 8; the pieces
+//!   then lead back to the free response at the onset, which is retraced. Without an
+//!   impact law the trapezoidal periodic LCP of a massive contact node is the ill-posed
+//!   case (module `lcp`).
 //! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
 //!   marching are no equation in `ω` to continue; solve frequency by frequency with
 //!   `ssn solve`.
