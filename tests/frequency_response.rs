@@ -495,9 +495,10 @@ fn penalty_branch_converges_like_one_over_the_penalty_and_meets_ssn_as_h_grows()
 }
 
 #[test]
-fn lcp_and_time_marching_sweeps_are_unsupported_with_a_reason() {
+fn lemke_and_time_marching_sweeps_are_unsupported_with_a_reason() {
+    // (lcp-ssn is continued in (w, z): tests/lcp_sweep.rs.)
     let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
-    for method in [Method::LcpLemke, Method::LcpSsn, Method::March] {
+    for method in [Method::LcpLemke, Method::March] {
         let err =
             frequency_response(&rod, &settings(method, 5), &sweep(0.5, 2.0), None).unwrap_err();
         assert!(matches!(err, RunError::Unsupported { .. }));

@@ -19,8 +19,8 @@
 //! ```
 //!
 //! `N` the number of dofs, `|ΔX|` the 2-norm of the change of all displacement coefficients
-//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by the contact
-//! stiffness scale), and `u_ref` the root-mean-square over the dofs of the linear response
+//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by `κ`, LCP gaps
+//! as displacements), and `u_ref` the root-mean-square over the dofs of the linear response
 //! (contacts removed) at `ω_1` ([`FrequencyResponse::reference_amplitude`]). The linear
 //! resonance is thus at distance about 1 from zero in both directions, whatever `H`, `Nt`
 //! or the mesh: `[sweep] step = 0.01` means about one percent of `ω_1` on flat parts of the
@@ -40,7 +40,11 @@
 //!   point for [`RESTART_POINTS`] points with `θ = `[`THETA_RESTART`] (the arclength then
 //!   measures mostly the state, so a branch that reverses in `ω` at a corner is still cut by
 //!   the constraint), heading the way `ω` last moved, or the other way when that restart
-//!   cannot make a single step; at most [`MAX_RESTARTS`] times;
+//!   cannot make a single step; at most [`MAX_RESTARTS`] times. A restarted segment that
+//!   goes back along the branch (one of its points within a quarter of `|x_j - x_last|` of
+//!   one of the [`RETRACE_WINDOW`] points `x_j` before the restart point `x_last`) is cut
+//!   there and the sweep stops, "stalled at omega_ratio ...": a branch returned twice, the
+//!   second time backwards, would be garbage;
 //! - penalty HB: corners crossed explicitly (below);
 //! - folds are found by the core's [`FoldDetector`] over the whole stitched branch (a fold
 //!   can fall between two segments): reversals of `ω` along the accepted points, located by
@@ -105,12 +109,50 @@
 //!
 //! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
 //!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
-//! - `lcp-ssn`, `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
-//!   marching are no equation in `ω` to continue. The min-map LCP is one, and was tried
-//!   (the LCP rebuilt at each `ω`, dense Jacobian): its unknowns are the contact forces,
-//!   identically zero below contact onset, and the branch has a corner there where the
-//!   corrector stalls; the free response is also invisible to the arclength. Use natural
-//!   steps instead, one `ssn solve` per frequency.
+//! - `lcp-ssn`: the periodic LCP as the equation [`FrequencyLcp`] in the gaps and forces
+//!   `y = (w, z)` at the `Nt` time nodes, `w - q(ω) - A(ω) z = 0`, `min(z, κ w) = 0`
+//!   (`κ` = the scene's `c`, default the contact stiffness scale; the force unit of the
+//!   arclength), with the active-block solver [`FrequencyLcpSolver`] and the analytic
+//!   `dF/dω`; the LCP is rebuilt at each new `ω` (`Nt/2 + 1` sparse LUs, two cached). It
+//!   starts from the runner's mesh-sequenced min-map solve at `omega_from`. The tip
+//!   extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a contact).
+//!   (An earlier attempt on the min-map in `z` alone stalled at the contact onset, where
+//!   `z` leaves zero at a corner and the free response is invisible to the arclength; in
+//!   `(w, z)` the free response moves `w` and the onset is an ordinary switch of the min.)
+//!
+//!   The discrete LCP branch has a small fold at many changes of the active set (a node
+//!   entering or leaving contact): on the canonical rod with the modified mass the
+//!   overhang carries 34 / 60 / 66 reversals of `ω` at `Nt = 128 / 256 / 512`, of width
+//!   about 1e-3 / 3e-4 / 1e-4 `ω_1`, all reported in `folds` (every point is a solution
+//!   of the LCP at its `ω`, checked in tests/lcp_sweep.rs). The outermost folds and the
+//!   peak converge at second order to SSN-HB at high `H` (highest fold 1.03059 / 1.02965 /
+//!   1.02942 `ω_1` against 1.02935 at `H = 40`; peak 0.54519 / 0.54342 / 0.54302 against
+//!   0.54305).
+//!
+//!   Measured (canonical rod, modified mass, `[0.5, 2] ω_1`, one run of
+//!   `cargo run --release --example lcp_sweep -- 128 256 512`): ssn-hb `H = 20` 73 points,
+//!   225 corrector iterations, 0.033 s (`H = 40`: 0.069 s); lcp-ssn `Nt = 128` 175 points,
+//!   618 iterations, 0.25 s; `Nt = 256` 324 points, 1224 iterations, 1.02 s; `Nt = 512`
+//!   762 points, 3286 iterations, 6.7 s (about 2 ms per corrector iteration, 1.3 ms of
+//!   which rebuild the LCP at the new `ω`: `Nt/2 + 1` sparse LUs and the dense `A`).
+//!
+//!   Known limits (`converged = false`, the reason in `termination`): a contact on a node
+//!   with mass. With the consistent mass the branch has a corner right after the contact
+//!   onset that neither the arclength, the core's corner passes nor the restarts turn;
+//!   the sweep stops there ("stalled at omega_ratio 0.9825", `Nt = 128`; before the
+//!   retrace check below it went back along the branch to `omega_from`). Likewise with
+//!   the mid-span node 10 in contact (`two_contacts.toml` as an lcp-ssn scene, `Nt = 128`:
+//!   stalled at 0.9788 `ω_1`, where SSN-HB `H = 20` passes): several nodes graze almost
+//!   together at the onset (gaps 8e-5, 1.5e-4, 7e-4 at nodes 8, 9, 7) and the pieces lead
+//!   back to the free response. Without an impact law the trapezoidal periodic LCP of a
+//!   massive contact node is the ill-posed case (module `lcp`). At `Nt = 1024` (modified
+//!   mass) the overhang has a sharp corner every few points; a problem-side corner step
+//!   ([`FrequencyLcp::corner_step`], not wired into the sweep) carried it from 1.0167 to
+//!   1.0270 `ω_1` before the pieces closed into a cycle (two nodes switching almost
+//!   together).
+//! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
+//!   marching are no equation in `ω` to continue; solve frequency by frequency with
+//!   `ssn solve`.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -132,6 +174,9 @@ use corners::{Corners, PenaltyCorners};
 
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+};
+use crate::lcp::{
+    solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver, PeriodicLcp, PeriodicLcpOptions,
 };
 use crate::rod::RodModel;
 use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
@@ -169,6 +214,10 @@ pub const RESTART_POINTS: usize = 4;
 
 /// Restarts allowed per sweep.
 pub const MAX_RESTARTS: usize = 20;
+
+/// Points before a restart against which the restarted segment's points are checked for
+/// going back along the branch.
+pub const RETRACE_WINDOW: usize = 8;
 
 /// Failed steps in a row (each halving the step) after which a penalty-HB continuation
 /// segment stops and the corner ahead is crossed explicitly (module documentation).
@@ -209,7 +258,8 @@ pub struct FrequencyResponse {
     pub continuation: ContinuationCounters,
     /// Iterations of the initial globalized Newton solve at `omega_from`.
     pub initial_iterations: usize,
-    /// Continuation restarts after failed steps (module documentation).
+    /// Continuation restarts after failed steps, corner steps included (module
+    /// documentation).
     pub restarts: usize,
     /// Corners of a penalty branch stepped over explicitly (module documentation).
     pub corners: usize,
@@ -217,8 +267,8 @@ pub struct FrequencyResponse {
     pub reference_amplitude: f64,
     /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
     pub output_points: usize,
-    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP `z`),
-    /// unscaled, for warm starts and re-solves.
+    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
+    /// `[w; z]`), unscaled, for warm starts and re-solves.
     pub states: Vec<Vec<f64>>,
 }
 
@@ -230,6 +280,24 @@ impl FrequencyResponse {
         self.amplitude.push(max.abs().max(min.abs()));
         self.iterations.push(iterations);
         self.states.push(state);
+    }
+
+    /// Keeps the first `len` points, and the folds confirmed by them (a fold at the last
+    /// kept point needs a point after it).
+    fn truncate(&mut self, len: usize) {
+        self.omega.truncate(len);
+        self.tip_max.truncate(len);
+        self.tip_min.truncate(len);
+        self.amplitude.truncate(len);
+        self.iterations.truncate(len);
+        self.states.truncate(len);
+        let keep = self
+            .fold_indices
+            .iter()
+            .take_while(|&&i| i + 1 < len)
+            .count();
+        self.folds.truncate(keep);
+        self.fold_indices.truncate(keep);
     }
 
     /// Number of branch points.
@@ -576,6 +644,9 @@ struct Setup<'a> {
     started: Instant,
     /// Rounding floor of `|F|` (0 where negligible): the corrector tolerance is at least this.
     residual_floor: f64,
+    /// Starting guess of the Newton solve at `omega_from` (zero when `None`) and the work
+    /// spent computing it.
+    start: Option<(Vec<f64>, RunCounters)>,
 }
 
 fn follow<P, S>(
@@ -600,6 +671,7 @@ where
         output_points,
         started,
         residual_floor,
+        start,
     } = setup;
     let n = problem.dim();
     // q = (ω/ω_1) / sqrt(1 - θ): (1 - θ) Δq² = Δ(ω/ω_1)².
@@ -612,9 +684,10 @@ where
 
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
-    let mut x = vec![0.0; n];
+    let (mut x, start_counters) = start.unwrap_or_else(|| (vec![0.0; n], RunCounters::default()));
     let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
     let mut counters = RunCounters::from(report.counters);
+    add_run_counters(&mut counters, &start_counters);
     let mut response = FrequencyResponse {
         method: settings.method,
         omega_1,
@@ -678,6 +751,10 @@ where
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
+    // Whether the segment about to run is a restart, and where the sweep stopped because a
+    // restart went back along the branch.
+    let mut restarted = false;
+    let mut retraced: Option<f64> = None;
     // After a corner the segment starts at a new point (otherwise at the last one).
     let mut new_start = false;
     let mut crossed = 0;
@@ -816,6 +893,31 @@ where
         add_counters(&mut c, &cont.counters());
         let termination = cont.termination().cloned();
         drop(cont);
+        // A restarted segment must not go back along the branch. A point of it is taken as
+        // going back when it is within a quarter of `|x_j - x_last|` of a point `x_j` among
+        // the few before the restart point `x_last` (a genuine turn that close is sharper
+        // than 165°).
+        if std::mem::take(&mut restarted) && offset >= 2 {
+            let distance = |i: usize, j: usize| {
+                let dy: f64 = response.states[i]
+                    .iter()
+                    .zip(&response.states[j])
+                    .zip(&scale)
+                    .map(|((a, b), s)| ((a - b) / s).powi(2))
+                    .sum();
+                let dq = (response.omega[i] - response.omega[j]) / omega_unit;
+                (THETA / n as f64 * dy + (1.0 - THETA) * dq * dq).sqrt()
+            };
+            let back = (offset..response.omega.len()).find(|&i| {
+                (offset.saturating_sub(RETRACE_WINDOW)..offset - 1)
+                    .any(|j| distance(i, j) < 0.25 * distance(j, offset - 1))
+            });
+            if let Some(i) = back {
+                response.truncate(i);
+                retraced = Some(response.omega[offset - 1]);
+                break termination;
+            }
+        }
         if start_failure.is_some() {
             break termination;
         }
@@ -873,6 +975,7 @@ where
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
             restart = true;
+            restarted = true;
         } else if short_done {
             restart = false;
         } else {
@@ -897,6 +1000,7 @@ where
             (true, Direction::Decreasing) => Direction::Increasing,
             _ => forward,
         };
+
         travel = direction_sign(direction);
     };
     response.restarts = restarts;
@@ -918,6 +1022,14 @@ where
         (_, Some(failure)) => (
             false,
             format!("the start point could not be corrected: {failure}"),
+        ),
+        (_, None) if retraced.is_some() => (
+            false,
+            format!(
+                "stalled at omega_ratio {}: no step ahead (a corner the continuation cannot \
+                 turn), and the only step found goes back along the branch",
+                retraced.unwrap_or(f64::NAN) / omega_1
+            ),
         ),
         (Some(ContinuationTermination::ReachedBound { parameter, bound }), None) => {
             let reached_end = *bound == to_q;
@@ -1013,6 +1125,15 @@ fn record_fold(
     }
 }
 
+fn add_run_counters(total: &mut RunCounters, c: &RunCounters) {
+    total.residual_evaluations += c.residual_evaluations;
+    total.jacobian_evaluations += c.jacobian_evaluations;
+    total.factorizations += c.factorizations;
+    total.linear_solves += c.linear_solves;
+    total.line_search_backtracks += c.line_search_backtracks;
+    total.ffts += c.ffts;
+}
+
 fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
     total.work += c.work;
     total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
@@ -1094,6 +1215,7 @@ pub fn frequency_response(
         output_points,
         started,
         residual_floor,
+        start: None,
     };
     match settings.method {
         Method::SsnHb => {
@@ -1185,13 +1307,78 @@ pub fn frequency_response(
                 ),
             }
         }
-        Method::LcpSsn => Err(RunError::Unsupported {
-            method: "lcp-ssn",
-            what: "a branch the continuation can follow: the periodic LCP's unknowns are the \
-                   contact forces, which leave zero at a corner of the branch (contact onset) \
-                   where the corrector stalls; sweep with ssn-hb or penalty-hb, or solve \
-                   frequency by frequency with `ssn solve`",
-        }),
+        Method::LcpSsn => {
+            if model.contacts.is_empty() {
+                return Err(RunError::Unsupported {
+                    method: "lcp-ssn",
+                    what: "a [contact] section (the periodic LCP is posed on the contact \
+                           forces; sweep a linear scene with ssn-hb or penalty-hb)",
+                });
+            }
+            let kappa = settings.c.unwrap_or(model.contact_stiffness_scale());
+            let lcp_options = PeriodicLcpOptions {
+                time_samples: settings.time_samples,
+                observed_dofs: Vec::new(),
+            };
+            // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
+            let mut start_model = model.clone();
+            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
+            let sequenced = solve_min_map_sequenced(
+                &start_model,
+                lcp_options.clone(),
+                &newton_options(settings),
+            )?;
+            let mut start_counters = RunCounters::default();
+            for level in &sequenced.levels {
+                add_run_counters(&mut start_counters, &level.report.counters.into());
+            }
+            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
+            let y0 = problem.state_from_forces(&sequenced.z)?;
+            let half = problem.half();
+            let units = (0..problem.dim())
+                .map(|i| if i < half { 1.0 } else { kappa })
+                .collect();
+            // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip's
+            // history from an LCP at the point's frequency with the tip observed.
+            let contacts = model.contact_count();
+            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
+            let gap = tip_contact.map_or(0.0, |c| model.contacts[c].gap);
+            let time_samples = settings.time_samples;
+            let mut measure = |p: &FrequencyLcp, y: &[f64]| -> Result<(f64, f64), RunError> {
+                let half = p.half();
+                match tip_contact {
+                    Some(c) => {
+                        let tip: Vec<f64> = (0..time_samples)
+                            .map(|n| gap - y[n * contacts + c])
+                            .collect();
+                        Ok(extremes(&tip))
+                    }
+                    None => {
+                        let mut m = model.clone();
+                        m.forcing.omega = p.parameter();
+                        let options = PeriodicLcpOptions {
+                            time_samples,
+                            observed_dofs: vec![tip],
+                        };
+                        let lcp = PeriodicLcp::new(&m, options)?;
+                        let u = lcp.displacements(&y[half..])?;
+                        Ok(extremes(&u[0]))
+                    }
+                }
+            };
+            let setup = Setup {
+                start: Some((y0, start_counters)),
+                ..setup(units, settings.time_samples, 0.0)
+            };
+            follow(
+                &mut problem,
+                &mut FrequencyLcpSolver::new(),
+                setup,
+                &mut measure,
+                None,
+                progress,
+            )
+        }
         Method::LcpLemke => Err(RunError::Unsupported {
             method: "lcp-lemke",
             what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \

@@ -681,3 +681,71 @@ fn compare_writes_its_table_and_refuses_an_unwritable_directory() {
     assert!(stderr(&out).contains("a-file"), "{}", stderr(&out));
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
+
+/// `ssn sweep` with method lcp-ssn (the periodic LCP continued in its gaps and forces):
+/// JSON with the issue's fields, one entry per point, through the overhang to the end; the
+/// last point, at the scene's forcing frequency beyond the overhang (one solution there),
+/// equals what `ssn solve` finds by mesh-sequenced Newton from zero on the same scene.
+#[test]
+fn lcp_ssn_sweep_prints_a_branch_that_ends_on_the_fixed_frequency_solution() {
+    let dir = TempDir::new("lcp-sweep");
+    let scene = "title = \"lcp-ssn sweep\"\n\
+        [rod]\nelements = 20\nmass = \"modified\"\n\
+        [damping]\nzeta = 0.01\n\
+        [forcing]\namplitude = 0.04\nomega_ratio = 1.1\n\
+        [contact]\ngap = 0.5\n\
+        [solver]\nmethod = \"lcp-ssn\"\ntime_samples = 128\n\
+        [sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.1\n";
+    let path = dir.write("lcp_sweep.toml", scene);
+    let out = ssn(&["sweep", "--json", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
+    for key in [
+        "points",
+        "omega",
+        "tip_max",
+        "tip_min",
+        "amplitude",
+        "folds",
+        "converged",
+        "solve_seconds",
+        "termination",
+        "counters",
+    ] {
+        assert!(json.get(key).is_some(), "{key}");
+    }
+    assert_eq!(
+        json["converged"],
+        Value::Bool(true),
+        "{}",
+        json["termination"]
+    );
+    let omega = json["omega"].as_array().expect("omega array");
+    assert!(omega.len() >= 2 && json["points"] == omega.len());
+    for key in ["tip_max", "tip_min", "amplitude"] {
+        let v = json[key].as_array().expect("array");
+        assert_eq!(v.len(), omega.len(), "{key}");
+        assert!(
+            v.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)),
+            "{key}"
+        );
+    }
+    assert!(!json["folds"].as_array().expect("folds").is_empty());
+
+    let out = ssn(&["solve", "--json", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let solve: Value = serde_json::from_str(&stdout(&out)).expect("solve JSON");
+    let last = |key: &str| {
+        json[key]
+            .as_array()
+            .and_then(|v| v.last())
+            .and_then(Value::as_f64)
+            .expect("a number")
+    };
+    assert!((last("omega") - solve["omega"].as_f64().unwrap()).abs() <= 1e-12);
+    // Both are solutions of the same LCP to |F| <= 1e-10 (A of order 1): 1e-8 on the tip.
+    for key in ["tip_max", "tip_min"] {
+        let (a, b) = (last(key), solve[key].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-8, "{key}: sweep {a} vs solve {b}");
+    }
+}

@@ -100,8 +100,10 @@
 //! ```
 
 mod dft;
+mod frequency;
 mod min_map;
 
+pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
 pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp};
 
 use faer::linalg::solvers::Solve;
@@ -260,6 +262,10 @@ pub enum LcpError {
     /// The Newton driver could not run (invalid options).
     #[error("semismooth Newton could not run: {0}")]
     Newton(#[from] NewtonError),
+    /// [`PeriodicLcp::frequency_derivative`] on an LCP built without it (use
+    /// [`PeriodicLcp::with_frequency_derivative`]).
+    #[error("the LCP was built without its frequency derivative")]
+    NoFrequencyDerivative,
     /// A vector passed in has the wrong length.
     #[error("{what} has length {found}, expected {expected}")]
     WrongLength {
@@ -294,6 +300,17 @@ pub struct PeriodicLcp {
     symmetric_spectrum: (f64, f64),
     /// Number of dofs without mass and damping (the Nyquist-limit set `V`).
     static_dofs: usize,
+    /// `dH_k/domega` and `dX/domega` on the contact rows, when asked for.
+    derivative: Option<FrequencyDerivative>,
+}
+
+/// Derivatives with respect to `omega` of the bin receptances `H_k` (contact rows only,
+/// `[(k * m + c) * m + c2]`, `k = 0..=Nt/2`) and of the linear amplitudes `X_c` at the
+/// contact dofs.
+#[derive(Debug, Clone)]
+struct FrequencyDerivative {
+    transfer: Vec<c64>,
+    linear_amplitude: Vec<c64>,
 }
 
 /// Column-compressed union pattern of `K`, `M`, `D` with, for each source matrix, the
@@ -440,6 +457,27 @@ impl PeriodicLcp {
     /// Cost: `Nt/2 + 1` sparse complex LU factorizations of size `N` (one symbolic
     /// analysis), `m` solves each, and `m^2` FFTs of length `Nt` for the kernel.
     pub fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, LcpError> {
+        Self::build(model, options, false)
+    }
+
+    /// [`PeriodicLcp::new`] that also computes the derivatives with respect to `omega` of
+    /// `q` and `A` ([`PeriodicLcp::frequency_derivative`]). The Tustin frequency
+    /// `sigma_k = omega tau_k`, `tau_k = (Nt/pi) tan(pi k/Nt)`, is linear in `omega`, so
+    /// `dZ_k/domega = i tau_k D - 2 omega tau_k^2 M` and
+    /// `dZ_k^{-1}/domega = -Z_k^{-1} (dZ_k/domega) Z_k^{-1}`: one more solve per bin and
+    /// column with the same LU (the Nyquist limit does not depend on `omega`).
+    pub fn with_frequency_derivative(
+        model: &StructuralModel,
+        options: PeriodicLcpOptions,
+    ) -> Result<Self, LcpError> {
+        Self::build(model, options, true)
+    }
+
+    fn build(
+        model: &StructuralModel,
+        options: PeriodicLcpOptions,
+        with_derivative: bool,
+    ) -> Result<Self, LcpError> {
         validate_model(model)?;
         let n = model.dofs();
         let m = model.contact_count();
@@ -459,6 +497,10 @@ impl PeriodicLcp {
         let zero = c64::new(0.0, 0.0);
         let mut transfer = vec![zero; bins * nr * m];
         let mut linear_amplitude = vec![zero; nr];
+        let mut derivative = with_derivative.then(|| FrequencyDerivative {
+            transfer: vec![zero; bins * m * m],
+            linear_amplitude: vec![zero; m],
+        });
 
         let mut union = union_pattern(model)?;
         let symbolic =
@@ -524,6 +566,35 @@ impl PeriodicLcp {
                     linear_amplitude[r] = rhs[(dof, m)];
                 }
             }
+            if let Some(d) = derivative.as_mut() {
+                // Y = Z_k^{-1} (dZ_k/domega) X, X = Z_k^{-1} [G^T, f]; dX/domega = -Y.
+                let tau = sigma / omega;
+                let mut y = Mat::<c64>::zeros(n, ncols);
+                let mut apply = |matrix: &SparseMatrix, coefficient: c64| {
+                    let a = matrix.as_ref();
+                    for j in 0..n {
+                        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+                            let f = coefficient * *v;
+                            for col in 0..ncols {
+                                y[(i, col)] += f * rhs[(j, col)];
+                            }
+                        }
+                    }
+                };
+                apply(&model.mass, c64::new(-2.0 * omega * tau * tau, 0.0));
+                if let Some(damping) = &model.damping {
+                    apply(damping, c64::new(0.0, tau));
+                }
+                lu.solve_in_place(y.as_mut());
+                for (r, &dof) in contact_dofs.iter().enumerate() {
+                    for c in 0..m {
+                        d.transfer[(k * m + r) * m + c] = -y[(dof, c)];
+                    }
+                    if with_forcing {
+                        d.linear_amplitude[r] = -y[(dof, m)];
+                    }
+                }
+            }
         }
 
         // Nyquist limit: static receptance of the dofs with neither mass nor damping.
@@ -559,12 +630,26 @@ impl PeriodicLcp {
             }
         }
         let size = m * nt;
-        let matrix = Mat::from_fn(size, size, |i, j| {
-            let (ni, ci) = (i / m, i % m);
-            let (nj, cj) = (j / m, j % m);
-            let p = (ni + nt - nj) % nt;
-            kernel[(p * m + ci) * m + cj]
-        });
+        // A[(ni, ci), (nj, cj)] = a_{ni - nj}[ci, cj]: column (nj, cj) is the column cj of
+        // the kernel blocks, rotated down by nj nodes (filled by contiguous copies).
+        let mut matrix = Mat::<f64>::zeros(size, size);
+        let mut column0 = vec![0.0; size];
+        for cj in 0..m {
+            for p in 0..nt {
+                for ci in 0..m {
+                    column0[p * m + ci] = kernel[(p * m + ci) * m + cj];
+                }
+            }
+            for nj in 0..nt {
+                let shift = nj * m;
+                let col = matrix.col_mut(nj * m + cj).try_as_col_major_mut();
+                let col = col
+                    .expect("a freshly allocated Mat is column-major")
+                    .as_slice_mut();
+                col[shift..].copy_from_slice(&column0[..size - shift]);
+                col[..shift].copy_from_slice(&column0[size - shift..]);
+            }
+        }
         let mut q = vec![0.0; size];
         for node in 0..nt {
             let phase = 2.0 * std::f64::consts::PI * node as f64 / nt as f64;
@@ -587,7 +672,61 @@ impl PeriodicLcp {
             linear_amplitude,
             symmetric_spectrum,
             static_dofs: static_set.len(),
+            derivative,
         })
+    }
+
+    /// `d(q + A z)/domega` at fixed `z` into `out` (time-major, length `m Nt`): the
+    /// derivative of the gap `w = q + A z` along the frequency. `A z` is applied by FFT with
+    /// the bin derivatives `dH_k/domega`, `dq_n/domega = -Re(dX/domega e^{2 pi i n/Nt})`.
+    /// Needs an LCP built by [`PeriodicLcp::with_frequency_derivative`].
+    pub fn frequency_derivative(&self, z: &[f64], out: &mut [f64]) -> Result<(), LcpError> {
+        self.check_z(z)?;
+        if out.len() != self.dim() {
+            return Err(LcpError::WrongLength {
+                what: "out",
+                expected: self.dim(),
+                found: out.len(),
+            });
+        }
+        let d = self
+            .derivative
+            .as_ref()
+            .ok_or(LcpError::NoFrequencyDerivative)?;
+        let nt = self.nt;
+        let m = self.contacts;
+        let zero = c64::new(0.0, 0.0);
+        let mut plan = Dft::new(nt);
+        let spectra: Vec<Vec<c64>> = (0..m)
+            .map(|c| {
+                let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
+                plan.forward(&mut s);
+                s
+            })
+            .collect();
+        let mut buffer = vec![zero; nt];
+        for c in 0..m {
+            for (k, b) in buffer.iter_mut().enumerate() {
+                let (bin, conj) = if 2 * k > nt {
+                    (nt - k, true)
+                } else {
+                    (k, false)
+                };
+                let mut sum = zero;
+                for (c2, s) in spectra.iter().enumerate() {
+                    let h = d.transfer[(bin * m + c) * m + c2];
+                    sum += if conj { h.conj() } else { h } * s[k];
+                }
+                *b = sum;
+            }
+            plan.backward(&mut buffer);
+            for (n, b) in buffer.iter().enumerate() {
+                let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
+                let linear = (d.linear_amplitude[c] * c64::new(phase.cos(), phase.sin())).re;
+                out[n * m + c] = b.re / nt as f64 - linear;
+            }
+        }
+        Ok(())
     }
 
     /// Number of time steps per period `Nt`.
@@ -981,7 +1120,10 @@ fn fill_spectrum(spectrum: &mut [c64], bin: impl Fn(usize) -> c64) {
 fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale: f64) -> f64 {
     let n = z.nrows();
     let zr = z.as_ref();
-    let z_max = z.val().iter().fold(scale, |a, v| a.max(v.norm()));
+    // Largest moduli through squared moduli (one square root each, no hypot per entry).
+    let max_norm =
+        |it: &mut dyn Iterator<Item = c64>| it.fold(0.0f64, |a, v| a.max(v.norm_sqr())).sqrt();
+    let z_max = scale.max(max_norm(&mut z.val().iter().copied()));
     let mut worst = 0.0f64;
     for col in 0..x.ncols() {
         let mut r: Vec<c64> = (0..n).map(|i| -b[(i, col)]).collect();
@@ -991,9 +1133,9 @@ fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale:
                 r[i] += *v * xj;
             }
         }
-        let x_max = (0..n).fold(0.0f64, |a, i| a.max(x[(i, col)].norm()));
-        let b_max = (0..n).fold(0.0f64, |a, i| a.max(b[(i, col)].norm()));
-        let r_max = r.iter().fold(0.0f64, |a, v| a.max(v.norm()));
+        let x_max = max_norm(&mut (0..n).map(|i| x[(i, col)]));
+        let b_max = max_norm(&mut (0..n).map(|i| b[(i, col)]));
+        let r_max = max_norm(&mut r.iter().copied());
         let denominator = z_max * x_max + b_max;
         let rel = if denominator > 0.0 {
             r_max / denominator
