@@ -25,12 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..RodSpec::canonical()
     })?;
     let sweep = SweepSettings {
-        omega_ratio_from: 0.5,
-        omega_ratio_to: 2.0,
-        step: 0.01,
-        min_step: 1e-5,
-        max_step: 0.05,
         max_points: 5000,
+        ..SweepSettings::new(0.5, 2.0)
     };
     println!(
         "{:<16} {:>7} {:>9} {:>6} {:>9} {:>12} {:>10}  folds (count, lowest, highest omega/omega_1)",

@@ -16,13 +16,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use semismooth_problems::cli::{default_settings, figure_2_sweep};
 use semismooth_problems::output::{prepare_directory, write_atomically, write_line_plot};
 use semismooth_problems::output::{PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
-use semismooth_problems::scene::{
-    default_hb_time_samples, GlobalizationChoice, LinearSolverChoice, Method, SolverSettings,
-    SweepSettings,
-};
+use semismooth_problems::scene::{GlobalizationChoice, SolverSettings, SweepSettings};
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
 
 /// Gaps of the paper's Fig. 2 (`None`: no contact).
@@ -30,31 +28,15 @@ const GAPS: [Option<f64>; 4] = [Some(0.25), Some(0.5), Some(0.75), None];
 
 fn settings(harmonics: usize) -> SolverSettings {
     SolverSettings {
-        method: Method::SsnHb,
-        harmonics,
-        time_samples: default_hb_time_samples(harmonics),
-        c: None,
-        penalty_stiffness: None,
-        linear_solver: LinearSolverChoice::Structured,
         max_iterations: 100,
         globalization: GlobalizationChoice::Nonmonotone,
-        tolerance: 1e-10,
         steps_per_period: 1024,
-        max_periods: 2000,
-        march_tolerance: 1e-8,
-        restitution: 0.0,
+        ..default_settings(harmonics)
     }
 }
 
 fn sweep() -> SweepSettings {
-    SweepSettings {
-        omega_ratio_from: 0.5,
-        omega_ratio_to: 2.0,
-        step: 0.02,
-        min_step: 1e-5,
-        max_step: 0.1,
-        max_points: 5000,
-    }
+    figure_2_sweep()
 }
 
 fn rod(gap: Option<f64>, amplitude: f64, mass: MassModel) -> RodModel {

@@ -552,6 +552,18 @@ pub struct ContinuationCounters {
     pub corner_passes: u64,
 }
 
+impl std::ops::AddAssign for ContinuationCounters {
+    fn add_assign(&mut self, rhs: Self) {
+        self.work += rhs.work;
+        self.parameter_derivative_evaluations += rhs.parameter_derivative_evaluations;
+        self.dense_bordered_factorizations += rhs.dense_bordered_factorizations;
+        self.corrector_iterations += rhs.corrector_iterations;
+        self.rejected_iterations += rhs.rejected_iterations;
+        self.rejected_steps += rhs.rejected_steps;
+        self.corner_passes += rhs.corner_passes;
+    }
+}
+
 /// A computed branch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Branch {

@@ -9,43 +9,29 @@ use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::continuation::natural_sweep;
 use semismooth::newton::{self, Globalization, NewtonOptions};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth_problems::cli::default_settings;
 use semismooth_problems::hb::{HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::model::StructuralModel;
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::RunError;
 use semismooth_problems::scene::{
-    default_hb_time_samples, GlobalizationChoice, LinearSolverChoice, Method, SolverSettings,
-    SweepSettings, DEFAULT_RELATIVE_PENALTY,
+    default_hb_time_samples, GlobalizationChoice, Method, SolverSettings, SweepSettings,
+    DEFAULT_RELATIVE_PENALTY,
 };
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
 
 fn settings(method: Method, harmonics: usize) -> SolverSettings {
     SolverSettings {
         method,
-        harmonics,
-        time_samples: default_hb_time_samples(harmonics),
-        c: None,
-        penalty_stiffness: None,
-        linear_solver: LinearSolverChoice::Structured,
         max_iterations: 100,
         globalization: GlobalizationChoice::Nonmonotone,
-        tolerance: 1e-10,
         steps_per_period: 1024,
-        max_periods: 2000,
-        march_tolerance: 1e-8,
-        restitution: 0.0,
+        ..default_settings(harmonics)
     }
 }
 
 fn sweep(from: f64, to: f64) -> SweepSettings {
-    SweepSettings {
-        omega_ratio_from: from,
-        omega_ratio_to: to,
-        step: 0.01,
-        min_step: 1e-5,
-        max_step: 0.05,
-        max_points: 2000,
-    }
+    SweepSettings::new(from, to)
 }
 
 fn rod(gap: Option<f64>, amplitude: f64, mass: MassModel) -> RodModel {

@@ -756,14 +756,7 @@ fn continuation_crosses_the_grazing_point() {
     for method in [Method::SsnHb, Method::PenaltyHb] {
         let mut settings = with_method(method, &hb(10));
         settings.max_iterations = 50;
-        let sweep = SweepSettings {
-            omega_ratio_from: 0.5,
-            omega_ratio_to: 1.5,
-            step: 0.01,
-            min_step: 1e-5,
-            max_step: 0.05,
-            max_points: 2000,
-        };
+        let sweep = SweepSettings::new(0.5, 1.5);
         let run = catch_unwind(AssertUnwindSafe(|| {
             frequency_response(&rod, &settings, &sweep, None)
         }));

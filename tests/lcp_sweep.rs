@@ -6,42 +6,28 @@
 use std::sync::OnceLock;
 
 use semismooth::newton::{self, Globalization, NewtonOptions};
+use semismooth_problems::cli::default_settings;
 use semismooth_problems::lcp::{ActiveSetSolver, PeriodicLcp, PeriodicLcpOptions};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::RunError;
 use semismooth_problems::scene::{
-    default_hb_time_samples, GlobalizationChoice, LinearSolverChoice, Method, SolverSettings,
-    SweepSettings,
+    default_hb_time_samples, GlobalizationChoice, Method, SolverSettings, SweepSettings,
 };
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
 
 fn settings(method: Method, harmonics: usize, time_samples: usize) -> SolverSettings {
     SolverSettings {
         method,
-        harmonics,
         time_samples,
-        c: None,
-        penalty_stiffness: None,
-        linear_solver: LinearSolverChoice::Structured,
         max_iterations: 100,
         globalization: GlobalizationChoice::Nonmonotone,
-        tolerance: 1e-10,
         steps_per_period: 1024,
-        max_periods: 2000,
-        march_tolerance: 1e-8,
-        restitution: 0.0,
+        ..default_settings(harmonics)
     }
 }
 
 fn sweep(from: f64, to: f64) -> SweepSettings {
-    SweepSettings {
-        omega_ratio_from: from,
-        omega_ratio_to: to,
-        step: 0.01,
-        min_step: 1e-5,
-        max_step: 0.05,
-        max_points: 2000,
-    }
+    SweepSettings::new(from, to)
 }
 
 /// The canonical rod with the modified mass (massless contact node), gap 0.5, p0 = 0.04.

@@ -674,20 +674,23 @@ pub struct Fig2Curve {
     pub converged: bool,
 }
 
+/// The sweep of the default run's Fig. 2: `omega/omega_1` in `[0.5, 2]`, steps twice the
+/// scene defaults (`0.02`, at most `0.1`), up to 5000 points.
+pub fn figure_2_sweep() -> crate::scene::SweepSettings {
+    crate::scene::SweepSettings {
+        step: 0.02,
+        max_step: 0.1,
+        max_points: 5000,
+        ..crate::scene::SweepSettings::new(0.5, 2.0)
+    }
+}
+
 /// Fig. 2 of the paper: `max |u_tip|` against omega/omega_1 on [0.5, 2] for gaps 0.25, 0.5,
 /// 0.75 and the linear rod, SSN-HB with `harmonics` harmonics, by pseudo-arclength
 /// continuation; writes `fig2_H<h>.svg` and `.csv` into `out`.
 pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Curve>, CliError> {
     use crate::rod::RodContact;
-    use crate::scene::SweepSettings;
-    let sweep = SweepSettings {
-        omega_ratio_from: 0.5,
-        omega_ratio_to: 2.0,
-        step: 0.02,
-        min_step: 1e-5,
-        max_step: 0.1,
-        max_points: 5000,
-    };
+    let sweep = figure_2_sweep();
     let settings = default_settings(harmonics);
     let bar = progress_bar(4, &format!("Fig. 2 (H = {harmonics})"), quiet);
     let mut curves = Vec::new();

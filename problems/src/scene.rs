@@ -183,6 +183,22 @@ pub struct SweepSettings {
     pub max_points: usize,
 }
 
+impl SweepSettings {
+    /// A sweep from `omega_ratio_from` to `omega_ratio_to` (units of omega_1) with the
+    /// scene defaults: `step = 0.01`, `min_step = 1e-5`, `max_step = 0.05`,
+    /// `max_points = 2000` (not validated; the sweep checks).
+    pub fn new(omega_ratio_from: f64, omega_ratio_to: f64) -> Self {
+        Self {
+            omega_ratio_from,
+            omega_ratio_to,
+            step: 0.01,
+            min_step: 1e-5,
+            max_step: 0.05,
+            max_points: 2000,
+        }
+    }
+}
+
 /// A validated scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -604,9 +620,12 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
                     "a value different from omega_ratio_from",
                 ));
             }
-            let step = ck.positive("sweep.step", sw.step.unwrap_or(0.01))?;
-            let min_step = ck.positive("sweep.min_step", sw.min_step.unwrap_or(1e-5))?;
-            let max_step = ck.positive("sweep.max_step", sw.max_step.unwrap_or(0.05))?;
+            let defaults = SweepSettings::new(from, to);
+            let step = ck.positive("sweep.step", sw.step.unwrap_or(defaults.step))?;
+            let min_step =
+                ck.positive("sweep.min_step", sw.min_step.unwrap_or(defaults.min_step))?;
+            let max_step =
+                ck.positive("sweep.max_step", sw.max_step.unwrap_or(defaults.max_step))?;
             if step < min_step || step > max_step {
                 return Err(ck.invalid(
                     "sweep.step",
@@ -616,7 +635,7 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             }
             let max_points = match sw.max_points {
                 Some(n) => ck.count("sweep.max_points", n, 2, 1_000_000)?,
-                None => 2000,
+                None => defaults.max_points,
             };
             Some(SweepSettings {
                 omega_ratio_from: from,

@@ -164,7 +164,7 @@ use semismooth::continuation::{
 };
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{self, NewtonReport};
+use semismooth::newton::{self, NewtonReport, WorkCounters};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use serde_json::json;
 
@@ -646,7 +646,7 @@ struct Setup<'a> {
     residual_floor: f64,
     /// Starting guess of the Newton solve at `omega_from` (zero when `None`) and the work
     /// spent computing it.
-    start: Option<(Vec<f64>, RunCounters)>,
+    start: Option<(Vec<f64>, WorkCounters)>,
 }
 
 fn follow<P, S>(
@@ -684,10 +684,10 @@ where
 
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
-    let (mut x, start_counters) = start.unwrap_or_else(|| (vec![0.0; n], RunCounters::default()));
+    let (mut x, mut work) = start.unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
     let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
-    let mut counters = RunCounters::from(report.counters);
-    add_run_counters(&mut counters, &start_counters);
+    work += report.counters;
+    let mut counters = RunCounters::from(work);
     let mut response = FrequencyResponse {
         method: settings.method,
         omega_1,
@@ -890,7 +890,7 @@ where
                 break;
             }
         }
-        add_counters(&mut c, &cont.counters());
+        c += cont.counters();
         let termination = cont.termination().cloned();
         drop(cont);
         // A restarted segment must not go back along the branch. A point of it is taken as
@@ -1125,25 +1125,6 @@ fn record_fold(
     }
 }
 
-fn add_run_counters(total: &mut RunCounters, c: &RunCounters) {
-    total.residual_evaluations += c.residual_evaluations;
-    total.jacobian_evaluations += c.jacobian_evaluations;
-    total.factorizations += c.factorizations;
-    total.linear_solves += c.linear_solves;
-    total.line_search_backtracks += c.line_search_backtracks;
-    total.ffts += c.ffts;
-}
-
-fn add_counters(total: &mut ContinuationCounters, c: &ContinuationCounters) {
-    total.work += c.work;
-    total.parameter_derivative_evaluations += c.parameter_derivative_evaluations;
-    total.dense_bordered_factorizations += c.dense_bordered_factorizations;
-    total.corrector_iterations += c.corrector_iterations;
-    total.rejected_iterations += c.rejected_iterations;
-    total.rejected_steps += c.rejected_steps;
-    total.corner_passes += c.corner_passes;
-}
-
 /// Reconstructs one dof over a period from HB coefficients (index `j N + dof`).
 struct HbTip {
     aft: Aft,
@@ -1328,9 +1309,9 @@ pub fn frequency_response(
                 lcp_options.clone(),
                 &newton_options(settings),
             )?;
-            let mut start_counters = RunCounters::default();
+            let mut start_counters = WorkCounters::default();
             for level in &sequenced.levels {
-                add_run_counters(&mut start_counters, &level.report.counters.into());
+                start_counters += level.report.counters;
             }
             let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
             let y0 = problem.state_from_forces(&sequenced.z)?;

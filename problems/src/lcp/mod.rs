@@ -313,6 +313,58 @@ struct FrequencyDerivative {
     linear_amplitude: Vec<c64>,
 }
 
+/// Histories over the `Nt` nodes of the rows `rows` of `u = Re(X_r e^{i omega t}) - R z`:
+/// the harmonic-1 linear response with amplitudes `linear_amplitude[r]` minus the
+/// circulant response to the compressive forces `z` (time-major, `m` contacts), applied by
+/// FFT with the bin kernels `transfer[(k * rows_total + r) * m + c]`, `k = 0..=Nt/2` (the
+/// other bins by conjugate symmetry).
+fn kernel_response(
+    nt: usize,
+    m: usize,
+    transfer: &[c64],
+    rows_total: usize,
+    linear_amplitude: &[c64],
+    z: &[f64],
+    rows: &[usize],
+) -> Vec<Vec<f64>> {
+    let zero = c64::new(0.0, 0.0);
+    let mut plan = Dft::new(nt);
+    // Spectra of the contact forces z_c.
+    let spectra: Vec<Vec<c64>> = (0..m)
+        .map(|c| {
+            let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
+            plan.forward(&mut s);
+            s
+        })
+        .collect();
+    let mut buffer = vec![zero; nt];
+    rows.iter()
+        .map(|&r| {
+            for (k, out) in buffer.iter_mut().enumerate() {
+                let (bin, conj) = if 2 * k > nt {
+                    (nt - k, true)
+                } else {
+                    (k, false)
+                };
+                let mut sum = zero;
+                for (c, s) in spectra.iter().enumerate() {
+                    let t = transfer[(bin * rows_total + r) * m + c];
+                    sum += if conj { t.conj() } else { t } * s[k];
+                }
+                *out = sum;
+            }
+            plan.backward(&mut buffer);
+            (0..nt)
+                .map(|n| {
+                    let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
+                    let linear = (linear_amplitude[r] * c64::new(phase.cos(), phase.sin())).re;
+                    linear - buffer[n].re / nt as f64
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Column-compressed union pattern of `K`, `M`, `D` with, for each source matrix, the
 /// position of each of its stored entries in the union.
 struct UnionPattern {
@@ -693,37 +745,13 @@ impl PeriodicLcp {
             .derivative
             .as_ref()
             .ok_or(LcpError::NoFrequencyDerivative)?;
-        let nt = self.nt;
         let m = self.contacts;
-        let zero = c64::new(0.0, 0.0);
-        let mut plan = Dft::new(nt);
-        let spectra: Vec<Vec<c64>> = (0..m)
-            .map(|c| {
-                let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
-                plan.forward(&mut s);
-                s
-            })
-            .collect();
-        let mut buffer = vec![zero; nt];
-        for c in 0..m {
-            for (k, b) in buffer.iter_mut().enumerate() {
-                let (bin, conj) = if 2 * k > nt {
-                    (nt - k, true)
-                } else {
-                    (k, false)
-                };
-                let mut sum = zero;
-                for (c2, s) in spectra.iter().enumerate() {
-                    let h = d.transfer[(bin * m + c) * m + c2];
-                    sum += if conj { h.conj() } else { h } * s[k];
-                }
-                *b = sum;
-            }
-            plan.backward(&mut buffer);
-            for (n, b) in buffer.iter().enumerate() {
-                let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
-                let linear = (d.linear_amplitude[c] * c64::new(phase.cos(), phase.sin())).re;
-                out[n * m + c] = b.re / nt as f64 - linear;
+        let rows: Vec<usize> = (0..m).collect();
+        // `w = g - u_c` along the contact rows: dw/domega = -(du_c/domega).
+        let du = kernel_response(self.nt, m, &d.transfer, m, &d.linear_amplitude, z, &rows);
+        for (c, history) in du.iter().enumerate() {
+            for (n, v) in history.iter().enumerate() {
+                out[n * m + c] = -v;
             }
         }
         Ok(())
@@ -882,46 +910,15 @@ impl PeriodicLcp {
     }
 
     fn response_rows(&self, z: &[f64], rows: &[usize]) -> Vec<Vec<f64>> {
-        let nt = self.nt;
-        let m = self.contacts;
-        let nr = self.rows();
-        let zero = c64::new(0.0, 0.0);
-        let mut plan = Dft::new(nt);
-        // Spectra of the contact forces z_c.
-        let spectra: Vec<Vec<c64>> = (0..m)
-            .map(|c| {
-                let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
-                plan.forward(&mut s);
-                s
-            })
-            .collect();
-        let mut buffer = vec![zero; nt];
-        rows.iter()
-            .map(|&r| {
-                for (k, out) in buffer.iter_mut().enumerate() {
-                    let (bin, conj) = if 2 * k > nt {
-                        (nt - k, true)
-                    } else {
-                        (k, false)
-                    };
-                    let mut sum = zero;
-                    for (c, s) in spectra.iter().enumerate() {
-                        let t = self.transfer[(bin * nr + r) * m + c];
-                        sum += if conj { t.conj() } else { t } * s[k];
-                    }
-                    *out = sum;
-                }
-                plan.backward(&mut buffer);
-                (0..nt)
-                    .map(|n| {
-                        let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
-                        let linear =
-                            (self.linear_amplitude[r] * c64::new(phase.cos(), phase.sin())).re;
-                        linear - buffer[n].re / nt as f64
-                    })
-                    .collect()
-            })
-            .collect()
+        kernel_response(
+            self.nt,
+            self.contacts,
+            &self.transfer,
+            self.rows(),
+            &self.linear_amplitude,
+            z,
+            rows,
+        )
     }
 
     /// Solves the LCP by Lemke's method (method `"lcp-lemke"`), reusing the workspace
