@@ -43,6 +43,34 @@ pub fn load(path: &Path) -> Result<(Scene, RodModel), CliError> {
     Ok((scene, rod))
 }
 
+/// Largest number of folds listed one by one in the human-readable sweep summary.
+const LISTED_FOLDS: usize = 8;
+
+/// The folds of a sweep in words (units of omega_1): all of them when there are few; else
+/// their count, range, first and last (LCP and stiff-penalty branches have tens to
+/// hundreds of small folds where the contact moves from node to node; `--json` and
+/// `--csv` keep every one).
+fn folds_summary(folds: &[f64], omega_1: f64) -> String {
+    let ratio: Vec<f64> = folds.iter().map(|w| w / omega_1).collect();
+    match ratio.len() {
+        0 => "none".into(),
+        n if n <= LISTED_FOLDS => ratio
+            .iter()
+            .map(|r| format!("{r:.4}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        n => {
+            let lo = ratio.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = ratio.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            format!(
+                "{n} between {lo:.4} and {hi:.4} (first {:.4}, last {:.4}; all in --json)",
+                ratio[0],
+                ratio[n - 1]
+            )
+        }
+    }
+}
+
 /// The JSON object of the work counters.
 pub fn counters_json(c: &RunCounters) -> Value {
     json!({
@@ -269,18 +297,9 @@ pub fn sweep(
                 ratio[i]
             );
         }
-        let folds: Vec<String> = response
-            .folds
-            .iter()
-            .map(|w| format!("{:.4}", w / rod.omega_1))
-            .collect();
         println!(
             "folds             {}",
-            if folds.is_empty() {
-                "none".into()
-            } else {
-                folds.join(", ")
-            }
+            folds_summary(&response.folds, rod.omega_1)
         );
         println!(
             "converged         {} ({}), {:.3} s",
@@ -796,4 +815,20 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
         start.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::folds_summary;
+
+    #[test]
+    fn few_folds_are_listed_and_many_are_summarised_by_count_and_range() {
+        assert_eq!(folds_summary(&[], 2.0), "none");
+        assert_eq!(folds_summary(&[2.1, 2.05], 2.0), "1.0500, 1.0250");
+        let many: Vec<f64> = (0..20).map(|k| 2.0 + 0.001 * k as f64).collect();
+        assert_eq!(
+            folds_summary(&many, 2.0),
+            "20 between 1.0000 and 1.0095 (first 1.0000, last 1.0095; all in --json)"
+        );
+    }
 }
