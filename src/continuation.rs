@@ -1399,24 +1399,13 @@ where
     fn advance(&mut self) -> Option<BranchPoint> {
         let n = self.ws.n;
         let last = self.last.clone()?;
-        let theta_x = self.options.theta / n as f64;
         let mut x = vec![0.0; n];
         loop {
             let ds = self.step;
-            for (((xi, wi), si), di) in x
-                .iter_mut()
-                .zip(self.ws.w.iter_mut())
-                .zip(&last.state)
-                .zip(&self.direction)
-            {
+            for ((xi, si), di) in x.iter_mut().zip(&last.state).zip(&self.direction) {
                 *xi = si + ds * di;
-                *wi = theta_x * di;
             }
-            if !self.ws.weights.is_empty() {
-                for (wi, v) in self.ws.w.iter_mut().zip(&self.ws.weights) {
-                    *wi *= v;
-                }
-            }
+            self.direction_weights();
             let mut p = last.parameter + ds * self.direction[n];
             let w_p = (1.0 - self.options.theta) * self.direction[n];
             let w_dot_last: f64 = self
@@ -1438,10 +1427,7 @@ where
             match corrected {
                 Ok(c) => return self.accept(&last, x, p, ds, c, None),
                 Err(failure) => {
-                    self.counters.rejected_steps += 1;
-                    self.counters.rejected_iterations +=
-                        self.counters.corrector_iterations - before;
-                    self.problem.set_parameter(last.parameter);
+                    self.reject(before, last.parameter);
                     self.consecutive_failures += 1;
                     let ending = ds <= self.options.min_step
                         || self.consecutive_failures >= self.options.max_consecutive_failures;
@@ -1475,13 +1461,29 @@ where
         }
     }
 
+    /// `ws.w = (θ/n) s⁻² ⊙ d_x`: the state part of the normal of the arclength constraint
+    /// along the current direction `d` (`s` the state scale, 1 without one).
+    fn direction_weights(&mut self) {
+        let theta_x = self.options.theta / self.ws.n as f64;
+        for (i, (wi, di)) in self.ws.w.iter_mut().zip(&self.direction).enumerate() {
+            *wi = theta_x * di * self.ws.weights.get(i).copied().unwrap_or(1.0);
+        }
+    }
+
+    /// Books a rejected attempt (begun at `before` corrector iterations) and restores the
+    /// problem's parameter to the last accepted point's.
+    fn reject(&mut self, before: u64, parameter: f64) {
+        self.counters.rejected_steps += 1;
+        self.counters.rejected_iterations += self.counters.corrector_iterations - before;
+        self.problem.set_parameter(parameter);
+    }
+
     /// The corner passes of the module documentation (*Corners*), with step `ds` from
     /// `last` along the current direction: first on the hyperplane normal to the direction's
     /// state part, then at the next parameter `p + ds / sqrt(1 - θ)` (sign of the direction's
     /// parameter component). `Some(result of accept)` when one converged.
     fn pass_corner(&mut self, last: &BranchPoint, ds: f64) -> Option<Option<BranchPoint>> {
         let n = self.ws.n;
-        let theta_x = self.options.theta / n as f64;
         let d = self.direction.clone();
         let state_part = self.ws.dot(&d[..n], 0.0, &d[..n], 0.0);
         let parameter_part = (1.0 - self.options.theta) * d[n] * d[n];
@@ -1490,9 +1492,7 @@ where
                 if state_part < 1e-6 {
                     continue;
                 }
-                for (i, (wi, di)) in self.ws.w.iter_mut().zip(&d).enumerate() {
-                    *wi = theta_x * di * self.ws.weights.get(i).copied().unwrap_or(1.0);
-                }
+                self.direction_weights();
                 let mut along = d.clone();
                 along[n] = 0.0;
                 let target: f64 = self
@@ -1544,12 +1544,7 @@ where
                     );
                     return Some(self.accept(last, x, p, step, c, Some(&along)));
                 }
-                Err(_) => {
-                    self.counters.rejected_steps += 1;
-                    self.counters.rejected_iterations +=
-                        self.counters.corrector_iterations - before;
-                    self.problem.set_parameter(last.parameter);
-                }
+                Err(_) => self.reject(before, last.parameter),
             }
         }
         None

@@ -146,10 +146,11 @@
 //!   together at the onset (gaps 8e-5, 1.5e-4, 7e-4 at nodes 8, 9, 7) and the pieces lead
 //!   back to the free response. Without an impact law the trapezoidal periodic LCP of a
 //!   massive contact node is the ill-posed case (module `lcp`). At `Nt = 1024` (modified
-//!   mass) the overhang has a sharp corner every few points; a problem-side corner step
-//!   ([`FrequencyLcp::corner_step`], not wired into the sweep) carried it from 1.0167 to
-//!   1.0270 `ω_1` before the pieces closed into a cycle (two nodes switching almost
-//!   together).
+//!   mass) the overhang has a sharp corner every few points and the sweep stalls at 1.0167
+//!   `ω_1` (1573 points, 70 s on `[1, 1.04] ω_1`); an explicit step to the neighbouring
+//!   piece of the LCP (extrapolating the current piece to its first switch, as
+//!   `sweep/corners.rs` does for the penalty) carried it to 1.0270 `ω_1` in an experiment,
+//!   where the pieces closed into a cycle (two nodes switching almost together).
 //! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
 //!   marching are no equation in `ω` to continue; solve frequency by frequency with
 //!   `ssn solve`.
@@ -751,9 +752,7 @@ where
     let mut c = ContinuationCounters::default();
     let mut start_failure = None;
     let mut last_tangent_parameter = 0.0;
-    // Whether the segment about to run is a restart, and where the sweep stopped because a
-    // restart went back along the branch.
-    let mut restarted = false;
+    // Where the sweep stopped because a restart went back along the branch.
     let mut retraced: Option<f64> = None;
     // After a corner the segment starts at a new point (otherwise at the last one).
     let mut new_start = false;
@@ -786,9 +785,9 @@ where
             segment_options,
         )
         .map_err(continuation_error)?;
-        // Index in `response` of each point of the segment (for the core's fold events),
-        // and where the segment stopped to let the next one start after a corner.
-        let mut index_map: Vec<usize> = Vec::new();
+        // Whether the segment's first point (a repeat of the last one) is still to come, and
+        // where the segment stopped to let the next one start after a corner.
+        let mut skip_first = repeat > 0;
         let mut next: Option<(Vec<f64>, f64, Direction, bool)> = None;
         while let Some(item) = cont.next() {
             let point = match item {
@@ -812,8 +811,7 @@ where
                 t.radius = TRUST_FACTOR * next;
             }
             // The start of a restarted segment repeats the last point.
-            if index_map.is_empty() && repeat > 0 {
-                index_map.push(offset - 1);
+            if std::mem::take(&mut skip_first) {
                 continue;
             }
             let state: Vec<f64> = point.state.iter().zip(&scale).map(|(y, s)| y * s).collect();
@@ -858,21 +856,21 @@ where
                 }
                 piece = Some(label);
             }
-            for (x, w) in corner_points {
-                let (max, min) = measure(&*cont.problem().inner, &x)?;
-                response.push(w, max, min, 0, x);
-                record_fold(&mut response, &mut fold_detector, w, 0.0, 0.0, omega_unit);
-                if let Some(report) = progress {
-                    report(response.omega.len() - 1, w / omega_1);
-                }
-            }
+            record_corners(
+                &mut response,
+                &mut fold_detector,
+                measure,
+                &*cont.problem().inner,
+                corner_points,
+                omega_unit,
+                progress,
+            )?;
             if matches!(next, Some((_, _, _, true))) {
                 break;
             }
             last_tangent_parameter = point.tangent_parameter;
             let (max, min) = measure(&*cont.problem().inner, &state)?;
             response.push(omega, max, min, point.iterations, state);
-            index_map.push(response.omega.len() - 1);
             record_fold(
                 &mut response,
                 &mut fold_detector,
@@ -897,7 +895,7 @@ where
         // going back when it is within a quarter of `|x_j - x_last|` of a point `x_j` among
         // the few before the restart point `x_last` (a genuine turn that close is sharper
         // than 165°).
-        if std::mem::take(&mut restarted) && offset >= 2 {
+        if restart && offset >= 2 {
             let distance = |i: usize, j: usize| {
                 let dy: f64 = response.states[i]
                     .iter()
@@ -945,14 +943,15 @@ where
                 &mut corner_work,
             ) {
                 crossed += walk.corners.len();
-                for (x, w) in walk.corners {
-                    let (max, min) = measure(&*scaled.inner, &x)?;
-                    response.push(w, max, min, 0, x);
-                    record_fold(&mut response, &mut fold_detector, w, 0.0, 0.0, omega_unit);
-                    if let Some(report) = progress {
-                        report(response.omega.len() - 1, w / omega_1);
-                    }
-                }
+                record_corners(
+                    &mut response,
+                    &mut fold_detector,
+                    measure,
+                    &*scaled.inner,
+                    walk.corners,
+                    omega_unit,
+                    progress,
+                )?;
                 piece = Some(c.piece(&walk.start));
                 travel = direction_sign(walk.direction);
                 next = Some((walk.start, walk.start_omega, walk.direction, true));
@@ -975,7 +974,6 @@ where
         if failed && restarts < MAX_RESTARTS && last_tangent_parameter != 0.0 {
             restarts += 1;
             restart = true;
-            restarted = true;
         } else if short_done {
             restart = false;
         } else {
@@ -1104,6 +1102,29 @@ fn direction_sign(direction: Direction) -> f64 {
         Direction::Increasing => 1.0,
         Direction::Decreasing => -1.0,
     }
+}
+
+/// Records corners stepped over explicitly (state and `ω` each) as branch points: their
+/// tip extremes, their folds (a corner has no tangent: a fold there is the corner itself),
+/// and the progress report.
+fn record_corners<P: ?Sized>(
+    response: &mut FrequencyResponse,
+    detector: &mut FoldDetector,
+    measure: &mut TipMeasure<'_, P>,
+    problem: &P,
+    corners: Vec<(Vec<f64>, f64)>,
+    omega_unit: f64,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<(), RunError> {
+    for (x, w) in corners {
+        let (max, min) = measure(problem, &x)?;
+        response.push(w, max, min, 0, x);
+        record_fold(response, detector, w, 0.0, 0.0, omega_unit);
+        if let Some(report) = progress {
+            report(response.omega.len() - 1, w / response.omega_1);
+        }
+    }
+    Ok(())
 }
 
 /// Feeds the point just pushed (at `omega`, with the tangent's scaled-parameter component
@@ -1255,7 +1276,6 @@ pub fn frequency_response(
             let setup = setup(units, output_points, floor);
             // A corner is searched within one largest step of the last point, and the next
             // piece is entered at most a quarter of the first step from it (in ω).
-            let limits = (sweep.max_step * omega_1, 0.25 * sweep.step * omega_1);
             let solver: Box<dyn LinearSolve<HbJacobian>> = match settings.linear_solver {
                 LinearSolverChoice::Structured => Box::new(StructuredHbSolver::new()),
                 LinearSolverChoice::Dense => Box::new(FaerDenseLu::new()),
@@ -1263,8 +1283,8 @@ pub fn frequency_response(
             let mut corners = PenaltyCorners {
                 problem: PenaltyHb::new(model, &options)?,
                 solver,
-                reach: limits.0,
-                shift: limits.1,
+                reach: sweep.max_step * omega_1,
+                shift: 0.25 * sweep.step * omega_1,
                 walk: sweep.max_step,
                 omega_1,
                 unit: (dofs as f64).sqrt() * u_ref,

@@ -588,16 +588,32 @@ fn lcp_and_march_scenes_print_json_without_harmonics() {
     }
 }
 
-#[test]
-fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
-    let fig2 = scenes_dir().join("paper_fig2.toml");
-    let out = ssn(&["sweep", "--json", fig2.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
-    assert_eq!(json["converged"], Value::Bool(true));
+/// The `ssn sweep --json` document of a converged branch: every field of the issue, the
+/// per-point arrays one finite entry per point (at least two points).
+fn assert_converged_sweep_json(json: &Value) {
+    for key in [
+        "points",
+        "omega",
+        "tip_max",
+        "tip_min",
+        "amplitude",
+        "folds",
+        "converged",
+        "solve_seconds",
+        "termination",
+        "counters",
+    ] {
+        assert!(json.get(key).is_some(), "{key}");
+    }
+    assert_eq!(
+        json["converged"],
+        Value::Bool(true),
+        "{}",
+        json["termination"]
+    );
     let omega = json["omega"].as_array().expect("omega array");
     assert!(omega.len() >= 2 && json["points"] == omega.len());
-    for key in ["tip_max", "tip_min", "amplitude"] {
+    for key in ["omega", "tip_max", "tip_min", "amplitude"] {
         let v = json[key].as_array().expect("array");
         assert_eq!(v.len(), omega.len(), "{key}");
         assert!(
@@ -605,6 +621,15 @@ fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
             "{key}"
         );
     }
+}
+
+#[test]
+fn sweep_prints_a_branch_and_rejects_scenes_it_cannot_sweep() {
+    let fig2 = scenes_dir().join("paper_fig2.toml");
+    let out = ssn(&["sweep", "--json", fig2.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
+    assert_converged_sweep_json(&json);
 
     // No [sweep] section: bad input naming the file and the section.
     let fig1 = scenes_dir().join("paper_fig1.toml");
@@ -700,36 +725,7 @@ fn lcp_ssn_sweep_prints_a_branch_that_ends_on_the_fixed_frequency_solution() {
     let out = ssn(&["sweep", "--json", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let json: Value = serde_json::from_str(&stdout(&out)).expect("sweep JSON");
-    for key in [
-        "points",
-        "omega",
-        "tip_max",
-        "tip_min",
-        "amplitude",
-        "folds",
-        "converged",
-        "solve_seconds",
-        "termination",
-        "counters",
-    ] {
-        assert!(json.get(key).is_some(), "{key}");
-    }
-    assert_eq!(
-        json["converged"],
-        Value::Bool(true),
-        "{}",
-        json["termination"]
-    );
-    let omega = json["omega"].as_array().expect("omega array");
-    assert!(omega.len() >= 2 && json["points"] == omega.len());
-    for key in ["tip_max", "tip_min", "amplitude"] {
-        let v = json[key].as_array().expect("array");
-        assert_eq!(v.len(), omega.len(), "{key}");
-        assert!(
-            v.iter().all(|x| x.as_f64().is_some_and(f64::is_finite)),
-            "{key}"
-        );
-    }
+    assert_converged_sweep_json(&json);
     assert!(!json["folds"].as_array().expect("folds").is_empty());
 
     let out = ssn(&["solve", "--json", path.to_str().unwrap()]);

@@ -26,13 +26,12 @@
 
 use std::rc::Rc;
 
-use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::{Mat, MatMut};
+use faer::MatMut;
 use semismooth::complementarity::min_function;
-use semismooth::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use semismooth::linalg::{DenseAssemble, LinearSolveError};
 use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
-use super::min_map::add_mat_vec;
+use super::min_map::{add_mat_vec, ActiveSetSolver, MinMapJacobian};
 use super::{LcpError, PeriodicLcp, PeriodicLcpOptions};
 use crate::model::StructuralModel;
 
@@ -50,7 +49,6 @@ pub struct FrequencyLcp {
     /// Most recent first.
     cache: Vec<Rc<PeriodicLcp>>,
     last_error: Option<LcpError>,
-    builds: u64,
     scratch: Vec<f64>,
 }
 
@@ -79,7 +77,6 @@ impl FrequencyLcp {
             omega: model.forcing.omega,
             cache: vec![Rc::new(lcp)],
             last_error: None,
-            builds: 1,
             scratch: vec![0.0; n],
         })
     }
@@ -92,11 +89,6 @@ impl FrequencyLcp {
     /// The force scale `kappa`.
     pub fn kappa(&self) -> f64 {
         self.kappa
-    }
-
-    /// Number of LCPs built so far (one per new frequency, bounded by the cache).
-    pub fn builds(&self) -> u64 {
-        self.builds
     }
 
     /// Why the last LCP build failed (evaluations there return NaN), if one did.
@@ -113,14 +105,6 @@ impl FrequencyLcp {
         Ok(y)
     }
 
-    /// The LCP at the current frequency if it is cached (no build).
-    pub fn cached(&self) -> Option<&PeriodicLcp> {
-        self.cache
-            .iter()
-            .find(|l| l.omega() == self.omega)
-            .map(|l| &**l)
-    }
-
     /// The LCP at the current frequency, built if needed.
     pub fn current(&mut self) -> Result<Rc<PeriodicLcp>, LcpError> {
         if let Some(i) = self.cache.iter().position(|l| l.omega() == self.omega) {
@@ -134,7 +118,6 @@ impl FrequencyLcp {
             &model,
             self.options.clone(),
         )?);
-        self.builds += 1;
         self.cache.insert(0, lcp.clone());
         self.cache.truncate(CACHE);
         Ok(lcp)
@@ -149,115 +132,6 @@ impl FrequencyLcp {
                 None
             }
         }
-    }
-}
-
-impl FrequencyLcp {
-    /// `(t, J)`: the tangent `t = (-a, 1)` in `(y, omega)` of the piece of the branch with
-    /// the active set of `jac` at `(y, omega)`, `J a = dF/domega`, or `None` if singular.
-    fn piece_tangent(&mut self, y: &[f64], jac: &FrequencyLcpJacobian) -> Option<Vec<f64>> {
-        let mut a = vec![0.0; self.dim()];
-        self.residual_parameter_derivative(y, &mut a);
-        let mut solver = FrequencyLcpSolver::new();
-        solver.factor(jac).ok()?;
-        solver.solve_in_place(&mut a).ok()?;
-        let mut t: Vec<f64> = a.iter().map(|v| -v).collect();
-        t.push(1.0);
-        t.iter().all(|v| v.is_finite()).then_some(t)
-    }
-
-    /// First switch of the min met from `y` along `t` (`t` in `(y, omega)`, `y` on a
-    /// piece with the given active rows), excluding row `skip`: `(tau, row)` with
-    /// `y + tau t` the corner (an inactive gap or an active force reaching zero).
-    fn first_switch(
-        &self,
-        y: &[f64],
-        t: &[f64],
-        active: &[bool],
-        skip: Option<usize>,
-    ) -> Option<(f64, usize)> {
-        let n = self.half();
-        (0..n)
-            .filter(|i| Some(*i) != skip)
-            .filter_map(|i| {
-                let (value, rate) = if active[i] {
-                    (y[n + i], t[n + i])
-                } else {
-                    (y[i], t[i])
-                };
-                (rate < 0.0).then(|| ((value / -rate).max(0.0), i))
-            })
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-    }
-
-    /// A starting point on the next piece of the branch past a corner (a node entering or
-    /// leaving contact) ahead of the branch point `(y, omega)`, reached from
-    /// `(y_prev, omega_prev)`: `(y', omega', increasing)`, or `None` when there is no such
-    /// corner or a tangent is singular.
-    ///
-    /// Where the branch turns by more than 90 degrees at a corner, no arclength hyperplane
-    /// normal to the incoming direction cuts the outgoing piece, so the corrector fails at
-    /// every step length. Here: the tangent `t1` of the current piece (active set `S`,
-    /// oriented along `y - y_prev`) meets its first switch at the corner
-    /// `c = (y, omega) + tau t1` (linear extrapolation: `F(c) = O(tau^2)`); the outgoing
-    /// piece has the active set `S` with that row switched and the tangent `t2`, oriented
-    /// so that the switched variable (the force of a node entering contact, the gap of one
-    /// leaving it) grows from zero; the start is `c + eps t2` with `eps` half the smaller of
-    /// `tau` (`1e-8 omega` at least) and the distance to the next switch along `t2` (all in
-    /// units of `omega`, the last component of the tangents being `±1`).
-    pub fn corner_step(
-        &mut self,
-        y: &[f64],
-        omega: f64,
-        y_prev: &[f64],
-        omega_prev: f64,
-    ) -> Option<(Vec<f64>, f64, bool)> {
-        let n = self.half();
-        self.set_parameter(omega);
-        let mut jac = self.new_jacobian();
-        self.jacobian(y, &mut jac);
-        let mut t1 = self.piece_tangent(y, &jac)?;
-        let heading: f64 = y
-            .iter()
-            .zip(y_prev)
-            .zip(&t1)
-            .map(|((a, b), t)| (a - b) * t)
-            .sum::<f64>()
-            + (omega - omega_prev) * t1[2 * n];
-        if heading < 0.0 {
-            t1.iter_mut().for_each(|v| *v = -*v);
-        }
-        let (tau, j) = self.first_switch(y, &t1, &jac.active, None)?;
-        let corner: Vec<f64> = y.iter().zip(&t1).map(|(a, t)| a + tau * t).collect();
-        let omega_c = omega + tau * t1[2 * n];
-        // The outgoing piece: row j switched, the switched variable exactly zero.
-        let mut corner = corner;
-        if jac.active[j] {
-            corner[n + j] = 0.0;
-        } else {
-            corner[j] = 0.0;
-        }
-        self.set_parameter(omega_c);
-        let mut jac2 = self.new_jacobian();
-        self.jacobian(&corner, &mut jac2);
-        jac2.active.clone_from(&jac.active);
-        jac2.active[j] = !jac.active[j];
-        let mut t2 = self.piece_tangent(&corner, &jac2)?;
-        let grows = if jac2.active[j] { t2[n + j] } else { t2[j] };
-        if grows < 0.0 {
-            t2.iter_mut().for_each(|v| *v = -*v);
-        }
-        let next = self
-            .first_switch(&corner, &t2, &jac2.active, Some(j))
-            .map_or(f64::INFINITY, |(tau2, _)| tau2);
-        let eps = 0.5 * tau.max(1e-8 * omega).min(next);
-        if !(eps.is_finite() && eps > 0.0) {
-            return None;
-        }
-        let start: Vec<f64> = corner.iter().zip(&t2).map(|(a, t)| a + eps * t).collect();
-        let omega_start = omega_c + eps * t2[2 * n];
-        self.set_parameter(omega);
-        Some((start, omega_start, t2[2 * n] > 0.0))
     }
 }
 
@@ -388,18 +262,19 @@ impl DenseAssemble for FrequencyLcpJacobian {
 }
 
 /// Solves with a [`FrequencyLcpJacobian`] by one LU of the active block `A_II` (module
-/// documentation). A singular or non-finite block is a [`LinearSolveError`] (no
-/// regularisation: the continuation then halves its step).
+/// documentation): the `z` part is the min-map system `[A_I; P_J] dz = (r2_I / kappa - r1_I,
+/// r2_J)` of [`ActiveSetSolver`] (here without its regularisation: a singular or non-finite
+/// block is a [`LinearSolveError`], and the continuation halves its step), then
+/// `dw = r1 + A dz` on the inactive rows and `r2 / kappa` on the active ones.
 #[derive(Debug)]
 pub struct FrequencyLcpSolver {
     lcp: Option<Rc<PeriodicLcp>>,
-    active: Vec<usize>,
-    inactive: Vec<usize>,
+    active: Vec<bool>,
     kappa: f64,
-    lu: Option<PartialPivLu<f64>>,
-    block_rhs: Mat<f64>,
-    dz: Vec<f64>,
-    pivot_threshold: f64,
+    block: ActiveSetSolver,
+    /// Scratch: `dw`, and `r2_I / kappa` on the active rows (in order).
+    dw: Vec<f64>,
+    dw_active: Vec<f64>,
 }
 
 impl Default for FrequencyLcpSolver {
@@ -409,110 +284,76 @@ impl Default for FrequencyLcpSolver {
 }
 
 impl FrequencyLcpSolver {
-    /// A solver with the default relative pivot threshold [`DEFAULT_PIVOT_THRESHOLD`].
+    /// A solver with the default relative pivot threshold of [`ActiveSetSolver`].
     pub fn new() -> Self {
         Self {
             lcp: None,
             active: Vec::new(),
-            inactive: Vec::new(),
             kappa: 1.0,
-            lu: None,
-            block_rhs: Mat::zeros(0, 1),
-            dz: Vec::new(),
-            pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
+            block: ActiveSetSolver::new().without_regularization(),
+            dw: Vec::new(),
+            dw_active: Vec::new(),
         }
     }
 
     /// Size of the active block of the last factorization.
     pub fn active_count(&self) -> usize {
-        self.active.len()
+        self.block.active_count()
     }
 }
 
 impl LinearSolve<FrequencyLcpJacobian> for FrequencyLcpSolver {
     fn factor(&mut self, jac: &FrequencyLcpJacobian) -> Result<(), LinearSolveError> {
-        self.lu = None;
         self.lcp = None;
         let lcp = jac.lcp.clone().ok_or(LinearSolveError::NonFiniteEntry {
             row: 0,
             col: 0,
             value: f64::NAN,
         })?;
-        self.active.clear();
-        self.inactive.clear();
-        for (i, a) in jac.active.iter().enumerate() {
-            if *a {
-                self.active.push(i);
-            } else {
-                self.inactive.push(i);
+        let min_map = MinMapJacobian::new(lcp.matrix(), jac.active.clone()).map_err(|_| {
+            LinearSolveError::DimensionMismatch {
+                expected: lcp.dim(),
+                found: jac.active.len(),
             }
-        }
+        })?;
+        self.block.factor(&min_map)?;
+        self.active.clone_from(&jac.active);
         self.kappa = jac.kappa;
-        let a = lcp.matrix();
-        let k = self.active.len();
-        let mut block = Mat::<f64>::zeros(k, k);
-        for (c, &j) in self.active.iter().enumerate() {
-            for (r, &i) in self.active.iter().enumerate() {
-                let value = a[(i, j)];
-                if !value.is_finite() {
-                    return Err(LinearSolveError::NonFiniteEntry {
-                        row: i,
-                        col: j,
-                        value,
-                    });
-                }
-                block[(r, c)] = value;
-            }
-        }
-        if k > 0 {
-            let lu = PartialPivLu::new(block.as_ref());
-            let u = lu.U();
-            check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold)?;
-            self.lu = Some(lu);
-        }
-        self.block_rhs = Mat::zeros(k, 1);
-        self.dz = vec![0.0; jac.active.len()];
         self.lcp = Some(lcp);
         Ok(())
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         let lcp = self.lcp.as_ref().ok_or(LinearSolveError::NotFactored)?;
-        let n = self.dz.len();
+        let n = self.active.len();
         if rhs.len() != 2 * n {
             return Err(LinearSolveError::DimensionMismatch {
                 expected: 2 * n,
                 found: rhs.len(),
             });
         }
-        let a = lcp.matrix();
         let (r1, r2) = rhs.split_at_mut(n);
-        // Inactive rows: dz_J = r2_J; active block: dz_I from A_II dz_I = dw_I - r1_I - A_IJ dz_J.
-        self.dz.fill(0.0);
-        for &j in &self.inactive {
-            self.dz[j] = r2[j];
-        }
-        if let Some(lu) = &self.lu {
-            for (r, &i) in self.active.iter().enumerate() {
-                let mut v = r2[i] / self.kappa - r1[i];
-                for &j in &self.inactive {
-                    v -= a[(i, j)] * self.dz[j];
-                }
-                self.block_rhs[(r, 0)] = v;
-            }
-            lu.solve_in_place(self.block_rhs.as_mut());
-            for (r, &i) in self.active.iter().enumerate() {
-                self.dz[i] = self.block_rhs[(r, 0)];
+        // dw_I = r2_I / kappa (kept aside); r2 becomes the min-map right-hand side, then dz.
+        self.dw_active.clear();
+        for (i, &active) in self.active.iter().enumerate() {
+            if active {
+                let dw = r2[i] / self.kappa;
+                self.dw_active.push(dw);
+                r2[i] = dw - r1[i];
             }
         }
-        // dw = r1 + A dz on the inactive rows, r2 / kappa on the active ones.
-        let mut dw = r1.to_vec();
-        add_mat_vec(a, &self.dz, &mut dw);
-        for &i in &self.active {
-            dw[i] = r2[i] / self.kappa;
+        self.block.solve_in_place(r2)?;
+        // dw = r1 + A dz on the inactive rows.
+        self.dw.clear();
+        self.dw.extend_from_slice(r1);
+        add_mat_vec(lcp.matrix(), r2, &mut self.dw);
+        let mut kept = self.dw_active.iter();
+        for (dw, &active) in self.dw.iter_mut().zip(&self.active) {
+            if active {
+                *dw = *kept.next().unwrap_or(&f64::NAN);
+            }
         }
-        r1.copy_from_slice(&dw);
-        r2.copy_from_slice(&self.dz);
+        r1.copy_from_slice(&self.dw);
         Ok(())
     }
 }
@@ -598,67 +439,6 @@ mod tests {
                 analytic[i]
             );
         }
-    }
-
-    /// The LCP solution `(w, z)` at `omega` by min-map Newton (sequenced from zero).
-    fn solution(p: &mut FrequencyLcp, omega: f64) -> Vec<f64> {
-        let mut model = p.model.clone();
-        model.forcing.omega = omega;
-        let options = semismooth::newton::NewtonOptions {
-            absolute_tolerance: 1e-13,
-            max_iterations: 200,
-            ..Default::default()
-        };
-        let s = super::super::solve_min_map_sequenced(&model, p.options.clone(), &options).unwrap();
-        assert!(s.converged());
-        p.set_parameter(omega);
-        p.state_from_forces(&s.z).unwrap()
-    }
-
-    fn active_rows(p: &FrequencyLcp, y: &[f64]) -> Vec<bool> {
-        let n = p.half();
-        (0..n).map(|i| p.kappa * y[i] < y[n + i]).collect()
-    }
-
-    #[test]
-    fn corner_step_lands_on_the_neighbouring_piece_of_the_branch() {
-        let mut p = problem(64);
-        let omega_1 = p.parameter();
-        let (w0, w1) = (1.0 * omega_1, 1.0001 * omega_1);
-        let y0 = solution(&mut p, w0);
-        let y1 = solution(&mut p, w1);
-        let (start, omega, _) = p.corner_step(&y1, w1, &y0, w0).unwrap();
-        // Correct the start at its frequency by Newton on (w, z) with the structured solver.
-        p.set_parameter(omega);
-        let mut y = start.clone();
-        let options = semismooth::newton::NewtonOptions {
-            absolute_tolerance: 1e-12,
-            max_iterations: 20,
-            globalization: semismooth::newton::Globalization::None,
-            ..Default::default()
-        };
-        let report =
-            semismooth::newton::solve(&mut p, &mut FrequencyLcpSolver::new(), &mut y, &options)
-                .unwrap();
-        assert!(report.converged(), "{:?}", report.termination);
-        // On the neighbouring piece: exactly one contact state differs from the branch
-        // point's, and the corrected point is the start up to the O(tau^2) of the linear
-        // extrapolation to the corner (here 2e-3 omega_1 ahead, on a branch whose state
-        // changes by O(1) per 1e-2 omega_1: measured 2.6e-2 of the state).
-        let (a1, a) = (active_rows(&p, &y1), active_rows(&p, &y));
-        let switched: Vec<usize> = (0..a.len()).filter(|&i| a[i] != a1[i]).collect();
-        assert_eq!(switched.len(), 1, "{switched:?}");
-        let moved = y
-            .iter()
-            .zip(&start)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        let size = y1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        println!(
-            "switched row {switched:?}, omega {} -> {}, corrected by {moved:e} (state {size:e})",
-            w1 / omega_1,
-            omega / omega_1
-        );
-        assert!(moved <= 0.1 * size, "{moved:e}");
     }
 
     #[test]
