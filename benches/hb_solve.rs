@@ -23,9 +23,9 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton;
-use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
 use semismooth_problems::cli::default_settings;
-use semismooth_problems::hb::{HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
+use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::{newton_options, solve_rod};
 use semismooth_problems::scene::{default_hb_time_samples, Method, SolverSettings};
@@ -70,13 +70,7 @@ fn solve_dense(rod: &RodModel, h: usize) -> usize {
     let mut problem = SsnHb::new(&rod.model, &hb_options(h, None)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let mut solver = FaerDenseLu::new();
-    let report = newton::solve(
-        &mut problem,
-        &mut solver as &mut dyn LinearSolve<HbJacobian>,
-        &mut x,
-        &options,
-    )
-    .expect("runs");
+    let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
     assert!(report.converged(), "dense solve did not converge");
     report.iterations
 }
@@ -120,7 +114,7 @@ fn newton_solver(c: &mut Criterion) {
     let mut solver = StructuredHbSolver::new();
     newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
     let mut jac = problem.new_jacobian();
-    problem.jacobian(&x, &mut jac);
+    problem.jacobian(&x, &mut jac).expect("evaluates");
     let rhs: Vec<f64> = (0..problem.dim())
         .map(|i| (i as f64 * 0.37).sin())
         .collect();
@@ -153,13 +147,13 @@ fn newton_solver(c: &mut Criterion) {
     let mut f = vec![0.0; problem.dim()];
     group.bench_function("part_residual", |b| {
         b.iter(|| {
-            problem.residual(&x, &mut f);
+            problem.residual(&x, &mut f).expect("evaluates");
             black_box(f[0])
         })
     });
     group.bench_function("part_jacobian", |b| {
         b.iter(|| {
-            problem.jacobian(&x, &mut jac);
+            problem.jacobian(&x, &mut jac).expect("evaluates");
             black_box(jac.harmonics())
         })
     });
@@ -176,9 +170,9 @@ fn newton_solver(c: &mut Criterion) {
     let mut dense = FaerDenseLu::new();
     group.bench_function("dense", |b| {
         b.iter(|| {
-            LinearSolve::<HbJacobian>::factor(&mut dense, &jac).expect("factors");
+            dense.factor(&jac).expect("factors");
             work.copy_from_slice(&rhs);
-            LinearSolve::<HbJacobian>::solve_in_place(&mut dense, &mut work).expect("solves");
+            dense.solve_in_place(&mut work).expect("solves");
             black_box(work[0])
         })
     });

@@ -15,7 +15,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Par};
 use semismooth::linalg::{FaerDenseLu, FaerSparseLu, NalgebraLu};
-use semismooth::LinearSolve;
+use semismooth::Factorize;
 
 /// tridiag(-1, 4, -1) plus entries (0, n-1) and (n-1, 0) equal to -1 (periodic chain).
 fn triplets(n: usize) -> Vec<Triplet<usize, usize, f64>> {
@@ -51,7 +51,7 @@ fn rhs(n: usize) -> Vec<f64> {
 }
 
 /// One timed iteration: factor `a` with the reused solver, solve for `b` into `x`.
-fn factor_and_solve<J, S: LinearSolve<J>>(lu: &mut S, a: &J, b: &[f64], x: &mut [f64]) {
+fn factor_and_solve<J, S: Factorize<J>>(lu: &mut S, a: &J, b: &[f64], x: &mut [f64]) {
     lu.factor(a).expect("regular");
     x.copy_from_slice(b);
     lu.solve_in_place(x).expect("factored");

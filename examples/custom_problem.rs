@@ -11,12 +11,12 @@
 //! Run: `cargo run --release --example custom_problem` (exits non-zero if the two
 //! answers differ by more than 1e-9; `tests/lemke.rs` runs the same comparison).
 
-use faer::Mat;
 use semismooth::complementarity::min_function;
+use semismooth::faer::Mat;
 use semismooth::lemke::{solve_lcp, LemkeOptions};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions};
-use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
 
 /// The spring chain between two walls.
 pub struct SpringChain {
@@ -56,7 +56,7 @@ impl Residual for SpringChain {
     fn dim(&self) -> usize {
         self.force.len() + 2
     }
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let n = self.force.len();
         let (u, l) = x.split_at(n);
         for (i, o) in out[..n].iter_mut().enumerate() {
@@ -68,6 +68,7 @@ impl Residual for SpringChain {
         for w in 0..2 {
             out[n + w] = min_function(l[w], self.c * g[w]).value;
         }
+        Ok(())
     }
 }
 
@@ -76,7 +77,7 @@ impl GeneralizedJacobian for SpringChain {
     fn new_jacobian(&self) -> Mat<f64> {
         Mat::zeros(self.dim(), self.dim())
     }
-    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let n = self.force.len();
         jac.fill(0.0);
         jac.as_mut()
@@ -89,6 +90,7 @@ impl GeneralizedJacobian for SpringChain {
             jac[(n + w, n + w)] = phi.da;
             jac[(n + w, node)] = phi.db * self.c * dgap;
         }
+        Ok(())
     }
 }
 
@@ -96,22 +98,14 @@ impl GeneralizedJacobian for SpringChain {
 pub fn newton_and_lemke(chain: &mut SpringChain) -> Result<[Vec<f64>; 2], String> {
     let n = chain.force.len();
     let mut x = vec![0.0; n + 2];
-    let newton = solve(
-        chain,
-        &mut FaerDenseLu::new(),
-        &mut x,
-        &NewtonOptions::default(),
-    );
-    newton
-        .and_then(|r| r.into_result())
-        .map_err(|e| e.to_string())?;
-    // Condensed LCP: K^{-1} f, K^{-1} C_0^T (C_0^T = e_0), K^{-1} C_1^T (C_1^T = -e_{N-1}).
     let mut lu = FaerDenseLu::new();
-    LinearSolve::<Mat<f64>>::factor(&mut lu, &chain.stiffness).map_err(|e| e.to_string())?;
+    solve(chain, &mut lu, &mut x, &NewtonOptions::default()).map_err(|e| e.to_string())?;
+    // Condensed LCP: K^{-1} f, K^{-1} C_0^T (C_0^T = e_0), K^{-1} C_1^T (C_1^T = -e_{N-1}).
+    lu.factor(&chain.stiffness).map_err(|e| e.to_string())?;
     let mut v = [chain.force.clone(), vec![0.0; n], vec![0.0; n]];
     (v[1][0], v[2][n - 1]) = (1.0, -1.0);
     for rhs in &mut v {
-        LinearSolve::<Mat<f64>>::solve_in_place(&mut lu, rhs).map_err(|e| e.to_string())?;
+        lu.solve_in_place(rhs).map_err(|e| e.to_string())?;
     }
     let c = |y: &[f64]| [y[0], -y[n - 1]];
     let q: Vec<f64> = (0..2).map(|a| chain.gaps[a] + c(&v[0])[a]).collect();

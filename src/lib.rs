@@ -24,4 +24,13 @@ pub mod linesearch;
 pub mod newton;
 mod traits;
 
-pub use traits::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+pub use traits::{
+    EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,
+    ProblemCounters, Residual, MAX_PROBLEM_COUNTERS,
+};
+
+/// The linear-algebra crates of the public API (matrix types of Jacobians, sparse
+/// patterns): use these re-exports so that a problem's matrices are the versions the
+/// solvers expect.
+pub use faer;
+pub use nalgebra;

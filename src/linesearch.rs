@@ -51,6 +51,24 @@ pub struct InvalidLineSearchOption {
     pub allowed: &'static str,
 }
 
+impl InvalidLineSearchOption {
+    /// The field's name inside the options field `within` (`"line_search"` gives
+    /// `"line_search.shrink"`); the bare name for other prefixes.
+    pub fn qualified_name(&self, within: &'static str) -> &'static str {
+        match (within, self.name) {
+            ("line_search", "sufficient_decrease") => "line_search.sufficient_decrease",
+            ("line_search", "shrink") => "line_search.shrink",
+            ("line_search", "min_step") => "line_search.min_step",
+            ("corrector_line_search", "sufficient_decrease") => {
+                "corrector_line_search.sufficient_decrease"
+            }
+            ("corrector_line_search", "shrink") => "corrector_line_search.shrink",
+            ("corrector_line_search", "min_step") => "corrector_line_search.min_step",
+            _ => self.name,
+        }
+    }
+}
+
 /// Checks `lo < value < hi` (open) or `lo < value <= hi` (`closed_hi`).
 fn check_range(
     name: &'static str,

@@ -1,7 +1,103 @@
-//! The three core traits: a residual, one element of its generalized Jacobian, and a
-//! linear solver that factors a Jacobian once and solves many right-hand sides.
+//! The core traits: a residual, one element of its generalized Jacobian, a scalar
+//! parameter for continuation, and linear solvers split into a factorization and the
+//! solves that reuse it.
 
 use crate::linalg::LinearSolveError;
+
+/// Why a problem could not evaluate its residual, Jacobian or parameter derivative at `x`.
+///
+/// The drivers treat it like an infinite merit: a line search shortens the step, a
+/// continuation corrector rejects the attempt (and the step is halved), a Newton run that
+/// cannot evaluate its initial guess stops with
+/// [`Termination::OutsideDomain`](crate::newton::Termination::OutsideDomain).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EvaluationError {
+    /// `x` (or the problem's parameter) lies outside the set where the problem is defined.
+    #[error("outside the problem's domain: {what} = {value:e}")]
+    OutsideDomain {
+        /// The quantity that is out of range, in words.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// Capacity of [`ProblemCounters`].
+pub const MAX_PROBLEM_COUNTERS: usize = 4;
+
+/// Work a problem counts in its own units (the transforms of a harmonic-balance residual,
+/// the matrices a parametrised problem rebuilds, ...): up to [`MAX_PROBLEM_COUNTERS`] named
+/// totals. The drivers report the difference over a run next to their own counters.
+///
+/// ```
+/// use semismooth::ProblemCounters;
+/// let before = ProblemCounters::new().with("transforms", 3);
+/// let after = ProblemCounters::new().with("transforms", 10);
+/// assert_eq!(after.since(&before).get("transforms"), 7);
+/// assert_eq!(after.get("something else"), 0);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ProblemCounters {
+    names: [&'static str; MAX_PROBLEM_COUNTERS],
+    values: [u64; MAX_PROBLEM_COUNTERS],
+    len: usize,
+}
+
+impl ProblemCounters {
+    /// No counter.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds `value` to the counter `name` (created if new; a name beyond
+    /// [`MAX_PROBLEM_COUNTERS`] distinct ones is ignored).
+    pub fn add(&mut self, name: &'static str, value: u64) {
+        if let Some(i) = self.names[..self.len].iter().position(|n| *n == name) {
+            self.values[i] += value;
+        } else if self.len < MAX_PROBLEM_COUNTERS {
+            self.names[self.len] = name;
+            self.values[self.len] = value;
+            self.len += 1;
+        }
+    }
+
+    /// `self` with `value` added to `name` (builder form of [`ProblemCounters::add`]).
+    pub fn with(mut self, name: &'static str, value: u64) -> Self {
+        self.add(name, value);
+        self
+    }
+
+    /// The counter `name` (0 when absent).
+    pub fn get(&self, name: &str) -> u64 {
+        self.iter().find(|(n, _)| *n == name).map_or(0, |(_, v)| v)
+    }
+
+    /// `(name, value)` pairs in the order they were first added.
+    pub fn iter(&self) -> impl Iterator<Item = (&'static str, u64)> + '_ {
+        self.names[..self.len]
+            .iter()
+            .copied()
+            .zip(self.values[..self.len].iter().copied())
+    }
+
+    /// The work done since `earlier` (counter by counter, saturating at 0).
+    pub fn since(&self, earlier: &ProblemCounters) -> ProblemCounters {
+        let mut out = ProblemCounters::new();
+        for (name, value) in self.iter() {
+            out.add(name, value.saturating_sub(earlier.get(name)));
+        }
+        out
+    }
+}
+
+impl std::ops::AddAssign for ProblemCounters {
+    fn add_assign(&mut self, rhs: Self) {
+        for (name, value) in rhs.iter() {
+            self.add(name, value);
+        }
+    }
+}
 
 /// A square system `F(x) = 0`, `F: R^n -> R^n`, Lipschitz continuous.
 ///
@@ -9,28 +105,31 @@ use crate::linalg::LinearSolveError;
 /// `&mut self`), so that repeated evaluations allocate nothing.
 ///
 /// ```
-/// use semismooth::Residual;
+/// use semismooth::{EvaluationError, Residual};
 /// /// F(x) = x^2 - 2 on R^1.
 /// struct Sqrt2;
 /// impl Residual for Sqrt2 {
 ///     fn dim(&self) -> usize { 1 }
-///     fn residual(&mut self, x: &[f64], out: &mut [f64]) { out[0] = x[0] * x[0] - 2.0; }
+///     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+///         out[0] = x[0] * x[0] - 2.0;
+///         Ok(())
+///     }
 /// }
 /// let mut f = [0.0];
-/// Sqrt2.residual(&[1.0], &mut f);
+/// Sqrt2.residual(&[1.0], &mut f).unwrap();
 /// assert_eq!(f[0], -1.0);
 /// ```
 pub trait Residual {
     /// Number of unknowns `n` (and of equations).
     fn dim(&self) -> usize;
 
-    /// Writes `F(x)` into `out` (both of length [`Residual::dim`]).
-    fn residual(&mut self, x: &[f64], out: &mut [f64]);
+    /// Writes `F(x)` into `out` (both of length [`Residual::dim`]); an `x` where `F` is not
+    /// defined is an [`EvaluationError`], never a NaN.
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError>;
 
-    /// Number of fast Fourier transforms performed so far, for problems that count them
-    /// (harmonic balance through alternating frequency/time); 0 otherwise.
-    fn fft_count(&self) -> u64 {
-        0
+    /// The problem's own work counters (totals since it was built); none by default.
+    fn problem_counters(&self) -> ProblemCounters {
+        ProblemCounters::new()
     }
 }
 
@@ -47,7 +146,7 @@ pub trait GeneralizedJacobian: Residual {
     fn new_jacobian(&self) -> Self::Jacobian;
 
     /// Writes an element of `∂F(x)` into `jac`.
-    fn jacobian(&mut self, x: &[f64], jac: &mut Self::Jacobian);
+    fn jacobian(&mut self, x: &[f64], jac: &mut Self::Jacobian) -> Result<(), EvaluationError>;
 }
 
 /// A residual that depends on a scalar parameter `p` (a forcing frequency, a load
@@ -61,32 +160,44 @@ pub trait ParameterDependent: Residual {
 
     /// Writes `∂F/∂p (x, p)` into `out`.
     ///
-    /// The default is a central finite difference with step `1e-7 (1 + |p|)`; problems
-    /// with an analytic derivative should override it.
-    fn residual_parameter_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+    /// The default is a central finite difference with step `1e-7 (1 + |p|)` (it allocates
+    /// one vector per call); problems with an analytic derivative should override it.
+    fn residual_parameter_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         let p = self.parameter();
         let h = 1e-7 * (1.0 + p.abs());
         let mut minus = vec![0.0; out.len()];
         self.set_parameter(p + h);
-        self.residual(x, out);
+        let plus = self.residual(x, out);
         self.set_parameter(p - h);
-        self.residual(x, &mut minus);
+        let below = self.residual(x, &mut minus);
         self.set_parameter(p);
+        plus?;
+        below?;
         for (o, m) in out.iter_mut().zip(&minus) {
             *o = (*o - m) / (2.0 * h);
         }
+        Ok(())
     }
 }
 
-/// Factor once, solve many: the linear-algebra half of a Newton step.
-///
-/// `factor` may be called again with a new matrix of the same shape; implementations
-/// reuse their storage. `solve_in_place` overwrites `rhs` with `J^{-1} rhs` using the
-/// most recent successful factorization.
-pub trait LinearSolve<J: ?Sized> {
-    /// Factors `jac`. A singular or non-finite matrix is a typed error.
-    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError>;
-
+/// The solve half of a linear solver: `rhs <- J^{-1} rhs` with the factorization made by
+/// the last successful [`Factorize::factor`] (Newton step, continuation tangent and
+/// bordered solves all reuse one factorization).
+pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
+}
+
+/// The factorization half of a linear solver for Jacobians of type `J`.
+///
+/// `factor` may be called again with a new matrix of the same shape; implementations
+/// reuse their storage (and any symbolic analysis of a sparsity pattern).
+pub trait Factorize<J: ?Sized>: LinearSolve {
+    /// Factors `jac`. A singular or non-finite matrix is a typed error, after which the
+    /// solver holds no factorization.
+    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError>;
 }

@@ -10,7 +10,7 @@ use semismooth::continuation::{
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
 use semismooth::newton::{self, Globalization, NewtonOptions};
-use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
 
 type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
 type JacobianFn = Box<dyn Fn(&[f64], f64, &mut Mat<f64>)>;
@@ -29,8 +29,9 @@ impl Residual for Closure {
     fn dim(&self) -> usize {
         self.n
     }
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
-        (self.f)(x, self.p, out)
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        (self.f)(x, self.p, out);
+        Ok(())
     }
 }
 
@@ -39,8 +40,9 @@ impl GeneralizedJacobian for Closure {
     fn new_jacobian(&self) -> Mat<f64> {
         Mat::zeros(self.n, self.n)
     }
-    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
-        (self.j)(x, self.p, jac)
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+        (self.j)(x, self.p, jac);
+        Ok(())
     }
 }
 
@@ -51,7 +53,11 @@ impl ParameterDependent for Closure {
     fn set_parameter(&mut self, p: f64) {
         self.p = p;
     }
-    fn residual_parameter_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual_parameter_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         match &self.fp {
             Some(fp) => fp(x, self.p, out),
             None => {
@@ -65,6 +71,7 @@ impl ParameterDependent for Closure {
                 }
             }
         }
+        Ok(())
     }
 }
 
@@ -933,7 +940,7 @@ struct DiagonalSolver {
     diagonal: Vec<f64>,
 }
 
-impl semismooth::LinearSolve<Diagonal> for DiagonalSolver {
+impl semismooth::Factorize<Diagonal> for DiagonalSolver {
     fn factor(&mut self, jac: &Diagonal) -> Result<(), LinearSolveError> {
         let max_pivot = jac.0.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         if let Some(index) = jac.0.iter().position(|d| *d == 0.0 || !d.is_finite()) {
@@ -946,6 +953,9 @@ impl semismooth::LinearSolve<Diagonal> for DiagonalSolver {
         self.diagonal.clone_from(&jac.0);
         Ok(())
     }
+}
+
+impl semismooth::LinearSolve for DiagonalSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         for (r, d) in rhs.iter_mut().zip(&self.diagonal) {
             *r /= d;
@@ -975,10 +985,11 @@ impl Residual for DecoupledCurves {
     fn dim(&self) -> usize {
         self.n
     }
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         for (i, (o, xi)) in out.iter_mut().zip(x).enumerate() {
             *o = xi.powi(3) + self.coefficient(i) * xi - self.p;
         }
+        Ok(())
     }
 }
 
@@ -996,10 +1007,11 @@ impl GeneralizedJacobian for DecoupledCurves {
     fn new_jacobian(&self) -> Diagonal {
         Diagonal(vec![0.0; self.n])
     }
-    fn jacobian(&mut self, x: &[f64], jac: &mut Diagonal) {
+    fn jacobian(&mut self, x: &[f64], jac: &mut Diagonal) -> Result<(), EvaluationError> {
         for (i, (d, xi)) in jac.0.iter_mut().zip(x).enumerate() {
             *d = 3.0 * xi * xi + self.coefficient(i);
         }
+        Ok(())
     }
 }
 
@@ -1010,7 +1022,7 @@ impl Residual for DenseDecoupled {
     fn dim(&self) -> usize {
         self.0.n
     }
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.0.residual(x, out)
     }
 }
@@ -1029,14 +1041,15 @@ impl GeneralizedJacobian for DenseDecoupled {
     fn new_jacobian(&self) -> Mat<f64> {
         Mat::zeros(self.0.n, self.0.n)
     }
-    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let mut d = self.0.new_jacobian();
-        self.0.jacobian(x, &mut d);
+        self.0.jacobian(x, &mut d).unwrap();
         for i in 0..self.0.n {
             for j in 0..self.0.n {
                 jac[(i, j)] = if i == j { d.0[i] } else { 0.0 };
             }
         }
+        Ok(())
     }
 }
 

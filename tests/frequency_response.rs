@@ -8,7 +8,7 @@ use faer::sparse::SparseColMat;
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::continuation::natural_sweep;
 use semismooth::newton::{self, Globalization, NewtonOptions};
-use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use semismooth_problems::cli::default_settings;
 use semismooth_problems::hb::{HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::model::StructuralModel;
@@ -288,7 +288,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
         sweep
             .failure
             .as_ref()
-            .map(|f| (f.parameter / rod.omega_1, f.termination.clone())),
+            .map(|f| (f.parameter / rod.omega_1, f.termination)),
         at / rod.omega_1,
         arc.folds
             .iter()
@@ -371,9 +371,9 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
         let (mut worst_f, mut worst_step): (f64, f64) = (0.0, 0.0);
         for (x, &w) in r.states.iter().zip(&r.omega) {
             problem.set_parameter(w);
-            problem.residual(x, &mut f);
+            problem.residual(x, &mut f).unwrap();
             let fnorm = norm(&f);
-            problem.jacobian(x, &mut jac);
+            problem.jacobian(x, &mut jac).unwrap();
             solver.factor(&jac).unwrap();
             solver.solve_in_place(&mut f).unwrap();
             let step = norm(&f) / norm(x);

@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::linalg::{DenseAssemble, FaerDenseLu};
 use semismooth::newton::{self, NewtonOptions, NewtonReport};
-use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use semismooth_problems::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
@@ -86,9 +86,9 @@ fn fd_jacobian<P: Residual>(problem: &mut P, x: &[f64], h: f64) -> Mat<f64> {
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
     for col in 0..n {
         xp[col] = x[col] + h;
-        problem.residual(&xp, &mut fp);
+        problem.residual(&xp, &mut fp).unwrap();
         xp[col] = x[col] - h;
-        problem.residual(&xp, &mut fm);
+        problem.residual(&xp, &mut fm).unwrap();
         xp[col] = x[col];
         for r in 0..n {
             out[(r, col)] = (fp[r] - fm[r]) / (2.0 * h);
@@ -124,7 +124,7 @@ fn dynamic_blocks_match_time_domain_equation_of_motion() {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let u = random_vector(&mut rng, 3 * size, 1.0);
     let mut r = vec![0.0; hb.dim()];
-    hb.residual(&u, &mut r);
+    hb.residual(&u, &mut r).unwrap();
 
     let (m, d, k) = (
         dense(&model.mass),
@@ -233,7 +233,7 @@ fn ssn_jacobian_matches_central_differences_away_from_kinks() {
     let mut hb = SsnHb::new(&model, &options).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
     let mut jac = hb.new_jacobian();
-    hb.jacobian(&x, &mut jac);
+    hb.jacobian(&x, &mut jac).unwrap();
     let analytic = assemble(&jac);
     // Step 1e-6: the switching samples move by at most c * h * 2 = 4e-6 < margin 1e-3, so no
     // kink is crossed and the residual is smooth (quadratic pieces: FD error ~ rounding
@@ -264,7 +264,7 @@ fn penalty_jacobian_matches_central_differences_away_from_kinks() {
         ssn_switching(&model, 1.0, &padded, h, nt)
     });
     let mut jac = hb.new_jacobian();
-    hb.jacobian(&x, &mut jac);
+    hb.jacobian(&x, &mut jac).unwrap();
     let analytic = assemble(&jac);
     let fd = fd_jacobian(&mut hb, &x, 1e-6);
     let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
@@ -286,13 +286,13 @@ fn omega_derivative_matches_central_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mut analytic = vec![0.0; hb.dim()];
-    hb.residual_parameter_derivative(&x, &mut analytic);
+    hb.residual_parameter_derivative(&x, &mut analytic).unwrap();
     let (mut fp, mut fm) = (vec![0.0; hb.dim()], vec![0.0; hb.dim()]);
     let step = 1e-5;
     hb.set_parameter(1.1 + step);
-    hb.residual(&x, &mut fp);
+    hb.residual(&x, &mut fp).unwrap();
     hb.set_parameter(1.1 - step);
-    hb.residual(&x, &mut fm);
+    hb.residual(&x, &mut fm).unwrap();
     hb.set_parameter(1.1);
     // A(w) is quadratic in w: the central difference is exact up to rounding.
     let fd: Vec<f64> = fp
@@ -337,9 +337,9 @@ fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
         let mut hb = SsnHb::new(&model, &HbOptions::default()).unwrap();
         let mut x = vec![0.0; hb.dim()];
         let mut r = vec![0.0; hb.dim()];
-        hb.residual(&x, &mut r);
+        hb.residual(&x, &mut r).unwrap();
         let mut jac = hb.new_jacobian();
-        hb.jacobian(&x, &mut jac);
+        hb.jacobian(&x, &mut jac).unwrap();
         let mut solver = StructuredHbSolver::new();
         solver.factor(&jac).unwrap();
         // One Newton step solves the linear problem: x = -J^{-1} R(0).
@@ -361,9 +361,9 @@ fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
                 assert!(v.abs() < 1e-14 * scale, "coefficient {j} = {v}");
             }
         }
-        hb.residual(&x, &mut r);
+        hb.residual(&x, &mut r).unwrap();
         assert!(norm(&r) < 1e-12 * norm(&model.forcing.amplitude));
-        assert_eq!(hb.fft_count(), 0, "no contact: no FFT");
+        assert_eq!(hb.problem_counters().get("ffts"), 0, "no contact: no FFT");
     }
 }
 
@@ -373,9 +373,9 @@ where
 {
     let n = problem.dim();
     let mut r = vec![0.0; n];
-    problem.residual(x, &mut r);
+    problem.residual(x, &mut r).unwrap();
     let mut jac = problem.new_jacobian();
-    problem.jacobian(x, &mut jac);
+    problem.jacobian(x, &mut jac).unwrap();
     let mut structured = StructuredHbSolver::new();
     let mut dense = FaerDenseLu::new();
     structured.factor(&jac).unwrap();
@@ -383,7 +383,7 @@ where
     let mut ds = r.clone();
     let mut dd = r.clone();
     structured.solve_in_place(&mut ds).unwrap();
-    LinearSolve::<HbJacobian>::solve_in_place(&mut dense, &mut dd).unwrap();
+    dense.solve_in_place(&mut dd).unwrap();
     let diff: Vec<f64> = ds.iter().zip(&dd).map(|(a, b)| a - b).collect();
     norm(&diff) / norm(&dd)
 }
@@ -453,14 +453,14 @@ fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
     let mut solver = StructuredHbSolver::new();
     for _ in 0..3 {
         let x = random_vector(&mut rng, hb.dim(), 0.3);
-        hb.jacobian(&x, &mut jac);
+        hb.jacobian(&x, &mut jac).unwrap();
         solver.factor(&jac).unwrap();
     }
     assert_eq!(solver.dynamic_factorizations(), 1);
     assert_eq!(solver.schur_factorizations(), 3);
     hb.set_omega(1.3).unwrap();
     let x = random_vector(&mut rng, hb.dim(), 0.3);
-    hb.jacobian(&x, &mut jac);
+    hb.jacobian(&x, &mut jac).unwrap();
     solver.factor(&jac).unwrap();
     assert_eq!(solver.dynamic_factorizations(), 2);
     // And the refactored solver still agrees with the dense one.
@@ -604,9 +604,9 @@ fn structured_solve_stays_backward_stable_for_stiff_penalties() {
         )
         .unwrap();
         let mut r = vec![0.0; u.len()];
-        penalty.residual(&u, &mut r);
+        penalty.residual(&u, &mut r).unwrap();
         let mut jac = penalty.new_jacobian();
-        penalty.jacobian(&u, &mut jac);
+        penalty.jacobian(&u, &mut jac).unwrap();
         let dense_j = assemble(&jac);
         let mut solver = StructuredHbSolver::new();
         solver.factor(&jac).unwrap();
@@ -675,14 +675,14 @@ fn newton_iteration_work_is_allocation_free() {
         let mut jac = p.new_jacobian();
         let mut solver = StructuredHbSolver::new();
         // Warm-up: builds the plans' scratch, the sparse factors and the workspaces.
-        p.residual(&x, &mut r);
-        p.jacobian(&x, &mut jac);
+        p.residual(&x, &mut r).unwrap();
+        p.jacobian(&x, &mut jac).unwrap();
         solver.factor(&jac).unwrap();
         solver.solve_in_place(&mut r).unwrap();
         let before = counting::allocations();
         for _ in 0..3 {
-            p.residual(&x, &mut r);
-            p.jacobian(&x, &mut jac);
+            p.residual(&x, &mut r).unwrap();
+            p.jacobian(&x, &mut jac).unwrap();
             solver.factor(&jac).unwrap();
             solver.solve_in_place(&mut r).unwrap();
         }
@@ -831,7 +831,7 @@ fn canonical_modified_rod_ssn_hb_converges_from_zero() {
             s.displacement_max,
             s.displacement_rms,
             s.contact_force_mean[0],
-            hb.fft_count(),
+            hb.problem_counters().get("ffts"),
             elapsed
         );
         tip_min.push(s.displacement_min);
@@ -1051,7 +1051,7 @@ fn condensed_ssn_hb_matches_the_full_problem_on_the_canonical_rod() {
     assert!(report.converged(), "{:?}", report.termination);
     let x = condensed.expand(&lambda).unwrap();
     let mut r = vec![0.0; full.dim()];
-    full.residual(&x, &mut r);
+    full.residual(&x, &mut r).unwrap();
     let d: Vec<f64> = x.iter().zip(&x_full).map(|(a, b)| a - b).collect();
     let s = condensed.summary(&lambda, 19, 1024).unwrap();
     println!(

@@ -12,7 +12,7 @@ use semismooth::lemke::{
 };
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions};
-use semismooth::{GeneralizedJacobian, Residual};
+use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 /// Counts heap allocations made by the current thread (tests run on parallel threads,
 /// so the count is per thread).
@@ -585,11 +585,12 @@ impl Residual for MinMap<'_> {
     fn dim(&self) -> usize {
         self.q.len()
     }
-    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let w = residual(self.m, self.q, z);
         for i in 0..z.len() {
             out[i] = z[i].min(w[i]);
         }
+        Ok(())
     }
 }
 
@@ -598,7 +599,7 @@ impl GeneralizedJacobian for MinMap<'_> {
     fn new_jacobian(&self) -> Mat<f64> {
         Mat::zeros(self.q.len(), self.q.len())
     }
-    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let n = z.len();
         let w = residual(self.m, self.q, z);
         for i in 0..n {
@@ -611,6 +612,7 @@ impl GeneralizedJacobian for MinMap<'_> {
                 };
             }
         }
+        Ok(())
     }
 }
 
@@ -675,7 +677,7 @@ fn custom_problem_newton_agrees_with_lemke_in_every_contact_state() {
         let diff = max_abs_diff(&x, &y);
         assert!(diff <= 1e-9, "load {load}: difference {diff:e}");
         let mut f = vec![0.0; y.len()];
-        chain.residual(&y, &mut f);
+        chain.residual(&y, &mut f).unwrap();
         // Forces of order 1, stiffness 100: rounding leaves residuals ~1e-14.
         assert!(
             max_abs(&f) <= 1e-10,

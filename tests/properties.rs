@@ -11,7 +11,7 @@ use proptest::prelude::*;
 use semismooth::lemke::{Lemke, LemkeOptions};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{self, NewtonOptions};
-use semismooth::{GeneralizedJacobian, Residual};
+use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 use semismooth_problems::rod::build_rod;
 use semismooth_problems::runner::solve_rod;
 use semismooth_problems::scene::Scene;
@@ -38,10 +38,11 @@ impl Residual for MinMap {
     fn dim(&self) -> usize {
         self.q.len()
     }
-    fn residual(&mut self, z: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, z: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         for (i, o) in out.iter_mut().enumerate() {
             *o = z[i].min(self.w(z, i));
         }
+        Ok(())
     }
 }
 
@@ -50,7 +51,7 @@ impl GeneralizedJacobian for MinMap {
     fn new_jacobian(&self) -> Mat<f64> {
         Mat::zeros(self.q.len(), self.q.len())
     }
-    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) {
+    fn jacobian(&mut self, z: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let n = z.len();
         for i in 0..n {
             let use_identity = z[i] <= self.w(z, i);
@@ -66,6 +67,7 @@ impl GeneralizedJacobian for MinMap {
                 };
             }
         }
+        Ok(())
     }
 }
 

@@ -410,14 +410,15 @@ struct SparseLu {
 impl SparseLu {
     fn new(a: &SparseMatrix) -> Result<Self, LinearSolveError> {
         let n = a.nrows();
-        let sparse_err = |reason: String| LinearSolveError::Sparse { reason };
         let symbolic = factorize_symbolic_lu(a.symbolic(), Default::default())
-            .map_err(|e| sparse_err(format!("symbolic analysis: {e:?}")))?;
+            .map_err(|e| LinearSolveError::from_faer(e, "analysing the iteration matrix"))?;
         let mut numeric = NumericLu::new();
         let mut buffer = MemBuffer::try_new(
             symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
         )
-        .map_err(|e| sparse_err(format!("scratch allocation: {e:?}")))?;
+        .map_err(|_| LinearSolveError::OutOfMemory {
+            during: "allocating the LU workspace",
+        })?;
         symbolic
             .factorize_numeric_lu(
                 &mut numeric,
@@ -426,9 +427,11 @@ impl SparseLu {
                 MemStack::new(&mut buffer),
                 Default::default(),
             )
-            .map_err(|e| sparse_err(format!("numeric factorization: {e:?}")))?;
+            .map_err(|e| LinearSolveError::from_sparse_lu(e, "factoring the iteration matrix"))?;
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
-            .map_err(|e| sparse_err(format!("scratch allocation: {e:?}")))?;
+            .map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the solve workspace",
+            })?;
         let mut lu = Self {
             symbolic,
             numeric,
@@ -460,10 +463,12 @@ impl SparseLu {
         if error.is_finite() && error < 1e-6 {
             Ok(())
         } else {
-            Err(LinearSolveError::Sparse {
-                reason: format!(
-                    "matrix singular or ill-conditioned: a test solve has error {error:e}"
-                ),
+            // A singular or hopelessly ill-conditioned matrix: the test solve's error stands
+            // for the negligible pivot faer does not report.
+            Err(LinearSolveError::Singular {
+                index: 0,
+                pivot: error,
+                max_pivot: f64::NAN,
             })
         }
     }
@@ -502,9 +507,7 @@ fn combine(model: &StructuralModel, a: f64, b: f64, c: f64) -> Result<SparseMatr
     let n = model.dofs();
     SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|e| MarchError::Factorization {
         matrix: "iteration matrix",
-        source: LinearSolveError::Sparse {
-            reason: format!("assembly: {e:?}"),
-        },
+        source: LinearSolveError::from_creation(e, "assembling the iteration matrix"),
     })
 }
 
@@ -769,11 +772,14 @@ impl<'a> TimeMarcher<'a> {
                 w[(i, k)] = col[ci.dof];
             }
         }
-        if y.iter().any(|v| !v.is_finite()) {
+        // Y = K_eff^{-1} G^T, column k for contact k.
+        if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(MarchError::Factorization {
                 matrix: name,
-                source: LinearSolveError::Sparse {
-                    reason: "non-finite contact compliance".into(),
+                source: LinearSolveError::NonFiniteEntry {
+                    row: index % n,
+                    col: index / n,
+                    value,
                 },
             });
         }

@@ -5,6 +5,7 @@
 //! applies, non-positive: it pushes the structure back).
 
 use faer::sparse::SparseColMat;
+use semismooth::{Factorize, LinearSolve};
 
 /// Sparse symmetric matrix storage used for `M`, `D` and `K` (column-compressed, faer).
 pub type SparseMatrix = SparseColMat<usize, f64>;

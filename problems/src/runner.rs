@@ -10,8 +10,10 @@ use std::time::Instant;
 
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, Globalization, NewtonOptions, NewtonReport, WorkCounters};
-use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::newton::{
+    self, Globalization, NewtonError, NewtonOptions, NewtonReport, WorkCounters,
+};
+use semismooth::{GeneralizedJacobian, Residual};
 
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
@@ -101,7 +103,7 @@ impl From<WorkCounters> for RunCounters {
             factorizations: c.factorizations,
             linear_solves: c.linear_solves,
             line_search_backtracks: c.line_search_backtracks,
-            ffts: c.ffts,
+            ffts: c.problem.get("ffts"),
             ..RunCounters::default()
         }
     }
@@ -167,23 +169,12 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
     }
 }
 
-fn termination_name(report: &NewtonReport) -> String {
-    use newton::Termination as T;
-    match &report.termination {
-        T::Converged => "converged".into(),
-        T::MaxIterations => "max-iterations".into(),
-        T::Stalled => "stalled".into(),
-        T::LineSearchFailed => "line-search-failed".into(),
-        T::SingularJacobian(e) => format!("singular-jacobian: {e}"),
-        T::NonFinite => "non-finite".into(),
-    }
-}
-
-/// A Newton solve with the linear solver chosen by the settings.
+/// A Newton solve with the linear solver chosen by the settings, converged or not.
 ///
-/// The absolute tolerance is raised to the round-off level of the model when that is above
-/// the scene's (`eps max K_ii sqrt(n) max|g|`: 4e-8 for 10^5 elements at H = 20, far
-/// below 1e-10 for the shipped scenes).
+/// The residual floor of the Newton options is the round-off level of the model
+/// (`eps max K_ii sqrt(n) max|g|`: 4e-8 for 10^5 elements at H = 20, far below 1e-10 for
+/// the shipped scenes): the tolerance is raised to it, and a run that stalls within 100
+/// times of it has converged as far as floating point allows.
 fn newton_hb<P>(
     problem: &mut P,
     x: &mut [f64],
@@ -200,30 +191,20 @@ where
         .iter()
         .fold(0.0f64, |a, c| a.max(c.gap.abs()))
         .max(f64::MIN_POSITIVE);
-    let roundoff = roundoff_floor(model, problem.dim(), gap_scale, extra_stiffness) / 100.0;
-    options.absolute_tolerance = options.absolute_tolerance.max(roundoff);
+    options.residual_floor = roundoff_floor(model, problem.dim(), gap_scale, extra_stiffness);
     let report = match settings.linear_solver {
         LinearSolverChoice::Structured => {
-            let mut solver = StructuredHbSolver::new();
-            newton::solve(problem, &mut solver, x, &options)?
+            newton::solve(problem, &mut StructuredHbSolver::new(), x, &options)
         }
-        LinearSolverChoice::Dense => {
-            let mut solver = FaerDenseLu::new();
-            newton::solve(
-                problem,
-                &mut solver as &mut dyn LinearSolve<HbJacobian>,
-                x,
-                &options,
-            )?
-        }
+        LinearSolverChoice::Dense => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
     };
-    Ok(report)
+    Ok(report.or_else(NewtonError::into_report)?)
 }
 
-/// Round-off floor of a harmonic-balance residual: 100 ulps of the largest force term,
-/// `100 eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
-/// the iterate) below it has converged as far as floating point allows: large models
-/// (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
+/// Round-off level of a harmonic-balance residual: one ulp of the largest force term,
+/// `eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
+/// the iterate) within 100 times of it has converged as far as floating point allows:
+/// large models (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
 fn roundoff_floor(
     model: &crate::model::StructuralModel,
     dim: usize,
@@ -233,26 +214,7 @@ fn roundoff_floor(
     let k_max = (0..model.dofs())
         .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
         .fold(extra_stiffness, f64::max);
-    100.0 * f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
-}
-
-/// Marks a stalled run below the round-off floor as converged (`extra_stiffness`: a
-/// penalty stiffness, which enters the residual like `K`).
-fn accept_roundoff(
-    sol: &mut Solution,
-    model: &crate::model::StructuralModel,
-    extra_stiffness: f64,
-) {
-    if sol.converged || !sol.termination.starts_with("stalled") {
-        return;
-    }
-    let u_max = sol.tip.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    let floor = roundoff_floor(model, sol.state.len(), u_max, extra_stiffness);
-    if sol.residual_norm <= floor {
-        sol.converged = true;
-        sol.termination =
-            format!("converged (stalled at the round-off floor {floor:.1e} of this model)");
-    }
+    f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
 }
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
@@ -334,7 +296,7 @@ fn hb_solution(
         omega,
         omega_1: rod.omega_1,
         converged: report.converged(),
-        termination: termination_name(report),
+        termination: report.termination.to_string(),
         iterations: report.iterations,
         residual_norm: report.residual_norm(),
         observed_order: report.observed_order,
@@ -408,7 +370,6 @@ pub fn solve_rod(
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let mut sol = hb_outputs(&problem, rod, settings, &report, seconds, x, points)?;
             sol.c = (problem.contacts() > 0).then(|| problem.c());
-            accept_roundoff(&mut sol, model, 0.0);
             Ok(sol)
         }
         Method::PenaltyHb => {
@@ -479,7 +440,6 @@ pub fn solve_rod(
                     .unwrap_or(0);
                 sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
             }
-            accept_roundoff(&mut sol, model, target);
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
@@ -557,7 +517,8 @@ fn solve_lcp(
                     let mut problem = lcp.min_map();
                     let mut z = w.to_vec();
                     let mut solver = ActiveSetSolver::new();
-                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)?;
+                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
+                        .or_else(NewtonError::into_report)?;
                     (z, vec![report])
                 }
                 _ => {
@@ -586,7 +547,7 @@ fn solve_lcp(
             (
                 z,
                 last.converged(),
-                termination_name(last),
+                last.termination.to_string(),
                 report_list.iter().map(|r| r.iterations).sum(),
                 last.residual_norm(),
                 counters,

@@ -165,8 +165,11 @@ use semismooth::continuation::{
 };
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{self, NewtonReport, WorkCounters};
-use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::newton::{self, WorkCounters};
+use semismooth::{
+    EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,
+    ProblemCounters, Residual,
+};
 use serde_json::json;
 
 mod corners;
@@ -406,16 +409,18 @@ impl<P: ParameterDependent + ?Sized> Residual for Scaled<'_, P> {
     fn dim(&self) -> usize {
         self.inner.dim()
     }
-    fn residual(&mut self, y: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, y: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         if !self.trusted(y) {
-            out.fill(f64::NAN);
-            return;
+            return Err(EvaluationError::OutsideDomain {
+                what: "distance from the last branch point beyond the trust radius",
+                value: f64::INFINITY,
+            });
         }
         self.unscale(y);
-        self.inner.residual(&self.x, out);
+        self.inner.residual(&self.x, out)
     }
-    fn fft_count(&self) -> u64 {
-        self.inner.fft_count()
+    fn problem_counters(&self) -> ProblemCounters {
+        self.inner.problem_counters()
     }
 }
 
@@ -426,9 +431,9 @@ impl<P: GeneralizedJacobian + ParameterDependent + ?Sized> GeneralizedJacobian f
     }
     /// The Jacobian in `y` is `J(x) diag(s)`; the column scaling is applied by
     /// [`ScaledSolver`], so `J(x)` itself is stored.
-    fn jacobian(&mut self, y: &[f64], jac: &mut P::Jacobian) {
+    fn jacobian(&mut self, y: &[f64], jac: &mut P::Jacobian) -> Result<(), EvaluationError> {
         self.unscale(y);
-        self.inner.jacobian(&self.x, jac);
+        self.inner.jacobian(&self.x, jac)
     }
 }
 
@@ -440,12 +445,17 @@ impl<P: ParameterDependent + ?Sized> ParameterDependent for Scaled<'_, P> {
         self.inner.set_parameter(q * self.omega_unit);
     }
     /// `dF/dq = ω_unit dF/dω`.
-    fn residual_parameter_derivative(&mut self, y: &[f64], out: &mut [f64]) {
+    fn residual_parameter_derivative(
+        &mut self,
+        y: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         self.unscale(y);
-        self.inner.residual_parameter_derivative(&self.x, out);
+        self.inner.residual_parameter_derivative(&self.x, out)?;
         for o in out.iter_mut() {
             *o *= self.omega_unit;
         }
+        Ok(())
     }
 }
 
@@ -455,10 +465,13 @@ struct ScaledSolver<'a, S: ?Sized> {
     scale: &'a [f64],
 }
 
-impl<J: ?Sized, S: LinearSolve<J> + ?Sized> LinearSolve<J> for ScaledSolver<'_, S> {
+impl<J: ?Sized, S: Factorize<J> + ?Sized> Factorize<J> for ScaledSolver<'_, S> {
     fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
         self.inner.factor(jac)
     }
+}
+
+impl<S: LinearSolve + ?Sized> LinearSolve for ScaledSolver<'_, S> {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         self.inner.solve_in_place(rhs)?;
         for (r, s) in rhs.iter_mut().zip(self.scale) {
@@ -488,8 +501,9 @@ fn reference_amplitude(rod: &RodModel) -> f64 {
         let x = vec![0.0; n];
         let mut r = vec![0.0; n];
         let mut jac = problem.new_jacobian();
-        problem.jacobian(&x, &mut jac);
-        problem.residual(&x, &mut r);
+        if problem.jacobian(&x, &mut jac).is_err() || problem.residual(&x, &mut r).is_err() {
+            continue;
+        }
         let mut solver = StructuredHbSolver::new();
         if solver.factor(&jac).is_err() || solver.solve_in_place(&mut r).is_err() {
             continue;
@@ -617,18 +631,6 @@ fn continuation_error(e: ContinuationError) -> RunError {
     }
 }
 
-fn newton_termination(report: &NewtonReport) -> String {
-    use newton::Termination as T;
-    match &report.termination {
-        T::Converged => "converged".into(),
-        T::MaxIterations => "max-iterations".into(),
-        T::Stalled => "stalled".into(),
-        T::LineSearchFailed => "line-search-failed".into(),
-        T::SingularJacobian(e) => format!("singular-jacobian: {e}"),
-        T::NonFinite => "non-finite".into(),
-    }
-}
-
 /// Reduces a state to `(tip_max, tip_min)` over one period.
 type TipMeasure<'m, P> = dyn FnMut(&P, &[f64]) -> Result<(f64, f64), RunError> + 'm;
 
@@ -660,7 +662,7 @@ fn follow<P, S>(
 ) -> Result<FrequencyResponse, RunError>
 where
     P: GeneralizedJacobian + ParameterDependent,
-    S: LinearSolve<P::Jacobian>,
+    S: Factorize<P::Jacobian>,
 {
     let Setup {
         settings,
@@ -686,7 +688,8 @@ where
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
     let (mut x, mut work) = start.unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
-    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
+    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))
+        .or_else(newton::NewtonError::into_report)?;
     work += report.counters;
     let mut counters = RunCounters::from(work);
     let mut response = FrequencyResponse {
@@ -715,7 +718,7 @@ where
         response.termination = format!(
             "the start at omega_ratio {} did not converge: {} after {} iterations (|F| = {:e})",
             sweep.omega_ratio_from,
-            newton_termination(&report),
+            report.termination,
             report.iterations,
             report.residual_norm()
         );
@@ -1004,14 +1007,14 @@ where
     response.restarts = restarts;
     response.corners = crossed;
     if let Some(c) = corners.as_ref() {
-        corner_work.ffts += c.ffts();
+        corner_work.problem.add("ffts", c.ffts());
     }
     c.work += corner_work;
     counters.residual_evaluations += c.work.residual_evaluations;
     counters.jacobian_evaluations += c.work.jacobian_evaluations;
     counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
     counters.linear_solves += c.work.linear_solves;
-    counters.ffts += c.work.ffts;
+    counters.ffts += c.work.problem.get("ffts");
     response.counters = counters;
     response.continuation = c;
     let to_q = sweep.omega_ratio_to / q_unit;
@@ -1276,7 +1279,7 @@ pub fn frequency_response(
             let setup = setup(units, output_points, floor);
             // A corner is searched within one largest step of the last point, and the next
             // piece is entered at most a quarter of the first step from it (in ω).
-            let solver: Box<dyn LinearSolve<HbJacobian>> = match settings.linear_solver {
+            let solver: Box<dyn Factorize<HbJacobian>> = match settings.linear_solver {
                 LinearSolverChoice::Structured => Box::new(StructuredHbSolver::new()),
                 LinearSolverChoice::Dense => Box::new(FaerDenseLu::new()),
             };

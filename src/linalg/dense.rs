@@ -7,7 +7,7 @@ use faer::{Mat, MatMut, Par};
 
 use super::scratch::Scratch;
 use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use crate::LinearSolve;
+use crate::{Factorize, LinearSolve};
 
 /// A Jacobian type that can be written out as a dense `n x n` matrix.
 ///
@@ -65,14 +65,12 @@ pub(crate) fn check_finite_dense(
 /// scratch memory are kept as well, so repeated [`factor`](FaerDenseLu::factor) /
 /// [`solve_in_place`](FaerDenseLu::solve_in_place) calls of one size allocate nothing.
 ///
-/// Both operations exist as inherent methods (usable without importing
-/// [`LinearSolve`] and without naming the Jacobian type) and through the
-/// [`LinearSolve<J>`] trait for every `J: DenseAssemble`, which is what the Newton
-/// driver uses.
+/// It factors every `J: DenseAssemble` ([`Factorize<J>`]).
 ///
 /// ```
 /// use faer::Mat;
 /// use semismooth::linalg::FaerDenseLu;
+/// use semismooth::{Factorize, LinearSolve};
 /// let a = Mat::from_fn(2, 2, |i, j| [[4.0, 1.0], [2.0, 3.0]][i][j]);
 /// let mut lu = FaerDenseLu::new();
 /// lu.factor(&a).unwrap();
@@ -131,11 +129,19 @@ impl FaerDenseLu {
         self.parallelism
             .unwrap_or_else(faer::get_global_parallelism)
     }
+}
 
+impl Default for FaerDenseLu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<J: DenseAssemble + ?Sized> Factorize<J> for FaerDenseLu {
     /// Factors `jac` (`P A = L U`, partial pivoting). Errors: a non-finite entry
     /// ([`LinearSolveError::NonFiniteEntry`]) or a pivot `|u_ii| <= threshold * max |u_jj|`
     /// ([`LinearSolveError::Singular`]); after an error the solver is unfactored.
-    pub fn factor<J: DenseAssemble + ?Sized>(&mut self, jac: &J) -> Result<(), LinearSolveError> {
+    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
         let n = jac.dim();
         self.factored = false;
         if self.factors.nrows() != n {
@@ -161,9 +167,11 @@ impl FaerDenseLu {
         self.factored = true;
         Ok(())
     }
+}
 
+impl LinearSolve for FaerDenseLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
-    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         if !self.factored {
             return Err(LinearSolveError::NotFactored);
         }
@@ -187,21 +195,5 @@ impl FaerDenseLu {
             stack,
         );
         Ok(())
-    }
-}
-
-impl Default for FaerDenseLu {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl<J: DenseAssemble + ?Sized> LinearSolve<J> for FaerDenseLu {
-    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
-        FaerDenseLu::factor(self, jac)
-    }
-
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        FaerDenseLu::solve_in_place(self, rhs)
     }
 }

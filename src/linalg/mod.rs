@@ -1,4 +1,5 @@
-//! Linear solvers behind the [`LinearSolve`](crate::LinearSolve) trait.
+//! Linear solvers behind the [`Factorize`](crate::Factorize) and
+//! [`LinearSolve`](crate::LinearSolve) traits.
 //!
 //! Every implementation checks its pivots against a relative threshold and returns
 //! [`LinearSolveError::Singular`] instead of dividing by a (near) zero pivot: a singular
@@ -10,11 +11,10 @@
 //! | [`NalgebraLu`] | any [`DenseAssemble`] | matrix reused; nalgebra allocates its permutation and the U copy for the pivot check |
 //! | [`FaerSparseLu`] | `faer::sparse::SparseColMat<usize, f64>` | column ordering once per pattern, factor storage reused |
 //!
-//! Each solver has inherent `factor` and `solve_in_place` methods with the same meaning
-//! as the [`LinearSolve`](crate::LinearSolve) trait methods, so direct use needs neither
-//! the trait in scope nor an annotation of the Jacobian type (the dense solvers implement
-//! `LinearSolve<J>` for every `J: DenseAssemble`, which would otherwise make
-//! `lu.solve_in_place(..)` ambiguous). Generic code (the Newton driver) uses the trait.
+//! Every solver implements [`Factorize<J>`](crate::Factorize) for the Jacobian types it
+//! can factor (the dense ones for every [`DenseAssemble`] type) and the single
+//! [`LinearSolve`](crate::LinearSolve) (the solves with the last factorization), so
+//! `lu.factor(&a)` and `lu.solve_in_place(&mut x)` need no annotation of the Jacobian type.
 
 mod dense;
 mod nalgebra_lu;
@@ -30,7 +30,7 @@ pub use sparse::FaerSparseLu;
 pub const DEFAULT_PIVOT_THRESHOLD: f64 = 1e-13;
 
 /// Why a factorization or a solve could not be carried out.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum LinearSolveError {
     /// A pivot is zero or negligible relative to the largest pivot.
     #[error(
@@ -65,12 +65,64 @@ pub enum LinearSolveError {
     /// `solve_in_place` was called without a successful factorization.
     #[error("solve requested before a successful factorization")]
     NotFactored,
-    /// The sparse factorization failed for a reason other than a small pivot.
-    #[error("sparse factorization failed: {reason}")]
-    Sparse {
-        /// Description from the sparse backend.
-        reason: String,
+    /// The storage of a factorization could not be allocated.
+    #[error("out of memory while {during}")]
+    OutOfMemory {
+        /// What was being allocated.
+        during: &'static str,
     },
+    /// An index of the sparse backend overflowed (a pattern too large for its index type).
+    #[error("index overflow while {during}")]
+    IndexOverflow {
+        /// What was being built.
+        during: &'static str,
+    },
+}
+
+impl LinearSolveError {
+    /// A short name of the kind of failure: `singular-jacobian` (a singular or
+    /// non-finite matrix), `out-of-memory`, `index-overflow`, `linear-solve-failed`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Singular { .. } | Self::NonFiniteEntry { .. } => "singular-jacobian",
+            Self::OutOfMemory { .. } => "out-of-memory",
+            Self::IndexOverflow { .. } => "index-overflow",
+            Self::DimensionMismatch { .. } | Self::NotFactored => "linear-solve-failed",
+        }
+    }
+
+    /// The error of a faer sparse operation `during` something.
+    pub fn from_faer(error: faer::sparse::FaerError, during: &'static str) -> Self {
+        match error {
+            faer::sparse::FaerError::OutOfMemory => Self::OutOfMemory { during },
+            _ => Self::IndexOverflow { during },
+        }
+    }
+
+    /// The error of a faer sparse LU `during` something: a structurally singular matrix
+    /// is [`LinearSolveError::Singular`] (pivot 0 at the failing column).
+    pub fn from_sparse_lu(error: faer::sparse::linalg::LuError, during: &'static str) -> Self {
+        match error {
+            faer::sparse::linalg::LuError::SymbolicSingular { index } => Self::Singular {
+                index,
+                pivot: 0.0,
+                max_pivot: f64::NAN,
+            },
+            faer::sparse::linalg::LuError::Generic(e) => Self::from_faer(e, during),
+        }
+    }
+
+    /// The error of building a faer sparse matrix `during` something (an entry out of
+    /// bounds is a [`LinearSolveError::DimensionMismatch`] on its row).
+    pub fn from_creation(error: faer::sparse::CreationError, during: &'static str) -> Self {
+        match error {
+            faer::sparse::CreationError::Generic(e) => Self::from_faer(e, during),
+            faer::sparse::CreationError::OutOfBounds { row, .. } => Self::DimensionMismatch {
+                expected: row,
+                found: row + 1,
+            },
+        }
+    }
 }
 
 /// Scans the diagonal of an upper-triangular factor: `Err(Singular)` if some

@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 
 use super::dense::{check_finite_dense, DenseAssemble};
 use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use crate::LinearSolve;
+use crate::{Factorize, LinearSolve};
 
 /// nalgebra's `LU` (partial pivoting, `P A = L U`) behind [`LinearSolve`], with the same
 /// relative pivot check as [`FaerDenseLu`](super::FaerDenseLu) (nalgebra itself only
@@ -19,6 +19,7 @@ use crate::LinearSolve;
 /// ```
 /// use nalgebra::DMatrix;
 /// use semismooth::linalg::NalgebraLu;
+/// use semismooth::{Factorize, LinearSolve};
 /// let a = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 2.0, 3.0]);
 /// let mut lu = NalgebraLu::new();
 /// lu.factor(&a).unwrap();
@@ -70,11 +71,18 @@ impl NalgebraLu {
     pub fn dim(&self) -> usize {
         self.dim
     }
+}
 
+impl Default for NalgebraLu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<J: DenseAssemble + ?Sized> Factorize<J> for NalgebraLu {
     /// Factors `jac`. Errors: a non-finite entry or a negligible pivot (as for
-    /// [`FaerDenseLu::factor`](super::FaerDenseLu::factor)); after an error the solver
-    /// is unfactored.
-    pub fn factor<J: DenseAssemble + ?Sized>(&mut self, jac: &J) -> Result<(), LinearSolveError> {
+    /// [`FaerDenseLu`](super::FaerDenseLu)); after an error the solver is unfactored.
+    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
         let n = jac.dim();
         let state = std::mem::replace(&mut self.state, State::Empty(DMatrix::zeros(0, 0)));
         let mut storage = match state {
@@ -109,9 +117,11 @@ impl NalgebraLu {
             }
         }
     }
+}
 
+impl LinearSolve for NalgebraLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
-    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         let State::Factored(lu) = &self.state else {
             return Err(LinearSolveError::NotFactored);
         };
@@ -138,21 +148,5 @@ impl NalgebraLu {
                 max_pivot: 0.0,
             })
         }
-    }
-}
-
-impl Default for NalgebraLu {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl<J: DenseAssemble + ?Sized> LinearSolve<J> for NalgebraLu {
-    fn factor(&mut self, jac: &J) -> Result<(), LinearSolveError> {
-        NalgebraLu::factor(self, jac)
-    }
-
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        NalgebraLu::solve_in_place(self, rhs)
     }
 }

@@ -12,17 +12,21 @@ use faer::{Conj, MatMut, Par};
 
 use super::scratch::Scratch;
 use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use crate::LinearSolve;
+use crate::{Factorize, LinearSolve};
 
 /// faer sparse LU for [`SparseColMat<usize, f64>`]: `P A Q = L U` with a COLAMD column
 /// ordering `Q` and partial row pivoting `P`.
 ///
-/// - **Symbolic analysis once per pattern.** The column ordering is computed on the
-///   first factorization and recomputed only when the sparsity pattern (column pointers
-///   and row indices) changes; [`FaerSparseLu::symbolic_analyses`] counts how often.
-/// - **Numeric refactorization per [`factor`](FaerSparseLu::factor)** into the factor
-///   storage of the previous call (it grows only if the fill grows), so repeated
-///   factorizations of one pattern allocate nothing once the storage has settled.
+/// - **Symbolic analysis explicit and cached.** The column ordering is computed by
+///   [`FaerSparseLu::analyze`], or by the first [`factor`](Factorize::factor) of a new
+///   dimension, and reused by every later factorization: `factor` does not compare
+///   patterns. An ordering computed for another pattern is still a valid column
+///   permutation (the row pivoting keeps the factorization correct), only possibly a
+///   worse one for fill: call `analyze` when the pattern changes for good.
+///   [`FaerSparseLu::symbolic_analyses`] counts the orderings computed.
+/// - **Numeric refactorization per `factor`** into the factor storage of the previous
+///   call (it grows only if the fill grows), so repeated factorizations of one pattern
+///   allocate nothing once the storage has settled.
 /// - **Singularity is detected**: faer's sparse LU reports only structural
 ///   singularity; the diagonal of `U` is scanned against the same relative threshold as
 ///   the dense solvers ([`LinearSolveError::Singular`]).
@@ -34,6 +38,7 @@ use crate::LinearSolve;
 /// ```
 /// use faer::sparse::{SparseColMat, Triplet};
 /// use semismooth::linalg::FaerSparseLu;
+/// use semismooth::{Factorize, LinearSolve};
 /// // Tridiagonal [2 -1 0; -1 2 -1; 0 -1 2] times [1, 1, 1] = [1, 0, 1].
 /// let t = [(0, 0, 2.0), (1, 0, -1.0), (0, 1, -1.0), (1, 1, 2.0), (2, 1, -1.0), (1, 2, -1.0), (2, 2, 2.0)];
 /// let triplets: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
@@ -47,17 +52,13 @@ use crate::LinearSolve;
 #[derive(Debug)]
 pub struct FaerSparseLu {
     dim: usize,
-    /// Pattern the column ordering was computed for.
-    pattern_col_ptr: Vec<usize>,
-    pattern_col_nnz: Option<Vec<usize>>,
-    pattern_row_idx: Vec<usize>,
     col_perm_fwd: Vec<usize>,
     col_perm_inv: Vec<usize>,
     row_perm_fwd: Vec<usize>,
     row_perm_inv: Vec<usize>,
     lu: SimplicialLu<usize, f64>,
     scratch: Scratch,
-    has_pattern: bool,
+    analyzed: bool,
     factored: bool,
     pivot_threshold: f64,
     symbolic_analyses: u64,
@@ -68,16 +69,13 @@ impl FaerSparseLu {
     pub fn new() -> Self {
         Self {
             dim: 0,
-            pattern_col_ptr: Vec::new(),
-            pattern_col_nnz: None,
-            pattern_row_idx: Vec::new(),
             col_perm_fwd: Vec::new(),
             col_perm_inv: Vec::new(),
             row_perm_fwd: Vec::new(),
             row_perm_inv: Vec::new(),
             lu: SimplicialLu::new(),
             scratch: Scratch::new(),
-            has_pattern: false,
+            analyzed: false,
             factored: false,
             pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
             symbolic_analyses: 0,
@@ -92,7 +90,7 @@ impl FaerSparseLu {
         }
     }
 
-    /// Dimension of the last factored matrix.
+    /// Dimension of the last analysed matrix.
     pub fn dim(&self) -> usize {
         self.dim
     }
@@ -103,24 +101,19 @@ impl FaerSparseLu {
         self.symbolic_analyses
     }
 
-    fn same_pattern(&self, a: &SparseColMat<usize, f64>) -> bool {
+    /// Computes the fill-reducing column ordering of `a`'s sparsity pattern, used by the
+    /// following factorizations (square matrices only).
+    pub fn analyze(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
         let s = a.symbolic();
-        self.has_pattern
-            && self.dim == s.nrows()
-            && self.pattern_col_ptr == s.col_ptr()
-            && self.pattern_col_nnz.as_deref() == s.col_nnz()
-            && self.pattern_row_idx == s.row_idx()
-    }
-
-    fn analyse(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
-        let s = a.symbolic();
-        let n = s.nrows();
-        self.has_pattern = false;
-        self.pattern_col_ptr.clear();
-        self.pattern_col_ptr.extend_from_slice(s.col_ptr());
-        self.pattern_col_nnz = s.col_nnz().map(<[usize]>::to_vec);
-        self.pattern_row_idx.clear();
-        self.pattern_row_idx.extend_from_slice(s.row_idx());
+        let (n, ncols) = (s.nrows(), s.ncols());
+        if n != ncols {
+            return Err(LinearSolveError::DimensionMismatch {
+                expected: n,
+                found: ncols,
+            });
+        }
+        self.analyzed = false;
+        self.factored = false;
         self.col_perm_fwd.resize(n, 0);
         self.col_perm_inv.resize(n, 0);
         self.row_perm_fwd.resize(n, 0);
@@ -134,22 +127,29 @@ impl FaerSparseLu {
             colamd::Control::default(),
             stack,
         )
-        .map_err(|e| LinearSolveError::Sparse {
-            reason: format!("column ordering failed: {e:?}"),
-        })?;
+        .map_err(|e| LinearSolveError::from_faer(e, "ordering the columns"))?;
         self.dim = n;
-        self.has_pattern = true;
+        self.analyzed = true;
         self.symbolic_analyses += 1;
         Ok(())
     }
+}
 
-    /// Factors `a` (square). Errors: [`LinearSolveError::DimensionMismatch`] for a
+impl Default for FaerSparseLu {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Factorize<SparseColMat<usize, f64>> for FaerSparseLu {
+    /// Factors `a` (square), analysing its pattern first when no analysis of this
+    /// dimension is cached. Errors: [`LinearSolveError::DimensionMismatch`] for a
     /// non-square matrix, [`LinearSolveError::NonFiniteEntry`],
     /// [`LinearSolveError::Singular`] for a structurally singular matrix (then `pivot`
     /// is 0 and `max_pivot` is the largest absolute entry of `a`, the pivots not being
-    /// available) or a negligible pivot, [`LinearSolveError::Sparse`] if faer fails
-    /// otherwise (out of memory). After an error the solver is unfactored.
-    pub fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
+    /// available) or a negligible pivot, [`LinearSolveError::OutOfMemory`]. After an
+    /// error the solver is unfactored.
+    fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
         self.factored = false;
         let (nrows, ncols) = (a.nrows(), a.ncols());
         if nrows != ncols {
@@ -167,8 +167,8 @@ impl FaerSparseLu {
                 max_entry = max_entry.max(value.abs());
             }
         }
-        if !self.same_pattern(a) {
-            self.analyse(a)?;
+        if !self.analyzed || self.dim != nrows {
+            self.analyze(a)?;
         }
         let n = self.dim;
         let req = StackReq::or(
@@ -195,9 +195,7 @@ impl FaerSparseLu {
                 })
             }
             Err(LuError::Generic(e)) => {
-                return Err(LinearSolveError::Sparse {
-                    reason: format!("{e:?}"),
-                })
+                return Err(LinearSolveError::from_faer(e, "factoring a sparse matrix"))
             }
         }
         let u = self.lu.u_factor_unsorted();
@@ -212,9 +210,11 @@ impl FaerSparseLu {
         self.factored = true;
         Ok(())
     }
+}
 
+impl LinearSolve for FaerSparseLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
-    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         if !self.factored {
             return Err(LinearSolveError::NotFactored);
         }
@@ -238,21 +238,5 @@ impl FaerSparseLu {
             stack,
         );
         Ok(())
-    }
-}
-
-impl Default for FaerSparseLu {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl LinearSolve<SparseColMat<usize, f64>> for FaerSparseLu {
-    fn factor(&mut self, jac: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
-        FaerSparseLu::factor(self, jac)
-    }
-
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        FaerSparseLu::solve_in_place(self, rhs)
     }
 }

@@ -2,7 +2,7 @@
 
 use faer::{c64, Mat};
 use semismooth::harmonic::{Aft, FourierBasis};
-use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters, Residual};
 
 use super::jacobian::ContactCoupling;
 use super::ssn::{HbOptions, SsnHb};
@@ -189,7 +189,7 @@ impl Residual for CondensedSsnHb {
         self.full.contacts() * self.full.basis().basis_size()
     }
 
-    fn residual(&mut self, lambda: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let m = self.full.contacts();
         let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
@@ -203,10 +203,12 @@ impl Residual for CondensedSsnHb {
                 out[j * m + i] = lambda[j * m + i] + self.coeffs[j];
             }
         }
+        Ok(())
     }
 
-    fn fft_count(&self) -> u64 {
-        self.aft.fft_count()
+    /// `ffts`: the transforms of the alternating frequency/time scheme.
+    fn problem_counters(&self) -> ProblemCounters {
+        ProblemCounters::new().with("ffts", self.aft.fft_count())
     }
 }
 
@@ -218,7 +220,7 @@ impl GeneralizedJacobian for CondensedSsnHb {
         Mat::zeros(n, n)
     }
 
-    fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) {
+    fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let m = self.full.contacts();
         let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
@@ -237,5 +239,6 @@ impl GeneralizedJacobian for CondensedSsnHb {
             m,
             jac.as_mut(),
         );
+        Ok(())
     }
 }

@@ -1,7 +1,9 @@
 //! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
 
 use semismooth::harmonic::FourierBasis;
-use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+use semismooth::{
+    EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
+};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
@@ -247,7 +249,7 @@ impl Residual for PenaltyHb {
         self.state.linear.dofs * self.state.linear.size()
     }
 
-    fn residual(&mut self, u: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
         let (n, size) = (lin.dofs, lin.size());
         lin.dynamic_residual(self.state.omega, u, out);
@@ -267,10 +269,12 @@ impl Residual for PenaltyHb {
                 out[j * n + dof] += self.coeffs[j];
             }
         }
+        Ok(())
     }
 
-    fn fft_count(&self) -> u64 {
-        self.state.aft.fft_count()
+    /// `ffts`: the transforms of the alternating frequency/time scheme.
+    fn problem_counters(&self) -> ProblemCounters {
+        ProblemCounters::new().with("ffts", self.state.aft.fft_count())
     }
 }
 
@@ -287,7 +291,7 @@ impl GeneralizedJacobian for PenaltyHb {
         )
     }
 
-    fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) {
+    fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
         if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
             *jac = self.new_jacobian();
         }
@@ -306,6 +310,7 @@ impl GeneralizedJacobian for PenaltyHb {
             }
             self.state.write_contact_block(&mut self.samples, jac, i);
         }
+        Ok(())
     }
 }
 
@@ -319,9 +324,14 @@ impl ParameterDependent for PenaltyHb {
     }
 
     /// `dR/dw = dA/dw U` (the penalty term does not depend on `w`).
-    fn residual_parameter_derivative(&mut self, u: &[f64], out: &mut [f64]) {
+    fn residual_parameter_derivative(
+        &mut self,
+        u: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         self.state
             .linear
             .dynamic_omega_derivative(self.state.omega, u, out);
+        Ok(())
     }
 }

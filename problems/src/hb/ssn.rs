@@ -2,7 +2,9 @@
 //! equations (5)-(6)).
 
 use semismooth::harmonic::FourierBasis;
-use semismooth::{GeneralizedJacobian, ParameterDependent, Residual};
+use semismooth::{
+    EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
+};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
@@ -264,7 +266,7 @@ impl Residual for SsnHb {
         (lin.dofs + lin.contacts()) * lin.size()
     }
 
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
@@ -287,10 +289,12 @@ impl Residual for SsnHb {
                 out_l[j * m + i] = x[offset + j * m + i] + self.coeffs[j];
             }
         }
+        Ok(())
     }
 
-    fn fft_count(&self) -> u64 {
-        self.state.aft.fft_count()
+    /// `ffts`: the transforms of the alternating frequency/time scheme.
+    fn problem_counters(&self) -> ProblemCounters {
+        ProblemCounters::new().with("ffts", self.state.aft.fft_count())
     }
 }
 
@@ -305,7 +309,7 @@ impl GeneralizedJacobian for SsnHb {
         )
     }
 
-    fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) {
+    fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
         if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
             *jac = self.new_jacobian();
         }
@@ -315,6 +319,7 @@ impl GeneralizedJacobian for SsnHb {
             self.switching_samples(x, i);
             self.state.write_contact_block(&mut self.samples, jac, i);
         }
+        Ok(())
     }
 }
 
@@ -328,12 +333,17 @@ impl ParameterDependent for SsnHb {
     }
 
     /// `dR/dw = [dA/dw U; 0]`.
-    fn residual_parameter_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual_parameter_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         let offset = self.displacement_len();
         let (out_u, out_l) = out.split_at_mut(offset);
         self.state
             .linear
             .dynamic_omega_derivative(self.state.omega, &x[..offset], out_u);
         out_l.fill(0.0);
+        Ok(())
     }
 }

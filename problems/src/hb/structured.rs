@@ -23,7 +23,7 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, Symbolic
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
 use faer::{c64, Conj, Mat, MatMut, MatRef, Par};
 use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use semismooth::LinearSolve;
+use semismooth::{Factorize, LinearSolve};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::LinearData;
@@ -65,9 +65,7 @@ impl Pattern {
         }
         let union =
             SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).map_err(|e| {
-                LinearSolveError::Sparse {
-                    reason: format!("building the union sparsity pattern: {e:?}"),
-                }
+                LinearSolveError::from_creation(e, "building the union sparsity pattern")
             })?;
         let positions = |m: &SparseMatrix| -> Vec<usize> {
             let m = m.as_ref();
@@ -89,12 +87,8 @@ impl Pattern {
         let stiffness_pos = positions(&lin.stiffness);
         let mass_pos = positions(&lin.mass);
         let damping_pos = lin.damping.as_ref().map(positions).unwrap_or_default();
-        let symbolic =
-            factorize_symbolic_lu(union.symbolic(), Default::default()).map_err(|e| {
-                LinearSolveError::Sparse {
-                    reason: format!("symbolic LU of the dynamic blocks: {e:?}"),
-                }
-            })?;
+        let symbolic = factorize_symbolic_lu(union.symbolic(), Default::default())
+            .map_err(|e| LinearSolveError::from_faer(e, "analysing the dynamic blocks"))?;
         Ok(Self {
             union,
             stiffness_pos,
@@ -239,8 +233,8 @@ impl StructuredHbSolver {
             dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
             dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
         ]);
-        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::Sparse {
-            reason: "out of memory for the LU workspace".into(),
+        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
+            during: "allocating the LU workspace",
         })?;
         self.values
             .resize(pattern.union.val().len(), c64::new(0.0, 0.0));
@@ -280,9 +274,7 @@ impl StructuredHbSolver {
                     stack,
                     Default::default(),
                 )
-                .map_err(|e| LinearSolveError::Sparse {
-                    reason: format!("harmonic {k} dynamic block: {e:?}"),
-                })?;
+                .map_err(|e| LinearSolveError::from_sparse_lu(e, "factoring a dynamic block"))?;
             let z = &mut self.response[k];
             if z.nrows() != n || z.ncols() != m {
                 *z = Mat::zeros(n, m);
@@ -423,7 +415,7 @@ impl StructuredHbSolver {
     }
 }
 
-impl LinearSolve<HbJacobian> for StructuredHbSolver {
+impl Factorize<HbJacobian> for StructuredHbSolver {
     fn factor(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
         self.schur_ready = false;
         let reuse = matches!(&self.factored_for,
@@ -480,7 +472,9 @@ impl LinearSolve<HbJacobian> for StructuredHbSolver {
         self.schur_ready = true;
         Ok(())
     }
+}
 
+impl LinearSolve for StructuredHbSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         self.work_rhs.clear();
         self.work_rhs.extend_from_slice(rhs);

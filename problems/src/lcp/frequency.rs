@@ -29,7 +29,9 @@ use std::rc::Rc;
 use faer::MatMut;
 use semismooth::complementarity::min_function;
 use semismooth::linalg::{DenseAssemble, LinearSolveError};
-use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::{
+    EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual,
+};
 
 use super::min_map::{add_mat_vec, ActiveSetSolver, MinMapJacobian};
 use super::{LcpError, PeriodicLcp, PeriodicLcpOptions};
@@ -48,7 +50,6 @@ pub struct FrequencyLcp {
     omega: f64,
     /// Most recent first.
     cache: Vec<Rc<PeriodicLcp>>,
-    last_error: Option<LcpError>,
     scratch: Vec<f64>,
 }
 
@@ -76,7 +77,6 @@ impl FrequencyLcp {
             kappa,
             omega: model.forcing.omega,
             cache: vec![Rc::new(lcp)],
-            last_error: None,
             scratch: vec![0.0; n],
         })
     }
@@ -89,11 +89,6 @@ impl FrequencyLcp {
     /// The force scale `kappa`.
     pub fn kappa(&self) -> f64 {
         self.kappa
-    }
-
-    /// Why the last LCP build failed (evaluations there return NaN), if one did.
-    pub fn last_error(&self) -> Option<&LcpError> {
-        self.last_error.as_ref()
     }
 
     /// The unknowns `(w, z)` of a solution `z` of the LCP at the current frequency:
@@ -123,15 +118,13 @@ impl FrequencyLcp {
         Ok(lcp)
     }
 
-    /// The current LCP, or `None` after recording why it could not be built.
-    fn lcp_or_record(&mut self) -> Option<Rc<PeriodicLcp>> {
-        match self.current() {
-            Ok(lcp) => Some(lcp),
-            Err(e) => {
-                self.last_error = Some(e);
-                None
-            }
-        }
+    /// The current LCP; a frequency where it cannot be built (a bin of the dynamic
+    /// stiffness singular) is outside the problem's domain.
+    fn current_in_domain(&mut self) -> Result<Rc<PeriodicLcp>, EvaluationError> {
+        self.current().map_err(|_| EvaluationError::OutsideDomain {
+            what: "omega (the periodic LCP cannot be built at this frequency)",
+            value: self.omega,
+        })
     }
 }
 
@@ -140,11 +133,8 @@ impl Residual for FrequencyLcp {
         2 * self.half()
     }
 
-    fn residual(&mut self, y: &[f64], out: &mut [f64]) {
-        let Some(lcp) = self.lcp_or_record() else {
-            out.fill(f64::NAN);
-            return;
-        };
+    fn residual(&mut self, y: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        let lcp = self.current_in_domain()?;
         let n = self.half();
         let (w, z) = y.split_at(n);
         let (f1, f2) = out.split_at_mut(n);
@@ -157,6 +147,7 @@ impl Residual for FrequencyLcp {
         for ((f, zi), wi) in f2.iter_mut().zip(z).zip(w) {
             *f = min_function(*zi, self.kappa * wi).value;
         }
+        Ok(())
     }
 }
 
@@ -171,7 +162,11 @@ impl GeneralizedJacobian for FrequencyLcp {
         }
     }
 
-    fn jacobian(&mut self, y: &[f64], jac: &mut FrequencyLcpJacobian) {
+    fn jacobian(
+        &mut self,
+        y: &[f64],
+        jac: &mut FrequencyLcpJacobian,
+    ) -> Result<(), EvaluationError> {
         let n = self.half();
         let (w, z) = y.split_at(n);
         for ((a, zi), wi) in jac.active.iter_mut().zip(z).zip(w) {
@@ -179,7 +174,8 @@ impl GeneralizedJacobian for FrequencyLcp {
             *a = min_function(*zi, self.kappa * wi).db == 1.0;
         }
         jac.kappa = self.kappa;
-        jac.lcp = self.lcp_or_record();
+        jac.lcp = Some(self.current_in_domain()?);
+        Ok(())
     }
 }
 
@@ -194,20 +190,23 @@ impl ParameterDependent for FrequencyLcp {
     }
 
     /// `dF1/domega = -d(q + A z)/domega` (analytic), `dF2/domega = 0`.
-    fn residual_parameter_derivative(&mut self, y: &[f64], out: &mut [f64]) {
+    fn residual_parameter_derivative(
+        &mut self,
+        y: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
         let n = self.half();
-        let result = self
-            .current()
-            .and_then(|lcp| lcp.frequency_derivative(&y[n..], &mut out[..n]));
-        if let Err(e) = result {
-            self.last_error = Some(e);
-            out.fill(f64::NAN);
-            return;
-        }
+        let lcp = self.current_in_domain()?;
+        lcp.frequency_derivative(&y[n..], &mut out[..n])
+            .map_err(|_| EvaluationError::OutsideDomain {
+                what: "omega (the frequency derivative of the periodic LCP is unavailable)",
+                value: self.omega,
+            })?;
         for o in out[..n].iter_mut() {
             *o = -*o;
         }
         out[n..].fill(0.0);
+        Ok(())
     }
 }
 
@@ -215,7 +214,7 @@ impl ParameterDependent for FrequencyLcp {
 /// P_J]]` with `P_I`, `P_J` the selections of the active and inactive rows.
 #[derive(Debug, Clone)]
 pub struct FrequencyLcpJacobian {
-    /// `None` when the LCP at the frequency could not be built.
+    /// The LCP at the frequency of the last evaluation (`None` before the first).
     lcp: Option<Rc<PeriodicLcp>>,
     active: Vec<bool>,
     kappa: f64,
@@ -238,7 +237,7 @@ impl DenseAssemble for FrequencyLcpJacobian {
         2 * self.active.len()
     }
 
-    /// The `2 m Nt` square matrix (NaN everywhere when the LCP could not be built).
+    /// The `2 m Nt` square matrix (NaN everywhere before the first evaluation).
     fn assemble_dense(&self, mut out: MatMut<'_, f64>) {
         let n = self.active.len();
         let Some(lcp) = &self.lcp else {
@@ -302,14 +301,11 @@ impl FrequencyLcpSolver {
     }
 }
 
-impl LinearSolve<FrequencyLcpJacobian> for FrequencyLcpSolver {
+impl Factorize<FrequencyLcpJacobian> for FrequencyLcpSolver {
     fn factor(&mut self, jac: &FrequencyLcpJacobian) -> Result<(), LinearSolveError> {
         self.lcp = None;
-        let lcp = jac.lcp.clone().ok_or(LinearSolveError::NonFiniteEntry {
-            row: 0,
-            col: 0,
-            value: f64::NAN,
-        })?;
+        // A Jacobian never evaluated holds no matrix: nothing to factor.
+        let lcp = jac.lcp.clone().ok_or(LinearSolveError::NotFactored)?;
         let min_map = MinMapJacobian::new(lcp.matrix(), jac.active.clone()).map_err(|_| {
             LinearSolveError::DimensionMismatch {
                 expected: lcp.dim(),
@@ -322,7 +318,9 @@ impl LinearSolve<FrequencyLcpJacobian> for FrequencyLcpSolver {
         self.lcp = Some(lcp);
         Ok(())
     }
+}
 
+impl LinearSolve for FrequencyLcpSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         let lcp = self.lcp.as_ref().ok_or(LinearSolveError::NotFactored)?;
         let n = self.active.len();
@@ -393,7 +391,7 @@ mod tests {
         let mut p = problem(32);
         let y = state(&p);
         let mut jac = p.new_jacobian();
-        p.jacobian(&y, &mut jac);
+        p.jacobian(&y, &mut jac).unwrap();
         assert!(jac.active_count() > 0 && jac.active_count() < p.half());
         let rhs: Vec<f64> = (0..p.dim()).map(|i| (0.37 * i as f64).sin()).collect();
         let mut x1 = rhs.clone();
@@ -403,7 +401,7 @@ mod tests {
         let mut x2 = rhs.clone();
         let mut dense = FaerDenseLu::new();
         dense.factor(&jac).unwrap();
-        LinearSolve::<FrequencyLcpJacobian>::solve_in_place(&mut dense, &mut x2).unwrap();
+        dense.solve_in_place(&mut x2).unwrap();
         let scale = x2.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         // Two backward-stable solves; the active block of A (entries O(1), smallest
         // receptance O(1e-2)) keeps the condition number moderate: 1e-10 relative.
@@ -418,7 +416,7 @@ mod tests {
         let y = state(&p);
         let omega = p.parameter();
         let mut analytic = vec![0.0; p.dim()];
-        p.residual_parameter_derivative(&y, &mut analytic);
+        p.residual_parameter_derivative(&y, &mut analytic).unwrap();
         // Central differences at the resonance (zeta = 0.01: F varies on the scale
         // zeta omega): truncation (h / (zeta omega))^2 ~ 1e-8 relative, rounding
         // 1e-16 |F| / h ~ 1e-10 of the derivative (|F| ~ 1, |F'| ~ 1e2).
@@ -426,9 +424,9 @@ mod tests {
         let mut plus = vec![0.0; p.dim()];
         let mut minus = vec![0.0; p.dim()];
         p.set_parameter(omega + h);
-        p.residual(&y, &mut plus);
+        p.residual(&y, &mut plus).unwrap();
         p.set_parameter(omega - h);
-        p.residual(&y, &mut minus);
+        p.residual(&y, &mut minus).unwrap();
         let scale = analytic.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(scale > 0.0);
         for i in 0..p.dim() {
@@ -457,7 +455,7 @@ mod tests {
         let mut y = vec![0.0; 2 * n];
         y[n..].fill(1.0); // z = 1 > kappa w = 0 everywhere
         let mut jac = p.new_jacobian();
-        p.jacobian(&y, &mut jac);
+        p.jacobian(&y, &mut jac).unwrap();
         assert_eq!(jac.active_count(), n);
         let mut solver = FrequencyLcpSolver::new();
         assert!(matches!(

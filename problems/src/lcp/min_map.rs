@@ -13,7 +13,7 @@ use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut, MatRef};
 use semismooth::complementarity::min_function;
 use semismooth::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use semismooth::{GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
 
 use super::LcpError;
 
@@ -81,11 +81,12 @@ impl Residual for MinMapLcp<'_> {
         self.q.len()
     }
 
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.gap(x);
         for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
             *o = min_function(*z, *w).value;
         }
+        Ok(())
     }
 }
 
@@ -99,12 +100,13 @@ impl<'a> GeneralizedJacobian for MinMapLcp<'a> {
         }
     }
 
-    fn jacobian(&mut self, x: &[f64], jac: &mut MinMapJacobian<'a>) {
+    fn jacobian(&mut self, x: &[f64], jac: &mut MinMapJacobian<'a>) -> Result<(), EvaluationError> {
         self.gap(x);
         for ((a, z), w) in jac.active.iter_mut().zip(x).zip(&self.w) {
             // min_function's gradient is (0, 1) exactly where w < z (tie: (1, 0)).
             *a = min_function(*z, *w).db == 1.0;
         }
+        Ok(())
     }
 }
 
@@ -218,7 +220,7 @@ impl ActiveSetSolver {
 /// Relative diagonal shift applied to a singular active block (see `factor`).
 const REGULARIZATION: f64 = 1e-8;
 
-impl LinearSolve<MinMapJacobian<'_>> for ActiveSetSolver {
+impl Factorize<MinMapJacobian<'_>> for ActiveSetSolver {
     fn factor(&mut self, jac: &MinMapJacobian<'_>) -> Result<(), LinearSolveError> {
         self.lu = None;
         let n = jac.active.len();
@@ -289,7 +291,9 @@ impl LinearSolve<MinMapJacobian<'_>> for ActiveSetSolver {
         self.rhs = Mat::zeros(k, 1);
         Ok(())
     }
+}
 
+impl LinearSolve for ActiveSetSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         if rhs.len() != self.n {
             return Err(LinearSolveError::DimensionMismatch {
@@ -357,7 +361,7 @@ mod tests {
                 active_solver.solve_in_place(&mut x1).unwrap();
                 let mut dense = FaerDenseLu::new();
                 dense.factor(&jac).unwrap();
-                LinearSolve::<MinMapJacobian<'_>>::solve_in_place(&mut dense, &mut x2).unwrap();
+                dense.solve_in_place(&mut x2).unwrap();
                 // Both are backward-stable solves of a well-conditioned system (condition
                 // number O(10)): agreement to a few hundred ulps.
                 for (u, v) in x1.iter().zip(&x2) {
@@ -401,17 +405,17 @@ mod tests {
         let z: Vec<f64> = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
         let mut f = MinMapLcp::new(a.as_ref(), &q).unwrap();
         let mut jac = f.new_jacobian();
-        f.jacobian(&z, &mut jac);
+        f.jacobian(&z, &mut jac).unwrap();
         let mut dense = Mat::<f64>::zeros(n, n);
         jac.assemble_dense(dense.as_mut());
         let h = 1e-7;
         let mut f0 = vec![0.0; n];
-        f.residual(&z, &mut f0);
+        f.residual(&z, &mut f0).unwrap();
         for j in 0..n {
             let mut zp = z.clone();
             zp[j] += h;
             let mut fp = vec![0.0; n];
-            f.residual(&zp, &mut fp);
+            f.residual(&zp, &mut fp).unwrap();
             for i in 0..n {
                 // Piecewise linear: the one-sided difference is exact up to round-off
                 // (1e-16 / 1e-7) unless a kink is crossed, which these values avoid.

@@ -1070,7 +1070,8 @@ pub fn solve_min_map_sequenced(
         let report = {
             let mut problem = lcp.min_map();
             let mut solver = ActiveSetSolver::new();
-            newton::solve(&mut problem, &mut solver, &mut z, newton_options)?
+            newton::solve(&mut problem, &mut solver, &mut z, newton_options)
+                .or_else(NewtonError::into_report)?
         };
         levels.push(SequencingLevel {
             time_samples: nt,

@@ -24,7 +24,7 @@
 
 use semismooth::continuation::Direction;
 use semismooth::newton::WorkCounters;
-use semismooth::{GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::{Factorize, GeneralizedJacobian, ParameterDependent, Residual};
 
 use crate::hb::{HbJacobian, PenaltyHb};
 
@@ -71,7 +71,7 @@ pub(super) trait Corners {
 /// [`Corners`] of penalty-HB branches (module documentation).
 pub(super) struct PenaltyCorners {
     pub problem: PenaltyHb,
-    pub solver: Box<dyn LinearSolve<HbJacobian>>,
+    pub solver: Box<dyn Factorize<HbJacobian>>,
     /// Farthest a first crossing is searched from the starting point (in `ω`).
     pub reach: f64,
     /// Largest shift from the last corner to the entry point (in `ω`).
@@ -106,7 +106,7 @@ impl Corners for PenaltyCorners {
     }
 
     fn ffts(&self) -> u64 {
-        self.problem.fft_count()
+        self.problem.problem_counters().get("ffts")
     }
 }
 
@@ -231,14 +231,14 @@ impl PenaltyCorners {
         problem.freeze_activity(Some(activity.to_vec()));
         problem.set_parameter(omega);
         let mut jac = problem.new_jacobian();
-        problem.jacobian(x, &mut jac);
+        problem.jacobian(x, &mut jac).ok()?;
         work.jacobian_evaluations += 1;
         work.factorizations += 1;
         self.solver.factor(&jac).ok()?;
         let mut u = x.to_vec();
         let mut r = vec![0.0; u.len()];
         for _ in 0..2 {
-            problem.residual(&u, &mut r);
+            problem.residual(&u, &mut r).ok()?;
             work.residual_evaluations += 1;
             work.linear_solves += 1;
             self.solver.solve_in_place(&mut r).ok()?;
@@ -246,7 +246,7 @@ impl PenaltyCorners {
                 *a -= d;
             }
         }
-        problem.residual_parameter_derivative(&u, &mut r);
+        problem.residual_parameter_derivative(&u, &mut r).ok()?;
         work.linear_solves += 1;
         self.solver.solve_in_place(&mut r).ok()?;
         let v: Vec<f64> = r.iter().map(|d| -d).collect();

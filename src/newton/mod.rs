@@ -10,25 +10,35 @@
 //!
 //! The driver owns the loop; the line search sees only `alpha -> merit`
 //! ([`crate::linesearch`]); the linear solver only matrices and right-hand sides
-//! ([`LinearSolve`]). [`NewtonSolver`] keeps all buffers (and the Jacobian) between
-//! solves, so continuation and parameter sweeps allocate nothing per iteration; [`solve`]
-//! is a one-shot wrapper.
+//! ([`Factorize`], [`LinearSolve`]). The iteration itself (step rule, termination tests,
+//! best iterate) is the one the continuation corrector runs too, with a bordered direction
+//! instead of the plain solve. [`NewtonSolver`] keeps all buffers (and the Jacobian)
+//! between solves, so continuation and parameter sweeps allocate nothing per iteration;
+//! [`solve`] is a one-shot wrapper.
 //!
-//! Options and defaults ([`NewtonOptions`]):
+//! # Outcome
+//!
+//! [`solve`] returns `Ok(report)` only when the run converged; a run that stopped without
+//! converging is [`NewtonError::NotConverged`], which carries the whole report (the best
+//! iterate is still written to `x`). Callers that want the report either way say so:
+//! `solve(..).or_else(NewtonError::into_report)`.
+//!
+//! # Options and defaults ([`NewtonOptions`])
 //!
 //! | field | default | meaning |
 //! |---|---|---|
-//! | `absolute_tolerance` | `1e-10` | converged when `\|F\|_2 <= max(abs, rel \|F(x_0)\|_2)` |
+//! | `absolute_tolerance` | `1e-10` | converged when `\|F\|_2 <= max(abs, rel \|F(x_0)\|_2, floor)` |
 //! | `relative_tolerance` | `0` (off) | see above; in `[0, 1)` |
+//! | `residual_floor` | `0` (off) | `\|F\|` round-off alone produces near a solution: the tolerance is at least this, and a run that stalls with `\|F\| <= 100 floor` has converged ([`Termination::ConvergedAtRoundoff`]) |
 //! | `step_tolerance` | `1e-15` | stalled when `alpha \|d\| <= step_tol (1 + \|x\|)` |
-//! | `max_iterations` | `100` | Newton iterations (not counting line-search trials) |
-//! | `globalization` | `NonMonotone { memory: 10, .. }` | none, Armijo or non-monotone |
+//! | `max_iterations` | `200` | Newton iterations (not counting line-search trials) |
+//! | `globalization` | [`Globalization::hybrid`] | none, Armijo, non-monotone or hybrid |
 //!
 //! ```
 //! use faer::Mat;
 //! use semismooth::linalg::FaerDenseLu;
 //! use semismooth::newton::{solve, NewtonOptions};
-//! use semismooth::{GeneralizedJacobian, Residual};
+//! use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 //!
 //! /// F(x) = min(x, A x + q) for the LCP with A = [[2, 1], [1, 2]], q = [-1, 1]:
 //! /// solution x = [0.5, 0] (w = A x + q = [0, 1.5]).
@@ -37,17 +47,18 @@
 //! const Q: [f64; 2] = [-1.0, 1.0];
 //! impl Residual for Lcp {
 //!     fn dim(&self) -> usize { 2 }
-//!     fn residual(&mut self, x: &[f64], out: &mut [f64]) {
+//!     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
 //!         for i in 0..2 {
 //!             let w = A[i][0] * x[0] + A[i][1] * x[1] + Q[i];
 //!             out[i] = x[i].min(w);
 //!         }
+//!         Ok(())
 //!     }
 //! }
 //! impl GeneralizedJacobian for Lcp {
 //!     type Jacobian = Mat<f64>;
 //!     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(2, 2) }
-//!     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) {
+//!     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
 //!         for i in 0..2 {
 //!             let w = A[i][0] * x[0] + A[i][1] * x[1] + Q[i];
 //!             for j in 0..2 {
@@ -55,24 +66,26 @@
 //!                 jac[(i, j)] = if x[i] <= w { (i == j) as u8 as f64 } else { A[i][j] };
 //!             }
 //!         }
+//!         Ok(())
 //!     }
 //! }
 //!
 //! let mut x = [1.0, 1.0];
 //! let report = solve(&mut Lcp, &mut FaerDenseLu::new(), &mut x, &NewtonOptions::default())
-//!     .unwrap()
-//!     .into_result()
 //!     .unwrap();
 //! assert!((x[0] - 0.5).abs() < 1e-12 && x[1].abs() < 1e-12);
 //! assert!(report.iterations <= 5);
 //! ```
 
+pub(crate) mod kernel;
+
 use std::ops::AddAssign;
 
 use crate::linalg::LinearSolveError;
-use crate::linesearch::{backtrack, NonMonotoneHistory};
 pub use crate::linesearch::{InvalidLineSearchOption, LineSearchOptions};
-use crate::{GeneralizedJacobian, LinearSolve};
+use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters};
+pub use kernel::FLOOR_STALL_FACTOR;
+use kernel::{Kernel, KernelRules, NewtonSystem, Stop};
 
 /// How the step length is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,11 +103,11 @@ pub enum Globalization {
         line_search: LineSearchOptions,
     },
     /// Full steps first, then the non-monotone line search: the first `full_steps`
-    /// iterations take `alpha = 1` whenever `F` stays finite (semismooth Newton on
-    /// complementarity systems then behaves as a primal-dual active-set method, which
-    /// may cross regions of large residual on its way to the solution); if it has not
-    /// converged by then, it restarts from the initial guess with the GLL line search
-    /// (the best iterate of both phases is returned).
+    /// iterations take `alpha = 1` whenever `F` can be evaluated and stays finite
+    /// (semismooth Newton on complementarity systems then behaves as a primal-dual
+    /// active-set method, which may cross regions of large residual on its way to the
+    /// solution); if it has not converged by then, it restarts from the initial guess with
+    /// the GLL line search (the best iterate of both phases is returned).
     Hybrid {
         /// Iterations of the full-step phase.
         full_steps: usize,
@@ -106,10 +119,18 @@ pub enum Globalization {
 }
 
 impl Globalization {
-    /// [`Globalization::Hybrid`] with 30 full steps, then GLL with memory 10.
+    /// [`Globalization::Hybrid`] with 30 full steps, then GLL with memory 10 (the default).
     pub fn hybrid() -> Self {
         Self::Hybrid {
             full_steps: 30,
+            memory: 10,
+            line_search: LineSearchOptions::default(),
+        }
+    }
+
+    /// [`Globalization::NonMonotone`] with memory 10.
+    pub fn non_monotone() -> Self {
+        Self::NonMonotone {
             memory: 10,
             line_search: LineSearchOptions::default(),
         }
@@ -118,10 +139,7 @@ impl Globalization {
 
 impl Default for Globalization {
     fn default() -> Self {
-        Self::NonMonotone {
-            memory: 10,
-            line_search: LineSearchOptions::default(),
-        }
+        Self::hybrid()
     }
 }
 
@@ -132,6 +150,10 @@ pub struct NewtonOptions {
     pub absolute_tolerance: f64,
     /// Relative tolerance on `|F|_2 / |F(x_0)|_2`, in `[0, 1)` (0 = off).
     pub relative_tolerance: f64,
+    /// `|F|_2` that round-off alone produces near a solution, `>= 0` (0 = off): the
+    /// tolerance is at least this, and a stall with `|F| <= 100 residual_floor` is
+    /// convergence ([`Termination::ConvergedAtRoundoff`]).
+    pub residual_floor: f64,
     /// Stall threshold on the accepted step, `>= 0`.
     pub step_tolerance: f64,
     /// Maximum number of Newton iterations.
@@ -145,8 +167,9 @@ impl Default for NewtonOptions {
         Self {
             absolute_tolerance: 1e-10,
             relative_tolerance: 0.0,
+            residual_floor: 0.0,
             step_tolerance: 1e-15,
-            max_iterations: 100,
+            max_iterations: 200,
             globalization: Globalization::default(),
         }
     }
@@ -160,17 +183,18 @@ impl NewtonOptions {
             value,
             allowed,
         };
-        let t = self.absolute_tolerance;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(invalid("absolute_tolerance", t, "finite and >= 0"));
+        for (name, t) in [
+            ("absolute_tolerance", self.absolute_tolerance),
+            ("residual_floor", self.residual_floor),
+            ("step_tolerance", self.step_tolerance),
+        ] {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(invalid(name, t, "finite and >= 0"));
+            }
         }
         let t = self.relative_tolerance;
         if !(t.is_finite() && (0.0..1.0).contains(&t)) {
             return Err(invalid("relative_tolerance", t, "[0, 1)"));
-        }
-        let t = self.step_tolerance;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(invalid("step_tolerance", t, "finite and >= 0"));
         }
         let line_search = match self.globalization {
             Globalization::None => None,
@@ -191,34 +215,79 @@ impl NewtonOptions {
             }
         };
         if let Some(ls) = line_search {
-            ls.validate().map_err(|e| {
-                let name = match e.name {
-                    "sufficient_decrease" => "line_search.sufficient_decrease",
-                    "shrink" => "line_search.shrink",
-                    _ => "line_search.min_step",
-                };
-                invalid(name, e.value, e.allowed)
-            })?;
+            ls.validate()
+                .map_err(|e| invalid(e.qualified_name("line_search"), e.value, e.allowed))?;
         }
         Ok(())
+    }
+
+    fn rules(&self) -> KernelRules {
+        KernelRules {
+            absolute_tolerance: self.absolute_tolerance,
+            relative_tolerance: self.relative_tolerance,
+            residual_floor: self.residual_floor,
+            step_tolerance: self.step_tolerance,
+            max_iterations: self.max_iterations,
+            min_iterations: 0,
+            globalization: self.globalization,
+            restore_best: true,
+        }
     }
 }
 
 /// Why the iteration stopped.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Termination {
-    /// `|F| <= max(absolute, relative |F(x_0)|)`.
+    /// `|F| <= max(absolute, relative |F(x_0)|, residual_floor)`.
     Converged,
+    /// The step stalled with `|F|` within 100 times the residual floor of
+    /// [`NewtonOptions::residual_floor`]: converged as far as floating point allows.
+    ConvergedAtRoundoff {
+        /// `100 residual_floor`.
+        floor: f64,
+    },
     /// `max_iterations` reached without convergence.
     MaxIterations,
     /// The accepted step `alpha |d|` fell below `step_tolerance (1 + |x|)`.
     Stalled,
     /// No step length `>= min_step` gave sufficient decrease.
     LineSearchFailed,
-    /// The Jacobian could not be factored (or the solve failed).
-    SingularJacobian(LinearSolveError),
+    /// The Jacobian could not be factored, or the solve failed (singular, out of memory).
+    LinearSolve(LinearSolveError),
     /// `F` or the Newton direction had a NaN or infinite component.
     NonFinite,
+    /// The problem could not be evaluated (at the initial guess, at a full step without
+    /// line search, or for its Jacobian).
+    OutsideDomain(EvaluationError),
+}
+
+impl Termination {
+    /// Whether the run converged ([`Termination::Converged`] or
+    /// [`Termination::ConvergedAtRoundoff`]).
+    pub fn converged(&self) -> bool {
+        matches!(self, Self::Converged | Self::ConvergedAtRoundoff { .. })
+    }
+}
+
+/// Short names: `converged`, `max-iterations`, `stalled`, `line-search-failed`,
+/// `singular-jacobian: ...` (or `out-of-memory: ...` and the like for other linear-solver
+/// failures), `non-finite`, `outside-domain: ...`.
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Converged => write!(f, "converged"),
+            Self::ConvergedAtRoundoff { floor } => write!(
+                f,
+                "converged (stalled at the round-off floor {floor:.1e} of this model)"
+            ),
+            Self::MaxIterations => write!(f, "max-iterations"),
+            Self::Stalled => write!(f, "stalled"),
+            Self::LineSearchFailed => write!(f, "line-search-failed"),
+            Self::LinearSolve(e) => write!(f, "{}: {e}", e.kind()),
+            Self::NonFinite => write!(f, "non-finite"),
+            Self::OutsideDomain(e) => write!(f, "outside-domain: {e}"),
+        }
+    }
 }
 
 /// Work done by a solve. Summable (`+=`) over several solves.
@@ -228,14 +297,14 @@ pub struct WorkCounters {
     pub residual_evaluations: u64,
     /// Calls to `GeneralizedJacobian::jacobian`.
     pub jacobian_evaluations: u64,
-    /// Calls to `LinearSolve::factor` (successful or not).
+    /// Calls to `Factorize::factor` (successful or not).
     pub factorizations: u64,
     /// Calls to `LinearSolve::solve_in_place`.
     pub linear_solves: u64,
     /// Rejected line-search trials.
     pub line_search_backtracks: u64,
-    /// FFTs performed by the problem during the solve (difference of `fft_count`).
-    pub ffts: u64,
+    /// The problem's own counters over the solve ([`crate::Residual::problem_counters`]).
+    pub problem: ProblemCounters,
 }
 
 impl AddAssign for WorkCounters {
@@ -245,7 +314,7 @@ impl AddAssign for WorkCounters {
         self.factorizations += rhs.factorizations;
         self.linear_solves += rhs.linear_solves;
         self.line_search_backtracks += rhs.line_search_backtracks;
-        self.ffts += rhs.ffts;
+        self.problem += rhs.problem;
     }
 }
 
@@ -256,6 +325,9 @@ pub struct NewtonReport {
     pub termination: Termination,
     /// Accepted Newton steps.
     pub iterations: usize,
+    /// The tolerance the run was judged against: `max(absolute, relative |F(x_0)|,
+    /// residual_floor)`.
+    pub effective_tolerance: f64,
     /// `|F|_2` at the initial guess and after each accepted step (`iterations + 1` values).
     pub residual_norms: Vec<f64>,
     /// Accepted step lengths `alpha_k` (`iterations` values).
@@ -273,9 +345,9 @@ pub struct NewtonReport {
 }
 
 impl NewtonReport {
-    /// Whether the termination is [`Termination::Converged`].
+    /// Whether the run converged (see [`Termination::converged`]).
     pub fn converged(&self) -> bool {
-        self.termination == Termination::Converged
+        self.termination.converged()
     }
 
     /// `|F|_2` at the returned `x`, the best accepted iterate (the smallest entry of
@@ -287,23 +359,9 @@ impl NewtonReport {
             .reduce(f64::min)
             .unwrap_or(f64::NAN)
     }
-
-    /// `Ok(self)` if converged, otherwise [`NewtonError::NotConverged`] with the numbers.
-    pub fn into_result(self) -> Result<NewtonReport, NewtonError> {
-        if self.converged() {
-            Ok(self)
-        } else {
-            Err(NewtonError::NotConverged {
-                initial_residual_norm: self.residual_norms.first().copied().unwrap_or(f64::NAN),
-                residual_norm: self.residual_norm(),
-                iterations: self.iterations,
-                termination: self.termination,
-            })
-        }
-    }
 }
 
-/// The solver could not run, or (through [`NewtonReport::into_result`]) did not converge.
+/// The solver could not run, or it ran and did not converge.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum NewtonError {
     /// An option is outside its allowed range.
@@ -324,36 +382,35 @@ pub enum NewtonError {
         /// `x.len()`.
         found: usize,
     },
-    /// The run stopped without convergence.
+    /// The run stopped without convergence; the report has every number (the best
+    /// iterate was written to `x`).
     #[error(
-        "Newton did not converge ({termination:?}) after {iterations} iterations: |F| = {residual_norm:e} (initial {initial_residual_norm:e})"
+        "Newton did not converge ({}) after {} iterations: |F| = {:e} (initial {:e})",
+        .0.termination,
+        .0.iterations,
+        .0.residual_norm(),
+        .0.residual_norms.first().copied().unwrap_or(f64::NAN)
     )]
-    NotConverged {
-        /// Why it stopped.
-        termination: Termination,
-        /// Iterations done.
-        iterations: usize,
-        /// Best residual norm reached.
-        residual_norm: f64,
-        /// Residual norm at the initial guess.
-        initial_residual_norm: f64,
-    },
+    NotConverged(Box<NewtonReport>),
 }
 
-fn norm2(v: &[f64]) -> f64 {
-    // Infinity for any NaN/inf component; scaled to avoid overflow (diverging iterates)
-    // and underflow of the squares.
-    let mut scale = 0.0_f64;
-    for x in v {
-        if !x.is_finite() {
-            return f64::INFINITY;
+impl NewtonError {
+    /// The report of a run that did not converge, `Err(self)` for the errors that kept it
+    /// from running: `solve(..).or_else(NewtonError::into_report)` accepts both outcomes.
+    pub fn into_report(self) -> Result<NewtonReport, NewtonError> {
+        match self {
+            Self::NotConverged(report) => Ok(*report),
+            other => Err(other),
         }
-        scale = scale.max(x.abs());
     }
-    if scale == 0.0 {
-        return 0.0;
+
+    /// The report of a run that did not converge (`None` for the other errors).
+    pub fn report(&self) -> Option<&NewtonReport> {
+        match self {
+            Self::NotConverged(report) => Some(report),
+            _ => None,
+        }
     }
-    scale * v.iter().map(|x| (x / scale).powi(2)).sum::<f64>().sqrt()
 }
 
 /// `log(r3/r2) / log(r2/r1)` from the last three norms, see
@@ -372,6 +429,53 @@ fn observed_order(norms: &[f64]) -> Option<f64> {
     q.is_finite().then_some(q)
 }
 
+/// Why a plain Newton direction could not be computed.
+enum PlainFailure {
+    Linear(LinearSolveError),
+    Evaluation(EvaluationError),
+}
+
+/// `J d = -F` with the problem's Jacobian and the linear solver.
+struct PlainNewton<'a, P: GeneralizedJacobian + ?Sized, S: ?Sized> {
+    problem: &'a mut P,
+    solver: &'a mut S,
+    jacobian: &'a mut P::Jacobian,
+}
+
+impl<P, S> NewtonSystem for PlainNewton<'_, P, S>
+where
+    P: GeneralizedJacobian + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    type Failure = PlainFailure;
+
+    fn evaluate(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+        self.problem.residual(x, f)
+    }
+
+    fn direction(
+        &mut self,
+        x: &[f64],
+        f: &[f64],
+        d: &mut [f64],
+        counters: &mut WorkCounters,
+    ) -> Result<(), PlainFailure> {
+        counters.jacobian_evaluations += 1;
+        self.problem
+            .jacobian(x, self.jacobian)
+            .map_err(PlainFailure::Evaluation)?;
+        counters.factorizations += 1;
+        self.solver
+            .factor(self.jacobian)
+            .map_err(PlainFailure::Linear)?;
+        for (di, fi) in d.iter_mut().zip(f) {
+            *di = -fi;
+        }
+        counters.linear_solves += 1;
+        self.solver.solve_in_place(d).map_err(PlainFailure::Linear)
+    }
+}
+
 /// A reusable semismooth Newton solver: options plus every buffer of the iteration and
 /// the Jacobian `J`, kept between [`NewtonSolver::solve`] calls.
 ///
@@ -384,13 +488,7 @@ pub struct NewtonSolver<J> {
     options: NewtonOptions,
     jacobian: Option<J>,
     dim: usize,
-    f: Vec<f64>,
-    f_trial: Vec<f64>,
-    direction: Vec<f64>,
-    trial: Vec<f64>,
-    best_x: Vec<f64>,
-    start_x: Vec<f64>,
-    history: NonMonotoneHistory,
+    kernel: Kernel,
 }
 
 impl<J> NewtonSolver<J> {
@@ -401,13 +499,7 @@ impl<J> NewtonSolver<J> {
             options,
             jacobian: None,
             dim: 0,
-            f: Vec::new(),
-            f_trial: Vec::new(),
-            direction: Vec::new(),
-            trial: Vec::new(),
-            best_x: Vec::new(),
-            start_x: Vec::new(),
-            history: NonMonotoneHistory::new(1),
+            kernel: Kernel::default(),
         })
     }
 
@@ -430,31 +522,16 @@ impl<J> NewtonSolver<J> {
 
     /// The residual `F(x)` at the returned `x` of the last solve (empty before any solve).
     pub fn residual(&self) -> &[f64] {
-        &self.f[..self.dim.min(self.f.len())]
-    }
-
-    fn resize(&mut self, n: usize) {
-        if self.dim != n {
-            self.jacobian = None;
-        }
-        self.dim = n;
-        for v in [
-            &mut self.f,
-            &mut self.f_trial,
-            &mut self.direction,
-            &mut self.trial,
-            &mut self.best_x,
-            &mut self.start_x,
-        ] {
-            v.resize(n, 0.0);
-        }
+        let f = self.kernel.residual();
+        &f[..self.dim.min(f.len())]
     }
 
     /// Runs semismooth Newton from `x` (initial guess in, best iterate out).
     ///
-    /// `Ok(report)` whenever it ran, converged or not ([`NewtonReport::converged`],
-    /// [`NewtonReport::into_result`]); `Err` only for a dimension mismatch. `x` always
-    /// holds finite values on return if it did on entry.
+    /// `Ok(report)` when it converged; [`NewtonError::NotConverged`] (with the report)
+    /// when it ran and stopped without converging; [`NewtonError::DimensionMismatch`] when
+    /// `x` does not fit the problem. `x` always holds finite values on return if it did
+    /// on entry.
     pub fn solve<P, S>(
         &mut self,
         problem: &mut P,
@@ -463,7 +540,7 @@ impl<J> NewtonSolver<J> {
     ) -> Result<NewtonReport, NewtonError>
     where
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
-        S: LinearSolve<J> + ?Sized,
+        S: Factorize<J> + ?Sized,
     {
         let n = problem.dim();
         if x.len() != n {
@@ -472,170 +549,59 @@ impl<J> NewtonSolver<J> {
                 found: x.len(),
             });
         }
-        self.resize(n);
-        let options = self.options;
-        let fft_start = problem.fft_count();
-        let mut counters = WorkCounters::default();
-        let capacity = options.max_iterations.min(1000);
-        let mut residual_norms = Vec::with_capacity(capacity + 1);
-        let mut step_lengths = Vec::with_capacity(capacity);
-        let mut step_norms = Vec::with_capacity(capacity);
-
-        problem.residual(x, &mut self.f);
-        counters.residual_evaluations += 1;
-        let mut norm = norm2(&self.f);
-        residual_norms.push(norm);
-        let tolerance = options
-            .absolute_tolerance
-            .max(options.relative_tolerance * norm);
-        let (memory, line_search, mut full_steps) = match options.globalization {
-            Globalization::None => (1, None, 0),
-            Globalization::Armijo(ls) => (1, Some(ls), 0),
-            Globalization::NonMonotone {
-                memory,
-                line_search,
-            } => (memory, Some(line_search), 0),
-            Globalization::Hybrid {
-                full_steps,
-                memory,
-                line_search,
-            } => (memory, Some(line_search), full_steps),
-        };
-        self.history.reset(memory);
-        self.history.push(0.5 * norm * norm);
-        self.best_x.copy_from_slice(x);
-        self.start_x.copy_from_slice(x);
-        let mut best_norm = norm;
-        let mut iterations = 0;
-
-        let termination = 'newton: {
-            if !norm.is_finite() {
-                break 'newton Termination::NonFinite;
-            }
-            if norm <= tolerance {
-                break 'newton Termination::Converged;
-            }
-            let jac = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
-            while iterations < options.max_iterations {
-                if full_steps > 0 && iterations == full_steps {
-                    // End of the full-step phase: start again from the initial guess with
-                    // the line search (the full steps may have wandered into a region where
-                    // descent stalls; the best iterate so far is still kept and returned if
-                    // nothing better is found).
-                    full_steps = 0;
-                    x.copy_from_slice(&self.start_x);
-                    problem.residual(x, &mut self.f);
-                    counters.residual_evaluations += 1;
-                    norm = norm2(&self.f);
-                    self.history.reset(memory);
-                    self.history.push(0.5 * norm * norm);
-                }
-                problem.jacobian(x, jac);
-                counters.jacobian_evaluations += 1;
-                counters.factorizations += 1;
-                if let Err(e) = linear.factor(jac) {
-                    break 'newton Termination::SingularJacobian(e);
-                }
-                for (d, f) in self.direction.iter_mut().zip(&self.f) {
-                    *d = -f;
-                }
-                counters.linear_solves += 1;
-                if let Err(e) = linear.solve_in_place(&mut self.direction) {
-                    break 'newton Termination::SingularJacobian(e);
-                }
-                if self.direction.iter().any(|d| !d.is_finite()) {
-                    break 'newton Termination::NonFinite;
-                }
-
-                let merit0 = 0.5 * norm * norm;
-                let (f_trial, trial, direction) =
-                    (&mut self.f_trial, &mut self.trial, &self.direction);
-                let mut merit = |alpha: f64| {
-                    for ((t, xi), d) in trial.iter_mut().zip(x.iter()).zip(direction) {
-                        *t = xi + alpha * d;
-                    }
-                    problem.residual(trial, f_trial);
-                    counters.residual_evaluations += 1;
-                    let r = norm2(f_trial);
-                    if r.is_finite() {
-                        0.5 * r * r
-                    } else {
-                        f64::INFINITY
-                    }
-                };
-                let mut alpha_taken = 1.0;
-                let full_step_phase = iterations < full_steps;
-                if full_step_phase && merit(1.0).is_finite() {
-                    // Full step accepted without a merit test.
-                } else if let Some(ls) = line_search {
-                    if full_step_phase {
-                        // A non-finite full step ends the full-step phase.
-                        full_steps = 0;
-                        self.history.reset(memory);
-                        self.history.push(merit0);
-                    }
-                    match backtrack(self.history.reference(), -2.0 * merit0, &ls, &mut merit) {
-                        Ok(step) => {
-                            counters.line_search_backtracks += step.backtracks;
-                            alpha_taken = step.step;
-                        }
-                        Err(fail) => {
-                            counters.line_search_backtracks += fail.backtracks;
-                            break 'newton Termination::LineSearchFailed;
-                        }
-                    }
-                } else if !merit(1.0).is_finite() {
-                    break 'newton Termination::NonFinite;
-                }
-                let alpha = alpha_taken;
-
-                // Accept: x <- trial, F <- F(trial).
-                x.copy_from_slice(&self.trial);
-                std::mem::swap(&mut self.f, &mut self.f_trial);
-                norm = norm2(&self.f);
-                iterations += 1;
-                let step_norm = alpha * norm2(&self.direction);
-                residual_norms.push(norm);
-                step_lengths.push(alpha);
-                step_norms.push(step_norm);
-                self.history.push(0.5 * norm * norm);
-                if norm < best_norm {
-                    best_norm = norm;
-                    self.best_x.copy_from_slice(x);
-                }
-                if norm <= tolerance {
-                    break 'newton Termination::Converged;
-                }
-                if step_norm <= options.step_tolerance * (1.0 + norm2(x)) {
-                    break 'newton Termination::Stalled;
-                }
-            }
-            Termination::MaxIterations
-        };
-
-        // Return the best iterate (non-monotone steps and failures may end elsewhere).
-        if norm.is_nan() || best_norm < norm {
-            x.copy_from_slice(&self.best_x);
-            problem.residual(x, &mut self.f);
-            counters.residual_evaluations += 1;
+        if self.dim != n {
+            self.jacobian = None;
         }
-        counters.ffts = problem.fft_count().saturating_sub(fft_start);
-        Ok(NewtonReport {
+        self.dim = n;
+        let start = problem.problem_counters();
+        let mut counters = WorkCounters::default();
+        let jacobian = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
+        let mut system = PlainNewton {
+            problem: &mut *problem,
+            solver: linear,
+            jacobian,
+        };
+        let rules = self.options.rules();
+        let run = self.kernel.run(&mut system, x, &rules, &mut counters);
+        counters.problem = problem.problem_counters().since(&start);
+        let termination = match run.stop {
+            Stop::Converged => Termination::Converged,
+            Stop::ConvergedAtFloor => Termination::ConvergedAtRoundoff {
+                floor: FLOOR_STALL_FACTOR * rules.residual_floor,
+            },
+            Stop::MaxIterations => Termination::MaxIterations,
+            Stop::Stalled { .. } => Termination::Stalled,
+            Stop::LineSearchFailed { .. } => Termination::LineSearchFailed,
+            Stop::Direction(PlainFailure::Linear(e)) => Termination::LinearSolve(e),
+            Stop::Direction(PlainFailure::Evaluation(e)) | Stop::OutsideDomain(e) => {
+                Termination::OutsideDomain(e)
+            }
+            Stop::NonFinite => Termination::NonFinite,
+        };
+        let residual_norms = self.kernel.residual_norms.clone();
+        let report = NewtonReport {
             observed_order: observed_order(&residual_norms),
             termination,
-            iterations,
+            iterations: run.iterations,
+            effective_tolerance: run.tolerance,
             residual_norms,
-            step_lengths,
-            step_norms,
+            step_lengths: self.kernel.step_lengths.clone(),
+            step_norms: self.kernel.step_norms.clone(),
             counters,
-        })
+        };
+        if report.converged() {
+            Ok(report)
+        } else {
+            Err(NewtonError::NotConverged(Box::new(report)))
+        }
     }
 }
 
 /// One-shot semismooth Newton: validates `options`, runs [`NewtonSolver::solve`].
 ///
-/// `x`: initial guess in, best iterate out. `Ok(report)` whenever it ran (converged or
-/// not); `Err` only when it could not run (invalid options, dimension mismatch).
+/// `x`: initial guess in, best iterate out. `Ok(report)` when it converged;
+/// [`NewtonError::NotConverged`] (with the report) when it ran without converging; the
+/// other errors when it could not run (invalid options, dimension mismatch).
 pub fn solve<P, S>(
     problem: &mut P,
     solver: &mut S,
@@ -644,13 +610,14 @@ pub fn solve<P, S>(
 ) -> Result<NewtonReport, NewtonError>
 where
     P: GeneralizedJacobian + ?Sized,
-    S: LinearSolve<P::Jacobian> + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
 {
     NewtonSolver::<P::Jacobian>::new(*options)?.solve(problem, solver, x)
 }
 
 #[cfg(test)]
 mod tests {
+    use super::kernel::norm2;
     use super::*;
 
     #[test]

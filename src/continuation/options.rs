@@ -1,0 +1,235 @@
+//! Options of the continuation: step control, bounds, metric, predictor.
+
+use super::ContinuationError;
+use crate::linesearch::LineSearchOptions;
+
+/// Relative size below which the block-elimination pivot `w_p - w_x·a` is treated as zero:
+/// `|w_p - w_x·a| <= BORDER_PIVOT_THRESHOLD (|w_p| + |w_x| |a|)`.
+pub const BORDER_PIVOT_THRESHOLD: f64 = 1e-12;
+
+/// In which direction of the parameter the branch is followed from the starting point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Direction {
+    /// The first step increases the parameter (default).
+    #[default]
+    Increasing,
+    /// The first step decreases the parameter.
+    Decreasing,
+}
+
+impl Direction {
+    /// `+1` for [`Direction::Increasing`], `-1` for [`Direction::Decreasing`].
+    pub fn sign(self) -> f64 {
+        match self {
+            Direction::Increasing => 1.0,
+            Direction::Decreasing => -1.0,
+        }
+    }
+}
+
+/// How the next point is predicted from the last accepted one.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Predictor {
+    /// Along the secant through the last two accepted points (default; the first step
+    /// always uses the tangent).
+    #[default]
+    Secant,
+    /// Along the tangent at the last accepted point (from the corrector's last
+    /// factorization, no extra cost).
+    Tangent,
+}
+
+/// Options of the pseudo-arclength continuation. Build with struct update syntax from
+/// [`Default`] and check with [`ContinuationOptions::validate`] (done by
+/// [`Continuation::new`]).
+///
+/// Step lengths are measured in the `theta`-weighted norm of the module documentation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContinuationOptions {
+    /// First step length `ds`. Default `0.01`.
+    pub initial_step: f64,
+    /// Smallest step length; a failure at this step ends the run. Default `0.002`
+    /// (NLvib's habit: `ds/5 .. 5 ds` around the initial step).
+    pub min_step: f64,
+    /// Largest step length. Default `0.05`.
+    pub max_step: f64,
+    /// Corrector iterations the step control aims at: after `k` iterations the step is
+    /// multiplied by `sqrt(target / k)` clamped to `[1/2, 2]`. Default `3`.
+    pub target_iterations: usize,
+    /// Corrector iterations (factorizations) allowed per attempted step. Default `10`.
+    pub max_corrector_iterations: usize,
+    /// The corrector has converged when the 2-norm `|F(x, p)| <= corrector_tolerance`
+    /// (after at least one Newton correction). Default `1e-10`.
+    pub corrector_tolerance: f64,
+    /// The corrector gives up (stalled) when a correction has `|dy|_θ <= step_tolerance
+    /// (1 + |y|_θ)` while `|F|` is still above the tolerance. Default `1e-14`.
+    pub step_tolerance: f64,
+    /// Lower bound of the parameter: the run stops when the branch goes below it.
+    /// Default `-inf` (no bound).
+    pub parameter_min: f64,
+    /// Upper bound of the parameter: the run stops when the branch goes above it.
+    /// Default `+inf` (no bound).
+    pub parameter_max: f64,
+    /// Largest number of accepted points, the starting point included. Default `1000`.
+    pub max_points: usize,
+    /// Failed attempts in a row (each halving the step) after which the run stops.
+    /// Default `3` (NLvib).
+    pub max_consecutive_failures: usize,
+    /// Weight `θ` in `(0, 1)` between the state (`θ/n` per component) and the parameter
+    /// (`1 - θ`) in the arclength. Default `0.5`.
+    pub theta: f64,
+    /// Typical magnitude `s_i > 0` of each unknown (length `n`): the state part of the
+    /// inner product becomes `(θ/n) Σ a_i b_i / s_i^2`, so that unknowns of different
+    /// units (displacements and contact forces) weigh alike. Default `None` (all `1`).
+    pub state_scale: Option<Vec<f64>>,
+    /// Typical magnitude `s_p > 0` of the parameter: the parameter part of the inner product
+    /// becomes `(1 - θ) α β / s_p^2`. Default `1`.
+    pub parameter_scale: f64,
+    /// Direction of the parameter on the first step. Default [`Direction::Increasing`].
+    pub direction: Direction,
+    /// Predictor after the first step. Default [`Predictor::Secant`].
+    pub predictor: Predictor,
+    /// Backtracking (Armijo) on the corrector's merit `(|F|^2 + N^2) / 2` along each
+    /// bordered Newton correction; `None` takes full steps. Default `None` (the predictor
+    /// is usually close enough; a line search helps nonsmooth problems whose full steps
+    /// jump between active sets, and a poor starting guess).
+    pub corrector_line_search: Option<LineSearchOptions>,
+    /// Locate folds by cubic Hermite interpolation of `p(s)` between the two points that
+    /// bracket the sign change (otherwise the fold is reported at the extreme point of the
+    /// accepted points). Default `true`.
+    pub refine_folds: bool,
+    /// When the step has been halved to its end (the run would stop), try once to pass a
+    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
+    /// before giving up. Default `true`.
+    pub pass_corners: bool,
+}
+
+impl Default for ContinuationOptions {
+    fn default() -> Self {
+        Self {
+            initial_step: 0.01,
+            min_step: 0.002,
+            max_step: 0.05,
+            target_iterations: 3,
+            max_corrector_iterations: 10,
+            corrector_tolerance: 1e-10,
+            step_tolerance: 1e-14,
+            parameter_min: f64::NEG_INFINITY,
+            parameter_max: f64::INFINITY,
+            max_points: 1000,
+            max_consecutive_failures: 3,
+            theta: 0.5,
+            state_scale: None,
+            parameter_scale: 1.0,
+            direction: Direction::Increasing,
+            predictor: Predictor::Secant,
+            corrector_line_search: None,
+            refine_folds: true,
+            pass_corners: true,
+        }
+    }
+}
+
+impl ContinuationOptions {
+    /// NLvib-like step settings around `ds`: `initial_step = ds`, `min_step = ds / 5`,
+    /// `max_step = 5 ds`, other fields at their defaults.
+    pub fn with_step(ds: f64) -> Self {
+        Self {
+            initial_step: ds,
+            min_step: ds / 5.0,
+            max_step: 5.0 * ds,
+            ..Self::default()
+        }
+    }
+
+    /// Checks every field; the error names the field, its value and what is allowed.
+    pub fn validate(&self) -> Result<(), ContinuationError> {
+        fn invalid(name: &'static str, value: f64, allowed: &'static str) -> ContinuationError {
+            ContinuationError::InvalidOption {
+                name,
+                value,
+                allowed,
+            }
+        }
+        let positive_finite = |name, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(invalid(name, v, "finite and > 0"))
+            }
+        };
+        positive_finite("min_step", self.min_step)?;
+        positive_finite("max_step", self.max_step)?;
+        positive_finite("initial_step", self.initial_step)?;
+        if self.max_step < self.min_step {
+            return Err(invalid("max_step", self.max_step, ">= min_step"));
+        }
+        if self.initial_step < self.min_step || self.initial_step > self.max_step {
+            return Err(invalid(
+                "initial_step",
+                self.initial_step,
+                "within [min_step, max_step]",
+            ));
+        }
+        if self.target_iterations == 0 {
+            return Err(invalid("target_iterations", 0.0, ">= 1"));
+        }
+        if self.max_corrector_iterations == 0 {
+            return Err(invalid("max_corrector_iterations", 0.0, ">= 1"));
+        }
+        positive_finite("corrector_tolerance", self.corrector_tolerance)?;
+        if !(self.step_tolerance.is_finite() && self.step_tolerance >= 0.0) {
+            return Err(invalid(
+                "step_tolerance",
+                self.step_tolerance,
+                "finite and >= 0",
+            ));
+        }
+        if self.parameter_min.is_nan() || self.parameter_min == f64::INFINITY {
+            return Err(invalid(
+                "parameter_min",
+                self.parameter_min,
+                "a number or -inf",
+            ));
+        }
+        if self.parameter_max.is_nan() || self.parameter_max == f64::NEG_INFINITY {
+            return Err(invalid(
+                "parameter_max",
+                self.parameter_max,
+                "a number or +inf",
+            ));
+        }
+        if self.parameter_max <= self.parameter_min {
+            return Err(invalid(
+                "parameter_max",
+                self.parameter_max,
+                "> parameter_min",
+            ));
+        }
+        if self.max_points == 0 {
+            return Err(invalid("max_points", 0.0, ">= 1"));
+        }
+        if self.max_consecutive_failures == 0 {
+            return Err(invalid("max_consecutive_failures", 0.0, ">= 1"));
+        }
+        if !(self.theta > 0.0 && self.theta < 1.0) {
+            return Err(invalid("theta", self.theta, "in the open interval (0, 1)"));
+        }
+        positive_finite("parameter_scale", self.parameter_scale)?;
+        if let Some(scale) = &self.state_scale {
+            if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+                return Err(invalid("state_scale", bad, "finite and > 0 entries"));
+            }
+        }
+        if let Some(ls) = &self.corrector_line_search {
+            ls.validate().map_err(|e| {
+                invalid(
+                    e.qualified_name("corrector_line_search"),
+                    e.value,
+                    e.allowed,
+                )
+            })?;
+        }
+        Ok(())
+    }
+}
