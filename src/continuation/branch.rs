@@ -19,8 +19,12 @@ pub struct BranchPoint {
     /// Step length (θ-norm) that produced this point; `0` for the starting point.
     pub step: f64,
     /// Parameter component `t_p` of the unit (θ-norm) tangent, oriented along the branch;
-    /// it changes sign at folds.
+    /// it changes sign at folds (0 at a corner, which has no tangent).
     pub tangent_parameter: f64,
+    /// A corner of a piecewise-affine branch located exactly
+    /// ([`Continuation::with_affine_pieces`](super::Continuation::with_affine_pieces)),
+    /// not a corrected point (`iterations`, `residual_norm` and `step` are 0).
+    pub corner: bool,
 }
 
 /// Something noticed along the branch.
@@ -36,6 +40,14 @@ pub enum ContinuationEvent {
         index: usize,
         /// Parameter at the fold (refined by interpolation when
         /// [`ContinuationOptions::refine_folds`] is set).
+        parameter: f64,
+    },
+    /// A corner of a piecewise-affine branch, crossed exactly
+    /// ([`Continuation::with_affine_pieces`](super::Continuation::with_affine_pieces)).
+    Corner {
+        /// Index of the corner point in the branch.
+        index: usize,
+        /// Its parameter.
         parameter: f64,
     },
 }
@@ -147,6 +159,21 @@ pub enum ContinuationTermination {
         /// Why the last attempt failed.
         failure: CorrectorFailure,
     },
+    /// A restarted segment went back along the branch (one of its points came close to a
+    /// point before the restart, [`RestartPolicy`](super::RestartPolicy)): the branch
+    /// ends at the restart point, where no step ahead was found.
+    Retraced {
+        /// Parameter of the restart point.
+        parameter: f64,
+    },
+    /// A new segment (after a restart or a walk over corners) could not be corrected at
+    /// its starting parameter.
+    SegmentStartFailed {
+        /// The starting parameter.
+        parameter: f64,
+        /// Why the corrector failed.
+        failure: CorrectorFailure,
+    },
 }
 
 impl std::fmt::Display for ContinuationTermination {
@@ -180,6 +207,15 @@ impl std::fmt::Display for ContinuationTermination {
                 "{failures} failed attempts in a row from p = {parameter}, last step {step:e} \
                  (smallest |F| {residual_norm:e}): {failure}"
             ),
+            Self::Retraced { parameter } => write!(
+                f,
+                "stalled at p = {parameter}: no step ahead (a corner the continuation cannot \
+                 turn), and the only step found goes back along the branch"
+            ),
+            Self::SegmentStartFailed { parameter, failure } => write!(
+                f,
+                "a new segment could not be corrected at p = {parameter}: {failure}"
+            ),
         }
     }
 }
@@ -190,7 +226,8 @@ pub struct ContinuationCounters {
     /// The Newton-style counters: residual evaluations (line-search trials included),
     /// Jacobian evaluations and `factor` calls (one each per corrector iteration), solves
     /// (two per corrector iteration with block elimination), corrector line-search
-    /// backtracks, and the FFTs the problem counted during the run.
+    /// backtracks, corner walks (their Jacobians, factorizations and solves), and the
+    /// problem's own counters over the run.
     pub work: WorkCounters,
     /// Evaluations of `F_p` (each may cost residual evaluations inside the problem, which
     /// are not counted in `work`).
@@ -206,6 +243,10 @@ pub struct ContinuationCounters {
     pub rejected_steps: u64,
     /// Points accepted by a corner pass (module documentation, *Corners*).
     pub corner_passes: u64,
+    /// Restarts after failed steps ([`ContinuationOptions::restarts`]).
+    pub restarts: u64,
+    /// Corners of a piecewise-affine branch crossed exactly.
+    pub corners: u64,
 }
 
 impl std::ops::AddAssign for ContinuationCounters {
@@ -217,6 +258,8 @@ impl std::ops::AddAssign for ContinuationCounters {
         self.rejected_iterations += rhs.rejected_iterations;
         self.rejected_steps += rhs.rejected_steps;
         self.corner_passes += rhs.corner_passes;
+        self.restarts += rhs.restarts;
+        self.corners += rhs.corners;
     }
 }
 
@@ -243,8 +286,20 @@ impl Branch {
     pub fn fold_parameters(&self) -> Vec<f64> {
         self.events
             .iter()
-            .map(|e| match e {
-                ContinuationEvent::Fold { parameter, .. } => *parameter,
+            .filter_map(|e| match e {
+                ContinuationEvent::Fold { parameter, .. } => Some(*parameter),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Parameters of the corners crossed exactly, in branch order.
+    pub fn corner_parameters(&self) -> Vec<f64> {
+        self.events
+            .iter()
+            .filter_map(|e| match e {
+                ContinuationEvent::Corner { parameter, .. } => Some(*parameter),
+                _ => None,
             })
             .collect()
     }

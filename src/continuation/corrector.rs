@@ -177,7 +177,8 @@ struct BorderedSystem<'a, P: GeneralizedJacobian + ?Sized, S: ?Sized> {
     fallback: Option<DenseAssembler<P::Jacobian>>,
     metric: &'a Metric,
     constraint: Constraint,
-    trust: Option<&'a TrustBall>,
+    /// The ball and the metric it is measured in.
+    trust: Option<(&'a TrustBall, &'a Metric)>,
     counts: &'a mut CorrectorCounts,
 }
 
@@ -190,8 +191,8 @@ where
 
     fn evaluate(&mut self, y: &[f64], g: &mut [f64]) -> Result<(), EvaluationError> {
         let n = self.metric.n;
-        if let Some(ball) = self.trust.filter(|b| b.center.len() == n + 1) {
-            let distance = self.metric.distance(y, &ball.center);
+        if let Some((ball, metric)) = self.trust.filter(|(b, _)| b.center.len() == n + 1) {
+            let distance = metric.distance(y, &ball.center);
             if distance.is_nan() || distance > ball.radius {
                 return Err(EvaluationError::OutsideDomain {
                     what: "distance from the last branch point beyond the trust radius",
@@ -387,7 +388,8 @@ pub(super) struct Corrector<'a, P: GeneralizedJacobian + ?Sized, S: ?Sized> {
     pub ws: &'a mut Bordered<P::Jacobian>,
     pub fallback: Option<DenseAssembler<P::Jacobian>>,
     pub metric: &'a Metric,
-    pub trust: Option<&'a TrustBall>,
+    /// The trust ball and the metric it is measured in.
+    pub trust: Option<(&'a TrustBall, &'a Metric)>,
     pub rules: KernelRules,
 }
 

@@ -102,6 +102,49 @@ pub struct ContinuationOptions {
     /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
     /// before giving up. Default `true`.
     pub pass_corners: bool,
+    /// The corrector may not leave the θ-ball of radius `trust_factor` times the largest
+    /// step the next attempt can take (twice the last step, at most `max_step`) around the
+    /// last accepted point: an iterate outside it is rejected like one outside the
+    /// problem's domain, and the step is halved. On piecewise-smooth branches Newton can
+    /// otherwise converge on the far side of an overhang and skip both folds. Default
+    /// `None` (no ball).
+    pub trust_factor: Option<f64>,
+    /// What to do when the steps fail for good (module documentation, *Restarts*);
+    /// `None` ends the run there. Default `None`.
+    pub restarts: Option<RestartPolicy>,
+}
+
+/// Restarts after the steps from a point failed for good: the branch is taken up again
+/// from that point with a state-heavy metric for a few points, heading the way the
+/// parameter last moved (the other way when a restart could not make a single step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RestartPolicy {
+    /// `θ` of a restarted segment, in `(0, 1)`: close to 1, the arclength measures mostly
+    /// the state, so the constraint still cuts a branch that reverses in `p` at a corner
+    /// while its state moves on. Default `0.95`.
+    pub theta: f64,
+    /// Points of a restarted segment before the options' `θ` is taken again (`>= 1`).
+    /// Default `4`.
+    pub points: usize,
+    /// Restarts allowed per run. Default `20`.
+    pub max_restarts: usize,
+    /// Points before the restart point against which a restarted segment is checked for
+    /// going back along the branch: a point within a quarter of `|y_j - y_restart|` of one
+    /// of them `y_j` (a genuine turn that close is sharper than 165°) ends the run there
+    /// ([`ContinuationTermination::Retraced`](super::ContinuationTermination::Retraced)).
+    /// `0` disables the check. Default `8`.
+    pub retrace_window: usize,
+}
+
+impl Default for RestartPolicy {
+    fn default() -> Self {
+        Self {
+            theta: 0.95,
+            points: 4,
+            max_restarts: 20,
+            retrace_window: 8,
+        }
+    }
 }
 
 impl Default for ContinuationOptions {
@@ -126,6 +169,8 @@ impl Default for ContinuationOptions {
             corrector_line_search: None,
             refine_folds: true,
             pass_corners: true,
+            trust_factor: None,
+            restarts: None,
         }
     }
 }
@@ -216,6 +261,21 @@ impl ContinuationOptions {
             return Err(invalid("theta", self.theta, "in the open interval (0, 1)"));
         }
         positive_finite("parameter_scale", self.parameter_scale)?;
+        if let Some(factor) = self.trust_factor {
+            positive_finite("trust_factor", factor)?;
+        }
+        if let Some(policy) = &self.restarts {
+            if !(policy.theta > 0.0 && policy.theta < 1.0) {
+                return Err(invalid(
+                    "restarts.theta",
+                    policy.theta,
+                    "in the open interval (0, 1)",
+                ));
+            }
+            if policy.points == 0 {
+                return Err(invalid("restarts.points", 0.0, ">= 1"));
+            }
+        }
         if let Some(scale) = &self.state_scale {
             if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
                 return Err(invalid("state_scale", bad, "finite and > 0 entries"));

@@ -1,5 +1,6 @@
 //! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
 
+use semismooth::continuation::PiecewiseAffine;
 use semismooth::harmonic::FourierBasis;
 use semismooth::{
     EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
@@ -66,17 +67,20 @@ impl PenaltyHbOptions {
 ///
 /// With the activity `h` held fixed the residual is affine in `U`: the branch of solutions
 /// in `w` is made of pieces `U_h(w)` (one per set of active samples), each a graph over
-/// `w`, joined at corners where one sample's gap changes sign. [`crate::sweep`] steps over
-/// such corners with the pieces themselves (a crate-internal frozen activity).
+/// `w`, joined at corners where one sample's gap changes sign: the problem is
+/// [`PiecewiseAffine`], its switching functions the gaps at the samples, and the
+/// continuation crosses its corners exactly.
 #[derive(Debug)]
 pub struct PenaltyHb {
     state: HbState,
     stiffness: f64,
     coeffs: Vec<f64>,
     samples: Vec<f64>,
-    /// Frozen activity `h` (contact-major, `m Nt` entries): while `Some`, the penalty force
-    /// is `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
-    frozen: Option<Vec<bool>>,
+    /// Held piece `h` (contact-major, `m Nt` entries): while `Some`, the penalty force is
+    /// `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
+    frozen: Vec<bool>,
+    /// Whether `frozen` is held (its storage is kept either way).
+    holding: bool,
 }
 
 impl PenaltyHb {
@@ -92,7 +96,8 @@ impl PenaltyHb {
             stiffness: kp,
             coeffs: vec![0.0; size],
             samples: vec![0.0; nt],
-            frozen: None,
+            frozen: Vec::new(),
+            holding: false,
         })
     }
 
@@ -192,33 +197,11 @@ impl PenaltyHb {
         displacement_summary(&self.state.linear, u, dof, points, means)
     }
 
-    /// Gaps `G u(t_n) - g` at the `Nt` AFT samples, contact-major (`i Nt + n`): the numbers
-    /// whose signs decide which samples carry penalty force.
-    pub(crate) fn gap_samples_all(&mut self, u: &[f64]) -> Vec<f64> {
-        let nt = self.samples.len();
-        let mut out = Vec::with_capacity(self.contacts() * nt);
-        for i in 0..self.contacts() {
-            self.gap_samples(u, i);
-            out.extend_from_slice(&self.samples);
-        }
-        out
-    }
-
-    /// Freezes the activity (`Some(h)`, contact-major, `m Nt` entries): residual and
-    /// Jacobian become those of the affine piece with penalty force `k_p h_n (G u_n - g)`,
-    /// whatever the signs of the gaps. `None` restores `k_p max(0, G u_n - g)`.
-    pub(crate) fn freeze_activity(&mut self, activity: Option<Vec<bool>>) {
-        debug_assert!(activity
-            .as_ref()
-            .is_none_or(|h| h.len() == self.contacts() * self.samples.len()));
-        self.frozen = activity;
-    }
-
     /// Replaces the gap samples of contact `i` in `self.samples` by the penalty
     /// "activity-weighted gaps": `max(0, s_n)`, or `h_n s_n` when the activity is frozen.
     fn penetrations(&mut self, i: usize) {
         let nt = self.samples.len();
-        match &self.frozen {
+        match self.holding.then_some(&self.frozen) {
             Some(h) => {
                 for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     if !on {
@@ -302,7 +285,7 @@ impl GeneralizedJacobian for PenaltyHb {
         let nt = self.samples.len();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
-            if let Some(h) = &self.frozen {
+            if let Some(h) = self.holding.then_some(&self.frozen) {
                 // The indicator is the sign of the sample: impose the frozen one.
                 for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     *s = if on { 1.0 } else { 0.0 };
@@ -333,5 +316,30 @@ impl ParameterDependent for PenaltyHb {
             .linear
             .dynamic_omega_derivative(self.state.omega, u, out);
         Ok(())
+    }
+}
+
+/// The switching functions are the gaps `G u(t_n) - g` at the `Nt` AFT samples,
+/// contact-major (`i Nt + n`): a sample carries penalty force where its gap is positive.
+impl PiecewiseAffine for PenaltyHb {
+    fn switching_count(&self) -> usize {
+        self.contacts() * self.samples.len()
+    }
+
+    fn switching(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        let nt = self.samples.len();
+        for i in 0..self.contacts() {
+            self.gap_samples(u, i);
+            out[i * nt..(i + 1) * nt].copy_from_slice(&self.samples);
+        }
+        Ok(())
+    }
+
+    fn hold_piece(&mut self, piece: Option<&[bool]>) {
+        self.holding = piece.is_some();
+        if let Some(h) = piece {
+            self.frozen.clear();
+            self.frozen.extend_from_slice(h);
+        }
     }
 }

@@ -100,6 +100,19 @@ impl FrequencyLcp {
         Ok(y)
     }
 
+    /// The LCP at `omega`: the cached one, or a new one (not cached).
+    pub fn lcp_at(&self, omega: f64) -> Result<Rc<PeriodicLcp>, LcpError> {
+        if let Some(lcp) = self.cache.iter().find(|l| l.omega() == omega) {
+            return Ok(lcp.clone());
+        }
+        let mut model = self.model.clone();
+        model.forcing.omega = omega;
+        Ok(Rc::new(PeriodicLcp::with_frequency_derivative(
+            &model,
+            self.options.clone(),
+        )?))
+    }
+
     /// The LCP at the current frequency, built if needed.
     pub fn current(&mut self) -> Result<Rc<PeriodicLcp>, LcpError> {
         if let Some(i) = self.cache.iter().position(|l| l.omega() == self.omega) {

@@ -1,0 +1,175 @@
+//! The result of a sweep: a frequency-response curve and its JSON form.
+
+use semismooth::continuation::ContinuationCounters;
+use semismooth::harmonic::{Aft, FourierBasis};
+use serde_json::json;
+
+use crate::hb::HbError;
+use crate::runner::{RunCounters, RunError};
+use crate::scene::Method;
+
+/// A frequency-response curve: one entry per branch point, in branch order (the frequency
+/// is not monotone across folds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrequencyResponse {
+    /// Method used.
+    pub method: Method,
+    /// First natural frequency of the rod (the curve's frequency unit).
+    pub omega_1: f64,
+    /// Forcing frequency `ω` of each point (absolute).
+    pub omega: Vec<f64>,
+    /// `max_t u_tip(t)` over one period.
+    pub tip_max: Vec<f64>,
+    /// `min_t u_tip(t)` over one period.
+    pub tip_min: Vec<f64>,
+    /// `max_t |u_tip(t)|` over one period.
+    pub amplitude: Vec<f64>,
+    /// Corrector iterations of each point (the first: those of the start correction).
+    pub iterations: Vec<usize>,
+    /// Frequencies `ω` (absolute) where the branch turns back, in branch order.
+    pub folds: Vec<f64>,
+    /// Index of the extreme point at each fold (same order as `folds`).
+    pub fold_indices: Vec<usize>,
+    /// Whether the branch reached `omega_ratio_to` (the bound at the end of the sweep).
+    pub converged: bool,
+    /// Why the continuation stopped, in words.
+    pub termination: String,
+    /// Wall time of the whole computation after the rod was built (reference amplitude,
+    /// initial Newton solve, continuation, tip reconstructions).
+    pub solve_seconds: f64,
+    /// Work counters (initial Newton solve + continuation).
+    pub counters: RunCounters,
+    /// The continuation's own counters (corrector iterations, rejected steps).
+    pub continuation: ContinuationCounters,
+    /// Iterations of the initial globalized Newton solve at `omega_from`.
+    pub initial_iterations: usize,
+    /// Continuation restarts after failed steps (the core's restart policy).
+    pub restarts: usize,
+    /// Corners of a piecewise-affine (penalty) branch crossed exactly.
+    pub corners: usize,
+    /// `u_ref` of the step scaling (module documentation).
+    pub reference_amplitude: f64,
+    /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
+    pub output_points: usize,
+    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
+    /// `[w; z]`), unscaled, for warm starts and re-solves.
+    pub states: Vec<Vec<f64>>,
+}
+
+impl FrequencyResponse {
+    pub(super) fn push(
+        &mut self,
+        omega: f64,
+        max: f64,
+        min: f64,
+        iterations: usize,
+        state: Vec<f64>,
+    ) {
+        self.omega.push(omega);
+        self.tip_max.push(max);
+        self.tip_min.push(min);
+        self.amplitude.push(max.abs().max(min.abs()));
+        self.iterations.push(iterations);
+        self.states.push(state);
+    }
+
+    /// Number of branch points.
+    pub fn points(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// `ω / ω_1` of each point.
+    pub fn omega_ratio(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / self.omega_1).collect()
+    }
+
+    /// Index and value of the largest amplitude (`None` for an empty curve).
+    pub fn peak(&self) -> Option<(usize, f64)> {
+        self.amplitude
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(None, |best, (i, a)| match best {
+                Some((_, b)) if b >= a => best,
+                _ => Some((i, a)),
+            })
+    }
+
+    /// The JSON object of `ssn sweep --json`: `points`, `omega`, `tip_max`,
+    /// `tip_min`, `amplitude`, `folds`, `converged`, `solve_seconds`, `termination`,
+    /// `counters`. Non-finite numbers (never produced by a converged branch) become `null`.
+    pub fn to_json(&self) -> serde_json::Value {
+        let c = &self.counters;
+        json!({
+            "points": self.points(),
+            "omega": self.omega,
+            "tip_max": self.tip_max,
+            "tip_min": self.tip_min,
+            "amplitude": self.amplitude,
+            "folds": self.folds,
+            "converged": self.converged,
+            "solve_seconds": self.solve_seconds,
+            "termination": self.termination,
+            "counters": {
+                "residual_evaluations": c.residual_evaluations,
+                "jacobian_evaluations": c.jacobian_evaluations,
+                "factorizations": c.factorizations,
+                "linear_solves": c.linear_solves,
+                "line_search_backtracks": c.line_search_backtracks,
+                "ffts": c.ffts,
+                "corrector_iterations": self.continuation.corrector_iterations,
+                "rejected_steps": self.continuation.rejected_steps,
+                "corner_passes": self.continuation.corner_passes,
+                "restarts": self.restarts,
+                "corners": self.corners,
+            },
+        })
+    }
+}
+
+/// Reconstructs one dof over a period from HB coefficients (index `j N + dof`).
+pub(super) struct HbTip {
+    aft: Aft,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+    dofs: usize,
+    dof: usize,
+}
+
+impl HbTip {
+    pub(super) fn new(
+        harmonics: usize,
+        points: usize,
+        dofs: usize,
+        dof: usize,
+    ) -> Result<Self, RunError> {
+        let basis = FourierBasis::new(harmonics, points).map_err(HbError::from)?;
+        Ok(Self {
+            aft: Aft::new(basis),
+            coeffs: vec![0.0; 2 * harmonics + 1],
+            samples: vec![0.0; points],
+            dofs,
+            dof,
+        })
+    }
+
+    /// `(max, min)` of the dof over a period.
+    pub(super) fn extremes(&mut self, x: &[f64]) -> Result<(f64, f64), RunError> {
+        for (j, c) in self.coeffs.iter_mut().enumerate() {
+            *c = x[j * self.dofs + self.dof];
+        }
+        self.aft
+            .to_time(&self.coeffs, &mut self.samples)
+            .map_err(HbError::from)?;
+        Ok(extremes(&self.samples))
+    }
+}
+
+/// `(max, min)` of samples.
+pub(super) fn extremes(samples: &[f64]) -> (f64, f64) {
+    samples
+        .iter()
+        .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), v| {
+            (hi.max(*v), lo.min(*v))
+        })
+}

@@ -1,0 +1,1112 @@
+//! The continuation driver: an iterator over accepted branch points with step control,
+//! corner passes, bound landing, the trust ball, restarts and piecewise-affine corners.
+
+use std::collections::VecDeque;
+
+use super::corrector::{
+    Bordered, Constraint, Corrected, Corrector, CorrectorCounts, DenseAssembler, Metric, TrustBall,
+};
+use super::pieces::{AffineOps, PiecewiseAffine, Walk, Walker};
+use super::{
+    BranchPoint, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
+    ContinuationTermination, CorrectorFailure, Direction, FoldDetector, Predictor,
+};
+use crate::linalg::DenseAssemble;
+use crate::newton::kernel::{armijo, KernelRules};
+use crate::newton::WorkCounters;
+use crate::{Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters};
+
+enum Phase {
+    NotStarted { x0: Vec<f64>, p0: f64 },
+    Running,
+    Finished,
+}
+
+/// The kind of the current segment of the branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Segment {
+    /// The options' metric.
+    Main,
+    /// A restart after a failed step: the restart policy's metric for `points_left` more
+    /// points.
+    Restart { points_left: usize },
+}
+
+/// The points before a restart, against which the restarted segment is checked for going
+/// back along the branch (joined `(x, p)` vectors).
+struct Retrace {
+    earlier: Vec<Vec<f64>>,
+    anchor: Vec<f64>,
+}
+
+/// The piecewise-affine capability: the problem's switching functions and the walk state.
+struct Pieces<P: ?Sized> {
+    ops: AffineOps<P>,
+    /// The piece of the last corrected point.
+    current: Option<Vec<bool>>,
+    /// Which way `p` last moved along the branch (`+1` or `-1`).
+    travel: f64,
+}
+
+/// A converged correction made a branch point (with the θ-length of its chord from the
+/// last point), or the run ended on a bound without a new point.
+type Accepted = Option<(BranchPoint, f64)>;
+
+/// What the piece bookkeeping of an accepted point decided.
+enum Tracked {
+    /// Go on (`Some`: elsewhere than from the point).
+    Resume(Option<Resume>),
+    /// The run ended while the corners were emitted.
+    Ended,
+}
+
+/// How the branch goes on after a walk over corners.
+enum Resume {
+    /// From the walk's entry point on the next piece (a new point).
+    Fresh(Vec<f64>, f64, Direction),
+    /// From the point just accepted, heading this way.
+    Repeat(Direction),
+}
+
+/// Pseudo-arclength continuation as an iterator over accepted [`BranchPoint`]s (the module
+/// documentation has the method, the options and their defaults).
+///
+/// The first item is the starting point corrected at fixed `p0` by the continuation's own
+/// corrector (Newton, with the line search of
+/// [`ContinuationOptions::corrector_line_search`] if set; from a poor guess, solve first
+/// with [`crate::newton`]). An `Err` item (the start could not be corrected) ends the
+/// iteration. When the iteration ends, [`Continuation::termination`] says why,
+/// [`Continuation::events`] lists the folds and corners, and the problem's parameter is
+/// that of the last accepted point.
+pub struct Continuation<'a, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    problem: &'a mut P,
+    solver: &'a mut S,
+    options: ContinuationOptions,
+    fallback: Option<DenseAssembler<P::Jacobian>>,
+    /// The metric of the current segment.
+    metric: Metric,
+    /// The options' metric (trust ball, retrace test, corner walks).
+    main_metric: Metric,
+    bordered: Bordered<P::Jacobian>,
+    work: WorkCounters,
+    corrector_counts: CorrectorCounts,
+    phase: Phase,
+    /// Last point emitted (or the corrected start of a segment that repeats it).
+    last: Option<BranchPoint>,
+    /// Unit tangent at the last accepted point (length n + 1).
+    tangent: Vec<f64>,
+    /// Unit predictor direction for the next step (length n + 1).
+    direction: Vec<f64>,
+    step: f64,
+    points: usize,
+    consecutive_failures: usize,
+    folds: FoldDetector,
+    events: Vec<ContinuationEvent>,
+    termination: Option<ContinuationTermination>,
+    counters: ContinuationCounters,
+    problem_start: ProblemCounters,
+    trust: TrustBall,
+    segment: Segment,
+    segment_direction: Direction,
+    /// Points emitted since the current segment began.
+    segment_points: usize,
+    /// Joined states of the last emitted points (for the retrace test).
+    recent: VecDeque<Vec<f64>>,
+    retrace: Option<Retrace>,
+    /// Parameter component of the tangent at the last corrected (not corner) point.
+    last_tangent_parameter: f64,
+    pending: VecDeque<BranchPoint>,
+    pieces: Option<Pieces<P>>,
+}
+
+impl<'a, P, S> Continuation<'a, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    /// Prepares a continuation from the guess `x0` at parameter `p0`. Checks the options,
+    /// the dimension and that `p0` is finite and within the bounds; the work starts with the
+    /// first call of [`Iterator::next`].
+    pub fn new(
+        problem: &'a mut P,
+        solver: &'a mut S,
+        x0: &[f64],
+        p0: f64,
+        options: ContinuationOptions,
+    ) -> Result<Self, ContinuationError> {
+        options.validate()?;
+        let n = problem.dim();
+        if n == 0 || x0.len() != n {
+            return Err(ContinuationError::DimensionMismatch {
+                expected: n,
+                found: x0.len(),
+            });
+        }
+        if !p0.is_finite() || p0 < options.parameter_min || p0 > options.parameter_max {
+            return Err(ContinuationError::InvalidStart {
+                parameter: p0,
+                min: options.parameter_min,
+                max: options.parameter_max,
+            });
+        }
+        if let Some(scale) = &options.state_scale {
+            if scale.len() != n {
+                return Err(ContinuationError::InvalidOption {
+                    name: "state_scale",
+                    value: scale.len() as f64,
+                    allowed: "one entry per unknown (the problem's dimension)",
+                });
+            }
+        }
+        let main_metric = Metric::new(
+            n,
+            options.theta,
+            options.state_scale.as_deref(),
+            options.parameter_scale,
+        );
+        let bordered = Bordered::new(n, problem.new_jacobian());
+        let problem_start = problem.problem_counters();
+        let folds = FoldDetector::new(options.refine_folds);
+        let window = options.restarts.map_or(0, |r| r.retrace_window);
+        Ok(Self {
+            problem,
+            solver,
+            step: options.initial_step,
+            segment_direction: options.direction,
+            options,
+            fallback: None,
+            metric: main_metric.clone(),
+            main_metric,
+            bordered,
+            work: WorkCounters::default(),
+            corrector_counts: CorrectorCounts::default(),
+            phase: Phase::NotStarted {
+                x0: x0.to_vec(),
+                p0,
+            },
+            last: None,
+            tangent: vec![0.0; n + 1],
+            direction: vec![0.0; n + 1],
+            points: 0,
+            consecutive_failures: 0,
+            folds,
+            events: Vec::new(),
+            termination: None,
+            counters: ContinuationCounters::default(),
+            problem_start,
+            trust: TrustBall::default(),
+            segment: Segment::Main,
+            segment_points: 0,
+            recent: VecDeque::with_capacity(window + 1),
+            retrace: None,
+            last_tangent_parameter: 0.0,
+            pending: VecDeque::new(),
+            pieces: None,
+        })
+    }
+
+    /// Why the run stopped (`None` while it runs, or after a start failure).
+    pub fn termination(&self) -> Option<&ContinuationTermination> {
+        self.termination.as_ref()
+    }
+
+    /// Events found so far.
+    pub fn events(&self) -> &[ContinuationEvent] {
+        &self.events
+    }
+
+    /// Work done so far.
+    pub fn counters(&self) -> ContinuationCounters {
+        let mut c = self.counters;
+        c.work = self.work;
+        c.work.problem = self.problem.problem_counters().since(&self.problem_start);
+        c.parameter_derivative_evaluations = self.corrector_counts.parameter_derivatives;
+        c.dense_bordered_factorizations = self.corrector_counts.dense_factorizations;
+        c.corrector_iterations = self.corrector_counts.iterations;
+        c
+    }
+
+    /// The problem (its parameter is that of the last accepted point between items), e.g.
+    /// to evaluate user quantities at the point just returned.
+    pub fn problem(&self) -> &P {
+        self.problem
+    }
+
+    /// The step length the next attempt will use.
+    pub fn next_step(&self) -> f64 {
+        self.step
+    }
+
+    /// Runs to the end and collects the branch.
+    pub fn run(mut self) -> Result<super::Branch, ContinuationError> {
+        let mut points = Vec::new();
+        for item in self.by_ref() {
+            points.push(item?);
+        }
+        let termination = self
+            .termination
+            .clone()
+            .unwrap_or(ContinuationTermination::MaxPoints {
+                points: points.len(),
+            });
+        Ok(super::Branch {
+            points,
+            events: std::mem::take(&mut self.events),
+            termination,
+            counters: self.counters(),
+        })
+    }
+
+    fn finished(&self) -> bool {
+        matches!(self.phase, Phase::Finished)
+    }
+
+    fn finish(&mut self, termination: ContinuationTermination) {
+        if !self.finished() {
+            self.termination = Some(termination);
+            self.phase = Phase::Finished;
+        }
+    }
+
+    /// Normalises the corrector's raw tangent in the θ-norm into `self.tangent`, oriented
+    /// to have a non-negative inner product with `(ref_x, ref_p)`.
+    fn take_tangent(&mut self, reference: Option<&[f64]>, ref_p: f64) {
+        let n = self.metric.n;
+        let raw = &self.bordered.tangent;
+        let norm = self.metric.norm(&raw[..n], raw[n]);
+        for (t, r) in self.tangent.iter_mut().zip(raw) {
+            *t = r / norm;
+        }
+        let t = &self.tangent;
+        let orientation = match reference {
+            Some(r) => self.metric.dot(&t[..n], t[n], &r[..n], r[n]),
+            None => t[n] * ref_p,
+        };
+        if orientation < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
+    }
+
+    /// The corrector on this run's problem, solver, workspace and counters, from
+    /// `(x, p)`; the converged point is written back. Also returns the smallest finite
+    /// residual norm seen.
+    fn correct_at(
+        &mut self,
+        x: &mut [f64],
+        p: &mut f64,
+        constraint: Constraint,
+    ) -> (Result<Corrected, CorrectorFailure>, f64) {
+        let n = self.metric.n;
+        let mut y = Vec::with_capacity(n + 1);
+        y.extend_from_slice(x);
+        y.push(*p);
+        let corrector = Corrector {
+            problem: &mut *self.problem,
+            solver: &mut *self.solver,
+            ws: &mut self.bordered,
+            fallback: self.fallback,
+            metric: &self.metric,
+            trust: self
+                .options
+                .trust_factor
+                .map(|_| (&self.trust, &self.main_metric)),
+            rules: KernelRules {
+                absolute_tolerance: self.options.corrector_tolerance,
+                relative_tolerance: 0.0,
+                residual_floor: 0.0,
+                step_tolerance: self.options.step_tolerance,
+                max_iterations: self.options.max_corrector_iterations,
+                min_iterations: 1,
+                globalization: armijo(self.options.corrector_line_search),
+                restore_best: false,
+            },
+        };
+        let outcome = corrector.correct(
+            &mut y,
+            constraint,
+            &mut self.work,
+            &mut self.corrector_counts,
+        );
+        x.copy_from_slice(&y[..n]);
+        *p = y[n];
+        outcome
+    }
+
+    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented so that `p`
+    /// moves as `direction` says.
+    fn correct_start(
+        &mut self,
+        x: &mut [f64],
+        p: &mut f64,
+        direction: Direction,
+    ) -> Result<Corrected, CorrectorFailure> {
+        let constraint = Constraint {
+            arclength: false,
+            w_p: 1.0,
+            target: *p,
+        };
+        let corrected = self.correct_at(x, p, constraint).0?;
+        self.take_tangent(None, direction.sign());
+        self.direction.copy_from_slice(&self.tangent);
+        Ok(corrected)
+    }
+
+    fn start(&mut self, x0: Vec<f64>, p0: f64) -> Result<(), ContinuationError> {
+        let mut x = x0;
+        let mut p = p0;
+        let corrected = match self.correct_start(&mut x, &mut p, self.options.direction) {
+            Ok(c) => c,
+            Err(failure) => {
+                self.problem.set_parameter(p0);
+                self.phase = Phase::Finished;
+                return Err(ContinuationError::StartNotConverged {
+                    parameter: p0,
+                    failure,
+                });
+            }
+        };
+        self.phase = Phase::Running;
+        let n = self.metric.n;
+        let point = BranchPoint {
+            state: x,
+            parameter: p,
+            iterations: corrected.iterations,
+            residual_norm: corrected.residual_norm,
+            step: 0.0,
+            tangent_parameter: self.tangent[n],
+            corner: false,
+        };
+        self.after_accept(point, 0.0);
+        Ok(())
+    }
+
+    /// Begins a new segment of the branch at `(x, p)`: a correction at fixed `p`, the
+    /// tangent oriented by `direction`, the initial step, `segment`'s metric. The corrected
+    /// point is a new branch point when `emit`, else it replaces the last point (a
+    /// repeat).
+    fn begin_segment(
+        &mut self,
+        mut x: Vec<f64>,
+        mut p: f64,
+        direction: Direction,
+        segment: Segment,
+        emit: bool,
+    ) {
+        self.metric.theta = match (segment, self.options.restarts) {
+            (Segment::Restart { .. }, Some(policy)) => policy.theta,
+            _ => self.options.theta,
+        };
+        self.retrace = match segment {
+            Segment::Restart { .. } if self.recent.len() >= 2 => {
+                let mut earlier: Vec<Vec<f64>> = self.recent.iter().cloned().collect();
+                let anchor = earlier.pop().unwrap_or_default();
+                Some(Retrace { earlier, anchor })
+            }
+            _ => None,
+        };
+        self.segment = segment;
+        self.segment_direction = direction;
+        self.segment_points = 0;
+        self.set_trust(&x, p, 0.0);
+        let corrected = match self.correct_start(&mut x, &mut p, direction) {
+            Ok(c) => c,
+            Err(failure) => {
+                let parameter = self.last.as_ref().map_or(p, |l| l.parameter);
+                self.problem.set_parameter(parameter);
+                self.finish(ContinuationTermination::SegmentStartFailed {
+                    parameter: p,
+                    failure,
+                });
+                return;
+            }
+        };
+        self.step = self.options.initial_step;
+        self.consecutive_failures = 0;
+        let n = self.metric.n;
+        let point = BranchPoint {
+            state: x,
+            parameter: p,
+            iterations: corrected.iterations,
+            residual_norm: corrected.residual_norm,
+            step: 0.0,
+            tangent_parameter: self.tangent[n],
+            corner: false,
+        };
+        if emit {
+            self.emit(point, 0.0);
+        } else {
+            self.last = Some(point);
+        }
+    }
+
+    /// The trust ball around `(x, p)` for the next attempts: radius `trust_factor` times
+    /// the largest step they can take (twice the last step, at most `max_step`).
+    fn set_trust(&mut self, x: &[f64], p: f64, step: f64) {
+        let Some(factor) = self.options.trust_factor else {
+            return;
+        };
+        self.trust.center.clear();
+        self.trust.center.extend_from_slice(x);
+        self.trust.center.push(p);
+        let next = if step > 0.0 {
+            (2.0 * step).min(self.options.max_step)
+        } else {
+            self.options.max_step
+        };
+        self.trust.radius = factor * next;
+    }
+
+    /// Makes `point` a branch point: the retrace test of a restarted segment, fold and
+    /// corner events, the counters. Returns `false` when the point goes back along the
+    /// branch (the run then ends without it).
+    fn emit(&mut self, point: BranchPoint, chord: f64) -> bool {
+        let joined = self.joined(&point.state, point.parameter);
+        if let Some(retrace) = &self.retrace {
+            let d = |a: &[f64], b: &[f64]| self.main_metric.distance(a, b);
+            let back = retrace
+                .earlier
+                .iter()
+                .any(|e| d(&joined, e) < 0.25 * d(e, &retrace.anchor));
+            if back {
+                // The point is dropped and the run ends here, whatever ended it before.
+                let parameter = retrace.anchor[self.metric.n];
+                self.termination = Some(ContinuationTermination::Retraced { parameter });
+                self.phase = Phase::Finished;
+                return false;
+            }
+        }
+        let index = self.points;
+        if point.corner {
+            if let Some(event) = self.folds.push(point.parameter, 0.0, 0.0) {
+                self.events.push(event);
+            }
+            self.events.push(ContinuationEvent::Corner {
+                index,
+                parameter: point.parameter,
+            });
+            self.counters.corners += 1;
+        } else {
+            if let Some(event) = self
+                .folds
+                .push(point.parameter, point.tangent_parameter, chord)
+            {
+                self.events.push(event);
+            }
+            self.last_tangent_parameter = point.tangent_parameter;
+            self.set_trust(&point.state, point.parameter, point.step);
+        }
+        let window = self.options.restarts.map_or(0, |r| r.retrace_window);
+        if window > 0 {
+            if self.recent.len() > window {
+                self.recent.pop_front();
+            }
+            self.recent.push_back(joined);
+        }
+        self.points += 1;
+        self.segment_points += 1;
+        self.last = Some(point.clone());
+        self.pending.push_back(point);
+        if self.points >= self.options.max_points {
+            self.finish(ContinuationTermination::MaxPoints {
+                points: self.points,
+            });
+        }
+        true
+    }
+
+    fn joined(&self, x: &[f64], p: f64) -> Vec<f64> {
+        let mut y = Vec::with_capacity(x.len() + 1);
+        y.extend_from_slice(x);
+        y.push(p);
+        y
+    }
+
+    /// After a point was accepted: the piece bookkeeping of a piecewise-affine branch
+    /// (which may cross corners and resume elsewhere), then the point itself, then the end
+    /// of a restarted segment.
+    fn after_accept(&mut self, point: BranchPoint, chord: f64) {
+        let resume = if self.pieces.is_some() && !self.finished() {
+            match self.track_pieces(&point) {
+                Tracked::Resume(resume) => resume,
+                Tracked::Ended => return,
+            }
+        } else {
+            None
+        };
+        match resume {
+            Some(Resume::Fresh(x, p, direction)) => {
+                self.begin_segment(x, p, direction, Segment::Main, true);
+                return;
+            }
+            Some(Resume::Repeat(direction)) => {
+                let (x, p) = (point.state.clone(), point.parameter);
+                if self.emit(point, chord) && !self.finished() {
+                    self.begin_segment(x, p, direction, Segment::Main, false);
+                }
+                return;
+            }
+            None => {
+                if !self.emit(point, chord) {
+                    return;
+                }
+            }
+        }
+        if let Segment::Restart { points_left } = self.segment {
+            let left = points_left.saturating_sub(1);
+            self.segment = Segment::Restart { points_left: left };
+            if left == 0 && !self.finished() {
+                let direction = self.heading();
+                if let Some(last) = self.last.clone() {
+                    self.begin_segment(last.state, last.parameter, direction, Segment::Main, false);
+                }
+            }
+        }
+    }
+
+    /// The piece of `point` against the last one; on a change, the corners between them
+    /// are walked and emitted, and the branch may resume elsewhere.
+    fn track_pieces(&mut self, point: &BranchPoint) -> Tracked {
+        let k = self.points;
+        let remaining = self.options.max_points.saturating_sub(k);
+        let previous = self.last.clone();
+        let label = self.walker().and_then(|mut w| {
+            w.problem.set_parameter(point.parameter);
+            w.piece(&point.state)
+        });
+        let (Some(mut label), Some(pieces)) = (label, self.pieces.as_ref()) else {
+            // No piece to compare with: the point stands as it is.
+            return Tracked::Resume(None);
+        };
+        let (current, mut travel) = (pieces.current.clone(), pieces.travel);
+        let mut resume = None;
+        let mut corners = Vec::new();
+        match (&current, &previous) {
+            (Some(current), Some(prev)) if *current != label && k > 0 => {
+                let walk = self
+                    .walker()
+                    .and_then(|mut w| w.cross(&prev.state, prev.parameter, travel, remaining));
+                if let Some(Walk {
+                    corners: found,
+                    start,
+                    start_parameter,
+                    direction,
+                }) = walk
+                {
+                    let along = direction.sign();
+                    let start_label = self.walker().and_then(|mut w| {
+                        w.problem.set_parameter(start_parameter);
+                        w.piece(&start)
+                    });
+                    if found.len() > 1 || start_label.as_ref() != Some(&label) {
+                        if let Some(start_label) = start_label {
+                            label = start_label;
+                        }
+                        resume = Some(Resume::Fresh(start, start_parameter, direction));
+                    } else if (point.parameter - prev.parameter) * along < 0.0 {
+                        resume = Some(Resume::Repeat(direction));
+                    }
+                    corners = found;
+                    travel = along;
+                } else {
+                    travel = (point.parameter - prev.parameter).signum();
+                }
+                self.problem.set_parameter(point.parameter);
+            }
+            (Some(_), Some(prev)) if k > 0 && point.parameter != prev.parameter => {
+                travel = (point.parameter - prev.parameter).signum();
+            }
+            _ => {}
+        }
+        if let Some(pieces) = self.pieces.as_mut() {
+            pieces.current = Some(label);
+            pieces.travel = travel;
+        }
+        if !self.emit_corners(corners) {
+            return Tracked::Ended;
+        }
+        Tracked::Resume(resume)
+    }
+
+    /// Emits corners found by a walk; `false` if the run ended on one.
+    fn emit_corners(&mut self, corners: Vec<(Vec<f64>, f64)>) -> bool {
+        for (state, parameter) in corners {
+            let point = BranchPoint {
+                state,
+                parameter,
+                iterations: 0,
+                residual_norm: 0.0,
+                step: 0.0,
+                tangent_parameter: 0.0,
+                corner: true,
+            };
+            if !self.emit(point, 0.0) || self.finished() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The corner walker on this run's problem, solver and counters.
+    fn walker(&mut self) -> Option<Walker<'_, P, S>> {
+        let ops = self.pieces.as_ref()?.ops;
+        let parameter_unit = 1.0 / self.main_metric.parameter_dot(1.0, 1.0).sqrt();
+        Some(Walker {
+            problem: &mut *self.problem,
+            solver: &mut *self.solver,
+            jac: &mut self.bordered.jac,
+            ops,
+            metric: &self.main_metric,
+            work: &mut self.work,
+            reach: self.options.max_step * parameter_unit,
+            shift: 0.25 * self.options.initial_step * parameter_unit,
+            walk: self.options.max_step,
+            bounds: (self.options.parameter_min, self.options.parameter_max),
+        })
+    }
+
+    /// The direction the branch last moved in `p` (the last increment between points, or
+    /// the last tangent).
+    fn heading(&self) -> Direction {
+        let k = self.recent.len();
+        let n = self.metric.n;
+        let heading = if k >= 2 {
+            self.recent[k - 1][n] - self.recent[k - 2][n]
+        } else {
+            self.last_tangent_parameter
+        };
+        if heading >= 0.0 {
+            Direction::Increasing
+        } else {
+            Direction::Decreasing
+        }
+    }
+
+    /// Attempts steps until one is accepted or the run ends; accepted points (and corners)
+    /// go to `pending`.
+    fn advance(&mut self) {
+        let n = self.metric.n;
+        let Some(last) = self.last.clone() else {
+            self.finish(ContinuationTermination::MaxPoints { points: 0 });
+            return;
+        };
+        let mut x = vec![0.0; n];
+        loop {
+            let ds = self.step;
+            for ((xi, si), di) in x.iter_mut().zip(&last.state).zip(&self.direction) {
+                *xi = si + ds * di;
+            }
+            self.direction_weights();
+            let mut p = last.parameter + ds * self.direction[n];
+            let w_p = self.metric.parameter_dot(self.direction[n], 1.0);
+            let w_dot_last: f64 = self
+                .bordered
+                .w
+                .iter()
+                .zip(&last.state)
+                .map(|(u, v)| u * v)
+                .sum::<f64>()
+                + w_p * last.parameter;
+            let constraint = Constraint {
+                arclength: true,
+                w_p,
+                target: w_dot_last + ds,
+            };
+            let before = self.corrector_counts.iterations;
+            let (corrected, smallest) = self.correct_at(&mut x, &mut p, constraint);
+            let failure = match corrected {
+                Ok(c) => {
+                    if let Some((point, chord)) = self.accept(&last, x, p, ds, c, None) {
+                        self.after_accept(point, chord);
+                    }
+                    return;
+                }
+                Err(failure) => failure,
+            };
+            self.reject(before, last.parameter);
+            self.consecutive_failures += 1;
+            let too_small = ds <= self.options.min_step;
+            let too_many = self.consecutive_failures >= self.options.max_consecutive_failures;
+            if !(too_small || too_many) {
+                self.step = (0.5 * ds).max(self.options.min_step);
+                continue;
+            }
+            if self.options.pass_corners {
+                if let Some(accepted) = self.pass_corner(&last, ds) {
+                    if let Some((point, chord)) = accepted {
+                        self.after_accept(point, chord);
+                    }
+                    return;
+                }
+            }
+            let termination = if too_small {
+                ContinuationTermination::StepTooSmall {
+                    parameter: last.parameter,
+                    step: ds,
+                    residual_norm: smallest,
+                    failure,
+                }
+            } else {
+                ContinuationTermination::TooManyFailures {
+                    parameter: last.parameter,
+                    step: ds,
+                    failures: self.consecutive_failures,
+                    residual_norm: smallest,
+                    failure,
+                }
+            };
+            self.recover(last, termination);
+            return;
+        }
+    }
+
+    /// After the steps from `last` failed for good: a walk over the corners ahead (a
+    /// piecewise-affine branch), else a restart (the restart policy), else the end.
+    fn recover(&mut self, last: BranchPoint, termination: ContinuationTermination) {
+        if self.pieces.is_some() {
+            let remaining = self.options.max_points.saturating_sub(self.points);
+            let travel = self.pieces.as_ref().map_or(1.0, |p| p.travel);
+            let walk = self
+                .walker()
+                .and_then(|mut w| w.cross(&last.state, last.parameter, travel, remaining));
+            self.problem.set_parameter(last.parameter);
+            if let Some(walk) = walk {
+                if !self.emit_corners(walk.corners) {
+                    return;
+                }
+                let label = self.walker().and_then(|mut w| {
+                    w.problem.set_parameter(walk.start_parameter);
+                    w.piece(&walk.start)
+                });
+                if let Some(pieces) = self.pieces.as_mut() {
+                    pieces.current = label;
+                    pieces.travel = walk.direction.sign();
+                }
+                self.begin_segment(
+                    walk.start,
+                    walk.start_parameter,
+                    walk.direction,
+                    Segment::Main,
+                    true,
+                );
+                return;
+            }
+        }
+        if let Some(policy) = self.options.restarts {
+            let stuck = matches!(self.segment, Segment::Restart { .. }) && self.segment_points == 0;
+            if self.counters.restarts < policy.max_restarts as u64
+                && self.last_tangent_parameter != 0.0
+            {
+                self.counters.restarts += 1;
+                let direction = match (stuck, self.segment_direction) {
+                    (true, Direction::Increasing) => Direction::Decreasing,
+                    (true, Direction::Decreasing) => Direction::Increasing,
+                    _ => self.heading(),
+                };
+                if let Some(pieces) = self.pieces.as_mut() {
+                    pieces.travel = direction.sign();
+                }
+                self.begin_segment(
+                    last.state,
+                    last.parameter,
+                    direction,
+                    Segment::Restart {
+                        points_left: policy.points,
+                    },
+                    false,
+                );
+                return;
+            }
+        }
+        self.finish(termination);
+    }
+
+    /// `w_x = (θ/n) s⁻² ⊙ d_x`: the state part of the normal of the arclength constraint
+    /// along the current direction `d` (`s` the state scale, 1 without one).
+    fn direction_weights(&mut self) {
+        let n = self.metric.n;
+        self.metric
+            .state_normal(&self.direction[..n], &mut self.bordered.w);
+    }
+
+    /// Books a rejected attempt (begun at `before` corrector iterations) and restores the
+    /// problem's parameter to the last accepted point's.
+    fn reject(&mut self, before: u64, parameter: f64) {
+        self.counters.rejected_steps += 1;
+        self.counters.rejected_iterations += self.corrector_counts.iterations - before;
+        self.problem.set_parameter(parameter);
+    }
+
+    /// The corner passes of the module documentation (*Corners*), with step `ds` from
+    /// `last` along the current direction: first on the hyperplane normal to the direction's
+    /// state part, then at the next parameter `p + ds / sqrt((1 - θ) / s_p²)` (sign of the
+    /// direction's parameter component). `Some(result of accept)` when one converged.
+    #[allow(clippy::type_complexity)]
+    fn pass_corner(&mut self, last: &BranchPoint, ds: f64) -> Option<Option<(BranchPoint, f64)>> {
+        let n = self.metric.n;
+        let d = self.direction.clone();
+        let state_part = self.metric.state_dot(&d[..n], &d[..n]);
+        let parameter_part = self.metric.parameter_dot(d[n], d[n]);
+        for on_state in [true, false] {
+            let (scale, along, constraint) = if on_state {
+                if state_part < 1e-6 {
+                    continue;
+                }
+                self.direction_weights();
+                let mut along = d.clone();
+                along[n] = 0.0;
+                let target: f64 = self
+                    .bordered
+                    .w
+                    .iter()
+                    .zip(&last.state)
+                    .zip(&d)
+                    .map(|((w, x), di)| w * (x + ds * di))
+                    .sum();
+                let constraint = Constraint {
+                    arclength: true,
+                    w_p: 0.0,
+                    target,
+                };
+                (ds, along, constraint)
+            } else {
+                if parameter_part < 1e-6 {
+                    continue;
+                }
+                let step_p = ds / self.metric.parameter_dot(1.0, 1.0).sqrt() * d[n].signum();
+                let mut along = vec![0.0; n + 1];
+                along[n] = d[n].signum();
+                let constraint = Constraint {
+                    arclength: false,
+                    w_p: 1.0,
+                    target: last.parameter + step_p,
+                };
+                (step_p / d[n], along, constraint)
+            };
+            let mut x: Vec<f64> = last
+                .state
+                .iter()
+                .zip(&d)
+                .map(|(x, di)| x + scale * di)
+                .collect();
+            let mut p = last.parameter + scale * d[n];
+            let before = self.corrector_counts.iterations;
+            match self.correct_at(&mut x, &mut p, constraint).0 {
+                Ok(c) => {
+                    self.counters.corner_passes += 1;
+                    let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
+                    let step = self.metric.norm(&dx, p - last.parameter);
+                    return Some(self.accept(last, x, p, step, c, Some(&along)));
+                }
+                Err(_) => self.reject(before, last.parameter),
+            }
+        }
+        None
+    }
+
+    /// Turns a converged correction into the next branch point: bound landing, tangent
+    /// orientation, next direction and step. Returns the point and the θ-length of the
+    /// chord from `last` (`None` when the run ends on a bound without a new point).
+    fn accept(
+        &mut self,
+        last: &BranchPoint,
+        mut x: Vec<f64>,
+        mut p: f64,
+        ds: f64,
+        corrected: Corrected,
+        along: Option<&[f64]>,
+    ) -> Accepted {
+        let n = self.metric.n;
+        self.consecutive_failures = 0;
+        let direction = self.direction.clone();
+        self.take_tangent(Some(&direction), 0.0);
+        let mut iterations = corrected.iterations;
+        let mut residual_norm = corrected.residual_norm;
+        let mut step = ds;
+
+        // Leaving the bounds: re-solve at the bound from the interpolated point.
+        let bound = if p > self.options.parameter_max {
+            Some(self.options.parameter_max)
+        } else if p < self.options.parameter_min {
+            Some(self.options.parameter_min)
+        } else {
+            None
+        };
+        if bound == Some(last.parameter) {
+            // Already on the bound and heading out: nothing new to report.
+            self.problem.set_parameter(last.parameter);
+            self.finish(ContinuationTermination::ReachedBound {
+                parameter: last.parameter,
+                bound: last.parameter,
+            });
+            return None;
+        }
+        if let Some(pb) = bound {
+            let lambda = (pb - last.parameter) / (p - last.parameter);
+            let mut xb: Vec<f64> = last
+                .state
+                .iter()
+                .zip(&x)
+                .map(|(a, b)| a + lambda * (b - a))
+                .collect();
+            let mut pbv = pb;
+            let constraint = Constraint {
+                arclength: false,
+                w_p: 1.0,
+                target: pb,
+            };
+            let saved_tangent = self.tangent.clone();
+            match self.correct_at(&mut xb, &mut pbv, constraint).0 {
+                Ok(c) => {
+                    self.take_tangent(Some(&direction), 0.0);
+                    x = xb;
+                    p = pbv;
+                    iterations += c.iterations;
+                    residual_norm = c.residual_norm;
+                    step = lambda * ds;
+                }
+                Err(_) => {
+                    self.tangent = saved_tangent;
+                    // Keep the point outside the bound; the problem follows it.
+                    self.problem.set_parameter(p);
+                }
+            }
+        }
+
+        // Secant direction for the next predictor.
+        let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
+        let dpar = p - last.parameter;
+        let chord = self.metric.norm(&dx, dpar);
+        // Orient the tangent along the step just taken: where the branch turns sharply the
+        // predictor's direction can make an obtuse angle with the new tangent, and orienting
+        // by it would reverse the tangent (a spurious fold, and a tangent predictor heading
+        // back along the branch). The secant always has a positive component along the
+        // predictor (the arclength constraint), so it is the forward direction here.
+        let forward = match along {
+            Some(a) => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], &a[..n], a[n]),
+            None if chord > 0.0 => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], &dx, dpar),
+            None => 0.0,
+        };
+        if forward < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
+
+        match self.options.predictor {
+            // After a corner the chord cuts across it: the new piece's tangent is the way on.
+            Predictor::Secant if chord > 0.0 && along.is_none() => {
+                for (d, v) in self.direction.iter_mut().zip(&dx) {
+                    *d = v / chord;
+                }
+                self.direction[n] = dpar / chord;
+            }
+            _ => self.direction.copy_from_slice(&self.tangent),
+        }
+
+        let factor = (self.options.target_iterations as f64 / iterations.max(1) as f64)
+            .sqrt()
+            .clamp(0.5, 2.0);
+        self.step = (ds * factor).clamp(self.options.min_step, self.options.max_step);
+
+        let point = BranchPoint {
+            state: x,
+            parameter: p,
+            iterations,
+            residual_norm,
+            step,
+            tangent_parameter: self.tangent[n],
+            corner: false,
+        };
+        if let Some(pb) = bound {
+            self.finish(ContinuationTermination::ReachedBound {
+                parameter: point.parameter,
+                bound: pb,
+            });
+        }
+        Some((point, chord))
+    }
+}
+
+impl<'a, P, S> Continuation<'a, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    P::Jacobian: DenseAssemble,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    /// Enables the dense fallback: when `J` is singular (the factorization fails) or the
+    /// block-elimination pivot vanishes, the corrector assembles the `(n+1) x (n+1)`
+    /// bordered matrix and solves it by dense LU (counted in
+    /// [`ContinuationCounters::dense_bordered_factorizations`]). Only available when the
+    /// Jacobian type implements [`DenseAssemble`]; meant for small or dense problems.
+    pub fn with_dense_fallback(mut self) -> Self {
+        self.fallback = Some(<P::Jacobian as DenseAssemble>::assemble_dense);
+        self
+    }
+}
+
+impl<'a, P, S> Continuation<'a, P, S>
+where
+    P: PiecewiseAffine + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    /// Crosses the corners of a piecewise-affine branch exactly (module documentation,
+    /// *Piecewise-affine branches*): when an accepted point lies on another piece than the
+    /// last one, or when the steps fail for good, the corners ahead are walked on the
+    /// pieces themselves and emitted as branch points ([`BranchPoint::corner`], a
+    /// [`ContinuationEvent::Corner`] each); folds are then reported at corners, never
+    /// interpolated.
+    pub fn with_affine_pieces(mut self) -> Self {
+        self.pieces = Some(Pieces {
+            ops: AffineOps::of(),
+            current: None,
+            travel: self.options.direction.sign(),
+        });
+        self.folds = FoldDetector::new(false);
+        self
+    }
+}
+
+impl<P, S> Iterator for Continuation<'_, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    type Item = Result<BranchPoint, ContinuationError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(point) = self.pending.pop_front() {
+                return Some(Ok(point));
+            }
+            match std::mem::replace(&mut self.phase, Phase::Running) {
+                Phase::Finished => {
+                    self.phase = Phase::Finished;
+                    return None;
+                }
+                Phase::NotStarted { x0, p0 } => {
+                    if let Err(e) = self.start(x0, p0) {
+                        return Some(Err(e));
+                    }
+                }
+                Phase::Running => self.advance(),
+            }
+        }
+    }
+}
+
+impl<P, S> std::iter::FusedIterator for Continuation<'_, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+}
