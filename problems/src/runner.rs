@@ -8,6 +8,7 @@
 
 use std::time::Instant;
 
+use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
@@ -26,9 +27,6 @@ use crate::rod::{ModelError, RodModel};
 use crate::scene::{
     GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
 };
-
-/// Ratio between successive penalty stiffnesses of the penalty homotopy.
-pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
@@ -386,40 +384,31 @@ pub fn solve_rod(
             let start = Instant::now();
             // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
             // is the linear response, deep in the obstacle), so without a warm start the
-            // stiffness is raised from the static contact stiffness by factors of 10, each
-            // stage starting from the previous answer.
+            // stiffness is raised in log k_p from 10 x the static contact stiffness
+            // (mesh-independent; the local one grows with the mesh and is already too stiff
+            // a start on fine meshes) by factors of 10, a failed stage going back to the
+            // last converged stiffness with the square root of the factor.
             let mut counters = WorkCounters::default();
             let mut homotopy_iterations = 0;
             if warm_start.is_none() {
-                // From 10 x the static contact stiffness (mesh-independent; the local one grows
-                // with the mesh and is already too stiff a start on fine meshes).
-                let mut k = model
+                let k0 = model
                     .static_contact_stiffness()
                     .map(|s| DEFAULT_C_FACTOR * s)
                     .unwrap_or(scale);
-                // Adaptive steps in log k_p: a failed stage goes back to the last converged
-                // stiffness and takes the square root of the factor (10, 3.2, 1.8, ...).
-                let mut factor = PENALTY_HOMOTOPY_FACTOR;
-                let mut last_converged: Option<f64> = None;
-                while k < target && factor > 1.05 {
-                    let stage_options = PenaltyHbOptions {
-                        penalty_stiffness: k,
-                        ..options
-                    };
-                    let mut stage = PenaltyHb::new(model, &stage_options)?;
-                    let mut trial = x.clone();
-                    let report = newton_hb(&mut stage, &mut trial, settings, model, k)?;
-                    counters += report.counters;
-                    homotopy_iterations += report.iterations;
-                    if report.converged() {
-                        x = trial;
-                        last_converged = Some(k);
-                        k *= factor;
-                    } else {
-                        factor = factor.sqrt();
-                        k = last_converged.map_or(k / factor, |kc| kc * factor);
-                    }
-                }
+                let stages = homotopy(
+                    k0.ln(),
+                    target.ln(),
+                    &HomotopySchedule::default(),
+                    &mut x,
+                    |log_k, x| {
+                        let k = log_k.exp();
+                        problem.set_penalty_stiffness(k)?;
+                        newton_hb(&mut problem, x, settings, model, k)
+                    },
+                )?;
+                counters += stages.counters;
+                homotopy_iterations = stages.iterations;
+                problem.set_penalty_stiffness(target)?;
             }
             let mut report = newton_hb(&mut problem, &mut x, settings, model, target)?;
             counters += report.counters;

@@ -133,6 +133,7 @@ mod branch;
 mod corrector;
 mod driver;
 mod folds;
+mod homotopy;
 mod natural;
 mod options;
 mod pieces;
@@ -143,6 +144,7 @@ pub use branch::{
 };
 pub use driver::Continuation;
 pub use folds::FoldDetector;
+pub use homotopy::{homotopy, HomotopyReport, HomotopySchedule};
 pub use natural::{natural_sweep, NaturalSweep, SweepFailure, SweepPoint};
 pub use options::{
     ContinuationOptions, Direction, Predictor, RestartPolicy, BORDER_PIVOT_THRESHOLD,

@@ -121,6 +121,17 @@ impl PenaltyHb {
         self.stiffness
     }
 
+    /// Sets the penalty stiffness `k_p` (finite, `> 0`).
+    pub fn set_penalty_stiffness(&mut self, k: f64) -> Result<(), HbError> {
+        PenaltyHbOptions {
+            penalty_stiffness: k,
+            ..PenaltyHbOptions::default()
+        }
+        .validate()?;
+        self.stiffness = k;
+        Ok(())
+    }
+
     /// Current angular frequency `w`.
     pub fn omega(&self) -> f64 {
         self.state.omega
