@@ -2,7 +2,9 @@
 
 use faer::{c64, Mat};
 use semismooth::harmonic::{Aft, FourierBasis};
-use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters, Residual};
+use semismooth::{
+    EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
+};
 
 use super::jacobian::ContactCoupling;
 use super::ssn::{HbOptions, SsnHb};
@@ -21,6 +23,11 @@ use crate::model::StructuralModel;
 /// the dense `I - Q + c Q R` (`Q = P diag(h) E` per contact): solve it with a dense LU
 /// (`semismooth::linalg::FaerDenseLu`). The full solution `[U; Lambda]` of [`SsnHb`] is
 /// recovered by [`CondensedSsnHb::expand`], and is a root of the full residual.
+///
+/// The parameter of [`ParameterDependent`] is `w`: setting it marks the factorization stale
+/// (it is redone at the next evaluation; a `w` where a dynamic block is singular is outside
+/// the domain), and `dR/dw = c P diag(h) E dy/dw` with `dy/dw = -G A^{-1} (dA/dw) U`,
+/// `U = A^{-1} (F + G^T Lambda)`: one structured solve per evaluation.
 #[derive(Debug)]
 pub struct CondensedSsnHb {
     full: SsnHb,
@@ -29,6 +36,13 @@ pub struct CondensedSsnHb {
     linear_response: Vec<f64>,
     contact_linear: Vec<f64>,
     y: Vec<f64>,
+    /// Full-size workspace for `U` and `(dA/dw) U`.
+    full_u: Vec<f64>,
+    full_w: Vec<f64>,
+    /// Indicator `h_n` of the active samples (F_p).
+    mask: Vec<f64>,
+    /// `w` of the last factorization differs from the problem's.
+    stale: bool,
     q: Mat<f64>,
     coeffs: Vec<f64>,
     samples: Vec<f64>,
@@ -48,6 +62,10 @@ impl CondensedSsnHb {
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],
+            full_u: vec![0.0; full.displacement_len()],
+            full_w: vec![0.0; full.displacement_len()],
+            mask: vec![0.0; basis.time_samples()],
+            stale: false,
             q: Mat::zeros(size, m * size),
             coeffs: vec![0.0; size],
             samples: vec![0.0; basis.time_samples()],
@@ -73,15 +91,25 @@ impl CondensedSsnHb {
                 self.contact_linear[j * m + i] = self.linear_response[j * n + dof];
             }
         }
-        self.receptance = (0..=h)
-            .map(|k| {
-                self.solver
-                    .receptance(k)
-                    .cloned()
-                    .unwrap_or_else(|| Mat::zeros(m, m))
-            })
-            .collect();
+        self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
+        for (k, r) in self.receptance.iter_mut().enumerate() {
+            if let Some(factored) = self.solver.receptance(k) {
+                r.copy_from(factored);
+            }
+        }
+        self.stale = false;
         Ok(())
+    }
+
+    /// Refactors when `w` changed since the last factorization.
+    fn ensure_factored(&mut self) -> Result<(), EvaluationError> {
+        if !self.stale {
+            return Ok(());
+        }
+        self.refactor().map_err(|_| EvaluationError::OutsideDomain {
+            what: "omega (a dynamic block of harmonic balance is singular)",
+            value: self.full.omega(),
+        })
     }
 
     /// The full SSN-HB problem (for reconstruction and summaries of expanded solutions).
@@ -128,10 +156,13 @@ impl CondensedSsnHb {
         self.refactor()
     }
 
-    /// The full unknowns `[U; Lambda]` of [`SsnHb`] from `Lambda`:
-    /// `U = A^{-1} (F + G^T Lambda)`.
-    pub fn expand(&self, lambda: &[f64]) -> Result<Vec<f64>, HbError> {
+    /// The full unknowns `[U; Lambda]` of [`SsnHb`] from `Lambda` at the current `w`:
+    /// `U = A^{-1} (F + G^T Lambda)` (refactoring first if `w` changed).
+    pub fn expand(&mut self, lambda: &[f64]) -> Result<Vec<f64>, HbError> {
         check_len("contact-force coefficients", self.dim(), lambda.len())?;
+        if self.stale {
+            self.refactor()?;
+        }
         let mut x = self.linear_response.clone();
         self.solver.add_response(lambda, 1.0, &mut x);
         x.extend_from_slice(lambda);
@@ -140,7 +171,7 @@ impl CondensedSsnHb {
 
     /// [`SsnHb::summary`] of the expanded solution.
     pub fn summary(
-        &self,
+        &mut self,
         lambda: &[f64],
         dof: usize,
         points: usize,
@@ -190,6 +221,7 @@ impl Residual for CondensedSsnHb {
     }
 
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        self.ensure_factored()?;
         let m = self.full.contacts();
         let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
@@ -221,6 +253,7 @@ impl GeneralizedJacobian for CondensedSsnHb {
     }
 
     fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+        self.ensure_factored()?;
         let m = self.full.contacts();
         let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
@@ -239,6 +272,71 @@ impl GeneralizedJacobian for CondensedSsnHb {
             m,
             jac.as_mut(),
         );
+        Ok(())
+    }
+}
+
+impl ParameterDependent for CondensedSsnHb {
+    fn parameter(&self) -> f64 {
+        self.full.omega()
+    }
+
+    /// Sets `w`; the dynamic blocks are refactored at the next evaluation.
+    fn set_parameter(&mut self, omega: f64) {
+        if omega.to_bits() != self.full.omega().to_bits() {
+            self.full.set_parameter(omega);
+            self.stale = true;
+        }
+    }
+
+    /// `dR/dw = c P diag(h) E dy/dw`, `dy/dw = -G A^{-1} (dA/dw) U` (type documentation).
+    fn residual_parameter_derivative(
+        &mut self,
+        lambda: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        self.ensure_factored()?;
+        let lin = self.full.state.linear.clone();
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        // U = A^{-1} F + A^{-1} G^T Lambda.
+        self.full_u.copy_from_slice(&self.linear_response);
+        self.solver.add_response(lambda, 1.0, &mut self.full_u);
+        lin.dynamic_omega_derivative(self.full.omega(), &self.full_u, &mut self.full_w);
+        self.solver
+            .apply_dynamic_inverse(&mut self.full_w)
+            .map_err(|_| EvaluationError::OutsideDomain {
+                what: "omega (a dynamic block of harmonic balance is singular)",
+                value: self.full.omega(),
+            })?;
+        self.contact_displacements(lambda);
+        let c = self.full.c();
+        for i in 0..m {
+            self.switching_samples(lambda, i);
+            for (h, s) in self.mask.iter_mut().zip(&self.samples) {
+                *h = if *s > 0.0 { 1.0 } else { 0.0 };
+            }
+            for j in 0..size {
+                self.coeffs[j] = -c * self.full_w[j * n + lin.contact_dofs[i]];
+            }
+            self.aft
+                .to_time(&self.coeffs, &mut self.samples)
+                .map_err(|_| EvaluationError::OutsideDomain {
+                    what: "contact-force coefficients (length)",
+                    value: lambda.len() as f64,
+                })?;
+            for (s, h) in self.samples.iter_mut().zip(&self.mask) {
+                *s *= h;
+            }
+            self.aft
+                .to_coefficients(&self.samples, &mut self.coeffs)
+                .map_err(|_| EvaluationError::OutsideDomain {
+                    what: "contact-force coefficients (length)",
+                    value: lambda.len() as f64,
+                })?;
+            for j in 0..size {
+                out[j * m + i] = self.coeffs[j];
+            }
+        }
         Ok(())
     }
 }
