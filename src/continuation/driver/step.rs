@@ -1,0 +1,294 @@
+//! One step of the continuation: the corrector call, the tangent, the corner passes and the
+//! acceptance of a corrected point (bound landing, orientation, next direction and step).
+
+use super::super::corrector::{Constraint, Corrected, Corrector};
+use super::{Accepted, Continuation};
+use crate::continuation::{
+    BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
+};
+use crate::newton::kernel::{armijo, KernelRules};
+use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
+
+impl<P, S> Continuation<'_, P, S>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    /// Normalises the corrector's raw tangent in the θ-norm into `self.tangent`, oriented
+    /// to have a non-negative inner product with `(ref_x, ref_p)`.
+    pub(super) fn take_tangent(&mut self, reference: Option<&[f64]>, ref_p: f64) {
+        let n = self.metric.n;
+        let raw = &self.bordered.tangent;
+        let norm = self.metric.norm(&raw[..n], raw[n]);
+        for (t, r) in self.tangent.iter_mut().zip(raw) {
+            *t = r / norm;
+        }
+        let t = &self.tangent;
+        let orientation = match reference {
+            Some(r) => self.metric.dot(&t[..n], t[n], &r[..n], r[n]),
+            None => t[n] * ref_p,
+        };
+        if orientation < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
+    }
+
+    /// The corrector on this run's problem, solver, workspace and counters, from
+    /// `(x, p)`; the converged point is written back. Also returns the smallest finite
+    /// residual norm seen.
+    pub(super) fn correct_at(
+        &mut self,
+        x: &mut [f64],
+        p: &mut f64,
+        constraint: Constraint,
+    ) -> (Result<Corrected, CorrectorFailure>, f64) {
+        let n = self.metric.n;
+        let mut y = Vec::with_capacity(n + 1);
+        y.extend_from_slice(x);
+        y.push(*p);
+        let corrector = Corrector {
+            problem: &mut *self.problem,
+            solver: &mut *self.solver,
+            ws: &mut self.bordered,
+            fallback: self.fallback,
+            metric: &self.metric,
+            trust: self
+                .options
+                .trust_factor
+                .map(|_| (&self.trust, &self.main_metric)),
+            rules: KernelRules {
+                absolute_tolerance: self.options.corrector_tolerance,
+                relative_tolerance: 0.0,
+                residual_floor: 0.0,
+                step_tolerance: self.options.step_tolerance,
+                max_iterations: self.options.max_corrector_iterations,
+                min_iterations: 1,
+                globalization: armijo(self.options.corrector_line_search),
+                restore_best: false,
+            },
+        };
+        let outcome = corrector.correct(
+            &mut y,
+            constraint,
+            &mut self.work,
+            &mut self.corrector_counts,
+        );
+        x.copy_from_slice(&y[..n]);
+        *p = y[n];
+        outcome
+    }
+
+    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented so that `p`
+    /// moves as `direction` says.
+    pub(super) fn correct_start(
+        &mut self,
+        x: &mut [f64],
+        p: &mut f64,
+        direction: Direction,
+    ) -> Result<Corrected, CorrectorFailure> {
+        let constraint = Constraint {
+            arclength: false,
+            w_p: 1.0,
+            target: *p,
+        };
+        let corrected = self.correct_at(x, p, constraint).0?;
+        self.take_tangent(None, direction.sign());
+        self.direction.copy_from_slice(&self.tangent);
+        Ok(corrected)
+    }
+
+    /// The corner passes of the module documentation (*Corners*), with step `ds` from
+    /// `last` along the current direction: first on the hyperplane normal to the direction's
+    /// state part, then at the next parameter `p + ds / sqrt((1 - θ) / s_p²)` (sign of the
+    /// direction's parameter component). `Some(result of accept)` when one converged.
+    pub(super) fn pass_corner(&mut self, last: &BranchPoint, ds: f64) -> Option<Accepted> {
+        let n = self.metric.n;
+        let d = self.direction.clone();
+        let state_part = self.metric.state_dot(&d[..n], &d[..n]);
+        let parameter_part = self.metric.parameter_dot(d[n], d[n]);
+        for on_state in [true, false] {
+            let (scale, along, constraint) = if on_state {
+                if state_part < 1e-6 {
+                    continue;
+                }
+                self.direction_weights();
+                let mut along = d.clone();
+                along[n] = 0.0;
+                let target: f64 = self
+                    .bordered
+                    .w
+                    .iter()
+                    .zip(&last.state)
+                    .zip(&d)
+                    .map(|((w, x), di)| w * (x + ds * di))
+                    .sum();
+                let constraint = Constraint {
+                    arclength: true,
+                    w_p: 0.0,
+                    target,
+                };
+                (ds, along, constraint)
+            } else {
+                if parameter_part < 1e-6 {
+                    continue;
+                }
+                let step_p = ds / self.metric.parameter_dot(1.0, 1.0).sqrt() * d[n].signum();
+                let mut along = vec![0.0; n + 1];
+                along[n] = d[n].signum();
+                let constraint = Constraint {
+                    arclength: false,
+                    w_p: 1.0,
+                    target: last.parameter + step_p,
+                };
+                (step_p / d[n], along, constraint)
+            };
+            let mut x: Vec<f64> = last
+                .state
+                .iter()
+                .zip(&d)
+                .map(|(x, di)| x + scale * di)
+                .collect();
+            let mut p = last.parameter + scale * d[n];
+            let before = self.corrector_counts.iterations;
+            match self.correct_at(&mut x, &mut p, constraint).0 {
+                Ok(c) => {
+                    self.counters.corner_passes += 1;
+                    let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
+                    let step = self.metric.norm(&dx, p - last.parameter);
+                    return Some(self.accept(last, x, p, step, c, Some(&along)));
+                }
+                Err(_) => self.reject(before, last.parameter),
+            }
+        }
+        None
+    }
+
+    /// Turns a converged correction into the next branch point: bound landing, tangent
+    /// orientation, next direction and step. Returns the point and the θ-length of the
+    /// chord from `last` (`None` when the run ends on a bound without a new point).
+    pub(super) fn accept(
+        &mut self,
+        last: &BranchPoint,
+        mut x: Vec<f64>,
+        mut p: f64,
+        ds: f64,
+        corrected: Corrected,
+        along: Option<&[f64]>,
+    ) -> Accepted {
+        let n = self.metric.n;
+        self.consecutive_failures = 0;
+        let direction = self.direction.clone();
+        self.take_tangent(Some(&direction), 0.0);
+        let mut iterations = corrected.iterations;
+        let mut residual_norm = corrected.residual_norm;
+        let mut step = ds;
+
+        // Leaving the bounds: re-solve at the bound from the interpolated point.
+        let bound = if p > self.options.parameter_max {
+            Some(self.options.parameter_max)
+        } else if p < self.options.parameter_min {
+            Some(self.options.parameter_min)
+        } else {
+            None
+        };
+        if bound == Some(last.parameter) {
+            // Already on the bound and heading out: nothing new to report.
+            self.problem.set_parameter(last.parameter);
+            self.finish(ContinuationTermination::ReachedBound {
+                parameter: last.parameter,
+                bound: last.parameter,
+            });
+            return None;
+        }
+        if let Some(pb) = bound {
+            let lambda = (pb - last.parameter) / (p - last.parameter);
+            let mut xb: Vec<f64> = last
+                .state
+                .iter()
+                .zip(&x)
+                .map(|(a, b)| a + lambda * (b - a))
+                .collect();
+            let mut pbv = pb;
+            let constraint = Constraint {
+                arclength: false,
+                w_p: 1.0,
+                target: pb,
+            };
+            let saved_tangent = self.tangent.clone();
+            match self.correct_at(&mut xb, &mut pbv, constraint).0 {
+                Ok(c) => {
+                    self.take_tangent(Some(&direction), 0.0);
+                    x = xb;
+                    p = pbv;
+                    iterations += c.iterations;
+                    residual_norm = c.residual_norm;
+                    step = lambda * ds;
+                }
+                Err(_) => {
+                    self.tangent = saved_tangent;
+                    // Keep the point outside the bound; the problem follows it.
+                    self.problem.set_parameter(p);
+                }
+            }
+        }
+
+        // Secant direction for the next predictor.
+        let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
+        let dpar = p - last.parameter;
+        let chord = self.metric.norm(&dx, dpar);
+        // Orient the tangent along the step just taken: where the branch turns sharply the
+        // predictor's direction can make an obtuse angle with the new tangent, and orienting
+        // by it would reverse the tangent (a spurious fold, and a tangent predictor heading
+        // back along the branch). The secant always has a positive component along the
+        // predictor (the arclength constraint), so it is the forward direction here.
+        let forward = match along {
+            Some(a) => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], &a[..n], a[n]),
+            None if chord > 0.0 => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], &dx, dpar),
+            None => 0.0,
+        };
+        if forward < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
+
+        match self.options.predictor {
+            // After a corner the chord cuts across it: the new piece's tangent is the way on.
+            Predictor::Secant if chord > 0.0 && along.is_none() => {
+                for (d, v) in self.direction.iter_mut().zip(&dx) {
+                    *d = v / chord;
+                }
+                self.direction[n] = dpar / chord;
+            }
+            _ => self.direction.copy_from_slice(&self.tangent),
+        }
+
+        let factor = (self.options.target_iterations as f64 / iterations.max(1) as f64)
+            .sqrt()
+            .clamp(0.5, 2.0);
+        self.step = (ds * factor).clamp(self.options.min_step, self.options.max_step);
+
+        let point = BranchPoint {
+            state: x,
+            parameter: p,
+            iterations,
+            residual_norm,
+            step,
+            tangent_parameter: self.tangent[n],
+            corner: false,
+        };
+        if let Some(pb) = bound {
+            self.finish(ContinuationTermination::ReachedBound {
+                parameter: point.parameter,
+                bound: pb,
+            });
+        }
+        Some((point, chord))
+    }
+}
