@@ -4,13 +4,52 @@
 //! but not everywhere differentiable (it contains `max`/`min` of smooth pieces), as
 //! arising from complementarity and unilateral-contact problems.
 //!
+//! ```
+//! use semismooth::faer::Mat;
+//! use semismooth::linalg::FaerDenseLu;
+//! use semismooth::newton::{solve, NewtonOptions};
+//! use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
+//!
+//! /// A spring of stiffness 2 pushed by a force 3 towards a wall at distance 1: the
+//! /// displacement u and the wall's force l >= 0 satisfy 2 u + l = 3 and
+//! /// min(l, 1 - u) = 0 (contact: u = 1, l = 1).
+//! struct Spring;
+//! impl Residual for Spring {
+//!     fn dim(&self) -> usize { 2 }
+//!     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+//!         f[0] = 2.0 * x[0] + x[1] - 3.0;
+//!         f[1] = x[1].min(1.0 - x[0]);
+//!         Ok(())
+//!     }
+//! }
+//! impl GeneralizedJacobian for Spring {
+//!     type Jacobian = Mat<f64>;
+//!     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(2, 2) }
+//!     fn jacobian(&mut self, x: &[f64], j: &mut Mat<f64>) -> Result<(), EvaluationError> {
+//!         (j[(0, 0)], j[(0, 1)]) = (2.0, 1.0);
+//!         // The min picks l where l <= 1 - u, else 1 - u: one element of the B-Jacobian.
+//!         (j[(1, 0)], j[(1, 1)]) = if x[1] <= 1.0 - x[0] { (0.0, 1.0) } else { (-1.0, 0.0) };
+//!         Ok(())
+//!     }
+//! }
+//!
+//! let mut x = [0.0, 0.0];
+//! let report = solve(&mut Spring, &mut FaerDenseLu::new(), &mut x, &NewtonOptions::default())
+//!     .unwrap(); // Err(NewtonError::NotConverged(report)) if it had not converged
+//! assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
+//! assert!(report.iterations <= 3);
+//! ```
+//!
 //! The crate separates three things:
 //! - the **problem**: a [`Residual`] and an element of its generalized (Clarke/B-)
 //!   Jacobian, [`GeneralizedJacobian`], written into the problem's own matrix type;
-//! - the **linear algebra**: [`LinearSolve`] factors a Jacobian once and solves many
-//!   right-hand sides (Newton step, continuation tangent, bordered solves);
-//! - the **drivers**: semismooth Newton with line-search globalization, pseudo-arclength
-//!   continuation, Lemke's algorithm for linear complementarity problems.
+//! - the **linear algebra**: [`Factorize`] factors a Jacobian once and [`LinearSolve`]
+//!   solves many right-hand sides with it (Newton step, continuation tangent, bordered
+//!   solves);
+//! - the **drivers**: semismooth Newton with line-search globalization (one iteration kernel,
+//!   also the continuation's corrector), pseudo-arclength continuation (trust ball,
+//!   restarts, exact corners of piecewise-affine branches) and a natural-parameter
+//!   homotopy, Lemke's algorithm for linear complementarity problems.
 //!
 //! Nothing in this crate knows about rods, contact or any particular model: those live
 //! in the `semismooth-problems` crate, which uses only this crate's public API.

@@ -31,7 +31,7 @@ pub struct BranchPoint {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum ContinuationEvent {
-    /// The parameter turns back (see [`FoldDetector`]): on a smooth branch `t_p` changed
+    /// The parameter turns back (see [`FoldDetector`](super::FoldDetector)): on a smooth branch `t_p` changed
     /// sign between points `index - 1` and `index`; at a corner of a piecewise-smooth branch
     /// `index` is the extreme point itself.
     Fold {
@@ -39,7 +39,7 @@ pub enum ContinuationEvent {
         /// the extreme point where `t_p` did not change sign.
         index: usize,
         /// Parameter at the fold (refined by interpolation when
-        /// [`ContinuationOptions::refine_folds`] is set).
+        /// [`ContinuationOptions::refine_folds`](super::ContinuationOptions::refine_folds) is set).
         parameter: f64,
     },
     /// A corner of a piecewise-affine branch, crossed exactly
@@ -243,7 +243,7 @@ pub struct ContinuationCounters {
     pub rejected_steps: u64,
     /// Points accepted by a corner pass (module documentation, *Corners*).
     pub corner_passes: u64,
-    /// Restarts after failed steps ([`ContinuationOptions::restarts`]).
+    /// Restarts after failed steps ([`ContinuationOptions::restarts`](super::ContinuationOptions::restarts)).
     pub restarts: u64,
     /// Corners of a piecewise-affine branch crossed exactly.
     pub corners: u64,

@@ -10,14 +10,15 @@
 //! <(a, α), (b, β)>_θ = (θ / n) a·b + (1 - θ) α β,        |y|_θ = sqrt(<y, y>_θ),
 //! ```
 //!
-//! (with [`ContinuationOptions::state_scale`] `s`, `a·b` becomes `Σ a_i b_i / s_i^2`),
-//! and step lengths `ds` are lengths in that norm. From an accepted point `y0` with unit
+//! (with [`ContinuationOptions::state_scale`] `s`, `a·b` becomes `Σ a_i b_i / s_i^2`; with
+//! [`ContinuationOptions::parameter_scale`] `s_p`, `α β` becomes `α β / s_p^2`), and step
+//! lengths `ds` are lengths in that norm. From an accepted point `y0` with unit
 //! direction `t` (tangent for the first step, secant afterwards by default) the predictor is
 //! `y0 + ds t`; the corrector is Newton on the bordered system
 //!
 //! ```text
 //! F(x, p) = 0,    N(x, p) = <t, y - y0>_θ - ds = 0,
-//! [[J, F_p], [w_x^T, w_p]] [dx; dp] = -[F; N],    w_x = (θ/n) t_x,  w_p = (1-θ) t_p,
+//! [[J, F_p], [w_x^T, w_p]] [dx; dp] = -[F; N],    w_x = (θ/n) t_x / s^2,  w_p = (1-θ) t_p / s_p^2,
 //! ```
 //!
 //! solved by block elimination with ONE factorization of `J` per corrector iteration and two
@@ -32,13 +33,13 @@
 //!
 //! At a fold `J` is singular while the bordered matrix is not. Block elimination then loses
 //! accuracy (the pivot `w_p - w_x·a` is a difference of large numbers) or the factorization
-//! reports [`LinearSolveError::Singular`]. In practice the iterates rarely hit the singular
+//! reports [`LinearSolveError::Singular`](crate::linalg::LinearSolveError::Singular). In practice the iterates rarely hit the singular
 //! set exactly, and block elimination passes folds (the tests pass several). For Jacobians
 //! that are singular on whole regions (piecewise-linear problems with a flat piece), the
 //! continuation can fall back to a dense LU of the assembled `(n+1) x (n+1)` bordered
 //! matrix. This is an optional capability chosen by a second entry point,
 //! [`Continuation::with_dense_fallback`], which exists only when the Jacobian type
-//! implements [`DenseAssemble`]; structured Jacobians that cannot be assembled use
+//! implements [`DenseAssemble`](crate::linalg::DenseAssemble); structured Jacobians that cannot be assembled use
 //! [`Continuation::new`] and report a corrector failure instead (the step is then halved).
 //!
 //! # Step control
@@ -69,14 +70,48 @@
 //! failed last is tried twice more from the last point: on the hyperplane normal to `d`'s
 //! state part only, `d_x · (x - x_k) = ds |d_x|²` (cuts a far piece along which the state
 //! keeps moving forward, e.g. a fold at a corner), then at the next parameter
-//! `p_k + sign(d_p) ds / sqrt(1 - θ)` (cuts a far piece along which the parameter keeps
+//! `p_k + sign(d_p) ds s_p / sqrt(1 - θ)` (cuts a far piece along which the parameter keeps
 //! moving). A point found this way ([`ContinuationCounters::corner_passes`]) is accepted
 //! with its tangent oriented along that constraint's normal, and the next predictor
 //! follows that tangent (the chord across the corner is no direction for the far piece).
 //!
-//! The corrector takes full Newton steps unless
+//! The corrector is the crate's Newton iteration ([`crate::newton`]: the same step rule and
+//! termination tests) with the bordered direction above; it takes full steps unless
 //! [`ContinuationOptions::corrector_line_search`] asks for Armijo backtracking on
-//! `(|F|^2 + N^2) / 2` ([`crate::linesearch::backtrack`]).
+//! `(|F|^2 + N^2) / 2`. A point where the problem cannot be evaluated
+//! ([`EvaluationError`](crate::EvaluationError)) fails the attempt like a divergence.
+//!
+//! # Trust ball and restarts
+//!
+//! Two options for branches with sharp corners and overhangs. With
+//! [`ContinuationOptions::trust_factor`] the corrector may not leave the θ-ball of
+//! `trust_factor` times the largest next step around the last point (a corrector that
+//! wanders farther has left for another part of the branch). With
+//! [`ContinuationOptions::restarts`] ([`RestartPolicy`]), a run whose steps failed for good
+//! is taken up again from its last point with a state-heavy metric (`θ` near 1) for a few
+//! points, heading the way `p` last moved (the other way when a restart could not make a
+//! single step), then with the options' metric again ([`ContinuationCounters::restarts`]).
+//! A restarted segment that comes back near the points before the restart is going back
+//! along the branch: the run then ends ([`ContinuationTermination::Retraced`]).
+//!
+//! # Piecewise-affine branches
+//!
+//! When the residual is affine in `x` on each piece of a sign pattern
+//! ([`PiecewiseAffine`]: a sampled penalty law), the branch is a chain of pieces that are
+//! graphs over `p`, and every fold is a corner. [`Continuation::with_affine_pieces`] crosses
+//! those corners exactly: when an accepted point lies on another piece than the last one,
+//! or when the steps fail for good, the corners ahead are located on the pieces themselves
+//! (Newton in `p` on the first switching function to change sign, one linear solve of the
+//! affine piece per iterate), emitted as branch points ([`BranchPoint::corner`],
+//! [`ContinuationEvent::Corner`]) while they follow each other within one largest step,
+//! and the continuation resumes a short way along the first long piece. Folds are then
+//! reported at corners, never interpolated.
+//!
+//! # Homotopy
+//!
+//! [`homotopy`] is the natural-parameter counterpart for a parameter the problem offers
+//! (a penalty stiffness, a load factor): stages from an easy value towards a hard one, each
+//! solved by Newton from the previous solution, the step halved after a failure.
 //!
 //! # Style
 //!

@@ -48,7 +48,7 @@ pub struct NaturalSweep {
 /// Natural-parameter continuation: for each `p` in `parameters`, semismooth Newton
 /// ([`crate::newton`], with `options`) at fixed `p` from the previous solution (`x0` for
 /// the first). At a fold it fails or jumps to another branch; it exists to be compared with
-/// the pseudo-arclength [`Continuation`]. Stops at the first failure; the problem's
+/// the pseudo-arclength [`Continuation`](super::Continuation). Stops at the first failure; the problem's
 /// parameter is then left at the last solved point.
 pub fn natural_sweep<P, S>(
     problem: &mut P,

@@ -41,7 +41,7 @@ pub enum Predictor {
 
 /// Options of the pseudo-arclength continuation. Build with struct update syntax from
 /// [`Default`] and check with [`ContinuationOptions::validate`] (done by
-/// [`Continuation::new`]).
+/// [`Continuation::new`](super::Continuation::new)).
 ///
 /// Step lengths are measured in the `theta`-weighted norm of the module documentation.
 #[derive(Clone, Debug, PartialEq)]

@@ -10,7 +10,7 @@
 //!
 //! The driver owns the loop; the line search sees only `alpha -> merit`
 //! ([`crate::linesearch`]); the linear solver only matrices and right-hand sides
-//! ([`Factorize`], [`LinearSolve`]). The iteration itself (step rule, termination tests,
+//! ([`Factorize`], [`LinearSolve`](crate::LinearSolve)). The iteration itself (step rule, termination tests,
 //! best iterate) is the one the continuation corrector runs too, with a bordered direction
 //! instead of the plain solve. [`NewtonSolver`] keeps all buffers (and the Jacobian)
 //! between solves, so continuation and parameter sweeps allocate nothing per iteration;

@@ -122,7 +122,7 @@ where
     /// *Piecewise-affine branches*): when an accepted point lies on another piece than the
     /// last one, or when the steps fail for good, the corners ahead are walked on the
     /// pieces themselves and emitted as branch points ([`BranchPoint::corner`], a
-    /// [`ContinuationEvent::Corner`] each); folds are then reported at corners, never
+    /// [`ContinuationEvent::Corner`](crate::continuation::ContinuationEvent::Corner) each); folds are then reported at corners, never
     /// interpolated.
     pub fn with_affine_pieces(mut self) -> Self {
         self.pieces = Some(Pieces {
