@@ -674,7 +674,7 @@ fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
     let parameters: Vec<f64> = (0..=40).map(|i| -1.0 + 0.05 * i as f64).collect();
     let mut solver = FaerDenseLu::new();
     let below = -1.0 / 3f64.sqrt();
-    for globalization in [Globalization::None, Globalization::default()] {
+    for globalization in [Globalization::None, Globalization::non_monotone()] {
         let mut problem = s_curve();
         let options = NewtonOptions {
             globalization,

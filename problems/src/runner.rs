@@ -156,7 +156,7 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
     let globalization = match settings.globalization {
         GlobalizationChoice::None => Globalization::None,
         GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
-        GlobalizationChoice::Nonmonotone => NewtonOptions::default().globalization,
+        GlobalizationChoice::Nonmonotone => Globalization::non_monotone(),
         GlobalizationChoice::Hybrid => Globalization::hybrid(),
     };
     NewtonOptions {
