@@ -151,6 +151,30 @@ pub struct Solution {
     pub state: Vec<f64>,
 }
 
+/// SSN-HB options from scene settings.
+pub(crate) fn hb_options(settings: &SolverSettings) -> HbOptions {
+    HbOptions {
+        harmonics: settings.harmonics,
+        time_samples: Some(settings.time_samples),
+        c: settings.c,
+    }
+}
+
+/// Penalty-HB options from scene settings (the default penalty relative to the model's
+/// contact stiffness scale).
+pub(crate) fn penalty_options(
+    settings: &SolverSettings,
+    model: &crate::model::StructuralModel,
+) -> PenaltyHbOptions {
+    PenaltyHbOptions {
+        harmonics: settings.harmonics,
+        time_samples: Some(settings.time_samples),
+        penalty_stiffness: settings
+            .penalty_stiffness
+            .unwrap_or(DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()),
+    }
+}
+
 /// Newton options from scene settings.
 pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
     let globalization = match settings.globalization {
@@ -355,12 +379,7 @@ pub fn solve_rod(
     let scale = model.contact_stiffness_scale();
     match settings.method {
         Method::SsnHb => {
-            let options = HbOptions {
-                harmonics: settings.harmonics,
-                time_samples: Some(settings.time_samples),
-                c: settings.c,
-            };
-            let mut problem = SsnHb::new(model, &options)?;
+            let mut problem = SsnHb::new(model, &hb_options(settings))?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
             let report = newton_hb(&mut problem, &mut x, settings, model, 0.0)?;
@@ -371,14 +390,8 @@ pub fn solve_rod(
             Ok(sol)
         }
         Method::PenaltyHb => {
-            let target = settings
-                .penalty_stiffness
-                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
-            let options = PenaltyHbOptions {
-                harmonics: settings.harmonics,
-                time_samples: Some(settings.time_samples),
-                penalty_stiffness: target,
-            };
+            let options = penalty_options(settings, model);
+            let target = options.penalty_stiffness;
             let mut problem = PenaltyHb::new(model, &options)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();

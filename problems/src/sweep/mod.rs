@@ -88,15 +88,13 @@ use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent
 pub use response::FrequencyResponse;
 use response::{extremes, HbTip};
 
-use crate::hb::{
-    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
-};
+use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver, PeriodicLcpOptions};
 use crate::rod::RodModel;
-use crate::runner::{newton_options, RunCounters, RunError, HB_OUTPUT_POINTS};
-use crate::scene::{
-    LinearSolverChoice, Method, SolverSettings, SweepSettings, DEFAULT_RELATIVE_PENALTY,
+use crate::runner::{
+    hb_options, newton_options, penalty_options, RunCounters, RunError, HB_OUTPUT_POINTS,
 };
+use crate::scene::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
 
 /// Weight `θ` of the state in the arclength (module documentation: with the scaling used
 /// here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the θ-norm
@@ -547,12 +545,7 @@ pub fn frequency_response(
     };
     match settings.method {
         Method::SsnHb => {
-            let options = HbOptions {
-                harmonics: settings.harmonics,
-                time_samples: Some(settings.time_samples),
-                c: settings.c,
-            };
-            let mut problem = SsnHb::new(model, &options)?;
+            let mut problem = SsnHb::new(model, &hb_options(settings))?;
             let split = problem.displacement_len();
             let c = problem.c();
             let units = (0..problem.dim())
@@ -575,13 +568,7 @@ pub fn frequency_response(
             )
         }
         Method::PenaltyHb => {
-            let options = PenaltyHbOptions {
-                harmonics: settings.harmonics,
-                time_samples: Some(settings.time_samples),
-                penalty_stiffness: settings
-                    .penalty_stiffness
-                    .unwrap_or(DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()),
-            };
+            let options = penalty_options(settings, model);
             let mut problem = PenaltyHb::new(model, &options)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);

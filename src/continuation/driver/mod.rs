@@ -6,7 +6,9 @@ mod step;
 
 use std::collections::VecDeque;
 
-use super::corrector::{Bordered, Constraint, CorrectorCounts, DenseAssembler, Metric, TrustBall};
+use super::corrector::{
+    Bordered, Constraint, Corrected, CorrectorCounts, DenseAssembler, Metric, TrustBall,
+};
 use super::pieces::AffineOps;
 use super::{
     BranchPoint, ContinuationCounters, ContinuationError, ContinuationEvent, ContinuationOptions,
@@ -287,16 +289,7 @@ where
             }
         };
         self.phase = Phase::Running;
-        let n = self.metric.n;
-        let point = BranchPoint {
-            state: x,
-            parameter: p,
-            iterations: corrected.iterations,
-            residual_norm: corrected.residual_norm,
-            step: 0.0,
-            tangent_parameter: self.tangent[n],
-            corner: false,
-        };
+        let point = self.start_point(x, p, corrected);
         self.after_accept(point, 0.0);
         Ok(())
     }
@@ -343,20 +336,24 @@ where
         };
         self.step = self.options.initial_step;
         self.consecutive_failures = 0;
-        let n = self.metric.n;
-        let point = BranchPoint {
-            state: x,
-            parameter: p,
-            iterations: corrected.iterations,
-            residual_norm: corrected.residual_norm,
-            step: 0.0,
-            tangent_parameter: self.tangent[n],
-            corner: false,
-        };
+        let point = self.start_point(x, p, corrected);
         if emit {
             self.emit(point, 0.0);
         } else {
             self.last = Some(point);
+        }
+    }
+
+    /// The point of a segment's start corrected at fixed `p` (with the tangent just taken).
+    fn start_point(&self, state: Vec<f64>, parameter: f64, corrected: Corrected) -> BranchPoint {
+        BranchPoint {
+            state,
+            parameter,
+            iterations: corrected.iterations,
+            residual_norm: corrected.residual_norm,
+            step: 0.0,
+            tangent_parameter: self.tangent[self.metric.n],
+            corner: false,
         }
     }
 
