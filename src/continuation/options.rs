@@ -216,11 +216,15 @@ impl ContinuationOptions {
                 "within [min_step, max_step]",
             ));
         }
-        if self.target_iterations == 0 {
-            return Err(invalid("target_iterations", 0.0, ">= 1"));
-        }
-        if self.max_corrector_iterations == 0 {
-            return Err(invalid("max_corrector_iterations", 0.0, ">= 1"));
+        for (name, count) in [
+            ("target_iterations", self.target_iterations),
+            ("max_corrector_iterations", self.max_corrector_iterations),
+            ("max_points", self.max_points),
+            ("max_consecutive_failures", self.max_consecutive_failures),
+        ] {
+            if count == 0 {
+                return Err(invalid(name, 0.0, ">= 1"));
+            }
         }
         positive_finite("corrector_tolerance", self.corrector_tolerance)?;
         if !(self.step_tolerance.is_finite() && self.step_tolerance >= 0.0) {
@@ -251,27 +255,20 @@ impl ContinuationOptions {
                 "> parameter_min",
             ));
         }
-        if self.max_points == 0 {
-            return Err(invalid("max_points", 0.0, ">= 1"));
-        }
-        if self.max_consecutive_failures == 0 {
-            return Err(invalid("max_consecutive_failures", 0.0, ">= 1"));
-        }
-        if !(self.theta > 0.0 && self.theta < 1.0) {
-            return Err(invalid("theta", self.theta, "in the open interval (0, 1)"));
-        }
+        let open_unit = |name, v: f64| {
+            if v > 0.0 && v < 1.0 {
+                Ok(())
+            } else {
+                Err(invalid(name, v, "in the open interval (0, 1)"))
+            }
+        };
+        open_unit("theta", self.theta)?;
         positive_finite("parameter_scale", self.parameter_scale)?;
         if let Some(factor) = self.trust_factor {
             positive_finite("trust_factor", factor)?;
         }
         if let Some(policy) = &self.restarts {
-            if !(policy.theta > 0.0 && policy.theta < 1.0) {
-                return Err(invalid(
-                    "restarts.theta",
-                    policy.theta,
-                    "in the open interval (0, 1)",
-                ));
-            }
+            open_unit("restarts.theta", policy.theta)?;
             if policy.points == 0 {
                 return Err(invalid("restarts.points", 0.0, ">= 1"));
             }
