@@ -24,7 +24,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::{newton_options, solve_rod};

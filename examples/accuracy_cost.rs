@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::output::{prepare_directory, write_atomically};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::scene::Scene;

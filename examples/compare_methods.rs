@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::output::{
     csv_table, prepare_directory, write_atomically, write_line_plot, PlotSpec, Series,
 };

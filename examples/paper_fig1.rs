@@ -11,7 +11,7 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::cli::{default_settings, fig1_table, figure_1};
+use semismooth_problems::figures::{default_settings, fig1_table, figure_1};
 use semismooth_problems::output::{prepare_directory, write_line_plot, PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::runner::solve_rod;

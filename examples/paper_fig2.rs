@@ -16,7 +16,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use semismooth_problems::cli::{default_settings, figure_2_sweep};
+use semismooth_problems::figures::{default_settings, figure_2_sweep};
 use semismooth_problems::output::{prepare_directory, write_atomically, write_line_plot};
 use semismooth_problems::output::{PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};

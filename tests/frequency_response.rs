@@ -9,7 +9,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::continuation::natural_sweep;
 use semismooth::newton::{self, Globalization, NewtonOptions};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::model::StructuralModel;
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};

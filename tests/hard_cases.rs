@@ -22,7 +22,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbOptions, SsnHb};
 use semismooth_problems::rod::{
     build_rod, DampingSpec, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,

@@ -6,7 +6,7 @@
 use std::sync::OnceLock;
 
 use semismooth::newton::{self, Globalization, NewtonOptions};
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::lcp::{ActiveSetSolver, PeriodicLcp, PeriodicLcpOptions};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::RunError;

@@ -2,7 +2,7 @@
 //! by semismooth Newton, and time marching — agrees on the canonical modified-mass rod, with
 //! differences that shrink as each discretisation is refined.
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::rod::{build_rod, MassModel, RodModel, RodSpec};
 use semismooth_problems::runner::{solve_rod, Solution};
 use semismooth_problems::scene::{default_hb_time_samples, Method, SolverSettings};

@@ -1,7 +1,7 @@
 //! The paper's rod (issue 4): SSN-HB from zero against closed forms and the time-marching
 //! reference.
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 use semismooth_problems::runner::{solve_rod, Solution};
 use semismooth_problems::scene::{Method, SolverSettings};

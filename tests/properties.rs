@@ -321,7 +321,7 @@ proptest! {
                     prop_assert!(w[0].is_finite() && w[0] > 0.0);
                 }
                 // And a small SSN-HB solve reports finite numbers or an error.
-                let mut settings = semismooth_problems::cli::default_settings(3);
+                let mut settings = semismooth_problems::figures::default_settings(3);
                 settings.max_iterations = 20;
                 match solve_rod(&rod, &settings, None) {
                     Err(e) => prop_assert!(!e.to_string().is_empty()),

@@ -536,7 +536,7 @@ mod tests {
             ..RodSpec::canonical()
         })
         .unwrap();
-        let study = accuracy_cost(&rod, &crate::cli::default_settings(20), None).unwrap();
+        let study = accuracy_cost(&rod, &crate::figures::default_settings(20), None).unwrap();
         let r = &study.reference;
         assert!(
             r.uncertainty < 1e-5,
