@@ -1,8 +1,11 @@
 //! The semismooth Newton driver on problems with known answers: convergence order on
 //! smooth and nonsmooth problems, globalization, exact work counters, every termination.
 
+mod common;
+
 use std::cell::Cell;
 
+use common::allocations;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use rand::{Rng, SeedableRng};
@@ -844,30 +847,8 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     );
 }
 
-/// Counts heap allocations made by the current thread (tests run in parallel threads).
-struct CountingAllocator;
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
-        unsafe { std::alloc::System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.realloc(ptr, layout, size) }
-    }
-}
 #[global_allocator]
-static GLOBAL: CountingAllocator = CountingAllocator;
-
-fn allocations() -> u64 {
-    ALLOCATIONS.with(Cell::get)
-}
+static GLOBAL: common::CountingAllocator = common::CountingAllocator;
 
 /// One warm-up solve (buffers, Jacobian, factor storage), then from each start: the
 /// solve converges in >= 3 iterations and makes exactly 3 allocations (the report's
