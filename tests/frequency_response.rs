@@ -438,18 +438,7 @@ fn json_has_the_issue_fields_one_entry_per_point() {
     let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
     let r = curve(&rod, Method::SsnHb, 3, 0.8, 1.2);
     let v = r.to_json();
-    for key in [
-        "points",
-        "omega",
-        "tip_max",
-        "tip_min",
-        "amplitude",
-        "folds",
-        "converged",
-        "solve_seconds",
-        "termination",
-        "counters",
-    ] {
+    for key in common::json_fields::SWEEP {
         assert!(v.get(key).is_some(), "{key}");
     }
     assert_eq!(v["points"].as_u64().unwrap() as usize, r.points());

@@ -514,7 +514,7 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
 
 /// The condensed (Woodbury) solve subtracts large terms when the penalty is stiff; with
 /// one refinement step its residual `|J d - r| / |r|` stays at rounding level, like the
-/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (issue 5's finest setting).
+/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (the scenes' default penalty).
 #[test]
 fn structured_solve_stays_backward_stable_for_stiff_penalties() {
     let model = canonical_modified_rod();

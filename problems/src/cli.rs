@@ -364,23 +364,8 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
     bar.finish_and_clear();
     print!("{}", study.table());
     println!("\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip minimum:");
-    for (method, entry) in study.cheapest(accuracy) {
-        match entry {
-            Some(e) => println!(
-                "  {:<11} {:<28} {:>10.3} ms  (error {:.1e})",
-                method.name(),
-                e.setting,
-                1e3 * e.seconds,
-                e.tip_min_error
-            ),
-            None => println!(
-                "  {:<11} none of the settings tried reaches it",
-                method.name()
-            ),
-        }
-    }
-    write_atomically(&out.join("accuracy_cost.csv"), study.to_csv().as_bytes())?;
-    study.write_svg(&out.join("accuracy_cost.svg"))?;
+    print!("{}", study.cheapest_table(accuracy));
+    study.write_files(out)?;
     println!(
         "\nWrote {}/accuracy_cost.csv and accuracy_cost.svg",
         out.display()

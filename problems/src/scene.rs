@@ -698,17 +698,8 @@ impl Check<'_> {
 mod tests {
     use super::*;
 
-    const CANONICAL: &str = r#"
-[rod]
-elements = 20
-[damping]
-zeta = 0.01
-[forcing]
-amplitude = 0.04
-omega_ratio = 1.0
-[contact]
-gap = 0.5
-"#;
+    /// The shipped scene of the paper's Fig. 1: the canonical rod, SSN-HB with H = 20.
+    const CANONICAL: &str = include_str!("../scenes/paper_fig1.toml");
 
     #[test]
     fn canonical_scene_resolves_to_the_canonical_rod() {
@@ -721,10 +712,13 @@ gap = 0.5
 
     #[test]
     fn hb_time_sample_default_is_a_power_of_two_of_at_least_four_per_basis_function() {
-        assert_eq!(default_hb_time_samples(1), 64);
-        assert_eq!(default_hb_time_samples(5), 64);
-        assert_eq!(default_hb_time_samples(10), 128);
-        assert_eq!(default_hb_time_samples(100), 1024);
+        for (harmonics, samples) in [(1, 64), (5, 64), (10, 128), (100, 1024)] {
+            assert_eq!(
+                default_hb_time_samples(harmonics),
+                samples,
+                "H = {harmonics}"
+            );
+        }
     }
 
     #[test]
@@ -736,7 +730,7 @@ gap = 0.5
 
     #[test]
     fn too_few_time_samples_for_the_harmonics_are_rejected() {
-        let text = format!("{CANONICAL}\n[solver]\nharmonics = 20\ntime_samples = 40\n");
+        let text = CANONICAL.replace("harmonics = 20", "harmonics = 20\ntime_samples = 40");
         let err = Scene::from_toml(&text, "x.toml").unwrap_err().to_string();
         assert!(
             err.contains("solver.time_samples") && err.contains("40"),

@@ -6,6 +6,8 @@
 
 #![allow(dead_code)]
 
+pub mod json_fields;
+
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
 
