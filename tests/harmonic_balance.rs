@@ -23,9 +23,8 @@ use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel}
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
-/// `D = beta K` (or none), forcing `amplitude` on every dof at `omega`, contacts
-/// `(dof, gap)`.
-fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: &[(usize, f64)]) -> StructuralModel {
+/// `D = beta K` (or none), forcing `amplitude` on every dof at `omega`.
+fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -> StructuralModel {
     let k = [3.0, 2.0, 1.5, 1.2, 1.0];
     let mass = [1.0, 0.7, 0.5, 0.4, 0.3];
     let mut kt = Vec::new();
@@ -57,11 +56,16 @@ fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: &[(usize, f64)]) -> 
             amplitude: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
             omega,
         },
-        contacts: contacts
-            .iter()
-            .map(|&(dof, gap)| ContactPoint { dof, gap })
-            .collect(),
+        contacts,
     }
+}
+
+/// Contact points `(dof, gap)`.
+fn contacts(points: &[(usize, f64)]) -> Vec<ContactPoint> {
+    points
+        .iter()
+        .map(|&(dof, gap)| ContactPoint { dof, gap })
+        .collect()
 }
 
 /// SSN-HB options: `harmonics`, `time_samples` (`None`: the default for `harmonics`) and
@@ -140,7 +144,7 @@ fn max_abs(m: &Mat<f64>) -> f64 {
 fn dynamic_blocks_match_time_domain_equation_of_motion() {
     // R = A(w) U - F with F = 0 and no contact, against M u'' + D u' + K u evaluated at
     // the samples (derivatives from the coefficient-space operator) and projected by P.
-    let mut model = chain(3, Some(0.05), 1.3, &[]);
+    let mut model = chain(3, Some(0.05), 1.3, vec![]);
     model.forcing.amplitude = vec![0.0; 3];
     let mut hb = SsnHb::new(&model, &hb_options(4, Some(32), None)).unwrap();
     let basis = FourierBasis::new(4, 32).unwrap();
@@ -259,7 +263,7 @@ where
 
 #[test]
 fn ssn_jacobian_matches_central_differences_away_from_kinks() {
-    let model = chain(3, Some(0.02), 0.9, &[(1, 0.2), (2, 0.1)]);
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
     let (h, nt) = (3, 16);
     let mut hb = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
@@ -268,7 +272,7 @@ fn ssn_jacobian_matches_central_differences_away_from_kinks() {
 
 #[test]
 fn penalty_jacobian_matches_central_differences_away_from_kinks() {
-    let model = chain(3, Some(0.02), 0.9, &[(0, 0.05), (2, 0.1)]);
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(0, 0.05), (2, 0.1)]));
     let (h, nt) = (3, 16);
     let mut hb = PenaltyHb::new(&model, &penalty_options(h, Some(nt), 50.0)).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.3, |x| {
@@ -282,7 +286,7 @@ fn penalty_jacobian_matches_central_differences_away_from_kinks() {
 
 #[test]
 fn omega_derivative_matches_central_differences() {
-    let model = chain(3, Some(0.03), 1.1, &[(2, 0.1)]);
+    let model = chain(3, Some(0.03), 1.1, vec![ContactPoint { dof: 2, gap: 0.1 }]);
     let mut hb = SsnHb::new(&model, &hb_options(3, Some(16), None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
@@ -322,7 +326,7 @@ fn exact_linear_response(model: &StructuralModel) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
     for damping in [Some(0.04), None] {
-        let model = chain(4, damping, 1.7, &[]);
+        let model = chain(4, damping, 1.7, vec![]);
         let mut hb = SsnHb::new(&model, &HbOptions::default()).unwrap();
         let mut x = vec![0.0; hb.dim()];
         let mut r = vec![0.0; hb.dim()];
@@ -393,21 +397,21 @@ where
 
 #[test]
 fn structured_and_dense_newton_steps_agree_ssn() {
-    let model = chain(5, Some(0.02), 1.2, &[(1, 0.2), (3, 0.1)]);
+    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.2), (3, 0.1)]));
     let mut hb = SsnHb::new(&model, &hb_options(6, None, Some(3.0))).unwrap();
     assert_steps_agree_at_random_points(&mut hb);
 }
 
 #[test]
 fn structured_and_dense_newton_steps_agree_penalty() {
-    let model = chain(5, Some(0.02), 1.2, &[(1, 0.05), (3, 0.02)]);
+    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.05), (3, 0.02)]));
     let mut hb = PenaltyHb::new(&model, &penalty_options(6, None, 100.0)).unwrap();
     assert_steps_agree_at_random_points(&mut hb);
 }
 
 #[test]
 fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
-    let model = chain(3, Some(0.02), 1.2, &[(2, 0.1)]);
+    let model = chain(3, Some(0.02), 1.2, vec![ContactPoint { dof: 2, gap: 0.1 }]);
     let mut hb = SsnHb::new(&model, &hb_options(4, None, None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let mut jac = hb.new_jacobian();
@@ -430,11 +434,10 @@ fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
 
 #[test]
 fn bad_options_are_typed_errors_with_the_numbers() {
-    let model = chain(3, None, 1.0, &[(2, 0.1)]);
-    let ssn_error =
-        |model: &StructuralModel, options: HbOptions| SsnHb::new(model, &options).unwrap_err();
+    let model = chain(3, None, 1.0, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let err = SsnHb::new(&model, &hb_options(10, Some(20), None)).unwrap_err();
     assert!(matches!(
-        ssn_error(&model, hb_options(10, Some(20), None)),
+        err,
         HbError::Harmonic(HarmonicError::TooFewSamples {
             harmonics: 10,
             time_samples: 20,
@@ -445,36 +448,43 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         c: Some(-1.0),
         ..HbOptions::default()
     };
-    let err = ssn_error(&model, negative_c);
+    let err = SsnHb::new(&model, &negative_c).unwrap_err();
     assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
-    let bad = chain(3, None, 1.0, &[(7, 0.1)]);
-    assert!(matches!(
-        ssn_error(&bad, HbOptions::default()),
-        HbError::IndexOutOfRange {
-            index: 7,
-            count: 3,
-            ..
-        }
-    ));
-    let mut bad = chain(3, None, 1.0, &[]);
-    bad.forcing.omega = 0.0;
     let nan_penalty = PenaltyHbOptions {
         penalty_stiffness: f64::NAN,
         ..PenaltyHbOptions::default()
     };
     for (err, option) in [
-        (ssn_error(&model, hb_options(0, None, None)), "harmonics"),
+        (
+            SsnHb::new(&model, &hb_options(0, None, None)).unwrap_err(),
+            "harmonics",
+        ),
         (
             PenaltyHb::new(&model, &nan_penalty).unwrap_err(),
             "penalty_stiffness",
         ),
-        (ssn_error(&bad, HbOptions::default()), "omega"),
     ] {
         assert!(
             matches!(err, HbError::InvalidOption { name, .. } if name == option),
             "{option}: {err:?}"
         );
     }
+    let bad = chain(3, None, 1.0, vec![ContactPoint { dof: 7, gap: 0.1 }]);
+    let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
+    assert!(matches!(
+        err,
+        HbError::IndexOutOfRange {
+            index: 7,
+            count: 3,
+            ..
+        }
+    ));
+    let mut bad = chain(3, None, 1.0, vec![]);
+    bad.forcing.omega = 0.0;
+    assert!(matches!(
+        SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
+        HbError::InvalidOption { name: "omega", .. }
+    ));
 }
 
 fn canonical_modified_rod() -> StructuralModel {
@@ -656,7 +666,7 @@ fn sample_complementarity(hb: &SsnHb, x: &[f64], contact: ContactPoint) -> (f64,
 /// convergence for the same chain with mass 0.5 on the contact node).
 #[test]
 fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
-    let mut model = chain(3, Some(0.02), 0.5, &[(2, 0.3)]);
+    let mut model = chain(3, Some(0.02), 0.5, vec![ContactPoint { dof: 2, gap: 0.3 }]);
     let masses = [
         Triplet::new(0, 0, 1.0),
         Triplet::new(1, 1, 0.7),
