@@ -1,6 +1,6 @@
 //! Harmonic-balance solve times, single-threaded (`faer::Par::Seq`).
 //!
-//! `cargo bench --bench hb_solve` (about two minutes), or e.g. `-- canonical` for one group:
+//! `cargo bench --bench hb_solve`, or e.g. `-- canonical` for one group:
 //! - `canonical/{modified,consistent}`: the canonical rod (20 elements), H = 20, from zero:
 //!   SSN-HB problem + structured solver built and Newton run to 1e-10 (target < 2 ms);
 //! - `newton_solver/{structured,dense}`: the same full Newton solve (modified mass) with the
@@ -20,12 +20,13 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
-use semismooth_problems::cli::default_settings;
-use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
+use semismooth_problems::figures::default_settings;
+use semismooth_problems::hb::{HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_problems::runner::{newton_options, solve_rod};
 use semismooth_problems::scene::{default_hb_time_samples, Method, SolverSettings};
@@ -53,34 +54,60 @@ fn hb_options(h: usize, c: Option<f64>) -> HbOptions {
     }
 }
 
-/// One SSN-HB solve from zero with the structured solver (`c`: `None` for the default
-/// `K[tip, tip]`); returns the iterations.
-fn solve_structured(rod: &RodModel, h: usize, c: Option<f64>) -> usize {
+/// SSN-HB on `rod` (`c`: `None` for the default) solved from zero with `solver`; returns
+/// the problem and its solution.
+fn solve<S: Factorize<HbJacobian>>(
+    rod: &RodModel,
+    h: usize,
+    c: Option<f64>,
+    mut solver: S,
+) -> (SsnHb, Vec<f64>) {
     let options = newton_options(&default_settings(h));
     let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
-    let mut solver = StructuredHbSolver::new();
-    let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
-    assert!(report.converged(), "structured solve did not converge");
-    report.iterations
+    newton::solve(&mut problem, &mut solver, &mut x, &options).expect("converges");
+    (problem, x)
 }
 
-fn solve_dense(rod: &RodModel, h: usize) -> usize {
-    let options = newton_options(&default_settings(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h, None)).expect("valid HB problem");
-    let mut x = vec![0.0; problem.dim()];
-    let mut solver = FaerDenseLu::new();
-    let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
-    assert!(report.converged(), "dense solve did not converge");
-    report.iterations
+/// One SSN-HB solve from zero with the structured solver (`c`: `None` for the default);
+/// returns the solution's first entry.
+fn solve_structured(rod: &RodModel, h: usize, c: Option<f64>) -> f64 {
+    solve(rod, h, c, StructuredHbSolver::new()).1[0]
+}
+
+/// Factors `jac` with `solver` and solves for `rhs` in `work`; returns `work[0]`.
+fn factor_and_solve<S: Factorize<HbJacobian>>(
+    solver: &mut S,
+    jac: &HbJacobian,
+    rhs: &[f64],
+    work: &mut [f64],
+) -> f64 {
+    solver.factor(jac).expect("factors");
+    work.copy_from_slice(rhs);
+    solver.solve_in_place(work).expect("solves");
+    work[0]
+}
+
+/// A benchmark group with `samples` samples, warmed up for `warm_up_ms` and measured for
+/// `measure_s` seconds.
+fn configured_group<'a>(
+    c: &'a mut Criterion,
+    name: &str,
+    samples: usize,
+    warm_up_ms: u64,
+    measure_s: u64,
+) -> BenchmarkGroup<'a, WallTime> {
+    let mut group = c.benchmark_group(name);
+    group
+        .sample_size(samples)
+        .warm_up_time(Duration::from_millis(warm_up_ms))
+        .measurement_time(Duration::from_secs(measure_s));
+    group
 }
 
 fn canonical(c: &mut Criterion) {
     faer::set_global_parallelism(faer::Par::Seq);
-    let mut group = c.benchmark_group("canonical");
-    group
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3));
+    let mut group = configured_group(c, "canonical", 100, 500, 3);
     for (name, mass) in [
         ("modified", MassModel::Modified),
         ("consistent", MassModel::Consistent),
@@ -96,51 +123,33 @@ fn canonical(c: &mut Criterion) {
 fn newton_solver(c: &mut Criterion) {
     faer::set_global_parallelism(faer::Par::Seq);
     let rod = rod(MassModel::Modified, 20);
-    let mut group = c.benchmark_group("newton_solver");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(4));
+    let mut group = configured_group(c, "newton_solver", 10, 500, 4);
     group.bench_function("structured", |b| {
         b.iter(|| black_box(solve_structured(&rod, H, None)))
     });
-    group.bench_function("dense", |b| b.iter(|| black_box(solve_dense(&rod, H))));
+    group.bench_function("dense", |b| {
+        b.iter(|| black_box(solve(&rod, H, None, FaerDenseLu::new()).1[0]))
+    });
     group.finish();
 
     // One Newton system at the converged state (an active set with contact).
-    let options = newton_options(&default_settings(H));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(H, None)).expect("valid HB problem");
-    let mut x = vec![0.0; problem.dim()];
-    let mut solver = StructuredHbSolver::new();
-    newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
+    let (mut problem, x) = solve(&rod, H, None, StructuredHbSolver::new());
     let mut jac = problem.new_jacobian();
     problem.jacobian(&x, &mut jac).expect("evaluates");
     let rhs: Vec<f64> = (0..problem.dim())
         .map(|i| (i as f64 * 0.37).sin())
         .collect();
     let mut work = rhs.clone();
-    let mut group = c.benchmark_group("linear_solve");
-    group
-        .sample_size(20)
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2));
+    let mut group = configured_group(c, "linear_solve", 20, 300, 2);
     let mut structured = StructuredHbSolver::new();
     structured.factor(&jac).expect("factors");
     group.bench_function("structured_iteration", |b| {
-        b.iter(|| {
-            structured.factor(&jac).expect("factors");
-            work.copy_from_slice(&rhs);
-            structured.solve_in_place(&mut work).expect("solves");
-            black_box(work[0])
-        })
+        b.iter(|| black_box(factor_and_solve(&mut structured, &jac, &rhs, &mut work)))
     });
     group.bench_function("structured_fresh", |b| {
         b.iter(|| {
-            let mut s = StructuredHbSolver::new();
-            s.factor(&jac).expect("factors");
-            work.copy_from_slice(&rhs);
-            s.solve_in_place(&mut work).expect("solves");
-            black_box(work[0])
+            let mut fresh = StructuredHbSolver::new();
+            black_box(factor_and_solve(&mut fresh, &jac, &rhs, &mut work))
         })
     });
     // The parts of one Newton iteration (profile of the canonical H = 20 solve).
@@ -169,23 +178,14 @@ fn newton_solver(c: &mut Criterion) {
     });
     let mut dense = FaerDenseLu::new();
     group.bench_function("dense", |b| {
-        b.iter(|| {
-            dense.factor(&jac).expect("factors");
-            work.copy_from_slice(&rhs);
-            dense.solve_in_place(&mut work).expect("solves");
-            black_box(work[0])
-        })
+        b.iter(|| black_box(factor_and_solve(&mut dense, &jac, &rhs, &mut work)))
     });
     group.finish();
 }
 
 fn elements(c: &mut Criterion) {
     faer::set_global_parallelism(faer::Par::Seq);
-    let mut group = c.benchmark_group("elements");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(200))
-        .measurement_time(Duration::from_secs(3));
+    let mut group = configured_group(c, "elements", 10, 200, 3);
     for n in [1000, 10_000] {
         let rod = rod(MassModel::Modified, n);
         // c = EA / L, the static tip stiffness (see examples/scaling.rs: the default
@@ -253,17 +253,12 @@ fn march_vs_hb(c: &mut Criterion) {
         "march_vs_hb: reference tip min {reference:.10}; march {} steps/period (tolerance 1e-6), SSN-HB H = {} Nt = {}",
         march.steps_per_period, hb.harmonics, hb.time_samples
     );
-    let mut group = c.benchmark_group("march_vs_hb");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(3));
-    group.bench_function("march", |b| {
-        b.iter(|| black_box(solve_rod(&rod, &march, None).expect("runs").stats.min))
-    });
-    group.bench_function("ssn_hb", |b| {
-        b.iter(|| black_box(solve_rod(&rod, &hb, None).expect("runs").stats.min))
-    });
+    let mut group = configured_group(c, "march_vs_hb", 10, 300, 3);
+    for (name, settings) in [("march", &march), ("ssn_hb", &hb)] {
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(solve_rod(&rod, settings, None).expect("runs").stats.min))
+        });
+    }
     group.finish();
 }
 

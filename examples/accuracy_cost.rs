@@ -7,8 +7,8 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::cli::default_settings;
-use semismooth_problems::output::{prepare_directory, write_atomically};
+use semismooth_problems::figures::default_settings;
+use semismooth_problems::output::prepare_directory;
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::scene::Scene;
 use semismooth_problems::study::accuracy_cost;
@@ -44,23 +44,11 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     println!("{}", study.table());
     for accuracy in [1e-3, 1e-4] {
         println!("cheapest setting for {accuracy:.0e} on the tip minimum:");
-        for (method, entry) in study.cheapest(accuracy) {
-            match entry {
-                Some(e) => println!(
-                    "  {:<11} {:<22} {:.3e} s (error {:.1e})",
-                    method.name(),
-                    e.setting,
-                    e.seconds,
-                    e.tip_min_error
-                ),
-                None => println!("  {:<11} not reached", method.name()),
-            }
-        }
+        print!("{}", study.cheapest_table(accuracy));
     }
     let out = PathBuf::from("out/accuracy_cost");
     prepare_directory(&out)?;
-    write_atomically(&out.join("accuracy_cost.csv"), study.to_csv().as_bytes())?;
-    study.write_svg(&out.join("accuracy_cost.svg"))?;
+    study.write_files(&out)?;
     println!(
         "\nWrote {0}/accuracy_cost.csv and {0}/accuracy_cost.svg",
         out.display()

@@ -8,12 +8,10 @@
 //!
 //! `cargo run --release --example compare_methods [OUT_DIR]`
 
-use std::path::PathBuf;
+mod common;
 
-use semismooth_problems::cli::default_settings;
-use semismooth_problems::output::{
-    csv_table, prepare_directory, write_atomically, write_line_plot, PlotSpec, Series,
-};
+use semismooth_problems::figures::default_settings;
+use semismooth_problems::output::{csv_table, write_atomically, write_line_plot, PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::runner::{solve_rod, Solution};
 use semismooth_problems::scene::{Method, SolverSettings};
@@ -24,11 +22,7 @@ struct Row {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out: PathBuf = std::env::args()
-        .nth(1)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out/compare_methods"));
-    prepare_directory(&out)?;
+    let out = common::output_directory("out/compare_methods")?;
     for mass in [MassModel::Modified, MassModel::Consistent] {
         compare(mass, &out)?;
     }

@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release --example lcp_sweep [NT ...]`
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::scene::{Method, SweepSettings};
 use semismooth_problems::sweep::frequency_response;

@@ -9,19 +9,15 @@
 //!
 //! `cargo run --release --example paper_fig1 [OUT_DIR]`
 
-use std::path::PathBuf;
+mod common;
 
-use semismooth_problems::cli::{default_settings, fig1_table, figure_1};
-use semismooth_problems::output::{prepare_directory, write_line_plot, PlotSpec, Series};
+use semismooth_problems::figures::{default_settings, fig1_table, figure_1};
+use semismooth_problems::output::{write_line_plot, PlotSpec, Series};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::runner::solve_rod;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out: PathBuf = std::env::args()
-        .nth(1)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out/paper_fig1"));
-    prepare_directory(&out)?;
+    let out = common::output_directory("out/paper_fig1")?;
     let quiet = true;
     let map = |e: semismooth_problems::cli::CliError| format!("{e:?}");
     let mut rows = figure_1(&out, MassModel::Modified, quiet).map_err(map)?;

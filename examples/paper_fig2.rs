@@ -13,18 +13,16 @@
 //! frequencies a slow sweep would see) and the difference between `H = 5` and `H = 20`, and
 //! the measured timings.
 
-use std::path::PathBuf;
+mod common;
+
 use std::time::Instant;
 
-use semismooth_problems::cli::{default_settings, figure_2_sweep};
-use semismooth_problems::output::{prepare_directory, write_atomically, write_line_plot};
+use semismooth_problems::figures::{default_settings, fig2_rod, figure_2_sweep, FIG2_GAPS as GAPS};
+use semismooth_problems::output::{write_atomically, write_line_plot};
 use semismooth_problems::output::{PlotSpec, Series};
-use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
+use semismooth_problems::rod::{build_rod, MassModel, RodModel, RodSpec};
 use semismooth_problems::scene::{GlobalizationChoice, SolverSettings, SweepSettings};
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
-
-/// Gaps of the paper's Fig. 2 (`None`: no contact).
-const GAPS: [Option<f64>; 4] = [Some(0.25), Some(0.5), Some(0.75), None];
 
 fn settings(harmonics: usize) -> SolverSettings {
     SolverSettings {
@@ -43,10 +41,7 @@ fn rod(gap: Option<f64>, amplitude: f64, mass: MassModel) -> RodModel {
     let spec = RodSpec {
         amplitude,
         mass,
-        contacts: gap
-            .map(|gap| vec![RodContact { node: 20, gap }])
-            .unwrap_or_default(),
-        ..RodSpec::canonical()
+        ..fig2_rod(gap)
     };
     build_rod(&spec).expect("the paper's rod builds")
 }
@@ -120,11 +115,7 @@ fn header() {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let dir = std::env::args()
-        .nth(1)
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("out/paper_fig2"));
-    prepare_directory(&dir)?;
+    let dir = common::output_directory("out/paper_fig2")?;
 
     // Warm-up (page faults, FFT plans) so that the timings below measure the sweeps.
     let _ = run(
@@ -268,7 +259,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     println!(
         "timings (wall clock, release build, {} logical cores available): four H = 5 curves {:.3} s in total \
-         (issue 7 target 0.2 s); one contact curve (gap 0.5) at H = 20 {:.3} s (target 0.5 s)",
+         (target 0.2 s); one contact curve (gap 0.5) at H = 20 {:.3} s (target 0.5 s)",
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         h5,
         h20_contact

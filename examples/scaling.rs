@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use semismooth::newton::{self, NewtonOptions};
 use semismooth::Residual;
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 use semismooth_problems::runner::newton_options;

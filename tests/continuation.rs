@@ -715,21 +715,7 @@ fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
     // moves at most max_step = 0.05 in the θ-norm (0.071 Euclidean for θ = 1/2, n = 1) and
     // the corrector moves orthogonally to it by much less, so 0.1 bounds the Euclidean
     // distance between consecutive points.
-    let mut problem = s_curve();
-    let branch = Continuation::new(
-        &mut problem,
-        &mut solver,
-        &[-1.3],
-        -1.0,
-        ContinuationOptions {
-            parameter_min: -1.0,
-            parameter_max: 1.0,
-            ..Default::default()
-        },
-    )
-    .unwrap()
-    .run()
-    .unwrap();
+    let branch = s_curve_branch();
     for w in branch.points.windows(2) {
         let d = (w[1].state[0] - w[0].state[0]).hypot(w[1].parameter - w[0].parameter);
         assert!(d < 0.1, "{d}");
@@ -849,47 +835,25 @@ fn bad_input_is_a_typed_error_with_the_numbers() {
         bad(ContinuationOptions { theta: 1.0, ..Default::default() }),
         ContinuationError::InvalidOption { name: "theta", value, .. } if value == 1.0
     ));
-    assert!(matches!(
-        bad(ContinuationOptions {
-            initial_step: 1.0,
-            ..Default::default()
-        }),
-        ContinuationError::InvalidOption {
-            name: "initial_step",
-            ..
-        }
-    ));
-    assert!(matches!(
-        bad(ContinuationOptions {
-            min_step: f64::NAN,
-            ..Default::default()
-        }),
-        ContinuationError::InvalidOption {
-            name: "min_step",
-            ..
-        }
-    ));
-    assert!(matches!(
-        bad(ContinuationOptions {
-            parameter_min: 2.0,
-            parameter_max: 1.0,
-            ..Default::default()
-        }),
-        ContinuationError::InvalidOption {
-            name: "parameter_max",
-            ..
-        }
-    ));
-    assert!(matches!(
-        bad(ContinuationOptions {
-            max_points: 0,
-            ..Default::default()
-        }),
-        ContinuationError::InvalidOption {
-            name: "max_points",
-            ..
-        }
-    ));
+    // Each case spoils the default options; the error names the field.
+    type Spoil = fn(&mut ContinuationOptions);
+    let cases: [(Spoil, &str); 4] = [
+        (|o| o.initial_step = 1.0, "initial_step"),
+        (|o| o.min_step = f64::NAN, "min_step"),
+        (
+            |o| (o.parameter_min, o.parameter_max) = (2.0, 1.0),
+            "parameter_max",
+        ),
+        (|o| o.max_points = 0, "max_points"),
+    ];
+    for (spoil, field) in cases {
+        let mut options = ContinuationOptions::default();
+        spoil(&mut options);
+        assert!(
+            matches!(bad(options), ContinuationError::InvalidOption { name, .. } if name == field),
+            "{field}"
+        );
+    }
     assert!(ContinuationOptions::with_step(0.1).validate().is_ok());
     assert!(matches!(
         Continuation::new(

@@ -1,49 +1,25 @@
-//! Frequency-response curves by pseudo-arclength continuation (issue 6), checked against
+//! Frequency-response curves by pseudo-arclength continuation, checked against
 //! independent references: the exact linear response (complex dense solve), plain Newton
 //! re-solves at every branch point, the natural-parameter sweep, the penalty formulation
 //! (its own residual at every point, its convergence in the penalty) and SSN-HB at a higher
 //! `H`.
 
-use faer::sparse::SparseColMat;
-use nalgebra::{Complex, DMatrix, DVector};
+mod common;
+
+use common::{exact_linear, fig2_rod_model as rod, norm, sweep_solver as settings};
 use semismooth::continuation::natural_sweep;
-use semismooth::newton::{self, Globalization, NewtonOptions};
+use semismooth::newton::NewtonOptions;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
-use semismooth_problems::cli::default_settings;
-use semismooth_problems::hb::{HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
-use semismooth_problems::model::StructuralModel;
-use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
+use semismooth_problems::hb::{PenaltyHb, PenaltyHbOptions, StructuredHbSolver};
+use semismooth_problems::rod::{MassModel, RodModel};
 use semismooth_problems::runner::RunError;
 use semismooth_problems::scene::{
-    default_hb_time_samples, GlobalizationChoice, Method, SolverSettings, SweepSettings,
-    DEFAULT_RELATIVE_PENALTY,
+    default_hb_time_samples, Method, SweepSettings, DEFAULT_RELATIVE_PENALTY,
 };
 use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
 
-fn settings(method: Method, harmonics: usize) -> SolverSettings {
-    SolverSettings {
-        method,
-        max_iterations: 100,
-        globalization: GlobalizationChoice::Nonmonotone,
-        steps_per_period: 1024,
-        ..default_settings(harmonics)
-    }
-}
-
 fn sweep(from: f64, to: f64) -> SweepSettings {
     SweepSettings::new(from, to)
-}
-
-fn rod(gap: Option<f64>, amplitude: f64, mass: MassModel) -> RodModel {
-    build_rod(&RodSpec {
-        amplitude,
-        mass,
-        contacts: gap
-            .map(|gap| vec![RodContact { node: 20, gap }])
-            .unwrap_or_default(),
-        ..RodSpec::canonical()
-    })
-    .unwrap()
 }
 
 fn curve(
@@ -56,27 +32,6 @@ fn curve(
     let r = frequency_response(rod, &settings(method, harmonics), &sweep(from, to), None).unwrap();
     assert!(r.converged, "{}", r.termination);
     r
-}
-
-fn dense(m: &SparseColMat<usize, f64>) -> DMatrix<f64> {
-    let d = m.to_dense();
-    DMatrix::from_fn(d.nrows(), d.ncols(), |i, j| d[(i, j)])
-}
-
-/// Exact complex amplitude `z` of `(K - w^2 M + i w D) z = f` (`u = Re(z e^{iwt})`).
-fn exact_linear(model: &StructuralModel, w: f64) -> DVector<Complex<f64>> {
-    let (m, k) = (dense(&model.mass), dense(&model.stiffness));
-    let d = model.damping.as_ref().map(dense).unwrap();
-    let n = m.nrows();
-    let a = DMatrix::from_fn(n, n, |i, j| {
-        Complex::new(k[(i, j)] - w * w * m[(i, j)], w * d[(i, j)])
-    });
-    let f = DVector::from_fn(n, |i, _| Complex::new(model.forcing.amplitude[i], 0.0));
-    a.lu().solve(&f).unwrap()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
 }
 
 #[test]
@@ -194,30 +149,15 @@ fn every_branch_point_is_a_fixed_point_of_plain_newton() {
         let rod = rod(Some(gap), amplitude, mass);
         let h = 5;
         let r = curve(&rod, Method::SsnHb, h, 0.5, 2.0);
-        let options = HbOptions {
-            harmonics: h,
-            time_samples: Some(default_hb_time_samples(h)),
-            c: None,
-        };
-        let mut problem = SsnHb::new(&rod.model, &options).unwrap();
+        let mut problem = common::ssn_hb(&rod.model, h);
         let mut solver = StructuredHbSolver::new();
-        let newton = NewtonOptions {
-            absolute_tolerance: 1e-12,
-            max_iterations: 20,
-            globalization: Globalization::None,
-            ..NewtonOptions::default()
-        };
+        let newton = common::plain_newton();
         let mut worst: f64 = 0.0;
         for (i, x0) in r.states.iter().enumerate() {
             problem.set_parameter(r.omega[i]);
             let mut x = x0.clone();
-            let report = newton::solve(&mut problem, &mut solver, &mut x, &newton).unwrap();
-            assert!(
-                report.converged(),
-                "w = {}: {:?}",
-                r.omega[i],
-                report.termination
-            );
+            let what = format!("w = {}", r.omega[i]);
+            common::newton_converged(&what, &mut problem, &mut solver, &mut x, &newton);
             let dx: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
             let moved = norm(&dx) / norm(x0);
             worst = worst.max(moved);
@@ -241,12 +181,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
     let arc = curve(&rod, Method::SsnHb, h, 0.9, 1.2);
     assert!(arc.folds.len() >= 2, "{:?}", arc.folds);
     let jump_down = arc.folds.iter().copied().fold(f64::NAN, f64::max);
-    let options = HbOptions {
-        harmonics: h,
-        time_samples: Some(default_hb_time_samples(h)),
-        c: None,
-    };
-    let mut problem = SsnHb::new(&rod.model, &options).unwrap();
+    let mut problem = common::ssn_hb(&rod.model, h);
     let mut solver = StructuredHbSolver::new();
     let count = 300;
     let (w0, w1) = (0.9, 1.2);
@@ -503,18 +438,7 @@ fn json_has_the_issue_fields_one_entry_per_point() {
     let rod = rod(Some(0.5), 0.04, MassModel::Consistent);
     let r = curve(&rod, Method::SsnHb, 3, 0.8, 1.2);
     let v = r.to_json();
-    for key in [
-        "points",
-        "omega",
-        "tip_max",
-        "tip_min",
-        "amplitude",
-        "folds",
-        "converged",
-        "solve_seconds",
-        "termination",
-        "counters",
-    ] {
+    for key in common::json_fields::SWEEP {
         assert!(v.get(key).is_some(), "{key}");
     }
     assert_eq!(v["points"].as_u64().unwrap() as usize, r.points());

@@ -1,4 +1,4 @@
-//! Hard cases (issue 9): each case is solved by SSN-HB and, where it applies, penalty HB and
+//! Hard cases: each case is solved by SSN-HB and, where it applies, penalty HB and
 //! the periodic LCP (Lemke, semismooth Newton), on the canonical rod with the modified mass
 //! (massless contact node) unless said otherwise. Every run must either converge to a
 //! physically plausible answer or end with a typed, non-converged outcome naming the reason;
@@ -20,12 +20,14 @@
 //!   penetration must be below `1e-9` (relative to the gap scale 1).
 //! - Mean contact force `<= 0` (the obstacle only pushes), up to `1e-9 max |λ|` of rounding.
 
+mod common;
+
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use semismooth_problems::cli::default_settings;
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbOptions, SsnHb};
 use semismooth_problems::rod::{
-    build_rod, DampingSpec, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
+    build_rod, DampingSpec, FrequencySpec, MassModel, RodModel, RodSpec,
 };
 use semismooth_problems::runner::{solve_rod, Solution};
 use semismooth_problems::scene::{Method, Scene, SolverSettings, SweepSettings};
@@ -33,17 +35,12 @@ use semismooth_problems::sweep::frequency_response;
 
 /// The canonical rod (paper Fig. 1) with the modified mass.
 fn canonical() -> RodSpec {
-    RodSpec {
-        mass: MassModel::Modified,
-        ..RodSpec::canonical()
-    }
+    common::canonical(MassModel::Modified)
 }
 
+/// The canonical modified-mass rod with its tip contact at `gap`.
 fn with_gap(gap: f64) -> RodSpec {
-    RodSpec {
-        contacts: vec![RodContact { node: 20, gap }],
-        ..canonical()
-    }
+    common::refined(20, gap)
 }
 
 /// SSN-HB settings with `H` harmonics (scene defaults, 200 iterations at most).
@@ -103,8 +100,26 @@ impl Outcome {
     }
 }
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m: f64, x| m.max(x.abs()))
+/// The tip minima of `a` and `b` differ by at most `tol` (`what` names the comparison,
+/// printed as a table line).
+fn assert_tip_min_close(what: &str, a: &Solution, b: &Solution, tol: f64) {
+    let diff = (a.stats.min - b.stats.min).abs();
+    println!("HARD | {what} | tip min diff {diff:.2e} (tol {tol:.2e})");
+    assert!(
+        diff <= tol,
+        "{what}: tip min {} vs {} (diff {diff:e} > {tol:e})",
+        a.stats.min,
+        b.stats.min
+    );
+}
+
+/// How far SSN-HB and an LCP with `nt` steps per period may differ on the tip minimum (away
+/// from the contact, where the response is smooth): the HB truncation bound plus the LCP's
+/// first-order time discretisation, `ω A Δt = 2 π A / Nt` with `Δt = T / Nt` (one step of
+/// motion at the amplitude `A`).
+fn hb_vs_lcp_tolerance(hb: &Solution, nt: usize) -> f64 {
+    let a = 0.5 * (hb.stats.max - hb.stats.min);
+    hb_penetration_bound(hb) + 2.0 * std::f64::consts::PI * a / nt as f64
 }
 
 fn print_row(case: &str, method: Method, outcome: &Outcome) {
@@ -175,7 +190,7 @@ fn assert_plausible(
     let force_scale = s
         .contact_forces
         .iter()
-        .map(|f| max_abs(f))
+        .map(|f| common::max_abs(f))
         .fold(0.0, f64::max);
     let bound = match method {
         Method::SsnHb => hb_penetration_bound(s),
@@ -279,9 +294,9 @@ fn run_all(case: &str, spec: &RodSpec, base: &SolverSettings, methods: &[Method]
     methods.iter().map(|&m| run(case, spec, base, m)).collect()
 }
 
-/// When SSN-HB and Lemke both converged, their tip minima (away from the contact, where
-/// the response is smooth) agree within the HB truncation bound plus the LCP's
-/// first-order time discretisation, `ω A Δt` with `Δt = T / Nt` (one step of motion).
+/// When two methods both converged, their tip minima agree: SSN-HB and Lemke within
+/// [`hb_vs_lcp_tolerance`], SSN-HB and penalty HB within both truncation bounds plus the
+/// penalty's penetration, Lemke and LCP-SSN (the same LCP) to the solvers' tolerance.
 fn cross_check(case: &str, outcomes: &[Outcome], methods: &[Method]) {
     let find = |m: Method| {
         methods
@@ -290,42 +305,33 @@ fn cross_check(case: &str, outcomes: &[Outcome], methods: &[Method]) {
             .and_then(|i| outcomes[i].converged())
     };
     if let (Some(hb), Some(lcp)) = (find(Method::SsnHb), find(Method::LcpLemke)) {
-        let a = 0.5 * (hb.stats.max - hb.stats.min);
-        let dt_motion =
-            hb.omega * a * (2.0 * std::f64::consts::PI / hb.omega) / lcp.time_samples as f64;
-        let tol = hb_penetration_bound(hb) + dt_motion;
-        let diff = (hb.stats.min - lcp.stats.min).abs();
-        println!("HARD | {case:<34} | cross-check ssn-hb vs lcp-lemke tip min: diff {diff:.2e} (tol {tol:.2e})");
-        assert!(
-            diff <= tol,
-            "{case}: SSN-HB tip min {} vs Lemke {} (diff {diff:e} > {tol:e})",
-            hb.stats.min,
-            lcp.stats.min
-        );
+        let tol = hb_vs_lcp_tolerance(hb, lcp.time_samples);
+        assert_tip_min_close(&format!("{case:<34} | ssn-hb vs lcp-lemke"), hb, lcp, tol);
     }
     if let (Some(e), Some(p)) = (find(Method::SsnHb), find(Method::PenaltyHb)) {
         // Same harmonics and quadrature; both within the truncation bound of the exact
         // periodic answer, the penalty also within its own penetration max|λ| / k_p.
         let tol = hb_penetration_bound(e) + hb_penetration_bound(p) + p.stats.max_penetration;
-        let diff = (e.stats.min - p.stats.min).abs();
-        println!("HARD | {case:<34} | cross-check ssn-hb vs penalty-hb tip min: diff {diff:.2e} (tol {tol:.2e})");
-        assert!(
-            diff <= tol,
-            "{case}: SSN-HB tip min {} vs penalty {}",
-            e.stats.min,
-            p.stats.min
-        );
+        assert_tip_min_close(&format!("{case:<34} | ssn-hb vs penalty-hb"), e, p, tol);
     }
     if let (Some(a), Some(b)) = (find(Method::LcpLemke), find(Method::LcpSsn)) {
         // Same LCP, two solvers: the solution of a P-matrix LCP is unique; 1e-8 of the
         // amplitude covers the Newton tolerance 1e-10 on the forces times the compliance.
-        let diff = (a.stats.min - b.stats.min).abs();
-        assert!(
-            diff <= 1e-8 * (1.0 + a.stats.min.abs()),
-            "{case}: Lemke {} vs LCP-SSN {}",
-            a.stats.min,
-            b.stats.min
-        );
+        let tol = 1e-8 * (1.0 + a.stats.min.abs());
+        assert_tip_min_close(&format!("{case:<34} | lcp-lemke vs lcp-ssn"), a, b, tol);
+    }
+}
+
+/// Runs `method` on the case (as [`run`]) and returns the solution; fails unless it
+/// converged.
+fn run_converged(case: &str, spec: &RodSpec, base: &SolverSettings, method: Method) -> Solution {
+    match run(case, spec, base, method) {
+        Outcome::Converged(s) => s,
+        other => panic!(
+            "{case} / {} must converge: {}",
+            method.name(),
+            other.summary()
+        ),
     }
 }
 
@@ -373,22 +379,10 @@ fn undamped_at_resonance_converges_with_ssn_hb() {
         damping: None,
         ..canonical()
     };
-    let hb_out = run("undamped, omega_1", &spec, &hb(20), Method::SsnHb);
-    let lcp_out = run("undamped, omega_1", &spec, &hb(20), Method::LcpSsn);
-    let e = hb_out
-        .converged()
-        .expect("SSN-HB converges undamped at omega_1");
-    let l = lcp_out
-        .converged()
-        .expect("LCP-SSN converges undamped at omega_1");
-    let a = 0.5 * (e.stats.max - e.stats.min);
-    let tol = hb_penetration_bound(e) + 2.0 * std::f64::consts::PI * a / l.time_samples as f64;
-    assert!(
-        (e.stats.min - l.stats.min).abs() <= tol,
-        "SSN-HB {} vs LCP-SSN {}",
-        e.stats.min,
-        l.stats.min
-    );
+    let e = run_converged("undamped, omega_1", &spec, &hb(20), Method::SsnHb);
+    let l = run_converged("undamped, omega_1", &spec, &hb(20), Method::LcpSsn);
+    let tol = hb_vs_lcp_tolerance(&e, l.time_samples);
+    assert_tip_min_close("undamped, SSN-HB vs LCP-SSN", &e, &l, tol);
 }
 
 #[test]
@@ -438,13 +432,12 @@ fn preloaded_contact_negative_gap() {
 /// pivot path.
 #[test]
 fn preloaded_contact_lemke_is_accurate() {
-    let out = run(
+    let s = run_converged(
         "gap = -0.1 (preload)",
         &with_gap(-0.1),
         &hb(20),
         Method::LcpLemke,
     );
-    let s = out.converged().expect("Lemke solves the preloaded LCP");
     assert!(
         s.residual_norm <= 1e-9,
         "complementarity error {:e}",
@@ -498,14 +491,7 @@ fn many_harmonics_h100_nt4096() {
 }
 
 fn two_thousand_element_rod() -> RodSpec {
-    RodSpec {
-        elements: 2000,
-        contacts: vec![RodContact {
-            node: 2000,
-            gap: 0.5,
-        }],
-        ..canonical()
-    }
+    common::refined(2000, 0.5)
 }
 
 /// 2,000 elements. The default `c` was `K[tip, tip] = EA / h` (2000 here, 100 times the
@@ -521,24 +507,10 @@ fn two_thousand_elements() {
     run_all("2000 elements", &spec, &hb(20), &methods);
     let mut s = hb(20);
     s.c = Some(1.0);
-    let fine = run("2000 elements, c = EA/L = 1", &spec, &s, Method::SsnHb);
-    let fine = fine
-        .converged()
-        .expect("2000 elements with c = 1 converges");
-    let coarse = run(
-        "gap = 0.5 (reference, 20 el.)",
-        &canonical(),
-        &hb(20),
-        Method::SsnHb,
-    );
-    let coarse = coarse.converged().expect("the canonical case converges");
-    let tol = hb_penetration_bound(coarse);
-    assert!(
-        (fine.stats.min - coarse.stats.min).abs() <= tol,
-        "2000 el. {} vs 20 el. {}",
-        fine.stats.min,
-        coarse.stats.min
-    );
+    let fine = run_converged("2000 elements, c = EA/L = 1", &spec, &s, Method::SsnHb);
+    let coarse = run_converged("gap = 0.5 (20 el.)", &canonical(), &hb(20), Method::SsnHb);
+    let tol = hb_penetration_bound(&coarse);
+    assert_tip_min_close("2000 el. vs 20 el.", &fine, &coarse, tol);
 }
 
 /// What the library should do: the periodic LCP (Nt = 256) solves the 2,000-element rod as
@@ -549,31 +521,22 @@ fn two_thousand_elements() {
 #[ignore = "reason: on 2000 elements (Nt = 256) LCP-SSN ends max-iterations (residual 1.87) and Lemke at the pivot limit (12900); SSN-HB converges (tip min -0.52378)"]
 fn two_thousand_elements_lcp_converges() {
     let spec = two_thousand_element_rod();
-    let e = run("2000 elements", &spec, &hb(20), Method::SsnHb);
-    let l = run("2000 elements", &spec, &hb(20), Method::LcpSsn);
-    let e = e.converged().expect("SSN-HB converges");
-    let l = l.converged().expect("LCP-SSN converges on 2000 elements");
-    let tol = hb_penetration_bound(e)
-        + 2.0 * std::f64::consts::PI * 0.5 * (e.stats.max - e.stats.min) / 256.0;
-    assert!(
-        (e.stats.min - l.stats.min).abs() <= tol,
-        "SSN-HB {} vs LCP-SSN {}",
-        e.stats.min,
-        l.stats.min
-    );
+    let e = run_converged("2000 elements", &spec, &hb(20), Method::SsnHb);
+    let l = run_converged("2000 elements", &spec, &hb(20), Method::LcpSsn);
+    let tol = hb_vs_lcp_tolerance(&e, 256);
+    assert_tip_min_close("2000 elements, SSN-HB vs LCP-SSN", &e, &l, tol);
 }
 
 /// SSN-HB converges on 2,000 elements with its default settings (mesh-independent default
 /// `c`, 10 times the static contact stiffness `1 / (G K^-1 G^T)`).
 #[test]
 fn two_thousand_elements_converge_with_default_settings() {
-    let out = run(
+    run_converged(
         "2000 elements",
         &two_thousand_element_rod(),
         &hb(20),
         Method::SsnHb,
     );
-    assert!(out.converged().is_some(), "{}", out.summary());
 }
 
 /// What the library should do: penalty HB converges on a refined rod with its default
@@ -585,16 +548,8 @@ fn two_thousand_elements_converge_with_default_settings() {
 /// c did).
 #[test]
 fn penalty_hb_converges_on_200_elements() {
-    let spec = RodSpec {
-        elements: 200,
-        contacts: vec![RodContact {
-            node: 200,
-            gap: 0.5,
-        }],
-        ..canonical()
-    };
-    let out = run("200 elements", &spec, &hb(20), Method::PenaltyHb);
-    assert!(out.converged().is_some(), "penalty-hb: {}", out.summary());
+    let spec = common::refined(200, 0.5);
+    run_converged("200 elements", &spec, &hb(20), Method::PenaltyHb);
 }
 
 #[test]
@@ -611,12 +566,7 @@ fn stiff_penalty_kp_1e8() {
     // penalty penetration max|λ|/k_p plus the HB truncation bound.
     if let (Some(p), Some(e)) = (out[0].converged(), out[1].converged()) {
         let tol = hb_penetration_bound(e) + 1e-6;
-        assert!(
-            (p.stats.min - e.stats.min).abs() <= tol,
-            "penalty {} vs SSN-HB {}",
-            p.stats.min,
-            e.stats.min
-        );
+        assert_tip_min_close("k_p = 1e8, penalty vs SSN-HB", p, e, tol);
     }
 }
 
@@ -648,12 +598,7 @@ fn complementarity_constant_across_six_decades() {
         .expect("the default c must converge");
     let tol = hb_penetration_bound(reference);
     for (f, s) in &converged {
-        assert!(
-            (s.stats.min - reference.stats.min).abs() <= tol,
-            "c factor {f}: tip min {} vs {} (tol {tol:e})",
-            s.stats.min,
-            reference.stats.min
-        );
+        assert_tip_min_close(&format!("c factor {f} vs 1"), s, reference, tol);
     }
     // Measured: every factor up to 1e2 converges (default c = 10 EA/L = 10 here).
     for f in [1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0] {
@@ -672,19 +617,14 @@ fn complementarity_constant_across_six_decades() {
 fn large_complementarity_constant_converges() {
     let mut s = hb(20);
     s.c = Some(1e3 * default_c());
-    let out = run("c = 1e3 x default", &canonical(), &s, Method::SsnHb);
-    assert!(out.converged().is_some(), "c factor 1e3: {}", out.summary());
+    run_converged("c = 1e3 x default", &canonical(), &s, Method::SsnHb);
 }
 
 #[test]
 fn superharmonic_resonance_half_omega_1() {
     let spec = RodSpec {
         frequency: FrequencySpec::Ratio(0.5),
-        contacts: vec![RodContact {
-            node: 20,
-            gap: 0.02,
-        }],
-        ..canonical()
+        ..with_gap(0.02)
     };
     let out = run_all("omega_1/2, gap 0.02", &spec, &hb(20), &ALL);
     cross_check("omega_1/2, gap 0.02", &out, &ALL);
@@ -693,11 +633,7 @@ fn superharmonic_resonance_half_omega_1() {
 fn third_omega_1() -> RodSpec {
     RodSpec {
         frequency: FrequencySpec::Ratio(1.0 / 3.0),
-        contacts: vec![RodContact {
-            node: 20,
-            gap: 0.01,
-        }],
-        ..canonical()
+        ..with_gap(0.01)
     }
 }
 
@@ -714,12 +650,7 @@ fn superharmonic_resonance_third_omega_1() {
         .expect("penalty HB converges at omega_1/3");
     let l = out[2].converged().expect("Lemke converges at omega_1/3");
     let tol = hb_penetration_bound(p) + 1e-3;
-    assert!(
-        (p.stats.min - l.stats.min).abs() <= tol,
-        "penalty {} vs Lemke {}",
-        p.stats.min,
-        l.stats.min
-    );
+    assert_tip_min_close("omega_1/3, penalty vs Lemke", p, l, tol);
 }
 
 /// What the library should do: the semismooth LCP solves the superharmonic case that
@@ -727,20 +658,17 @@ fn superharmonic_resonance_third_omega_1() {
 #[test]
 #[ignore = "reason: at omega_1/3, gap 0.01, LCP-SSN (Nt = 256) ends line-search-failed after 368 iterations (residual 1.3e-2, tip min -0.02291), while Lemke solves the same LCP (269 pivots, tip min -0.028124)"]
 fn superharmonic_third_converges_with_lcp_ssn() {
-    let out = run(
+    run_converged(
         "omega_1/3, gap 0.01",
         &third_omega_1(),
         &hb(20),
         Method::LcpSsn,
     );
-    assert!(out.converged().is_some(), "lcp-ssn: {}", out.summary());
 }
 
 #[test]
 fn two_contact_nodes_scene() {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/scenes/two_contacts.toml");
-    let scene = Scene::from_path(&path).unwrap();
+    let scene = Scene::from_path(common::scenes_dir().join("two_contacts.toml")).unwrap();
     let out = run_all("two contacts (scene)", &scene.rod, &scene.solver, &ALL);
     cross_check("two contacts (scene)", &out, &ALL);
 }

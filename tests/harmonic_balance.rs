@@ -2,14 +2,18 @@
 //! evaluations, the linear case against the exact frequency response, and the structured
 //! (condensed) solver against the dense LU.
 
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::{dense, exact_linear, newton_converged, norm};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
-use nalgebra::{Complex, DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use semismooth::harmonic::{Aft, FourierBasis};
+use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::linalg::{DenseAssemble, FaerDenseLu};
-use semismooth::newton::{self, NewtonOptions, NewtonReport};
+use semismooth::newton::{NewtonOptions, NewtonReport};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use semismooth_problems::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
@@ -56,9 +60,42 @@ fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -
     }
 }
 
-fn dense(m: &SparseColMat<usize, f64>) -> DMatrix<f64> {
-    let d = m.to_dense();
-    DMatrix::from_fn(d.nrows(), d.ncols(), |i, j| d[(i, j)])
+/// Contact points `(dof, gap)`.
+fn contacts(points: &[(usize, f64)]) -> Vec<ContactPoint> {
+    points
+        .iter()
+        .map(|&(dof, gap)| ContactPoint { dof, gap })
+        .collect()
+}
+
+/// SSN-HB options: `harmonics`, `time_samples` (`None`: the default for `harmonics`) and
+/// `c` (`None`: the default).
+fn hb_options(harmonics: usize, time_samples: Option<usize>, c: Option<f64>) -> HbOptions {
+    HbOptions {
+        harmonics,
+        time_samples,
+        c,
+    }
+}
+
+/// Penalty HB options: `harmonics`, `time_samples` (`None`: the default) and the absolute
+/// penalty stiffness `k_p`.
+fn penalty_options(harmonics: usize, time_samples: Option<usize>, kp: f64) -> PenaltyHbOptions {
+    PenaltyHbOptions {
+        harmonics,
+        time_samples,
+        penalty_stiffness: kp,
+    }
+}
+
+/// Penalty HB on `model` with the default harmonics and `k_p = relative` times the contact
+/// stiffness scale.
+fn penalty_hb(model: &StructuralModel, relative: f64) -> PenaltyHb {
+    let options = PenaltyHbOptions {
+        penalty_stiffness: relative * model.contact_stiffness_scale(),
+        ..PenaltyHbOptions::default()
+    };
+    PenaltyHb::new(model, &options).unwrap()
 }
 
 fn random_vector(rng: &mut ChaCha8Rng, len: usize, scale: f64) -> Vec<f64> {
@@ -72,10 +109,6 @@ fn assemble(jac: &HbJacobian) -> Mat<f64> {
     let mut out = Mat::zeros(n, n);
     jac.assemble_dense(out.as_mut());
     out
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Central finite-difference Jacobian of `problem` at `x` (step `h`).
@@ -113,12 +146,7 @@ fn dynamic_blocks_match_time_domain_equation_of_motion() {
     // the samples (derivatives from the coefficient-space operator) and projected by P.
     let mut model = chain(3, Some(0.05), 1.3, vec![]);
     model.forcing.amplitude = vec![0.0; 3];
-    let options = HbOptions {
-        harmonics: 4,
-        time_samples: Some(32),
-        c: None,
-    };
-    let mut hb = SsnHb::new(&model, &options).unwrap();
+    let mut hb = SsnHb::new(&model, &hb_options(4, Some(32), None)).unwrap();
     let basis = FourierBasis::new(4, 32).unwrap();
     let size = basis.basis_size();
     let mut rng = ChaCha8Rng::seed_from_u64(1);
@@ -217,72 +245,49 @@ fn ssn_switching(
     (min_abs, active, nt * m)
 }
 
-#[test]
-fn ssn_jacobian_matches_central_differences_away_from_kinks() {
-    let contacts = vec![
-        ContactPoint { dof: 1, gap: 0.2 },
-        ContactPoint { dof: 2, gap: 0.1 },
-    ];
-    let model = chain(3, Some(0.02), 0.9, contacts);
-    let (h, nt) = (3, 16);
-    let options = HbOptions {
-        harmonics: h,
-        time_samples: Some(nt),
-        c: Some(2.0),
-    };
-    let mut hb = SsnHb::new(&model, &options).unwrap();
-    let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
+/// The generalized Jacobian of `hb` at `x` (away from kinks) against central differences.
+fn assert_jacobian_matches_central_differences<P>(hb: &mut P, x: &[f64])
+where
+    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+{
     let mut jac = hb.new_jacobian();
-    hb.jacobian(&x, &mut jac).unwrap();
+    hb.jacobian(x, &mut jac).unwrap();
     let analytic = assemble(&jac);
-    // Step 1e-6: the switching samples move by at most c * h * 2 = 4e-6 < margin 1e-3, so no
-    // kink is crossed and the residual is smooth (quadratic pieces: FD error ~ rounding
-    // 1e-16 / 1e-6 = 1e-10 relative).
-    let fd = fd_jacobian(&mut hb, &x, 1e-6);
+    // Step 1e-6: the switching samples move by at most 2 c h = 4e-6 (c <= 2 here) < margin
+    // 1e-3, so no kink is crossed and the residual is smooth (quadratic pieces: FD error ~
+    // rounding 1e-16 / 1e-6 = 1e-10 relative).
+    let fd = fd_jacobian(hb, x, 1e-6);
     let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
     assert!(err < 1e-6, "relative Jacobian error {err:e}");
 }
 
 #[test]
-fn penalty_jacobian_matches_central_differences_away_from_kinks() {
-    let contacts = vec![
-        ContactPoint { dof: 0, gap: 0.05 },
-        ContactPoint { dof: 2, gap: 0.1 },
-    ];
-    let model = chain(3, Some(0.02), 0.9, contacts);
+fn ssn_jacobian_matches_central_differences_away_from_kinks() {
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
     let (h, nt) = (3, 16);
-    let options = PenaltyHbOptions {
-        harmonics: h,
-        time_samples: Some(nt),
-        penalty_stiffness: 50.0,
-    };
-    let mut hb = PenaltyHb::new(&model, &options).unwrap();
+    let mut hb = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
+    assert_jacobian_matches_central_differences(&mut hb, &x);
+}
+
+#[test]
+fn penalty_jacobian_matches_central_differences_away_from_kinks() {
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(0, 0.05), (2, 0.1)]));
+    let (h, nt) = (3, 16);
+    let mut hb = PenaltyHb::new(&model, &penalty_options(h, Some(nt), 50.0)).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.3, |x| {
         // Penalty switching function: G u - g (c = 1, no force unknowns).
         let mut padded = x.to_vec();
         padded.extend(std::iter::repeat_n(0.0, 2 * (2 * h + 1)));
         ssn_switching(&model, 1.0, &padded, h, nt)
     });
-    let mut jac = hb.new_jacobian();
-    hb.jacobian(&x, &mut jac).unwrap();
-    let analytic = assemble(&jac);
-    let fd = fd_jacobian(&mut hb, &x, 1e-6);
-    let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
-    assert!(err < 1e-6, "relative Jacobian error {err:e}");
+    assert_jacobian_matches_central_differences(&mut hb, &x);
 }
 
 #[test]
 fn omega_derivative_matches_central_differences() {
     let model = chain(3, Some(0.03), 1.1, vec![ContactPoint { dof: 2, gap: 0.1 }]);
-    let mut hb = SsnHb::new(
-        &model,
-        &HbOptions {
-            harmonics: 3,
-            time_samples: Some(16),
-            c: None,
-        },
-    )
-    .unwrap();
+    let mut hb = SsnHb::new(&model, &hb_options(3, Some(16), None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mut analytic = vec![0.0; hb.dim()];
@@ -308,22 +313,10 @@ fn omega_derivative_matches_central_differences() {
     );
 }
 
-/// Exact linear response `u(t) = Re(z e^{i w t})`, `(K - w^2 M + i w D) z = f`.
+/// Exact linear response at the model's frequency, `u(t) = c cos(w t) + s sin(w t)`:
+/// `(c, s) = (Re z, -Im z)` with `(K - w^2 M + i w D) z = f`.
 fn exact_linear_response(model: &StructuralModel) -> (Vec<f64>, Vec<f64>) {
-    let w = model.forcing.omega;
-    let (m, k) = (dense(&model.mass), dense(&model.stiffness));
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(m.nrows(), m.ncols()));
-    let n = m.nrows();
-    let a = DMatrix::from_fn(n, n, |i, j| {
-        Complex::new(k[(i, j)] - w * w * m[(i, j)], w * d[(i, j)])
-    });
-    let f = DVector::from_fn(n, |i, _| Complex::new(model.forcing.amplitude[i], 0.0));
-    let z = a.lu().solve(&f).unwrap();
-    // u = Re z cos(wt) - Im z sin(wt).
+    let z = exact_linear(model, model.forcing.omega);
     (
         z.iter().map(|c| c.re).collect(),
         z.iter().map(|c| -c.im).collect(),
@@ -388,66 +381,38 @@ where
     norm(&diff) / norm(&dd)
 }
 
-#[test]
-fn structured_and_dense_newton_steps_agree_ssn() {
-    let contacts = vec![
-        ContactPoint { dof: 1, gap: 0.2 },
-        ContactPoint { dof: 3, gap: 0.1 },
-    ];
-    let model = chain(5, Some(0.02), 1.2, contacts);
-    let mut hb = SsnHb::new(
-        &model,
-        &HbOptions {
-            harmonics: 6,
-            time_samples: None,
-            c: Some(3.0),
-        },
-    )
-    .unwrap();
+/// Structured and dense Newton steps of `problem` at three random points agree.
+fn assert_steps_agree_at_random_points<P>(problem: &mut P)
+where
+    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+{
     for seed in 0..3 {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let x = random_vector(&mut rng, hb.dim(), 0.3);
-        let err = structured_vs_dense_step(&mut hb, &x);
+        let x = random_vector(&mut rng, problem.dim(), 0.3);
+        let err = structured_vs_dense_step(problem, &x);
         // Two backward-stable solves of a well-conditioned system: agreement to ~1e-13.
         assert!(err < 1e-10, "seed {seed}: relative step difference {err:e}");
     }
 }
 
 #[test]
+fn structured_and_dense_newton_steps_agree_ssn() {
+    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.2), (3, 0.1)]));
+    let mut hb = SsnHb::new(&model, &hb_options(6, None, Some(3.0))).unwrap();
+    assert_steps_agree_at_random_points(&mut hb);
+}
+
+#[test]
 fn structured_and_dense_newton_steps_agree_penalty() {
-    let contacts = vec![
-        ContactPoint { dof: 1, gap: 0.05 },
-        ContactPoint { dof: 3, gap: 0.02 },
-    ];
-    let model = chain(5, Some(0.02), 1.2, contacts);
-    let mut hb = PenaltyHb::new(
-        &model,
-        &PenaltyHbOptions {
-            harmonics: 6,
-            time_samples: None,
-            penalty_stiffness: 100.0,
-        },
-    )
-    .unwrap();
-    for seed in 0..3 {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let x = random_vector(&mut rng, hb.dim(), 0.3);
-        let err = structured_vs_dense_step(&mut hb, &x);
-        assert!(err < 1e-10, "seed {seed}: relative step difference {err:e}");
-    }
+    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.05), (3, 0.02)]));
+    let mut hb = PenaltyHb::new(&model, &penalty_options(6, None, 100.0)).unwrap();
+    assert_steps_agree_at_random_points(&mut hb);
 }
 
 #[test]
 fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
     let model = chain(3, Some(0.02), 1.2, vec![ContactPoint { dof: 2, gap: 0.1 }]);
-    let mut hb = SsnHb::new(
-        &model,
-        &HbOptions {
-            harmonics: 4,
-            ..HbOptions::default()
-        },
-    )
-    .unwrap();
+    let mut hb = SsnHb::new(&model, &hb_options(4, None, None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let mut jac = hb.new_jacobian();
     let mut solver = StructuredHbSolver::new();
@@ -470,62 +435,40 @@ fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
 #[test]
 fn bad_options_are_typed_errors_with_the_numbers() {
     let model = chain(3, None, 1.0, vec![ContactPoint { dof: 2, gap: 0.1 }]);
-    let err = SsnHb::new(
-        &model,
-        &HbOptions {
-            harmonics: 10,
-            time_samples: Some(20),
-            c: None,
-        },
-    )
-    .unwrap_err();
+    let err = SsnHb::new(&model, &hb_options(10, Some(20), None)).unwrap_err();
     assert!(matches!(
         err,
-        HbError::Harmonic(semismooth::harmonic::HarmonicError::TooFewSamples {
+        HbError::Harmonic(HarmonicError::TooFewSamples {
             harmonics: 10,
             time_samples: 20,
             minimum: 21
         })
     ));
-    let err = SsnHb::new(
-        &model,
-        &HbOptions {
-            c: Some(-1.0),
-            ..HbOptions::default()
-        },
-    )
-    .unwrap_err();
+    let negative_c = HbOptions {
+        c: Some(-1.0),
+        ..HbOptions::default()
+    };
+    let err = SsnHb::new(&model, &negative_c).unwrap_err();
     assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
-    let err = SsnHb::new(
-        &model,
-        &HbOptions {
-            harmonics: 0,
-            ..HbOptions::default()
-        },
-    )
-    .unwrap_err();
-    assert!(matches!(
-        err,
-        HbError::InvalidOption {
-            name: "harmonics",
-            ..
-        }
-    ));
-    let err = PenaltyHb::new(
-        &model,
-        &PenaltyHbOptions {
-            penalty_stiffness: f64::NAN,
-            ..PenaltyHbOptions::default()
-        },
-    )
-    .unwrap_err();
-    assert!(matches!(
-        err,
-        HbError::InvalidOption {
-            name: "penalty_stiffness",
-            ..
-        }
-    ));
+    let nan_penalty = PenaltyHbOptions {
+        penalty_stiffness: f64::NAN,
+        ..PenaltyHbOptions::default()
+    };
+    for (err, option) in [
+        (
+            SsnHb::new(&model, &hb_options(0, None, None)).unwrap_err(),
+            "harmonics",
+        ),
+        (
+            PenaltyHb::new(&model, &nan_penalty).unwrap_err(),
+            "penalty_stiffness",
+        ),
+    ] {
+        assert!(
+            matches!(err, HbError::InvalidOption { name, .. } if name == option),
+            "{option}: {err:?}"
+        );
+    }
     let bad = chain(3, None, 1.0, vec![ContactPoint { dof: 7, gap: 0.1 }]);
     let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
     assert!(matches!(
@@ -545,25 +488,15 @@ fn bad_options_are_typed_errors_with_the_numbers() {
 }
 
 fn canonical_modified_rod() -> StructuralModel {
-    let mut spec = RodSpec::canonical();
-    spec.mass = MassModel::Modified;
-    build_rod(&spec).unwrap().model
+    build_rod(&common::canonical(MassModel::Modified))
+        .unwrap()
+        .model
 }
 
-#[test]
-fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
-    let model = canonical_modified_rod();
-    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
-    let mut penalty = PenaltyHb::new(
-        &model,
-        &PenaltyHbOptions {
-            penalty_stiffness: 1e3 * model.contact_stiffness_scale(),
-            ..PenaltyHbOptions::default()
-        },
-    )
-    .unwrap();
-    // A point where the tip overshoots the gap over part of the period: the constant
-    // coefficient of every dof is 0.45 * (position along the rod), first cosine 0.3 * x.
+/// Displacement coefficients (H = 20) where the tip overshoots the gap over part of the
+/// period: the constant coefficient of every dof is 0.45 * (position along the rod), the
+/// first cosine 0.3 * x, the second sine 0.02 * x.
+fn overshooting_displacement(model: &StructuralModel) -> Vec<f64> {
     let (n, size) = (model.dofs(), 41);
     let mut u = vec![0.0; n * size];
     for dof in 0..n {
@@ -572,8 +505,17 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
         u[n + dof] = 0.3 * x;
         u[4 * n + dof] = 0.02 * x;
     }
+    u
+}
+
+#[test]
+fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
+    let model = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut penalty = penalty_hb(&model, 1e3);
+    let u = overshooting_displacement(&model);
     let mut x = u.clone();
-    x.extend((0..size).map(|j| if j == 0 { -0.1 } else { 0.01 }));
+    x.extend((0..41).map(|j| if j == 0 { -0.1 } else { 0.01 }));
     let err = structured_vs_dense_step(&mut ssn, &x);
     assert!(err < 1e-10, "SSN-HB: relative step difference {err:e}");
     let err = structured_vs_dense_step(&mut penalty, &u);
@@ -582,27 +524,13 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
 
 /// The condensed (Woodbury) solve subtracts large terms when the penalty is stiff; with
 /// one refinement step its residual `|J d - r| / |r|` stays at rounding level, like the
-/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (issue 5's finest setting).
+/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (the scenes' default penalty).
 #[test]
 fn structured_solve_stays_backward_stable_for_stiff_penalties() {
     let model = canonical_modified_rod();
-    let (n, size) = (model.dofs(), 41);
-    let mut u = vec![0.0; n * size];
-    for dof in 0..n {
-        let x = (dof + 1) as f64 / n as f64;
-        u[dof] = 0.45 * x;
-        u[n + dof] = 0.3 * x;
-        u[4 * n + dof] = 0.02 * x;
-    }
+    let u = overshooting_displacement(&model);
     for relative in [1e1, 1e3, 1e5] {
-        let mut penalty = PenaltyHb::new(
-            &model,
-            &PenaltyHbOptions {
-                penalty_stiffness: relative * model.contact_stiffness_scale(),
-                ..PenaltyHbOptions::default()
-            },
-        )
-        .unwrap();
+        let mut penalty = penalty_hb(&model, relative);
         let mut r = vec![0.0; u.len()];
         penalty.residual(&u, &mut r).unwrap();
         let mut jac = penalty.new_jacobian();
@@ -628,38 +556,8 @@ fn structured_solve_stays_backward_stable_for_stiff_penalties() {
     }
 }
 
-/// Counts allocations made by the current thread (tests run in parallel threads).
-mod counting {
-    use std::alloc::{GlobalAlloc, Layout, System};
-    use std::cell::Cell;
-
-    pub struct Counting;
-
-    thread_local! {
-        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-    }
-
-    unsafe impl GlobalAlloc for Counting {
-        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-            unsafe { System.alloc(layout) }
-        }
-        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-            unsafe { System.dealloc(ptr, layout) }
-        }
-        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-            let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-            unsafe { System.realloc(ptr, layout, new_size) }
-        }
-    }
-
-    pub fn allocations() -> u64 {
-        ALLOCATIONS.with(|c| c.get())
-    }
-}
-
 #[global_allocator]
-static ALLOCATOR: counting::Counting = counting::Counting;
+static ALLOCATOR: common::CountingAllocator = common::CountingAllocator;
 
 /// One Newton iteration's work (residual, Jacobian, structured factor, solve) at a fixed
 /// frequency allocates nothing once the workspaces exist.
@@ -679,19 +577,19 @@ fn newton_iteration_work_is_allocation_free() {
         p.jacobian(&x, &mut jac).unwrap();
         solver.factor(&jac).unwrap();
         solver.solve_in_place(&mut r).unwrap();
-        let before = counting::allocations();
+        let before = common::allocations();
         for _ in 0..3 {
             p.residual(&x, &mut r).unwrap();
             p.jacobian(&x, &mut jac).unwrap();
             solver.factor(&jac).unwrap();
             solver.solve_in_place(&mut r).unwrap();
         }
-        counting::allocations() - before
+        common::allocations() - before
     }
     // The counter sees allocations at all.
-    let before = counting::allocations();
+    let before = common::allocations();
     let probe = std::hint::black_box(vec![1u8; 16]);
-    assert!(counting::allocations() > before && probe.len() == 16);
+    assert!(common::allocations() > before && probe.len() == 16);
     assert_eq!(iterate(&mut ssn, 1), 0, "SSN-HB iteration allocated");
     assert_eq!(
         iterate(&mut penalty, 2),
@@ -712,15 +610,8 @@ fn solve_ssn(model: &StructuralModel, options: &HbOptions) -> (SsnHb, Vec<f64>, 
     let mut hb = SsnHb::new(model, options).unwrap();
     let mut x = vec![0.0; hb.dim()];
     let mut solver = StructuredHbSolver::new();
-    let report = newton::solve(&mut hb, &mut solver, &mut x, &newton_options()).unwrap();
-    assert!(
-        report.converged(),
-        "H = {}: {:?} after {} iterations, |F| = {:e}",
-        options.harmonics,
-        report.termination,
-        report.iterations,
-        report.residual_norm()
-    );
+    let what = format!("SSN-HB, H = {}", options.harmonics);
+    let report = newton_converged(&what, &mut hb, &mut solver, &mut x, &newton_options());
     // The dynamic blocks are factored once per frequency, the condensed system once per
     // Newton iteration.
     assert_eq!(solver.dynamic_factorizations(), 1);
@@ -729,6 +620,25 @@ fn solve_ssn(model: &StructuralModel, options: &HbOptions) -> (SsnHb, Vec<f64>, 
         report.counters.factorizations
     );
     (hb, x, report)
+}
+
+/// Solves the condensed SSN-HB problem (force coefficients only) from zero with the dense
+/// LU; returns the problem, the solution and the report.
+fn solve_condensed(
+    model: &StructuralModel,
+    options: &HbOptions,
+) -> (CondensedSsnHb, Vec<f64>, NewtonReport) {
+    let mut condensed = CondensedSsnHb::new(model, options).unwrap();
+    let mut lambda = vec![0.0; condensed.dim()];
+    let what = format!("condensed SSN-HB, c = {:?}", options.c);
+    let report = newton_converged(
+        &what,
+        &mut condensed,
+        &mut FaerDenseLu::new(),
+        &mut lambda,
+        &newton_options(),
+    );
+    (condensed, lambda, report)
 }
 
 /// Sample-wise complementarity of an SSN-HB solution at its own `Nt` samples:
@@ -857,39 +767,20 @@ fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
     let scale = model.contact_stiffness_scale();
     for (h, limit) in [(20, 1e-2), (40, 2e-3)] {
         let nt = 1024;
-        let (_, x, _) = solve_ssn(
-            &model,
-            &HbOptions {
-                harmonics: h,
-                time_samples: Some(nt),
-                c: None,
-            },
-        );
+        let (_, x, _) = solve_ssn(&model, &hb_options(h, Some(nt), None));
         let reference = x[..model.dofs() * (2 * h + 1)].to_vec();
         let mut u = vec![0.0; reference.len()];
         let mut penetrations = Vec::new();
         let mut distance = f64::NAN;
         for relative in [1e1, 1e2, 1e3, 1e4, 1e5] {
-            let mut p = PenaltyHb::new(
-                &model,
-                &PenaltyHbOptions {
-                    harmonics: h,
-                    time_samples: Some(nt),
-                    penalty_stiffness: relative * scale,
-                },
-            )
-            .unwrap();
-            let report = newton::solve(
+            let mut p =
+                PenaltyHb::new(&model, &penalty_options(h, Some(nt), relative * scale)).unwrap();
+            let report = newton_converged(
+                &format!("k_p = {relative:e}"),
                 &mut p,
                 &mut StructuredHbSolver::new(),
                 &mut u,
                 &newton_options(),
-            )
-            .unwrap();
-            assert!(
-                report.converged(),
-                "k_p = {relative:e}: {:?}",
-                report.termination
             );
             let s = p.summary(&u, 19, nt).unwrap();
             let d: Vec<f64> = u.iter().zip(&reference).map(|(a, b)| a - b).collect();
@@ -912,34 +803,28 @@ fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
     }
 }
 
+/// SSN-HB with `options` solved from zero with `solver`: the solution, the report and the
+/// wall time.
+fn timed_solve<S: Factorize<HbJacobian>>(
+    model: &StructuralModel,
+    options: &HbOptions,
+    mut solver: S,
+) -> (Vec<f64>, NewtonReport, Duration) {
+    let mut hb = SsnHb::new(model, options).unwrap();
+    let mut x = vec![0.0; hb.dim()];
+    let start = Instant::now();
+    let report = newton_converged("SSN-HB", &mut hb, &mut solver, &mut x, &newton_options());
+    (x, report, start.elapsed())
+}
+
 /// A whole Newton solve with the structured solver and with the dense LU: same iterations,
 /// same solution (1e-10 relative).
 #[test]
 fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
     let model = canonical_modified_rod();
     let options = HbOptions::default();
-    let mut structured = SsnHb::new(&model, &options).unwrap();
-    let mut dense = SsnHb::new(&model, &options).unwrap();
-    let mut xs = vec![0.0; structured.dim()];
-    let mut xd = xs.clone();
-    let t0 = std::time::Instant::now();
-    let rs = newton::solve(
-        &mut structured,
-        &mut StructuredHbSolver::new(),
-        &mut xs,
-        &newton_options(),
-    )
-    .unwrap();
-    let ts = t0.elapsed();
-    let t0 = std::time::Instant::now();
-    let rd = newton::solve(
-        &mut dense,
-        &mut FaerDenseLu::new(),
-        &mut xd,
-        &newton_options(),
-    )
-    .unwrap();
-    let td = t0.elapsed();
+    let (xs, rs, ts) = timed_solve(&model, &options, StructuredHbSolver::new());
+    let (xd, rd, td) = timed_solve(&model, &options, FaerDenseLu::new());
     println!(
         "H = 20: structured {} iterations in {ts:?}, dense {} iterations in {td:?} (ratio {:.1})",
         rs.iterations,
@@ -954,70 +839,33 @@ fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
 
 /// Measurement, not a claim (run with `--ignored --nocapture`): SSN-HB from zero on the
 /// modified-mass rod at H = 20 for growing element counts and two values of c. Prints the
-/// Newton iterations, the time per solve and per iteration, and the tip minimum.
+/// Newton iterations, the time per solve and per iteration, and the tip minimum (the
+/// condensed problem alone above 1000 elements).
 #[test]
 #[ignore]
 fn report_iterations_and_time_versus_elements() {
     for elements in [20usize, 1000, 10000, 100000] {
-        let mut spec = RodSpec::canonical();
-        spec.mass = MassModel::Modified;
-        spec.elements = elements;
-        spec.contacts[0].node = elements;
-        let rod = build_rod(&spec).unwrap();
+        let rod = build_rod(&common::refined(elements, 0.5)).unwrap();
         let scale = rod.model.contact_stiffness_scale();
         for c in [1.0, scale] {
             let options = HbOptions {
                 c: Some(c),
                 ..HbOptions::default()
             };
-            let mut hb = SsnHb::new(&rod.model, &options).unwrap();
-            let mut x = vec![0.0; hb.dim()];
-            let start = std::time::Instant::now();
-            if elements > 1000 {
-                let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
-                let mut lambda = vec![0.0; condensed.dim()];
-                let reduced = newton::solve(
-                    &mut condensed,
-                    &mut FaerDenseLu::new(),
-                    &mut lambda,
-                    &newton_options(),
-                )
-                .unwrap();
-                let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
-                println!(
-                    "elements {elements}, c = {c}, condensed (incl. factorization): {:?} after {} iterations, {:?}, tip min {:.6}",
-                    reduced.termination,
-                    reduced.iterations,
-                    start.elapsed(),
-                    sc.displacement_min
-                );
-                continue;
-            }
-            let report = newton::solve(
-                &mut hb,
-                &mut StructuredHbSolver::new(),
-                &mut x,
-                &newton_options(),
-            )
-            .unwrap();
-            let elapsed = start.elapsed();
-            let s = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
-            let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
-            let mut lambda = vec![0.0; condensed.dim()];
-            let start = std::time::Instant::now();
-            let reduced = newton::solve(
-                &mut condensed,
-                &mut FaerDenseLu::new(),
-                &mut lambda,
-                &newton_options(),
-            )
-            .unwrap();
+            let start = Instant::now();
+            let (condensed, lambda, reduced) = solve_condensed(&rod.model, &options);
             let reduced_time = start.elapsed();
             let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
             println!(
-                "elements {elements}, c = {c}, condensed: {:?} after {} iterations, {reduced_time:?}, tip min {:.6}",
+                "elements {elements}, c = {c}, condensed (incl. factorization): {:?} after {} iterations, {reduced_time:?}, tip min {:.6}",
                 reduced.termination, reduced.iterations, sc.displacement_min
             );
+            if elements > 1000 {
+                continue;
+            }
+            let (x, report, elapsed) = timed_solve(&rod.model, &options, StructuredHbSolver::new());
+            let hb = SsnHb::new(&rod.model, &options).unwrap();
+            let s = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
             println!(
                 "elements {elements}, c = {c}: {:?} after {} iterations, {} residual evaluations, \
                  {elapsed:?} ({:?} per iteration), tip min {:.6}",
@@ -1039,16 +887,7 @@ fn condensed_ssn_hb_matches_the_full_problem_on_the_canonical_rod() {
     let model = canonical_modified_rod();
     let options = HbOptions::default();
     let (mut full, x_full, full_report) = solve_ssn(&model, &options);
-    let mut condensed = CondensedSsnHb::new(&model, &options).unwrap();
-    let mut lambda = vec![0.0; condensed.dim()];
-    let report = newton::solve(
-        &mut condensed,
-        &mut FaerDenseLu::new(),
-        &mut lambda,
-        &newton_options(),
-    )
-    .unwrap();
-    assert!(report.converged(), "{:?}", report.termination);
+    let (condensed, lambda, report) = solve_condensed(&model, &options);
     let x = condensed.expand(&lambda).unwrap();
     let mut r = vec![0.0; full.dim()];
     full.residual(&x, &mut r).unwrap();

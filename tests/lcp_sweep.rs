@@ -3,45 +3,28 @@
 //! high `H`, against plain min-map Newton re-solves at every branch point, and across two
 //! `Nt` (the LCP's discretisation error must shrink at second order).
 
+mod common;
+
 use std::sync::OnceLock;
 
-use semismooth::newton::{self, Globalization, NewtonOptions};
-use semismooth_problems::cli::default_settings;
+use common::{fig2_rod_model, sweep_fig2_interval};
 use semismooth_problems::lcp::{ActiveSetSolver, PeriodicLcp, PeriodicLcpOptions};
-use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
+use semismooth_problems::rod::{MassModel, RodModel};
 use semismooth_problems::runner::RunError;
-use semismooth_problems::scene::{
-    default_hb_time_samples, GlobalizationChoice, Method, SolverSettings, SweepSettings,
-};
-use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
+use semismooth_problems::scene::{default_hb_time_samples, Method, SolverSettings};
+use semismooth_problems::sweep::FrequencyResponse;
 
 fn settings(method: Method, harmonics: usize, time_samples: usize) -> SolverSettings {
     SolverSettings {
-        method,
         time_samples,
-        max_iterations: 100,
-        globalization: GlobalizationChoice::Nonmonotone,
-        steps_per_period: 1024,
-        ..default_settings(harmonics)
+        ..common::sweep_solver(method, harmonics)
     }
-}
-
-fn sweep(from: f64, to: f64) -> SweepSettings {
-    SweepSettings::new(from, to)
 }
 
 /// The canonical rod with the modified mass (massless contact node), gap 0.5, p0 = 0.04.
 fn rod() -> &'static RodModel {
     static ROD: OnceLock<RodModel> = OnceLock::new();
-    ROD.get_or_init(|| {
-        build_rod(&RodSpec {
-            amplitude: 0.04,
-            mass: MassModel::Modified,
-            contacts: vec![RodContact { node: 20, gap: 0.5 }],
-            ..RodSpec::canonical()
-        })
-        .unwrap()
-    })
+    ROD.get_or_init(|| fig2_rod_model(Some(0.5), 0.04, MassModel::Modified))
 }
 
 /// The lcp-ssn branch over `[0.5, 2] omega_1` with `Nt` steps per period (computed once).
@@ -53,15 +36,12 @@ fn lcp_branch(nt: usize) -> &'static FrequencyResponse {
         256 => &B256,
         _ => unreachable!("only Nt = 128, 256 are cached"),
     };
-    cell.get_or_init(|| {
-        let s = settings(Method::LcpSsn, 5, nt);
-        frequency_response(rod(), &s, &sweep(0.5, 2.0), None).unwrap()
-    })
+    cell.get_or_init(|| sweep_fig2_interval(rod(), &settings(Method::LcpSsn, 5, nt)).unwrap())
 }
 
 fn hb_branch(h: usize) -> FrequencyResponse {
     let s = settings(Method::SsnHb, h, default_hb_time_samples(h));
-    let r = frequency_response(rod(), &s, &sweep(0.5, 2.0), None).unwrap();
+    let r = sweep_fig2_interval(rod(), &s).unwrap();
     assert!(r.converged, "H = {h}: {}", r.termination);
     r
 }
@@ -155,12 +135,7 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
     let rod = rod();
     let r = lcp_branch(128);
     assert!(r.converged, "{}", r.termination);
-    let newton = NewtonOptions {
-        absolute_tolerance: 1e-12,
-        max_iterations: 20,
-        globalization: Globalization::None,
-        ..NewtonOptions::default()
-    };
+    let newton = common::plain_newton();
     let mut worst: f64 = 0.0;
     let mut worst_gap: f64 = 0.0;
     let mut model = rod.model.clone();
@@ -187,13 +162,8 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
         let mut z = z0.to_vec();
         let mut problem = lcp.min_map();
         let mut solver = ActiveSetSolver::new().without_regularization();
-        let report = newton::solve(&mut problem, &mut solver, &mut z, &newton).unwrap();
-        assert!(
-            report.converged(),
-            "w = {}: {:?}",
-            r.omega[i],
-            report.termination
-        );
+        let what = format!("w = {}", r.omega[i]);
+        common::newton_converged(&what, &mut problem, &mut solver, &mut z, &newton);
         let moved: f64 = z
             .iter()
             .zip(z0)
@@ -220,19 +190,8 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
 
 #[test]
 fn lcp_ssn_sweep_of_a_scene_without_contact_is_a_typed_error() {
-    let linear = build_rod(&RodSpec {
-        mass: MassModel::Modified,
-        contacts: Vec::new(),
-        ..RodSpec::canonical()
-    })
-    .unwrap();
-    let err = frequency_response(
-        &linear,
-        &settings(Method::LcpSsn, 5, 128),
-        &sweep(0.5, 2.0),
-        None,
-    )
-    .unwrap_err();
+    let linear = fig2_rod_model(None, 0.04, MassModel::Modified);
+    let err = sweep_fig2_interval(&linear, &settings(Method::LcpSsn, 5, 128)).unwrap_err();
     assert!(matches!(
         err,
         RunError::Unsupported {
@@ -249,20 +208,8 @@ fn lcp_ssn_sweep_of_a_scene_without_contact_is_a_typed_error() {
 /// down to `omega_from`, returning the branch twice).
 #[test]
 fn lcp_ssn_sweep_that_cannot_turn_a_corner_stops_with_a_reason_instead_of_going_back() {
-    let rod = build_rod(&RodSpec {
-        amplitude: 0.04,
-        mass: MassModel::Consistent,
-        contacts: vec![RodContact { node: 20, gap: 0.5 }],
-        ..RodSpec::canonical()
-    })
-    .unwrap();
-    let r = frequency_response(
-        &rod,
-        &settings(Method::LcpSsn, 5, 128),
-        &sweep(0.5, 2.0),
-        None,
-    )
-    .unwrap();
+    let rod = fig2_rod_model(Some(0.5), 0.04, MassModel::Consistent);
+    let r = sweep_fig2_interval(&rod, &settings(Method::LcpSsn, 5, 128)).unwrap();
     println!("{} points: {}", r.points(), r.termination);
     assert!(!r.converged);
     assert!(r.termination.contains("stalled"), "{}", r.termination);

@@ -2,6 +2,9 @@
 //! projected Gauss–Seidel on the equivalent QP, closed forms, and theory (rays on
 //! infeasible copositive-plus LCPs).
 
+mod common;
+
+use common::{allocations, thread_cpu_seconds};
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::Mat;
 use rand::{Rng, SeedableRng};
@@ -14,34 +17,8 @@ use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
-/// Counts heap allocations made by the current thread (tests run on parallel threads,
-/// so the count is per thread).
-struct CountingAllocator;
-
-thread_local! {
-    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
-        unsafe { std::alloc::System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.realloc(ptr, layout, size) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: CountingAllocator = CountingAllocator;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(|c| c.get())
-}
+static GLOBAL: common::CountingAllocator = common::CountingAllocator;
 
 fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
@@ -616,7 +593,7 @@ impl GeneralizedJacobian for MinMap<'_> {
     }
 }
 
-/// Issue 3: Lemke and the semismooth Newton method on `min(z, q + M z) = 0` give the same
+/// Lemke and the semismooth Newton method on `min(z, q + M z) = 0` give the same
 /// solution. Newton stops at `|F|_2 <= 1e-13`; for these well-conditioned P-matrices (and
 /// once the active set is right Newton is exact up to rounding) the distance to the
 /// solution is of the same order, far below the 1e-10 agreement tolerance.
@@ -710,15 +687,6 @@ fn circulant_case(n: usize) -> (Mat<f64>, Vec<f64>) {
         .map(|i| 0.5 - (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos())
         .collect();
     (m, q)
-}
-
-/// CPU time of the current thread in seconds (Linux `/proc/thread-self/schedstat`; the
-/// machine this was measured on is shared, so wall time overstates the cost).
-fn thread_cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(f64::NAN, |ns| ns * 1e-9)
 }
 
 /// Timing of n = 2048 (not asserted): run with

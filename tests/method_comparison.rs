@@ -1,28 +1,23 @@
-//! Issue 5: every method on the same scene — SSN-HB, penalty HB, the periodic LCP by Lemke and
-//! by semismooth Newton, and time marching — agrees on the canonical modified-mass rod, with
+//! Every method on the same scene (SSN-HB, penalty HB, the periodic LCP by Lemke and by
+//! semismooth Newton, and time marching) agrees on the canonical modified-mass rod, with
 //! differences that shrink as each discretisation is refined.
 
-use semismooth_problems::cli::default_settings;
-use semismooth_problems::rod::{build_rod, MassModel, RodModel, RodSpec};
-use semismooth_problems::runner::{solve_rod, Solution};
+mod common;
+
+use common::{relative, solve_converged as solve};
+use semismooth_problems::figures::default_settings;
+use semismooth_problems::rod::{build_rod, MassModel, RodModel};
+use semismooth_problems::runner::Solution;
 use semismooth_problems::scene::{default_hb_time_samples, Method, SolverSettings};
 
 fn rod() -> RodModel {
-    build_rod(&RodSpec {
-        mass: MassModel::Modified,
-        ..RodSpec::canonical()
-    })
-    .unwrap()
+    build_rod(&common::canonical(MassModel::Modified)).unwrap()
 }
 
-fn solve(rod: &RodModel, settings: SolverSettings) -> Solution {
-    let s = solve_rod(rod, &settings, None).unwrap();
-    assert!(
-        s.converged,
-        "{:?}: {} ({} iterations)",
-        settings.method, s.termination, s.iterations
-    );
-    s
+/// The time-marching reference: 4000 steps per period, marched to a period-to-period
+/// change below 1e-10.
+fn reference(rod: &RodModel) -> Solution {
+    solve(rod, &common::march(4000, 1e-10))
 }
 
 fn hb(method: Method, h: usize) -> SolverSettings {
@@ -40,30 +35,18 @@ fn lcp(method: Method, nt: usize) -> SolverSettings {
     }
 }
 
-fn relative(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
-
 #[test]
 fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
     let rod = rod();
-    let reference = solve(
-        &rod,
-        SolverSettings {
-            method: Method::March,
-            steps_per_period: 4000,
-            march_tolerance: 1e-10,
-            ..default_settings(20)
-        },
-    );
+    let reference = reference(&rod);
     let scale = rod.model.contact_stiffness_scale();
     let finest = [
-        ("ssn-hb H=40", solve(&rod, hb(Method::SsnHb, 40))),
+        ("ssn-hb H=40", solve(&rod, &hb(Method::SsnHb, 40))),
         (
             "penalty-hb H=40 kp=1e5 scale",
             solve(
                 &rod,
-                SolverSettings {
+                &SolverSettings {
                     penalty_stiffness: Some(1e5 * scale),
                     ..hb(Method::PenaltyHb, 40)
                 },
@@ -71,9 +54,9 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
         ),
         (
             "lcp-lemke Nt=1024",
-            solve(&rod, lcp(Method::LcpLemke, 1024)),
+            solve(&rod, &lcp(Method::LcpLemke, 1024)),
         ),
-        ("lcp-ssn Nt=1024", solve(&rod, lcp(Method::LcpSsn, 1024))),
+        ("lcp-ssn Nt=1024", solve(&rod, &lcp(Method::LcpSsn, 1024))),
     ];
     for (name, s) in &finest {
         let d = relative(s.stats.min, reference.stats.min);
@@ -81,7 +64,7 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
             "{name:<30} tip min {:.8} (vs march {:.2e}), penetration {:.2e}, mean force {:.6e}",
             s.stats.min, d, s.stats.max_penetration, s.stats.mean_contact_force
         );
-        // Issue 5: 2e-3 relative at the finest settings.
+        // 2e-3 relative at the finest settings.
         assert!(d < 2e-3, "{name}: {d:e}");
         assert!(s.stats.mean_contact_force < 0.0);
     }
@@ -97,20 +80,12 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
 #[test]
 fn differences_to_the_reference_shrink_with_refinement() {
     let rod = rod();
-    let reference = solve(
-        &rod,
-        SolverSettings {
-            method: Method::March,
-            steps_per_period: 4000,
-            march_tolerance: 1e-10,
-            ..default_settings(20)
-        },
-    );
+    let reference = reference(&rod);
     let error = |s: &Solution| relative(s.stats.min, reference.stats.min);
     // LCP over Nt: the bilinear-map error is second order in the step.
     let lcp_errors: Vec<f64> = [128, 256, 512, 1024]
         .iter()
-        .map(|&nt| error(&solve(&rod, lcp(Method::LcpLemke, nt))))
+        .map(|&nt| error(&solve(&rod, &lcp(Method::LcpLemke, nt))))
         .collect();
     println!("lcp-lemke errors over Nt = 128..1024: {lcp_errors:?}");
     assert!(lcp_errors.windows(2).all(|w| w[1] < w[0]), "{lcp_errors:?}");
@@ -119,7 +94,7 @@ fn differences_to_the_reference_shrink_with_refinement() {
     // envelope: every refinement beats H = 10 and H = 80 is within 2e-5.
     let hb_errors: Vec<f64> = [10, 20, 40, 80]
         .iter()
-        .map(|&h| error(&solve(&rod, hb(Method::SsnHb, h))))
+        .map(|&h| error(&solve(&rod, &hb(Method::SsnHb, h))))
         .collect();
     println!("ssn-hb errors over H = 10, 20, 40, 80: {hb_errors:?}");
     assert!(
@@ -135,7 +110,7 @@ fn differences_to_the_reference_shrink_with_refinement() {
         .map(|&k| {
             solve(
                 &rod,
-                SolverSettings {
+                &SolverSettings {
                     penalty_stiffness: Some(k * scale),
                     time_samples: default_hb_time_samples(40),
                     ..hb(Method::PenaltyHb, 40)

@@ -1,8 +1,11 @@
 //! The semismooth Newton driver on problems with known answers: convergence order on
 //! smooth and nonsmooth problems, globalization, exact work counters, every termination.
 
+mod common;
+
 use std::cell::Cell;
 
+use common::allocations;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 use rand::{Rng, SeedableRng};
@@ -704,28 +707,68 @@ fn relative_tolerance_is_relative_to_initial_residual() {
 /// conditions hold to 1e-12 (checked directly: u >= psi, K u - f >= 0, product 0).
 #[test]
 fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
-    struct Obstacle {
+    /// The obstacle problem, its Jacobian stored as `J` (sparse or dense).
+    struct Obstacle<J> {
         n: usize,
         psi: Vec<f64>,
         f: f64,
+        storage: std::marker::PhantomData<J>,
     }
-    impl Obstacle {
+    impl<J> Obstacle<J> {
         fn ku(&self, u: &[f64], i: usize) -> f64 {
             let left = if i > 0 { u[i - 1] } else { 0.0 };
             let right = if i + 1 < self.n { u[i + 1] } else { 0.0 };
             2.0 * u[i] - left - right - self.f
         }
-        fn pattern(&self) -> Vec<Triplet<usize, usize, f64>> {
+        /// Jacobian entry `(i, j)` (zero outside the tridiagonal band).
+        fn entry(&self, u: &[f64], i: usize, j: usize) -> f64 {
+            let g = min_function(u[i] - self.psi[i], self.ku(u, i));
+            let k = match i.abs_diff(j) {
+                0 => 2.0,
+                1 => -1.0,
+                _ => 0.0,
+            };
+            g.db * k + if i == j { g.da } else { 0.0 }
+        }
+    }
+    /// A Jacobian storage: created for `n` unknowns (the band's pattern for a sparse
+    /// matrix, a fixed pattern whose values are overwritten in place), filled entry-wise.
+    trait Storage: Sized {
+        fn band(n: usize) -> Self;
+        fn fill(&mut self, entry: impl Fn(usize, usize) -> f64);
+    }
+    impl Storage for SparseColMat<usize, f64> {
+        fn band(n: usize) -> Self {
             let mut t = Vec::new();
-            for j in 0..self.n {
-                for i in j.saturating_sub(1)..(j + 2).min(self.n) {
+            for j in 0..n {
+                for i in j.saturating_sub(1)..(j + 2).min(n) {
                     t.push(Triplet::new(i, j, 0.0));
                 }
             }
-            t
+            SparseColMat::try_new_from_triplets(n, n, &t).unwrap()
+        }
+        fn fill(&mut self, entry: impl Fn(usize, usize) -> f64) {
+            for j in 0..self.ncols() {
+                let rows: Vec<usize> = self.row_idx_of_col(j).collect();
+                for (v, &i) in self.val_of_col_mut(j).iter_mut().zip(&rows) {
+                    *v = entry(i, j);
+                }
+            }
         }
     }
-    impl Residual for Obstacle {
+    impl Storage for Mat<f64> {
+        fn band(n: usize) -> Self {
+            Mat::zeros(n, n)
+        }
+        fn fill(&mut self, entry: impl Fn(usize, usize) -> f64) {
+            for j in 0..self.ncols() {
+                for i in 0..self.nrows() {
+                    self[(i, j)] = entry(i, j);
+                }
+            }
+        }
+    }
+    impl<J> Residual for Obstacle<J> {
         fn dim(&self) -> usize {
             self.n
         }
@@ -736,79 +779,33 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
             Ok(())
         }
     }
-    /// The same problem with two Jacobian types: a `SparseColMat` with a fixed pattern
-    /// (values overwritten in place) and a dense `Mat`.
-    struct Sparse(Obstacle);
-    struct Dense(Obstacle);
-    impl Residual for Sparse {
-        fn dim(&self) -> usize {
-            self.0.n
+    impl<J: Storage> GeneralizedJacobian for Obstacle<J> {
+        type Jacobian = J;
+        fn new_jacobian(&self) -> J {
+            J::band(self.n)
         }
-        fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-            self.0.residual(u, out)
-        }
-    }
-    impl Residual for Dense {
-        fn dim(&self) -> usize {
-            self.0.n
-        }
-        fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-            self.0.residual(u, out)
-        }
-    }
-    fn entry(o: &Obstacle, u: &[f64], i: usize, j: usize) -> f64 {
-        let g = min_function(u[i] - o.psi[i], o.ku(u, i));
-        let k = match i.abs_diff(j) {
-            0 => 2.0,
-            1 => -1.0,
-            _ => 0.0,
-        };
-        g.db * k + if i == j { g.da } else { 0.0 }
-    }
-    impl GeneralizedJacobian for Sparse {
-        type Jacobian = SparseColMat<usize, f64>;
-        fn new_jacobian(&self) -> Self::Jacobian {
-            SparseColMat::try_new_from_triplets(self.0.n, self.0.n, &self.0.pattern()).unwrap()
-        }
-        fn jacobian(&mut self, u: &[f64], jac: &mut Self::Jacobian) -> Result<(), EvaluationError> {
-            for j in 0..self.0.n {
-                let rows: Vec<usize> = jac.row_idx_of_col(j).collect();
-                let vals = jac.val_of_col_mut(j);
-                for (v, &i) in vals.iter_mut().zip(&rows) {
-                    *v = entry(&self.0, u, i, j);
-                }
-            }
-            Ok(())
-        }
-    }
-    impl GeneralizedJacobian for Dense {
-        type Jacobian = Mat<f64>;
-        fn new_jacobian(&self) -> Mat<f64> {
-            Mat::zeros(self.0.n, self.0.n)
-        }
-        fn jacobian(&mut self, u: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-            for j in 0..self.0.n {
-                for i in 0..self.0.n {
-                    jac[(i, j)] = entry(&self.0, u, i, j);
-                }
-            }
+        fn jacobian(&mut self, u: &[f64], jac: &mut J) -> Result<(), EvaluationError> {
+            jac.fill(|i, j| self.entry(u, i, j));
             Ok(())
         }
     }
     let n = 200;
-    let make = || Obstacle {
-        n,
-        // A tilted obstacle above zero in the middle, below the boundary values.
-        psi: (0..n)
-            .map(|i| {
-                let t = (i + 1) as f64 / (n + 1) as f64;
-                0.3 - 4.0 * (t - 0.4).powi(2)
-            })
-            .collect(),
-        f: -1e-5,
-    };
-    let mut sparse = Sparse(make());
-    let mut dense = Dense(make());
+    fn make<J>(n: usize) -> Obstacle<J> {
+        Obstacle {
+            n,
+            // A tilted obstacle above zero in the middle, below the boundary values.
+            psi: (0..n)
+                .map(|i| {
+                    let t = (i + 1) as f64 / (n + 1) as f64;
+                    0.3 - 4.0 * (t - 0.4).powi(2)
+                })
+                .collect(),
+            f: -1e-5,
+            storage: std::marker::PhantomData,
+        }
+    }
+    let mut sparse: Obstacle<SparseColMat<usize, f64>> = make(n);
+    let mut dense: Obstacle<Mat<f64>> = make(n);
     let opts = NewtonOptions {
         absolute_tolerance: 1e-12,
         ..Default::default()
@@ -824,7 +821,7 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     );
     assert!(rs.converged() && rd.converged());
     assert_eq!(slu.symbolic_analyses(), 1, "one pattern, analysed once");
-    let o = &sparse.0;
+    let o = &sparse;
     let mut contacts = 0;
     for i in 0..n {
         assert!((us[i] - ud[i]).abs() < 1e-12);
@@ -844,30 +841,8 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     );
 }
 
-/// Counts heap allocations made by the current thread (tests run in parallel threads).
-struct CountingAllocator;
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
-        unsafe { std::alloc::System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.realloc(ptr, layout, size) }
-    }
-}
 #[global_allocator]
-static GLOBAL: CountingAllocator = CountingAllocator;
-
-fn allocations() -> u64 {
-    ALLOCATIONS.with(Cell::get)
-}
+static GLOBAL: common::CountingAllocator = common::CountingAllocator;
 
 /// One warm-up solve (buffers, Jacobian, factor storage), then from each start: the
 /// solve converges in >= 3 iterations and makes exactly 3 allocations (the report's

@@ -1,34 +1,22 @@
-//! The paper's rod (issue 4): SSN-HB from zero against closed forms and the time-marching
-//! reference.
+//! The paper's rod: SSN-HB from zero against closed forms and the time-marching reference.
 
-use semismooth_problems::cli::default_settings;
+mod common;
+
+use common::{relative, solve_converged};
+use semismooth_problems::figures::default_settings;
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 use semismooth_problems::runner::{solve_rod, Solution};
-use semismooth_problems::scene::{Method, SolverSettings};
+use semismooth_problems::scene::SolverSettings;
 
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
-fn relative(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
-
-fn modified() -> RodSpec {
-    RodSpec {
-        mass: MassModel::Modified,
-        ..RodSpec::canonical()
-    }
-}
-
 fn march(spec: &RodSpec, steps: usize) -> Solution {
     let rod = build_rod(spec).unwrap();
     let settings = SolverSettings {
-        method: Method::March,
-        steps_per_period: steps,
-        march_tolerance: 1e-10,
         max_periods: 5000,
-        ..default_settings(20)
+        ..common::march(steps, 1e-10)
     };
     solve_rod(&rod, &settings, None).unwrap()
 }
@@ -36,33 +24,10 @@ fn march(spec: &RodSpec, steps: usize) -> Solution {
 /// Exact steady response of the tip, `Re(U e^{i w t})` with `(K - w^2 M + i w D) U = f`,
 /// solved densely in complex arithmetic (independent of the HB code).
 fn exact_linear_tip(spec: &RodSpec, times: &[f64]) -> Vec<f64> {
-    use nalgebra::{Complex, DMatrix, DVector};
-    let rod = build_rod(spec).unwrap();
-    let m = &rod.model;
-    let n = m.dofs();
-    let w = m.forcing.omega;
-    let dense = |s: &faer::sparse::SparseColMat<usize, f64>| {
-        let mut d = DMatrix::<f64>::zeros(n, n);
-        let r = s.as_ref();
-        for j in 0..n {
-            for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-                d[(i, j)] += v;
-            }
-        }
-        d
-    };
-    let (k, mm) = (dense(&m.stiffness), dense(&m.mass));
-    let d = m
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or(DMatrix::zeros(n, n));
-    let z = DMatrix::from_fn(n, n, |i, j| {
-        Complex::new(k[(i, j)] - w * w * mm[(i, j)], w * d[(i, j)])
-    });
-    let f = DVector::from_fn(n, |i, _| Complex::new(m.forcing.amplitude[i], 0.0));
-    let u = z.lu().solve(&f).unwrap();
-    let tip = u[n - 1];
+    use nalgebra::Complex;
+    let model = build_rod(spec).unwrap().model;
+    let w = model.forcing.omega;
+    let tip = common::exact_linear(&model, w)[model.dofs() - 1];
     times
         .iter()
         .map(|t| (tip * Complex::new((w * t).cos(), (w * t).sin())).re)
@@ -108,11 +73,7 @@ fn without_contact_the_hb_answer_is_the_exact_linear_response_after_one_newton_s
 #[test]
 fn canonical_case_converges_from_zero_for_every_harmonic_count_from_5_to_40() {
     for mass in [MassModel::Consistent, MassModel::Modified] {
-        let rod = build_rod(&RodSpec {
-            mass,
-            ..RodSpec::canonical()
-        })
-        .unwrap();
+        let rod = build_rod(&common::canonical(mass)).unwrap();
         for h in [5, 10, 15, 20, 25, 30, 35, 40] {
             let s = solve_rod(&rod, &default_settings(h), None).unwrap();
             assert!(
@@ -138,7 +99,7 @@ fn canonical_case_converges_from_zero_for_every_harmonic_count_from_5_to_40() {
 fn modified_mass_hb_converges_to_the_time_marching_reference() {
     // Reference: the energy-conserving trapezoidal scheme, refined until the step's effect
     // is below the tolerances checked here (observed order printed and checked).
-    let spec = modified();
+    let spec = common::canonical(MassModel::Modified);
     let coarse = march(&spec, 1000);
     let medium = march(&spec, 2000);
     let fine = march(&spec, 4000);
@@ -163,8 +124,7 @@ fn modified_mass_hb_converges_to_the_time_marching_reference() {
     let rod = build_rod(&spec).unwrap();
     let mut errors = Vec::new();
     for h in [10, 20, 40] {
-        let s = solve_rod(&rod, &default_settings(h), None).unwrap();
-        assert!(s.converged);
+        let s = solve_converged(&rod, &default_settings(h));
         let e_min = relative(s.stats.min, fine.stats.min);
         let e_rms = relative(rms(&s.tip), rms(&fine.tip));
         let e_force = relative(s.stats.mean_contact_force, fine.stats.mean_contact_force);
@@ -174,7 +134,7 @@ fn modified_mass_hb_converges_to_the_time_marching_reference() {
         );
         errors.push(e_min);
         if h == 40 {
-            // Issue 4: within 1e-3 in the minimum and the RMS, 1e-2 in the mean force.
+            // Within 1e-3 in the minimum and the RMS, 1e-2 in the mean force.
             assert!(e_min < 1e-3 && e_rms < 1e-3 && e_force < 1e-2);
         }
     }
@@ -189,7 +149,7 @@ fn dependence_of_the_answer_on_c_shrinks_as_harmonics_grow() {
     // The Galerkin projection of max(0, c(Gu - g) - lambda) is not invariant to c: at finite H
     // the answer depends on it, and the dependence is a truncation effect that must vanish as
     // H grows. c over two decades around the default (0.3 to 30 x the static stiffness).
-    let rod = build_rod(&modified()).unwrap();
+    let rod = build_rod(&common::canonical(MassModel::Modified)).unwrap();
     let k_static = rod.model.static_contact_stiffness().unwrap();
     assert!(
         (k_static - 1.0).abs() < 1e-12,
@@ -204,8 +164,7 @@ fn dependence_of_the_answer_on_c_shrinks_as_harmonics_grow() {
                     c: Some(factor * k_static),
                     ..default_settings(h)
                 };
-                let s = solve_rod(&rod, &settings, None).unwrap();
-                assert!(s.converged, "H = {h}, c = {factor}: {}", s.termination);
+                let s = solve_converged(&rod, &settings);
                 assert_eq!(s.c, Some(factor * k_static), "the JSON reports the c used");
                 s.stats.min
             })

@@ -1,8 +1,11 @@
-//! The periodic time-domain LCP (issue 5): its matrix, vector and linear response checked
+//! The periodic time-domain LCP: its matrix, vector and linear response checked
 //! against independent computations (the analytic frequency response, a direct static
 //! solve, the trapezoidal rule written out in the time domain, dense eigenvalues), and its
 //! solvers against each other.
 
+mod common;
+
+use common::{dense, dense_kmd, exact_linear, max_abs_diff, thread_cpu_seconds};
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions};
@@ -11,28 +14,6 @@ use semismooth_problems::lcp::{
 };
 use semismooth_problems::model::{SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
-
-fn dense(m: &SparseMatrix) -> DMatrix<f64> {
-    let r = m.as_ref();
-    let mut d = DMatrix::zeros(r.nrows(), r.ncols());
-    for j in 0..r.ncols() {
-        for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            d[(i, j)] += v;
-        }
-    }
-    d
-}
-
-/// Dense `K`, `M`, `D` (zero when undamped).
-fn dense_kmd(model: &StructuralModel) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
-    let k = dense(&model.stiffness);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(k.nrows(), k.ncols()));
-    (k, dense(&model.mass), d)
-}
 
 /// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
 fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
@@ -66,31 +47,17 @@ fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
 
 /// `Re((K + i s D - s^2 M)^{-1} a e^{i 2 pi n / Nt})` at the nodes, by a dense complex solve.
 fn frequency_response(model: &StructuralModel, s: f64, nt: usize) -> Vec<Vec<f64>> {
-    let (k, m, d) = dense_kmd(model);
-    let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
-        Complex::new(k[(i, j)] - s * s * m[(i, j)], s * d[(i, j)])
-    });
-    let a = DVector::from_fn(k.nrows(), |i, _| {
-        Complex::new(model.forcing.amplitude[i], 0.0)
-    });
-    let x = z.lu().solve(&a).unwrap();
-    (0..k.nrows())
-        .map(|dof| {
+    let x = exact_linear(model, s);
+    x.iter()
+        .map(|z| {
             (0..nt)
                 .map(|n| {
                     let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
-                    (x[dof] * Complex::new(phase.cos(), phase.sin())).re
+                    (z * Complex::new(phase.cos(), phase.sin())).re
                 })
                 .collect()
         })
         .collect()
-}
-
-fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -416,15 +383,6 @@ fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
         }
         other => panic!("{other:?}"),
     }
-}
-
-/// CPU time of this thread (from /proc; 0 where unavailable), for timings on a shared
-/// machine.
-fn thread_cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(0.0, |ns| ns * 1e-9)
 }
 
 /// Numbers for the report (run with `--ignored --nocapture`); nothing asserted on time.

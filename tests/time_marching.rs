@@ -3,93 +3,39 @@
 //! convergence under step refinement, the energy balance of the trapezoidal scheme, the
 //! restitution dependence of Moreau–Jean, and typed errors for bad input.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+mod common;
+
 use std::time::Instant;
 
-use nalgebra::{DMatrix, DVector};
+use common::{allocations, dense};
+use nalgebra::DVector;
 use semismooth_problems::march::{
     march_from_state, march_to_steady_state, MarchError, MarchOptions, MarchScheme, MarchState,
     SteadyPeriod, TimeMarcher,
 };
-use semismooth_problems::model::{SparseMatrix, StructuralModel};
+use semismooth_problems::model::StructuralModel;
 use semismooth_problems::rod::{
     build_rod, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
 };
 
-/// Counts heap allocations per thread (tests run on parallel threads), to check that
-/// stepping does not allocate.
-struct CountingAllocator;
-
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
+static ALLOCATOR: common::CountingAllocator = common::CountingAllocator;
 
-fn allocations() -> u64 {
-    ALLOCATIONS.with(|c| c.get())
-}
-
-fn dense(m: &SparseMatrix) -> DMatrix<f64> {
-    let r = m.as_ref();
-    let mut d = DMatrix::zeros(r.nrows(), r.ncols());
-    for j in 0..r.ncols() {
-        for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            d[(i, j)] += v;
-        }
-    }
-    d
+/// The Moreau–Jean scheme with `theta` and the restitution coefficient `restitution`.
+fn moreau_jean(theta: f64, restitution: f64) -> MarchScheme {
+    MarchScheme::MoreauJean { theta, restitution }
 }
 
 fn modified_rod() -> RodModel {
-    build_rod(&RodSpec {
-        mass: MassModel::Modified,
-        ..RodSpec::canonical()
-    })
-    .unwrap()
+    build_rod(&common::canonical(MassModel::Modified)).unwrap()
 }
 
 /// Exact steady response of `M u'' + D u' + K u = f cos(omega t)` without contact:
-/// `u(t) = u_c cos(omega t) + u_s sin(omega t)` with
-/// `[[K - w^2 M, w D], [-w D, K - w^2 M]] [u_c; u_s] = [f; 0]` (dense LU, nalgebra).
+/// `u(t) = u_c cos(omega t) + u_s sin(omega t)`, `u_c - i u_s = z` with
+/// `(K - w^2 M + i w D) z = f` (dense complex LU, nalgebra).
 fn linear_response(model: &StructuralModel) -> (DVector<f64>, DVector<f64>) {
-    let n = model.dofs();
-    let w = model.forcing.omega;
-    let k = dense(&model.stiffness);
-    let m = dense(&model.mass);
-    let d = model
-        .damping
-        .as_ref()
-        .map(dense)
-        .unwrap_or_else(|| DMatrix::zeros(n, n));
-    let a = &k - w * w * &m;
-    let mut big = DMatrix::zeros(2 * n, 2 * n);
-    big.view_mut((0, 0), (n, n)).copy_from(&a);
-    big.view_mut((n, n), (n, n)).copy_from(&a);
-    big.view_mut((0, n), (n, n)).copy_from(&(w * &d));
-    big.view_mut((n, 0), (n, n)).copy_from(&(-w * &d));
-    let mut rhs = DVector::zeros(2 * n);
-    for i in 0..n {
-        rhs[i] = model.forcing.amplitude[i];
-    }
-    let x = big.lu().solve(&rhs).expect("regular dynamic stiffness");
-    (x.rows(0, n).into_owned(), x.rows(n, n).into_owned())
+    let z = common::exact_linear(model, model.forcing.omega);
+    (z.map(|c| c.re), z.map(|c| -c.im))
 }
 
 /// Largest error of the marched period against the exact response on the observed dofs,
@@ -270,13 +216,7 @@ fn modified_mass_steady_period_converges_under_step_refinement() {
 fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
     // Free steps allocate nothing (buffers and the sparse-LU scratch are kept); a step
     // with a closed contact allocates only the two vectors of Lemke's report.
-    for spec in [
-        RodSpec {
-            mass: MassModel::Modified,
-            ..RodSpec::canonical()
-        },
-        RodSpec::canonical(),
-    ] {
+    for spec in [common::canonical(MassModel::Modified), RodSpec::canonical()] {
         let rod = build_rod(&spec).unwrap();
         let options = MarchOptions {
             steps_per_period: 500,
@@ -346,10 +286,7 @@ fn moreau_jean_statistics(restitution: f64, spp: usize) -> ImpactStatistics {
     let tip = rod.tip_dof();
     let options = MarchOptions {
         steps_per_period: spp,
-        scheme: MarchScheme::MoreauJean {
-            theta: 0.5,
-            restitution,
-        },
+        scheme: moreau_jean(0.5, restitution),
         ..MarchOptions::default()
     };
     let mut marcher =
@@ -521,57 +458,19 @@ fn undamped_massless_contact_trapezoidal_balances_energy_exactly_at_every_step()
 fn bad_options_and_inputs_are_rejected_with_the_field_name() {
     let rod = modified_rod();
     let model = &rod.model;
-    let cases: Vec<(MarchOptions, &str)> = vec![
-        (
-            MarchOptions {
-                steps_per_period: 0,
-                ..MarchOptions::default()
-            },
-            "steps_per_period",
-        ),
-        (
-            MarchOptions {
-                max_periods: 0,
-                ..MarchOptions::default()
-            },
-            "max_periods",
-        ),
-        (
-            MarchOptions {
-                tolerance: f64::NAN,
-                ..MarchOptions::default()
-            },
-            "tolerance",
-        ),
-        (
-            MarchOptions {
-                tolerance: -1.0,
-                ..MarchOptions::default()
-            },
-            "tolerance",
-        ),
-        (
-            MarchOptions {
-                scheme: MarchScheme::MoreauJean {
-                    theta: 0.2,
-                    restitution: 0.0,
-                },
-                ..MarchOptions::default()
-            },
-            "theta",
-        ),
-        (
-            MarchOptions {
-                scheme: MarchScheme::MoreauJean {
-                    theta: 0.5,
-                    restitution: 1.5,
-                },
-                ..MarchOptions::default()
-            },
-            "restitution",
-        ),
+    // Each case spoils one field of the default options.
+    type Spoil = fn(&mut MarchOptions);
+    let cases: [(Spoil, &str); 6] = [
+        (|o| o.steps_per_period = 0, "steps_per_period"),
+        (|o| o.max_periods = 0, "max_periods"),
+        (|o| o.tolerance = f64::NAN, "tolerance"),
+        (|o| o.tolerance = -1.0, "tolerance"),
+        (|o| o.scheme = moreau_jean(0.2, 0.0), "theta"),
+        (|o| o.scheme = moreau_jean(0.5, 1.5), "restitution"),
     ];
-    for (options, field) in cases {
+    for (spoil, field) in cases {
+        let mut options = MarchOptions::default();
+        spoil(&mut options);
         let err = march_to_steady_state(model, &options, &[19]).unwrap_err();
         assert!(
             matches!(err, MarchError::InvalidOption { name, .. } if name == field),
@@ -741,10 +640,7 @@ fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
             let options = MarchOptions {
                 steps_per_period: spp,
                 max_periods: 400,
-                scheme: MarchScheme::MoreauJean {
-                    theta: 0.5,
-                    restitution: e,
-                },
+                scheme: moreau_jean(0.5, e),
                 ..MarchOptions::default()
             };
             let period = match march_to_steady_state(&rod.model, &options, &[tip]) {

@@ -1,18 +1,24 @@
 //! The `ssn` command-line program's commands, as library functions (so tests and examples
-//! can call them): `solve`, `scene-check` and the default run that reproduces the paper.
+//! can call them): `solve`, `sweep`, `compare` and `scene-check`, their JSON documents and
+//! printed summaries. The default run (the paper's figures) is in [`crate::figures`].
+//!
+//! Every command maps its failure onto [`CliError`], whose variants are the documented exit
+//! codes: 1 when the solver ran and did not converge (its output is still printed), 2 for
+//! bad input (the message names the file, the key and what is allowed), 3 when an output
+//! could not be written (nothing half-written is left).
 
+use std::fmt::Display;
 use std::io::IsTerminal;
-use std::path::Path;
-use std::time::Instant;
+use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
 use crate::output::{
     csv_table, prepare_directory, write_atomically, write_line_plot, PlotSpec, Series,
 };
-use crate::rod::{build_rod, MassModel, RodModel, RodSpec};
-use crate::runner::{solve_rod, RunCounters, RunError, Solution};
-use crate::scene::{default_hb_time_samples, Method, Scene, SolverSettings};
+use crate::rod::{build_rod, natural_frequencies, ModelError, RodModel};
+use crate::runner::{solve_rod, RunCounters, Solution};
+use crate::scene::{Method, Scene};
 
 /// How a command failed, mapped by `main` onto the documented exit codes.
 #[derive(Debug)]
@@ -31,16 +37,91 @@ impl From<crate::output::OutputError> for CliError {
     }
 }
 
-fn run_error(path: &Path, e: RunError) -> CliError {
+/// Bad input found in the scene file `path`: the message starts with the file.
+fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
 /// Loads a scene and builds its rod.
 pub fn load(path: &Path) -> Result<(Scene, RodModel), CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
-    let rod = build_rod(&scene.rod)
-        .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
+    let rod = build_rod(&scene.rod).map_err(|e| input_error(path, e))?;
     Ok((scene, rod))
+}
+
+/// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
+/// (the help texts are those of `solve`; `main` words them for `sweep`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the tip displacement and contact force over one period as CSV.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write a plot of the tip displacement over one period as SVG.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+}
+
+/// The curve of a run's SVG: titled by the scene, or `untitled` when it has no title.
+struct Plot {
+    untitled: &'static str,
+    x_label: &'static str,
+    y_label: &'static str,
+    series: Series,
+}
+
+impl RunArgs {
+    /// Writes the requested outputs: the CSV of `columns` under `headers`, and the SVG of
+    /// `plot` (built only when an SVG is requested).
+    fn write_outputs(
+        &self,
+        scene: &Scene,
+        headers: &[&str],
+        columns: &[&[f64]],
+        plot: impl FnOnce() -> Plot,
+    ) -> Result<(), CliError> {
+        if let Some(csv) = &self.csv {
+            write_atomically(csv, csv_table(headers, columns).as_bytes())?;
+        }
+        if let Some(svg) = &self.svg {
+            let plot = plot();
+            let spec = PlotSpec {
+                title: scene.title.clone().unwrap_or_else(|| plot.untitled.into()),
+                x_label: plot.x_label.into(),
+                y_label: plot.y_label.into(),
+                log_log: false,
+            };
+            write_line_plot(svg, &spec, &[plot.series])?;
+        }
+        Ok(())
+    }
+
+    /// Prints the result, as JSON (`--json`) or as the text `print_text` writes, and maps
+    /// convergence onto the outcome.
+    fn report(
+        &self,
+        json: impl FnOnce() -> Value,
+        print_text: impl FnOnce(),
+        converged: bool,
+    ) -> Result<(), CliError> {
+        if self.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&json()).expect("JSON of plain values")
+            );
+        } else {
+            print_text();
+        }
+        if converged {
+            Ok(())
+        } else {
+            Err(CliError::NotConverged)
+        }
+    }
 }
 
 /// Largest number of folds listed one by one in the human-readable sweep summary.
@@ -123,67 +204,41 @@ fn finite_or_null(v: f64) -> Value {
 }
 
 /// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG.
-pub fn solve(
-    path: &Path,
-    as_json: bool,
-    csv: Option<&Path>,
-    svg: Option<&Path>,
-    quiet: bool,
-) -> Result<(), CliError> {
-    let (scene, rod) = load(path)?;
+pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+    let (scene, rod) = load(&args.scene)?;
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
         progress_spinner("time marching to a steady state", quiet)
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let solution = solve_rod(&rod, &scene.solver, None).map_err(|e| run_error(path, e))?;
+    let solution = solve_rod(&rod, &scene.solver, None).map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
-    if let Some(csv) = csv {
-        let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
-        let mut headers = vec!["t".to_string(), "u_tip".to_string()];
-        for (i, f) in solution.contact_forces.iter().enumerate() {
-            columns.push(f);
-            headers.push(format!("lambda_{i}"));
-        }
-        let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
-        write_atomically(csv, csv_table(&headers, &columns).as_bytes())?;
+    let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
+    let mut headers = vec!["t".to_string(), "u_tip".to_string()];
+    for (i, f) in solution.contact_forces.iter().enumerate() {
+        columns.push(f);
+        headers.push(format!("lambda_{i}"));
     }
-    if let Some(svg) = svg {
+    let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
+    args.write_outputs(&scene, &headers, &columns, || {
         let period = 2.0 * std::f64::consts::PI / solution.omega;
-        let phase: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
-        write_line_plot(
-            svg,
-            &PlotSpec {
-                title: scene
-                    .title
-                    .clone()
-                    .unwrap_or_else(|| "tip displacement".into()),
-                x_label: "t / T".into(),
-                y_label: "u_tip".into(),
-                log_log: false,
-            },
-            &[Series::new(
+        Plot {
+            untitled: "tip displacement",
+            x_label: "t / T",
+            y_label: "u_tip",
+            series: Series::new(
                 describe_method(&solution),
-                phase,
+                solution.times.iter().map(|t| t / period).collect(),
                 solution.tip.clone(),
-            )],
-        )?;
-    }
-    if as_json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&solution_json(path, &solution))
-                .expect("JSON of plain values")
-        );
-    } else {
-        print_solution(&solution);
-    }
-    if solution.converged {
-        Ok(())
-    } else {
-        Err(CliError::NotConverged)
-    }
+            ),
+        }
+    })?;
+    args.report(
+        || solution_json(&args.scene, &solution),
+        || print_solution(&solution),
+        solution.converged,
+    )
 }
 
 fn describe_method(s: &Solution) -> String {
@@ -217,19 +272,13 @@ fn print_solution(s: &Solution) {
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
-pub fn sweep(
-    path: &Path,
-    as_json: bool,
-    csv: Option<&Path>,
-    svg: Option<&Path>,
-    quiet: bool,
-) -> Result<(), CliError> {
-    let (scene, rod) = load(path)?;
+pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+    let (scene, rod) = load(&args.scene)?;
     let Some(settings) = scene.sweep.as_ref() else {
-        return Err(CliError::BadInput(format!(
-            "{}: no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
-            path.display()
-        )));
+        return Err(input_error(
+            &args.scene,
+            "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
+        ));
     };
     let bar = progress_spinner("sweep", quiet);
     let progress = |points: usize, omega: f64| {
@@ -240,35 +289,24 @@ pub fn sweep(
         bar.tick();
     };
     let response = crate::sweep::frequency_response(&rod, &scene.solver, settings, Some(&progress))
-        .map_err(|e| run_error(path, e))?;
+        .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
-    if let Some(csv) = csv {
-        let text = csv_table(
-            &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
-            &[
-                &response.omega,
-                &ratio,
-                &response.tip_max,
-                &response.tip_min,
-                &response.amplitude,
-            ],
-        );
-        write_atomically(csv, text.as_bytes())?;
-    }
-    if let Some(svg) = svg {
-        write_line_plot(
-            svg,
-            &PlotSpec {
-                title: scene
-                    .title
-                    .clone()
-                    .unwrap_or_else(|| "frequency response".into()),
-                x_label: "omega / omega_1".into(),
-                y_label: "max |u_tip|".into(),
-                log_log: false,
-            },
-            &[Series::new(
+    args.write_outputs(
+        &scene,
+        &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
+        &[
+            &response.omega,
+            &ratio,
+            &response.tip_max,
+            &response.tip_min,
+            &response.amplitude,
+        ],
+        || Plot {
+            untitled: "frequency response",
+            x_label: "omega / omega_1",
+            y_label: "max |u_tip|",
+            series: Series::new(
                 format!(
                     "{} H = {}",
                     scene.solver.method.name(),
@@ -276,15 +314,10 @@ pub fn sweep(
                 ),
                 ratio.clone(),
                 response.amplitude.clone(),
-            )],
-        )?;
-    }
-    if as_json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&response.to_json()).expect("JSON of plain values")
-        );
-    } else {
+            ),
+        },
+    )?;
+    let print_text = || {
         println!(
             "sweep             {} points, omega/omega_1 from {:.4} to {:.4}",
             response.points(),
@@ -305,12 +338,8 @@ pub fn sweep(
             "converged         {} ({}), {:.3} s",
             response.converged, response.termination, response.solve_seconds
         );
-    }
-    if response.converged {
-        Ok(())
-    } else {
-        Err(CliError::NotConverged)
-    }
+    };
+    args.report(|| response.to_json(), print_text, response.converged)
 }
 
 /// `ssn compare SCENE`: accuracy against cost of every applicable method on the scene's rod
@@ -331,27 +360,12 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
         bar.tick();
     };
     let study = crate::study::accuracy_cost(&rod, &scene.solver, Some(&say))
-        .map_err(|e| run_error(path, e))?;
+        .map_err(|e| input_error(path, e))?;
     bar.finish_and_clear();
     print!("{}", study.table());
     println!("\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip minimum:");
-    for (method, entry) in study.cheapest(accuracy) {
-        match entry {
-            Some(e) => println!(
-                "  {:<11} {:<28} {:>10.3} ms  (error {:.1e})",
-                method.name(),
-                e.setting,
-                1e3 * e.seconds,
-                e.tip_min_error
-            ),
-            None => println!(
-                "  {:<11} none of the settings tried reaches it",
-                method.name()
-            ),
-        }
-    }
-    write_atomically(&out.join("accuracy_cost.csv"), study.to_csv().as_bytes())?;
-    study.write_svg(&out.join("accuracy_cost.svg"))?;
+    print!("{}", study.cheapest_table(accuracy));
+    study.write_files(out)?;
     println!(
         "\nWrote {}/accuracy_cost.csv and accuracy_cost.svg",
         out.display()
@@ -368,6 +382,21 @@ pub fn progress_spinner(message: &str, quiet: bool) -> indicatif::ProgressBar {
     bar.set_message(message.to_string());
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     bar
+}
+
+/// `ssn scene-check SCENE`: validates the scene and prints the resolved model with up to
+/// five natural frequencies (massless dofs have none: a modified-mass rod has one fewer).
+pub fn scene_check(path: &Path) -> Result<(), CliError> {
+    let (scene, rod) = load(path)?;
+    let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
+        Err(ModelError::TooManyModes { available, .. }) => {
+            natural_frequencies(&rod.model, available)
+        }
+        other => other,
+    }
+    .map_err(|e| input_error(path, e))?;
+    print!("{}", describe(&scene, &rod, &modes));
+    Ok(())
 }
 
 /// The resolved model of a scene, in words (`ssn scene-check`).
@@ -498,323 +527,6 @@ pub fn progress_bar(len: u64, message: &str, quiet: bool) -> indicatif::Progress
     );
     bar.set_message(message.to_string());
     bar
-}
-
-/// One row of the default run's Fig. 1 table.
-#[derive(Debug, Clone)]
-pub struct Fig1Row {
-    /// Mass model.
-    pub mass: MassModel,
-    /// Harmonics (None for the reference).
-    pub harmonics: Option<usize>,
-    /// Newton iterations (periods for the reference).
-    pub iterations: usize,
-    /// Wall time of the solve.
-    pub seconds: f64,
-    /// Tip minimum over the period.
-    pub tip_min: f64,
-    /// Tip maximum over the period.
-    pub tip_max: f64,
-    /// Relative difference of the tip minimum to the reference.
-    pub difference: f64,
-}
-
-/// Writes `<stem>.svg` (the series) and `<stem>.csv` (the named columns) into `out`.
-fn write_figure(
-    out: &Path,
-    stem: &str,
-    plot: &PlotSpec,
-    series: &[Series],
-    columns: &[(String, Vec<f64>)],
-) -> Result<(), CliError> {
-    write_line_plot(&out.join(format!("{stem}.svg")), plot, series)?;
-    let headers: Vec<&str> = columns.iter().map(|(h, _)| h.as_str()).collect();
-    let data: Vec<&[f64]> = columns.iter().map(|(_, c)| c.as_slice()).collect();
-    write_atomically(
-        &out.join(format!("{stem}.csv")),
-        csv_table(&headers, &data).as_bytes(),
-    )?;
-    Ok(())
-}
-
-/// Fig. 1 of the paper for one mass model: SSN-HB at H = 10, 15, 20 against the time-marching
-/// reference; writes `fig1_<mass>.svg` and `.csv` into `out`.
-pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>, CliError> {
-    let spec = RodSpec {
-        mass,
-        ..RodSpec::canonical()
-    };
-    let rod = build_rod(&spec).map_err(|e| CliError::BadInput(e.to_string()))?;
-    let name = match mass {
-        MassModel::Consistent => "consistent",
-        MassModel::Lumped => "lumped",
-        MassModel::Modified => "modified",
-    };
-    let bar = progress_bar(4, &format!("Fig. 1 ({name} mass)"), quiet);
-    // Reference: energy-conserving trapezoidal steps with a massless contact node; the
-    // Moreau–Jean scheme (restitution 0) otherwise, with finer steps (first order).
-    let reference_settings = SolverSettings {
-        method: Method::March,
-        steps_per_period: if mass == MassModel::Modified {
-            4000
-        } else {
-            8000
-        },
-        march_tolerance: if mass == MassModel::Modified {
-            1e-9
-        } else {
-            1e-6
-        },
-        ..default_settings(20)
-    };
-    let reference = solve_rod(&rod, &reference_settings, None)
-        .map_err(|e| CliError::BadInput(e.to_string()))?;
-    bar.inc(1);
-    let period = 2.0 * std::f64::consts::PI / reference.omega;
-    let mut series = Vec::new();
-    let mut csv_columns: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut rows = Vec::new();
-    for h in [10usize, 15, 20] {
-        let settings = default_settings(h);
-        let s = solve_rod(&rod, &settings, None).map_err(|e| CliError::BadInput(e.to_string()))?;
-        bar.inc(1);
-        let phase: Vec<f64> = s.times.iter().map(|t| t / period).collect();
-        series.push(Series::new(
-            format!("SSN-HB H = {h}"),
-            phase.clone(),
-            s.tip.clone(),
-        ));
-        csv_columns.push((format!("t_over_T_H{h}"), phase));
-        csv_columns.push((format!("u_tip_H{h}"), s.tip.clone()));
-        rows.push(Fig1Row {
-            mass,
-            harmonics: Some(h),
-            iterations: s.iterations,
-            seconds: s.solve_seconds,
-            tip_min: s.stats.min,
-            tip_max: s.stats.max,
-            difference: (s.stats.min - reference.stats.min).abs() / reference.stats.min.abs(),
-        });
-    }
-    let phase: Vec<f64> = reference.times.iter().map(|t| t / period).collect();
-    series.push(Series::dashed(
-        "reference (time marching)",
-        phase.clone(),
-        reference.tip.clone(),
-    ));
-    csv_columns.push(("t_over_T_reference".into(), phase));
-    csv_columns.push(("u_tip_reference".into(), reference.tip.clone()));
-    rows.push(Fig1Row {
-        mass,
-        harmonics: None,
-        iterations: reference.iterations,
-        seconds: reference.solve_seconds,
-        tip_min: reference.stats.min,
-        tip_max: reference.stats.max,
-        difference: 0.0,
-    });
-    bar.finish_and_clear();
-    write_figure(
-        out,
-        &format!("fig1_{name}_mass"),
-        &PlotSpec {
-            title: format!(
-                "Fig. 1: rod tip over one period, gap 0.5, omega = omega_1 ({name} mass)"
-            ),
-            x_label: "t / T".into(),
-            y_label: "u_tip".into(),
-            log_log: false,
-        },
-        &series,
-        &csv_columns,
-    )?;
-    Ok(rows)
-}
-
-/// The Fig. 1 table: mass, method, iterations, time, tip extremes, difference to the reference.
-pub fn fig1_table(rows: &[Fig1Row]) -> String {
-    let mut out = String::from(
-        "Fig. 1: rod tip over one period (20 elements, gap 0.5, omega = omega_1, zeta = 0.01)\n",
-    );
-    out.push_str(&format!(
-        "{:<11} {:<10} {:>6} {:>9} {:>11} {:>11} {:>11}\n",
-        "mass", "method", "iter", "ms", "tip min", "tip max", "diff (min)"
-    ));
-    for r in rows {
-        out.push_str(&format!(
-            "{:<11} {:<10} {:>6} {:>9.2} {:>11.6} {:>11.6} {:>11.2e}\n",
-            format!("{:?}", r.mass).to_lowercase(),
-            r.harmonics
-                .map(|h| format!("H = {h}"))
-                .unwrap_or_else(|| "reference".into()),
-            r.iterations,
-            1e3 * r.seconds,
-            r.tip_min,
-            r.tip_max,
-            r.difference
-        ));
-    }
-    out
-}
-
-/// Default solver settings for SSN-HB with `h` harmonics.
-pub fn default_settings(h: usize) -> SolverSettings {
-    SolverSettings {
-        method: Method::SsnHb,
-        harmonics: h,
-        time_samples: default_hb_time_samples(h),
-        c: None,
-        penalty_stiffness: None,
-        linear_solver: Default::default(),
-        max_iterations: 200,
-        globalization: Default::default(),
-        tolerance: 1e-10,
-        steps_per_period: 2000,
-        max_periods: 2000,
-        march_tolerance: 1e-8,
-        restitution: 0.0,
-    }
-}
-
-/// One curve of the default run's Fig. 2.
-#[derive(Debug, Clone)]
-pub struct Fig2Curve {
-    /// Gap (None: no contact, the linear rod).
-    pub gap: Option<f64>,
-    /// Points on the branch.
-    pub points: usize,
-    /// Fold frequencies, in units of omega_1.
-    pub folds: Vec<f64>,
-    /// Peak amplitude and its frequency (units of omega_1).
-    pub peak: (f64, f64),
-    /// Wall time of the sweep.
-    pub seconds: f64,
-    /// Whether the branch reached the end of the interval.
-    pub converged: bool,
-}
-
-/// The sweep of the default run's Fig. 2: `omega/omega_1` in `[0.5, 2]`, steps twice the
-/// scene defaults (`0.02`, at most `0.1`), up to 5000 points.
-pub fn figure_2_sweep() -> crate::scene::SweepSettings {
-    crate::scene::SweepSettings {
-        step: 0.02,
-        max_step: 0.1,
-        max_points: 5000,
-        ..crate::scene::SweepSettings::new(0.5, 2.0)
-    }
-}
-
-/// Fig. 2 of the paper: `max |u_tip|` against omega/omega_1 on [0.5, 2] for gaps 0.25, 0.5,
-/// 0.75 and the linear rod, SSN-HB with `harmonics` harmonics, by pseudo-arclength
-/// continuation; writes `fig2_H<h>.svg` and `.csv` into `out`.
-pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Curve>, CliError> {
-    use crate::rod::RodContact;
-    let sweep = figure_2_sweep();
-    let settings = default_settings(harmonics);
-    let bar = progress_bar(4, &format!("Fig. 2 (H = {harmonics})"), quiet);
-    let mut curves = Vec::new();
-    let mut series = Vec::new();
-    let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
-    for gap in [Some(0.25), Some(0.5), Some(0.75), None] {
-        let spec = RodSpec {
-            contacts: gap
-                .map(|g| vec![RodContact { node: 20, gap: g }])
-                .unwrap_or_default(),
-            ..RodSpec::canonical()
-        };
-        let rod = build_rod(&spec).map_err(|e| CliError::BadInput(e.to_string()))?;
-        let r = crate::sweep::frequency_response(&rod, &settings, &sweep, None)
-            .map_err(|e| CliError::BadInput(e.to_string()))?;
-        bar.inc(1);
-        let ratio = r.omega_ratio();
-        let label = gap
-            .map(|g| format!("gap {g}"))
-            .unwrap_or_else(|| "linear".into());
-        let peak = r
-            .peak()
-            .map(|(i, a)| (a, ratio[i]))
-            .unwrap_or((f64::NAN, f64::NAN));
-        curves.push(Fig2Curve {
-            gap,
-            points: r.points(),
-            folds: r.folds.iter().map(|w| w / rod.omega_1).collect(),
-            peak,
-            seconds: r.solve_seconds,
-            converged: r.converged,
-        });
-        let key = label.replace(' ', "_");
-        columns.push((format!("omega_ratio_{key}"), ratio.clone()));
-        columns.push((format!("amplitude_{key}"), r.amplitude.clone()));
-        series.push(if gap.is_some() {
-            Series::new(label, ratio, r.amplitude)
-        } else {
-            Series::dashed(label, ratio, r.amplitude)
-        });
-    }
-    bar.finish_and_clear();
-    write_figure(
-        out,
-        &format!("fig2_H{harmonics}"),
-        &PlotSpec {
-            title: format!("Fig. 2: frequency response of the rod tip, H = {harmonics}"),
-            x_label: "omega / omega_1".into(),
-            y_label: "max over a period of |u_tip|".into(),
-            log_log: false,
-        },
-        &series,
-        &columns,
-    )?;
-    Ok(curves)
-}
-
-/// The default run (`ssn` without a subcommand): the paper's figures into `out`.
-pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
-    prepare_directory(out)?;
-    let start = Instant::now();
-    let mut rows = figure_1(out, MassModel::Modified, quiet)?;
-    rows.extend(figure_1(out, MassModel::Consistent, quiet)?);
-    print!("{}", fig1_table(&rows));
-    println!(
-        "With the modified mass (massless contact node) harmonic balance converges to the \
-         time-marching reference; with the consistent mass the reference depends on the impact \
-         law (here restitution 0) and the two need not agree."
-    );
-    println!();
-    let curves = figure_2(out, 5, quiet)?;
-    println!("Fig. 2: frequency response max|u_tip| on omega/omega_1 in [0.5, 2], H = 5 (the paper's setting)");
-    println!(
-        "{:<8} {:>7} {:>11} {:>10} {:>22} {:>9}",
-        "curve", "points", "peak", "at omega", "folds (omega/omega_1)", "ms"
-    );
-    for c in &curves {
-        let folds: Vec<String> = c.folds.iter().map(|f| format!("{f:.4}")).collect();
-        println!(
-            "{:<8} {:>7} {:>11.6} {:>10.4} {:>22} {:>9.2}{}",
-            c.gap
-                .map(|g| format!("gap {g}"))
-                .unwrap_or_else(|| "linear".into()),
-            c.points,
-            c.peak.0,
-            c.peak.1,
-            if folds.is_empty() {
-                "none".to_string()
-            } else {
-                folds.join(", ")
-            },
-            1e3 * c.seconds,
-            if c.converged { "" } else { "  (stopped early)" }
-        );
-    }
-    println!(
-        "Contact stiffens the rod: the peak moves to higher frequency and is bounded by the gap; \
-         the branches fold over (the jump frequencies are the folds)."
-    );
-    println!(
-        "\nWrote {} in {:.1} s.",
-        out.display(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(())
 }
 
 #[cfg(test)]

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use semismooth_problems::rod::{build_rod, natural_frequencies};
-use semismooth_problems::scene::Scene;
+use semismooth_problems::cli::{self, CliError, RunArgs};
+use semismooth_problems::figures;
 
 const EXIT_CODES: &str = "\
 Examples:
@@ -57,40 +57,20 @@ enum Command {
         max_penetration, contact_force_mean, c (SSN-HB), counters {residual_evaluations,\n  \
         jacobian_evaluations, factorizations, linear_solves, ffts, ...}\n\n"
     )]
-    Solve {
-        /// Scene file (TOML).
-        scene: PathBuf,
-        /// Print the result as JSON on stdout.
-        #[arg(long)]
-        json: bool,
-        /// Write the tip displacement and contact force over one period as CSV.
-        #[arg(long)]
-        csv: Option<PathBuf>,
-        /// Write a plot of the tip displacement over one period as SVG.
-        #[arg(long)]
-        svg: Option<PathBuf>,
-    },
+    Solve(RunArgs),
     /// Follow the response in frequency (pseudo-arclength continuation) over the scene's
     /// [sweep] range.
     #[command(
         after_help = "Examples:\n  ssn sweep problems/scenes/paper_fig2.toml\n  \
         ssn sweep problems/scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
         JSON fields: points, omega, tip_max, tip_min, amplitude (arrays in branch order),\n  \
-        folds (omega where the branch turns), converged, termination, solve_seconds, counters\n\n"
+        folds (omega where the branch turns), converged, termination, solve_seconds, counters\n\n",
+        mut_arg("scene", |a| a.help("Scene file (TOML) with a [sweep] section")),
+        mut_arg("json", |a| a.help("Print the branch as JSON on stdout")),
+        mut_arg("csv", |a| a.help("Write the branch as CSV")),
+        mut_arg("svg", |a| a.help("Write the frequency response as SVG"))
     )]
-    Sweep {
-        /// Scene file (TOML) with a [sweep] section.
-        scene: PathBuf,
-        /// Print the branch as JSON on stdout.
-        #[arg(long)]
-        json: bool,
-        /// Write the branch as CSV.
-        #[arg(long)]
-        csv: Option<PathBuf>,
-        /// Write the frequency response as SVG.
-        #[arg(long)]
-        svg: Option<PathBuf>,
-    },
+    Sweep(RunArgs),
     /// Accuracy against cost: every method over its discretisation settings, error against a
     /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
     #[command(
@@ -112,73 +92,27 @@ enum Command {
     },
 }
 
-/// Outcome of a command, mapped onto the documented exit codes.
-enum Failure {
-    NotConverged,
-    BadInput(String),
-    Output(String),
-}
-
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match &cli.command {
-        None => semismooth_problems::cli::default_run(&cli.out, cli.quiet).map(|_| ()),
-        Some(Command::SceneCheck { scene }) => scene_check(scene),
-        Some(Command::Solve {
-            scene,
-            json,
-            csv,
-            svg,
-        }) => {
-            semismooth_problems::cli::solve(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
-        }
-        Some(Command::Sweep {
-            scene,
-            json,
-            csv,
-            svg,
-        }) => {
-            semismooth_problems::cli::sweep(scene, *json, csv.as_deref(), svg.as_deref(), cli.quiet)
-        }
+    let args = Cli::parse();
+    let result = match &args.command {
+        None => figures::default_run(&args.out, args.quiet),
+        Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
+        Some(Command::Solve(run)) => cli::solve(run, args.quiet),
+        Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
         Some(Command::Compare { scene, accuracy }) => {
-            semismooth_problems::cli::compare(scene, &cli.out, *accuracy, cli.quiet)
+            cli::compare(scene, &args.out, *accuracy, args.quiet)
         }
-    }
-    .map_err(|e| match e {
-        semismooth_problems::cli::CliError::NotConverged => Failure::NotConverged,
-        semismooth_problems::cli::CliError::BadInput(m) => Failure::BadInput(m),
-        semismooth_problems::cli::CliError::Output(m) => Failure::Output(m),
-    });
+    };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::NotConverged) => ExitCode::from(1),
-        Err(Failure::BadInput(m)) => {
+        Err(CliError::NotConverged) => ExitCode::from(1),
+        Err(CliError::BadInput(m)) => {
             eprintln!("error: {m}");
             ExitCode::from(2)
         }
-        Err(Failure::Output(m)) => {
+        Err(CliError::Output(m)) => {
             eprintln!("error: {m}");
             ExitCode::from(3)
         }
     }
-}
-
-fn scene_check(path: &std::path::Path) -> Result<(), semismooth_problems::cli::CliError> {
-    use semismooth_problems::cli::CliError;
-    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
-    let rod = build_rod(&scene.rod)
-        .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
-    // Up to five modes; massless dofs have none (a modified-mass rod has one fewer).
-    let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
-        Err(semismooth_problems::rod::ModelError::TooManyModes { available, .. }) => {
-            natural_frequencies(&rod.model, available)
-        }
-        other => other,
-    }
-    .map_err(|e| CliError::BadInput(format!("{}: {e}", path.display())))?;
-    print!(
-        "{}",
-        semismooth_problems::cli::describe(&scene, &rod, &modes)
-    );
-    Ok(())
 }

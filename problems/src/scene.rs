@@ -378,6 +378,18 @@ impl Check<'_> {
             Err(self.invalid(key, v, &format!("an integer in {min}..={max}")))
         }
     }
+
+    /// `count` of `v` when given, else `default`.
+    fn count_or(
+        &self,
+        key: &str,
+        v: Option<i64>,
+        min: usize,
+        max: usize,
+        default: usize,
+    ) -> Result<usize, SceneError> {
+        v.map_or(Ok(default), |v| self.count(key, v, min, max))
+    }
 }
 
 impl Scene {
@@ -402,131 +414,153 @@ impl Scene {
     }
 }
 
+/// Validates a parsed scene section by section, in file order; the first invalid value is
+/// the error.
 fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let ck = Check { path };
-    let elements = ck.count(
-        "rod.elements",
-        raw.rod.elements,
-        1,
-        crate::rod::MAX_ELEMENTS,
-    )?;
-    let length = ck.positive("rod.length", raw.rod.length.unwrap_or(1.0))?;
-    let axial_stiffness = ck.positive(
-        "rod.axial_stiffness",
-        raw.rod.axial_stiffness.unwrap_or(1.0),
-    )?;
-    let mass_per_length = ck.positive(
-        "rod.mass_per_length",
-        raw.rod.mass_per_length.unwrap_or(1.0),
-    )?;
-    let mass = match raw.rod.mass {
-        RawMass::Consistent => MassModel::Consistent,
-        RawMass::Lumped => MassModel::Lumped,
-        RawMass::Modified => MassModel::Modified,
-    };
-
-    let damping = match raw.damping {
-        None => None,
-        Some(d) => {
-            let model = match (d.model, d.zeta, d.alpha, d.beta) {
-                (Some(m), _, _, _) => m,
-                (None, Some(_), None, None) => RawDampingModel::StiffnessProportional,
-                (None, None, a, b) if a.is_some() || b.is_some() => RawDampingModel::Rayleigh,
-                (None, None, None, None) => {
-                    return Err(ck.invalid(
-                        "damping",
-                        "an empty section",
-                        "`zeta` (stiffness-proportional) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
-                    ))
-                }
-                _ => {
-                    return Err(ck.invalid(
-                        "damping.zeta",
-                        "given together with alpha/beta",
-                        "either `zeta` (model = \"stiffness-proportional\") or `alpha`/`beta` (model = \"rayleigh\")",
-                    ))
-                }
-            };
-            match model {
-                RawDampingModel::StiffnessProportional => {
-                    if d.alpha.is_some() || d.beta.is_some() {
-                        return Err(ck.invalid(
-                            "damping.alpha",
-                            "given with model = \"stiffness-proportional\"",
-                            "only `zeta` for this model",
-                        ));
-                    }
-                    let zeta = d.zeta.ok_or_else(|| {
-                        ck.invalid(
-                            "damping.zeta",
-                            "missing",
-                            "a finite number >= 0 (required by model = \"stiffness-proportional\")",
-                        )
-                    })?;
-                    Some(DampingSpec::StiffnessProportional {
-                        zeta: ck.non_negative("damping.zeta", zeta)?,
-                    })
-                }
-                RawDampingModel::Rayleigh => {
-                    if d.zeta.is_some() {
-                        return Err(ck.invalid(
-                            "damping.zeta",
-                            "given with model = \"rayleigh\"",
-                            "only `alpha` and `beta` for this model",
-                        ));
-                    }
-                    Some(DampingSpec::Rayleigh {
-                        alpha: ck.non_negative("damping.alpha", d.alpha.unwrap_or(0.0))?,
-                        beta: ck.non_negative("damping.beta", d.beta.unwrap_or(0.0))?,
-                    })
-                }
-            }
-        }
-    };
-
-    let amplitude = ck.finite("forcing.amplitude", raw.forcing.amplitude)?;
-    let frequency = match (raw.forcing.omega_ratio, raw.forcing.omega) {
-        (Some(r), None) => FrequencySpec::Ratio(ck.positive("forcing.omega_ratio", r)?),
-        (None, Some(w)) => FrequencySpec::Absolute(ck.positive("forcing.omega", w)?),
-        (None, None) => FrequencySpec::Ratio(1.0),
-        (Some(_), Some(_)) => {
-            return Err(ck.invalid(
-                "forcing.omega",
-                "given together with omega_ratio",
-                "either `omega_ratio` (units of omega_1) or `omega` (rad per unit time)",
-            ))
-        }
-    };
-    let load = match raw.forcing.load {
-        RawLoad::Distributed => LoadKind::Distributed,
-        RawLoad::Tip => LoadKind::Tip,
-    };
-
-    let mut contacts = Vec::new();
+    let mut rod = ck.rod(&raw.rod)?;
+    rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
+    (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
     if let Some(c) = raw.contact {
-        match (c.gap, c.point) {
-            (Some(gap), None) => {
-                let node = match c.node {
-                    Some(n) => ck.count("contact.node", n, 1, elements)?,
-                    None => elements,
-                };
-                contacts.push(RodContact {
-                    node,
-                    gap: ck.finite("contact.gap", gap)?,
-                });
+        rod.contacts = ck.contacts(c, rod.elements)?;
+    }
+    // An LCP without contact is empty: allowed, solved as the linear response.
+    let solver = ck.solver(&raw.solver)?;
+    let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
+    Ok(Scene {
+        path: path.to_path_buf(),
+        title: raw.title,
+        rod,
+        solver,
+        sweep,
+    })
+}
+
+impl Check<'_> {
+    /// `[rod]`: the mesh and the material; the other sections fill in damping, forcing and
+    /// contacts (none until they do).
+    fn rod(&self, r: &RawRod) -> Result<RodSpec, SceneError> {
+        Ok(RodSpec {
+            elements: self.count("rod.elements", r.elements, 1, crate::rod::MAX_ELEMENTS)?,
+            length: self.positive("rod.length", r.length.unwrap_or(1.0))?,
+            axial_stiffness: self
+                .positive("rod.axial_stiffness", r.axial_stiffness.unwrap_or(1.0))?,
+            mass_per_length: self
+                .positive("rod.mass_per_length", r.mass_per_length.unwrap_or(1.0))?,
+            mass: match r.mass {
+                RawMass::Consistent => MassModel::Consistent,
+                RawMass::Lumped => MassModel::Lumped,
+                RawMass::Modified => MassModel::Modified,
+            },
+            damping: None,
+            load: LoadKind::Distributed,
+            amplitude: 0.0,
+            frequency: FrequencySpec::Ratio(1.0),
+            contacts: Vec::new(),
+        })
+    }
+
+    /// `[damping]`: stiffness-proportional (`zeta`) or Rayleigh (`alpha`, `beta`), chosen by
+    /// `model` or by the keys present.
+    fn damping(&self, d: &RawDamping) -> Result<DampingSpec, SceneError> {
+        let model = match (d.model, d.zeta, d.alpha, d.beta) {
+            (Some(m), _, _, _) => m,
+            (None, Some(_), None, None) => RawDampingModel::StiffnessProportional,
+            (None, None, a, b) if a.is_some() || b.is_some() => RawDampingModel::Rayleigh,
+            (None, None, None, None) => {
+                return Err(self.invalid(
+                    "damping",
+                    "an empty section",
+                    "`zeta` (stiffness-proportional) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
+                ))
             }
+            _ => {
+                return Err(self.invalid(
+                    "damping.zeta",
+                    "given together with alpha/beta",
+                    "either `zeta` (model = \"stiffness-proportional\") or `alpha`/`beta` (model = \"rayleigh\")",
+                ))
+            }
+        };
+        match model {
+            RawDampingModel::StiffnessProportional => {
+                if d.alpha.is_some() || d.beta.is_some() {
+                    return Err(self.invalid(
+                        "damping.alpha",
+                        "given with model = \"stiffness-proportional\"",
+                        "only `zeta` for this model",
+                    ));
+                }
+                let zeta = d.zeta.ok_or_else(|| {
+                    self.invalid(
+                        "damping.zeta",
+                        "missing",
+                        "a finite number >= 0 (required by model = \"stiffness-proportional\")",
+                    )
+                })?;
+                Ok(DampingSpec::StiffnessProportional {
+                    zeta: self.non_negative("damping.zeta", zeta)?,
+                })
+            }
+            RawDampingModel::Rayleigh => {
+                if d.zeta.is_some() {
+                    return Err(self.invalid(
+                        "damping.zeta",
+                        "given with model = \"rayleigh\"",
+                        "only `alpha` and `beta` for this model",
+                    ));
+                }
+                Ok(DampingSpec::Rayleigh {
+                    alpha: self.non_negative("damping.alpha", d.alpha.unwrap_or(0.0))?,
+                    beta: self.non_negative("damping.beta", d.beta.unwrap_or(0.0))?,
+                })
+            }
+        }
+    }
+
+    /// `[forcing]`: the load, its amplitude and its frequency (`omega_1` by default).
+    fn forcing(&self, f: &RawForcing) -> Result<(LoadKind, f64, FrequencySpec), SceneError> {
+        let amplitude = self.finite("forcing.amplitude", f.amplitude)?;
+        let frequency = match (f.omega_ratio, f.omega) {
+            (Some(r), None) => FrequencySpec::Ratio(self.positive("forcing.omega_ratio", r)?),
+            (None, Some(w)) => FrequencySpec::Absolute(self.positive("forcing.omega", w)?),
+            (None, None) => FrequencySpec::Ratio(1.0),
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    "forcing.omega",
+                    "given together with omega_ratio",
+                    "either `omega_ratio` (units of omega_1) or `omega` (rad per unit time)",
+                ))
+            }
+        };
+        let load = match f.load {
+            RawLoad::Distributed => LoadKind::Distributed,
+            RawLoad::Tip => LoadKind::Tip,
+        };
+        Ok((load, amplitude, frequency))
+    }
+
+    /// `[contact]`: one contact (`gap`, at `node` or the tip) or a list of
+    /// `[[contact.point]]` at distinct nodes of the `elements`-element rod.
+    fn contacts(&self, c: RawContact, elements: usize) -> Result<Vec<RodContact>, SceneError> {
+        match (c.gap, c.point) {
+            (Some(gap), None) => Ok(vec![RodContact {
+                node: self.count_or("contact.node", c.node, 1, elements, elements)?,
+                gap: self.finite("contact.gap", gap)?,
+            }]),
             (None, Some(points)) if c.node.is_none() => {
                 if points.is_empty() {
-                    return Err(ck.invalid(
+                    return Err(self.invalid(
                         "contact.point",
                         "an empty list",
                         "at least one [[contact.point]] with node and gap",
                     ));
                 }
+                let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
                 for p in points {
-                    let node = ck.count("contact.point.node", p.node, 1, elements)?;
-                    if contacts.iter().any(|c: &RodContact| c.node == node) {
-                        return Err(ck.invalid(
+                    let node = self.count("contact.point.node", p.node, 1, elements)?;
+                    if contacts.iter().any(|c| c.node == node) {
+                        return Err(self.invalid(
                             "contact.point.node",
                             node,
                             "distinct nodes (one contact per node)",
@@ -534,136 +568,77 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
                     }
                     contacts.push(RodContact {
                         node,
-                        gap: ck.finite("contact.point.gap", p.gap)?,
+                        gap: self.finite("contact.point.gap", p.gap)?,
                     });
                 }
+                Ok(contacts)
             }
-            (None, None) => {
-                return Err(ck.invalid(
-                    "contact",
-                    "a section without gap",
-                    "`gap` (and optional `node`) or [[contact.point]] entries; omit [contact] for a linear problem",
-                ))
-            }
-            _ => {
-                return Err(ck.invalid(
-                    "contact.gap",
-                    "given together with [[contact.point]] or node",
-                    "either `gap` (+ optional `node`) or [[contact.point]] entries",
-                ))
-            }
+            (None, None) => Err(self.invalid(
+                "contact",
+                "a section without gap",
+                "`gap` (and optional `node`) or [[contact.point]] entries; omit [contact] for a linear problem",
+            )),
+            _ => Err(self.invalid(
+                "contact.gap",
+                "given together with [[contact.point]] or node",
+                "either `gap` (+ optional `node`) or [[contact.point]] entries",
+            )),
         }
     }
 
-    let s = raw.solver;
-    let method = s.method;
-    let harmonics = match s.harmonics {
-        Some(h) => ck.count("solver.harmonics", h, 1, MAX_HARMONICS)?,
-        None => DEFAULT_HARMONICS,
-    };
-    let time_samples = match (s.time_samples, method) {
-        (Some(n), m) if m.is_harmonic_balance() => {
-            let n = ck.count("solver.time_samples", n, 1, MAX_TIME_SAMPLES)?;
-            if n <= 2 * harmonics {
-                return Err(ck.invalid(
-                    "solver.time_samples",
-                    n,
-                    &format!(
-                        "an integer > 2 * harmonics = {} (the AFT needs more samples than basis functions)",
-                        2 * harmonics
-                    ),
-                ));
+    /// `[solver]`: the method and its discretisation and iteration settings, defaults filled
+    /// in (an HB method needs more AFT samples than `2 H`).
+    fn solver(&self, s: &RawSolver) -> Result<SolverSettings, SceneError> {
+        let method = s.method;
+        let harmonics = self.count_or(
+            "solver.harmonics",
+            s.harmonics,
+            1,
+            MAX_HARMONICS,
+            DEFAULT_HARMONICS,
+        )?;
+        let time_samples = match (s.time_samples, method.is_harmonic_balance()) {
+            (Some(n), true) => {
+                let n = self.count("solver.time_samples", n, 1, MAX_TIME_SAMPLES)?;
+                if n <= 2 * harmonics {
+                    return Err(self.invalid(
+                        "solver.time_samples",
+                        n,
+                        &format!(
+                            "an integer > 2 * harmonics = {} (the AFT needs more samples than basis functions)",
+                            2 * harmonics
+                        ),
+                    ));
+                }
+                n
             }
-            n
+            (Some(n), false) => self.count("solver.time_samples", n, 8, MAX_TIME_SAMPLES)?,
+            (None, true) => default_hb_time_samples(harmonics),
+            (None, false) => DEFAULT_LCP_TIME_SAMPLES,
+        };
+        let c = s.c.map(|c| self.positive("solver.c", c)).transpose()?;
+        let penalty_stiffness = s
+            .penalty_stiffness
+            .map(|k| self.positive("solver.penalty_stiffness", k))
+            .transpose()?;
+        let max_iterations =
+            self.count_or("solver.max_iterations", s.max_iterations, 1, 100_000, 200)?;
+        let tolerance = self.positive("solver.tolerance", s.tolerance.unwrap_or(1e-10))?;
+        let steps_per_period = self.count_or(
+            "solver.steps_per_period",
+            s.steps_per_period,
+            8,
+            MAX_TIME_SAMPLES,
+            2000,
+        )?;
+        let max_periods = self.count_or("solver.max_periods", s.max_periods, 1, 1_000_000, 2000)?;
+        let march_tolerance =
+            self.positive("solver.march_tolerance", s.march_tolerance.unwrap_or(1e-8))?;
+        let restitution = s.restitution.unwrap_or(0.0);
+        if !(0.0..=1.0).contains(&restitution) {
+            return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
         }
-        (Some(n), _) => ck.count("solver.time_samples", n, 8, MAX_TIME_SAMPLES)?,
-        (None, m) if m.is_harmonic_balance() => default_hb_time_samples(harmonics),
-        (None, _) => DEFAULT_LCP_TIME_SAMPLES,
-    };
-    let c = s.c.map(|c| ck.positive("solver.c", c)).transpose()?;
-    let penalty_stiffness = s
-        .penalty_stiffness
-        .map(|k| ck.positive("solver.penalty_stiffness", k))
-        .transpose()?;
-    let max_iterations = match s.max_iterations {
-        Some(n) => ck.count("solver.max_iterations", n, 1, 100_000)?,
-        None => 200,
-    };
-    let tolerance = ck.positive("solver.tolerance", s.tolerance.unwrap_or(1e-10))?;
-    let steps_per_period = match s.steps_per_period {
-        Some(n) => ck.count("solver.steps_per_period", n, 8, MAX_TIME_SAMPLES)?,
-        None => 2000,
-    };
-    let max_periods = match s.max_periods {
-        Some(n) => ck.count("solver.max_periods", n, 1, 1_000_000)?,
-        None => 2000,
-    };
-    let march_tolerance =
-        ck.positive("solver.march_tolerance", s.march_tolerance.unwrap_or(1e-8))?;
-    let restitution = s.restitution.unwrap_or(0.0);
-    if !(0.0..=1.0).contains(&restitution) {
-        return Err(ck.invalid("solver.restitution", restitution, "a number in [0, 1]"));
-    }
-    if contacts.is_empty() && matches!(method, Method::LcpLemke | Method::LcpSsn) {
-        // An LCP without contact is empty; allowed, solved as the linear response.
-    }
-
-    let sweep = match raw.sweep {
-        None => None,
-        Some(sw) => {
-            let from = ck.positive("sweep.omega_ratio_from", sw.omega_ratio_from)?;
-            let to = ck.positive("sweep.omega_ratio_to", sw.omega_ratio_to)?;
-            if to == from {
-                return Err(ck.invalid(
-                    "sweep.omega_ratio_to",
-                    to,
-                    "a value different from omega_ratio_from",
-                ));
-            }
-            let defaults = SweepSettings::new(from, to);
-            let step = ck.positive("sweep.step", sw.step.unwrap_or(defaults.step))?;
-            let min_step =
-                ck.positive("sweep.min_step", sw.min_step.unwrap_or(defaults.min_step))?;
-            let max_step =
-                ck.positive("sweep.max_step", sw.max_step.unwrap_or(defaults.max_step))?;
-            if step < min_step || step > max_step {
-                return Err(ck.invalid(
-                    "sweep.step",
-                    step,
-                    &format!("min_step ({min_step}) <= step <= max_step ({max_step})"),
-                ));
-            }
-            let max_points = match sw.max_points {
-                Some(n) => ck.count("sweep.max_points", n, 2, 1_000_000)?,
-                None => defaults.max_points,
-            };
-            Some(SweepSettings {
-                omega_ratio_from: from,
-                omega_ratio_to: to,
-                step,
-                min_step,
-                max_step,
-                max_points,
-            })
-        }
-    };
-
-    Ok(Scene {
-        path: path.to_path_buf(),
-        title: raw.title,
-        rod: RodSpec {
-            elements,
-            length,
-            axial_stiffness,
-            mass_per_length,
-            mass,
-            damping,
-            load,
-            amplitude,
-            frequency,
-            contacts,
-        },
-        solver: SolverSettings {
+        Ok(SolverSettings {
             method,
             harmonics,
             time_samples,
@@ -677,26 +652,54 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             max_periods,
             march_tolerance,
             restitution,
-        },
-        sweep,
-    })
+        })
+    }
+
+    /// `[sweep]`: a non-empty frequency interval and arclength steps with
+    /// `min_step <= step <= max_step`.
+    fn sweep(&self, sw: &RawSweep) -> Result<SweepSettings, SceneError> {
+        let from = self.positive("sweep.omega_ratio_from", sw.omega_ratio_from)?;
+        let to = self.positive("sweep.omega_ratio_to", sw.omega_ratio_to)?;
+        if to == from {
+            return Err(self.invalid(
+                "sweep.omega_ratio_to",
+                to,
+                "a value different from omega_ratio_from",
+            ));
+        }
+        let defaults = SweepSettings::new(from, to);
+        let step = self.positive("sweep.step", sw.step.unwrap_or(defaults.step))?;
+        let min_step = self.positive("sweep.min_step", sw.min_step.unwrap_or(defaults.min_step))?;
+        let max_step = self.positive("sweep.max_step", sw.max_step.unwrap_or(defaults.max_step))?;
+        if step < min_step || step > max_step {
+            return Err(self.invalid(
+                "sweep.step",
+                step,
+                &format!("min_step ({min_step}) <= step <= max_step ({max_step})"),
+            ));
+        }
+        Ok(SweepSettings {
+            step,
+            min_step,
+            max_step,
+            max_points: self.count_or(
+                "sweep.max_points",
+                sw.max_points,
+                2,
+                1_000_000,
+                defaults.max_points,
+            )?,
+            ..defaults
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const CANONICAL: &str = r#"
-[rod]
-elements = 20
-[damping]
-zeta = 0.01
-[forcing]
-amplitude = 0.04
-omega_ratio = 1.0
-[contact]
-gap = 0.5
-"#;
+    /// The shipped scene of the paper's Fig. 1: the canonical rod, SSN-HB with H = 20.
+    const CANONICAL: &str = include_str!("../scenes/paper_fig1.toml");
 
     #[test]
     fn canonical_scene_resolves_to_the_canonical_rod() {
@@ -709,10 +712,13 @@ gap = 0.5
 
     #[test]
     fn hb_time_sample_default_is_a_power_of_two_of_at_least_four_per_basis_function() {
-        assert_eq!(default_hb_time_samples(1), 64);
-        assert_eq!(default_hb_time_samples(5), 64);
-        assert_eq!(default_hb_time_samples(10), 128);
-        assert_eq!(default_hb_time_samples(100), 1024);
+        for (harmonics, samples) in [(1, 64), (5, 64), (10, 128), (100, 1024)] {
+            assert_eq!(
+                default_hb_time_samples(harmonics),
+                samples,
+                "H = {harmonics}"
+            );
+        }
     }
 
     #[test]
@@ -724,7 +730,7 @@ gap = 0.5
 
     #[test]
     fn too_few_time_samples_for_the_harmonics_are_rejected() {
-        let text = format!("{CANONICAL}\n[solver]\nharmonics = 20\ntime_samples = 40\n");
+        let text = CANONICAL.replace("harmonics = 20", "harmonics = 20\ntime_samples = 40");
         let err = Scene::from_toml(&text, "x.toml").unwrap_err().to_string();
         assert!(
             err.contains("solver.time_samples") && err.contains("40"),

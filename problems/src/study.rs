@@ -22,7 +22,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::output::{write_line_plot, OutputError, PlotSpec, Series};
+use crate::output::{write_atomically, write_line_plot, OutputError, PlotSpec, Series};
 use crate::rod::RodModel;
 use crate::runner::{solve_rod, RunError, Solution};
 use crate::scene::{default_hb_time_samples, Method, SolverSettings};
@@ -140,20 +140,8 @@ impl AccuracyCost {
             "method,setting,tip_min_error,tip_rms_error,mean_force_error,seconds,iterations,converged\n",
         );
         for e in &self.entries {
-            let _ = writeln!(
-                s,
-                "{},{},{:e},{:e},{},{:e},{},{}",
-                e.method.name(),
-                e.setting,
-                e.tip_min_error,
-                e.tip_rms_error,
-                e.mean_force_error
-                    .map(|v| format!("{v:e}"))
-                    .unwrap_or_default(),
-                e.seconds,
-                e.iterations,
-                e.converged
-            );
+            s.push_str(&e.cells(Cells::Csv).join(","));
+            s.push('\n');
         }
         s
     }
@@ -177,28 +165,45 @@ impl AccuracyCost {
                 .map(|v| format!("{v:.1e}"))
                 .unwrap_or_else(|| "n/a".into())
         );
-        let _ = writeln!(
-            s,
-            "{:<11} {:<22} {:>10} {:>10} {:>10} {:>11} {:>6} {:>5}",
-            "method", "setting", "err(min)", "err(rms)", "err(F)", "time [s]", "iter", "conv"
-        );
+        let header = [
+            "method", "setting", "err(min)", "err(rms)", "err(F)", "time [s]", "iter", "conv",
+        ];
+        table_line(&mut s, header.map(String::from));
         for e in &self.entries {
-            let _ = writeln!(
-                s,
-                "{:<11} {:<22} {:>10.2e} {:>10.2e} {:>10} {:>11.3e} {:>6} {:>5}",
-                e.method.name(),
-                e.setting,
-                e.tip_min_error,
-                e.tip_rms_error,
-                e.mean_force_error
-                    .map(|v| format!("{v:.2e}"))
-                    .unwrap_or_else(|| "-".into()),
-                e.seconds,
-                e.iterations,
-                if e.converged { "yes" } else { "no" }
-            );
+            table_line(&mut s, e.cells(Cells::Table));
         }
         s
+    }
+
+    /// The cheapest setting of each method reaching `accuracy` (relative error of the tip
+    /// minimum), one indented line per method (`ssn compare`).
+    pub fn cheapest_table(&self, accuracy: f64) -> String {
+        let mut s = String::new();
+        for (method, entry) in self.cheapest(accuracy) {
+            let _ = match entry {
+                Some(e) => writeln!(
+                    s,
+                    "  {:<11} {:<28} {:>10.3} ms  (error {:.1e})",
+                    method.name(),
+                    e.setting,
+                    1e3 * e.seconds,
+                    e.tip_min_error
+                ),
+                None => writeln!(
+                    s,
+                    "  {:<11} none of the settings tried reaches it",
+                    method.name()
+                ),
+            };
+        }
+        s
+    }
+
+    /// Writes the study into the directory `out` (which must exist): `accuracy_cost.csv`
+    /// ([`AccuracyCost::to_csv`]) and `accuracy_cost.svg` ([`AccuracyCost::write_svg`]).
+    pub fn write_files(&self, out: &Path) -> Result<(), OutputError> {
+        write_atomically(&out.join("accuracy_cost.csv"), self.to_csv().as_bytes())?;
+        self.write_svg(&out.join("accuracy_cost.svg"))
     }
 
     /// Log-log plot of the tip-minimum error against wall time, one curve per method
@@ -229,6 +234,54 @@ impl AccuracyCost {
         };
         write_line_plot(path, &spec, &series)
     }
+}
+
+/// How [`Entry::cells`] writes numbers: CSV at full precision, the table rounded.
+#[derive(Clone, Copy, PartialEq)]
+enum Cells {
+    Csv,
+    Table,
+}
+
+impl Entry {
+    /// The entry's columns: method, setting, the relative errors of the tip minimum, tip RMS
+    /// and mean force, seconds, iterations, converged.
+    fn cells(&self, style: Cells) -> [String; 8] {
+        let csv = style == Cells::Csv;
+        let number = |v: f64, digits: usize| {
+            if csv {
+                format!("{v:e}")
+            } else {
+                format!("{v:.digits$e}")
+            }
+        };
+        let missing = if csv { "" } else { "-" };
+        let converged = match (csv, self.converged) {
+            (true, c) => c.to_string(),
+            (false, true) => "yes".into(),
+            (false, false) => "no".into(),
+        };
+        [
+            self.method.name().into(),
+            self.setting.clone(),
+            number(self.tip_min_error, 2),
+            number(self.tip_rms_error, 2),
+            self.mean_force_error
+                .map_or_else(|| missing.into(), |v| number(v, 2)),
+            number(self.seconds, 3),
+            self.iterations.to_string(),
+            converged,
+        ]
+    }
+}
+
+/// One line of the printed table (header or entry).
+fn table_line(s: &mut String, c: [String; 8]) {
+    let _ = writeln!(
+        s,
+        "{:<11} {:<22} {:>10} {:>10} {:>10} {:>11} {:>6} {:>5}",
+        c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]
+    );
 }
 
 /// Runs `settings`, repeating fast runs and keeping the median wall time.
@@ -536,7 +589,7 @@ mod tests {
             ..RodSpec::canonical()
         })
         .unwrap();
-        let study = accuracy_cost(&rod, &crate::cli::default_settings(20), None).unwrap();
+        let study = accuracy_cost(&rod, &crate::figures::default_settings(20), None).unwrap();
         let r = &study.reference;
         assert!(
             r.uncertainty < 1e-5,

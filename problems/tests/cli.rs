@@ -1,4 +1,4 @@
-//! The `ssn` program as users run it (issue 9): help texts, `ssn solve` on every shipped
+//! The `ssn` program as users run it: help texts, `ssn solve` on every shipped
 //! scene (JSON fields, exit code 0), bad scenes (exit code 2, message naming the file and the
 //! key), unwritable outputs (exit code 3, nothing left behind), a non-converged run (JSON
 //! with `converged = false`, exit code 1) and `ssn scene-check`.
@@ -7,6 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
+
+#[path = "../../tests/common/json_fields.rs"]
+mod json_fields;
 
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
 
@@ -140,8 +143,7 @@ fn program_help_exits_zero_and_documents_the_exit_codes() {
     }
 }
 
-/// What the issue asks: the program's own help shows an example command line too (today
-/// only the subcommands' help does).
+/// The program's own help shows an example command line, as every subcommand's help does.
 #[test]
 fn program_help_shows_an_example() {
     let text = stdout(&ssn(&["--help"]));
@@ -254,21 +256,8 @@ fn the_linear_scene_costs_one_factorization_no_fft_one_iteration() {
     );
 }
 
-/// A scene with one of the canonical keys replaced or added.
-const CANONICAL: &str = "\
-[rod]
-elements = 20
-mass = \"modified\"
-[damping]
-zeta = 0.01
-[forcing]
-amplitude = 0.04
-omega_ratio = 1.0
-[contact]
-gap = 0.5
-[solver]
-harmonics = 20
-";
+/// The shipped modified-mass scene of Fig. 1; the bad scenes replace or add one of its keys.
+const CANONICAL: &str = include_str!("../scenes/paper_fig1_modified_mass.toml");
 
 fn bad_scene_case(dir: &TempDir, name: &str, text: &str, must_name: &[&str]) {
     let path = dir.write(&format!("{name}.toml"), text);
@@ -302,64 +291,27 @@ fn bad_scene_case(dir: &TempDir, name: &str, text: &str, must_name: &[&str]) {
 #[test]
 fn bad_scenes_exit_2_naming_the_file_and_the_key() {
     let dir = TempDir::new("bad");
-    let cases: Vec<(&str, String, Vec<&str>)> = vec![
-        ("malformed", "[rod\nelements = 20\n".into(), vec!["line 1"]),
-        (
-            "unknown_key",
-            CANONICAL.replace("gap = 0.5", "gapp = 0.5"),
-            vec!["gapp"],
-        ),
-        (
-            "missing_key",
-            CANONICAL.replace("amplitude = 0.04\n", ""),
-            vec!["amplitude"],
-        ),
-        (
-            "wrong_type",
-            CANONICAL.replace("elements = 20", "elements = \"twenty\""),
-            vec!["elements"],
-        ),
-        (
-            "negative_size",
-            CANONICAL.replace("elements = 20", "elements = -5"),
-            vec!["rod.elements", "-5"],
-        ),
-        (
-            "zero_size",
-            CANONICAL.replace("elements = 20", "elements = 0"),
-            vec!["rod.elements"],
-        ),
-        (
-            "nan",
-            CANONICAL.replace("amplitude = 0.04", "amplitude = nan"),
-            vec!["forcing.amplitude", "NaN"],
-        ),
-        (
-            "infinite",
-            CANONICAL.replace("gap = 0.5", "gap = inf"),
-            vec!["contact.gap"],
-        ),
-        (
-            "zero_harmonics",
-            CANONICAL.replace("harmonics = 20", "harmonics = 0"),
-            vec!["solver.harmonics"],
-        ),
-        (
-            "nt_too_small",
-            CANONICAL.replace("harmonics = 20", "harmonics = 20\ntime_samples = 16"),
-            vec!["solver.time_samples", "16"],
-        ),
-        (
-            "node_out_of_range",
-            CANONICAL.replace(
-                "[contact]\ngap = 0.5",
-                "[[contact.point]]\nnode = 25\ngap = 0.5",
-            ),
-            vec!["node", "25"],
-        ),
+    bad_scene_case(&dir, "malformed", "[rod\nelements = 20\n", &["line 1"]);
+    // (name, text replaced in the scene, replacement, what the message must contain)
+    #[rustfmt::skip]
+    let cases: [(&str, &str, &str, &[&str]); 10] = [
+        ("unknown_key", "gap = 0.5", "gapp = 0.5", &["gapp"]),
+        ("missing_key", "amplitude = 0.04\n", "", &["amplitude"]),
+        ("wrong_type", "elements = 20", "elements = \"twenty\"", &["elements"]),
+        ("negative_size", "elements = 20", "elements = -5", &["rod.elements", "-5"]),
+        ("zero_size", "elements = 20", "elements = 0", &["rod.elements"]),
+        ("nan", "amplitude = 0.04", "amplitude = nan", &["forcing.amplitude", "NaN"]),
+        ("infinite", "gap = 0.5", "gap = inf", &["contact.gap"]),
+        ("zero_harmonics", "harmonics = 20", "harmonics = 0", &["solver.harmonics"]),
+        ("nt_too_small", "harmonics = 20", "harmonics = 20\ntime_samples = 16", &["solver.time_samples", "16"]),
+        ("node_out_of_range", "[contact]\ngap = 0.5", "[[contact.point]]\nnode = 25\ngap = 0.5", &["node", "25"]),
     ];
-    for (name, text, needles) in &cases {
-        bad_scene_case(&dir, name, text, needles);
+    for (name, from, to, needles) in cases {
+        assert!(
+            CANONICAL.contains(from),
+            "{name}: `{from}` not in the scene"
+        );
+        bad_scene_case(&dir, name, &CANONICAL.replace(from, to), needles);
     }
 }
 
@@ -397,25 +349,18 @@ fn an_unwritable_output_exits_3_and_leaves_no_file() {
     // /nonexistent/dir could be), so the write must fail and leave nothing.
     let dir = TempDir::new("out");
     let file = dir.write("a-file", "x");
-    let under_file = file.join("x.csv");
-    let out = ssn(&["solve", scene, "--csv", under_file.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(3), "stderr {}", stderr(&out));
-    assert_eq!(
-        dir.entries(),
-        vec!["a-file".to_string()],
-        "something was left behind"
-    );
+    // `ssn solve --csv target` exits 3 and leaves only `left` in `dir`.
+    let write_fails = |target: &Path, left: &str| {
+        let out = ssn(&["solve", scene, "--csv", target.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(3), "stderr {}", stderr(&out));
+        assert_eq!(dir.entries(), vec![left], "something was left behind");
+    };
+    write_fails(&file.join("x.csv"), "a-file");
     std::fs::remove_file(&file).unwrap();
     // The target is an existing directory: the write fails and no temporary file is left.
     let sub = dir.0.join("a-directory");
     std::fs::create_dir(&sub).unwrap();
-    let out = ssn(&["solve", scene, "--csv", sub.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(3), "stderr {}", stderr(&out));
-    assert_eq!(
-        dir.entries(),
-        vec!["a-directory".to_string()],
-        "something was left behind"
-    );
+    write_fails(&sub, "a-directory");
     assert!(
         std::fs::read_dir(&sub).unwrap().next().is_none(),
         "files left in the target"
@@ -540,7 +485,7 @@ fn scene_check_prints_frequencies_and_the_effects_present() {
     );
 }
 
-/// What the issue asks: scene-check says when a contact node has mass. In
+/// scene-check says when a contact node has mass. In
 /// `two_contacts.toml` (modified mass) node 10 is interior and keeps its mass, so the LCP
 /// and time marching need an impact law (measured: Lemke ends at the pivot limit, 25,700
 /// pivots, on this scene), but scene-check only warns for non-modified mass models.
@@ -568,7 +513,10 @@ fn lcp_and_march_scenes_print_json_without_harmonics() {
         ("lcp-lemke", "time_samples = 128", "lemke_pivots"),
         ("march", "steps_per_period = 256", "time_steps"),
     ] {
-        let text = CANONICAL.replace("harmonics = 20", &format!("method = \"{method}\"\n{extra}"));
+        let text = CANONICAL.replace(
+            "method = \"ssn-hb\"\nharmonics = 20",
+            &format!("method = \"{method}\"\n{extra}"),
+        );
         let path = dir.write(&format!("{method}.toml"), &text);
         let (out, json) = solve_json(&path, &[]);
         assert_eq!(out.status.code(), Some(0), "{method}: {}", stderr(&out));
@@ -588,21 +536,10 @@ fn lcp_and_march_scenes_print_json_without_harmonics() {
     }
 }
 
-/// The `ssn sweep --json` document of a converged branch: every field of the issue, the
+/// The `ssn sweep --json` document of a converged branch: every documented field, the
 /// per-point arrays one finite entry per point (at least two points).
 fn assert_converged_sweep_json(json: &Value) {
-    for key in [
-        "points",
-        "omega",
-        "tip_max",
-        "tip_min",
-        "amplitude",
-        "folds",
-        "converged",
-        "solve_seconds",
-        "termination",
-        "counters",
-    ] {
+    for key in json_fields::SWEEP {
         assert!(json.get(key).is_some(), "{key}");
     }
     assert_eq!(
@@ -708,7 +645,7 @@ fn compare_writes_its_table_and_refuses_an_unwritable_directory() {
 }
 
 /// `ssn sweep` with method lcp-ssn (the periodic LCP continued in its gaps and forces):
-/// JSON with the issue's fields, one entry per point, through the overhang to the end; the
+/// JSON with the documented fields, one entry per point, through the overhang to the end; the
 /// last point, at the scene's forcing frequency beyond the overhang (one solution there),
 /// equals what `ssn solve` finds by mesh-sequenced Newton from zero on the same scene.
 #[test]
