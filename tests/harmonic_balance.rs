@@ -853,7 +853,7 @@ fn report_iterations_and_time_versus_elements() {
                 ..HbOptions::default()
             };
             let start = Instant::now();
-            let (condensed, lambda, reduced) = solve_condensed(&rod.model, &options);
+            let (mut condensed, lambda, reduced) = solve_condensed(&rod.model, &options);
             let reduced_time = start.elapsed();
             let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
             println!(
@@ -887,7 +887,7 @@ fn condensed_ssn_hb_matches_the_full_problem_on_the_canonical_rod() {
     let model = canonical_modified_rod();
     let options = HbOptions::default();
     let (mut full, x_full, full_report) = solve_ssn(&model, &options);
-    let (condensed, lambda, report) = solve_condensed(&model, &options);
+    let (mut condensed, lambda, report) = solve_condensed(&model, &options);
     let x = condensed.expand(&lambda).unwrap();
     let mut r = vec![0.0; full.dim()];
     full.residual(&x, &mut r).unwrap();
