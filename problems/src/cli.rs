@@ -154,16 +154,10 @@ fn folds_summary(folds: &[f64], omega_1: f64) -> String {
 
 /// The JSON object of the work counters.
 pub fn counters_json(c: &RunCounters) -> Value {
-    json!({
-        "residual_evaluations": c.residual_evaluations,
-        "jacobian_evaluations": c.jacobian_evaluations,
-        "factorizations": c.factorizations,
-        "linear_solves": c.linear_solves,
-        "line_search_backtracks": c.line_search_backtracks,
-        "ffts": c.ffts,
-        "lemke_pivots": c.lemke_pivots,
-        "time_steps": c.time_steps,
-    })
+    let mut map = c.newton_json();
+    map.insert("lemke_pivots".into(), c.lemke_pivots.into());
+    map.insert("time_steps".into(), c.time_steps.into());
+    Value::Object(map)
 }
 
 /// The JSON document of `ssn solve --json` (documented in README.md). `harmonics` is absent
@@ -179,6 +173,7 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "termination": s.termination,
         "iterations": s.iterations,
         "residual_norm": finite_or_null(s.residual_norm),
+        "effective_tolerance": s.effective_tolerance,
         "solve_seconds": s.solve_seconds,
         "tip_max": finite_or_null(s.stats.max),
         "tip_min": finite_or_null(s.stats.min),

@@ -93,6 +93,26 @@ pub struct RunCounters {
     pub time_steps: u64,
 }
 
+impl RunCounters {
+    /// The JSON fields of the Newton-style counters: `residual_evaluations`,
+    /// `jacobian_evaluations`, `factorizations`, `linear_solves`, `line_search_backtracks`,
+    /// `ffts`.
+    pub fn newton_json(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut map = serde_json::Map::new();
+        for (name, value) in [
+            ("residual_evaluations", self.residual_evaluations),
+            ("jacobian_evaluations", self.jacobian_evaluations),
+            ("factorizations", self.factorizations),
+            ("linear_solves", self.linear_solves),
+            ("line_search_backtracks", self.line_search_backtracks),
+            ("ffts", self.ffts),
+        ] {
+            map.insert(name.to_string(), value.into());
+        }
+        map
+    }
+}
+
 impl From<WorkCounters> for RunCounters {
     fn from(c: WorkCounters) -> Self {
         RunCounters {
@@ -131,6 +151,10 @@ pub struct Solution {
     /// Final residual norm (Newton methods), complementarity error (Lemke), period change
     /// (time marching).
     pub residual_norm: f64,
+    /// The tolerance the run was judged against (Newton methods: the scene's tolerance, or
+    /// the model's round-off floor when that is larger; the march tolerance for time
+    /// marching; `None` for Lemke, which ends on a basis, not a tolerance).
+    pub effective_tolerance: Option<f64>,
     /// Convergence order observed over the last Newton iterations (Newton methods).
     pub observed_order: Option<f64>,
     /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
@@ -321,6 +345,7 @@ fn hb_solution(
         termination: report.termination.to_string(),
         iterations: report.iterations,
         residual_norm: report.residual_norm(),
+        effective_tolerance: Some(report.effective_tolerance),
         observed_order: report.observed_order,
         residual_history: report.residual_norms.clone(),
         solve_seconds: seconds,
@@ -575,6 +600,8 @@ fn solve_lcp(
         termination,
         iterations,
         residual_norm: residual,
+        // The min-map Newton runs with the scene's absolute tolerance and no floor.
+        effective_tolerance: (method == Method::LcpSsn).then_some(settings.tolerance),
         observed_order: None,
         residual_history: Vec::new(),
         solve_seconds: seconds,
@@ -632,6 +659,7 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         termination: "converged".into(),
         iterations: period.periods,
         residual_norm: period.period_change,
+        effective_tolerance: Some(settings.march_tolerance),
         observed_order: None,
         residual_history: Vec::new(),
         solve_seconds: seconds,

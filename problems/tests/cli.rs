@@ -150,12 +150,13 @@ fn program_help_shows_an_example() {
     assert!(text.to_lowercase().contains("example"), "{text}");
 }
 
-const REQUIRED_FIELDS: [&str; 12] = [
+const REQUIRED_FIELDS: [&str; 13] = [
     "method",
     "converged",
     "termination",
     "iterations",
     "residual_norm",
+    "effective_tolerance",
     "omega",
     "time_samples",
     "tip_max",
@@ -236,6 +237,28 @@ fn solve_every_shipped_scene_prints_the_documented_json() {
             "{name}: mean contact force > 0"
         );
     }
+}
+
+/// A tolerance below the model's round-off floor is raised to it and the JSON reports the
+/// tolerance actually used: the scene asks 1e-300, the run converges against
+/// `eps max K_ii sqrt(n) max|g|` with `K_ii = 2 EA / h = 40` (20 elements), `n = 21 x 41`
+/// SSN-HB unknowns at H = 20 and the gap 0.5; at the scene's default 1e-10 the floor is
+/// below it and the tolerance is the scene's.
+#[test]
+fn a_tolerance_below_the_round_off_floor_is_raised_and_reported() {
+    let dir = TempDir::new("tolerance");
+    let scene = dir.write(
+        "tiny_tolerance.toml",
+        &CANONICAL.replace("[solver]", "[solver]\ntolerance = 1e-300"),
+    );
+    let (out, json) = solve_json(&scene, &[]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let floor = f64::EPSILON * 40.0 * ((21.0 * 41.0) as f64).sqrt() * 0.5;
+    let used = json["effective_tolerance"].as_f64().unwrap();
+    assert!((used / floor - 1.0).abs() < 1e-12, "{used:e} vs {floor:e}");
+    assert!(json["residual_norm"].as_f64().unwrap() <= used);
+    let (_, json) = solve_json(&scenes_dir().join("paper_fig1_modified_mass.toml"), &[]);
+    assert_eq!(json["effective_tolerance"].as_f64(), Some(1e-10));
 }
 
 #[test]

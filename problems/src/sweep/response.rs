@@ -99,7 +99,19 @@ impl FrequencyResponse {
     /// `tip_min`, `amplitude`, `folds`, `converged`, `solve_seconds`, `termination`,
     /// `counters`. Non-finite numbers (never produced by a converged branch) become `null`.
     pub fn to_json(&self) -> serde_json::Value {
-        let c = &self.counters;
+        let mut counters = self.counters.newton_json();
+        for (name, value) in [
+            (
+                "corrector_iterations",
+                self.continuation.corrector_iterations,
+            ),
+            ("rejected_steps", self.continuation.rejected_steps),
+            ("corner_passes", self.continuation.corner_passes),
+            ("restarts", self.restarts as u64),
+            ("corners", self.corners as u64),
+        ] {
+            counters.insert(name.to_string(), value.into());
+        }
         json!({
             "points": self.points(),
             "omega": self.omega,
@@ -110,19 +122,7 @@ impl FrequencyResponse {
             "converged": self.converged,
             "solve_seconds": self.solve_seconds,
             "termination": self.termination,
-            "counters": {
-                "residual_evaluations": c.residual_evaluations,
-                "jacobian_evaluations": c.jacobian_evaluations,
-                "factorizations": c.factorizations,
-                "linear_solves": c.linear_solves,
-                "line_search_backtracks": c.line_search_backtracks,
-                "ffts": c.ffts,
-                "corrector_iterations": self.continuation.corrector_iterations,
-                "rejected_steps": self.continuation.rejected_steps,
-                "corner_passes": self.continuation.corner_passes,
-                "restarts": self.restarts,
-                "corners": self.corners,
-            },
+            "counters": counters,
         })
     }
 }
