@@ -253,7 +253,7 @@ fn a_tolerance_below_the_round_off_floor_is_raised_and_reported() {
     );
     let (out, json) = solve_json(&scene, &[]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let floor = f64::EPSILON * 40.0 * ((21.0 * 41.0) as f64).sqrt() * 0.5;
+    let floor = f64::EPSILON * 40.0 * (21.0f64 * 41.0).sqrt() * 0.5;
     let used = json["effective_tolerance"].as_f64().unwrap();
     assert!((used / floor - 1.0).abs() < 1e-12, "{used:e} vs {floor:e}");
     assert!(json["residual_norm"].as_f64().unwrap() <= used);
