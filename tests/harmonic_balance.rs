@@ -15,7 +15,7 @@ use semismooth_problems::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
 };
-use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel};
+use semismooth_problems::model::{ContactPoint, HarmonicForcing, InvalidModel, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
@@ -530,17 +530,17 @@ fn bad_options_are_typed_errors_with_the_numbers() {
     let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
     assert!(matches!(
         err,
-        HbError::IndexOutOfRange {
-            index: 7,
-            count: 3,
+        HbError::Model(InvalidModel::ContactDofOutOfRange {
+            dof: 7,
+            dofs: 3,
             ..
-        }
+        })
     ));
     let mut bad = chain(3, None, 1.0, vec![]);
     bad.forcing.omega = 0.0;
     assert!(matches!(
         SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
-        HbError::InvalidOption { name: "omega", .. }
+        HbError::Model(InvalidModel::Omega { .. })
     ));
 }
 

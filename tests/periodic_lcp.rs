@@ -9,7 +9,7 @@ use semismooth::newton::{self, NewtonOptions};
 use semismooth_problems::lcp::{
     solve_min_map_sequenced, ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions,
 };
-use semismooth_problems::model::{SparseMatrix, StructuralModel};
+use semismooth_problems::model::{InvalidModel, SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 
 fn dense(m: &SparseMatrix) -> DMatrix<f64> {
@@ -364,7 +364,7 @@ fn bad_options_and_models_are_typed_errors() {
     bad.forcing.omega = f64::NAN;
     assert!(matches!(
         PeriodicLcp::new(&bad, options(16, vec![])),
-        Err(LcpError::InvalidModel { name: "omega", .. })
+        Err(LcpError::Model(InvalidModel::Omega { .. }))
     ));
     let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
     assert_eq!(

@@ -125,7 +125,7 @@ use faer::{Conj, Mat, MatMut, Par};
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
 use semismooth::linalg::LinearSolveError;
 
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::{sparse_mul_add, InvalidModel, SparseMatrix, StructuralModel};
 
 /// The one-step scheme used to march.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -308,16 +308,9 @@ pub enum MarchError {
         /// What is allowed.
         allowed: &'static str,
     },
-    /// The model is inconsistent (sizes, non-finite data, non-positive frequency).
-    #[error("invalid model {name} = {value}: allowed {allowed}")]
-    InvalidModel {
-        /// Which part of the model.
-        name: &'static str,
-        /// The offending value (a size, an index or a number).
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
+    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    #[error(transparent)]
+    Model(#[from] InvalidModel),
     /// An observed dof does not exist.
     #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
     ObservedDofOutOfRange {
@@ -457,7 +450,7 @@ impl SparseLu {
     fn check(&mut self, a: &SparseMatrix) -> Result<(), LinearSolveError> {
         let ones = vec![1.0; self.n];
         let mut x = vec![0.0; self.n];
-        sparse_mul_add(a, 1.0, &ones, &mut x);
+        sparse_mul_add(a.as_ref(), 1.0, &ones, &mut x);
         self.solve_in_place(&mut x);
         let error = x.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
         if error.is_finite() && error < 1e-6 {
@@ -470,20 +463,6 @@ impl SparseLu {
                 pivot: error,
                 max_pivot: f64::NAN,
             })
-        }
-    }
-}
-
-/// `y += alpha A x` for a column-compressed `A`.
-fn sparse_mul_add(a: &SparseMatrix, alpha: f64, x: &[f64], y: &mut [f64]) {
-    let r = a.as_ref();
-    for (j, xj) in x.iter().enumerate().take(r.ncols()) {
-        let s = alpha * xj;
-        if s == 0.0 {
-            continue;
-        }
-        for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            y[i] += v * s;
         }
     }
 }
@@ -517,86 +496,6 @@ fn column_max_abs(m: &SparseMatrix, j: usize) -> f64 {
         .val_of_col(j)
         .iter()
         .fold(0.0_f64, |a, v| a.max(v.abs()))
-}
-
-fn validate_model(model: &StructuralModel) -> Result<(), MarchError> {
-    let n = model.dofs();
-    let bad = |name, value: f64, allowed| MarchError::InvalidModel {
-        name,
-        value,
-        allowed,
-    };
-    if n == 0 {
-        return Err(bad("dofs", 0.0, "at least 1"));
-    }
-    let square = |m: &SparseMatrix| m.nrows() == n && m.ncols() == n;
-    if !square(&model.stiffness) {
-        return Err(bad(
-            "stiffness columns",
-            model.stiffness.ncols() as f64,
-            "a square matrix",
-        ));
-    }
-    if !square(&model.mass) {
-        return Err(bad(
-            "mass size",
-            model.mass.nrows() as f64,
-            "the size of the stiffness matrix",
-        ));
-    }
-    if let Some(d) = &model.damping {
-        if !square(d) {
-            return Err(bad(
-                "damping size",
-                d.nrows() as f64,
-                "the size of the stiffness matrix",
-            ));
-        }
-    }
-    let omega = model.forcing.omega;
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(bad("omega", omega, "a finite number > 0"));
-    }
-    if model.forcing.amplitude.len() != n {
-        return Err(bad(
-            "forcing amplitude length",
-            model.forcing.amplitude.len() as f64,
-            "the number of dofs",
-        ));
-    }
-    if let Some(v) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
-        return Err(bad("forcing amplitude", *v, "finite numbers"));
-    }
-    let matrices = [
-        Some(&model.stiffness),
-        Some(&model.mass),
-        model.damping.as_ref(),
-    ];
-    for m in matrices.into_iter().flatten() {
-        if let Some(v) = m.as_ref().val().iter().find(|v| !v.is_finite()) {
-            return Err(bad("matrix entry", *v, "finite numbers"));
-        }
-    }
-    for (k, c) in model.contacts.iter().enumerate() {
-        if c.dof >= n {
-            return Err(bad(
-                "contact dof",
-                c.dof as f64,
-                "an index below the number of dofs",
-            ));
-        }
-        if !c.gap.is_finite() {
-            return Err(bad("contact gap", c.gap, "a finite number"));
-        }
-        if model.contacts[..k].iter().any(|o| o.dof == c.dof) {
-            return Err(bad(
-                "contact dof",
-                c.dof as f64,
-                "at most one contact per dof",
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// The scheme `Auto` resolves to for this model.
@@ -713,7 +612,7 @@ impl<'a> TimeMarcher<'a> {
         initial: &MarchState,
     ) -> Result<Self, MarchError> {
         options.validate()?;
-        validate_model(model)?;
+        model.validate()?;
         let n = model.dofs();
         let m = model.contact_count();
         for (what, vec, len) in [
@@ -831,9 +730,9 @@ impl<'a> TimeMarcher<'a> {
             self.r[ct.dof] += l;
         }
         if let Some(d) = &model.damping {
-            sparse_mul_add(d, -1.0, &self.v, &mut self.r);
+            sparse_mul_add(d.as_ref(), -1.0, &self.v, &mut self.r);
         }
-        sparse_mul_add(&model.stiffness, -1.0, &self.u, &mut self.r);
+        sparse_mul_add(model.stiffness.as_ref(), -1.0, &self.u, &mut self.r);
         for (ri, &ml) in self.r.iter_mut().zip(&self.massless) {
             if ml {
                 *ri = 0.0;
@@ -971,12 +870,12 @@ impl<'a> TimeMarcher<'a> {
             self.rhs[i] = c * model.forcing.amplitude[i] + self.r[i];
             self.tmp[i] = 4.0 / (h * h) * self.u[i] + 4.0 / h * self.v[i];
         }
-        sparse_mul_add(&model.mass, 1.0, &self.tmp, &mut self.rhs);
+        sparse_mul_add(model.mass.as_ref(), 1.0, &self.tmp, &mut self.rhs);
         if let Some(d) = &model.damping {
             for i in 0..n {
                 self.tmp[i] = 2.0 / h * self.u[i] + self.v[i];
             }
-            sparse_mul_add(d, 1.0, &self.tmp, &mut self.rhs);
+            sparse_mul_add(d.as_ref(), 1.0, &self.tmp, &mut self.rhs);
         }
         self.lu.solve_in_place(&mut self.rhs);
         self.counters.linear_solves += 1;
@@ -1009,14 +908,14 @@ impl<'a> TimeMarcher<'a> {
         for i in 0..n {
             self.rhs[i] = h * f_theta * model.forcing.amplitude[i];
         }
-        sparse_mul_add(&model.mass, 1.0, &self.v, &mut self.rhs);
+        sparse_mul_add(model.mass.as_ref(), 1.0, &self.v, &mut self.rhs);
         if let Some(d) = &model.damping {
-            sparse_mul_add(d, -h * (1.0 - theta), &self.v, &mut self.rhs);
+            sparse_mul_add(d.as_ref(), -h * (1.0 - theta), &self.v, &mut self.rhs);
         }
         for i in 0..n {
             self.tmp[i] = self.u[i] + h * theta * (1.0 - theta) * self.v[i];
         }
-        sparse_mul_add(&model.stiffness, -h, &self.tmp, &mut self.rhs);
+        sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
         self.lu.solve_in_place(&mut self.rhs);
         self.counters.linear_solves += 1;
         // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).

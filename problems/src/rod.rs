@@ -15,7 +15,7 @@
 use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use crate::model::{ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel};
+use crate::model::{sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel};
 
 /// How the rod's mass is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -446,16 +446,12 @@ fn rayleigh_ritz(
     Ok((nu, vectors))
 }
 
-/// Multiplies a sparse matrix by a dense block.
+/// Multiplies a sparse matrix by a dense block (column by column).
 fn sparse_times(m: &SparseMatrix, x: &DMatrix<f64>) -> DMatrix<f64> {
-    let r = m.as_ref();
-    let mut out = DMatrix::zeros(r.nrows(), x.ncols());
-    for j in 0..r.ncols() {
-        for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            for c in 0..x.ncols() {
-                out[(i, c)] += v * x[(j, c)];
-            }
-        }
+    let mut out = DMatrix::zeros(m.nrows(), x.ncols());
+    let columns = x.as_slice().chunks(x.nrows().max(1));
+    for (o, xc) in out.as_mut_slice().chunks_mut(m.nrows().max(1)).zip(columns) {
+        sparse_mul_add(m.as_ref(), 1.0, xc, o);
     }
     out
 }

@@ -113,7 +113,7 @@ use faer::{c64, Mat, MatRef};
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeReport, LemkeTermination};
 use semismooth::newton::{self, NewtonError, NewtonOptions, NewtonReport};
 
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::{InvalidModel, SparseMatrix, StructuralModel};
 use dft::Dft;
 
 /// Default number of time steps per period `Nt` of the periodic LCP.
@@ -193,28 +193,13 @@ pub enum LcpError {
         /// Size found.
         found: usize,
     },
-    /// A scalar of the model is not acceptable.
-    #[error("invalid model {name} = {value}: allowed {allowed}")]
-    InvalidModel {
-        /// Which quantity.
-        name: &'static str,
-        /// The value found.
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
+    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    #[error(transparent)]
+    Model(#[from] InvalidModel),
     /// An observed dof does not exist.
     #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
     ObservedDofOutOfRange {
         /// The dof requested.
-        dof: usize,
-        /// Number of dofs.
-        dofs: usize,
-    },
-    /// A contact refers to a dof that does not exist.
-    #[error("contact dof {dof} is out of range: the model has {dofs} dofs")]
-    ContactDofOutOfRange {
-        /// The dof of the contact.
         dof: usize,
         /// Number of dofs.
         dofs: usize,
@@ -428,76 +413,6 @@ fn union_pattern(model: &StructuralModel) -> Result<UnionPattern, LcpError> {
     })
 }
 
-fn check_square(what: &'static str, m: &SparseMatrix, n: usize) -> Result<(), LcpError> {
-    for found in [m.nrows(), m.ncols()] {
-        if found != n {
-            return Err(LcpError::DimensionMismatch {
-                what,
-                expected: n,
-                found,
-            });
-        }
-    }
-    if let Some(&value) = m.val().iter().find(|v| !v.is_finite()) {
-        return Err(LcpError::InvalidModel {
-            name: what,
-            value,
-            allowed: "finite entries",
-        });
-    }
-    Ok(())
-}
-
-fn validate_model(model: &StructuralModel) -> Result<(), LcpError> {
-    let n = model.dofs();
-    check_square("stiffness", &model.stiffness, n)?;
-    check_square("mass", &model.mass, n)?;
-    if let Some(d) = &model.damping {
-        check_square("damping", d, n)?;
-    }
-    if model.forcing.amplitude.len() != n {
-        return Err(LcpError::DimensionMismatch {
-            what: "forcing amplitude",
-            expected: n,
-            found: model.forcing.amplitude.len(),
-        });
-    }
-    if let Some(&value) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
-        return Err(LcpError::InvalidModel {
-            name: "forcing amplitude",
-            value,
-            allowed: "finite entries",
-        });
-    }
-    let omega = model.forcing.omega;
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(LcpError::InvalidModel {
-            name: "omega",
-            value: omega,
-            allowed: "a finite number > 0",
-        });
-    }
-    if model.contacts.is_empty() {
-        return Err(LcpError::NoContacts);
-    }
-    for c in &model.contacts {
-        if c.dof >= n {
-            return Err(LcpError::ContactDofOutOfRange {
-                dof: c.dof,
-                dofs: n,
-            });
-        }
-        if !c.gap.is_finite() {
-            return Err(LcpError::InvalidModel {
-                name: "gap",
-                value: c.gap,
-                allowed: "a finite number",
-            });
-        }
-    }
-    Ok(())
-}
-
 /// `true` when column `j` of `m` has no non-zero entry.
 fn column_is_zero(m: &SparseMatrix, j: usize) -> bool {
     m.as_ref().val_of_col(j).iter().all(|v| *v == 0.0)
@@ -530,7 +445,10 @@ impl PeriodicLcp {
         options: PeriodicLcpOptions,
         with_derivative: bool,
     ) -> Result<Self, LcpError> {
-        validate_model(model)?;
+        model.validate()?;
+        if model.contacts.is_empty() {
+            return Err(LcpError::NoContacts);
+        }
         let n = model.dofs();
         let m = model.contact_count();
         options.validate(m, n)?;
