@@ -7,7 +7,7 @@ use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounter
 use super::jacobian::ContactCoupling;
 use super::ssn::{HbOptions, SsnHb};
 use super::structured::{condensed_matrix, StructuredHbSolver};
-use super::{check_len, HbError, ResponseSummary};
+use super::{check_len, indicator, HbError, ResponseSummary};
 use crate::model::StructuralModel;
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
@@ -29,9 +29,8 @@ pub struct CondensedSsnHb {
     linear_response: Vec<f64>,
     contact_linear: Vec<f64>,
     y: Vec<f64>,
-    q: Mat<f64>,
-    coeffs: Vec<f64>,
-    samples: Vec<f64>,
+    /// `Q_i = P diag(h_i) E` per contact.
+    q: Vec<Mat<f64>>,
     aft: Aft,
 }
 
@@ -48,9 +47,7 @@ impl CondensedSsnHb {
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],
-            q: Mat::zeros(size, m * size),
-            coeffs: vec![0.0; size],
-            samples: vec![0.0; basis.time_samples()],
+            q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
             aft: Aft::new(basis),
             full,
         };
@@ -170,17 +167,17 @@ impl CondensedSsnHb {
         }
     }
 
-    /// Samples of `s = c (G u - g) - lambda` of contact `i` into `self.samples`.
+    /// Samples of `s = c (G u - g) - lambda` of contact `i` into the AFT's samples.
     fn switching_samples(&mut self, lambda: &[f64], i: usize) {
         let lin = &self.full.state.linear;
         let m = lin.contacts();
         let c = self.full.c();
-        for j in 0..lin.size() {
-            self.coeffs[j] = c * self.y[j * m + i] - lambda[j * m + i];
+        let coeffs = self.aft.coefficients_mut();
+        for (j, coeff) in coeffs.iter_mut().enumerate() {
+            *coeff = c * self.y[j * m + i] - lambda[j * m + i];
         }
-        self.coeffs[0] -= c * lin.gaps[i];
-        // Lengths are fixed at construction: the transform cannot fail.
-        let _ = self.aft.to_time(&self.coeffs, &mut self.samples);
+        coeffs[0] -= c * lin.gaps[i];
+        self.aft.coefficients_to_samples();
     }
 }
 
@@ -191,16 +188,15 @@ impl Residual for CondensedSsnHb {
 
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let m = self.full.contacts();
-        let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
         for i in 0..m {
             self.switching_samples(lambda, i);
-            for s in &mut self.samples {
+            for s in self.aft.samples_mut() {
                 *s = s.max(0.0);
             }
-            let _ = self.aft.to_coefficients(&self.samples, &mut self.coeffs);
-            for j in 0..size {
-                out[j * m + i] = lambda[j * m + i] + self.coeffs[j];
+            self.aft.samples_to_coefficients();
+            for (j, c) in self.aft.coefficients().iter().enumerate() {
+                out[j * m + i] = lambda[j * m + i] + c;
             }
         }
         Ok(())
@@ -222,19 +218,15 @@ impl GeneralizedJacobian for CondensedSsnHb {
 
     fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         let m = self.full.contacts();
-        let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
         for i in 0..m {
             self.switching_samples(lambda, i);
-            for s in &mut self.samples {
-                *s = if *s > 0.0 { 1.0 } else { 0.0 };
-            }
-            let block = self.q.as_mut().subcols_mut(i * size, size);
-            let _ = self.aft.multiplication_matrix(&self.samples, block);
+            indicator(self.aft.samples_mut());
+            self.aft.samples_multiplication_matrix(&mut self.q[i]);
         }
         condensed_matrix(
             &self.receptance,
-            self.q.as_ref(),
+            &self.q,
             ContactCoupling::Complementarity { c: self.full.c() },
             m,
             jac.as_mut(),

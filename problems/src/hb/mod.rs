@@ -383,28 +383,12 @@ pub(crate) struct HbState {
 }
 
 impl HbState {
-    /// Turns the switching samples of contact `i` into the indicator `h_n = [s_n > 0]` (in
-    /// place) and writes the block `P diag(h) E` of the Jacobian; records the active count.
-    pub(crate) fn write_contact_block(
-        &mut self,
-        samples: &mut [f64],
-        jac: &mut jacobian::HbJacobian,
-        i: usize,
-    ) {
-        let mut active = 0;
-        for s in samples.iter_mut() {
-            *s = if *s > 0.0 {
-                active += 1;
-                1.0
-            } else {
-                0.0
-            };
-        }
-        jac.active[i] = active;
-        let size = self.linear.size();
-        let block = jac.q.as_mut().subcols_mut(i * size, size);
-        // Lengths are fixed at construction: the product cannot fail.
-        let _ = self.aft.multiplication_matrix(samples, block);
+    /// Turns the switching samples of contact `i` (the AFT's samples) into the indicator
+    /// `h_n = [s_n > 0]` and writes the block `P diag(h) E` of the Jacobian; records the
+    /// active count.
+    pub(crate) fn write_contact_block(&mut self, jac: &mut jacobian::HbJacobian, i: usize) {
+        jac.active[i] = indicator(self.aft.samples_mut());
+        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
     }
 
     pub(crate) fn new(linear: LinearData, omega: f64) -> Self {
@@ -415,4 +399,18 @@ impl HbState {
             aft,
         }
     }
+}
+
+/// Replaces each sample by the indicator `[s_n > 0]`; returns how many are 1.
+pub(crate) fn indicator(samples: &mut [f64]) -> usize {
+    let mut active = 0;
+    for s in samples.iter_mut() {
+        *s = if *s > 0.0 {
+            active += 1;
+            1.0
+        } else {
+            0.0
+        };
+    }
+    active
 }

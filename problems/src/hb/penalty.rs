@@ -72,8 +72,6 @@ impl PenaltyHbOptions {
 pub struct PenaltyHb {
     state: HbState,
     stiffness: f64,
-    coeffs: Vec<f64>,
-    samples: Vec<f64>,
     /// Frozen activity `h` (contact-major, `m Nt` entries): while `Some`, the penalty force
     /// is `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
     frozen: Option<Vec<bool>>,
@@ -85,13 +83,9 @@ impl PenaltyHb {
         options.validate()?;
         let kp = options.penalty_stiffness;
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
-        let size = linear.size();
-        let nt = linear.basis.time_samples();
         Ok(Self {
             state: HbState::new(linear, model.forcing.omega),
             stiffness: kp,
-            coeffs: vec![0.0; size],
-            samples: vec![0.0; nt],
             frozen: None,
         })
     }
@@ -195,13 +189,17 @@ impl PenaltyHb {
     /// Gaps `G u(t_n) - g` at the `Nt` AFT samples, contact-major (`i Nt + n`): the numbers
     /// whose signs decide which samples carry penalty force.
     pub(crate) fn gap_samples_all(&mut self, u: &[f64]) -> Vec<f64> {
-        let nt = self.samples.len();
+        let nt = self.time_samples();
         let mut out = Vec::with_capacity(self.contacts() * nt);
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
-            out.extend_from_slice(&self.samples);
+            out.extend_from_slice(self.state.aft.samples());
         }
         out
+    }
+
+    fn time_samples(&self) -> usize {
+        self.state.linear.basis.time_samples()
     }
 
     /// Freezes the activity (`Some(h)`, contact-major, `m Nt` entries): residual and
@@ -210,37 +208,38 @@ impl PenaltyHb {
     pub(crate) fn freeze_activity(&mut self, activity: Option<Vec<bool>>) {
         debug_assert!(activity
             .as_ref()
-            .is_none_or(|h| h.len() == self.contacts() * self.samples.len()));
+            .is_none_or(|h| h.len() == self.contacts() * self.time_samples()));
         self.frozen = activity;
     }
 
-    /// Replaces the gap samples of contact `i` in `self.samples` by the penalty
+    /// Replaces the gap samples of contact `i` (the AFT's samples) by the penalty
     /// "activity-weighted gaps": `max(0, s_n)`, or `h_n s_n` when the activity is frozen.
     fn penetrations(&mut self, i: usize) {
-        let nt = self.samples.len();
+        let samples = self.state.aft.samples_mut();
+        let nt = samples.len();
         match &self.frozen {
             Some(h) => {
-                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     if !on {
                         *s = 0.0;
                     }
                 }
             }
             None => {
-                for s in &mut self.samples {
+                for s in samples {
                     *s = s.max(0.0);
                 }
             }
         }
     }
 
-    /// Samples `G u_n - g` of contact `i` into `self.samples`.
+    /// Samples `G u_n - g` of contact `i` into the AFT's samples.
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
-        lin.gather(u, lin.contact_dofs[i], &mut self.coeffs);
-        self.coeffs[0] -= lin.gaps[i];
-        // Lengths are fixed at construction: the transform cannot fail.
-        let _ = self.state.aft.to_time(&self.coeffs, &mut self.samples);
+        let coeffs = self.state.aft.coefficients_mut();
+        lin.gather(u, lin.contact_dofs[i], coeffs);
+        coeffs[0] -= lin.gaps[i];
+        self.state.aft.coefficients_to_samples();
     }
 }
 
@@ -251,22 +250,19 @@ impl Residual for PenaltyHb {
 
     fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
-        let (n, size) = (lin.dofs, lin.size());
+        let n = lin.dofs;
         lin.dynamic_residual(self.state.omega, u, out);
         for i in 0..lin.contacts() {
             self.gap_samples(u, i);
             self.penetrations(i);
-            for s in &mut self.samples {
+            for s in self.state.aft.samples_mut() {
                 *s *= self.stiffness;
             }
-            let _ = self
-                .state
-                .aft
-                .to_coefficients(&self.samples, &mut self.coeffs);
+            self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
             let dof = lin.contact_dofs[i];
-            for j in 0..size {
-                out[j * n + dof] += self.coeffs[j];
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                out[j * n + dof] += c;
             }
         }
         Ok(())
@@ -299,16 +295,17 @@ impl GeneralizedJacobian for PenaltyHb {
         jac.coupling = ContactCoupling::Penalty {
             stiffness: self.stiffness,
         };
-        let nt = self.samples.len();
+        let nt = self.time_samples();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
             if let Some(h) = &self.frozen {
                 // The indicator is the sign of the sample: impose the frozen one.
-                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                let samples = self.state.aft.samples_mut();
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     *s = if on { 1.0 } else { 0.0 };
                 }
             }
-            self.state.write_contact_block(&mut self.samples, jac, i);
+            self.state.write_contact_block(jac, i);
         }
         Ok(())
     }

@@ -21,7 +21,7 @@ use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solv
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{c64, Conj, Mat, MatMut, MatRef, Par};
+use faer::{c64, Conj, Mat, MatMut, Par};
 use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{Factorize, LinearSolve};
 
@@ -119,7 +119,8 @@ pub struct StructuredHbSolver {
     /// `R_k = G Z_k^{-1} G^T` (m x m) per harmonic.
     receptance: Vec<Mat<c64>>,
     coupling: ContactCoupling,
-    q: Mat<f64>,
+    /// `Q_i` per contact, copied from the Jacobian.
+    q: Vec<Mat<f64>>,
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -165,7 +166,7 @@ impl StructuredHbSolver {
             response: Vec::new(),
             receptance: Vec::new(),
             coupling: ContactCoupling::Complementarity { c: 1.0 },
-            q: Mat::zeros(0, 0),
+            q: Vec::new(),
             schur: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
@@ -326,7 +327,7 @@ impl StructuredHbSolver {
         self.schur = Mat::zeros(nc, nc);
         self.perm.resize(nc, 0);
         self.perm_inv.resize(nc, 0);
-        self.q = Mat::zeros(size, nc);
+        self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
         self.factored_for = Some((lin, jac.omega));
         self.dynamic_factorizations += 1;
         Ok(())
@@ -401,13 +402,12 @@ impl StructuredHbSolver {
     }
 
     /// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
-    fn apply_coupling(q: &Mat<f64>, m: usize, p: &[f64], out: &mut [f64]) {
-        let size = q.nrows();
-        for i in 0..m {
-            for j in 0..size {
+    fn apply_coupling(q: &[Mat<f64>], m: usize, p: &[f64], out: &mut [f64]) {
+        for (i, qi) in q.iter().enumerate() {
+            for j in 0..qi.nrows() {
                 let mut sum = 0.0;
-                for l in 0..size {
-                    sum += q[(j, i * size + l)] * p[l * m + i];
+                for l in 0..qi.ncols() {
+                    sum += qi[(j, l)] * p[l * m + i];
                 }
                 out[j * m + i] = sum;
             }
@@ -428,17 +428,21 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         let (m, size) = (lin.contacts(), lin.size());
         let nc = m * size;
         self.coupling = jac.coupling;
-        self.q.copy_from(&jac.q);
-        if let Some((row, col, value)) = (0..nc)
-            .flat_map(|c| (0..size).map(move |r| (r, c)))
-            .map(|(r, c)| (r, c, jac.q[(r, c)]))
-            .find(|(_, _, v)| !v.is_finite())
-        {
-            return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+        for (i, (q, source)) in self.q.iter_mut().zip(&jac.q).enumerate() {
+            q.copy_from(source);
+            for col in 0..size {
+                for row in 0..size {
+                    let value = q[(row, col)];
+                    if !value.is_finite() {
+                        let col = i * size + col;
+                        return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+                    }
+                }
+            }
         }
         condensed_matrix(
             &self.receptance,
-            self.q.as_ref(),
+            &self.q,
             self.coupling,
             m,
             self.schur.as_mut(),
@@ -662,15 +666,15 @@ fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> 
 
 /// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R`
 /// (SSN-HB) or `I + k_p R Q` (penalty), using that `R` only couples the two basis
-/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` in column blocks.
+/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` of each contact.
 pub(crate) fn condensed_matrix(
     receptance: &[Mat<c64>],
-    q: MatRef<'_, f64>,
+    q: &[Mat<f64>],
     coupling: ContactCoupling,
     m: usize,
     mut out: MatMut<'_, f64>,
 ) {
-    let size = q.nrows();
+    let size = (2 * receptance.len()).saturating_sub(1);
     out.fill(0.0);
     for l in 0..size {
         let k = l.div_ceil(2);
@@ -680,16 +684,15 @@ pub(crate) fn condensed_matrix(
             let col = l * m + ip;
             match coupling {
                 ContactCoupling::Complementarity { c } => {
-                    for i in 0..m {
+                    for (i, qi) in q.iter().enumerate() {
                         let (rho0, rho1) = receptance_column(receptance, l, i, ip);
-                        let qi = i * size;
                         for j in 0..size {
-                            let mut value = c * rho0 * q[(j, qi + first)];
+                            let mut value = c * rho0 * qi[(j, first)];
                             if count == 2 {
-                                value += c * rho1 * q[(j, qi + first + 1)];
+                                value += c * rho1 * qi[(j, first + 1)];
                             }
                             if i == ip {
-                                value -= q[(j, qi + l)];
+                                value -= qi[(j, l)];
                             }
                             out[(j * m + i, col)] = value;
                         }
@@ -697,14 +700,14 @@ pub(crate) fn condensed_matrix(
                 }
                 ContactCoupling::Penalty { stiffness } => {
                     // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
-                    let qp = ip * size;
+                    let qp = &q[ip];
                     for i in 0..m {
                         let r0 = receptance[0][(i, ip)].re;
-                        out[(i, col)] = stiffness * r0 * q[(0, qp + l)];
+                        out[(i, col)] = stiffness * r0 * qp[(0, l)];
                         for (kk, rk) in receptance.iter().enumerate().skip(1) {
                             let (jc, js) = (2 * kk - 1, 2 * kk);
                             let r = rk[(i, ip)];
-                            let (pc, ps) = (q[(jc, qp + l)], q[(js, qp + l)]);
+                            let (pc, ps) = (qp[(jc, l)], qp[(js, l)]);
                             out[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
                             out[(js * m + i, col)] = stiffness * (-r.im * pc + r.re * ps);
                         }
