@@ -100,7 +100,6 @@
 //! ```
 
 mod build;
-mod dft;
 mod frequency;
 mod min_map;
 mod sequencing;
@@ -111,12 +110,15 @@ pub use sequencing::{
     solve_min_map_sequenced, SequencedSolution, SequencingLevel, SEQUENCING_COARSEST_TIME_SAMPLES,
 };
 
+use std::sync::Arc;
+
 use faer::{c64, Mat, MatRef};
+use rustfft::{Fft, FftPlanner};
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeReport, LemkeTermination};
+use semismooth::linalg::LinearSolveError;
 use semismooth::newton::NewtonError;
 
 use crate::model::InvalidModel;
-use dft::Dft;
 
 /// Default number of time steps per period `Nt` of the periodic LCP.
 pub const DEFAULT_LCP_TIME_SAMPLES: usize = 256;
@@ -202,27 +204,26 @@ pub enum LcpError {
         /// Number of dofs.
         dofs: usize,
     },
-    /// The sparse factorization of a dynamic stiffness failed.
-    #[error("factorization of the dynamic stiffness of bin {bin} failed: {reason}")]
+    /// A dynamic stiffness could not be factored for want of memory or indices, or the
+    /// static block of the Nyquist limit is singular.
+    #[error("factorization of the dynamic stiffness of bin {bin} failed: {source}")]
     Factorization {
         /// DFT bin (`Nt/2` is the Nyquist limit problem).
         bin: usize,
-        /// Backend's description.
-        reason: String,
+        /// What the sparse LU reported.
+        source: LinearSolveError,
     },
-    /// `Z_k` is numerically singular (a warped bin frequency on a natural frequency of an
-    /// undamped model).
-    #[error(
-        "dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: \
-         relative residual {relative_residual:e}"
-    )]
+    /// The LU of `Z_k` broke down (a zero pivot: a warped bin frequency on a natural
+    /// frequency of an undamped model).
+    #[error("dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: {source}")]
     SingularBin {
         /// DFT bin.
         bin: usize,
         /// Warped angular frequency `(2/dt) tan(pi k / Nt)`.
         frequency: f64,
-        /// Relative residual of the solve.
-        relative_residual: f64,
+        /// The singular pivot ([`LinearSolveError::Singular`]: its dof, value and the
+        /// largest pivot).
+        source: LinearSolveError,
     },
     /// Lemke's method ran but did not solve the LCP (secondary ray or pivot limit). A ray
     /// is possible when `A` is not copositive-plus: `symmetric_part_min_eigenvalue < 0`
@@ -285,6 +286,57 @@ pub struct PeriodicLcp {
     static_dofs: usize,
     /// `dH_k/domega` and `dX/domega` on the contact rows, when asked for.
     derivative: Option<FrequencyDerivative>,
+    /// FFTs of length `Nt`, planned once.
+    plans: FftPlans,
+}
+
+/// Complex FFT plans of one length `Nt` (any `Nt >= 1`, rustfft), both unnormalised:
+/// `forward`: `X_k = sum_n x_n e^{-2 pi i k n / Nt}`, `inverse`: the conjugate sum.
+#[derive(Clone)]
+struct FftPlans {
+    forward: Arc<dyn Fft<f64>>,
+    inverse: Arc<dyn Fft<f64>>,
+}
+
+impl std::fmt::Debug for FftPlans {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FftPlans")
+            .field("len", &self.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl FftPlans {
+    fn new(nt: usize) -> Self {
+        let mut planner = FftPlanner::new();
+        Self {
+            forward: planner.plan_fft_forward(nt),
+            inverse: planner.plan_fft_inverse(nt),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.forward.len()
+    }
+
+    /// A scratch buffer for both directions.
+    fn scratch(&self) -> Vec<c64> {
+        let len = self
+            .forward
+            .get_inplace_scratch_len()
+            .max(self.inverse.get_inplace_scratch_len());
+        vec![c64::new(0.0, 0.0); len]
+    }
+
+    /// In place forward transform of `x` (length `Nt`).
+    fn forward(&self, x: &mut [c64], scratch: &mut [c64]) {
+        self.forward.process_with_scratch(x, scratch);
+    }
+
+    /// In place inverse (unnormalised) transform of `x` (length `Nt`).
+    fn inverse(&self, x: &mut [c64], scratch: &mut [c64]) {
+        self.inverse.process_with_scratch(x, scratch);
+    }
 }
 
 /// Derivatives with respect to `omega` of the bin receptances `H_k` (contact rows only,
@@ -302,7 +354,7 @@ struct FrequencyDerivative {
 /// FFT with the bin kernels `transfer[(k * rows_total + r) * m + c]`, `k = 0..=Nt/2` (the
 /// other bins by conjugate symmetry).
 fn kernel_response(
-    nt: usize,
+    plans: &FftPlans,
     m: usize,
     transfer: &[c64],
     rows_total: usize,
@@ -311,12 +363,13 @@ fn kernel_response(
     rows: &[usize],
 ) -> Vec<Vec<f64>> {
     let zero = c64::new(0.0, 0.0);
-    let mut plan = Dft::new(nt);
+    let nt = plans.len();
+    let mut scratch = plans.scratch();
     // Spectra of the contact forces z_c.
     let spectra: Vec<Vec<c64>> = (0..m)
         .map(|c| {
             let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
-            plan.forward(&mut s);
+            plans.forward(&mut s, &mut scratch);
             s
         })
         .collect();
@@ -336,7 +389,7 @@ fn kernel_response(
                 }
                 *out = sum;
             }
-            plan.backward(&mut buffer);
+            plans.inverse(&mut buffer, &mut scratch);
             (0..nt)
                 .map(|n| {
                     let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
@@ -369,7 +422,15 @@ impl PeriodicLcp {
         let m = self.contacts;
         let rows: Vec<usize> = (0..m).collect();
         // `w = g - u_c` along the contact rows: dw/domega = -(du_c/domega).
-        let du = kernel_response(self.nt, m, &d.transfer, m, &d.linear_amplitude, z, &rows);
+        let du = kernel_response(
+            &self.plans,
+            m,
+            &d.transfer,
+            m,
+            &d.linear_amplitude,
+            z,
+            &rows,
+        );
         for (c, history) in du.iter().enumerate() {
             for (n, v) in history.iter().enumerate() {
                 out[n * m + c] = -v;
@@ -532,7 +593,7 @@ impl PeriodicLcp {
 
     fn response_rows(&self, z: &[f64], rows: &[usize]) -> Vec<Vec<f64>> {
         kernel_response(
-            self.nt,
+            &self.plans,
             self.contacts,
             &self.transfer,
             self.rows(),

@@ -3,116 +3,51 @@
 
 use std::f64::consts::PI;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Conj, Mat, MatMut, Par};
+use faer::Mat;
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
-use semismooth::linalg::LinearSolveError;
+use semismooth::linalg::FaerSparseLu;
+use semismooth::{Factorize, LinearSolve};
 
 use super::{
     column_max_abs, resolve_scheme, MarchCounters, MarchError, MarchOptions, MarchScheme,
     MarchState,
 };
+use crate::dynamic::UnionPattern;
 use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
 
-/// Sparse LU with symbolic analysis and numeric factorization done once, and a kept
-/// scratch buffer so that solves do not allocate.
-struct SparseLu {
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
-    scratch: MemBuffer,
-    n: usize,
+/// The scheme actually marched (`Auto` resolved).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scheme {
+    Trapezoidal,
+    MoreauJean { theta: f64, restitution: f64 },
 }
 
-impl SparseLu {
-    fn new(a: &SparseMatrix) -> Result<Self, LinearSolveError> {
-        let n = a.nrows();
-        let symbolic = factorize_symbolic_lu(a.symbolic(), Default::default())
-            .map_err(|e| LinearSolveError::from_faer(e, "analysing the iteration matrix"))?;
-        let mut numeric = NumericLu::new();
-        let mut buffer = MemBuffer::try_new(
-            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-        )
-        .map_err(|_| LinearSolveError::OutOfMemory {
-            during: "allocating the LU workspace",
-        })?;
-        symbolic
-            .factorize_numeric_lu(
-                &mut numeric,
-                a.as_ref(),
-                Par::Seq,
-                MemStack::new(&mut buffer),
-                Default::default(),
-            )
-            .map_err(|e| LinearSolveError::from_sparse_lu(e, "factoring the iteration matrix"))?;
-        let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq))
-            .map_err(|_| LinearSolveError::OutOfMemory {
-                during: "allocating the solve workspace",
-            })?;
-        let mut lu = Self {
-            symbolic,
-            numeric,
-            scratch,
-            n,
-        };
-        lu.check(a)?;
-        Ok(lu)
-    }
-
-    fn solve_in_place(&mut self, rhs: &mut [f64]) {
-        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        lu.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, self.n, 1),
-            Par::Seq,
-            MemStack::new(&mut self.scratch),
-        );
-    }
-
-    /// faer's sparse LU does not report small pivots: solve `A x = A 1` and check that
-    /// `x` is finite and close to 1 (a singular or hopelessly ill-conditioned `A` fails).
-    fn check(&mut self, a: &SparseMatrix) -> Result<(), LinearSolveError> {
-        let ones = vec![1.0; self.n];
-        let mut x = vec![0.0; self.n];
-        sparse_mul_add(a.as_ref(), 1.0, &ones, &mut x);
-        self.solve_in_place(&mut x);
-        let error = x.iter().map(|v| (v - 1.0).abs()).fold(0.0, f64::max);
-        if error.is_finite() && error < 1e-6 {
-            Ok(())
-        } else {
-            // A singular or hopelessly ill-conditioned matrix: the test solve's error stands
-            // for the negligible pivot faer does not report.
-            Err(LinearSolveError::Singular {
-                index: 0,
-                pivot: error,
-                max_pivot: f64::NAN,
-            })
+impl Scheme {
+    fn resolve(model: &StructuralModel, scheme: MarchScheme) -> Self {
+        match resolve_scheme(model, scheme) {
+            MarchScheme::MoreauJean { theta, restitution } => {
+                Self::MoreauJean { theta, restitution }
+            }
+            MarchScheme::MasslessContactTrapezoidal | MarchScheme::Auto => Self::Trapezoidal,
         }
     }
-}
 
-/// `a K + b D + c M` (the pattern is the union of the three patterns).
-fn combine(model: &StructuralModel, a: f64, b: f64, c: f64) -> Result<SparseMatrix, MarchError> {
-    let mut triplets = Vec::new();
-    let mut push = |m: &SparseMatrix, s: f64| {
-        let r = m.as_ref();
-        for j in 0..r.ncols() {
-            for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-                triplets.push(Triplet::new(i, j, s * v));
+    fn public(self) -> MarchScheme {
+        match self {
+            Self::Trapezoidal => MarchScheme::MasslessContactTrapezoidal,
+            Self::MoreauJean { theta, restitution } => {
+                MarchScheme::MoreauJean { theta, restitution }
             }
         }
-    };
-    push(&model.stiffness, a);
-    if let Some(d) = &model.damping {
-        push(d, b);
     }
-    push(&model.mass, c);
-    let n = model.dofs();
-    SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|e| MarchError::Factorization {
-        matrix: "iteration matrix",
-        source: LinearSolveError::from_creation(e, "assembling the iteration matrix"),
-    })
+
+    /// Name of the iteration matrix.
+    fn matrix(self) -> &'static str {
+        match self {
+            Self::Trapezoidal => "K_eff",
+            Self::MoreauJean { .. } => "M_hat",
+        }
+    }
 }
 
 /// Lemke workspaces, one per LCP size (so varying active sets never reallocate), and a
@@ -173,7 +108,7 @@ impl ContactLcp {
 /// an active contact).
 pub struct TimeMarcher<'a> {
     model: &'a StructuralModel,
-    scheme: MarchScheme,
+    scheme: Scheme,
     steps_per_period: usize,
     h: f64,
     /// `cos(2 pi j / steps_per_period)`, `j = 0..=steps_per_period`.
@@ -182,7 +117,7 @@ pub struct TimeMarcher<'a> {
     phase: usize,
     /// Periods completed.
     completed_periods: usize,
-    lu: SparseLu,
+    lu: FaerSparseLu,
     /// `Y = A^{-1} G^T` (N x m, column-major), `A` = K_eff or M_hat.
     y: Vec<f64>,
     /// `W = G Y` (m x m).
@@ -234,52 +169,46 @@ impl<'a> TimeMarcher<'a> {
                 });
             }
         }
-        let scheme = resolve_scheme(model, options.scheme);
+        let scheme = Scheme::resolve(model, options.scheme);
         let massless: Vec<bool> = (0..n)
             .map(|j| column_max_abs(&model.mass, j) == 0.0)
             .collect();
         let spp = options.steps_per_period;
         let h = 2.0 * PI / model.forcing.omega / spp as f64;
-        let (matrix, name) = match scheme {
-            MarchScheme::MasslessContactTrapezoidal => {
+        // a K + b D + c M, summed in the order K, D, M.
+        let (a, b, c) = match scheme {
+            Scheme::Trapezoidal => {
                 if let Some(c) = model.contacts.iter().find(|c| !massless[c.dof]) {
                     return Err(MarchError::MassiveContactDof {
                         dof: c.dof,
                         mass: column_max_abs(&model.mass, c.dof),
                     });
                 }
-                (combine(model, 1.0, 2.0 / h, 4.0 / (h * h))?, "K_eff")
+                (1.0, 2.0 / h, 4.0 / (h * h))
             }
-            MarchScheme::MoreauJean { theta, .. } => (
-                combine(model, h * h * theta * theta, h * theta, 1.0)?,
-                "M_hat",
-            ),
-            MarchScheme::Auto => unreachable!("resolved above"),
+            Scheme::MoreauJean { theta, .. } => (h * h * theta * theta, h * theta, 1.0),
         };
-        let mut lu = SparseLu::new(&matrix).map_err(|source| MarchError::Factorization {
-            matrix: name,
+        let mut sources = vec![(&model.stiffness, a)];
+        sources.extend(model.damping.as_ref().map(|d| (d, b)));
+        sources.push((&model.mass, c));
+        let (matrices, coefficients): (Vec<&SparseMatrix>, Vec<f64>) = sources.into_iter().unzip();
+        let matrix = UnionPattern::linear_combination(n, &matrices, &coefficients);
+        let failed = |source| MarchError::Factorization {
+            matrix: scheme.matrix(),
             source,
-        })?;
+        };
+        let mut lu = FaerSparseLu::new();
+        lu.factor(&matrix).map_err(failed)?;
+        // Y = A^{-1} G^T, column k for contact k; W = G Y.
         let mut y = vec![0.0; n * m];
         let mut w = Mat::zeros(m, m);
         for (k, c) in model.contacts.iter().enumerate() {
             let col = &mut y[k * n..(k + 1) * n];
             col[c.dof] = 1.0;
-            lu.solve_in_place(col);
+            lu.solve_in_place(col).map_err(failed)?;
             for (i, ci) in model.contacts.iter().enumerate() {
                 w[(i, k)] = col[ci.dof];
             }
-        }
-        // Y = K_eff^{-1} G^T, column k for contact k.
-        if let Some((index, &value)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(MarchError::Factorization {
-                matrix: name,
-                source: LinearSolveError::NonFiniteEntry {
-                    row: index % n,
-                    col: index / n,
-                    value,
-                },
-            });
         }
         let cosines = (0..=spp)
             .map(|j| (2.0 * PI * j as f64 / spp as f64).cos())
@@ -312,7 +241,7 @@ impl<'a> TimeMarcher<'a> {
                 ..MarchCounters::default()
             },
         };
-        if scheme == MarchScheme::MasslessContactTrapezoidal {
+        if scheme == Scheme::Trapezoidal {
             marcher.equilibrium_inertia(0);
         }
         Ok(marcher)
@@ -341,7 +270,7 @@ impl<'a> TimeMarcher<'a> {
 
     /// The scheme in use (never `Auto`).
     pub fn scheme(&self) -> MarchScheme {
-        self.scheme
+        self.scheme.public()
     }
 
     /// The time step `h = T / steps_per_period`.
@@ -398,11 +327,10 @@ impl<'a> TimeMarcher<'a> {
     pub fn step(&mut self) -> Result<(), MarchError> {
         let j = self.phase;
         match self.scheme {
-            MarchScheme::MasslessContactTrapezoidal => self.step_trapezoidal(j)?,
-            MarchScheme::MoreauJean { theta, restitution } => {
+            Scheme::Trapezoidal => self.step_trapezoidal(j)?,
+            Scheme::MoreauJean { theta, restitution } => {
                 self.step_moreau_jean(j, theta, restitution)?
             }
-            MarchScheme::Auto => unreachable!("resolved in new"),
         }
         self.counters.steps += 1;
         if self.u.iter().chain(&self.v).any(|x| !x.is_finite()) {
@@ -459,6 +387,18 @@ impl<'a> TimeMarcher<'a> {
         Ok(())
     }
 
+    /// `rhs <- A^{-1} rhs` with the iteration matrix (counted).
+    fn solve_rhs(&mut self) -> Result<(), MarchError> {
+        self.lu
+            .solve_in_place(&mut self.rhs)
+            .map_err(|source| MarchError::Factorization {
+                matrix: self.scheme.matrix(),
+                source,
+            })?;
+        self.counters.linear_solves += 1;
+        Ok(())
+    }
+
     fn step_trapezoidal(&mut self, j: usize) -> Result<(), MarchError> {
         let model = self.model;
         let n = self.u.len();
@@ -476,8 +416,7 @@ impl<'a> TimeMarcher<'a> {
             }
             sparse_mul_add(d.as_ref(), 1.0, &self.tmp, &mut self.rhs);
         }
-        self.lu.solve_in_place(&mut self.rhs);
-        self.counters.linear_solves += 1;
+        self.solve_rhs()?;
         // rhs = u_free. Contact LCP on all contacts (when one is closed): q = g - G u_free.
         self.active.clear();
         let mut closed = false;
@@ -515,8 +454,7 @@ impl<'a> TimeMarcher<'a> {
             self.tmp[i] = self.u[i] + h * theta * (1.0 - theta) * self.v[i];
         }
         sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
-        self.lu.solve_in_place(&mut self.rhs);
-        self.counters.linear_solves += 1;
+        self.solve_rhs()?;
         // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
         self.active.clear();
         for (k, ct) in model.contacts.iter().enumerate() {
