@@ -18,7 +18,9 @@ use semismooth::{GeneralizedJacobian, Residual};
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
-use crate::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
+use crate::lcp::{
+    ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
+};
 use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
 use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
@@ -516,20 +518,14 @@ fn solve_lcp(
                 Some(w) if w.len() == lcp.dim() => {
                     let mut problem = lcp.min_map();
                     let mut z = w.to_vec();
-                    let mut solver = ActiveSetSolver::new();
+                    let mut solver = ActiveSetSolver::new()
+                        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
                     let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
                         .or_else(NewtonError::into_report)?;
                     (z, vec![report])
                 }
                 _ => {
-                    let sequenced = crate::lcp::solve_min_map_sequenced(
-                        model,
-                        PeriodicLcpOptions {
-                            time_samples: settings.time_samples,
-                            observed_dofs: Vec::new(),
-                        },
-                        &options,
-                    )?;
+                    let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
                     let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
                     (sequenced.z, reports)
                 }

@@ -1329,7 +1329,7 @@ pub fn frequency_response(
             start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
             let sequenced = solve_min_map_sequenced(
                 &start_model,
-                lcp_options.clone(),
+                &PeriodicLcp::new(&start_model, lcp_options.clone())?,
                 &newton_options(settings),
             )?;
             let mut start_counters = WorkCounters::default();

@@ -105,7 +105,7 @@ mod min_map;
 mod sequencing;
 
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
-pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp};
+pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
 pub use sequencing::{
     solve_min_map_sequenced, SequencedSolution, SequencingLevel, SEQUENCING_COARSEST_TIME_SAMPLES,
 };
@@ -250,6 +250,16 @@ pub enum LcpError {
     /// [`PeriodicLcp::with_frequency_derivative`]).
     #[error("the LCP was built without its frequency derivative")]
     NoFrequencyDerivative,
+    /// The LCP given to [`solve_min_map_sequenced`] was not built for its model.
+    #[error("the finest LCP's {what} is {lcp}, the model's {model}")]
+    ForeignLcp {
+        /// What differs: `"omega"`, `"contact count"`, `"contact dof"` or `"contact gap"`.
+        what: &'static str,
+        /// The LCP's value.
+        lcp: f64,
+        /// The model's value.
+        model: f64,
+    },
     /// A vector passed in has the wrong length.
     #[error("{what} has length {found}, expected {expected}")]
     WrongLength {
@@ -476,6 +486,11 @@ impl PeriodicLcp {
         build::bin_frequency(self.nt, self.time_step(), k)
     }
 
+    /// The contact gaps `g`, in contact order.
+    pub fn gaps(&self) -> &[f64] {
+        &self.gaps
+    }
+
     /// The contact dofs, in contact order.
     pub fn contact_dofs(&self) -> &[usize] {
         &self.contact_dofs
@@ -635,6 +650,6 @@ impl PeriodicLcp {
 
     /// The semismooth equation `min(z, q + A z) = 0` of this LCP (method `"lcp-ssn"`).
     pub fn min_map(&self) -> MinMapLcp<'_> {
-        MinMapLcp::new(self.matrix.as_ref(), &self.q).expect("A and q have matching sizes")
+        MinMapLcp::of_lcp(self.matrix.as_ref(), &self.q)
     }
 }

@@ -3,7 +3,10 @@
 
 use semismooth::newton::{self, NewtonError, NewtonOptions, NewtonReport};
 
-use super::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, MIN_LCP_TIME_SAMPLES};
+use super::{
+    ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
+    MIN_LCP_TIME_SAMPLES,
+};
 use crate::model::StructuralModel;
 
 impl PeriodicLcp {
@@ -50,14 +53,13 @@ pub struct SequencingLevel {
     pub report: NewtonReport,
 }
 
-/// Result of [`solve_min_map_sequenced`]: the finest LCP, its solution and every level.
+/// Result of [`solve_min_map_sequenced`]: the solution of the finest LCP (the caller's)
+/// and every level.
 #[derive(Debug, Clone)]
 pub struct SequencedSolution {
-    /// The LCP at the requested `Nt`.
-    pub lcp: PeriodicLcp,
     /// Best iterate on the finest level (the solution when its report converged).
     pub z: Vec<f64>,
-    /// Levels from coarsest to finest; the last one is the requested `Nt`.
+    /// Levels from coarsest to finest; the last one is the finest LCP's `Nt`.
     pub levels: Vec<SequencingLevel>,
 }
 
@@ -73,12 +75,18 @@ impl SequencedSolution {
     }
 }
 
-/// Semismooth Newton on `min(z, q + A z) = 0` by mesh sequencing (method `"lcp-ssn"`
-/// at large `Nt`): the LCP is solved at `Nt / 2^j` (halving while even and not below
-/// [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0`, then each finer level starts from
-/// the previous solution interpolated in time ([`PeriodicLcp::interpolate_forces`]), with
-/// the [`ActiveSetSolver`]. A level that does not converge still passes its best iterate
-/// on; `Ok` whenever every level ran (check [`SequencedSolution::converged`]).
+/// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
+/// `"lcp-ssn"` at large `Nt`): the LCP of `model` is solved at `Nt / 2^j` (halving while
+/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0`, then each finer
+/// level starts from the previous solution interpolated in time
+/// ([`PeriodicLcp::interpolate_forces`]); the last level is `finest` itself (built by the
+/// caller, with whatever observed dofs it needs; only the coarser levels are built here).
+/// The linear solver is the [`ActiveSetSolver`] regularised by
+/// [`DEFAULT_ACTIVE_SET_REGULARIZATION`], so that a singular first Jacobian (every node
+/// in contact at `z = 0`) does not stop the run. A level that does not converge still
+/// passes its best iterate on; `Ok` whenever every level ran (check
+/// [`SequencedSolution::converged`]). `finest` must be an LCP of `model`
+/// ([`LcpError::ForeignLcp`] otherwise).
 ///
 /// Why: with a damped massless contact node the high-frequency receptances tend to 0, so
 /// `A` is ill-conditioned and from `z = 0` the active set creeps one node at a time (on
@@ -87,55 +95,113 @@ impl SequencedSolution {
 /// 2048); from the interpolated coarser solution 5 / 7 / 8 / 42 iterations.
 pub fn solve_min_map_sequenced(
     model: &StructuralModel,
-    options: PeriodicLcpOptions,
+    finest: &PeriodicLcp,
     newton_options: &NewtonOptions,
 ) -> Result<SequencedSolution, LcpError> {
     newton_options.validate()?;
-    options.validate(model.contact_count(), model.dofs())?;
-    let mut sizes = vec![options.time_samples];
+    check_same_model(model, finest)?;
+    let mut sizes = vec![finest.time_samples()];
     while let Some(&nt) = sizes.last() {
         if nt % 2 != 0 || nt / 2 < SEQUENCING_COARSEST_TIME_SAMPLES.max(MIN_LCP_TIME_SAMPLES) {
             break;
         }
         sizes.push(nt / 2);
     }
+    sizes.pop(); // the finest level is the caller's
     sizes.reverse();
-    let mut levels = Vec::with_capacity(sizes.len());
-    let mut previous: Option<Vec<f64>> = None;
-    let mut finest = None;
-    for (index, &nt) in sizes.iter().enumerate() {
-        let last = index + 1 == sizes.len();
-        let level_options = PeriodicLcpOptions {
-            time_samples: nt,
-            observed_dofs: if last {
-                options.observed_dofs.clone()
-            } else {
-                Vec::new()
-            },
-        };
-        let lcp = PeriodicLcp::new(model, level_options)?;
+    let mut solver =
+        ActiveSetSolver::new().with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
+    let mut levels = Vec::with_capacity(sizes.len() + 1);
+    let mut z: Option<Vec<f64>> = None;
+    let mut solve_level = |lcp: &PeriodicLcp, previous: Option<Vec<f64>>| {
         let mut z = match &previous {
             Some(coarse) => lcp.interpolate_forces(coarse)?,
             None => vec![0.0; lcp.dim()],
         };
-        let report = {
-            let mut problem = lcp.min_map();
-            let mut solver = ActiveSetSolver::new();
-            newton::solve(&mut problem, &mut solver, &mut z, newton_options)
-                .or_else(NewtonError::into_report)?
-        };
+        let report = newton::solve(&mut lcp.min_map(), &mut solver, &mut z, newton_options)
+            .or_else(NewtonError::into_report)?;
         levels.push(SequencingLevel {
-            time_samples: nt,
+            time_samples: lcp.time_samples(),
             report,
         });
-        if last {
-            finest = Some(lcp);
-        }
-        previous = Some(z);
+        Ok::<_, LcpError>(z)
+    };
+    for nt in sizes {
+        let options = PeriodicLcpOptions {
+            time_samples: nt,
+            observed_dofs: Vec::new(),
+        };
+        z = Some(solve_level(&PeriodicLcp::new(model, options)?, z)?);
     }
-    Ok(SequencedSolution {
-        lcp: finest.expect("at least one level"),
-        z: previous.expect("at least one level"),
-        levels,
-    })
+    let z = solve_level(finest, z)?;
+    Ok(SequencedSolution { z, levels })
+}
+
+/// `Err(ForeignLcp)` unless `lcp` was built for `model` (same frequency and contacts).
+fn check_same_model(model: &StructuralModel, lcp: &PeriodicLcp) -> Result<(), LcpError> {
+    let foreign = |what, lcp: f64, model: f64| Err(LcpError::ForeignLcp { what, lcp, model });
+    if lcp.omega() != model.forcing.omega {
+        return foreign("omega", lcp.omega(), model.forcing.omega);
+    }
+    if lcp.contact_count() != model.contact_count() {
+        let (a, b) = (lcp.contact_count(), model.contact_count());
+        return foreign("contact count", a as f64, b as f64);
+    }
+    for ((&dof, gap), c) in lcp
+        .contact_dofs()
+        .iter()
+        .zip(lcp.gaps())
+        .zip(&model.contacts)
+    {
+        if dof != c.dof {
+            return foreign("contact dof", dof as f64, c.dof as f64);
+        }
+        if *gap != c.gap {
+            return foreign("contact gap", *gap, c.gap);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rod::{build_rod, MassModel, RodSpec};
+
+    #[test]
+    fn the_finest_lcp_must_be_the_models() {
+        let mut spec = RodSpec::canonical();
+        spec.mass = MassModel::Modified;
+        let model = build_rod(&spec).unwrap().model;
+        let options = PeriodicLcpOptions {
+            time_samples: 16,
+            ..Default::default()
+        };
+        let lcp = PeriodicLcp::new(&model, options).unwrap();
+        let newton = NewtonOptions::default();
+        let solved = solve_min_map_sequenced(&model, &lcp, &newton).unwrap();
+        // Nt = 16 is below the coarsest level: one level, the caller's LCP.
+        assert_eq!(solved.levels.len(), 1);
+        assert_eq!(solved.levels[0].time_samples, 16);
+        assert_eq!(solved.z.len(), lcp.dim());
+        let mut other = model.clone();
+        other.forcing.omega *= 2.0;
+        assert_eq!(
+            solve_min_map_sequenced(&other, &lcp, &newton).unwrap_err(),
+            LcpError::ForeignLcp {
+                what: "omega",
+                lcp: model.forcing.omega,
+                model: other.forcing.omega
+            }
+        );
+        let mut other = model.clone();
+        other.contacts[0].gap = 0.25;
+        assert!(matches!(
+            solve_min_map_sequenced(&other, &lcp, &newton),
+            Err(LcpError::ForeignLcp {
+                what: "contact gap",
+                ..
+            })
+        ));
+    }
 }
