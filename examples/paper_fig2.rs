@@ -268,7 +268,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     println!(
         "timings (wall clock, release build, {} logical cores available): four H = 5 curves {:.3} s in total \
-         (issue 7 target 0.2 s); one contact curve (gap 0.5) at H = 20 {:.3} s (target 0.5 s)",
+         (target 0.2 s); one contact curve (gap 0.5) at H = 20 {:.3} s (target 0.5 s)",
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         h5,
         h20_contact

@@ -1,4 +1,4 @@
-//! Hard cases (issue 9): each case is solved by SSN-HB and, where it applies, penalty HB and
+//! Hard cases: each case is solved by SSN-HB and, where it applies, penalty HB and
 //! the periodic LCP (Lemke, semismooth Newton), on the canonical rod with the modified mass
 //! (massless contact node) unless said otherwise. Every run must either converge to a
 //! physically plausible answer or end with a typed, non-converged outcome naming the reason;

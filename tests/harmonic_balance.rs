@@ -515,7 +515,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         &model,
         &PenaltyHbOptions {
             penalty_stiffness: f64::NAN,
-            ..PenaltyHbOptions::default()
+            ..PenaltyHbOptions::for_model(&model)
         },
     )
     .unwrap_err();
@@ -558,7 +558,7 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
         &model,
         &PenaltyHbOptions {
             penalty_stiffness: 1e3 * model.contact_stiffness_scale(),
-            ..PenaltyHbOptions::default()
+            ..PenaltyHbOptions::for_model(&model)
         },
     )
     .unwrap();
@@ -582,7 +582,8 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
 
 /// The condensed (Woodbury) solve subtracts large terms when the penalty is stiff; with
 /// one refinement step its residual `|J d - r| / |r|` stays at rounding level, like the
-/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (issue 5's finest setting).
+/// dense LU, up to `k_p = 1e5` times the contact stiffness scale (the finest setting of the
+/// method comparison).
 #[test]
 fn structured_solve_stays_backward_stable_for_stiff_penalties() {
     let model = canonical_modified_rod();
@@ -599,7 +600,7 @@ fn structured_solve_stays_backward_stable_for_stiff_penalties() {
             &model,
             &PenaltyHbOptions {
                 penalty_stiffness: relative * model.contact_stiffness_scale(),
-                ..PenaltyHbOptions::default()
+                ..PenaltyHbOptions::for_model(&model)
             },
         )
         .unwrap();
@@ -667,7 +668,7 @@ static ALLOCATOR: counting::Counting = counting::Counting;
 fn newton_iteration_work_is_allocation_free() {
     let model = canonical_modified_rod();
     let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
-    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::for_model(&model)).unwrap();
     fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let x = random_vector(&mut rng, p.dim(), 0.5);

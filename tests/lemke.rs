@@ -616,7 +616,7 @@ impl GeneralizedJacobian for MinMap<'_> {
     }
 }
 
-/// Issue 3: Lemke and the semismooth Newton method on `min(z, q + M z) = 0` give the same
+/// Lemke and the semismooth Newton method on `min(z, q + M z) = 0` give the same
 /// solution. Newton stops at `|F|_2 <= 1e-13`; for these well-conditioned P-matrices (and
 /// once the active set is right Newton is exact up to rounding) the distance to the
 /// solution is of the same order, far below the 1e-10 agreement tolerance.

@@ -1,4 +1,4 @@
-//! Issue 5: every method on the same scene — SSN-HB, penalty HB, the periodic LCP by Lemke and
+//! Every method on the same scene — SSN-HB, penalty HB, the periodic LCP by Lemke and
 //! by semismooth Newton, and time marching — agrees on the canonical modified-mass rod, with
 //! differences that shrink as each discretisation is refined.
 
@@ -81,7 +81,7 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
             "{name:<30} tip min {:.8} (vs march {:.2e}), penetration {:.2e}, mean force {:.6e}",
             s.stats.min, d, s.stats.max_penetration, s.stats.mean_contact_force
         );
-        // Issue 5: 2e-3 relative at the finest settings.
+        // The target: 2e-3 relative at the finest settings.
         assert!(d < 2e-3, "{name}: {d:e}");
         assert!(s.stats.mean_contact_force < 0.0);
     }

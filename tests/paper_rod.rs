@@ -1,4 +1,4 @@
-//! The paper's rod (issue 4): SSN-HB from zero against closed forms and the time-marching
+//! The paper's rod: SSN-HB from zero against closed forms and the time-marching
 //! reference.
 
 use semismooth_problems::cli::default_settings;
@@ -174,7 +174,7 @@ fn modified_mass_hb_converges_to_the_time_marching_reference() {
         );
         errors.push(e_min);
         if h == 40 {
-            // Issue 4: within 1e-3 in the minimum and the RMS, 1e-2 in the mean force.
+            // The target: within 1e-3 in the minimum and the RMS, 1e-2 in the mean force.
             assert!(e_min < 1e-3 && e_rms < 1e-3 && e_force < 1e-2);
         }
     }

@@ -1,4 +1,4 @@
-//! The periodic time-domain LCP (issue 5): its matrix, vector and linear response checked
+//! The periodic time-domain LCP: its matrix, vector and linear response checked
 //! against independent computations (the analytic frequency response, a direct static
 //! solve, the trapezoidal rule written out in the time domain, dense eigenvalues), and its
 //! solvers against each other.

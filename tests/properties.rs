@@ -1,4 +1,4 @@
-//! Property tests (issue 9), modest case counts so the file runs in seconds in release mode:
+//! Property tests, modest case counts so the file runs in seconds in release mode:
 //!
 //! - random P-matrix LCPs (`n <= 12`): Lemke and the semismooth Newton method on the min
 //!   map (dense LU) find the same, unique, solution within an a-posteriori error bound;

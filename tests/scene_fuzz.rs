@@ -1,4 +1,4 @@
-//! Fuzzing the scene parser with proptest (issue 9): arbitrary text, and mutations of a valid
+//! Fuzzing the scene parser with proptest: arbitrary text, and mutations of a valid
 //! scene, never panic; every rejection names the file.
 
 use proptest::prelude::*;

@@ -1,5 +1,5 @@
 //! Scenes: every shipped scene parses; bad input gives an error naming the file, the key and
-//! what is allowed (issue 9).
+//! what is allowed.
 
 use semismooth_problems::rod::{build_rod, MassModel};
 use semismooth_problems::scene::{Method, Scene, SceneError};

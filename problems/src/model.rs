@@ -219,7 +219,7 @@ impl StructuralModel {
             lu.solve_in_place(&mut rhs).ok()?;
             compliances.push(rhs[c.dof]);
         }
-        mean_stiffness(&compliances)
+        mean_stiffness(compliances)
     }
 
     /// Default complementarity constant `c` of SSN-HB: ten times the static contact
@@ -262,11 +262,16 @@ fn first_non_finite(part: &'static str, values: &[f64]) -> Result<(), InvalidMod
 /// The mean of `1 / compliance` over the contacts' static compliances `(G K^{-1} G^T)_ii`:
 /// the static contact stiffness. `None` without contacts or when a compliance is not a
 /// finite positive number (`K` not positive definite).
-pub(crate) fn mean_stiffness(compliances: &[f64]) -> Option<f64> {
-    if compliances.is_empty() || !compliances.iter().all(|c| c.is_finite() && *c > 0.0) {
-        return None;
+pub(crate) fn mean_stiffness(compliances: impl IntoIterator<Item = f64>) -> Option<f64> {
+    let (mut count, mut sum) = (0usize, 0.0);
+    for c in compliances {
+        if !(c.is_finite() && c > 0.0) {
+            return None;
+        }
+        count += 1;
+        sum += 1.0 / c;
     }
-    Some(compliances.iter().map(|c| 1.0 / c).sum::<f64>() / compliances.len() as f64)
+    (count > 0).then(|| sum / count as f64)
 }
 
 /// `y += alpha A x` for a column-compressed `A` (`x` of length `ncols`, `y` of length
@@ -411,9 +416,9 @@ mod tests {
 
     #[test]
     fn static_stiffness_is_the_mean_inverse_compliance() {
-        assert_eq!(mean_stiffness(&[]), None);
-        assert_eq!(mean_stiffness(&[0.5, 0.25]), Some(3.0));
-        assert_eq!(mean_stiffness(&[0.5, -1.0]), None);
+        assert_eq!(mean_stiffness([]), None);
+        assert_eq!(mean_stiffness([0.5, 0.25]), Some(3.0));
+        assert_eq!(mean_stiffness([0.5, -1.0]), None);
         // K = tridiag(-1, 2, -1) on 3 dofs: (K^-1)_22 = 3/4.
         let k = chain().static_contact_stiffness().unwrap();
         assert!((k - 4.0 / 3.0).abs() < 1e-14, "{k}");

@@ -558,9 +558,9 @@ mod tests {
     }
 
     #[test]
-    fn canonical_first_frequency_matches_the_issue_value() {
+    fn canonical_first_frequency_matches_the_reference_value() {
         let rod = build_rod(&RodSpec::canonical()).unwrap();
-        // The issue quotes omega_1 = 1.571200 for 20 consistent elements (continuous: pi/2).
+        // The reference value is omega_1 = 1.571200 for 20 consistent elements (continuous: pi/2).
         assert!((rod.omega_1 - 1.571200).abs() < 5e-7, "{}", rod.omega_1);
     }
 

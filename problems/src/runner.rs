@@ -25,9 +25,7 @@ use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme}
 use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
 use crate::rod::{ModelError, RodModel};
-use crate::scene::{
-    GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
-};
+use crate::scene::{GlobalizationChoice, LinearSolverChoice, Method, SolverSettings};
 
 /// Ratio between successive penalty stiffnesses of the penalty homotopy.
 pub const PENALTY_HOMOTOPY_FACTOR: f64 = 10.0;
@@ -377,7 +375,7 @@ pub fn solve_rod(
         Method::PenaltyHb => {
             let target = settings
                 .penalty_stiffness
-                .unwrap_or(DEFAULT_RELATIVE_PENALTY * scale);
+                .unwrap_or_else(|| PenaltyHbOptions::default_penalty_stiffness(model));
             let options = PenaltyHbOptions {
                 harmonics: settings.harmonics,
                 time_samples: Some(settings.time_samples),

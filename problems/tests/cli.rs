@@ -1,4 +1,4 @@
-//! The `ssn` program as users run it (issue 9): help texts, `ssn solve` on every shipped
+//! The `ssn` program as users run it: help texts, `ssn solve` on every shipped
 //! scene (JSON fields, exit code 0), bad scenes (exit code 2, message naming the file and the
 //! key), unwritable outputs (exit code 3, nothing left behind), a non-converged run (JSON
 //! with `converged = false`, exit code 1) and `ssn scene-check`.

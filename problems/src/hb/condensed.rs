@@ -8,7 +8,7 @@ use super::jacobian::ContactCoupling;
 use super::ssn::{HbOptions, SsnHb};
 use super::structured::{condensed_matrix, StructuredHbSolver};
 use super::{check_len, indicator, HbError, ResponseSummary};
-use crate::model::StructuralModel;
+use crate::model::{mean_stiffness, StructuralModel};
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
 /// index `j m + contact`).
@@ -102,16 +102,18 @@ impl CondensedSsnHb {
     }
 
     /// Static stiffness seen by the contacts: the mean over contacts of
-    /// `1 / (G K^{-1} G^T)_ii` (for the rod, `EA / L` whatever the mesh). A mesh-independent
-    /// scale for `c`, unlike `K[dof, dof]` (which grows like the element count); see
-    /// [`CondensedSsnHb::set_c`].
+    /// `1 / (G K^{-1} G^T)_ii` (for the rod, `EA / L` whatever the mesh), the formula of
+    /// [`StructuralModel::static_contact_stiffness`] on the harmonic-0 receptance already
+    /// factored here; 1 without contacts (or when `K` is not positive definite). A
+    /// mesh-independent scale for `c`, unlike `K[dof, dof]` (which grows like the element
+    /// count); see [`CondensedSsnHb::set_c`].
     pub fn static_contact_stiffness(&self) -> f64 {
-        let m = self.full.contacts();
-        if m == 0 {
-            return 1.0;
-        }
-        let r0 = &self.receptance[0];
-        (0..m).map(|i| 1.0 / r0[(i, i)].re).sum::<f64>() / m as f64
+        let compliances = self
+            .receptance
+            .first()
+            .into_iter()
+            .flat_map(|r0| (0..r0.nrows()).map(|i| r0[(i, i)].re));
+        mean_stiffness(compliances).unwrap_or(1.0)
     }
 
     /// Current angular frequency `w`.

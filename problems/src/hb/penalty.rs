@@ -11,18 +11,18 @@ use super::{
     HbError, HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
+use crate::scene::DEFAULT_RELATIVE_PENALTY;
 
 /// Options of [`PenaltyHb`].
 ///
-/// | field | default | allowed |
+/// | field | default ([`PenaltyHbOptions::for_model`]) | allowed |
 /// |---|---|---|
 /// | `harmonics` (`H`) | 20 | `>= 1` |
 /// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` | `> 2H` |
-/// | `penalty_stiffness` (`k_p`) | `1e3` | finite, `> 0` |
+/// | `penalty_stiffness` (`k_p`) | [`PenaltyHbOptions::default_penalty_stiffness`]: [`DEFAULT_RELATIVE_PENALTY`] `x` [`StructuralModel::contact_stiffness_scale`] | finite, `> 0` |
 ///
-/// `penalty_stiffness` is **absolute** (force per length). Issue 5 and the scenes speak of
-/// `k_p` relative to the contact stiffness scale: multiply by
-/// [`StructuralModel::contact_stiffness_scale`] (e.g. `1e5 * scale`).
+/// `penalty_stiffness` is **absolute** (force per length); the scenes give it relative to
+/// the contact stiffness scale, and their default is the same `1e5 x scale`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PenaltyHbOptions {
     /// Number of harmonics `H`.
@@ -33,17 +33,23 @@ pub struct PenaltyHbOptions {
     pub penalty_stiffness: f64,
 }
 
-impl Default for PenaltyHbOptions {
-    fn default() -> Self {
+impl PenaltyHbOptions {
+    /// The default options for `model`: 20 harmonics, the default `Nt` and
+    /// [`PenaltyHbOptions::default_penalty_stiffness`].
+    pub fn for_model(model: &StructuralModel) -> Self {
         Self {
             harmonics: 20,
             time_samples: None,
-            penalty_stiffness: 1e3,
+            penalty_stiffness: Self::default_penalty_stiffness(model),
         }
     }
-}
 
-impl PenaltyHbOptions {
+    /// The default penalty stiffness of `model`: [`DEFAULT_RELATIVE_PENALTY`] times its
+    /// contact stiffness scale ([`StructuralModel::contact_stiffness_scale`]).
+    pub fn default_penalty_stiffness(model: &StructuralModel) -> f64 {
+        DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()
+    }
+
     /// Checks `harmonics >= 1`, `time_samples > 2H`, `penalty_stiffness` finite and `> 0`.
     pub fn validate(&self) -> Result<(), HbError> {
         validate_basis(self.harmonics, self.time_samples)?;
