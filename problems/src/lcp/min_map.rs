@@ -297,6 +297,9 @@ impl ActiveSetSolver {
         self.n = n;
         self.active.clear();
         self.inactive.clear();
+        // Room for any split of the n rows.
+        self.active.reserve(n);
+        self.inactive.reserve(n);
         for (i, a) in active.iter().enumerate() {
             if *a {
                 self.active.push(i);

@@ -131,7 +131,7 @@ pub const MAX_LCP_SIZE: usize = 8192;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PeriodicLcpOptions {
     /// Number of time steps per period `Nt` (default [`DEFAULT_LCP_TIME_SAMPLES`]);
-    /// `Nt >= 8` and `contacts * Nt <= MAX_LCP_SIZE`. Powers of two use a radix-2 FFT.
+    /// `Nt >= 8` and `contacts * Nt <= MAX_LCP_SIZE`. Any such `Nt` (FFTs by rustfft).
     pub time_samples: usize,
     /// Degrees of freedom whose displacement history [`PeriodicLcp::displacements`]
     /// returns (default none; the contact dofs are always available through
