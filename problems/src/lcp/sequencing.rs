@@ -100,14 +100,13 @@ pub fn solve_min_map_sequenced(
 ) -> Result<SequencedSolution, LcpError> {
     newton_options.validate()?;
     check_same_model(model, finest)?;
-    let mut sizes = vec![finest.time_samples()];
-    while let Some(&nt) = sizes.last() {
-        if nt % 2 != 0 || nt / 2 < SEQUENCING_COARSEST_TIME_SAMPLES.max(MIN_LCP_TIME_SAMPLES) {
-            break;
-        }
-        sizes.push(nt / 2);
+    // The coarser levels, finest first: Nt / 2, Nt / 4, ... (the finest is the caller's).
+    let mut sizes = Vec::new();
+    let mut nt = finest.time_samples();
+    while nt % 2 == 0 && nt / 2 >= SEQUENCING_COARSEST_TIME_SAMPLES.max(MIN_LCP_TIME_SAMPLES) {
+        nt /= 2;
+        sizes.push(nt);
     }
-    sizes.pop(); // the finest level is the caller's
     sizes.reverse();
     let mut solver =
         ActiveSetSolver::new().with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
@@ -184,6 +183,16 @@ mod tests {
         assert_eq!(solved.levels.len(), 1);
         assert_eq!(solved.levels[0].time_samples, 16);
         assert_eq!(solved.z.len(), lcp.dim());
+        // Nt = 512: 128, 256, then the caller's 512.
+        let options = PeriodicLcpOptions {
+            time_samples: 512,
+            ..Default::default()
+        };
+        let fine = PeriodicLcp::new(&model, options).unwrap();
+        let solved = solve_min_map_sequenced(&model, &fine, &newton).unwrap();
+        let sizes: Vec<usize> = solved.levels.iter().map(|l| l.time_samples).collect();
+        assert_eq!(sizes, [128, 256, 512]);
+        assert!(solved.converged());
         let mut other = model.clone();
         other.forcing.omega *= 2.0;
         assert_eq!(
