@@ -18,6 +18,13 @@
 //! trigonometric polynomials of degree `< Nt - H`. Both transforms are real FFTs (realfft),
 //! with plans built once and buffers kept, so repeated transforms allocate nothing.
 //!
+//! [`Aft`] offers each transform twice: on slices passed in (checked, a wrong length is a
+//! [`HarmonicError`]) and on buffers it owns, sized by the basis when it is built
+//! ([`Aft::coefficients_mut`], [`Aft::samples_mut`], then [`Aft::coefficients_to_samples`],
+//! [`Aft::samples_to_coefficients`], [`Aft::samples_multiplication_matrix`]), which cannot
+//! fail: a residual evaluated in a hot loop needs no error path for lengths fixed at
+//! construction.
+//!
 //! Reference: Cameron & Griffin (1989), "An alternating frequency/time domain method for
 //! calculating the steady-state response of nonlinear dynamic systems", J. Appl. Mech.
 
@@ -25,7 +32,7 @@ use std::f64::consts::PI;
 use std::fmt;
 use std::sync::Arc;
 
-use faer::MatMut;
+use faer::{Mat, MatMut};
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
@@ -158,12 +165,17 @@ impl FourierBasis {
     /// `u(theta)` at phase `theta = omega t` from the coefficients of one signal.
     pub fn evaluate_at_phase(&self, coeffs: &[f64], theta: f64) -> Result<f64, HarmonicError> {
         self.check_len("coefficients", coeffs.len())?;
+        Ok(self.sum_at_phase(coeffs, theta))
+    }
+
+    /// The trigonometric sum of `coeffs` (length `2H + 1`) at `theta`.
+    fn sum_at_phase(&self, coeffs: &[f64], theta: f64) -> f64 {
         let mut value = coeffs[0];
         for k in 1..=self.harmonics {
             let (s, c) = (k as f64 * theta).sin_cos();
             value += coeffs[2 * k - 1] * c + coeffs[2 * k] * s;
         }
-        Ok(value)
+        value
     }
 
     /// `u(t)` at an arbitrary time `t` for angular frequency `omega`.
@@ -235,11 +247,29 @@ impl FourierBasis {
 /// Alternating frequency/time transforms for one [`FourierBasis`]: real FFT plans built
 /// once, buffers kept, so [`Aft::to_time`] and [`Aft::to_coefficients`] allocate nothing.
 /// Counts the FFTs it performs.
+///
+/// The owned coefficient and sample buffers make the transforms infallible:
+///
+/// ```
+/// use semismooth::harmonic::{Aft, FourierBasis};
+/// let mut aft = Aft::new(FourierBasis::new(2, 8).unwrap());
+/// aft.coefficients_mut().copy_from_slice(&[1.0, 0.5, 0.0, 0.0, 0.25]);
+/// aft.coefficients_to_samples(); // u(theta) = 1 + cos(theta) / 2 + sin(2 theta) / 4
+/// let theta = std::f64::consts::PI / 4.0;
+/// assert!((aft.samples()[1] - (1.0 + 0.5 * theta.cos() + 0.25)).abs() < 1e-15);
+/// aft.samples_mut().iter_mut().for_each(|u| *u *= 2.0);
+/// aft.samples_to_coefficients();
+/// assert!((aft.coefficients()[4] - 0.5).abs() < 1e-15);
+/// ```
 pub struct Aft {
     basis: FourierBasis,
     forward: Arc<dyn RealToComplex<f64>>,
     inverse: Arc<dyn ComplexToReal<f64>>,
+    /// Input of the forward FFT (realfft uses it as scratch).
     time: Vec<f64>,
+    /// Owned buffers of the infallible transforms (`2H + 1` and `Nt` entries).
+    coefficients: Vec<f64>,
+    samples: Vec<f64>,
     spectrum: Vec<Complex<f64>>,
     forward_scratch: Vec<Complex<f64>>,
     inverse_scratch: Vec<Complex<f64>>,
@@ -262,7 +292,8 @@ impl Clone for Aft {
 }
 
 impl Aft {
-    /// Plans the forward and inverse real FFTs of length `Nt` and allocates the buffers.
+    /// Plans the forward and inverse real FFTs of length `Nt` and allocates the buffers
+    /// (the owned ones zeroed).
     pub fn new(basis: FourierBasis) -> Self {
         let nt = basis.time_samples();
         let mut planner = RealFftPlanner::<f64>::new();
@@ -276,6 +307,8 @@ impl Aft {
             forward,
             inverse,
             time: vec![0.0; nt],
+            coefficients: vec![0.0; basis.basis_size()],
+            samples: vec![0.0; nt],
             spectrum,
             forward_scratch,
             inverse_scratch,
@@ -296,24 +329,9 @@ impl Aft {
     /// `E`: coefficients of one signal (length `2H + 1`) to its `Nt` samples
     /// `u(theta_n)`, `theta_n = 2 pi n / Nt`.
     pub fn to_time(&mut self, coeffs: &[f64], samples: &mut [f64]) -> Result<(), HarmonicError> {
-        let h = self.basis.harmonics();
         self.basis.check_len("coefficients", coeffs.len())?;
         self.check_samples("samples", samples.len())?;
-        // Inverse real DFT x_n = sum_k X_k e^{+i theta_n k} (unnormalised, Hermitian
-        // extension): X_0 = u_0 and X_k = (a_k - i b_k) / 2 give
-        // x_n = u_0 + sum_k (a_k cos k theta_n + b_k sin k theta_n). H < Nt / 2, so bin H is
-        // never the Nyquist bin.
-        self.spectrum.fill(Complex::new(0.0, 0.0));
-        self.spectrum[0] = Complex::new(coeffs[0], 0.0);
-        for k in 1..=h {
-            self.spectrum[k] = Complex::new(0.5 * coeffs[2 * k - 1], -0.5 * coeffs[2 * k]);
-        }
-        self.inverse
-            .process_with_scratch(&mut self.spectrum, samples, &mut self.inverse_scratch)
-            .map_err(|e| HarmonicError::Fft {
-                reason: e.to_string(),
-            })?;
-        self.ffts += 1;
+        self.synthesize(coeffs, samples);
         Ok(())
     }
 
@@ -328,13 +346,8 @@ impl Aft {
         self.check_samples("samples", samples.len())?;
         self.basis.check_len("coefficients", coeffs.len())?;
         self.time.copy_from_slice(samples);
-        self.forward_spectrum()?;
-        let scale = 1.0 / self.basis.time_samples() as f64;
-        coeffs[0] = self.spectrum[0].re * scale;
-        for k in 1..=self.basis.harmonics() {
-            coeffs[2 * k - 1] = 2.0 * self.spectrum[k].re * scale;
-            coeffs[2 * k] = -2.0 * self.spectrum[k].im * scale;
-        }
+        self.forward_spectrum();
+        self.project(coeffs);
         Ok(())
     }
 
@@ -351,27 +364,14 @@ impl Aft {
         let nt = self.basis.time_samples();
         check("harmonic-major coefficients", size * signals, coeffs.len())?;
         check("signal-major samples", nt * signals, samples.len())?;
+        let mut gathered = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
-            // Gather signal s into the spectrum directly (no temporary).
-            self.spectrum.fill(Complex::new(0.0, 0.0));
-            self.spectrum[0] = Complex::new(coeffs[s], 0.0);
-            for k in 1..=self.basis.harmonics() {
-                self.spectrum[k] = Complex::new(
-                    0.5 * coeffs[(2 * k - 1) * signals + s],
-                    -0.5 * coeffs[2 * k * signals + s],
-                );
+            for (j, g) in gathered.iter_mut().enumerate() {
+                *g = coeffs[j * signals + s];
             }
-            self.inverse
-                .process_with_scratch(
-                    &mut self.spectrum,
-                    &mut samples[s * nt..(s + 1) * nt],
-                    &mut self.inverse_scratch,
-                )
-                .map_err(|e| HarmonicError::Fft {
-                    reason: e.to_string(),
-                })?;
-            self.ffts += 1;
+            self.synthesize(&gathered, &mut samples[s * nt..(s + 1) * nt]);
         }
+        self.coefficients = gathered;
         Ok(())
     }
 
@@ -387,16 +387,16 @@ impl Aft {
         let nt = self.basis.time_samples();
         check("signal-major samples", nt * signals, samples.len())?;
         check("harmonic-major coefficients", size * signals, coeffs.len())?;
-        let scale = 1.0 / nt as f64;
+        let mut projected = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
             self.time.copy_from_slice(&samples[s * nt..(s + 1) * nt]);
-            self.forward_spectrum()?;
-            coeffs[s] = self.spectrum[0].re * scale;
-            for k in 1..=self.basis.harmonics() {
-                coeffs[(2 * k - 1) * signals + s] = 2.0 * self.spectrum[k].re * scale;
-                coeffs[2 * k * signals + s] = -2.0 * self.spectrum[k].im * scale;
+            self.forward_spectrum();
+            self.project(&mut projected);
+            for (j, p) in projected.iter().enumerate() {
+                coeffs[j * signals + s] = *p;
             }
         }
+        self.coefficients = projected;
         Ok(())
     }
 
@@ -410,7 +410,7 @@ impl Aft {
     pub fn multiplication_matrix(
         &mut self,
         weights: &[f64],
-        mut out: MatMut<'_, f64>,
+        out: MatMut<'_, f64>,
     ) -> Result<(), HarmonicError> {
         let size = self.basis.basis_size();
         self.check_samples("weights", weights.len())?;
@@ -426,7 +426,66 @@ impl Aft {
             });
         }
         self.time.copy_from_slice(weights);
-        self.forward_spectrum()?;
+        self.forward_spectrum();
+        self.fill_multiplication_matrix(out);
+        Ok(())
+    }
+
+    /// The buffer of coefficients (`2H + 1`) of the infallible transforms.
+    pub fn coefficients(&self) -> &[f64] {
+        &self.coefficients
+    }
+
+    /// The buffer of coefficients (`2H + 1`), to be filled before
+    /// [`Aft::coefficients_to_samples`].
+    pub fn coefficients_mut(&mut self) -> &mut [f64] {
+        &mut self.coefficients
+    }
+
+    /// The buffer of samples (`Nt`) of the infallible transforms.
+    pub fn samples(&self) -> &[f64] {
+        &self.samples
+    }
+
+    /// The buffer of samples (`Nt`), to be filled before [`Aft::samples_to_coefficients`] or
+    /// [`Aft::samples_multiplication_matrix`].
+    pub fn samples_mut(&mut self) -> &mut [f64] {
+        &mut self.samples
+    }
+
+    /// `E` on the owned buffers: [`Aft::samples`] `<-` `E` [`Aft::coefficients`] (one FFT).
+    pub fn coefficients_to_samples(&mut self) {
+        let coeffs = std::mem::take(&mut self.coefficients);
+        let mut samples = std::mem::take(&mut self.samples);
+        self.synthesize(&coeffs, &mut samples);
+        self.coefficients = coeffs;
+        self.samples = samples;
+    }
+
+    /// `P` on the owned buffers: [`Aft::coefficients`] `<-` `P` [`Aft::samples`] (one FFT;
+    /// the samples are kept).
+    pub fn samples_to_coefficients(&mut self) {
+        self.time.copy_from_slice(&self.samples);
+        self.forward_spectrum();
+        let mut coeffs = std::mem::take(&mut self.coefficients);
+        self.project(&mut coeffs);
+        self.coefficients = coeffs;
+    }
+
+    /// [`Aft::multiplication_matrix`] of the owned samples into `out`, which is resized to
+    /// `(2H + 1) x (2H + 1)` when its shape differs (no allocation when it has it).
+    pub fn samples_multiplication_matrix(&mut self, out: &mut Mat<f64>) {
+        let size = self.basis.basis_size();
+        if out.nrows() != size || out.ncols() != size {
+            out.resize_with(size, size, |_, _| 0.0);
+        }
+        self.time.copy_from_slice(&self.samples);
+        self.forward_spectrum();
+        self.fill_multiplication_matrix(out.as_mut());
+    }
+
+    /// `P diag(w) E` from the spectrum of `w` in `self.spectrum` (`out` is `2H + 1` square).
+    fn fill_multiplication_matrix(&self, mut out: MatMut<'_, f64>) {
         let nt = self.basis.time_samples();
         let h = self.basis.harmonics() as i64;
         let scale = 1.0 / nt as f64;
@@ -466,26 +525,80 @@ impl Aft {
                 out[(ps, qc)] = s_plus + s_minus;
             }
         }
-        Ok(())
     }
 
-    /// Forward FFT of `self.time` into `self.spectrum` (counts one FFT).
-    fn forward_spectrum(&mut self) -> Result<(), HarmonicError> {
-        self.forward
+    /// Forward FFT of `self.time` into `self.spectrum` (counts one FFT; `self.time` is
+    /// overwritten). realfft refuses only buffers of other lengths than its plan's, and
+    /// these are the plan's own; were it to refuse, the bins are summed directly.
+    fn forward_spectrum(&mut self) {
+        let refused = self
+            .forward
             .process_with_scratch(
                 &mut self.time,
                 &mut self.spectrum,
                 &mut self.forward_scratch,
             )
-            .map_err(|e| HarmonicError::Fft {
-                reason: e.to_string(),
-            })?;
+            .is_err();
+        if refused {
+            direct_spectrum(&self.time, &mut self.spectrum);
+        }
         self.ffts += 1;
-        Ok(())
+    }
+
+    /// Coefficients (`2H + 1`) from the spectrum in `self.spectrum` (`P` after the FFT).
+    fn project(&self, coeffs: &mut [f64]) {
+        let scale = 1.0 / self.basis.time_samples() as f64;
+        coeffs[0] = self.spectrum[0].re * scale;
+        for k in 1..=self.basis.harmonics() {
+            coeffs[2 * k - 1] = 2.0 * self.spectrum[k].re * scale;
+            coeffs[2 * k] = -2.0 * self.spectrum[k].im * scale;
+        }
+    }
+
+    /// `samples <- E coeffs` (lengths `2H + 1` and `Nt`, checked by the callers; one FFT).
+    ///
+    /// Inverse real DFT `x_n = sum_k X_k e^{+i theta_n k}` (unnormalised, Hermitian
+    /// extension): `X_0 = u_0` and `X_k = (a_k - i b_k) / 2` give
+    /// `x_n = u_0 + sum_k (a_k cos k theta_n + b_k sin k theta_n)`. `H < Nt / 2`, so bin `H`
+    /// is never the Nyquist bin and the bins realfft requires real (0 and `Nt/2`) are real.
+    /// realfft refuses only other buffer lengths or such imaginary parts; were it to refuse,
+    /// the trigonometric sums are evaluated directly.
+    fn synthesize(&mut self, coeffs: &[f64], samples: &mut [f64]) {
+        self.spectrum.fill(Complex::new(0.0, 0.0));
+        self.spectrum[0] = Complex::new(coeffs[0], 0.0);
+        for k in 1..=self.basis.harmonics() {
+            self.spectrum[k] = Complex::new(0.5 * coeffs[2 * k - 1], -0.5 * coeffs[2 * k]);
+        }
+        let refused = self
+            .inverse
+            .process_with_scratch(&mut self.spectrum, samples, &mut self.inverse_scratch)
+            .is_err();
+        if refused {
+            for (n, x) in samples.iter_mut().enumerate() {
+                *x = self.basis.sum_at_phase(coeffs, self.basis.phase(n));
+            }
+        }
+        self.ffts += 1;
     }
 
     fn check_samples(&self, what: &'static str, found: usize) -> Result<(), HarmonicError> {
         check(what, self.basis.time_samples(), found)
+    }
+}
+
+/// `spectrum[k] = sum_n x_n e^{-2 pi i k n / Nt}` for the bins `k < spectrum.len()`, by
+/// direct summation (the reference the FFT path must reproduce).
+fn direct_spectrum(x: &[f64], spectrum: &mut [Complex<f64>]) {
+    let nt = x.len() as f64;
+    for (k, bin) in spectrum.iter_mut().enumerate() {
+        *bin = x
+            .iter()
+            .enumerate()
+            .map(|(n, v)| {
+                let angle = -2.0 * PI * (k * n) as f64 / nt;
+                Complex::new(v * angle.cos(), v * angle.sin())
+            })
+            .sum();
     }
 }
 
@@ -685,6 +798,50 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn owned_buffers_give_the_checked_transforms() {
+        let basis = FourierBasis::new(7, 40).unwrap();
+        let mut aft = Aft::new(basis);
+        let coeffs = coefficients(basis.basis_size(), 11);
+        let mut samples = vec![0.0; 40];
+        aft.to_time(&coeffs, &mut samples).unwrap();
+        aft.coefficients_mut().copy_from_slice(&coeffs);
+        aft.coefficients_to_samples();
+        assert_eq!(aft.samples(), &samples[..]);
+        for (n, x) in samples.iter().enumerate() {
+            // The direct trigonometric sum (the fallback) agrees with the FFT.
+            let direct = basis.sum_at_phase(&coeffs, basis.phase(n));
+            assert!((direct - x).abs() < 1e-13, "{direct} vs {x}");
+        }
+        let weights: Vec<f64> = samples.iter().map(|x| x.max(0.0)).collect();
+        let mut projected = vec![0.0; basis.basis_size()];
+        aft.to_coefficients(&weights, &mut projected).unwrap();
+        let mut m = Mat::zeros(basis.basis_size(), basis.basis_size());
+        aft.multiplication_matrix(&weights, m.as_mut()).unwrap();
+        aft.samples_mut().copy_from_slice(&weights);
+        aft.samples_to_coefficients();
+        assert_eq!(aft.coefficients(), &projected[..]);
+        assert_eq!(aft.samples(), &weights[..], "the samples are kept");
+        let mut owned = Mat::zeros(1, 1); // resized to 2H + 1
+        aft.samples_multiplication_matrix(&mut owned);
+        assert_eq!(owned, m);
+        assert_eq!(aft.fft_count(), 6);
+    }
+
+    #[test]
+    fn direct_spectrum_matches_the_fft() {
+        let basis = FourierBasis::new(3, 24).unwrap();
+        let mut aft = Aft::new(basis);
+        let x = coefficients(24, 5);
+        aft.time.copy_from_slice(&x);
+        aft.forward_spectrum();
+        let mut direct = vec![Complex::new(0.0, 0.0); aft.spectrum.len()];
+        direct_spectrum(&x, &mut direct);
+        for (a, b) in aft.spectrum.iter().zip(&direct) {
+            assert!((a - b).norm() < 1e-13, "{a} vs {b}");
         }
     }
 

@@ -19,7 +19,7 @@ use semismooth_problems::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
 };
-use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel};
+use semismooth_problems::model::{ContactPoint, HarmonicForcing, InvalidModel, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
@@ -93,7 +93,7 @@ fn penalty_options(harmonics: usize, time_samples: Option<usize>, kp: f64) -> Pe
 fn penalty_hb(model: &StructuralModel, relative: f64) -> PenaltyHb {
     let options = PenaltyHbOptions {
         penalty_stiffness: relative * model.contact_stiffness_scale(),
-        ..PenaltyHbOptions::default()
+        ..PenaltyHbOptions::for_model(model)
     };
     PenaltyHb::new(model, &options).unwrap()
 }
@@ -452,7 +452,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
     assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
     let nan_penalty = PenaltyHbOptions {
         penalty_stiffness: f64::NAN,
-        ..PenaltyHbOptions::default()
+        ..PenaltyHbOptions::for_model(&model)
     };
     for (err, option) in [
         (
@@ -473,17 +473,17 @@ fn bad_options_are_typed_errors_with_the_numbers() {
     let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
     assert!(matches!(
         err,
-        HbError::IndexOutOfRange {
-            index: 7,
-            count: 3,
+        HbError::Model(InvalidModel::ContactDofOutOfRange {
+            dof: 7,
+            dofs: 3,
             ..
-        }
+        })
     ));
     let mut bad = chain(3, None, 1.0, vec![]);
     bad.forcing.omega = 0.0;
     assert!(matches!(
         SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
-        HbError::InvalidOption { name: "omega", .. }
+        HbError::Model(InvalidModel::Omega { .. })
     ));
 }
 
@@ -565,7 +565,7 @@ static ALLOCATOR: common::CountingAllocator = common::CountingAllocator;
 fn newton_iteration_work_is_allocation_free() {
     let model = canonical_modified_rod();
     let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
-    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::for_model(&model)).unwrap();
     fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let x = random_vector(&mut rng, p.dim(), 0.5);

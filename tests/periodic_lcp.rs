@@ -11,8 +11,9 @@ use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions};
 use semismooth_problems::lcp::{
     solve_min_map_sequenced, ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions,
+    DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use semismooth_problems::model::{SparseMatrix, StructuralModel};
+use semismooth_problems::model::{InvalidModel, SparseMatrix, StructuralModel};
 use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
 
 /// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
@@ -331,7 +332,7 @@ fn bad_options_and_models_are_typed_errors() {
     bad.forcing.omega = f64::NAN;
     assert!(matches!(
         PeriodicLcp::new(&bad, options(16, vec![])),
-        Err(LcpError::InvalidModel { name: "omega", .. })
+        Err(LcpError::Model(InvalidModel::Omega { .. }))
     ));
     let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
     assert_eq!(
@@ -356,7 +357,9 @@ fn ssn_solution(lcp: &PeriodicLcp) -> (Vec<f64>, newton::NewtonReport) {
 
 fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonReport) {
     let mut problem = lcp.min_map();
-    let mut solver = ActiveSetSolver::new();
+    let mut solver = ActiveSetSolver::new()
+        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
+        .unwrap();
     let report =
         newton::solve(&mut problem, &mut solver, &mut z, &NewtonOptions::default()).unwrap();
     (z, report)
@@ -455,15 +458,13 @@ fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass
     for nt in [256usize, 1024] {
         // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
         // interpolated previous Newton solution); Lemke independently on the finest LCP.
-        let sequenced =
-            solve_min_map_sequenced(&model, options(nt, vec![]), &NewtonOptions::default())
-                .unwrap();
+        let lcp = &PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let sequenced = solve_min_map_sequenced(&model, lcp, &NewtonOptions::default()).unwrap();
         assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
         assert_eq!(
             sequenced.levels.len(),
             1 + (nt / 128).trailing_zeros() as usize
         );
-        let lcp = &sequenced.lcp;
         let z = &sequenced.z;
         let lemke = lcp.check_lemke(lemke_solution(lcp)).unwrap();
         // Lemke's basic solution is exact up to the round-off of a solve with the final

@@ -6,6 +6,7 @@
 //! Shi & Legrand, and the formulations that solve it.
 
 pub mod cli;
+mod dynamic;
 pub mod figures;
 pub mod hb;
 pub mod lcp;

@@ -19,14 +19,14 @@ use semismooth::{GeneralizedJacobian, Residual};
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
-use crate::lcp::{ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions};
+use crate::lcp::{
+    ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
+};
 use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
 use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
 use crate::rod::{ModelError, RodModel};
-use crate::scene::{
-    GlobalizationChoice, LinearSolverChoice, Method, SolverSettings, DEFAULT_RELATIVE_PENALTY,
-};
+use crate::scene::{GlobalizationChoice, LinearSolverChoice, Method, SolverSettings};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
@@ -195,7 +195,7 @@ pub(crate) fn penalty_options(
         time_samples: Some(settings.time_samples),
         penalty_stiffness: settings
             .penalty_stiffness
-            .unwrap_or(DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()),
+            .unwrap_or_else(|| PenaltyHbOptions::default_penalty_stiffness(model)),
     }
 }
 
@@ -543,20 +543,14 @@ fn solve_lcp(
                 Some(w) if w.len() == lcp.dim() => {
                     let mut problem = lcp.min_map();
                     let mut z = w.to_vec();
-                    let mut solver = ActiveSetSolver::new();
+                    let mut solver = ActiveSetSolver::new()
+                        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
                     let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
                         .or_else(NewtonError::into_report)?;
                     (z, vec![report])
                 }
                 _ => {
-                    let sequenced = crate::lcp::solve_min_map_sequenced(
-                        model,
-                        PeriodicLcpOptions {
-                            time_samples: settings.time_samples,
-                            observed_dofs: Vec::new(),
-                        },
-                        &options,
-                    )?;
+                    let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
                     let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
                     (sequenced.z, reports)
                 }

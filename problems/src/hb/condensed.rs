@@ -6,11 +6,11 @@ use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
 };
 
-use super::jacobian::ContactCoupling;
+use super::jacobian::{ContactCoupling, HbJacobian};
 use super::ssn::{HbOptions, SsnHb};
 use super::structured::{condensed_matrix, StructuredHbSolver};
-use super::{check_len, HbError, ResponseSummary};
-use crate::model::StructuralModel;
+use super::{check_len, indicator, HbError, ResponseSummary};
+use crate::model::{mean_stiffness, StructuralModel};
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
 /// index `j m + contact`).
@@ -36,17 +36,18 @@ pub struct CondensedSsnHb {
     linear_response: Vec<f64>,
     contact_linear: Vec<f64>,
     y: Vec<f64>,
+    /// `Q_i = P diag(h_i) E` per contact.
+    q: Vec<Mat<f64>>,
+    aft: Aft,
+    /// The dynamic part `A(w)` handed to the structured solver.
+    dynamic: HbJacobian,
     /// Full-size workspace for `U` and `(dA/dw) U`.
     full_u: Vec<f64>,
     full_w: Vec<f64>,
-    /// Indicator `h_n` of the active samples (F_p).
+    /// Indicator `h_n` of the active samples (for `dR/dw`).
     mask: Vec<f64>,
     /// `w` of the last factorization differs from the problem's.
     stale: bool,
-    q: Mat<f64>,
-    coeffs: Vec<f64>,
-    samples: Vec<f64>,
-    aft: Aft,
 }
 
 impl CondensedSsnHb {
@@ -62,14 +63,13 @@ impl CondensedSsnHb {
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],
+            q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
+            aft: Aft::new(basis),
+            dynamic: full.new_jacobian(),
             full_u: vec![0.0; full.displacement_len()],
             full_w: vec![0.0; full.displacement_len()],
             mask: vec![0.0; basis.time_samples()],
             stale: false,
-            q: Mat::zeros(size, m * size),
-            coeffs: vec![0.0; size],
-            samples: vec![0.0; basis.time_samples()],
-            aft: Aft::new(basis),
             full,
         };
         this.refactor()?;
@@ -78,8 +78,8 @@ impl CondensedSsnHb {
 
     /// Factors `A(w)` at the current `w`, then `A^{-1} F`, `G A^{-1} F` and `R`.
     fn refactor(&mut self) -> Result<(), HbError> {
-        let jac = self.full.new_jacobian();
-        self.solver.factor(&jac)?;
+        self.dynamic.omega = self.full.omega();
+        self.solver.factor(&self.dynamic)?;
         let lin = self.full.state.linear.clone();
         let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
         self.linear_response.fill(0.0);
@@ -133,16 +133,18 @@ impl CondensedSsnHb {
     }
 
     /// Static stiffness seen by the contacts: the mean over contacts of
-    /// `1 / (G K^{-1} G^T)_ii` (for the rod, `EA / L` whatever the mesh). A mesh-independent
-    /// scale for `c`, unlike `K[dof, dof]` (which grows like the element count); see
-    /// [`CondensedSsnHb::set_c`].
+    /// `1 / (G K^{-1} G^T)_ii` (for the rod, `EA / L` whatever the mesh), the formula of
+    /// [`StructuralModel::static_contact_stiffness`] on the harmonic-0 receptance already
+    /// factored here; 1 without contacts (or when `K` is not positive definite). A
+    /// mesh-independent scale for `c`, unlike `K[dof, dof]` (which grows like the element
+    /// count); see [`CondensedSsnHb::set_c`].
     pub fn static_contact_stiffness(&self) -> f64 {
-        let m = self.full.contacts();
-        if m == 0 {
-            return 1.0;
-        }
-        let r0 = &self.receptance[0];
-        (0..m).map(|i| 1.0 / r0[(i, i)].re).sum::<f64>() / m as f64
+        let compliances = self
+            .receptance
+            .first()
+            .into_iter()
+            .flat_map(|r0| (0..r0.nrows()).map(|i| r0[(i, i)].re));
+        mean_stiffness(compliances).unwrap_or(1.0)
     }
 
     /// Current angular frequency `w`.
@@ -201,17 +203,17 @@ impl CondensedSsnHb {
         }
     }
 
-    /// Samples of `s = c (G u - g) - lambda` of contact `i` into `self.samples`.
+    /// Samples of `s = c (G u - g) - lambda` of contact `i` into the AFT's samples.
     fn switching_samples(&mut self, lambda: &[f64], i: usize) {
         let lin = &self.full.state.linear;
         let m = lin.contacts();
         let c = self.full.c();
-        for j in 0..lin.size() {
-            self.coeffs[j] = c * self.y[j * m + i] - lambda[j * m + i];
+        let coeffs = self.aft.coefficients_mut();
+        for (j, coeff) in coeffs.iter_mut().enumerate() {
+            *coeff = c * self.y[j * m + i] - lambda[j * m + i];
         }
-        self.coeffs[0] -= c * lin.gaps[i];
-        // Lengths are fixed at construction: the transform cannot fail.
-        let _ = self.aft.to_time(&self.coeffs, &mut self.samples);
+        coeffs[0] -= c * lin.gaps[i];
+        self.aft.coefficients_to_samples();
     }
 }
 
@@ -223,16 +225,15 @@ impl Residual for CondensedSsnHb {
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let m = self.full.contacts();
-        let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
         for i in 0..m {
             self.switching_samples(lambda, i);
-            for s in &mut self.samples {
+            for s in self.aft.samples_mut() {
                 *s = s.max(0.0);
             }
-            let _ = self.aft.to_coefficients(&self.samples, &mut self.coeffs);
-            for j in 0..size {
-                out[j * m + i] = lambda[j * m + i] + self.coeffs[j];
+            self.aft.samples_to_coefficients();
+            for (j, c) in self.aft.coefficients().iter().enumerate() {
+                out[j * m + i] = lambda[j * m + i] + c;
             }
         }
         Ok(())
@@ -255,19 +256,15 @@ impl GeneralizedJacobian for CondensedSsnHb {
     fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let m = self.full.contacts();
-        let size = self.full.basis().basis_size();
         self.contact_displacements(lambda);
         for i in 0..m {
             self.switching_samples(lambda, i);
-            for s in &mut self.samples {
-                *s = if *s > 0.0 { 1.0 } else { 0.0 };
-            }
-            let block = self.q.as_mut().subcols_mut(i * size, size);
-            let _ = self.aft.multiplication_matrix(&self.samples, block);
+            indicator(self.aft.samples_mut());
+            self.aft.samples_multiplication_matrix(&mut self.q[i]);
         }
         condensed_matrix(
             &self.receptance,
-            self.q.as_ref(),
+            &self.q,
             ContactCoupling::Complementarity { c: self.full.c() },
             m,
             jac.as_mut(),
@@ -297,7 +294,7 @@ impl ParameterDependent for CondensedSsnHb {
     ) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let (n, m) = (lin.dofs, lin.contacts());
         // U = A^{-1} F + A^{-1} G^T Lambda.
         self.full_u.copy_from_slice(&self.linear_response);
         self.solver.add_response(lambda, 1.0, &mut self.full_u);
@@ -312,29 +309,20 @@ impl ParameterDependent for CondensedSsnHb {
         let c = self.full.c();
         for i in 0..m {
             self.switching_samples(lambda, i);
-            for (h, s) in self.mask.iter_mut().zip(&self.samples) {
+            for (h, s) in self.mask.iter_mut().zip(self.aft.samples()) {
                 *h = if *s > 0.0 { 1.0 } else { 0.0 };
             }
-            for j in 0..size {
-                self.coeffs[j] = -c * self.full_w[j * n + lin.contact_dofs[i]];
+            let dof = lin.contact_dofs[i];
+            for (j, coeff) in self.aft.coefficients_mut().iter_mut().enumerate() {
+                *coeff = -c * self.full_w[j * n + dof];
             }
-            self.aft
-                .to_time(&self.coeffs, &mut self.samples)
-                .map_err(|_| EvaluationError::OutsideDomain {
-                    what: "contact-force coefficients (length)",
-                    value: lambda.len() as f64,
-                })?;
-            for (s, h) in self.samples.iter_mut().zip(&self.mask) {
+            self.aft.coefficients_to_samples();
+            for (s, h) in self.aft.samples_mut().iter_mut().zip(&self.mask) {
                 *s *= h;
             }
-            self.aft
-                .to_coefficients(&self.samples, &mut self.coeffs)
-                .map_err(|_| EvaluationError::OutsideDomain {
-                    what: "contact-force coefficients (length)",
-                    value: lambda.len() as f64,
-                })?;
-            for j in 0..size {
-                out[j * m + i] = self.coeffs[j];
+            self.aft.samples_to_coefficients();
+            for (j, coeff) in self.aft.coefficients().iter().enumerate() {
+                out[j * m + i] = *coeff;
             }
         }
         Ok(())

@@ -37,8 +37,8 @@ pub struct HbJacobian {
     pub(crate) linear: Arc<LinearData>,
     pub(crate) omega: f64,
     pub(crate) coupling: ContactCoupling,
-    /// `Q_i` in columns `i (2H+1) .. (i+1) (2H+1)`.
-    pub(crate) q: Mat<f64>,
+    /// `Q_i` of each contact (`(2H + 1)` square).
+    pub(crate) q: Vec<Mat<f64>>,
     pub(crate) active: Vec<usize>,
 }
 
@@ -47,7 +47,7 @@ impl HbJacobian {
         let size = linear.size();
         let m = linear.contacts();
         Self {
-            q: Mat::zeros(size, size * m),
+            q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
             active: vec![0; m],
             linear,
             omega,
@@ -82,8 +82,7 @@ impl HbJacobian {
 
     /// `Q_i = P diag(h_i) E` of contact `i` (`(2H + 1)` square), or `None` if out of range.
     pub fn contact_block(&self, contact: usize) -> Option<MatRef<'_, f64>> {
-        let size = self.linear.size();
-        (contact < self.contacts()).then(|| self.q.as_ref().subcols(contact * size, size))
+        self.q.get(contact).map(|q| q.as_ref())
     }
 
     /// Number of time samples where contact `i` is active (`h_n = 1`).
@@ -144,7 +143,7 @@ impl DenseAssemble for HbJacobian {
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-            let q = self.q.as_ref().subcols(i * size, size);
+            let q = &self.q[i];
             match self.coupling {
                 ContactCoupling::Complementarity { c } => {
                     for j in 0..size {

@@ -72,7 +72,7 @@ use std::sync::Arc;
 
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::{sparse_mul_add, InvalidModel, SparseMatrix, StructuralModel};
 
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
@@ -93,24 +93,9 @@ pub enum HbError {
         /// The allowed range, in words.
         allowed: &'static str,
     },
-    /// The model's parts have inconsistent sizes.
-    #[error("model {what}: expected {expected}, found {found}")]
-    InconsistentModel {
-        /// Which part of the model.
-        what: &'static str,
-        /// Expected size.
-        expected: usize,
-        /// Size found.
-        found: usize,
-    },
-    /// A model entry is NaN or infinite.
-    #[error("model {what} holds a non-finite value {value}")]
-    NonFiniteModel {
-        /// Which part of the model.
-        what: &'static str,
-        /// The value found.
-        value: f64,
-    },
+    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    #[error(transparent)]
+    Model(#[from] InvalidModel),
     /// A degree of freedom or contact index is out of range.
     #[error("{what} index {index} is out of range: allowed 0..{count}")]
     IndexOutOfRange {
@@ -180,7 +165,7 @@ impl LinearData {
         harmonics: usize,
         time_samples: Option<usize>,
     ) -> Result<Self, HbError> {
-        validate_model(model)?;
+        model.validate()?;
         validate_basis(harmonics, time_samples)?;
         let basis = match time_samples {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
@@ -219,19 +204,19 @@ impl LinearData {
     pub(crate) fn apply_dynamic(&self, omega: f64, u: &[f64], out: &mut [f64]) {
         let n = self.dofs;
         out.fill(0.0);
-        spmv_add(&self.stiffness, &u[..n], &mut out[..n], 1.0);
+        sparse_mul_add(self.stiffness.as_ref(), 1.0, &u[..n], &mut out[..n]);
         for k in 1..=self.basis.harmonics() {
             let kw = k as f64 * omega;
             let (c, s) = ((2 * k - 1) * n, 2 * k * n);
             let (a, b) = (&u[c..c + n], &u[s..s + n]);
             let (out_c, out_s) = out[c..s + n].split_at_mut(n);
-            spmv_add(&self.stiffness, a, out_c, 1.0);
-            spmv_add(&self.mass, a, out_c, -kw * kw);
-            spmv_add(&self.stiffness, b, out_s, 1.0);
-            spmv_add(&self.mass, b, out_s, -kw * kw);
+            sparse_mul_add(self.stiffness.as_ref(), 1.0, a, out_c);
+            sparse_mul_add(self.mass.as_ref(), -kw * kw, a, out_c);
+            sparse_mul_add(self.stiffness.as_ref(), 1.0, b, out_s);
+            sparse_mul_add(self.mass.as_ref(), -kw * kw, b, out_s);
             if let Some(d) = &self.damping {
-                spmv_add(d, b, out_c, kw);
-                spmv_add(d, a, out_s, -kw);
+                sparse_mul_add(d.as_ref(), kw, b, out_c);
+                sparse_mul_add(d.as_ref(), -kw, a, out_s);
             }
         }
     }
@@ -246,11 +231,11 @@ impl LinearData {
             let (c, s) = ((2 * k - 1) * n, 2 * k * n);
             let (a, b) = (&u[c..c + n], &u[s..s + n]);
             let (out_c, out_s) = out[c..s + n].split_at_mut(n);
-            spmv_add(&self.mass, a, out_c, -2.0 * kf * kf * omega);
-            spmv_add(&self.mass, b, out_s, -2.0 * kf * kf * omega);
+            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, a, out_c);
+            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, b, out_s);
             if let Some(d) = &self.damping {
-                spmv_add(d, b, out_c, kf);
-                spmv_add(d, a, out_s, -kf);
+                sparse_mul_add(d.as_ref(), kf, b, out_c);
+                sparse_mul_add(d.as_ref(), -kf, a, out_s);
             }
         }
     }
@@ -284,77 +269,6 @@ impl LinearData {
         }
         Ok(())
     }
-}
-
-/// `y += alpha A x` for a column-compressed `A`.
-pub(crate) fn spmv_add(a: &SparseMatrix, x: &[f64], y: &mut [f64], alpha: f64) {
-    let a = a.as_ref();
-    let symbolic = a.symbolic();
-    let rows = symbolic.row_idx();
-    let values = a.val();
-    for (j, &xj) in x.iter().enumerate() {
-        if xj == 0.0 {
-            continue;
-        }
-        let scaled = alpha * xj;
-        for p in symbolic.col_range(j) {
-            y[rows[p]] += values[p] * scaled;
-        }
-    }
-}
-
-fn validate_model(model: &StructuralModel) -> Result<(), HbError> {
-    let n = model.dofs();
-    let square = |what: &'static str, m: &SparseMatrix| -> Result<(), HbError> {
-        for found in [m.nrows(), m.ncols()] {
-            if found != n {
-                return Err(HbError::InconsistentModel {
-                    what,
-                    expected: n,
-                    found,
-                });
-            }
-        }
-        if let Some(&value) = m.as_ref().val().iter().find(|v| !v.is_finite()) {
-            return Err(HbError::NonFiniteModel { what, value });
-        }
-        Ok(())
-    };
-    square("stiffness matrix size", &model.stiffness)?;
-    square("mass matrix size", &model.mass)?;
-    if let Some(d) = &model.damping {
-        square("damping matrix size", d)?;
-    }
-    if model.forcing.amplitude.len() != n {
-        return Err(HbError::InconsistentModel {
-            what: "forcing amplitude length",
-            expected: n,
-            found: model.forcing.amplitude.len(),
-        });
-    }
-    if let Some(&value) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
-        return Err(HbError::NonFiniteModel {
-            what: "forcing amplitude",
-            value,
-        });
-    }
-    check_omega(model.forcing.omega)?;
-    for contact in &model.contacts {
-        if contact.dof >= n {
-            return Err(HbError::IndexOutOfRange {
-                what: "contact dof",
-                index: contact.dof,
-                count: n,
-            });
-        }
-        if !contact.gap.is_finite() {
-            return Err(HbError::NonFiniteModel {
-                what: "contact gap",
-                value: contact.gap,
-            });
-        }
-    }
-    Ok(())
 }
 
 /// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
@@ -469,28 +383,12 @@ pub(crate) struct HbState {
 }
 
 impl HbState {
-    /// Turns the switching samples of contact `i` into the indicator `h_n = [s_n > 0]` (in
-    /// place) and writes the block `P diag(h) E` of the Jacobian; records the active count.
-    pub(crate) fn write_contact_block(
-        &mut self,
-        samples: &mut [f64],
-        jac: &mut jacobian::HbJacobian,
-        i: usize,
-    ) {
-        let mut active = 0;
-        for s in samples.iter_mut() {
-            *s = if *s > 0.0 {
-                active += 1;
-                1.0
-            } else {
-                0.0
-            };
-        }
-        jac.active[i] = active;
-        let size = self.linear.size();
-        let block = jac.q.as_mut().subcols_mut(i * size, size);
-        // Lengths are fixed at construction: the product cannot fail.
-        let _ = self.aft.multiplication_matrix(samples, block);
+    /// Turns the switching samples of contact `i` (the AFT's samples) into the indicator
+    /// `h_n = [s_n > 0]` and writes the block `P diag(h) E` of the Jacobian; records the
+    /// active count.
+    pub(crate) fn write_contact_block(&mut self, jac: &mut jacobian::HbJacobian, i: usize) {
+        jac.active[i] = indicator(self.aft.samples_mut());
+        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
     }
 
     pub(crate) fn new(linear: LinearData, omega: f64) -> Self {
@@ -501,4 +399,18 @@ impl HbState {
             aft,
         }
     }
+}
+
+/// Replaces each sample by the indicator `[s_n > 0]`; returns how many are 1.
+pub(crate) fn indicator(samples: &mut [f64]) -> usize {
+    let mut active = 0;
+    for s in samples.iter_mut() {
+        *s = if *s > 0.0 {
+            active += 1;
+            1.0
+        } else {
+            0.0
+        };
+    }
+    active
 }

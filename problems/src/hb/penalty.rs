@@ -12,18 +12,18 @@ use super::{
     HbError, HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
+use crate::scene::DEFAULT_RELATIVE_PENALTY;
 
 /// Options of [`PenaltyHb`].
 ///
-/// | field | default | allowed |
+/// | field | default ([`PenaltyHbOptions::for_model`]) | allowed |
 /// |---|---|---|
 /// | `harmonics` (`H`) | 20 | `>= 1` |
 /// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` | `> 2H` |
-/// | `penalty_stiffness` (`k_p`) | `1e3` | finite, `> 0` |
+/// | `penalty_stiffness` (`k_p`) | [`PenaltyHbOptions::default_penalty_stiffness`]: [`DEFAULT_RELATIVE_PENALTY`] `x` [`StructuralModel::contact_stiffness_scale`] | finite, `> 0` |
 ///
-/// `penalty_stiffness` is **absolute** (force per length). Issue 5 and the scenes speak of
-/// `k_p` relative to the contact stiffness scale: multiply by
-/// [`StructuralModel::contact_stiffness_scale`] (e.g. `1e5 * scale`).
+/// `penalty_stiffness` is **absolute** (force per length); the scenes give it relative to
+/// the contact stiffness scale, and their default is the same `1e5 x scale`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PenaltyHbOptions {
     /// Number of harmonics `H`.
@@ -34,30 +34,39 @@ pub struct PenaltyHbOptions {
     pub penalty_stiffness: f64,
 }
 
-impl Default for PenaltyHbOptions {
-    fn default() -> Self {
+impl PenaltyHbOptions {
+    /// The default options for `model`: 20 harmonics, the default `Nt` and
+    /// [`PenaltyHbOptions::default_penalty_stiffness`].
+    pub fn for_model(model: &StructuralModel) -> Self {
         Self {
             harmonics: 20,
             time_samples: None,
-            penalty_stiffness: 1e3,
+            penalty_stiffness: Self::default_penalty_stiffness(model),
         }
     }
-}
 
-impl PenaltyHbOptions {
+    /// The default penalty stiffness of `model`: [`DEFAULT_RELATIVE_PENALTY`] times its
+    /// contact stiffness scale ([`StructuralModel::contact_stiffness_scale`]).
+    pub fn default_penalty_stiffness(model: &StructuralModel) -> f64 {
+        DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()
+    }
+
     /// Checks `harmonics >= 1`, `time_samples > 2H`, `penalty_stiffness` finite and `> 0`.
     pub fn validate(&self) -> Result<(), HbError> {
         validate_basis(self.harmonics, self.time_samples)?;
-        let kp = self.penalty_stiffness;
-        if !(kp.is_finite() && kp > 0.0) {
-            return Err(HbError::InvalidOption {
-                name: "penalty_stiffness",
-                value: kp,
-                allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
-            });
-        }
-        Ok(())
+        check_penalty_stiffness(self.penalty_stiffness)
     }
+}
+
+fn check_penalty_stiffness(kp: f64) -> Result<(), HbError> {
+    if !(kp.is_finite() && kp > 0.0) {
+        return Err(HbError::InvalidOption {
+            name: "penalty_stiffness",
+            value: kp,
+            allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
+        });
+    }
+    Ok(())
 }
 
 /// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),
@@ -74,9 +83,7 @@ impl PenaltyHbOptions {
 pub struct PenaltyHb {
     state: HbState,
     stiffness: f64,
-    coeffs: Vec<f64>,
-    samples: Vec<f64>,
-    /// Held piece `h` (contact-major, `m Nt` entries): while `Some`, the penalty force is
+    /// Held piece `h` (contact-major, `m Nt` entries): while `holding`, the penalty force is
     /// `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
     frozen: Vec<bool>,
     /// Whether `frozen` is held (its storage is kept either way).
@@ -89,13 +96,9 @@ impl PenaltyHb {
         options.validate()?;
         let kp = options.penalty_stiffness;
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
-        let size = linear.size();
-        let nt = linear.basis.time_samples();
         Ok(Self {
             state: HbState::new(linear, model.forcing.omega),
             stiffness: kp,
-            coeffs: vec![0.0; size],
-            samples: vec![0.0; nt],
             frozen: Vec::new(),
             holding: false,
         })
@@ -123,11 +126,7 @@ impl PenaltyHb {
 
     /// Sets the penalty stiffness `k_p` (finite, `> 0`).
     pub fn set_penalty_stiffness(&mut self, k: f64) -> Result<(), HbError> {
-        PenaltyHbOptions {
-            penalty_stiffness: k,
-            ..PenaltyHbOptions::default()
-        }
-        .validate()?;
+        check_penalty_stiffness(k)?;
         self.stiffness = k;
         Ok(())
     }
@@ -208,33 +207,38 @@ impl PenaltyHb {
         displacement_summary(&self.state.linear, u, dof, points, means)
     }
 
-    /// Replaces the gap samples of contact `i` in `self.samples` by the penalty
+    fn time_samples(&self) -> usize {
+        self.state.linear.basis.time_samples()
+    }
+
+    /// Replaces the gap samples of contact `i` (the AFT's samples) by the penalty
     /// "activity-weighted gaps": `max(0, s_n)`, or `h_n s_n` when the activity is frozen.
     fn penetrations(&mut self, i: usize) {
-        let nt = self.samples.len();
+        let samples = self.state.aft.samples_mut();
+        let nt = samples.len();
         match self.holding.then_some(&self.frozen) {
             Some(h) => {
-                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     if !on {
                         *s = 0.0;
                     }
                 }
             }
             None => {
-                for s in &mut self.samples {
+                for s in samples {
                     *s = s.max(0.0);
                 }
             }
         }
     }
 
-    /// Samples `G u_n - g` of contact `i` into `self.samples`.
+    /// Samples `G u_n - g` of contact `i` into the AFT's samples.
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
-        lin.gather(u, lin.contact_dofs[i], &mut self.coeffs);
-        self.coeffs[0] -= lin.gaps[i];
-        // Lengths are fixed at construction: the transform cannot fail.
-        let _ = self.state.aft.to_time(&self.coeffs, &mut self.samples);
+        let coeffs = self.state.aft.coefficients_mut();
+        lin.gather(u, lin.contact_dofs[i], coeffs);
+        coeffs[0] -= lin.gaps[i];
+        self.state.aft.coefficients_to_samples();
     }
 }
 
@@ -245,22 +249,19 @@ impl Residual for PenaltyHb {
 
     fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
-        let (n, size) = (lin.dofs, lin.size());
+        let n = lin.dofs;
         lin.dynamic_residual(self.state.omega, u, out);
         for i in 0..lin.contacts() {
             self.gap_samples(u, i);
             self.penetrations(i);
-            for s in &mut self.samples {
+            for s in self.state.aft.samples_mut() {
                 *s *= self.stiffness;
             }
-            let _ = self
-                .state
-                .aft
-                .to_coefficients(&self.samples, &mut self.coeffs);
+            self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
             let dof = lin.contact_dofs[i];
-            for j in 0..size {
-                out[j * n + dof] += self.coeffs[j];
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                out[j * n + dof] += c;
             }
         }
         Ok(())
@@ -293,16 +294,17 @@ impl GeneralizedJacobian for PenaltyHb {
         jac.coupling = ContactCoupling::Penalty {
             stiffness: self.stiffness,
         };
-        let nt = self.samples.len();
+        let nt = self.time_samples();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
             if let Some(h) = self.holding.then_some(&self.frozen) {
                 // The indicator is the sign of the sample: impose the frozen one.
-                for (s, &on) in self.samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                let samples = self.state.aft.samples_mut();
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     *s = if on { 1.0 } else { 0.0 };
                 }
             }
-            self.state.write_contact_block(&mut self.samples, jac, i);
+            self.state.write_contact_block(jac, i);
         }
         Ok(())
     }
@@ -334,14 +336,14 @@ impl ParameterDependent for PenaltyHb {
 /// contact-major (`i Nt + n`): a sample carries penalty force where its gap is positive.
 impl PiecewiseAffine for PenaltyHb {
     fn switching_count(&self) -> usize {
-        self.contacts() * self.samples.len()
+        self.contacts() * self.time_samples()
     }
 
     fn switching(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        let nt = self.samples.len();
+        let nt = self.time_samples();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
-            out[i * nt..(i + 1) * nt].copy_from_slice(&self.samples);
+            out[i * nt..(i + 1) * nt].copy_from_slice(self.state.aft.samples());
         }
         Ok(())
     }

@@ -75,8 +75,6 @@ impl HbOptions {
 pub struct SsnHb {
     pub(crate) state: HbState,
     c: f64,
-    coeffs: Vec<f64>,
-    samples: Vec<f64>,
 }
 
 impl SsnHb {
@@ -95,13 +93,9 @@ impl SsnHb {
                 allowed: "a finite complementarity constant > 0 (force per length)",
             });
         }
-        let size = linear.size();
-        let nt = linear.basis.time_samples();
         Ok(Self {
             state: HbState::new(linear, model.forcing.omega),
             c,
-            coeffs: vec![0.0; size],
-            samples: vec![0.0; nt],
         })
     }
 
@@ -245,18 +239,18 @@ impl SsnHb {
             .collect()
     }
 
-    /// Samples `s_n = c (G u_n - g) - lambda_n` of contact `i` into `self.samples`.
+    /// Samples `s_n = c (G u_n - g) - lambda_n` of contact `i` into the AFT's samples.
     fn switching_samples(&mut self, x: &[f64], i: usize) {
         let lin = &self.state.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
         let dof = lin.contact_dofs[i];
-        for j in 0..size {
-            self.coeffs[j] = self.c * x[j * n + dof] - x[offset + j * m + i];
+        let coeffs = self.state.aft.coefficients_mut();
+        for (j, c) in coeffs.iter_mut().enumerate() {
+            *c = self.c * x[j * n + dof] - x[offset + j * m + i];
         }
-        self.coeffs[0] -= self.c * lin.gaps[i];
-        // Lengths are fixed at construction: the transform cannot fail.
-        let _ = self.state.aft.to_time(&self.coeffs, &mut self.samples);
+        coeffs[0] -= self.c * lin.gaps[i];
+        self.state.aft.coefficients_to_samples();
     }
 }
 
@@ -278,15 +272,12 @@ impl Residual for SsnHb {
                 out_u[j * n + dof] -= x[offset + j * m + i];
             }
             self.switching_samples(x, i);
-            for s in &mut self.samples {
+            for s in self.state.aft.samples_mut() {
                 *s = s.max(0.0);
             }
-            let _ = self
-                .state
-                .aft
-                .to_coefficients(&self.samples, &mut self.coeffs);
-            for j in 0..size {
-                out_l[j * m + i] = x[offset + j * m + i] + self.coeffs[j];
+            self.state.aft.samples_to_coefficients();
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                out_l[j * m + i] = x[offset + j * m + i] + c;
             }
         }
         Ok(())
@@ -317,7 +308,7 @@ impl GeneralizedJacobian for SsnHb {
         jac.coupling = ContactCoupling::Complementarity { c: self.c };
         for i in 0..self.contacts() {
             self.switching_samples(x, i);
-            self.state.write_contact_block(&mut self.samples, jac, i);
+            self.state.write_contact_block(jac, i);
         }
         Ok(())
     }

@@ -3,9 +3,10 @@
 //!
 //! For harmonic `k >= 1` the real `2N x 2N` block on `(u_ck, u_sk)` is equivalent to the
 //! complex `N x N` matrix `Z_k = K - (k w)^2 M + i k w D` acting on `z = u_c - i u_s`
-//! (`k = 0`: `K` on `u_0`). Each `Z_k` is factored once per frequency by faer's sparse LU
-//! (symbolic analysis once per sparsity pattern), so the cost is linear in `N` for banded
-//! models. The receptance `R_k = G Z_k^{-1} G^T` (`m x m` complex) maps contact-force
+//! (`k = 0`: `K` on `u_0`). Each `Z_k` is factored once per frequency by the crate's
+//! dynamic stiffness (sparse LU; column ordering once per model, numeric factorization per
+//! frequency into reused storage, rejected only on a zero pivot), so the cost is linear in
+//! `N` for banded models. The receptance `R_k = G Z_k^{-1} G^T` (`m x m` complex) maps contact-force
 //! coefficients to contact-displacement coefficients.
 //!
 //! SSN-HB, `J = [[A, -G^T], [c Q G, I - Q]]`: with `w = A^{-1} r_u` and `y = G w`,
@@ -19,107 +20,41 @@ use std::sync::Arc;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solve};
 use faer::perm::PermRef;
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
-use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{c64, Conj, Mat, MatMut, MatRef, Par};
+use faer::{c64, Conj, Mat, MatMut, Par};
 use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{Factorize, LinearSolve};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::LinearData;
-use crate::model::SparseMatrix;
+use crate::dynamic::DynamicStiffness;
 
 /// Relative residual `|J x - b| / |b|` below which iterative refinement stops.
 const REFINEMENT_TARGET: f64 = 1e-14;
-
-/// Sparsity pattern of `K + M + D` with the positions of each matrix's entries in it, and
-/// its symbolic LU (computed once per model).
-struct Pattern {
-    union: SparseColMat<usize, f64>,
-    stiffness_pos: Vec<usize>,
-    mass_pos: Vec<usize>,
-    damping_pos: Vec<usize>,
-    symbolic: SymbolicLu<usize>,
-}
-
-impl Pattern {
-    fn new(lin: &LinearData) -> Result<Self, LinearSolveError> {
-        let n = lin.dofs;
-        let mut triplets = Vec::new();
-        let mut push = |m: &SparseMatrix| {
-            let m = m.as_ref();
-            let symbolic = m.symbolic();
-            for j in 0..n {
-                for p in symbolic.col_range(j) {
-                    triplets.push(Triplet::new(symbolic.row_idx()[p], j, 0.0));
-                }
-            }
-        };
-        push(&lin.stiffness);
-        push(&lin.mass);
-        if let Some(d) = &lin.damping {
-            push(d);
-        }
-        for j in 0..n {
-            triplets.push(Triplet::new(j, j, 0.0));
-        }
-        let union =
-            SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).map_err(|e| {
-                LinearSolveError::from_creation(e, "building the union sparsity pattern")
-            })?;
-        let positions = |m: &SparseMatrix| -> Vec<usize> {
-            let m = m.as_ref();
-            let sm = m.symbolic();
-            let su = union.symbolic();
-            let mut out = Vec::with_capacity(m.val().len());
-            for j in 0..n {
-                let range = su.col_range(j);
-                let rows = &su.row_idx()[range.clone()];
-                for p in sm.col_range(j) {
-                    let r = sm.row_idx()[p];
-                    // The union contains every entry of m by construction.
-                    let offset = rows.binary_search(&r).unwrap_or(0);
-                    out.push(range.start + offset);
-                }
-            }
-            out
-        };
-        let stiffness_pos = positions(&lin.stiffness);
-        let mass_pos = positions(&lin.mass);
-        let damping_pos = lin.damping.as_ref().map(positions).unwrap_or_default();
-        let symbolic = factorize_symbolic_lu(union.symbolic(), Default::default())
-            .map_err(|e| LinearSolveError::from_faer(e, "analysing the dynamic blocks"))?;
-        Ok(Self {
-            union,
-            stiffness_pos,
-            mass_pos,
-            damping_pos,
-            symbolic,
-        })
-    }
-}
 
 /// Structured [`LinearSolve`] for [`HbJacobian`] (SSN-HB and penalty HB): see the module
 /// documentation of this file for the algebra.
 ///
 /// Work per Newton iteration at fixed `w`: one dense LU of size `m (2H + 1)`, `H + 1`
-/// sparse complex solves per right-hand side; no allocation once the sizes are set.
+/// sparse complex solves per right-hand side. Workspaces are allocated once per model:
+/// neither a Newton iteration nor a change of `w` (refactoring the dynamic blocks)
+/// allocates.
 /// The per-harmonic sparse factorizations are redone only when the Jacobian's dynamic part
 /// changes ([`HbJacobian::same_dynamic_part`]), which
 /// [`StructuredHbSolver::dynamic_factorizations`] counts.
 pub struct StructuredHbSolver {
-    pattern: Option<(Arc<LinearData>, Pattern)>,
+    /// The model the workspaces are sized for, and its dynamic stiffness with one
+    /// factorization slot per harmonic `k = 0..=H`.
+    dynamic: Option<(Arc<LinearData>, DynamicStiffness)>,
     /// Jacobian whose dynamic part is currently factored (only its `linear` and `omega`
     /// matter).
     factored_for: Option<(Arc<LinearData>, f64)>,
-    numeric: Vec<NumericLu<usize, c64>>,
-    values: Vec<c64>,
     /// `Z_k^{-1} G^T` (N x m) per harmonic `k = 0..=H`.
     response: Vec<Mat<c64>>,
     /// `R_k = G Z_k^{-1} G^T` (m x m) per harmonic.
     receptance: Vec<Mat<c64>>,
     coupling: ContactCoupling,
-    q: Mat<f64>,
+    /// `Q_i` per contact, copied from the Jacobian.
+    q: Vec<Mat<f64>>,
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -158,14 +93,12 @@ impl StructuredHbSolver {
     /// A solver with the default relative pivot threshold for the condensed system.
     pub fn new() -> Self {
         Self {
-            pattern: None,
+            dynamic: None,
             factored_for: None,
-            numeric: Vec::new(),
-            values: Vec::new(),
             response: Vec::new(),
             receptance: Vec::new(),
             coupling: ContactCoupling::Complementarity { c: 1.0 },
-            q: Mat::zeros(0, 0),
+            q: Vec::new(),
             schur: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
@@ -210,123 +143,91 @@ impl StructuredHbSolver {
         self.receptance.get(k)
     }
 
-    fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
-        let lin = jac.linear.clone();
-        let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
-        let same_model = matches!(&self.pattern, Some((l, _)) if Arc::ptr_eq(l, &lin));
-        if !same_model {
-            self.pattern = Some((lin.clone(), Pattern::new(&lin)?));
-            self.numeric = (0..=h).map(|_| NumericLu::new()).collect();
+    /// Sizes every workspace for the model of `lin` (once per model: nothing here depends
+    /// on the frequency).
+    fn prepare(&mut self, lin: &Arc<LinearData>) -> Result<(), LinearSolveError> {
+        if matches!(&self.dynamic, Some((l, _)) if Arc::ptr_eq(l, lin)) {
+            return Ok(());
         }
-        let Some((_, pattern)) = &self.pattern else {
-            return Err(LinearSolveError::NotFactored);
-        };
+        self.dynamic = None;
+        let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
+        let dynamic = DynamicStiffness::new(
+            &lin.stiffness,
+            &lin.mass,
+            lin.damping.as_ref(),
+            h + 1,
+            m.max(1),
+        )?;
         let size = 2 * h + 1;
         let nc = m * size;
         let req = StackReq::any_of(&[
-            pattern
-                .symbolic
-                .factorize_numeric_lu_scratch::<c64>(Par::Seq, Default::default()),
-            pattern
-                .symbolic
-                .solve_in_place_scratch::<c64>(m.max(1), Par::Seq),
             dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
             dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
         ]);
         self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-            during: "allocating the LU workspace",
+            during: "allocating the condensed LU workspace",
         })?;
-        self.values
-            .resize(pattern.union.val().len(), c64::new(0.0, 0.0));
-        self.response.resize_with(h + 1, || Mat::zeros(n, m));
-        self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
-        let stack = MemStack::new(&mut self.mem);
-        for k in 0..=h {
+        self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
+        self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
+        self.complex_rhs = Mat::zeros(n, 1);
+        self.work_u = vec![0.0; n * size];
+        self.work_a = vec![0.0; nc];
+        self.work_c = vec![0.0; nc];
+        self.work_d = vec![0.0; nc];
+        self.work_rhs = Vec::with_capacity(n * size + nc);
+        self.work_res = Vec::with_capacity(n * size + nc);
+        self.work_b = Mat::zeros(nc, 1);
+        self.schur = Mat::zeros(nc, nc);
+        self.perm = vec![0; nc];
+        self.perm_inv = vec![0; nc];
+        self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
+        self.dynamic = Some((lin.clone(), dynamic));
+        Ok(())
+    }
+
+    /// Factors `Z_k = K - (k w)^2 M + i k w D` for every harmonic and forms the responses
+    /// `Z_k^{-1} G^T` and receptances `G Z_k^{-1} G^T` (no allocation once prepared).
+    fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
+        let lin = jac.linear.clone();
+        self.prepare(&lin)?;
+        let Some((_, dynamic)) = &mut self.dynamic else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let n = lin.dofs;
+        for k in 0..=lin.basis.harmonics() {
             let kw = k as f64 * jac.omega;
-            self.values.fill(c64::new(0.0, 0.0));
-            let add = |values: &mut [c64], mat: &SparseMatrix, pos: &[usize], scale: c64| {
-                for (&p, &v) in pos.iter().zip(mat.as_ref().val()) {
-                    values[p] += scale * v;
-                }
-            };
-            add(
-                &mut self.values,
-                &lin.stiffness,
-                &pattern.stiffness_pos,
-                c64::new(1.0, 0.0),
-            );
-            add(
-                &mut self.values,
-                &lin.mass,
-                &pattern.mass_pos,
-                c64::new(-kw * kw, 0.0),
-            );
-            if let Some(d) = &lin.damping {
-                add(&mut self.values, d, &pattern.damping_pos, c64::new(0.0, kw));
-            }
-            let matrix = SparseColMatRef::new(pattern.union.symbolic(), &self.values);
-            let lu = pattern
-                .symbolic
-                .factorize_numeric_lu(
-                    &mut self.numeric[k],
-                    matrix,
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|e| LinearSolveError::from_sparse_lu(e, "factoring a dynamic block"))?;
+            dynamic
+                .factor(k, c64::new(-kw * kw, 0.0), c64::new(0.0, kw))
+                .map_err(|e| match e {
+                    // The pivot's dof, as an unknown of the cosine block of harmonic k.
+                    LinearSolveError::Singular {
+                        index,
+                        pivot,
+                        max_pivot,
+                    } => LinearSolveError::Singular {
+                        index: if k == 0 {
+                            index
+                        } else {
+                            (2 * k - 1) * n + index
+                        },
+                        pivot,
+                        max_pivot,
+                    },
+                    other => other,
+                })?;
             let z = &mut self.response[k];
-            if z.nrows() != n || z.ncols() != m {
-                *z = Mat::zeros(n, m);
-            }
             z.fill(c64::new(0.0, 0.0));
             for (i, &dof) in lin.contact_dofs.iter().enumerate() {
                 z[(dof, i)] = c64::new(1.0, 0.0);
             }
-            lu.solve_in_place_with_conj(Conj::No, z.as_mut(), Par::Seq, stack);
+            dynamic.solve_in_place(k, z.as_mut())?;
             let r = &mut self.receptance[k];
-            if r.nrows() != m {
-                *r = Mat::zeros(m, m);
-            }
             for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                for ip in 0..m {
-                    let value = z[(dof, ip)];
-                    if !(value.re.is_finite() && value.im.is_finite()) {
-                        return Err(LinearSolveError::Singular {
-                            index: k,
-                            pivot: 0.0,
-                            max_pivot: f64::NAN,
-                        });
-                    }
-                    r[(i, ip)] = value;
-                }
-            }
-            // Without contacts, detect a singular block from a probe solve instead.
-            if m == 0 {
-                let probe = &mut self.complex_rhs;
-                *probe = Mat::from_fn(n, 1, |_, _| c64::new(1.0, 0.0));
-                lu.solve_in_place_with_conj(Conj::No, probe.as_mut(), Par::Seq, stack);
-                if (0..n).any(|r| !(probe[(r, 0)].re.is_finite() && probe[(r, 0)].im.is_finite())) {
-                    return Err(LinearSolveError::Singular {
-                        index: k,
-                        pivot: 0.0,
-                        max_pivot: f64::NAN,
-                    });
+                for ip in 0..lin.contacts() {
+                    r[(i, ip)] = z[(dof, ip)];
                 }
             }
         }
-        self.complex_rhs = Mat::zeros(n, 1);
-        self.work_u.resize(n * size, 0.0);
-        self.work_a.resize(nc, 0.0);
-        self.work_c.resize(nc, 0.0);
-        self.work_d.resize(nc, 0.0);
-        self.work_rhs.reserve(n * size + nc);
-        self.work_res.reserve(n * size + nc);
-        self.work_b = Mat::zeros(nc, 1);
-        self.schur = Mat::zeros(nc, nc);
-        self.perm.resize(nc, 0);
-        self.perm_inv.resize(nc, 0);
-        self.q = Mat::zeros(size, nc);
         self.factored_for = Some((lin, jac.omega));
         self.dynamic_factorizations += 1;
         Ok(())
@@ -334,11 +235,10 @@ impl StructuredHbSolver {
 
     /// `u <- A(w)^{-1} u` harmonic by harmonic (complex form).
     pub(crate) fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
-        let (Some((_, pattern)), Some((lin, _))) = (&self.pattern, &self.factored_for) else {
+        let (Some((_, dynamic)), Some((lin, _))) = (&mut self.dynamic, &self.factored_for) else {
             return Err(LinearSolveError::NotFactored);
         };
         let n = lin.dofs;
-        let stack = MemStack::new(&mut self.mem);
         for k in 0..=lin.basis.harmonics() {
             let rhs = &mut self.complex_rhs;
             if k == 0 {
@@ -351,12 +251,7 @@ impl StructuredHbSolver {
                     rhs[(r, 0)] = c64::new(u[c + r], -u[s + r]);
                 }
             }
-            LuRef::new_unchecked(&pattern.symbolic, &self.numeric[k]).solve_in_place_with_conj(
-                Conj::No,
-                rhs.as_mut(),
-                Par::Seq,
-                stack,
-            );
+            dynamic.solve_in_place(k, rhs.as_mut())?;
             if k == 0 {
                 for r in 0..n {
                     u[r] = rhs[(r, 0)].re;
@@ -401,15 +296,17 @@ impl StructuredHbSolver {
     }
 
     /// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
-    fn apply_coupling(q: &Mat<f64>, m: usize, p: &[f64], out: &mut [f64]) {
-        let size = q.nrows();
-        for i in 0..m {
-            for j in 0..size {
-                let mut sum = 0.0;
-                for l in 0..size {
-                    sum += q[(j, i * size + l)] * p[l * m + i];
+    fn apply_coupling(q: &[Mat<f64>], m: usize, p: &[f64], out: &mut [f64]) {
+        for (i, qi) in q.iter().enumerate() {
+            // Column by column (contiguous), each sum still accumulated in the order of l.
+            for o in out[i..].iter_mut().step_by(m) {
+                *o = 0.0;
+            }
+            for l in 0..qi.ncols() {
+                let pl = p[l * m + i];
+                for (o, v) in out[i..].iter_mut().step_by(m).zip(qi.col_as_slice(l)) {
+                    *o += v * pl;
                 }
-                out[j * m + i] = sum;
             }
         }
     }
@@ -428,17 +325,20 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         let (m, size) = (lin.contacts(), lin.size());
         let nc = m * size;
         self.coupling = jac.coupling;
-        self.q.copy_from(&jac.q);
-        if let Some((row, col, value)) = (0..nc)
-            .flat_map(|c| (0..size).map(move |r| (r, c)))
-            .map(|(r, c)| (r, c, jac.q[(r, c)]))
-            .find(|(_, _, v)| !v.is_finite())
-        {
-            return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+        for (i, (q, source)) in self.q.iter_mut().zip(&jac.q).enumerate() {
+            q.copy_from(source);
+            for col in 0..size {
+                let column = q.col_as_slice(col);
+                if let Some((row, &value)) = column.iter().enumerate().find(|(_, v)| !v.is_finite())
+                {
+                    let col = i * size + col;
+                    return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+                }
+            }
         }
         condensed_matrix(
             &self.receptance,
-            self.q.as_ref(),
+            &self.q,
             self.coupling,
             m,
             self.schur.as_mut(),
@@ -662,15 +562,15 @@ fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> 
 
 /// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R`
 /// (SSN-HB) or `I + k_p R Q` (penalty), using that `R` only couples the two basis
-/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` in column blocks.
+/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` of each contact.
 pub(crate) fn condensed_matrix(
     receptance: &[Mat<c64>],
-    q: MatRef<'_, f64>,
+    q: &[Mat<f64>],
     coupling: ContactCoupling,
     m: usize,
     mut out: MatMut<'_, f64>,
 ) {
-    let size = q.nrows();
+    let size = (2 * receptance.len()).saturating_sub(1);
     out.fill(0.0);
     for l in 0..size {
         let k = l.div_ceil(2);
@@ -680,16 +580,18 @@ pub(crate) fn condensed_matrix(
             let col = l * m + ip;
             match coupling {
                 ContactCoupling::Complementarity { c } => {
-                    for i in 0..m {
+                    for (i, qi) in q.iter().enumerate() {
                         let (rho0, rho1) = receptance_column(receptance, l, i, ip);
-                        let qi = i * size;
-                        for j in 0..size {
-                            let mut value = c * rho0 * q[(j, qi + first)];
+                        let (q0, ql) = (qi.col_as_slice(first), qi.col_as_slice(l));
+                        let q1 = qi.col_as_slice(first + count - 1);
+                        let rho1 = if count == 2 { rho1 } else { 0.0 };
+                        for (j, ((a, b), d)) in q0.iter().zip(q1).zip(ql).enumerate() {
+                            let mut value = c * rho0 * a;
                             if count == 2 {
-                                value += c * rho1 * q[(j, qi + first + 1)];
+                                value += c * rho1 * b;
                             }
                             if i == ip {
-                                value -= q[(j, qi + l)];
+                                value -= d;
                             }
                             out[(j * m + i, col)] = value;
                         }
@@ -697,14 +599,14 @@ pub(crate) fn condensed_matrix(
                 }
                 ContactCoupling::Penalty { stiffness } => {
                     // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
-                    let qp = ip * size;
+                    let qp = &q[ip];
                     for i in 0..m {
                         let r0 = receptance[0][(i, ip)].re;
-                        out[(i, col)] = stiffness * r0 * q[(0, qp + l)];
+                        out[(i, col)] = stiffness * r0 * qp[(0, l)];
                         for (kk, rk) in receptance.iter().enumerate().skip(1) {
                             let (jc, js) = (2 * kk - 1, 2 * kk);
                             let r = rk[(i, ip)];
-                            let (pc, ps) = (q[(jc, qp + l)], q[(js, qp + l)]);
+                            let (pc, ps) = (qp[(jc, l)], qp[(js, l)]);
                             out[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
                             out[(js * m + i, col)] = stiffness * (-r.im * pc + r.re * ps);
                         }

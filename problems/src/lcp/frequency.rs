@@ -33,7 +33,7 @@ use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual,
 };
 
-use super::min_map::{add_mat_vec, ActiveSetSolver, MinMapJacobian};
+use super::min_map::{add_mat_vec, ActiveSetSolver};
 use super::{LcpError, PeriodicLcp, PeriodicLcpOptions};
 use crate::model::StructuralModel;
 
@@ -275,7 +275,7 @@ impl DenseAssemble for FrequencyLcpJacobian {
 
 /// Solves with a [`FrequencyLcpJacobian`] by one LU of the active block `A_II` (module
 /// documentation): the `z` part is the min-map system `[A_I; P_J] dz = (r2_I / kappa - r1_I,
-/// r2_J)` of [`ActiveSetSolver`] (here without its regularisation: a singular or non-finite
+/// r2_J)` of [`ActiveSetSolver`] (without regularisation, its default: a singular or non-finite
 /// block is a [`LinearSolveError`], and the continuation halves its step), then
 /// `dw = r1 + A dz` on the inactive rows and `r2 / kappa` on the active ones.
 #[derive(Debug)]
@@ -302,7 +302,7 @@ impl FrequencyLcpSolver {
             lcp: None,
             active: Vec::new(),
             kappa: 1.0,
-            block: ActiveSetSolver::new().without_regularization(),
+            block: ActiveSetSolver::new(),
             dw: Vec::new(),
             dw_active: Vec::new(),
         }
@@ -319,13 +319,7 @@ impl Factorize<FrequencyLcpJacobian> for FrequencyLcpSolver {
         self.lcp = None;
         // A Jacobian never evaluated holds no matrix: nothing to factor.
         let lcp = jac.lcp.clone().ok_or(LinearSolveError::NotFactored)?;
-        let min_map = MinMapJacobian::new(lcp.matrix(), jac.active.clone()).map_err(|_| {
-            LinearSolveError::DimensionMismatch {
-                expected: lcp.dim(),
-                found: jac.active.len(),
-            }
-        })?;
-        self.block.factor(&min_map)?;
+        self.block.factor_rows(lcp.matrix(), &jac.active)?;
         self.active.clone_from(&jac.active);
         self.kappa = jac.kappa;
         self.lcp = Some(lcp);

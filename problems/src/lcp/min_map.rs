@@ -9,8 +9,10 @@
 //! `A_II d_I = r_I - A_IJ r_J`: one `|I| x |I|` LU instead of an `m Nt` one. Newton on this
 //! equation is the primal-dual active-set method.
 
-use faer::linalg::solvers::{PartialPivLu, Solve};
-use faer::{Mat, MatMut, MatRef};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve};
+use faer::perm::PermRef;
+use faer::{MatMut, MatRef, Par};
 use semismooth::complementarity::min_function;
 use semismooth::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
@@ -62,11 +64,16 @@ impl<'a> MinMapLcp<'a> {
                 });
             }
         }
-        Ok(Self {
+        Ok(Self::of_lcp(matrix, q))
+    }
+
+    /// The equation of an LCP whose `A` is square of the length of `q` by construction.
+    pub(crate) fn of_lcp(matrix: MatRef<'a, f64>, q: &'a [f64]) -> Self {
+        Self {
             matrix,
             q,
             w: vec![0.0; q.len()],
-        })
+        }
     }
 
     /// `w = q + A z` into `w`.
@@ -163,19 +170,51 @@ impl DenseAssemble for MinMapJacobian<'_> {
     }
 }
 
+/// Default relative diagonal shift of [`ActiveSetSolver::with_regularization`]: `1e-8`
+/// of the largest entry of the active block.
+pub const DEFAULT_ACTIVE_SET_REGULARIZATION: f64 = 1e-8;
+
 /// Solves with a [`MinMapJacobian`] by factoring only its active block `A_II`
 /// (dense LU with partial pivoting and a relative pivot check).
-#[derive(Debug)]
+///
+/// A singular active block is [`LinearSolveError::Singular`], as [`Factorize`] promises,
+/// unless a regularisation is asked for ([`ActiveSetSolver::with_regularization`]): then
+/// the diagonal of a singular block is shifted by `shift` times its largest entry and
+/// factored again (a Levenberg–Marquardt-like step, still a descent direction for the
+/// merit; e.g. at `z = 0` when every node is in contact and `A` has a null vector).
+///
+/// Storage (the block, the coupling `A_IJ`, the permutation, the scratch) is kept between
+/// factorizations and grows only when a larger active set needs more: a Newton run
+/// allocates only while its active sets reach new sizes.
 pub struct ActiveSetSolver {
     n: usize,
     active: Vec<usize>,
     inactive: Vec<usize>,
-    /// `A_IJ`, `|I| x |J|`.
-    coupling: Mat<f64>,
-    lu: Option<PartialPivLu<f64>>,
-    rhs: Mat<f64>,
+    /// The factors of `A_II` (`k x k`, column-major, in place).
+    block: Vec<f64>,
+    /// `A_IJ` (`k x |J|`, column-major).
+    coupling: Vec<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    /// `r_I - A_IJ r_J`, then `d_I`.
+    rhs: Vec<f64>,
+    mem: MemBuffer,
+    mem_req: StackReq,
+    factored: bool,
     pivot_threshold: f64,
-    regularize: bool,
+    regularization: Option<f64>,
+}
+
+impl std::fmt::Debug for ActiveSetSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ActiveSetSolver")
+            .field("n", &self.n)
+            .field("active", &self.active.len())
+            .field("factored", &self.factored)
+            .field("pivot_threshold", &self.pivot_threshold)
+            .field("regularization", &self.regularization)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Default for ActiveSetSolver {
@@ -185,7 +224,8 @@ impl Default for ActiveSetSolver {
 }
 
 impl ActiveSetSolver {
-    /// A solver with the default relative pivot threshold [`DEFAULT_PIVOT_THRESHOLD`].
+    /// A solver with the default relative pivot threshold [`DEFAULT_PIVOT_THRESHOLD`] and
+    /// no regularisation.
     pub fn new() -> Self {
         Self::with_pivot_threshold(DEFAULT_PIVOT_THRESHOLD)
     }
@@ -196,59 +236,80 @@ impl ActiveSetSolver {
             n: 0,
             active: Vec::new(),
             inactive: Vec::new(),
-            coupling: Mat::zeros(0, 0),
-            lu: None,
-            rhs: Mat::zeros(0, 1),
+            block: Vec::new(),
+            coupling: Vec::new(),
+            perm: Vec::new(),
+            perm_inv: Vec::new(),
+            rhs: Vec::new(),
+            mem: MemBuffer::new(StackReq::EMPTY),
+            mem_req: StackReq::EMPTY,
+            factored: false,
             pivot_threshold: threshold,
-            regularize: true,
+            regularization: None,
         }
     }
 
-    /// Reports a singular active block as [`LinearSolveError::Singular`] instead of
-    /// shifting its diagonal (the default regularises it, see `factor`).
+    /// Shifts the diagonal of a singular active block by `shift` times its largest entry
+    /// (`shift` finite and `> 0`, e.g. [`DEFAULT_ACTIVE_SET_REGULARIZATION`]) instead of
+    /// reporting it.
+    pub fn with_regularization(mut self, shift: f64) -> Result<Self, LcpError> {
+        if !(shift.is_finite() && shift > 0.0) {
+            return Err(LcpError::InvalidOption {
+                name: "regularization",
+                value: shift,
+                allowed: "a finite relative diagonal shift > 0",
+            });
+        }
+        self.regularization = Some(shift);
+        Ok(self)
+    }
+
+    /// Reports a singular active block as [`LinearSolveError::Singular`] (the default).
     pub fn without_regularization(mut self) -> Self {
-        self.regularize = false;
+        self.regularization = None;
         self
+    }
+
+    /// The relative diagonal shift applied to a singular block, if any.
+    pub fn regularization(&self) -> Option<f64> {
+        self.regularization
     }
 
     /// Size of the active block of the last factorization.
     pub fn active_count(&self) -> usize {
         self.active.len()
     }
-}
 
-/// Relative diagonal shift applied to a singular active block (see `factor`).
-const REGULARIZATION: f64 = 1e-8;
-
-impl Factorize<MinMapJacobian<'_>> for ActiveSetSolver {
-    fn factor(&mut self, jac: &MinMapJacobian<'_>) -> Result<(), LinearSolveError> {
-        self.lu = None;
-        let n = jac.active.len();
+    /// Factors the Jacobian of `min(z, q + A z)` with the rows `active` of `matrix` (`A`,
+    /// square of the length of `active`) and unit rows elsewhere.
+    pub(crate) fn factor_rows(
+        &mut self,
+        matrix: MatRef<'_, f64>,
+        active: &[bool],
+    ) -> Result<(), LinearSolveError> {
+        self.factored = false;
+        let n = active.len();
+        for found in [matrix.nrows(), matrix.ncols()] {
+            if found != n {
+                return Err(LinearSolveError::DimensionMismatch { expected: n, found });
+            }
+        }
         self.n = n;
         self.active.clear();
         self.inactive.clear();
-        for (i, a) in jac.active.iter().enumerate() {
+        // Room for any split of the n rows.
+        self.active.reserve(n);
+        self.inactive.reserve(n);
+        for (i, a) in active.iter().enumerate() {
             if *a {
                 self.active.push(i);
             } else {
                 self.inactive.push(i);
             }
         }
-        let k = self.active.len();
-        let a = jac.matrix;
-        let mut block = Mat::<f64>::zeros(k, k);
-        self.coupling = Mat::zeros(k, self.inactive.len());
-        for (r, &i) in self.active.iter().enumerate() {
-            for (c, &j) in self.active.iter().enumerate() {
-                block[(r, c)] = a[(i, j)];
-            }
-            for (c, &j) in self.inactive.iter().enumerate() {
-                self.coupling[(r, c)] = a[(i, j)];
-            }
-        }
         for &i in &self.active {
             for j in 0..n {
-                let value = a[(i, j)];
+                let value = matrix[(i, j)];
                 if !value.is_finite() {
                     return Err(LinearSolveError::NonFiniteEntry {
                         row: i,
@@ -258,43 +319,91 @@ impl Factorize<MinMapJacobian<'_>> for ActiveSetSolver {
                 }
             }
         }
+        let k = self.active.len();
+        self.coupling.resize(k * self.inactive.len(), 0.0);
+        for (c, &j) in self.inactive.iter().enumerate() {
+            for (r, &i) in self.active.iter().enumerate() {
+                self.coupling[c * k + r] = matrix[(i, j)];
+            }
+        }
+        self.rhs.resize(k, 0.0);
+        self.perm.resize(k, 0);
+        self.perm_inv.resize(k, 0);
+        self.block.resize(k * k, 0.0);
         if k > 0 {
-            let lu = PartialPivLu::new(block.as_ref());
-            let u = lu.U();
-            match check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold) {
-                Ok(()) => self.lu = Some(lu),
-                Err(singular) if !self.regularize => return Err(singular),
-                Err(singular) => {
-                    // A singular active block (e.g. at z = 0 when every time node is in
-                    // contact and A has a null vector): shift the diagonal by 1e-8 of the
-                    // largest entry (a Levenberg–Marquardt-like regularised Newton step,
-                    // still a descent direction for the merit), or report the singularity.
-                    let largest = (0..k)
-                        .flat_map(|r| (0..k).map(move |c| (r, c)))
-                        .fold(0.0_f64, |m, (r, c)| m.max(block[(r, c)].abs()));
-                    let shift = REGULARIZATION * largest;
-                    for d in 0..k {
-                        block[(d, d)] += shift;
+            let req = StackReq::any_of(&[
+                lu_factor::lu_in_place_scratch::<usize, f64>(k, k, Par::Seq, Default::default()),
+                lu_solve::solve_in_place_scratch::<usize, f64>(k, 1, Par::Seq),
+            ]);
+            if req.size_bytes() > self.mem_req.size_bytes()
+                || req.align_bytes() > self.mem_req.align_bytes()
+            {
+                self.mem_req = self.mem_req.or(req);
+                self.mem = MemBuffer::try_new(self.mem_req).map_err(|_| {
+                    LinearSolveError::OutOfMemory {
+                        during: "allocating the active-block LU workspace",
                     }
-                    let lu = PartialPivLu::new(block.as_ref());
-                    let u = lu.U();
-                    if shift > 0.0
-                        && check_pivots((0..k).map(|i| u[(i, i)]), self.pivot_threshold).is_ok()
-                    {
-                        self.lu = Some(lu);
-                    } else {
+                })?;
+            }
+            match self.factor_block(matrix, 0.0) {
+                Ok(()) => {}
+                Err(singular) => {
+                    let Some(relative) = self.regularization else {
+                        return Err(singular);
+                    };
+                    let largest = self.active.iter().fold(0.0_f64, |m, &i| {
+                        self.active
+                            .iter()
+                            .fold(m, |m, &j| m.max(matrix[(i, j)].abs()))
+                    });
+                    let shift = relative * largest;
+                    if !(shift > 0.0 && self.factor_block(matrix, shift).is_ok()) {
                         return Err(singular);
                     }
                 }
             }
         }
-        self.rhs = Mat::zeros(k, 1);
+        self.factored = true;
         Ok(())
+    }
+
+    /// Copies `A_II + shift I` into the block and factors it in place (pivots checked).
+    fn factor_block(
+        &mut self,
+        matrix: MatRef<'_, f64>,
+        shift: f64,
+    ) -> Result<(), LinearSolveError> {
+        let k = self.active.len();
+        for (c, &j) in self.active.iter().enumerate() {
+            for (r, &i) in self.active.iter().enumerate() {
+                self.block[c * k + r] = matrix[(i, j)];
+            }
+            self.block[c * k + c] += shift;
+        }
+        lu_factor::lu_in_place(
+            MatMut::from_column_major_slice_mut(&mut self.block, k, k),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
+        let block = &self.block;
+        check_pivots((0..k).map(|d| block[d * k + d]), self.pivot_threshold)
+    }
+}
+
+impl Factorize<MinMapJacobian<'_>> for ActiveSetSolver {
+    fn factor(&mut self, jac: &MinMapJacobian<'_>) -> Result<(), LinearSolveError> {
+        self.factor_rows(jac.matrix, &jac.active)
     }
 }
 
 impl LinearSolve for ActiveSetSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        if !self.factored {
+            return Err(LinearSolveError::NotFactored);
+        }
         if rhs.len() != self.n {
             return Err(LinearSolveError::DimensionMismatch {
                 expected: self.n,
@@ -305,18 +414,27 @@ impl LinearSolve for ActiveSetSolver {
         if k == 0 {
             return Ok(()); // J = I
         }
-        let lu = self.lu.as_ref().ok_or(LinearSolveError::NotFactored)?;
         // d_J = r_J; A_II d_I = r_I - A_IJ r_J.
-        for (r, &i) in self.active.iter().enumerate() {
-            let mut v = rhs[i];
-            for (c, &j) in self.inactive.iter().enumerate() {
-                v -= self.coupling[(r, c)] * rhs[j];
-            }
-            self.rhs[(r, 0)] = v;
+        for (v, &i) in self.rhs.iter_mut().zip(&self.active) {
+            *v = rhs[i];
         }
-        lu.solve_in_place(self.rhs.as_mut());
-        for (r, &i) in self.active.iter().enumerate() {
-            rhs[i] = self.rhs[(r, 0)];
+        for (column, &j) in self.coupling.chunks_exact(k).zip(&self.inactive) {
+            let rj = rhs[j];
+            for (v, a) in self.rhs.iter_mut().zip(column) {
+                *v -= a * rj;
+            }
+        }
+        let factors = MatRef::from_column_major_slice(&self.block, k, k);
+        lu_solve::solve_in_place(
+            factors,
+            factors,
+            PermRef::new_checked(&self.perm, &self.perm_inv, k),
+            MatMut::from_column_major_slice_mut(&mut self.rhs, k, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+        for (v, &i) in self.rhs.iter().zip(&self.active) {
+            rhs[i] = *v;
         }
         Ok(())
     }
@@ -325,6 +443,7 @@ impl LinearSolve for ActiveSetSolver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::Mat;
     use semismooth::linalg::FaerDenseLu;
 
     /// A deterministic, non-symmetric, diagonally heavy test matrix.
@@ -379,12 +498,23 @@ mod tests {
         // Rows 0 and 1 of the active block are equal: A_II = [[1, 1], [1, 1]].
         let a = Mat::from_fn(3, 3, |i, j| f64::from(i == j || (i < 2 && j < 2)));
         let jac = MinMapJacobian::new(a.as_ref(), vec![true, true, false]).unwrap();
-        // By default the block is regularised and the solve is finite.
-        let mut regularised = ActiveSetSolver::new();
+        // Regularised on request, the solve is finite.
+        let mut regularised = ActiveSetSolver::new()
+            .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
+            .unwrap();
         regularised.factor(&jac).unwrap();
         let mut x = vec![1.0; 3];
         regularised.solve_in_place(&mut x).unwrap();
         assert!(x.iter().all(|v| v.is_finite()));
+        assert!(ActiveSetSolver::new()
+            .with_regularization(f64::NAN)
+            .is_err());
+        // By default (and explicitly without) the singular block is a typed error.
+        let mut default = ActiveSetSolver::new();
+        assert!(matches!(
+            default.factor(&jac),
+            Err(LinearSolveError::Singular { .. })
+        ));
         let mut solver = ActiveSetSolver::new().without_regularization();
         assert!(matches!(
             solver.factor(&jac),

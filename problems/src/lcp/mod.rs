@@ -70,7 +70,7 @@
 //! # Measured on the canonical rod (20 elements, `zeta = 0.01`, `omega = omega_1`, gap 0.5)
 //!
 //! Modified mass (massless tip): Lemke solves at every `Nt` (61 / 172 / 529 / 1894 / 7118
-//! pivots at `Nt` = 128 / 256 / 512 / 1024 / 2048, 0.37 s of CPU at 2048), tip minimum
+//! pivots at `Nt` = 128 / 256 / 512 / 1024 / 2048; README for the time), tip minimum
 //! -0.5234851 / -0.5232093 / -0.5231566 / -0.5231539 / -0.5231508, identical (to 1e-13)
 //! to semismooth Newton and to the steady state of the massless-contact trapezoidal march
 //! with the same step. `(A + A^T)/2` is slightly indefinite (smallest eigenvalue about
@@ -99,22 +99,26 @@
 //! assert!((highest - 0.5).abs() < 1e-12); // the tip reaches the obstacle
 //! ```
 
-mod dft;
+mod build;
 mod frequency;
 mod min_map;
+mod sequencing;
 
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
-pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp};
+pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
+pub use sequencing::{
+    solve_min_map_sequenced, SequencedSolution, SequencingLevel, SEQUENCING_COARSEST_TIME_SAMPLES,
+};
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
+use std::sync::Arc;
+
 use faer::{c64, Mat, MatRef};
+use rustfft::{Fft, FftPlanner};
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeReport, LemkeTermination};
-use semismooth::newton::{self, NewtonError, NewtonOptions, NewtonReport};
+use semismooth::linalg::LinearSolveError;
+use semismooth::newton::NewtonError;
 
-use crate::model::{SparseMatrix, StructuralModel};
-use dft::Dft;
+use crate::model::InvalidModel;
 
 /// Default number of time steps per period `Nt` of the periodic LCP.
 pub const DEFAULT_LCP_TIME_SAMPLES: usize = 256;
@@ -123,15 +127,11 @@ pub const MIN_LCP_TIME_SAMPLES: usize = 8;
 /// Largest accepted LCP size `contacts * Nt` (the dense matrix holds its square: 512 MB).
 pub const MAX_LCP_SIZE: usize = 8192;
 
-/// Relative residual `|Z x - b| / (|Z| |x| + |b|)` above which a bin solve is rejected
-/// (a forcing-free resonance: `Z_k` numerically singular).
-const BIN_RESIDUAL_TOLERANCE: f64 = 1e-8;
-
 /// Options of [`PeriodicLcp::new`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct PeriodicLcpOptions {
     /// Number of time steps per period `Nt` (default [`DEFAULT_LCP_TIME_SAMPLES`]);
-    /// `Nt >= 8` and `contacts * Nt <= MAX_LCP_SIZE`. Powers of two use a radix-2 FFT.
+    /// `Nt >= 8` and `contacts * Nt <= MAX_LCP_SIZE`. Any such `Nt` (FFTs by rustfft).
     pub time_samples: usize,
     /// Degrees of freedom whose displacement history [`PeriodicLcp::displacements`]
     /// returns (default none; the contact dofs are always available through
@@ -193,16 +193,9 @@ pub enum LcpError {
         /// Size found.
         found: usize,
     },
-    /// A scalar of the model is not acceptable.
-    #[error("invalid model {name} = {value}: allowed {allowed}")]
-    InvalidModel {
-        /// Which quantity.
-        name: &'static str,
-        /// The value found.
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
+    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    #[error(transparent)]
+    Model(#[from] InvalidModel),
     /// An observed dof does not exist.
     #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
     ObservedDofOutOfRange {
@@ -211,35 +204,26 @@ pub enum LcpError {
         /// Number of dofs.
         dofs: usize,
     },
-    /// A contact refers to a dof that does not exist.
-    #[error("contact dof {dof} is out of range: the model has {dofs} dofs")]
-    ContactDofOutOfRange {
-        /// The dof of the contact.
-        dof: usize,
-        /// Number of dofs.
-        dofs: usize,
-    },
-    /// The sparse factorization of a dynamic stiffness failed.
-    #[error("factorization of the dynamic stiffness of bin {bin} failed: {reason}")]
+    /// A dynamic stiffness could not be factored for want of memory or indices, or the
+    /// static block of the Nyquist limit is singular.
+    #[error("factorization of the dynamic stiffness of bin {bin} failed: {source}")]
     Factorization {
         /// DFT bin (`Nt/2` is the Nyquist limit problem).
         bin: usize,
-        /// Backend's description.
-        reason: String,
+        /// What the sparse LU reported.
+        source: LinearSolveError,
     },
-    /// `Z_k` is numerically singular (a warped bin frequency on a natural frequency of an
-    /// undamped model).
-    #[error(
-        "dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: \
-         relative residual {relative_residual:e}"
-    )]
+    /// The LU of `Z_k` broke down (a zero pivot: a warped bin frequency on a natural
+    /// frequency of an undamped model).
+    #[error("dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: {source}")]
     SingularBin {
         /// DFT bin.
         bin: usize,
         /// Warped angular frequency `(2/dt) tan(pi k / Nt)`.
         frequency: f64,
-        /// Relative residual of the solve.
-        relative_residual: f64,
+        /// The singular pivot ([`LinearSolveError::Singular`]: its dof, value and the
+        /// largest pivot).
+        source: LinearSolveError,
     },
     /// Lemke's method ran but did not solve the LCP (secondary ray or pivot limit). A ray
     /// is possible when `A` is not copositive-plus: `symmetric_part_min_eigenvalue < 0`
@@ -266,6 +250,16 @@ pub enum LcpError {
     /// [`PeriodicLcp::with_frequency_derivative`]).
     #[error("the LCP was built without its frequency derivative")]
     NoFrequencyDerivative,
+    /// The LCP given to [`solve_min_map_sequenced`] was not built for its model.
+    #[error("the finest LCP's {what} is {lcp}, the model's {model}")]
+    ForeignLcp {
+        /// What differs: `"omega"`, `"contact count"`, `"contact dof"` or `"contact gap"`.
+        what: &'static str,
+        /// The LCP's value.
+        lcp: f64,
+        /// The model's value.
+        model: f64,
+    },
     /// A vector passed in has the wrong length.
     #[error("{what} has length {found}, expected {expected}")]
     WrongLength {
@@ -302,6 +296,57 @@ pub struct PeriodicLcp {
     static_dofs: usize,
     /// `dH_k/domega` and `dX/domega` on the contact rows, when asked for.
     derivative: Option<FrequencyDerivative>,
+    /// FFTs of length `Nt`, planned once.
+    plans: FftPlans,
+}
+
+/// Complex FFT plans of one length `Nt` (any `Nt >= 1`, rustfft), both unnormalised:
+/// `forward`: `X_k = sum_n x_n e^{-2 pi i k n / Nt}`, `inverse`: the conjugate sum.
+#[derive(Clone)]
+struct FftPlans {
+    forward: Arc<dyn Fft<f64>>,
+    inverse: Arc<dyn Fft<f64>>,
+}
+
+impl std::fmt::Debug for FftPlans {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FftPlans")
+            .field("len", &self.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl FftPlans {
+    fn new(nt: usize) -> Self {
+        let mut planner = FftPlanner::new();
+        Self {
+            forward: planner.plan_fft_forward(nt),
+            inverse: planner.plan_fft_inverse(nt),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.forward.len()
+    }
+
+    /// A scratch buffer for both directions.
+    fn scratch(&self) -> Vec<c64> {
+        let len = self
+            .forward
+            .get_inplace_scratch_len()
+            .max(self.inverse.get_inplace_scratch_len());
+        vec![c64::new(0.0, 0.0); len]
+    }
+
+    /// In place forward transform of `x` (length `Nt`).
+    fn forward(&self, x: &mut [c64], scratch: &mut [c64]) {
+        self.forward.process_with_scratch(x, scratch);
+    }
+
+    /// In place inverse (unnormalised) transform of `x` (length `Nt`).
+    fn inverse(&self, x: &mut [c64], scratch: &mut [c64]) {
+        self.inverse.process_with_scratch(x, scratch);
+    }
 }
 
 /// Derivatives with respect to `omega` of the bin receptances `H_k` (contact rows only,
@@ -319,7 +364,7 @@ struct FrequencyDerivative {
 /// FFT with the bin kernels `transfer[(k * rows_total + r) * m + c]`, `k = 0..=Nt/2` (the
 /// other bins by conjugate symmetry).
 fn kernel_response(
-    nt: usize,
+    plans: &FftPlans,
     m: usize,
     transfer: &[c64],
     rows_total: usize,
@@ -328,12 +373,13 @@ fn kernel_response(
     rows: &[usize],
 ) -> Vec<Vec<f64>> {
     let zero = c64::new(0.0, 0.0);
-    let mut plan = Dft::new(nt);
+    let nt = plans.len();
+    let mut scratch = plans.scratch();
     // Spectra of the contact forces z_c.
     let spectra: Vec<Vec<c64>> = (0..m)
         .map(|c| {
             let mut s: Vec<c64> = (0..nt).map(|n| c64::new(z[n * m + c], 0.0)).collect();
-            plan.forward(&mut s);
+            plans.forward(&mut s, &mut scratch);
             s
         })
         .collect();
@@ -353,7 +399,7 @@ fn kernel_response(
                 }
                 *out = sum;
             }
-            plan.backward(&mut buffer);
+            plans.inverse(&mut buffer, &mut scratch);
             (0..nt)
                 .map(|n| {
                     let phase = 2.0 * std::f64::consts::PI * n as f64 / nt as f64;
@@ -365,369 +411,7 @@ fn kernel_response(
         .collect()
 }
 
-/// Column-compressed union pattern of `K`, `M`, `D` with, for each source matrix, the
-/// position of each of its stored entries in the union.
-struct UnionPattern {
-    pattern: SparseColMat<usize, c64>,
-    stiffness: Vec<usize>,
-    mass: Vec<usize>,
-    damping: Vec<usize>,
-}
-
-fn union_pattern(model: &StructuralModel) -> Result<UnionPattern, LcpError> {
-    let n = model.dofs();
-    let mut triplets = Vec::new();
-    let mut sources: Vec<&SparseMatrix> = vec![&model.stiffness, &model.mass];
-    if let Some(d) = &model.damping {
-        sources.push(d);
-    }
-    for m in &sources {
-        let r = m.as_ref();
-        for j in 0..n {
-            for i in r.row_idx_of_col(j) {
-                triplets.push(Triplet::new(i, j, c64::new(0.0, 0.0)));
-            }
-        }
-    }
-    // The diagonal is always present so that the symbolic LU can pivot on it.
-    for j in 0..n {
-        triplets.push(Triplet::new(j, j, c64::new(0.0, 0.0)));
-    }
-    let pattern =
-        SparseColMat::<usize, c64>::try_new_from_triplets(n, n, &triplets).map_err(|e| {
-            LcpError::Factorization {
-                bin: 0,
-                reason: format!("pattern assembly failed: {e:?}"),
-            }
-        })?;
-    let positions = |m: &SparseMatrix| -> Vec<usize> {
-        let symbolic = pattern.symbolic();
-        let rows = symbolic.row_idx();
-        let r = m.as_ref();
-        let mut out = Vec::with_capacity(r.compute_nnz());
-        for j in 0..n {
-            let range = symbolic.col_range(j);
-            let col_rows = &rows[range.clone()];
-            for i in r.row_idx_of_col(j) {
-                let offset = col_rows
-                    .binary_search(&i)
-                    .expect("every entry is in the union pattern");
-                out.push(range.start + offset);
-            }
-        }
-        out
-    };
-    let stiffness = positions(&model.stiffness);
-    let mass = positions(&model.mass);
-    let damping = model.damping.as_ref().map(positions).unwrap_or_default();
-    Ok(UnionPattern {
-        pattern,
-        stiffness,
-        mass,
-        damping,
-    })
-}
-
-fn check_square(what: &'static str, m: &SparseMatrix, n: usize) -> Result<(), LcpError> {
-    for found in [m.nrows(), m.ncols()] {
-        if found != n {
-            return Err(LcpError::DimensionMismatch {
-                what,
-                expected: n,
-                found,
-            });
-        }
-    }
-    if let Some(&value) = m.val().iter().find(|v| !v.is_finite()) {
-        return Err(LcpError::InvalidModel {
-            name: what,
-            value,
-            allowed: "finite entries",
-        });
-    }
-    Ok(())
-}
-
-fn validate_model(model: &StructuralModel) -> Result<(), LcpError> {
-    let n = model.dofs();
-    check_square("stiffness", &model.stiffness, n)?;
-    check_square("mass", &model.mass, n)?;
-    if let Some(d) = &model.damping {
-        check_square("damping", d, n)?;
-    }
-    if model.forcing.amplitude.len() != n {
-        return Err(LcpError::DimensionMismatch {
-            what: "forcing amplitude",
-            expected: n,
-            found: model.forcing.amplitude.len(),
-        });
-    }
-    if let Some(&value) = model.forcing.amplitude.iter().find(|v| !v.is_finite()) {
-        return Err(LcpError::InvalidModel {
-            name: "forcing amplitude",
-            value,
-            allowed: "finite entries",
-        });
-    }
-    let omega = model.forcing.omega;
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(LcpError::InvalidModel {
-            name: "omega",
-            value: omega,
-            allowed: "a finite number > 0",
-        });
-    }
-    if model.contacts.is_empty() {
-        return Err(LcpError::NoContacts);
-    }
-    for c in &model.contacts {
-        if c.dof >= n {
-            return Err(LcpError::ContactDofOutOfRange {
-                dof: c.dof,
-                dofs: n,
-            });
-        }
-        if !c.gap.is_finite() {
-            return Err(LcpError::InvalidModel {
-                name: "gap",
-                value: c.gap,
-                allowed: "a finite number",
-            });
-        }
-    }
-    Ok(())
-}
-
-/// `true` when column `j` of `m` has no non-zero entry.
-fn column_is_zero(m: &SparseMatrix, j: usize) -> bool {
-    m.as_ref().val_of_col(j).iter().all(|v| *v == 0.0)
-}
-
 impl PeriodicLcp {
-    /// Builds `A` and `q` for `model` with `options.time_samples` steps per period.
-    ///
-    /// Cost: `Nt/2 + 1` sparse complex LU factorizations of size `N` (one symbolic
-    /// analysis), `m` solves each, and `m^2` FFTs of length `Nt` for the kernel.
-    pub fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, LcpError> {
-        Self::build(model, options, false)
-    }
-
-    /// [`PeriodicLcp::new`] that also computes the derivatives with respect to `omega` of
-    /// `q` and `A` ([`PeriodicLcp::frequency_derivative`]). The Tustin frequency
-    /// `sigma_k = omega tau_k`, `tau_k = (Nt/pi) tan(pi k/Nt)`, is linear in `omega`, so
-    /// `dZ_k/domega = i tau_k D - 2 omega tau_k^2 M` and
-    /// `dZ_k^{-1}/domega = -Z_k^{-1} (dZ_k/domega) Z_k^{-1}`: one more solve per bin and
-    /// column with the same LU (the Nyquist limit does not depend on `omega`).
-    pub fn with_frequency_derivative(
-        model: &StructuralModel,
-        options: PeriodicLcpOptions,
-    ) -> Result<Self, LcpError> {
-        Self::build(model, options, true)
-    }
-
-    fn build(
-        model: &StructuralModel,
-        options: PeriodicLcpOptions,
-        with_derivative: bool,
-    ) -> Result<Self, LcpError> {
-        validate_model(model)?;
-        let n = model.dofs();
-        let m = model.contact_count();
-        options.validate(m, n)?;
-        let nt = options.time_samples;
-        let omega = model.forcing.omega;
-        let dt = 2.0 * std::f64::consts::PI / omega / nt as f64;
-        let contact_dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
-        let gaps: Vec<f64> = model.contacts.iter().map(|c| c.gap).collect();
-        let rows: Vec<usize> = contact_dofs
-            .iter()
-            .chain(&options.observed_dofs)
-            .copied()
-            .collect();
-        let nr = rows.len();
-        let bins = nt / 2 + 1;
-        let zero = c64::new(0.0, 0.0);
-        let mut transfer = vec![zero; bins * nr * m];
-        let mut linear_amplitude = vec![zero; nr];
-        let mut derivative = with_derivative.then(|| FrequencyDerivative {
-            transfer: vec![zero; bins * m * m],
-            linear_amplitude: vec![zero; m],
-        });
-
-        let mut union = union_pattern(model)?;
-        let symbolic =
-            SymbolicLu::try_new(union.pattern.symbolic()).map_err(|e| LcpError::Factorization {
-                bin: 0,
-                reason: format!("symbolic analysis failed: {e:?}"),
-            })?;
-        let stiffness_max = model
-            .stiffness
-            .val()
-            .iter()
-            .fold(0.0f64, |a, v| a.max(v.abs()));
-        for k in 0..bins {
-            if 2 * k == nt {
-                continue; // Nyquist: the limit problem below.
-            }
-            let sigma = bin_frequency(nt, dt, k);
-            let values = union.pattern.val_mut();
-            values.fill(zero);
-            for (p, v) in union.stiffness.iter().zip(model.stiffness.val()) {
-                values[*p] += c64::new(*v, 0.0);
-            }
-            for (p, v) in union.mass.iter().zip(model.mass.val()) {
-                values[*p] += c64::new(-sigma * sigma * v, 0.0);
-            }
-            if let Some(d) = &model.damping {
-                for (p, v) in union.damping.iter().zip(d.val()) {
-                    values[*p] += c64::new(0.0, sigma * v);
-                }
-            }
-            let lu = Lu::try_new_with_symbolic(symbolic.clone(), union.pattern.as_ref()).map_err(
-                |e| LcpError::Factorization {
-                    bin: k,
-                    reason: format!("{e:?}"),
-                },
-            )?;
-            let with_forcing = k == 1;
-            let ncols = m + usize::from(with_forcing);
-            let mut rhs = Mat::<c64>::zeros(n, ncols);
-            for (c, &dof) in contact_dofs.iter().enumerate() {
-                rhs[(dof, c)] = c64::new(1.0, 0.0);
-            }
-            if with_forcing {
-                for (i, a) in model.forcing.amplitude.iter().enumerate() {
-                    rhs[(i, m)] = c64::new(*a, 0.0);
-                }
-            }
-            let b = rhs.clone();
-            lu.solve_in_place(rhs.as_mut());
-            let relative_residual = bin_residual(&union.pattern, &rhs, &b, stiffness_max);
-            if relative_residual.is_nan() || relative_residual > BIN_RESIDUAL_TOLERANCE {
-                return Err(LcpError::SingularBin {
-                    bin: k,
-                    frequency: sigma,
-                    relative_residual,
-                });
-            }
-            for (r, &dof) in rows.iter().enumerate() {
-                for c in 0..m {
-                    transfer[(k * nr + r) * m + c] = rhs[(dof, c)];
-                }
-                if with_forcing {
-                    linear_amplitude[r] = rhs[(dof, m)];
-                }
-            }
-            if let Some(d) = derivative.as_mut() {
-                // Y = Z_k^{-1} (dZ_k/domega) X, X = Z_k^{-1} [G^T, f]; dX/domega = -Y.
-                let tau = sigma / omega;
-                let mut y = Mat::<c64>::zeros(n, ncols);
-                let mut apply = |matrix: &SparseMatrix, coefficient: c64| {
-                    let a = matrix.as_ref();
-                    for j in 0..n {
-                        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
-                            let f = coefficient * *v;
-                            for col in 0..ncols {
-                                y[(i, col)] += f * rhs[(j, col)];
-                            }
-                        }
-                    }
-                };
-                apply(&model.mass, c64::new(-2.0 * omega * tau * tau, 0.0));
-                if let Some(damping) = &model.damping {
-                    apply(damping, c64::new(0.0, tau));
-                }
-                lu.solve_in_place(y.as_mut());
-                for (r, &dof) in contact_dofs.iter().enumerate() {
-                    for c in 0..m {
-                        d.transfer[(k * m + r) * m + c] = -y[(dof, c)];
-                    }
-                    if with_forcing {
-                        d.linear_amplitude[r] = -y[(dof, m)];
-                    }
-                }
-            }
-        }
-
-        // Nyquist limit: static receptance of the dofs with neither mass nor damping.
-        let static_set: Vec<usize> = (0..n)
-            .filter(|&j| {
-                column_is_zero(&model.mass, j)
-                    && model.damping.as_ref().is_none_or(|d| column_is_zero(d, j))
-            })
-            .collect();
-        if nt % 2 == 0 && !static_set.is_empty() {
-            let k = nt / 2;
-            let columns = nyquist_static_receptance(model, &static_set, &contact_dofs, k)?;
-            for (r, &dof) in rows.iter().enumerate() {
-                if let Ok(v) = static_set.binary_search(&dof) {
-                    for c in 0..m {
-                        transfer[(k * nr + r) * m + c] = c64::new(columns[(v, c)], 0.0);
-                    }
-                }
-            }
-        }
-
-        // Kernel a_p = (1/Nt) sum_k H_k e^{2 pi i k p / Nt} for every contact pair, by FFT.
-        let mut plan = Dft::new(nt);
-        let mut spectrum = vec![zero; nt];
-        let mut kernel = vec![0.0; nt * m * m];
-        for c in 0..m {
-            for c2 in 0..m {
-                fill_spectrum(&mut spectrum, |k| transfer[(k * nr + c) * m + c2]);
-                plan.backward(&mut spectrum);
-                for (p, v) in spectrum.iter().enumerate() {
-                    kernel[(p * m + c) * m + c2] = v.re / nt as f64;
-                }
-            }
-        }
-        let size = m * nt;
-        // A[(ni, ci), (nj, cj)] = a_{ni - nj}[ci, cj]: column (nj, cj) is the column cj of
-        // the kernel blocks, rotated down by nj nodes (filled by contiguous copies).
-        let mut matrix = Mat::<f64>::zeros(size, size);
-        let mut column0 = vec![0.0; size];
-        for cj in 0..m {
-            for p in 0..nt {
-                for ci in 0..m {
-                    column0[p * m + ci] = kernel[(p * m + ci) * m + cj];
-                }
-            }
-            for nj in 0..nt {
-                let shift = nj * m;
-                let col = matrix.col_mut(nj * m + cj).try_as_col_major_mut();
-                let col = col
-                    .expect("a freshly allocated Mat is column-major")
-                    .as_slice_mut();
-                col[shift..].copy_from_slice(&column0[..size - shift]);
-                col[..shift].copy_from_slice(&column0[size - shift..]);
-            }
-        }
-        let mut q = vec![0.0; size];
-        for node in 0..nt {
-            let phase = 2.0 * std::f64::consts::PI * node as f64 / nt as f64;
-            let e = c64::new(phase.cos(), phase.sin());
-            for c in 0..m {
-                q[node * m + c] = gaps[c] - (linear_amplitude[c] * e).re;
-            }
-        }
-        let symmetric_spectrum = hermitian_part_range(&transfer, bins, nr, m);
-        Ok(Self {
-            nt,
-            contacts: m,
-            omega,
-            gaps,
-            contact_dofs,
-            observed_dofs: options.observed_dofs,
-            matrix,
-            q,
-            transfer,
-            linear_amplitude,
-            symmetric_spectrum,
-            static_dofs: static_set.len(),
-            derivative,
-        })
-    }
-
     /// `d(q + A z)/domega` at fixed `z` into `out` (time-major, length `m Nt`): the
     /// derivative of the gap `w = q + A z` along the frequency. `A z` is applied by FFT with
     /// the bin derivatives `dH_k/domega`, `dq_n/domega = -Re(dX/domega e^{2 pi i n/Nt})`.
@@ -748,7 +432,15 @@ impl PeriodicLcp {
         let m = self.contacts;
         let rows: Vec<usize> = (0..m).collect();
         // `w = g - u_c` along the contact rows: dw/domega = -(du_c/domega).
-        let du = kernel_response(self.nt, m, &d.transfer, m, &d.linear_amplitude, z, &rows);
+        let du = kernel_response(
+            &self.plans,
+            m,
+            &d.transfer,
+            m,
+            &d.linear_amplitude,
+            z,
+            &rows,
+        );
         for (c, history) in du.iter().enumerate() {
             for (n, v) in history.iter().enumerate() {
                 out[n * m + c] = -v;
@@ -791,7 +483,12 @@ impl PeriodicLcp {
     /// The warped angular frequency of bin `k`, `(2/dt) tan(pi k / Nt)` (infinite at the
     /// Nyquist bin `k = Nt/2`).
     pub fn bin_frequency(&self, k: usize) -> f64 {
-        bin_frequency(self.nt, self.time_step(), k)
+        build::bin_frequency(self.nt, self.time_step(), k)
+    }
+
+    /// The contact gaps `g`, in contact order.
+    pub fn gaps(&self) -> &[f64] {
+        &self.gaps
     }
 
     /// The contact dofs, in contact order.
@@ -911,7 +608,7 @@ impl PeriodicLcp {
 
     fn response_rows(&self, z: &[f64], rows: &[usize]) -> Vec<Vec<f64>> {
         kernel_response(
-            self.nt,
+            &self.plans,
             self.contacts,
             &self.transfer,
             self.rows(),
@@ -951,285 +648,8 @@ impl PeriodicLcp {
         })
     }
 
-    /// Periodic linear interpolation of a contact-force history `z_other` of another
-    /// discretisation (time-major, `m Nt'` entries for any `Nt' >= 1`) onto this LCP's
-    /// nodes: a warm start for semismooth Newton (mesh sequencing). On the canonical rod
-    /// with the modified mass, Newton from `z = 0` needs 13 / 64 / 126 / 282 iterations at
-    /// `Nt` = 128 / 256 / 512 / 1024 (the active set creeps), from the interpolated coarser
-    /// solution 5 to 8 up to `Nt = 1024`.
-    pub fn interpolate_forces(&self, z_other: &[f64]) -> Result<Vec<f64>, LcpError> {
-        let m = self.contacts;
-        if z_other.is_empty() || z_other.len() % m != 0 {
-            return Err(LcpError::WrongLength {
-                what: "z_other (a positive multiple of the contact count)",
-                expected: self.dim(),
-                found: z_other.len(),
-            });
-        }
-        let other = z_other.len() / m;
-        let mut z = vec![0.0; self.dim()];
-        for n in 0..self.nt {
-            let position = n as f64 * other as f64 / self.nt as f64;
-            let left = (position.floor() as usize).min(other - 1);
-            let fraction = position - left as f64;
-            let right = (left + 1) % other;
-            for c in 0..m {
-                z[n * m + c] =
-                    (1.0 - fraction) * z_other[left * m + c] + fraction * z_other[right * m + c];
-            }
-        }
-        Ok(z)
-    }
-
     /// The semismooth equation `min(z, q + A z) = 0` of this LCP (method `"lcp-ssn"`).
     pub fn min_map(&self) -> MinMapLcp<'_> {
-        MinMapLcp::new(self.matrix.as_ref(), &self.q).expect("A and q have matching sizes")
+        MinMapLcp::of_lcp(self.matrix.as_ref(), &self.q)
     }
-}
-
-/// Coarsest `Nt` of [`solve_min_map_sequenced`]'s level sequence.
-pub const SEQUENCING_COARSEST_TIME_SAMPLES: usize = 128;
-
-/// One level of [`solve_min_map_sequenced`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct SequencingLevel {
-    /// `Nt` of the level.
-    pub time_samples: usize,
-    /// The Newton run on that level.
-    pub report: NewtonReport,
-}
-
-/// Result of [`solve_min_map_sequenced`]: the finest LCP, its solution and every level.
-#[derive(Debug, Clone)]
-pub struct SequencedSolution {
-    /// The LCP at the requested `Nt`.
-    pub lcp: PeriodicLcp,
-    /// Best iterate on the finest level (the solution when its report converged).
-    pub z: Vec<f64>,
-    /// Levels from coarsest to finest; the last one is the requested `Nt`.
-    pub levels: Vec<SequencingLevel>,
-}
-
-impl SequencedSolution {
-    /// `true` when Newton converged on the finest level.
-    pub fn converged(&self) -> bool {
-        self.levels.last().is_some_and(|l| l.report.converged())
-    }
-
-    /// Newton iterations summed over the levels.
-    pub fn total_iterations(&self) -> usize {
-        self.levels.iter().map(|l| l.report.iterations).sum()
-    }
-}
-
-/// Semismooth Newton on `min(z, q + A z) = 0` by mesh sequencing (method `"lcp-ssn"`
-/// at large `Nt`): the LCP is solved at `Nt / 2^j` (halving while even and not below
-/// [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0`, then each finer level starts from
-/// the previous solution interpolated in time ([`PeriodicLcp::interpolate_forces`]), with
-/// the [`ActiveSetSolver`]. A level that does not converge still passes its best iterate
-/// on; `Ok` whenever every level ran (check [`SequencedSolution::converged`]).
-///
-/// Why: with a damped massless contact node the high-frequency receptances tend to 0, so
-/// `A` is ill-conditioned and from `z = 0` the active set creeps one node at a time (on
-/// the canonical rod with the modified mass: 13 / 64 / 126 / 282 iterations at
-/// `Nt = 128 .. 1024` with the default non-monotone line search, no convergence in 300 at
-/// 2048); from the interpolated coarser solution 5 / 7 / 8 / 42 iterations.
-pub fn solve_min_map_sequenced(
-    model: &StructuralModel,
-    options: PeriodicLcpOptions,
-    newton_options: &NewtonOptions,
-) -> Result<SequencedSolution, LcpError> {
-    newton_options.validate()?;
-    options.validate(model.contact_count(), model.dofs())?;
-    let mut sizes = vec![options.time_samples];
-    while let Some(&nt) = sizes.last() {
-        if nt % 2 != 0 || nt / 2 < SEQUENCING_COARSEST_TIME_SAMPLES.max(MIN_LCP_TIME_SAMPLES) {
-            break;
-        }
-        sizes.push(nt / 2);
-    }
-    sizes.reverse();
-    let mut levels = Vec::with_capacity(sizes.len());
-    let mut previous: Option<Vec<f64>> = None;
-    let mut finest = None;
-    for (index, &nt) in sizes.iter().enumerate() {
-        let last = index + 1 == sizes.len();
-        let level_options = PeriodicLcpOptions {
-            time_samples: nt,
-            observed_dofs: if last {
-                options.observed_dofs.clone()
-            } else {
-                Vec::new()
-            },
-        };
-        let lcp = PeriodicLcp::new(model, level_options)?;
-        let mut z = match &previous {
-            Some(coarse) => lcp.interpolate_forces(coarse)?,
-            None => vec![0.0; lcp.dim()],
-        };
-        let report = {
-            let mut problem = lcp.min_map();
-            let mut solver = ActiveSetSolver::new();
-            newton::solve(&mut problem, &mut solver, &mut z, newton_options)
-                .or_else(NewtonError::into_report)?
-        };
-        levels.push(SequencingLevel {
-            time_samples: nt,
-            report,
-        });
-        if last {
-            finest = Some(lcp);
-        }
-        previous = Some(z);
-    }
-    Ok(SequencedSolution {
-        lcp: finest.expect("at least one level"),
-        z: previous.expect("at least one level"),
-        levels,
-    })
-}
-
-/// `(2/dt) tan(pi k / Nt)`, infinite at the Nyquist bin.
-fn bin_frequency(nt: usize, dt: f64, k: usize) -> f64 {
-    if 2 * k == nt {
-        return f64::INFINITY;
-    }
-    2.0 / dt * (std::f64::consts::PI * k as f64 / nt as f64).tan()
-}
-
-/// Fills a length-`Nt` spectrum from bins `0..=Nt/2` by conjugate symmetry.
-fn fill_spectrum(spectrum: &mut [c64], bin: impl Fn(usize) -> c64) {
-    let nt = spectrum.len();
-    for (k, s) in spectrum.iter_mut().enumerate() {
-        *s = if 2 * k > nt {
-            bin(nt - k).conj()
-        } else {
-            bin(k)
-        };
-    }
-    // Bin 0 (and Nyquist) of a real sequence are real.
-    spectrum[0].im = 0.0;
-    if nt % 2 == 0 {
-        spectrum[nt / 2].im = 0.0;
-    }
-}
-
-/// `max |Z x - b| / (|K|_max |x|_max + |b|_max)` over all columns (Z in the union pattern).
-fn bin_residual(z: &SparseColMat<usize, c64>, x: &Mat<c64>, b: &Mat<c64>, scale: f64) -> f64 {
-    let n = z.nrows();
-    let zr = z.as_ref();
-    // Largest moduli through squared moduli (one square root each, no hypot per entry).
-    let max_norm =
-        |it: &mut dyn Iterator<Item = c64>| it.fold(0.0f64, |a, v| a.max(v.norm_sqr())).sqrt();
-    let z_max = scale.max(max_norm(&mut z.val().iter().copied()));
-    let mut worst = 0.0f64;
-    for col in 0..x.ncols() {
-        let mut r: Vec<c64> = (0..n).map(|i| -b[(i, col)]).collect();
-        for j in 0..n {
-            let xj = x[(j, col)];
-            for (i, v) in zr.row_idx_of_col(j).zip(zr.val_of_col(j)) {
-                r[i] += *v * xj;
-            }
-        }
-        let x_max = max_norm(&mut (0..n).map(|i| x[(i, col)]));
-        let b_max = max_norm(&mut (0..n).map(|i| b[(i, col)]));
-        let r_max = max_norm(&mut r.iter().copied());
-        let denominator = z_max * x_max + b_max;
-        let rel = if denominator > 0.0 {
-            r_max / denominator
-        } else {
-            0.0
-        };
-        if !rel.is_finite() || !x_max.is_finite() {
-            return f64::INFINITY;
-        }
-        worst = worst.max(rel);
-    }
-    worst
-}
-
-/// `K_VV^{-1}` applied to the contact columns restricted to `V` (columns of contacts
-/// outside `V` are zero), as a dense `|V| x m` matrix.
-fn nyquist_static_receptance(
-    model: &StructuralModel,
-    static_set: &[usize],
-    contact_dofs: &[usize],
-    bin: usize,
-) -> Result<Mat<f64>, LcpError> {
-    let nv = static_set.len();
-    let k = model.stiffness.as_ref();
-    let mut triplets = Vec::new();
-    for (jv, &j) in static_set.iter().enumerate() {
-        for (i, v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
-            if let Ok(iv) = static_set.binary_search(&i) {
-                triplets.push(Triplet::new(iv, jv, *v));
-            }
-        }
-    }
-    let kvv =
-        SparseColMat::<usize, f64>::try_new_from_triplets(nv, nv, &triplets).map_err(|e| {
-            LcpError::Factorization {
-                bin,
-                reason: format!("Nyquist static block assembly: {e:?}"),
-            }
-        })?;
-    let symbolic = SymbolicLu::try_new(kvv.symbolic()).map_err(|e| LcpError::Factorization {
-        bin,
-        reason: format!("Nyquist static block symbolic analysis: {e:?}"),
-    })?;
-    let lu =
-        Lu::try_new_with_symbolic(symbolic, kvv.as_ref()).map_err(|e| LcpError::Factorization {
-            bin,
-            reason: format!("Nyquist static block: {e:?}"),
-        })?;
-    let mut rhs = Mat::<f64>::zeros(nv, contact_dofs.len());
-    for (c, dof) in contact_dofs.iter().enumerate() {
-        if let Ok(v) = static_set.binary_search(dof) {
-            rhs[(v, c)] = 1.0;
-        }
-    }
-    lu.solve_in_place(rhs.as_mut());
-    if let Some((i, j)) = (0..nv)
-        .flat_map(|i| (0..contact_dofs.len()).map(move |j| (i, j)))
-        .find(|&(i, j)| !rhs[(i, j)].is_finite())
-    {
-        return Err(LcpError::Factorization {
-            bin,
-            reason: format!(
-                "Nyquist static block is singular (entry ({i}, {j}) of its inverse is not finite)"
-            ),
-        });
-    }
-    Ok(rhs)
-}
-
-/// Range of the eigenvalues of the Hermitian parts `(H_k + H_k^*)/2` over all bins.
-fn hermitian_part_range(transfer: &[c64], bins: usize, nr: usize, m: usize) -> (f64, f64) {
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
-    for k in 0..bins {
-        let h = |i: usize, j: usize| transfer[(k * nr + i) * m + j];
-        if m == 1 {
-            let v = h(0, 0).re;
-            lo = lo.min(v);
-            hi = hi.max(v);
-            continue;
-        }
-        // Real symmetric embedding [[Re S, -Im S], [Im S, Re S]] of the Hermitian
-        // S = (H + H^*)/2: same eigenvalues, each twice.
-        let s = |i: usize, j: usize| (h(i, j) + h(j, i).conj()) * 0.5;
-        let e = nalgebra::DMatrix::from_fn(2 * m, 2 * m, |i, j| {
-            let v = s(i % m, j % m);
-            match (i < m, j < m) {
-                (true, true) | (false, false) => v.re,
-                (true, false) => -v.im,
-                (false, true) => v.im,
-            }
-        });
-        for v in nalgebra::SymmetricEigen::new(e).eigenvalues.iter() {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
-    }
-    (lo, hi)
 }

@@ -616,16 +616,14 @@ pub fn frequency_response(
             // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
             let mut start_model = model.clone();
             start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
-            let sequenced = solve_min_map_sequenced(
-                &start_model,
-                lcp_options.clone(),
-                &newton_options(settings),
-            )?;
+            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
+            let finest = problem.current()?;
+            let sequenced =
+                solve_min_map_sequenced(&start_model, &finest, &newton_options(settings))?;
             let mut start_counters = WorkCounters::default();
             for level in &sequenced.levels {
                 start_counters += level.report.counters;
             }
-            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
             let y0 = problem.state_from_forces(&sequenced.z)?;
             let half = problem.half();
             let units = (0..problem.dim())

@@ -1,0 +1,536 @@
+//! The one-step schemes of the time-marching reference (module documentation of
+//! [`super`]): the iteration matrix factored once, the per-step contact LCP by Lemke.
+
+use std::f64::consts::PI;
+
+use faer::Mat;
+use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
+use semismooth::linalg::FaerSparseLu;
+use semismooth::{Factorize, LinearSolve};
+
+use super::{
+    column_max_abs, resolve_scheme, MarchCounters, MarchError, MarchOptions, MarchScheme,
+    MarchState,
+};
+use crate::dynamic::UnionPattern;
+use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
+
+/// The scheme actually marched (`Auto` resolved).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Scheme {
+    Trapezoidal,
+    MoreauJean { theta: f64, restitution: f64 },
+}
+
+impl Scheme {
+    fn resolve(model: &StructuralModel, scheme: MarchScheme) -> Self {
+        match resolve_scheme(model, scheme) {
+            MarchScheme::MoreauJean { theta, restitution } => {
+                Self::MoreauJean { theta, restitution }
+            }
+            MarchScheme::MasslessContactTrapezoidal | MarchScheme::Auto => Self::Trapezoidal,
+        }
+    }
+
+    fn public(self) -> MarchScheme {
+        match self {
+            Self::Trapezoidal => MarchScheme::MasslessContactTrapezoidal,
+            Self::MoreauJean { theta, restitution } => {
+                MarchScheme::MoreauJean { theta, restitution }
+            }
+        }
+    }
+
+    /// Name of the iteration matrix.
+    fn matrix(self) -> &'static str {
+        match self {
+            Self::Trapezoidal => "K_eff",
+            Self::MoreauJean { .. } => "M_hat",
+        }
+    }
+}
+
+/// Lemke workspaces, one per LCP size (so varying active sets never reallocate), and a
+/// dense buffer for the active block of `W`.
+struct ContactLcp {
+    lemke: Vec<Lemke>,
+    options: LemkeOptions,
+    block: Mat<f64>,
+}
+
+impl ContactLcp {
+    fn new(m: usize) -> Self {
+        Self {
+            lemke: (0..=m).map(Lemke::new).collect(),
+            options: LemkeOptions::default(),
+            block: Mat::zeros(m, m),
+        }
+    }
+
+    /// Solves `w = q + W_AA z` for the contacts listed in `active` (the block is copied
+    /// from the full `W`), writing `z` into `z[..active.len()]`; returns the pivots.
+    fn solve(
+        &mut self,
+        w_full: &Mat<f64>,
+        active: &[usize],
+        q: &[f64],
+        z: &mut [f64],
+    ) -> Result<usize, LemkeError> {
+        let a = active.len();
+        for (jj, &j) in active.iter().enumerate() {
+            for (ii, &i) in active.iter().enumerate() {
+                self.block[(ii, jj)] = w_full[(i, j)];
+            }
+        }
+        let report = self.lemke[a].solve(
+            self.block.as_ref().submatrix(0, 0, a, a),
+            &q[..a],
+            &self.options,
+        )?;
+        if report.termination != LemkeTermination::Solved {
+            return Err(LemkeError::NotSolved {
+                termination: report.termination,
+                pivots: report.pivots,
+                complementarity_error: report.complementarity_error,
+            });
+        }
+        // Lemke's z >= 0 up to round-off: clamp the (tiny) negative parts so that the
+        // reported force has the right sign exactly.
+        for (zi, ri) in z.iter_mut().zip(&report.z) {
+            *zi = ri.max(0.0);
+        }
+        Ok(report.pivots)
+    }
+}
+
+/// A one-step marcher: owns the factorization and every buffer, so that
+/// [`TimeMarcher::step`] allocates nothing (except inside Lemke's report on steps with
+/// an active contact).
+pub struct TimeMarcher<'a> {
+    model: &'a StructuralModel,
+    scheme: Scheme,
+    steps_per_period: usize,
+    h: f64,
+    /// `cos(2 pi j / steps_per_period)`, `j = 0..=steps_per_period`.
+    cosines: Vec<f64>,
+    /// Step index within the current period (0 at a period start).
+    phase: usize,
+    /// Periods completed.
+    completed_periods: usize,
+    lu: FaerSparseLu,
+    /// `Y = A^{-1} G^T` (N x m, column-major), `A` = K_eff or M_hat.
+    y: Vec<f64>,
+    /// `W = G Y` (m x m).
+    w: Mat<f64>,
+    lcp: ContactLcp,
+    massless: Vec<bool>,
+    u: Vec<f64>,
+    v: Vec<f64>,
+    /// Inertial force `M a` (trapezoidal only).
+    r: Vec<f64>,
+    lambda: Vec<f64>,
+    rhs: Vec<f64>,
+    tmp: Vec<f64>,
+    q: Vec<f64>,
+    z: Vec<f64>,
+    active: Vec<usize>,
+    counters: MarchCounters,
+}
+
+impl<'a> TimeMarcher<'a> {
+    /// Validates the options, the model and the initial state, factors the iteration
+    /// matrix and prepares `Y`, `W` and the initial inertial force. The time starts at 0.
+    pub fn new(
+        model: &'a StructuralModel,
+        options: &MarchOptions,
+        initial: &MarchState,
+    ) -> Result<Self, MarchError> {
+        options.validate()?;
+        model.validate()?;
+        let n = model.dofs();
+        let m = model.contact_count();
+        for (what, vec, len) in [
+            ("displacement", &initial.displacement, n),
+            ("velocity", &initial.velocity, n),
+            ("contact_force", &initial.contact_force, m),
+        ] {
+            if vec.len() != len {
+                return Err(MarchError::StateDimension {
+                    what,
+                    expected: len,
+                    found: vec.len(),
+                });
+            }
+            if let Some((index, value)) = vec.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(MarchError::NonFiniteState {
+                    what,
+                    index,
+                    value: *value,
+                });
+            }
+        }
+        let scheme = Scheme::resolve(model, options.scheme);
+        let massless: Vec<bool> = (0..n)
+            .map(|j| column_max_abs(&model.mass, j) == 0.0)
+            .collect();
+        let spp = options.steps_per_period;
+        let h = 2.0 * PI / model.forcing.omega / spp as f64;
+        // a K + b D + c M, summed in the order K, D, M.
+        let (a, b, c) = match scheme {
+            Scheme::Trapezoidal => {
+                if let Some(c) = model.contacts.iter().find(|c| !massless[c.dof]) {
+                    return Err(MarchError::MassiveContactDof {
+                        dof: c.dof,
+                        mass: column_max_abs(&model.mass, c.dof),
+                    });
+                }
+                (1.0, 2.0 / h, 4.0 / (h * h))
+            }
+            Scheme::MoreauJean { theta, .. } => (h * h * theta * theta, h * theta, 1.0),
+        };
+        let mut sources = vec![(&model.stiffness, a)];
+        sources.extend(model.damping.as_ref().map(|d| (d, b)));
+        sources.push((&model.mass, c));
+        let (matrices, coefficients): (Vec<&SparseMatrix>, Vec<f64>) = sources.into_iter().unzip();
+        let matrix = UnionPattern::linear_combination(n, &matrices, &coefficients);
+        let failed = |source| MarchError::Factorization {
+            matrix: scheme.matrix(),
+            source,
+        };
+        let mut lu = FaerSparseLu::new();
+        lu.factor(&matrix).map_err(failed)?;
+        // Y = A^{-1} G^T, column k for contact k; W = G Y.
+        let mut y = vec![0.0; n * m];
+        let mut w = Mat::zeros(m, m);
+        for (k, c) in model.contacts.iter().enumerate() {
+            let col = &mut y[k * n..(k + 1) * n];
+            col[c.dof] = 1.0;
+            lu.solve_in_place(col).map_err(failed)?;
+            for (i, ci) in model.contacts.iter().enumerate() {
+                w[(i, k)] = col[ci.dof];
+            }
+        }
+        let cosines = (0..=spp)
+            .map(|j| (2.0 * PI * j as f64 / spp as f64).cos())
+            .collect();
+        let mut marcher = Self {
+            model,
+            scheme,
+            steps_per_period: spp,
+            h,
+            cosines,
+            phase: 0,
+            completed_periods: 0,
+            lu,
+            y,
+            w,
+            lcp: ContactLcp::new(m),
+            massless,
+            u: initial.displacement.clone(),
+            v: initial.velocity.clone(),
+            r: vec![0.0; n],
+            lambda: initial.contact_force.clone(),
+            rhs: vec![0.0; n],
+            tmp: vec![0.0; n],
+            q: vec![0.0; m],
+            z: vec![0.0; m],
+            active: Vec::with_capacity(m),
+            counters: MarchCounters {
+                factorizations: 1,
+                linear_solves: m as u64 + 1,
+                ..MarchCounters::default()
+            },
+        };
+        if scheme == Scheme::Trapezoidal {
+            marcher.equilibrium_inertia(0);
+        }
+        Ok(marcher)
+    }
+
+    /// `r = f(t_j) + G^T lambda - D v - K u`, zero on massless rows.
+    fn equilibrium_inertia(&mut self, j: usize) {
+        let model = self.model;
+        let c = self.cosines[j];
+        for (ri, ai) in self.r.iter_mut().zip(&model.forcing.amplitude) {
+            *ri = c * ai;
+        }
+        for (ct, l) in model.contacts.iter().zip(&self.lambda) {
+            self.r[ct.dof] += l;
+        }
+        if let Some(d) = &model.damping {
+            sparse_mul_add(d.as_ref(), -1.0, &self.v, &mut self.r);
+        }
+        sparse_mul_add(model.stiffness.as_ref(), -1.0, &self.u, &mut self.r);
+        for (ri, &ml) in self.r.iter_mut().zip(&self.massless) {
+            if ml {
+                *ri = 0.0;
+            }
+        }
+    }
+
+    /// The scheme in use (never `Auto`).
+    pub fn scheme(&self) -> MarchScheme {
+        self.scheme.public()
+    }
+
+    /// The time step `h = T / steps_per_period`.
+    pub fn step_size(&self) -> f64 {
+        self.h
+    }
+
+    /// Current time, measured from the start of the march.
+    pub fn time(&self) -> f64 {
+        (self.completed_periods * self.steps_per_period + self.phase) as f64 * self.h
+    }
+
+    /// Step index within the current period (0 at a period start).
+    pub fn phase(&self) -> usize {
+        self.phase
+    }
+
+    /// Current displacements `u_n`.
+    pub fn displacement(&self) -> &[f64] {
+        &self.u
+    }
+
+    /// Current velocities `v_n`.
+    pub fn velocity(&self) -> &[f64] {
+        &self.v
+    }
+
+    /// Contact forces of the last step (`lambda <= 0`; impulse / h for Moreau–Jean).
+    pub fn contact_force(&self) -> &[f64] {
+        &self.lambda
+    }
+
+    /// The contact compliance `W = G A^{-1} G^T` of the per-step LCP (`A = K_eff` for the
+    /// trapezoidal scheme, `M_hat` for Moreau–Jean).
+    pub fn contact_compliance(&self) -> faer::MatRef<'_, f64> {
+        self.w.as_ref()
+    }
+
+    /// Work so far.
+    pub fn counters(&self) -> MarchCounters {
+        self.counters
+    }
+
+    /// A copy of the current state.
+    pub fn state(&self) -> MarchState {
+        MarchState {
+            displacement: self.u.clone(),
+            velocity: self.v.clone(),
+            contact_force: self.lambda.clone(),
+        }
+    }
+
+    /// Advances one step.
+    pub fn step(&mut self) -> Result<(), MarchError> {
+        let j = self.phase;
+        match self.scheme {
+            Scheme::Trapezoidal => self.step_trapezoidal(j)?,
+            Scheme::MoreauJean { theta, restitution } => {
+                self.step_moreau_jean(j, theta, restitution)?
+            }
+        }
+        self.counters.steps += 1;
+        if self.u.iter().chain(&self.v).any(|x| !x.is_finite()) {
+            return Err(MarchError::NonFinite {
+                period: self.completed_periods + 1,
+                step: j + 1,
+            });
+        }
+        self.phase += 1;
+        if self.phase == self.steps_per_period {
+            self.phase = 0;
+            self.completed_periods += 1;
+        }
+        Ok(())
+    }
+
+    fn lcp_error(&self, j: usize, source: LemkeError) -> MarchError {
+        MarchError::ContactSolve {
+            period: self.completed_periods + 1,
+            step: j + 1,
+            source,
+        }
+    }
+
+    /// Solves the LCP `w = q + W_AA z` on the active contacts (none: `lambda = 0`), applies
+    /// `rhs -= Y_A z` and sets `lambda_k = -z_k * force_scale`.
+    fn solve_contacts(&mut self, j: usize, force_scale: f64) -> Result<(), MarchError> {
+        self.lambda.fill(0.0);
+        if self.active.is_empty() {
+            return Ok(());
+        }
+        let n = self.u.len();
+        let pivots = self
+            .lcp
+            .solve(&self.w, &self.active, &self.q, &mut self.z)
+            .map_err(|err| self.lcp_error(j, err))?;
+        self.counters.contact_solves += 1;
+        self.counters.lemke_pivots += pivots as u64;
+        let mut any = false;
+        for (a, &k) in self.active.iter().enumerate() {
+            let zk = self.z[a];
+            if zk > 0.0 {
+                any = true;
+                self.lambda[k] = -zk * force_scale;
+                let col = &self.y[k * n..(k + 1) * n];
+                for (xi, yi) in self.rhs.iter_mut().zip(col) {
+                    *xi -= yi * zk;
+                }
+            }
+        }
+        if any {
+            self.counters.active_steps += 1;
+        }
+        Ok(())
+    }
+
+    /// `rhs <- A^{-1} rhs` with the iteration matrix (counted).
+    fn solve_rhs(&mut self) -> Result<(), MarchError> {
+        self.lu
+            .solve_in_place(&mut self.rhs)
+            .map_err(|source| MarchError::Factorization {
+                matrix: self.scheme.matrix(),
+                source,
+            })?;
+        self.counters.linear_solves += 1;
+        Ok(())
+    }
+
+    fn step_trapezoidal(&mut self, j: usize) -> Result<(), MarchError> {
+        let model = self.model;
+        let n = self.u.len();
+        let h = self.h;
+        let c = self.cosines[j + 1];
+        // rhs = f_{n+1} + r_n + M (4/h^2 u + 4/h v) + D (2/h u + v)
+        for i in 0..n {
+            self.rhs[i] = c * model.forcing.amplitude[i] + self.r[i];
+            self.tmp[i] = 4.0 / (h * h) * self.u[i] + 4.0 / h * self.v[i];
+        }
+        sparse_mul_add(model.mass.as_ref(), 1.0, &self.tmp, &mut self.rhs);
+        if let Some(d) = &model.damping {
+            for i in 0..n {
+                self.tmp[i] = 2.0 / h * self.u[i] + self.v[i];
+            }
+            sparse_mul_add(d.as_ref(), 1.0, &self.tmp, &mut self.rhs);
+        }
+        self.solve_rhs()?;
+        // rhs = u_free. Contact LCP on all contacts (when one is closed): q = g - G u_free.
+        self.active.clear();
+        let mut closed = false;
+        for (k, ct) in model.contacts.iter().enumerate() {
+            self.q[k] = ct.gap - self.rhs[ct.dof];
+            closed |= self.q[k] < 0.0;
+        }
+        if closed {
+            self.active.extend(0..model.contacts.len());
+        }
+        self.solve_contacts(j, 1.0)?;
+        // v_{n+1} = 2/h (u_{n+1} - u_n) - v_n; then u <- u_{n+1}.
+        for i in 0..n {
+            self.v[i] = 2.0 / h * (self.rhs[i] - self.u[i]) - self.v[i];
+        }
+        std::mem::swap(&mut self.u, &mut self.rhs);
+        self.equilibrium_inertia(j + 1);
+        Ok(())
+    }
+
+    fn step_moreau_jean(&mut self, j: usize, theta: f64, e: f64) -> Result<(), MarchError> {
+        let model = self.model;
+        let n = self.u.len();
+        let h = self.h;
+        let f_theta = theta * self.cosines[j + 1] + (1.0 - theta) * self.cosines[j];
+        // rhs = M v - h D (1 - theta) v - h K (u + h theta (1 - theta) v) + h f_theta
+        for i in 0..n {
+            self.rhs[i] = h * f_theta * model.forcing.amplitude[i];
+        }
+        sparse_mul_add(model.mass.as_ref(), 1.0, &self.v, &mut self.rhs);
+        if let Some(d) = &model.damping {
+            sparse_mul_add(d.as_ref(), -h * (1.0 - theta), &self.v, &mut self.rhs);
+        }
+        for i in 0..n {
+            self.tmp[i] = self.u[i] + h * theta * (1.0 - theta) * self.v[i];
+        }
+        sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
+        self.solve_rhs()?;
+        // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
+        self.active.clear();
+        for (k, ct) in model.contacts.iter().enumerate() {
+            if ct.gap - (self.u[ct.dof] + 0.5 * h * self.v[ct.dof]) <= 0.0 {
+                self.q[self.active.len()] = -(self.rhs[ct.dof] + e * self.v[ct.dof]);
+                self.active.push(k);
+            }
+        }
+        self.solve_contacts(j, 1.0 / h)?;
+        // u_{n+1} = u_n + h (theta v_{n+1} + (1 - theta) v_n)
+        for i in 0..n {
+            self.u[i] += h * (theta * self.rhs[i] + (1.0 - theta) * self.v[i]);
+        }
+        std::mem::swap(&mut self.v, &mut self.rhs);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lemke_step_lcp_agrees_with_the_closed_form_for_one_contact() {
+        // m = 1: w = q + W z, z >= 0, w >= 0, w z = 0 has the unique solution
+        // z = max(0, -q / W) for W > 0.
+        let mut lcp = ContactLcp::new(1);
+        let mut z = [0.0];
+        for &(wv, q) in &[
+            (0.3, -0.7),
+            (2.5, 1e-3),
+            (1e-4, -3.0),
+            (7.0, 0.0),
+            (1.0, -1e-14),
+        ] {
+            let w = Mat::from_fn(1, 1, |_, _| wv);
+            lcp.solve(&w, &[0], &[q], &mut z).unwrap();
+            let exact = f64::max(0.0, -q / wv);
+            assert!(
+                (z[0] - exact).abs() <= 1e-14 * exact.max(1.0),
+                "W={wv} q={q}: {} vs {exact}",
+                z[0]
+            );
+        }
+    }
+
+    #[test]
+    fn lemke_step_lcp_on_an_active_subset_matches_enumeration() {
+        // W symmetric positive definite 3x3, active set {0, 2}: compare with the solution
+        // found by enumerating the 4 complementary index sets of the 2x2 block.
+        let w = Mat::from_fn(3, 3, |i, j| if i == j { 2.0 + i as f64 } else { 0.5 });
+        let active = [0usize, 2];
+        let q = [-1.0, 0.4];
+        let mut lcp = ContactLcp::new(3);
+        let mut z = [0.0; 3];
+        lcp.solve(&w, &active, &q, &mut z).unwrap();
+        let (a, b, d) = (w[(0, 0)], w[(0, 2)], w[(2, 2)]);
+        let mut best = None;
+        for mask in 0..4u32 {
+            let mut zz = [0.0, 0.0];
+            match mask {
+                1 => zz[0] = -q[0] / a,
+                2 => zz[1] = -q[1] / d,
+                3 => {
+                    let det = a * d - b * b;
+                    zz[0] = (-q[0] * d + q[1] * b) / det;
+                    zz[1] = (-q[1] * a + q[0] * b) / det;
+                }
+                _ => {}
+            }
+            let ww = [q[0] + a * zz[0] + b * zz[1], q[1] + b * zz[0] + d * zz[1]];
+            if zz.iter().chain(&ww).all(|v| *v >= -1e-15) {
+                best = Some(zz);
+            }
+        }
+        let best = best.unwrap();
+        assert!((z[0] - best[0]).abs() < 1e-14 && (z[1] - best[1]).abs() < 1e-14);
+    }
+}
