@@ -270,29 +270,29 @@ trait HbReconstruction {
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
 }
 
-impl HbReconstruction for SsnHb {
-    fn contact_count(&self) -> usize {
-        self.contacts()
-    }
-    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError> {
-        self.displacement_samples(x, dof, points)
-    }
-    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
-        self.contact_force_samples(x, i, points)
-    }
+/// Both harmonic-balance problems reconstruct through the same inherent methods.
+macro_rules! hb_reconstruction {
+    ($($problem:ty),*) => {$(
+        impl HbReconstruction for $problem {
+            fn contact_count(&self) -> usize {
+                self.contacts()
+            }
+            fn displacement(
+                &self,
+                x: &[f64],
+                dof: usize,
+                points: usize,
+            ) -> Result<Vec<f64>, HbError> {
+                self.displacement_samples(x, dof, points)
+            }
+            fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
+                self.contact_force_samples(x, i, points)
+            }
+        }
+    )*};
 }
 
-impl HbReconstruction for PenaltyHb {
-    fn contact_count(&self) -> usize {
-        self.contacts()
-    }
-    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError> {
-        self.displacement_samples(x, dof, points)
-    }
-    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
-        self.contact_force_samples(x, i, points)
-    }
-}
+hb_reconstruction!(SsnHb, PenaltyHb);
 
 /// The tip, the contact forces and the statistics of an HB solution on `points` times.
 fn hb_outputs(

@@ -62,6 +62,63 @@
 //! assert!((same.displacement_min - summary.displacement_min).abs() < 1e-9);
 //! ```
 
+/// The accessors and reconstructions SSN-HB and penalty HB share: both hold their
+/// [`HbState`] in a field `state` and define `displacement_part(&self, x) -> Result<&[f64],
+/// HbError>` (the displacement coefficients `U` of their unknowns).
+macro_rules! shared_accessors {
+    () => {
+        /// The Fourier basis (`H`, `Nt`).
+        pub fn basis(&self) -> semismooth::harmonic::FourierBasis {
+            self.state.linear.basis
+        }
+
+        /// Number of degrees of freedom `N`.
+        pub fn dofs(&self) -> usize {
+            self.state.linear.dofs
+        }
+
+        /// Number of contacts `m`.
+        pub fn contacts(&self) -> usize {
+            self.state.linear.contacts()
+        }
+
+        /// Current angular frequency `w`.
+        pub fn omega(&self) -> f64 {
+            self.state.omega
+        }
+
+        /// Sets `w` (finite, `> 0`).
+        pub fn set_omega(&mut self, omega: f64) -> Result<(), $crate::hb::HbError> {
+            $crate::hb::check_omega(omega)?;
+            self.state.omega = omega;
+            Ok(())
+        }
+
+        /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
+        pub fn displacement_samples(
+            &self,
+            x: &[f64],
+            dof: usize,
+            points: usize,
+        ) -> Result<Vec<f64>, $crate::hb::HbError> {
+            let u = self.displacement_part(x)?;
+            self.state.linear.check_dof(dof)?;
+            $crate::hb::fine_samples(&self.state.linear, u, dof, points)
+        }
+
+        /// `u_dof(t)` at arbitrary times.
+        pub fn displacement_at(
+            &self,
+            x: &[f64],
+            dof: usize,
+            times: &[f64],
+        ) -> Result<Vec<f64>, $crate::hb::HbError> {
+            let u = self.displacement_part(x)?;
+            $crate::hb::displacement_at(&self.state.linear, self.state.omega, u, dof, times)
+        }
+    };
+}
+
 mod condensed;
 mod jacobian;
 mod penalty;

@@ -1,15 +1,14 @@
 //! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
 
 use semismooth::continuation::PiecewiseAffine;
-use semismooth::harmonic::FourierBasis;
 use semismooth::{
     EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
 };
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_omega, displacement_at, displacement_summary, fine_samples, validate_basis,
-    HbError, HbState, LinearData, ResponseSummary,
+    check_len, displacement_summary, fine_samples, validate_basis, HbError, HbState, LinearData,
+    ResponseSummary,
 };
 use crate::model::StructuralModel;
 use crate::scene::DEFAULT_RELATIVE_PENALTY;
@@ -91,6 +90,14 @@ pub struct PenaltyHb {
 }
 
 impl PenaltyHb {
+    shared_accessors!();
+
+    /// The displacement coefficients `U` (all the unknowns).
+    fn displacement_part<'a>(&self, u: &'a [f64]) -> Result<&'a [f64], HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        Ok(u)
+    }
+
     /// Builds the problem; validates the model and the options.
     pub fn new(model: &StructuralModel, options: &PenaltyHbOptions) -> Result<Self, HbError> {
         options.validate()?;
@@ -104,21 +111,6 @@ impl PenaltyHb {
         })
     }
 
-    /// The Fourier basis (`H`, `Nt`).
-    pub fn basis(&self) -> FourierBasis {
-        self.state.linear.basis
-    }
-
-    /// Number of degrees of freedom `N`.
-    pub fn dofs(&self) -> usize {
-        self.state.linear.dofs
-    }
-
-    /// Number of contacts `m`.
-    pub fn contacts(&self) -> usize {
-        self.state.linear.contacts()
-    }
-
     /// The penalty stiffness `k_p` in use.
     pub fn penalty_stiffness(&self) -> f64 {
         self.stiffness
@@ -129,41 +121,6 @@ impl PenaltyHb {
         check_penalty_stiffness(k)?;
         self.stiffness = k;
         Ok(())
-    }
-
-    /// Current angular frequency `w`.
-    pub fn omega(&self) -> f64 {
-        self.state.omega
-    }
-
-    /// Sets `w` (finite, `> 0`).
-    pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
-        check_omega(omega)?;
-        self.state.omega = omega;
-        Ok(())
-    }
-
-    /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
-    pub fn displacement_samples(
-        &self,
-        u: &[f64],
-        dof: usize,
-        points: usize,
-    ) -> Result<Vec<f64>, HbError> {
-        check_len("HB unknowns", self.dim(), u.len())?;
-        self.state.linear.check_dof(dof)?;
-        fine_samples(&self.state.linear, u, dof, points)
-    }
-
-    /// `u_dof(t)` at arbitrary times.
-    pub fn displacement_at(
-        &self,
-        u: &[f64],
-        dof: usize,
-        times: &[f64],
-    ) -> Result<Vec<f64>, HbError> {
-        check_len("HB unknowns", self.dim(), u.len())?;
-        displacement_at(&self.state.linear, self.state.omega, u, dof, times)
     }
 
     /// Penalty force `lambda_i(t_n) = -k_p max(0, u(t_n) - g_i)` at `points` equally spaced

@@ -8,8 +8,7 @@ use semismooth::{
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_omega, displacement_at, displacement_summary, fine_samples, validate_basis,
-    HbError, HbState, LinearData, ResponseSummary,
+    check_len, displacement_summary, validate_basis, HbError, HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -78,6 +77,13 @@ pub struct SsnHb {
 }
 
 impl SsnHb {
+    shared_accessors!();
+
+    /// The displacement coefficients `U` of the unknowns `X = [U; Lambda]`.
+    fn displacement_part<'a>(&self, x: &'a [f64]) -> Result<&'a [f64], HbError> {
+        self.displacement_coefficients(x)
+    }
+
     /// Builds the problem; validates the model and the options.
     pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
         options.validate()?;
@@ -99,29 +105,9 @@ impl SsnHb {
         })
     }
 
-    /// The Fourier basis (`H`, `Nt`).
-    pub fn basis(&self) -> FourierBasis {
-        self.state.linear.basis
-    }
-
-    /// Number of degrees of freedom `N`.
-    pub fn dofs(&self) -> usize {
-        self.state.linear.dofs
-    }
-
-    /// Number of contacts `m`.
-    pub fn contacts(&self) -> usize {
-        self.state.linear.contacts()
-    }
-
     /// The complementarity constant `c` in use.
     pub fn c(&self) -> f64 {
         self.c
-    }
-
-    /// Current angular frequency `w`.
-    pub fn omega(&self) -> f64 {
-        self.state.omega
     }
 
     /// Sets the complementarity constant `c` (finite, `> 0`).
@@ -132,13 +118,6 @@ impl SsnHb {
         }
         .validate()?;
         self.c = c;
-        Ok(())
-    }
-
-    /// Sets `w` (finite, `> 0`).
-    pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
-        check_omega(omega)?;
-        self.state.omega = omega;
         Ok(())
     }
 
@@ -157,29 +136,6 @@ impl SsnHb {
     pub fn force_coefficients<'a>(&self, x: &'a [f64]) -> Result<&'a [f64], HbError> {
         check_len("HB unknowns", self.dim(), x.len())?;
         Ok(&x[self.displacement_len()..])
-    }
-
-    /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
-    pub fn displacement_samples(
-        &self,
-        x: &[f64],
-        dof: usize,
-        points: usize,
-    ) -> Result<Vec<f64>, HbError> {
-        let u = self.displacement_coefficients(x)?;
-        self.state.linear.check_dof(dof)?;
-        fine_samples(&self.state.linear, u, dof, points)
-    }
-
-    /// `u_dof(t)` at arbitrary times.
-    pub fn displacement_at(
-        &self,
-        x: &[f64],
-        dof: usize,
-        times: &[f64],
-    ) -> Result<Vec<f64>, HbError> {
-        let u = self.displacement_coefficients(x)?;
-        displacement_at(&self.state.linear, self.state.omega, u, dof, times)
     }
 
     /// `lambda_i(t_n) = (E Lambda_i)_n` at `points` equally spaced times over one period.

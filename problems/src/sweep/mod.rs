@@ -333,23 +333,22 @@ where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
-    let Setup {
+    let (settings, sweep, omega_1) = (setup.settings, setup.sweep, setup.omega_1);
+    let n = problem.dim();
+    let options = continuation_options(
         settings,
         sweep,
         omega_1,
-        u_ref,
-        dofs,
-        method,
-        output_points,
-        started,
-        start,
-    } = setup;
-    let n = problem.dim();
-    let options = continuation_options(settings, sweep, omega_1, dofs, u_ref, &method)?;
+        setup.dofs,
+        setup.u_ref,
+        &setup.method,
+    )?;
 
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
-    let (mut x, mut work) = start.unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
+    let (mut x, mut work) = setup
+        .start
+        .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
     let report = newton::solve(problem, solver, &mut x, &newton_options(settings))
         .or_else(NewtonError::into_report)?;
     work += report.counters;
@@ -371,8 +370,8 @@ where
         initial_iterations: report.iterations,
         restarts: 0,
         corners: 0,
-        reference_amplitude: u_ref,
-        output_points,
+        reference_amplitude: setup.u_ref,
+        output_points: setup.output_points,
         states: Vec::new(),
     };
     if !report.converged() {
@@ -383,7 +382,7 @@ where
             report.iterations,
             report.residual_norm()
         );
-        response.solve_seconds = started.elapsed().as_secs_f64();
+        response.solve_seconds = setup.started.elapsed().as_secs_f64();
         return Ok(response);
     }
 
@@ -507,7 +506,7 @@ where
     };
     response.converged = converged;
     response.termination = words;
-    response.solve_seconds = started.elapsed().as_secs_f64();
+    response.solve_seconds = setup.started.elapsed().as_secs_f64();
     Ok(response)
 }
 
