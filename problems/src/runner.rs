@@ -199,6 +199,25 @@ pub(crate) fn penalty_options(
     }
 }
 
+/// The periodic LCP's options of a scene and the index of the tip's contact: the tip is
+/// observed (its history kept) when it is not a contact.
+pub(crate) fn lcp_options(
+    rod: &RodModel,
+    settings: &SolverSettings,
+) -> (PeriodicLcpOptions, Option<usize>) {
+    let tip = rod.tip_dof();
+    let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
+    let options = PeriodicLcpOptions {
+        time_samples: settings.time_samples,
+        observed_dofs: if tip_contact.is_some() {
+            Vec::new()
+        } else {
+            vec![tip]
+        },
+    };
+    (options, tip_contact)
+}
+
 /// Newton options from scene settings.
 pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
     let globalization = match settings.globalization {
@@ -294,77 +313,128 @@ macro_rules! hb_reconstruction {
 
 hb_reconstruction!(SsnHb, PenaltyHb);
 
+/// How a run ended, as its outputs report it.
+struct Outcome<'a> {
+    converged: bool,
+    termination: String,
+    iterations: usize,
+    residual_norm: f64,
+    effective_tolerance: Option<f64>,
+    counters: RunCounters,
+    solve_seconds: f64,
+    /// The Newton report of a Newton method (order and residual history).
+    newton: Option<&'a NewtonReport>,
+}
+
+impl<'a> Outcome<'a> {
+    fn of_newton(report: &'a NewtonReport, solve_seconds: f64) -> Self {
+        Self {
+            converged: report.converged(),
+            termination: report.termination.to_string(),
+            iterations: report.iterations,
+            residual_norm: report.residual_norm(),
+            effective_tolerance: Some(report.effective_tolerance),
+            counters: report.counters.into(),
+            solve_seconds,
+            newton: Some(report),
+        }
+    }
+}
+
+/// One period of a run's answer.
+struct Period {
+    times: Vec<f64>,
+    tip: Vec<f64>,
+    contact_forces: Vec<Vec<f64>>,
+    contact_displacements: Vec<Vec<f64>>,
+}
+
+/// The solution record of a run of the scene's method.
+fn solution(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    time_samples: usize,
+    outcome: Outcome<'_>,
+    period: Period,
+    state: Vec<f64>,
+) -> Solution {
+    let method = settings.method;
+    Solution {
+        method,
+        harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
+        time_samples,
+        c: None,
+        omega: rod.model.forcing.omega,
+        omega_1: rod.omega_1,
+        converged: outcome.converged,
+        termination: outcome.termination,
+        iterations: outcome.iterations,
+        residual_norm: outcome.residual_norm,
+        effective_tolerance: outcome.effective_tolerance,
+        observed_order: outcome.newton.and_then(|r| r.observed_order),
+        residual_history: outcome
+            .newton
+            .map_or_else(Vec::new, |r| r.residual_norms.clone()),
+        solve_seconds: outcome.solve_seconds,
+        stats: statistics(
+            rod,
+            &period.tip,
+            &period.contact_forces,
+            &period.contact_displacements,
+        ),
+        times: period.times,
+        tip: period.tip,
+        contact_forces: period.contact_forces,
+        counters: outcome.counters,
+        state,
+    }
+}
+
 /// The tip, the contact forces and the statistics of an HB solution on `points` times.
 fn hb_outputs(
     problem: &impl HbReconstruction,
     rod: &RodModel,
     settings: &SolverSettings,
-    report: &NewtonReport,
-    seconds: f64,
+    outcome: Outcome<'_>,
     x: Vec<f64>,
     points: usize,
 ) -> Result<Solution, RunError> {
-    let tip_series = problem.displacement(&x, rod.tip_dof(), points)?;
-    let forces = (0..problem.contact_count())
+    let tip = problem.displacement(&x, rod.tip_dof(), points)?;
+    let contact_forces = (0..problem.contact_count())
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let contact_u = rod
+    let contact_displacements = rod
         .model
         .contacts
         .iter()
         .map(|c| problem.displacement(&x, c.dof, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut sol = hb_solution(rod, settings, report, seconds, tip_series, forces, x);
-    sol.stats = statistics(rod, &sol.tip, &sol.contact_forces, Some(&contact_u));
-    Ok(sol)
-}
-
-fn hb_solution(
-    rod: &RodModel,
-    settings: &SolverSettings,
-    report: &NewtonReport,
-    seconds: f64,
-    tip: Vec<f64>,
-    contact_forces: Vec<Vec<f64>>,
-    state: Vec<f64>,
-) -> Solution {
-    let omega = rod.model.forcing.omega;
-    let period = 2.0 * std::f64::consts::PI / omega;
-    let points = tip.len();
+    let period = 2.0 * std::f64::consts::PI / rod.model.forcing.omega;
     let times = (0..points)
         .map(|n| period * n as f64 / points as f64)
         .collect();
-    Solution {
-        method: settings.method,
-        harmonics: Some(settings.harmonics),
-        time_samples: settings.time_samples,
-        c: None,
-        omega,
-        omega_1: rod.omega_1,
-        converged: report.converged(),
-        termination: report.termination.to_string(),
-        iterations: report.iterations,
-        residual_norm: report.residual_norm(),
-        effective_tolerance: Some(report.effective_tolerance),
-        observed_order: report.observed_order,
-        residual_history: report.residual_norms.clone(),
-        solve_seconds: seconds,
-        stats: statistics(rod, &tip, &contact_forces, None),
+    let period = Period {
         times,
         tip,
         contact_forces,
-        counters: report.counters.into(),
-        state,
-    }
+        contact_displacements,
+    };
+    Ok(solution(
+        rod,
+        settings,
+        settings.time_samples,
+        outcome,
+        period,
+        x,
+    ))
 }
 
-/// Tip statistics; the penetration is the largest over all contacts when their
-/// displacement series are given, else over the tip's contact.
+/// Tip statistics; the penetration is the largest over all contacts (and the tip's).
 fn statistics(
     rod: &RodModel,
     tip: &[f64],
     forces: &[Vec<f64>],
-    contact_displacements: Option<&[Vec<f64>]>,
+    contact_displacements: &[Vec<f64>],
 ) -> PeriodStatistics {
     let tip_dof = rod.tip_dof();
     let contacts = &rod.model.contacts;
@@ -384,11 +454,9 @@ fn statistics(
     if stats.mean_contact_force > 0.0 && stats.mean_contact_force <= 1e-14 * force_scale {
         stats.mean_contact_force = 0.0;
     }
-    if let Some(series) = contact_displacements {
-        for (c, u) in contacts.iter().zip(series) {
-            let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
-            stats.max_penetration = stats.max_penetration.max(p);
-        }
+    for (c, u) in contacts.iter().zip(contact_displacements) {
+        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
+        stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
 }
@@ -410,7 +478,8 @@ pub fn solve_rod(
             let report = newton_hb(&mut problem, &mut x, settings, model, 0.0)?;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let mut sol = hb_outputs(&problem, rod, settings, &report, seconds, x, points)?;
+            let outcome = Outcome::of_newton(&report, seconds);
+            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
             sol.c = (problem.contacts() > 0).then(|| problem.c());
             Ok(sol)
         }
@@ -455,7 +524,8 @@ pub fn solve_rod(
             report.iterations += homotopy_iterations;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let mut sol = hb_outputs(&problem, rod, settings, &report, seconds, x, points)?;
+            let outcome = Outcome::of_newton(&report, seconds);
+            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
             // The mean penalty force as the equations see it: over the Nt AFT samples (a
             // finer grid resolves narrow force peaks the quadrature does not).
             if problem.contacts() > 0 {
@@ -494,16 +564,7 @@ fn solve_lcp(
             what: "a [contact] section (the periodic LCP is posed on the contact forces)",
         });
     }
-    let tip = rod.tip_dof();
-    let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
-    let options = PeriodicLcpOptions {
-        time_samples: settings.time_samples,
-        observed_dofs: if tip_contact.is_some() {
-            Vec::new()
-        } else {
-            vec![tip]
-        },
-    };
+    let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
     let lcp = PeriodicLcp::new(model, options)?;
     let (z, converged, termination, iterations, residual, counters) = match method {
@@ -582,30 +643,24 @@ fn solve_lcp(
         Some(i) => contact_u[i].clone(),
         None => lcp.displacements(&z)?.remove(0),
     };
-    let times = lcp.times();
-    let mut sol = Solution {
-        method,
-        harmonics: None,
-        time_samples: settings.time_samples,
-        c: None,
-        omega: model.forcing.omega,
-        omega_1: rod.omega_1,
+    let outcome = Outcome {
         converged,
         termination,
         iterations,
         residual_norm: residual,
         // The min-map Newton runs with the scene's absolute tolerance and no floor.
         effective_tolerance: (method == Method::LcpSsn).then_some(settings.tolerance),
-        observed_order: None,
-        residual_history: Vec::new(),
+        counters,
         solve_seconds: seconds,
-        stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
-        times,
+        newton: None,
+    };
+    let period = Period {
+        times: lcp.times(),
         tip: tip_series,
         contact_forces: forces,
-        counters,
-        state: z,
+        contact_displacements: contact_u,
     };
+    let mut sol = solution(rod, settings, settings.time_samples, outcome, period, z);
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
     Ok(sol)
 }
@@ -642,30 +697,32 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         .iter()
         .map(|t| t - start_time)
         .collect();
-    Ok(Solution {
-        method: Method::March,
-        harmonics: None,
-        time_samples: settings.steps_per_period,
-        c: None,
-        omega: model.forcing.omega,
-        omega_1: rod.omega_1,
+    let outcome = Outcome {
         converged: true,
         termination: "converged".into(),
         iterations: period.periods,
         residual_norm: period.period_change,
         effective_tolerance: Some(settings.march_tolerance),
-        observed_order: None,
-        residual_history: Vec::new(),
-        solve_seconds: seconds,
-        stats: statistics(rod, &tip_series, &forces, Some(&contact_u)),
-        times,
-        tip: tip_series,
-        contact_forces: forces,
         counters: RunCounters {
             time_steps: period.counters.steps,
             factorizations: period.counters.factorizations,
             ..RunCounters::default()
         },
-        state: Vec::new(),
-    })
+        solve_seconds: seconds,
+        newton: None,
+    };
+    let period = Period {
+        times,
+        tip: tip_series,
+        contact_forces: forces,
+        contact_displacements: contact_u,
+    };
+    Ok(solution(
+        rod,
+        settings,
+        settings.steps_per_period,
+        outcome,
+        period,
+        Vec::new(),
+    ))
 }

@@ -119,6 +119,31 @@ macro_rules! shared_accessors {
     };
 }
 
+/// `w` as the parameter of SSN-HB and penalty HB (both hold an [`HbState`] `state` and
+/// define `displacement_len`): only `A(w)` depends on it, `dR/dw = [dA/dw U; 0]`.
+macro_rules! omega_parameter {
+    ($($problem:ty),*) => {$(
+        impl semismooth::ParameterDependent for $problem {
+            fn parameter(&self) -> f64 {
+                self.state.omega
+            }
+
+            fn set_parameter(&mut self, p: f64) {
+                self.state.omega = p;
+            }
+
+            fn residual_parameter_derivative(
+                &mut self,
+                x: &[f64],
+                out: &mut [f64],
+            ) -> Result<(), semismooth::EvaluationError> {
+                self.state.omega_derivative(x, self.displacement_len(), out);
+                Ok(())
+            }
+        }
+    )*};
+}
+
 mod condensed;
 mod jacobian;
 mod penalty;
@@ -136,6 +161,8 @@ pub use jacobian::{ContactCoupling, HbJacobian};
 pub use penalty::{PenaltyHb, PenaltyHbOptions};
 pub use ssn::{HbOptions, SsnHb};
 pub use structured::StructuredHbSolver;
+
+omega_parameter!(SsnHb, PenaltyHb);
 
 /// Why a harmonic-balance problem could not be built or a reconstruction not made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -446,6 +473,30 @@ impl HbState {
     pub(crate) fn write_contact_block(&mut self, jac: &mut jacobian::HbJacobian, i: usize) {
         jac.active[i] = indicator(self.aft.samples_mut());
         self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+    }
+
+    /// A Jacobian of this state's model at its frequency with `coupling`.
+    pub(crate) fn new_jacobian(&self, coupling: ContactCoupling) -> HbJacobian {
+        HbJacobian::new(self.linear.clone(), self.omega, coupling)
+    }
+
+    /// Makes `jac` a Jacobian of this state's model at its frequency with `coupling` (its
+    /// contact blocks are then written contact by contact).
+    pub(crate) fn prepare_jacobian(&self, jac: &mut HbJacobian, coupling: ContactCoupling) {
+        if !Arc::ptr_eq(&jac.linear, &self.linear) {
+            *jac = self.new_jacobian(coupling);
+        }
+        jac.omega = self.omega;
+        jac.coupling = coupling;
+    }
+
+    /// `dR/dw` of the displacement equations, `dA/dw U`, into `out` (first `len` entries,
+    /// `U = x[..len]`); the rest of `out` (force equations) is zero.
+    pub(crate) fn omega_derivative(&self, x: &[f64], len: usize, out: &mut [f64]) {
+        let (out_u, rest) = out.split_at_mut(len);
+        self.linear
+            .dynamic_omega_derivative(self.omega, &x[..len], out_u);
+        rest.fill(0.0);
     }
 
     pub(crate) fn new(linear: LinearData, omega: f64) -> Self {

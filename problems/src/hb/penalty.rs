@@ -1,9 +1,7 @@
 //! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
 
 use semismooth::continuation::PiecewiseAffine;
-use semismooth::{
-    EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
-};
+use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
@@ -80,7 +78,7 @@ fn check_penalty_stiffness(kp: f64) -> Result<(), HbError> {
 /// continuation crosses its corners exactly.
 #[derive(Debug)]
 pub struct PenaltyHb {
-    state: HbState,
+    pub(crate) state: HbState,
     stiffness: f64,
     /// Held piece `h` (contact-major, `m Nt` entries): while `holding`, the penalty force is
     /// `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
@@ -91,6 +89,18 @@ pub struct PenaltyHb {
 
 impl PenaltyHb {
     shared_accessors!();
+
+    /// How the penalty enters the Jacobian.
+    fn coupling(&self) -> ContactCoupling {
+        ContactCoupling::Penalty {
+            stiffness: self.stiffness,
+        }
+    }
+
+    /// Length of `U`: all the unknowns.
+    pub fn displacement_len(&self) -> usize {
+        self.dim()
+    }
 
     /// The displacement coefficients `U` (all the unknowns).
     fn displacement_part<'a>(&self, u: &'a [f64]) -> Result<&'a [f64], HbError> {
@@ -234,23 +244,11 @@ impl GeneralizedJacobian for PenaltyHb {
     type Jacobian = HbJacobian;
 
     fn new_jacobian(&self) -> HbJacobian {
-        HbJacobian::new(
-            self.state.linear.clone(),
-            self.state.omega,
-            ContactCoupling::Penalty {
-                stiffness: self.stiffness,
-            },
-        )
+        self.state.new_jacobian(self.coupling())
     }
 
     fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
-        if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
-            *jac = self.new_jacobian();
-        }
-        jac.omega = self.state.omega;
-        jac.coupling = ContactCoupling::Penalty {
-            stiffness: self.stiffness,
-        };
+        self.state.prepare_jacobian(jac, self.coupling());
         let nt = self.time_samples();
         for i in 0..self.contacts() {
             self.gap_samples(u, i);
@@ -263,28 +261,6 @@ impl GeneralizedJacobian for PenaltyHb {
             }
             self.state.write_contact_block(jac, i);
         }
-        Ok(())
-    }
-}
-
-impl ParameterDependent for PenaltyHb {
-    fn parameter(&self) -> f64 {
-        self.state.omega
-    }
-
-    fn set_parameter(&mut self, p: f64) {
-        self.state.omega = p;
-    }
-
-    /// `dR/dw = dA/dw U` (the penalty term does not depend on `w`).
-    fn residual_parameter_derivative(
-        &mut self,
-        u: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), EvaluationError> {
-        self.state
-            .linear
-            .dynamic_omega_derivative(self.state.omega, u, out);
         Ok(())
     }
 }

@@ -2,9 +2,7 @@
 //! equations (5)-(6)).
 
 use semismooth::harmonic::FourierBasis;
-use semismooth::{
-    EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
-};
+use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
@@ -69,7 +67,7 @@ impl HbOptions {
 ///
 /// Generalized Jacobian: `dR_lambda/dU = c P diag(h) G E`, `dR_lambda/dLambda = I - P diag(h) E`,
 /// `h_n = 1` where `s_n = c (G u_n - g) - lambda_n > 0` (else 0). The parameter of
-/// [`ParameterDependent`] is `w`; only `A(w)` depends on it.
+/// [`ParameterDependent`](semismooth::ParameterDependent) is `w`; only `A(w)` depends on it.
 #[derive(Debug)]
 pub struct SsnHb {
     pub(crate) state: HbState,
@@ -249,48 +247,17 @@ impl GeneralizedJacobian for SsnHb {
     type Jacobian = HbJacobian;
 
     fn new_jacobian(&self) -> HbJacobian {
-        HbJacobian::new(
-            self.state.linear.clone(),
-            self.state.omega,
-            ContactCoupling::Complementarity { c: self.c },
-        )
+        self.state
+            .new_jacobian(ContactCoupling::Complementarity { c: self.c })
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
-        if !std::sync::Arc::ptr_eq(&jac.linear, &self.state.linear) {
-            *jac = self.new_jacobian();
-        }
-        jac.omega = self.state.omega;
-        jac.coupling = ContactCoupling::Complementarity { c: self.c };
+        self.state
+            .prepare_jacobian(jac, ContactCoupling::Complementarity { c: self.c });
         for i in 0..self.contacts() {
             self.switching_samples(x, i);
             self.state.write_contact_block(jac, i);
         }
-        Ok(())
-    }
-}
-
-impl ParameterDependent for SsnHb {
-    fn parameter(&self) -> f64 {
-        self.state.omega
-    }
-
-    fn set_parameter(&mut self, p: f64) {
-        self.state.omega = p;
-    }
-
-    /// `dR/dw = [dA/dw U; 0]`.
-    fn residual_parameter_derivative(
-        &mut self,
-        x: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), EvaluationError> {
-        let offset = self.displacement_len();
-        let (out_u, out_l) = out.split_at_mut(offset);
-        self.state
-            .linear
-            .dynamic_omega_derivative(self.state.omega, &x[..offset], out_u);
-        out_l.fill(0.0);
         Ok(())
     }
 }

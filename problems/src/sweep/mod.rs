@@ -89,10 +89,11 @@ pub use response::FrequencyResponse;
 use response::{extremes, HbTip};
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
-use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver, PeriodicLcpOptions};
+use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
 use crate::rod::RodModel;
 use crate::runner::{
-    hb_options, newton_options, penalty_options, RunCounters, RunError, HB_OUTPUT_POINTS,
+    hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
+    HB_OUTPUT_POINTS,
 };
 use crate::scene::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
 
@@ -603,15 +604,7 @@ pub fn frequency_response(
             // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip is
             // observed by the LCPs the problem builds.
             let contacts = model.contact_count();
-            let tip_contact = model.contacts.iter().position(|c| c.dof == tip);
-            let lcp_options = PeriodicLcpOptions {
-                time_samples: settings.time_samples,
-                observed_dofs: if tip_contact.is_some() {
-                    Vec::new()
-                } else {
-                    vec![tip]
-                },
-            };
+            let (lcp_options, tip_contact) = lcp_options(rod, settings);
             // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
             let mut start_model = model.clone();
             start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
