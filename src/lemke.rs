@@ -57,6 +57,8 @@
 
 use faer::MatRef;
 
+use crate::linalg::{check_finite_dense, LinearSolveError};
+
 /// Marker for "not in the basis" in the row-of-variable map.
 const NONBASIC: usize = usize::MAX;
 
@@ -386,17 +388,10 @@ impl Lemke {
                 value,
             });
         }
-        for j in 0..n {
-            for i in 0..n {
-                let value = m[(i, j)];
-                if !value.is_finite() {
-                    return Err(LemkeError::NonFiniteMatrixEntry {
-                        row: i,
-                        col: j,
-                        value,
-                    });
-                }
-            }
+        if let Err(LinearSolveError::NonFiniteEntry { row, col, value }) =
+            check_finite_dense(n, n, |i, j| m[(i, j)])
+        {
+            return Err(LemkeError::NonFiniteMatrixEntry { row, col, value });
         }
         if n != self.n {
             self.resize(n);

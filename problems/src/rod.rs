@@ -193,40 +193,34 @@ pub enum ModelError {
     },
 }
 
-fn check_positive(name: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value > 0.0 {
+/// `Err(InvalidParameter { name, value, allowed })` unless `value` is finite and `ok`.
+fn check(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    allowed: &'static str,
+) -> Result<(), ModelError> {
+    if value.is_finite() && ok {
         Ok(())
     } else {
         Err(ModelError::InvalidParameter {
             name,
             value,
-            allowed: "a finite number > 0",
+            allowed,
         })
     }
+}
+
+fn check_positive(name: &'static str, value: f64) -> Result<(), ModelError> {
+    check(name, value, value > 0.0, "a finite number > 0")
 }
 
 fn check_non_negative(name: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            name,
-            value,
-            allowed: "a finite number >= 0",
-        })
-    }
+    check(name, value, value >= 0.0, "a finite number >= 0")
 }
 
 fn check_finite(name: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            name,
-            value,
-            allowed: "a finite number",
-        })
-    }
+    check(name, value, true, "a finite number")
 }
 
 /// Largest element count accepted (a guard against absurd sizes, about 1.6 GB of matrices).

@@ -284,22 +284,21 @@ impl Branch {
 
     /// Parameters of the detected folds, in branch order.
     pub fn fold_parameters(&self) -> Vec<f64> {
-        self.events
-            .iter()
-            .filter_map(|e| match e {
-                ContinuationEvent::Fold { parameter, .. } => Some(*parameter),
-                _ => None,
-            })
-            .collect()
+        self.event_parameters(|e| matches!(e, ContinuationEvent::Fold { .. }))
     }
 
     /// Parameters of the corners crossed exactly, in branch order.
     pub fn corner_parameters(&self) -> Vec<f64> {
+        self.event_parameters(|e| matches!(e, ContinuationEvent::Corner { .. }))
+    }
+
+    fn event_parameters(&self, kind: impl Fn(&ContinuationEvent) -> bool) -> Vec<f64> {
         self.events
             .iter()
-            .filter_map(|e| match e {
-                ContinuationEvent::Corner { parameter, .. } => Some(*parameter),
-                _ => None,
+            .filter(|e| kind(e))
+            .map(|e| match e {
+                ContinuationEvent::Fold { parameter, .. }
+                | ContinuationEvent::Corner { parameter, .. } => *parameter,
             })
             .collect()
     }

@@ -6,7 +6,7 @@ use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut};
 
 use super::{CorrectorFailure, BORDER_PIVOT_THRESHOLD};
-use crate::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use crate::linalg::{check_finite_dense, check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::newton::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::newton::WorkCounters;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent};
@@ -346,18 +346,7 @@ where
         }
         m[(n, n)] = constraint.w_p;
         let result = (|| {
-            for j in 0..=n {
-                for i in 0..=n {
-                    let value = m[(i, j)];
-                    if !value.is_finite() {
-                        return Err(LinearSolveError::NonFiniteEntry {
-                            row: i,
-                            col: j,
-                            value,
-                        });
-                    }
-                }
-            }
+            check_finite_dense(n + 1, n + 1, |i, j| m[(i, j)])?;
             let lu = PartialPivLu::new(m.as_ref());
             let u = lu.U();
             check_pivots((0..=n).map(|i| u[(i, i)]), DEFAULT_PIVOT_THRESHOLD)?;

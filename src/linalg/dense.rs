@@ -6,7 +6,7 @@ use faer::perm::PermRef;
 use faer::{Mat, MatMut, Par};
 
 use super::scratch::Scratch;
-use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::{Factorize, LinearSolve};
 
 /// A Jacobian type that can be written out as a dense `n x n` matrix.
@@ -41,8 +41,9 @@ impl DenseAssemble for nalgebra::DMatrix<f64> {
     }
 }
 
-/// Returns the first non-finite entry of a dense matrix as a typed error.
-pub(crate) fn check_finite_dense(
+/// Returns the first non-finite entry of a dense `nrows x ncols` matrix (read through
+/// `entry(row, col)`, column by column) as [`LinearSolveError::NonFiniteEntry`].
+pub fn check_finite_dense(
     nrows: usize,
     ncols: usize,
     entry: impl Fn(usize, usize) -> f64,
@@ -172,16 +173,8 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for FaerDenseLu {
 impl LinearSolve for FaerDenseLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        if !self.factored {
-            return Err(LinearSolveError::NotFactored);
-        }
         let n = self.factors.nrows();
-        if rhs.len() != n {
-            return Err(LinearSolveError::DimensionMismatch {
-                expected: n,
-                found: rhs.len(),
-            });
-        }
+        check_solve(self.factored, n, rhs.len())?;
         let par = self.par();
         let req = lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, par);
         let stack = self.scratch.stack(req);

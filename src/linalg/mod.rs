@@ -21,7 +21,7 @@ mod nalgebra_lu;
 mod scratch;
 mod sparse;
 
-pub use dense::{DenseAssemble, FaerDenseLu};
+pub use dense::{check_finite_dense, DenseAssemble, FaerDenseLu};
 pub use nalgebra_lu::NalgebraLu;
 pub use sparse::FaerSparseLu;
 
@@ -123,6 +123,18 @@ impl LinearSolveError {
             },
         }
     }
+}
+
+/// The preconditions of a solve: a factorization exists (`factored`) of dimension `n`, and
+/// the right-hand side has `found` entries.
+pub(crate) fn check_solve(factored: bool, n: usize, found: usize) -> Result<(), LinearSolveError> {
+    if !factored {
+        return Err(LinearSolveError::NotFactored);
+    }
+    if found != n {
+        return Err(LinearSolveError::DimensionMismatch { expected: n, found });
+    }
+    Ok(())
 }
 
 /// Scans the diagonal of an upper-triangular factor: `Err(Singular)` if some

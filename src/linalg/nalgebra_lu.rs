@@ -4,7 +4,7 @@
 use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 
 use super::dense::{check_finite_dense, DenseAssemble};
-use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::{Factorize, LinearSolve};
 
 /// nalgebra's `LU` (partial pivoting, `P A = L U`) behind [`LinearSolve`], with the same
@@ -122,16 +122,11 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for NalgebraLu {
 impl LinearSolve for NalgebraLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        let n = self.dim();
+        check_solve(matches!(self.state, State::Factored(_)), n, rhs.len())?;
         let State::Factored(lu) = &self.state else {
             return Err(LinearSolveError::NotFactored);
         };
-        let n = self.dim();
-        if rhs.len() != n {
-            return Err(LinearSolveError::DimensionMismatch {
-                expected: n,
-                found: rhs.len(),
-            });
-        }
         if n == 0 {
             // nalgebra's triangular solves index out of bounds on 0 x 0 factors.
             return Ok(());

@@ -11,7 +11,7 @@ use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par};
 
 use super::scratch::Scratch;
-use super::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::{Factorize, LinearSolve};
 
 /// faer sparse LU for [`SparseColMat<usize, f64>`]: `P A Q = L U` with a COLAMD column
@@ -215,16 +215,8 @@ impl Factorize<SparseColMat<usize, f64>> for FaerSparseLu {
 impl LinearSolve for FaerSparseLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        if !self.factored {
-            return Err(LinearSolveError::NotFactored);
-        }
         let n = self.dim;
-        if rhs.len() != n {
-            return Err(LinearSolveError::DimensionMismatch {
-                expected: n,
-                found: rhs.len(),
-            });
-        }
+        check_solve(self.factored, n, rhs.len())?;
         let req = simplicial::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq);
         let stack = self.scratch.stack(req);
         let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);

@@ -370,15 +370,25 @@ pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> R
     Ok(())
 }
 
-pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(HbError::InvalidOption {
-            name: "omega",
-            value: omega,
-            allowed: "a finite angular frequency > 0",
-        });
+/// `Err(InvalidOption { name, value, allowed })` unless `value` is finite and `> 0`.
+pub(crate) fn check_positive(
+    name: &'static str,
+    value: f64,
+    allowed: &'static str,
+) -> Result<(), HbError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(HbError::InvalidOption {
+            name,
+            value,
+            allowed,
+        })
     }
-    Ok(())
+}
+
+pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
+    check_positive("omega", omega, "a finite angular frequency > 0")
 }
 
 pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {

@@ -5,8 +5,8 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, displacement_summary, fine_samples, validate_basis, HbError, HbState, LinearData,
-    ResponseSummary,
+    check_len, check_positive, displacement_summary, fine_samples, validate_basis, HbError,
+    HbState, LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 use crate::scene::DEFAULT_RELATIVE_PENALTY;
@@ -56,14 +56,11 @@ impl PenaltyHbOptions {
 }
 
 fn check_penalty_stiffness(kp: f64) -> Result<(), HbError> {
-    if !(kp.is_finite() && kp > 0.0) {
-        return Err(HbError::InvalidOption {
-            name: "penalty_stiffness",
-            value: kp,
-            allowed: "a finite penalty stiffness > 0 (absolute, force per length)",
-        });
-    }
-    Ok(())
+    check_positive(
+        "penalty_stiffness",
+        kp,
+        "a finite penalty stiffness > 0 (absolute, force per length)",
+    )
 }
 
 /// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),

@@ -6,7 +6,8 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, displacement_summary, validate_basis, HbError, HbState, LinearData, ResponseSummary,
+    check_len, check_positive, displacement_summary, validate_basis, HbError, HbState, LinearData,
+    ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -42,17 +43,16 @@ impl HbOptions {
     /// `c` finite and `> 0` when given.
     pub fn validate(&self) -> Result<(), HbError> {
         validate_basis(self.harmonics, self.time_samples)?;
-        if let Some(c) = self.c {
-            if !(c.is_finite() && c > 0.0) {
-                return Err(HbError::InvalidOption {
-                    name: "c",
-                    value: c,
-                    allowed: "a finite complementarity constant > 0 (force per length)",
-                });
-            }
-        }
-        Ok(())
+        self.c.map_or(Ok(()), check_c)
     }
+}
+
+fn check_c(c: f64) -> Result<(), HbError> {
+    check_positive(
+        "c",
+        c,
+        "a finite complementarity constant > 0 (force per length)",
+    )
 }
 
 /// SSN-HB on a [`StructuralModel`] with `m >= 0` contacts.
@@ -90,13 +90,7 @@ impl SsnHb {
             Some(c) => c,
             None => model.default_complementarity_constant(),
         };
-        if !(c.is_finite() && c > 0.0) {
-            return Err(HbError::InvalidOption {
-                name: "c",
-                value: c,
-                allowed: "a finite complementarity constant > 0 (force per length)",
-            });
-        }
+        check_c(c)?;
         Ok(Self {
             state: HbState::new(linear, model.forcing.omega),
             c,
@@ -110,11 +104,7 @@ impl SsnHb {
 
     /// Sets the complementarity constant `c` (finite, `> 0`).
     pub fn set_c(&mut self, c: f64) -> Result<(), HbError> {
-        HbOptions {
-            c: Some(c),
-            ..HbOptions::default()
-        }
-        .validate()?;
+        check_c(c)?;
         self.c = c;
         Ok(())
     }

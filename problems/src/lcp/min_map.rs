@@ -14,7 +14,9 @@ use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve}
 use faer::perm::PermRef;
 use faer::{MatMut, MatRef, Par};
 use semismooth::complementarity::min_function;
-use semismooth::linalg::{check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use semismooth::linalg::{
+    check_finite_dense, check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD,
+};
 use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
 
 use super::LcpError;
@@ -307,18 +309,20 @@ impl ActiveSetSolver {
                 self.inactive.push(i);
             }
         }
-        for &i in &self.active {
-            for j in 0..n {
-                let value = matrix[(i, j)];
-                if !value.is_finite() {
-                    return Err(LinearSolveError::NonFiniteEntry {
-                        row: i,
-                        col: j,
+        // The active rows of A (the others are unit rows).
+        let active = &self.active;
+        check_finite_dense(active.len(), n, |r, j| matrix[(active[r], j)]).map_err(
+            |e| match e {
+                LinearSolveError::NonFiniteEntry { row, col, value } => {
+                    LinearSolveError::NonFiniteEntry {
+                        row: active[row],
+                        col,
                         value,
-                    });
+                    }
                 }
-            }
-        }
+                other => other,
+            },
+        )?;
         let k = self.active.len();
         self.coupling.resize(k * self.inactive.len(), 0.0);
         for (c, &j) in self.inactive.iter().enumerate() {
