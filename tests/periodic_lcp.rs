@@ -320,7 +320,7 @@ fn bad_options_and_models_are_typed_errors() {
     assert!(PeriodicLcp::new(&model, options(8, vec![])).is_ok());
     assert_eq!(
         PeriodicLcp::new(&model, options(16, vec![20])).unwrap_err(),
-        LcpError::ObservedDofOutOfRange { dof: 20, dofs: 20 }
+        LcpError::Model(InvalidModel::ObservedDofOutOfRange { dof: 20, dofs: 20 })
     );
     let mut free = model.clone();
     free.contacts.clear();

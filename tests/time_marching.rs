@@ -13,7 +13,7 @@ use semismooth_problems::march::{
     march_from_state, march_to_steady_state, MarchError, MarchOptions, MarchScheme, MarchState,
     SteadyPeriod, TimeMarcher,
 };
-use semismooth_problems::model::StructuralModel;
+use semismooth_problems::model::{InvalidModel, StructuralModel};
 use semismooth_problems::rod::{
     build_rod, FrequencySpec, MassModel, RodContact, RodModel, RodSpec,
 };
@@ -479,7 +479,10 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         assert!(err.to_string().contains(field), "{err}");
     }
     let err = march_to_steady_state(model, &MarchOptions::default(), &[20]).unwrap_err();
-    assert_eq!(err, MarchError::ObservedDofOutOfRange { dof: 20, dofs: 20 });
+    assert_eq!(
+        err,
+        MarchError::Model(InvalidModel::ObservedDofOutOfRange { dof: 20, dofs: 20 })
+    );
     let short = MarchState {
         displacement: vec![0.0; 3],
         ..MarchState::rest(model)

@@ -115,6 +115,29 @@ pub enum InvalidModel {
         /// The shared dof.
         dof: usize,
     },
+    /// A dof asked to be observed does not exist.
+    #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
+    ObservedDofOutOfRange {
+        /// The dof requested.
+        dof: usize,
+        /// `N`.
+        dofs: usize,
+    },
+}
+
+impl StructuralModel {
+    /// `Err(ObservedDofOutOfRange)` for the first of `observed` that is not a dof.
+    pub fn check_observed(&self, observed: &[usize]) -> Result<(), InvalidModel> {
+        check_observed(observed, self.dofs())
+    }
+}
+
+/// `Err(ObservedDofOutOfRange)` for the first of `observed` that is not below `dofs`.
+pub(crate) fn check_observed(observed: &[usize], dofs: usize) -> Result<(), InvalidModel> {
+    match observed.iter().find(|&&d| d >= dofs) {
+        Some(&dof) => Err(InvalidModel::ObservedDofOutOfRange { dof, dofs }),
+        None => Ok(()),
+    }
 }
 
 impl StructuralModel {

@@ -454,28 +454,29 @@ pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<
             available: n,
         });
     }
-    let finite = |nu: &[f64]| -> Result<Vec<f64>, ModelError> {
+    // The lowest `count` finite frequencies from the eigenvalues `nu = 1 / omega^2`
+    // (descending); massless dofs give `nu = 0`.
+    let lowest = |nu: &[f64]| -> Result<Vec<f64>, ModelError> {
         let nu_max = nu.iter().cloned().fold(0.0, f64::max);
         let freqs: Vec<f64> = nu
             .iter()
             .filter(|&&v| v > 1e-13 * nu_max)
             .map(|&v| 1.0 / v.sqrt())
             .collect();
-        Ok(freqs)
-    };
-    if n <= 64 {
-        let k = to_dense(&model.stiffness);
-        let m = to_dense(&model.mass);
-        let y = DMatrix::identity(n, n);
-        let (nu, _) = rayleigh_ritz(&k, &m, &y)?;
-        let freqs = finite(&nu)?;
         if freqs.len() < count {
             return Err(ModelError::TooManyModes {
                 requested: count,
                 available: freqs.len(),
             });
         }
-        return Ok(freqs[..count].to_vec());
+        Ok(freqs[..count].to_vec())
+    };
+    if n <= 64 {
+        let k = to_dense(&model.stiffness);
+        let m = to_dense(&model.mass);
+        let y = DMatrix::identity(n, n);
+        let (nu, _) = rayleigh_ritz(&k, &m, &y)?;
+        return lowest(&nu);
     }
     let factorization_failed =
         |e: semismooth::linalg::LinearSolveError| ModelError::Factorization {
@@ -500,14 +501,7 @@ pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<
         let kz = sparse_times(&model.stiffness, &z);
         let mz = sparse_times(&model.mass, &z);
         let (nu, vectors) = rayleigh_ritz(&kz, &mz, &z)?;
-        let freqs = finite(&nu)?;
-        if freqs.len() < count {
-            return Err(ModelError::TooManyModes {
-                requested: count,
-                available: freqs.len(),
-            });
-        }
-        let current = freqs[..count].to_vec();
+        let current = lowest(&nu)?;
         if let Some(prev) = &previous {
             change = current
                 .iter()

@@ -188,6 +188,13 @@ fn solve_json(scene: &Path, extra: &[&str]) -> (Output, Value) {
     (out, json)
 }
 
+/// `ssn solve --json` on a scene given as text (written to a temporary directory).
+fn solve_text(tag: &str, text: &str) -> (Output, Value) {
+    let dir = TempDir::new(tag);
+    let scene = dir.write("scene.toml", text);
+    solve_json(&scene, &[])
+}
+
 #[test]
 fn solve_every_shipped_scene_prints_the_documented_json() {
     for scene in shipped_scenes() {
@@ -246,12 +253,10 @@ fn solve_every_shipped_scene_prints_the_documented_json() {
 /// below it and the tolerance is the scene's.
 #[test]
 fn a_tolerance_below_the_round_off_floor_is_raised_and_reported() {
-    let dir = TempDir::new("tolerance");
-    let scene = dir.write(
-        "tiny_tolerance.toml",
+    let (out, json) = solve_text(
+        "tolerance",
         &CANONICAL.replace("[solver]", "[solver]\ntolerance = 1e-300"),
     );
-    let (out, json) = solve_json(&scene, &[]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let floor = f64::EPSILON * 40.0 * (21.0f64 * 41.0).sqrt() * 0.5;
     let used = json["effective_tolerance"].as_f64().unwrap();
@@ -425,12 +430,7 @@ fn a_writable_output_is_complete_csv() {
 
 #[test]
 fn a_run_that_does_not_converge_prints_its_json_and_exits_1() {
-    let dir = TempDir::new("noconv");
-    let path = dir.write(
-        "one_iteration.toml",
-        &format!("{CANONICAL}max_iterations = 1\n"),
-    );
-    let (out, json) = solve_json(&path, &[]);
+    let (out, json) = solve_text("noconv", &format!("{CANONICAL}max_iterations = 1\n"));
     assert_eq!(out.status.code(), Some(1), "stderr {}", stderr(&out));
     assert_eq!(json["converged"], Value::Bool(false));
     assert_eq!(json["termination"], "max-iterations", "{json}");

@@ -160,10 +160,7 @@ impl PeriodicLcpOptions {
                 allowed: "an integer >= 8 with contacts * time_samples <= 8192",
             });
         }
-        if let Some(&dof) = self.observed_dofs.iter().find(|&&d| d >= dofs) {
-            return Err(LcpError::ObservedDofOutOfRange { dof, dofs });
-        }
-        Ok(())
+        Ok(crate::model::check_observed(&self.observed_dofs, dofs)?)
     }
 }
 
@@ -196,14 +193,6 @@ pub enum LcpError {
     /// The model is not usable (sizes, non-finite data, frequency, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),
-    /// An observed dof does not exist.
-    #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
-    ObservedDofOutOfRange {
-        /// The dof requested.
-        dof: usize,
-        /// Number of dofs.
-        dofs: usize,
-    },
     /// A dynamic stiffness could not be factored for want of memory or indices, or the
     /// static block of the Nyquist limit is singular.
     #[error("factorization of the dynamic stiffness of bin {bin} failed: {source}")]

@@ -309,14 +309,6 @@ pub enum MarchError {
     /// The model is not usable (sizes, non-finite data, frequency, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),
-    /// An observed dof does not exist.
-    #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
-    ObservedDofOutOfRange {
-        /// The dof given.
-        dof: usize,
-        /// Number of dofs of the model.
-        dofs: usize,
-    },
     /// A vector of the initial state has the wrong length.
     #[error("initial state {what} has length {found}, expected {expected}")]
     StateDimension {
@@ -457,9 +449,7 @@ pub fn march_from_state(
     let mut marcher = TimeMarcher::new(model, options, initial)?;
     let n = model.dofs();
     let m = model.contact_count();
-    if let Some(&dof) = observed_dofs.iter().find(|&&d| d >= n) {
-        return Err(MarchError::ObservedDofOutOfRange { dof, dofs: n });
-    }
+    model.check_observed(observed_dofs)?;
     let spp = options.steps_per_period;
     let samples = spp + 1;
     let nobs = observed_dofs.len();
