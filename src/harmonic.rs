@@ -232,15 +232,7 @@ impl FourierBasis {
     }
 
     fn check_len(&self, what: &'static str, found: usize) -> Result<(), HarmonicError> {
-        let expected = self.basis_size();
-        if found != expected {
-            return Err(HarmonicError::DimensionMismatch {
-                what,
-                expected,
-                found,
-            });
-        }
-        Ok(())
+        check_length(what, self.basis_size(), found)
     }
 }
 
@@ -362,8 +354,8 @@ impl Aft {
     ) -> Result<(), HarmonicError> {
         let size = self.basis.basis_size();
         let nt = self.basis.time_samples();
-        check("harmonic-major coefficients", size * signals, coeffs.len())?;
-        check("signal-major samples", nt * signals, samples.len())?;
+        check_length("harmonic-major coefficients", size * signals, coeffs.len())?;
+        check_length("signal-major samples", nt * signals, samples.len())?;
         let mut gathered = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
             for (j, g) in gathered.iter_mut().enumerate() {
@@ -385,8 +377,8 @@ impl Aft {
     ) -> Result<(), HarmonicError> {
         let size = self.basis.basis_size();
         let nt = self.basis.time_samples();
-        check("signal-major samples", nt * signals, samples.len())?;
-        check("harmonic-major coefficients", size * signals, coeffs.len())?;
+        check_length("signal-major samples", nt * signals, samples.len())?;
+        check_length("harmonic-major coefficients", size * signals, coeffs.len())?;
         let mut projected = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
             self.time.copy_from_slice(&samples[s * nt..(s + 1) * nt]);
@@ -582,7 +574,7 @@ impl Aft {
     }
 
     fn check_samples(&self, what: &'static str, found: usize) -> Result<(), HarmonicError> {
-        check(what, self.basis.time_samples(), found)
+        check_length(what, self.basis.time_samples(), found)
     }
 }
 
@@ -602,7 +594,12 @@ fn direct_spectrum(x: &[f64], spectrum: &mut [Complex<f64>]) {
     }
 }
 
-fn check(what: &'static str, expected: usize, found: usize) -> Result<(), HarmonicError> {
+/// `Err(DimensionMismatch { what, expected, found })` unless the lengths agree.
+pub fn check_length(
+    what: &'static str,
+    expected: usize,
+    found: usize,
+) -> Result<(), HarmonicError> {
     if expected != found {
         return Err(HarmonicError::DimensionMismatch {
             what,

@@ -32,7 +32,7 @@ use faer::sparse::linalg::LuError;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{c64, Conj, MatMut, Par};
 use num_traits::Zero;
-use semismooth::linalg::{check_pivots, LinearSolveError};
+use semismooth::linalg::{check_pivots, diagonal_entry, LinearSolveError};
 
 use crate::model::SparseMatrix;
 
@@ -261,13 +261,7 @@ impl DynamicStiffness {
         let checked = match result {
             Ok(()) => {
                 let u = s.lu.u_factor_unsorted();
-                let diagonal = (0..n).map(|j| {
-                    u.row_idx_of_col_raw(j)
-                        .iter()
-                        .zip(u.val_of_col(j))
-                        .find(|(&i, _)| i == j)
-                        .map_or(0.0, |(_, v)| v.norm())
-                });
+                let diagonal = (0..n).map(|j| diagonal_entry(u, j).map_or(0.0, |v| v.norm()));
                 check_pivots(diagonal, PIVOT_THRESHOLD)
             }
             Err(LuError::SymbolicSingular { index }) => Err(LinearSolveError::Singular {

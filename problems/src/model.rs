@@ -265,13 +265,7 @@ pub const DEFAULT_C_FACTOR: f64 = 10.0;
 
 /// Entry `(i, i)` of a column-compressed matrix (0 when not stored).
 pub fn diagonal_entry(matrix: &SparseMatrix, i: usize) -> f64 {
-    let m = matrix.as_ref();
-    let rows = m.row_idx_of_col(i);
-    let vals = m.val_of_col(i);
-    rows.zip(vals.iter())
-        .filter(|(r, _)| *r == i)
-        .map(|(_, v)| *v)
-        .sum()
+    semismooth::linalg::diagonal_entry(matrix.as_ref(), i).unwrap_or(0.0)
 }
 
 /// `Err(NonFinite)` with the first NaN or infinite entry of `values`.

@@ -23,7 +23,7 @@ mod sparse;
 
 pub use dense::{check_finite_dense, DenseAssemble, FaerDenseLu};
 pub use nalgebra_lu::NalgebraLu;
-pub use sparse::FaerSparseLu;
+pub use sparse::{diagonal_entry, FaerSparseLu};
 
 /// Default relative pivot threshold: a pivot `|u_ii| <= threshold * max_j |u_jj|` is
 /// treated as zero.

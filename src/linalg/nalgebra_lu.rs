@@ -52,18 +52,15 @@ impl std::fmt::Debug for NalgebraLu {
 impl NalgebraLu {
     /// A solver with the default pivot threshold [`DEFAULT_PIVOT_THRESHOLD`].
     pub fn new() -> Self {
-        Self {
-            state: State::Empty(DMatrix::zeros(0, 0)),
-            dim: 0,
-            pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
-        }
+        Self::with_pivot_threshold(DEFAULT_PIVOT_THRESHOLD)
     }
 
     /// A solver that treats `|u_ii| <= threshold * max |u_jj|` as a zero pivot.
-    pub fn with_pivot_threshold(threshold: f64) -> Self {
+    pub fn with_pivot_threshold(pivot_threshold: f64) -> Self {
         Self {
-            pivot_threshold: threshold,
-            ..Self::new()
+            state: State::Empty(DMatrix::zeros(0, 0)),
+            dim: 0,
+            pivot_threshold,
         }
     }
 

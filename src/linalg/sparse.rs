@@ -7,12 +7,22 @@ use faer::perm::PermRef;
 use faer::sparse::linalg::colamd;
 use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
 use faer::sparse::linalg::LuError;
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
 use super::scratch::Scratch;
 use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use crate::{Factorize, LinearSolve};
+
+/// Entry `(j, j)` of a column-compressed matrix (rows of a column unsorted allowed), `None`
+/// when it is not stored.
+pub fn diagonal_entry<T: Copy>(m: SparseColMatRef<'_, usize, T>, j: usize) -> Option<T> {
+    m.row_idx_of_col_raw(j)
+        .iter()
+        .zip(m.val_of_col(j))
+        .find(|(&i, _)| i == j)
+        .map(|(_, &v)| v)
+}
 
 /// faer sparse LU for [`SparseColMat<usize, f64>`]: `P A Q = L U` with a COLAMD column
 /// ordering `Q` and partial row pivoting `P`.
@@ -199,13 +209,7 @@ impl Factorize<SparseColMat<usize, f64>> for FaerSparseLu {
             }
         }
         let u = self.lu.u_factor_unsorted();
-        let diagonal = (0..n).map(|j| {
-            u.row_idx_of_col_raw(j)
-                .iter()
-                .zip(u.val_of_col(j))
-                .find(|(&i, _)| i == j)
-                .map_or(0.0, |(_, &v)| v)
-        });
+        let diagonal = (0..n).map(|j| diagonal_entry(u, j).unwrap_or(0.0));
         check_pivots(diagonal, self.pivot_threshold)?;
         self.factored = true;
         Ok(())

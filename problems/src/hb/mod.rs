@@ -392,14 +392,7 @@ pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
 }
 
 pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {
-    if expected != found {
-        return Err(HbError::DimensionMismatch {
-            what,
-            expected,
-            found,
-        });
-    }
-    Ok(())
+    Ok(semismooth::harmonic::check_length(what, expected, found)?)
 }
 
 /// Samples of one dof over a period at `points` equally spaced times `t_n = n T / points`
