@@ -449,9 +449,9 @@ fn statistics(
         _ => period_statistics(tip, None),
     };
     // A contact that never closes has a mean force of zero up to round-off (Newton lands on
-    // +-1e-32): report it as 0, never as a (non-physical) positive pull.
+    // +-1e-32): report it as 0 (never as a non-physical positive pull).
     let force_scale = forces.iter().flatten().fold(1.0f64, |a, f| a.max(f.abs()));
-    if stats.mean_contact_force > 0.0 && stats.mean_contact_force <= 1e-14 * force_scale {
+    if stats.mean_contact_force.abs() <= 1e-14 * force_scale {
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
