@@ -102,12 +102,10 @@ impl UnionPattern {
         T: Copy + Zero + AddAssign + Mul<f64, Output = T>,
     {
         values.fill(T::zero());
+        // `positions` follows each source's storage order (its columns one after the other).
         for ((a, c), positions) in terms.into_iter().zip(&self.positions) {
-            let (symbolic, val) = (a.symbolic(), a.val());
-            for j in 0..symbolic.ncols() {
-                for p in symbolic.col_range(j) {
-                    values[positions[p]] += c * val[p];
-                }
+            for (&p, &v) in positions.iter().zip(a.val()) {
+                values[p] += c * v;
             }
         }
     }
@@ -261,8 +259,9 @@ impl DynamicStiffness {
         let checked = match result {
             Ok(()) => {
                 let u = s.lu.u_factor_unsorted();
-                let diagonal = (0..n).map(|j| diagonal_entry(u, j).map_or(0.0, |v| v.norm()));
-                check_pivots(diagonal, PIVOT_THRESHOLD)
+                // Squared moduli (no square root per pivot): zero and non-finite alike.
+                let diagonal = (0..n).map(|j| diagonal_entry(u, j).map_or(0.0, |v| v.norm_sqr()));
+                check_pivots(diagonal, PIVOT_THRESHOLD * PIVOT_THRESHOLD)
             }
             Err(LuError::SymbolicSingular { index }) => Err(LinearSolveError::Singular {
                 index,
