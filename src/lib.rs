@@ -65,7 +65,7 @@ mod traits;
 
 pub use traits::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,
-    ProblemCounters, Residual, MAX_PROBLEM_COUNTERS,
+    ProblemCounters, Residual, Smoothing, MAX_PROBLEM_COUNTERS,
 };
 
 /// The linear-algebra crates of the public API (matrix types of Jacobians, sparse

@@ -131,6 +131,36 @@ pub trait Residual {
     fn problem_counters(&self) -> ProblemCounters {
         ProblemCounters::new()
     }
+
+    /// The smoothing of its nonsmooth terms the problem offers ([`Smoothing`]), `None` (the
+    /// default) when it offers none. Problems that do return `Some(self)`.
+    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
+        None
+    }
+}
+
+/// A smoothing of a problem's nonsmooth terms by a parameter `mu >= 0`: `F_mu` is
+/// continuously differentiable for `mu > 0` and `F_0 = F`; typically each `max(0, s)` is
+/// replaced by the Chen–Harker–Kanzow–Smale function `(s + sqrt(s^2 + 4 mu^2)) / 2`, which
+/// lies within `mu` of it. While `mu > 0` is set, [`Residual::residual`] evaluates `F_mu`
+/// and [`GeneralizedJacobian::jacobian`] its Jacobian.
+///
+/// The Newton driver's polyalgorithm follows the smoothing path `F_mu(x) = 0` from a large
+/// `mu` (where the problem is nearly affine) to `mu = 0` ([`crate::newton`], *Polyalgorithm*).
+pub trait Smoothing {
+    /// The scale of `mu` at which the smoothing blurs the problem's switching quantities
+    /// over their whole range at the initial guess (e.g. `c |g|` for `max(0, c (u - g))`).
+    fn smoothing_scale(&self) -> f64;
+
+    /// Sets `mu >= 0` (0: the problem itself).
+    fn set_smoothing(&mut self, mu: f64);
+
+    /// Writes `dF_mu(x)/dmu` into `out`.
+    fn residual_smoothing_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError>;
 }
 
 /// One element `J` of the generalized Jacobian `∂F(x)` (Clarke or Bouligand), written

@@ -924,3 +924,77 @@ fn static_contact_stiffness_of_the_rod_is_ea_over_l_for_any_mesh() {
         assert!((rod.model.contact_stiffness_scale() - elements as f64).abs() < 1e-9);
     }
 }
+
+#[test]
+fn smoothed_ssn_jacobian_and_mu_derivative_match_central_differences() {
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
+    let (h, nt) = (3, 16);
+    let mut hb = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let x = random_vector(&mut rng, hb.dim(), 0.5);
+    let mu = 0.05;
+    hb.smoothing().unwrap().set_smoothing(mu);
+    // F_mu is smooth everywhere (no kink to avoid); its second derivative is at most of
+    // order c^2 / mu = 80, so the central difference with step 1e-6 errs by ~1e-10
+    // relative, and rounding by ~1e-10 too.
+    let mut jac = hb.new_jacobian();
+    hb.jacobian(&x, &mut jac).unwrap();
+    let analytic = assemble(&jac);
+    let fd = fd_jacobian(&mut hb, &x, 1e-6);
+    let err = max_abs(&(&analytic - &fd)) / max_abs(&analytic);
+    assert!(err < 1e-8, "relative Jacobian error {err:e}");
+
+    let n = hb.dim();
+    let mut analytic = vec![0.0; n];
+    hb.smoothing()
+        .unwrap()
+        .residual_smoothing_derivative(&x, &mut analytic)
+        .unwrap();
+    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+    let step = 1e-6;
+    hb.smoothing().unwrap().set_smoothing(mu + step);
+    hb.residual(&x, &mut fp).unwrap();
+    hb.smoothing().unwrap().set_smoothing(mu - step);
+    hb.residual(&x, &mut fm).unwrap();
+    let diff: Vec<f64> = analytic
+        .iter()
+        .zip(fp.iter().zip(&fm))
+        .map(|(a, (p, m))| a - (p - m) / (2.0 * step))
+        .collect();
+    assert!(norm(&analytic) > 0.0);
+    assert!(
+        norm(&diff) < 1e-7 * norm(&analytic),
+        "{:e}",
+        norm(&diff) / norm(&analytic)
+    );
+}
+
+#[test]
+fn zero_smoothing_is_the_formulation_itself_and_small_smoothing_is_within_mu() {
+    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
+    let (h, nt) = (3, 16);
+    let mut plain = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut smoothed = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let x = random_vector(&mut rng, plain.dim(), 0.5);
+    let n = plain.dim();
+    let (mut f0, mut f) = (vec![0.0; n], vec![0.0; n]);
+    plain.residual(&x, &mut f0).unwrap();
+    smoothed.smoothing().unwrap().set_smoothing(0.3);
+    smoothed.residual(&x, &mut f).unwrap();
+    assert!(f != f0);
+    smoothed.smoothing().unwrap().set_smoothing(0.0);
+    smoothed.residual(&x, &mut f).unwrap();
+    assert_eq!(f, f0);
+    // 0 <= phi_mu(s) - max(0, s) <= mu at every sample, so each force coefficient moves by
+    // at most mu times the 1-norm of a row of P (<= 2) and the displacement rows not at all.
+    let mu = 1e-3;
+    smoothed.smoothing().unwrap().set_smoothing(mu);
+    smoothed.residual(&x, &mut f).unwrap();
+    let largest = f
+        .iter()
+        .zip(&f0)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(largest > 0.0 && largest <= 2.0 * mu, "{largest:e}");
+}

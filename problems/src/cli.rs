@@ -184,6 +184,21 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     if let Some(h) = s.harmonics {
         v["harmonics"] = json!(h);
     }
+    if let Some(strategy) = s.strategy {
+        v["strategy"] = json!(strategy);
+        v["attempts"] = s
+            .attempts
+            .iter()
+            .map(|a| {
+                json!({
+                    "strategy": a.strategy.name(),
+                    "iterations": a.iterations,
+                    "converged": a.converged,
+                    "outcome": a.outcome,
+                })
+            })
+            .collect();
+    }
     if let Some(c) = s.c {
         v["c"] = json!(c);
     }

@@ -8,6 +8,7 @@
 pub mod cli;
 mod dynamic;
 pub mod figures;
+pub mod from_zero;
 pub mod hb;
 pub mod lcp;
 pub mod march;

@@ -54,7 +54,7 @@ enum Command {
         ssn solve problems/scenes/paper_fig1.toml --json --csv tip.csv --svg tip.svg\n\n\
         JSON fields: scene, method, harmonics (HB only), time_samples, omega, omega_ratio,\n  \
         converged, termination, iterations, residual_norm, effective_tolerance,\n  \
-        solve_seconds, tip_max, tip_min,\n  \
+        strategy and attempts (Newton methods), solve_seconds, tip_max, tip_min,\n  \
         max_penetration, contact_force_mean, c (SSN-HB), counters {residual_evaluations,\n  \
         jacobian_evaluations, factorizations, linear_solves, ffts, ...}\n\n"
     )]

@@ -155,6 +155,11 @@ pub struct Solution {
     /// the model's round-off floor when that is larger; the march tolerance for time
     /// marching; `None` for Lemke, which ends on a basis, not a tolerance).
     pub effective_tolerance: Option<f64>,
+    /// The strategy of the Newton run that produced the answer (`newton`, `smoothing`,
+    /// `newton-homotopy`, `line-search`; Newton methods).
+    pub strategy: Option<&'static str>,
+    /// Every strategy the Newton run tried, in order (Newton methods).
+    pub attempts: Vec<semismooth::newton::Attempt>,
     /// Convergence order observed over the last Newton iterations (Newton methods).
     pub observed_order: Option<f64>,
     /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
@@ -225,6 +230,7 @@ pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
         GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
         GlobalizationChoice::Nonmonotone => Globalization::non_monotone(),
         GlobalizationChoice::Hybrid => Globalization::hybrid(),
+        GlobalizationChoice::Auto => Globalization::polyalgorithm(),
     };
     NewtonOptions {
         absolute_tolerance: settings.tolerance,
@@ -371,6 +377,8 @@ fn solution(
         iterations: outcome.iterations,
         residual_norm: outcome.residual_norm,
         effective_tolerance: outcome.effective_tolerance,
+        strategy: outcome.newton.map(|r| r.strategy.name()),
+        attempts: outcome.newton.map_or_else(Vec::new, |r| r.attempts.clone()),
         observed_order: outcome.newton.and_then(|r| r.observed_order),
         residual_history: outcome
             .newton

@@ -118,9 +118,12 @@ pub enum GlobalizationChoice {
     /// Non-monotone (Grippo–Lampariello–Lucidi) line search.
     Nonmonotone,
     /// Full steps for 30 iterations (active-set behaviour), then the non-monotone line
-    /// search from the best iterate.
-    #[default]
+    /// search from the initial guess.
     Hybrid,
+    /// Full steps for 30 iterations, then the Newton homotopy from the initial guess, then
+    /// the non-monotone line search; the report names the strategy that converged.
+    #[default]
+    Auto,
 }
 
 /// Default number of harmonics.

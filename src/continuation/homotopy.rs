@@ -47,13 +47,15 @@ pub struct HomotopyReport {
 ///
 /// ```
 /// use semismooth::continuation::{homotopy, HomotopySchedule};
-/// use semismooth::newton::{NewtonReport, Termination, WorkCounters};
+/// use semismooth::newton::{NewtonReport, Strategy, Termination, WorkCounters};
 /// // A fake solver that converges for p <= 2.5 only: from 0 with steps 1, 0.5, 0.25, ...
 /// let solve = |p: f64, x: &mut [f64]| -> Result<NewtonReport, ()> {
 ///     x[0] = p;
 ///     let ok = p <= 2.5;
 ///     Ok(NewtonReport {
 ///         termination: if ok { Termination::Converged } else { Termination::MaxIterations },
+///         strategy: Strategy::FullSteps,
+///         attempts: Vec::new(),
 ///         iterations: 1,
 ///         effective_tolerance: 0.0,
 ///         residual_norms: vec![1.0, 0.0],

@@ -191,6 +191,11 @@ impl Kernel {
                 full_steps,
                 memory,
                 line_search,
+            }
+            | Globalization::Polyalgorithm {
+                full_steps,
+                memory,
+                line_search,
             } => (memory, Some(line_search), full_steps),
         };
         let history = self
@@ -347,6 +352,12 @@ impl Kernel {
     /// `G` at the iterate the last run returned.
     pub(crate) fn residual(&self) -> &[f64] {
         &self.g
+    }
+
+    /// Replaces the stored `G` (when a caller returns another iterate than the last run's).
+    pub(crate) fn set_residual(&mut self, g: &[f64]) {
+        self.g.clear();
+        self.g.extend_from_slice(g);
     }
 }
 

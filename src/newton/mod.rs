@@ -32,7 +32,32 @@
 //! | `residual_floor` | `0` (off) | `\|F\|` round-off alone produces near a solution: the tolerance is at least this, and a run that stalls with `\|F\| <= 100 floor` has converged ([`Termination::ConvergedAtRoundoff`]) |
 //! | `step_tolerance` | `1e-15` | stalled when `alpha \|d\| <= step_tol (1 + \|x\|)` |
 //! | `max_iterations` | `200` | Newton iterations (not counting line-search trials) |
-//! | `globalization` | [`Globalization::hybrid`] | none, Armijo, non-monotone or hybrid |
+//! | `globalization` | [`Globalization::polyalgorithm`] | none, Armijo, non-monotone, hybrid or polyalgorithm |
+//!
+//! # Polyalgorithm (the default globalization)
+//!
+//! Semismooth Newton on a complementarity system with full steps behaves like a primal-dual
+//! active-set method: from a reasonable guess it finds the active set in a few iterations,
+//! but it may cycle between active sets or creep one switch per iteration; a line search on
+//! `|F|^2 / 2` cannot repair this, because the merit has kinks wherever the active set
+//! changes and backtracking stalls on them. [`Globalization::Polyalgorithm`] therefore
+//! tries, within one budget of `max_iterations`:
+//!
+//! 1. `full_steps` full Newton steps (the fast path: most solves end here);
+//! 2. when the problem offers a [`Smoothing`](crate::Smoothing): the smoothing path
+//!    `F_mu(x) = 0` from the initial guess, `mu` from the problem's smoothing scale down four
+//!    decades (Newton with an Armijo search on the smooth merit at the start, then the
+//!    crate's pseudo-arclength continuation in `log10 mu`), then full Newton steps on `F`;
+//! 3. the non-monotone line search from the initial guess, on at most half of the
+//!    iterations left;
+//! 4. the Newton homotopy `H(x, t) = F(x) - (1 - t) F(x_0)` from `(x_0, 0)` to `t = 1`,
+//!    followed by the continuation (the state weighted 0.99 in the arclength so that
+//!    corners where `t` turns back are passed), then full Newton steps on `F` at `t = 1`.
+//!    It needs nothing from the problem but `F` and `J`; for a forced structure whose
+//!    contacts are open at `x_0 = 0` it is the load homotopy.
+//!
+//! The report names the strategy that converged ([`NewtonReport::strategy`]) and every
+//! attempt ([`NewtonReport::attempts`]); the best iterate of all attempts is returned.
 //!
 //! ```
 //! use faer::Mat;
@@ -78,12 +103,13 @@
 //! ```
 
 pub(crate) mod kernel;
+mod path;
 
 use std::ops::AddAssign;
 
 use crate::linalg::LinearSolveError;
 pub use crate::linesearch::{InvalidLineSearchOption, LineSearchOptions};
-use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters};
+use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters, Residual};
 pub use kernel::FLOOR_STALL_FACTOR;
 use kernel::{Kernel, KernelRules, NewtonSystem, Stop};
 
@@ -116,12 +142,36 @@ pub enum Globalization {
         /// Backtracking options of the non-monotone phase.
         line_search: LineSearchOptions,
     },
+    /// A polyalgorithm (the default): full steps first; when they have not converged
+    /// after `full_steps` iterations, the smoothing path (problems with a
+    /// [`Smoothing`](crate::Smoothing)), the non-monotone line search, then the Newton
+    /// homotopy `F(x) - (1 - t) F(x_0) = 0`, each from the initial guess
+    /// ([module docs](self), *Polyalgorithm*). The report names the strategy that
+    /// converged ([`NewtonReport::strategy`]) and every attempt.
+    Polyalgorithm {
+        /// Iterations of the full-step phase.
+        full_steps: usize,
+        /// Memory of the line-search phase (`>= 1`).
+        memory: usize,
+        /// Backtracking options of the line-search phase.
+        line_search: LineSearchOptions,
+    },
 }
 
 impl Globalization {
     /// [`Globalization::Hybrid`] with 30 full steps, then GLL with memory 10 (the default).
     pub fn hybrid() -> Self {
         Self::Hybrid {
+            full_steps: 30,
+            memory: 10,
+            line_search: LineSearchOptions::default(),
+        }
+    }
+
+    /// [`Globalization::Polyalgorithm`] with 30 full steps, then the smoothing path and
+    /// the Newton homotopy, then GLL with memory 10 (the default).
+    pub fn polyalgorithm() -> Self {
+        Self::Polyalgorithm {
             full_steps: 30,
             memory: 10,
             line_search: LineSearchOptions::default(),
@@ -139,7 +189,7 @@ impl Globalization {
 
 impl Default for Globalization {
     fn default() -> Self {
-        Self::hybrid()
+        Self::polyalgorithm()
     }
 }
 
@@ -207,6 +257,11 @@ impl NewtonOptions {
                 memory,
                 line_search,
                 ..
+            }
+            | Globalization::Polyalgorithm {
+                memory,
+                line_search,
+                ..
             } => {
                 if memory == 0 {
                     return Err(invalid("globalization.memory", 0.0, ">= 1"));
@@ -259,6 +314,75 @@ pub enum Termination {
     /// The problem could not be evaluated (at the initial guess, at a full step without
     /// line search, or for its Jacobian).
     OutsideDomain(EvaluationError),
+}
+
+/// A way of reaching a root, as a report names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Strategy {
+    /// Newton with full steps (`newton`).
+    FullSteps,
+    /// Newton with a line search on the merit (`line-search`).
+    LineSearch,
+    /// The Newton homotopy followed to `t = 1`, then Newton (`newton-homotopy`).
+    Homotopy,
+    /// The smoothing path followed to a small smoothing, then Newton (`smoothing`).
+    Smoothing,
+}
+
+impl Strategy {
+    /// The name used in reports: `newton`, `line-search`, `newton-homotopy`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::FullSteps => "newton",
+            Self::LineSearch => "line-search",
+            Self::Homotopy => "newton-homotopy",
+            Self::Smoothing => "smoothing",
+        }
+    }
+}
+
+impl std::fmt::Display for Strategy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One strategy tried by a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attempt {
+    /// The strategy.
+    pub strategy: Strategy,
+    /// Its iterations (for the homotopy: corrector iterations along the path, failed
+    /// steps included, plus the Newton iterations at `t = 1`).
+    pub iterations: usize,
+    /// Whether it converged.
+    pub converged: bool,
+    /// How it ended, in words.
+    pub outcome: String,
+}
+
+impl Attempt {
+    fn new(strategy: Strategy, iterations: usize, termination: &Termination) -> Self {
+        Self {
+            strategy,
+            iterations,
+            converged: termination.converged(),
+            outcome: termination.to_string(),
+        }
+    }
+
+    fn failed_path(strategy: Strategy, path: &path::PathOutcome) -> Self {
+        Self {
+            strategy,
+            iterations: path.iterations,
+            converged: false,
+            outcome: format!(
+                "the path stopped at {:.6} of its length: {}",
+                path.furthest,
+                path.reason.as_deref().unwrap_or("no reason given")
+            ),
+        }
+    }
 }
 
 impl Termination {
@@ -323,16 +447,23 @@ impl AddAssign for WorkCounters {
 pub struct NewtonReport {
     /// Why it stopped.
     pub termination: Termination,
-    /// Accepted Newton steps.
+    /// The strategy of the last attempt (the one that converged, when one did).
+    pub strategy: Strategy,
+    /// Every strategy tried, in order (one entry unless the globalization is
+    /// [`Globalization::Polyalgorithm`]).
+    pub attempts: Vec<Attempt>,
+    /// Newton iterations over all attempts (corrector iterations of a homotopy included).
     pub iterations: usize,
     /// The tolerance the run was judged against: `max(absolute, relative |F(x_0)|,
     /// residual_floor)`.
     pub effective_tolerance: f64,
-    /// `|F|_2` at the initial guess and after each accepted step (`iterations + 1` values).
+    /// `|F|_2` at the initial guess and after each accepted step of the attempts that
+    /// iterate on `F` (`iterations + 1` values with a single attempt; a homotopy's corrector
+    /// iterates on the homotopy, and its iterations are not listed).
     pub residual_norms: Vec<f64>,
-    /// Accepted step lengths `alpha_k` (`iterations` values).
+    /// Accepted step lengths `alpha_k`, as `residual_norms`.
     pub step_lengths: Vec<f64>,
-    /// Accepted step norms `alpha_k |d_k|_2` (`iterations` values).
+    /// Accepted step norms `alpha_k |d_k|_2`, as `residual_norms`.
     pub step_norms: Vec<f64>,
     /// Estimated order `q` from the last three residual norms,
     /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})` (also for runs that did not converge: a
@@ -489,6 +620,8 @@ pub struct NewtonSolver<J> {
     jacobian: Option<J>,
     dim: usize,
     kernel: Kernel,
+    /// The initial guess, kept by the polyalgorithm (each attempt starts from it).
+    start: Vec<f64>,
 }
 
 impl<J> NewtonSolver<J> {
@@ -500,6 +633,7 @@ impl<J> NewtonSolver<J> {
             jacobian: None,
             dim: 0,
             kernel: Kernel::default(),
+            start: Vec::new(),
         })
     }
 
@@ -555,15 +689,86 @@ impl<J> NewtonSolver<J> {
         self.dim = n;
         let start = problem.problem_counters();
         let mut counters = WorkCounters::default();
+        let mut log = Log::default();
+        let (termination, strategy, attempts, tolerance) = match self.options.globalization {
+            Globalization::Polyalgorithm {
+                full_steps,
+                memory,
+                line_search,
+            } => self.polyalgorithm(
+                problem,
+                linear,
+                x,
+                (full_steps, memory, line_search),
+                &mut counters,
+                &mut log,
+            ),
+            globalization => {
+                let rules = self.options.rules();
+                let (termination, run) =
+                    self.phase(problem, linear, x, &rules, &mut counters, &mut log);
+                let strategy = match globalization {
+                    Globalization::None => Strategy::FullSteps,
+                    Globalization::Hybrid { full_steps, .. } if run.iterations <= full_steps => {
+                        Strategy::FullSteps
+                    }
+                    _ => Strategy::LineSearch,
+                };
+                let attempt = Attempt {
+                    strategy,
+                    iterations: run.iterations,
+                    converged: termination.converged(),
+                    outcome: termination.to_string(),
+                };
+                (termination, strategy, vec![attempt], run.tolerance)
+            }
+        };
+        counters.problem = problem.problem_counters().since(&start);
+        let report = NewtonReport {
+            observed_order: observed_order(&log.residual_norms),
+            termination,
+            strategy,
+            iterations: attempts.iter().map(|a| a.iterations).sum(),
+            attempts,
+            effective_tolerance: tolerance,
+            residual_norms: log.residual_norms,
+            step_lengths: log.step_lengths,
+            step_norms: log.step_norms,
+            counters,
+        };
+        if report.converged() {
+            Ok(report)
+        } else {
+            Err(NewtonError::NotConverged(Box::new(report)))
+        }
+    }
+
+    /// One run of the kernel with the plain direction; its histories are appended to `log`.
+    fn phase<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        rules: &KernelRules,
+        counters: &mut WorkCounters,
+        log: &mut Log,
+    ) -> (Termination, kernel::Run<PlainFailure>)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
         let jacobian = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
         let mut system = PlainNewton {
-            problem: &mut *problem,
+            problem,
             solver: linear,
             jacobian,
         };
-        let rules = self.options.rules();
-        let run = self.kernel.run(&mut system, x, &rules, &mut counters);
-        counters.problem = problem.problem_counters().since(&start);
+        let run = self.kernel.run(&mut system, x, rules, counters);
+        log.residual_norms
+            .extend_from_slice(&self.kernel.residual_norms);
+        log.step_lengths
+            .extend_from_slice(&self.kernel.step_lengths);
+        log.step_norms.extend_from_slice(&self.kernel.step_norms);
         let termination = match run.stop {
             Stop::Converged => Termination::Converged,
             Stop::ConvergedAtFloor => Termination::ConvergedAtRoundoff {
@@ -578,22 +783,347 @@ impl<J> NewtonSolver<J> {
             }
             Stop::NonFinite => Termination::NonFinite,
         };
-        let residual_norms = self.kernel.residual_norms.clone();
-        let report = NewtonReport {
-            observed_order: observed_order(&residual_norms),
-            termination,
-            iterations: run.iterations,
-            effective_tolerance: run.tolerance,
-            residual_norms,
-            step_lengths: self.kernel.step_lengths.clone(),
-            step_norms: self.kernel.step_norms.clone(),
-            counters,
+        (termination, run)
+    }
+
+    /// Full steps, then the smoothing path, the line search and the Newton homotopy (see
+    /// [`Globalization::Polyalgorithm`]); the best iterate of all attempts is returned.
+    fn polyalgorithm<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        settings: (usize, usize, LineSearchOptions),
+        counters: &mut WorkCounters,
+        log: &mut Log,
+    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        // The initial guess in storage kept between solves (no allocation once sized).
+        let mut start = std::mem::take(&mut self.start);
+        start.clear();
+        start.extend_from_slice(x);
+        let result = self.attempts(problem, linear, x, &start, settings, (counters, log));
+        self.start = start;
+        result
+    }
+
+    /// The attempts of the polyalgorithm from `start` (= `x` on entry), with the run's
+    /// counters and histories.
+    fn attempts<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        start: &[f64],
+        (full_steps, memory, line_search): (usize, usize, LineSearchOptions),
+        (counters, log): (&mut WorkCounters, &mut Log),
+    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        let max_iterations = self.options.max_iterations;
+        let base = KernelRules {
+            globalization: Globalization::None,
+            max_iterations: full_steps.min(max_iterations),
+            ..self.options.rules()
         };
-        if report.converged() {
-            Ok(report)
-        } else {
-            Err(NewtonError::NotConverged(Box::new(report)))
+        let mut attempts = Vec::new();
+        let mut used = 0;
+
+        // 1. Full steps.
+        let (termination, run) = self.phase(problem, linear, x, &base, counters, log);
+        let tolerance = run.tolerance;
+        attempts.push(Attempt::new(
+            Strategy::FullSteps,
+            run.iterations,
+            &termination,
+        ));
+        used += run.iterations;
+        if termination.converged() {
+            return (termination, Strategy::FullSteps, attempts, tolerance);
         }
+        let mut best = Best::new(x, self.kernel.residual(), run.smallest);
+        let first_step = self.kernel.step_norms.first().copied().unwrap_or(f64::NAN);
+        let scale = path::state_scale(first_step, x.len());
+        let mut last = termination;
+        let mut strategy = Strategy::FullSteps;
+
+        // Full steps on F from the end of a path (it is near a root: usually a few steps).
+        let finish = |solver: &mut Self,
+                      problem: &mut P,
+                      linear: &mut S,
+                      x: &mut [f64],
+                      used: usize,
+                      counters: &mut WorkCounters,
+                      log: &mut Log| {
+            let rules = KernelRules {
+                max_iterations: max_iterations
+                    .saturating_sub(used)
+                    .clamp(1, full_steps.max(1)),
+                ..base
+            };
+            solver.phase(problem, linear, x, &rules, counters, log)
+        };
+
+        // 2. The smoothing path, when the problem offers a smoothing.
+        if let Some(mu0) = problem
+            .smoothing()
+            .map(|s| SMOOTHING_START * s.smoothing_scale())
+            .filter(|mu| mu.is_finite() && *mu > 0.0)
+        {
+            x.copy_from_slice(start);
+            let budget = max_iterations.saturating_sub(used);
+            let setup = SmoothingSetup {
+                mu0,
+                state_scale: scale,
+                tolerance,
+                budget,
+                line_search,
+            };
+            let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
+            used += outcome.iterations;
+            strategy = Strategy::Smoothing;
+            if outcome.reached {
+                let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                used += run.iterations;
+                attempts.push(Attempt::new(
+                    Strategy::Smoothing,
+                    outcome.iterations + run.iterations,
+                    &termination,
+                ));
+                if termination.converged() {
+                    return (termination, Strategy::Smoothing, attempts, tolerance);
+                }
+                best.update(x, self.kernel.residual(), run.smallest);
+                last = termination;
+            } else {
+                attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
+            }
+        }
+
+        // 3. The non-monotone line search from the initial guess, on at most half of what is
+        // left (it ends early when backtracking fails at a kink of the merit).
+        let budget = max_iterations.saturating_sub(used) / 2;
+        if budget > 0 {
+            x.copy_from_slice(start);
+            let rules = KernelRules {
+                globalization: Globalization::NonMonotone {
+                    memory,
+                    line_search,
+                },
+                max_iterations: budget,
+                ..base
+            };
+            let (termination, run) = self.phase(problem, linear, x, &rules, counters, log);
+            used += run.iterations;
+            attempts.push(Attempt::new(
+                Strategy::LineSearch,
+                run.iterations,
+                &termination,
+            ));
+            if termination.converged() {
+                return (termination, Strategy::LineSearch, attempts, tolerance);
+            }
+            best.update(x, self.kernel.residual(), run.smallest);
+            last = termination;
+            strategy = Strategy::LineSearch;
+        }
+
+        // 4. The Newton homotopy from the initial guess to t = 1.
+        let budget = max_iterations.saturating_sub(used);
+        if budget > 0 {
+            let mut f0 = vec![0.0; start.len()];
+            counters.residual_evaluations += 1;
+            if problem.residual(start, &mut f0).is_ok() && f0.iter().all(|v| v.is_finite()) {
+                x.copy_from_slice(start);
+                let plan = path::PathPlan {
+                    end: 1.0,
+                    // Ten steps over an affine path; small enough that a corner of the path (a
+                    // contact closing) is approached before it is overshot.
+                    steps: 10.0,
+                    growth: 1.0,
+                    // The state dominates the arclength: at a corner where t turns back
+                    // while the state moves on (a contact closing inside an overhang), the
+                    // arclength hyperplane still cuts the far piece.
+                    theta: 0.99,
+                    target_iterations: 5,
+                    state_scale: scale,
+                    accuracy: tolerance.max(path::PATH_ACCURACY * kernel::norm2(&f0)),
+                    budget,
+                };
+                let mut homotopy = path::NewtonHomotopy::new(&mut *problem, &f0);
+                let outcome = path::follow(&mut homotopy, &mut *linear, x, &plan);
+                *counters += outcome.counters;
+                used += outcome.iterations;
+                strategy = Strategy::Homotopy;
+                if outcome.reached {
+                    let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                    attempts.push(Attempt::new(
+                        Strategy::Homotopy,
+                        outcome.iterations + run.iterations,
+                        &termination,
+                    ));
+                    if termination.converged() {
+                        return (termination, Strategy::Homotopy, attempts, tolerance);
+                    }
+                    best.update(x, self.kernel.residual(), run.smallest);
+                    last = termination;
+                } else {
+                    attempts.push(Attempt::failed_path(Strategy::Homotopy, &outcome));
+                }
+            }
+        }
+
+        if best.restore(x) {
+            self.kernel.set_residual(&best.f);
+        }
+        (last, strategy, attempts, tolerance)
+    }
+
+    /// The smoothing path from `x`: `F_mu0(x) = 0` solved by Newton with an Armijo search
+    /// (the smoothed merit is differentiable), then followed to `mu0 10^-SMOOTHING_DECADES`.
+    fn smoothing_path<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        setup: &SmoothingSetup,
+        counters: &mut WorkCounters,
+    ) -> path::PathOutcome
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        let mut failed = path::PathOutcome {
+            reached: false,
+            iterations: 0,
+            furthest: 0.0,
+            reason: None,
+            counters: WorkCounters::default(),
+        };
+        let SmoothingSetup {
+            mu0,
+            state_scale,
+            tolerance,
+            budget,
+            line_search,
+        } = *setup;
+        let Some(mut smoothed) = path::SmoothingPath::new(&mut *problem, mu0) else {
+            return failed;
+        };
+        let mut f = vec![0.0; x.len()];
+        counters.residual_evaluations += 1;
+        if smoothed.residual(x, &mut f).is_err() {
+            failed.reason = Some("the smoothed residual cannot be evaluated at the start".into());
+            return failed;
+        }
+        let accuracy = tolerance.max(SMOOTHING_ACCURACY * kernel::norm2(&f));
+        let rules = KernelRules {
+            absolute_tolerance: accuracy,
+            relative_tolerance: 0.0,
+            globalization: Globalization::Armijo(line_search),
+            max_iterations: budget.min(SMOOTHING_START_ITERATIONS),
+            ..self.options.rules()
+        };
+        let mut scratch = Log::default();
+        // The smoothed iterates are not iterates of F: their histories are not reported.
+        let (termination, run) =
+            self.phase(&mut smoothed, linear, x, &rules, counters, &mut scratch);
+        failed.iterations = run.iterations;
+        if !termination.converged() {
+            failed.reason = Some(format!("the smoothed problem at the start: {termination}"));
+            return failed;
+        }
+        let plan = path::PathPlan {
+            end: SMOOTHING_DECADES,
+            steps: SMOOTHING_DECADES,
+            // A smooth path: the step may grow to several decades where the state barely
+            // moves (late on the path), state and parameter weigh alike.
+            growth: 4.0,
+            theta: 0.5,
+            target_iterations: 3,
+            state_scale,
+            accuracy,
+            budget: budget.saturating_sub(run.iterations),
+        };
+        let mut outcome = path::follow(&mut smoothed, &mut *linear, x, &plan);
+        *counters += outcome.counters;
+        outcome.iterations += run.iterations;
+        outcome
+    }
+}
+
+/// What the smoothing path starts from: `mu0`, the state scale of the path, the run's
+/// tolerance, the iterations left and the line search of the smoothed start.
+#[derive(Clone, Copy, Debug)]
+struct SmoothingSetup {
+    mu0: f64,
+    state_scale: f64,
+    tolerance: f64,
+    budget: usize,
+    line_search: LineSearchOptions,
+}
+
+/// The smoothing path starts at `mu = SMOOTHING_START x` the problem's smoothing scale
+/// (smaller starts leave the smoothed problem as hard as the problem itself; larger ones
+/// lengthen the path).
+const SMOOTHING_START: f64 = 1.0;
+/// Decades of `mu` the smoothing path descends before Newton on `F` takes over.
+const SMOOTHING_DECADES: f64 = 4.0;
+/// Accuracy of the smoothing path's points relative to `|F_mu0|` at the start: the end of
+/// the path must lie in the basin of semismooth Newton on `F` (1e-2 measured too loose).
+const SMOOTHING_ACCURACY: f64 = 1e-3;
+/// Newton iterations at most on the smoothed problem at the path's start.
+const SMOOTHING_START_ITERATIONS: usize = 30;
+
+/// Histories of the attempts that iterate on `F`.
+#[derive(Debug, Default)]
+struct Log {
+    residual_norms: Vec<f64>,
+    step_lengths: Vec<f64>,
+    step_norms: Vec<f64>,
+}
+
+/// The best iterate over several attempts.
+struct Best {
+    x: Vec<f64>,
+    f: Vec<f64>,
+    norm: f64,
+    /// Whether the last attempt ended elsewhere.
+    moved: bool,
+}
+
+impl Best {
+    fn new(x: &[f64], f: &[f64], norm: f64) -> Self {
+        Self {
+            x: x.to_vec(),
+            f: f.to_vec(),
+            norm,
+            moved: false,
+        }
+    }
+
+    fn update(&mut self, x: &[f64], f: &[f64], norm: f64) {
+        if norm < self.norm || self.norm.is_nan() {
+            self.x.copy_from_slice(x);
+            self.f.copy_from_slice(f);
+            self.norm = norm;
+            self.moved = false;
+        } else {
+            self.moved = true;
+        }
+    }
+
+    /// Writes the best iterate into `x` if the last attempt ended elsewhere.
+    fn restore(&self, x: &mut [f64]) -> bool {
+        if self.moved {
+            x.copy_from_slice(&self.x);
+        }
+        self.moved
     }
 }
 

@@ -478,6 +478,18 @@ impl HbState {
         self.aft.samples_multiplication_matrix(&mut jac.q[i]);
     }
 
+    /// Writes the block `P diag(w) E` of contact `i` with the weights `w_n` in the AFT's
+    /// samples (a smoothed indicator in `[0, 1]`); records the samples with `w_n > 1/2` as
+    /// active.
+    pub(crate) fn write_weighted_contact_block(
+        &mut self,
+        jac: &mut jacobian::HbJacobian,
+        i: usize,
+    ) {
+        jac.active[i] = self.aft.samples_mut().iter().filter(|w| **w > 0.5).count();
+        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+    }
+
     /// A Jacobian of this state's model at its frequency with `coupling`.
     pub(crate) fn new_jacobian(&self, coupling: ContactCoupling) -> HbJacobian {
         HbJacobian::new(self.linear.clone(), self.omega, coupling)

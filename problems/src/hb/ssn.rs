@@ -2,7 +2,7 @@
 //! equations (5)-(6)).
 
 use semismooth::harmonic::FourierBasis;
-use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
+use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual, Smoothing};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
@@ -72,6 +72,8 @@ fn check_c(c: f64) -> Result<(), HbError> {
 pub struct SsnHb {
     pub(crate) state: HbState,
     c: f64,
+    /// Smoothing parameter `mu >= 0` of `max(0, s)` (0: the formulation itself).
+    smoothing: f64,
 }
 
 impl SsnHb {
@@ -94,6 +96,7 @@ impl SsnHb {
         Ok(Self {
             state: HbState::new(linear, model.forcing.omega),
             c,
+            smoothing: 0.0,
         })
     }
 
@@ -216,8 +219,9 @@ impl Residual for SsnHb {
                 out_u[j * n + dof] -= x[offset + j * m + i];
             }
             self.switching_samples(x, i);
+            let mu = self.smoothing;
             for s in self.state.aft.samples_mut() {
-                *s = s.max(0.0);
+                *s = smoothed_max(*s, mu);
             }
             self.state.aft.samples_to_coefficients();
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
@@ -230,6 +234,10 @@ impl Residual for SsnHb {
     /// `ffts`: the transforms of the alternating frequency/time scheme.
     fn problem_counters(&self) -> ProblemCounters {
         ProblemCounters::new().with("ffts", self.state.aft.fft_count())
+    }
+
+    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
+        Some(self)
     }
 }
 
@@ -246,7 +254,74 @@ impl GeneralizedJacobian for SsnHb {
             .prepare_jacobian(jac, ContactCoupling::Complementarity { c: self.c });
         for i in 0..self.contacts() {
             self.switching_samples(x, i);
-            self.state.write_contact_block(jac, i);
+            if self.smoothing > 0.0 {
+                let mu = self.smoothing;
+                for s in self.state.aft.samples_mut() {
+                    *s = smoothed_max_slope(*s, mu);
+                }
+                self.state.write_weighted_contact_block(jac, i);
+            } else {
+                self.state.write_contact_block(jac, i);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2`, the Chen–Harker–Kanzow–Smale smoothing of
+/// `max(0, s)` (`phi_0 = max(0, .)`, `0 < phi_mu(s) - max(0, s) <= mu`).
+fn smoothed_max(s: f64, mu: f64) -> f64 {
+    if mu == 0.0 {
+        s.max(0.0)
+    } else {
+        0.5 * (s + s.hypot(2.0 * mu))
+    }
+}
+
+/// `phi_mu'(s) = (1 + s / sqrt(s^2 + 4 mu^2)) / 2`, in `(0, 1)` for `mu > 0`.
+fn smoothed_max_slope(s: f64, mu: f64) -> f64 {
+    0.5 * (1.0 + s / s.hypot(2.0 * mu))
+}
+
+/// `d phi_mu(s) / d mu = 2 mu / sqrt(s^2 + 4 mu^2)`.
+fn smoothed_max_mu_derivative(s: f64, mu: f64) -> f64 {
+    2.0 * mu / s.hypot(2.0 * mu)
+}
+
+impl Smoothing for SsnHb {
+    fn smoothing_scale(&self) -> f64 {
+        let g = self
+            .state
+            .linear
+            .gaps
+            .iter()
+            .fold(0.0f64, |a, g| a.max(g.abs()));
+        self.c * g.max(f64::MIN_POSITIVE)
+    }
+
+    fn set_smoothing(&mut self, mu: f64) {
+        self.smoothing = mu.max(0.0);
+    }
+
+    fn residual_smoothing_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        let lin = &self.state.linear;
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let offset = n * size;
+        out[..offset].fill(0.0);
+        let mu = self.smoothing;
+        for i in 0..m {
+            self.switching_samples(x, i);
+            for s in self.state.aft.samples_mut() {
+                *s = smoothed_max_mu_derivative(*s, mu);
+            }
+            self.state.aft.samples_to_coefficients();
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                out[offset + j * m + i] = *c;
+            }
         }
         Ok(())
     }

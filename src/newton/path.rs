@@ -1,0 +1,331 @@
+//! Paths that lead from the initial guess to a root, followed by the crate's
+//! pseudo-arclength continuation: the Newton homotopy and the smoothing path.
+//!
+//! # The Newton homotopy
+//!
+//! `H(x, t) = F(x) - (1 - t) F(x_0)`, followed in `t` from the initial guess `(x_0, 0)` to
+//! `t = 1`.
+//!
+//! `H(x_0, 0) = 0` exactly, `H(., 1) = F`, `∂H/∂x = J` (the problem's own generalized
+//! Jacobian) and `∂H/∂t = F(x_0)`: the path needs nothing from the problem but `F` and `J`.
+//! Its tangent at the start is the Newton direction, so on a problem that is affine along
+//! the path one step of length 1 reaches `t = 1`; where the plain iteration cycles between
+//! active sets or a line search stalls at a kink of the merit, the path moves through the
+//! kinks one at a time, passing turning points in `t` (where `J` is singular) by the
+//! arclength constraint (Keller 1978; Allgower & Georg, *Introduction to Numerical
+//! Continuation Methods*, ch. 11 on the global Newton method). For a forced structure with
+//! open contacts at `x_0 = 0`, `F(x_0)` is minus the forcing and the path is the load
+//! homotopy: contacts close one after the other as the forcing grows. Its path is only
+//! piecewise smooth (a kink wherever a switching quantity changes sign), which costs steps.
+//!
+//! # The smoothing path
+//!
+//! For a problem with a [`Smoothing`], `F_mu(x) = 0` followed from `mu_0` down to
+//! `mu_0 10^(-decades)` in the parameter `p = log10(mu_0 / mu)` (so
+//! `dF/dp = -ln(10) mu dF_mu/dmu`). The path is smooth (every kink of `F` is rounded off over
+//! a width `mu`), so its steps are long; near its end the iterate lies within `O(mu)` of a
+//! root of `F`, where semismooth Newton on `F` terminates in a few steps (Chen, Harker,
+//! Kanzow & Smale; Qi, Sun & Zhou 2000, *A new look at smoothing Newton methods*). Turning
+//! points in `mu` (where several roots coexist) are passed by the arclength.
+
+use crate::continuation::{
+    Continuation, ContinuationOptions, ContinuationTermination, Direction, RestartPolicy,
+};
+use crate::{
+    EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
+    Smoothing,
+};
+
+use super::WorkCounters;
+
+/// `H(x, t) = F(x) - (1 - t) F(x_0)` around a problem `F`.
+pub(crate) struct NewtonHomotopy<'a, P: ?Sized> {
+    problem: &'a mut P,
+    start_residual: Vec<f64>,
+    t: f64,
+}
+
+impl<P: Residual + ?Sized> Residual for NewtonHomotopy<'_, P> {
+    fn dim(&self) -> usize {
+        self.problem.dim()
+    }
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        self.problem.residual(x, out)?;
+        let s = 1.0 - self.t;
+        for (o, r) in out.iter_mut().zip(&self.start_residual) {
+            *o -= s * r;
+        }
+        Ok(())
+    }
+
+    fn problem_counters(&self) -> ProblemCounters {
+        self.problem.problem_counters()
+    }
+}
+
+impl<P: GeneralizedJacobian + ?Sized> GeneralizedJacobian for NewtonHomotopy<'_, P> {
+    type Jacobian = P::Jacobian;
+
+    fn new_jacobian(&self) -> P::Jacobian {
+        self.problem.new_jacobian()
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut P::Jacobian) -> Result<(), EvaluationError> {
+        self.problem.jacobian(x, jac)
+    }
+}
+
+impl<P: Residual + ?Sized> ParameterDependent for NewtonHomotopy<'_, P> {
+    fn parameter(&self) -> f64 {
+        self.t
+    }
+
+    fn set_parameter(&mut self, t: f64) {
+        self.t = t;
+    }
+
+    fn residual_parameter_derivative(
+        &mut self,
+        _x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        out.copy_from_slice(&self.start_residual);
+        Ok(())
+    }
+}
+
+impl<'a, P: Residual + ?Sized> NewtonHomotopy<'a, P> {
+    /// The homotopy around `problem` from a point where `F = start_residual`, at `t = 0`.
+    pub(crate) fn new(problem: &'a mut P, start_residual: &[f64]) -> Self {
+        Self {
+            problem,
+            start_residual: start_residual.to_vec(),
+            t: 0.0,
+        }
+    }
+}
+
+/// `F_mu(x)` with `mu = mu_0 10^(-p)`, the parameter `p` (see the module docs). Dropping it
+/// sets the problem's smoothing back to 0.
+pub(crate) struct SmoothingPath<'a, P: Residual + ?Sized> {
+    problem: &'a mut P,
+    mu0: f64,
+    p: f64,
+}
+
+impl<'a, P: Residual + ?Sized> SmoothingPath<'a, P> {
+    /// The path of `problem` at `p = 0` (`mu = mu0`); `None` when the problem offers no
+    /// smoothing.
+    pub(crate) fn new(problem: &'a mut P, mu0: f64) -> Option<Self> {
+        problem.smoothing()?.set_smoothing(mu0);
+        Some(Self {
+            problem,
+            mu0,
+            p: 0.0,
+        })
+    }
+
+    fn mu(&self) -> f64 {
+        self.mu0 * 10f64.powf(-self.p)
+    }
+
+    fn smoothing(&mut self) -> &mut dyn Smoothing {
+        self.problem
+            .smoothing()
+            .expect("a SmoothingPath is only built for a problem with a smoothing")
+    }
+}
+
+impl<P: Residual + ?Sized> Drop for SmoothingPath<'_, P> {
+    fn drop(&mut self) {
+        self.smoothing().set_smoothing(0.0);
+    }
+}
+
+impl<P: Residual + ?Sized> Residual for SmoothingPath<'_, P> {
+    fn dim(&self) -> usize {
+        self.problem.dim()
+    }
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        self.problem.residual(x, out)
+    }
+
+    fn problem_counters(&self) -> ProblemCounters {
+        self.problem.problem_counters()
+    }
+}
+
+impl<P: GeneralizedJacobian + ?Sized> GeneralizedJacobian for SmoothingPath<'_, P> {
+    type Jacobian = P::Jacobian;
+
+    fn new_jacobian(&self) -> P::Jacobian {
+        self.problem.new_jacobian()
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut P::Jacobian) -> Result<(), EvaluationError> {
+        self.problem.jacobian(x, jac)
+    }
+}
+
+impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+        let mu = self.mu();
+        self.smoothing().set_smoothing(mu);
+    }
+
+    fn residual_parameter_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        let factor = -std::f64::consts::LN_10 * self.mu();
+        self.smoothing().residual_smoothing_derivative(x, out)?;
+        for o in out.iter_mut() {
+            *o *= factor;
+        }
+        Ok(())
+    }
+}
+
+/// How a path-following attempt ended.
+#[derive(Clone, Debug)]
+pub(crate) struct PathOutcome {
+    /// The end of the path was reached (`x` is then on the path there, to the accuracy).
+    pub reached: bool,
+    /// Corrector iterations spent (failed attempts included).
+    pub iterations: usize,
+    /// Largest parameter reached.
+    pub furthest: f64,
+    /// Why the path ended when it did not reach its end.
+    pub reason: Option<String>,
+    /// Work done.
+    pub counters: WorkCounters,
+}
+
+/// Where a path goes and how: from parameter 0 to `end`, first steps of `1 / steps` of the
+/// path's length, growing up to `growth` times that; the state lengths measured in
+/// `state_scale` with the weight `theta`; points to `accuracy` (the corrector aims at
+/// `target_iterations` and rejects a step after one more); at most `budget` corrector
+/// iterations.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathPlan {
+    pub end: f64,
+    pub steps: f64,
+    pub growth: f64,
+    pub theta: f64,
+    pub target_iterations: usize,
+    pub state_scale: f64,
+    pub accuracy: f64,
+    pub budget: usize,
+}
+
+/// Continuation settings of a path (lengths in the θ-norm of [`crate::continuation`]: the
+/// parameter measured in units of the whole path, the state in `plan.state_scale`).
+fn path_options(n: usize, plan: &PathPlan) -> ContinuationOptions {
+    let step = 1.0 / plan.steps;
+    ContinuationOptions {
+        // Small enough that a corner of the path (a contact closing) is approached before
+        // it is overshot.
+        initial_step: step,
+        max_step: step * plan.growth,
+        min_step: 1e-4 * step,
+        max_consecutive_failures: 8,
+        max_corrector_iterations: plan.target_iterations + 1,
+        target_iterations: plan.target_iterations,
+        theta: plan.theta,
+        corrector_tolerance: plan.accuracy,
+        parameter_min: -plan.end,
+        parameter_max: plan.end,
+        parameter_scale: plan.end,
+        state_scale: Some(vec![plan.state_scale; n]),
+        direction: Direction::Increasing,
+        refine_folds: false,
+        restarts: Some(RestartPolicy::default()),
+        ..ContinuationOptions::default()
+    }
+}
+
+/// Relative accuracy of the points along a path, `|H| <= PATH_ACCURACY |F(x_0)|`: the path
+/// only leads to its end, where Newton on `F` finishes to the run's tolerance.
+pub(crate) const PATH_ACCURACY: f64 = 1e-2;
+
+/// The state scale of a path from the norm of the first Newton step (per component).
+pub(crate) fn state_scale(first_step_norm: f64, n: usize) -> f64 {
+    if first_step_norm.is_finite() && first_step_norm > 0.0 {
+        first_step_norm / (n as f64).sqrt()
+    } else {
+        1.0
+    }
+}
+
+/// Follows `homotopy` from `(x, 0)` to the parameter `plan.end` within `plan.budget`
+/// corrector iterations; on success `x` is the end of the path.
+pub(crate) fn follow<H, S>(
+    homotopy: &mut H,
+    solver: &mut S,
+    x: &mut [f64],
+    plan: &PathPlan,
+) -> PathOutcome
+where
+    H: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<H::Jacobian> + ?Sized,
+{
+    let n = x.len();
+    let options = path_options(n, plan);
+    let mut outcome = PathOutcome {
+        reached: false,
+        iterations: 0,
+        furthest: 0.0,
+        reason: None,
+        counters: WorkCounters::default(),
+    };
+    let start = x.to_vec();
+    let mut continuation = match Continuation::new(homotopy, solver, &start, 0.0, options) {
+        Ok(c) => c,
+        Err(e) => {
+            outcome.reason = Some(e.to_string());
+            return outcome;
+        }
+    };
+    let mut last = 0.0;
+    while let Some(item) = continuation.next() {
+        match item {
+            Ok(point) => {
+                outcome.furthest = outcome.furthest.max(point.parameter);
+                last = point.parameter;
+                x.copy_from_slice(&point.state);
+            }
+            Err(e) => {
+                outcome.reason = Some(e.to_string());
+                break;
+            }
+        }
+        if continuation.counters().corrector_iterations as usize >= plan.budget {
+            outcome.reason = Some(format!("the iteration budget ({}) was spent", plan.budget));
+            break;
+        }
+    }
+    let counters = continuation.counters();
+    outcome.iterations = counters.corrector_iterations as usize;
+    outcome.counters = counters.work;
+    match continuation.termination() {
+        Some(ContinuationTermination::ReachedBound { parameter, bound })
+            if *bound == plan.end && *parameter == plan.end =>
+        {
+            outcome.reached = true;
+        }
+        Some(t) if outcome.reason.is_none() => outcome.reason = Some(t.to_string()),
+        _ => {}
+    }
+    if !outcome.reached && outcome.reason.is_none() {
+        outcome.reason = Some(format!("the path ended at {last}"));
+    }
+    outcome
+}
