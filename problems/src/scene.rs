@@ -393,13 +393,18 @@ impl Check<'_> {
 }
 
 impl Scene {
-    /// Reads and validates a scene file.
+    /// Reads and validates a scene file (a regular file of at most
+    /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
     pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        // Only a regular file of at most 1 MiB: a FIFO would block, a device never end.
+        let text =
+            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
+                SceneError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         Scene::from_toml(&text, path)
     }
 

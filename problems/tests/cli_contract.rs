@@ -1,0 +1,286 @@
+//! The `ssn` program's contract under hostile conditions: standard output that is full,
+//! closed or a closed pipe (exit code 3, never a panic), scene inputs that are not regular
+//! files, outputs that are not regular files or clash with each other or the scene, the
+//! all-or-nothing rule for several outputs, `--quiet`, `--out` where it does not apply and
+//! control characters in a scene's title.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+const SSN: &str = env!("CARGO_BIN_EXE_ssn");
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .to_str()
+        .expect("utf-8 path")
+        .to_string()
+}
+
+fn fig1() -> String {
+    scene("paper_fig1_modified_mass.toml")
+}
+
+fn ssn(args: &[&str]) -> Output {
+    Command::new(SSN).args(args).output().expect("ssn runs")
+}
+
+fn ssn_with_stdout(args: &[&str], stdout: Stdio) -> Output {
+    Command::new(SSN)
+        .args(args)
+        .stdout(stdout)
+        .stderr(Stdio::piped())
+        .output()
+        .expect("ssn runs")
+}
+
+fn err(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn out(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn assert_exit(o: &Output, code: i32, what: &str) {
+    assert_eq!(o.status.code(), Some(code), "{what}: stderr {}", err(o));
+    assert!(!err(o).contains("panicked"), "{what}: {}", err(o));
+}
+
+/// Every subcommand that prints something, as `ssn` arguments.
+fn printing_commands() -> Vec<Vec<String>> {
+    let sweep = scene("paper_fig2.toml");
+    vec![
+        vec!["solve".into(), fig1(), "--json".into()],
+        vec!["solve".into(), fig1()],
+        vec!["sweep".into(), sweep.clone(), "--json".into()],
+        vec!["sweep".into(), sweep],
+        vec!["scene-check".into(), fig1()],
+        vec!["--help".into()],
+        vec!["solve".into(), "--help".into()],
+    ]
+}
+
+#[test]
+fn a_full_standard_output_exits_3_in_every_command() {
+    for args in printing_commands() {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let full = File::options().write(true).open("/dev/full").unwrap();
+        let o = ssn_with_stdout(&args, Stdio::from(full));
+        assert_exit(&o, 3, &args.join(" "));
+        assert!(err(&o).contains("standard output"), "{}", err(&o));
+    }
+}
+
+#[test]
+fn a_closed_pipe_exits_3_in_every_command() {
+    for args in printing_commands() {
+        let mut child = Command::new(SSN)
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the reading end before the program writes anything.
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        assert_exit(&o, 3, &args.join(" "));
+    }
+}
+
+#[test]
+fn a_closed_standard_output_exits_3_and_dev_null_stays_a_silent_output() {
+    for args in printing_commands() {
+        let o = Command::new("sh")
+            .arg("-c")
+            .arg("exec \"$0\" \"$@\" >&-")
+            .arg(SSN)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_exit(&o, 3, &args.join(" "));
+        assert!(err(&o).contains("closed"), "{}", err(&o));
+    }
+    let null = File::options().write(true).open("/dev/null").unwrap();
+    let o = ssn_with_stdout(&["solve", &fig1(), "--json"], Stdio::from(null));
+    assert_exit(&o, 0, "> /dev/null");
+}
+
+#[test]
+fn a_fifo_a_device_a_directory_or_a_huge_file_is_not_read_as_a_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("scene.fifo");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let huge = dir.path().join("huge.toml");
+    std::fs::write(&huge, vec![b'#'; (1 << 20) + 1]).unwrap();
+    for (path, says) in [
+        (fifo.clone(), "a FIFO"),
+        (PathBuf::from("/dev/zero"), "a device"),
+        (dir.path().to_path_buf(), "a directory"),
+        (huge, "limit of 1048576 bytes"),
+    ] {
+        let p = path.to_str().unwrap();
+        // A FIFO without a writer would block this test forever if it were opened.
+        let o = ssn(&["solve", p]);
+        assert_exit(&o, 2, p);
+        assert!(err(&o).contains(p) && err(&o).contains(says), "{}", err(&o));
+    }
+}
+
+#[test]
+fn an_output_that_is_a_symlink_or_a_device_is_refused_and_left_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("target.txt");
+    std::fs::write(&target, "keep").unwrap();
+    let link = dir.path().join("link.csv");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    for flag in ["--csv", "--svg"] {
+        for path in [link.to_str().unwrap(), "/dev/null"] {
+            let o = ssn(&["solve", &fig1(), "--json", flag, path]);
+            assert_exit(&o, 3, path);
+            assert!(err(&o).contains("only regular files"), "{}", err(&o));
+            assert!(out(&o).is_empty(), "nothing printed before the refusal");
+        }
+    }
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep");
+    // As root a regular file would have replaced the device: it is still one.
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+}
+
+#[test]
+fn an_output_on_the_scene_or_two_outputs_on_one_file_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("s.toml");
+    std::fs::copy(fig1(), &scene_path).unwrap();
+    let before = std::fs::read_to_string(&scene_path).unwrap();
+    let s = scene_path.to_str().unwrap();
+    let o = ssn(&["solve", s, "--csv", s]);
+    assert_exit(&o, 2, "--csv SCENE");
+    assert!(err(&o).contains("the scene") && err(&o).contains("--csv"));
+    let same = dir.path().join("x");
+    let x = same.to_str().unwrap();
+    let o = ssn(&["solve", s, "--csv", x, "--svg", x]);
+    assert_exit(&o, 2, "--csv X --svg X");
+    assert!(err(&o).contains("--csv and --svg"), "{}", err(&o));
+    let o = ssn(&["solve", s, "--json", "--csv", "-"]);
+    assert_exit(&o, 2, "--json --csv -");
+    assert_eq!(std::fs::read_to_string(&scene_path).unwrap(), before);
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1, "only the scene is left");
+}
+
+#[test]
+fn several_outputs_are_written_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("t.csv");
+    let svg = dir.path().join("missing").join("t.svg");
+    let o = ssn(&[
+        "solve",
+        &fig1(),
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 3, "svg into a missing directory");
+    assert!(out(&o).is_empty(), "no JSON for a run whose outputs failed");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "the CSV (or a temporary file) was left behind"
+    );
+}
+
+#[test]
+fn a_dash_writes_the_csv_to_standard_output() {
+    let o = ssn(&["solve", &fig1(), "--quiet", "--csv", "-"]);
+    assert_exit(&o, 0, "--csv -");
+    let text = out(&o);
+    assert!(text.starts_with("t,u_tip,lambda_0\n"), "{text}");
+    assert_eq!(text.lines().count(), 1025);
+    // Without --quiet the text summary already has standard output.
+    let o = ssn(&["solve", &fig1(), "--csv", "-"]);
+    assert_exit(&o, 2, "--csv - with the summary");
+}
+
+#[test]
+fn quiet_prints_nothing_but_errors_and_json() {
+    for args in [
+        vec!["solve", "--quiet"],
+        vec!["scene-check", "-q"],
+        vec!["sweep", "--quiet"],
+    ] {
+        let path = if args[0] == "sweep" {
+            scene("paper_fig2.toml")
+        } else {
+            fig1()
+        };
+        let mut a = args.clone();
+        a.insert(1, &path);
+        let o = ssn(&a);
+        assert_exit(&o, 0, &a.join(" "));
+        assert!(out(&o).is_empty() && err(&o).is_empty(), "{}", out(&o));
+    }
+    let o = ssn(&["solve", &fig1(), "--quiet", "--json"]);
+    assert_exit(&o, 0, "--quiet --json");
+    assert!(out(&o).contains("\"converged\": true"));
+    let o = ssn(&["solve", "/nonexistent.toml", "--quiet"]);
+    assert_exit(&o, 2, "missing scene");
+    assert!(err(&o).contains("/nonexistent.toml"));
+}
+
+#[test]
+fn out_is_refused_where_it_does_not_apply() {
+    for cmd in ["solve", "scene-check", "sweep"] {
+        let o = ssn(&[cmd, &fig1(), "--out", "somewhere"]);
+        assert_exit(&o, 2, cmd);
+        assert!(
+            err(&o).contains("--out") && err(&o).contains(cmd),
+            "{}",
+            err(&o)
+        );
+        assert!(!Path::new("somewhere").exists());
+    }
+}
+
+#[test]
+fn control_characters_of_a_title_are_escaped_by_scene_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fig1()).unwrap();
+    let text = format!(
+        "title = \"red \\u001b[31mALERT\\r\"\n{}",
+        strip_title(&text)
+    );
+    let path = dir.path().join("ansi.toml");
+    std::fs::write(&path, text).unwrap();
+    let o = ssn(&["scene-check", path.to_str().unwrap()]);
+    assert_exit(&o, 0, "scene-check");
+    let printed = out(&o);
+    assert!(!printed.contains('\u{1b}') && !printed.contains('\r'));
+    assert!(
+        printed.contains("title             red \\u{1b}[31mALERT\\u{d}"),
+        "{printed}"
+    );
+}
+
+fn strip_title(text: &str) -> String {
+    text.lines()
+        .filter(|l| !l.starts_with("title"))
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
