@@ -52,9 +52,17 @@ fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
-/// Loads a scene and builds its rod.
+/// Loads a scene and builds its rod, after checking that one run of its method fits in
+/// memory ([`crate::limits`]).
 pub fn load(path: &Path) -> Result<(Scene, RodModel), CliError> {
+    load_checked(path, false)
+}
+
+/// [`load`], with the memory of `ssn compare`'s runs when `compare`.
+fn load_checked(path: &Path, compare: bool) -> Result<(Scene, RodModel), CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let need = crate::limits::scene_memory(&scene, compare);
+    crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
     let rod = build_rod(&scene.rod).map_err(|e| input_error(path, e))?;
     Ok((scene, rod))
 }
@@ -407,7 +415,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
         )));
     }
-    let (scene, rod) = load(path)?;
+    let (scene, rod) = load_checked(path, true)?;
     prepare_directory(out)?;
     let bar = progress_spinner("compare", quiet);
     let say = |line: &str| {

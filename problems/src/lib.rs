@@ -11,6 +11,7 @@ pub mod figures;
 pub mod hb;
 pub mod io;
 pub mod lcp;
+pub mod limits;
 pub mod march;
 pub mod model;
 pub mod output;

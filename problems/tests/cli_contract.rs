@@ -284,3 +284,54 @@ fn strip_title(text: &str) -> String {
         .map(|l| format!("{l}\n"))
         .collect()
 }
+
+/// A scene of `elements` elements with the given `[solver]` lines, in `dir`.
+fn sized_scene(dir: &Path, elements: usize, solver: &str) -> String {
+    let path = dir.join(format!("e{elements}.toml"));
+    std::fs::write(
+        &path,
+        format!(
+            "[rod]\nelements = {elements}\nmass = \"modified\"\n[forcing]\namplitude = 0.04\n\
+             omega_ratio = 1.0\n[contact]\ngap = 0.5\n[solver]\n{solver}\n"
+        ),
+    )
+    .unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn a_run_too_large_for_memory_is_refused_up_front_naming_the_keys_need_and_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let ssn_limited = |args: &[&str]| {
+        Command::new(SSN)
+            .args(args)
+            .env("SSN_MEMORY_LIMIT", "4e9")
+            .output()
+            .unwrap()
+    };
+    // Ten million elements at H = 20: about 130 GB.
+    let huge = sized_scene(dir.path(), 10_000_000, "harmonics = 20");
+    for cmd in ["solve", "sweep", "scene-check"] {
+        let o = ssn_limited(&[cmd, &huge]);
+        assert_exit(&o, 2, cmd);
+        for word in [huge.as_str(), "rod.elements", "GB", "4.0 GB available"] {
+            assert!(err(&o).contains(word), "{cmd} {word}: {}", err(&o));
+        }
+    }
+    // The dense solver on 400 elements at H = 40: 32,481 unknowns, about 10.6 GB.
+    let dense = sized_scene(dir.path(), 400, "harmonics = 40\nlinear_solver = \"dense\"");
+    let o = ssn_limited(&["solve", &dense]);
+    assert_exit(&o, 2, "dense");
+    for word in [
+        "solver.linear_solver",
+        "32481 unknowns",
+        "\"structured\" needs",
+    ] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // ssn compare runs the SSN-HB reference at H = 320: refused at 10^5 elements.
+    let large = sized_scene(dir.path(), 100_000, "harmonics = 20");
+    let o = ssn_limited(&["compare", &large, "--out", dir.path().to_str().unwrap()]);
+    assert_exit(&o, 2, "compare");
+    assert!(err(&o).contains("solver.harmonics"), "{}", err(&o));
+}
