@@ -684,7 +684,13 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
     let mut observed = vec![tip];
     observed.extend(model.contacts.iter().map(|c| c.dof));
     let start = Instant::now();
-    let period = march_to_steady_state(model, &options, &observed)?;
+    // A march that does not settle is a run that did not converge: its last period is
+    // reported with the last period-to-period change.
+    let (period, steady) = match march_to_steady_state(model, &options, &observed) {
+        Ok(period) => (period, true),
+        Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
+        Err(e) => return Err(e.into()),
+    };
     let seconds = start.elapsed().as_secs_f64();
     // Drop the closing sample (t = T repeats t = 0).
     let keep = period.times.len().saturating_sub(1).max(1);
@@ -698,8 +704,16 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         .map(|t| t - start_time)
         .collect();
     let outcome = Outcome {
-        converged: true,
-        termination: "converged".into(),
+        converged: steady,
+        termination: if steady {
+            "converged".into()
+        } else {
+            format!(
+                "not-steady: period-to-period change {:.3e} above the tolerance {:e} after {} \
+                 periods (solver.max_periods)",
+                period.period_change, settings.march_tolerance, period.periods
+            )
+        },
         iterations: period.periods,
         residual_norm: period.period_change,
         effective_tolerance: Some(settings.march_tolerance),

@@ -335,3 +335,33 @@ fn a_run_too_large_for_memory_is_refused_up_front_naming_the_keys_need_and_limit
     assert_exit(&o, 2, "compare");
     assert!(err(&o).contains("solver.harmonics"), "{}", err(&o));
 }
+
+#[test]
+fn a_march_that_does_not_settle_exits_1_with_its_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = sized_scene(
+        dir.path(),
+        20,
+        "method = \"march\"\nsteps_per_period = 200\nmax_periods = 3",
+    );
+    let o = ssn(&["solve", &path, "--json"]);
+    assert_exit(&o, 1, "march");
+    let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+    assert_eq!(json["converged"], false);
+    assert_eq!(json["iterations"], 3, "{json}");
+    let termination = json["termination"].as_str().unwrap();
+    assert!(
+        termination.starts_with("not-steady") && termination.contains("solver.max_periods"),
+        "{termination}"
+    );
+    // The last change is reported and is above the tolerance the run was judged against.
+    let change = json["residual_norm"].as_f64().unwrap();
+    let tolerance = json["effective_tolerance"].as_f64().unwrap();
+    assert!(change > tolerance && change.is_finite(), "{json}");
+    // The answer of the last period is there: the tip moved and stayed behind the gap.
+    let (tip_min, tip_max) = (
+        json["tip_min"].as_f64().unwrap(),
+        json["tip_max"].as_f64().unwrap(),
+    );
+    assert!(tip_min < tip_max && tip_max <= 0.5 + 1e-12, "{json}");
+}
