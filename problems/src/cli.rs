@@ -225,6 +225,7 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "tip_min": finite_or_null(s.stats.min),
         "max_penetration": finite_or_null(s.stats.max_penetration),
         "contact_force_mean": finite_or_null(s.stats.mean_contact_force),
+        "contacts": s.contacts.iter().map(|c| c.to_json()).collect::<Vec<_>>(),
         "counters": counters_json(&s.counters),
     });
     if let Some(h) = s.harmonics {
@@ -317,6 +318,19 @@ fn solution_text(s: &Solution) -> String {
         )?;
         writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
         writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        if s.contacts.len() > 1 {
+            for c in &s.contacts {
+                writeln!(
+                    t,
+                    "  contact node {:<4} mean force {:.6e}, in contact {:.1} % of the period, \
+                     max penetration {:.3e}",
+                    c.node,
+                    c.force_mean,
+                    100.0 * c.contact_fraction,
+                    c.max_penetration
+                )?;
+            }
+        }
         writeln!(
             t,
             "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",

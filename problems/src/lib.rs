@@ -6,6 +6,7 @@
 //! Shi & Legrand, and the formulations that solve it.
 
 pub mod cli;
+pub mod contacts;
 mod dynamic;
 pub mod figures;
 pub mod hb;

@@ -56,7 +56,9 @@ enum Command {
         JSON fields: scene, method, harmonics (HB only), time_samples, omega, omega_ratio,\n  \
         converged, termination, iterations, residual_norm, effective_tolerance,\n  \
         solve_seconds, tip_max, tip_min,\n  \
-        max_penetration, contact_force_mean, c (SSN-HB), counters {residual_evaluations,\n  \
+        max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
+        gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
+        displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \
         jacobian_evaluations, factorizations, linear_solves, ffts, ...}\n\n"
     )]
     Solve(RunArgs),

@@ -16,6 +16,7 @@ use semismooth::newton::{
 };
 use semismooth::{GeneralizedJacobian, Residual};
 
+use crate::contacts::{contact_reports, ContactReport};
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
@@ -167,8 +168,11 @@ pub struct Solution {
     pub tip: Vec<f64>,
     /// Contact forces at `times`, one series per contact.
     pub contact_forces: Vec<Vec<f64>>,
-    /// Tip statistics (penetration over all contacts, mean force of the first contact).
+    /// Tip statistics (penetration over all contacts; the mean contact force is the sum of
+    /// the contacts' mean forces).
     pub stats: PeriodStatistics,
+    /// Every contact point over the period.
+    pub contacts: Vec<ContactReport>,
     /// Work counters.
     pub counters: RunCounters,
     /// The method's unknowns (HB coefficients, LCP z), for warm starts.
@@ -359,8 +363,25 @@ fn solution(
     state: Vec<f64>,
 ) -> Solution {
     let method = settings.method;
+    let contacts = contact_reports(
+        &rod.model
+            .contacts
+            .iter()
+            .map(|c| (c.dof, c.gap))
+            .collect::<Vec<_>>(),
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    let mut stats = statistics(
+        rod,
+        &period.tip,
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    stats.mean_contact_force = contacts.iter().map(|c| c.force_mean).sum();
     Solution {
         method,
+        contacts,
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         c: None,
@@ -376,12 +397,7 @@ fn solution(
             .newton
             .map_or_else(Vec::new, |r| r.residual_norms.clone()),
         solve_seconds: outcome.solve_seconds,
-        stats: statistics(
-            rod,
-            &period.tip,
-            &period.contact_forces,
-            &period.contact_displacements,
-        ),
+        stats,
         times: period.times,
         tip: period.tip,
         contact_forces: period.contact_forces,
@@ -530,12 +546,11 @@ pub fn solve_rod(
             // finer grid resolves narrow force peaks the quadrature does not).
             if problem.contacts() > 0 {
                 let summary = problem.summary(&sol.state, tip, points)?;
-                let tip_contact = model
-                    .contacts
-                    .iter()
-                    .position(|c| c.dof == tip)
-                    .unwrap_or(0);
-                sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
+                for (c, mean) in sol.contacts.iter_mut().zip(&summary.contact_force_mean) {
+                    // (+0 for a contact that never closes, not -0.)
+                    c.force_mean = if *mean == 0.0 { 0.0 } else { *mean };
+                }
+                sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
             }
             Ok(sol)
         }
