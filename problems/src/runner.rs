@@ -595,7 +595,11 @@ fn solve_lcp(
                         report.pivots
                     )
                 }
-                LemkeTermination::PivotLimit => format!("pivot-limit ({})", report.pivots),
+                LemkeTermination::PivotLimit => format!(
+                    "pivot-limit ({}): the tip values are those of the unfinished path's last \
+                     basis, not of a solution",
+                    report.pivots
+                ),
             };
             let counters = RunCounters {
                 lemke_pivots: report.pivots as u64,

@@ -411,3 +411,26 @@ fn every_contact_is_reported_and_the_mean_force_is_their_sum() {
     let rel = (force(&ssn_hb) - force(&penalty)).abs() / force(&ssn_hb).abs();
     assert!(rel < 0.02, "{rel:e}");
 }
+
+#[test]
+fn lemke_at_its_pivot_limit_marks_its_values_as_those_of_an_unfinished_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(scene("paper_fig1.toml"))
+        .unwrap()
+        .replace(
+            "method = \"ssn-hb\"",
+            "method = \"lcp-lemke\"\ntime_samples = 256",
+        );
+    let path = dir.path().join("lemke.toml");
+    std::fs::write(&path, text).unwrap();
+    let o = ssn(&["solve", path.to_str().unwrap(), "--json"]);
+    assert_exit(&o, 1, "lemke");
+    let json: serde_json::Value = serde_json::from_str(&out(&o)).unwrap();
+    let termination = json["termination"].as_str().unwrap();
+    assert!(
+        termination.starts_with("pivot-limit") && termination.contains("unfinished path"),
+        "{termination}"
+    );
+    // The pivot limit measured on this scene (consistent mass, Nt = 256).
+    assert_eq!(json["iterations"], 12900, "{json}");
+}
