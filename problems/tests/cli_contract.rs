@@ -434,3 +434,61 @@ fn lemke_at_its_pivot_limit_marks_its_values_as_those_of_an_unfinished_path() {
     // The pivot limit measured on this scene (consistent mass, Nt = 256).
     assert_eq!(json["iterations"], 12900, "{json}");
 }
+
+#[test]
+fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |name: &str, rod: &str, rest: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(
+            &path,
+            format!(
+                "[rod]\n{rod}\n{rest}\n[forcing]\namplitude = 0.04\n[contact]\ngap = 0.5\n\
+                 [solver]\n"
+            ),
+        )
+        .unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    for (path, words) in [
+        (
+            scene("one.toml", "elements = 1\nmass = \"modified\"", ""),
+            &["rod.elements", "= 1", "at least 2"][..],
+        ),
+        (
+            scene("long.toml", "elements = 20\nlength = 1e300", ""),
+            &["rod.length", "1e300", "[1e-100, 1e100]"][..],
+        ),
+        (
+            scene("short.toml", "elements = 20\nlength = 5e-324", ""),
+            &["rod.length", "5e-324", "[1e-100, 1e100]"][..],
+        ),
+        (
+            scene(
+                "rayleigh.toml",
+                "elements = 20",
+                "[damping]\nmodel = \"rayleigh\"",
+            ),
+            &["damping.model", "rayleigh", "alpha", "beta"][..],
+        ),
+        (
+            scene("overflow.toml", "elements = 20\nlength = 1e309", ""),
+            &["line 3", "overflowed", "allowed", "1.7976931348623157e308"][..],
+        ),
+    ] {
+        let o = ssn(&["solve", &path]);
+        assert_exit(&o, 2, &path);
+        for word in std::iter::once(path.as_str()).chain(words.iter().copied()) {
+            assert!(err(&o).contains(word), "{word}: {}", err(&o));
+        }
+    }
+    let lcp = scene("lcp.toml", "elements = 20", "").to_string();
+    let text =
+        std::fs::read_to_string(&lcp).unwrap() + "method = \"lcp-lemke\"\ntime_samples = 10000\n";
+    std::fs::write(&lcp, text).unwrap();
+    let o = ssn(&["solve", &lcp]);
+    assert_exit(&o, 2, "lcp");
+    for word in ["solver.time_samples", "10000", "8192"] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+}
