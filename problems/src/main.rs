@@ -2,7 +2,7 @@
 //!
 //! Without a subcommand it reproduces the paper's figures into `./out/`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -105,9 +105,9 @@ fn main() -> ExitCode {
     io::set_quiet(args.quiet);
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
     let result = match &args.command {
-        None => figures::default_run(&out, args.quiet),
+        None => in_new_directory(&out, || figures::default_run(&out, args.quiet)),
         Some(Command::Compare { scene, accuracy }) => {
-            cli::compare(scene, &out, *accuracy, args.quiet)
+            in_new_directory(&out, || cli::compare(scene, &out, *accuracy, args.quiet))
         }
         Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
             "--out applies only to the default run and `ssn compare`; `ssn {}` writes the \
@@ -130,6 +130,27 @@ fn main() -> ExitCode {
             ExitCode::from(3)
         }
     }
+}
+
+/// Runs `run`, which writes into the directory `out`; when `out` did not exist before and
+/// the run fails, the directories it created (from the outermost one that did not exist)
+/// are removed with what was written into them, so a failed run leaves nothing behind.
+fn in_new_directory(
+    out: &Path,
+    run: impl FnOnce() -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    // The outermost ancestor of `out` that does not exist yet (the run creates it).
+    let created = out
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .take_while(|a| std::fs::symlink_metadata(a).is_err())
+        .last()
+        .map(Path::to_path_buf);
+    let result = run();
+    if let (Err(_), Some(created)) = (&result, created) {
+        let _ = std::fs::remove_dir_all(created);
+    }
+    result
 }
 
 impl Command {

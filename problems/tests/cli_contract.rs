@@ -492,3 +492,18 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
         assert!(err(&o).contains(word), "{word}: {}", err(&o));
     }
 }
+
+#[test]
+fn a_default_run_that_fails_leaves_no_directory_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("new").join("out");
+    // The figures are written, then the summary cannot be printed: exit 3, and the
+    // directory the run created is gone with its files.
+    let full = File::options().write(true).open("/dev/full").unwrap();
+    let o = ssn_with_stdout(&["--out", out_dir.to_str().unwrap()], Stdio::from(full));
+    assert_exit(&o, 3, "default run");
+    assert!(
+        !dir.path().join("new").exists(),
+        "the output directory was left behind"
+    );
+}
