@@ -155,10 +155,10 @@ impl PeriodicLcpOptions {
         let nt = self.time_samples;
         if nt < MIN_LCP_TIME_SAMPLES || contacts.saturating_mul(nt) > MAX_LCP_SIZE {
             return Err(LcpError::InvalidOption {
-                name: "time_samples (the scene's solver.time_samples)",
+                name: "time_samples",
                 value: nt as f64,
-                allowed: "an integer >= 8 with (number of contacts) * time_samples <= 8192 (the \
-                          LCP matrix is dense)",
+                allowed: "an integer >= 8 with (number of contacts) * time_samples <= 8192 (a \
+                          scene's solver.time_samples; the LCP matrix is dense)",
             });
         }
         Ok(crate::model::check_observed(&self.observed_dofs, dofs)?)
