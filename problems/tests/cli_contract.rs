@@ -77,15 +77,11 @@ fn a_full_standard_output_exits_3_in_every_command() {
 #[test]
 fn a_closed_pipe_exits_3_in_every_command() {
     for args in printing_commands() {
-        let mut child = Command::new(SSN)
-            .args(&args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        // Close the reading end before the program writes anything.
-        drop(child.stdout.take());
-        let o = child.wait_with_output().unwrap();
+        // A pipe whose reading end is closed before the program starts (no race).
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = ssn_with_stdout(&args, Stdio::from(writer));
         assert_exit(&o, 3, &args.join(" "));
     }
 }
