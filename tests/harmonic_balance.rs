@@ -842,7 +842,7 @@ fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
 /// Newton iterations, the time per solve and per iteration, and the tip minimum (the
 /// condensed problem alone above 1000 elements).
 #[test]
-#[ignore]
+#[ignore = "measurement up to 100,000 elements (tens of seconds), nothing asserted; run with --ignored --nocapture"]
 fn report_iterations_and_time_versus_elements() {
     for elements in [20usize, 1000, 10000, 100000] {
         let rod = build_rod(&common::refined(elements, 0.5)).unwrap();

@@ -692,7 +692,7 @@ fn circulant_case(n: usize) -> (Mat<f64>, Vec<f64>) {
 /// Timing of n = 2048 (not asserted): run with
 /// `cargo test --release --test lemke -- --ignored --nocapture timing`.
 #[test]
-#[ignore]
+#[ignore = "timing measurement of n = 2048 (nothing asserted); run with --ignored --nocapture"]
 fn timing_n2048() {
     use semismooth_problems::lcp::{PeriodicLcp, PeriodicLcpOptions};
     use semismooth_problems::rod::{build_rod, MassModel, RodSpec};

@@ -294,3 +294,32 @@ fn empty_system_is_trivially_solved() {
     s.factor(&to_sparse(&a)).unwrap();
     s.solve_in_place(&mut x).unwrap();
 }
+
+/// A matrix that only claims a size: 2^26 rows, whose dense factors (2^52 numbers, 32 PiB)
+/// cannot be allocated anywhere.
+struct Enormous;
+
+impl semismooth::linalg::DenseAssemble for Enormous {
+    fn dim(&self) -> usize {
+        1 << 26
+    }
+    fn assemble_dense(&self, _out: faer::MatMut<'_, f64>) {
+        unreachable!("the factors cannot be allocated")
+    }
+}
+
+#[test]
+fn a_dense_matrix_too_large_for_memory_is_a_typed_out_of_memory_error() {
+    let mut lu = FaerDenseLu::new();
+    let err = lu.factor(&Enormous).unwrap_err();
+    assert!(
+        matches!(err, LinearSolveError::OutOfMemory { .. }),
+        "{err:?}"
+    );
+    assert_eq!(err.kind(), "out-of-memory");
+    // The solver stays usable: a small system factors and solves afterwards.
+    let a = well_conditioned(5, 7);
+    let b = vec![1.0; 5];
+    let x = solve_with(&mut lu, &a, &b);
+    assert!(rel_diff(&matvec(&a, &x), &b) < 1e-12);
+}

@@ -390,7 +390,7 @@ fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
 
 /// Numbers for the report (run with `--ignored --nocapture`); nothing asserted on time.
 #[test]
-#[ignore]
+#[ignore = "prints the LCP numbers of the README (Nt up to 2048, slow); run with --ignored --nocapture"]
 fn report_lcp_numbers() {
     let minimum = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
     for mass in [MassModel::Modified, MassModel::Consistent] {

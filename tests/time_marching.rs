@@ -532,7 +532,7 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
 /// The numbers for the report: canonical modified-mass case at 1000..8000 steps per period.
 /// `cargo test --release --test time_marching -- --ignored --nocapture`
 #[test]
-#[ignore]
+#[ignore = "prints the refinement table for the README (about a minute); run with --ignored --nocapture"]
 fn report_canonical_modified_mass_refinement_table() {
     for tolerance in [1e-8, 1e-11] {
         println!("tolerance {tolerance:e}");
@@ -587,7 +587,7 @@ fn ssn_hb_tip(
 /// against this reference at 8000 steps per period on the canonical modified-mass case.
 /// `cargo test --release --test time_marching -- --ignored --nocapture`
 #[test]
-#[ignore]
+#[ignore = "prints the HB-against-reference numbers for the README (8000 steps per period, slow); run with --ignored --nocapture"]
 fn report_harmonic_balance_against_the_reference() {
     let rod = modified_rod();
     let tip = rod.tip_dof();
@@ -618,7 +618,7 @@ fn report_harmonic_balance_against_the_reference() {
 /// 1000 and 4000 steps per period; the last period when the march does not lock onto the
 /// forcing period). `cargo test --release --test time_marching -- --ignored --nocapture`
 #[test]
-#[ignore]
+#[ignore = "prints the consistent-mass comparison for the README (slow); run with --ignored --nocapture"]
 fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
     let rod = build_rod(&RodSpec::canonical()).unwrap();
     let tip = rod.tip_dof();

@@ -13,9 +13,8 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
-use crate::output::{
-    csv_table, prepare_directory, write_atomically, write_line_plot, PlotSpec, Series,
-};
+use crate::io::{printable, write_text, OutputSet, TargetError};
+use crate::output::{csv_table, line_plot_svg, prepare_directory, PlotSpec, Series};
 use crate::rod::{build_rod, natural_frequencies, ModelError, RodModel};
 use crate::runner::{solve_rod, RunCounters, Solution};
 use crate::scene::{Method, Scene};
@@ -37,14 +36,33 @@ impl From<crate::output::OutputError> for CliError {
     }
 }
 
+/// A target that is not a regular file cannot be written (exit code 3); two uses of one
+/// file are a bad combination of options (exit code 2).
+impl From<TargetError> for CliError {
+    fn from(e: TargetError) -> Self {
+        match e {
+            TargetError::NotRegular { .. } => CliError::Output(e.to_string()),
+            TargetError::Clash { .. } => CliError::BadInput(e.to_string()),
+        }
+    }
+}
+
 /// Bad input found in the scene file `path`: the message starts with the file.
 fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
-/// Loads a scene and builds its rod.
+/// Loads a scene and builds its rod, after checking that one run of its method fits in
+/// memory ([`crate::limits`]).
 pub fn load(path: &Path) -> Result<(Scene, RodModel), CliError> {
+    load_checked(path, false)
+}
+
+/// [`load`], with the memory of `ssn compare`'s runs when `compare`.
+fn load_checked(path: &Path, compare: bool) -> Result<(Scene, RodModel), CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let need = crate::limits::scene_memory(&scene, compare);
+    crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
     let rod = build_rod(&scene.rod).map_err(|e| input_error(path, e))?;
     Ok((scene, rod))
 }
@@ -58,10 +76,11 @@ pub struct RunArgs {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
-    /// Write the tip displacement and contact force over one period as CSV.
+    /// Write the tip displacement and contact force over one period as CSV (`-`: standard
+    /// output).
     #[arg(long)]
     pub csv: Option<PathBuf>,
-    /// Write a plot of the tip displacement over one period as SVG.
+    /// Write a plot of the tip displacement over one period as SVG (`-`: standard output).
     #[arg(long)]
     pub svg: Option<PathBuf>,
 }
@@ -75,17 +94,38 @@ struct Plot {
 }
 
 impl RunArgs {
-    /// Writes the requested outputs: the CSV of `columns` under `headers`, and the SVG of
+    /// Claims the run's outputs before it starts: the scene is an input no output may
+    /// replace, standard output carries the JSON (or the text summary unless `--quiet`),
+    /// and every file target must be new or a regular file.
+    fn plan(&self) -> Result<OutputSet, CliError> {
+        let mut set = OutputSet::new();
+        set.input(&self.scene, "the scene");
+        if self.json {
+            set.stdout("--json")?;
+        } else if !crate::io::quiet() {
+            set.stdout("the text summary (add --quiet or --json)")?;
+        }
+        if let Some(csv) = &self.csv {
+            set.target(csv, "--csv")?;
+        }
+        if let Some(svg) = &self.svg {
+            set.target(svg, "--svg")?;
+        }
+        Ok(set)
+    }
+
+    /// Queues the requested outputs: the CSV of `columns` under `headers`, and the SVG of
     /// `plot` (built only when an SVG is requested).
-    fn write_outputs(
+    fn queue_outputs(
         &self,
+        set: &mut OutputSet,
         scene: &Scene,
         headers: &[&str],
         columns: &[&[f64]],
         plot: impl FnOnce() -> Plot,
     ) -> Result<(), CliError> {
         if let Some(csv) = &self.csv {
-            write_atomically(csv, csv_table(headers, columns).as_bytes())?;
+            set.add(csv, csv_table(headers, columns).into_bytes());
         }
         if let Some(svg) = &self.svg {
             let plot = plot();
@@ -95,26 +135,32 @@ impl RunArgs {
                 y_label: plot.y_label.into(),
                 log_log: false,
             };
-            write_line_plot(svg, &spec, &[plot.series])?;
+            set.add(svg, line_plot_svg(&spec, &[plot.series])?.into_bytes());
         }
         Ok(())
     }
 
-    /// Prints the result, as JSON (`--json`) or as the text `print_text` writes, and maps
+    /// Writes the outputs (all or none), then the result on standard output, as JSON
+    /// (`--json`) or as the text `text` returns (nothing with `--quiet`), and maps
     /// convergence onto the outcome.
-    fn report(
+    fn finish(
         &self,
+        mut set: OutputSet,
         json: impl FnOnce() -> Value,
-        print_text: impl FnOnce(),
+        text: impl FnOnce() -> String,
         converged: bool,
     ) -> Result<(), CliError> {
         if self.json {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&json()).expect("JSON of plain values")
+            let doc = serde_json::to_string_pretty(&json())
+                .map_err(|e| CliError::Output(format!("cannot format the JSON: {e}")))?;
+            set.add(
+                Path::new(crate::io::STDOUT_NAME),
+                format!("{doc}\n").into_bytes(),
             );
-        } else {
-            print_text();
+        }
+        set.commit()?;
+        if !self.json {
+            write_text(&text())?;
         }
         if converged {
             Ok(())
@@ -179,6 +225,7 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "tip_min": finite_or_null(s.stats.min),
         "max_penetration": finite_or_null(s.stats.max_penetration),
         "contact_force_mean": finite_or_null(s.stats.mean_contact_force),
+        "contacts": s.contacts.iter().map(|c| c.to_json()).collect::<Vec<_>>(),
         "counters": counters_json(&s.counters),
     });
     if let Some(h) = s.harmonics {
@@ -215,6 +262,7 @@ fn finite_or_null(v: f64) -> Value {
 
 /// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG.
 pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+    let mut outputs = args.plan()?;
     let (scene, rod) = load(&args.scene)?;
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
@@ -231,7 +279,7 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         headers.push(format!("lambda_{i}"));
     }
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
-    args.write_outputs(&scene, &headers, &columns, || {
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
         let period = 2.0 * std::f64::consts::PI / solution.omega;
         Plot {
             untitled: "tip displacement",
@@ -244,9 +292,10 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             ),
         }
     })?;
-    args.report(
+    args.finish(
+        outputs,
         || solution_json(&args.scene, &solution),
-        || print_solution(&solution),
+        || solution_text(&solution),
         solution.converged,
     )
 }
@@ -258,31 +307,62 @@ fn describe_method(s: &Solution) -> String {
     }
 }
 
-fn print_solution(s: &Solution) {
-    println!("method            {}", describe_method(s));
-    println!(
-        "omega             {:.6} ({:.4} omega_1)",
-        s.omega,
-        s.omega / s.omega_1
-    );
-    println!(
-        "converged         {} ({}), {} iterations, residual {:.3e}",
-        s.converged, s.termination, s.iterations, s.residual_norm
-    );
-    println!("solve time        {:.3} ms", 1e3 * s.solve_seconds);
-    println!("tip max / min     {:.6} / {:.6}", s.stats.max, s.stats.min);
-    println!("max penetration   {:.3e}", s.stats.max_penetration);
-    println!("mean contact force {:.6e}", s.stats.mean_contact_force);
+fn solution_text(s: &Solution) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
     let c = &s.counters;
-    println!(
-        "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",
-        c.residual_evaluations, c.jacobian_evaluations, c.factorizations, c.linear_solves, c.ffts
-    );
+    // Writing into a String cannot fail.
+    let _ = (|| -> std::fmt::Result {
+        writeln!(t, "method            {}", describe_method(s))?;
+        writeln!(
+            t,
+            "omega             {:.6} ({:.4} omega_1)",
+            s.omega,
+            s.omega / s.omega_1
+        )?;
+        writeln!(
+            t,
+            "converged         {} ({}), {} iterations, residual {:.3e}",
+            s.converged, s.termination, s.iterations, s.residual_norm
+        )?;
+        writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
+        writeln!(
+            t,
+            "tip max / min     {:.6} / {:.6}",
+            s.stats.max, s.stats.min
+        )?;
+        writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
+        writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        if s.contacts.len() > 1 {
+            for c in &s.contacts {
+                writeln!(
+                    t,
+                    "  contact node {:<4} mean force {:.6e}, in contact {:.1} % of the period, \
+                     max penetration {:.3e}",
+                    c.node,
+                    c.force_mean,
+                    100.0 * c.contact_fraction,
+                    c.max_penetration
+                )?;
+            }
+        }
+        writeln!(
+            t,
+            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",
+            c.residual_evaluations,
+            c.jacobian_evaluations,
+            c.factorizations,
+            c.linear_solves,
+            c.ffts
+        )
+    })();
+    t
 }
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
 pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+    let mut outputs = args.plan()?;
     let (scene, rod) = load(&args.scene)?;
     let Some(settings) = scene.sweep.as_ref() else {
         return Err(input_error(
@@ -302,7 +382,8 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
-    args.write_outputs(
+    args.queue_outputs(
+        &mut outputs,
         &scene,
         &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
         &[
@@ -327,29 +408,30 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             ),
         },
     )?;
-    let print_text = || {
-        println!(
-            "sweep             {} points, omega/omega_1 from {:.4} to {:.4}",
+    let text = || {
+        let mut t = format!(
+            "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",
             response.points(),
             ratio.first().copied().unwrap_or(f64::NAN),
             ratio.last().copied().unwrap_or(f64::NAN)
         );
         if let Some((i, a)) = response.peak() {
-            println!(
-                "peak amplitude    {a:.6} at omega/omega_1 = {:.4}",
+            t += &format!(
+                "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
                 ratio[i]
             );
         }
-        println!(
-            "folds             {}",
+        t += &format!(
+            "folds             {}\n",
             folds_summary(&response.folds, rod.omega_1)
         );
-        println!(
-            "converged         {} ({}), {:.3} s",
+        t += &format!(
+            "converged         {} ({}), {:.3} s\n",
             response.converged, response.termination, response.solve_seconds
         );
+        t
     };
-    args.report(|| response.to_json(), print_text, response.converged)
+    args.finish(outputs, || response.to_json(), text, response.converged)
 }
 
 /// `ssn compare SCENE`: accuracy against cost of every applicable method on the scene's rod
@@ -362,7 +444,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
         )));
     }
-    let (scene, rod) = load(path)?;
+    let (scene, rod) = load_checked(path, true)?;
     prepare_directory(out)?;
     let bar = progress_spinner("compare", quiet);
     let say = |line: &str| {
@@ -372,14 +454,14 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
     let study = crate::study::accuracy_cost(&rod, &scene.solver, Some(&say))
         .map_err(|e| input_error(path, e))?;
     bar.finish_and_clear();
-    print!("{}", study.table());
-    println!("\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip minimum:");
-    print!("{}", study.cheapest_table(accuracy));
     study.write_files(out)?;
-    println!(
-        "\nWrote {}/accuracy_cost.csv and accuracy_cost.svg",
-        out.display()
-    );
+    write_text(&format!(
+        "{}\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip \
+         minimum:\n{}\nWrote {}/accuracy_cost.csv and accuracy_cost.svg\n",
+        study.table(),
+        study.cheapest_table(accuracy),
+        printable(&out.display().to_string())
+    ))?;
     Ok(())
 }
 
@@ -405,7 +487,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         other => other,
     }
     .map_err(|e| input_error(path, e))?;
-    print!("{}", describe(&scene, &rod, &modes));
+    write_text(&describe(&scene, &rod, &modes))?;
     Ok(())
 }
 
@@ -418,9 +500,12 @@ pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!("scene             {}", scene.path.display()));
+    line(format!(
+        "scene             {}",
+        printable(&scene.path.display().to_string())
+    ));
     if let Some(t) = &scene.title {
-        line(format!("title             {t}"));
+        line(format!("title             {}", printable(t)));
     }
     line(format!(
         "rod               {} elements, L = {}, EA = {}, rhoA = {}, {:?} mass",

@@ -309,22 +309,27 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
     let start = Instant::now();
     let mut rows = figure_1(out, MassModel::Modified, quiet)?;
     rows.extend(figure_1(out, MassModel::Consistent, quiet)?);
-    print!("{}", fig1_table(&rows));
-    println!(
+    crate::io::write_text(&fig1_table(&rows))?;
+    crate::outln!(
         "With the modified mass (massless contact node) harmonic balance converges to the \
          time-marching reference; with the consistent mass the reference depends on the impact \
          law (here restitution 0) and the two need not agree."
-    );
-    println!();
+    )?;
+    crate::outln!()?;
     let curves = figure_2(out, 5, quiet)?;
-    println!("Fig. 2: frequency response max|u_tip| on omega/omega_1 in [0.5, 2], H = 5 (the paper's setting)");
-    println!(
+    crate::outln!("Fig. 2: frequency response max|u_tip| on omega/omega_1 in [0.5, 2], H = 5 (the paper's setting)")?;
+    crate::outln!(
         "{:<8} {:>7} {:>11} {:>10} {:>22} {:>9}",
-        "curve", "points", "peak", "at omega", "folds (omega/omega_1)", "ms"
-    );
+        "curve",
+        "points",
+        "peak",
+        "at omega",
+        "folds (omega/omega_1)",
+        "ms"
+    )?;
     for c in &curves {
         let folds: Vec<String> = c.folds.iter().map(|f| format!("{f:.4}")).collect();
-        println!(
+        crate::outln!(
             "{:<8} {:>7} {:>11.6} {:>10.4} {:>22} {:>9.2}{}",
             curve_label(c.gap),
             c.points,
@@ -337,16 +342,16 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
             },
             1e3 * c.seconds,
             if c.converged { "" } else { "  (stopped early)" }
-        );
+        )?;
     }
-    println!(
+    crate::outln!(
         "Contact stiffens the rod: the peak moves to higher frequency and is bounded by the gap; \
          the branches fold over (the jump frequencies are the folds)."
-    );
-    println!(
+    )?;
+    crate::outln!(
         "\nWrote {} in {:.1} s.",
         out.display(),
         start.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }

@@ -6,11 +6,14 @@
 //! Shi & Legrand, and the formulations that solve it.
 
 pub mod cli;
+pub mod contacts;
 mod dynamic;
 pub mod figures;
 pub mod from_zero;
 pub mod hb;
+pub mod io;
 pub mod lcp;
+pub mod limits;
 pub mod march;
 pub mod model;
 pub mod output;

@@ -2,12 +2,12 @@
 //!
 //! Without a subcommand it reproduces the paper's figures into `./out/`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use semismooth_problems::cli::{self, CliError, RunArgs};
-use semismooth_problems::figures;
+use semismooth_problems::{figures, io};
 
 const EXIT_CODES: &str = "\
 Examples:
@@ -38,10 +38,11 @@ Exit codes:
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Output directory of the default run.
-    #[arg(long, default_value = "out", global = true)]
-    out: PathBuf,
-    /// No progress display.
+    /// Output directory of the default run and of `compare` [default: out].
+    #[arg(long, global = true)]
+    out: Option<PathBuf>,
+    /// Nothing on stdout or stderr but errors (no progress, no text summary; `--json` is
+    /// still printed).
     #[arg(long, short, global = true)]
     quiet: bool,
 }
@@ -55,7 +56,9 @@ enum Command {
         JSON fields: scene, method, harmonics (HB only), time_samples, omega, omega_ratio,\n  \
         converged, termination, iterations, residual_norm, effective_tolerance,\n  \
         strategy and attempts (Newton methods), solve_seconds, tip_max, tip_min,\n  \
-        max_penetration, contact_force_mean, c (SSN-HB), counters {residual_evaluations,\n  \
+        max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
+        gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
+        displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \
         jacobian_evaluations, factorizations, linear_solves, ffts, ...}\n\n"
     )]
     Solve(RunArgs),
@@ -94,26 +97,87 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let args = Cli::parse();
+    io::guard_standard_streams();
+    let args = match Cli::try_parse() {
+        Ok(args) => args,
+        Err(e) => return clap_exit(&e),
+    };
+    io::set_quiet(args.quiet);
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
     let result = match &args.command {
-        None => figures::default_run(&args.out, args.quiet),
+        None => in_new_directory(&out, || figures::default_run(&out, args.quiet)),
+        Some(Command::Compare { scene, accuracy }) => {
+            in_new_directory(&out, || cli::compare(scene, &out, *accuracy, args.quiet))
+        }
+        Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
+            "--out applies only to the default run and `ssn compare`; `ssn {}` writes the \
+             files named by --csv and --svg",
+            command.name()
+        ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::Solve(run)) => cli::solve(run, args.quiet),
         Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
-        Some(Command::Compare { scene, accuracy }) => {
-            cli::compare(scene, &args.out, *accuracy, args.quiet)
-        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(CliError::NotConverged) => ExitCode::from(1),
         Err(CliError::BadInput(m)) => {
-            eprintln!("error: {m}");
+            io::write_stderr(&format!("error: {m}\n"));
             ExitCode::from(2)
         }
         Err(CliError::Output(m)) => {
-            eprintln!("error: {m}");
+            io::write_stderr(&format!("error: {m}\n"));
             ExitCode::from(3)
+        }
+    }
+}
+
+/// Runs `run`, which writes into the directory `out`; when `out` did not exist before and
+/// the run fails, the directories it created (from the outermost one that did not exist)
+/// are removed with what was written into them, so a failed run leaves nothing behind.
+fn in_new_directory(
+    out: &Path,
+    run: impl FnOnce() -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    // The outermost ancestor of `out` that does not exist yet (the run creates it).
+    let created = out
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .take_while(|a| std::fs::symlink_metadata(a).is_err())
+        .last()
+        .map(Path::to_path_buf);
+    let result = run();
+    if let (Err(_), Some(created)) = (&result, created) {
+        let _ = std::fs::remove_dir_all(created);
+    }
+    result
+}
+
+impl Command {
+    fn name(&self) -> &'static str {
+        match self {
+            Command::Solve(_) => "solve",
+            Command::Sweep(_) => "sweep",
+            Command::Compare { .. } => "compare",
+            Command::SceneCheck { .. } => "scene-check",
+        }
+    }
+}
+
+/// Help and version go to standard output (exit code 0, or 3 when it cannot be written);
+/// a usage error goes to standard error (exit code 2).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let text = e.render().to_string();
+    if e.use_stderr() {
+        io::write_stderr(&text);
+        ExitCode::from(2)
+    } else {
+        match io::write_stdout(&text) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(err) => {
+                io::write_stderr(&format!("error: {err}\n"));
+                ExitCode::from(3)
+            }
         }
     }
 }

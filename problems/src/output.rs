@@ -1,7 +1,6 @@
 //! Outputs: CSV tables, SVG line plots and files written atomically (a temporary name in the
 //! same directory, then a rename), so a failed run never leaves a half-written file.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
@@ -27,44 +26,29 @@ pub enum OutputError {
     },
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename:
-/// readers see either the old file or the whole new one.
+/// Writes `bytes` to `path` through an exclusive temporary file in the same directory and a
+/// rename: readers see either the old file or the whole new one. A target that exists and
+/// is not a regular file (a symbolic link, a device, a FIFO, a directory) is not replaced
+/// (see [`crate::io::OutputSet`], which writes several files all or nothing).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let io = |source| OutputError::Io {
+    let mut set = crate::io::OutputSet::new();
+    set.target(path, "output").map_err(|e| OutputError::Io {
         path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".into());
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+        source: std::io::Error::other(e.to_string()),
+    })?;
+    set.add(path, bytes.to_vec());
+    set.commit()
 }
 
-/// Creates `dir` (and parents) and checks that a file can be created in it.
+/// Creates `dir` (and parents) and checks that a file can be created in it (an anonymous
+/// temporary file, removed when closed).
 pub fn prepare_directory(dir: &Path) -> Result<(), OutputError> {
     let io = |source| OutputError::Io {
         path: dir.to_path_buf(),
         source,
     };
     std::fs::create_dir_all(dir).map_err(io)?;
-    let probe = dir.join(format!(".ssn-write-probe-{}", std::process::id()));
-    std::fs::File::create(&probe).map_err(io)?;
-    let _ = std::fs::remove_file(&probe);
+    tempfile::tempfile_in(dir).map_err(io)?;
     Ok(())
 }
 

@@ -16,6 +16,7 @@ use semismooth::newton::{
 };
 use semismooth::{GeneralizedJacobian, Residual};
 
+use crate::contacts::{contact_reports, ContactReport};
 use crate::hb::{
     HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
@@ -172,8 +173,11 @@ pub struct Solution {
     pub tip: Vec<f64>,
     /// Contact forces at `times`, one series per contact.
     pub contact_forces: Vec<Vec<f64>>,
-    /// Tip statistics (penetration over all contacts, mean force of the first contact).
+    /// Tip statistics (penetration over all contacts; the mean contact force is the sum of
+    /// the contacts' mean forces).
     pub stats: PeriodStatistics,
+    /// Every contact point over the period.
+    pub contacts: Vec<ContactReport>,
     /// Work counters.
     pub counters: RunCounters,
     /// The method's unknowns (HB coefficients, LCP z), for warm starts.
@@ -365,8 +369,25 @@ fn solution(
     state: Vec<f64>,
 ) -> Solution {
     let method = settings.method;
+    let contacts = contact_reports(
+        &rod.model
+            .contacts
+            .iter()
+            .map(|c| (c.dof, c.gap))
+            .collect::<Vec<_>>(),
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    let mut stats = statistics(
+        rod,
+        &period.tip,
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    stats.mean_contact_force = contacts.iter().map(|c| c.force_mean).sum();
     Solution {
         method,
+        contacts,
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         c: None,
@@ -384,12 +405,7 @@ fn solution(
             .newton
             .map_or_else(Vec::new, |r| r.residual_norms.clone()),
         solve_seconds: outcome.solve_seconds,
-        stats: statistics(
-            rod,
-            &period.tip,
-            &period.contact_forces,
-            &period.contact_displacements,
-        ),
+        stats,
         times: period.times,
         tip: period.tip,
         contact_forces: period.contact_forces,
@@ -538,12 +554,11 @@ pub fn solve_rod(
             // finer grid resolves narrow force peaks the quadrature does not).
             if problem.contacts() > 0 {
                 let summary = problem.summary(&sol.state, tip, points)?;
-                let tip_contact = model
-                    .contacts
-                    .iter()
-                    .position(|c| c.dof == tip)
-                    .unwrap_or(0);
-                sol.stats.mean_contact_force = summary.contact_force_mean[tip_contact];
+                for (c, mean) in sol.contacts.iter_mut().zip(&summary.contact_force_mean) {
+                    // (+0 for a contact that never closes, not -0.)
+                    c.force_mean = if *mean == 0.0 { 0.0 } else { *mean };
+                }
+                sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
             }
             Ok(sol)
         }
@@ -588,7 +603,11 @@ fn solve_lcp(
                         report.pivots
                     )
                 }
-                LemkeTermination::PivotLimit => format!("pivot-limit ({})", report.pivots),
+                LemkeTermination::PivotLimit => format!(
+                    "pivot-limit ({}): the tip values are those of the unfinished path's last \
+                     basis, not of a solution",
+                    report.pivots
+                ),
             };
             let counters = RunCounters {
                 lemke_pivots: report.pivots as u64,
@@ -692,7 +711,13 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
     let mut observed = vec![tip];
     observed.extend(model.contacts.iter().map(|c| c.dof));
     let start = Instant::now();
-    let period = march_to_steady_state(model, &options, &observed)?;
+    // A march that does not settle is a run that did not converge: its last period is
+    // reported with the last period-to-period change.
+    let (period, steady) = match march_to_steady_state(model, &options, &observed) {
+        Ok(period) => (period, true),
+        Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
+        Err(e) => return Err(e.into()),
+    };
     let seconds = start.elapsed().as_secs_f64();
     // Drop the closing sample (t = T repeats t = 0).
     let keep = period.times.len().saturating_sub(1).max(1);
@@ -706,8 +731,16 @@ fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, Ru
         .map(|t| t - start_time)
         .collect();
     let outcome = Outcome {
-        converged: true,
-        termination: "converged".into(),
+        converged: steady,
+        termination: if steady {
+            "converged".into()
+        } else {
+            format!(
+                "not-steady: period-to-period change {:.3e} above the tolerance {:e} after {} \
+                 periods (solver.max_periods)",
+                period.period_change, settings.march_tolerance, period.periods
+            )
+        },
         iterations: period.periods,
         residual_norm: period.period_change,
         effective_tolerance: Some(settings.march_tolerance),

@@ -396,23 +396,40 @@ impl Check<'_> {
 }
 
 impl Scene {
-    /// Reads and validates a scene file.
+    /// Reads and validates a scene file (a regular file of at most
+    /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
     pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        // Only a regular file of at most 1 MiB: a FIFO would block, a device never end.
+        let text =
+            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
+                SceneError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         Scene::from_toml(&text, path)
     }
 
     /// Parses and validates scene text; `path` is only used in messages.
     pub fn from_toml(text: &str, path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let raw: RawScene = toml::from_str(text).map_err(|e| SceneError::Parse {
-            path: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let raw: RawScene = toml::from_str(text)
+            .map_err(|e| {
+                let mut message = e.to_string().trim_end().to_string();
+                // toml's words for a number outside f64 or i64: say what is allowed.
+                if message.contains("overflow") || message.contains("as i128") {
+                    message.push_str(
+                        "\nallowed: floats of magnitude at most 1.7976931348623157e308, integers \
+                     within 64 bits (each key's own range is in the README's scene table)",
+                    );
+                }
+                message
+            })
+            .map_err(|message| SceneError::Parse {
+                path: path.to_path_buf(),
+                message,
+            })?;
         resolve(raw, path)
     }
 }
@@ -443,7 +460,7 @@ impl Check<'_> {
     /// `[rod]`: the mesh and the material; the other sections fill in damping, forcing and
     /// contacts (none until they do).
     fn rod(&self, r: &RawRod) -> Result<RodSpec, SceneError> {
-        Ok(RodSpec {
+        let spec = RodSpec {
             elements: self.count("rod.elements", r.elements, 1, crate::rod::MAX_ELEMENTS)?,
             length: self.positive("rod.length", r.length.unwrap_or(1.0))?,
             axial_stiffness: self
@@ -460,7 +477,55 @@ impl Check<'_> {
             amplitude: 0.0,
             frequency: FrequencySpec::Ratio(1.0),
             contacts: Vec::new(),
-        })
+        };
+        self.rod_scales(&spec)?;
+        Ok(spec)
+    }
+
+    /// The rod must vibrate at a representable frequency: the modified mass needs a node
+    /// with mass besides the massless tip, and the element length `h = L / elements`, the
+    /// element stiffness `EA / h`, mass `rhoA h` and the first frequency
+    /// `(pi / 2) sqrt(EA / rhoA) / L` must stay within `[1e-100, 1e100]` (far inside
+    /// floating point, so that squares and products of them neither overflow nor vanish).
+    fn rod_scales(&self, s: &RodSpec) -> Result<(), SceneError> {
+        if s.mass == MassModel::Modified && s.elements < 2 {
+            return Err(self.invalid(
+                "rod.elements",
+                format!("{} with mass = \"modified\"", s.elements),
+                "at least 2 with the modified mass (the tip node is massless, so a one-element \
+                 rod has no vibration mode)",
+            ));
+        }
+        let h = s.length / s.elements as f64;
+        let omega_1 =
+            0.5 * std::f64::consts::PI * (s.axial_stiffness / s.mass_per_length).sqrt() / s.length;
+        let in_range = |v: f64| (1e-100..=1e100).contains(&v);
+        for (what, v) in [
+            ("the element length L / elements", h),
+            (
+                "the element stiffness EA elements / L",
+                s.axial_stiffness / h,
+            ),
+            ("the element mass rhoA L / elements", s.mass_per_length * h),
+            (
+                "the first natural frequency (pi / 2) sqrt(EA / rhoA) / L",
+                omega_1,
+            ),
+        ] {
+            if !in_range(v) {
+                return Err(self.invalid(
+                    "rod.length",
+                    format!(
+                        "{:?} (with axial_stiffness = {:?}, mass_per_length = {:?}, elements = {}: \
+                         {what} is {v:e})",
+                        s.length, s.axial_stiffness, s.mass_per_length, s.elements
+                    ),
+                    "length, axial_stiffness and mass_per_length whose element length, element \
+                     stiffness, element mass and first natural frequency lie in [1e-100, 1e100]",
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// `[damping]`: stiffness-proportional (`zeta`) or Rayleigh (`alpha`, `beta`), chosen by
@@ -511,6 +576,14 @@ impl Check<'_> {
                         "damping.zeta",
                         "given with model = \"rayleigh\"",
                         "only `alpha` and `beta` for this model",
+                    ));
+                }
+                if d.alpha.is_none() && d.beta.is_none() {
+                    return Err(self.invalid(
+                        "damping.model",
+                        "\"rayleigh\" without alpha or beta",
+                        "model = \"rayleigh\" with `alpha` and/or `beta` (D = alpha M + beta K); \
+                         omit [damping] for no damping",
                     ));
                 }
                 Ok(DampingSpec::Rayleigh {

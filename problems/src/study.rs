@@ -79,6 +79,10 @@ pub struct Entry {
     pub iterations: usize,
     /// Whether the method converged.
     pub converged: bool,
+    /// Why the run failed: the error of a run that could not start (its errors and time
+    /// are then NaN and printed as missing), or the termination of one that did not
+    /// converge; `None` when it converged.
+    pub failure: Option<String>,
 }
 
 /// Result of [`accuracy_cost`].
@@ -137,11 +141,13 @@ impl AccuracyCost {
             r.description, r.tip_min, r.tip_rms, r.mean_force, r.uncertainty
         );
         s.push_str(
-            "method,setting,tip_min_error,tip_rms_error,mean_force_error,seconds,iterations,converged\n",
+            "method,setting,tip_min_error,tip_rms_error,mean_force_error,seconds,iterations,converged,failure\n",
         );
         for e in &self.entries {
             s.push_str(&e.cells(Cells::Csv).join(","));
-            s.push('\n');
+            // The reason in one quoted CSV cell (quotes doubled).
+            let failure = e.failure.as_deref().unwrap_or("").replace('"', "\"\"");
+            s.push_str(&format!(",\"{failure}\"\n"));
         }
         s
     }
@@ -171,6 +177,23 @@ impl AccuracyCost {
         table_line(&mut s, header.map(String::from));
         for e in &self.entries {
             table_line(&mut s, e.cells(Cells::Table));
+        }
+        let failed: Vec<&Entry> = self
+            .entries
+            .iter()
+            .filter(|e| e.failure.is_some())
+            .collect();
+        if !failed.is_empty() {
+            let _ = writeln!(s, "settings that did not converge, and why:");
+            for e in failed {
+                let _ = writeln!(
+                    s,
+                    "  {:<11} {:<22} {}",
+                    e.method.name(),
+                    e.setting,
+                    e.failure.as_deref().unwrap_or("")
+                );
+            }
         }
         s
     }
@@ -248,14 +271,16 @@ impl Entry {
     /// and mean force, seconds, iterations, converged.
     fn cells(&self, style: Cells) -> [String; 8] {
         let csv = style == Cells::Csv;
+        let missing = if csv { "" } else { "-" };
         let number = |v: f64, digits: usize| {
-            if csv {
+            if !v.is_finite() {
+                missing.to_string()
+            } else if csv {
                 format!("{v:e}")
             } else {
                 format!("{v:.digits$e}")
             }
         };
-        let missing = if csv { "" } else { "-" };
         let converged = match (csv, self.converged) {
             (true, c) => c.to_string(),
             (false, true) => "yes".into(),
@@ -418,10 +443,12 @@ fn reference(
         say(&format!(
             "reference: time marching, {REFERENCE_STEPS} steps per period, tolerance {tolerance:e}"
         ));
-        let Ok(fine) = march(REFERENCE_STEPS, tolerance, periods) else {
+        // A march that does not settle reports converged = false.
+        let steady = |r: Result<Solution, RunError>| r.ok().filter(|s| s.converged);
+        let Some(fine) = steady(march(REFERENCE_STEPS, tolerance, periods)) else {
             continue;
         };
-        let Ok(half) = march(REFERENCE_STEPS / 2, tolerance, periods) else {
+        let Some(half) = steady(march(REFERENCE_STEPS / 2, tolerance, periods)) else {
             continue;
         };
         let tip_min = fine.stats.min;
@@ -479,8 +506,9 @@ fn reference(
 /// `base` supplies the Newton tolerance, iteration limit, globalization, linear solver and
 /// time-marching limits; `progress` receives one line per run.
 ///
-/// A run that fails to start is recorded as not converged with infinite errors; only a
-/// failure of the reference is an error.
+/// A run that fails to start is recorded as not converged with NaN errors and the error in
+/// [`Entry::failure`] (printed as missing values and the reason); only a failure of the
+/// reference is an error.
 pub fn accuracy_cost(
     rod: &RodModel,
     base: &SolverSettings,
@@ -511,16 +539,18 @@ pub fn accuracy_cost(
                 seconds: sol.solve_seconds,
                 iterations: sol.iterations,
                 converged: sol.converged,
+                failure: (!sol.converged).then(|| sol.termination.clone()),
             },
-            Err(_) => Entry {
+            Err(e) => Entry {
                 method,
                 setting,
-                tip_min_error: f64::INFINITY,
-                tip_rms_error: f64::INFINITY,
+                tip_min_error: f64::NAN,
+                tip_rms_error: f64::NAN,
                 mean_force_error: None,
                 seconds: f64::NAN,
                 iterations: 0,
                 converged: false,
+                failure: Some(format!("could not run: {e}")),
             },
         };
         entries.push(entry);
@@ -542,6 +572,7 @@ mod tests {
             seconds,
             iterations: 1,
             converged,
+            failure: (!converged).then(|| "max-iterations".to_string()),
         }
     }
 
@@ -574,6 +605,41 @@ mod tests {
         assert!(best[1].1.is_none());
         let csv = study.to_csv();
         assert_eq!(csv.lines().count(), 2 + study.entries.len());
+    }
+
+    #[test]
+    fn a_failed_setting_is_printed_with_its_reason_never_as_inf_or_nan() {
+        let mut failed = entry(Method::LcpLemke, f64::NAN, f64::NAN, false);
+        failed.failure = Some("could not run: invalid time_samples, \"x\"".into());
+        let study = AccuracyCost {
+            reference: Reference {
+                description: "r".into(),
+                tip_min: -1.0,
+                tip_rms: 1.0,
+                mean_force: -1.0,
+                uncertainty: 0.0,
+                cross_check: None,
+                seconds: 0.0,
+                march_tolerance: None,
+            },
+            entries: vec![entry(Method::SsnHb, 1e-4, 0.003, true), failed],
+        };
+        let (table, csv) = (study.table(), study.to_csv());
+        for text in [&table, &csv] {
+            let lower = text.to_lowercase();
+            assert!(!lower.contains("nan") && !lower.contains("inf"), "{text}");
+        }
+        assert!(table.contains("did not converge, and why"), "{table}");
+        assert!(
+            table.contains("could not run: invalid time_samples"),
+            "{table}"
+        );
+        let last = csv.lines().last().unwrap();
+        assert!(
+            last.starts_with("lcp-lemke,,,,,,1,false,")
+                && last.ends_with("\"could not run: invalid time_samples, \"\"x\"\"\""),
+            "{last}"
+        );
     }
 
     /// The canonical modified-mass rod: the time-marching reference and SSN-HB at 320

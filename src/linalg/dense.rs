@@ -146,7 +146,16 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for FaerDenseLu {
         let n = jac.dim();
         self.factored = false;
         if self.factors.nrows() != n {
-            self.factors = Mat::zeros(n, n);
+            // n^2 numbers: fallible, so that a matrix too large for memory is an error.
+            self.factors = Mat::new();
+            let mut factors = Mat::new();
+            factors
+                .try_reserve(n, n)
+                .map_err(|_| LinearSolveError::OutOfMemory {
+                    during: "allocating the dense LU factors",
+                })?;
+            factors.resize_with(n, n, |_, _| 0.0);
+            self.factors = factors;
             self.perm_fwd.resize(n, 0);
             self.perm_inv.resize(n, 0);
         }
@@ -154,7 +163,7 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for FaerDenseLu {
         check_finite_dense(n, n, |i, j| self.factors[(i, j)])?;
         let par = self.par();
         let req = lu_factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default());
-        let stack = self.scratch.stack(req);
+        let stack = self.scratch.stack(req)?;
         lu_factor::lu_in_place(
             self.factors.as_mut(),
             &mut self.perm_fwd,
@@ -177,7 +186,7 @@ impl LinearSolve for FaerDenseLu {
         check_solve(self.factored, n, rhs.len())?;
         let par = self.par();
         let req = lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, par);
-        let stack = self.scratch.stack(req);
+        let stack = self.scratch.stack(req)?;
         let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
         lu_solve::solve_in_place(
             self.factors.as_ref(),

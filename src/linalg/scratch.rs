@@ -2,6 +2,8 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 
+use super::LinearSolveError;
+
 /// Keeps one allocation and regrows it only when a kernel asks for more, so repeated
 /// factorizations and solves of the same size allocate nothing.
 pub(crate) struct Scratch {
@@ -17,13 +19,17 @@ impl Scratch {
         }
     }
 
-    /// A stack with room for at least `req`.
-    pub(crate) fn stack(&mut self, req: StackReq) -> &mut MemStack {
+    /// A stack with room for at least `req`; an allocation failure is
+    /// [`LinearSolveError::OutOfMemory`], not an abort.
+    pub(crate) fn stack(&mut self, req: StackReq) -> Result<&mut MemStack, LinearSolveError> {
         if req.size_bytes() > self.req.size_bytes() || req.align_bytes() > self.req.align_bytes() {
-            self.req = self.req.or(req);
-            self.buffer = MemBuffer::new(self.req);
+            let grown = self.req.or(req);
+            self.buffer = MemBuffer::try_new(grown).map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the scratch memory of a factorization",
+            })?;
+            self.req = grown;
         }
-        MemStack::new(&mut self.buffer)
+        Ok(MemStack::new(&mut self.buffer))
     }
 }
 

@@ -129,7 +129,7 @@ impl FaerSparseLu {
         self.row_perm_fwd.resize(n, 0);
         self.row_perm_inv.resize(n, 0);
         let req = colamd::order_scratch::<usize>(n, n, s.compute_nnz());
-        let stack = self.scratch.stack(req);
+        let stack = self.scratch.stack(req)?;
         colamd::order(
             &mut self.col_perm_fwd,
             &mut self.col_perm_inv,
@@ -185,7 +185,7 @@ impl Factorize<SparseColMat<usize, f64>> for FaerSparseLu {
             simplicial::factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n),
             simplicial::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
         );
-        let stack = self.scratch.stack(req);
+        let stack = self.scratch.stack(req)?;
         let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
         let result = simplicial::factorize_simplicial_numeric_lu(
             &mut self.row_perm_fwd,
@@ -222,7 +222,7 @@ impl LinearSolve for FaerSparseLu {
         let n = self.dim;
         check_solve(self.factored, n, rhs.len())?;
         let req = simplicial::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq);
-        let stack = self.scratch.stack(req);
+        let stack = self.scratch.stack(req)?;
         let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);
         let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
         self.lu.solve_in_place_with_conj(

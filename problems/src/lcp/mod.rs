@@ -157,7 +157,8 @@ impl PeriodicLcpOptions {
             return Err(LcpError::InvalidOption {
                 name: "time_samples",
                 value: nt as f64,
-                allowed: "an integer >= 8 with contacts * time_samples <= 8192",
+                allowed: "an integer >= 8 with (number of contacts) * time_samples <= 8192 (a \
+                          scene's solver.time_samples; the LCP matrix is dense)",
             });
         }
         Ok(crate::model::check_observed(&self.observed_dofs, dofs)?)

@@ -1,0 +1,252 @@
+//! Up-front memory estimates of a run, so that a scene too large for the machine is refused
+//! before anything is allocated (exit code 2, naming the keys, the need and the limit)
+//! instead of aborting on an allocation failure or being killed half-way.
+//!
+//! The estimates are upper bounds fitted to peak resident sizes measured on the rod
+//! (`/usr/bin/time -f %M`, release build), with `N` elements, `m` contacts, `S = 2H + 1`
+//! harmonic functions and `Nt` time samples:
+//!
+//! | method | estimate (bytes) | measured |
+//! |---|---|---|
+//! | HB, structured solver | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
+//! | HB, dense solver | `10 n^2` more, `n = (N + m) S` (SSN-HB) or `N S` (penalty) | 156 MB at N = 100, H = 20 (n = 4141); 570 MB at N = 200 (n = 8241) |
+//! | periodic LCP | `24 (m Nt)^2 + 1000 N` | 71 MB (Lemke), 48 MB (Newton) at Nt = 2048, m = 1 |
+//! | time marching | `1000 N` | 12 MB at N = 10^4 |
+//!
+//! plus `400 N` for the rod itself. The limit is the memory available to new processes
+//! (`MemAvailable` of `/proc/meminfo`), or the number of bytes in the environment variable
+//! `SSN_MEMORY_LIMIT` when it is set; where neither is known nothing is refused.
+
+use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
+
+/// What a run needs, in words and bytes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MemoryEstimate {
+    /// Estimated peak memory in bytes (a float: hostile settings overflow any integer).
+    pub bytes: f64,
+    /// The dominant storage, in words.
+    pub what: String,
+    /// The scene keys that drive it (what to reduce).
+    pub keys: &'static str,
+}
+
+/// Bytes of the rod model itself (sparse K, M, D, load vectors) per element.
+const ROD_BYTES_PER_ELEMENT: f64 = 400.0;
+
+/// Estimated peak memory of one run of `settings` on a rod of `elements` elements with
+/// `contacts` contact points.
+pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -> MemoryEstimate {
+    let n = elements as f64;
+    let m = contacts as f64;
+    let rod = ROD_BYTES_PER_ELEMENT * n;
+    match settings.method {
+        Method::SsnHb | Method::PenaltyHb => {
+            let h = settings.harmonics as f64;
+            let s = 2.0 * h + 1.0;
+            let nt = settings.time_samples as f64;
+            let aft = 8.0 * (2.0 * s * nt + 3.0 * m * s * s + 2.0 * (m * s).powi(2));
+            let structured = 300.0 * n * s + aft + 16.0 * (h + 1.0) * n * m;
+            match settings.linear_solver {
+                LinearSolverChoice::Structured => MemoryEstimate {
+                    bytes: rod + structured,
+                    what: format!(
+                        "per-harmonic factorizations of {elements} dofs x {} harmonic functions",
+                        2 * settings.harmonics as u128 + 1
+                    ),
+                    keys: "rod.elements, solver.harmonics (and the number of contacts)",
+                },
+                LinearSolverChoice::Dense => {
+                    let unknowns = match settings.method {
+                        Method::SsnHb => (n + m) * s,
+                        _ => n * s,
+                    };
+                    MemoryEstimate {
+                        bytes: rod + structured + 10.0 * unknowns * unknowns,
+                        what: format!(
+                            "a dense Jacobian and its LU on {unknowns:.0} unknowns \
+                             (solver.linear_solver = \"dense\"; \"structured\" needs about {})",
+                            human(rod + structured)
+                        ),
+                        keys: "solver.linear_solver, solver.harmonics, rod.elements",
+                    }
+                }
+            }
+        }
+        Method::LcpLemke | Method::LcpSsn => {
+            let dim = m * settings.time_samples as f64;
+            MemoryEstimate {
+                bytes: rod + 24.0 * dim * dim + 1000.0 * n,
+                what: format!(
+                    "the dense periodic LCP matrix of {dim:.0} = contacts x time samples unknowns"
+                ),
+                keys: "solver.time_samples (and the number of contacts)",
+            }
+        }
+        Method::March => MemoryEstimate {
+            bytes: rod + 1000.0 * n,
+            what: format!("time-stepping matrices of {elements} dofs"),
+            keys: "rod.elements",
+        },
+    }
+}
+
+/// Estimated peak memory of `ssn compare` on the scene: the largest of its runs (SSN-HB up
+/// to the reference's 320 harmonics, penalty HB up to 80, the LCP up to Nt = 1024, time
+/// marching), each with the scene's other settings.
+pub fn compare_memory(elements: usize, contacts: usize, base: &SolverSettings) -> MemoryEstimate {
+    let hb = |method, harmonics: usize| SolverSettings {
+        method,
+        harmonics,
+        time_samples: default_hb_time_samples(harmonics),
+        ..base.clone()
+    };
+    let runs = [
+        hb(Method::SsnHb, crate::study::REFERENCE_HARMONICS),
+        hb(Method::PenaltyHb, 80),
+        SolverSettings {
+            method: Method::LcpSsn,
+            time_samples: 1024,
+            ..base.clone()
+        },
+        SolverSettings {
+            method: Method::March,
+            ..base.clone()
+        },
+    ];
+    runs.iter()
+        .map(|s| run_memory(elements, contacts, s))
+        .fold(None::<MemoryEstimate>, |best, e| match best {
+            Some(b) if b.bytes >= e.bytes => Some(b),
+            _ => Some(e),
+        })
+        .expect("four runs")
+}
+
+/// The memory a run may use: `SSN_MEMORY_LIMIT` (bytes) when set, else `MemAvailable`.
+pub fn memory_limit() -> Option<f64> {
+    if let Ok(v) = std::env::var("SSN_MEMORY_LIMIT") {
+        if let Ok(b) = v.trim().parse::<f64>() {
+            if b.is_finite() && b > 0.0 {
+                return Some(b);
+            }
+        }
+    }
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: f64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
+/// limit.
+pub fn check(need: &MemoryEstimate, limit: Option<f64>) -> Result<(), String> {
+    match limit {
+        Some(limit) if need.bytes.is_nan() || need.bytes > limit => Err(format!(
+            "these settings need about {} of memory ({}), more than the {} available \
+             (MemAvailable, or SSN_MEMORY_LIMIT when set): allowed are settings whose estimate \
+             fits; reduce {}",
+            human(need.bytes),
+            need.what,
+            human(limit),
+            need.keys
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The estimate of the command run on `scene` (`compare` runs several settings).
+pub fn scene_memory(scene: &Scene, compare: bool) -> MemoryEstimate {
+    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+    if compare {
+        compare_memory(n, m, &scene.solver)
+    } else {
+        run_memory(n, m, &scene.solver)
+    }
+}
+
+/// Bytes in words: `1.5 GB`.
+pub fn human(bytes: f64) -> String {
+    const UNITS: [&str; 7] = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = bytes;
+    let mut unit = 0;
+    while v >= 1000.0 && unit + 1 < UNITS.len() {
+        v /= 1000.0;
+        unit += 1;
+    }
+    if v.is_finite() {
+        format!("{v:.1} {}", UNITS[unit])
+    } else {
+        "more than can be counted".into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(method: Method, h: usize, dense: bool) -> SolverSettings {
+        let mut s = crate::scene::Scene::from_toml(
+            "[rod]\nelements = 20\n[forcing]\namplitude = 0.1\n[contact]\ngap = 0.5\n",
+            "t.toml",
+        )
+        .unwrap()
+        .solver;
+        s.method = method;
+        s.harmonics = h;
+        s.time_samples = default_hb_time_samples(h);
+        if dense {
+            s.linear_solver = LinearSolverChoice::Dense;
+        }
+        s
+    }
+
+    #[test]
+    fn estimates_bound_the_measured_peaks_within_a_factor_three() {
+        // Peak resident sizes measured with /usr/bin/time (see the module table).
+        for (elements, method, h, dense, measured) in [
+            (10_000, Method::SsnHb, 20, false, 86e6),
+            (10_000, Method::SsnHb, 80, false, 289e6),
+            (10_000, Method::PenaltyHb, 20, false, 90e6),
+            (100, Method::SsnHb, 20, true, 156e6),
+            (200, Method::SsnHb, 20, true, 570e6),
+        ] {
+            let e = run_memory(elements, 1, &settings(method, h, dense)).bytes;
+            assert!(
+                e >= measured && e <= 3.0 * measured,
+                "{elements} {method:?} H={h}: estimate {e:e} against {measured:e}"
+            );
+        }
+        let mut lcp = settings(Method::LcpLemke, 5, false);
+        lcp.time_samples = 2048;
+        let e = run_memory(20, 1, &lcp).bytes;
+        assert!((71e6..3.0 * 71e6).contains(&e), "{e:e}");
+    }
+
+    #[test]
+    fn a_refusal_names_the_keys_the_need_and_the_limit() {
+        let dense = run_memory(400, 1, &settings(Method::SsnHb, 2000, true));
+        let e = check(&dense, Some(16e9)).unwrap_err();
+        for word in [
+            "solver.linear_solver",
+            "TB",
+            "16.0 GB",
+            "\"structured\" needs",
+        ] {
+            assert!(e.contains(word), "{word}: {e}");
+        }
+        let structured = run_memory(400, 1, &settings(Method::SsnHb, 20, false));
+        assert!(check(&structured, Some(16e9)).is_ok());
+        assert!(
+            check(&dense, None).is_ok(),
+            "no limit known: nothing refused"
+        );
+        let huge = run_memory(usize::MAX, usize::MAX, &settings(Method::SsnHb, 20, false));
+        assert!(check(&huge, Some(1e30)).is_err());
+    }
+}
