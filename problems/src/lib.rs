@@ -16,5 +16,6 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod stability;
 pub mod study;
 pub mod sweep;

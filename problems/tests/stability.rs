@@ -1,0 +1,276 @@
+//! Floquet multipliers of harmonic-balance solutions against time marching: started from
+//! the solution plus a small perturbation, the march's period-to-period change decays
+//! (stable) or grows (unstable) at the rate of the largest multiplier.
+
+use semismooth_problems::march::{MarchOptions, MarchScheme, MarchState, TimeMarcher};
+use semismooth_problems::rod::{build_rod, RodModel};
+use semismooth_problems::runner::solve_rod;
+use semismooth_problems::scene::Scene;
+use semismooth_problems::stability::{hb_stability, Stability, StabilityOptions};
+use semismooth_problems::sweep::{frequency_response, FrequencyResponse};
+
+/// The strongly forced rod: 20 elements, modified mass, p0 = 0.2, gap 0.5, H = 20.
+const STRONG: &str = r#"
+[rod]
+elements = 20
+mass = "modified"
+[damping]
+zeta = 0.01
+[forcing]
+amplitude = 0.2
+omega_ratio = 1.14
+[contact]
+gap = 0.5
+[solver]
+harmonics = 20
+[sweep]
+omega_ratio_from = 0.8
+omega_ratio_to = 1.6
+"#;
+
+fn scene(text: &str) -> Scene {
+    Scene::from_toml(text, "<test>").unwrap()
+}
+
+fn strong_sweep() -> (RodModel, Scene, FrequencyResponse) {
+    let scene = scene(STRONG);
+    let rod = build_rod(&scene.rod).unwrap();
+    let r = frequency_response(&rod, &scene.solver, scene.sweep.as_ref().unwrap(), None).unwrap();
+    assert!(r.converged, "{}", r.termination);
+    (rod, scene, r)
+}
+
+/// Marches `periods` periods from `start` plus `perturbation` on the displacements and
+/// returns the period-to-period changes `|x_{k+1} - x_k|` of the state `(u, v / omega)` at
+/// the period starts.
+fn march_changes(
+    rod: &RodModel,
+    omega: f64,
+    start: &MarchState,
+    perturbation: f64,
+    steps_per_period: usize,
+    periods: usize,
+    reset: bool,
+) -> Vec<f64> {
+    let mut model = rod.model.clone();
+    model.forcing.omega = omega;
+    let mut state = start.clone();
+    for (i, x) in state.displacement.iter_mut().enumerate() {
+        *x += perturbation * ((i + 1) as f64 * 0.7).sin();
+    }
+    let options = MarchOptions {
+        steps_per_period,
+        scheme: MarchScheme::MasslessContactTrapezoidal,
+        ..MarchOptions::default()
+    };
+    let mut marcher = TimeMarcher::new(&model, &options, &state).unwrap();
+    marcher.set_closed_contact_velocity_reset(reset);
+    let snapshot = |m: &TimeMarcher| -> Vec<f64> {
+        m.displacement()
+            .iter()
+            .copied()
+            .chain(m.velocity().iter().map(|v| v / omega))
+            .collect()
+    };
+    let mut previous = snapshot(&marcher);
+    let mut changes = Vec::new();
+    for _ in 0..periods {
+        for _ in 0..steps_per_period {
+            marcher.step().unwrap();
+        }
+        let now = snapshot(&marcher);
+        let d = now
+            .iter()
+            .zip(&previous)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        changes.push(d);
+        previous = now;
+    }
+    changes
+}
+
+/// Marches (with the closed-contact velocity reset of the stability analysis) until the
+/// change of the state over a period is below `tolerance` relative; returns the periods
+/// marched and the tip minimum over the last one.
+fn march_until_steady(
+    rod: &RodModel,
+    start: &MarchState,
+    steps_per_period: usize,
+    max_periods: usize,
+    tolerance: f64,
+) -> (usize, f64) {
+    let options = MarchOptions {
+        steps_per_period,
+        scheme: MarchScheme::MasslessContactTrapezoidal,
+        ..MarchOptions::default()
+    };
+    let mut marcher = TimeMarcher::new(&rod.model, &options, start).unwrap();
+    marcher.set_closed_contact_velocity_reset(true);
+    let tip = rod.tip_dof();
+    let mut previous = marcher.displacement().to_vec();
+    for period in 1..=max_periods {
+        let mut tip_min = f64::INFINITY;
+        for _ in 0..steps_per_period {
+            marcher.step().unwrap();
+            tip_min = tip_min.min(marcher.displacement()[tip]);
+        }
+        let now = marcher.displacement();
+        let scale = now.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let change = now
+            .iter()
+            .zip(&previous)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        if change < tolerance * scale {
+            return (period, tip_min);
+        }
+        previous = now.to_vec();
+    }
+    panic!("not steady after {max_periods} periods");
+}
+
+/// Per-period factor of `changes[from..to]`: least-squares slope of `ln d_k` against `k`
+/// (a complex dominant pair makes `d_k` oscillate about the geometric trend).
+fn fitted_rate(changes: &[f64], from: usize, to: usize) -> f64 {
+    let points: Vec<(f64, f64)> = (from..to).map(|k| (k as f64, changes[k].ln())).collect();
+    let m = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / m, sy / m);
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    (sxy / sxx).exp()
+}
+
+fn stability_of(rod: &RodModel, harmonics: usize, omega: f64, x: &[f64]) -> Stability {
+    let n = rod.model.dofs() * (2 * harmonics + 1);
+    hb_stability(
+        &rod.model,
+        harmonics,
+        omega,
+        &x[..n],
+        &StabilityOptions::default(),
+    )
+    .unwrap()
+}
+
+/// Index of the sweep point nearest to `ratio` on the branch segment `range`.
+fn nearest(
+    r: &FrequencyResponse,
+    omega_1: f64,
+    range: std::ops::Range<usize>,
+    ratio: f64,
+) -> usize {
+    range
+        .min_by(|&a, &b| {
+            (r.omega[a] / omega_1 - ratio)
+                .abs()
+                .total_cmp(&(r.omega[b] / omega_1 - ratio).abs())
+        })
+        .unwrap()
+}
+
+#[test]
+fn largest_multiplier_predicts_the_decay_and_growth_rates_of_time_marching() {
+    let (rod, scene, r) = strong_sweep();
+    let h = scene.solver.harmonics;
+    assert_eq!(r.fold_indices.len(), 2, "folds {:?}", r.folds);
+    let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
+    let w1 = rod.omega_1;
+    // A stable point on the upper (contact) branch and an unstable one on the middle
+    // branch, both at about 1.14 omega_1 inside the overhang, and a stable no-contact point.
+    let cases = [
+        (nearest(&r, w1, 0..upper_fold, 1.14), true),
+        (nearest(&r, w1, upper_fold..lower_fold, 1.14), false),
+        (nearest(&r, w1, lower_fold..r.points(), 1.14), true),
+    ];
+    for (i, stable) in cases {
+        let omega = r.omega[i];
+        let s = stability_of(&rod, h, omega, &r.states[i]);
+        assert_eq!(s.stable, Some(stable), "point {i} at {}: {s:?}", omega / w1);
+        let mu = s.floquet_max_abs.unwrap();
+        let orbit = s.orbit.clone().unwrap();
+        // Stable: the march decays towards the orbit from 1e-4; unstable: it leaves it from
+        // 1e-9 (the growth stays linear over the periods fitted: 1e-9 mu^40 < 1e-5).
+        let (delta, periods) = if stable { (1e-4, 45) } else { (1e-9, 45) };
+        let changes = march_changes(&rod, omega, &orbit, delta, 2000, periods, true);
+        let rate = fitted_rate(&changes, 5, periods);
+        let plain = march_changes(&rod, omega, &orbit, delta, 2000, periods, false);
+        println!(
+            "omega_ratio {:.5}: |mu|max {mu:.5} (dominant {:?}), march rate {rate:.5} \
+             (plain trapezoidal velocity: {:.5})",
+            omega / w1,
+            s.dominant(),
+            fitted_rate(&plain, 5, periods)
+        );
+        assert!(
+            (rate - mu).abs() <= 0.1 * mu,
+            "point {i}: march rate {rate} against the largest multiplier {mu}"
+        );
+        if !stable {
+            assert!(changes[periods - 1] > 100.0 * changes[5], "{changes:?}");
+        } else {
+            assert!(changes[periods - 1] < 0.2 * changes[5], "{changes:?}");
+        }
+    }
+}
+
+#[test]
+fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
+    let (rod, scene, r) = strong_sweep();
+    let h = scene.solver.harmonics;
+    let w1 = rod.omega_1;
+    let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
+    let middle = nearest(&r, w1, upper_fold..lower_fold, 1.14);
+    let omega = r.omega[middle];
+    let s = stability_of(&rod, h, omega, &r.states[middle]);
+    assert_eq!(s.stable, Some(false));
+    // The two stable solutions at exactly this frequency: Newton from the nearest points of
+    // the upper and lower branches.
+    let mut at_omega = rod.clone();
+    at_omega.model.forcing.omega = omega;
+    let mut stable_tips = Vec::new();
+    for range in [0..upper_fold, lower_fold..r.points()] {
+        let i = nearest(&r, w1, range, omega / w1);
+        let sol = solve_rod(&at_omega, &scene.solver, Some(&r.states[i])).unwrap();
+        assert!(sol.converged, "{}", sol.termination);
+        let st = stability_of(&rod, h, omega, &sol.state);
+        assert_eq!(st.stable, Some(true));
+        stable_tips.push(sol.stats.min);
+    }
+    let unstable_tip = r.tip_min[middle];
+    // Nudged off the unstable orbit both ways, the march settles on one of the stable ones
+    // (the branches are 0.7 apart; the march and SSN-HB at H = 20 differ by 3.6e-3 relative
+    // on the upper branch at this forcing, measured).
+    let mut landed = Vec::new();
+    for sign in [1.0, -1.0] {
+        let mut start = s.orbit.clone().unwrap();
+        for (i, x) in start.displacement.iter_mut().enumerate() {
+            *x += sign * 1e-6 * (i + 1) as f64 / rod.model.dofs() as f64;
+        }
+        let (periods, tip_min) = march_until_steady(&at_omega, &start, 2000, 3000, 1e-9);
+        let branch = stable_tips
+            .iter()
+            .position(|t| (t - tip_min).abs() < 5e-3 * t.abs())
+            .unwrap_or_else(|| panic!("tip min {tip_min} is on no stable branch {stable_tips:?}"));
+        assert!(
+            (tip_min - unstable_tip).abs() > 0.1,
+            "still on the unstable orbit"
+        );
+        println!(
+            "nudged by {sign:+}: {} periods, tip min {tip_min:.6} (stable branch {branch}: \
+             {:.6}; unstable {unstable_tip:.6})",
+            periods, stable_tips[branch]
+        );
+        landed.push(branch);
+    }
+    landed.sort();
+    assert_eq!(
+        landed,
+        [0, 1],
+        "the two nudges land on the two stable branches"
+    );
+}
