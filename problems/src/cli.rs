@@ -287,15 +287,41 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
+    let st = &response.stability;
+    // stable: 1 / 0, NaN when undecided.
+    let stable: Vec<f64> = st
+        .stable
+        .iter()
+        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
+        .collect();
+    let floquet: Vec<f64> = st
+        .floquet_max_abs
+        .iter()
+        .map(|a| a.unwrap_or(f64::NAN))
+        .collect();
     args.write_outputs(
         &scene,
-        &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
+        &[
+            "omega",
+            "omega_ratio",
+            "tip_max",
+            "tip_min",
+            "amplitude",
+            "stable",
+            "floquet_max_abs",
+            "contact_force_mean",
+            "max_penetration",
+        ],
         &[
             &response.omega,
             &ratio,
             &response.tip_max,
             &response.tip_min,
             &response.amplitude,
+            &stable,
+            &floquet,
+            &st.contact_force_mean,
+            &st.max_penetration,
         ],
         || Plot {
             untitled: "frequency response",
@@ -329,6 +355,23 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             "folds             {}",
             folds_summary(&response.folds, rod.omega_1)
         );
+        let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
+        let undecided = st.stable.iter().filter(|s| s.is_none()).count();
+        println!(
+            "stability         {} stable, {unstable} unstable, {undecided} undecided{}",
+            st.stable.len() - unstable - undecided,
+            st.note
+                .as_ref()
+                .map(|n| format!(" ({n})"))
+                .unwrap_or_default()
+        );
+        for e in &st.events {
+            println!(
+                "  {:<15} at omega/omega_1 = {:.4}",
+                e.kind.name(),
+                e.omega / rod.omega_1
+            );
+        }
         println!(
             "converged         {} ({}), {:.3} s",
             response.converged, response.termination, response.solve_seconds

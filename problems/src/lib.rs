@@ -5,6 +5,7 @@
 //! contact `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, the finite-element rod of
 //! Shi & Legrand, and the formulations that solve it.
 
+pub mod branch;
 pub mod cli;
 mod dynamic;
 pub mod figures;

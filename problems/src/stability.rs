@@ -117,6 +117,9 @@ pub enum StabilityError {
     /// The eigenvalues could not be computed.
     #[error(transparent)]
     Floquet(#[from] FloquetError),
+    /// The harmonic-balance problem of a branch could not be rebuilt.
+    #[error(transparent)]
+    Hb(#[from] crate::hb::HbError),
 }
 
 /// The stability of one periodic solution.

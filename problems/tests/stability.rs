@@ -2,6 +2,7 @@
 //! the solution plus a small perturbation, the march's period-to-period change decays
 //! (stable) or grows (unstable) at the rate of the largest multiplier.
 
+use semismooth::floquet::BifurcationKind;
 use semismooth_problems::march::{MarchOptions, MarchScheme, MarchState, TimeMarcher};
 use semismooth_problems::rod::{build_rod, RodModel};
 use semismooth_problems::runner::solve_rod;
@@ -273,4 +274,105 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
         [0, 1],
         "the two nudges land on the two stable branches"
     );
+}
+
+#[test]
+fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
+    let (rod, _, r) = strong_sweep();
+    let w1 = rod.omega_1;
+    let st = &r.stability;
+    assert_eq!(st.stable.len(), r.points());
+    let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
+    for (i, s) in st.stable.iter().enumerate() {
+        let ratio = r.omega[i] / w1;
+        if i == upper_fold || i == lower_fold {
+            // At a fold a multiplier is 1: either answer, or none when the time-stepping
+            // map's own fold lies just below the harmonic-balance one.
+            continue;
+        }
+        let expected = !(upper_fold < i && i < lower_fold);
+        assert_eq!(*s, Some(expected), "point {i} at omega_ratio {ratio:.5}");
+        let mu = st.floquet_max_abs[i].unwrap();
+        assert_eq!(mu < 1.0, expected);
+    }
+    // Two fold events, where the continuation found the folds (1.1846 and 1.0982): the
+    // interpolated crossing of |mu| = 1 lies between the neighbouring points, which are at
+    // most 1.1e-3 omega_1 from the fold here.
+    assert_eq!(st.events.len(), 2, "{:?}", st.events);
+    for (e, fold) in st.events.iter().zip(&r.folds) {
+        assert_eq!(e.kind, BifurcationKind::Fold);
+        assert!(
+            ((e.omega - fold) / w1).abs() < 2e-3,
+            "event at {} against the fold at {}",
+            e.omega / w1,
+            fold / w1
+        );
+    }
+    // Contact diagnostics: no contact on the lower branch far from the overhang, contact
+    // (a negative mean force) on the upper branch.
+    let first = 0;
+    assert_eq!(st.contact_force_mean[first], 0.0);
+    assert_eq!(st.max_penetration[first], 0.0);
+    assert!(st.contact_force_mean[upper_fold - 2] < 0.0);
+}
+
+#[test]
+fn sweep_json_and_csv_carry_the_stability_of_every_point() {
+    let dir = std::env::temp_dir().join(format!("ssn-stability-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("strong.toml");
+    std::fs::write(&scene, STRONG).unwrap();
+    let csv = dir.join("strong.csv");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ssn"))
+        .args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--json",
+            "--csv",
+            csv.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = json["points"].as_u64().unwrap() as usize;
+    for key in [
+        "omega_ratio",
+        "stable",
+        "floquet_max_abs",
+        "contact_force_mean",
+        "max_penetration",
+    ] {
+        assert_eq!(json[key].as_array().unwrap().len(), points, "{key}");
+    }
+    let stable = json["stable"].as_array().unwrap();
+    assert!(stable.iter().any(|s| s == &serde_json::Value::Bool(false)));
+    let events = json["events"].as_array().unwrap();
+    assert_eq!(events.len(), 2);
+    assert!(events.iter().all(|e| e["kind"] == "fold"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(header.contains("stable,floquet_max_abs,contact_force_mean,max_penetration"));
+    assert_eq!(text.lines().count(), points + 1);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+#[ignore]
+fn timing() {
+    let (rod, scene, r) = strong_sweep();
+    let h = scene.solver.harmonics;
+    for i in [5usize, 19, 35, 60] {
+        let t = std::time::Instant::now();
+        let s = stability_of(&rod, h, r.omega[i], &r.states[i]);
+        println!(
+            "{i}: {:.2} ms, {} shooting iterations",
+            t.elapsed().as_secs_f64() * 1e3,
+            s.shooting_iterations
+        );
+    }
 }
