@@ -16,9 +16,11 @@
 use semismooth::floquet::{crossing, BifurcationKind};
 
 use crate::hb::{HbError, PenaltyHb, SsnHb};
+use crate::model::StructuralModel;
 use crate::rod::RodModel;
-use crate::runner::{hb_options, penalty_options};
+use crate::runner::{hb_options, penalty_options, RunError};
 use crate::scene::{Method, SolverSettings};
+use crate::solutions::ContactSummary;
 use crate::stability::{hb_stability, Stability, StabilityError, StabilityOptions};
 use crate::sweep::FrequencyResponse;
 
@@ -68,12 +70,77 @@ impl BranchStability {
 }
 
 /// The harmonic-balance problem whose reconstructions a branch's states belong to.
-enum Reconstruction {
+pub(crate) enum Reconstruction {
     Ssn(SsnHb),
     Penalty(PenaltyHb),
 }
 
 impl Reconstruction {
+    /// The scene's harmonic-balance problem (`Unsupported` for other methods).
+    pub(crate) fn new(
+        model: &StructuralModel,
+        settings: &SolverSettings,
+    ) -> Result<Self, RunError> {
+        Ok(match settings.method {
+            Method::SsnHb => Self::Ssn(SsnHb::new(model, &hb_options(settings))?),
+            Method::PenaltyHb => {
+                Self::Penalty(PenaltyHb::new(model, &penalty_options(settings, model))?)
+            }
+            other => {
+                return Err(RunError::Unsupported {
+                    method: other.name(),
+                    what: "a harmonic-balance method (ssn-hb or penalty-hb)",
+                })
+            }
+        })
+    }
+
+    /// Mean force and largest penetration of each contact.
+    pub(crate) fn contacts(
+        &self,
+        model: &StructuralModel,
+        x: &[f64],
+    ) -> Result<Vec<ContactSummary>, HbError> {
+        let (summary, samples) = match self {
+            Self::Ssn(p) => (
+                p.summary(
+                    x,
+                    model.contacts.first().map_or(0, |c| c.dof),
+                    DIAGNOSTIC_POINTS,
+                )?,
+                model
+                    .contacts
+                    .iter()
+                    .map(|c| p.displacement_samples(x, c.dof, DIAGNOSTIC_POINTS))
+                    .collect::<Result<Vec<_>, _>>()?,
+            ),
+            Self::Penalty(p) => (
+                p.summary(
+                    x,
+                    model.contacts.first().map_or(0, |c| c.dof),
+                    DIAGNOSTIC_POINTS,
+                )?,
+                model
+                    .contacts
+                    .iter()
+                    .map(|c| p.displacement_samples(x, c.dof, DIAGNOSTIC_POINTS))
+                    .collect::<Result<Vec<_>, _>>()?,
+            ),
+        };
+        Ok(model
+            .contacts
+            .iter()
+            .zip(samples)
+            .enumerate()
+            .map(|(k, (c, u))| ContactSummary {
+                dof: c.dof,
+                gap: c.gap,
+                contact_force_mean: summary.contact_force_mean.get(k).copied().unwrap_or(0.0),
+                max_penetration: u.iter().fold(0.0f64, |a, v| a.max(v - c.gap)),
+            })
+            .collect())
+    }
+
     fn summary(&self, x: &[f64], dof: usize) -> Result<(f64, f64), HbError> {
         let s = match self {
             Self::Ssn(p) => p.summary(x, dof, DIAGNOSTIC_POINTS)?,

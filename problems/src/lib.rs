@@ -17,6 +17,7 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod solutions;
 pub mod stability;
 pub mod study;
 pub mod sweep;

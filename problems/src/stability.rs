@@ -148,7 +148,8 @@ pub struct Stability {
 }
 
 impl Stability {
-    fn undecided(reason: String, steps_per_period: usize) -> Self {
+    /// Not decided, for `reason`.
+    pub fn undecided(reason: String, steps_per_period: usize) -> Self {
         Self {
             stable: None,
             floquet_max_abs: None,

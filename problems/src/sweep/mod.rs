@@ -544,7 +544,7 @@ pub fn frequency_response(
 }
 
 /// The branch of [`frequency_response`] without its stability.
-fn follow_branch(
+pub(crate) fn follow_branch(
     rod: &RodModel,
     settings: &SolverSettings,
     sweep: &SweepSettings,
