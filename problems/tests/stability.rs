@@ -367,7 +367,7 @@ fn sweep_json_and_csv_carry_the_stability_of_every_point() {
 
 #[test]
 #[ignore]
-fn timing() {
+fn report_stability_cost_per_point() {
     let (rod, scene, r) = strong_sweep();
     let h = scene.solver.harmonics;
     for i in [5usize, 19, 35, 60] {
