@@ -49,13 +49,15 @@
 //! - the **drivers**: semismooth Newton with line-search globalization (one iteration kernel,
 //!   also the continuation's corrector), pseudo-arclength continuation (trust ball,
 //!   restarts, exact corners of piecewise-affine branches) and a natural-parameter
-//!   homotopy, Lemke's algorithm for linear complementarity problems.
+//!   homotopy, Lemke's algorithm for linear complementarity problems, and Floquet
+//!   multipliers of a periodic orbit's monodromy matrix ([`floquet`]).
 //!
 //! Nothing in this crate knows about rods, contact or any particular model: those live
 //! in the `semismooth-problems` crate, which uses only this crate's public API.
 
 pub mod complementarity;
 pub mod continuation;
+pub mod floquet;
 pub mod harmonic;
 pub mod lemke;
 pub mod linalg;

@@ -97,7 +97,7 @@ impl RunArgs {
     /// Claims the run's outputs before it starts: the scene is an input no output may
     /// replace, standard output carries the JSON (or the text summary unless `--quiet`),
     /// and every file target must be new or a regular file.
-    fn plan(&self) -> Result<OutputSet, CliError> {
+    pub(crate) fn plan(&self) -> Result<OutputSet, CliError> {
         let mut set = OutputSet::new();
         set.input(&self.scene, "the scene");
         if self.json {
@@ -143,7 +143,7 @@ impl RunArgs {
     /// Writes the outputs (all or none), then the result on standard output, as JSON
     /// (`--json`) or as the text `text` returns (nothing with `--quiet`), and maps
     /// convergence onto the outcome.
-    fn finish(
+    pub(crate) fn finish(
         &self,
         mut set: OutputSet,
         json: impl FnOnce() -> Value,
@@ -382,16 +382,42 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
+    let st = &response.stability;
+    // stable: 1 / 0, NaN when undecided.
+    let stable: Vec<f64> = st
+        .stable
+        .iter()
+        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
+        .collect();
+    let floquet: Vec<f64> = st
+        .floquet_max_abs
+        .iter()
+        .map(|a| a.unwrap_or(f64::NAN))
+        .collect();
     args.queue_outputs(
         &mut outputs,
         &scene,
-        &["omega", "omega_ratio", "tip_max", "tip_min", "amplitude"],
+        &[
+            "omega",
+            "omega_ratio",
+            "tip_max",
+            "tip_min",
+            "amplitude",
+            "stable",
+            "floquet_max_abs",
+            "contact_force_mean",
+            "max_penetration",
+        ],
         &[
             &response.omega,
             &ratio,
             &response.tip_max,
             &response.tip_min,
             &response.amplitude,
+            &stable,
+            &floquet,
+            &st.contact_force_mean,
+            &st.max_penetration,
         ],
         || Plot {
             untitled: "frequency response",
@@ -425,6 +451,23 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             "folds             {}\n",
             folds_summary(&response.folds, rod.omega_1)
         );
+        let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
+        let undecided = st.stable.iter().filter(|s| s.is_none()).count();
+        t += &format!(
+            "stability         {} stable, {unstable} unstable, {undecided} undecided{}\n",
+            st.stable.len() - unstable - undecided,
+            st.note
+                .as_ref()
+                .map(|n| format!(" ({n})"))
+                .unwrap_or_default()
+        );
+        for e in &st.events {
+            t += &format!(
+                "  {:<15} at omega/omega_1 = {:.4}\n",
+                e.kind.name(),
+                e.omega / rod.omega_1
+            );
+        }
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
             response.converged, response.termination, response.solve_seconds

@@ -5,6 +5,7 @@
 //! contact `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, the finite-element rod of
 //! Shi & Legrand, and the formulations that solve it.
 
+pub mod branch;
 pub mod cli;
 pub mod contacts;
 mod dynamic;
@@ -20,5 +21,7 @@ pub mod output;
 pub mod rod;
 pub mod runner;
 pub mod scene;
+pub mod solutions;
+pub mod stability;
 pub mod study;
 pub mod sweep;

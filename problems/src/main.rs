@@ -75,6 +75,19 @@ enum Command {
         mut_arg("svg", |a| a.help("Write the frequency response as SVG"))
     )]
     Sweep(RunArgs),
+    /// Every periodic solution at the scene's forcing frequency, with its stability (follows
+    /// the branch through the frequency and corrects each crossing there).
+    #[command(
+        after_help = "Example:\n  ssn solutions SCENE.toml --json --csv solutions.csv --svg solutions.svg\n\n\
+        JSON fields: omega, omega_ratio, window, branch_points, branch_converged, crossings,\n  \
+        failed_corrections, seconds, solutions [{tip_min, tip_max, contact_force_mean,\n  \
+        max_penetration, contacts, stable, floquet_max_abs, stability_note, iterations,\n  \
+        residual_norm}]\n\n",
+        mut_arg("json", |a| a.help("Print the solutions as JSON on stdout")),
+        mut_arg("csv", |a| a.help("Write one CSV row per solution")),
+        mut_arg("svg", |a| a.help("Write the tip over one period of every solution as SVG"))
+    )]
+    Solutions(RunArgs),
     /// Accuracy against cost: every method over its discretisation settings, error against a
     /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
     #[command(
@@ -117,6 +130,7 @@ fn main() -> ExitCode {
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::Solve(run)) => cli::solve(run, args.quiet),
         Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
+        Some(Command::Solutions(run)) => semismooth_problems::solutions::command(run),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -158,6 +172,7 @@ impl Command {
         match self {
             Command::Solve(_) => "solve",
             Command::Sweep(_) => "sweep",
+            Command::Solutions(_) => "solutions",
             Command::Compare { .. } => "compare",
             Command::SceneCheck { .. } => "scene-check",
         }

@@ -1,6 +1,8 @@
 //! The one-step schemes of the time-marching reference (module documentation of
 //! [`super`]): the iteration matrix factored once, the per-step contact LCP by Lemke.
 
+mod tangent;
+
 use std::f64::consts::PI;
 
 use faer::Mat;
@@ -129,6 +131,8 @@ pub struct TimeMarcher<'a> {
     /// Inertial force `M a` (trapezoidal only).
     r: Vec<f64>,
     lambda: Vec<f64>,
+    /// Set the velocity of a closed contact's dof to 0 after each trapezoidal step.
+    reset_closed_velocity: bool,
     rhs: Vec<f64>,
     tmp: Vec<f64>,
     q: Vec<f64>,
@@ -229,6 +233,7 @@ impl<'a> TimeMarcher<'a> {
             u: initial.displacement.clone(),
             v: initial.velocity.clone(),
             r: vec![0.0; n],
+            reset_closed_velocity: false,
             lambda: initial.contact_force.clone(),
             rhs: vec![0.0; n],
             tmp: vec![0.0; n],
@@ -431,6 +436,15 @@ impl<'a> TimeMarcher<'a> {
         // v_{n+1} = 2/h (u_{n+1} - u_n) - v_n; then u <- u_{n+1}.
         for i in 0..n {
             self.v[i] = 2.0 / h * (self.rhs[i] - self.u[i]) - self.v[i];
+        }
+        // Optionally (stability analysis), a closed contact holds its massless dof at the gap
+        // with velocity 0 (module `tangent`).
+        if self.reset_closed_velocity {
+            for (ct, l) in model.contacts.iter().zip(&self.lambda) {
+                if *l < 0.0 {
+                    self.v[ct.dof] = 0.0;
+                }
+            }
         }
         std::mem::swap(&mut self.u, &mut self.rhs);
         self.equilibrium_inertia(j + 1);

@@ -88,6 +88,7 @@ use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent
 pub use response::FrequencyResponse;
 use response::{extremes, HbTip};
 
+use crate::branch::{branch_stability, BranchStability};
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
 use crate::rod::RodModel;
@@ -96,6 +97,7 @@ use crate::runner::{
     HB_OUTPUT_POINTS,
 };
 use crate::scene::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
+use crate::stability::StabilityOptions;
 
 /// Weight `θ` of the state in the arclength (module documentation: with the scaling used
 /// here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the θ-norm
@@ -374,6 +376,8 @@ where
         reference_amplitude: setup.u_ref,
         output_points: setup.output_points,
         states: Vec::new(),
+        stability: BranchStability::default(),
+        stability_seconds: 0.0,
     };
     if !report.converged() {
         response.termination = format!(
@@ -518,7 +522,29 @@ where
 /// `Err` when the sweep could not start (bad settings, unsupported method, a model the
 /// method cannot build); a branch that stopped early is an `Ok` curve with
 /// `converged = false` and the reason in `termination`.
+///
+/// Each point then gets its stability and contact diagnostics
+/// ([`crate::branch::branch_stability`], in [`FrequencyResponse::stability`]); a failure
+/// there leaves the points undecided with the reason in its `note`.
 pub fn frequency_response(
+    rod: &RodModel,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    let mut response = follow_branch(rod, settings, sweep, progress)?;
+    let started = Instant::now();
+    let options = StabilityOptions::default();
+    response.stability =
+        branch_stability(rod, settings, &response, &options).unwrap_or_else(|err| {
+            BranchStability::undecided(response.points(), format!("stability not computed: {err}"))
+        });
+    response.stability_seconds = started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+/// The branch of [`frequency_response`] without its stability.
+pub(crate) fn follow_branch(
     rod: &RodModel,
     settings: &SolverSettings,
     sweep: &SweepSettings,

@@ -4,6 +4,7 @@ use semismooth::continuation::ContinuationCounters;
 use semismooth::harmonic::{Aft, FourierBasis};
 use serde_json::json;
 
+use crate::branch::BranchStability;
 use crate::hb::HbError;
 use crate::runner::{RunCounters, RunError};
 use crate::scene::Method;
@@ -54,6 +55,10 @@ pub struct FrequencyResponse {
     /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
     /// `[w; z]`), unscaled, for warm starts and re-solves.
     pub states: Vec<Vec<f64>>,
+    /// Stability, contact diagnostics and bifurcations of the points.
+    pub stability: BranchStability,
+    /// Wall time of the stability analysis (not in `solve_seconds`).
+    pub stability_seconds: f64,
 }
 
 impl FrequencyResponse {
@@ -95,9 +100,12 @@ impl FrequencyResponse {
             })
     }
 
-    /// The JSON object of `ssn sweep --json`: `points`, `omega`, `tip_max`,
-    /// `tip_min`, `amplitude`, `folds`, `converged`, `solve_seconds`, `termination`,
-    /// `counters`. Non-finite numbers (never produced by a converged branch) become `null`.
+    /// The JSON object of `ssn sweep --json`: `points`, `omega`, `omega_ratio`, `tip_max`,
+    /// `tip_min`, `amplitude`, per point `stable` (true / false / null), `floquet_max_abs`,
+    /// `contact_force_mean`, `max_penetration`, then `stability_note` (why points are
+    /// undecided), `stability_seconds`, `events` ({`kind`, `omega`, `omega_ratio`,
+    /// `index`}), `folds`, `converged`, `solve_seconds`, `termination`, `counters`.
+    /// Non-finite numbers become `null`.
     pub fn to_json(&self) -> serde_json::Value {
         let mut counters = self.counters.newton_json();
         for (name, value) in [
@@ -112,12 +120,33 @@ impl FrequencyResponse {
         ] {
             counters.insert(name.to_string(), value.into());
         }
+        let st = &self.stability;
+        let events: Vec<serde_json::Value> = st
+            .events
+            .iter()
+            .map(|e| {
+                json!({
+                    "kind": e.kind.name(),
+                    "omega": e.omega,
+                    "omega_ratio": e.omega / self.omega_1,
+                    "index": e.index,
+                })
+            })
+            .collect();
         json!({
             "points": self.points(),
             "omega": self.omega,
+            "omega_ratio": self.omega_ratio(),
             "tip_max": self.tip_max,
             "tip_min": self.tip_min,
             "amplitude": self.amplitude,
+            "stable": st.stable,
+            "floquet_max_abs": st.floquet_max_abs,
+            "contact_force_mean": st.contact_force_mean,
+            "max_penetration": st.max_penetration,
+            "stability_note": st.note,
+            "stability_seconds": self.stability_seconds,
+            "events": events,
             "folds": self.folds,
             "converged": self.converged,
             "solve_seconds": self.solve_seconds,
