@@ -490,6 +490,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
 fn canonical_modified_rod() -> StructuralModel {
     build_rod(&common::canonical(MassModel::Modified))
         .unwrap()
+        .structure
         .model
 }
 

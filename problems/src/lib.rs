@@ -9,6 +9,7 @@ pub mod cli;
 mod dynamic;
 pub mod figures;
 pub mod hb;
+pub mod import;
 pub mod lcp;
 pub mod march;
 pub mod model;

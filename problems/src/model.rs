@@ -54,6 +54,19 @@ pub struct StructuralModel {
     pub contacts: Vec<ContactPoint>,
 }
 
+/// A structure ready for every method: the model, its first finite natural frequency
+/// `omega_1` (the unit of `omega_ratio` in scenes and sweeps) and the dof whose displacement
+/// outputs describe (`tip_*` fields, plots): the rod's tip, or a scene's `[output] dof`.
+#[derive(Debug, Clone)]
+pub struct Structure {
+    /// The semi-discrete model `M, D, K, f, G, g`.
+    pub model: StructuralModel,
+    /// First finite natural frequency (rad per unit time).
+    pub omega_1: f64,
+    /// The observed dof (0-based).
+    pub observed_dof: usize,
+}
+
 /// Why a [`StructuralModel`] cannot be used: the part, the value found and what is allowed.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum InvalidModel {

@@ -19,7 +19,9 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
 use crate::dynamic::UnionPattern;
-use crate::model::{sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel};
+use crate::model::{
+    sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure,
+};
 
 /// How the rod's mass is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -123,14 +125,12 @@ impl RodSpec {
     }
 }
 
-/// A rod problem ready for a formulation: the structural model plus its first natural
-/// frequency and the spec it was built from.
+/// A rod problem ready for a formulation: the [`Structure`] (model, first natural frequency,
+/// the tip as observed dof), through `Deref`, plus the spec it was built from.
 #[derive(Debug, Clone)]
 pub struct RodModel {
-    /// The semi-discrete model `M, D, K, f, G, g`.
-    pub model: StructuralModel,
-    /// First natural frequency of the discrete rod (rad per unit time).
-    pub omega_1: f64,
+    /// The structure every method runs on.
+    pub structure: Structure,
     /// The spec it was built from.
     pub spec: RodSpec,
 }
@@ -139,6 +139,19 @@ impl RodModel {
     /// Dof index of the tip node.
     pub fn tip_dof(&self) -> usize {
         self.spec.elements - 1
+    }
+}
+
+impl std::ops::Deref for RodModel {
+    type Target = Structure;
+    fn deref(&self) -> &Structure {
+        &self.structure
+    }
+}
+
+impl std::ops::DerefMut for RodModel {
+    fn deref_mut(&mut self) -> &mut Structure {
+        &mut self.structure
     }
 }
 
@@ -373,8 +386,11 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         });
     }
     Ok(RodModel {
-        model,
-        omega_1,
+        structure: Structure {
+            model,
+            omega_1,
+            observed_dof: n - 1,
+        },
         spec: spec.clone(),
     })
 }

@@ -90,7 +90,7 @@ use response::{extremes, HbTip};
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
-use crate::rod::RodModel;
+use crate::model::Structure;
 use crate::runner::{
     hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
     HB_OUTPUT_POINTS,
@@ -131,7 +131,7 @@ fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
 
 /// Root mean square over the dofs of the linear response (contacts removed) at `ω_1`
 /// (`0.95 ω_1`, then `0.5 ω_1` if that is singular, e.g. undamped); `1` if all fail.
-fn reference_amplitude(rod: &RodModel) -> f64 {
+fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
     let dofs = model.dofs().max(1);
@@ -519,7 +519,7 @@ where
 /// method cannot build); a branch that stopped early is an `Ok` curve with
 /// `converged = false` and the reason in `termination`.
 pub fn frequency_response(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(usize, f64)>,
@@ -527,7 +527,7 @@ pub fn frequency_response(
     check_sweep(sweep)?;
     let started = Instant::now();
     let model = &rod.model;
-    let tip = rod.tip_dof();
+    let tip = rod.observed_dof;
     let dofs = model.dofs();
     let omega_1 = rod.omega_1;
     let u_ref = reference_amplitude(rod);
