@@ -260,7 +260,7 @@ pub fn parse_matrix(text: &str, path: &Path) -> Result<SparseMatrix, ImportError
             let v = v.into_iter().map(|v| v as f64).collect();
             CooMatrix::try_from_triplets(rows, cols, r, c, v).map_err(|e| bad(e.to_string()))?
         }
-        Err(e) => return Err(bad(e.message().trim().to_string())),
+        Err(e) => return Err(bad(reader_message(e.message(), text))),
     };
     let mut triplets = Vec::with_capacity(coo.nnz());
     for (i, j, &v) in coo.triplet_iter() {
@@ -276,6 +276,22 @@ pub fn parse_matrix(text: &str, path: &Path) -> Result<SparseMatrix, ImportError
     }
     SparseMatrix::try_new_from_triplets(coo.nrows(), coo.ncols(), &triplets)
         .map_err(|e| bad(format!("{e:?}")))
+}
+
+/// The reader's message on one line: `line L, column C: `text`` when it locates the
+/// defect (its parser reports ` --> L:C` and a drawing of the line), else as it is.
+fn reader_message(message: &str, text: &str) -> String {
+    let located = message.split_once("--> ").and_then(|(_, rest)| {
+        let (line, rest) = rest.split_once(':')?;
+        let column: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        let line: usize = line.trim().parse().ok()?;
+        let content = text.lines().nth(line.checked_sub(1)?)?;
+        Some(format!(
+            "line {line}, column {column}: `{}` is not an entry of this header's format",
+            content.trim()
+        ))
+    });
+    located.unwrap_or_else(|| message.split_whitespace().collect::<Vec<_>>().join(" "))
 }
 
 /// `(A + A^T) / 2` after checking `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`.
