@@ -45,25 +45,7 @@ pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 /// Largest Matrix Market file read (bytes).
 pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
 
-/// Which side of a contact dof the obstacle is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ContactDirection {
-    /// Obstacle on the positive side: `u[dof] - gap <= 0`.
-    #[default]
-    Positive,
-    /// Obstacle on the negative side: `-u[dof] - gap <= 0`.
-    Negative,
-}
-
-impl ContactDirection {
-    /// `+1` or `-1`: the entry of the contact's row of `G`.
-    pub fn sign(self) -> f64 {
-        match self {
-            ContactDirection::Positive => 1.0,
-            ContactDirection::Negative => -1.0,
-        }
-    }
-}
+pub use crate::model::ContactDirection;
 
 /// A contact of an imported model on one dof.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -417,19 +399,10 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
     let mut contacts = Vec::with_capacity(spec.contacts.len());
     for c in &spec.contacts {
         dof_in_range("contact.point.dof", c.dof)?;
-        if c.direction == ContactDirection::Negative {
-            return Err(ImportError::Model {
-                scene: spec.scene.clone(),
-                reason: format!(
-                    "invalid `contact.point.direction` = -1 on dof {}: allowed 1 (obstacles on \
-                     the negative side are not supported)",
-                    c.dof + 1
-                ),
-            });
-        }
         contacts.push(ContactPoint {
             dof: c.dof,
             gap: c.gap,
+            direction: c.direction,
         });
     }
     let observed_dof = match spec.observed_dof {
@@ -636,9 +609,10 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     for c in &model.contacts {
         let _ = writeln!(
             t,
-            "\n[[contact.point]]\ndof = {}\ngap = {:?}",
+            "\n[[contact.point]]\ndof = {}\ngap = {:?}\ndirection = {}",
             c.dof + 1,
-            c.gap
+            c.gap,
+            c.sign() as i32
         );
     }
     let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);

@@ -343,10 +343,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
     let contacts = spec
         .contacts
         .iter()
-        .map(|c| ContactPoint {
-            dof: c.node - 1,
-            gap: c.gap,
-        })
+        .map(|c| ContactPoint::new(c.node - 1, c.gap))
         .collect();
     let mut model = StructuralModel {
         mass,

@@ -439,7 +439,9 @@ fn statistics(
 ) -> PeriodStatistics {
     let tip_dof = rod.observed_dof;
     let contacts = &rod.model.contacts;
-    let tip_contact = contacts.iter().position(|c| c.dof == tip_dof);
+    let tip_contact = contacts
+        .iter()
+        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
     let mut stats = match (tip_contact, forces.first()) {
         (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
         (None, Some(f)) => {
@@ -456,7 +458,10 @@ fn statistics(
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
-        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
+        let p = u
+            .iter()
+            .map(|v| (c.sign() * v - c.gap).max(0.0))
+            .fold(0.0, f64::max);
         stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
