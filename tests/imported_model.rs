@@ -284,3 +284,46 @@ fn import_error_is_a_typed_value() {
         })
     ));
 }
+
+#[test]
+fn scene_sections_of_an_imported_model_are_checked_by_key() {
+    let base = "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n[forcing]\nvector = \"f.mtx\"\n\
+                amplitude = 1.0\n[[contact.point]]\ndof = 1\ngap = 0.1\n";
+    let cases: [(&str, &[&str]); 6] = [
+        ("[rod]\nelements = 3\n", &["model", "[rod]"]),
+        ("[damping]\nzeta = 0.1\n", &[]),
+        ("[model]\n", &["model"]),
+        ("[output]\ndof = 0\n", &["output.dof", "0"]),
+        (
+            "[[contact.point]]\nnode = 2\ngap = 0.1\n",
+            &["contact.point.node", "dof"],
+        ),
+        (
+            "[[contact.point]]\ndof = 1\ngap = 0.2\ndirection = 1\n",
+            &["contact.point.dof", "direction"],
+        ),
+    ];
+    for (extra, expected) in cases {
+        let text = format!("{base}{extra}");
+        let result = Scene::from_toml(&text, "m.toml");
+        if expected.is_empty() {
+            assert!(result.is_ok(), "{extra}: {result:?}");
+            continue;
+        }
+        let message = result.unwrap_err().to_string();
+        for e in expected {
+            assert!(message.contains(e), "{extra}: `{e}` not in: {message}");
+        }
+    }
+    let without = Scene::from_toml("[forcing]\namplitude = 1.0\n", "m.toml").unwrap_err();
+    assert!(without.to_string().contains("[model]"), "{without}");
+    let damping_twice =
+        base.replace("K.mtx\"\n", "K.mtx\"\ndamping = \"D.mtx\"\n") + "[damping]\nzeta = 0.1\n";
+    let message = Scene::from_toml(&damping_twice, "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("damping") && message.contains("either"),
+        "{message}"
+    );
+}
