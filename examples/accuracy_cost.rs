@@ -10,7 +10,6 @@ use std::path::PathBuf;
 use semismooth_problems::figures::default_settings;
 use semismooth_problems::output::prepare_directory;
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
-use semismooth_problems::scene::Scene;
 use semismooth_problems::study::accuracy_cost;
 
 fn main() -> std::process::ExitCode {
@@ -25,20 +24,24 @@ fn main() -> std::process::ExitCode {
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     faer::set_global_parallelism(faer::Par::Seq);
-    let (spec, base) = match std::env::args().nth(1) {
+    let (rod, base) = match std::env::args().nth(1) {
+        // A rod or a [model] scene, as `ssn compare` reads it.
         Some(path) => {
-            let scene = Scene::from_path(&path)?;
-            (scene.rod, scene.solver)
+            use semismooth_problems::cli::{load, CliError};
+            let (scene, structure) = load(path.as_ref()).map_err(|e| match e {
+                CliError::BadInput(m) | CliError::Output(m) => m,
+                CliError::NotConverged => "not converged".to_string(),
+            })?;
+            (structure, scene.solver)
         }
-        None => (
-            RodSpec {
+        None => {
+            let spec = RodSpec {
                 mass: MassModel::Modified,
                 ..RodSpec::canonical()
-            },
-            default_settings(20),
-        ),
+            };
+            (build_rod(&spec)?.structure, default_settings(20))
+        }
     };
-    let rod = build_rod(&spec)?;
     let progress = |s: &str| eprintln!("  {s}");
     let study = accuracy_cost(&rod, &base, Some(&progress))?;
     println!("{}", study.table());

@@ -23,7 +23,7 @@ fn modified_rod() -> StructuralModel {
         mass: MassModel::Modified,
         ..RodSpec::canonical()
     };
-    build_rod(&spec).unwrap().model
+    build_rod(&spec).unwrap().structure.model
 }
 
 /// A deterministic state with contact activity at some samples.

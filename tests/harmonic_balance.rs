@@ -64,7 +64,7 @@ fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -
 fn contacts(points: &[(usize, f64)]) -> Vec<ContactPoint> {
     points
         .iter()
-        .map(|&(dof, gap)| ContactPoint { dof, gap })
+        .map(|&(dof, gap)| ContactPoint::new(dof, gap))
         .collect()
 }
 
@@ -286,7 +286,7 @@ fn penalty_jacobian_matches_central_differences_away_from_kinks() {
 
 #[test]
 fn omega_derivative_matches_central_differences() {
-    let model = chain(3, Some(0.03), 1.1, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let model = chain(3, Some(0.03), 1.1, vec![ContactPoint::new(2, 0.1)]);
     let mut hb = SsnHb::new(&model, &hb_options(3, Some(16), None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
@@ -411,7 +411,7 @@ fn structured_and_dense_newton_steps_agree_penalty() {
 
 #[test]
 fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
-    let model = chain(3, Some(0.02), 1.2, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let model = chain(3, Some(0.02), 1.2, vec![ContactPoint::new(2, 0.1)]);
     let mut hb = SsnHb::new(&model, &hb_options(4, None, None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let mut jac = hb.new_jacobian();
@@ -434,7 +434,7 @@ fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
 
 #[test]
 fn bad_options_are_typed_errors_with_the_numbers() {
-    let model = chain(3, None, 1.0, vec![ContactPoint { dof: 2, gap: 0.1 }]);
+    let model = chain(3, None, 1.0, vec![ContactPoint::new(2, 0.1)]);
     let err = SsnHb::new(&model, &hb_options(10, Some(20), None)).unwrap_err();
     assert!(matches!(
         err,
@@ -469,7 +469,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
             "{option}: {err:?}"
         );
     }
-    let bad = chain(3, None, 1.0, vec![ContactPoint { dof: 7, gap: 0.1 }]);
+    let bad = chain(3, None, 1.0, vec![ContactPoint::new(7, 0.1)]);
     let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
     assert!(matches!(
         err,
@@ -490,6 +490,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
 fn canonical_modified_rod() -> StructuralModel {
     build_rod(&common::canonical(MassModel::Modified))
         .unwrap()
+        .structure
         .model
 }
 
@@ -666,7 +667,7 @@ fn sample_complementarity(hb: &SsnHb, x: &[f64], contact: ContactPoint) -> (f64,
 /// convergence for the same chain with mass 0.5 on the contact node).
 #[test]
 fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
-    let mut model = chain(3, Some(0.02), 0.5, vec![ContactPoint { dof: 2, gap: 0.3 }]);
+    let mut model = chain(3, Some(0.02), 0.5, vec![ContactPoint::new(2, 0.3)]);
     let masses = [
         Triplet::new(0, 0, 1.0),
         Triplet::new(1, 1, 0.7),

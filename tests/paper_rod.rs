@@ -25,7 +25,7 @@ fn march(spec: &RodSpec, steps: usize) -> Solution {
 /// solved densely in complex arithmetic (independent of the HB code).
 fn exact_linear_tip(spec: &RodSpec, times: &[f64]) -> Vec<f64> {
     use nalgebra::Complex;
-    let model = build_rod(spec).unwrap().model;
+    let model = build_rod(spec).unwrap().structure.model;
     let w = model.forcing.omega;
     let tip = common::exact_linear(&model, w)[model.dofs() - 1];
     times

@@ -27,7 +27,7 @@ fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
         },
         RodContact { node: 20, gap: 0.5 },
     ];
-    build_rod(&spec).unwrap().model
+    build_rod(&spec).unwrap().structure.model
 }
 
 fn rod(mass: MassModel, damped: bool) -> StructuralModel {
@@ -36,7 +36,7 @@ fn rod(mass: MassModel, damped: bool) -> StructuralModel {
     if !damped {
         spec.damping = None;
     }
-    build_rod(&spec).unwrap().model
+    build_rod(&spec).unwrap().structure.model
 }
 
 fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
@@ -189,7 +189,7 @@ fn lcp_gap_equals_the_time_domain_trapezoidal_rule_for_odd_nt() {
         spec.elements = 4;
         spec.mass = mass;
         spec.contacts = vec![RodContact { node: 4, gap: 0.5 }];
-        let model = build_rod(&spec).unwrap().model;
+        let model = build_rod(&spec).unwrap().structure.model;
         let nt = 15; // odd, not a power of two: the direct-DFT path
         let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
         let z: Vec<f64> = (0..nt)

@@ -17,7 +17,7 @@ use semismooth::floquet::{crossing, BifurcationKind};
 
 use crate::hb::{HbError, PenaltyHb, SsnHb};
 use crate::model::StructuralModel;
-use crate::rod::RodModel;
+use crate::model::Structure;
 use crate::runner::{hb_options, penalty_options, RunError};
 use crate::scene::{Method, SolverSettings};
 use crate::solutions::ContactSummary;
@@ -157,7 +157,7 @@ impl Reconstruction {
 /// Stability and diagnostics of every point of `response`, computed with the scene's
 /// settings (module documentation).
 pub fn branch_stability(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
     options: &StabilityOptions,
@@ -193,7 +193,7 @@ pub fn branch_stability(
         out.stable.push(s.stable);
         out.floquet_max_abs.push(s.floquet_max_abs);
         let (mean, penetration) = reconstruction
-            .summary(x, rod.tip_dof())
+            .summary(x, rod.observed_dof)
             .unwrap_or((f64::NAN, f64::NAN));
         out.contact_force_mean.push(mean);
         out.max_penetration.push(penetration);

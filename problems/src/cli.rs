@@ -1,5 +1,5 @@
 //! The `ssn` command-line program's commands, as library functions (so tests and examples
-//! can call them): `solve`, `sweep`, `compare` and `scene-check`, their JSON documents and
+//! can call them): `solve`, `sweep`, `compare`, `scene-check` and `export-model`, their JSON documents and
 //! printed summaries. The default run (the paper's figures) is in [`crate::figures`].
 //!
 //! Every command maps its failure onto [`CliError`], whose variants are the documented exit
@@ -13,9 +13,11 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{json, Value};
 
+use crate::import::build_imported;
 use crate::io::{printable, write_text, OutputSet, TargetError};
+use crate::model::Structure;
 use crate::output::{csv_table, line_plot_svg, prepare_directory, PlotSpec, Series};
-use crate::rod::{build_rod, natural_frequencies, ModelError, RodModel};
+use crate::rod::{build_rod, natural_frequencies, ModelError};
 use crate::runner::{solve_rod, RunCounters, Solution};
 use crate::scene::{Method, Scene};
 
@@ -52,19 +54,32 @@ fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
-/// Loads a scene and builds its rod, after checking that one run of its method fits in
-/// memory ([`crate::limits`]).
-pub fn load(path: &Path) -> Result<(Scene, RodModel), CliError> {
+/// Loads a scene and builds its structure (the rod of a `[rod]` scene, the Matrix Market
+/// files of a `[model]` scene; `[output] dof` chooses the observed dof), after checking
+/// that one run of its method fits in memory ([`crate::limits`]).
+pub fn load(path: &Path) -> Result<(Scene, Structure), CliError> {
     load_checked(path, false)
 }
 
 /// [`load`], with the memory of `ssn compare`'s runs when `compare`.
-fn load_checked(path: &Path, compare: bool) -> Result<(Scene, RodModel), CliError> {
+fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let need = crate::limits::scene_memory(&scene, compare);
     crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
-    let rod = build_rod(&scene.rod).map_err(|e| input_error(path, e))?;
-    Ok((scene, rod))
+    let structure = match &scene.model {
+        // Import errors name the scene or the matrix file themselves.
+        Some(spec) => build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?,
+        None => {
+            let mut rod = build_rod(&scene.rod)
+                .map_err(|e| input_error(path, e))?
+                .structure;
+            if let Some(dof) = scene.output_dof {
+                rod.observed_dof = dof;
+            }
+            rod
+        }
+    };
+    Ok((scene, structure))
 }
 
 /// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
@@ -508,6 +523,26 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
     Ok(())
 }
 
+/// `ssn export-model SCENE DIR`: writes the scene's structure as Matrix Market files and a
+/// `[model]` scene (`DIR/scene.toml`) that solves the same problem.
+pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
+    let (scene, structure) = load(path)?;
+    prepare_directory(dir)?;
+    // All files or none: every target is claimed before anything is written.
+    let mut set = OutputSet::new();
+    set.input(path, "the scene");
+    let mut written = String::new();
+    for (name, text) in crate::import::export_files(&scene, &structure) {
+        let target = dir.join(&name);
+        set.target(&target, "export-model")?;
+        set.add(&target, text.into_bytes());
+        written += &format!("wrote {}\n", printable(&target.display().to_string()));
+    }
+    set.commit()?;
+    write_text(&written)?;
+    Ok(())
+}
+
 /// A spinner on stderr when it is a terminal and not `quiet`.
 pub fn progress_spinner(message: &str, quiet: bool) -> indicatif::ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
@@ -535,9 +570,12 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
 }
 
 /// The resolved model of a scene, in words (`ssn scene-check`).
-pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
+pub fn describe(scene: &Scene, rod: &Structure, modes: &[f64]) -> String {
     use crate::rod::{DampingSpec, FrequencySpec, LoadKind};
-    let s = &rod.spec;
+    if let Some(spec) = &scene.model {
+        return crate::import::describe(scene, spec, rod, modes);
+    }
+    let s = &scene.rod;
     let mut out = String::new();
     let mut line = |t: String| {
         out.push_str(&t);
@@ -603,6 +641,17 @@ pub fn describe(scene: &Scene, rod: &RodModel, modes: &[f64]) -> String {
             rod.model.contact_stiffness_scale()
         ));
     }
+    out.push_str(&describe_run(scene, rod));
+    out
+}
+
+/// The solver, sweep and contact-mass lines of [`describe`] (rod and imported scenes).
+pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
+    let mut out = String::new();
+    let mut line = |t: String| {
+        out.push_str(&t);
+        out.push('\n');
+    };
     let v = &scene.solver;
     line(match v.method {
         m if m.is_harmonic_balance() => format!(

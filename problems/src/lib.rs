@@ -12,6 +12,7 @@ mod dynamic;
 pub mod figures;
 pub mod from_zero;
 pub mod hb;
+pub mod import;
 pub mod io;
 pub mod lcp;
 pub mod limits;

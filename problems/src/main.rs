@@ -16,6 +16,7 @@ Examples:
   ssn sweep problems/scenes/paper_fig2.toml --csv fig2.csv --svg fig2.svg
   ssn compare problems/scenes/paper_fig1_modified_mass.toml --out out/compare
   ssn scene-check problems/scenes/two_contacts.toml
+  ssn export-model problems/scenes/paper_fig1.toml out/rod   (matrices and a [model] scene)
 
 Exit codes:
   0  converged (or, for scene-check, a valid scene)
@@ -101,6 +102,18 @@ enum Command {
         #[arg(long, default_value_t = 1e-3)]
         accuracy: f64,
     },
+    /// Write a scene's structure as Matrix Market files (M, K, D, f) and a [model] scene
+    /// that solves the same problem.
+    #[command(
+        after_help = "Example:\n  ssn export-model problems/scenes/paper_fig1_modified_mass.toml out/rod\n  \
+        ssn solve out/rod/scene.toml\n\n"
+    )]
+    ExportModel {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Directory to write M.mtx, K.mtx, D.mtx (when damped), f.mtx and scene.toml into.
+        dir: PathBuf,
+    },
     /// Validate a scene and print the resolved model (natural frequencies, effects present).
     #[command(after_help = "Example:\n  ssn scene-check problems/scenes/two_contacts.toml\n\n")]
     SceneCheck {
@@ -128,6 +141,7 @@ fn main() -> ExitCode {
             command.name()
         ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
+        Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
         Some(Command::Solve(run)) => cli::solve(run, args.quiet),
         Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
         Some(Command::Solutions(run)) => semismooth_problems::solutions::command(run),
@@ -173,6 +187,7 @@ impl Command {
             Command::Solve(_) => "solve",
             Command::Sweep(_) => "sweep",
             Command::Solutions(_) => "solutions",
+            Command::ExportModel { .. } => "export-model",
             Command::Compare { .. } => "compare",
             Command::SceneCheck { .. } => "scene-check",
         }

@@ -6,9 +6,12 @@
 //!
 //! [`StructuralModel::validate`] is the one check every formulation makes before using a
 //! model: square matrices of one size `N >= 1`, a forcing of length `N`, finite entries, a
-//! finite `omega > 0`, and contacts on distinct existing dofs with finite gaps (two contacts
-//! on one dof would make the contact rows of `G` dependent: the harmonic-balance Jacobian
-//! and the time-marching contact problem are then singular).
+//! finite `omega > 0`, and contacts on existing dofs with finite gaps, at most one per dof
+//! and side (two contacts on one side of a dof would make the rows of `G` equal: the
+//! harmonic-balance Jacobian and the time-marching contact problem are then singular). Two
+//! contacts on one dof from opposite sides are a two-sided clearance (backlash): their
+//! gaps must leave room between the obstacles (sum > 0), so that at most one is closed at a
+//! time.
 
 use std::ops::{AddAssign, Mul};
 
@@ -20,13 +23,53 @@ use semismooth::{Factorize, LinearSolve};
 pub type SparseMatrix = SparseColMat<usize, f64>;
 
 /// One unilateral contact: the obstacle limits degree of freedom `dof` to
-/// `u[dof] - gap <= 0`. Row of `G` is the unit vector on `dof`.
+/// `s u[dof] - gap <= 0`, `s = direction.sign()` (+1: obstacle on the positive side, -1: on
+/// the negative side). Row of `G` is `s` times the unit vector on `dof`; the force the
+/// obstacle applies to the dof is `s lambda` (`lambda <= 0`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactPoint {
     /// Index of the constrained degree of freedom (0-based among the free unknowns).
     pub dof: usize,
     /// Initial gap `g` (negative: preloaded against the obstacle at rest).
     pub gap: f64,
+    /// Side of the obstacle.
+    pub direction: ContactDirection,
+}
+
+impl ContactPoint {
+    /// A contact with the obstacle on the positive side (`u[dof] - gap <= 0`).
+    pub fn new(dof: usize, gap: f64) -> Self {
+        Self {
+            dof,
+            gap,
+            direction: ContactDirection::Positive,
+        }
+    }
+
+    /// The entry `s = +-1` of the contact's row of `G`.
+    pub fn sign(&self) -> f64 {
+        self.direction.sign()
+    }
+}
+
+/// Which side of a contact dof the obstacle is on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactDirection {
+    /// Obstacle on the positive side: `u[dof] - gap <= 0`.
+    #[default]
+    Positive,
+    /// Obstacle on the negative side: `-u[dof] - gap <= 0`.
+    Negative,
+}
+
+impl ContactDirection {
+    /// `+1` or `-1`: the entry of the contact's row of `G`.
+    pub fn sign(self) -> f64 {
+        match self {
+            ContactDirection::Positive => 1.0,
+            ContactDirection::Negative => -1.0,
+        }
+    }
 }
 
 /// Periodic external force `f(t) = amplitude * cos(omega t)` (a fixed spatial shape).
@@ -52,6 +95,19 @@ pub struct StructuralModel {
     pub forcing: HarmonicForcing,
     /// Unilateral contacts (rows of `G` and gaps `g`).
     pub contacts: Vec<ContactPoint>,
+}
+
+/// A structure ready for every method: the model, its first finite natural frequency
+/// `omega_1` (the unit of `omega_ratio` in scenes and sweeps) and the dof whose displacement
+/// outputs describe (`tip_*` fields, plots): the rod's tip, or a scene's `[output] dof`.
+#[derive(Debug, Clone)]
+pub struct Structure {
+    /// The semi-discrete model `M, D, K, f, G, g`.
+    pub model: StructuralModel,
+    /// First finite natural frequency (rad per unit time).
+    pub omega_1: f64,
+    /// The observed dof (0-based).
+    pub observed_dof: usize,
 }
 
 /// Why a [`StructuralModel`] cannot be used: the part, the value found and what is allowed.
@@ -105,8 +161,11 @@ pub enum InvalidModel {
         /// `N`.
         dofs: usize,
     },
-    /// Two contacts constrain the same dof.
-    #[error("contacts {first} and {second} are both on dof {dof}: allowed one contact per dof")]
+    /// Two contacts constrain the same dof from the same side.
+    #[error(
+        "contacts {first} and {second} are both on dof {dof}, same side: allowed one contact per \
+         dof and side"
+    )]
     DuplicateContactDof {
         /// The earlier contact.
         first: usize,
@@ -114,6 +173,21 @@ pub enum InvalidModel {
         second: usize,
         /// The shared dof.
         dof: usize,
+    },
+    /// Two contacts on one dof from opposite sides leave no room between the obstacles.
+    #[error(
+        "contacts {first} and {second} on dof {dof} leave a clearance {clearance} between the \
+         obstacles: allowed a sum of the two gaps > 0"
+    )]
+    NoClearance {
+        /// The earlier contact.
+        first: usize,
+        /// The later contact.
+        second: usize,
+        /// The shared dof.
+        dof: usize,
+        /// The sum of the two gaps.
+        clearance: f64,
     },
     /// A dof asked to be observed does not exist.
     #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
@@ -186,12 +260,26 @@ impl StructuralModel {
                 });
             }
             first_non_finite("contact gap", &[c.gap])?;
-            if let Some(first) = self.contacts[..contact].iter().position(|o| o.dof == c.dof) {
-                return Err(InvalidModel::DuplicateContactDof {
-                    first,
-                    second: contact,
-                    dof: c.dof,
-                });
+            for (first, o) in self.contacts[..contact].iter().enumerate() {
+                if o.dof != c.dof {
+                    continue;
+                }
+                if o.direction == c.direction {
+                    return Err(InvalidModel::DuplicateContactDof {
+                        first,
+                        second: contact,
+                        dof: c.dof,
+                    });
+                }
+                let clearance = o.gap + c.gap;
+                if clearance.is_nan() || clearance <= 0.0 {
+                    return Err(InvalidModel::NoClearance {
+                        first,
+                        second: contact,
+                        dof: c.dof,
+                        clearance,
+                    });
+                }
             }
         }
         Ok(())
@@ -334,7 +422,7 @@ mod tests {
                 amplitude: vec![0.0, 0.0, 1.0],
                 omega: 1.0,
             },
-            contacts: vec![ContactPoint { dof: 2, gap: 0.1 }],
+            contacts: vec![ContactPoint::new(2, 0.1)],
         }
     }
 
@@ -371,7 +459,7 @@ mod tests {
         m.forcing.omega = -1.0;
         assert_eq!(m.validate(), Err(InvalidModel::Omega { value: -1.0 }));
         let mut m = chain();
-        m.contacts.push(ContactPoint { dof: 3, gap: 0.0 });
+        m.contacts.push(ContactPoint::new(3, 0.0));
         assert_eq!(
             m.validate(),
             Err(InvalidModel::ContactDofOutOfRange {
@@ -381,8 +469,8 @@ mod tests {
             })
         );
         let mut m = chain();
-        m.contacts.push(ContactPoint { dof: 0, gap: 0.0 });
-        m.contacts.push(ContactPoint { dof: 2, gap: 0.3 });
+        m.contacts.push(ContactPoint::new(0, 0.0));
+        m.contacts.push(ContactPoint::new(2, 0.3));
         assert_eq!(
             m.validate(),
             Err(InvalidModel::DuplicateContactDof {

@@ -19,7 +19,9 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
 use crate::dynamic::UnionPattern;
-use crate::model::{sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel};
+use crate::model::{
+    sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure,
+};
 
 /// How the rod's mass is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -123,14 +125,12 @@ impl RodSpec {
     }
 }
 
-/// A rod problem ready for a formulation: the structural model plus its first natural
-/// frequency and the spec it was built from.
+/// A rod problem ready for a formulation: the [`Structure`] (model, first natural frequency,
+/// the tip as observed dof), through `Deref`, plus the spec it was built from.
 #[derive(Debug, Clone)]
 pub struct RodModel {
-    /// The semi-discrete model `M, D, K, f, G, g`.
-    pub model: StructuralModel,
-    /// First natural frequency of the discrete rod (rad per unit time).
-    pub omega_1: f64,
+    /// The structure every method runs on.
+    pub structure: Structure,
     /// The spec it was built from.
     pub spec: RodSpec,
 }
@@ -139,6 +139,19 @@ impl RodModel {
     /// Dof index of the tip node.
     pub fn tip_dof(&self) -> usize {
         self.spec.elements - 1
+    }
+}
+
+impl std::ops::Deref for RodModel {
+    type Target = Structure;
+    fn deref(&self) -> &Structure {
+        &self.structure
+    }
+}
+
+impl std::ops::DerefMut for RodModel {
+    fn deref_mut(&mut self) -> &mut Structure {
+        &mut self.structure
     }
 }
 
@@ -330,10 +343,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
     let contacts = spec
         .contacts
         .iter()
-        .map(|c| ContactPoint {
-            dof: c.node - 1,
-            gap: c.gap,
-        })
+        .map(|c| ContactPoint::new(c.node - 1, c.gap))
         .collect();
     let mut model = StructuralModel {
         mass,
@@ -373,8 +383,11 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         });
     }
     Ok(RodModel {
-        model,
-        omega_1,
+        structure: Structure {
+            model,
+            omega_1,
+            observed_dof: n - 1,
+        },
         spec: spec.clone(),
     })
 }
@@ -437,12 +450,17 @@ fn sparse_times(m: &SparseMatrix, x: &DMatrix<f64>) -> DMatrix<f64> {
     out
 }
 
+/// Relative change per subspace iteration below which the last estimate is accepted when
+/// [`natural_frequencies`] reaches its iteration limit.
+const ACCEPTED_EIGEN_CHANGE: f64 = 1e-9;
+
 /// The `count` lowest natural frequencies `omega` of `K v = omega^2 M v` (rad per unit
 /// time), ascending. Massless dofs have infinite frequencies and are not counted.
 ///
 /// Small models (n <= 64) are solved densely; larger ones by subspace iteration
 /// `Y <- K^{-1} M Y` with Rayleigh–Ritz (sparse LU of K, cost linear in n for a rod),
-/// until the requested frequencies change by less than 1e-13 relative.
+/// until the requested frequencies change by less than 1e-13 relative (or, after 200
+/// iterations, by less than 1e-9: clustered spectra converge slowly).
 pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<f64>, ModelError> {
     let n = model.dofs();
     if count == 0 {
@@ -492,7 +510,7 @@ pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<
     let mut previous: Option<Vec<f64>> = None;
     let max_iterations = 200;
     let mut change = f64::INFINITY;
-    for _ in 0..max_iterations {
+    for iteration in 0..max_iterations {
         // Y <- K^{-1} M Y
         let mut z = sparse_times(&model.mass, &y);
         for column in z.as_mut_slice().chunks_exact_mut(n) {
@@ -511,6 +529,12 @@ pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<
             if change < 1e-13 {
                 return Ok(current);
             }
+        }
+        if change < ACCEPTED_EIGEN_CHANGE && previous.is_some() && iteration + 1 == max_iterations {
+            // A cluster of nearly equal frequencies (e.g. a bladed disk's blade modes)
+            // converges slowly: the last estimate, changing by less than 1e-9 relative per
+            // iteration, is returned rather than nothing.
+            return Ok(current);
         }
         previous = Some(current);
         // Normalise the Ritz vectors to keep the iteration well scaled.

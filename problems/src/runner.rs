@@ -24,9 +24,10 @@ use crate::lcp::{
     ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
 use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
+use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
-use crate::rod::{ModelError, RodModel};
+use crate::rod::ModelError;
 use crate::scene::{GlobalizationChoice, LinearSolverChoice, Method, SolverSettings};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
@@ -211,10 +212,10 @@ pub(crate) fn penalty_options(
 /// The periodic LCP's options of a scene and the index of the tip's contact: the tip is
 /// observed (its history kept) when it is not a contact.
 pub(crate) fn lcp_options(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
 ) -> (PeriodicLcpOptions, Option<usize>) {
-    let tip = rod.tip_dof();
+    let tip = rod.observed_dof;
     let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
     let options = PeriodicLcpOptions {
         time_samples: settings.time_samples,
@@ -361,7 +362,7 @@ struct Period {
 
 /// The solution record of a run of the scene's method.
 fn solution(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     time_samples: usize,
     outcome: Outcome<'_>,
@@ -417,13 +418,13 @@ fn solution(
 /// The tip, the contact forces and the statistics of an HB solution on `points` times.
 fn hb_outputs(
     problem: &impl HbReconstruction,
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     outcome: Outcome<'_>,
     x: Vec<f64>,
     points: usize,
 ) -> Result<Solution, RunError> {
-    let tip = problem.displacement(&x, rod.tip_dof(), points)?;
+    let tip = problem.displacement(&x, rod.observed_dof, points)?;
     let contact_forces = (0..problem.contact_count())
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
@@ -455,14 +456,16 @@ fn hb_outputs(
 
 /// Tip statistics; the penetration is the largest over all contacts (and the tip's).
 fn statistics(
-    rod: &RodModel,
+    rod: &Structure,
     tip: &[f64],
     forces: &[Vec<f64>],
     contact_displacements: &[Vec<f64>],
 ) -> PeriodStatistics {
-    let tip_dof = rod.tip_dof();
+    let tip_dof = rod.observed_dof;
     let contacts = &rod.model.contacts;
-    let tip_contact = contacts.iter().position(|c| c.dof == tip_dof);
+    let tip_contact = contacts
+        .iter()
+        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
     let mut stats = match (tip_contact, forces.first()) {
         (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
         (None, Some(f)) => {
@@ -479,7 +482,10 @@ fn statistics(
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
-        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
+        let p = u
+            .iter()
+            .map(|v| (c.sign() * v - c.gap).max(0.0))
+            .fold(0.0, f64::max);
         stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
@@ -487,12 +493,12 @@ fn statistics(
 
 /// Solves the rod with the scene's method, from a zero initial guess (or `warm_start`).
 pub fn solve_rod(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
     let model = &rod.model;
-    let tip = rod.tip_dof();
+    let tip = rod.observed_dof;
     let scale = model.contact_stiffness_scale();
     match settings.method {
         Method::SsnHb => {
@@ -575,7 +581,7 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
 }
 
 fn solve_lcp(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
@@ -692,9 +698,9 @@ fn solve_lcp(
     Ok(sol)
 }
 
-fn solve_march(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, RunError> {
+fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
     let model = &rod.model;
-    let tip = rod.tip_dof();
+    let tip = rod.observed_dof;
     let options = MarchOptions {
         steps_per_period: settings.steps_per_period,
         max_periods: settings.max_periods,

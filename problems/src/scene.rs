@@ -24,6 +24,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use crate::import::{ContactDirection, DofContact, ModelSpec};
 use crate::rod::{DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec};
 
 /// Why a scene could not be used. Every variant names the file; `Invalid` also names the
@@ -209,8 +210,13 @@ pub struct Scene {
     pub path: PathBuf,
     /// Optional title (`title = "..."`).
     pub title: Option<String>,
-    /// The rod.
+    /// The rod of a `[rod]` scene (for a `[model]` scene: unused, the canonical rod).
     pub rod: RodSpec,
+    /// The imported structure of a `[model]` scene (`None` for a `[rod]` scene).
+    pub model: Option<ModelSpec>,
+    /// `[output] dof`, 0-based: the dof that `tip_*` outputs and plots describe (default: the
+    /// rod's tip; for a `[model]` scene the first contact dof).
+    pub output_dof: Option<usize>,
     /// Solver settings.
     pub solver: SolverSettings,
     /// Frequency sweep, if declared.
@@ -221,10 +227,12 @@ pub struct Scene {
 #[serde(deny_unknown_fields)]
 struct RawScene {
     title: Option<String>,
-    rod: RawRod,
+    rod: Option<RawRod>,
+    model: Option<RawModel>,
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
+    output: Option<RawOutput>,
     #[serde(default)]
     solver: RawSolver,
     sweep: Option<RawSweep>,
@@ -239,6 +247,20 @@ struct RawRod {
     mass_per_length: Option<f64>,
     #[serde(default)]
     mass: RawMass,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    mass: String,
+    stiffness: String,
+    damping: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    dof: i64,
 }
 
 #[derive(Debug, Deserialize, Default, Clone, Copy)]
@@ -277,8 +299,8 @@ enum RawLoad {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawForcing {
-    #[serde(default)]
-    load: RawLoad,
+    load: Option<RawLoad>,
+    vector: Option<String>,
     amplitude: f64,
     omega_ratio: Option<f64>,
     omega: Option<f64>,
@@ -295,8 +317,10 @@ struct RawContact {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawContactPoint {
-    node: i64,
+    node: Option<i64>,
+    dof: Option<i64>,
     gap: f64,
+    direction: Option<i64>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -438,12 +462,48 @@ impl Scene {
 /// the error.
 fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let ck = Check { path };
-    let mut rod = ck.rod(&raw.rod)?;
-    rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
-    (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
-    if let Some(c) = raw.contact {
-        rod.contacts = ck.contacts(c, rod.elements)?;
-    }
+    let (rod, model, output_dof) = match (&raw.rod, raw.model) {
+        (Some(raw_rod), None) => {
+            let mut rod = ck.rod(raw_rod)?;
+            if raw.forcing.vector.is_some() {
+                return Err(ck.invalid(
+                    "forcing.vector",
+                    "given in a [rod] scene",
+                    "`load` (\"distributed\" or \"tip\"); `vector` belongs to [model] scenes",
+                ));
+            }
+            rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
+            (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
+            if let Some(c) = raw.contact {
+                rod.contacts = ck.contacts(c, rod.elements)?;
+            }
+            let output_dof = raw
+                .output
+                .map(|o| ck.count("output.dof", o.dof, 1, rod.elements))
+                .transpose()?
+                .map(|dof| dof - 1);
+            (rod, None, output_dof)
+        }
+        (None, Some(m)) => {
+            let model = ck.model(m, raw.damping, &raw.forcing, raw.contact, raw.output)?;
+            let output_dof = model.observed_dof;
+            (RodSpec::canonical(), Some(model), output_dof)
+        }
+        (Some(_), Some(_)) => {
+            return Err(ck.invalid(
+                "model",
+                "given together with [rod]",
+                "either [rod] (the built-in rod) or [model] (Matrix Market files)",
+            ))
+        }
+        (None, None) => {
+            return Err(ck.invalid(
+                "rod",
+                "missing",
+                "a [rod] section (the built-in rod) or a [model] section (Matrix Market files)",
+            ))
+        }
+    };
     // An LCP without contact is empty: allowed, solved as the linear response.
     let solver = ck.solver(&raw.solver)?;
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
@@ -451,6 +511,8 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         path: path.to_path_buf(),
         title: raw.title,
         rod,
+        model,
+        output_dof,
         solver,
         sweep,
     })
@@ -609,7 +671,7 @@ impl Check<'_> {
                 ))
             }
         };
-        let load = match f.load {
+        let load = match f.load.unwrap_or_default() {
             RawLoad::Distributed => LoadKind::Distributed,
             RawLoad::Tip => LoadKind::Tip,
         };
@@ -634,7 +696,17 @@ impl Check<'_> {
                 }
                 let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
                 for p in points {
-                    let node = self.count("contact.point.node", p.node, 1, elements)?;
+                    if p.dof.is_some() || p.direction.is_some() {
+                        return Err(self.invalid(
+                            "contact.point.dof",
+                            "given in a [rod] scene",
+                            "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                        ));
+                    }
+                    let node = p.node.ok_or_else(|| {
+                        self.invalid("contact.point.node", "missing", "an integer node number")
+                    })?;
+                    let node = self.count("contact.point.node", node, 1, elements)?;
                     if contacts.iter().any(|c| c.node == node) {
                         return Err(self.invalid(
                             "contact.point.node",
@@ -660,6 +732,135 @@ impl Check<'_> {
                 "either `gap` (+ optional `node`) or [[contact.point]] entries",
             )),
         }
+    }
+
+    /// `[model]` and the sections an imported structure reads: `[damping]` (unless a
+    /// damping file is given), `[forcing]` with a load `vector` file, `[[contact.point]]`
+    /// with 1-based `dof`, `gap` and `direction` (+1 or -1), `[output] dof`. File names are
+    /// relative to the scene's directory; dof upper bounds are checked when the files are
+    /// read.
+    fn model(
+        &self,
+        m: RawModel,
+        damping: Option<RawDamping>,
+        f: &RawForcing,
+        contact: Option<RawContact>,
+        output: Option<RawOutput>,
+    ) -> Result<ModelSpec, SceneError> {
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        let file = |key: &str, name: &str| {
+            if name.trim().is_empty() {
+                Err(self.invalid(
+                    key,
+                    "\"\"",
+                    "a file name (relative to the scene's directory)",
+                ))
+            } else {
+                Ok(dir.join(name))
+            }
+        };
+        let mass = file("model.mass", &m.mass)?;
+        let stiffness = file("model.stiffness", &m.stiffness)?;
+        let damping_matrix = m.damping.map(|d| file("model.damping", &d)).transpose()?;
+        let damping = damping.map(|d| self.damping(&d)).transpose()?;
+        if damping_matrix.is_some() && damping.is_some() {
+            return Err(self.invalid(
+                "damping",
+                "a [damping] section together with model.damping",
+                "either a damping matrix file or a [damping] section",
+            ));
+        }
+        if f.load.is_some() {
+            return Err(self.invalid(
+                "forcing.load",
+                "given in a [model] scene",
+                "`vector` (a Matrix Market file of the load shape, N x 1)",
+            ));
+        }
+        let vector = f.vector.as_deref().ok_or_else(|| {
+            self.invalid(
+                "forcing.vector",
+                "missing",
+                "a Matrix Market file of the load shape, N x 1 (relative to the scene)",
+            )
+        })?;
+        let forcing_vector = file("forcing.vector", vector)?;
+        let (_, amplitude, frequency) = self.forcing(f)?;
+        let contacts = contact
+            .map(|c| self.dof_contacts(c))
+            .transpose()?
+            .unwrap_or_default();
+        let observed_dof = output
+            .map(|o| self.count("output.dof", o.dof, 1, usize::MAX >> 1))
+            .transpose()?
+            .map(|dof| dof - 1);
+        Ok(ModelSpec {
+            scene: self.path.to_path_buf(),
+            mass,
+            stiffness,
+            damping_matrix,
+            damping,
+            forcing_vector,
+            amplitude,
+            frequency,
+            contacts,
+            observed_dof,
+        })
+    }
+
+    /// `[[contact.point]]` entries of a `[model]` scene: `dof` (1-based), `gap`, `direction`
+    /// (+1, the default, or -1); one contact per dof and direction.
+    fn dof_contacts(&self, c: RawContact) -> Result<Vec<DofContact>, SceneError> {
+        let allowed = "[[contact.point]] entries with dof, gap and optional direction";
+        let points = match (c.gap, c.node, c.point) {
+            (None, None, Some(points)) if !points.is_empty() => points,
+            (None, None, _) => return Err(self.invalid("contact.point", "an empty list", allowed)),
+            (Some(_), _, _) => {
+                return Err(self.invalid("contact.gap", "given in a [model] scene", allowed))
+            }
+            (None, Some(_), _) => {
+                return Err(self.invalid("contact.node", "given in a [model] scene", allowed))
+            }
+        };
+        let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
+        for p in points {
+            if p.node.is_some() {
+                return Err(self.invalid(
+                    "contact.point.node",
+                    "given in a [model] scene",
+                    "`dof` (1-based, as in Matrix Market)",
+                ));
+            }
+            let dof = p.dof.ok_or_else(|| {
+                self.invalid("contact.point.dof", "missing", "a 1-based dof number")
+            })?;
+            let dof = self.count("contact.point.dof", dof, 1, usize::MAX >> 1)? - 1;
+            let direction = match p.direction.unwrap_or(1) {
+                1 => ContactDirection::Positive,
+                -1 => ContactDirection::Negative,
+                d => return Err(self.invalid(
+                    "contact.point.direction",
+                    d,
+                    "1 (obstacle on the positive side: u <= gap) or -1 (negative side: -u <= gap)",
+                )),
+            };
+            if contacts
+                .iter()
+                .any(|c| c.dof == dof && c.direction == direction)
+            {
+                return Err(self.invalid(
+                    "contact.point.dof",
+                    dof + 1,
+                    "one contact per dof and direction (two contacts on one dof need opposite directions)",
+                ));
+            }
+            contacts.push(DofContact {
+                dof,
+                gap: self.finite("contact.point.gap", p.gap)?,
+                direction,
+            });
+        }
+        Ok(contacts)
     }
 
     /// `[solver]`: the method and its discretisation and iteration settings, defaults filled

@@ -17,7 +17,7 @@
 use std::time::Instant;
 
 use crate::branch::Reconstruction;
-use crate::rod::RodModel;
+use crate::model::Structure;
 use crate::runner::{solve_rod, RunError, Solution};
 use crate::scene::{Method, SolverSettings, SweepSettings};
 use crate::stability::{hb_stability, Stability, StabilityOptions};
@@ -81,7 +81,7 @@ pub struct SolutionSet {
 /// `sweep`: the window and continuation settings (`None`: `[0.5, 2] w* / omega_1` with the
 /// scene defaults).
 pub fn find_solutions(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     sweep: Option<&SweepSettings>,
 ) -> Result<SolutionSet, RunError> {

@@ -22,8 +22,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::model::Structure;
 use crate::output::{write_atomically, write_line_plot, OutputError, PlotSpec, Series};
-use crate::rod::RodModel;
 use crate::runner::{solve_rod, RunError, Solution};
 use crate::scene::{default_hb_time_samples, Method, SolverSettings};
 
@@ -310,7 +310,7 @@ fn table_line(s: &mut String, c: [String; 8]) {
 }
 
 /// Runs `settings`, repeating fast runs and keeping the median wall time.
-fn timed(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, RunError> {
+fn timed(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
     let first = solve_rod(rod, settings, None)?;
     if first.solve_seconds >= REPEAT_BELOW_SECONDS {
         return Ok(first);
@@ -327,7 +327,7 @@ fn timed(rod: &RodModel, settings: &SolverSettings) -> Result<Solution, RunError
 
 /// The discretisations swept for each method: `(method, description, settings)`.
 fn sweep_settings(
-    rod: &RodModel,
+    rod: &Structure,
     base: &SolverSettings,
     march_tolerance: f64,
 ) -> Vec<(Method, String, SolverSettings)> {
@@ -416,7 +416,7 @@ fn hb_settings(base: &SolverSettings, harmonics: usize) -> SolverSettings {
 /// tolerance of [`REFERENCE_TOLERANCES`] that reaches a steady state; if none does, SSN-HB
 /// at [`REFERENCE_HARMONICS`] (uncertainty: the change from half the harmonics).
 fn reference(
-    rod: &RodModel,
+    rod: &Structure,
     base: &SolverSettings,
     say: &dyn Fn(&str),
 ) -> Result<Reference, RunError> {
@@ -510,7 +510,7 @@ fn reference(
 /// [`Entry::failure`] (printed as missing values and the reason); only a failure of the
 /// reference is an error.
 pub fn accuracy_cost(
-    rod: &RodModel,
+    rod: &Structure,
     base: &SolverSettings,
     progress: Option<&dyn Fn(&str)>,
 ) -> Result<AccuracyCost, RunError> {

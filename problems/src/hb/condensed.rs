@@ -87,8 +87,9 @@ impl CondensedSsnHb {
         self.solver
             .apply_dynamic_inverse(&mut self.linear_response)?;
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            let s = lin.contact_signs[i];
             for j in 0..lin.size() {
-                self.contact_linear[j * m + i] = self.linear_response[j * n + dof];
+                self.contact_linear[j * m + i] = s * self.linear_response[j * n + dof];
             }
         }
         self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
@@ -312,9 +313,9 @@ impl ParameterDependent for CondensedSsnHb {
             for (h, s) in self.mask.iter_mut().zip(self.aft.samples()) {
                 *h = if *s > 0.0 { 1.0 } else { 0.0 };
             }
-            let dof = lin.contact_dofs[i];
+            let (dof, s) = (lin.contact_dofs[i], lin.contact_signs[i]);
             for (j, coeff) in self.aft.coefficients_mut().iter_mut().enumerate() {
-                *coeff = -c * self.full_w[j * n + dof];
+                *coeff = -c * s * self.full_w[j * n + dof];
             }
             self.aft.coefficients_to_samples();
             for (s, h) in self.aft.samples_mut().iter_mut().zip(&self.mask) {

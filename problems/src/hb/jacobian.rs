@@ -144,14 +144,16 @@ impl DenseAssemble for HbJacobian {
         let offset = n * size;
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {
             let q = &self.q[i];
+            // G's entry of contact i; the penalty block G^T Q G has s^2 = 1.
+            let s = lin.contact_signs[i];
             match self.coupling {
                 ContactCoupling::Complementarity { c } => {
                     for j in 0..size {
                         // dR_u / dLambda = -G^T.
-                        out[(j * n + dof, offset + j * m + i)] -= 1.0;
+                        out[(j * n + dof, offset + j * m + i)] -= s;
                         for l in 0..size {
                             // dR_lambda / dU = c Q G, dR_lambda / dLambda = I - Q.
-                            out[(offset + j * m + i, l * n + dof)] += c * q[(j, l)];
+                            out[(offset + j * m + i, l * n + dof)] += c * s * q[(j, l)];
                             out[(offset + j * m + i, offset + l * m + i)] -= q[(j, l)];
                         }
                         out[(offset + j * m + i, offset + j * m + i)] += 1.0;

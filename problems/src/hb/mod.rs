@@ -240,6 +240,8 @@ pub(crate) struct LinearData {
     pub(crate) forcing: Vec<f64>,
     pub(crate) contact_dofs: Vec<usize>,
     pub(crate) gaps: Vec<f64>,
+    /// `s_i = +-1`: the entry of contact `i`'s row of `G` (its dof `contact_dofs[i]`).
+    pub(crate) contact_signs: Vec<f64>,
 }
 
 impl LinearData {
@@ -264,6 +266,7 @@ impl LinearData {
             forcing: model.forcing.amplitude.clone(),
             contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
+            contact_signs: model.contacts.iter().map(|c| c.sign()).collect(),
         })
     }
 
@@ -428,10 +431,15 @@ pub(crate) fn displacement_summary(
     lin.gather(u, dof, &mut coeffs);
     let displacement_rms = lin.basis.mean_square(&coeffs)?.sqrt();
     let mut max_penetration = 0.0f64;
-    for (&cdof, &gap) in lin.contact_dofs.iter().zip(&lin.gaps) {
+    for ((&cdof, &gap), &sign) in lin
+        .contact_dofs
+        .iter()
+        .zip(&lin.gaps)
+        .zip(&lin.contact_signs)
+    {
         let s = fine_samples(lin, u, cdof, points)?;
         for x in s {
-            max_penetration = max_penetration.max(x - gap);
+            max_penetration = max_penetration.max(sign * x - gap);
         }
     }
     Ok(ResponseSummary {

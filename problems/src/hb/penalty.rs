@@ -141,11 +141,11 @@ impl PenaltyHb {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
         lin.check_contact(contact)?;
-        let gap = lin.gaps[contact];
+        let (gap, sign) = (lin.gaps[contact], lin.contact_signs[contact]);
         let samples = fine_samples(lin, u, lin.contact_dofs[contact], points)?;
         Ok(samples
             .into_iter()
-            .map(|x| -self.stiffness * (x - gap).max(0.0))
+            .map(|x| -self.stiffness * (sign * x - gap).max(0.0))
             .collect())
     }
 
@@ -201,6 +201,10 @@ impl PenaltyHb {
         let lin = &self.state.linear;
         let coeffs = self.state.aft.coefficients_mut();
         lin.gather(u, lin.contact_dofs[i], coeffs);
+        let sign = lin.contact_signs[i];
+        for c in coeffs.iter_mut() {
+            *c *= sign;
+        }
         coeffs[0] -= lin.gaps[i];
         self.state.aft.coefficients_to_samples();
     }
@@ -223,9 +227,9 @@ impl Residual for PenaltyHb {
             }
             self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
-            let dof = lin.contact_dofs[i];
+            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                out[j * n + dof] += c;
+                out[j * n + dof] += sign * c;
             }
         }
         Ok(())

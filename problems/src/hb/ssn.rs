@@ -191,10 +191,10 @@ impl SsnHb {
         let lin = &self.state.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
-        let dof = lin.contact_dofs[i];
+        let (dof, sc) = (lin.contact_dofs[i], self.c * lin.contact_signs[i]);
         let coeffs = self.state.aft.coefficients_mut();
         for (j, c) in coeffs.iter_mut().enumerate() {
-            *c = self.c * x[j * n + dof] - x[offset + j * m + i];
+            *c = sc * x[j * n + dof] - x[offset + j * m + i];
         }
         coeffs[0] -= self.c * lin.gaps[i];
         self.state.aft.coefficients_to_samples();
@@ -214,9 +214,9 @@ impl Residual for SsnHb {
         let (out_u, out_l) = out.split_at_mut(offset);
         lin.dynamic_residual(self.state.omega, &x[..offset], out_u);
         for i in 0..m {
-            let dof = lin.contact_dofs[i];
+            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
             for j in 0..size {
-                out_u[j * n + dof] -= x[offset + j * m + i];
+                out_u[j * n + dof] -= sign * x[offset + j * m + i];
             }
             self.switching_samples(x, i);
             let mu = self.smoothing;

@@ -217,14 +217,16 @@ impl StructuredHbSolver {
                 })?;
             let z = &mut self.response[k];
             z.fill(c64::new(0.0, 0.0));
+            // Columns of G^T: s_i on dof_i (two contacts may share a dof).
             for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                z[(dof, i)] = c64::new(1.0, 0.0);
+                z[(dof, i)] = c64::new(lin.contact_signs[i], 0.0);
             }
             dynamic.solve_in_place(k, z.as_mut())?;
             let r = &mut self.receptance[k];
             for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                let s = lin.contact_signs[i];
                 for ip in 0..lin.contacts() {
-                    r[(i, ip)] = z[(dof, ip)];
+                    r[(i, ip)] = z[(dof, ip)] * s;
                 }
             }
         }
@@ -437,8 +439,9 @@ impl StructuredHbSolver {
         self.apply_dynamic_inverse(&mut w)?;
         // y = G w.
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            let s = lin.contact_signs[i];
             for j in 0..size {
-                self.work_a[j * m + i] = w[j * n + dof];
+                self.work_a[j * m + i] = s * w[j * n + dof];
             }
         }
         match self.coupling {
@@ -493,8 +496,9 @@ impl StructuredHbSolver {
         let nu = n * size;
         lin.apply_dynamic(omega, &x[..nu], &mut out[..nu]);
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            let s = lin.contact_signs[i];
             for j in 0..size {
-                self.work_a[j * m + i] = x[j * n + dof];
+                self.work_a[j * m + i] = s * x[j * n + dof];
             }
         }
         Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
@@ -504,17 +508,19 @@ impl StructuredHbSolver {
                 let x_l = &x[nu..];
                 Self::apply_coupling(&self.q, m, x_l, &mut self.work_d);
                 for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    let s = lin.contact_signs[i];
                     for j in 0..size {
                         let r = j * m + i;
-                        out_u[j * n + dof] -= x_l[r];
+                        out_u[j * n + dof] -= s * x_l[r];
                         out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
                     }
                 }
             }
             ContactCoupling::Penalty { stiffness } => {
                 for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    let s = lin.contact_signs[i];
                     for j in 0..size {
-                        out[j * n + dof] += stiffness * self.work_c[j * m + i];
+                        out[j * n + dof] += stiffness * s * self.work_c[j * m + i];
                     }
                 }
             }

@@ -9,7 +9,7 @@ use semismooth::{Factorize, LinearSolve};
 
 use super::{FftPlans, FrequencyDerivative, LcpError, PeriodicLcp, PeriodicLcpOptions};
 use crate::dynamic::DynamicStiffness;
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::{ContactDirection, SparseMatrix, StructuralModel};
 
 /// `true` when column `j` of `m` has no non-zero entry.
 fn column_is_zero(m: &SparseMatrix, j: usize) -> bool {
@@ -57,6 +57,17 @@ impl PeriodicLcp {
         model.validate()?;
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);
+        }
+        if let Some((contact, c)) = model
+            .contacts
+            .iter()
+            .enumerate()
+            .find(|(_, c)| c.direction != ContactDirection::Positive)
+        {
+            return Err(LcpError::NegativeDirection {
+                contact,
+                dof: c.dof,
+            });
         }
         let n = model.dofs();
         let m = model.contact_count();

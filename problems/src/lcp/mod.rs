@@ -181,6 +181,19 @@ pub enum LcpError {
     /// The model has no contact: there is no complementarity problem.
     #[error("the model has no contact: the periodic LCP needs at least one")]
     NoContacts,
+    /// A contact has its obstacle on the negative side (not formulated here).
+    #[error(
+        "contact {contact} (dof {}, 1-based) has its obstacle on the negative side: the \
+         periodic LCP allows direction = +1 only (solve two-sided stops with ssn-hb, penalty-hb \
+         or march)",
+        .dof + 1
+    )]
+    NegativeDirection {
+        /// Index of the contact.
+        contact: usize,
+        /// Its dof (0-based).
+        dof: usize,
+    },
     /// A model quantity has the wrong size.
     #[error("dimension mismatch in {what}: expected {expected}, found {found}")]
     DimensionMismatch {

@@ -171,7 +171,7 @@ mod tests {
     fn the_finest_lcp_must_be_the_models() {
         let mut spec = RodSpec::canonical();
         spec.mass = MassModel::Modified;
-        let model = build_rod(&spec).unwrap().model;
+        let model = build_rod(&spec).unwrap().structure.model;
         let options = PeriodicLcpOptions {
             time_samples: 16,
             ..Default::default()

@@ -208,10 +208,10 @@ impl<'a> TimeMarcher<'a> {
         let mut w = Mat::zeros(m, m);
         for (k, c) in model.contacts.iter().enumerate() {
             let col = &mut y[k * n..(k + 1) * n];
-            col[c.dof] = 1.0;
+            col[c.dof] = c.sign();
             lu.solve_in_place(col).map_err(failed)?;
             for (i, ci) in model.contacts.iter().enumerate() {
-                w[(i, k)] = col[ci.dof];
+                w[(i, k)] = ci.sign() * col[ci.dof];
             }
         }
         let cosines = (0..=spp)
@@ -260,7 +260,7 @@ impl<'a> TimeMarcher<'a> {
             *ri = c * ai;
         }
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
-            self.r[ct.dof] += l;
+            self.r[ct.dof] += ct.sign() * l;
         }
         if let Some(d) = &model.damping {
             sparse_mul_add(d.as_ref(), -1.0, &self.v, &mut self.r);
@@ -426,7 +426,7 @@ impl<'a> TimeMarcher<'a> {
         self.active.clear();
         let mut closed = false;
         for (k, ct) in model.contacts.iter().enumerate() {
-            self.q[k] = ct.gap - self.rhs[ct.dof];
+            self.q[k] = ct.gap - ct.sign() * self.rhs[ct.dof];
             closed |= self.q[k] < 0.0;
         }
         if closed {
@@ -472,8 +472,9 @@ impl<'a> TimeMarcher<'a> {
         // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
         self.active.clear();
         for (k, ct) in model.contacts.iter().enumerate() {
-            if ct.gap - (self.u[ct.dof] + 0.5 * h * self.v[ct.dof]) <= 0.0 {
-                self.q[self.active.len()] = -(self.rhs[ct.dof] + e * self.v[ct.dof]);
+            let s = ct.sign();
+            if ct.gap - s * (self.u[ct.dof] + 0.5 * h * self.v[ct.dof]) <= 0.0 {
+                self.q[self.active.len()] = -s * (self.rhs[ct.dof] + e * self.v[ct.dof]);
                 self.active.push(k);
             }
         }

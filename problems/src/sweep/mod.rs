@@ -91,7 +91,7 @@ use response::{extremes, HbTip};
 use crate::branch::{branch_stability, BranchStability};
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
-use crate::rod::RodModel;
+use crate::model::Structure;
 use crate::runner::{
     hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
     HB_OUTPUT_POINTS,
@@ -133,7 +133,7 @@ fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
 
 /// Root mean square over the dofs of the linear response (contacts removed) at `ω_1`
 /// (`0.95 ω_1`, then `0.5 ω_1` if that is singular, e.g. undamped); `1` if all fail.
-fn reference_amplitude(rod: &RodModel) -> f64 {
+fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
     let dofs = model.dofs().max(1);
@@ -527,7 +527,7 @@ where
 /// ([`crate::branch::branch_stability`], in [`FrequencyResponse::stability`]); a failure
 /// there leaves the points undecided with the reason in its `note`.
 pub fn frequency_response(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(usize, f64)>,
@@ -545,7 +545,7 @@ pub fn frequency_response(
 
 /// The branch of [`frequency_response`] without its stability.
 pub(crate) fn follow_branch(
-    rod: &RodModel,
+    rod: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(usize, f64)>,
@@ -553,7 +553,7 @@ pub(crate) fn follow_branch(
     check_sweep(sweep)?;
     let started = Instant::now();
     let model = &rod.model;
-    let tip = rod.tip_dof();
+    let tip = rod.observed_dof;
     let dofs = model.dofs();
     let omega_1 = rod.omega_1;
     let u_ref = reference_amplitude(rod);

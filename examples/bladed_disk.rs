@@ -1,0 +1,83 @@
+//! Writes a structure with many contacts: a mistuned bladed disk whose blade tips rub a
+//! casing, as Matrix Market files for a `[model]` scene (`problems/scenes/blades/` and
+//! `problems/scenes/bladed_disk_casing.toml` are its output for 100 blades).
+//!
+//! `B` sectors in a ring; sector `j` has a disk dof `d_j` (dof `3j + 1`, 1-based) and a blade
+//! tip dof `b_j` (dof `3j + 2`), both of unit mass, and a massless contact pad `p_j` (dof
+//! `3j + 3`). Springs: `k_g = 1` from each disk dof to the ground, `k_d = 1` between
+//! neighbouring disk dofs (cyclic), the blade `k_b (1 + delta_j)` between `d_j` and `b_j`
+//! with `k_b = 1` and a deterministic mistuning `delta_j = 0.02 sin(2.3 j)` (so that the
+//! blades do not all touch at the same instant), and the pad `k_c = 10` between `b_j` and
+//! `p_j` (a free massless pad carries no force: the pads change no natural frequency, and
+//! the contacts are well posed for every method). The load (`f.mtx`) is a unit force on
+//! every blade tip, in phase (engine order 0); the casing is a stop on every pad (the
+//! scene's `[[contact.point]]` list).
+//!
+//! `cargo run --release --example bladed_disk -- [BLADES] [DIR]` (defaults 100 and
+//! `problems/scenes/blades`); the scene's contact list is printed.
+
+use std::path::PathBuf;
+
+use semismooth::faer::sparse::Triplet;
+use semismooth_problems::import::{matrix_market_text, vector_market_text};
+use semismooth_problems::model::SparseMatrix;
+
+/// Stiffness, mass and load of a `blades`-sector disk (`3 blades` dofs).
+fn bladed_disk(blades: usize) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
+    let n = 3 * blades;
+    let (k_g, k_d, k_b, k_c) = (1.0, 1.0, 1.0, 10.0);
+    let mut k = Vec::new();
+    let mut spring = |i: usize, j: Option<usize>, s: f64| {
+        k.push(Triplet::new(i, i, s));
+        if let Some(j) = j {
+            k.push(Triplet::new(j, j, s));
+            k.push(Triplet::new(i, j, -s));
+            k.push(Triplet::new(j, i, -s));
+        }
+    };
+    for j in 0..blades {
+        let (d, b, p) = (3 * j, 3 * j + 1, 3 * j + 2);
+        spring(d, None, k_g);
+        if blades > 1 {
+            spring(d, Some(3 * ((j + 1) % blades)), k_d);
+        }
+        let delta = 0.02 * (2.3 * j as f64).sin();
+        spring(d, Some(b), k_b * (1.0 + delta));
+        spring(b, Some(p), k_c);
+    }
+    let m: Vec<Triplet<usize, usize, f64>> = (0..n)
+        .filter(|i| i % 3 != 2)
+        .map(|i| Triplet::new(i, i, 1.0))
+        .collect();
+    let k = SparseMatrix::try_new_from_triplets(n, n, &k).expect("valid triplets");
+    let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("valid triplets");
+    let f = (0..n).map(|i| if i % 3 == 1 { 1.0 } else { 0.0 }).collect();
+    (k, m, f)
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let blades: usize = args
+        .next()
+        .map(|a| a.parse().expect("BLADES: a positive integer"))
+        .unwrap_or(100);
+    assert!(blades >= 1, "BLADES: a positive integer");
+    let dir = PathBuf::from(
+        args.next()
+            .unwrap_or_else(|| "problems/scenes/blades".into()),
+    );
+    std::fs::create_dir_all(&dir).expect("output directory");
+    let (k, m, f) = bladed_disk(blades);
+    for (name, text) in [
+        ("K.mtx", matrix_market_text(&k)),
+        ("M.mtx", matrix_market_text(&m)),
+        ("f.mtx", vector_market_text(&f)),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).expect("writable output");
+        eprintln!("wrote {}", path.display());
+    }
+    for j in 0..blades {
+        println!("[[contact.point]]\ndof = {}\ngap = 1.0\n", 3 * j + 3);
+    }
+}
