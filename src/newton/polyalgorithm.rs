@@ -1,0 +1,343 @@
+//! The polyalgorithm of [`Globalization::Polyalgorithm`]: full steps, the smoothing path,
+//! the non-monotone line search and the Newton homotopy, each from the initial guess, within
+//! one iteration budget (module docs of [`crate::newton`], *Polyalgorithm*).
+
+use crate::linesearch::LineSearchOptions;
+use crate::{Factorize, GeneralizedJacobian, Residual};
+
+use super::kernel::{self, KernelRules};
+use super::{path, Attempt, Globalization, Log, NewtonSolver, Strategy, Termination, WorkCounters};
+
+impl<J> NewtonSolver<J> {
+    /// Full steps, then the smoothing path, the line search and the Newton homotopy (see
+    /// [`Globalization::Polyalgorithm`]); the best iterate of all attempts is returned.
+    pub(super) fn polyalgorithm<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        settings: (usize, usize, LineSearchOptions),
+        counters: &mut WorkCounters,
+        log: &mut Log,
+    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        // The initial guess in storage kept between solves (no allocation once sized).
+        let mut start = std::mem::take(&mut self.start);
+        start.clear();
+        start.extend_from_slice(x);
+        let result = self.attempts(problem, linear, x, &start, settings, (counters, log));
+        self.start = start;
+        result
+    }
+
+    /// The attempts of the polyalgorithm from `start` (= `x` on entry), with the run's
+    /// counters and histories.
+    fn attempts<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        start: &[f64],
+        (full_steps, memory, line_search): (usize, usize, LineSearchOptions),
+        (counters, log): (&mut WorkCounters, &mut Log),
+    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        let max_iterations = self.options.max_iterations;
+        let base = KernelRules {
+            globalization: Globalization::None,
+            max_iterations: full_steps.min(max_iterations),
+            ..self.options.rules()
+        };
+        let mut attempts = Vec::new();
+        let mut used = 0;
+
+        // 1. Full steps.
+        let (termination, run) = self.phase(problem, linear, x, &base, counters, log);
+        let tolerance = run.tolerance;
+        attempts.push(Attempt::new(
+            Strategy::FullSteps,
+            run.iterations,
+            &termination,
+        ));
+        used += run.iterations;
+        if termination.converged() {
+            return (termination, Strategy::FullSteps, attempts, tolerance);
+        }
+        let mut best = Best::new(x, self.kernel.residual(), run.smallest);
+        let first_step = self.kernel.step_norms.first().copied().unwrap_or(f64::NAN);
+        let scale = path::state_scale(first_step, x.len());
+        let mut last = termination;
+        let mut strategy = Strategy::FullSteps;
+
+        // Full steps on F from the end of a path (it is near a root: usually a few steps).
+        let finish = |solver: &mut Self,
+                      problem: &mut P,
+                      linear: &mut S,
+                      x: &mut [f64],
+                      used: usize,
+                      counters: &mut WorkCounters,
+                      log: &mut Log| {
+            let rules = KernelRules {
+                max_iterations: max_iterations
+                    .saturating_sub(used)
+                    .clamp(1, full_steps.max(1)),
+                ..base
+            };
+            solver.phase(problem, linear, x, &rules, counters, log)
+        };
+
+        // 2. The smoothing path, when the problem offers a smoothing.
+        if let Some(mu0) = problem
+            .smoothing()
+            .map(|s| SMOOTHING_START * s.smoothing_scale())
+            .filter(|mu| mu.is_finite() && *mu > 0.0)
+        {
+            x.copy_from_slice(start);
+            let budget = max_iterations.saturating_sub(used);
+            let setup = SmoothingSetup {
+                mu0,
+                state_scale: scale,
+                tolerance,
+                budget,
+                line_search,
+            };
+            let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
+            used += outcome.iterations;
+            strategy = Strategy::Smoothing;
+            if outcome.reached {
+                let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                used += run.iterations;
+                attempts.push(Attempt::new(
+                    Strategy::Smoothing,
+                    outcome.iterations + run.iterations,
+                    &termination,
+                ));
+                if termination.converged() {
+                    return (termination, Strategy::Smoothing, attempts, tolerance);
+                }
+                best.update(x, self.kernel.residual(), run.smallest);
+                last = termination;
+            } else {
+                attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
+            }
+        }
+
+        // 3. The non-monotone line search from the initial guess, on at most half of what is
+        // left (it ends early when backtracking fails at a kink of the merit).
+        let budget = max_iterations.saturating_sub(used) / 2;
+        if budget > 0 {
+            x.copy_from_slice(start);
+            let rules = KernelRules {
+                globalization: Globalization::NonMonotone {
+                    memory,
+                    line_search,
+                },
+                max_iterations: budget,
+                ..base
+            };
+            let (termination, run) = self.phase(problem, linear, x, &rules, counters, log);
+            used += run.iterations;
+            attempts.push(Attempt::new(
+                Strategy::LineSearch,
+                run.iterations,
+                &termination,
+            ));
+            if termination.converged() {
+                return (termination, Strategy::LineSearch, attempts, tolerance);
+            }
+            best.update(x, self.kernel.residual(), run.smallest);
+            last = termination;
+            strategy = Strategy::LineSearch;
+        }
+
+        // 4. The Newton homotopy from the initial guess to t = 1.
+        let budget = max_iterations.saturating_sub(used);
+        if budget > 0 {
+            let mut f0 = vec![0.0; start.len()];
+            counters.residual_evaluations += 1;
+            if problem.residual(start, &mut f0).is_ok() && f0.iter().all(|v| v.is_finite()) {
+                x.copy_from_slice(start);
+                let plan = path::PathPlan {
+                    end: 1.0,
+                    // Ten steps over an affine path; small enough that a corner of the path (a
+                    // contact closing) is approached before it is overshot.
+                    steps: 10.0,
+                    growth: 1.0,
+                    // The state dominates the arclength: at a corner where t turns back
+                    // while the state moves on (a contact closing inside an overhang), the
+                    // arclength hyperplane still cuts the far piece.
+                    theta: 0.99,
+                    target_iterations: 5,
+                    state_scale: scale,
+                    accuracy: tolerance.max(path::PATH_ACCURACY * kernel::norm2(&f0)),
+                    budget,
+                };
+                let mut homotopy = path::NewtonHomotopy::new(&mut *problem, &f0);
+                let outcome = path::follow(&mut homotopy, &mut *linear, x, &plan);
+                *counters += outcome.counters;
+                used += outcome.iterations;
+                strategy = Strategy::Homotopy;
+                if outcome.reached {
+                    let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                    attempts.push(Attempt::new(
+                        Strategy::Homotopy,
+                        outcome.iterations + run.iterations,
+                        &termination,
+                    ));
+                    if termination.converged() {
+                        return (termination, Strategy::Homotopy, attempts, tolerance);
+                    }
+                    best.update(x, self.kernel.residual(), run.smallest);
+                    last = termination;
+                } else {
+                    attempts.push(Attempt::failed_path(Strategy::Homotopy, &outcome));
+                }
+            }
+        }
+
+        if best.restore(x) {
+            self.kernel.set_residual(&best.f);
+        }
+        (last, strategy, attempts, tolerance)
+    }
+
+    /// The smoothing path from `x`: `F_mu0(x) = 0` solved by Newton with an Armijo search
+    /// (the smoothed merit is differentiable), then followed to `mu0 10^-SMOOTHING_DECADES`.
+    fn smoothing_path<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        setup: &SmoothingSetup,
+        counters: &mut WorkCounters,
+    ) -> path::PathOutcome
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
+        let mut failed = path::PathOutcome {
+            reached: false,
+            iterations: 0,
+            furthest: 0.0,
+            reason: None,
+            counters: WorkCounters::default(),
+        };
+        let SmoothingSetup {
+            mu0,
+            state_scale,
+            tolerance,
+            budget,
+            line_search,
+        } = *setup;
+        let Some(mut smoothed) = path::SmoothingPath::new(&mut *problem, mu0) else {
+            return failed;
+        };
+        let mut f = vec![0.0; x.len()];
+        counters.residual_evaluations += 1;
+        if smoothed.residual(x, &mut f).is_err() {
+            failed.reason = Some("the smoothed residual cannot be evaluated at the start".into());
+            return failed;
+        }
+        let accuracy = tolerance.max(SMOOTHING_ACCURACY * kernel::norm2(&f));
+        let rules = KernelRules {
+            absolute_tolerance: accuracy,
+            relative_tolerance: 0.0,
+            globalization: Globalization::Armijo(line_search),
+            max_iterations: budget.min(SMOOTHING_START_ITERATIONS),
+            ..self.options.rules()
+        };
+        let mut scratch = Log::default();
+        // The smoothed iterates are not iterates of F: their histories are not reported.
+        let (termination, run) =
+            self.phase(&mut smoothed, linear, x, &rules, counters, &mut scratch);
+        failed.iterations = run.iterations;
+        if !termination.converged() {
+            failed.reason = Some(format!("the smoothed problem at the start: {termination}"));
+            return failed;
+        }
+        let plan = path::PathPlan {
+            end: SMOOTHING_DECADES,
+            steps: SMOOTHING_DECADES,
+            // A smooth path: the step may grow to several decades where the state barely
+            // moves (late on the path), state and parameter weigh alike.
+            growth: 4.0,
+            theta: 0.5,
+            target_iterations: 3,
+            state_scale,
+            accuracy,
+            budget: budget.saturating_sub(run.iterations),
+        };
+        let mut outcome = path::follow(&mut smoothed, &mut *linear, x, &plan);
+        *counters += outcome.counters;
+        outcome.iterations += run.iterations;
+        outcome
+    }
+}
+
+/// What the smoothing path starts from: `mu0`, the state scale of the path, the run's
+/// tolerance, the iterations left and the line search of the smoothed start.
+#[derive(Clone, Copy, Debug)]
+struct SmoothingSetup {
+    mu0: f64,
+    state_scale: f64,
+    tolerance: f64,
+    budget: usize,
+    line_search: LineSearchOptions,
+}
+
+/// The smoothing path starts at `mu = SMOOTHING_START x` the problem's smoothing scale
+/// (smaller starts leave the smoothed problem as hard as the problem itself; larger ones
+/// lengthen the path).
+const SMOOTHING_START: f64 = 1.0;
+/// Decades of `mu` the smoothing path descends before Newton on `F` takes over.
+const SMOOTHING_DECADES: f64 = 4.0;
+/// Accuracy of the smoothing path's points relative to `|F_mu0|` at the start: the end of
+/// the path must lie in the basin of semismooth Newton on `F` (1e-2 measured too loose).
+const SMOOTHING_ACCURACY: f64 = 1e-3;
+/// Newton iterations at most on the smoothed problem at the path's start.
+const SMOOTHING_START_ITERATIONS: usize = 30;
+
+/// The best iterate over several attempts.
+struct Best {
+    x: Vec<f64>,
+    f: Vec<f64>,
+    norm: f64,
+    /// Whether the last attempt ended elsewhere.
+    moved: bool,
+}
+
+impl Best {
+    fn new(x: &[f64], f: &[f64], norm: f64) -> Self {
+        Self {
+            x: x.to_vec(),
+            f: f.to_vec(),
+            norm,
+            moved: false,
+        }
+    }
+
+    fn update(&mut self, x: &[f64], f: &[f64], norm: f64) {
+        if norm < self.norm || self.norm.is_nan() {
+            self.x.copy_from_slice(x);
+            self.f.copy_from_slice(f);
+            self.norm = norm;
+            self.moved = false;
+        } else {
+            self.moved = true;
+        }
+    }
+
+    /// Writes the best iterate into `x` if the last attempt ended elsewhere.
+    fn restore(&self, x: &mut [f64]) -> bool {
+        if self.moved {
+            x.copy_from_slice(&self.x);
+        }
+        self.moved
+    }
+}
