@@ -237,6 +237,32 @@ pub struct MarchState {
 }
 
 impl MarchState {
+    /// Checks that the state has `n` displacements and velocities and `m` contact forces,
+    /// all finite.
+    pub(crate) fn check(&self, n: usize, m: usize) -> Result<(), MarchError> {
+        for (what, vec, len) in [
+            ("displacement", &self.displacement, n),
+            ("velocity", &self.velocity, n),
+            ("contact_force", &self.contact_force, m),
+        ] {
+            if vec.len() != len {
+                return Err(MarchError::StateDimension {
+                    what,
+                    expected: len,
+                    found: vec.len(),
+                });
+            }
+            if let Some((index, value)) = vec.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(MarchError::NonFiniteState {
+                    what,
+                    index,
+                    value: *value,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The state at rest: `u = v = 0`, `lambda = 0`.
     pub fn rest(model: &StructuralModel) -> Self {
         Self {

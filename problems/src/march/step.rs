@@ -153,26 +153,7 @@ impl<'a> TimeMarcher<'a> {
         model.validate()?;
         let n = model.dofs();
         let m = model.contact_count();
-        for (what, vec, len) in [
-            ("displacement", &initial.displacement, n),
-            ("velocity", &initial.velocity, n),
-            ("contact_force", &initial.contact_force, m),
-        ] {
-            if vec.len() != len {
-                return Err(MarchError::StateDimension {
-                    what,
-                    expected: len,
-                    found: vec.len(),
-                });
-            }
-            if let Some((index, value)) = vec.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(MarchError::NonFiniteState {
-                    what,
-                    index,
-                    value: *value,
-                });
-            }
-        }
+        initial.check(n, m)?;
         let scheme = Scheme::resolve(model, options.scheme);
         let massless: Vec<bool> = (0..n)
             .map(|j| column_max_abs(&model.mass, j) == 0.0)

@@ -45,26 +45,7 @@ impl TimeMarcher<'_> {
     /// as if it had marched there (the inertial force is recomputed from the state).
     pub fn restart_at(&mut self, phase: usize, state: &MarchState) -> Result<(), MarchError> {
         let (n, m) = (self.u.len(), self.lambda.len());
-        for (what, vec, len) in [
-            ("displacement", &state.displacement, n),
-            ("velocity", &state.velocity, n),
-            ("contact_force", &state.contact_force, m),
-        ] {
-            if vec.len() != len {
-                return Err(MarchError::StateDimension {
-                    what,
-                    expected: len,
-                    found: vec.len(),
-                });
-            }
-            if let Some((index, value)) = vec.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(MarchError::NonFiniteState {
-                    what,
-                    index,
-                    value: *value,
-                });
-            }
-        }
+        state.check(n, m)?;
         if phase >= self.steps_per_period {
             return Err(MarchError::InvalidOption {
                 name: "phase",
