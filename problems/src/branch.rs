@@ -15,9 +15,8 @@
 
 use semismooth::floquet::{crossing, BifurcationKind};
 
-use crate::hb::{HbError, PenaltyHb, SsnHb};
-use crate::model::StructuralModel;
-use crate::model::Structure;
+use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
+use crate::model::{StructuralModel, Structure};
 use crate::runner::{hb_options, penalty_options, RunError};
 use crate::scene::{Method, SolverSettings};
 use crate::solutions::ContactSummary;
@@ -101,31 +100,24 @@ impl Reconstruction {
         model: &StructuralModel,
         x: &[f64],
     ) -> Result<Vec<ContactSummary>, HbError> {
+        let first = model.contacts.first().map_or(0, |c| c.dof);
+        // Both formulations offer the same summary and reconstruction.
+        let gather = |summary: Result<ResponseSummary, HbError>,
+                      samples: &dyn Fn(usize) -> Result<Vec<f64>, HbError>| {
+            let samples = model
+                .contacts
+                .iter()
+                .map(|c| samples(c.dof))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok::<_, HbError>((summary?, samples))
+        };
         let (summary, samples) = match self {
-            Self::Ssn(p) => (
-                p.summary(
-                    x,
-                    model.contacts.first().map_or(0, |c| c.dof),
-                    DIAGNOSTIC_POINTS,
-                )?,
-                model
-                    .contacts
-                    .iter()
-                    .map(|c| p.displacement_samples(x, c.dof, DIAGNOSTIC_POINTS))
-                    .collect::<Result<Vec<_>, _>>()?,
-            ),
-            Self::Penalty(p) => (
-                p.summary(
-                    x,
-                    model.contacts.first().map_or(0, |c| c.dof),
-                    DIAGNOSTIC_POINTS,
-                )?,
-                model
-                    .contacts
-                    .iter()
-                    .map(|c| p.displacement_samples(x, c.dof, DIAGNOSTIC_POINTS))
-                    .collect::<Result<Vec<_>, _>>()?,
-            ),
+            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
+                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            })?,
+            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
+                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            })?,
         };
         Ok(model
             .contacts
