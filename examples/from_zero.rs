@@ -10,10 +10,13 @@
 //! cargo run --release --example from_zero            # everything (about a minute)
 //! cargo run --release --example from_zero -- grid    # only the grid
 //! cargo run --release --example from_zero -- grid hybrid   # with another globalization
+//! cargo run --release --example from_zero -- hard auto "H = 80,undamped"  # some groups
 //! ```
 //!
 //! The second argument names the globalization as a scene does (`auto`, the default;
-//! `hybrid`, the default before the polyalgorithm; `none`, `armijo`, `nonmonotone`).
+//! `hybrid`, the default before the polyalgorithm; `none`, `armijo`, `nonmonotone`); the
+//! third keeps the groups whose name contains one of its comma-separated parts. Points that
+//! fail or take more than 60 iterations are listed with their attempts.
 
 use std::time::Instant;
 
@@ -45,7 +48,14 @@ fn main() {
         "{:<44} {:>6} {:>9} {:>6} {:>7} {:>10} {:>8}  strategies",
         "group", "points", "converged", "worst", "median", "backtracks", "seconds"
     );
+    let filter = std::env::args().nth(3);
     for (name, cases) in groups {
+        if filter
+            .as_deref()
+            .is_some_and(|f| !f.split(',').any(|p| name.contains(p)))
+        {
+            continue;
+        }
         let start = Instant::now();
         let mut converged = 0;
         let mut iterations = Vec::new();
@@ -58,16 +68,16 @@ fn main() {
             match solve_rod(&case.rod, &settings, None) {
                 Ok(sol) => {
                     backtracks += sol.counters.line_search_backtracks;
-                    if sol.converged && sol.iterations > 60 && std::env::var("SS_SHOW").is_ok() {
-                        println!(
-                            "    slow {} {}: {:?}",
-                            case.label,
-                            sol.iterations,
-                            sol.attempts
-                                .iter()
-                                .map(|a| (a.strategy.name(), a.iterations))
-                                .collect::<Vec<_>>()
-                        );
+                    if !sol.converged || sol.iterations > 60 {
+                        println!("    {} ({} iterations):", case.label, sol.iterations);
+                        for a in &sol.attempts {
+                            println!(
+                                "        {} {} {}",
+                                a.strategy.name(),
+                                a.iterations,
+                                a.outcome
+                            );
+                        }
                     }
                     if sol.converged {
                         converged += 1;

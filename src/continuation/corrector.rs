@@ -419,7 +419,9 @@ where
                 iterations: run.iterations,
                 residual_norm,
             }),
-            Stop::MaxIterations => Err(CorrectorFailure::MaxIterations {
+            // The corrector runs without a stagnation rule: a stagnation is an iteration
+            // budget spent.
+            Stop::MaxIterations | Stop::Stagnated => Err(CorrectorFailure::MaxIterations {
                 iterations: run.iterations,
                 residual_norm,
             }),

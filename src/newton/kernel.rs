@@ -52,6 +52,32 @@ pub(crate) struct KernelRules {
     pub globalization: Globalization,
     /// Return the iterate of smallest `|G|` rather than the last one.
     pub restore_best: bool,
+    /// Stop a run that stopped making progress ([`Stagnation`]); `None`: never.
+    pub stagnation: Option<Stagnation>,
+}
+
+/// A run stagnates when, after at least `after` iterations, the smallest `|G|` of the last
+/// `window` iterates is not below `factor` times the smallest of the iterates before them
+/// (the initial guess excluded: from `x_0 = 0` the first full step usually raises `|G|`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Stagnation {
+    pub after: usize,
+    pub window: usize,
+    pub factor: f64,
+}
+
+impl Stagnation {
+    /// Whether the history `norms` (`|G|` at the initial guess and after each step)
+    /// stagnates.
+    fn holds(&self, norms: &[f64]) -> bool {
+        let steps = norms.len().saturating_sub(1);
+        if steps < self.after.max(self.window + 1) {
+            return false;
+        }
+        let (before, recent) = norms[1..].split_at(steps - self.window);
+        let smallest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+        smallest(recent) >= self.factor * smallest(before)
+    }
 }
 
 /// A run that stalls with `|G| <= FLOOR_STALL_FACTOR * residual_floor` has converged as far
@@ -65,6 +91,8 @@ pub(crate) enum Stop<E> {
     /// Stalled within [`FLOOR_STALL_FACTOR`] of the residual floor.
     ConvergedAtFloor,
     MaxIterations,
+    /// No progress by the rule of [`KernelRules::stagnation`].
+    Stagnated,
     Stalled {
         step_norm: f64,
     },
@@ -324,6 +352,12 @@ impl Kernel {
                 }
                 if iterations >= rules.min_iterations && norm <= tolerance {
                     break 'newton Stop::Converged;
+                }
+                if rules
+                    .stagnation
+                    .is_some_and(|rule| rule.holds(&self.residual_norms))
+                {
+                    break 'newton Stop::Stagnated;
                 }
                 if step_norm <= rules.step_tolerance * (1.0 + system.step_norm(y)) {
                     break 'newton if norm <= FLOOR_STALL_FACTOR * rules.residual_floor {

@@ -43,11 +43,16 @@
 //! changes and backtracking stalls on them. [`Globalization::Polyalgorithm`] therefore
 //! tries, within one budget of `max_iterations`:
 //!
-//! 1. `full_steps` full Newton steps (the fast path: most solves end here);
+//! 1. `full_steps` full Newton steps (the fast path: most solves end here). When the
+//!    problem offers a [`Smoothing`](crate::Smoothing) they stop earlier once they stagnate
+//!    ([`Termination::Stagnated`]: after 8 steps, `|F|` did not fall tenfold over the last 6
+//!    against the smallest before them, the first iterate excluded);
 //! 2. when the problem offers a [`Smoothing`](crate::Smoothing): the smoothing path
-//!    `F_mu(x) = 0` from the initial guess, `mu` from the problem's smoothing scale down four
+//!    `F_mu(x) = 0` from the initial guess, `mu` from the problem's smoothing scale down three
 //!    decades (Newton with an Armijo search on the smooth merit at the start, then the
-//!    crate's pseudo-arclength continuation in `log10 mu`), then full Newton steps on `F`;
+//!    crate's pseudo-arclength continuation in `log10 mu` with the tangent predictor), then
+//!    full Newton steps on `F`; a path that stops after two decades hands its last point to
+//!    those steps too;
 //! 3. the non-monotone line search from the initial guess, on at most half of the
 //!    iterations left;
 //! 4. the Newton homotopy `H(x, t) = F(x) - (1 - t) F(x_0)` from `(x_0, 0)` to `t = 1`,
@@ -287,6 +292,7 @@ impl NewtonOptions {
             min_iterations: 0,
             globalization: self.globalization,
             restore_best: true,
+            stagnation: None,
         }
     }
 }
@@ -304,6 +310,9 @@ pub enum Termination {
     },
     /// `max_iterations` reached without convergence.
     MaxIterations,
+    /// The full-step phase of [`Globalization::Polyalgorithm`] made no progress: `|F|`
+    /// fell by less than a factor 10 over its last iterations.
+    Stagnated,
     /// The accepted step `alpha |d|` fell below `step_tolerance (1 + |x|)`.
     Stalled,
     /// No step length `>= min_step` gave sufficient decrease.
@@ -406,6 +415,7 @@ impl std::fmt::Display for Termination {
                 "converged (stalled at the round-off floor {floor:.1e} of this model)"
             ),
             Self::MaxIterations => write!(f, "max-iterations"),
+            Self::Stagnated => write!(f, "stagnated"),
             Self::Stalled => write!(f, "stalled"),
             Self::LineSearchFailed => write!(f, "line-search-failed"),
             Self::LinearSolve(e) => write!(f, "{}: {e}", e.kind()),
@@ -770,21 +780,26 @@ impl<J> NewtonSolver<J> {
         log.step_lengths
             .extend_from_slice(&self.kernel.step_lengths);
         log.step_norms.extend_from_slice(&self.kernel.step_norms);
-        let termination = match run.stop {
-            Stop::Converged => Termination::Converged,
-            Stop::ConvergedAtFloor => Termination::ConvergedAtRoundoff {
-                floor: FLOOR_STALL_FACTOR * rules.residual_floor,
-            },
-            Stop::MaxIterations => Termination::MaxIterations,
-            Stop::Stalled { .. } => Termination::Stalled,
-            Stop::LineSearchFailed { .. } => Termination::LineSearchFailed,
-            Stop::Direction(PlainFailure::Linear(e)) => Termination::LinearSolve(e),
-            Stop::Direction(PlainFailure::Evaluation(e)) | Stop::OutsideDomain(e) => {
-                Termination::OutsideDomain(e)
-            }
-            Stop::NonFinite => Termination::NonFinite,
-        };
+        let termination = termination_of(&run.stop, rules.residual_floor);
         (termination, run)
+    }
+}
+/// The termination a kernel stop means for a run on `F` with `residual_floor`.
+fn termination_of(stop: &Stop<PlainFailure>, residual_floor: f64) -> Termination {
+    match stop {
+        Stop::Converged => Termination::Converged,
+        Stop::ConvergedAtFloor => Termination::ConvergedAtRoundoff {
+            floor: FLOOR_STALL_FACTOR * residual_floor,
+        },
+        Stop::MaxIterations => Termination::MaxIterations,
+        Stop::Stagnated => Termination::Stagnated,
+        Stop::Stalled { .. } => Termination::Stalled,
+        Stop::LineSearchFailed { .. } => Termination::LineSearchFailed,
+        Stop::Direction(PlainFailure::Linear(e)) => Termination::LinearSolve(*e),
+        Stop::Direction(PlainFailure::Evaluation(e)) | Stop::OutsideDomain(e) => {
+            Termination::OutsideDomain(*e)
+        }
+        Stop::NonFinite => Termination::NonFinite,
     }
 }
 /// Histories of the attempts that iterate on `F`.

@@ -29,7 +29,7 @@
 //! points in `mu` (where several roots coexist) are passed by the arclength.
 
 use crate::continuation::{
-    Continuation, ContinuationOptions, ContinuationTermination, Direction, RestartPolicy,
+    Continuation, ContinuationOptions, ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
 use crate::{
     EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
@@ -212,8 +212,8 @@ pub(crate) struct PathOutcome {
 /// Where a path goes and how: from parameter 0 to `end`, first steps of `1 / steps` of the
 /// path's length, growing up to `growth` times that; the state lengths measured in
 /// `state_scale` with the weight `theta`; points to `accuracy` (the corrector aims at
-/// `target_iterations` and rejects a step after one more); at most `budget` corrector
-/// iterations.
+/// `target_iterations` and rejects a step after one more) from `predictor`; at most `budget`
+/// corrector iterations.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PathPlan {
     pub end: f64,
@@ -221,6 +221,7 @@ pub(crate) struct PathPlan {
     pub growth: f64,
     pub theta: f64,
     pub target_iterations: usize,
+    pub predictor: Predictor,
     pub state_scale: f64,
     pub accuracy: f64,
     pub budget: usize,
@@ -248,6 +249,7 @@ fn path_options(n: usize, plan: &PathPlan) -> ContinuationOptions {
         direction: Direction::Increasing,
         refine_folds: false,
         restarts: Some(RestartPolicy::default()),
+        predictor: plan.predictor,
         ..ContinuationOptions::default()
     }
 }

@@ -2,10 +2,11 @@
 //! the non-monotone line search and the Newton homotopy, each from the initial guess, within
 //! one iteration budget (module docs of [`crate::newton`], *Polyalgorithm*).
 
+use crate::continuation::Predictor;
 use crate::linesearch::LineSearchOptions;
 use crate::{Factorize, GeneralizedJacobian, Residual};
 
-use super::kernel::{self, KernelRules};
+use super::kernel::{self, KernelRules, Stagnation};
 use super::{path, Attempt, Globalization, Log, NewtonSolver, Strategy, Termination, WorkCounters};
 
 impl<J> NewtonSolver<J> {
@@ -54,11 +55,19 @@ impl<J> NewtonSolver<J> {
             max_iterations: full_steps.min(max_iterations),
             ..self.options.rules()
         };
+        // With a smoothing to fall back on, the full steps stop as soon as they stagnate.
+        let first = KernelRules {
+            stagnation: problem
+                .smoothing()
+                .is_some()
+                .then_some(FULL_STEP_STAGNATION),
+            ..base
+        };
         let mut attempts = Vec::new();
         let mut used = 0;
 
         // 1. Full steps.
-        let (termination, run) = self.phase(problem, linear, x, &base, counters, log);
+        let (termination, run) = self.phase(problem, linear, x, &first, counters, log);
         let tolerance = run.tolerance;
         attempts.push(Attempt::new(
             Strategy::FullSteps,
@@ -92,7 +101,8 @@ impl<J> NewtonSolver<J> {
             solver.phase(problem, linear, x, &rules, counters, log)
         };
 
-        // 2. The smoothing path, when the problem offers a smoothing.
+        // 2. The smoothing path, when the problem offers a smoothing; a path that stops
+        // after `SMOOTHING_PARTIAL` decades still hands its last point to Newton on `F`.
         if let Some(mu0) = problem
             .smoothing()
             .map(|s| SMOOTHING_START * s.smoothing_scale())
@@ -110,7 +120,7 @@ impl<J> NewtonSolver<J> {
             let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
             used += outcome.iterations;
             strategy = Strategy::Smoothing;
-            if outcome.reached {
+            if outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL {
                 let (termination, run) = finish(self, problem, linear, x, used, counters, log);
                 used += run.iterations;
                 attempts.push(Attempt::new(
@@ -174,6 +184,7 @@ impl<J> NewtonSolver<J> {
                     // arclength hyperplane still cuts the far piece.
                     theta: 0.99,
                     target_iterations: 5,
+                    predictor: Predictor::Secant,
                     state_scale: scale,
                     accuracy: tolerance.max(path::PATH_ACCURACY * kernel::norm2(&f0)),
                     budget,
@@ -264,11 +275,15 @@ impl<J> NewtonSolver<J> {
         let plan = path::PathPlan {
             end: SMOOTHING_DECADES,
             steps: SMOOTHING_DECADES,
-            // A smooth path: the step may grow to several decades where the state barely
-            // moves (late on the path), state and parameter weigh alike.
-            growth: 4.0,
+            // A smooth path, followed along its tangent (the corrector's factorization gives
+            // it free); steps of one decade at first, at most two; state and parameter
+            // weigh alike. Measured on the public grid: the tangent predictor and the
+            // cap of two decades save a fifth of the corrector iterations against the
+            // secant and a cap of four (fewer rejected steps where contacts form).
+            growth: 2.0,
             theta: 0.5,
             target_iterations: 3,
+            predictor: Predictor::Tangent,
             state_scale,
             accuracy,
             budget: budget.saturating_sub(run.iterations),
@@ -296,12 +311,22 @@ struct SmoothingSetup {
 /// lengthen the path).
 const SMOOTHING_START: f64 = 1.0;
 /// Decades of `mu` the smoothing path descends before Newton on `F` takes over.
-const SMOOTHING_DECADES: f64 = 4.0;
+const SMOOTHING_DECADES: f64 = 3.0;
+/// Decades of `mu` after which a path that stops short hands over to Newton on `F` anyway.
+const SMOOTHING_PARTIAL: f64 = 2.0;
 /// Accuracy of the smoothing path's points relative to `|F_mu0|` at the start: the end of
 /// the path must lie in the basin of semismooth Newton on `F` (1e-2 measured too loose).
 const SMOOTHING_ACCURACY: f64 = 1e-3;
 /// Newton iterations at most on the smoothed problem at the path's start.
 const SMOOTHING_START_ITERATIONS: usize = 30;
+/// The full-step phase stops when, after 8 steps, the last 6 did not bring `|F|` ten times
+/// below the smallest before them (measured on the public grid: every full-step run that
+/// converged later had made that progress, or crept one contact switch per step).
+const FULL_STEP_STAGNATION: Stagnation = Stagnation {
+    after: 8,
+    window: 6,
+    factor: 0.1,
+};
 
 /// The best iterate over several attempts.
 struct Best {

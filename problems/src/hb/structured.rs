@@ -58,6 +58,8 @@ pub struct StructuredHbSolver {
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
+    /// Column scaling `s_j = 1 / max_i |S_ij|` of the condensed matrix, factored as `S diag(s)`.
+    column_scale: Vec<f64>,
     schur_ready: bool,
     complex_rhs: Mat<c64>,
     work_u: Vec<f64>,
@@ -102,6 +104,7 @@ impl StructuredHbSolver {
             schur: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
+            column_scale: Vec::new(),
             schur_ready: false,
             complex_rhs: Mat::zeros(0, 0),
             work_u: Vec::new(),
@@ -180,6 +183,7 @@ impl StructuredHbSolver {
         self.schur = Mat::zeros(nc, nc);
         self.perm = vec![0; nc];
         self.perm_inv = vec![0; nc];
+        self.column_scale = vec![1.0; nc];
         self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
         self.dynamic = Some((lin.clone(), dynamic));
         Ok(())
@@ -346,6 +350,24 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
             self.schur.as_mut(),
         );
         if nc > 0 {
+            // Equilibrate the columns: near an undamped resonance the receptance of one
+            // harmonic dwarfs the others, and the pivot test must compare pivots of
+            // columns of one scale (the solve undoes the scaling).
+            for (j, scale) in self.column_scale.iter_mut().enumerate() {
+                let largest = self
+                    .schur
+                    .col_as_slice(j)
+                    .iter()
+                    .fold(0.0_f64, |a, v| a.max(v.abs()));
+                *scale = if largest > 0.0 && largest.is_finite() {
+                    1.0 / largest
+                } else {
+                    1.0
+                };
+                for v in self.schur.col_as_slice_mut(j) {
+                    *v *= *scale;
+                }
+            }
             let stack = MemStack::new(&mut self.mem);
             dense_lu::lu_in_place(
                 self.schur.as_mut(),
@@ -545,6 +567,9 @@ impl StructuredHbSolver {
             Par::Seq,
             stack,
         );
+        for (r, scale) in self.column_scale.iter().enumerate() {
+            self.work_b[(r, 0)] *= scale;
+        }
     }
 }
 

@@ -67,6 +67,7 @@ where
                 min_iterations: 1,
                 globalization: armijo(self.options.corrector_line_search),
                 restore_best: false,
+                stagnation: None,
             },
         };
         let outcome = corrector.correct(
