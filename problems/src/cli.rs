@@ -409,46 +409,48 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         .iter()
         .map(|a| a.unwrap_or(f64::NAN))
         .collect();
-    args.queue_outputs(
-        &mut outputs,
-        &scene,
-        &[
-            "omega",
-            "omega_ratio",
-            "tip_max",
-            "tip_min",
-            "amplitude",
-            "stable",
-            "floquet_max_abs",
-            "contact_force_mean",
-            "max_penetration",
-        ],
-        &[
-            &response.omega,
-            &ratio,
-            &response.tip_max,
-            &response.tip_min,
-            &response.amplitude,
-            &stable,
-            &floquet,
-            &st.contact_force_mean,
-            &st.max_penetration,
-        ],
-        || Plot {
-            untitled: "frequency response",
-            x_label: "omega / omega_1",
-            y_label: "max |u_tip|",
-            series: Series::new(
-                format!(
-                    "{} H = {}",
-                    scene.solver.method.name(),
-                    scene.solver.harmonics
-                ),
-                ratio.clone(),
-                response.amplitude.clone(),
+    let force_mean = response.contact_force_mean();
+    let contact_columns = response.contact_columns();
+    let mut headers = vec![
+        "omega",
+        "omega_ratio",
+        "tip_max",
+        "tip_min",
+        "amplitude",
+        "stable",
+        "floquet_max_abs",
+        "contact_force_mean",
+        "max_penetration",
+    ];
+    let mut columns: Vec<&[f64]> = vec![
+        &response.omega,
+        &ratio,
+        &response.tip_max,
+        &response.tip_min,
+        &response.amplitude,
+        &stable,
+        &floquet,
+        &force_mean,
+        &st.max_penetration,
+    ];
+    for (name, values) in &contact_columns {
+        headers.push(name);
+        columns.push(values);
+    }
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || Plot {
+        untitled: "frequency response",
+        x_label: "omega / omega_1",
+        y_label: "max |u_tip|",
+        series: Series::new(
+            format!(
+                "{} H = {}",
+                scene.solver.method.name(),
+                scene.solver.harmonics
             ),
-        },
-    )?;
+            ratio.clone(),
+            response.amplitude.clone(),
+        ),
+    })?;
     let text = || {
         let mut t = format!(
             "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",

@@ -294,7 +294,7 @@ fn roundoff_floor(
 }
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
-trait HbReconstruction {
+pub(crate) trait HbReconstruction {
     fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;

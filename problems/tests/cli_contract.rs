@@ -503,3 +503,84 @@ fn a_default_run_that_fails_leaves_no_directory_behind() {
         "the output directory was left behind"
     );
 }
+
+/// `ssn sweep` reports every contact at every point, in its JSON (`contacts`, with the
+/// numbers of `ssn solve`) and its CSV (`contact{k}_...` columns); `contact_force_mean` is
+/// their sum. The sweep of `two_contacts.toml` ends at the scene's frequency `omega_1`,
+/// where `ssn solve` gives the same solution independently (a Newton solve from zero, not
+/// the continuation): the same equations solved to the same tolerance, so the mean forces
+/// (exact means of the reconstructed trigonometric polynomials) agree to 1e-6 relative.
+#[test]
+fn a_sweep_reports_every_contact_at_every_point_as_solve_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(scene("two_contacts.toml")).unwrap()
+        + "\n[sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.0\n";
+    let path = dir.path().join("two_contacts_sweep.toml");
+    std::fs::write(&path, text).unwrap();
+    let path = path.to_str().unwrap();
+    let csv = dir.path().join("sweep.csv");
+    let o = ssn(&["sweep", path, "--json", "--csv", csv.to_str().unwrap()]);
+    assert_exit(&o, 0, "sweep");
+    let sweep: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+    let o = ssn(&["solve", path, "--json"]);
+    assert_exit(&o, 0, "solve");
+    let solve: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+
+    let points = sweep["points"].as_u64().unwrap() as usize;
+    let contacts = sweep["contacts"].as_array().expect("contacts per point");
+    assert_eq!(contacts.len(), points);
+    let sums = sweep["contact_force_mean"].as_array().unwrap();
+    for (point, sum) in contacts.iter().zip(sums) {
+        let list = point.as_array().unwrap();
+        assert_eq!(list.len(), 2);
+        assert_eq!(list[0]["node"].as_u64(), Some(20));
+        assert_eq!(list[1]["node"].as_u64(), Some(10));
+        // serde_json's default float parser may be off by one unit in the last place.
+        let total: f64 = list.iter().map(|c| c["force_mean"].as_f64().unwrap()).sum();
+        assert!((sum.as_f64().unwrap() - total).abs() <= 1e-15 * total.abs());
+    }
+    let ratio = sweep["omega_ratio"].as_array().unwrap();
+    assert!((ratio[points - 1].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    let last = &contacts[points - 1];
+    let node10 = |j: &serde_json::Value, key: &str| j[1][key].as_f64().unwrap();
+    let (swept, solved) = (
+        node10(last, "force_mean"),
+        node10(&solve["contacts"], "force_mean"),
+    );
+    println!("node 10 mean force at omega_1: sweep {swept:.9}, solve {solved:.9}");
+    assert!(solved < -0.01, "{solve}");
+    assert!((swept - solved).abs() <= 1e-6 * solved.abs());
+    let sum = sums[points - 1].as_f64().unwrap();
+    let solved_sum = solve["contact_force_mean"].as_f64().unwrap();
+    assert!((sum - solved_sum).abs() <= 1e-6 * solved_sum.abs());
+    // Displacement extremes: the same trigonometric polynomial sampled on two grids (the
+    // sweep's and the solve's), both of at least 1024 points per period: within 1e-4.
+    for key in ["displacement_min", "displacement_max"] {
+        let (a, b) = (node10(last, key), node10(&solve["contacts"], key));
+        assert!((a - b).abs() <= 1e-4, "{key}: {a} vs {b}");
+    }
+
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for k in 0..2 {
+        for field in [
+            "force_mean",
+            "max_penetration",
+            "contact_fraction",
+            "displacement_min",
+            "displacement_max",
+        ] {
+            let name = format!("contact{k}_{field}");
+            assert!(header.contains(&name.as_str()), "{header:?}");
+        }
+    }
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), points);
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row = &rows[points - 1];
+    assert!((row[column("contact1_force_mean")] - swept).abs() <= 1e-15 * swept.abs());
+    assert!((row[column("contact_force_mean")] - sum).abs() <= 1e-15 * sum.abs());
+}
