@@ -478,6 +478,24 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
             assert!(err(&o).contains(word), "{word}: {}", err(&o));
         }
     }
+    // An amplitude that would make the response overflow in the residual norms, with any
+    // method (Lemke's LCP data included).
+    let huge = scene("huge.toml", "elements = 20", "");
+    let text = std::fs::read_to_string(&huge)
+        .unwrap()
+        .replace("amplitude = 0.04", "amplitude = 1e300")
+        + "method = \"lcp-lemke\"\n";
+    std::fs::write(&huge, text).unwrap();
+    let o = ssn(&["solve", &huge]);
+    assert_exit(&o, 2, "huge amplitude");
+    for word in [
+        huge.as_str(),
+        "forcing.amplitude",
+        "1e300",
+        "|value| <= 1e100",
+    ] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
     let lcp = scene("lcp.toml", "elements = 20", "").to_string();
     let text =
         std::fs::read_to_string(&lcp).unwrap() + "method = \"lcp-lemke\"\ntime_samples = 10000\n";
