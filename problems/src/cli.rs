@@ -66,6 +66,9 @@ fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliErr
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let need = crate::limits::scene_memory(&scene, compare);
     crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
+    let work = crate::limits::scene_work(&scene, compare);
+    crate::limits::check_work(&work, crate::limits::work_limit())
+        .map_err(|e| input_error(path, e))?;
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
         Some(spec) => build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?,

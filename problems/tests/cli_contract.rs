@@ -602,3 +602,50 @@ fn a_sweep_reports_every_contact_at_every_point_as_solve_does() {
     assert!((row[column("contact1_force_mean")] - swept).abs() <= 1e-15 * swept.abs());
     assert!((row[column("contact_force_mean")] - sum).abs() <= 1e-15 * sum.abs());
 }
+
+/// A run that fits in memory but would take hours is refused up front (exit 2) with the
+/// keys, the operations it needs and the limit; `SSN_WORK_LIMIT` moves the limit.
+#[test]
+fn a_run_that_cannot_finish_in_time_is_refused_with_its_work_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dense.toml");
+    std::fs::write(
+        &path,
+        "[rod]\nelements = 400\n[forcing]\namplitude = 0.04\n[contact]\ngap = 0.5\n\
+         [solver]\nharmonics = 40\nlinear_solver = \"dense\"\n",
+    )
+    .unwrap();
+    let path = path.to_str().unwrap();
+    // Memory (10.5 GB for the dense LU) is not the question here: a machine that has it.
+    let o = Command::new(SSN)
+        .args(["solve", path])
+        .env("SSN_MEMORY_LIMIT", "1e12")
+        .env_remove("SSN_WORK_LIMIT")
+        .output()
+        .unwrap();
+    assert_exit(&o, 2, "dense 400 elements H = 40");
+    for word in [
+        path,
+        "solver.linear_solver",
+        "2.3e14",
+        "1.0e14",
+        "SSN_WORK_LIMIT",
+    ] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // The canonical scene (structured solver, 41 condensed unknowns: 4.6e5 operations)
+    // runs by default and is refused below that limit.
+    let o = Command::new(SSN)
+        .args(["solve", &fig1()])
+        .env("SSN_WORK_LIMIT", "1e5")
+        .output()
+        .unwrap();
+    assert_exit(&o, 2, "work limit 1e5");
+    assert!(err(&o).contains("limit of 1.0e5"), "{}", err(&o));
+    let o = Command::new(SSN)
+        .args(["solve", &fig1()])
+        .env_remove("SSN_WORK_LIMIT")
+        .output()
+        .unwrap();
+    assert_exit(&o, 0, "canonical");
+}
