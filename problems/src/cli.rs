@@ -313,7 +313,7 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
     args.finish(
         outputs,
         || solution_json(&args.scene, &solution),
-        || solution_text(&solution),
+        || solution_text(&solution, &scene.solver),
         solution.converged,
     )
 }
@@ -325,7 +325,9 @@ fn describe_method(s: &Solution) -> String {
     }
 }
 
-fn solution_text(s: &Solution) -> String {
+/// The text of `ssn solve`; `settings` gives the tolerance the scene asked for, which the
+/// text compares with the effective one.
+fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
     use std::fmt::Write;
     let mut t = String::new();
     let c = &s.counters;
@@ -343,6 +345,18 @@ fn solution_text(s: &Solution) -> String {
             "converged         {} ({}), {} iterations, residual {:.3e}",
             s.converged, s.termination, s.iterations, s.residual_norm
         )?;
+        let asked = if s.method == Method::March {
+            settings.march_tolerance
+        } else {
+            settings.tolerance
+        };
+        if let Some(effective) = s.effective_tolerance.filter(|&e| e > asked) {
+            writeln!(
+                t,
+                "tolerance         {effective:.3e} effective: the scene's {asked:e} is below the \
+                 round-off floor of this formulation"
+            )?;
+        }
         writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
         writeln!(
             t,

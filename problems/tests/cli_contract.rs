@@ -649,3 +649,48 @@ fn a_run_that_cannot_finish_in_time_is_refused_with_its_work_estimate() {
         .unwrap();
     assert_exit(&o, 0, "canonical");
 }
+
+/// A tolerance the formulation cannot reach is raised to its round-off floor and reported
+/// (`effective_tolerance` in the JSON, a `tolerance ... effective` line in the text), never
+/// a silent "converged": penalty HB's floor is `eps k_p sqrt(n) max|g|` (its force term is
+/// `k_p` times a gap), with the default `k_p = 1e5 K[tip, tip] = 2e6` on the 20-element
+/// rod, `n = 20 x 41` unknowns at H = 20 and the gap 0.5: 6.36e-9, above the default 1e-10
+/// too. The LCP's min-map (a length) has the floor `eps sqrt(n) max|q|`.
+#[test]
+fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(fig1()).unwrap();
+    let penalty_floor = f64::EPSILON * 2e6 * (20.0f64 * 41.0).sqrt() * 0.5;
+    for (method, tolerance, floor) in [
+        ("penalty-hb", "1e-300", Some(penalty_floor)),
+        ("penalty-hb", "1e-10", Some(penalty_floor)),
+        ("lcp-ssn", "1e-300", None),
+    ] {
+        let text = base.replace(
+            "method = \"ssn-hb\"",
+            &format!("method = \"{method}\"\ntolerance = {tolerance}"),
+        );
+        let path = dir.path().join(format!("{method}_{tolerance}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let path = path.to_str().unwrap();
+        let o = ssn(&["solve", path, "--json"]);
+        assert_exit(&o, 0, path);
+        let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+        let used = json["effective_tolerance"].as_f64().unwrap();
+        let asked: f64 = tolerance.parse().unwrap();
+        assert!(used > asked, "{method} {tolerance}: {json}");
+        assert!(json["residual_norm"].as_f64().unwrap() <= used);
+        match floor {
+            Some(f) => assert!((used / f - 1.0).abs() < 1e-12, "{used:e} vs {f:e}"),
+            // The LCP's q is of the gap's size: the floor is a few ulps of 0.5 x 16.
+            None => assert!(used < 1e-13, "{used:e}"),
+        }
+        let o = ssn(&["solve", path]);
+        assert_exit(&o, 0, path);
+        let text = out(&o);
+        assert!(
+            text.contains("effective") && text.contains(&format!("{asked:e}")),
+            "{text}"
+        );
+    }
+}
