@@ -365,11 +365,19 @@ fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonRepo
     (z, report)
 }
 
-/// Lemke (default options) ends with `expected`, and `check_lemke` turns the report into
-/// `LemkeNotSolved` carrying its pivots and the smallest eigenvalue of `(A + A^T)/2`.
-fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination) {
+/// Lemke (default options) ends with `expected` after `pivots` pivots (the measured count),
+/// and `check_lemke` turns the report into `LemkeNotSolved` carrying its pivots and the
+/// smallest eigenvalue of `(A + A^T)/2`.
+fn assert_not_solved(lcp: &PeriodicLcp, expected: LemkeTermination, pivots: usize) {
     let report = lemke_solution(lcp);
+    println!(
+        "Lemke {:?} after {} pivots (n = {})",
+        report.termination,
+        report.pivots,
+        lcp.dim()
+    );
     assert_eq!(report.termination, expected);
+    assert_eq!(report.pivots, pivots, "{expected:?}");
     match lcp.check_lemke(report.clone()) {
         Err(LcpError::LemkeNotSolved {
             termination,
@@ -497,7 +505,7 @@ fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much
     let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
     assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
     // With the default pivot limit 50 n + 100 Lemke stops without a solution (no ray):
-    assert_not_solved(&lcp, LemkeTermination::PivotLimit);
+    assert_not_solved(&lcp, LemkeTermination::PivotLimit, 50 * lcp.dim() + 100);
     // ... but with 100 n pivots it solves this one (25369 pivots measured, against 172 for
     // the modified mass): the path is long, not a ray. At Nt >= 512 it had not finished
     // after 1000 n pivots.
@@ -507,6 +515,10 @@ fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much
         ..LemkeOptions::default()
     };
     let solved = lcp.solve_with_lemke(&mut lemke, &generous).unwrap();
+    println!(
+        "generous limit: {:?} after {}",
+        solved.termination, solved.pivots
+    );
     assert!(
         solved.solved(),
         "{:?} after {}",
@@ -514,7 +526,13 @@ fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much
         solved.pivots
     );
     assert!(solved.complementarity_error < 1e-12);
-    assert!(solved.pivots > 50 * lcp.dim());
+    // Measured 25369 pivots; a window of 10 %: a longer path (a regression) or a much
+    // shorter one (an improvement) is noticed.
+    assert!(
+        (22_832..=27_906).contains(&solved.pivots),
+        "{} pivots, measured 25369",
+        solved.pivots
+    );
 }
 
 #[test]
@@ -588,5 +606,6 @@ fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers()
     assert_eq!(h1.im, 0.0);
     assert_eq!(lo, h1.re);
     assert!(lo < -1e3, "{lo}");
-    assert_not_solved(&lcp, LemkeTermination::Ray);
+    // Measured: the ray is met after 2 pivots.
+    assert_not_solved(&lcp, LemkeTermination::Ray, 2);
 }

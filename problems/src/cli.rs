@@ -66,6 +66,9 @@ fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliErr
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let need = crate::limits::scene_memory(&scene, compare);
     crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
+    let work = crate::limits::scene_work(&scene, compare);
+    crate::limits::check_work(&work, crate::limits::work_limit())
+        .map_err(|e| input_error(path, e))?;
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
         Some(spec) => build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?,
@@ -310,7 +313,7 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
     args.finish(
         outputs,
         || solution_json(&args.scene, &solution),
-        || solution_text(&solution),
+        || solution_text(&solution, &scene.solver),
         solution.converged,
     )
 }
@@ -322,7 +325,9 @@ fn describe_method(s: &Solution) -> String {
     }
 }
 
-fn solution_text(s: &Solution) -> String {
+/// The text of `ssn solve`; `settings` gives the tolerance the scene asked for, which the
+/// text compares with the effective one.
+fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
     use std::fmt::Write;
     let mut t = String::new();
     let c = &s.counters;
@@ -340,6 +345,18 @@ fn solution_text(s: &Solution) -> String {
             "converged         {} ({}), {} iterations, residual {:.3e}",
             s.converged, s.termination, s.iterations, s.residual_norm
         )?;
+        let asked = if s.method == Method::March {
+            settings.march_tolerance
+        } else {
+            settings.tolerance
+        };
+        if let Some(effective) = s.effective_tolerance.filter(|&e| e > asked) {
+            writeln!(
+                t,
+                "tolerance         {effective:.3e} effective: the scene's {asked:e} is below the \
+                 round-off floor of this formulation"
+            )?;
+        }
         writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
         writeln!(
             t,
@@ -409,46 +426,48 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         .iter()
         .map(|a| a.unwrap_or(f64::NAN))
         .collect();
-    args.queue_outputs(
-        &mut outputs,
-        &scene,
-        &[
-            "omega",
-            "omega_ratio",
-            "tip_max",
-            "tip_min",
-            "amplitude",
-            "stable",
-            "floquet_max_abs",
-            "contact_force_mean",
-            "max_penetration",
-        ],
-        &[
-            &response.omega,
-            &ratio,
-            &response.tip_max,
-            &response.tip_min,
-            &response.amplitude,
-            &stable,
-            &floquet,
-            &st.contact_force_mean,
-            &st.max_penetration,
-        ],
-        || Plot {
-            untitled: "frequency response",
-            x_label: "omega / omega_1",
-            y_label: "max |u_tip|",
-            series: Series::new(
-                format!(
-                    "{} H = {}",
-                    scene.solver.method.name(),
-                    scene.solver.harmonics
-                ),
-                ratio.clone(),
-                response.amplitude.clone(),
+    let force_mean = response.contact_force_mean();
+    let contact_columns = response.contact_columns();
+    let mut headers = vec![
+        "omega",
+        "omega_ratio",
+        "tip_max",
+        "tip_min",
+        "amplitude",
+        "stable",
+        "floquet_max_abs",
+        "contact_force_mean",
+        "max_penetration",
+    ];
+    let mut columns: Vec<&[f64]> = vec![
+        &response.omega,
+        &ratio,
+        &response.tip_max,
+        &response.tip_min,
+        &response.amplitude,
+        &stable,
+        &floquet,
+        &force_mean,
+        &st.max_penetration,
+    ];
+    for (name, values) in &contact_columns {
+        headers.push(name);
+        columns.push(values);
+    }
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || Plot {
+        untitled: "frequency response",
+        x_label: "omega / omega_1",
+        y_label: "max |u_tip|",
+        series: Series::new(
+            format!(
+                "{} H = {}",
+                scene.solver.method.name(),
+                scene.solver.harmonics
             ),
-        },
-    )?;
+            ratio.clone(),
+            response.amplitude.clone(),
+        ),
+    })?;
     let text = || {
         let mut t = format!(
             "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",

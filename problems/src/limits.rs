@@ -16,6 +16,9 @@
 //! plus `400 N` for the rod itself. The limit is the memory available to new processes
 //! (`MemAvailable` of `/proc/meminfo`), or the number of bytes in the environment variable
 //! `SSN_MEMORY_LIMIT` when it is set; where neither is known nothing is refused.
+//!
+//! A run that fits in memory can still take hours: [`run_work`] estimates the operations of
+//! its dense factorizations, refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
 
 use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
 
@@ -186,6 +189,110 @@ pub fn human(bytes: f64) -> String {
     }
 }
 
+// Work (floating-point operations), next to memory: a run that fits in memory can still
+// run for hours (a dense LU is cubic in its size).
+
+/// What a run costs in floating-point operations, in words and numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorkEstimate {
+    /// Estimated floating-point operations (a float: hostile settings overflow integers).
+    pub flops: f64,
+    /// The dominant work, in words.
+    pub what: String,
+    /// The scene keys that drive it (what to reduce).
+    pub keys: &'static str,
+}
+
+/// Factorizations counted for a Newton solve: the solves from zero on the rod take 12 to 13
+/// (measured with the dense solver at 100 and 200 elements, H = 20).
+const NEWTON_FACTORIZATIONS: f64 = 10.0;
+
+/// Default limit of [`work_limit`]: 1e14 operations, about 70 minutes at the 2.3e10
+/// operations per second that faer's dense LU reached on a 2-core machine (a factorization
+/// of 8241 unknowns, 3.7e11 operations, in 16 s).
+pub const DEFAULT_WORK_LIMIT: f64 = 1e14;
+
+/// Estimated work of one run: `NEWTON_FACTORIZATIONS` dense LU factorizations of
+/// `(2/3) n^3` operations each, `n` the unknowns of the dense Jacobian (the dense solver:
+/// `(N + m) S` for SSN-HB, `N S` for penalty HB) or of the condensed contact system (the
+/// structured solver: `m S`), `S = 2H + 1`. The sparse per-harmonic factorizations, the
+/// FFTs, the LCP and time marching are not the danger here and count as 0.
+pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
+    let (n, m) = (elements as f64, contacts as f64);
+    let s = 2.0 * settings.harmonics as f64 + 1.0;
+    let lu = |unknowns: f64| NEWTON_FACTORIZATIONS * 2.0 / 3.0 * unknowns.powi(3);
+    match (settings.method, settings.linear_solver) {
+        (Method::SsnHb | Method::PenaltyHb, LinearSolverChoice::Dense) => {
+            let unknowns = if settings.method == Method::SsnHb {
+                (n + m) * s
+            } else {
+                n * s
+            };
+            WorkEstimate {
+                flops: lu(unknowns),
+                what: format!(
+                    "{NEWTON_FACTORIZATIONS} LU factorizations of a dense Jacobian on \
+                     {unknowns:.0} unknowns (solver.linear_solver = \"dense\"; \"structured\" \
+                     factors per harmonic)"
+                ),
+                keys: "solver.linear_solver, solver.harmonics, rod.elements",
+            }
+        }
+        (Method::SsnHb, LinearSolverChoice::Structured) => WorkEstimate {
+            flops: lu(m * s),
+            what: format!(
+                "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
+                 on {:.0} unknowns",
+                m * s
+            ),
+            keys: "solver.harmonics and the number of contacts",
+        },
+        _ => WorkEstimate {
+            flops: 0.0,
+            what: "no dense factorization".into(),
+            keys: "",
+        },
+    }
+}
+
+/// The operations a run may take: `SSN_WORK_LIMIT` when set to a number > 0, else
+/// [`DEFAULT_WORK_LIMIT`].
+pub fn work_limit() -> f64 {
+    std::env::var("SSN_WORK_LIMIT")
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|b| b.is_finite() && *b > 0.0)
+        .unwrap_or(DEFAULT_WORK_LIMIT)
+}
+
+/// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
+/// limit, and how to lift it.
+pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
+    if need.flops.is_nan() || need.flops > limit {
+        Err(format!(
+            "these settings need about {:.1e} floating-point operations ({}), more than the \
+             limit of {limit:.1e} (SSN_WORK_LIMIT, default {DEFAULT_WORK_LIMIT:.0e}: about 70 \
+             minutes on 2 cores): allowed are settings whose estimate is within the limit; \
+             reduce {}, or raise SSN_WORK_LIMIT",
+            need.flops, need.what, need.keys
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// The work estimate of the command run on `scene` (`compare`: its SSN-HB reference run at
+/// 320 harmonics, the largest).
+pub fn scene_work(scene: &Scene, compare: bool) -> WorkEstimate {
+    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+    let mut settings = scene.solver.clone();
+    if compare {
+        settings.method = Method::SsnHb;
+        settings.harmonics = crate::study::REFERENCE_HARMONICS;
+    }
+    run_work(n, m, &settings)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -248,5 +355,32 @@ mod tests {
         );
         let huge = run_memory(usize::MAX, usize::MAX, &settings(Method::SsnHb, 20, false));
         assert!(check(&huge, Some(1e30)).is_err());
+    }
+
+    #[test]
+    fn the_dense_solver_on_400_elements_at_h_40_is_refused_for_its_work() {
+        // n = 401 x 81 = 32481 unknowns: (2/3) n^3 = 2.28e13 operations per factorization.
+        let dense = run_work(400, 1, &settings(Method::SsnHb, 40, true));
+        let n = 401.0 * 81.0;
+        assert!((dense.flops - 10.0 * 2.0 / 3.0 * n * n * n).abs() <= 1e-12 * dense.flops);
+        let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
+        for word in [
+            "solver.linear_solver",
+            "2.3e14",
+            "1.0e14",
+            "SSN_WORK_LIMIT",
+            "32481",
+        ] {
+            assert!(e.contains(word), "{word}: {e}");
+        }
+        // What the tests and examples run stays allowed: the dense solver at 200 elements,
+        // H = 20 (3.7e12), the structured one at 10,000 elements with 100 contacts.
+        assert!(check_work(&run_work(200, 1, &settings(Method::SsnHb, 20, true)), 1e14).is_ok());
+        let many = run_work(10_000, 100, &settings(Method::SsnHb, 20, false));
+        assert!(check_work(&many, DEFAULT_WORK_LIMIT).is_ok(), "{many:?}");
+        assert!(
+            check_work(&dense, 1e15).is_ok(),
+            "a raised limit lets it run"
+        );
     }
 }

@@ -69,7 +69,12 @@ enum Command {
         after_help = "Examples:\n  ssn sweep problems/scenes/paper_fig2.toml\n  \
         ssn sweep problems/scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
         JSON fields: points, omega, tip_max, tip_min, amplitude (arrays in branch order),\n  \
-        folds (omega where the branch turns), converged, termination, solve_seconds, counters\n\n",
+        contact_force_mean (sum over the contacts), max_penetration, contacts (per point,\n  \
+        the list of ssn solve), folds (omega where the branch turns), converged,\n  \
+        termination, solve_seconds, counters\n\n\
+        CSV: one row per point; contact k (from 0) adds contact{k}_force_mean,\n  \
+        contact{k}_max_penetration, contact{k}_contact_fraction, contact{k}_displacement_min,\n  \
+        contact{k}_displacement_max\n\n",
         mut_arg("scene", |a| a.help("Scene file (TOML) with a [sweep] section")),
         mut_arg("json", |a| a.help("Print the branch as JSON on stdout")),
         mut_arg("csv", |a| a.help("Write the branch as CSV")),

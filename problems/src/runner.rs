@@ -294,7 +294,7 @@ fn roundoff_floor(
 }
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
-trait HbReconstruction {
+pub(crate) trait HbReconstruction {
     fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
@@ -596,79 +596,86 @@ fn solve_lcp(
     let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
     let lcp = PeriodicLcp::new(model, options)?;
-    let (z, converged, termination, iterations, residual, counters) = match method {
-        Method::LcpLemke => {
-            let mut lemke = Lemke::new(lcp.dim());
-            let report = lemke.solve(lcp.matrix(), lcp.q(), &LemkeOptions::default())?;
-            let termination = match report.termination {
-                LemkeTermination::Solved => "converged".to_string(),
-                LemkeTermination::Ray => {
-                    let (min_eig, _) = lcp.symmetric_part_spectrum();
-                    format!(
+    let (z, converged, termination, iterations, residual, counters, effective_tolerance) =
+        match method {
+            Method::LcpLemke => {
+                let mut lemke = Lemke::new(lcp.dim());
+                let report = lemke.solve(lcp.matrix(), lcp.q(), &LemkeOptions::default())?;
+                let termination = match report.termination {
+                    LemkeTermination::Solved => "converged".to_string(),
+                    LemkeTermination::Ray => {
+                        let (min_eig, _) = lcp.symmetric_part_spectrum();
+                        format!(
                         "ray after {} pivots (smallest eigenvalue of the symmetric part of A: {min_eig:e})",
                         report.pivots
                     )
-                }
-                LemkeTermination::PivotLimit => format!(
-                    "pivot-limit ({}): the tip values are those of the unfinished path's last \
+                    }
+                    LemkeTermination::PivotLimit => format!(
+                        "pivot-limit ({}): the tip values are those of the unfinished path's last \
                      basis, not of a solution",
-                    report.pivots
-                ),
-            };
-            let counters = RunCounters {
-                lemke_pivots: report.pivots as u64,
-                ..RunCounters::default()
-            };
-            (
-                report.z.clone(),
-                report.solved(),
-                termination,
-                report.pivots,
-                report.complementarity_error,
-                counters,
-            )
-        }
-        _ => {
-            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
-            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
-            // creeps one time node per iteration.
-            let options = newton_options(settings);
-            let (z, report_list) = match warm_start {
-                Some(w) if w.len() == lcp.dim() => {
-                    let mut problem = lcp.min_map();
-                    let mut z = w.to_vec();
-                    let mut solver = ActiveSetSolver::new()
-                        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
-                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
-                        .or_else(NewtonError::into_report)?;
-                    (z, vec![report])
-                }
-                _ => {
-                    let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
-                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
-                    (sequenced.z, reports)
-                }
-            };
-            let last = report_list.last().expect("at least one level");
-            let mut counters = RunCounters::default();
-            for r in &report_list {
-                let c: RunCounters = r.counters.into();
-                counters.residual_evaluations += c.residual_evaluations;
-                counters.jacobian_evaluations += c.jacobian_evaluations;
-                counters.factorizations += c.factorizations;
-                counters.linear_solves += c.linear_solves;
-                counters.line_search_backtracks += c.line_search_backtracks;
+                        report.pivots
+                    ),
+                };
+                let counters = RunCounters {
+                    lemke_pivots: report.pivots as u64,
+                    ..RunCounters::default()
+                };
+                (
+                    report.z.clone(),
+                    report.solved(),
+                    termination,
+                    report.pivots,
+                    report.complementarity_error,
+                    counters,
+                    None,
+                )
             }
-            (
-                z,
-                last.converged(),
-                last.termination.to_string(),
-                report_list.iter().map(|r| r.iterations).sum(),
-                last.residual_norm(),
-                counters,
-            )
-        }
-    };
+            _ => {
+                // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+                // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+                // creeps one time node per iteration. Residual floor: the min-map residual
+                // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
+                // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
+                let mut options = newton_options(settings);
+                let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                options.residual_floor = f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale;
+                let (z, report_list) = match warm_start {
+                    Some(w) if w.len() == lcp.dim() => {
+                        let mut problem = lcp.min_map();
+                        let mut z = w.to_vec();
+                        let mut solver = ActiveSetSolver::new()
+                            .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
+                        let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
+                            .or_else(NewtonError::into_report)?;
+                        (z, vec![report])
+                    }
+                    _ => {
+                        let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
+                        let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                        (sequenced.z, reports)
+                    }
+                };
+                let last = report_list.last().expect("at least one level");
+                let mut counters = RunCounters::default();
+                for r in &report_list {
+                    let c: RunCounters = r.counters.into();
+                    counters.residual_evaluations += c.residual_evaluations;
+                    counters.jacobian_evaluations += c.jacobian_evaluations;
+                    counters.factorizations += c.factorizations;
+                    counters.linear_solves += c.linear_solves;
+                    counters.line_search_backtracks += c.line_search_backtracks;
+                }
+                (
+                    z,
+                    last.converged(),
+                    last.termination.to_string(),
+                    report_list.iter().map(|r| r.iterations).sum(),
+                    last.residual_norm(),
+                    counters,
+                    Some(last.effective_tolerance),
+                )
+            }
+        };
     let seconds = start.elapsed().as_secs_f64();
     let contact_u = lcp.contact_displacements(&z)?;
     let forces = lcp.contact_forces(&z)?;
@@ -681,8 +688,7 @@ fn solve_lcp(
         termination,
         iterations,
         residual_norm: residual,
-        // The min-map Newton runs with the scene's absolute tolerance and no floor.
-        effective_tolerance: (method == Method::LcpSsn).then_some(settings.tolerance),
+        effective_tolerance,
         counters,
         solve_seconds: seconds,
         newton: None,

@@ -478,6 +478,24 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
             assert!(err(&o).contains(word), "{word}: {}", err(&o));
         }
     }
+    // An amplitude that would make the response overflow in the residual norms, with any
+    // method (Lemke's LCP data included).
+    let huge = scene("huge.toml", "elements = 20", "");
+    let text = std::fs::read_to_string(&huge)
+        .unwrap()
+        .replace("amplitude = 0.04", "amplitude = 1e300")
+        + "method = \"lcp-lemke\"\n";
+    std::fs::write(&huge, text).unwrap();
+    let o = ssn(&["solve", &huge]);
+    assert_exit(&o, 2, "huge amplitude");
+    for word in [
+        huge.as_str(),
+        "forcing.amplitude",
+        "1e300",
+        "|value| <= 1e100",
+    ] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
     let lcp = scene("lcp.toml", "elements = 20", "").to_string();
     let text =
         std::fs::read_to_string(&lcp).unwrap() + "method = \"lcp-lemke\"\ntime_samples = 10000\n";
@@ -502,4 +520,177 @@ fn a_default_run_that_fails_leaves_no_directory_behind() {
         !dir.path().join("new").exists(),
         "the output directory was left behind"
     );
+}
+
+/// `ssn sweep` reports every contact at every point, in its JSON (`contacts`, with the
+/// numbers of `ssn solve`) and its CSV (`contact{k}_...` columns); `contact_force_mean` is
+/// their sum. The sweep of `two_contacts.toml` ends at the scene's frequency `omega_1`,
+/// where `ssn solve` gives the same solution independently (a Newton solve from zero, not
+/// the continuation): the same equations solved to the same tolerance, so the mean forces
+/// (exact means of the reconstructed trigonometric polynomials) agree to 1e-6 relative.
+#[test]
+fn a_sweep_reports_every_contact_at_every_point_as_solve_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(scene("two_contacts.toml")).unwrap()
+        + "\n[sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.0\n";
+    let path = dir.path().join("two_contacts_sweep.toml");
+    std::fs::write(&path, text).unwrap();
+    let path = path.to_str().unwrap();
+    let csv = dir.path().join("sweep.csv");
+    let o = ssn(&["sweep", path, "--json", "--csv", csv.to_str().unwrap()]);
+    assert_exit(&o, 0, "sweep");
+    let sweep: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+    let o = ssn(&["solve", path, "--json"]);
+    assert_exit(&o, 0, "solve");
+    let solve: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+
+    let points = sweep["points"].as_u64().unwrap() as usize;
+    let contacts = sweep["contacts"].as_array().expect("contacts per point");
+    assert_eq!(contacts.len(), points);
+    let sums = sweep["contact_force_mean"].as_array().unwrap();
+    for (point, sum) in contacts.iter().zip(sums) {
+        let list = point.as_array().unwrap();
+        assert_eq!(list.len(), 2);
+        assert_eq!(list[0]["node"].as_u64(), Some(20));
+        assert_eq!(list[1]["node"].as_u64(), Some(10));
+        // serde_json's default float parser may be off by one unit in the last place.
+        let total: f64 = list.iter().map(|c| c["force_mean"].as_f64().unwrap()).sum();
+        assert!((sum.as_f64().unwrap() - total).abs() <= 1e-15 * total.abs());
+    }
+    let ratio = sweep["omega_ratio"].as_array().unwrap();
+    assert!((ratio[points - 1].as_f64().unwrap() - 1.0).abs() < 1e-9);
+    let last = &contacts[points - 1];
+    let node10 = |j: &serde_json::Value, key: &str| j[1][key].as_f64().unwrap();
+    let (swept, solved) = (
+        node10(last, "force_mean"),
+        node10(&solve["contacts"], "force_mean"),
+    );
+    println!("node 10 mean force at omega_1: sweep {swept:.9}, solve {solved:.9}");
+    assert!(solved < -0.01, "{solve}");
+    assert!((swept - solved).abs() <= 1e-6 * solved.abs());
+    let sum = sums[points - 1].as_f64().unwrap();
+    let solved_sum = solve["contact_force_mean"].as_f64().unwrap();
+    assert!((sum - solved_sum).abs() <= 1e-6 * solved_sum.abs());
+    // Displacement extremes: the same trigonometric polynomial sampled on two grids (the
+    // sweep's and the solve's), both of at least 1024 points per period: within 1e-4.
+    for key in ["displacement_min", "displacement_max"] {
+        let (a, b) = (node10(last, key), node10(&solve["contacts"], key));
+        assert!((a - b).abs() <= 1e-4, "{key}: {a} vs {b}");
+    }
+
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for k in 0..2 {
+        for field in [
+            "force_mean",
+            "max_penetration",
+            "contact_fraction",
+            "displacement_min",
+            "displacement_max",
+        ] {
+            let name = format!("contact{k}_{field}");
+            assert!(header.contains(&name.as_str()), "{header:?}");
+        }
+    }
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), points);
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row = &rows[points - 1];
+    assert!((row[column("contact1_force_mean")] - swept).abs() <= 1e-15 * swept.abs());
+    assert!((row[column("contact_force_mean")] - sum).abs() <= 1e-15 * sum.abs());
+}
+
+/// A run that fits in memory but would take hours is refused up front (exit 2) with the
+/// keys, the operations it needs and the limit; `SSN_WORK_LIMIT` moves the limit.
+#[test]
+fn a_run_that_cannot_finish_in_time_is_refused_with_its_work_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dense.toml");
+    std::fs::write(
+        &path,
+        "[rod]\nelements = 400\n[forcing]\namplitude = 0.04\n[contact]\ngap = 0.5\n\
+         [solver]\nharmonics = 40\nlinear_solver = \"dense\"\n",
+    )
+    .unwrap();
+    let path = path.to_str().unwrap();
+    // Memory (10.5 GB for the dense LU) is not the question here: a machine that has it.
+    let o = Command::new(SSN)
+        .args(["solve", path])
+        .env("SSN_MEMORY_LIMIT", "1e12")
+        .env_remove("SSN_WORK_LIMIT")
+        .output()
+        .unwrap();
+    assert_exit(&o, 2, "dense 400 elements H = 40");
+    for word in [
+        path,
+        "solver.linear_solver",
+        "2.3e14",
+        "1.0e14",
+        "SSN_WORK_LIMIT",
+    ] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // The canonical scene (structured solver, 41 condensed unknowns: 4.6e5 operations)
+    // runs by default and is refused below that limit.
+    let o = Command::new(SSN)
+        .args(["solve", &fig1()])
+        .env("SSN_WORK_LIMIT", "1e5")
+        .output()
+        .unwrap();
+    assert_exit(&o, 2, "work limit 1e5");
+    assert!(err(&o).contains("limit of 1.0e5"), "{}", err(&o));
+    let o = Command::new(SSN)
+        .args(["solve", &fig1()])
+        .env_remove("SSN_WORK_LIMIT")
+        .output()
+        .unwrap();
+    assert_exit(&o, 0, "canonical");
+}
+
+/// A tolerance the formulation cannot reach is raised to its round-off floor and reported
+/// (`effective_tolerance` in the JSON, a `tolerance ... effective` line in the text), never
+/// a silent "converged": penalty HB's floor is `eps k_p sqrt(n) max|g|` (its force term is
+/// `k_p` times a gap), with the default `k_p = 1e5 K[tip, tip] = 2e6` on the 20-element
+/// rod, `n = 20 x 41` unknowns at H = 20 and the gap 0.5: 6.36e-9, above the default 1e-10
+/// too. The LCP's min-map (a length) has the floor `eps sqrt(n) max|q|`.
+#[test]
+fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(fig1()).unwrap();
+    let penalty_floor = f64::EPSILON * 2e6 * (20.0f64 * 41.0).sqrt() * 0.5;
+    for (method, tolerance, floor) in [
+        ("penalty-hb", "1e-300", Some(penalty_floor)),
+        ("penalty-hb", "1e-10", Some(penalty_floor)),
+        ("lcp-ssn", "1e-300", None),
+    ] {
+        let text = base.replace(
+            "method = \"ssn-hb\"",
+            &format!("method = \"{method}\"\ntolerance = {tolerance}"),
+        );
+        let path = dir.path().join(format!("{method}_{tolerance}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let path = path.to_str().unwrap();
+        let o = ssn(&["solve", path, "--json"]);
+        assert_exit(&o, 0, path);
+        let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+        let used = json["effective_tolerance"].as_f64().unwrap();
+        let asked: f64 = tolerance.parse().unwrap();
+        assert!(used > asked, "{method} {tolerance}: {json}");
+        assert!(json["residual_norm"].as_f64().unwrap() <= used);
+        match floor {
+            Some(f) => assert!((used / f - 1.0).abs() < 1e-12, "{used:e} vs {f:e}"),
+            // The LCP's q is of the gap's size: the floor is a few ulps of 0.5 x 16.
+            None => assert!(used < 1e-13, "{used:e}"),
+        }
+        let o = ssn(&["solve", path]);
+        assert_exit(&o, 0, path);
+        let text = out(&o);
+        assert!(
+            text.contains("effective") && text.contains(&format!("{asked:e}")),
+            "{text}"
+        );
+    }
 }

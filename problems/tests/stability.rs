@@ -366,7 +366,7 @@ fn sweep_json_and_csv_carry_the_stability_of_every_point() {
 }
 
 #[test]
-#[ignore]
+#[ignore = "timing report of the stability analysis per point, nothing asserted; run with --ignored --nocapture"]
 fn report_stability_cost_per_point() {
     let (rod, scene, r) = strong_sweep();
     let h = scene.solver.harmonics;

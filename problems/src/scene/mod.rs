@@ -359,6 +359,9 @@ struct RawSweep {
 pub const MAX_HARMONICS: usize = 2000;
 /// Largest sample / step count accepted.
 pub const MAX_TIME_SAMPLES: usize = 1 << 20;
+/// Largest accepted magnitude of a forcing amplitude or a gap: the response scales with
+/// them, and a residual's square must stay below the largest double (1.8e308).
+pub const MAX_RESPONSE_SCALE: f64 = 1e100;
 
 struct Check<'a> {
     path: &'a Path,
@@ -390,11 +393,17 @@ impl Check<'_> {
         }
     }
 
-    fn finite(&self, key: &str, v: f64) -> Result<f64, SceneError> {
-        if v.is_finite() {
+    /// A length or force of the response: `|v| <= MAX_RESPONSE_SCALE`, so that residuals
+    /// and their squares (merit functions) stay finite.
+    fn response_scale(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v.abs() <= MAX_RESPONSE_SCALE {
             Ok(v)
         } else {
-            Err(self.invalid(key, v, "a finite number"))
+            Err(self.invalid(
+                key,
+                format!("{v:e}"),
+                "a finite number with |value| <= 1e100",
+            ))
         }
     }
 
@@ -658,7 +667,7 @@ impl Check<'_> {
 
     /// `[forcing]`: the load, its amplitude and its frequency (`omega_1` by default).
     fn forcing(&self, f: &RawForcing) -> Result<(LoadKind, f64, FrequencySpec), SceneError> {
-        let amplitude = self.finite("forcing.amplitude", f.amplitude)?;
+        let amplitude = self.response_scale("forcing.amplitude", f.amplitude)?;
         let frequency = match (f.omega_ratio, f.omega) {
             (Some(r), None) => FrequencySpec::Ratio(self.positive("forcing.omega_ratio", r)?),
             (None, Some(w)) => FrequencySpec::Absolute(self.positive("forcing.omega", w)?),
@@ -684,7 +693,7 @@ impl Check<'_> {
         match (c.gap, c.point) {
             (Some(gap), None) => Ok(vec![RodContact {
                 node: self.count_or("contact.node", c.node, 1, elements, elements)?,
-                gap: self.finite("contact.gap", gap)?,
+                gap: self.response_scale("contact.gap", gap)?,
             }]),
             (None, Some(points)) if c.node.is_none() => {
                 if points.is_empty() {
@@ -716,7 +725,7 @@ impl Check<'_> {
                     }
                     contacts.push(RodContact {
                         node,
-                        gap: self.finite("contact.point.gap", p.gap)?,
+                        gap: self.response_scale("contact.point.gap", p.gap)?,
                     });
                 }
                 Ok(contacts)
@@ -856,7 +865,7 @@ impl Check<'_> {
             }
             contacts.push(DofContact {
                 dof,
-                gap: self.finite("contact.point.gap", p.gap)?,
+                gap: self.response_scale("contact.point.gap", p.gap)?,
                 direction,
             });
         }

@@ -73,6 +73,7 @@
 //! Measured branch sizes, timings and limits are in the README (*Sweeps*) and
 //! `examples/lcp_sweep.rs`.
 
+mod contacts;
 mod response;
 
 use std::time::Instant;
@@ -378,6 +379,7 @@ where
         states: Vec::new(),
         stability: BranchStability::default(),
         stability_seconds: 0.0,
+        contacts: Vec::new(),
     };
     if !report.converged() {
         response.termination = format!(
@@ -533,6 +535,7 @@ pub fn frequency_response(
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError> {
     let mut response = follow_branch(rod, settings, sweep, progress)?;
+    response.contacts = contacts::branch_contacts(rod, settings, &response)?;
     let started = Instant::now();
     let options = StabilityOptions::default();
     response.stability =

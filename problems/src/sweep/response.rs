@@ -5,9 +5,13 @@ use semismooth::harmonic::{Aft, FourierBasis};
 use serde_json::json;
 
 use crate::branch::BranchStability;
+use crate::contacts::ContactReport;
 use crate::hb::HbError;
 use crate::runner::{RunCounters, RunError};
 use crate::scene::Method;
+
+/// One number of a [`ContactReport`].
+type ContactField = fn(&ContactReport) -> f64;
 
 /// A frequency-response curve: one entry per branch point, in branch order (the frequency
 /// is not monotone across folds).
@@ -59,6 +63,8 @@ pub struct FrequencyResponse {
     pub stability: BranchStability,
     /// Wall time of the stability analysis (not in `solve_seconds`).
     pub stability_seconds: f64,
+    /// Every contact of each point, in the scene's order (as `ssn solve` reports them).
+    pub contacts: Vec<Vec<ContactReport>>,
 }
 
 impl FrequencyResponse {
@@ -88,6 +94,49 @@ impl FrequencyResponse {
         self.omega.iter().map(|w| w / self.omega_1).collect()
     }
 
+    /// The mean contact force of each point: the sum of its contacts' mean forces (the
+    /// stability diagnostics' value, NaN, where the contacts were not computed).
+    pub fn contact_force_mean(&self) -> Vec<f64> {
+        (0..self.points())
+            .map(|i| match self.contacts.get(i) {
+                Some(point) => point.iter().map(|c| c.force_mean).sum(),
+                None => self
+                    .stability
+                    .contact_force_mean
+                    .get(i)
+                    .copied()
+                    .unwrap_or(f64::NAN),
+            })
+            .collect()
+    }
+
+    /// The CSV columns of the contacts: for contact `k` (the scene's order, from 0, as the
+    /// `lambda_k` of `ssn solve --csv`) `contact{k}_force_mean`, `contact{k}_max_penetration`,
+    /// `contact{k}_contact_fraction`, `contact{k}_displacement_min` and
+    /// `contact{k}_displacement_max`, one value per point (NaN where not computed).
+    pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
+        let count = self.contacts.iter().map(Vec::len).max().unwrap_or(0);
+        let fields: [(&str, ContactField); 5] = [
+            ("force_mean", |c| c.force_mean),
+            ("max_penetration", |c| c.max_penetration),
+            ("contact_fraction", |c| c.contact_fraction),
+            ("displacement_min", |c| c.displacement_min),
+            ("displacement_max", |c| c.displacement_max),
+        ];
+        let mut columns = Vec::with_capacity(count * fields.len());
+        for k in 0..count {
+            for (name, field) in fields {
+                let values = self
+                    .contacts
+                    .iter()
+                    .map(|point| point.get(k).map_or(f64::NAN, field))
+                    .collect();
+                columns.push((format!("contact{k}_{name}"), values));
+            }
+        }
+        columns
+    }
+
     /// Index and value of the largest amplitude (`None` for an empty curve).
     pub fn peak(&self) -> Option<(usize, f64)> {
         self.amplitude
@@ -102,7 +151,8 @@ impl FrequencyResponse {
 
     /// The JSON object of `ssn sweep --json`: `points`, `omega`, `omega_ratio`, `tip_max`,
     /// `tip_min`, `amplitude`, per point `stable` (true / false / null), `floquet_max_abs`,
-    /// `contact_force_mean`, `max_penetration`, then `stability_note` (why points are
+    /// `contact_force_mean` (the sum over the contacts), `max_penetration`, `contacts` (per
+    /// point, the list of [`ContactReport`]s), then `stability_note` (why points are
     /// undecided), `stability_seconds`, `events` ({`kind`, `omega`, `omega_ratio`,
     /// `index`}), `folds`, `converged`, `solve_seconds`, `termination`, `counters`.
     /// Non-finite numbers become `null`.
@@ -142,8 +192,13 @@ impl FrequencyResponse {
             "amplitude": self.amplitude,
             "stable": st.stable,
             "floquet_max_abs": st.floquet_max_abs,
-            "contact_force_mean": st.contact_force_mean,
+            "contact_force_mean": self.contact_force_mean(),
             "max_penetration": st.max_penetration,
+            "contacts": self
+                .contacts
+                .iter()
+                .map(|point| point.iter().map(ContactReport::to_json).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
             "stability_note": st.note,
             "stability_seconds": self.stability_seconds,
             "events": events,
