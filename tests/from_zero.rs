@@ -19,7 +19,9 @@
 mod common;
 
 use semismooth_problems::figures::default_settings;
-use semismooth_problems::from_zero::{grid_frequency_ratios, grid_rod, GRID_GAPS};
+use semismooth_problems::from_zero::{
+    grid_frequency_ratios, grid_rod, many_contacts_rod, GRID_GAPS,
+};
 use semismooth_problems::rod::{build_rod, MassModel};
 use semismooth_problems::runner::solve_rod;
 use semismooth_problems::scene::{Method, SweepSettings};
@@ -196,5 +198,46 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
     assert_eq!(
         compared, 28,
         "{compared} single-valued points compared, measured 28"
+    );
+}
+
+/// Ten contact points over the last fifth of a 1,000-element rod, gaps shaped like the first
+/// mode so that they close nearly together at `omega_1`: the solve from zero converges within
+/// 60 iterations (measured 54) and lies on the frequency response followed by continuation
+/// from below the contact onset (0.9 `omega_1`), at the same tolerance as the grid.
+#[test]
+fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
+    let rod = build_rod(&many_contacts_rod(10)).unwrap();
+    let sol = solve_rod(&rod, &default_settings(20), None).unwrap();
+    assert!(
+        sol.converged && sol.iterations <= 60,
+        "{} after {} iterations",
+        sol.termination,
+        sol.iterations
+    );
+    let sweep = SweepSettings {
+        step: 0.01,
+        max_step: 0.01,
+        ..SweepSettings::new(0.9, 1.1)
+    };
+    let branch =
+        frequency_response(&rod, &common::sweep_solver(Method::SsnHb, 20), &sweep, None).unwrap();
+    assert!(branch.converged, "sweep: {}", branch.termination);
+    let ratio: Vec<f64> = branch.omega.iter().map(|w| w / rod.omega_1).collect();
+    let on_branch = branch_tip_max_at(&ratio, &branch.tip_max, 1.0);
+    let distance = on_branch
+        .iter()
+        .map(|a| (a - sol.stats.max).abs())
+        .fold(f64::INFINITY, f64::min);
+    println!(
+        "10 contacts: {} iterations ({}), tip max {} vs branch {on_branch:?}",
+        sol.iterations,
+        sol.strategy.unwrap_or("-"),
+        sol.stats.max
+    );
+    assert!(
+        distance < 1e-2,
+        "tip max {} off the branch {on_branch:?}",
+        sol.stats.max
     );
 }
