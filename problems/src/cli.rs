@@ -466,6 +466,14 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             "folds             {}\n",
             folds_summary(&response.folds, rod.omega_1)
         );
+        if !response.corner_folds.is_empty() {
+            t += &format!(
+                "corner reversals  {} (the frequency goes back by less than {} omega_1; in \
+                 --json as corner_folds)\n",
+                response.corner_folds.len(),
+                crate::sweep::TURNING_POINT_EXCURSION
+            );
+        }
         let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
         let undecided = st.stable.iter().filter(|s| s.is_none()).count();
         t += &format!(

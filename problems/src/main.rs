@@ -68,8 +68,11 @@ enum Command {
     #[command(
         after_help = "Examples:\n  ssn sweep problems/scenes/paper_fig2.toml\n  \
         ssn sweep problems/scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
-        JSON fields: points, omega, tip_max, tip_min, amplitude (arrays in branch order),\n  \
-        folds (omega where the branch turns), converged, termination, solve_seconds, counters\n\n",
+        JSON fields: points, omega, omega_ratio, tip_max, tip_min, amplitude, stable,\n  \
+        floquet_max_abs, contact_force_mean, max_penetration (arrays in branch order),\n  \
+        stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
+        branch turns), corner_folds (reversals of less than 2e-3 omega_1: corners),\n  \
+        converged, termination, solve_seconds, counters\n\n",
         mut_arg("scene", |a| a.help("Scene file (TOML) with a [sweep] section")),
         mut_arg("json", |a| a.help("Print the branch as JSON on stdout")),
         mut_arg("csv", |a| a.help("Write the branch as CSV")),
