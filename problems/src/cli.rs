@@ -100,6 +100,27 @@ pub struct RunArgs {
     pub svg: Option<PathBuf>,
 }
 
+/// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
+/// or to start from ([`crate::state`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SolveArgs {
+    /// The scene and the outputs every run has.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Write the solution's harmonic coefficients as JSON (method, harmonics, dofs,
+    /// contacts, omega and the coefficients: a state for --start; `-`: standard output).
+    #[arg(long)]
+    pub state: Option<PathBuf>,
+    /// Start Newton from a state written by --state, or from one solution of
+    /// `ssn solutions --json` (choose it with --entry). Only harmonics may differ: the state
+    /// is then lifted (zero higher harmonics) or truncated.
+    #[arg(long)]
+    pub start: Option<PathBuf>,
+    /// The solution of an `ssn solutions --json` file to start from (1 = the first listed).
+    #[arg(long, requires = "start")]
+    pub entry: Option<usize>,
+}
+
 /// The curve of a run's SVG: titled by the scene, or `untitled` when it has no title.
 struct Plot {
     untitled: &'static str,
@@ -275,17 +296,62 @@ fn finite_or_null(v: f64) -> Value {
     }
 }
 
-/// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG.
-pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+/// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
+/// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
+pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
+    use crate::state::{read_state, HbState, StateShape};
+    let args = &solve_args.run;
     let mut outputs = args.plan()?;
+    if let Some(state) = &solve_args.state {
+        outputs.target(state, "--state")?;
+    }
+    if let Some(start) = &solve_args.start {
+        outputs.input(start, "the --start state");
+    }
     let (scene, rod) = load(&args.scene)?;
+    let shape = StateShape {
+        method: scene.solver.method,
+        harmonics: scene.solver.harmonics,
+        dofs: rod.model.dofs(),
+        contacts: rod.model.contacts.len(),
+    };
+    for (given, option) in [
+        (solve_args.state.is_some(), "--state"),
+        (solve_args.start.is_some(), "--start"),
+    ] {
+        if given {
+            StateShape::check_method(shape.method, option)
+                .map_err(|e| input_error(&args.scene, e))?;
+        }
+    }
+    let start = match &solve_args.start {
+        Some(path) => {
+            let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
+            let (x, note) = state.unknowns_for(shape).map_err(|e| {
+                CliError::BadInput(format!("{}: {e}", printable(&path.display().to_string())))
+            })?;
+            Some(StartedFrom {
+                file: printable(&path.display().to_string()),
+                entry: solve_args.entry,
+                omega_ratio: state.omega / state.omega_1,
+                note,
+                unknowns: x,
+            })
+        }
+        None => None,
+    };
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
         progress_spinner("time marching to a steady state", quiet)
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let solution = solve_rod(&rod, &scene.solver, None).map_err(|e| input_error(&args.scene, e))?;
+    let solution = solve_rod(
+        &rod,
+        &scene.solver,
+        start.as_ref().map(|s| s.unknowns.as_slice()),
+    )
+    .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
     let mut headers = vec!["t".to_string(), "u_tip".to_string()];
@@ -307,12 +373,69 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             ),
         }
     })?;
+    if let Some(path) = &solve_args.state {
+        let mut doc =
+            HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
+                .to_json();
+        doc["converged"] = json!(solution.converged);
+        doc["residual_norm"] = finite_or_null(solution.residual_norm);
+        let text = serde_json::to_string_pretty(&doc)
+            .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
+        outputs.add(path, format!("{text}\n").into_bytes());
+    }
     args.finish(
         outputs,
-        || solution_json(&args.scene, &solution),
-        || solution_text(&solution),
+        || {
+            let mut v = solution_json(&args.scene, &solution);
+            if let Some(s) = &start {
+                v["started_from"] = s.to_json();
+            }
+            v
+        },
+        || {
+            let mut t = solution_text(&solution);
+            if let Some(s) = &start {
+                t += &format!("started from      {}\n", s.describe());
+            }
+            t
+        },
         solution.converged,
     )
+}
+
+/// The state `ssn solve --start` began from.
+struct StartedFrom {
+    file: String,
+    entry: Option<usize>,
+    omega_ratio: f64,
+    note: Option<String>,
+    unknowns: Vec<f64>,
+}
+
+impl StartedFrom {
+    fn to_json(&self) -> Value {
+        json!({
+            "file": self.file,
+            "entry": self.entry,
+            "omega_ratio": self.omega_ratio,
+            "note": self.note,
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "{}{} (a state at omega/omega_1 = {:.6}){}",
+            self.file,
+            self.entry
+                .map(|k| format!(", entry {k}"))
+                .unwrap_or_default(),
+            self.omega_ratio,
+            self.note
+                .as_ref()
+                .map(|n| format!("; {n}"))
+                .unwrap_or_default()
+        )
+    }
 }
 
 fn describe_method(s: &Solution) -> String {

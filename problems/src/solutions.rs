@@ -21,6 +21,7 @@ use crate::model::Structure;
 use crate::runner::{solve_rod, RunError, Solution};
 use crate::scene::{Method, SolverSettings, SweepSettings};
 use crate::stability::{hb_stability, Stability, StabilityOptions};
+use crate::state::{HbState, StateShape};
 use crate::sweep::follow_branch;
 
 /// Relative distance of the unknowns below which two corrected solutions are the same.
@@ -59,6 +60,8 @@ pub struct SolutionSet {
     pub omega: f64,
     /// First natural frequency.
     pub omega_1: f64,
+    /// The shape of every solution's unknowns (method, harmonics, dofs, contacts).
+    pub shape: StateShape,
     /// The distinct solutions, in branch order.
     pub solutions: Vec<PeriodicSolution>,
     /// The window searched, in units of `omega_1`.
@@ -118,6 +121,12 @@ pub fn find_solutions(
     let mut set = SolutionSet {
         omega,
         omega_1: rod.omega_1,
+        shape: StateShape {
+            method: settings.method,
+            harmonics: settings.harmonics,
+            dofs: rod.model.dofs(),
+            contacts: rod.model.contacts.len(),
+        },
         solutions: Vec::new(),
         window: (window.omega_ratio_from, window.omega_ratio_to),
         branch_points: branch.points(),
@@ -197,7 +206,8 @@ impl SolutionSet {
     /// `solutions`, each {`tip_min`, `tip_max`, `contact_force_mean`, `max_penetration`,
     /// `contacts` [{`dof`, `gap`, `contact_force_mean`, `max_penetration`}], `stable`
     /// (true / false / null), `floquet_max_abs`, `stability_note`, `iterations`,
-    /// `residual_norm`}.
+    /// `residual_norm`, `state` (the harmonic coefficients, [`crate::state`]: start
+    /// `ssn solve` from it with `--start FILE --entry K`)}.
     pub fn to_json(&self) -> serde_json::Value {
         let solutions: Vec<serde_json::Value> = self
             .solutions
@@ -226,6 +236,13 @@ impl SolutionSet {
                     "stability_note": s.stability.reason,
                     "iterations": s.solution.iterations,
                     "residual_norm": s.solution.residual_norm,
+                    "state": HbState::from_unknowns(
+                        self.shape,
+                        self.omega,
+                        self.omega_1,
+                        &s.solution.state
+                    )
+                    .to_json(),
                 })
             })
             .collect();
@@ -348,6 +365,10 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
         }
         for f in &set.failed_corrections {
             t += &format!("  not corrected: {f}\n");
+        }
+        if !set.solutions.is_empty() {
+            t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
+                  starts from solution K)\n";
         }
         t
     };
