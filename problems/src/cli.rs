@@ -16,7 +16,9 @@ use serde_json::{json, Value};
 use crate::import::build_imported;
 use crate::io::{printable, write_text, OutputSet, TargetError};
 use crate::model::Structure;
-use crate::output::{csv_table, line_plot_svg, prepare_directory, PlotSpec, Series};
+use crate::output::{
+    csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
+};
 use crate::rod::{build_rod, natural_frequencies, ModelError};
 use crate::runner::{solve_rod, RunCounters, Solution};
 use crate::scene::{Method, Scene};
@@ -126,7 +128,7 @@ struct Plot {
     untitled: &'static str,
     x_label: &'static str,
     y_label: &'static str,
-    series: Series,
+    series: Vec<Series>,
 }
 
 impl RunArgs {
@@ -171,7 +173,7 @@ impl RunArgs {
                 y_label: plot.y_label.into(),
                 log_log: false,
             };
-            set.add(svg, line_plot_svg(&spec, &[plot.series])?.into_bytes());
+            set.add(svg, line_plot_svg(&spec, &plot.series)?.into_bytes());
         }
         Ok(())
     }
@@ -362,15 +364,31 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
         let period = 2.0 * std::f64::consts::PI / solution.omega;
+        let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
+        let mut series = vec![Series::new(
+            describe_method(&solution),
+            t.clone(),
+            solution.tip.clone(),
+        )];
+        // The obstacle of a contact on the plotted dof.
+        for c in rod
+            .model
+            .contacts
+            .iter()
+            .filter(|c| c.dof == rod.observed_dof)
+        {
+            series.push(Series::horizontal(
+                format!("obstacle (gap {})", c.gap),
+                c.sign() * c.gap,
+                0.0,
+                1.0,
+            ));
+        }
         Plot {
             untitled: "tip displacement",
-            x_label: "t / T",
-            y_label: "u_tip",
-            series: Series::new(
-                describe_method(&solution),
-                solution.times.iter().map(|t| t / period).collect(),
-                solution.tip.clone(),
-            ),
+            x_label: "time t / T (T: forcing period)",
+            y_label: "tip displacement u_tip",
+            series,
         }
     })?;
     if let Some(path) = &solve_args.state {
@@ -557,19 +575,20 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             &st.contact_force_mean,
             &st.max_penetration,
         ],
-        || Plot {
-            untitled: "frequency response",
-            x_label: "omega / omega_1",
-            y_label: "max |u_tip|",
-            series: Series::new(
-                format!(
-                    "{} H = {}",
-                    scene.solver.method.name(),
-                    scene.solver.harmonics
-                ),
-                ratio.clone(),
-                response.amplitude.clone(),
-            ),
+        || {
+            let label = format!(
+                "{} H = {}",
+                scene.solver.method.name(),
+                scene.solver.harmonics
+            );
+            let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
+            series.extend(stability_key(&st.stable));
+            Plot {
+                untitled: "frequency response",
+                x_label: "forcing frequency omega / omega_1",
+                y_label: "tip amplitude max_t |u_tip(t)|",
+                series,
+            }
         },
     )?;
     let text = || {
