@@ -201,7 +201,11 @@ pub fn longest_plotted_step(series: &[Series]) -> f64 {
             });
         (hi - lo).max(f64::MIN_POSITIVE)
     };
-    let (rx, ry) = (range(&|s| &s.x), range(&|s| &s.y));
+    longest_plotted_step_on(series, range(&|s| &s.x), range(&|s| &s.y))
+}
+
+/// [`longest_plotted_step`] on axes of the ranges `rx` and `ry`.
+pub fn longest_plotted_step_on(series: &[Series], rx: f64, ry: f64) -> f64 {
     series
         .iter()
         .flat_map(|s| {
