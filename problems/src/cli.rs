@@ -304,11 +304,12 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     use crate::state::{read_state, HbState, StateShape};
     let args = &solve_args.run;
     let mut outputs = args.plan()?;
-    if let Some(state) = &solve_args.state {
-        outputs.target(state, "--state")?;
-    }
+    // The start is an input: no output may replace it.
     if let Some(start) = &solve_args.start {
         outputs.input(start, "the --start state");
+    }
+    if let Some(state) = &solve_args.state {
+        outputs.target(state, "--state")?;
     }
     let (scene, rod) = load(&args.scene)?;
     let shape = StateShape {

@@ -226,4 +226,8 @@ fn a_state_of_other_harmonics_is_lifted_or_truncated_and_mismatches_name_the_fie
     refused(STRONG, &bad, &[], "displacement[3]");
     let truncated = dir.write("cut.json", "{\"format\": ");
     refused(STRONG, &truncated, &[], "not a JSON state");
+    // The start is an input: --state may not replace it (the run writes nothing).
+    let before = std::fs::read_to_string(&state).unwrap();
+    refused(STRONG, &state, &["--state", &state], "--state");
+    assert_eq!(std::fs::read_to_string(&state).unwrap(), before);
 }
