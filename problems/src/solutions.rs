@@ -262,10 +262,10 @@ impl SolutionSet {
 
 /// `ssn solutions SCENE`: every periodic solution at the scene's frequency (module
 /// documentation); text or JSON on stdout, a CSV row per solution, an SVG of the tip over
-/// one period (stable solid, unstable or undecided dashed).
+/// one period (stable solid, unstable dashed, undecided dotted).
 pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
     use crate::cli::CliError;
-    use crate::output::{csv_table, line_plot_svg, PlotSpec, Series};
+    use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
     let (scene, rod) = crate::cli::load(&args.scene)?;
     let mut outputs = args.plan()?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
@@ -298,7 +298,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
         outputs.add(csv, csv_table(&headers, &refs).into_bytes());
     }
     if let Some(svg) = &args.svg {
-        let series: Vec<Series> = set
+        let mut series: Vec<Series> = set
             .solutions
             .iter()
             .enumerate()
@@ -314,19 +314,38 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
                     Some(false) => format!("solution {} (unstable)", k + 1),
                     None => format!("solution {} (stability undecided)", k + 1),
                 };
-                if s.stability.stable == Some(true) {
-                    Series::new(label, t, s.solution.tip.clone())
-                } else {
-                    Series::dashed(label, t, s.solution.tip.clone())
+                // The stability styles of the sweeps: solid, dashed, dotted.
+                let style = match s.stability.stable {
+                    Some(true) => LineStyle::Solid,
+                    Some(false) => LineStyle::Dashed,
+                    None => LineStyle::Dotted,
+                };
+                Series {
+                    style,
+                    ..Series::new(label, t, s.solution.tip.clone())
                 }
             })
             .collect();
+        // The obstacle of a contact on the plotted dof.
+        for c in rod
+            .model
+            .contacts
+            .iter()
+            .filter(|c| c.dof == rod.observed_dof)
+        {
+            series.push(Series::horizontal(
+                format!("obstacle (gap {})", c.gap),
+                c.sign() * c.gap,
+                0.0,
+                1.0,
+            ));
+        }
         let spec = PlotSpec {
             title: format!(
                 "periodic solutions at omega/omega_1 = {:.4}",
                 set.omega / set.omega_1
             ),
-            x_label: "t / T (time over the forcing period)".into(),
+            x_label: "time t / T (T: forcing period)".into(),
             y_label: "tip displacement u_tip".into(),
             log_log: false,
         };
