@@ -371,20 +371,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
             t.clone(),
             solution.tip.clone(),
         )];
-        // The obstacle of a contact on the plotted dof.
-        for c in rod
-            .model
-            .contacts
-            .iter()
-            .filter(|c| c.dof == rod.observed_dof)
-        {
-            series.push(Series::horizontal(
-                format!("obstacle (gap {})", c.gap),
-                c.sign() * c.gap,
-                0.0,
-                1.0,
-            ));
-        }
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
         Plot {
             untitled: "tip displacement",
             x_label: "time t / T (T: forcing period)",

@@ -16,6 +16,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::cli::{progress_bar, CliError};
+use crate::model::Structure;
 use crate::output::{
     csv_table, prepare_directory, stability_key, stability_series, write_atomically,
     write_line_plot, PlotSpec, Series,
@@ -137,14 +138,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         difference: 0.0,
     });
     bar.finish_and_clear();
-    for c in &rod.model.contacts {
-        series.push(Series::horizontal(
-            format!("obstacle (gap {})", c.gap),
-            c.sign() * c.gap,
-            0.0,
-            1.0,
-        ));
-    }
+    series.extend(obstacle_lines(&rod, 0.0, 1.0));
     write_figure(
         out,
         &format!("fig1_{name}_mass"),
@@ -160,6 +154,25 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         &csv_columns,
     )?;
     Ok(rows)
+}
+
+/// Dashed black lines at the obstacles of the contacts on the observed dof, over
+/// `[x0, x1]` (plots of the observed displacement against time).
+pub fn obstacle_lines(structure: &Structure, x0: f64, x1: f64) -> Vec<Series> {
+    structure
+        .model
+        .contacts
+        .iter()
+        .filter(|c| c.dof == structure.observed_dof)
+        .map(|c| {
+            Series::horizontal(
+                format!("obstacle (gap {})", c.gap),
+                c.sign() * c.gap,
+                x0,
+                x1,
+            )
+        })
+        .collect()
 }
 
 /// The Fig. 1 table: mass, method, iterations, time, tip extremes, difference to the reference.

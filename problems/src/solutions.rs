@@ -326,20 +326,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
                 }
             })
             .collect();
-        // The obstacle of a contact on the plotted dof.
-        for c in rod
-            .model
-            .contacts
-            .iter()
-            .filter(|c| c.dof == rod.observed_dof)
-        {
-            series.push(Series::horizontal(
-                format!("obstacle (gap {})", c.gap),
-                c.sign() * c.gap,
-                0.0,
-                1.0,
-            ));
-        }
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
         let spec = PlotSpec {
             title: format!(
                 "periodic solutions at omega/omega_1 = {:.4}",
