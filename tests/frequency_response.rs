@@ -279,15 +279,23 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
         assert!((r.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
         let (fold, peak) = jump_down_and_peak(&r);
         println!(
-            "gap {gap}, H = {h}: {} points, {} corners, {} folds, jump-down {fold}, peak {peak}, \
-             {} factorizations, {:.3} s",
+            "gap {gap}, H = {h}: {} points, {} corners, {} folds, {} corner reversals, jump-down \
+             {fold}, peak {peak}, {} factorizations, {:.3} s",
             r.points(),
             r.corners,
             r.folds.len(),
+            r.corner_folds.len(),
             r.counters.factorizations,
             r.solve_seconds
         );
-        assert!(r.corners > 0 && r.folds.len() > 2, "gap {gap}, H = {h}");
+        // The reversals at corners are listed apart from the turning points (the jump-down
+        // and jump-up frequencies, and at H = 5 the extra turns of the Galerkin contact).
+        assert!(
+            r.corners > 0 && !r.corner_folds.is_empty() && r.folds.len() >= 2,
+            "gap {gap}, H = {h}: folds {:?}, {} corner reversals",
+            r.folds,
+            r.corner_folds.len()
+        );
         let kp = DEFAULT_RELATIVE_PENALTY * rod.model.contact_stiffness_scale();
         let options = PenaltyHbOptions {
             harmonics: h,

@@ -16,7 +16,9 @@ use serde_json::{json, Value};
 use crate::import::build_imported;
 use crate::io::{printable, write_text, OutputSet, TargetError};
 use crate::model::Structure;
-use crate::output::{csv_table, line_plot_svg, prepare_directory, PlotSpec, Series};
+use crate::output::{
+    csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
+};
 use crate::rod::{build_rod, natural_frequencies, ModelError};
 use crate::runner::{solve_rod, RunCounters, Solution};
 use crate::scene::{Method, Scene};
@@ -103,12 +105,33 @@ pub struct RunArgs {
     pub svg: Option<PathBuf>,
 }
 
+/// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
+/// or to start from ([`crate::state`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SolveArgs {
+    /// The scene and the outputs every run has.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Write the solution's harmonic coefficients as JSON (method, harmonics, dofs,
+    /// contacts, omega and the coefficients: a state for --start; `-`: standard output).
+    #[arg(long)]
+    pub state: Option<PathBuf>,
+    /// Start Newton from a state written by --state, or from one solution of
+    /// `ssn solutions --json` (choose it with --entry). Only harmonics may differ: the state
+    /// is then lifted (zero higher harmonics) or truncated.
+    #[arg(long)]
+    pub start: Option<PathBuf>,
+    /// The solution of an `ssn solutions --json` file to start from (1 = the first listed).
+    #[arg(long, requires = "start")]
+    pub entry: Option<usize>,
+}
+
 /// The curve of a run's SVG: titled by the scene, or `untitled` when it has no title.
 struct Plot {
     untitled: &'static str,
     x_label: &'static str,
     y_label: &'static str,
-    series: Series,
+    series: Vec<Series>,
 }
 
 impl RunArgs {
@@ -153,7 +176,7 @@ impl RunArgs {
                 y_label: plot.y_label.into(),
                 log_log: false,
             };
-            set.add(svg, line_plot_svg(&spec, &[plot.series])?.into_bytes());
+            set.add(svg, line_plot_svg(&spec, &plot.series)?.into_bytes());
         }
         Ok(())
     }
@@ -278,17 +301,63 @@ fn finite_or_null(v: f64) -> Value {
     }
 }
 
-/// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG.
-pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+/// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
+/// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
+pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
+    use crate::state::{read_state, HbState, StateShape};
+    let args = &solve_args.run;
     let mut outputs = args.plan()?;
+    // The start is an input: no output may replace it.
+    if let Some(start) = &solve_args.start {
+        outputs.input(start, "the --start state");
+    }
+    if let Some(state) = &solve_args.state {
+        outputs.target(state, "--state")?;
+    }
     let (scene, rod) = load(&args.scene)?;
+    let shape = StateShape {
+        method: scene.solver.method,
+        harmonics: scene.solver.harmonics,
+        dofs: rod.model.dofs(),
+        contacts: rod.model.contacts.len(),
+    };
+    for (given, option) in [
+        (solve_args.state.is_some(), "--state"),
+        (solve_args.start.is_some(), "--start"),
+    ] {
+        if given {
+            StateShape::check_method(shape.method, option)
+                .map_err(|e| input_error(&args.scene, e))?;
+        }
+    }
+    let start = match &solve_args.start {
+        Some(path) => {
+            let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
+            let (x, note) = state.unknowns_for(shape).map_err(|e| {
+                CliError::BadInput(format!("{}: {e}", printable(&path.display().to_string())))
+            })?;
+            Some(StartedFrom {
+                file: printable(&path.display().to_string()),
+                entry: solve_args.entry,
+                omega_ratio: state.omega / state.omega_1,
+                note,
+                unknowns: x,
+            })
+        }
+        None => None,
+    };
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
         progress_spinner("time marching to a steady state", quiet)
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let solution = solve_rod(&rod, &scene.solver, None).map_err(|e| input_error(&args.scene, e))?;
+    let solution = solve_rod(
+        &rod,
+        &scene.solver,
+        start.as_ref().map(|s| s.unknowns.as_slice()),
+    )
+    .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
     let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
     let mut headers = vec!["t".to_string(), "u_tip".to_string()];
@@ -299,23 +368,83 @@ pub fn solve(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
         let period = 2.0 * std::f64::consts::PI / solution.omega;
+        let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
+        let mut series = vec![Series::new(
+            describe_method(&solution),
+            t.clone(),
+            solution.tip.clone(),
+        )];
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
         Plot {
             untitled: "tip displacement",
-            x_label: "t / T",
-            y_label: "u_tip",
-            series: Series::new(
-                describe_method(&solution),
-                solution.times.iter().map(|t| t / period).collect(),
-                solution.tip.clone(),
-            ),
+            x_label: "time t / T (T: forcing period)",
+            y_label: "tip displacement u_tip",
+            series,
         }
     })?;
+    if let Some(path) = &solve_args.state {
+        let mut doc =
+            HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
+                .to_json();
+        doc["converged"] = json!(solution.converged);
+        doc["residual_norm"] = finite_or_null(solution.residual_norm);
+        let text = serde_json::to_string_pretty(&doc)
+            .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
+        outputs.add(path, format!("{text}\n").into_bytes());
+    }
     args.finish(
         outputs,
-        || solution_json(&args.scene, &solution),
-        || solution_text(&solution, &scene.solver),
+        || {
+            let mut v = solution_json(&args.scene, &solution);
+            if let Some(s) = &start {
+                v["started_from"] = s.to_json();
+            }
+            v
+        },
+        || {
+            let mut t = solution_text(&solution, &scene.solver);
+            if let Some(s) = &start {
+                t += &format!("started from      {}\n", s.describe());
+            }
+            t
+        },
         solution.converged,
     )
+}
+
+/// The state `ssn solve --start` began from.
+struct StartedFrom {
+    file: String,
+    entry: Option<usize>,
+    omega_ratio: f64,
+    note: Option<String>,
+    unknowns: Vec<f64>,
+}
+
+impl StartedFrom {
+    fn to_json(&self) -> Value {
+        json!({
+            "file": self.file,
+            "entry": self.entry,
+            "omega_ratio": self.omega_ratio,
+            "note": self.note,
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "{}{} (a state at omega/omega_1 = {:.6}){}",
+            self.file,
+            self.entry
+                .map(|k| format!(", entry {k}"))
+                .unwrap_or_default(),
+            self.omega_ratio,
+            self.note
+                .as_ref()
+                .map(|n| format!("; {n}"))
+                .unwrap_or_default()
+        )
+    }
 }
 
 fn describe_method(s: &Solution) -> String {
@@ -454,19 +583,20 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         headers.push(name);
         columns.push(values);
     }
-    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || Plot {
-        untitled: "frequency response",
-        x_label: "omega / omega_1",
-        y_label: "max |u_tip|",
-        series: Series::new(
-            format!(
-                "{} H = {}",
-                scene.solver.method.name(),
-                scene.solver.harmonics
-            ),
-            ratio.clone(),
-            response.amplitude.clone(),
-        ),
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
+        let label = format!(
+            "{} H = {}",
+            scene.solver.method.name(),
+            scene.solver.harmonics
+        );
+        let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
+        series.extend(stability_key(&st.stable));
+        Plot {
+            untitled: "frequency response",
+            x_label: "forcing frequency omega / omega_1",
+            y_label: "tip amplitude max_t |u_tip(t)|",
+            series,
+        }
     })?;
     let text = || {
         let mut t = format!(
@@ -485,6 +615,14 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             "folds             {}\n",
             folds_summary(&response.folds, rod.omega_1)
         );
+        if !response.corner_folds.is_empty() {
+            t += &format!(
+                "corner reversals  {} (the frequency goes back by less than {} omega_1; in \
+                 --json as corner_folds)\n",
+                response.corner_folds.len(),
+                crate::sweep::TURNING_POINT_EXCURSION
+            );
+        }
         let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
         let undecided = st.stable.iter().filter(|s| s.is_none()).count();
         t += &format!(

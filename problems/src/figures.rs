@@ -16,8 +16,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::cli::{progress_bar, CliError};
+use crate::model::Structure;
 use crate::output::{
-    csv_table, prepare_directory, write_atomically, write_line_plot, PlotSpec, Series,
+    csv_table, prepare_directory, stability_key, stability_series, write_atomically,
+    write_line_plot, PlotSpec, Series,
 };
 use crate::rod::{build_rod, MassModel, RodContact, RodSpec};
 use crate::runner::solve_rod;
@@ -72,11 +74,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         ..RodSpec::canonical()
     };
     let rod = build_rod(&spec).map_err(bad_input)?;
-    let name = match mass {
-        MassModel::Consistent => "consistent",
-        MassModel::Lumped => "lumped",
-        MassModel::Modified => "modified",
-    };
+    let name = mass_name(mass);
     let bar = progress_bar(4, &format!("Fig. 1 ({name} mass)"), quiet);
     // Reference: energy-conserving trapezoidal steps with a massless contact node; the
     // Moreau–Jean scheme (restitution 0) otherwise, with finer steps (first order).
@@ -140,6 +138,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         difference: 0.0,
     });
     bar.finish_and_clear();
+    series.extend(obstacle_lines(&rod, 0.0, 1.0));
     write_figure(
         out,
         &format!("fig1_{name}_mass"),
@@ -147,14 +146,33 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
             title: format!(
                 "Fig. 1: rod tip over one period, gap 0.5, omega = omega_1 ({name} mass)"
             ),
-            x_label: "t / T".into(),
-            y_label: "u_tip".into(),
+            x_label: "time t / T (T: forcing period)".into(),
+            y_label: "tip displacement u_tip".into(),
             log_log: false,
         },
         &series,
         &csv_columns,
     )?;
     Ok(rows)
+}
+
+/// Dashed black lines at the obstacles of the contacts on the observed dof, over
+/// `[x0, x1]` (plots of the observed displacement against time).
+pub fn obstacle_lines(structure: &Structure, x0: f64, x1: f64) -> Vec<Series> {
+    structure
+        .model
+        .contacts
+        .iter()
+        .filter(|c| c.dof == structure.observed_dof)
+        .map(|c| {
+            Series::horizontal(
+                format!("obstacle (gap {})", c.gap),
+                c.sign() * c.gap,
+                x0,
+                x1,
+            )
+        })
+        .collect()
 }
 
 /// The Fig. 1 table: mass, method, iterations, time, tip extremes, difference to the reference.
@@ -217,6 +235,10 @@ pub struct Fig2Curve {
     pub seconds: f64,
     /// Whether the branch reached the end of the interval.
     pub converged: bool,
+    /// Points found unstable.
+    pub unstable: usize,
+    /// Points whose stability is undecided.
+    pub undecided: usize,
 }
 
 /// The gaps of Fig. 2 (`None`: the rod without contact).
@@ -238,31 +260,119 @@ fn curve_label(gap: Option<f64>) -> String {
         .unwrap_or_else(|| "linear".into())
 }
 
-/// The sweep of the default run's Fig. 2: `omega/omega_1` in `[0.5, 2]`, steps twice the
-/// scene defaults (`0.02`, at most `0.1`), up to 5000 points.
+/// The sweep of the default run's Fig. 2: `omega/omega_1` in `[0.5, 2]`, steps of at most
+/// [`FIG2_MAX_STEP`] so that each plotted step is at most [`FIG2_PLOTTED_STEP`] of the axis
+/// ranges, up to 5000 points.
 pub fn figure_2_sweep() -> SweepSettings {
     SweepSettings {
-        step: 0.02,
-        max_step: 0.1,
+        step: FIG2_MAX_STEP,
+        max_step: FIG2_MAX_STEP,
         max_points: 5000,
         ..SweepSettings::new(0.5, 2.0)
     }
 }
 
+/// Largest arclength step of the Fig. 2 sweeps (the sweep's own unit, module `sweep`).
+/// (0.0075 leaves one step of 2.2 % where the gap-0.25 branch loses contact at H = 20,
+/// measured; 0.005 gives at most 0.7 %.)
+pub const FIG2_MAX_STEP: f64 = 0.005;
+
+/// Largest plotted step of a Fig. 2 curve, as a fraction of the axis ranges.
+pub const FIG2_PLOTTED_STEP: f64 = 0.015;
+
+/// The mass model's name in file names and titles.
+fn mass_name(mass: MassModel) -> &'static str {
+    match mass {
+        MassModel::Consistent => "consistent",
+        MassModel::Lumped => "lumped",
+        MassModel::Modified => "modified",
+    }
+}
+
+/// The curves of Fig. 2 and their CSV columns, as drawn.
+#[derive(Debug, Clone)]
+pub struct Fig2 {
+    /// One per gap.
+    pub curves: Vec<Fig2Curve>,
+    /// The plotted series (the pieces of each branch by stability, the obstacle-free key).
+    pub series: Vec<Series>,
+    /// The CSV columns: per curve `omega_ratio_<curve>`, `amplitude_<curve>`,
+    /// `stable_<curve>` (1 stable, 0 unstable, empty undecided), of equal length.
+    pub columns: Vec<(String, Vec<f64>)>,
+    /// The file stem (`fig2_H<h>` for the consistent mass, the paper's rod;
+    /// `fig2_H<h>_<mass>_mass` else).
+    pub stem: String,
+}
+
 /// Fig. 2 of the paper: `max |u_tip|` against omega/omega_1 on [0.5, 2] for gaps 0.25, 0.5,
-/// 0.75 and the linear rod, SSN-HB with `harmonics` harmonics, by pseudo-arclength
-/// continuation; writes `fig2_H<h>.svg` and `.csv` into `out`.
-pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Curve>, CliError> {
-    let sweep = figure_2_sweep();
-    let settings = default_settings(harmonics);
+/// 0.75 and the linear rod, SSN-HB with `harmonics` harmonics and the `mass` model, by
+/// pseudo-arclength continuation, each branch drawn by stability
+/// ([`crate::output::STABILITY_KEY`]); writes `<stem>.svg` and `.csv` into `out`.
+///
+/// Stability is known for the modified mass (a massless contact node); with the consistent
+/// mass the contact node has mass, the monodromy would need the impact law's saltation, and
+/// the branches are drawn dotted (undecided).
+pub fn figure_2(
+    out: &Path,
+    harmonics: usize,
+    mass: MassModel,
+    quiet: bool,
+) -> Result<Vec<Fig2Curve>, CliError> {
+    let fig = figure_2_curves(harmonics, mass, quiet)?;
+    write_figure(
+        out,
+        &fig.stem,
+        &PlotSpec {
+            title: format!(
+                "Fig. 2: frequency response of the rod tip, H = {harmonics}, {} mass{}",
+                mass_name(mass),
+                if mass == MassModel::Consistent {
+                    " (stability undecided: massive contact node)"
+                } else {
+                    ""
+                }
+            ),
+            x_label: "forcing frequency omega / omega_1".into(),
+            y_label: "tip amplitude max_t |u_tip(t)|".into(),
+            log_log: false,
+        },
+        &fig.series,
+        &fig.columns,
+    )?;
+    Ok(fig.curves)
+}
+
+/// One branch of Fig. 2: the rod with `gap` (`None`: without contact) and `mass`, swept by
+/// SSN-HB with `harmonics` harmonics over [`figure_2_sweep`], with its stability.
+pub fn figure_2_branch(
+    gap: Option<f64>,
+    harmonics: usize,
+    mass: MassModel,
+) -> Result<(crate::rod::RodModel, crate::sweep::FrequencyResponse), CliError> {
+    let spec = RodSpec {
+        mass,
+        ..fig2_rod(gap)
+    };
+    let rod = build_rod(&spec).map_err(bad_input)?;
+    let r = crate::sweep::frequency_response(
+        &rod,
+        &default_settings(harmonics),
+        &figure_2_sweep(),
+        None,
+    )
+    .map_err(bad_input)?;
+    Ok((rod, r))
+}
+
+/// The sweeps and series of [`figure_2`], without writing them.
+pub fn figure_2_curves(harmonics: usize, mass: MassModel, quiet: bool) -> Result<Fig2, CliError> {
     let bar = progress_bar(4, &format!("Fig. 2 (H = {harmonics})"), quiet);
     let mut curves = Vec::new();
     let mut series = Vec::new();
     let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
-    for gap in FIG2_GAPS {
-        let rod = build_rod(&fig2_rod(gap)).map_err(bad_input)?;
-        let r =
-            crate::sweep::frequency_response(&rod, &settings, &sweep, None).map_err(bad_input)?;
+    let mut verdicts = Vec::new();
+    for (k, gap) in FIG2_GAPS.into_iter().enumerate() {
+        let (rod, r) = figure_2_branch(gap, harmonics, mass)?;
         bar.inc(1);
         let ratio = r.omega_ratio();
         let label = curve_label(gap);
@@ -270,37 +380,48 @@ pub fn figure_2(out: &Path, harmonics: usize, quiet: bool) -> Result<Vec<Fig2Cur
             .peak()
             .map(|(i, a)| (a, ratio[i]))
             .unwrap_or((f64::NAN, f64::NAN));
+        let stable = &r.stability.stable;
         curves.push(Fig2Curve {
             gap,
             points: r.points(),
             folds: r.folds.iter().map(|w| w / rod.omega_1).collect(),
             peak,
-            seconds: r.solve_seconds,
+            seconds: r.solve_seconds + r.stability_seconds,
             converged: r.converged,
+            unstable: stable.iter().filter(|s| **s == Some(false)).count(),
+            undecided: stable.iter().filter(|s| s.is_none()).count(),
         });
         let key = label.replace(' ', "_");
         columns.push((format!("omega_ratio_{key}"), ratio.clone()));
         columns.push((format!("amplitude_{key}"), r.amplitude.clone()));
-        series.push(if gap.is_some() {
-            Series::new(label, ratio, r.amplitude)
+        columns.push((
+            format!("stable_{key}"),
+            stable
+                .iter()
+                .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
+                .collect(),
+        ));
+        let pieces = stability_series(&label, k, &ratio, &r.amplitude, stable);
+        if gap.is_none() {
+            // The linear rod underneath: off contact the contact branches coincide with it.
+            series.splice(0..0, pieces);
         } else {
-            Series::dashed(label, ratio, r.amplitude)
-        });
+            series.extend(pieces);
+        }
+        verdicts.extend_from_slice(stable);
     }
+    series.extend(stability_key(&verdicts));
     bar.finish_and_clear();
-    write_figure(
-        out,
-        &format!("fig2_H{harmonics}"),
-        &PlotSpec {
-            title: format!("Fig. 2: frequency response of the rod tip, H = {harmonics}"),
-            x_label: "omega / omega_1".into(),
-            y_label: "max over a period of |u_tip|".into(),
-            log_log: false,
-        },
-        &series,
-        &columns,
-    )?;
-    Ok(curves)
+    let stem = match mass {
+        MassModel::Consistent => format!("fig2_H{harmonics}"),
+        other => format!("fig2_H{harmonics}_{}_mass", mass_name(other)),
+    };
+    Ok(Fig2 {
+        curves,
+        series,
+        columns,
+        stem,
+    })
 }
 
 /// The default run (`ssn` without a subcommand): the paper's figures into `out`.
@@ -316,37 +437,60 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
          law (here restitution 0) and the two need not agree."
     )?;
     crate::outln!()?;
-    let curves = figure_2(out, 5, quiet)?;
-    crate::outln!("Fig. 2: frequency response max|u_tip| on omega/omega_1 in [0.5, 2], H = 5 (the paper's setting)")?;
-    crate::outln!(
-        "{:<8} {:>7} {:>11} {:>10} {:>22} {:>9}",
-        "curve",
-        "points",
-        "peak",
-        "at omega",
-        "folds (omega/omega_1)",
-        "ms"
-    )?;
-    for c in &curves {
-        let folds: Vec<String> = c.folds.iter().map(|f| format!("{f:.4}")).collect();
+    for (harmonics, mass, setting) in [
+        (5, MassModel::Consistent, "the paper's setting, fig2_H5.svg"),
+        (
+            20,
+            MassModel::Modified,
+            "massless contact node: stability known, fig2_H20_modified_mass.svg",
+        ),
+    ] {
+        let curves = figure_2(out, harmonics, mass, quiet)?;
         crate::outln!(
-            "{:<8} {:>7} {:>11.6} {:>10.4} {:>22} {:>9.2}{}",
-            curve_label(c.gap),
-            c.points,
-            c.peak.0,
-            c.peak.1,
-            if folds.is_empty() {
-                "none".to_string()
-            } else {
-                folds.join(", ")
-            },
-            1e3 * c.seconds,
-            if c.converged { "" } else { "  (stopped early)" }
+            "Fig. 2 ({} mass, H = {harmonics}): frequency response max|u_tip| on \
+             omega/omega_1 in [0.5, 2] ({setting})",
+            mass_name(mass)
         )?;
+        crate::outln!(
+            "{:<8} {:>7} {:>11} {:>10} {:>22} {:>9} {:>9} {:>9}",
+            "curve",
+            "points",
+            "peak",
+            "at omega",
+            "folds (omega/omega_1)",
+            "unstable",
+            "undecided",
+            "ms"
+        )?;
+        for c in &curves {
+            let folds: Vec<String> = c.folds.iter().map(|f| format!("{f:.4}")).collect();
+            crate::outln!(
+                "{:<8} {:>7} {:>11.6} {:>10.4} {:>22} {:>9} {:>9} {:>9.2}{}",
+                curve_label(c.gap),
+                c.points,
+                c.peak.0,
+                c.peak.1,
+                if folds.is_empty() {
+                    "none".to_string()
+                } else {
+                    folds.join(", ")
+                },
+                c.unstable,
+                c.undecided,
+                1e3 * c.seconds,
+                if c.converged { "" } else { "  (stopped early)" }
+            )?;
+        }
     }
     crate::outln!(
         "Contact stiffens the rod: the peak moves to higher frequency and is bounded by the gap; \
-         the branches fold over (the jump frequencies are the folds)."
+         the branches fold over (the jump frequencies are the folds) and are unstable between \
+         their folds. Stability (solid stable, dashed unstable, dotted undecided) is known for \
+         the modified mass (fig2_H20_modified_mass.svg); with the consistent mass (the \
+         paper's rod, fig2_H5.svg) the contact node has mass, the monodromy would need the \
+         impact law's saltation, and the branches are dotted (undecided). At H = 5 the gap \
+         0.25 branch turns several times: the contact holds only in the Galerkin sense \
+         (examples/strange_loops.rs)."
     )?;
     crate::outln!(
         "\nWrote {} in {:.1} s.",

@@ -53,25 +53,34 @@ enum Command {
     /// Solve one periodic response at the scene's forcing frequency.
     #[command(
         after_help = "Examples:\n  ssn solve problems/scenes/paper_fig1_modified_mass.toml\n  \
-        ssn solve problems/scenes/paper_fig1.toml --json --csv tip.csv --svg tip.svg\n\n\
+        ssn solve problems/scenes/paper_fig1.toml --json --csv tip.csv --svg tip.svg\n  \
+        ssn solve SCENE.toml --state state.json     (write the harmonic coefficients)\n  \
+        ssn solve SCENE.toml --start state.json     (Newton from them)\n  \
+        ssn solve SCENE.toml --start solutions.json --entry 2   (from ssn solutions --json)\n\n\
         JSON fields: scene, method, harmonics (HB only), time_samples, omega, omega_ratio,\n  \
         converged, termination, iterations, residual_norm, effective_tolerance,\n  \
         strategy and attempts (Newton methods), solve_seconds, tip_max, tip_min,\n  \
         max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
         gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
         displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \
-        jacobian_evaluations, factorizations, linear_solves, ffts, ...}\n\n"
+        jacobian_evaluations, factorizations, linear_solves, ffts, ...}, started_from\n  \
+        {file, entry, omega_ratio, note} (with --start)\n\n\
+        State file (--state): format, version, method, harmonics, dofs, contacts, omega,\n  \
+        omega_ratio, layout, displacement [(2H+1) dofs], contact_force [(2H+1) contacts]\n  \
+        (ssn-hb), converged, residual_norm\n\n"
     )]
-    Solve(RunArgs),
+    Solve(cli::SolveArgs),
     /// Follow the response in frequency (pseudo-arclength continuation) over the scene's
     /// [sweep] range.
     #[command(
         after_help = "Examples:\n  ssn sweep problems/scenes/paper_fig2.toml\n  \
         ssn sweep problems/scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
-        JSON fields: points, omega, tip_max, tip_min, amplitude (arrays in branch order),\n  \
-        contact_force_mean (sum over the contacts), max_penetration, contacts (per point,\n  \
-        the list of ssn solve), folds (omega where the branch turns), converged,\n  \
-        termination, solve_seconds, counters\n\n\
+        JSON fields: points, omega, omega_ratio, tip_max, tip_min, amplitude, stable,\n  \
+        floquet_max_abs, contact_force_mean (sum over the contacts), max_penetration,\n  \
+        contacts (per point, the list of ssn solve) (arrays in branch order),\n  \
+        stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
+        branch turns), corner_folds (reversals of less than 2e-3 omega_1: corners),\n  \
+        converged, termination, solve_seconds, counters\n\n\
         CSV: one row per point; contact k (from 0) adds contact{k}_force_mean,\n  \
         contact{k}_max_penetration, contact{k}_contact_fraction, contact{k}_displacement_min,\n  \
         contact{k}_displacement_max\n\n",
@@ -88,7 +97,8 @@ enum Command {
         JSON fields: omega, omega_ratio, window, branch_points, branch_converged, crossings,\n  \
         failed_corrections, seconds, solutions [{tip_min, tip_max, contact_force_mean,\n  \
         max_penetration, contacts, stable, floquet_max_abs, stability_note, iterations,\n  \
-        residual_norm}]\n\n",
+        residual_norm, state}]; start a solve from solution K with\n  \
+        ssn solve SCENE.toml --start solutions.json --entry K\n\n",
         mut_arg("json", |a| a.help("Print the solutions as JSON on stdout")),
         mut_arg("csv", |a| a.help("Write one CSV row per solution")),
         mut_arg("svg", |a| a.help("Write the tip over one period of every solution as SVG"))
@@ -147,7 +157,7 @@ fn main() -> ExitCode {
         ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
-        Some(Command::Solve(run)) => cli::solve(run, args.quiet),
+        Some(Command::Solve(solve)) => cli::solve(solve, args.quiet),
         Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
         Some(Command::Solutions(run)) => semismooth_problems::solutions::command(run),
     };

@@ -21,6 +21,7 @@ use crate::model::Structure;
 use crate::runner::{solve_rod, RunError, Solution};
 use crate::scene::{Method, SolverSettings, SweepSettings};
 use crate::stability::{hb_stability, Stability, StabilityOptions};
+use crate::state::{HbState, StateShape};
 use crate::sweep::follow_branch;
 
 /// Relative distance of the unknowns below which two corrected solutions are the same.
@@ -59,6 +60,8 @@ pub struct SolutionSet {
     pub omega: f64,
     /// First natural frequency.
     pub omega_1: f64,
+    /// The shape of every solution's unknowns (method, harmonics, dofs, contacts).
+    pub shape: StateShape,
     /// The distinct solutions, in branch order.
     pub solutions: Vec<PeriodicSolution>,
     /// The window searched, in units of `omega_1`.
@@ -118,6 +121,12 @@ pub fn find_solutions(
     let mut set = SolutionSet {
         omega,
         omega_1: rod.omega_1,
+        shape: StateShape {
+            method: settings.method,
+            harmonics: settings.harmonics,
+            dofs: rod.model.dofs(),
+            contacts: rod.model.contacts.len(),
+        },
         solutions: Vec::new(),
         window: (window.omega_ratio_from, window.omega_ratio_to),
         branch_points: branch.points(),
@@ -197,7 +206,8 @@ impl SolutionSet {
     /// `solutions`, each {`tip_min`, `tip_max`, `contact_force_mean`, `max_penetration`,
     /// `contacts` [{`dof`, `gap`, `contact_force_mean`, `max_penetration`}], `stable`
     /// (true / false / null), `floquet_max_abs`, `stability_note`, `iterations`,
-    /// `residual_norm`}.
+    /// `residual_norm`, `state` (the harmonic coefficients, [`crate::state`]: start
+    /// `ssn solve` from it with `--start FILE --entry K`)}.
     pub fn to_json(&self) -> serde_json::Value {
         let solutions: Vec<serde_json::Value> = self
             .solutions
@@ -226,6 +236,13 @@ impl SolutionSet {
                     "stability_note": s.stability.reason,
                     "iterations": s.solution.iterations,
                     "residual_norm": s.solution.residual_norm,
+                    "state": HbState::from_unknowns(
+                        self.shape,
+                        self.omega,
+                        self.omega_1,
+                        &s.solution.state
+                    )
+                    .to_json(),
                 })
             })
             .collect();
@@ -245,10 +262,10 @@ impl SolutionSet {
 
 /// `ssn solutions SCENE`: every periodic solution at the scene's frequency (module
 /// documentation); text or JSON on stdout, a CSV row per solution, an SVG of the tip over
-/// one period (stable solid, unstable or undecided dashed).
+/// one period (stable solid, unstable dashed, undecided dotted).
 pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
     use crate::cli::CliError;
-    use crate::output::{csv_table, line_plot_svg, PlotSpec, Series};
+    use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
     let (scene, rod) = crate::cli::load(&args.scene)?;
     let mut outputs = args.plan()?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
@@ -281,7 +298,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
         outputs.add(csv, csv_table(&headers, &refs).into_bytes());
     }
     if let Some(svg) = &args.svg {
-        let series: Vec<Series> = set
+        let mut series: Vec<Series> = set
             .solutions
             .iter()
             .enumerate()
@@ -297,19 +314,25 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
                     Some(false) => format!("solution {} (unstable)", k + 1),
                     None => format!("solution {} (stability undecided)", k + 1),
                 };
-                if s.stability.stable == Some(true) {
-                    Series::new(label, t, s.solution.tip.clone())
-                } else {
-                    Series::dashed(label, t, s.solution.tip.clone())
+                // The stability styles of the sweeps: solid, dashed, dotted.
+                let style = match s.stability.stable {
+                    Some(true) => LineStyle::Solid,
+                    Some(false) => LineStyle::Dashed,
+                    None => LineStyle::Dotted,
+                };
+                Series {
+                    style,
+                    ..Series::new(label, t, s.solution.tip.clone())
                 }
             })
             .collect();
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
         let spec = PlotSpec {
             title: format!(
                 "periodic solutions at omega/omega_1 = {:.4}",
                 set.omega / set.omega_1
             ),
-            x_label: "t / T (time over the forcing period)".into(),
+            x_label: "time t / T (T: forcing period)".into(),
             y_label: "tip displacement u_tip".into(),
             log_log: false,
         };
@@ -348,6 +371,10 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::cli::CliError> {
         }
         for f in &set.failed_corrections {
             t += &format!("  not corrected: {f}\n");
+        }
+        if !set.solutions.is_empty() {
+            t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
+                  starts from solution K)\n";
         }
         t
     };

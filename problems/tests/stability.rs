@@ -286,6 +286,15 @@ fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
     let w1 = rod.omega_1;
     let st = &r.stability;
     assert_eq!(st.stable.len(), r.points());
+    // The two turning points of the branch: the jump-down near 1.185 and the jump-up near
+    // 1.098 omega_1 (1.1846 and 1.0982 measured with the default steps; every step at most
+    // 0.002 moves them by less than 4e-4).
+    assert_eq!(r.folds.len(), 2, "{:?}", r.folds);
+    let fold_ratios: Vec<f64> = r.folds.iter().map(|w| w / w1).collect();
+    assert!(
+        (fold_ratios[0] - 1.185).abs() < 2e-3 && (fold_ratios[1] - 1.098).abs() < 2e-3,
+        "{fold_ratios:?}"
+    );
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
     for (i, s) in st.stable.iter().enumerate() {
         let ratio = r.omega[i] / w1;

@@ -62,13 +62,22 @@
 //!   The tip extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a
 //!   contact, else from the LCP of the point's frequency with the tip observed). The
 //!   discrete LCP branch has a small fold at many changes of the active set (a node
-//!   entering or leaving contact), all reported in `folds`. Known limit: a contact on a
+//!   entering or leaving contact), reported in `corner_folds` (see below). Known limit: a contact on a
 //!   node with mass (the ill-posed case without an impact law, module `lcp`): the branch
 //!   has a corner right after the contact onset that neither the arclength, the corner
 //!   passes nor the restarts turn, and the sweep stops there with `converged = false`.
 //! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
 //!   marching are no equation in `ω` to continue; solve frequency by frequency with
 //!   `ssn solve`.
+//!
+//! # Folds and corners
+//!
+//! The continuation reports every reversal of the frequency. On piecewise-smooth branches
+//! most of them are corners, not turning points: fine steps resolve micro-zigzags of about
+//! 1e-4 `ω_1` where AFT samples enter contact, and a penalty branch turns back a little at
+//! many of its corners. [`separate_turning_points`] keeps as `folds` the reversals whose
+//! frequency excursion is at least [`TURNING_POINT_EXCURSION`] `ω_1` and lists the others
+//! as `corner_folds`.
 //!
 //! Measured branch sizes, timings and limits are in the README (*Sweeps*) and
 //! `examples/lcp_sweep.rs`.
@@ -86,8 +95,8 @@ use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{self, NewtonError, WorkCounters};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
-pub use response::FrequencyResponse;
 use response::{extremes, HbTip};
+pub use response::{separate_turning_points, FrequencyResponse, TURNING_POINT_EXCURSION};
 
 use crate::branch::{branch_stability, BranchStability};
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
@@ -366,6 +375,8 @@ where
         iterations: Vec::new(),
         folds: Vec::new(),
         fold_indices: Vec::new(),
+        corner_folds: Vec::new(),
+        corner_fold_indices: Vec::new(),
         converged: false,
         termination: String::new(),
         solve_seconds: 0.0,
@@ -415,11 +426,19 @@ where
         }
     }
     let c = continuation.counters();
-    for event in continuation.events() {
-        if let ContinuationEvent::Fold { index, parameter } = event {
-            response.folds.push(*parameter);
-            response.fold_indices.push(*index);
-        }
+    let reversals: Vec<(f64, usize)> = continuation
+        .events()
+        .iter()
+        .filter_map(|event| match event {
+            ContinuationEvent::Fold { index, parameter } => Some((*parameter, *index)),
+            _ => None,
+        })
+        .collect();
+    if let (Some(&first), Some(&last)) = (response.omega.first(), response.omega.last()) {
+        let (folds, corners) =
+            separate_turning_points(first, last, &reversals, TURNING_POINT_EXCURSION * omega_1);
+        (response.folds, response.fold_indices) = folds.into_iter().unzip();
+        (response.corner_folds, response.corner_fold_indices) = corners.into_iter().unzip();
     }
     let termination = continuation.termination().cloned();
     drop(continuation);
