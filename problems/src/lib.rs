@@ -24,5 +24,6 @@ pub mod runner;
 pub mod scene;
 pub mod solutions;
 pub mod stability;
+pub mod structures;
 pub mod study;
 pub mod sweep;
