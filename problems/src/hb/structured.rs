@@ -252,46 +252,20 @@ impl StructuredHbSolver {
         self.krylov = self.condensed.uses_krylov(m, h, complementarity);
         let size = 2 * h + 1;
         let nc = m * size;
-        if self.krylov {
-            let dynamic = DynamicStiffness::new(
-                &lin.stiffness,
-                &lin.mass,
-                lin.damping.as_ref(),
-                h + 1,
-                RECEPTANCE_BLOCK,
-            )?;
-            self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
-            self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
-            self.complex_rhs = Mat::zeros(n, 1);
-            self.work_u = vec![0.0; n * size];
-            self.work_a = vec![0.0; nc];
-            self.work_c = vec![0.0; nc];
-            self.work_d = vec![0.0; nc];
-            self.work_rhs = Vec::with_capacity(n * size + nc);
-            self.work_res = Vec::with_capacity(n * size + nc);
-            self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
-            self.response.clear();
-            self.receptance.clear();
-            self.schur = Mat::zeros(0, 0);
-            self.dynamic = Some((lin.clone(), dynamic));
-            return Ok(());
-        }
+        // Right-hand sides solved at once: a block of contacts for the receptance diagonal
+        // (matrix-free) or every contact's column of the response (dense).
+        let columns = if self.krylov {
+            RECEPTANCE_BLOCK
+        } else {
+            m.max(1)
+        };
         let dynamic = DynamicStiffness::new(
             &lin.stiffness,
             &lin.mass,
             lin.damping.as_ref(),
             h + 1,
-            m.max(1),
+            columns,
         )?;
-        let req = StackReq::any_of(&[
-            dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
-            dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
-        ]);
-        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-            during: "allocating the condensed LU workspace",
-        })?;
-        self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
-        self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
         self.complex_rhs = Mat::zeros(n, 1);
         self.work_u = vec![0.0; n * size];
         self.work_a = vec![0.0; nc];
@@ -299,11 +273,28 @@ impl StructuredHbSolver {
         self.work_d = vec![0.0; nc];
         self.work_rhs = Vec::with_capacity(n * size + nc);
         self.work_res = Vec::with_capacity(n * size + nc);
-        self.work_b = Mat::zeros(nc, 1);
-        self.schur = Mat::zeros(nc, nc);
-        self.perm = vec![0; nc];
-        self.perm_inv = vec![0; nc];
         self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
+        if self.krylov {
+            self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
+            self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
+            self.response.clear();
+            self.receptance.clear();
+            self.schur = Mat::zeros(0, 0);
+        } else {
+            let req = StackReq::any_of(&[
+                dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
+                dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
+            ]);
+            self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the condensed LU workspace",
+            })?;
+            self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
+            self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
+            self.work_b = Mat::zeros(nc, 1);
+            self.schur = Mat::zeros(nc, nc);
+            self.perm = vec![0; nc];
+            self.perm_inv = vec![0; nc];
+        }
         self.dynamic = Some((lin.clone(), dynamic));
         Ok(())
     }
