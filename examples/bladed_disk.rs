@@ -19,7 +19,7 @@
 
 use std::path::PathBuf;
 
-use semismooth_problems::import::{matrix_market_text, vector_market_text};
+use semismooth_problems::import::model_matrix_files;
 use semismooth_problems::structures::{BladedDisk, SHIPPED_MISTUNING};
 
 fn main() {
@@ -39,11 +39,7 @@ fn main() {
         mistuning: SHIPPED_MISTUNING,
     }
     .matrices();
-    for (name, text) in [
-        ("K.mtx", matrix_market_text(&k)),
-        ("M.mtx", matrix_market_text(&m)),
-        ("f.mtx", vector_market_text(&f)),
-    ] {
+    for (name, text) in model_matrix_files(&k, &m, &f) {
         let path = dir.join(name);
         std::fs::write(&path, text).expect("writable output");
         eprintln!("wrote {}", path.display());

@@ -116,6 +116,16 @@ pub enum LinearSolverChoice {
 }
 
 impl LinearSolverChoice {
+    /// The scene's name of the choice (`linear_solver = "..."`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Structured => "structured",
+            Self::CondensedDense => "condensed-dense",
+            Self::CondensedKrylov => "condensed-krylov",
+            Self::Dense => "dense",
+        }
+    }
+
     /// The condensed solve of the structured choices (`None` for the dense full LU).
     pub fn condensed(self) -> Option<crate::hb::CondensedSolve> {
         use crate::hb::CondensedSolve;
