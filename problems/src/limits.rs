@@ -9,7 +9,7 @@
 //! | method | estimate (bytes) | measured |
 //! |---|---|---|
 //! | HB, structured solver, dense condensed system | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
-//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 1000 m S` | see `examples/contact_scaling.rs` |
+//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 3300 m S` (GMRES basis of up to 201 vectors) | see `examples/contact_scaling.rs` |
 //! | HB, dense solver | `10 n^2` more, `n = (N + m) S` (SSN-HB) or `N S` (penalty) | 156 MB at N = 100, H = 20 (n = 4141); 570 MB at N = 200 (n = 8241) |
 //! | periodic LCP | `24 (m Nt)^2 + 1000 N` | 71 MB (Lemke), 48 MB (Newton) at Nt = 2048, m = 1 |
 //! | time marching | `1000 N` | 12 MB at N = 10^4 |
@@ -62,7 +62,7 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                     bytes: rod
                         + 600.0 * n * s
                         + 8.0 * (2.0 * s * nt + 3.0 * m * s * s)
-                        + 1000.0 * m * s,
+                        + 3300.0 * m * s,
                     what: format!(
                         "per-harmonic factorizations of {elements} dofs x {} harmonic functions \
                          (matrix-free condensed system of {:.0} unknowns)",
@@ -274,9 +274,9 @@ mod tests {
             );
         }
         // The matrix-free condensed path (SSN-HB, 1,000 contacts on the 10,002-dof disk of
-        // examples/contact_scaling.rs, H = 20): VmHWM 183 MB.
+        // examples/contact_scaling.rs, H = 20): VmHWM 200 MB.
         let krylov = run_memory(10_002, 1000, &settings(Method::SsnHb, 20, false)).bytes;
-        assert!((183e6..3.0 * 183e6).contains(&krylov), "{krylov:e}");
+        assert!((200e6..3.0 * 200e6).contains(&krylov), "{krylov:e}");
         let mut lcp = settings(Method::LcpLemke, 5, false);
         lcp.time_samples = 2048;
         let e = run_memory(20, 1, &lcp).bytes;

@@ -8,8 +8,9 @@
 //! which Givens rotations keep available at every step without forming `x`. With right
 //! preconditioning the monitored residual is the residual of the original system, so the
 //! stopping test is on `|b - A x|`, not on a preconditioned norm. After `k` steps the
-//! method restarts from the current `x` (memory `2 (k + 1) n` numbers: the basis and the
-//! preconditioned basis vectors, so that the preconditioner is applied once per step).
+//! method restarts from the current `x` (memory at most `2 (k + 1) n` numbers: the basis
+//! and the preconditioned basis vectors, so that the preconditioner is applied once per
+//! step; they are allocated as the steps reach them and kept for the next solve).
 //!
 //! The stopping test is `|b - A x| <= max(relative |b|, absolute)`; after each restart the
 //! residual is recomputed from `A x` (not the recurrence) and the test repeated on it.
@@ -101,9 +102,12 @@ impl Gmres {
         Self::default()
     }
 
+    /// Sizes the small arrays and the first basis vector; the other basis vectors are
+    /// added as the iteration reaches them (memory follows the steps actually taken).
     fn size(&mut self, n: usize, restart: usize) {
-        self.basis.resize((restart + 1) * n, 0.0);
-        self.preconditioned.resize(restart * n, 0.0);
+        if self.basis.len() < n {
+            self.basis.resize(n, 0.0);
+        }
         self.hessenberg.resize((restart + 1) * restart, 0.0);
         self.rotations.resize(restart, (1.0, 0.0));
         self.g.resize(restart + 1, 0.0);
@@ -167,6 +171,12 @@ impl Gmres {
             let mut steps = 0;
             while steps < restart && iterations < options.max_iterations {
                 let j = steps;
+                if self.basis.len() < (j + 2) * n {
+                    self.basis.resize((j + 2) * n, 0.0);
+                }
+                if self.preconditioned.len() < (j + 1) * n {
+                    self.preconditioned.resize((j + 1) * n, 0.0);
+                }
                 let (done, next) = self.basis.split_at_mut((j + 1) * n);
                 let vj = &done[j * n..];
                 let zj = &mut self.preconditioned[j * n..(j + 1) * n];
