@@ -1,6 +1,7 @@
 //! Writes a structure with many contacts: a mistuned bladed disk whose blade tips rub a
 //! casing, as Matrix Market files for a `[model]` scene (`problems/scenes/blades/` and
-//! `problems/scenes/bladed_disk_casing.toml` are its output for 100 blades).
+//! `problems/scenes/bladed_disk_casing.toml` are its output for 100 blades). The disk is
+//! `semismooth_problems::structures::BladedDisk` with the shipped mistuning:
 //!
 //! `B` sectors in a ring; sector `j` has a disk dof `d_j` (dof `3j + 1`, 1-based) and a blade
 //! tip dof `b_j` (dof `3j + 2`), both of unit mass, and a massless contact pad `p_j` (dof
@@ -18,42 +19,8 @@
 
 use std::path::PathBuf;
 
-use semismooth::faer::sparse::Triplet;
-use semismooth_problems::import::{matrix_market_text, vector_market_text};
-use semismooth_problems::model::SparseMatrix;
-
-/// Stiffness, mass and load of a `blades`-sector disk (`3 blades` dofs).
-fn bladed_disk(blades: usize) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
-    let n = 3 * blades;
-    let (k_g, k_d, k_b, k_c) = (1.0, 1.0, 1.0, 10.0);
-    let mut k = Vec::new();
-    let mut spring = |i: usize, j: Option<usize>, s: f64| {
-        k.push(Triplet::new(i, i, s));
-        if let Some(j) = j {
-            k.push(Triplet::new(j, j, s));
-            k.push(Triplet::new(i, j, -s));
-            k.push(Triplet::new(j, i, -s));
-        }
-    };
-    for j in 0..blades {
-        let (d, b, p) = (3 * j, 3 * j + 1, 3 * j + 2);
-        spring(d, None, k_g);
-        if blades > 1 {
-            spring(d, Some(3 * ((j + 1) % blades)), k_d);
-        }
-        let delta = 0.02 * (2.3 * j as f64).sin();
-        spring(d, Some(b), k_b * (1.0 + delta));
-        spring(b, Some(p), k_c);
-    }
-    let m: Vec<Triplet<usize, usize, f64>> = (0..n)
-        .filter(|i| i % 3 != 2)
-        .map(|i| Triplet::new(i, i, 1.0))
-        .collect();
-    let k = SparseMatrix::try_new_from_triplets(n, n, &k).expect("valid triplets");
-    let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("valid triplets");
-    let f = (0..n).map(|i| if i % 3 == 1 { 1.0 } else { 0.0 }).collect();
-    (k, m, f)
-}
+use semismooth_problems::import::model_matrix_files;
+use semismooth_problems::structures::{BladedDisk, SHIPPED_MISTUNING};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -67,12 +34,12 @@ fn main() {
             .unwrap_or_else(|| "problems/scenes/blades".into()),
     );
     std::fs::create_dir_all(&dir).expect("output directory");
-    let (k, m, f) = bladed_disk(blades);
-    for (name, text) in [
-        ("K.mtx", matrix_market_text(&k)),
-        ("M.mtx", matrix_market_text(&m)),
-        ("f.mtx", vector_market_text(&f)),
-    ] {
+    let (k, m, f) = BladedDisk {
+        blades,
+        mistuning: SHIPPED_MISTUNING,
+    }
+    .matrices();
+    for (name, text) in model_matrix_files(&k, &m, &f) {
         let path = dir.join(name);
         std::fs::write(&path, text).expect("writable output");
         eprintln!("wrote {}", path.display());

@@ -2,14 +2,12 @@
 //! (300 dofs, a stop on each of 100 blade tip pads), and its tuned twin, whose cyclic
 //! symmetry makes every blade answer exactly as one sector with one contact.
 
-use semismooth::faer::sparse::Triplet;
 use semismooth_problems::import::build_imported;
-use semismooth_problems::model::{
-    ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure,
-};
+use semismooth_problems::model::{ContactPoint, HarmonicForcing, StructuralModel, Structure};
 use semismooth_problems::rod::natural_frequencies;
 use semismooth_problems::runner::solve_rod;
 use semismooth_problems::scene::Scene;
+use semismooth_problems::structures::BladedDisk;
 
 mod common;
 
@@ -64,50 +62,28 @@ fn a_hundred_contacts_converge_and_the_linear_limit_is_exact() {
     assert!(diff < 1e-9 * z.norm(), "{diff:e}");
 }
 
-/// The tuned disk of `examples/bladed_disk.rs` (no mistuning) with `blades` sectors and a
-/// stop of gap `gap` on every pad, at the forcing frequency `omega`.
+/// The tuned disk of `semismooth_problems::structures` (no mistuning) with `blades` sectors
+/// and a stop of gap `gap` on every pad, at the forcing frequency `omega`; the load is 0.02
+/// on every blade tip, the damping `beta K` with `beta = 2 zeta / omega_1` of one sector
+/// (`zeta = 0.01`), the same for every disk size.
 fn tuned(blades: usize, gap: f64, omega: f64) -> StructuralModel {
-    let n = 3 * blades;
-    let mut k = Vec::new();
-    let mut spring = |i: usize, j: Option<usize>, s: f64| {
-        k.push(Triplet::new(i, i, s));
-        if let Some(j) = j {
-            k.push(Triplet::new(j, j, s));
-            k.push(Triplet::new(i, j, -s));
-            k.push(Triplet::new(j, i, -s));
-        }
-    };
-    for j in 0..blades {
-        let (d, b, p) = (3 * j, 3 * j + 1, 3 * j + 2);
-        spring(d, None, 1.0);
-        if blades > 1 {
-            spring(d, Some(3 * ((j + 1) % blades)), 1.0);
-        }
-        spring(d, Some(b), 1.0);
-        spring(b, Some(p), 10.0);
+    let (stiffness, mass, shape) = BladedDisk {
+        blades,
+        mistuning: 0.0,
     }
-    let m: Vec<_> = (0..n)
-        .filter(|i| i % 3 != 2)
-        .map(|i| Triplet::new(i, i, 1.0))
-        .collect();
-    let stiffness = SparseMatrix::try_new_from_triplets(n, n, &k).unwrap();
-    let mass = SparseMatrix::try_new_from_triplets(n, n, &m).unwrap();
-    let damping = Some(SparseMatrix::try_new_from_triplets(n, n, &k).unwrap());
+    .matrices();
     let mut model = StructuralModel {
         mass,
-        damping,
+        damping: Some(stiffness.clone()),
         stiffness,
         forcing: HarmonicForcing {
-            amplitude: (0..n)
-                .map(|i| if i % 3 == 1 { 0.02 } else { 0.0 })
-                .collect(),
+            amplitude: shape.iter().map(|f| 0.02 * f).collect(),
             omega,
         },
         contacts: (0..blades)
-            .map(|j| ContactPoint::new(3 * j + 2, gap))
+            .map(|j| ContactPoint::new(BladedDisk::pad(j), gap))
             .collect(),
     };
-    // D = beta K with beta = 2 zeta / omega_1 of one sector (zeta = 0.01).
     let omega_1 = natural_frequencies(&model, 1).unwrap()[0];
     let beta = 2.0 * 0.01 / omega_1;
     if let Some(d) = model.damping.as_mut() {
@@ -159,4 +135,18 @@ fn a_tuned_disk_with_a_hundred_contacts_answers_as_one_sector_with_one_contact()
         let d = common::max_abs_diff(f, &a.contact_forces[0]);
         assert!(d < 1e-10, "{d:e}");
     }
+}
+
+#[test]
+fn a_model_scene_is_estimated_from_its_imported_size_and_contacts() {
+    use semismooth_problems::limits::{rod_scene_memory, run_memory, structure_memory};
+    let (scene, s) = shipped(|t| t);
+    // A [model] scene has no rod to estimate before its files are read.
+    assert!(rod_scene_memory(&scene, false).is_none());
+    let need = structure_memory(&s, &scene.solver, false);
+    assert_eq!(need, run_memory(300, 100, &scene.solver));
+    // The placeholder rod (one contact) would have been estimated at far less: the dense
+    // condensed system of 100 x 11 unknowns is the difference.
+    let placeholder = run_memory(scene.rod.elements, 1, &scene.solver);
+    assert!(need.bytes > placeholder.bytes + 8.0 * 1100.0 * 1100.0);
 }

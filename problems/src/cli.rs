@@ -66,14 +66,24 @@ pub fn load(path: &Path) -> Result<(Scene, Structure), CliError> {
 /// [`load`], with the memory of `ssn compare`'s runs when `compare`.
 fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
-    let need = crate::limits::scene_memory(&scene, compare);
-    crate::limits::check(&need, crate::limits::memory_limit()).map_err(|e| input_error(path, e))?;
-    let work = crate::limits::scene_work(&scene, compare);
-    crate::limits::check_work(&work, crate::limits::work_limit())
-        .map_err(|e| input_error(path, e))?;
+    let limit = crate::limits::memory_limit();
+    // A rod is estimated before it is built; an imported model once its size is read.
+    if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
+        crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+    }
+    if scene.model.is_none() {
+        let work = crate::limits::scene_work(&scene, compare);
+        crate::limits::check_work(&work, crate::limits::work_limit())
+            .map_err(|e| input_error(path, e))?;
+    }
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
-        Some(spec) => build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?,
+        Some(spec) => {
+            let structure = build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?;
+            let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
+            crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+            structure
+        }
         None => {
             let mut rod = build_rod(&scene.rod)
                 .map_err(|e| input_error(path, e))?

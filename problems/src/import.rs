@@ -569,6 +569,20 @@ pub fn vector_market_text(v: &[f64]) -> String {
     nalgebra_sparse::io::save_to_matrix_market_str(&coo)
 }
 
+/// The Matrix Market files of a structure built in code for a `[model]` scene: `K.mtx`,
+/// `M.mtx` and the load shape `f.mtx`, as `(file name, text)`.
+pub fn model_matrix_files(
+    stiffness: &SparseMatrix,
+    mass: &SparseMatrix,
+    load: &[f64],
+) -> [(&'static str, String); 3] {
+    [
+        ("K.mtx", matrix_market_text(stiffness)),
+        ("M.mtx", matrix_market_text(mass)),
+        ("f.mtx", vector_market_text(load)),
+    ]
+}
+
 /// Name of the scene file [`export_files`] writes.
 pub const EXPORTED_SCENE: &str = "scene.toml";
 
@@ -633,7 +647,7 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     let _ = writeln!(
         t,
         "linear_solver = \"{}\"\nmax_iterations = {}\nglobalization = \"{}\"\ntolerance = {:?}",
-        lower(format!("{:?}", v.linear_solver)),
+        v.linear_solver.name(),
         v.max_iterations,
         lower(format!("{:?}", v.globalization)),
         v.tolerance

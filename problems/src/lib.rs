@@ -25,5 +25,6 @@ pub mod scene;
 pub mod solutions;
 pub mod stability;
 pub mod state;
+pub mod structures;
 pub mod study;
 pub mod sweep;

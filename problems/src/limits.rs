@@ -8,18 +8,21 @@
 //!
 //! | method | estimate (bytes) | measured |
 //! |---|---|---|
-//! | HB, structured solver | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
+//! | HB, structured solver, dense condensed system | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
+//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 3300 m S` (GMRES basis of up to 201 vectors) | see `examples/contact_scaling.rs` |
 //! | HB, dense solver | `10 n^2` more, `n = (N + m) S` (SSN-HB) or `N S` (penalty) | 156 MB at N = 100, H = 20 (n = 4141); 570 MB at N = 200 (n = 8241) |
 //! | periodic LCP | `24 (m Nt)^2 + 1000 N` | 71 MB (Lemke), 48 MB (Newton) at Nt = 2048, m = 1 |
 //! | time marching | `1000 N` | 12 MB at N = 10^4 |
 //!
-//! plus `400 N` for the rod itself. The limit is the memory available to new processes
+//! plus `400 N` for the rod itself (`N` the dofs of an imported `[model]`, whose size is
+//! known once its files are read: [`structure_memory`]). The limit is the memory available to new processes
 //! (`MemAvailable` of `/proc/meminfo`), or the number of bytes in the environment variable
 //! `SSN_MEMORY_LIMIT` when it is set; where neither is known nothing is refused.
 //!
 //! A run that fits in memory can still take hours: [`run_work`] estimates the operations of
 //! its dense factorizations, refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
 
+use crate::model::Structure;
 use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
 
 /// What a run needs, in words and bytes.
@@ -49,8 +52,31 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
             let nt = settings.time_samples as f64;
             let aft = 8.0 * (2.0 * s * nt + 3.0 * m * s * s + 2.0 * (m * s).powi(2));
             let structured = 300.0 * n * s + aft + 16.0 * (h + 1.0) * n * m;
+            let condensed = settings.linear_solver.condensed();
+            let krylov = condensed.is_some_and(|c| {
+                c.uses_krylov(
+                    contacts,
+                    settings.harmonics,
+                    settings.method == Method::SsnHb,
+                )
+            });
             match settings.linear_solver {
-                LinearSolverChoice::Structured => MemoryEstimate {
+                _ if krylov => MemoryEstimate {
+                    bytes: rod
+                        + 600.0 * n * s
+                        + 8.0 * (2.0 * s * nt + 3.0 * m * s * s)
+                        + 3300.0 * m * s,
+                    what: format!(
+                        "per-harmonic factorizations of {elements} dofs x {} harmonic functions \
+                         (matrix-free condensed system of {:.0} unknowns)",
+                        2 * settings.harmonics as u128 + 1,
+                        m * s
+                    ),
+                    keys: "rod.elements or the model's size, solver.harmonics",
+                },
+                LinearSolverChoice::Structured
+                | LinearSolverChoice::CondensedDense
+                | LinearSolverChoice::CondensedKrylov => MemoryEstimate {
                     bytes: rod + structured,
                     what: format!(
                         "per-harmonic factorizations of {elements} dofs x {} harmonic functions",
@@ -163,13 +189,38 @@ pub fn check(need: &MemoryEstimate, limit: Option<f64>) -> Result<(), String> {
     }
 }
 
-/// The estimate of the command run on `scene` (`compare` runs several settings).
-pub fn scene_memory(scene: &Scene, compare: bool) -> MemoryEstimate {
+/// The estimate of the command run on the rod of a `[rod]` scene (`compare` runs several
+/// settings), before the rod is built. `None` for a `[model]` scene, whose size is known
+/// only from its files: estimate it with [`structure_memory`] once imported.
+pub fn rod_scene_memory(scene: &Scene, compare: bool) -> Option<MemoryEstimate> {
+    if scene.model.is_some() {
+        return None;
+    }
     let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+    Some(size_memory(n, m, &scene.solver, compare))
+}
+
+/// The estimate of the command run with `settings` on a built structure (its dofs and
+/// contacts; `compare` runs several settings).
+pub fn structure_memory(
+    structure: &Structure,
+    settings: &SolverSettings,
+    compare: bool,
+) -> MemoryEstimate {
+    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+    size_memory(n, m, settings, compare)
+}
+
+fn size_memory(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+    compare: bool,
+) -> MemoryEstimate {
     if compare {
-        compare_memory(n, m, &scene.solver)
+        compare_memory(dofs, contacts, settings)
     } else {
-        run_memory(n, m, &scene.solver)
+        run_memory(dofs, contacts, settings)
     }
 }
 
@@ -329,6 +380,10 @@ mod tests {
                 "{elements} {method:?} H={h}: estimate {e:e} against {measured:e}"
             );
         }
+        // The matrix-free condensed path (SSN-HB, 1,000 contacts on the 10,002-dof disk of
+        // examples/contact_scaling.rs, H = 20): VmHWM 200 MB.
+        let krylov = run_memory(10_002, 1000, &settings(Method::SsnHb, 20, false)).bytes;
+        assert!((200e6..3.0 * 200e6).contains(&krylov), "{krylov:e}");
         let mut lcp = settings(Method::LcpLemke, 5, false);
         lcp.time_samples = 2048;
         let e = run_memory(20, 1, &lcp).bytes;
@@ -353,8 +408,10 @@ mod tests {
             check(&dense, None).is_ok(),
             "no limit known: nothing refused"
         );
+        // Hostile sizes give a large estimate (the matrix-free path: about 1e24 bytes), never
+        // an overflowed small one.
         let huge = run_memory(usize::MAX, usize::MAX, &settings(Method::SsnHb, 20, false));
-        assert!(check(&huge, Some(1e30)).is_err());
+        assert!(check(&huge, Some(1e20)).is_err());
     }
 
     #[test]

@@ -18,7 +18,8 @@ use semismooth::{GeneralizedJacobian, Residual};
 
 use crate::contacts::{contact_reports, ContactReport};
 use crate::hb::{
-    HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
+    CondensedSolve, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
+    StructuredHbSolver,
 };
 use crate::lcp::{
     ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -28,7 +29,7 @@ use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
 use crate::output::{period_statistics, PeriodStatistics};
 use crate::rod::ModelError;
-use crate::scene::{GlobalizationChoice, LinearSolverChoice, Method, SolverSettings};
+use crate::scene::{GlobalizationChoice, Method, SolverSettings};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
@@ -268,13 +269,23 @@ where
         .fold(0.0f64, |a, c| a.max(c.gap.abs()))
         .max(f64::MIN_POSITIVE);
     options.residual_floor = roundoff_floor(model, problem.dim(), gap_scale, extra_stiffness);
-    let report = match settings.linear_solver {
-        LinearSolverChoice::Structured => {
-            newton::solve(problem, &mut StructuredHbSolver::new(), x, &options)
+    let report = match settings.linear_solver.condensed() {
+        Some(condensed) => {
+            let mut solver = structured_solver(condensed, settings.tolerance);
+            newton::solve(problem, &mut solver, x, &options)
         }
-        LinearSolverChoice::Dense => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
+        None => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
     };
     Ok(report.or_else(NewtonError::into_report)?)
+}
+
+/// The structured solver of a Newton run with absolute tolerance `tolerance`: a
+/// matrix-free condensed solve stops at `tolerance / 100` (or `1e-10` relative), so that a
+/// step on the right piece leaves a residual well below the Newton tolerance.
+pub fn structured_solver(condensed: CondensedSolve, tolerance: f64) -> StructuredHbSolver {
+    StructuredHbSolver::new()
+        .with_condensed_solve(condensed)
+        .with_krylov_tolerance(0.01 * tolerance)
 }
 
 /// Round-off level of a harmonic-balance residual: one ulp of the largest force term,

@@ -11,17 +11,23 @@
 //! | [`NalgebraLu`] | any [`DenseAssemble`] | matrix reused; nalgebra allocates its permutation and the U copy for the pivot check |
 //! | [`FaerSparseLu`] | `faer::sparse::SparseColMat<usize, f64>` | column ordering once per pattern, factor storage reused |
 //!
+//! For systems too large to factor, [`Gmres`] solves `A x = b` matrix-free from products
+//! with `A` and a preconditioner ([`KrylovOperator`]); a problem's structured solver can
+//! use it inside its own [`LinearSolve`](crate::LinearSolve).
+//!
 //! Every solver implements [`Factorize<J>`](crate::Factorize) for the Jacobian types it
 //! can factor (the dense ones for every [`DenseAssemble`] type) and the single
 //! [`LinearSolve`](crate::LinearSolve) (the solves with the last factorization), so
 //! `lu.factor(&a)` and `lu.solve_in_place(&mut x)` need no annotation of the Jacobian type.
 
 mod dense;
+mod krylov;
 mod nalgebra_lu;
 mod scratch;
 mod sparse;
 
 pub use dense::{check_finite_dense, DenseAssemble, FaerDenseLu};
+pub use krylov::{Gmres, GmresOptions, GmresReport, KrylovOperator};
 pub use nalgebra_lu::NalgebraLu;
 pub use sparse::{diagonal_entry, FaerSparseLu};
 
@@ -71,6 +77,18 @@ pub enum LinearSolveError {
         /// What was being allocated.
         during: &'static str,
     },
+    /// An iterative solver did not reach its tolerance within its iteration budget.
+    #[error(
+        "iterative solve not converged: residual {residual:e} after {iterations} iterations, tolerance {tolerance:e}"
+    )]
+    NotConverged {
+        /// Iterations (operator products) done.
+        iterations: usize,
+        /// Residual norm `|b - A x|` reached.
+        residual: f64,
+        /// The tolerance it had to meet.
+        tolerance: f64,
+    },
     /// An index of the sparse backend overflowed (a pattern too large for its index type).
     #[error("index overflow while {during}")]
     IndexOverflow {
@@ -81,12 +99,14 @@ pub enum LinearSolveError {
 
 impl LinearSolveError {
     /// A short name of the kind of failure: `singular-jacobian` (a singular or
-    /// non-finite matrix), `out-of-memory`, `index-overflow`, `linear-solve-failed`.
+    /// non-finite matrix), `out-of-memory`, `index-overflow`, `krylov-not-converged` (an
+    /// iterative solve out of iterations), `linear-solve-failed`.
     pub fn kind(&self) -> &'static str {
         match self {
             Self::Singular { .. } | Self::NonFiniteEntry { .. } => "singular-jacobian",
             Self::OutOfMemory { .. } => "out-of-memory",
             Self::IndexOverflow { .. } => "index-overflow",
+            Self::NotConverged { .. } => "krylov-not-converged",
             Self::DimensionMismatch { .. } | Self::NotFactored => "linear-solve-failed",
         }
     }

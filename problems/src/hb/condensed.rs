@@ -8,7 +8,7 @@ use semismooth::{
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::ssn::{HbOptions, SsnHb};
-use super::structured::{condensed_matrix, StructuredHbSolver};
+use super::structured::{condensed_matrix, CondensedSolve, StructuredHbSolver};
 use super::{check_len, indicator, HbError, ResponseSummary};
 use crate::model::{mean_stiffness, StructuralModel};
 
@@ -59,7 +59,8 @@ impl CondensedSsnHb {
         let (m, size) = (full.contacts(), basis.basis_size());
         let mut this = Self {
             receptance: Vec::new(),
-            solver: StructuredHbSolver::new(),
+            // The receptance blocks are read here: the dense condensed path keeps them.
+            solver: StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense),
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],

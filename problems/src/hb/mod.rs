@@ -146,6 +146,7 @@ macro_rules! omega_parameter {
 
 mod condensed;
 mod jacobian;
+mod krylov;
 mod penalty;
 mod ssn;
 mod structured;
@@ -158,9 +159,10 @@ use crate::model::{sparse_mul_add, InvalidModel, SparseMatrix, StructuralModel};
 
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
+pub use krylov::KRYLOV_THRESHOLD;
 pub use penalty::{PenaltyHb, PenaltyHbOptions};
 pub use ssn::{HbOptions, SsnHb};
-pub use structured::StructuredHbSolver;
+pub use structured::{CondensedSolve, StructuredHbSolver, KRYLOV_RELATIVE_TOLERANCE};
 
 omega_parameter!(SsnHb, PenaltyHb);
 

@@ -14,6 +14,14 @@
 //! Penalty HB, `J = A + k_p G^T Q G`: `(I + k_p R Q) y = G A^{-1} r`, then
 //! `dU = A^{-1} (r - k_p G^T Q y)`. The dense Schur matrix (`m (2H + 1)` square) is
 //! refactored each Newton iteration; the sparse factors only when `w` or the model change.
+//!
+//! Large SSN-HB systems (more than [`KRYLOV_THRESHOLD`] condensed unknowns, or on request,
+//! [`CondensedSolve`]) are not formed: `(I - Q + c Q R) dLambda = b` is solved by
+//! restarted GMRES with the operator and preconditioner of [`super::krylov`], and
+//! `dU = A^{-1} (r_u + G^T dLambda)`. The step then satisfies `|J d - r| <= max(1e-10 |r|,
+//! tau)` with the absolute `tau` of [`StructuredHbSolver::with_krylov_tolerance`] (the
+//! `U` rows are solved exactly, so the full residual is the condensed one); a solve
+//! that does not reach it is [`LinearSolveError::NotConverged`].
 
 use std::sync::Arc;
 
@@ -21,15 +29,59 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solve};
 use faer::perm::PermRef;
 use faer::{c64, Conj, Mat, MatMut, Par};
-use semismooth::linalg::{check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use semismooth::linalg::{
+    check_pivots, Gmres, GmresOptions, LinearSolveError, DEFAULT_PIVOT_THRESHOLD,
+};
 use semismooth::{Factorize, LinearSolve};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
+use super::krylov::{CondensedOperator, ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::LinearData;
 use crate::dynamic::DynamicStiffness;
 
 /// Relative residual `|J x - b| / |b|` below which iterative refinement stops.
 const REFINEMENT_TARGET: f64 = 1e-14;
+
+/// Relative tolerance `|J d - r| <= KRYLOV_RELATIVE_TOLERANCE |r|` of a matrix-free solve
+/// (an inexact Newton forcing term small enough to keep the iteration counts of exact
+/// solves).
+pub const KRYLOV_RELATIVE_TOLERANCE: f64 = 1e-10;
+
+/// GMRES restart length and iteration budget of the matrix-free condensed solve. A restart
+/// of 60 stalled at a far-off iterate of cycling full steps (100 contacts, H = 5: residual
+/// 4.5e-4 after 1,200 iterations) where 200 converges; the basis grows only as far as a
+/// solve needs (at most `2 x 201 x 8 m (2H + 1)` bytes).
+const KRYLOV_RESTART: usize = 200;
+const KRYLOV_MAX_ITERATIONS: usize = 1200;
+
+/// How [`StructuredHbSolver`] solves the condensed SSN-HB system on the contact unknowns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CondensedSolve {
+    /// Dense LU up to [`KRYLOV_THRESHOLD`] condensed unknowns, GMRES above.
+    #[default]
+    Auto,
+    /// Always form and factor the dense condensed matrix.
+    Dense,
+    /// Always matrix-free GMRES (SSN-HB only; penalty HB stays dense).
+    Krylov,
+}
+
+impl CondensedSolve {
+    /// True when the system of `contacts` contacts and `harmonics` harmonics is solved
+    /// matrix-free (`complementarity`: SSN-HB, the only formulation with the Krylov path).
+    pub fn uses_krylov(self, contacts: usize, harmonics: usize, complementarity: bool) -> bool {
+        complementarity
+            && contacts > 0
+            && match self {
+                Self::Auto => {
+                    contacts.saturating_mul(harmonics.saturating_mul(2).saturating_add(1))
+                        > KRYLOV_THRESHOLD
+                }
+                Self::Dense => false,
+                Self::Krylov => true,
+            }
+    }
+}
 
 /// Structured [`LinearSolve`] for [`HbJacobian`] (SSN-HB and penalty HB): see the module
 /// documentation of this file for the algebra.
@@ -74,6 +126,16 @@ pub struct StructuredHbSolver {
     pivot_threshold: f64,
     dynamic_factorizations: u64,
     schur_factorizations: u64,
+    condensed: CondensedSolve,
+    /// The matrix-free path was chosen for the prepared model.
+    krylov: bool,
+    gmres: Gmres,
+    krylov_absolute_tolerance: f64,
+    krylov_iterations: u64,
+    /// `R_k,ii` at index `k m + i` (matrix-free path).
+    receptance_diagonal: Vec<c64>,
+    contact_blocks: ContactBlocks,
+    block_rhs: Mat<c64>,
 }
 
 impl std::fmt::Debug for StructuredHbSolver {
@@ -119,7 +181,41 @@ impl StructuredHbSolver {
             pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
             dynamic_factorizations: 0,
             schur_factorizations: 0,
+            condensed: CondensedSolve::Auto,
+            krylov: false,
+            gmres: Gmres::new(),
+            krylov_absolute_tolerance: 0.0,
+            krylov_iterations: 0,
+            receptance_diagonal: Vec::new(),
+            contact_blocks: ContactBlocks::default(),
+            block_rhs: Mat::zeros(0, 0),
         }
+    }
+
+    /// Chooses how the condensed system is solved (default [`CondensedSolve::Auto`]).
+    pub fn with_condensed_solve(mut self, condensed: CondensedSolve) -> Self {
+        self.condensed = condensed;
+        self.dynamic = None;
+        self
+    }
+
+    /// Absolute tolerance `tau` of the matrix-free solve: it stops when
+    /// `|J d - r| <= max(KRYLOV_RELATIVE_TOLERANCE |r|, tau)` (default 0). A Newton run
+    /// with absolute tolerance `t` on `|F|` passes `t / 100`: a full step on the right
+    /// piece then leaves `|F| <= t / 100`.
+    pub fn with_krylov_tolerance(mut self, tau: f64) -> Self {
+        self.krylov_absolute_tolerance = tau.max(0.0);
+        self
+    }
+
+    /// True when the prepared model's condensed system is solved matrix-free.
+    pub fn is_matrix_free(&self) -> bool {
+        self.krylov
+    }
+
+    /// GMRES iterations (operator products) of all matrix-free solves so far.
+    pub fn krylov_iterations(&self) -> u64 {
+        self.krylov_iterations
     }
 
     /// Sets the maximum number of iterative-refinement steps after each solve (default 1;
@@ -148,30 +244,34 @@ impl StructuredHbSolver {
 
     /// Sizes every workspace for the model of `lin` (once per model: nothing here depends
     /// on the frequency).
-    fn prepare(&mut self, lin: &Arc<LinearData>) -> Result<(), LinearSolveError> {
+    fn prepare(
+        &mut self,
+        lin: &Arc<LinearData>,
+        coupling: ContactCoupling,
+    ) -> Result<(), LinearSolveError> {
         if matches!(&self.dynamic, Some((l, _)) if Arc::ptr_eq(l, lin)) {
             return Ok(());
         }
         self.dynamic = None;
         let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
+        let complementarity = matches!(coupling, ContactCoupling::Complementarity { .. });
+        self.krylov = self.condensed.uses_krylov(m, h, complementarity);
+        let size = 2 * h + 1;
+        let nc = m * size;
+        // Right-hand sides solved at once: a block of contacts for the receptance diagonal
+        // (matrix-free) or every contact's column of the response (dense).
+        let columns = if self.krylov {
+            RECEPTANCE_BLOCK
+        } else {
+            m.max(1)
+        };
         let dynamic = DynamicStiffness::new(
             &lin.stiffness,
             &lin.mass,
             lin.damping.as_ref(),
             h + 1,
-            m.max(1),
+            columns,
         )?;
-        let size = 2 * h + 1;
-        let nc = m * size;
-        let req = StackReq::any_of(&[
-            dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
-            dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
-        ]);
-        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-            during: "allocating the condensed LU workspace",
-        })?;
-        self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
-        self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
         self.complex_rhs = Mat::zeros(n, 1);
         self.work_u = vec![0.0; n * size];
         self.work_a = vec![0.0; nc];
@@ -179,12 +279,29 @@ impl StructuredHbSolver {
         self.work_d = vec![0.0; nc];
         self.work_rhs = Vec::with_capacity(n * size + nc);
         self.work_res = Vec::with_capacity(n * size + nc);
-        self.work_b = Mat::zeros(nc, 1);
-        self.schur = Mat::zeros(nc, nc);
-        self.perm = vec![0; nc];
-        self.perm_inv = vec![0; nc];
-        self.column_scale = vec![1.0; nc];
         self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
+        if self.krylov {
+            self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
+            self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
+            self.response.clear();
+            self.receptance.clear();
+            self.schur = Mat::zeros(0, 0);
+        } else {
+            let req = StackReq::any_of(&[
+                dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
+                dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
+            ]);
+            self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the condensed LU workspace",
+            })?;
+            self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
+            self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
+            self.work_b = Mat::zeros(nc, 1);
+            self.schur = Mat::zeros(nc, nc);
+            self.perm = vec![0; nc];
+            self.perm_inv = vec![0; nc];
+            self.column_scale = vec![1.0; nc];
+        }
         self.dynamic = Some((lin.clone(), dynamic));
         Ok(())
     }
@@ -193,7 +310,7 @@ impl StructuredHbSolver {
     /// `Z_k^{-1} G^T` and receptances `G Z_k^{-1} G^T` (no allocation once prepared).
     fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
         let lin = jac.linear.clone();
-        self.prepare(&lin)?;
+        self.prepare(&lin, jac.coupling)?;
         let Some((_, dynamic)) = &mut self.dynamic else {
             return Err(LinearSolveError::NotFactored);
         };
@@ -219,6 +336,26 @@ impl StructuredHbSolver {
                     },
                     other => other,
                 })?;
+            if self.krylov {
+                // R_k,ii only, a block of contacts at a time.
+                let width = self.block_rhs.ncols();
+                for first in (0..lin.contacts()).step_by(width.max(1)) {
+                    let count = width.min(lin.contacts() - first);
+                    let mut z = self.block_rhs.as_mut().subcols_mut(0, count);
+                    z.fill(c64::new(0.0, 0.0));
+                    for j in 0..count {
+                        let i = first + j;
+                        z[(lin.contact_dofs[i], j)] = c64::new(lin.contact_signs[i], 0.0);
+                    }
+                    dynamic.solve_in_place(k, z.as_mut())?;
+                    for j in 0..count {
+                        let i = first + j;
+                        self.receptance_diagonal[k * lin.contacts() + i] =
+                            z[(lin.contact_dofs[i], j)] * lin.contact_signs[i];
+                    }
+                }
+                continue;
+            }
             let z = &mut self.response[k];
             z.fill(c64::new(0.0, 0.0));
             // Columns of G^T: s_i on dof_i (two contacts may share a dof).
@@ -300,19 +437,46 @@ impl StructuredHbSolver {
             }
         }
     }
+}
 
-    /// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
-    fn apply_coupling(q: &[Mat<f64>], m: usize, p: &[f64], out: &mut [f64]) {
-        for (i, qi) in q.iter().enumerate() {
-            // Column by column (contiguous), each sum still accumulated in the order of l.
-            for o in out[i..].iter_mut().step_by(m) {
-                *o = 0.0;
+/// `out = G u`: the contact displacements' coefficients (index `j m + i`) of the full
+/// coefficients `u` (index `j N + dof`).
+fn gather_contacts(lin: &LinearData, u: &[f64], out: &mut [f64]) {
+    let (n, m) = (lin.dofs, lin.contacts());
+    for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+        let s = lin.contact_signs[i];
+        for (j, o) in out[i..].iter_mut().step_by(m).enumerate() {
+            *o = s * u[j * n + dof];
+        }
+    }
+}
+
+/// `Ok` unless the solved step holds a non-finite entry.
+fn finite_step(step: &[f64]) -> Result<(), LinearSolveError> {
+    match step.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(LinearSolveError::NonFiniteEntry {
+            row: 0,
+            col: 0,
+            value,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
+pub(crate) fn apply_coupling(q: &[Mat<f64>], m: usize, p: &[f64], out: &mut [f64]) {
+    for (i, qi) in q.iter().enumerate() {
+        // Column by column (contiguous), each sum still accumulated in the order of l.
+        for o in out[i..].iter_mut().step_by(m) {
+            *o = 0.0;
+        }
+        for l in 0..qi.ncols() {
+            let pl = p[l * m + i];
+            if pl == 0.0 {
+                continue;
             }
-            for l in 0..qi.ncols() {
-                let pl = p[l * m + i];
-                for (o, v) in out[i..].iter_mut().step_by(m).zip(qi.col_as_slice(l)) {
-                    *o += v * pl;
-                }
+            for (o, v) in out[i..].iter_mut().step_by(m).zip(qi.col_as_slice(l)) {
+                *o += v * pl;
             }
         }
     }
@@ -341,6 +505,9 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
                     return Err(LinearSolveError::NonFiniteEntry { row, col, value });
                 }
             }
+        }
+        if self.krylov {
+            return self.factor_preconditioner();
         }
         condensed_matrix(
             &self.receptance,
@@ -403,6 +570,10 @@ impl LinearSolve for StructuredHbSolver {
         self.work_rhs.clear();
         self.work_rhs.extend_from_slice(rhs);
         self.solve_once(rhs)?;
+        if self.krylov {
+            // The matrix-free solve meets its own residual tolerance.
+            return Ok(());
+        }
         // Iterative refinement with the exact structured operator: the condensation
         // subtracts large terms when A(w) is ill-conditioned (near resonance, stiff
         // penalties); a correction step restores dense-LU accuracy.
@@ -456,20 +627,18 @@ impl StructuredHbSolver {
                 found: rhs.len(),
             });
         }
+        if self.krylov {
+            return self.solve_matrix_free(&lin, rhs);
+        }
         let mut w = std::mem::take(&mut self.work_u);
         w.copy_from_slice(&rhs[..nu]);
         self.apply_dynamic_inverse(&mut w)?;
         // y = G w.
-        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-            let s = lin.contact_signs[i];
-            for j in 0..size {
-                self.work_a[j * m + i] = s * w[j * n + dof];
-            }
-        }
+        gather_contacts(&lin, &w[..n * size], &mut self.work_a);
         match self.coupling {
             ContactCoupling::Complementarity { c } => {
                 // b = r_lambda - c Q y.
-                Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
                 for r in 0..nc {
                     self.work_b[(r, 0)] = rhs[nu + r] - c * self.work_c[r];
                 }
@@ -491,20 +660,13 @@ impl StructuredHbSolver {
                     self.work_a[r] = self.work_b[(r, 0)];
                 }
                 // dU = w - k_p A^{-1} G^T Q y.
-                Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
                 self.add_response(&self.work_c, -stiffness, &mut w);
                 rhs.copy_from_slice(&w);
             }
         }
         self.work_u = w;
-        if let Some(&value) = rhs.iter().find(|v| !v.is_finite()) {
-            return Err(LinearSolveError::NonFiniteEntry {
-                row: 0,
-                col: 0,
-                value,
-            });
-        }
-        Ok(())
+        finite_step(rhs)
     }
 }
 
@@ -517,18 +679,13 @@ impl StructuredHbSolver {
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let nu = n * size;
         lin.apply_dynamic(omega, &x[..nu], &mut out[..nu]);
-        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-            let s = lin.contact_signs[i];
-            for j in 0..size {
-                self.work_a[j * m + i] = s * x[j * n + dof];
-            }
-        }
-        Self::apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        gather_contacts(&lin, &x[..n * size], &mut self.work_a);
+        apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
         match self.coupling {
             ContactCoupling::Complementarity { c } => {
                 let (out_u, out_l) = out.split_at_mut(nu);
                 let x_l = &x[nu..];
-                Self::apply_coupling(&self.q, m, x_l, &mut self.work_d);
+                apply_coupling(&self.q, m, x_l, &mut self.work_d);
                 for (i, &dof) in lin.contact_dofs.iter().enumerate() {
                     let s = lin.contact_signs[i];
                     for j in 0..size {
@@ -547,6 +704,88 @@ impl StructuredHbSolver {
                 }
             }
         }
+    }
+
+    /// The contact-block preconditioner of the matrix-free path at the iterate of the
+    /// copied `Q_i` ([`super::krylov`]).
+    fn factor_preconditioner(&mut self) -> Result<(), LinearSolveError> {
+        let ContactCoupling::Complementarity { c } = self.coupling else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        self.contact_blocks
+            .factor(&self.q, &self.receptance_diagonal, c)?;
+        self.schur_factorizations += 1;
+        self.schur_ready = true;
+        Ok(())
+    }
+
+    /// The SSN-HB step without the condensed matrix: `w = A^{-1} r_u`,
+    /// `(I - Q + c Q R) dLambda = r_lambda - c Q G w` by GMRES, `dU = A^{-1} (r_u + G^T
+    /// dLambda)`.
+    fn solve_matrix_free(
+        &mut self,
+        lin: &LinearData,
+        rhs: &mut [f64],
+    ) -> Result<(), LinearSolveError> {
+        let ContactCoupling::Complementarity { c } = self.coupling else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
+        let nu = n * size;
+        let rhs_norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut w = std::mem::take(&mut self.work_u);
+        w.copy_from_slice(&rhs[..nu]);
+        self.apply_dynamic_inverse(&mut w)?;
+        gather_contacts(lin, &w[..n * size], &mut self.work_a);
+        apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        for (r, b) in self.work_c.iter_mut().enumerate() {
+            *b = rhs[nu + r] - c * *b;
+        }
+        self.work_d.fill(0.0);
+        let options = GmresOptions {
+            relative_tolerance: 0.0,
+            absolute_tolerance: (KRYLOV_RELATIVE_TOLERANCE * rhs_norm)
+                .max(self.krylov_absolute_tolerance),
+            restart: KRYLOV_RESTART,
+            max_iterations: KRYLOV_MAX_ITERATIONS,
+        };
+        let Some((_, dynamic)) = &mut self.dynamic else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let mut operator = CondensedOperator {
+            dynamic,
+            lin,
+            q: &self.q,
+            c,
+            rhs: &mut self.complex_rhs,
+            work: &mut self.work_a,
+            blocks: &mut self.contact_blocks,
+        };
+        let solved = self
+            .gmres
+            .solve(&mut operator, &self.work_c, &mut self.work_d, &options);
+        self.krylov_iterations += match &solved {
+            Ok(report) => report.iterations as u64,
+            Err(LinearSolveError::NotConverged { iterations, .. }) => *iterations as u64,
+            Err(_) => 0,
+        };
+        if let Err(e) = solved {
+            self.work_u = w;
+            return Err(e);
+        }
+        // dU = A^{-1} (r_u + G^T dLambda).
+        w.copy_from_slice(&rhs[..nu]);
+        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            let s = lin.contact_signs[i];
+            for j in 0..size {
+                w[j * n + dof] += s * self.work_d[j * m + i];
+            }
+        }
+        self.apply_dynamic_inverse(&mut w)?;
+        rhs[..nu].copy_from_slice(&w);
+        rhs[nu..].copy_from_slice(&self.work_d);
+        self.work_u = w;
+        finite_step(rhs)
     }
 
     /// `work_b <- S^{-1} work_b` with the factored condensed matrix.

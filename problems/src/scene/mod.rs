@@ -27,6 +27,9 @@ use serde::Deserialize;
 use crate::import::{ContactDirection, DofContact, ModelSpec};
 use crate::rod::{DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec};
 
+mod linear_solver;
+pub use linear_solver::LinearSolverChoice;
+
 /// Why a scene could not be used. Every variant names the file; `Invalid` also names the
 /// key, the value found and what is allowed.
 #[derive(Debug, thiserror::Error)]
@@ -95,17 +98,6 @@ impl Method {
     pub fn is_harmonic_balance(self) -> bool {
         matches!(self, Method::SsnHb | Method::PenaltyHb)
     }
-}
-
-/// Linear solver for the Newton systems of the harmonic-balance methods.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum LinearSolverChoice {
-    /// Condensation onto the contact unknowns (per-harmonic sparse factorizations).
-    #[default]
-    Structured,
-    /// Dense LU of the full Jacobian (for checking; cubic in the model size).
-    Dense,
 }
 
 /// Globalization of the Newton iterations.

@@ -135,9 +135,9 @@ pub const PENALTY_MAX_FAILURES: usize = 3;
 
 /// The structured or dense linear solver of a harmonic-balance scene.
 fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
-    match choice {
-        LinearSolverChoice::Structured => Box::new(StructuredHbSolver::new()),
-        LinearSolverChoice::Dense => Box::new(FaerDenseLu::new()),
+    match choice.condensed() {
+        Some(condensed) => Box::new(StructuredHbSolver::new().with_condensed_solve(condensed)),
+        None => Box::new(FaerDenseLu::new()),
     }
 }
 
