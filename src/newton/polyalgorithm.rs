@@ -96,7 +96,7 @@ impl<J> NewtonSolver<J> {
                 max_iterations: max_iterations
                     .saturating_sub(used)
                     .clamp(1, full_steps.max(1)),
-                ..first
+                ..base
             };
             solver.phase(problem, linear, x, &rules, counters, log)
         };
@@ -109,45 +109,32 @@ impl<J> NewtonSolver<J> {
             .filter(|mu| mu.is_finite() && *mu > 0.0)
         {
             x.copy_from_slice(start);
-            let mut spent = 0;
-            let mut segment_mu0 = mu0;
-            let mut path_end = Vec::new();
-            for segment in 0..SMOOTHING_SEGMENTS {
-                let setup = SmoothingSetup {
-                    mu0: segment_mu0,
-                    state_scale: scale,
-                    tolerance,
-                    budget: max_iterations.saturating_sub(used),
-                    line_search,
-                };
-                let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
-                used += outcome.iterations;
-                spent += outcome.iterations;
-                strategy = Strategy::Smoothing;
-                if !(outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL) {
-                    attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
-                    break;
-                }
-                path_end.clear();
-                path_end.extend_from_slice(x);
+            let budget = max_iterations.saturating_sub(used);
+            let setup = SmoothingSetup {
+                mu0,
+                state_scale: scale,
+                tolerance,
+                budget,
+                line_search,
+            };
+            let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
+            used += outcome.iterations;
+            strategy = Strategy::Smoothing;
+            if outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL {
                 let (termination, run) = finish(self, problem, linear, x, used, counters, log);
                 used += run.iterations;
-                spent += run.iterations;
+                attempts.push(Attempt::new(
+                    Strategy::Smoothing,
+                    outcome.iterations + run.iterations,
+                    &termination,
+                ));
                 if termination.converged() {
-                    attempts.push(Attempt::new(Strategy::Smoothing, spent, &termination));
                     return (termination, Strategy::Smoothing, attempts, tolerance);
                 }
                 best.update(x, self.kernel.residual(), run.smallest);
-                // Newton on `F` did not finish from the end of the path: go on down the
-                // path from there (a smaller `mu` puts the end closer to a root of `F`).
-                let extend = outcome.reached && segment + 1 < SMOOTHING_SEGMENTS;
-                if !extend {
-                    attempts.push(Attempt::new(Strategy::Smoothing, spent, &termination));
-                    last = termination;
-                    break;
-                }
-                x.copy_from_slice(&path_end);
-                segment_mu0 *= 10f64.powf(-SMOOTHING_DECADES);
+                last = termination;
+            } else {
+                attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
             }
         }
 
@@ -325,9 +312,6 @@ struct SmoothingSetup {
 const SMOOTHING_START: f64 = 1.0;
 /// Decades of `mu` the smoothing path descends before Newton on `F` takes over.
 const SMOOTHING_DECADES: f64 = 3.0;
-/// Segments of `SMOOTHING_DECADES` the smoothing path may descend: after each, Newton on `F`
-/// tries to finish, and the path goes on from the segment's end when it does not.
-const SMOOTHING_SEGMENTS: usize = 3;
 /// Decades of `mu` after which a path that stops short hands over to Newton on `F` anyway.
 const SMOOTHING_PARTIAL: f64 = 2.0;
 /// Accuracy of the smoothing path's points relative to `|F_mu0|` at the start: the end of
