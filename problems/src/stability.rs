@@ -141,9 +141,12 @@ pub struct Stability {
     /// `|u* - u_HB| / |u_HB|` between the displacements of the periodic orbit of the map and
     /// of the harmonic-balance solution at `t = 0` (`None` when not computed).
     pub orbit_distance: Option<f64>,
-    /// Newton iterations on the period map.
+    /// Newton iterations on the period map (0 when no contact closes along the orbit: the
+    /// map is then affine and its monodromy is known without the orbit).
     pub shooting_iterations: usize,
-    /// The periodic orbit's state at `t = 0` (`None` when not computed).
+    /// The periodic orbit's state at `t = 0` (`None` when not computed); when no contact
+    /// closes along it, the harmonic-balance state (within the time-step error of the
+    /// map's orbit; `orbit_distance` is then `None`).
     pub orbit: Option<MarchState>,
 }
 
@@ -290,6 +293,25 @@ pub fn hb_stability(
         .chain(&start.velocity)
         .copied()
         .collect();
+    if orbit_stays_open(&at_omega, harmonics, u) {
+        // No contact closes along the orbit: the map is affine with the linear part of the
+        // open contacts, whatever the orbit; its monodromy needs no shooting.
+        let runs = vec![(Vec::new(), spp)];
+        let monodromy = monodromy(&mut marcher, &runs)?;
+        let reduced = Mat::from_fn(keep.len(), keep.len(), |i, j| monodromy[(keep[i], keep[j])]);
+        let multipliers = Multipliers::of(reduced.as_ref())?;
+        return Ok(Stability {
+            stable: Some(multipliers.is_stable()),
+            floquet_max_abs: Some(multipliers.max_abs()),
+            multipliers,
+            reason: None,
+            steps_per_period: spp,
+            contact_steps: 0,
+            orbit_distance: None,
+            shooting_iterations: 0,
+            orbit: Some(start),
+        });
+    }
     let mut x: Vec<f64> = keep.iter().map(|&i| full[i]).collect();
     let x_hb = x.clone();
     let mut shooting = Shooting {
@@ -376,6 +398,25 @@ pub fn hb_stability(
         orbit: Some(shooting.state(&x, at_omega.contact_count())),
     })
 }
+
+/// Whether every contact stays open along the harmonic-balance orbit with a margin: at each
+/// contact, `s u_0 + sum_k |(a_k, b_k)| <= g - OPEN_MARGIN (|g| + sum_k |(a_k, b_k)|)` (a bound
+/// of `s u(t)` over the period; `s` the contact's direction). The margin covers the distance
+/// between the harmonic-balance orbit and the map's own (the time-step error, about
+/// `(2 pi / n_s)^2` relative).
+fn orbit_stays_open(model: &StructuralModel, harmonics: usize, u: &[f64]) -> bool {
+    let n = model.dofs();
+    model.contacts.iter().all(|c| {
+        let amplitude: f64 = (1..=harmonics)
+            .map(|k| u[(2 * k - 1) * n + c.dof].hypot(u[2 * k * n + c.dof]))
+            .sum();
+        let highest = c.direction.sign() * u[c.dof] + amplitude;
+        highest <= c.gap - OPEN_MARGIN * (c.gap.abs() + amplitude)
+    })
+}
+
+/// Relative margin of [`orbit_stays_open`].
+const OPEN_MARGIN: f64 = 1e-3;
 
 /// `|F|` of the period map's Newton solve relative to the largest state entry.
 pub const SHOOTING_TOLERANCE: f64 = 1e-9;
