@@ -110,8 +110,10 @@ pub struct StructuredHbSolver {
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
-    /// Column scaling `s_j = 1 / max_i |S_ij|` of the condensed matrix, factored as `S diag(s)`.
+    /// Column scaling `s_j = 1 / max_i |S_ij|` of the condensed matrix, factored as
+    /// `S diag(s)` when `scaled` (only after the unscaled factorization failed its pivot test).
     column_scale: Vec<f64>,
+    scaled: bool,
     schur_ready: bool,
     complex_rhs: Mat<c64>,
     work_u: Vec<f64>,
@@ -167,6 +169,7 @@ impl StructuredHbSolver {
             perm: Vec::new(),
             perm_inv: Vec::new(),
             column_scale: Vec::new(),
+            scaled: false,
             schur_ready: false,
             complex_rhs: Mat::zeros(0, 0),
             work_u: Vec::new(),
@@ -509,55 +512,18 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         if self.krylov {
             return self.factor_preconditioner();
         }
-        condensed_matrix(
-            &self.receptance,
-            &self.q,
-            self.coupling,
-            m,
-            self.schur.as_mut(),
-        );
+        self.scaled = false;
         if nc > 0 {
-            // Equilibrate the columns: near an undamped resonance the receptance of one
-            // harmonic dwarfs the others, and the pivot test must compare pivots of
-            // columns of one scale (the solve undoes the scaling).
-            for (j, scale) in self.column_scale.iter_mut().enumerate() {
-                let largest = self
-                    .schur
-                    .col_as_slice(j)
-                    .iter()
-                    .fold(0.0_f64, |a, v| a.max(v.abs()));
-                *scale = if largest > 0.0 && largest.is_finite() {
-                    1.0 / largest
-                } else {
-                    1.0
-                };
-                for v in self.schur.col_as_slice_mut(j) {
-                    *v *= *scale;
-                }
+            let unscaled = self.factor_condensed(lin.dofs * size, m, false);
+            if matches!(unscaled, Err(LinearSolveError::Singular { .. })) {
+                // Near an undamped resonance the receptance of one harmonic dwarfs the
+                // others: the pivot test must compare pivots of columns of one scale.
+                // Equilibrate the columns and factor again (the solve undoes the scaling).
+                self.scaled = true;
+                self.factor_condensed(lin.dofs * size, m, true)?;
+            } else {
+                unscaled?;
             }
-            let stack = MemStack::new(&mut self.mem);
-            dense_lu::lu_in_place(
-                self.schur.as_mut(),
-                &mut self.perm,
-                &mut self.perm_inv,
-                Par::Seq,
-                stack,
-                Default::default(),
-            );
-            check_pivots((0..nc).map(|i| self.schur[(i, i)]), self.pivot_threshold).map_err(
-                |e| match e {
-                    LinearSolveError::Singular {
-                        index,
-                        pivot,
-                        max_pivot,
-                    } => LinearSolveError::Singular {
-                        index: lin.dofs * size + index,
-                        pivot,
-                        max_pivot,
-                    },
-                    other => other,
-                },
-            )?;
         }
         self.schur_factorizations += 1;
         self.schur_ready = true;
@@ -788,6 +754,64 @@ impl StructuredHbSolver {
         finite_step(rhs)
     }
 
+    /// Forms the condensed matrix `S` (with its columns scaled to unit largest entry when
+    /// `equilibrate`), factors it and checks its pivots (`offset`: the index of its first
+    /// unknown in the full system, for the error).
+    fn factor_condensed(
+        &mut self,
+        offset: usize,
+        m: usize,
+        equilibrate: bool,
+    ) -> Result<(), LinearSolveError> {
+        condensed_matrix(
+            &self.receptance,
+            &self.q,
+            self.coupling,
+            m,
+            self.schur.as_mut(),
+        );
+        if equilibrate {
+            for (j, scale) in self.column_scale.iter_mut().enumerate() {
+                let largest = self
+                    .schur
+                    .col_as_slice(j)
+                    .iter()
+                    .fold(0.0_f64, |a, v| a.max(v.abs()));
+                *scale = if largest > 0.0 && largest.is_finite() {
+                    1.0 / largest
+                } else {
+                    1.0
+                };
+                for v in self.schur.col_as_slice_mut(j) {
+                    *v *= *scale;
+                }
+            }
+        }
+        let nc = self.schur.nrows();
+        let stack = MemStack::new(&mut self.mem);
+        dense_lu::lu_in_place(
+            self.schur.as_mut(),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            stack,
+            Default::default(),
+        );
+        check_pivots((0..nc).map(|i| self.schur[(i, i)]), self.pivot_threshold).map_err(|e| match e
+        {
+            LinearSolveError::Singular {
+                index,
+                pivot,
+                max_pivot,
+            } => LinearSolveError::Singular {
+                index: offset + index,
+                pivot,
+                max_pivot,
+            },
+            other => other,
+        })
+    }
+
     /// `work_b <- S^{-1} work_b` with the factored condensed matrix.
     fn solve_schur(&mut self) {
         let nc = self.schur.nrows();
@@ -806,8 +830,10 @@ impl StructuredHbSolver {
             Par::Seq,
             stack,
         );
-        for (r, scale) in self.column_scale.iter().enumerate() {
-            self.work_b[(r, 0)] *= scale;
+        if self.scaled {
+            for (r, scale) in self.column_scale.iter().enumerate() {
+                self.work_b[(r, 0)] *= scale;
+            }
         }
     }
 }
