@@ -71,8 +71,7 @@ fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliErr
     if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
         crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
     }
-    if scene.model.is_none() {
-        let work = crate::limits::scene_work(&scene, compare);
+    if let Some(work) = crate::limits::rod_scene_work(&scene, compare) {
         crate::limits::check_work(&work, crate::limits::work_limit())
             .map_err(|e| input_error(path, e))?;
     }
@@ -82,6 +81,9 @@ fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliErr
             let structure = build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+            let work = crate::limits::structure_work(&structure, &scene.solver, compare);
+            crate::limits::check_work(&work, crate::limits::work_limit())
+                .map_err(|e| input_error(path, e))?;
             structure
         }
         None => {

@@ -269,7 +269,18 @@ pub const DEFAULT_WORK_LIMIT: f64 = 1e14;
 /// structured solver: `m S`), `S = 2H + 1`. The sparse per-harmonic factorizations, the
 /// FFTs, the LCP and time marching are not the danger here and count as 0.
 pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
-    let (n, m) = (elements as f64, contacts as f64);
+    size_work(elements, contacts, settings, "rod.elements")
+}
+
+/// [`run_work`] for a model of `dofs` dofs and `contacts` contacts whose size is set by the
+/// key `size_key`.
+fn size_work(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+    size_key: &'static str,
+) -> WorkEstimate {
+    let (n, m) = (dofs as f64, contacts as f64);
     let s = 2.0 * settings.harmonics as f64 + 1.0;
     let lu = |unknowns: f64| NEWTON_FACTORIZATIONS * 2.0 / 3.0 * unknowns.powi(3);
     match (settings.method, settings.linear_solver) {
@@ -286,18 +297,33 @@ pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> 
                      {unknowns:.0} unknowns (solver.linear_solver = \"dense\"; \"structured\" \
                      factors per harmonic)"
                 ),
-                keys: "solver.linear_solver, solver.harmonics, rod.elements",
+                keys: match size_key {
+                    "rod.elements" => "solver.linear_solver, solver.harmonics, rod.elements",
+                    _ => "solver.linear_solver, solver.harmonics, the model's size",
+                },
             }
         }
-        (Method::SsnHb, LinearSolverChoice::Structured) => WorkEstimate {
-            flops: lu(m * s),
-            what: format!(
-                "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
+        // Above the threshold the automatic choice solves the condensed system matrix-free.
+        (Method::SsnHb, LinearSolverChoice::Structured)
+            if contacts * (2 * settings.harmonics + 1) > crate::hb::KRYLOV_THRESHOLD =>
+        {
+            WorkEstimate {
+                flops: 0.0,
+                what: "no dense factorization (matrix-free condensed solve)".into(),
+                keys: "",
+            }
+        }
+        (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {
+            WorkEstimate {
+                flops: lu(m * s),
+                what: format!(
+                    "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
                  on {:.0} unknowns",
-                m * s
-            ),
-            keys: "solver.harmonics and the number of contacts",
-        },
+                    m * s
+                ),
+                keys: "solver.harmonics and the number of contacts",
+            }
+        }
         _ => WorkEstimate {
             flops: 0.0,
             what: "no dense factorization".into(),
@@ -332,16 +358,36 @@ pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
     }
 }
 
-/// The work estimate of the command run on `scene` (`compare`: its SSN-HB reference run at
-/// 320 harmonics, the largest).
-pub fn scene_work(scene: &Scene, compare: bool) -> WorkEstimate {
+/// The work estimate of the command run on a rod `scene` (`compare`: its SSN-HB reference
+/// run at 320 harmonics, the largest); `None` for a `[model]` scene, estimated once imported
+/// ([`structure_work`]).
+pub fn rod_scene_work(scene: &Scene, compare: bool) -> Option<WorkEstimate> {
+    if scene.model.is_some() {
+        return None;
+    }
     let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
-    let mut settings = scene.solver.clone();
+    Some(run_work(n, m, &compared(&scene.solver, compare)))
+}
+
+/// The work estimate of `settings` (or of the comparison's reference run) on an imported
+/// `structure`.
+pub fn structure_work(
+    structure: &Structure,
+    settings: &SolverSettings,
+    compare: bool,
+) -> WorkEstimate {
+    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+    size_work(n, m, &compared(settings, compare), "model")
+}
+
+/// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
+fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
+    let mut settings = settings.clone();
     if compare {
         settings.method = Method::SsnHb;
         settings.harmonics = crate::study::REFERENCE_HARMONICS;
     }
-    run_work(n, m, &settings)
+    settings
 }
 
 #[cfg(test)]
@@ -439,5 +485,22 @@ mod tests {
             check_work(&dense, 1e15).is_ok(),
             "a raised limit lets it run"
         );
+    }
+
+    #[test]
+    fn imported_models_are_estimated_by_their_size_and_the_matrix_free_path_by_none() {
+        // A model of 32,481 dofs with the dense solver at H = 1: (32481 + 1) x 3 unknowns,
+        // 10 x (2/3) n^3 = 6.2e14 operations, refused, naming the model's size.
+        let dense = size_work(32_481, 1, &settings(Method::SsnHb, 1, true), "model");
+        let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
+        assert!(e.contains("the model's size"), "{e}");
+        // 1,000 contacts at H = 20: 41,000 condensed unknowns, solved matrix-free (a dense
+        // estimate would be 4.6e14 and refuse a run that takes seconds).
+        let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "model");
+        assert_eq!(many.flops, 0.0, "{many:?}");
+        // At the threshold the condensed system is still factored dense.
+        let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "model");
+        let n: f64 = 40.0 * 41.0;
+        assert!((dense_condensed.flops - 10.0 * 2.0 / 3.0 * n.powi(3)).abs() <= 1e-9 * n.powi(3));
     }
 }
