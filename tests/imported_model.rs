@@ -167,19 +167,8 @@ fn a_small_imported_chain_matches_its_closed_form_and_massless_dofs_are_allowed(
     let wide = build_imported(scene.model.as_ref().unwrap()).unwrap();
     let sol = solve_rod(&wide, &scene.solver, None).unwrap();
     assert!(sol.converged);
-    let w = wide.model.forcing.omega;
-    let z = common::exact_linear(&wide.model, w)[2];
-    let exact: Vec<f64> = sol
-        .times
-        .iter()
-        .map(|t| z.re * (w * t).cos() - z.im * (w * t).sin())
-        .collect();
-    let diff = common::max_abs_diff(&sol.tip, &exact);
-    assert!(
-        diff < 1e-10 * z.norm(),
-        "{diff:e} against |z| = {}",
-        z.norm()
-    );
+    let (diff, z) = common::linear_history_error(&wide.model, 2, &sol);
+    assert!(diff < 1e-10 * z, "{diff:e} against |z| = {z}");
 }
 
 #[test]

@@ -269,16 +269,21 @@ pub const DEFAULT_WORK_LIMIT: f64 = 1e14;
 /// structured solver: `m S`), `S = 2H + 1`. The sparse per-harmonic factorizations, the
 /// FFTs, the LCP and time marching are not the danger here and count as 0.
 pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
-    size_work(elements, contacts, settings, "rod.elements")
+    size_work(
+        elements,
+        contacts,
+        settings,
+        "solver.linear_solver, solver.harmonics, rod.elements",
+    )
 }
 
-/// [`run_work`] for a model of `dofs` dofs and `contacts` contacts whose size is set by the
-/// key `size_key`.
+/// [`run_work`] for a model of `dofs` dofs and `contacts` contacts; `dense_keys`: the keys a
+/// refusal of the dense solver names.
 fn size_work(
     dofs: usize,
     contacts: usize,
     settings: &SolverSettings,
-    size_key: &'static str,
+    dense_keys: &'static str,
 ) -> WorkEstimate {
     let (n, m) = (dofs as f64, contacts as f64);
     let s = 2.0 * settings.harmonics as f64 + 1.0;
@@ -297,10 +302,7 @@ fn size_work(
                      {unknowns:.0} unknowns (solver.linear_solver = \"dense\"; \"structured\" \
                      factors per harmonic)"
                 ),
-                keys: match size_key {
-                    "rod.elements" => "solver.linear_solver, solver.harmonics, rod.elements",
-                    _ => "solver.linear_solver, solver.harmonics, the model's size",
-                },
+                keys: dense_keys,
             }
         }
         // Above the threshold the automatic choice solves the condensed system matrix-free.
@@ -377,7 +379,12 @@ pub fn structure_work(
     compare: bool,
 ) -> WorkEstimate {
     let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
-    size_work(n, m, &compared(settings, compare), "model")
+    size_work(
+        n,
+        m,
+        &compared(settings, compare),
+        "solver.linear_solver, solver.harmonics, the model's size",
+    )
 }
 
 /// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
@@ -491,15 +498,20 @@ mod tests {
     fn imported_models_are_estimated_by_their_size_and_the_matrix_free_path_by_none() {
         // A model of 32,481 dofs with the dense solver at H = 1: (32481 + 1) x 3 unknowns,
         // 10 x (2/3) n^3 = 6.2e14 operations, refused, naming the model's size.
-        let dense = size_work(32_481, 1, &settings(Method::SsnHb, 1, true), "model");
+        let dense = size_work(
+            32_481,
+            1,
+            &settings(Method::SsnHb, 1, true),
+            "the model's size",
+        );
         let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
         assert!(e.contains("the model's size"), "{e}");
         // 1,000 contacts at H = 20: 41,000 condensed unknowns, solved matrix-free (a dense
         // estimate would be 4.6e14 and refuse a run that takes seconds).
-        let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "model");
+        let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "");
         assert_eq!(many.flops, 0.0, "{many:?}");
         // At the threshold the condensed system is still factored dense.
-        let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "model");
+        let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "");
         let n: f64 = 40.0 * 41.0;
         assert!((dense_condensed.flops - 10.0 * 2.0 / 3.0 * n.powi(3)).abs() <= 1e-9 * n.powi(3));
     }

@@ -287,19 +287,11 @@ pub fn hb_stability(
     marcher.set_closed_contact_velocity_reset(true);
     let keep = influential(&marcher);
     let start = hb_state(&at_omega, harmonics, omega, u, 0.0)?;
-    let full: Vec<f64> = start
-        .displacement
-        .iter()
-        .chain(&start.velocity)
-        .copied()
-        .collect();
     if orbit_stays_open(&at_omega, harmonics, u) {
         // No contact closes along the orbit: the map is affine with the linear part of the
         // open contacts, whatever the orbit; its monodromy needs no shooting.
         let runs = vec![(Vec::new(), spp)];
-        let monodromy = monodromy(&mut marcher, &runs)?;
-        let reduced = Mat::from_fn(keep.len(), keep.len(), |i, j| monodromy[(keep[i], keep[j])]);
-        let multipliers = Multipliers::of(reduced.as_ref())?;
+        let multipliers = reduced_multipliers(&monodromy(&mut marcher, &runs)?, &keep)?;
         return Ok(Stability {
             stable: Some(multipliers.is_stable()),
             floquet_max_abs: Some(multipliers.max_abs()),
@@ -312,6 +304,12 @@ pub fn hb_stability(
             orbit: Some(start),
         });
     }
+    let full: Vec<f64> = start
+        .displacement
+        .iter()
+        .chain(&start.velocity)
+        .copied()
+        .collect();
     let mut x: Vec<f64> = keep.iter().map(|&i| full[i]).collect();
     let x_hb = x.clone();
     let mut shooting = Shooting {
@@ -355,10 +353,9 @@ pub fn hb_stability(
         }
     };
     shooting.period(&x)?;
-    let monodromy = monodromy(&mut shooting.marcher, &shooting.runs)?;
     let keep = &shooting.keep;
-    let reduced = Mat::from_fn(keep.len(), keep.len(), |i, j| monodromy[(keep[i], keep[j])]);
-    let multipliers = Multipliers::of(reduced.as_ref())?;
+    let multipliers =
+        reduced_multipliers(&monodromy(&mut shooting.marcher, &shooting.runs)?, keep)?;
     let n = at_omega.dofs();
     let displacements = |x: &[f64]| -> Vec<f64> {
         keep.iter()
@@ -397,6 +394,15 @@ pub fn hb_stability(
         shooting_iterations: report.iterations,
         orbit: Some(shooting.state(&x, at_omega.contact_count())),
     })
+}
+
+/// The multipliers of `monodromy` restricted to the influential components `keep`.
+fn reduced_multipliers(
+    monodromy: &Mat<f64>,
+    keep: &[usize],
+) -> Result<Multipliers, StabilityError> {
+    let reduced = Mat::from_fn(keep.len(), keep.len(), |i, j| monodromy[(keep[i], keep[j])]);
+    Ok(Multipliers::of(reduced.as_ref())?)
 }
 
 /// Whether every contact stays open along the harmonic-balance orbit with a margin: at each

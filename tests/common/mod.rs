@@ -168,6 +168,23 @@ pub fn max_abs(v: &[f64]) -> f64 {
 }
 
 /// Largest absolute difference of two slices, entry by entry.
+/// Largest gap between `solution`'s observed-dof history and the exact linear response
+/// `Re(z e^{i w t})` of its dof `dof` (no contact closing); returns `(gap, |z|)`.
+pub fn linear_history_error(
+    model: &StructuralModel,
+    dof: usize,
+    solution: &semismooth_problems::runner::Solution,
+) -> (f64, f64) {
+    let w = model.forcing.omega;
+    let z = exact_linear(model, w)[dof];
+    let exact: Vec<f64> = solution
+        .times
+        .iter()
+        .map(|t| z.re * (w * t).cos() - z.im * (w * t).sin())
+        .collect();
+    (max_abs_diff(&solution.tip, &exact), z.norm())
+}
+
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
