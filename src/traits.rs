@@ -188,6 +188,16 @@ pub trait ParameterDependent: Residual {
     /// Sets the parameter used by subsequent evaluations.
     fn set_parameter(&mut self, p: f64);
 
+    /// The scale of `|F|` that counts as small at the parameter `p`, relative to the
+    /// continuation's `corrector_tolerance` (which it multiplies). Default 1: one tolerance
+    /// along the whole branch. A path whose solutions sharpen as it goes (a smoothing
+    /// parameter `mu -> 0`, whose Newton basin shrinks like `mu`) returns a scale that
+    /// shrinks with them.
+    fn tolerance_scale(&self, p: f64) -> f64 {
+        let _ = p;
+        1.0
+    }
+
     /// Writes `∂F/∂p (x, p)` into `out`.
     ///
     /// The default is a central finite difference with step `1e-7 (1 + |p|)` (it allocates

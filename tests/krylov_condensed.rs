@@ -148,3 +148,67 @@ fn the_automatic_choice_follows_the_documented_threshold() {
     assert!(!CondensedSolve::Krylov.uses_krylov(1000, 20, false));
     assert!(!CondensedSolve::Dense.uses_krylov(1000, 20, true));
 }
+
+/// Contacts close together on a fine rod (every second node of its last fifth, gaps shaped
+/// like the first mode) are coupled through the structure far beyond the contact blocks:
+/// after the first full step from zero (the linear response, deep in the obstacles) GMRES
+/// with the blocks does not reach its tolerance within one restart cycle, and the
+/// matrix-free solver takes the dense condensed matrix of that iterate as its
+/// preconditioner. The step it returns is the dense LU's (the same bound as above), and the
+/// dense preconditioner is kept for the next iterate.
+#[test]
+fn strongly_coupled_contacts_switch_to_the_dense_preconditioner_and_keep_the_dense_step() {
+    use semismooth_problems::from_zero::many_contacts_rod;
+    use semismooth_problems::rod::build_rod;
+    let harmonics = 5;
+    let rod = build_rod(&many_contacts_rod(100)).unwrap();
+    let options = HbOptions {
+        harmonics,
+        time_samples: Some(default_hb_time_samples(harmonics)),
+        c: None,
+    };
+    let mut problem = SsnHb::new(&rod.model, &options).unwrap();
+    let n = problem.dim();
+    // x1 = -J(0)^-1 F(0): the first full step from zero.
+    let mut x = vec![0.0; n];
+    let mut f = vec![0.0; n];
+    let mut jac = problem.new_jacobian();
+    problem.residual(&x, &mut f).unwrap();
+    problem.jacobian(&x, &mut jac).unwrap();
+    let mut dense = structured_solver(CondensedSolve::Dense, 1e-10);
+    dense.factor(&jac).unwrap();
+    dense.solve_in_place(&mut f).unwrap();
+    for (xi, di) in x.iter_mut().zip(&f) {
+        *xi = -di;
+    }
+    problem.residual(&x, &mut f).unwrap();
+    problem.jacobian(&x, &mut jac).unwrap();
+    let mut exact = f.clone();
+    dense.factor(&jac).unwrap();
+    dense.solve_in_place(&mut exact).unwrap();
+    let mut krylov = structured_solver(CondensedSolve::Krylov, 1e-10);
+    krylov.factor(&jac).unwrap();
+    let mut step = f.clone();
+    krylov.solve_in_place(&mut step).unwrap();
+    eprintln!(
+        "GMRES iterations {}, dense preconditioner factorizations {}",
+        krylov.krylov_iterations(),
+        krylov.dense_preconditioner_factorizations()
+    );
+    assert_eq!(krylov.dense_preconditioner_factorizations(), 1);
+    let r_norm = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let scale = exact.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let bound = 100.0 * KRYLOV_RELATIVE_TOLERANCE * r_norm;
+    let diff = common::max_abs_diff(&step, &exact);
+    eprintln!("step difference {diff:e} (bound {bound:e}, step scale {scale:e})");
+    assert!(diff <= bound.max(1e-12 * scale), "{diff:e} > {bound:e}");
+    // The next factorization keeps the dense preconditioner (no new dense factorization
+    // at the same iterate, and GMRES converges with it at once).
+    krylov.factor(&jac).unwrap();
+    let before = krylov.krylov_iterations();
+    let mut again = f.clone();
+    krylov.solve_in_place(&mut again).unwrap();
+    assert_eq!(krylov.dense_preconditioner_factorizations(), 1);
+    assert!(krylov.krylov_iterations() - before <= 3);
+    assert!(common::max_abs_diff(&again, &exact) <= bound.max(1e-12 * scale));
+}

@@ -9,7 +9,7 @@
 //! | method | estimate (bytes) | measured |
 //! |---|---|---|
 //! | HB, structured solver, dense condensed system | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
-//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 3300 m S` (GMRES basis of up to 201 vectors) | see `examples/contact_scaling.rs` |
+//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 3300 m S` (GMRES basis of up to 201 vectors), plus `8 (m S)^2 + 16 (H + 1) m^2` up to `DENSE_PRECONDITIONER_LIMIT` condensed unknowns (the dense preconditioner GMRES may fall back on) | see `examples/contact_scaling.rs` |
 //! | HB, dense solver | `10 n^2` more, `n = (N + m) S` (SSN-HB) or `N S` (penalty) | 156 MB at N = 100, H = 20 (n = 4141); 570 MB at N = 200 (n = 8241) |
 //! | periodic LCP | `24 (m Nt)^2 + 1000 N` | 71 MB (Lemke), 48 MB (Newton) at Nt = 2048, m = 1 |
 //! | time marching | `1000 N` | 12 MB at N = 10^4 |
@@ -24,6 +24,18 @@
 
 use crate::model::Structure;
 use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
+
+/// The dense condensed matrix (and full receptance) the matrix-free path may factor as
+/// GMRES's preconditioner: `8 (m S)^2 + 16 (H + 1) m^2` bytes up to
+/// [`DENSE_PRECONDITIONER_LIMIT`](crate::hb::DENSE_PRECONDITIONER_LIMIT) condensed unknowns,
+/// none above.
+fn dense_preconditioner_bytes(m: f64, s: f64) -> f64 {
+    if m * s <= crate::hb::DENSE_PRECONDITIONER_LIMIT as f64 {
+        8.0 * (m * s).powi(2) + 8.0 * (s + 1.0) * m * m
+    } else {
+        0.0
+    }
+}
 
 /// What a run needs, in words and bytes.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,7 +77,8 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                     bytes: rod
                         + 600.0 * n * s
                         + 8.0 * (2.0 * s * nt + 3.0 * m * s * s)
-                        + 3300.0 * m * s,
+                        + 3300.0 * m * s
+                        + dense_preconditioner_bytes(m, s),
                     what: format!(
                         "per-harmonic factorizations of {elements} dofs x {} harmonic functions \
                          (matrix-free condensed system of {:.0} unknowns)",
@@ -309,10 +322,25 @@ fn size_work(
         (Method::SsnHb, LinearSolverChoice::Structured)
             if contacts * (2 * settings.harmonics + 1) > crate::hb::KRYLOV_THRESHOLD =>
         {
-            WorkEstimate {
-                flops: 0.0,
-                what: "no dense factorization (matrix-free condensed solve)".into(),
-                keys: "",
+            // At most one dense factorization per iteration where GMRES may fall back on
+            // the dense preconditioner; none above its limit.
+            let unknowns = m * s;
+            if unknowns <= crate::hb::DENSE_PRECONDITIONER_LIMIT as f64 {
+                WorkEstimate {
+                    flops: lu(unknowns),
+                    what: format!(
+                        "{NEWTON_FACTORIZATIONS} LU factorizations at most of the condensed \
+                         contact system on {unknowns:.0} unknowns (the matrix-free solve's \
+                         dense preconditioner)"
+                    ),
+                    keys: "solver.harmonics and the number of contacts",
+                }
+            } else {
+                WorkEstimate {
+                    flops: 0.0,
+                    what: "no dense factorization (matrix-free condensed solve)".into(),
+                    keys: "",
+                }
             }
         }
         (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {

@@ -51,8 +51,13 @@
 //!    `F_mu(x) = 0` from the initial guess, `mu` from the problem's smoothing scale down three
 //!    decades (Newton with an Armijo search on the smooth merit at the start, then the
 //!    crate's pseudo-arclength continuation in `log10 mu` with the tangent predictor), then
-//!    full Newton steps on `F`; a path that stops after two decades hands its last point to
-//!    those steps too;
+//!    full Newton steps on `F` (stopped, like the first ones, when they stagnate); a path
+//!    that stops after two decades hands its last point to those steps too. When this
+//!    fails, the path is followed once more with its points corrected to a tolerance
+//!    shrinking like `mu` (`|F_mu| <= beta mu`, the neighbourhood of smoothing Newton
+//!    methods; [`ParameterDependent::tolerance_scale`](crate::ParameterDependent::tolerance_scale)):
+//!    late on the path the Newton basin of `F_mu` shrinks like `mu`, and points corrected
+//!    to one tolerance can lie outside it;
 //! 3. the non-monotone line search from the initial guess, on at most half of the
 //!    iterations left;
 //! 4. the Newton homotopy `H(x, t) = F(x) - (1 - t) F(x_0)` from `(x_0, 0)` to `t = 1`,

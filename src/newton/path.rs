@@ -112,6 +112,12 @@ pub(crate) struct SmoothingPath<'a, P: Residual + ?Sized> {
     problem: &'a mut P,
     mu0: f64,
     p: f64,
+    /// Decades of the tolerance per decade of `mu` ([`ParameterDependent::tolerance_scale`]
+    /// `= (mu / mu_0)^rate`; 0: one tolerance along the path).
+    tolerance_rate: f64,
+    /// Smallest [`ParameterDependent::tolerance_scale`] (the run's own tolerance over the
+    /// path's accuracy: points are never asked for more than the run asks of a root).
+    smallest_scale: f64,
 }
 
 impl<'a, P: Residual + ?Sized> SmoothingPath<'a, P> {
@@ -123,7 +129,17 @@ impl<'a, P: Residual + ?Sized> SmoothingPath<'a, P> {
             problem,
             mu0,
             p: 0.0,
+            tolerance_rate: 0.0,
+            smallest_scale: 0.0,
         })
+    }
+
+    /// Points at `mu` are corrected to the path's accuracy times `(mu / mu_0)^rate`, but
+    /// never to less than `smallest` times it.
+    pub(crate) fn with_tolerance_decay(mut self, rate: f64, smallest: f64) -> Self {
+        self.tolerance_rate = rate;
+        self.smallest_scale = smallest;
+        self
     }
 
     fn mu(&self) -> f64 {
@@ -178,6 +194,18 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
         self.p = p;
         let mu = self.mu();
         self.smoothing().set_smoothing(mu);
+    }
+
+    /// `(mu / mu_0)^rate = 10^(-rate p)`: with rate 1, points are corrected to
+    /// `|F_mu| <= tolerance mu / mu_0`, the neighbourhood of the path where smoothing Newton
+    /// methods keep their iterates (`|F_mu| <= beta mu`, Chen, Harker, Kanzow & Smale).
+    fn tolerance_scale(&self, p: f64) -> f64 {
+        if self.tolerance_rate == 0.0 {
+            return 1.0;
+        }
+        10f64
+            .powf(-self.tolerance_rate * p.max(0.0))
+            .max(self.smallest_scale)
     }
 
     fn residual_parameter_derivative(

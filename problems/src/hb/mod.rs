@@ -162,7 +162,9 @@ pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
 pub use penalty::{PenaltyHb, PenaltyHbOptions};
 pub use ssn::{HbOptions, SsnHb};
-pub use structured::{CondensedSolve, StructuredHbSolver, KRYLOV_RELATIVE_TOLERANCE};
+pub use structured::{
+    CondensedSolve, StructuredHbSolver, DENSE_PRECONDITIONER_LIMIT, KRYLOV_RELATIVE_TOLERANCE,
+};
 
 omega_parameter!(SsnHb, PenaltyHb);
 

@@ -35,7 +35,9 @@ use semismooth::linalg::{
 use semismooth::{Factorize, LinearSolve};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
-use super::krylov::{CondensedOperator, ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
+use super::krylov::{
+    CondensedOperator, CondensedPreconditioner, ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK,
+};
 use super::LinearData;
 use crate::dynamic::DynamicStiffness;
 
@@ -53,6 +55,23 @@ pub const KRYLOV_RELATIVE_TOLERANCE: f64 = 1e-10;
 /// solve needs (at most `2 x 201 x 8 m (2H + 1)` bytes).
 const KRYLOV_RESTART: usize = 200;
 const KRYLOV_MAX_ITERATIONS: usize = 1200;
+
+/// Up to this many condensed unknowns (`8 n^2` bytes: 288 MB, and one dense LU of about
+/// `1.4e11` flops) the matrix-free path may fall back on the dense condensed matrix as
+/// GMRES's preconditioner, when the contact blocks leave GMRES short of its tolerance after
+/// one restart cycle (contacts coupled strongly through the structure: many contacts
+/// close together). Above it, GMRES with the contact blocks has the whole budget.
+pub const DENSE_PRECONDITIONER_LIMIT: usize = 6000;
+
+/// GMRES iterations with the dense preconditioner of an earlier iterate above which it is
+/// refactored at the next iterate (about the cost of refactoring: one product costs
+/// `H + 1` sparse solves and an `n^2` triangular solve, the factorization `n^3 / 1.5`).
+const DENSE_REFRESH_ITERATIONS: usize = 30;
+
+/// GMRES iterations with the dense preconditioner of an earlier iterate after which it is
+/// refactored at the current one and the solve goes on with it (about the cost of one
+/// factorization).
+const DENSE_LAGGED_ITERATIONS: usize = 60;
 
 /// How [`StructuredHbSolver`] solves the condensed SSN-HB system on the contact unknowns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -138,6 +157,15 @@ pub struct StructuredHbSolver {
     receptance_diagonal: Vec<c64>,
     contact_blocks: ContactBlocks,
     block_rhs: Mat<c64>,
+    /// Matrix-free path: `schur` holds the LU of the dense condensed matrix of a recent
+    /// iterate, used as GMRES's preconditioner instead of the contact blocks.
+    dense_preconditioner: bool,
+    /// The dense preconditioner is refactored at the next iterate (it needed more than
+    /// [`DENSE_REFRESH_ITERATIONS`] GMRES iterations).
+    refresh_dense: bool,
+    /// Frequency (bits of `w`) of the full receptance `receptance` on the matrix-free path.
+    receptance_omega: Option<u64>,
+    dense_preconditioner_factorizations: u64,
 }
 
 impl std::fmt::Debug for StructuredHbSolver {
@@ -192,6 +220,10 @@ impl StructuredHbSolver {
             receptance_diagonal: Vec::new(),
             contact_blocks: ContactBlocks::default(),
             block_rhs: Mat::zeros(0, 0),
+            dense_preconditioner: false,
+            refresh_dense: false,
+            receptance_omega: None,
+            dense_preconditioner_factorizations: 0,
         }
     }
 
@@ -219,6 +251,12 @@ impl StructuredHbSolver {
     /// GMRES iterations (operator products) of all matrix-free solves so far.
     pub fn krylov_iterations(&self) -> u64 {
         self.krylov_iterations
+    }
+
+    /// Dense factorizations of the condensed matrix made on the matrix-free path as GMRES's
+    /// preconditioner (after the contact blocks failed; module documentation).
+    pub fn dense_preconditioner_factorizations(&self) -> u64 {
+        self.dense_preconditioner_factorizations
     }
 
     /// Sets the maximum number of iterative-refinement steps after each solve (default 1;
@@ -289,6 +327,9 @@ impl StructuredHbSolver {
             self.response.clear();
             self.receptance.clear();
             self.schur = Mat::zeros(0, 0);
+            self.dense_preconditioner = false;
+            self.refresh_dense = false;
+            self.receptance_omega = None;
         } else {
             let req = StackReq::any_of(&[
                 dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
@@ -340,23 +381,15 @@ impl StructuredHbSolver {
                     other => other,
                 })?;
             if self.krylov {
-                // R_k,ii only, a block of contacts at a time.
-                let width = self.block_rhs.ncols();
-                for first in (0..lin.contacts()).step_by(width.max(1)) {
-                    let count = width.min(lin.contacts() - first);
-                    let mut z = self.block_rhs.as_mut().subcols_mut(0, count);
-                    z.fill(c64::new(0.0, 0.0));
-                    for j in 0..count {
+                // R_k,ii only.
+                let diagonal = &mut self.receptance_diagonal;
+                receptance_columns(dynamic, &lin, k, &mut self.block_rhs, |first, z| {
+                    for j in 0..z.ncols() {
                         let i = first + j;
-                        z[(lin.contact_dofs[i], j)] = c64::new(lin.contact_signs[i], 0.0);
-                    }
-                    dynamic.solve_in_place(k, z.as_mut())?;
-                    for j in 0..count {
-                        let i = first + j;
-                        self.receptance_diagonal[k * lin.contacts() + i] =
+                        diagonal[k * lin.contacts() + i] =
                             z[(lin.contact_dofs[i], j)] * lin.contact_signs[i];
                     }
-                }
+                })?;
                 continue;
             }
             let z = &mut self.response[k];
@@ -442,6 +475,30 @@ impl StructuredHbSolver {
     }
 }
 
+/// `Z_k^{-1} G^T`, a block of contacts' columns at a time (as many as `block` has): calls
+/// `visit(first, z)` with the columns of contacts `first..first + z.ncols()`.
+fn receptance_columns(
+    dynamic: &mut DynamicStiffness,
+    lin: &LinearData,
+    k: usize,
+    block: &mut Mat<c64>,
+    mut visit: impl FnMut(usize, faer::MatRef<'_, c64>),
+) -> Result<(), LinearSolveError> {
+    let width = block.ncols().max(1);
+    for first in (0..lin.contacts()).step_by(width) {
+        let count = width.min(lin.contacts() - first);
+        let mut z = block.as_mut().subcols_mut(0, count);
+        z.fill(c64::new(0.0, 0.0));
+        for j in 0..count {
+            let i = first + j;
+            z[(lin.contact_dofs[i], j)] = c64::new(lin.contact_signs[i], 0.0);
+        }
+        dynamic.solve_in_place(k, z.as_mut())?;
+        visit(first, z.as_ref());
+    }
+    Ok(())
+}
+
 /// `out = G u`: the contact displacements' coefficients (index `j m + i`) of the full
 /// coefficients `u` (index `j N + dof`).
 fn gather_contacts(lin: &LinearData, u: &[f64], out: &mut [f64]) {
@@ -510,6 +567,14 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
             }
         }
         if self.krylov {
+            if self.dense_preconditioner && !self.refresh_dense {
+                // The dense factorization of a recent iterate stays the preconditioner.
+                self.schur_ready = true;
+                return Ok(());
+            }
+            if self.dense_preconditioner {
+                return self.factor_dense_preconditioner(jac.omega);
+            }
             return self.factor_preconditioner();
         }
         self.scaled = false;
@@ -708,33 +773,27 @@ impl StructuredHbSolver {
             *b = rhs[nu + r] - c * *b;
         }
         self.work_d.fill(0.0);
-        let options = GmresOptions {
-            relative_tolerance: 0.0,
-            absolute_tolerance: (KRYLOV_RELATIVE_TOLERANCE * rhs_norm)
-                .max(self.krylov_absolute_tolerance),
-            restart: KRYLOV_RESTART,
-            max_iterations: KRYLOV_MAX_ITERATIONS,
-        };
-        let Some((_, dynamic)) = &mut self.dynamic else {
-            return Err(LinearSolveError::NotFactored);
-        };
-        let mut operator = CondensedOperator {
-            dynamic,
-            lin,
-            q: &self.q,
-            c,
-            rhs: &mut self.complex_rhs,
-            work: &mut self.work_a,
-            blocks: &mut self.contact_blocks,
-        };
-        let solved = self
-            .gmres
-            .solve(&mut operator, &self.work_c, &mut self.work_d, &options);
-        self.krylov_iterations += match &solved {
-            Ok(report) => report.iterations as u64,
-            Err(LinearSolveError::NotConverged { iterations, .. }) => *iterations as u64,
-            Err(_) => 0,
-        };
+        let tolerance = (KRYLOV_RELATIVE_TOLERANCE * rhs_norm).max(self.krylov_absolute_tolerance);
+        let nc = m * size;
+        let fallback = nc <= DENSE_PRECONDITIONER_LIMIT;
+        let mut solved = self.gmres_condensed(lin, c, tolerance, fallback);
+        match &solved {
+            Ok(iterations) if self.dense_preconditioner => {
+                self.refresh_dense = *iterations > DENSE_REFRESH_ITERATIONS;
+            }
+            Err(LinearSolveError::NotConverged { .. }) if fallback => {
+                // The preconditioner no longer captures the coupling at this iterate:
+                // factor the dense condensed matrix here and go on from GMRES's last
+                // iterate with it.
+                let omega = self.factored_for.as_ref().map_or(0.0, |(_, w)| *w);
+                if let Err(e) = self.factor_dense_preconditioner(omega) {
+                    self.work_u = w;
+                    return Err(e);
+                }
+                solved = self.gmres_condensed(lin, c, tolerance, false);
+            }
+            _ => {}
+        }
         if let Err(e) = solved {
             self.work_u = w;
             return Err(e);
@@ -752,6 +811,131 @@ impl StructuredHbSolver {
         rhs[nu..].copy_from_slice(&self.work_d);
         self.work_u = w;
         finite_step(rhs)
+    }
+
+    /// GMRES on `S dLambda = work_c` into `work_d` (its initial guess) with the current
+    /// preconditioner; `short`: the budget of one restart cycle (a dense preconditioner
+    /// can take over when it is spent). Returns the iterations.
+    fn gmres_condensed(
+        &mut self,
+        lin: &LinearData,
+        c: f64,
+        tolerance: f64,
+        short: bool,
+    ) -> Result<usize, LinearSolveError> {
+        let options = GmresOptions {
+            relative_tolerance: 0.0,
+            absolute_tolerance: tolerance,
+            restart: KRYLOV_RESTART,
+            max_iterations: if short && self.dense_preconditioner {
+                DENSE_LAGGED_ITERATIONS
+            } else if short {
+                KRYLOV_RESTART
+            } else {
+                KRYLOV_MAX_ITERATIONS
+            },
+        };
+        let Some((_, dynamic)) = &mut self.dynamic else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let preconditioner = if self.dense_preconditioner {
+            let nc = self.schur.nrows();
+            CondensedPreconditioner::Dense(FactoredCondensed {
+                lu: self.schur.as_ref(),
+                perm: PermRef::new_checked(&self.perm, &self.perm_inv, nc),
+                scale: self.scaled.then_some(self.column_scale.as_slice()),
+                mem: &mut self.mem,
+                rhs: &mut self.work_b,
+            })
+        } else {
+            CondensedPreconditioner::Blocks(&mut self.contact_blocks)
+        };
+        let mut operator = CondensedOperator {
+            dynamic,
+            lin,
+            q: &self.q,
+            c,
+            rhs: &mut self.complex_rhs,
+            work: &mut self.work_a,
+            preconditioner,
+        };
+        let solved = self
+            .gmres
+            .solve(&mut operator, &self.work_c, &mut self.work_d, &options);
+        self.krylov_iterations += match &solved {
+            Ok(report) => report.iterations as u64,
+            Err(LinearSolveError::NotConverged { iterations, .. }) => *iterations as u64,
+            Err(_) => 0,
+        };
+        solved.map(|report| report.iterations)
+    }
+
+    /// Matrix-free path: forms the dense condensed matrix at the current `Q` (the full
+    /// receptance at `omega` first, when not yet computed there), factors it and makes it
+    /// GMRES's preconditioner until it needs more than [`DENSE_REFRESH_ITERATIONS`].
+    fn factor_dense_preconditioner(&mut self, omega: f64) -> Result<(), LinearSolveError> {
+        let Some((lin, _)) = self.factored_for.clone() else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let (m, size) = (lin.contacts(), lin.size());
+        let nc = m * size;
+        if self.schur.nrows() != nc {
+            let req = StackReq::any_of(&[
+                dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
+                dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
+            ]);
+            self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the dense condensed preconditioner",
+            })?;
+            self.schur = Mat::zeros(nc, nc);
+            self.work_b = Mat::zeros(nc, 1);
+            self.perm = vec![0; nc];
+            self.perm_inv = vec![0; nc];
+            self.column_scale = vec![1.0; nc];
+        }
+        if self.receptance_omega != Some(omega.to_bits()) {
+            self.full_receptance(&lin)?;
+            self.receptance_omega = Some(omega.to_bits());
+        }
+        self.scaled = false;
+        let unscaled = self.factor_condensed(lin.dofs * size, m, false);
+        if matches!(unscaled, Err(LinearSolveError::Singular { .. })) {
+            self.scaled = true;
+            self.factor_condensed(lin.dofs * size, m, true)?;
+        } else {
+            unscaled?;
+        }
+        self.dense_preconditioner = true;
+        self.refresh_dense = false;
+        self.dense_preconditioner_factorizations += 1;
+        self.schur_factorizations += 1;
+        self.schur_ready = true;
+        Ok(())
+    }
+
+    /// `R_k = G Z_k^{-1} G^T` for every harmonic, a block of contacts' columns at a time
+    /// (matrix-free path: the `N x m` responses are not kept).
+    fn full_receptance(&mut self, lin: &LinearData) -> Result<(), LinearSolveError> {
+        let m = lin.contacts();
+        let harmonics = lin.basis.harmonics();
+        if self.receptance.len() != harmonics + 1 {
+            self.receptance = (0..=harmonics).map(|_| Mat::zeros(m, m)).collect();
+        }
+        let Some((_, dynamic)) = &mut self.dynamic else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        for k in 0..=harmonics {
+            let r = &mut self.receptance[k];
+            receptance_columns(dynamic, lin, k, &mut self.block_rhs, |first, z| {
+                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+                    let s = lin.contact_signs[i];
+                    for j in 0..z.ncols() {
+                        r[(i, first + j)] = z[(dof, j)] * s;
+                    }
+                }
+            })?;
+        }
+        Ok(())
     }
 
     /// Forms the condensed matrix `S` (with its columns scaled to unit largest entry when
@@ -818,22 +1002,55 @@ impl StructuredHbSolver {
         if nc == 0 {
             return;
         }
-        let stack = MemStack::new(&mut self.mem);
-        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, nc);
-        let rhs: MatMut<'_, f64> = self.work_b.as_mut();
+        FactoredCondensed {
+            lu: self.schur.as_ref(),
+            perm: PermRef::new_checked(&self.perm, &self.perm_inv, nc),
+            scale: self.scaled.then_some(self.column_scale.as_slice()),
+            mem: &mut self.mem,
+            rhs: &mut self.work_b,
+        }
+        .solve_rhs();
+    }
+}
+
+/// The LU of the condensed matrix `S diag(scale) = P^T L U` (`scale`: the column
+/// equilibration, when it was needed) with its solve workspace.
+pub(crate) struct FactoredCondensed<'a> {
+    lu: faer::MatRef<'a, f64>,
+    perm: PermRef<'a, usize>,
+    scale: Option<&'a [f64]>,
+    mem: &'a mut MemBuffer,
+    /// `nc x 1` right-hand side, overwritten by the solution.
+    rhs: &'a mut Mat<f64>,
+}
+
+impl FactoredCondensed<'_> {
+    /// `rhs <- S^{-1} rhs`.
+    fn solve_rhs(&mut self) {
         dense_solve::solve_in_place_with_conj(
-            self.schur.as_ref(),
-            self.schur.as_ref(),
-            perm,
+            self.lu,
+            self.lu,
+            self.perm,
             Conj::No,
-            rhs,
+            self.rhs.as_mut(),
             Par::Seq,
-            stack,
+            MemStack::new(self.mem),
         );
-        if self.scaled {
-            for (r, scale) in self.column_scale.iter().enumerate() {
-                self.work_b[(r, 0)] *= scale;
+        if let Some(scale) = self.scale {
+            for (r, s) in scale.iter().enumerate() {
+                self.rhs[(r, 0)] *= s;
             }
+        }
+    }
+
+    /// `out = S^{-1} b`.
+    pub(crate) fn solve(&mut self, b: &[f64], out: &mut [f64]) {
+        for (r, v) in b.iter().enumerate() {
+            self.rhs[(r, 0)] = *v;
+        }
+        self.solve_rhs();
+        for (r, o) in out.iter_mut().enumerate() {
+            *o = self.rhs[(r, 0)];
         }
     }
 }

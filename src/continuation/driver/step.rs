@@ -48,6 +48,7 @@ where
         let mut y = Vec::with_capacity(n + 1);
         y.extend_from_slice(x);
         y.push(*p);
+        let tolerance = self.options.corrector_tolerance * self.problem.tolerance_scale(*p);
         let corrector = Corrector {
             problem: &mut *self.problem,
             solver: &mut *self.solver,
@@ -59,7 +60,7 @@ where
                 .trust_factor
                 .map(|_| (&self.trust, &self.main_metric)),
             rules: KernelRules {
-                absolute_tolerance: self.options.corrector_tolerance,
+                absolute_tolerance: tolerance,
                 relative_tolerance: 0.0,
                 residual_floor: 0.0,
                 step_tolerance: self.options.step_tolerance,
