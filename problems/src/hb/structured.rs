@@ -331,20 +331,9 @@ impl StructuredHbSolver {
             self.refresh_dense = false;
             self.receptance_omega = None;
         } else {
-            let req = StackReq::any_of(&[
-                dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
-                dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
-            ]);
-            self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-                during: "allocating the condensed LU workspace",
-            })?;
+            self.allocate_condensed_lu(nc, "allocating the condensed LU workspace")?;
             self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
             self.receptance = (0..=h).map(|_| Mat::zeros(m, m)).collect();
-            self.work_b = Mat::zeros(nc, 1);
-            self.schur = Mat::zeros(nc, nc);
-            self.perm = vec![0; nc];
-            self.perm_inv = vec![0; nc];
-            self.column_scale = vec![1.0; nc];
         }
         self.dynamic = Some((lin.clone(), dynamic));
         Ok(())
@@ -579,16 +568,7 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         }
         self.scaled = false;
         if nc > 0 {
-            let unscaled = self.factor_condensed(lin.dofs * size, m, false);
-            if matches!(unscaled, Err(LinearSolveError::Singular { .. })) {
-                // Near an undamped resonance the receptance of one harmonic dwarfs the
-                // others: the pivot test must compare pivots of columns of one scale.
-                // Equilibrate the columns and factor again (the solve undoes the scaling).
-                self.scaled = true;
-                self.factor_condensed(lin.dofs * size, m, true)?;
-            } else {
-                unscaled?;
-            }
+            self.factor_condensed_equilibrated_if_needed(lin.dofs * size, m)?;
         }
         self.schur_factorizations += 1;
         self.schur_ready = true;
@@ -880,31 +860,13 @@ impl StructuredHbSolver {
         let (m, size) = (lin.contacts(), lin.size());
         let nc = m * size;
         if self.schur.nrows() != nc {
-            let req = StackReq::any_of(&[
-                dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
-                dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
-            ]);
-            self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-                during: "allocating the dense condensed preconditioner",
-            })?;
-            self.schur = Mat::zeros(nc, nc);
-            self.work_b = Mat::zeros(nc, 1);
-            self.perm = vec![0; nc];
-            self.perm_inv = vec![0; nc];
-            self.column_scale = vec![1.0; nc];
+            self.allocate_condensed_lu(nc, "allocating the dense condensed preconditioner")?;
         }
         if self.receptance_omega != Some(omega.to_bits()) {
             self.full_receptance(&lin)?;
             self.receptance_omega = Some(omega.to_bits());
         }
-        self.scaled = false;
-        let unscaled = self.factor_condensed(lin.dofs * size, m, false);
-        if matches!(unscaled, Err(LinearSolveError::Singular { .. })) {
-            self.scaled = true;
-            self.factor_condensed(lin.dofs * size, m, true)?;
-        } else {
-            unscaled?;
-        }
+        self.factor_condensed_equilibrated_if_needed(lin.dofs * size, m)?;
         self.dense_preconditioner = true;
         self.refresh_dense = false;
         self.dense_preconditioner_factorizations += 1;
@@ -936,6 +898,44 @@ impl StructuredHbSolver {
             })?;
         }
         Ok(())
+    }
+
+    /// The dense condensed LU's storage and workspace for `nc` unknowns.
+    fn allocate_condensed_lu(
+        &mut self,
+        nc: usize,
+        during: &'static str,
+    ) -> Result<(), LinearSolveError> {
+        let req = StackReq::any_of(&[
+            dense_lu::lu_in_place_scratch::<usize, f64>(nc, nc, Par::Seq, Default::default()),
+            dense_solve::solve_in_place_scratch::<usize, f64>(nc, 1, Par::Seq),
+        ]);
+        self.mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory { during })?;
+        self.work_b = Mat::zeros(nc, 1);
+        self.schur = Mat::zeros(nc, nc);
+        self.perm = vec![0; nc];
+        self.perm_inv = vec![0; nc];
+        self.column_scale = vec![1.0; nc];
+        Ok(())
+    }
+
+    /// Factors the condensed matrix; when its unscaled factorization fails the pivot test,
+    /// factors it again with equilibrated columns. Near an undamped resonance the
+    /// receptance of one harmonic dwarfs the others: the pivot test must compare pivots of
+    /// columns of one scale (the solve undoes the scaling).
+    fn factor_condensed_equilibrated_if_needed(
+        &mut self,
+        offset: usize,
+        m: usize,
+    ) -> Result<(), LinearSolveError> {
+        self.scaled = false;
+        let unscaled = self.factor_condensed(offset, m, false);
+        if matches!(unscaled, Err(LinearSolveError::Singular { .. })) {
+            self.scaled = true;
+            self.factor_condensed(offset, m, true)
+        } else {
+            unscaled
+        }
     }
 
     /// Forms the condensed matrix `S` (with its columns scaled to unit largest entry when
