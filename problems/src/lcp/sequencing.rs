@@ -77,7 +77,8 @@ impl SequencedSolution {
 
 /// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
 /// `"lcp-ssn"` at large `Nt`): the LCP of `model` is solved at `Nt / 2^j` (halving while
-/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0`, then each finer
+/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0` (offering the
+/// polyalgorithm the min-map's smoothing, [`super::MinMapLcp::with_smoothing`]), then each finer
 /// level starts from the previous solution interpolated in time
 /// ([`PeriodicLcp::interpolate_forces`]); the last level is `finest` itself (built by the
 /// caller, with whatever observed dofs it needs; only the coarser levels are built here).
