@@ -609,3 +609,161 @@ fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers()
     // Measured: the ray is met after 2 pivots.
     assert_not_solved(&lcp, LemkeTermination::Ray, 2);
 }
+
+/// The 40-element rod of the from-zero hard cases (damping ratio 0.02, `p0 = 0.1`, tip gap
+/// 0.3: the linear response overshoots the gap fourfold) with the given mass model, its
+/// LCP at `nt`, and `lcp-ssn` run on it from zero as a user runs it.
+fn forty_element_lcp(
+    mass: MassModel,
+    nt: usize,
+) -> (PeriodicLcp, semismooth_problems::runner::Solution) {
+    use semismooth_problems::figures::default_settings;
+    use semismooth_problems::from_zero::forty_element_rod;
+    use semismooth_problems::scene::{Method, SolverSettings};
+    let rod = build_rod(&RodSpec {
+        mass,
+        ..forty_element_rod()
+    })
+    .unwrap();
+    let lcp = PeriodicLcp::new(&rod.structure.model, options(nt, vec![])).unwrap();
+    let settings = SolverSettings {
+        method: Method::LcpSsn,
+        time_samples: nt,
+        ..default_settings(20)
+    };
+    let sol = semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap();
+    (lcp, sol)
+}
+
+/// Why `lcp-ssn` does not converge from zero on the strongly forced 40-element rod with its
+/// consistent mass. With stiffness-proportional damping every dof has mass or damping, so
+/// the Nyquist receptance is 0 and the alternating vector `(-1)^n` is a null vector of `A`:
+/// a contact force that alternates node to node moves nothing. On the long contact phase
+/// of this rod the LCP solution uses it: the force chatters (active nodes interleaved with
+/// inactive ones) and inactive nodes sit within 1e-4 of the obstacle, so the solution is
+/// nearly degenerate. Full Newton steps converge from it perturbed by 1e-6, not by 1e-4;
+/// Lemke needs 28,349 pivots (the default limit 50 n + 100 = 6,500 stops it).
+#[test]
+fn strongly_forced_rod_has_a_chattering_nearly_degenerate_lcp_solution_with_a_tiny_newton_basin() {
+    let nt = 128;
+    let (lcp, sol) = forty_element_lcp(MassModel::Consistent, nt);
+    let a = lcp.matrix();
+    let alternating: Vec<f64> = (0..nt)
+        .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+        .collect();
+    let mut image = vec![0.0; nt];
+    for (j, v) in alternating.iter().enumerate() {
+        for (i, out) in image.iter_mut().enumerate() {
+            *out += a[(i, j)] * v;
+        }
+    }
+    // The kernel by FFT: round-off of the largest entry (1e-2) times a few ulps.
+    let largest = max_entry(a);
+    assert!(image.iter().all(|v| v.abs() < 1e-13 * largest), "{image:?}");
+    assert_not_solved(&lcp, LemkeTermination::PivotLimit, 50 * nt + 100);
+    let mut lemke = Lemke::new(nt);
+    let generous = LemkeOptions {
+        max_pivots: Some(250 * nt),
+        ..LemkeOptions::default()
+    };
+    let solved = lcp.check_lemke(lcp.solve_with_lemke(&mut lemke, &generous).unwrap());
+    let solved = solved.unwrap();
+    // Measured 28,349 pivots: a window of 10 %.
+    assert!(
+        (25_514..=31_184).contains(&solved.pivots),
+        "{}",
+        solved.pivots
+    );
+    assert!(solved.complementarity_error < 1e-12);
+    let z = &solved.z;
+    let w = &solved.w;
+    let active: Vec<usize> = (0..nt).filter(|&i| z[i] > 0.0).collect();
+    let (first, last) = (active[0], *active.last().unwrap());
+    // Measured: 12 active nodes between 1 and 17, five inactive ones among them.
+    let holes = (first..=last).filter(|i| z[*i] == 0.0).count();
+    assert!(holes >= 3, "active nodes {active:?}");
+    let nearest = (0..nt)
+        .filter(|&i| z[i] == 0.0)
+        .map(|i| w[i])
+        .fold(f64::INFINITY, f64::min);
+    let weakest = active.iter().map(|&i| z[i]).fold(f64::INFINITY, f64::min);
+    // Measured: 1.6e-5 (against the gap 0.3) and 5.7e-2.
+    assert!(nearest < 1e-4 && weakest > 1e-2, "{nearest:e}, {weakest:e}");
+    let newton_from = |size: f64| {
+        let start: Vec<f64> = z
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v + size * ((i * 7919 % 13) as f64 / 13.0 - 0.3))
+            .collect();
+        let options = NewtonOptions {
+            max_iterations: 50,
+            globalization: newton::Globalization::None,
+            ..NewtonOptions::default()
+        };
+        let mut problem = lcp.min_map();
+        let mut solver = ActiveSetSolver::new()
+            .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
+            .unwrap();
+        let mut x = start;
+        newton::solve(&mut problem, &mut solver, &mut x, &options)
+            .or_else(newton::NewtonError::into_report)
+            .unwrap()
+    };
+    let near = newton_from(1e-6);
+    assert!(near.converged() && near.iterations <= 2, "{near:?}");
+    assert!(!newton_from(1e-4).converged());
+    // lcp-lemke as a user runs it says where it stopped and why.
+    let rod = build_rod(&RodSpec {
+        mass: MassModel::Consistent,
+        ..semismooth_problems::from_zero::forty_element_rod()
+    })
+    .unwrap();
+    let settings = semismooth_problems::scene::SolverSettings {
+        method: semismooth_problems::scene::Method::LcpLemke,
+        time_samples: nt,
+        ..semismooth_problems::figures::default_settings(20)
+    };
+    let lemke_run = semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap();
+    assert!(
+        lemke_run
+            .termination
+            .starts_with("pivot-limit (6500 pivots done, the limit 6500 = 50 n + 100 for n = 128)"),
+        "{}",
+        lemke_run.termination
+    );
+    // From zero (the smoothing path on the min-map, then the line search and the Newton
+    // homotopy) lcp-ssn does not get there: measured max-iterations after 209 iterations.
+    assert!(!sol.converged);
+    assert!(sol.termination.starts_with("max-iterations"));
+    assert!((188..=230).contains(&sol.iterations), "{}", sol.iterations);
+}
+
+/// With the tip's mass moved to its neighbour (modified mass) the same rod's LCP is solved
+/// by `lcp-ssn` from zero at `Nt` = 128 and 256: the coarsest level follows the smoothing
+/// path of the min-map (`min(z, w) = z - max(0, z - w)`, the max smoothed), the finer one
+/// starts from it interpolated. The answer is Lemke's (the same LCP solved by pivoting) to
+/// round-off. At `Nt = 512` the finer level starts from an interpolation whose chattering
+/// active set is wrong and ends at the iteration limit (measured 324 iterations).
+#[test]
+fn modified_mass_strongly_forced_rod_lcp_ssn_from_zero_reaches_lemkes_solution_at_nt_128_and_256() {
+    // (Nt, iterations measured over the levels: 41 and 41 + 54).
+    for (nt, measured) in [(128usize, 41usize), (256, 95)] {
+        let (lcp, sol) = forty_element_lcp(MassModel::Modified, nt);
+        assert!(sol.converged, "Nt = {nt}: {}", sol.termination);
+        let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
+        let zmax = lemke.z.iter().cloned().fold(0.0, f64::max);
+        // Both end on one exact solve with the same active set (condition of A_II ~1e3):
+        // agreement to round-off, asserted at 1e-9 of the largest force.
+        let diff = max_abs_diff(&sol.state, &lemke.z);
+        assert!(diff < 1e-9 * zmax, "Nt = {nt}: {diff:e}");
+        let window = measured * 9 / 10..=measured * 11 / 10;
+        assert!(
+            window.contains(&sol.iterations),
+            "Nt = {nt}: {}",
+            sol.iterations
+        );
+    }
+    let (_, sol) = forty_element_lcp(MassModel::Modified, 512);
+    assert!(sol.termination.starts_with("max-iterations"));
+    assert!((292..=356).contains(&sol.iterations), "{}", sol.iterations);
+}

@@ -164,20 +164,36 @@ pub fn hard_cases() -> Result<Vec<(String, Vec<GridCase>)>, ModelError> {
             None,
         )?);
     }
-    let forty = build_rod(&forty_element_rod())?;
-    let lcp_cases = [128, 256, 512, 1024, 2048]
-        .into_iter()
-        .map(|nt| GridCase {
-            label: format!("Nt = {nt}"),
-            rod: forty.clone(),
-            harmonics: 20,
-            settings: Some(SolverSettings {
-                method: Method::LcpSsn,
-                time_samples: nt,
-                ..default_settings(20)
-            }),
-        })
-        .collect();
-    groups.push(("40 elements, lcp-ssn, Nt = 128..2048".into(), lcp_cases));
+    // The periodic LCP of the 40-element rod, as built (consistent mass) and with the tip's
+    // mass moved to its neighbour (modified mass, the massless contact node).
+    for (name, mass) in [
+        (
+            "40 elements, lcp-ssn, Nt = 128..2048",
+            MassModel::Consistent,
+        ),
+        (
+            "40 elements, modified mass, lcp-ssn, Nt = 128..2048",
+            MassModel::Modified,
+        ),
+    ] {
+        let forty = build_rod(&RodSpec {
+            mass,
+            ..forty_element_rod()
+        })?;
+        let lcp_cases = [128, 256, 512, 1024, 2048]
+            .into_iter()
+            .map(|nt| GridCase {
+                label: format!("Nt = {nt}"),
+                rod: forty.clone(),
+                harmonics: 20,
+                settings: Some(SolverSettings {
+                    method: Method::LcpSsn,
+                    time_samples: nt,
+                    ..default_settings(20)
+                }),
+            })
+            .collect();
+        groups.push((name.into(), lcp_cases));
+    }
     Ok(groups)
 }

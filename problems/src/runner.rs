@@ -611,7 +611,8 @@ fn solve_lcp(
         match method {
             Method::LcpLemke => {
                 let mut lemke = Lemke::new(lcp.dim());
-                let report = lemke.solve(lcp.matrix(), lcp.q(), &LemkeOptions::default())?;
+                let lemke_options = LemkeOptions::default();
+                let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
                 let termination = match report.termination {
                     LemkeTermination::Solved => "converged".to_string(),
                     LemkeTermination::Ray => {
@@ -622,9 +623,12 @@ fn solve_lcp(
                     )
                     }
                     LemkeTermination::PivotLimit => format!(
-                        "pivot-limit ({}): the tip values are those of the unfinished path's last \
-                     basis, not of a solution",
-                        report.pivots
+                        "pivot-limit ({} pivots done, the limit {} = 50 n + 100 for n = {}): the \
+                         tip values are those of the unfinished path's last basis, not of a \
+                         solution",
+                        report.pivots,
+                        lemke_options.pivot_limit(lcp.dim()),
+                        lcp.dim()
                     ),
                 };
                 let counters = RunCounters {

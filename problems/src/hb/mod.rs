@@ -161,6 +161,7 @@ pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
 pub use penalty::{PenaltyHb, PenaltyHbOptions};
+pub(crate) use ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use ssn::{HbOptions, SsnHb};
 pub use structured::{
     CondensedSolve, StructuredHbSolver, DENSE_PRECONDITIONER_LIMIT, KRYLOV_RELATIVE_TOLERANCE,

@@ -270,7 +270,7 @@ impl GeneralizedJacobian for SsnHb {
 
 /// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2`, the Chen–Harker–Kanzow–Smale smoothing of
 /// `max(0, s)` (`phi_0 = max(0, .)`, `0 < phi_mu(s) - max(0, s) <= mu`).
-fn smoothed_max(s: f64, mu: f64) -> f64 {
+pub(crate) fn smoothed_max(s: f64, mu: f64) -> f64 {
     if mu == 0.0 {
         s.max(0.0)
     } else {
@@ -279,12 +279,12 @@ fn smoothed_max(s: f64, mu: f64) -> f64 {
 }
 
 /// `phi_mu'(s) = (1 + s / sqrt(s^2 + 4 mu^2)) / 2`, in `(0, 1)` for `mu > 0`.
-fn smoothed_max_slope(s: f64, mu: f64) -> f64 {
+pub(crate) fn smoothed_max_slope(s: f64, mu: f64) -> f64 {
     0.5 * (1.0 + s / s.hypot(2.0 * mu))
 }
 
 /// `d phi_mu(s) / d mu = 2 mu / sqrt(s^2 + 4 mu^2)`.
-fn smoothed_max_mu_derivative(s: f64, mu: f64) -> f64 {
+pub(crate) fn smoothed_max_mu_derivative(s: f64, mu: f64) -> f64 {
     2.0 * mu / s.hypot(2.0 * mu)
 }
 

@@ -8,6 +8,12 @@
 //! active `I` then inactive `J`, `J d = r` reads `d_J = r_J`,
 //! `A_II d_I = r_I - A_IJ r_J`: one `|I| x |I|` LU instead of an `m Nt` one. Newton on this
 //! equation is the primal-dual active-set method.
+//!
+//! On request ([`MinMapLcp::with_smoothing`]) the equation offers the core's
+//! [`Smoothing`]: `min(z, w) = z - max(0, z - w)` with the max replaced by the
+//! Chen–Harker–Kanzow–Smale function, `min_mu(z, w) = z - (s + sqrt(s^2 + 4 mu^2)) / 2`,
+//! `s = z - w`; its Jacobian rows are `(1 - t_i) e_i + t_i A_i` with weights
+//! `t_i in (0, 1)`, solved by a dense LU (the active-set split needs 0/1 rows).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve};
@@ -15,11 +21,15 @@ use faer::perm::PermRef;
 use faer::{MatMut, MatRef, Par};
 use semismooth::complementarity::min_function;
 use semismooth::linalg::{
-    check_finite_dense, check_pivots, DenseAssemble, LinearSolveError, DEFAULT_PIVOT_THRESHOLD,
+    check_finite_dense, check_pivots, DenseAssemble, FaerDenseLu, LinearSolveError,
+    DEFAULT_PIVOT_THRESHOLD,
 };
-use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
+use semismooth::{
+    EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual, Smoothing,
+};
 
 use super::LcpError;
+use crate::hb::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 
 /// `out += a x` for a dense matrix (column by column).
 pub(crate) fn add_mat_vec(a: MatRef<'_, f64>, x: &[f64], out: &mut [f64]) {
@@ -49,6 +59,8 @@ pub struct MinMapLcp<'a> {
     matrix: MatRef<'a, f64>,
     q: &'a [f64],
     w: Vec<f64>,
+    /// `None`: no smoothing offered; `Some(mu)`: offered, `mu >= 0` set (0: `F` itself).
+    smoothing: Option<f64>,
 }
 
 impl<'a> MinMapLcp<'a> {
@@ -75,7 +87,23 @@ impl<'a> MinMapLcp<'a> {
             matrix,
             q,
             w: vec![0.0; q.len()],
+            smoothing: None,
         }
+    }
+
+    /// The same equation offering the smoothing `min_mu(z, w) = z - phi_mu(z - w)`,
+    /// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2` (within `mu` of `min`; `mu = 0` is `F`
+    /// exactly), so that the polyalgorithm can follow the smoothing path from `mu = max |q|`.
+    /// Its Jacobians at `mu > 0` have fractional rows: solve them with the
+    /// [`ActiveSetSolver`] (dense LU for those) or a dense solver.
+    pub fn with_smoothing(mut self) -> Self {
+        self.smoothing = Some(0.0);
+        self
+    }
+
+    /// The smoothing set (0 when none is offered or set).
+    fn mu(&self) -> f64 {
+        self.smoothing.unwrap_or(0.0)
     }
 
     /// `w = q + A z` into `w`.
@@ -92,8 +120,55 @@ impl Residual for MinMapLcp<'_> {
 
     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.gap(x);
+        let mu = self.mu();
         for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
-            *o = min_function(*z, *w).value;
+            *o = if mu == 0.0 {
+                min_function(*z, *w).value
+            } else {
+                z - smoothed_max(z - w, mu)
+            };
+        }
+        Ok(())
+    }
+
+    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
+        if self.smoothing.is_some() {
+            Some(self)
+        } else {
+            None
+        }
+    }
+}
+
+impl Smoothing for MinMapLcp<'_> {
+    /// `max |q|`: the spread of the switching quantity `z - w = -q` at `z = 0`.
+    fn smoothing_scale(&self) -> f64 {
+        self.q
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()))
+            .max(f64::MIN_POSITIVE)
+    }
+
+    fn set_smoothing(&mut self, mu: f64) {
+        if self.smoothing.is_some() {
+            self.smoothing = Some(mu.max(0.0));
+        }
+    }
+
+    /// `d min_mu(z, w) / d mu = -2 mu / sqrt(s^2 + 4 mu^2)`, `s = z - w`.
+    fn residual_smoothing_derivative(
+        &mut self,
+        x: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        self.gap(x);
+        let mu = self.mu();
+        for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
+            *o = if mu == 0.0 {
+                0.0
+            } else {
+                -smoothed_max_mu_derivative(z - w, mu)
+            };
         }
         Ok(())
     }
@@ -106,25 +181,45 @@ impl<'a> GeneralizedJacobian for MinMapLcp<'a> {
         MinMapJacobian {
             matrix: self.matrix,
             active: vec![false; self.q.len()],
+            weights: Vec::new(),
         }
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut MinMapJacobian<'a>) -> Result<(), EvaluationError> {
         self.gap(x);
-        for ((a, z), w) in jac.active.iter_mut().zip(x).zip(&self.w) {
-            // min_function's gradient is (0, 1) exactly where w < z (tie: (1, 0)).
-            *a = min_function(*z, *w).db == 1.0;
+        let mu = self.mu();
+        if mu == 0.0 {
+            jac.weights.clear();
+            for ((a, z), w) in jac.active.iter_mut().zip(x).zip(&self.w) {
+                // min_function's gradient is (0, 1) exactly where w < z (tie: (1, 0)).
+                *a = min_function(*z, *w).db == 1.0;
+            }
+        } else {
+            jac.weights.resize(x.len(), 0.0);
+            for (((a, t), z), w) in jac
+                .active
+                .iter_mut()
+                .zip(jac.weights.iter_mut())
+                .zip(x)
+                .zip(&self.w)
+            {
+                *t = smoothed_max_slope(z - w, mu);
+                *a = *t > 0.5;
+            }
         }
         Ok(())
     }
 }
 
 /// An element of the generalized Jacobian of `min(z, q + A z)`: row `i` of `A` where
-/// `active[i]`, the unit row `e_i` elsewhere.
+/// `active[i]`, the unit row `e_i` elsewhere; of a smoothed equation
+/// ([`MinMapLcp::with_smoothing`]), the rows `(1 - t_i) e_i + t_i A_i`.
 #[derive(Debug, Clone)]
 pub struct MinMapJacobian<'a> {
     matrix: MatRef<'a, f64>,
     active: Vec<bool>,
+    /// The weights `t_i` of a smoothed Jacobian (empty: the 0/1 rows of `active`).
+    weights: Vec<f64>,
 }
 
 impl<'a> MinMapJacobian<'a> {
@@ -137,7 +232,16 @@ impl<'a> MinMapJacobian<'a> {
                 found: active.len(),
             });
         }
-        Ok(Self { matrix, active })
+        Ok(Self {
+            matrix,
+            active,
+            weights: Vec::new(),
+        })
+    }
+
+    /// Whether the rows are weighted (a smoothed equation at `mu > 0`), not 0/1.
+    pub fn is_weighted(&self) -> bool {
+        !self.weights.is_empty()
     }
 
     /// Which rows are active (take the row of `A`).
@@ -158,6 +262,15 @@ impl DenseAssemble for MinMapJacobian<'_> {
 
     fn assemble_dense(&self, mut out: MatMut<'_, f64>) {
         let n = self.active.len();
+        if self.is_weighted() {
+            for j in 0..n {
+                for (i, t) in self.weights.iter().enumerate() {
+                    let unit = if i == j { 1.0 - t } else { 0.0 };
+                    out[(i, j)] = t * self.matrix[(i, j)] + unit;
+                }
+            }
+            return;
+        }
         for j in 0..n {
             for i in 0..n {
                 out[(i, j)] = if self.active[i] {
@@ -188,6 +301,9 @@ pub const DEFAULT_ACTIVE_SET_REGULARIZATION: f64 = 1e-8;
 /// Storage (the block, the coupling `A_IJ`, the permutation, the scratch) is kept between
 /// factorizations and grows only when a larger active set needs more: a Newton run
 /// allocates only while its active sets reach new sizes.
+///
+/// A weighted Jacobian (of a smoothed equation, [`MinMapJacobian::is_weighted`]) has no
+/// unit rows to split off: it is factored whole by a dense LU with the same pivot test.
 pub struct ActiveSetSolver {
     n: usize,
     active: Vec<usize>,
@@ -205,6 +321,10 @@ pub struct ActiveSetSolver {
     factored: bool,
     pivot_threshold: f64,
     regularization: Option<f64>,
+    /// The whole-matrix LU of weighted Jacobians; `dense_factored` when it holds the last
+    /// factorization.
+    dense: FaerDenseLu,
+    dense_factored: bool,
 }
 
 impl std::fmt::Debug for ActiveSetSolver {
@@ -248,6 +368,8 @@ impl ActiveSetSolver {
             factored: false,
             pivot_threshold: threshold,
             regularization: None,
+            dense: FaerDenseLu::with_pivot_threshold(threshold),
+            dense_factored: false,
         }
     }
 
@@ -290,6 +412,7 @@ impl ActiveSetSolver {
         active: &[bool],
     ) -> Result<(), LinearSolveError> {
         self.factored = false;
+        self.dense_factored = false;
         let n = active.len();
         for found in [matrix.nrows(), matrix.ncols()] {
             if found != n {
@@ -399,12 +522,22 @@ impl ActiveSetSolver {
 
 impl Factorize<MinMapJacobian<'_>> for ActiveSetSolver {
     fn factor(&mut self, jac: &MinMapJacobian<'_>) -> Result<(), LinearSolveError> {
+        self.dense_factored = false;
+        if jac.is_weighted() {
+            self.factored = false;
+            self.dense.factor(jac)?;
+            self.dense_factored = true;
+            return Ok(());
+        }
         self.factor_rows(jac.matrix, &jac.active)
     }
 }
 
 impl LinearSolve for ActiveSetSolver {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        if self.dense_factored {
+            return self.dense.solve_in_place(rhs);
+        }
         if !self.factored {
             return Err(LinearSolveError::NotFactored);
         }
@@ -529,6 +662,72 @@ mod tests {
             solver.solve_in_place(&mut rhs),
             Err(LinearSolveError::NotFactored)
         );
+    }
+
+    #[test]
+    fn smoothing_at_mu_zero_is_bitwise_the_min_map_and_its_derivatives_match_differences() {
+        let n = 12;
+        let a = matrix(n);
+        let q: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
+        let z: Vec<f64> = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
+        let mut plain = MinMapLcp::new(a.as_ref(), &q).unwrap();
+        let mut smooth = MinMapLcp::new(a.as_ref(), &q).unwrap().with_smoothing();
+        assert!(plain.smoothing().is_none());
+        let (mut f0, mut f1) = (vec![0.0; n], vec![0.0; n]);
+        plain.residual(&z, &mut f0).unwrap();
+        smooth.residual(&z, &mut f1).unwrap();
+        assert_eq!(f0, f1);
+        let (mut j0, mut j1) = (plain.new_jacobian(), smooth.new_jacobian());
+        plain.jacobian(&z, &mut j0).unwrap();
+        smooth.jacobian(&z, &mut j1).unwrap();
+        assert_eq!(j0.active(), j1.active());
+        assert!(!j1.is_weighted());
+        // At mu > 0: F_mu within mu of F, its Jacobian and mu-derivative against central
+        // differences (smooth, step 1e-6: error O(1e-12 / mu^2) plus round-off 1e-10).
+        let mu = 0.3;
+        smooth.smoothing().unwrap().set_smoothing(mu);
+        smooth.residual(&z, &mut f1).unwrap();
+        assert!(f0.iter().zip(&f1).all(|(a, b)| a - b > 0.0 && a - b <= mu));
+        smooth.jacobian(&z, &mut j1).unwrap();
+        assert!(j1.is_weighted());
+        let mut dense = Mat::<f64>::zeros(n, n);
+        j1.assemble_dense(dense.as_mut());
+        let h = 1e-6;
+        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..n {
+            let (mut zp, mut zm) = (z.clone(), z.clone());
+            zp[j] += h;
+            zm[j] -= h;
+            smooth.residual(&zp, &mut fp).unwrap();
+            smooth.residual(&zm, &mut fm).unwrap();
+            for i in 0..n {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!((fd - dense[(i, j)]).abs() < 1e-8, "({i}, {j})");
+            }
+        }
+        let mut dmu = vec![0.0; n];
+        smooth
+            .smoothing()
+            .unwrap()
+            .residual_smoothing_derivative(&z, &mut dmu)
+            .unwrap();
+        for (sign, out) in [(1.0, &mut fp), (-1.0, &mut fm)] {
+            smooth.smoothing().unwrap().set_smoothing(mu + sign * h);
+            smooth.residual(&z, out).unwrap();
+        }
+        for i in 0..n {
+            assert!(((fp[i] - fm[i]) / (2.0 * h) - dmu[i]).abs() < 1e-8, "{i}");
+        }
+        // The weighted Jacobian is solved whole: as the dense LU does.
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin() + 0.1).collect();
+        let (mut x1, mut x2) = (rhs.clone(), rhs);
+        let mut solver = ActiveSetSolver::new();
+        solver.factor(&j1).unwrap();
+        solver.solve_in_place(&mut x1).unwrap();
+        let mut lu = FaerDenseLu::new();
+        lu.factor(&j1).unwrap();
+        lu.solve_in_place(&mut x2).unwrap();
+        assert_eq!(x1, x2);
     }
 
     #[test]

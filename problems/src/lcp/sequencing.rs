@@ -77,7 +77,8 @@ impl SequencedSolution {
 
 /// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
 /// `"lcp-ssn"` at large `Nt`): the LCP of `model` is solved at `Nt / 2^j` (halving while
-/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0`, then each finer
+/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0` (offering the
+/// polyalgorithm the min-map's smoothing, [`super::MinMapLcp::with_smoothing`]), then each finer
 /// level starts from the previous solution interpolated in time
 /// ([`PeriodicLcp::interpolate_forces`]); the last level is `finest` itself (built by the
 /// caller, with whatever observed dofs it needs; only the coarser levels are built here).
@@ -113,11 +114,13 @@ pub fn solve_min_map_sequenced(
     let mut levels = Vec::with_capacity(sizes.len() + 1);
     let mut z: Option<Vec<f64>> = None;
     let mut solve_level = |lcp: &PeriodicLcp, previous: Option<Vec<f64>>| {
-        let mut z = match &previous {
-            Some(coarse) => lcp.interpolate_forces(coarse)?,
-            None => vec![0.0; lcp.dim()],
+        // The level started from zero offers the smoothing path to the polyalgorithm; the
+        // finer ones start near their solution.
+        let (mut z, mut problem) = match &previous {
+            Some(coarse) => (lcp.interpolate_forces(coarse)?, lcp.min_map()),
+            None => (vec![0.0; lcp.dim()], lcp.min_map().with_smoothing()),
         };
-        let report = newton::solve(&mut lcp.min_map(), &mut solver, &mut z, newton_options)
+        let report = newton::solve(&mut problem, &mut solver, &mut z, newton_options)
             .or_else(NewtonError::into_report)?;
         levels.push(SequencingLevel {
             time_samples: lcp.time_samples(),
