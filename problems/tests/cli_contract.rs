@@ -502,8 +502,43 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
     std::fs::write(&lcp, text).unwrap();
     let o = ssn(&["solve", &lcp]);
     assert_exit(&o, 2, "lcp");
-    for word in ["solver.time_samples", "10000", "8192"] {
+    for word in ["invalid `solver.time_samples` = 10000", "8..=8192"] {
         assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // The LCP's dense matrix has order contacts x time_samples <= 8192: with two contacts
+    // 4096 samples pass the loader and 4097 are refused by solve, sweep and scene-check,
+    // naming the key, the value and the range for that number of contacts.
+    let two = |samples: usize, method: &str| {
+        let path = dir.path().join(format!("two_{samples}_{method}.toml"));
+        std::fs::write(
+            &path,
+            format!(
+                "[rod]\nelements = 20\nmass = \"modified\"\n[forcing]\namplitude = 0.04\n\
+                 [[contact.point]]\nnode = 20\ngap = 0.5\n[[contact.point]]\nnode = 10\n\
+                 gap = 0.3\n[solver]\nmethod = \"{method}\"\ntime_samples = {samples}\n\
+                 [sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.1\n"
+            ),
+        )
+        .unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    for method in ["lcp-lemke", "lcp-ssn"] {
+        let ok = two(4096, method);
+        assert_exit(&ssn(&["scene-check", &ok]), 0, "4096 samples, two contacts");
+        let refused = two(4097, method);
+        for command in ["solve", "sweep", "scene-check"] {
+            let o = ssn(&[command, &refused]);
+            assert_exit(&o, 2, &format!("{command} {refused}"));
+            for word in [
+                refused.as_str(),
+                "invalid `solver.time_samples` = 4097",
+                "8..=4096",
+                method,
+                "2 contacts",
+            ] {
+                assert!(err(&o).contains(word), "{command} {word}: {}", err(&o));
+            }
+        }
     }
 }
 
