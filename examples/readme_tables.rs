@@ -9,7 +9,7 @@
 //! Sections: `methods` (method comparison, both mass models, about 3 s), `accuracy`
 //! (cheapest setting per method, about 5 s), `sweeps` (about 10 s), `from-zero` (the public
 //! grid with `auto` and `hybrid`, about 6 s), `performance` (what the examples time, about
-//! 2 s), `hard` (the hard cases from zero, about 6 minutes: the 100-contact rod takes 5).
+//! 2 s), `hard` (the hard cases from zero, about 2 minutes, most of it the 100-contact rod).
 //! Wall times vary with the machine and its load; every other cell is deterministic, and
 //! `tests/readme_tables.rs` checks those of the cheap tables against README.md.
 

@@ -6,7 +6,7 @@
 //! `cargo run --release --example readme_tables -- SECTION` and paste it.
 
 use semismooth_problems::figures::default_settings;
-use semismooth_problems::from_zero::public_grid;
+use semismooth_problems::from_zero::{hard_cases, public_grid};
 use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
 use semismooth_problems::scene::GlobalizationChoice;
 use semismooth_problems::study::accuracy_cost;
@@ -106,4 +106,19 @@ fn cheapest_settings_in_the_readme_reach_their_accuracy() {
             );
         }
     }
+}
+
+/// The hard cases that take under a second (not the 1,000-element rods with 50 and 100
+/// contacts, nor the LCP over its time grids).
+#[test]
+fn hard_cases_table_is_the_codes_for_the_cases_under_a_second() {
+    let slow = ["50 contacts", "100 contacts", "lcp-ssn"];
+    let groups: Vec<tables::GroupSummary> = hard_cases()
+        .unwrap()
+        .iter()
+        .filter(|(name, _)| !slow.iter().any(|s| name.contains(s)))
+        .map(|(name, cases)| tables::solve_group(name, cases, GlobalizationChoice::Auto))
+        .collect();
+    assert_eq!(groups.len(), 5);
+    assert_in_readme("hard", &tables::from_zero_hard(&groups));
 }

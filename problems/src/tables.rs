@@ -373,8 +373,10 @@ pub struct GroupSummary {
     pub points: usize,
     /// Cases that converged.
     pub converged: usize,
-    /// Largest and median iteration count of the converged cases (0 when none).
+    /// Largest iteration count of the converged cases (0 when none).
     pub worst: usize,
+    /// Largest iteration count of all cases, converged or not.
+    pub largest: usize,
     /// Median iteration count of the converged cases.
     pub median: usize,
     /// Line-search backtracks over the group.
@@ -383,6 +385,8 @@ pub struct GroupSummary {
     pub strategies: Vec<(String, usize)>,
     /// `label (termination)` or `label: error` of each case that did not converge.
     pub failures: Vec<String>,
+    /// The distinct terminations (or errors) of the cases that did not converge.
+    pub terminations: Vec<String>,
     /// Cases that did not converge or took more than 60 iterations: the label, the
     /// iterations and per attempt its strategy, iterations and outcome.
     pub details: Vec<String>,
@@ -414,10 +418,12 @@ pub fn solve_group(
         points: cases.len(),
         converged: 0,
         worst: 0,
+        largest: 0,
         median: 0,
         backtracks: 0,
         strategies: Vec::new(),
         failures: Vec::new(),
+        terminations: Vec::new(),
         details: Vec::new(),
         seconds: 0.0,
     };
@@ -429,10 +435,14 @@ pub fn solve_group(
             Ok(sol) => sol,
             Err(e) => {
                 g.failures.push(format!("{}: {e}", case.label));
+                if !g.terminations.contains(&e.to_string()) {
+                    g.terminations.push(e.to_string());
+                }
                 continue;
             }
         };
         g.backtracks += sol.counters.line_search_backtracks;
+        g.largest = g.largest.max(sol.iterations);
         if !sol.converged || sol.iterations > 60 {
             let mut d = format!("{} ({} iterations):", case.label, sol.iterations);
             for a in &sol.attempts {
@@ -452,6 +462,9 @@ pub fn solve_group(
         } else {
             g.failures
                 .push(format!("{} ({})", case.label, sol.termination));
+            if !g.terminations.contains(&sol.termination) {
+                g.terminations.push(sol.termination.clone());
+            }
             "failed".to_string()
         };
         match g.strategies.iter_mut().find(|(k, _)| *k == strategy) {
@@ -495,26 +508,26 @@ pub fn from_zero_grid(auto: &[GroupSummary], hybrid: &[GroupSummary]) -> Table {
     table
 }
 
-/// The README's table of the hard cases solved from zero (`auto`): per case the
-/// converged points of its group, the worst iteration count, the strategies (or `failed`)
-/// and the wall time (the timing column).
+/// The README's table of the hard cases solved from zero (`auto`): per case (a group of
+/// cases for the LCP) the cases that converged, the largest iteration count (converged or
+/// not), the strategies that converged or the terminations of those that did not, and the
+/// wall time (the timing column).
 pub fn from_zero_hard(groups: &[GroupSummary]) -> Table {
     let mut table = Table::new(
-        &[
-            "case",
-            "converged",
-            "worst iterations",
-            "strategies",
-            "seconds",
-        ],
+        &["case", "converged", "iterations", "outcome", "seconds"],
         &[4],
     );
     for g in groups {
+        let outcome = if g.terminations.is_empty() {
+            g.strategies_text()
+        } else {
+            format!("not converged: {}", g.terminations.join("; "))
+        };
         table.rows.push(vec![
             g.name.clone(),
             format!("{} of {}", g.converged, g.points),
-            g.worst.to_string(),
-            g.strategies_text(),
+            g.largest.to_string(),
+            outcome,
             format!("{:.1}", g.seconds),
         ]);
     }

@@ -505,6 +505,23 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
     for word in ["invalid `solver.time_samples` = 10000", "8..=8192"] {
         assert!(err(&o).contains(word), "{word}: {}", err(&o));
     }
+    // A value nested 5,000 deep (arrays of arrays): the parser's recursion limit, reported with the
+    // line and column where it stopped.
+    let deep = dir.path().join("deep.toml");
+    std::fs::write(
+        &deep,
+        format!(
+            "title = \"deep\"\nx = {}{}\n",
+            "[".repeat(5000),
+            "]".repeat(5000)
+        ),
+    )
+    .unwrap();
+    let o = ssn(&["solve", deep.to_str().unwrap()]);
+    assert_exit(&o, 2, "deep nesting");
+    for word in [deep.to_str().unwrap(), "line 2", "recurs"] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
     // The LCP's dense matrix has order contacts x time_samples <= 8192: with two contacts
     // 4096 samples pass the loader and 4097 are refused by solve, sweep and scene-check,
     // naming the key, the value and the range for that number of contacts.
