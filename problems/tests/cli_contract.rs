@@ -746,3 +746,43 @@ fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
         );
     }
 }
+
+/// `ssn solve --csv` carries one force column per contact (`lambda_0`, `lambda_1`, in the
+/// order of the JSON's `contacts`), and the mean of each column over the period (uniform
+/// samples of a trigonometric polynomial of lower degree: exactly its constant term) is the
+/// JSON's `force_mean` of that contact, whose sum is `contact_force_mean`.
+#[test]
+fn the_solve_csv_has_a_force_column_per_contact_matching_the_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("two.csv");
+    let o = ssn(&[
+        "solve",
+        &scene("two_contacts.toml"),
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 0, "two contacts");
+    let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header, ["t", "u_tip", "lambda_0", "lambda_1"]);
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let contacts = json["contacts"].as_array().unwrap();
+    let mut sum = 0.0;
+    for (i, contact) in contacts.iter().enumerate() {
+        let mean = rows.iter().map(|r| r[2 + i]).sum::<f64>() / rows.len() as f64;
+        let reported = contact["force_mean"].as_f64().unwrap();
+        // Measured: equal to the last bit.
+        assert!(
+            (mean - reported).abs() <= 1e-15 + 1e-12 * reported.abs(),
+            "contact {i}: CSV mean {mean:e}, JSON {reported:e}"
+        );
+        sum += reported;
+    }
+    assert!(sum < -0.01, "the mid-span contact carries force: {sum}");
+    assert_eq!(json["contact_force_mean"].as_f64().unwrap(), sum);
+}
