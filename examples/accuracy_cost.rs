@@ -49,17 +49,11 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         println!("cheapest setting for {accuracy:.0e} on the tip minimum:");
         print!("{}", study.cheapest_table(accuracy));
     }
-    // The same as a markdown table, pasted as is into the README (`ms`: wall time of one
-    // cold solve, the problem already built).
-    println!("\n| method | for 1e-3 | for 1e-4 |\n|---|---|---|");
-    let (coarse, fine) = (study.cheapest(1e-3), study.cheapest(1e-4));
-    for ((method, a), (_, b)) in coarse.iter().zip(&fine) {
-        let cell = |e: &Option<semismooth_problems::study::Entry>| match e {
-            Some(e) => format!("{}, {:.2} ms", e.setting, 1e3 * e.seconds),
-            None => "not reached".to_string(),
-        };
-        println!("| {} | {} | {} |", method.name(), cell(a), cell(b));
-    }
+    // The README's table (`ms`: wall time of one cold solve, the problem already built).
+    print!(
+        "\n{}",
+        semismooth_problems::tables::cheapest_settings(&study).markdown()
+    );
     let out = PathBuf::from("out/accuracy_cost");
     prepare_directory(&out)?;
     study.write_files(&out)?;

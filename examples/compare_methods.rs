@@ -10,16 +10,9 @@
 
 mod common;
 
-use semismooth_problems::figures::default_settings;
 use semismooth_problems::output::{csv_table, write_atomically, write_line_plot, PlotSpec, Series};
-use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
-use semismooth_problems::runner::{solve_rod, Solution};
-use semismooth_problems::scene::{Method, SolverSettings};
-
-struct Row {
-    label: String,
-    result: Result<Solution, String>,
-}
+use semismooth_problems::rod::MassModel;
+use semismooth_problems::tables::method_comparison;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = common::output_directory("out/compare_methods")?;
@@ -31,135 +24,53 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 fn compare(mass: MassModel, out: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
-    let rod = build_rod(&RodSpec {
-        mass,
-        ..RodSpec::canonical()
-    })?;
-    let scale = rod.model.contact_stiffness_scale();
     let name = format!("{mass:?}").to_lowercase();
-    let base = default_settings(20);
-    let mut cases: Vec<(String, SolverSettings)> = Vec::new();
-    // The reference first: trapezoidal steps with a massless contact node, Moreau–Jean
-    // (restitution 0, first order) otherwise.
-    let (steps, tolerance) = if mass == MassModel::Modified {
-        (4000, 1e-10)
-    } else {
-        (8000, 1e-6)
-    };
-    cases.push((
-        format!("march {steps} steps/period"),
-        SolverSettings {
-            method: Method::March,
-            steps_per_period: steps,
-            march_tolerance: tolerance,
-            ..base.clone()
-        },
-    ));
-    for h in [10, 20, 40] {
-        cases.push((
-            format!("ssn-hb H={h}"),
-            SolverSettings {
-                method: Method::SsnHb,
-                ..default_settings(h)
-            },
-        ));
-    }
-    for k in [1e2, 1e3, 1e5] {
-        cases.push((
-            format!("penalty-hb H=40 kp={k:.0e}x{scale}"),
-            SolverSettings {
-                method: Method::PenaltyHb,
-                penalty_stiffness: Some(k * scale),
-                ..default_settings(40)
-            },
-        ));
-    }
-    for nt in [256, 1024] {
-        for method in [Method::LcpLemke, Method::LcpSsn] {
-            cases.push((
-                format!("{} Nt={nt}", method.name()),
-                SolverSettings {
-                    method,
-                    time_samples: nt,
-                    ..base.clone()
-                },
-            ));
-        }
-    }
-    let rows: Vec<Row> = cases
-        .into_iter()
-        .map(|(label, settings)| Row {
-            label,
-            result: solve_rod(&rod, &settings, None).map_err(|e| e.to_string()),
-        })
-        .collect();
+    let (table, rows) = method_comparison(mass)?;
     let reference = rows[0].result.as_ref().ok().cloned();
-
     println!(
         "\n{} mass (canonical rod, gap 0.5, omega = omega_1). Reference: {}",
         name, rows[0].label
     );
-    // A markdown table, pasted as is into the README (`ms`: wall time of the Newton
-    // iterations / pivots / periods of one cold solve, the problem already built).
-    println!(
-        "\n| method | iterations | ms | tip min | max penetration | mean force | diff. tip min |"
-    );
-    println!("|---|---|---|---|---|---|---|");
+    // The README's table (`ms`: wall time of the Newton iterations / pivots / periods of one
+    // cold solve, the problem already built).
+    print!("\n{}", table.markdown());
     let mut csv_rows: Vec<Vec<f64>> = vec![Vec::new(); 8];
     let mut labels = Vec::new();
     let mut series = Vec::new();
     for row in &rows {
-        match &row.result {
-            Ok(s) => {
-                let diff = reference
-                    .as_ref()
-                    .map(|r| (s.stats.min - r.stats.min).abs() / r.stats.min.abs())
-                    .unwrap_or(f64::NAN);
-                println!(
-                    "| {}{} | {} | {:.2} | {:.6} | {:.1e} | {:.4e} | {:.1e} |",
-                    row.label,
-                    if s.converged {
-                        String::new()
-                    } else {
-                        format!(" (not converged: {})", s.termination)
-                    },
-                    s.iterations,
-                    1e3 * s.solve_seconds,
-                    s.stats.min,
-                    s.stats.max_penetration,
-                    s.stats.mean_contact_force,
-                    diff,
-                );
-                labels.push(row.label.clone());
-                for (column, v) in csv_rows.iter_mut().zip([
-                    if s.converged { 1.0 } else { 0.0 },
-                    s.iterations as f64,
-                    s.solve_seconds,
-                    s.stats.max,
-                    s.stats.min,
-                    s.stats.max_penetration,
-                    s.stats.mean_contact_force,
-                    diff,
-                ]) {
-                    column.push(v);
-                }
-                if s.converged
-                    && (row.label.starts_with("march")
-                        || row.label == "ssn-hb H=40"
-                        || row.label.starts_with("penalty-hb H=40 kp=1e2")
-                        || row.label == "lcp-lemke Nt=1024")
-                {
-                    let period = 2.0 * std::f64::consts::PI / s.omega;
-                    let phase = s.times.iter().map(|t| t / period).collect();
-                    let item = if row.label.starts_with("march") {
-                        Series::dashed(row.label.clone(), phase, s.tip.clone())
-                    } else {
-                        Series::new(row.label.clone(), phase, s.tip.clone())
-                    };
-                    series.push(item);
-                }
+        if let Ok(s) = &row.result {
+            let diff = reference
+                .as_ref()
+                .map(|r| (s.stats.min - r.stats.min).abs() / r.stats.min.abs())
+                .unwrap_or(f64::NAN);
+            labels.push(row.label.clone());
+            for (column, v) in csv_rows.iter_mut().zip([
+                if s.converged { 1.0 } else { 0.0 },
+                s.iterations as f64,
+                s.solve_seconds,
+                s.stats.max,
+                s.stats.min,
+                s.stats.max_penetration,
+                s.stats.mean_contact_force,
+                diff,
+            ]) {
+                column.push(v);
             }
-            Err(e) => println!("| {} | error: {e} | | | | | |", row.label),
+            if s.converged
+                && (row.label.starts_with("march")
+                    || row.label == "ssn-hb H=40"
+                    || row.label.starts_with("penalty-hb H=40 kp=1e2")
+                    || row.label == "lcp-lemke Nt=1024")
+            {
+                let period = 2.0 * std::f64::consts::PI / s.omega;
+                let phase = s.times.iter().map(|t| t / period).collect();
+                let item = if row.label.starts_with("march") {
+                    Series::dashed(row.label.clone(), phase, s.tip.clone())
+                } else {
+                    Series::new(row.label.clone(), phase, s.tip.clone())
+                };
+                series.push(item);
+            }
         }
     }
     let mut text = String::from("method,");

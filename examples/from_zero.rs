@@ -18,11 +18,9 @@
 //! third keeps the groups whose name contains one of its comma-separated parts. Points that
 //! fail or take more than 60 iterations are listed with their attempts.
 
-use std::time::Instant;
-
-use semismooth_problems::from_zero::{hard_cases, public_grid, GridCase};
-use semismooth_problems::runner::solve_rod;
+use semismooth_problems::from_zero::{hard_cases, public_grid};
 use semismooth_problems::scene::GlobalizationChoice;
+use semismooth_problems::tables::solve_group;
 
 fn main() {
     let only = std::env::args().nth(1).filter(|o| o != "all");
@@ -37,7 +35,7 @@ fn main() {
             std::process::exit(2);
         }
     };
-    let mut groups: Vec<(String, Vec<GridCase>)> = Vec::new();
+    let mut groups = Vec::new();
     if only.as_deref().is_none_or(|o| o == "grid") {
         groups.extend(public_grid(&[0.1, 0.2, 0.4]).expect("grid rods build"));
     }
@@ -56,71 +54,26 @@ fn main() {
         {
             continue;
         }
-        let start = Instant::now();
-        let mut converged = 0;
-        let mut iterations = Vec::new();
-        let mut backtracks = 0;
-        let mut strategies: Vec<(String, usize)> = Vec::new();
-        let mut failures = Vec::new();
-        for case in &cases {
-            let mut settings = case.solver_settings();
-            settings.globalization = globalization;
-            match solve_rod(&case.rod, &settings, None) {
-                Ok(sol) => {
-                    backtracks += sol.counters.line_search_backtracks;
-                    if !sol.converged || sol.iterations > 60 {
-                        println!("    {} ({} iterations):", case.label, sol.iterations);
-                        for a in &sol.attempts {
-                            println!(
-                                "        {} {} {}",
-                                a.strategy.name(),
-                                a.iterations,
-                                a.outcome
-                            );
-                        }
-                    }
-                    if sol.converged {
-                        converged += 1;
-                        iterations.push(sol.iterations);
-                    } else {
-                        failures.push(format!("{} ({})", case.label, sol.termination));
-                    }
-                    let s = if sol.converged {
-                        sol.strategy.unwrap_or("-").to_string()
-                    } else {
-                        "failed".to_string()
-                    };
-                    match strategies.iter_mut().find(|(k, _)| *k == s) {
-                        Some((_, n)) => *n += 1,
-                        None => strategies.push((s, 1)),
-                    }
-                }
-                Err(e) => failures.push(format!("{}: {e}", case.label)),
-            }
+        let g = solve_group(&name, &cases, globalization);
+        for d in &g.details {
+            println!("    {}", d.replace('\n', "\n    "));
         }
-        iterations.sort_unstable();
-        let worst = iterations.last().copied().unwrap_or(0);
-        let median = iterations.get(iterations.len() / 2).copied().unwrap_or(0);
-        let strategies: Vec<String> = strategies
-            .iter()
-            .map(|(s, n)| format!("{s}: {n}"))
-            .collect();
         println!(
             "{:<44} {:>6} {:>9} {:>6} {:>7} {:>10} {:>8.2}  {}",
-            name,
-            cases.len(),
-            converged,
-            worst,
-            median,
-            backtracks,
-            start.elapsed().as_secs_f64(),
-            strategies.join(", ")
+            g.name,
+            g.points,
+            g.converged,
+            g.worst,
+            g.median,
+            g.backtracks,
+            g.seconds,
+            g.strategies_text()
         );
-        for f in failures.iter().take(4) {
+        for f in g.failures.iter().take(4) {
             println!("    not converged: {f}");
         }
-        if failures.len() > 4 {
-            println!("    ... and {} more", failures.len() - 4);
+        if g.failures.len() > 4 {
+            println!("    ... and {} more", g.failures.len() - 4);
         }
     }
 }

@@ -40,10 +40,12 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
     let rod = rod();
     let reference = reference(&rod);
     let scale = rod.model.contact_stiffness_scale();
+    // With the relative difference of each to the reference, measured (release build).
     let finest = [
-        ("ssn-hb H=40", solve(&rod, &hb(Method::SsnHb, 40))),
+        ("ssn-hb H=40", 6.10e-5, solve(&rod, &hb(Method::SsnHb, 40))),
         (
             "penalty-hb H=40 kp=1e5 scale",
+            1.15e-4,
             solve(
                 &rod,
                 &SolverSettings {
@@ -54,27 +56,40 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
         ),
         (
             "lcp-lemke Nt=1024",
+            6.08e-6,
             solve(&rod, &lcp(Method::LcpLemke, 1024)),
         ),
-        ("lcp-ssn Nt=1024", solve(&rod, &lcp(Method::LcpSsn, 1024))),
+        (
+            "lcp-ssn Nt=1024",
+            6.08e-6,
+            solve(&rod, &lcp(Method::LcpSsn, 1024)),
+        ),
     ];
-    for (name, s) in &finest {
+    // Each within twice its measured difference: HB's truncation at H = 40, the penalty's
+    // limit at fixed H, the LCP's time step; all within 2e-3 a priori.
+    let tolerance = |measured: f64| 2.0 * measured;
+    for (name, measured, s) in &finest {
         let d = relative(s.stats.min, reference.stats.min);
         println!(
             "{name:<30} tip min {:.8} (vs march {:.2e}), penetration {:.2e}, mean force {:.6e}",
             s.stats.min, d, s.stats.max_penetration, s.stats.mean_contact_force
         );
-        // 2e-3 relative at the finest settings.
-        assert!(d < 2e-3, "{name}: {d:e}");
+        assert!(
+            d < tolerance(*measured),
+            "{name}: {d:e}, measured {measured:e}"
+        );
         assert!(s.stats.mean_contact_force < 0.0);
     }
-    for (a, sa) in &finest {
-        for (b, sb) in &finest {
-            assert!(relative(sa.stats.min, sb.stats.min) < 2e-3, "{a} vs {b}");
+    for (a, ma, sa) in &finest {
+        for (b, mb, sb) in &finest {
+            let d = relative(sa.stats.min, sb.stats.min);
+            assert!(d < tolerance(*ma) + tolerance(*mb), "{a} vs {b}: {d:e}");
         }
     }
-    // Lemke and Newton solve the same LCP: same answer to solver precision.
-    assert!(relative(finest[2].1.stats.min, finest[3].1.stats.min) < 1e-9);
+    // Lemke and Newton solve the same LCP: same answer to round-off (measured 8.5e-16).
+    let same = relative(finest[2].2.stats.min, finest[3].2.stats.min);
+    println!("lcp-lemke vs lcp-ssn at Nt = 1024: {same:e}");
+    assert!(same < 1e-13, "{same:e}");
 }
 
 #[test]

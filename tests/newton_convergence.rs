@@ -604,6 +604,47 @@ fn singular_jacobian_is_a_termination_carrying_the_linear_solver_error() {
     assert_eq!(x, [0.0]);
 }
 
+/// A linear solver that cannot allocate its factors: every `factor` is `OutOfMemory`.
+struct NoMemory;
+
+impl semismooth::LinearSolve for NoMemory {
+    fn solve_in_place(&mut self, _rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        Err(LinearSolveError::NotFactored)
+    }
+}
+
+impl semismooth::Factorize<Mat<f64>> for NoMemory {
+    fn factor(&mut self, _jac: &Mat<f64>) -> Result<(), LinearSolveError> {
+        Err(LinearSolveError::OutOfMemory {
+            during: "the dense factors",
+        })
+    }
+}
+
+/// A factorization that runs out of memory ends the run with its own termination,
+/// `out-of-memory`, not as a singular Jacobian; x is kept.
+#[test]
+fn an_allocation_failure_is_its_own_termination_not_a_singular_jacobian() {
+    let mut p = scalar(|x| x * x - 4.0, |x| 2.0 * x);
+    let mut x = [1.0];
+    let report = not_converged(solve(
+        &mut p,
+        &mut NoMemory,
+        &mut x,
+        &NewtonOptions::default(),
+    ));
+    assert_eq!(
+        report.termination,
+        Termination::LinearSolve(LinearSolveError::OutOfMemory {
+            during: "the dense factors"
+        })
+    );
+    let text = report.termination.to_string();
+    assert!(text.starts_with("out-of-memory"), "{text}");
+    assert!(!text.contains("singular"), "{text}");
+    assert_eq!(x, [1.0]);
+}
+
 /// A NaN residual at the start (sqrt of a negative number) is NonFinite with x
 /// unchanged; the reported norm is infinite, not NaN.
 #[test]

@@ -28,3 +28,4 @@ pub mod state;
 pub mod structures;
 pub mod study;
 pub mod sweep;
+pub mod tables;

@@ -502,8 +502,60 @@ fn refusals_name_the_file_the_key_the_value_and_what_is_allowed() {
     std::fs::write(&lcp, text).unwrap();
     let o = ssn(&["solve", &lcp]);
     assert_exit(&o, 2, "lcp");
-    for word in ["solver.time_samples", "10000", "8192"] {
+    for word in ["invalid `solver.time_samples` = 10000", "8..=8192"] {
         assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // A value nested 5,000 deep (arrays of arrays): the parser's recursion limit, reported with the
+    // line and column where it stopped.
+    let deep = dir.path().join("deep.toml");
+    std::fs::write(
+        &deep,
+        format!(
+            "title = \"deep\"\nx = {}{}\n",
+            "[".repeat(5000),
+            "]".repeat(5000)
+        ),
+    )
+    .unwrap();
+    let o = ssn(&["solve", deep.to_str().unwrap()]);
+    assert_exit(&o, 2, "deep nesting");
+    for word in [deep.to_str().unwrap(), "line 2", "recurs"] {
+        assert!(err(&o).contains(word), "{word}: {}", err(&o));
+    }
+    // The LCP's dense matrix has order contacts x time_samples <= 8192: with two contacts
+    // 4096 samples pass the loader and 4097 are refused by solve, sweep and scene-check,
+    // naming the key, the value and the range for that number of contacts.
+    let two = |samples: usize, method: &str| {
+        let path = dir.path().join(format!("two_{samples}_{method}.toml"));
+        std::fs::write(
+            &path,
+            format!(
+                "[rod]\nelements = 20\nmass = \"modified\"\n[forcing]\namplitude = 0.04\n\
+                 [[contact.point]]\nnode = 20\ngap = 0.5\n[[contact.point]]\nnode = 10\n\
+                 gap = 0.3\n[solver]\nmethod = \"{method}\"\ntime_samples = {samples}\n\
+                 [sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.1\n"
+            ),
+        )
+        .unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    for method in ["lcp-lemke", "lcp-ssn"] {
+        let ok = two(4096, method);
+        assert_exit(&ssn(&["scene-check", &ok]), 0, "4096 samples, two contacts");
+        let refused = two(4097, method);
+        for command in ["solve", "sweep", "scene-check"] {
+            let o = ssn(&[command, &refused]);
+            assert_exit(&o, 2, &format!("{command} {refused}"));
+            for word in [
+                refused.as_str(),
+                "invalid `solver.time_samples` = 4097",
+                "8..=4096",
+                method,
+                "2 contacts",
+            ] {
+                assert!(err(&o).contains(word), "{command} {word}: {}", err(&o));
+            }
+        }
     }
 }
 
@@ -693,4 +745,44 @@ fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
             "{text}"
         );
     }
+}
+
+/// `ssn solve --csv` carries one force column per contact (`lambda_0`, `lambda_1`, in the
+/// order of the JSON's `contacts`), and the mean of each column over the period (uniform
+/// samples of a trigonometric polynomial of lower degree: exactly its constant term) is the
+/// JSON's `force_mean` of that contact, whose sum is `contact_force_mean`.
+#[test]
+fn the_solve_csv_has_a_force_column_per_contact_matching_the_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("two.csv");
+    let o = ssn(&[
+        "solve",
+        &scene("two_contacts.toml"),
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 0, "two contacts");
+    let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header, ["t", "u_tip", "lambda_0", "lambda_1"]);
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let contacts = json["contacts"].as_array().unwrap();
+    let mut sum = 0.0;
+    for (i, contact) in contacts.iter().enumerate() {
+        let mean = rows.iter().map(|r| r[2 + i]).sum::<f64>() / rows.len() as f64;
+        let reported = contact["force_mean"].as_f64().unwrap();
+        // Measured: equal to the last bit.
+        assert!(
+            (mean - reported).abs() <= 1e-15 + 1e-12 * reported.abs(),
+            "contact {i}: CSV mean {mean:e}, JSON {reported:e}"
+        );
+        sum += reported;
+    }
+    assert!(sum < -0.01, "the mid-span contact carries force: {sum}");
+    assert_eq!(json["contact_force_mean"].as_f64().unwrap(), sum);
 }

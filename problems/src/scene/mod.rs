@@ -507,6 +507,10 @@ fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     };
     // An LCP without contact is empty: allowed, solved as the linear response.
     let solver = ck.solver(&raw.solver)?;
+    let contacts = model
+        .as_ref()
+        .map_or(rod.contacts.len(), |m| m.contacts.len());
+    ck.lcp_size(&solver, contacts, raw.solver.time_samples.is_some())?;
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
@@ -862,6 +866,45 @@ impl Check<'_> {
             });
         }
         Ok(contacts)
+    }
+
+    /// The periodic LCP's matrix is dense, of order `contacts x time_samples`: that order
+    /// must not exceed [`crate::lcp::MAX_LCP_SIZE`], so `solver.time_samples` is refused
+    /// above `MAX_LCP_SIZE / contacts` for `lcp-lemke` and `lcp-ssn`.
+    fn lcp_size(
+        &self,
+        solver: &SolverSettings,
+        contacts: usize,
+        given: bool,
+    ) -> Result<(), SceneError> {
+        let nt = solver.time_samples;
+        if !matches!(solver.method, Method::LcpLemke | Method::LcpSsn)
+            || contacts.saturating_mul(nt) <= crate::lcp::MAX_LCP_SIZE
+        {
+            return Ok(());
+        }
+        let most = crate::lcp::MAX_LCP_SIZE / contacts;
+        let value = if given {
+            nt.to_string()
+        } else {
+            format!("{nt} (the default)")
+        };
+        let allowed = if most >= 8 {
+            format!(
+                "an integer in 8..={most} for {} with {contacts} contacts (contacts x \
+                 time_samples <= {}: the LCP matrix is dense)",
+                solver.method.name(),
+                crate::lcp::MAX_LCP_SIZE
+            )
+        } else {
+            format!(
+                "none for {} with {contacts} contacts (contacts x time_samples <= {} with \
+                 time_samples >= 8: the LCP matrix is dense); use ssn-hb or penalty-hb",
+                solver.method.name(),
+                crate::lcp::MAX_LCP_SIZE
+            )
+        };
+        Err(self.invalid("solver.time_samples", value, &allowed))
     }
 
     /// `[solver]`: the method and its discretisation and iteration settings, defaults filled
