@@ -51,8 +51,9 @@
 //!    `F_mu(x) = 0` from the initial guess, `mu` from the problem's smoothing scale down three
 //!    decades (Newton with an Armijo search on the smooth merit at the start, then the
 //!    crate's pseudo-arclength continuation in `log10 mu` with the tangent predictor), then
-//!    full Newton steps on `F` (stopped, like the first ones, when they stagnate); a path
-//!    that stops after two decades hands its last point to those steps too. When this
+//!    full Newton steps on `F`; a path that stops after two decades hands its last point to
+//!    those steps too (stopped when they stagnate: after 15 steps, `|F|` did not fall
+//!    tenfold over the last 10). When this
 //!    fails, the path is followed once more with its points corrected to a tolerance
 //!    shrinking like `mu` (`|F_mu| <= beta mu`, the neighbourhood of smoothing Newton
 //!    methods; [`ParameterDependent::tolerance_scale`](crate::ParameterDependent::tolerance_scale)):

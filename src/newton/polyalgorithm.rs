@@ -84,21 +84,23 @@ impl<J> NewtonSolver<J> {
         let mut last = termination;
         let mut strategy = Strategy::FullSteps;
 
-        // Full steps on F from the end of a path (it is near a root: usually a few steps;
-        // they stop when they stagnate, as the first ones do, leaving the budget to the
-        // next attempt).
+        // Full steps on F from the end of a path (it is near a root: usually a few steps,
+        // sometimes a slow creep that still converges). From a path that stopped short they
+        // stop when they stagnate, as the first ones do, leaving the budget to the next
+        // attempt.
         let finish = |solver: &mut Self,
                       problem: &mut P,
                       linear: &mut S,
                       x: &mut [f64],
-                      used: usize,
+                      (used, reached): (usize, bool),
                       counters: &mut WorkCounters,
                       log: &mut Log| {
             let rules = KernelRules {
                 max_iterations: max_iterations
                     .saturating_sub(used)
                     .clamp(1, full_steps.max(1)),
-                ..first
+                stagnation: (!reached && first.stagnation.is_some()).then_some(FINISH_STAGNATION),
+                ..base
             };
             solver.phase(problem, linear, x, &rules, counters, log)
         };
@@ -130,7 +132,15 @@ impl<J> NewtonSolver<J> {
                 used += outcome.iterations;
                 strategy = Strategy::Smoothing;
                 if outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL {
-                    let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                    let (termination, run) = finish(
+                        self,
+                        problem,
+                        linear,
+                        x,
+                        (used, outcome.reached),
+                        counters,
+                        log,
+                    );
                     used += run.iterations;
                     attempts.push(Attempt::new(
                         Strategy::Smoothing,
@@ -205,7 +215,8 @@ impl<J> NewtonSolver<J> {
                 used += outcome.iterations;
                 strategy = Strategy::Homotopy;
                 if outcome.reached {
-                    let (termination, run) = finish(self, problem, linear, x, used, counters, log);
+                    let (termination, run) =
+                        finish(self, problem, linear, x, (used, true), counters, log);
                     attempts.push(Attempt::new(
                         Strategy::Homotopy,
                         outcome.iterations + run.iterations,
@@ -346,6 +357,16 @@ const SMOOTHING_START_ITERATIONS: usize = 30;
 const FULL_STEP_STAGNATION: Stagnation = Stagnation {
     after: 8,
     window: 6,
+    factor: 0.1,
+};
+
+/// Full steps from the end of a path that stopped short stop when, after 15 steps, the
+/// last 10 did not bring `|F|` ten times below the smallest before them (a looser rule than
+/// the first full steps': from such a point they may creep and still converge, measured
+/// on `c = 100 x` the default on the canonical rod).
+const FINISH_STAGNATION: Stagnation = Stagnation {
+    after: 15,
+    window: 10,
     factor: 0.1,
 };
 
