@@ -199,10 +199,9 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
     /// `(mu / mu_0)^rate = 10^(-rate p)`: with rate 1, points are corrected to
     /// `|F_mu| <= tolerance mu / mu_0`, the neighbourhood of the path where smoothing Newton
     /// methods keep their iterates (`|F_mu| <= beta mu`, Chen, Harker, Kanzow & Smale).
+    /// (Rate 0 gives 1: `smallest_scale <= 1`, the run's tolerance being at most the
+    /// path's accuracy.)
     fn tolerance_scale(&self, p: f64) -> f64 {
-        if self.tolerance_rate == 0.0 {
-            return 1.0;
-        }
         10f64
             .powf(-self.tolerance_rate * p.max(0.0))
             .max(self.smallest_scale)
