@@ -804,8 +804,9 @@ pub fn describe(scene: &Scene, rod: &Structure, modes: &[f64]) -> String {
             ));
         }
         line(format!(
-            "contact stiffness static {:.6e} (default c = 10 x static = {:.6e}), local K[dof,dof] = {:.6e} (penalty unit)",
+            "contact stiffness static {:.6e}, shared {:.6e} (default c = 10 x shared = {:.6e}), local K[dof,dof] = {:.6e} (penalty unit)",
             rod.model.static_contact_stiffness().unwrap_or(f64::NAN),
+            rod.model.shared_contact_stiffness().unwrap_or(f64::NAN),
             rod.model.default_complementarity_constant(),
             rod.model.contact_stiffness_scale()
         ));

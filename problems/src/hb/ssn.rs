@@ -17,7 +17,7 @@ use crate::model::StructuralModel;
 /// |---|---|---|
 /// | `harmonics` (`H`) | 20 | `>= 1` |
 /// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` (256 for `H = 20`) | `> 2H` |
-/// | `c` | `None`: [`StructuralModel::default_complementarity_constant`] (10 x the static contact stiffness) | finite, `> 0` |
+/// | `c` | `None`: [`StructuralModel::default_complementarity_constant`] (10 x the static contact stiffness shared by the contacts that close together, [`StructuralModel::shared_contact_stiffness`]) | finite, `> 0` |
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HbOptions {
     /// Number of harmonics `H`.
