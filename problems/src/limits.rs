@@ -78,7 +78,9 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                         + 600.0 * n * s
                         + 8.0 * (2.0 * s * nt + 3.0 * m * s * s)
                         + 3300.0 * m * s
-                        + dense_preconditioner_bytes(m, s),
+                        + dense_preconditioner_bytes(m, s)
+                        // The static compliance between contacts behind the default `c`.
+                        + 8.0 * m * m,
                     what: format!(
                         "per-harmonic factorizations of {elements} dofs x {} harmonic functions \
                          (matrix-free condensed system of {:.0} unknowns)",
