@@ -345,8 +345,7 @@ impl StructuralModel {
     /// `None` without contacts or when `K` cannot be factored.
     pub fn static_contact_stiffness(&self) -> Option<f64> {
         let m = self.contacts.len();
-        let compliance = self.static_contact_compliance()?;
-        mean_stiffness((0..m).map(|i| compliance[i * m + i]))
+        mean_stiffness(diagonal(&self.static_contact_compliance()?, m))
     }
 
     /// Static stiffness per contact when the contacts that push the structure the same way
@@ -358,12 +357,14 @@ impl StructuralModel {
     /// that move as one; `None` when the static contact stiffness is.
     pub fn shared_contact_stiffness(&self) -> Option<f64> {
         let m = self.contacts.len();
-        let compliance = self.static_contact_compliance()?;
-        let stiffness = mean_stiffness((0..m).map(|i| compliance[i * m + i]))?;
-        let positive: Vec<f64> = compliance.iter().map(|v| v.max(0.0)).collect();
-        let largest = (0..m).map(|i| compliance[i * m + i]).fold(0.0, f64::max);
+        let mut compliance = self.static_contact_compliance()?;
+        let stiffness = mean_stiffness(diagonal(&compliance, m))?;
+        let largest = diagonal(&compliance, m).fold(0.0, f64::max);
+        for v in &mut compliance {
+            *v = v.max(0.0);
+        }
         // (Exactly 1 when the root is the largest compliance: one contact keeps its value.)
-        let sharing = (perron_root(&positive, m) / largest).max(1.0);
+        let sharing = (perron_root(&compliance, m) / largest).max(1.0);
         Some(stiffness / sharing)
     }
 
@@ -407,6 +408,11 @@ fn first_non_finite(part: &'static str, values: &[f64]) -> Result<(), InvalidMod
     }
 }
 
+/// The diagonal of the row-major `m x m` matrix `a`.
+fn diagonal(a: &[f64], m: usize) -> impl Iterator<Item = f64> + '_ {
+    a.iter().step_by(m + 1).copied()
+}
+
 /// Perron root of the symmetric non-negative `m x m` matrix `a` (row-major): power
 /// iteration from the vector of ones, stopped when the Collatz-Wielandt bounds
 /// `min_i (a x)_i / x_i <= rho <= max_i (a x)_i / x_i` agree to `1e-6` relative, or when
@@ -426,8 +432,9 @@ fn perron_root(a: &[f64], m: usize) -> f64 {
                 .sum();
         }
         let (mut lower, mut high) = (f64::INFINITY, 0.0f64);
+        // (Every `x_i > 0`: it starts at 1 and is floored below.)
         for (yi, xi) in y.iter().zip(&x) {
-            let ratio = if *xi > 0.0 { yi / xi } else { 0.0 };
+            let ratio = yi / xi;
             lower = lower.min(ratio);
             high = high.max(ratio);
         }
