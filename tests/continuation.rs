@@ -6,7 +6,7 @@
 use faer::Mat;
 use semismooth::continuation::{
     natural_sweep, Branch, Continuation, ContinuationError, ContinuationEvent, ContinuationOptions,
-    ContinuationTermination, CorrectorFailure, Direction, Predictor,
+    ContinuationTermination, CorrectorFailure, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
 use semismooth::newton::{self, Globalization, NewtonOptions};
@@ -660,6 +660,131 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
         }
     );
     assert_eq!(problem.parameter(), 1.0);
+}
+
+#[test]
+fn a_run_never_spends_more_corrector_iterations_than_its_budget() {
+    // The unlimited S-curve branch is the reference: a budget only cuts it short, so its
+    // points are a prefix of the reference's, and a budget at least the reference's total
+    // changes nothing.
+    let options = |budget: Option<usize>| ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        max_total_corrector_iterations: budget,
+        ..Default::default()
+    };
+    let run = |budget: Option<usize>| {
+        let mut problem = s_curve();
+        let mut solver = FaerDenseLu::new();
+        Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(budget))
+            .unwrap()
+            .run()
+            .unwrap()
+    };
+    let reference = run(None);
+    let total = reference.counters.corrector_iterations as usize;
+    assert!(total > 20, "{total}");
+    assert_eq!(run(Some(total)), reference);
+    // The start takes its own iterations: a smaller budget is a start that did not
+    // converge, a typed error.
+    let start = reference.points[0].iterations;
+    assert!(start > 1, "{start}");
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let error = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(Some(1)))
+        .unwrap()
+        .run()
+        .unwrap_err();
+    assert!(
+        matches!(
+            error,
+            ContinuationError::StartNotConverged {
+                failure: CorrectorFailure::MaxIterations { iterations: 1, .. },
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    for budget in [start, start + 1, start + 4, total / 3, total / 2, total - 1] {
+        let branch = run(Some(budget));
+        assert!(
+            branch.counters.corrector_iterations as usize <= budget,
+            "{budget}: {}",
+            branch.counters.corrector_iterations
+        );
+        let last = branch.points.last().unwrap().parameter;
+        match branch.termination {
+            ContinuationTermination::IterationBudgetSpent {
+                parameter,
+                budget: b,
+            } => {
+                assert_eq!((parameter, b), (last, budget));
+                assert!(branch.points.len() < reference.points.len());
+            }
+            // The budget ran out in the re-solve of the point past the bound: that point
+            // is kept where the step put it (as when the re-solve fails for any reason).
+            ContinuationTermination::ReachedBound { parameter, bound } => {
+                assert_eq!(budget, total - 1);
+                assert_eq!((parameter, bound), (last, 1.0));
+                assert!(parameter > 1.0);
+            }
+            ref other => panic!("{budget}: {other:?}"),
+        }
+        let compared = branch.points.len().min(reference.points.len() - 1);
+        for (cut, full) in branch.points[..compared].iter().zip(&reference.points) {
+            assert_eq!(cut, full);
+        }
+    }
+
+    // A run that fails for good and restarts: each failing attempt, corner pass and
+    // segment start counts. Without a budget it spends far more than 30 iterations on the
+    // restarts at the end of the branch (`x - p = 0` up to `p = 1`, no root beyond:
+    // `x^2 + p = 0`); with one it stops at 30.
+    let failing = |budget: Option<usize>| {
+        let mut problem = Closure {
+            n: 1,
+            p: 0.0,
+            f: Box::new(|x, p, out| out[0] = if p > 1.0 { x[0] * x[0] + p } else { x[0] - p }),
+            j: Box::new(|x, p, jac| jac[(0, 0)] = if p > 1.0 { 2.0 * x[0] } else { 1.0 }),
+            fp: Some(Box::new(|_, p, out| {
+                out[0] = if p > 1.0 { 1.0 } else { -1.0 }
+            })),
+        };
+        let mut solver = FaerDenseLu::new();
+        let options = ContinuationOptions {
+            max_consecutive_failures: 8,
+            restarts: Some(RestartPolicy::default()),
+            max_total_corrector_iterations: budget,
+            ..Default::default()
+        };
+        Continuation::new(&mut problem, &mut solver, &[0.9], 0.9, options)
+            .unwrap()
+            .run()
+            .unwrap()
+    };
+    let unlimited = failing(None);
+    assert!(unlimited.counters.corrector_iterations > 60);
+    let limited = failing(Some(30));
+    assert!(limited.counters.corrector_iterations <= 30);
+    assert!(matches!(
+        limited.termination,
+        ContinuationTermination::IterationBudgetSpent { budget: 30, .. }
+    ));
+
+    // No budget of zero iterations: the error names the field.
+    let mut problem = s_curve();
+    let mut solver = FaerDenseLu::new();
+    let error = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(Some(0)))
+        .err()
+        .unwrap();
+    assert_eq!(
+        error,
+        ContinuationError::InvalidOption {
+            name: "max_total_corrector_iterations",
+            value: 0.0,
+            allowed: ">= 1"
+        }
+    );
 }
 
 #[test]

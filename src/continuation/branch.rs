@@ -166,6 +166,15 @@ pub enum ContinuationTermination {
         /// Parameter of the restart point.
         parameter: f64,
     },
+    /// The corrector iterations allowed over the run
+    /// ([`ContinuationOptions::max_total_corrector_iterations`](super::ContinuationOptions::max_total_corrector_iterations))
+    /// were spent.
+    IterationBudgetSpent {
+        /// Parameter of the last accepted point.
+        parameter: f64,
+        /// The budget (every corrector iteration of the run, all of it spent).
+        budget: usize,
+    },
     /// A new segment (after a restart or a walk over corners) could not be corrected at
     /// its starting parameter.
     SegmentStartFailed {
@@ -211,6 +220,10 @@ impl std::fmt::Display for ContinuationTermination {
                 f,
                 "stalled at p = {parameter}: no step ahead (a corner the continuation cannot \
                  turn), and the only step found goes back along the branch"
+            ),
+            Self::IterationBudgetSpent { parameter, budget } => write!(
+                f,
+                "the {budget} corrector iterations allowed were spent (last point at p = {parameter})"
             ),
             Self::SegmentStartFailed { parameter, failure } => write!(
                 f,

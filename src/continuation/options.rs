@@ -72,6 +72,12 @@ pub struct ContinuationOptions {
     pub parameter_max: f64,
     /// Largest number of accepted points, the starting point included. Default `1000`.
     pub max_points: usize,
+    /// Corrector iterations allowed over the whole run: every attempt, accepted or not,
+    /// the start, segment starts after restarts and corner passes. An attempt gets at most
+    /// what is left, and the run ends
+    /// ([`ContinuationTermination::IterationBudgetSpent`](super::ContinuationTermination::IterationBudgetSpent))
+    /// once it is spent, so a run never does more. Default `None` (no limit).
+    pub max_total_corrector_iterations: Option<usize>,
     /// Failed attempts in a row (each halving the step) after which the run stops.
     /// Default `3` (NLvib).
     pub max_consecutive_failures: usize,
@@ -160,6 +166,7 @@ impl Default for ContinuationOptions {
             parameter_min: f64::NEG_INFINITY,
             parameter_max: f64::INFINITY,
             max_points: 1000,
+            max_total_corrector_iterations: None,
             max_consecutive_failures: 3,
             theta: 0.5,
             state_scale: None,
@@ -221,6 +228,10 @@ impl ContinuationOptions {
             ("max_corrector_iterations", self.max_corrector_iterations),
             ("max_points", self.max_points),
             ("max_consecutive_failures", self.max_consecutive_failures),
+            (
+                "max_total_corrector_iterations",
+                self.max_total_corrector_iterations.unwrap_or(1),
+            ),
         ] {
             if count == 0 {
                 return Err(invalid(name, 0.0, ">= 1"));

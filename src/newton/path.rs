@@ -276,6 +276,7 @@ fn path_options(n: usize, plan: &PathPlan) -> ContinuationOptions {
         direction: Direction::Increasing,
         refine_folds: false,
         restarts: Some(RestartPolicy::default()),
+        max_total_corrector_iterations: Some(plan.budget),
         predictor: plan.predictor,
         ..ContinuationOptions::default()
     }
@@ -315,6 +316,10 @@ where
         reason: None,
         counters: WorkCounters::default(),
     };
+    if plan.budget == 0 {
+        outcome.reason = Some("no iterations left".into());
+        return outcome;
+    }
     let start = x.to_vec();
     let mut continuation = match Continuation::new(homotopy, solver, &start, 0.0, options) {
         Ok(c) => c,
@@ -324,7 +329,7 @@ where
         }
     };
     let mut last = 0.0;
-    while let Some(item) = continuation.next() {
+    for item in continuation.by_ref() {
         match item {
             Ok(point) => {
                 outcome.furthest = outcome.furthest.max(point.parameter);
@@ -335,10 +340,6 @@ where
                 outcome.reason = Some(e.to_string());
                 break;
             }
-        }
-        if continuation.counters().corrector_iterations as usize >= plan.budget {
-            outcome.reason = Some(format!("the iteration budget ({}) was spent", plan.budget));
-            break;
         }
     }
     let counters = continuation.counters();

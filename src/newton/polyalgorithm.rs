@@ -96,9 +96,9 @@ impl<J> NewtonSolver<J> {
                       counters: &mut WorkCounters,
                       log: &mut Log| {
             let rules = KernelRules {
-                max_iterations: max_iterations
-                    .saturating_sub(used)
-                    .clamp(1, full_steps.max(1)),
+                // What is left of the budget (none left: the end of the path is only
+                // checked against the tolerance).
+                max_iterations: max_iterations.saturating_sub(used).min(full_steps.max(1)),
                 stagnation: (!reached && first.stagnation.is_some()).then_some(FINISH_STAGNATION),
                 ..base
             };

@@ -491,6 +491,13 @@ where
                 ),
             )
         }
+        (Some(ContinuationTermination::IterationBudgetSpent { parameter, budget }), None) => (
+            false,
+            format!(
+                "the {budget} corrector iterations allowed were spent at omega_ratio {}",
+                ratio(*parameter)
+            ),
+        ),
         (Some(ContinuationTermination::MaxPoints { points }), None) => (
             false,
             format!(

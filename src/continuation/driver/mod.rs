@@ -267,6 +267,29 @@ where
         matches!(self.phase, Phase::Finished)
     }
 
+    /// Corrector iterations left of [`ContinuationOptions::max_total_corrector_iterations`]
+    /// (`None`: no limit).
+    pub(super) fn iterations_left(&self) -> Option<usize> {
+        self.options
+            .max_total_corrector_iterations
+            .map(|budget| budget.saturating_sub(self.corrector_counts.iterations as usize))
+    }
+
+    /// Ends the run when its corrector iterations are spent (the last accepted point at
+    /// `parameter`); `true` when it did.
+    fn stop_if_budget_spent(&mut self, parameter: f64) -> bool {
+        match (
+            self.iterations_left(),
+            self.options.max_total_corrector_iterations,
+        ) {
+            (Some(0), Some(budget)) => {
+                self.finish(ContinuationTermination::IterationBudgetSpent { parameter, budget });
+                true
+            }
+            _ => false,
+        }
+    }
+
     fn finish(&mut self, termination: ContinuationTermination) {
         if !self.finished() {
             self.termination = Some(termination);
@@ -322,6 +345,10 @@ where
         self.segment_direction = direction;
         self.segment_points = 0;
         self.set_trust(&x, p, 0.0);
+        let parameter = self.last.as_ref().map_or(p, |l| l.parameter);
+        if self.stop_if_budget_spent(parameter) {
+            return;
+        }
         let corrected = match self.correct_start(&mut x, &mut p, direction) {
             Ok(c) => c,
             Err(failure) => {
@@ -508,6 +535,9 @@ where
         };
         let mut x = vec![0.0; n];
         loop {
+            if self.stop_if_budget_spent(last.parameter) {
+                return;
+            }
             let ds = self.step;
             for ((xi, si), di) in x.iter_mut().zip(&last.state).zip(&self.direction) {
                 *xi = si + ds * di;
@@ -579,6 +609,9 @@ where
     /// After the steps from `last` failed for good: a walk over the corners ahead (a
     /// piecewise-affine branch), else a restart (the restart policy), else the end.
     fn recover(&mut self, last: BranchPoint, termination: ContinuationTermination) {
+        if self.stop_if_budget_spent(last.parameter) {
+            return;
+        }
         if self.pieces.is_some() {
             let remaining = self.options.max_points.saturating_sub(self.points);
             let travel = self.pieces.as_ref().map_or(1.0, |p| p.travel);

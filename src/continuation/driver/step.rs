@@ -45,6 +45,17 @@ where
         constraint: Constraint,
     ) -> (Result<Corrected, CorrectorFailure>, f64) {
         let n = self.metric.n;
+        let max_iterations = match self.iterations_left() {
+            Some(0) => {
+                let failure = CorrectorFailure::MaxIterations {
+                    iterations: 0,
+                    residual_norm: f64::INFINITY,
+                };
+                return (Err(failure), f64::INFINITY);
+            }
+            Some(left) => left.min(self.options.max_corrector_iterations),
+            None => self.options.max_corrector_iterations,
+        };
         let mut y = Vec::with_capacity(n + 1);
         y.extend_from_slice(x);
         y.push(*p);
@@ -64,7 +75,7 @@ where
                 relative_tolerance: 0.0,
                 residual_floor: 0.0,
                 step_tolerance: self.options.step_tolerance,
-                max_iterations: self.options.max_corrector_iterations,
+                max_iterations,
                 min_iterations: 1,
                 globalization: armijo(self.options.corrector_line_search),
                 restore_best: false,
@@ -111,6 +122,9 @@ where
         let state_part = self.metric.state_dot(&d[..n], &d[..n]);
         let parameter_part = self.metric.parameter_dot(d[n], d[n]);
         for on_state in [true, false] {
+            if self.iterations_left() == Some(0) {
+                return None;
+            }
             let (scale, along, constraint) = if on_state {
                 if state_part < 1e-6 {
                     continue;
