@@ -284,6 +284,9 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     if let Some(h) = s.harmonics {
         v["harmonics"] = json!(h);
     }
+    if let Some(scheme) = s.lcp_scheme {
+        v["lcp_scheme"] = json!(scheme.name());
+    }
     if let Some(strategy) = s.strategy {
         v["strategy"] = json!(strategy);
         v["attempts"] = s

@@ -217,6 +217,7 @@ pub fn default_settings(h: usize) -> SolverSettings {
         max_periods: 2000,
         march_tolerance: 1e-8,
         restitution: 0.0,
+        lcp_scheme: Default::default(),
     }
 }
 

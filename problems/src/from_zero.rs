@@ -9,7 +9,7 @@
 use crate::figures::default_settings;
 use crate::rod::ModelError;
 use crate::rod::{build_rod, DampingSpec, FrequencySpec, MassModel, RodContact, RodModel, RodSpec};
-use crate::scene::{Method, SolverSettings};
+use crate::scene::{LcpScheme, Method, SolverSettings};
 
 /// One solve from zero.
 #[derive(Debug, Clone)]
@@ -165,15 +165,28 @@ pub fn hard_cases() -> Result<Vec<(String, Vec<GridCase>)>, ModelError> {
         )?);
     }
     // The periodic LCP of the 40-element rod, as built (consistent mass) and with the tip's
-    // mass moved to its neighbour (modified mass, the massless contact node).
-    for (name, mass) in [
+    // mass moved to its neighbour (modified mass, the massless contact node), with the
+    // trapezoidal rule and with BDF2.
+    for (name, mass, lcp_scheme) in [
         (
             "40 elements, lcp-ssn, Nt = 128..2048",
             MassModel::Consistent,
+            LcpScheme::Trapezoidal,
         ),
         (
             "40 elements, modified mass, lcp-ssn, Nt = 128..2048",
             MassModel::Modified,
+            LcpScheme::Trapezoidal,
+        ),
+        (
+            "40 elements, lcp-ssn BDF2, Nt = 128..2048",
+            MassModel::Consistent,
+            LcpScheme::Bdf2,
+        ),
+        (
+            "40 elements, modified mass, lcp-ssn BDF2, Nt = 128..2048",
+            MassModel::Modified,
+            LcpScheme::Bdf2,
         ),
     ] {
         let forty = build_rod(&RodSpec {
@@ -189,6 +202,7 @@ pub fn hard_cases() -> Result<Vec<(String, Vec<GridCase>)>, ModelError> {
                 settings: Some(SolverSettings {
                     method: Method::LcpSsn,
                     time_samples: nt,
+                    lcp_scheme,
                     ..default_settings(20)
                 }),
             })

@@ -654,8 +654,12 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     );
     let _ = writeln!(
         t,
-        "steps_per_period = {}\nmax_periods = {}\nmarch_tolerance = {:?}\nrestitution = {:?}",
-        v.steps_per_period, v.max_periods, v.march_tolerance, v.restitution
+        "steps_per_period = {}\nmax_periods = {}\nmarch_tolerance = {:?}\nrestitution = {:?}\nlcp_scheme = \"{}\"",
+        v.steps_per_period,
+        v.max_periods,
+        v.march_tolerance,
+        v.restitution,
+        v.lcp_scheme.name()
     );
     if let Some(sw) = &scene.sweep {
         let _ = writeln!(

@@ -22,7 +22,8 @@ use crate::hb::{
     StructuredHbSolver,
 };
 use crate::lcp::{
-    ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
+    ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
+    DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
 use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
 use crate::model::Structure;
@@ -139,6 +140,8 @@ pub struct Solution {
     pub harmonics: Option<usize>,
     /// AFT samples (HB), time steps per period (LCP, time marching).
     pub time_samples: usize,
+    /// Time discretisation of the periodic LCP (LCP methods only).
+    pub lcp_scheme: Option<LcpScheme>,
     /// Complementarity constant `c` (SSN-HB only).
     pub c: Option<f64>,
     /// Forcing frequency.
@@ -225,6 +228,7 @@ pub(crate) fn lcp_options(
         } else {
             vec![tip]
         },
+        scheme: settings.lcp_scheme,
     };
     (options, tip_contact)
 }
@@ -402,6 +406,7 @@ fn solution(
         contacts,
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
+        lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
         c: None,
         omega: rod.model.forcing.omega,
         omega_1: rod.omega_1,
@@ -607,7 +612,7 @@ fn solve_lcp(
     let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
     let lcp = PeriodicLcp::new(model, options)?;
-    let (z, converged, termination, iterations, residual, counters, effective_tolerance) =
+    let (z, converged, termination, iterations, residual, counters, effective_tolerance, finest) =
         match method {
             Method::LcpLemke => {
                 let mut lemke = Lemke::new(lcp.dim());
@@ -642,6 +647,7 @@ fn solve_lcp(
                     report.pivots,
                     report.complementarity_error,
                     counters,
+                    None,
                     None,
                 )
             }
@@ -688,6 +694,9 @@ fn solve_lcp(
                     last.residual_norm(),
                     counters,
                     Some(last.effective_tolerance),
+                    // The finest level's run: its strategy, attempts and residual history
+                    // are the answer's (the iterations and counters are the levels' sums).
+                    report_list.last().cloned(),
                 )
             }
         };
@@ -706,7 +715,7 @@ fn solve_lcp(
         effective_tolerance,
         counters,
         solve_seconds: seconds,
-        newton: None,
+        newton: finest.as_ref(),
     };
     let period = Period {
         times: lcp.times(),

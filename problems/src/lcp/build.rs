@@ -7,7 +7,7 @@ use faer::{c64, Mat};
 use semismooth::linalg::{FaerSparseLu, LinearSolveError};
 use semismooth::{Factorize, LinearSolve};
 
-use super::{FftPlans, FrequencyDerivative, LcpError, PeriodicLcp, PeriodicLcpOptions};
+use super::{FftPlans, FrequencyDerivative, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions};
 use crate::dynamic::DynamicStiffness;
 use crate::model::{ContactDirection, SparseMatrix, StructuralModel};
 
@@ -87,7 +87,7 @@ impl PeriodicLcp {
             mut transfer,
             linear_amplitude,
             derivative,
-        } = bin_transfers(model, nt, &rows, with_derivative)?;
+        } = bin_transfers(model, nt, options.scheme, &rows, with_derivative)?;
 
         // Nyquist limit: static receptance of the dofs with neither mass nor damping.
         let static_set: Vec<usize> = (0..n)
@@ -96,7 +96,7 @@ impl PeriodicLcp {
                     && model.damping.as_ref().is_none_or(|d| column_is_zero(d, j))
             })
             .collect();
-        if nt % 2 == 0 && !static_set.is_empty() {
+        if options.scheme == LcpScheme::Trapezoidal && nt % 2 == 0 && !static_set.is_empty() {
             let k = nt / 2;
             let nv = static_set.len();
             let columns = nyquist_static_receptance(model, &static_set, &contact_dofs, k)?;
@@ -122,6 +122,7 @@ impl PeriodicLcp {
         let symmetric_spectrum = hermitian_part_range(&transfer, bins, nr, m);
         Ok(Self {
             nt,
+            scheme: options.scheme,
             contacts: m,
             omega,
             gaps,
@@ -145,6 +146,7 @@ impl PeriodicLcp {
 fn bin_transfers(
     model: &StructuralModel,
     nt: usize,
+    scheme: LcpScheme,
     rows: &[usize],
     with_derivative: bool,
 ) -> Result<Bins, LcpError> {
@@ -174,16 +176,24 @@ fn bin_transfers(
     let mut y = Mat::<c64>::zeros(n, m + 1);
     let mut values = Vec::new();
     for k in 0..bins {
-        if 2 * k == nt {
-            continue; // Nyquist: the limit problem.
-        }
-        let sigma = bin_frequency(nt, dt, k);
+        // The symbol s_k of d/dt; Z_k = K + s_k D + s_k^2 M.
+        let symbol = match scheme {
+            // Nyquist: the limit problem.
+            LcpScheme::Trapezoidal if 2 * k == nt => continue,
+            LcpScheme::Trapezoidal => c64::new(0.0, bin_frequency(nt, dt, k)),
+            LcpScheme::Bdf2 => bdf2_symbol(nt, dt, k),
+        };
+        let (mass_factor, damping_factor) = match scheme {
+            // Written out so that the trapezoidal LCP is bit for bit what it always was.
+            LcpScheme::Trapezoidal => (c64::new(-symbol.im * symbol.im, 0.0), symbol),
+            LcpScheme::Bdf2 => (symbol * symbol, symbol),
+        };
         dynamic
-            .factor(0, c64::new(-sigma * sigma, 0.0), c64::new(0.0, sigma))
+            .factor(0, mass_factor, damping_factor)
             .map_err(|source| match source {
                 LinearSolveError::Singular { .. } => LcpError::SingularBin {
                     bin: k,
-                    frequency: sigma,
+                    frequency: symbol.im,
                     source,
                 },
                 other => LcpError::Factorization {
@@ -215,13 +225,23 @@ fn bin_transfers(
             }
         }
         if let Some(d) = out.derivative.as_mut() {
-            // Y = Z_k^{-1} (dZ_k/domega) X, X = Z_k^{-1} [G^T, f]; dX/domega = -Y.
-            let tau = sigma / omega;
-            let dz = [
-                zero,
-                c64::new(-2.0 * omega * tau * tau, 0.0),
-                c64::new(0.0, tau),
-            ];
+            // Y = Z_k^{-1} (dZ_k/domega) X, X = Z_k^{-1} [G^T, f]; dX/domega = -Y. Both
+            // symbols are s_k = omega tau_k (dt = 2 pi / (omega Nt)), so
+            // dZ_k/domega = tau_k D + 2 omega tau_k^2 M.
+            let dz = match scheme {
+                LcpScheme::Trapezoidal => {
+                    let tau = symbol.im / omega;
+                    [
+                        zero,
+                        c64::new(-2.0 * omega * tau * tau, 0.0),
+                        c64::new(0.0, tau),
+                    ]
+                }
+                LcpScheme::Bdf2 => {
+                    let tau = symbol / omega;
+                    [zero, tau * tau * (2.0 * omega), tau]
+                }
+            };
             for col in 0..ncols {
                 let yc = y.col_as_slice_mut(col);
                 yc.fill(zero);
@@ -285,6 +305,15 @@ pub(super) fn bin_frequency(nt: usize, dt: f64, k: usize) -> f64 {
         return f64::INFINITY;
     }
     2.0 / dt * (std::f64::consts::PI * k as f64 / nt as f64).tan()
+}
+
+/// The BDF2 symbol of bin `k`, `(3 - 4 e^{-i theta} + e^{-2 i theta}) / (2 dt)`,
+/// `theta = 2 pi k / Nt`: `i theta / dt (1 + theta^2 / 3) + theta^4 / (4 dt) + ...`, real
+/// and `4 / dt` at the Nyquist bin.
+pub(super) fn bdf2_symbol(nt: usize, dt: f64, k: usize) -> c64 {
+    let theta = 2.0 * std::f64::consts::PI * k as f64 / nt as f64;
+    let back = c64::new(theta.cos(), -theta.sin());
+    (c64::new(3.0, 0.0) - back * 4.0 + back * back) / (2.0 * dt)
 }
 
 /// Fills a length-`Nt` spectrum from bins `0..=Nt/2` by conjugate symmetry.

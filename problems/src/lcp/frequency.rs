@@ -366,15 +366,21 @@ impl LinearSolve for FrequencyLcpSolver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lcp::LcpScheme;
     use crate::rod::{build_rod, MassModel, RodSpec};
     use semismooth::linalg::FaerDenseLu;
 
     fn problem(nt: usize) -> FrequencyLcp {
+        problem_with(nt, LcpScheme::Trapezoidal)
+    }
+
+    fn problem_with(nt: usize, scheme: LcpScheme) -> FrequencyLcp {
         let mut spec = RodSpec::canonical();
         spec.mass = MassModel::Modified;
         let rod = build_rod(&spec).unwrap();
         let options = PeriodicLcpOptions {
             time_samples: nt,
+            scheme,
             ..Default::default()
         };
         let kappa = rod.model.contact_stiffness_scale();
@@ -419,7 +425,13 @@ mod tests {
 
     #[test]
     fn parameter_derivative_matches_central_differences_of_lcp_builds() {
-        let mut p = problem(32);
+        for scheme in [LcpScheme::Trapezoidal, LcpScheme::Bdf2] {
+            parameter_derivative_matches_central_differences(scheme);
+        }
+    }
+
+    fn parameter_derivative_matches_central_differences(scheme: LcpScheme) {
+        let mut p = problem_with(32, scheme);
         let y = state(&p);
         let omega = p.parameter();
         let mut analytic = vec![0.0; p.dim()];
@@ -440,7 +452,7 @@ mod tests {
             let fd = (plus[i] - minus[i]) / (2.0 * h);
             assert!(
                 (fd - analytic[i]).abs() <= 1e-6 * scale,
-                "{i}: {fd} vs {}",
+                "{scheme:?} {i}: {fd} vs {}",
                 analytic[i]
             );
         }

@@ -132,6 +132,7 @@ pub fn solve_min_map_sequenced(
         let options = PeriodicLcpOptions {
             time_samples: nt,
             observed_dofs: Vec::new(),
+            scheme: finest.scheme(),
         };
         z = Some(solve_level(&PeriodicLcp::new(model, options)?, z)?);
     }

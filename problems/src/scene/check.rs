@@ -584,6 +584,7 @@ impl Check<'_> {
             max_periods,
             march_tolerance,
             restitution,
+            lcp_scheme: s.lcp_scheme,
         })
     }
 

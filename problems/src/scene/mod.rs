@@ -31,6 +31,8 @@ mod check;
 mod linear_solver;
 pub use linear_solver::LinearSolverChoice;
 
+pub use crate::lcp::LcpScheme;
+
 /// Why a scene could not be used. Every variant names the file; `Invalid` also names the
 /// key, the value found and what is allowed.
 #[derive(Debug, thiserror::Error)]
@@ -99,6 +101,11 @@ impl Method {
     pub fn is_harmonic_balance(self) -> bool {
         matches!(self, Method::SsnHb | Method::PenaltyHb)
     }
+
+    /// Whether the method solves the periodic LCP.
+    pub fn is_lcp(self) -> bool {
+        matches!(self, Method::LcpLemke | Method::LcpSsn)
+    }
 }
 
 /// Globalization of the Newton iterations.
@@ -161,6 +168,8 @@ pub struct SolverSettings {
     pub march_tolerance: f64,
     /// Restitution coefficient of the Moreau–Jean scheme (massive contact nodes).
     pub restitution: f64,
+    /// Time discretisation of the periodic LCP (`lcp-lemke`, `lcp-ssn`).
+    pub lcp_scheme: LcpScheme,
 }
 
 /// Validated sweep settings (`[sweep]`).
@@ -335,6 +344,8 @@ struct RawSolver {
     max_periods: Option<i64>,
     march_tolerance: Option<f64>,
     restitution: Option<f64>,
+    #[serde(default)]
+    lcp_scheme: LcpScheme,
 }
 
 #[derive(Debug, Deserialize)]
