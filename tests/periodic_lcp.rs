@@ -764,6 +764,14 @@ fn strongly_forced_rod_has_a_chattering_nearly_degenerate_lcp_solution_with_a_ti
     assert!(!sol.converged);
     assert!(sol.termination.starts_with("max-iterations"));
     assert_eq!(sol.iterations, 200);
+    // The run says why, and what has no null vector.
+    assert!(lcp.has_alternating_null_vector());
+    let diagnosis = sol.diagnosis.as_deref().unwrap_or_default();
+    assert!(
+        diagnosis.contains("Nyquist receptance is 0")
+            && diagnosis.contains("lcp_scheme = \"bdf2\""),
+        "{diagnosis}"
+    );
 }
 
 /// With the tip's mass moved to its neighbour (modified mass) the same rod's LCP is solved
@@ -778,6 +786,7 @@ fn modified_mass_strongly_forced_rod_lcp_ssn_from_zero_reaches_lemkes_solution_a
     for (nt, measured) in [(128usize, 41usize), (256, 95)] {
         let (lcp, sol) = forty_element_lcp(MassModel::Modified, nt);
         assert!(sol.converged, "Nt = {nt}: {}", sol.termination);
+        assert!(sol.diagnosis.is_none());
         let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
         let zmax = lemke.z.iter().cloned().fold(0.0, f64::max);
         // Both end on one exact solve with the same active set (condition of A_II ~1e3):
@@ -795,6 +804,8 @@ fn modified_mass_strongly_forced_rod_lcp_ssn_from_zero_reaches_lemkes_solution_a
     assert!(sol.termination.starts_with("max-iterations"));
     // 41 + 54 on the coarser levels, the whole budget of 200 on the last.
     assert_eq!(sol.iterations, 295);
+    // The massless tip has stiffness-proportional damping: the same null vector.
+    assert!(sol.diagnosis.is_some());
 }
 
 /// A level that fails does not spend more than its budget: the polyalgorithm's paths
@@ -970,6 +981,8 @@ fn bdf2_lcp_of_the_strongly_forced_rod_is_solved_from_zero_and_agrees_with_lemke
             // homotopy on the rest.
             assert!(!sol.converged, "{case}");
             assert!(sol.termination.starts_with("max-iterations"));
+            // Not the trapezoidal null vector: no diagnosis.
+            assert!(!lcp.has_alternating_null_vector() && sol.diagnosis.is_none());
             // The line search needs 160 iterations there: with max_iterations = 400 it gets
             // 185 and converges (270 iterations over the levels).
             let rod = build_rod(&RodSpec {

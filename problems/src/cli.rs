@@ -287,6 +287,9 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     if let Some(scheme) = s.lcp_scheme {
         v["lcp_scheme"] = json!(scheme.name());
     }
+    if let Some(diagnosis) = &s.diagnosis {
+        v["diagnosis"] = json!(diagnosis);
+    }
     if let Some(strategy) = s.strategy {
         v["strategy"] = json!(strategy);
         v["attempts"] = s
@@ -463,9 +466,15 @@ impl StartedFrom {
 }
 
 fn describe_method(s: &Solution) -> String {
-    match s.harmonics {
-        Some(h) => format!("{} H={h} Nt={}", s.method.name(), s.time_samples),
-        None => format!("{} Nt={}", s.method.name(), s.time_samples),
+    match (s.harmonics, s.lcp_scheme) {
+        (Some(h), _) => format!("{} H={h} Nt={}", s.method.name(), s.time_samples),
+        (None, Some(scheme)) if scheme != crate::lcp::LcpScheme::Trapezoidal => format!(
+            "{} Nt={} {}",
+            s.method.name(),
+            s.time_samples,
+            scheme.name()
+        ),
+        (None, _) => format!("{} Nt={}", s.method.name(), s.time_samples),
     }
 }
 
@@ -489,6 +498,9 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
             "converged         {} ({}), {} iterations, residual {:.3e}",
             s.converged, s.termination, s.iterations, s.residual_norm
         )?;
+        if let Some(diagnosis) = &s.diagnosis {
+            writeln!(t, "diagnosis         {diagnosis}")?;
+        }
         let asked = if s.method == Method::March {
             settings.march_tolerance
         } else {

@@ -57,9 +57,10 @@ enum Command {
         ssn solve SCENE.toml --state state.json     (write the harmonic coefficients)\n  \
         ssn solve SCENE.toml --start state.json     (Newton from them)\n  \
         ssn solve SCENE.toml --start solutions.json --entry 2   (from ssn solutions --json)\n\n\
-        JSON fields: scene, method, harmonics (HB only), time_samples, omega, omega_ratio,\n  \
-        converged, termination, iterations, residual_norm, effective_tolerance,\n  \
-        strategy and attempts (Newton methods), solve_seconds, tip_max, tip_min,\n  \
+        JSON fields: scene, method, harmonics (HB only), time_samples, lcp_scheme (LCP\n  \
+        only), omega, omega_ratio, converged, termination, diagnosis (when known),\n  \
+        iterations, residual_norm, effective_tolerance, strategy and attempts (Newton\n  \
+        methods), solve_seconds, tip_max, tip_min,\n  \
         max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
         gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
         displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \

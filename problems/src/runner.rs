@@ -142,6 +142,9 @@ pub struct Solution {
     pub time_samples: usize,
     /// Time discretisation of the periodic LCP (LCP methods only).
     pub lcp_scheme: Option<LcpScheme>,
+    /// What is known to make a run that did not converge hard, and what to change (`None`
+    /// when it converged or nothing is known).
+    pub diagnosis: Option<String>,
     /// Complementarity constant `c` (SSN-HB only).
     pub c: Option<f64>,
     /// Forcing frequency.
@@ -407,6 +410,7 @@ fn solution(
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
+        diagnosis: None,
         c: None,
         omega: rod.model.forcing.omega,
         omega_1: rod.omega_1,
@@ -725,6 +729,15 @@ fn solve_lcp(
     };
     let mut sol = solution(rod, settings, settings.time_samples, outcome, period, z);
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
+    if !sol.converged && lcp.has_alternating_null_vector() {
+        sol.diagnosis = Some(
+            "every contact dof has mass or damping, so the trapezoidal LCP's Nyquist receptance \
+             is 0 and a contact force alternating node to node moves nothing (a null vector of \
+             A): solutions chatter and are nearly degenerate; lcp_scheme = \"bdf2\" has no such \
+             vector"
+                .into(),
+        );
+    }
     Ok(sol)
 }
 

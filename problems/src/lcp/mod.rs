@@ -563,6 +563,18 @@ impl PeriodicLcp {
         self.scheme
     }
 
+    /// Whether the alternating force `(-1)^n` (on every contact) is a null vector of `A`:
+    /// the trapezoidal rule at even `Nt` when the Nyquist receptance is exactly 0, i.e.
+    /// every contact dof has mass or damping (module documentation, *Nyquist bin*).
+    pub fn has_alternating_null_vector(&self) -> bool {
+        self.scheme == LcpScheme::Trapezoidal
+            && self.nt % 2 == 0
+            && self
+                .receptance(self.nt / 2)
+                .iter()
+                .all(|h| h.re == 0.0 && h.im == 0.0)
+    }
+
     /// The contact gaps `g`, in contact order.
     pub fn gaps(&self) -> &[f64] {
         &self.gaps
