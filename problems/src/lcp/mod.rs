@@ -282,12 +282,13 @@ pub enum LcpError {
         source: LinearSolveError,
     },
     /// The LU of `Z_k` broke down (a zero pivot: a warped bin frequency on a natural
-    /// frequency of an undamped model).
+    /// frequency of an undamped model; with the trapezoidal rule only, since the BDF2
+    /// symbol has `Re s_k > 0` for `k >= 1`).
     #[error("dynamic stiffness of bin {bin} (warped frequency {frequency}) is singular: {source}")]
     SingularBin {
         /// DFT bin.
         bin: usize,
-        /// Warped angular frequency `(2/dt) tan(pi k / Nt)`.
+        /// Warped angular frequency `(2/dt) tan(pi k / Nt)` (`Im s_k` for BDF2).
         frequency: f64,
         /// The singular pivot ([`LinearSolveError::Singular`]: its dof, value and the
         /// largest pivot).
