@@ -1060,3 +1060,59 @@ fn bdf2_tip_minimum_converges_at_second_order_to_the_trapezoidal_lcps() {
         "BDF2 {bdf2:?}, trapezoidal {trapezoidal:?}"
     );
 }
+
+/// BDF2 is no cure at fine steps for a massive contact node: its Nyquist receptance, the
+/// static-like solve of `K + (4/dt) D + (16/dt^2) M`, shrinks like `dt^2`, and the LCP becomes
+/// nearly degenerate again. On the canonical rod with the consistent mass, `lcp-ssn` from zero
+/// (measured: 8 / 20 / 40 iterations over the levels) and Lemke agree at `Nt` = 128 / 256 /
+/// 512, with tip minima approaching each other at second order; at `Nt = 1024` lcp-ssn ends
+/// at its budget on the last level (40 + 200 iterations), a measured limit.
+#[test]
+fn bdf2_with_a_massive_contact_node_solves_up_to_nt_512_and_not_at_1024() {
+    let rod = build_rod(&RodSpec {
+        mass: MassModel::Consistent,
+        ..RodSpec::canonical()
+    })
+    .unwrap();
+    let solve = |nt: usize| {
+        let settings = semismooth_problems::scene::SolverSettings {
+            method: semismooth_problems::scene::Method::LcpSsn,
+            time_samples: nt,
+            lcp_scheme: LcpScheme::Bdf2,
+            ..semismooth_problems::figures::default_settings(20)
+        };
+        semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap()
+    };
+    let mut minima = Vec::new();
+    for (nt, measured) in [(128, 8), (256, 20), (512, 40)] {
+        let sol = solve(nt);
+        assert!(sol.converged, "Nt = {nt}: {}", sol.termination);
+        assert!(
+            sol.iterations + 2 >= measured * 9 / 10 && sol.iterations <= measured * 11 / 10 + 2,
+            "Nt = {nt}: {}",
+            sol.iterations
+        );
+        let lcp = PeriodicLcp::new(&rod.structure.model, bdf2_options(nt, vec![])).unwrap();
+        let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
+        let zmax = lemke.z.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            max_abs_diff(&sol.state, &lemke.z) < 1e-9 * zmax,
+            "Nt = {nt}"
+        );
+        minima.push(sol.stats.min);
+    }
+    // Measured -0.525709 / -0.523562 / -0.523253: changes 2.1e-3 then 3.1e-4.
+    assert!(
+        (minima[0] - minima[1]).abs() > 4.0 * (minima[1] - minima[2]).abs(),
+        "{minima:?}"
+    );
+    let sol = solve(1024);
+    assert!(!sol.converged);
+    // The line search stops at a kink of the merit, the Newton homotopy spends the rest.
+    assert!(
+        sol.termination.starts_with("line-search-failed"),
+        "{}",
+        sol.termination
+    );
+    assert_eq!(sol.iterations, 240);
+}
