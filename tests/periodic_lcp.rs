@@ -14,7 +14,7 @@ use semismooth_problems::lcp::{
     DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
 use semismooth_problems::model::{InvalidModel, SparseMatrix, StructuralModel};
-use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodSpec};
+use semismooth_problems::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 
 /// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
 fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
@@ -640,27 +640,40 @@ fn forty_element_lcp_with(
     nt: usize,
     scheme: LcpScheme,
 ) -> (PeriodicLcp, semismooth_problems::runner::Solution) {
-    use semismooth_problems::figures::default_settings;
-    use semismooth_problems::from_zero::forty_element_rod;
-    use semismooth_problems::scene::{Method, SolverSettings};
-    let rod = build_rod(&RodSpec {
-        mass,
-        ..forty_element_rod()
-    })
-    .unwrap();
+    let rod = forty_element_rod_with(mass);
     let lcp_options = PeriodicLcpOptions {
         scheme,
         ..options(nt, vec![])
     };
     let lcp = PeriodicLcp::new(&rod.structure.model, lcp_options).unwrap();
-    let settings = SolverSettings {
-        method: Method::LcpSsn,
+    (lcp, lcp_ssn_from_zero(&rod, nt, scheme, 200))
+}
+
+/// The strongly forced 40-element rod with the given mass model.
+fn forty_element_rod_with(mass: MassModel) -> RodModel {
+    build_rod(&RodSpec {
+        mass,
+        ..semismooth_problems::from_zero::forty_element_rod()
+    })
+    .unwrap()
+}
+
+/// `lcp-ssn` from zero (mesh sequencing) as a scene runs it, with the scene defaults but the
+/// time discretisation and the iteration budget per level.
+fn lcp_ssn_from_zero(
+    rod: &RodModel,
+    nt: usize,
+    scheme: LcpScheme,
+    max_iterations: usize,
+) -> semismooth_problems::runner::Solution {
+    let settings = semismooth_problems::scene::SolverSettings {
+        method: semismooth_problems::scene::Method::LcpSsn,
         time_samples: nt,
         lcp_scheme: scheme,
-        ..default_settings(20)
+        max_iterations,
+        ..semismooth_problems::figures::default_settings(20)
     };
-    let sol = semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap();
-    (lcp, sol)
+    semismooth_problems::runner::solve_rod(rod, &settings, None).unwrap()
 }
 
 /// Why `lcp-ssn` does not converge from zero on the strongly forced 40-element rod with its
@@ -741,11 +754,7 @@ fn strongly_forced_rod_has_a_chattering_nearly_degenerate_lcp_solution_with_a_ti
     assert!(near.converged() && near.iterations <= 2, "{near:?}");
     assert!(!newton_from(1e-4).converged());
     // lcp-lemke as a user runs it says where it stopped and why.
-    let rod = build_rod(&RodSpec {
-        mass: MassModel::Consistent,
-        ..semismooth_problems::from_zero::forty_element_rod()
-    })
-    .unwrap();
+    let rod = forty_element_rod_with(MassModel::Consistent);
     let settings = semismooth_problems::scene::SolverSettings {
         method: semismooth_problems::scene::Method::LcpLemke,
         time_samples: nt,
@@ -814,12 +823,7 @@ fn modified_mass_strongly_forced_rod_lcp_ssn_from_zero_reaches_lemkes_solution_a
 /// 1,396 iterations on the last level at `Nt` = 512 and 1024 for a budget of 200.
 #[test]
 fn every_sequencing_level_stays_within_the_iteration_budget_when_it_fails() {
-    use semismooth_problems::from_zero::forty_element_rod;
-    let rod = build_rod(&RodSpec {
-        mass: MassModel::Modified,
-        ..forty_element_rod()
-    })
-    .unwrap();
+    let rod = forty_element_rod_with(MassModel::Modified);
     let model = &rod.structure.model;
     for (nt, budget) in [(512, 200), (1024, 200), (1024, 60)] {
         let lcp = PeriodicLcp::new(model, options(nt, vec![])).unwrap();
@@ -905,11 +909,7 @@ fn bdf2_linear_response_is_the_response_at_its_symbol_and_converges_at_second_or
 #[test]
 fn bdf2_nyquist_receptance_is_positive_so_the_alternating_force_is_no_null_vector() {
     for mass in [MassModel::Consistent, MassModel::Modified] {
-        let rod = build_rod(&RodSpec {
-            mass,
-            ..semismooth_problems::from_zero::forty_element_rod()
-        })
-        .unwrap();
+        let rod = forty_element_rod_with(mass);
         let model = &rod.structure.model;
         let tip = model.contacts[0].dof;
         let nt = 128;
@@ -985,19 +985,7 @@ fn bdf2_lcp_of_the_strongly_forced_rod_is_solved_from_zero_and_agrees_with_lemke
             assert!(!lcp.has_alternating_null_vector() && sol.diagnosis.is_none());
             // The line search needs 160 iterations there: with max_iterations = 400 it gets
             // 185 and converges (270 iterations over the levels).
-            let rod = build_rod(&RodSpec {
-                mass,
-                ..semismooth_problems::from_zero::forty_element_rod()
-            })
-            .unwrap();
-            let settings = semismooth_problems::scene::SolverSettings {
-                method: semismooth_problems::scene::Method::LcpSsn,
-                time_samples: nt,
-                lcp_scheme: LcpScheme::Bdf2,
-                max_iterations: 400,
-                ..semismooth_problems::figures::default_settings(20)
-            };
-            let sol = semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap();
+            let sol = lcp_ssn_from_zero(&forty_element_rod_with(mass), nt, LcpScheme::Bdf2, 400);
             assert!(within(270, sol.iterations), "{case}: {}", sol.iterations);
             assert_eq!(sol.strategy, Some("line-search"));
             sol
@@ -1043,11 +1031,7 @@ fn bdf2_tip_minimum_converges_at_second_order_to_the_trapezoidal_lcps() {
     let trapezoidal: Vec<f64> = [256, 512]
         .into_iter()
         .map(|nt| {
-            let rod = build_rod(&RodSpec {
-                mass: MassModel::Modified,
-                ..semismooth_problems::from_zero::forty_element_rod()
-            })
-            .unwrap();
+            let rod = forty_element_rod_with(MassModel::Modified);
             let lcp = PeriodicLcp::new(&rod.structure.model, options(nt, vec![])).unwrap();
             let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
             tip_min(&lcp, &lemke.z)
@@ -1074,15 +1058,7 @@ fn bdf2_with_a_massive_contact_node_solves_up_to_nt_512_and_not_at_1024() {
         ..RodSpec::canonical()
     })
     .unwrap();
-    let solve = |nt: usize| {
-        let settings = semismooth_problems::scene::SolverSettings {
-            method: semismooth_problems::scene::Method::LcpSsn,
-            time_samples: nt,
-            lcp_scheme: LcpScheme::Bdf2,
-            ..semismooth_problems::figures::default_settings(20)
-        };
-        semismooth_problems::runner::solve_rod(&rod, &settings, None).unwrap()
-    };
+    let solve = |nt: usize| lcp_ssn_from_zero(&rod, nt, LcpScheme::Bdf2, 200);
     let mut minima = Vec::new();
     for (nt, measured) in [(128, 8), (256, 20), (512, 40)] {
         let sol = solve(nt);

@@ -176,12 +176,10 @@ fn bin_transfers(
     let mut y = Mat::<c64>::zeros(n, m + 1);
     let mut values = Vec::new();
     for k in 0..bins {
-        // The symbol s_k of d/dt; Z_k = K + s_k D + s_k^2 M.
-        let symbol = match scheme {
-            // Nyquist: the limit problem.
-            LcpScheme::Trapezoidal if 2 * k == nt => continue,
-            LcpScheme::Trapezoidal => c64::new(0.0, bin_frequency(nt, dt, k)),
-            LcpScheme::Bdf2 => bdf2_symbol(nt, dt, k),
+        // The symbol s_k of d/dt; Z_k = K + s_k D + s_k^2 M. The trapezoidal Nyquist bin is
+        // the limit problem.
+        let Some(symbol) = bin_symbol(scheme, nt, dt, k) else {
+            continue;
         };
         let (mass_factor, damping_factor) = match scheme {
             // Written out so that the trapezoidal LCP is bit for bit what it always was.
@@ -299,21 +297,23 @@ fn circulant(plans: &FftPlans, transfer: &[c64], nr: usize, m: usize) -> Mat<f64
     matrix
 }
 
-/// `(2/dt) tan(pi k / Nt)`, infinite at the Nyquist bin.
-pub(super) fn bin_frequency(nt: usize, dt: f64, k: usize) -> f64 {
-    if 2 * k == nt {
-        return f64::INFINITY;
+/// The symbol `s_k` of `d/dt` on bin `k`:
+/// - trapezoidal: `(2/dt) i tan(pi k / Nt)`, `None` (infinite) at the Nyquist bin;
+/// - BDF2: `(3 - 4 e^{-i theta} + e^{-2 i theta}) / (2 dt)`, `theta = 2 pi k / Nt`, i.e.
+///   `i theta / dt (1 + theta^2 / 3) + theta^4 / (4 dt) + ...`, real and `4 / dt` at Nyquist.
+pub(super) fn bin_symbol(scheme: LcpScheme, nt: usize, dt: f64, k: usize) -> Option<c64> {
+    match scheme {
+        LcpScheme::Trapezoidal if 2 * k == nt => None,
+        LcpScheme::Trapezoidal => Some(c64::new(
+            0.0,
+            2.0 / dt * (std::f64::consts::PI * k as f64 / nt as f64).tan(),
+        )),
+        LcpScheme::Bdf2 => {
+            let theta = 2.0 * std::f64::consts::PI * k as f64 / nt as f64;
+            let back = c64::new(theta.cos(), -theta.sin());
+            Some((c64::new(3.0, 0.0) - back * 4.0 + back * back) / (2.0 * dt))
+        }
     }
-    2.0 / dt * (std::f64::consts::PI * k as f64 / nt as f64).tan()
-}
-
-/// The BDF2 symbol of bin `k`, `(3 - 4 e^{-i theta} + e^{-2 i theta}) / (2 dt)`,
-/// `theta = 2 pi k / Nt`: `i theta / dt (1 + theta^2 / 3) + theta^4 / (4 dt) + ...`, real
-/// and `4 / dt` at the Nyquist bin.
-pub(super) fn bdf2_symbol(nt: usize, dt: f64, k: usize) -> c64 {
-    let theta = 2.0 * std::f64::consts::PI * k as f64 / nt as f64;
-    let back = c64::new(theta.cos(), -theta.sin());
-    (c64::new(3.0, 0.0) - back * 4.0 + back * back) / (2.0 * dt)
 }
 
 /// Fills a length-`Nt` spectrum from bins `0..=Nt/2` by conjugate symmetry.

@@ -553,10 +553,7 @@ impl PeriodicLcp {
     /// The warped angular frequency of bin `k`: `(2/dt) tan(pi k / Nt)` for the trapezoidal
     /// rule (infinite at the Nyquist bin `k = Nt/2`), `Im s_k` for BDF2.
     pub fn bin_frequency(&self, k: usize) -> f64 {
-        match self.scheme {
-            LcpScheme::Trapezoidal => build::bin_frequency(self.nt, self.time_step(), k),
-            LcpScheme::Bdf2 => build::bdf2_symbol(self.nt, self.time_step(), k).im,
-        }
+        build::bin_symbol(self.scheme, self.nt, self.time_step(), k).map_or(f64::INFINITY, |s| s.im)
     }
 
     /// The time discretisation.

@@ -278,16 +278,15 @@ where
     /// Ends the run when its corrector iterations are spent (the last accepted point at
     /// `parameter`); `true` when it did.
     fn stop_if_budget_spent(&mut self, parameter: f64) -> bool {
-        match (
-            self.iterations_left(),
-            self.options.max_total_corrector_iterations,
-        ) {
-            (Some(0), Some(budget)) => {
-                self.finish(ContinuationTermination::IterationBudgetSpent { parameter, budget });
-                true
-            }
-            _ => false,
+        let spent = self.iterations_left() == Some(0);
+        if let Some(budget) = self
+            .options
+            .max_total_corrector_iterations
+            .filter(|_| spent)
+        {
+            self.finish(ContinuationTermination::IterationBudgetSpent { parameter, budget });
         }
+        spent
     }
 
     fn finish(&mut self, termination: ContinuationTermination) {
