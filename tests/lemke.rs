@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{allocations, thread_cpu_seconds};
+use common::allocations;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::Mat;
 use rand::{Rng, SeedableRng};
@@ -669,72 +669,4 @@ fn custom_problem_newton_agrees_with_lemke_in_every_contact_state() {
             &y[n..]
         );
     }
-}
-
-/// Periodic-LCP stand-in for timing: a symmetric positive definite circulant matrix
-/// (exponential kernel plus identity) and `q_i = 0.5 - cos(2 pi i / n)` (a gap of 0.5
-/// closed by a harmonic motion of amplitude 1: about a third of the period in contact).
-fn circulant_case(n: usize) -> (Mat<f64>, Vec<f64>) {
-    let kernel = |k: usize| {
-        let d = k.min(n - k) as f64;
-        (-d / (0.02 * n as f64)).exp()
-    };
-    let m = Mat::from_fn(n, n, |i, j| {
-        let k = (i + n - j) % n;
-        kernel(k) / (0.02 * n as f64) + if k == 0 { 1.0 } else { 0.0 }
-    });
-    let q = (0..n)
-        .map(|i| 0.5 - (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos())
-        .collect();
-    (m, q)
-}
-
-/// Timing of n = 2048 (not asserted): run with
-/// `cargo test --release --test lemke -- --ignored --nocapture timing`.
-#[test]
-#[ignore = "timing measurement of n = 2048 (nothing asserted); run with --ignored --nocapture"]
-fn timing_n2048() {
-    use semismooth_problems::lcp::{PeriodicLcp, PeriodicLcpOptions};
-    use semismooth_problems::rod::{build_rod, MassModel, RodSpec};
-    let n = 2048;
-    let mut lemke = Lemke::new(n);
-    let mut timed = |label: &str, m: faer::MatRef<'_, f64>, q: &[f64]| {
-        let start = std::time::Instant::now();
-        let cpu = thread_cpu_seconds();
-        let report = lemke.solve(m, q, &LemkeOptions::default()).unwrap();
-        let cpu = thread_cpu_seconds() - cpu;
-        println!(
-            "{label} n={}: {:?}, {} pivots, {} active, error {:e}, wall {:.3} s, cpu {cpu:.3} s",
-            q.len(),
-            report.termination,
-            report.pivots,
-            report.z.iter().filter(|&&z| z > 0.0).count(),
-            report.complementarity_error,
-            start.elapsed().as_secs_f64()
-        );
-    };
-    for mass in [MassModel::Modified, MassModel::Consistent] {
-        let spec = RodSpec {
-            mass,
-            ..RodSpec::canonical()
-        };
-        let rod = build_rod(&spec).unwrap();
-        let options = PeriodicLcpOptions {
-            time_samples: n,
-            ..PeriodicLcpOptions::default()
-        };
-        let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
-        timed(
-            &format!("canonical rod, {mass:?} mass"),
-            lcp.matrix(),
-            lcp.q(),
-        );
-    }
-    let (m, q) = circulant_case(n);
-    timed("circulant", m.as_ref(), &q);
-    timed("circulant (reused workspace)", m.as_ref(), &q);
-    let mut r = rng(7);
-    let m = spd_matrix(n, 1.0, &mut r);
-    let q: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
-    timed("random SPD", m.as_ref(), &q);
 }

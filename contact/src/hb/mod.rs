@@ -1,0 +1,552 @@
+//! Harmonic balance for periodic contact problems: the semismooth formulation of Shi &
+//! Legrand (SSN-HB, their equations (5)-(6)) and penalty harmonic balance.
+//!
+//! Both expand the displacements of the [`StructuralModel`] with `H` harmonics in the real
+//! basis of [`semismooth::harmonic`] (`u(t) = u_0 + sum_k u_ck cos(k w t) + u_sk sin(k w t)`),
+//! harmonic-major: unknown `j * N + dof` is coefficient `j` of `dof`. The linear dynamics
+//! `M u'' + D u' + K u` become the block-diagonal `A(w) U` with, for harmonic `k` on
+//! `(u_ck, u_sk)`,
+//!
+//! `[[K - (k w)^2 M,  k w D], [-k w D,  K - (k w)^2 M]]`
+//!
+//! (from `d/dt (a cos + b sin) = k w (b cos - a sin)`), and `K` alone on `u_0`.
+//!
+//! - [`SsnHb`]: unknowns `X = [U; Lambda]`, `Lambda` the contact-force coefficients (index
+//!   `j * m + contact`), residual `R_u = A(w) U - F - G^T Lambda`,
+//!   `R_lambda = Lambda + P max(0, c (G E U - g) - E Lambda)` through AFT with `Nt` samples.
+//! - [`PenaltyHb`]: unknowns `U` only, `lambda(t) = -k_p max(0, G u(t) - g)`,
+//!   residual `R = A(w) U - F - G^T P lambda(E U)`.
+//!
+//! Both write their generalized Jacobian into an [`HbJacobian`] (dynamic blocks shared, not
+//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact). It can be
+//! assembled densely ([`semismooth::linalg::DenseAssemble`], for the dense LU solvers) or
+//! solved by [`StructuredHbSolver`], which factors each harmonic's dynamic block once per
+//! frequency (sparse complex LU) and solves the Newton system on the `m (2H + 1)` contact
+//! unknowns (receptance / Schur-complement condensation).
+//!
+//! [`CondensedSsnHb`] eliminates `U` once and for all (`G U = G A^{-1} F + R Lambda`) and
+//! runs Newton on the `m (2H + 1)` force coefficients alone: the same Newton direction as
+//! the full problem once `R_u = 0`, but a residual that costs `O(m^2 H + m Nt log Nt)`,
+//! independent of `N`, and a merit function that sees only the contact equations.
+//!
+//! Without contacts (`m = 0`) both problems are linear and no FFT is performed.
+//!
+//! ```
+//! use semismooth::linalg::FaerDenseLu;
+//! use semismooth::newton::{solve, NewtonOptions};
+//! use semismooth::Residual;
+//! use semismooth_contact::hb::{CondensedSsnHb, HbOptions, SsnHb, StructuredHbSolver};
+//! use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+//!
+//! let mut spec = RodSpec::canonical();
+//! spec.mass = MassModel::Modified; // massless contact node: a well-posed periodic problem
+//! let rod = build_rod(&spec).unwrap();
+//! let options = HbOptions { harmonics: 20, ..HbOptions::default() };
+//!
+//! // Full unknowns [U; Lambda], structured (condensed) linear solves.
+//! let mut hb = SsnHb::new(&rod.model, &options).unwrap();
+//! let mut x = vec![0.0; hb.dim()];
+//! let report = solve(&mut hb, &mut StructuredHbSolver::new(), &mut x, &NewtonOptions::default())
+//!     .unwrap();
+//! assert!(report.converged());
+//! let summary = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
+//! assert!(summary.displacement_min < -0.5 && summary.contact_force_mean[0] < 0.0);
+//!
+//! // Newton on the force coefficients alone: same solution, far fewer iterations.
+//! let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
+//! let mut lambda = vec![0.0; condensed.dim()];
+//! let reduced = solve(&mut condensed, &mut FaerDenseLu::new(), &mut lambda, &NewtonOptions::default())
+//!     .unwrap();
+//! assert!(reduced.converged() && reduced.iterations < report.iterations);
+//! let same = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
+//! assert!((same.displacement_min - summary.displacement_min).abs() < 1e-9);
+//! ```
+
+/// The accessors and reconstructions SSN-HB and penalty HB share: both hold their
+/// [`HbState`] in a field `state` and define `displacement_part(&self, x) -> Result<&[f64],
+/// HbError>` (the displacement coefficients `U` of their unknowns).
+macro_rules! shared_accessors {
+    () => {
+        /// The Fourier basis (`H`, `Nt`).
+        pub fn basis(&self) -> semismooth::harmonic::FourierBasis {
+            self.state.linear.basis
+        }
+
+        /// Number of degrees of freedom `N`.
+        pub fn dofs(&self) -> usize {
+            self.state.linear.dofs
+        }
+
+        /// Number of contacts `m`.
+        pub fn contacts(&self) -> usize {
+            self.state.linear.contacts()
+        }
+
+        /// Current angular frequency `w`.
+        pub fn omega(&self) -> f64 {
+            self.state.omega
+        }
+
+        /// Sets `w` (finite, `> 0`).
+        pub fn set_omega(&mut self, omega: f64) -> Result<(), $crate::hb::HbError> {
+            $crate::hb::check_omega(omega)?;
+            self.state.omega = omega;
+            Ok(())
+        }
+
+        /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
+        pub fn displacement_samples(
+            &self,
+            x: &[f64],
+            dof: usize,
+            points: usize,
+        ) -> Result<Vec<f64>, $crate::hb::HbError> {
+            let u = self.displacement_part(x)?;
+            self.state.linear.check_dof(dof)?;
+            $crate::hb::fine_samples(&self.state.linear, u, dof, points)
+        }
+
+        /// `u_dof(t)` at arbitrary times.
+        pub fn displacement_at(
+            &self,
+            x: &[f64],
+            dof: usize,
+            times: &[f64],
+        ) -> Result<Vec<f64>, $crate::hb::HbError> {
+            let u = self.displacement_part(x)?;
+            $crate::hb::displacement_at(&self.state.linear, self.state.omega, u, dof, times)
+        }
+    };
+}
+
+/// `w` as the parameter of SSN-HB and penalty HB (both hold an [`HbState`] `state` and
+/// define `displacement_len`): only `A(w)` depends on it, `dR/dw = [dA/dw U; 0]`.
+macro_rules! omega_parameter {
+    ($($problem:ty),*) => {$(
+        impl semismooth::ParameterDependent for $problem {
+            fn parameter(&self) -> f64 {
+                self.state.omega
+            }
+
+            fn set_parameter(&mut self, p: f64) {
+                self.state.omega = p;
+            }
+
+            fn residual_parameter_derivative(
+                &mut self,
+                x: &[f64],
+                out: &mut [f64],
+            ) -> Result<(), semismooth::EvaluationError> {
+                self.state.omega_derivative(x, self.displacement_len(), out);
+                Ok(())
+            }
+        }
+    )*};
+}
+
+mod condensed;
+mod jacobian;
+mod krylov;
+mod penalty;
+mod ssn;
+mod structured;
+
+use std::sync::Arc;
+
+use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
+
+use crate::model::{sparse_mul_add, InvalidModel, SparseMatrix, StructuralModel};
+
+pub use condensed::CondensedSsnHb;
+pub use jacobian::{ContactCoupling, HbJacobian};
+pub use krylov::KRYLOV_THRESHOLD;
+pub use penalty::{PenaltyHb, PenaltyHbOptions, DEFAULT_RELATIVE_PENALTY};
+pub(crate) use ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
+pub use ssn::{HbOptions, SsnHb};
+pub use structured::{
+    CondensedSolve, StructuredHbSolver, DENSE_PRECONDITIONER_LIMIT, KRYLOV_RELATIVE_TOLERANCE,
+};
+
+omega_parameter!(SsnHb, PenaltyHb);
+
+/// Why a harmonic-balance problem could not be built or a reconstruction not made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HbError {
+    /// An option or parameter is outside its allowed range.
+    #[error("invalid {name} = {value}: allowed {allowed}")]
+    InvalidOption {
+        /// Which option (field name).
+        name: &'static str,
+        /// The value received.
+        value: f64,
+        /// The allowed range, in words.
+        allowed: &'static str,
+    },
+    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    #[error(transparent)]
+    Model(#[from] InvalidModel),
+    /// A degree of freedom or contact index is out of range.
+    #[error("{what} index {index} is out of range: allowed 0..{count}")]
+    IndexOutOfRange {
+        /// What the index refers to.
+        what: &'static str,
+        /// The index received.
+        index: usize,
+        /// Number of items.
+        count: usize,
+    },
+    /// A vector has the wrong length.
+    #[error("{what}: expected length {expected}, found {found}")]
+    DimensionMismatch {
+        /// Which vector.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length received.
+        found: usize,
+    },
+    /// The Fourier basis could not be built.
+    #[error(transparent)]
+    Harmonic(#[from] HarmonicError),
+    /// The dynamic blocks `A(w)` could not be factored (e.g. an undamped resonance).
+    #[error("dynamic blocks: {0}")]
+    Linear(#[from] semismooth::linalg::LinearSolveError),
+}
+
+/// Extremes and contact diagnostics of a harmonic-balance solution over one period,
+/// reconstructed on `points` equally spaced times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResponseSummary {
+    /// Degree of freedom whose extremes are reported.
+    pub dof: usize,
+    /// Number of reconstruction points per period.
+    pub points: usize,
+    /// Maximum of `u_dof(t)` over the period.
+    pub displacement_max: f64,
+    /// Minimum of `u_dof(t)` over the period.
+    pub displacement_min: f64,
+    /// Root mean square of `u_dof(t)` over the period (exact, by Parseval).
+    pub displacement_rms: f64,
+    /// `max_t max_contacts (G u(t) - g)`, clipped at 0 (0 when there is no contact).
+    pub max_penetration: f64,
+    /// Mean of `lambda_i(t)` over the period for each contact (`<= 0` at a solution).
+    pub contact_force_mean: Vec<f64>,
+}
+
+/// The linear data shared by the formulations and their Jacobians (immutable, behind an
+/// `Arc`): matrices, forcing, contact rows and the Fourier basis.
+#[derive(Debug)]
+pub(crate) struct LinearData {
+    pub(crate) dofs: usize,
+    pub(crate) basis: FourierBasis,
+    pub(crate) mass: SparseMatrix,
+    pub(crate) damping: Option<SparseMatrix>,
+    pub(crate) stiffness: SparseMatrix,
+    pub(crate) forcing: Vec<f64>,
+    pub(crate) contact_dofs: Vec<usize>,
+    pub(crate) gaps: Vec<f64>,
+    /// `s_i = +-1`: the entry of contact `i`'s row of `G` (its dof `contact_dofs[i]`).
+    pub(crate) contact_signs: Vec<f64>,
+}
+
+impl LinearData {
+    /// Validates the model and the basis parameters and copies what HB needs.
+    pub(crate) fn new(
+        model: &StructuralModel,
+        harmonics: usize,
+        time_samples: Option<usize>,
+    ) -> Result<Self, HbError> {
+        model.validate()?;
+        validate_basis(harmonics, time_samples)?;
+        let basis = match time_samples {
+            Some(nt) => FourierBasis::new(harmonics, nt)?,
+            None => FourierBasis::with_default_samples(harmonics),
+        };
+        Ok(Self {
+            dofs: model.dofs(),
+            basis,
+            mass: model.mass.clone(),
+            damping: model.damping.clone(),
+            stiffness: model.stiffness.clone(),
+            forcing: model.forcing.amplitude.clone(),
+            contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
+            gaps: model.contacts.iter().map(|c| c.gap).collect(),
+            contact_signs: model.contacts.iter().map(|c| c.sign()).collect(),
+        })
+    }
+
+    pub(crate) fn contacts(&self) -> usize {
+        self.contact_dofs.len()
+    }
+
+    pub(crate) fn size(&self) -> usize {
+        self.basis.basis_size()
+    }
+
+    /// `out = A(w) U - F`.
+    pub(crate) fn dynamic_residual(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        self.apply_dynamic(omega, u, out);
+        let n = self.dofs;
+        for (o, f) in out[n..2 * n].iter_mut().zip(&self.forcing) {
+            *o -= f;
+        }
+    }
+
+    /// `out = A(w) U`.
+    pub(crate) fn apply_dynamic(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        let n = self.dofs;
+        out.fill(0.0);
+        sparse_mul_add(self.stiffness.as_ref(), 1.0, &u[..n], &mut out[..n]);
+        for k in 1..=self.basis.harmonics() {
+            let kw = k as f64 * omega;
+            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+            let (a, b) = (&u[c..c + n], &u[s..s + n]);
+            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
+            sparse_mul_add(self.stiffness.as_ref(), 1.0, a, out_c);
+            sparse_mul_add(self.mass.as_ref(), -kw * kw, a, out_c);
+            sparse_mul_add(self.stiffness.as_ref(), 1.0, b, out_s);
+            sparse_mul_add(self.mass.as_ref(), -kw * kw, b, out_s);
+            if let Some(d) = &self.damping {
+                sparse_mul_add(d.as_ref(), kw, b, out_c);
+                sparse_mul_add(d.as_ref(), -kw, a, out_s);
+            }
+        }
+    }
+
+    /// `out = dA/dw (w) U`: for harmonic `k`, `-2 k^2 w M` on the diagonal blocks and
+    /// `+-k D` off the diagonal.
+    pub(crate) fn dynamic_omega_derivative(&self, omega: f64, u: &[f64], out: &mut [f64]) {
+        let n = self.dofs;
+        out.fill(0.0);
+        for k in 1..=self.basis.harmonics() {
+            let kf = k as f64;
+            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
+            let (a, b) = (&u[c..c + n], &u[s..s + n]);
+            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
+            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, a, out_c);
+            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, b, out_s);
+            if let Some(d) = &self.damping {
+                sparse_mul_add(d.as_ref(), kf, b, out_c);
+                sparse_mul_add(d.as_ref(), -kf, a, out_s);
+            }
+        }
+    }
+
+    /// Coefficients (length `2H + 1`) of `dof` from a harmonic-major vector.
+    pub(crate) fn gather(&self, u: &[f64], dof: usize, out: &mut [f64]) {
+        let n = self.dofs;
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = u[j * n + dof];
+        }
+    }
+
+    pub(crate) fn check_dof(&self, dof: usize) -> Result<(), HbError> {
+        if dof >= self.dofs {
+            return Err(HbError::IndexOutOfRange {
+                what: "dof",
+                index: dof,
+                count: self.dofs,
+            });
+        }
+        Ok(())
+    }
+
+    pub(crate) fn check_contact(&self, contact: usize) -> Result<(), HbError> {
+        if contact >= self.contacts() {
+            return Err(HbError::IndexOutOfRange {
+                what: "contact",
+                index: contact,
+                count: self.contacts(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
+pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> Result<(), HbError> {
+    if harmonics == 0 {
+        return Err(HbError::InvalidOption {
+            name: "harmonics",
+            value: 0.0,
+            allowed: "an integer >= 1 (the forcing is harmonic 1)",
+        });
+    }
+    if let Some(nt) = time_samples {
+        FourierBasis::new(harmonics, nt)?;
+    }
+    Ok(())
+}
+
+/// `Err(InvalidOption { name, value, allowed })` unless `value` is finite and `> 0`.
+pub(crate) fn check_positive(
+    name: &'static str,
+    value: f64,
+    allowed: &'static str,
+) -> Result<(), HbError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(HbError::InvalidOption {
+            name,
+            value,
+            allowed,
+        })
+    }
+}
+
+pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
+    check_positive("omega", omega, "a finite angular frequency > 0")
+}
+
+pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {
+    Ok(semismooth::harmonic::check_length(what, expected, found)?)
+}
+
+/// Samples of one dof over a period at `points` equally spaced times `t_n = n T / points`
+/// (a finer AFT grid than the solver's when `points > Nt`).
+pub(crate) fn fine_samples(
+    lin: &LinearData,
+    u: &[f64],
+    dof: usize,
+    points: usize,
+) -> Result<Vec<f64>, HbError> {
+    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
+    let mut aft = Aft::new(basis);
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let mut samples = vec![0.0; points];
+    aft.to_time(&coeffs, &mut samples)?;
+    Ok(samples)
+}
+
+/// Displacement extremes, RMS and penetration from the displacement coefficients `u`.
+pub(crate) fn displacement_summary(
+    lin: &LinearData,
+    u: &[f64],
+    dof: usize,
+    points: usize,
+    contact_force_mean: Vec<f64>,
+) -> Result<ResponseSummary, HbError> {
+    lin.check_dof(dof)?;
+    let samples = fine_samples(lin, u, dof, points)?;
+    let displacement_max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let displacement_min = samples.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let displacement_rms = lin.basis.mean_square(&coeffs)?.sqrt();
+    let mut max_penetration = 0.0f64;
+    for ((&cdof, &gap), &sign) in lin
+        .contact_dofs
+        .iter()
+        .zip(&lin.gaps)
+        .zip(&lin.contact_signs)
+    {
+        let s = fine_samples(lin, u, cdof, points)?;
+        for x in s {
+            max_penetration = max_penetration.max(sign * x - gap);
+        }
+    }
+    Ok(ResponseSummary {
+        dof,
+        points,
+        displacement_max,
+        displacement_min,
+        displacement_rms,
+        max_penetration,
+        contact_force_mean,
+    })
+}
+
+/// `u_dof(t)` at arbitrary times from harmonic-major coefficients.
+pub(crate) fn displacement_at(
+    lin: &LinearData,
+    omega: f64,
+    u: &[f64],
+    dof: usize,
+    times: &[f64],
+) -> Result<Vec<f64>, HbError> {
+    lin.check_dof(dof)?;
+    let mut coeffs = vec![0.0; lin.size()];
+    lin.gather(u, dof, &mut coeffs);
+    let mut out = vec![0.0; times.len()];
+    lin.basis.evaluate_many(&coeffs, omega, times, &mut out)?;
+    Ok(out)
+}
+
+/// Shared state of both formulations at the current frequency.
+#[derive(Debug)]
+pub(crate) struct HbState {
+    pub(crate) linear: Arc<LinearData>,
+    pub(crate) omega: f64,
+    pub(crate) aft: Aft,
+}
+
+impl HbState {
+    /// Turns the switching samples of contact `i` (the AFT's samples) into the indicator
+    /// `h_n = [s_n > 0]` and writes the block `P diag(h) E` of the Jacobian; records the
+    /// active count.
+    pub(crate) fn write_contact_block(&mut self, jac: &mut jacobian::HbJacobian, i: usize) {
+        jac.active[i] = indicator(self.aft.samples_mut());
+        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+    }
+
+    /// Writes the block `P diag(w) E` of contact `i` with the weights `w_n` in the AFT's
+    /// samples (a smoothed indicator in `[0, 1]`); records the samples with `w_n > 1/2` as
+    /// active.
+    pub(crate) fn write_weighted_contact_block(
+        &mut self,
+        jac: &mut jacobian::HbJacobian,
+        i: usize,
+    ) {
+        jac.active[i] = self.aft.samples_mut().iter().filter(|w| **w > 0.5).count();
+        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+    }
+
+    /// A Jacobian of this state's model at its frequency with `coupling`.
+    pub(crate) fn new_jacobian(&self, coupling: ContactCoupling) -> HbJacobian {
+        HbJacobian::new(self.linear.clone(), self.omega, coupling)
+    }
+
+    /// Makes `jac` a Jacobian of this state's model at its frequency with `coupling` (its
+    /// contact blocks are then written contact by contact).
+    pub(crate) fn prepare_jacobian(&self, jac: &mut HbJacobian, coupling: ContactCoupling) {
+        if !Arc::ptr_eq(&jac.linear, &self.linear) {
+            *jac = self.new_jacobian(coupling);
+        }
+        jac.omega = self.omega;
+        jac.coupling = coupling;
+    }
+
+    /// `dR/dw` of the displacement equations, `dA/dw U`, into `out` (first `len` entries,
+    /// `U = x[..len]`); the rest of `out` (force equations) is zero.
+    pub(crate) fn omega_derivative(&self, x: &[f64], len: usize, out: &mut [f64]) {
+        let (out_u, rest) = out.split_at_mut(len);
+        self.linear
+            .dynamic_omega_derivative(self.omega, &x[..len], out_u);
+        rest.fill(0.0);
+    }
+
+    pub(crate) fn new(linear: LinearData, omega: f64) -> Self {
+        let aft = Aft::new(linear.basis);
+        Self {
+            linear: Arc::new(linear),
+            omega,
+            aft,
+        }
+    }
+}
+
+/// Replaces each sample by the indicator `[s_n > 0]`; returns how many are 1.
+pub(crate) fn indicator(samples: &mut [f64]) -> usize {
+    let mut active = 0;
+    for s in samples.iter_mut() {
+        *s = if *s > 0.0 {
+            active += 1;
+            1.0
+        } else {
+            0.0
+        };
+    }
+    active
+}

@@ -1,0 +1,295 @@
+//! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
+
+use semismooth::continuation::PiecewiseAffine;
+use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
+
+use super::jacobian::{ContactCoupling, HbJacobian};
+use super::{
+    check_len, check_positive, displacement_summary, fine_samples, validate_basis, HbError,
+    HbState, LinearData, ResponseSummary,
+};
+use crate::model::StructuralModel;
+
+/// Default penalty stiffness, relative to the contact stiffness scale
+/// ([`StructuralModel::contact_stiffness_scale`]).
+pub const DEFAULT_RELATIVE_PENALTY: f64 = 1e5;
+
+/// Options of [`PenaltyHb`].
+///
+/// | field | default ([`PenaltyHbOptions::for_model`]) | allowed |
+/// |---|---|---|
+/// | `harmonics` (`H`) | 20 | `>= 1` |
+/// | `time_samples` (`Nt`) | `None`: [`semismooth::harmonic::default_time_samples`]`(H)` | `> 2H` |
+/// | `penalty_stiffness` (`k_p`) | [`PenaltyHbOptions::default_penalty_stiffness`]: [`DEFAULT_RELATIVE_PENALTY`] `x` [`StructuralModel::contact_stiffness_scale`] | finite, `> 0` |
+///
+/// `penalty_stiffness` is **absolute** (force per length); the scenes give it relative to
+/// the contact stiffness scale, and their default is the same `1e5 x scale`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PenaltyHbOptions {
+    /// Number of harmonics `H`.
+    pub harmonics: usize,
+    /// AFT samples per period `Nt`.
+    pub time_samples: Option<usize>,
+    /// Penalty stiffness `k_p` (absolute).
+    pub penalty_stiffness: f64,
+}
+
+impl PenaltyHbOptions {
+    /// The default options for `model`: 20 harmonics, the default `Nt` and
+    /// [`PenaltyHbOptions::default_penalty_stiffness`].
+    pub fn for_model(model: &StructuralModel) -> Self {
+        Self {
+            harmonics: 20,
+            time_samples: None,
+            penalty_stiffness: Self::default_penalty_stiffness(model),
+        }
+    }
+
+    /// The default penalty stiffness of `model`: [`DEFAULT_RELATIVE_PENALTY`] times its
+    /// contact stiffness scale ([`StructuralModel::contact_stiffness_scale`]).
+    pub fn default_penalty_stiffness(model: &StructuralModel) -> f64 {
+        DEFAULT_RELATIVE_PENALTY * model.contact_stiffness_scale()
+    }
+
+    /// Checks `harmonics >= 1`, `time_samples > 2H`, `penalty_stiffness` finite and `> 0`.
+    pub fn validate(&self) -> Result<(), HbError> {
+        validate_basis(self.harmonics, self.time_samples)?;
+        check_penalty_stiffness(self.penalty_stiffness)
+    }
+}
+
+fn check_penalty_stiffness(kp: f64) -> Result<(), HbError> {
+    check_positive(
+        "penalty_stiffness",
+        kp,
+        "a finite penalty stiffness > 0 (absolute, force per length)",
+    )
+}
+
+/// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),
+/// residual `R = A(w) U - F - G^T P lambda(E U)` with
+/// `lambda_i(t_n) = -k_p max(0, u_{dof_i}(t_n) - g_i)`, generalized Jacobian
+/// `A(w) + k_p G^T P diag(h) G E`, `h_n = 1` where `G u_n - g > 0`.
+///
+/// With the activity `h` held fixed the residual is affine in `U`: the branch of solutions
+/// in `w` is made of pieces `U_h(w)` (one per set of active samples), each a graph over
+/// `w`, joined at corners where one sample's gap changes sign: the problem is
+/// [`PiecewiseAffine`], its switching functions the gaps at the samples, and the
+/// continuation crosses its corners exactly.
+#[derive(Debug)]
+pub struct PenaltyHb {
+    pub(crate) state: HbState,
+    stiffness: f64,
+    /// Held piece `h` (contact-major, `m Nt` entries): while `holding`, the penalty force is
+    /// `k_p h_n (G u_n - g)` (the affine piece) instead of `k_p max(0, G u_n - g)`.
+    frozen: Vec<bool>,
+    /// Whether `frozen` is held (its storage is kept either way).
+    holding: bool,
+}
+
+impl PenaltyHb {
+    shared_accessors!();
+
+    /// How the penalty enters the Jacobian.
+    fn coupling(&self) -> ContactCoupling {
+        ContactCoupling::Penalty {
+            stiffness: self.stiffness,
+        }
+    }
+
+    /// Length of `U`: all the unknowns.
+    pub fn displacement_len(&self) -> usize {
+        self.dim()
+    }
+
+    /// The displacement coefficients `U` (all the unknowns).
+    fn displacement_part<'a>(&self, u: &'a [f64]) -> Result<&'a [f64], HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        Ok(u)
+    }
+
+    /// Builds the problem; validates the model and the options.
+    pub fn new(model: &StructuralModel, options: &PenaltyHbOptions) -> Result<Self, HbError> {
+        options.validate()?;
+        let kp = options.penalty_stiffness;
+        let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
+        Ok(Self {
+            state: HbState::new(linear, model.forcing.omega),
+            stiffness: kp,
+            frozen: Vec::new(),
+            holding: false,
+        })
+    }
+
+    /// The penalty stiffness `k_p` in use.
+    pub fn penalty_stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    /// Sets the penalty stiffness `k_p` (finite, `> 0`).
+    pub fn set_penalty_stiffness(&mut self, k: f64) -> Result<(), HbError> {
+        check_penalty_stiffness(k)?;
+        self.stiffness = k;
+        Ok(())
+    }
+
+    /// Penalty force `lambda_i(t_n) = -k_p max(0, u(t_n) - g_i)` at `points` equally spaced
+    /// times (evaluated pointwise on the fine grid, not through the `H`-harmonic projection).
+    pub fn contact_force_samples(
+        &self,
+        u: &[f64],
+        contact: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let lin = &self.state.linear;
+        lin.check_contact(contact)?;
+        let (gap, sign) = (lin.gaps[contact], lin.contact_signs[contact]);
+        let samples = fine_samples(lin, u, lin.contact_dofs[contact], points)?;
+        Ok(samples
+            .into_iter()
+            .map(|x| -self.stiffness * (sign * x - gap).max(0.0))
+            .collect())
+    }
+
+    /// Extremes of `u_dof` and penetration over a period reconstructed on `points` times,
+    /// and the mean penalty force of each contact as the equations see it: the mean over
+    /// the `Nt` AFT samples, `(P lambda)_0` (the static balance `K u_0 = f_0 + G^T Lambda_0`).
+    /// A finer grid would resolve a stiff penalty's narrow force peaks that the `Nt`-point
+    /// quadrature does not, and give a mean inconsistent with the solution.
+    pub fn summary(
+        &self,
+        u: &[f64],
+        dof: usize,
+        points: usize,
+    ) -> Result<ResponseSummary, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let nt = self.state.linear.basis.time_samples();
+        let means = (0..self.contacts())
+            .map(|i| {
+                self.contact_force_samples(u, i, nt)
+                    .map(|f| f.iter().sum::<f64>() / nt as f64)
+            })
+            .collect::<Result<Vec<f64>, HbError>>()?;
+        displacement_summary(&self.state.linear, u, dof, points, means)
+    }
+
+    fn time_samples(&self) -> usize {
+        self.state.linear.basis.time_samples()
+    }
+
+    /// Replaces the gap samples of contact `i` (the AFT's samples) by the penalty
+    /// "activity-weighted gaps": `max(0, s_n)`, or `h_n s_n` when the activity is frozen.
+    fn penetrations(&mut self, i: usize) {
+        let samples = self.state.aft.samples_mut();
+        let nt = samples.len();
+        match self.holding.then_some(&self.frozen) {
+            Some(h) => {
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                    if !on {
+                        *s = 0.0;
+                    }
+                }
+            }
+            None => {
+                for s in samples {
+                    *s = s.max(0.0);
+                }
+            }
+        }
+    }
+
+    /// Samples `G u_n - g` of contact `i` into the AFT's samples.
+    fn gap_samples(&mut self, u: &[f64], i: usize) {
+        let lin = &self.state.linear;
+        let coeffs = self.state.aft.coefficients_mut();
+        lin.gather(u, lin.contact_dofs[i], coeffs);
+        let sign = lin.contact_signs[i];
+        for c in coeffs.iter_mut() {
+            *c *= sign;
+        }
+        coeffs[0] -= lin.gaps[i];
+        self.state.aft.coefficients_to_samples();
+    }
+}
+
+impl Residual for PenaltyHb {
+    fn dim(&self) -> usize {
+        self.state.linear.dofs * self.state.linear.size()
+    }
+
+    fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        let lin = self.state.linear.clone();
+        let n = lin.dofs;
+        lin.dynamic_residual(self.state.omega, u, out);
+        for i in 0..lin.contacts() {
+            self.gap_samples(u, i);
+            self.penetrations(i);
+            for s in self.state.aft.samples_mut() {
+                *s *= self.stiffness;
+            }
+            self.state.aft.samples_to_coefficients();
+            // - G^T P lambda = + k_p G^T P max(0, G u - g).
+            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                out[j * n + dof] += sign * c;
+            }
+        }
+        Ok(())
+    }
+
+    /// `ffts`: the transforms of the alternating frequency/time scheme.
+    fn problem_counters(&self) -> ProblemCounters {
+        ProblemCounters::new().with("ffts", self.state.aft.fft_count())
+    }
+}
+
+impl GeneralizedJacobian for PenaltyHb {
+    type Jacobian = HbJacobian;
+
+    fn new_jacobian(&self) -> HbJacobian {
+        self.state.new_jacobian(self.coupling())
+    }
+
+    fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
+        self.state.prepare_jacobian(jac, self.coupling());
+        let nt = self.time_samples();
+        for i in 0..self.contacts() {
+            self.gap_samples(u, i);
+            if let Some(h) = self.holding.then_some(&self.frozen) {
+                // The indicator is the sign of the sample: impose the frozen one.
+                let samples = self.state.aft.samples_mut();
+                for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
+                    *s = if on { 1.0 } else { 0.0 };
+                }
+            }
+            self.state.write_contact_block(jac, i);
+        }
+        Ok(())
+    }
+}
+
+/// The switching functions are the gaps `G u(t_n) - g` at the `Nt` AFT samples,
+/// contact-major (`i Nt + n`): a sample carries penalty force where its gap is positive.
+impl PiecewiseAffine for PenaltyHb {
+    fn switching_count(&self) -> usize {
+        self.contacts() * self.time_samples()
+    }
+
+    fn switching(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        let nt = self.time_samples();
+        for i in 0..self.contacts() {
+            self.gap_samples(u, i);
+            out[i * nt..(i + 1) * nt].copy_from_slice(self.state.aft.samples());
+        }
+        Ok(())
+    }
+
+    fn hold_piece(&mut self, piece: Option<&[bool]>) {
+        self.holding = piece.is_some();
+        if let Some(h) = piece {
+            self.frozen.clear();
+            self.frozen.extend_from_slice(h);
+        }
+    }
+}

@@ -1,0 +1,25 @@
+//! # semismooth-contact
+//!
+//! Periodic vibrations of structures with unilateral contact, as a library built only on
+//! the public API of the `semismooth` core: the structural model
+//! `M u'' + D u' + K u = f(t) + G^T lambda(t)` with contact
+//! `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0`, its builders (the finite-element
+//! rod of Shi & Legrand, a beam, a bladed disk, Matrix Market files), the formulations that
+//! solve it (harmonic balance with exact or penalty contact, the periodic LCP, time
+//! marching), stability, frequency responses and the solutions at one frequency.
+
+pub mod contacts;
+mod dynamic;
+pub mod from_zero;
+pub mod hb;
+pub mod lcp;
+pub mod march;
+pub mod matrix_market;
+pub mod model;
+pub mod rod;
+pub mod settings;
+pub mod solutions;
+pub mod solve;
+pub mod stability;
+pub mod structures;
+pub mod sweep;

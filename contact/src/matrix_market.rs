@@ -1,0 +1,511 @@
+//! Imported structures: a `[model]` scene's Matrix Market files resolved into the
+//! [`Structure`] every method runs on, and the inverse, a rod written as such files.
+//!
+//! The files hold the matrices of `M u'' + D u' + K u = f(t) + G^T lambda(t)` on the free
+//! dofs (the finite-element code has already removed the constrained ones): `M`, `K` and an
+//! optional `D`, `N x N`, and the load shape `f`, `N x 1`, applied as
+//! `amplitude * f * cos(omega t)`. Matrix Market coordinate (real or integer; general or
+//! symmetric, the lower triangle then mirrored) and array formats are read by
+//! nalgebra-sparse's reader; duplicate coordinate entries are summed (assembly).
+//!
+//! Contract of [`build_imported`] (each violation is an [`ImportError`] naming the file, and
+//! the entry or the key with its value):
+//!
+//! - every matrix is square of the stiffness' size `N >= 1`, the load vector is `N x 1`,
+//!   every entry finite;
+//! - `K` and `M` are symmetric to round-off, `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`
+//!   (files written with ten significant digits pass), and are then replaced by
+//!   `(A + A^T) / 2`; `D` may be any matrix (e.g. gyroscopic terms);
+//! - `M` has no negative diagonal entry; zero rows are massless dofs (allowed, as the rod's
+//!   modified mass: their frequencies are infinite and are not counted);
+//! - `K` is nonsingular on the free dofs (its sparse LU has no zero pivot) and the pencil
+//!   `(K, M)` has a lowest finite natural frequency `omega_1` (Rayleigh–Ritz / subspace
+//!   iteration of [`natural_frequencies`]);
+//! - contact and observed dofs exist (`1..=N` in the scene, 1-based as in Matrix Market).
+//!
+//! `[damping] zeta` gives `D = (2 zeta / omega_1) K`, `alpha`/`beta` give
+//! `D = alpha M + beta K`, exactly as for the rod; a `damping` file and a `[damping]`
+//! section together are an error (of the scene).
+
+use std::path::{Path, PathBuf};
+
+use faer::sparse::Triplet;
+use nalgebra_sparse::io::{load_coo_from_matrix_market_str, MatrixMarketErrorKind};
+use nalgebra_sparse::CooMatrix;
+use semismooth::linalg::FaerSparseLu;
+use semismooth::Factorize;
+
+use crate::dynamic::UnionPattern;
+use crate::model::{ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure};
+use crate::rod::{natural_frequencies, DampingSpec, FrequencySpec};
+
+/// Relative tolerance of the symmetry check of `K` and `M`.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
+
+/// Largest Matrix Market file read (bytes).
+pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
+
+pub use crate::model::ContactDirection;
+
+/// A contact of an imported model on one dof.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DofContact {
+    /// The dof, 0-based (the scene's `dof` minus one).
+    pub dof: usize,
+    /// Gap (negative: preloaded).
+    pub gap: f64,
+    /// Side of the obstacle.
+    pub direction: ContactDirection,
+}
+
+/// Everything a `[model]` scene declares (paths resolved against the scene's directory).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelSpec {
+    /// The scene file (for messages).
+    pub scene: PathBuf,
+    /// Mass matrix file.
+    pub mass: PathBuf,
+    /// Stiffness matrix file.
+    pub stiffness: PathBuf,
+    /// Damping matrix file (optional).
+    pub damping_matrix: Option<PathBuf>,
+    /// Damping from the `[damping]` section (not with a damping file).
+    pub damping: Option<DampingSpec>,
+    /// Load shape file (`N x 1`).
+    pub forcing_vector: PathBuf,
+    /// Load amplitude (multiplies the load shape).
+    pub amplitude: f64,
+    /// Forcing frequency (`Ratio` in units of `omega_1`).
+    pub frequency: FrequencySpec,
+    /// Contacts.
+    pub contacts: Vec<DofContact>,
+    /// Observed dof (0-based); `None`: the first contact dof, else the largest load entry.
+    pub observed_dof: Option<usize>,
+}
+
+/// Why an imported model could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// A file is larger than [`MAX_MATRIX_FILE_BYTES`].
+    #[error("{path}: {bytes} bytes: allowed at most {limit} bytes for a Matrix Market file")]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// The Matrix Market reader rejected the file (the message has the line and column of a
+    /// malformed line).
+    #[error("{path}: not a valid Matrix Market file: {message}")]
+    MatrixMarket {
+        /// The file.
+        path: PathBuf,
+        /// The reader's message.
+        message: String,
+    },
+    /// A matrix or vector has the wrong size.
+    #[error("{path}: {what} is {rows} x {cols}: allowed {expected}")]
+    Size {
+        /// The file.
+        path: PathBuf,
+        /// `"mass matrix"`, ...
+        what: &'static str,
+        /// Rows found.
+        rows: usize,
+        /// Columns found.
+        cols: usize,
+        /// What is allowed, in words.
+        expected: String,
+    },
+    /// An entry is NaN or infinite.
+    #[error("{path}: entry ({row}, {col}) = {value}: allowed finite numbers")]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// 1-based row.
+        row: usize,
+        /// 1-based column.
+        col: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// `K` or `M` is not symmetric to round-off.
+    #[error(
+        "{path}: {what} is not symmetric: entry ({row}, {col}) = {value:e} but ({col}, {row}) = \
+         {transposed:e}: allowed |a_ij - a_ji| <= {tolerance:e} (relative {SYMMETRY_TOLERANCE:e} \
+         of the largest entry)"
+    )]
+    NotSymmetric {
+        /// The file.
+        path: PathBuf,
+        /// `"stiffness matrix"` or `"mass matrix"`.
+        what: &'static str,
+        /// 1-based row.
+        row: usize,
+        /// 1-based column.
+        col: usize,
+        /// `a_ij`.
+        value: f64,
+        /// `a_ji`.
+        transposed: f64,
+        /// Absolute tolerance.
+        tolerance: f64,
+    },
+    /// A diagonal entry of `M` is negative.
+    #[error(
+        "{path}: mass matrix entry ({dof}, {dof}) = {value:e}: allowed >= 0 (0: a massless dof)"
+    )]
+    NegativeMass {
+        /// The file.
+        path: PathBuf,
+        /// 1-based dof.
+        dof: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// `K` is singular on the free dofs, or `(K, M)` has no finite natural frequency.
+    #[error("{path}: {reason}")]
+    Stiffness {
+        /// The stiffness file.
+        path: PathBuf,
+        /// What failed.
+        reason: String,
+    },
+    /// A dof named in the scene does not exist.
+    #[error("{scene}: invalid `{key}` = {value}: allowed 1..={dofs} (the model has {dofs} dofs)")]
+    DofOutOfRange {
+        /// The scene file.
+        scene: PathBuf,
+        /// `contact.point.dof` or `output.dof`.
+        key: &'static str,
+        /// The 1-based value found.
+        value: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// Any other defect of the assembled model or of the forcing frequency.
+    #[error("{scene}: {reason}")]
+    Model {
+        /// The scene file.
+        scene: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ImportError + '_ {
+    move |source| ImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Reads a real Matrix Market file (module documentation) as a sparse matrix, entries
+/// checked finite.
+pub fn read_matrix(path: &Path) -> Result<SparseMatrix, ImportError> {
+    let bytes = std::fs::metadata(path).map_err(io(path))?.len();
+    if bytes > MAX_MATRIX_FILE_BYTES {
+        return Err(ImportError::TooLarge {
+            path: path.to_path_buf(),
+            bytes,
+            limit: MAX_MATRIX_FILE_BYTES,
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(io(path))?;
+    parse_matrix(&text, path)
+}
+
+/// Parses Matrix Market text (`path` for messages only).
+pub fn parse_matrix(text: &str, path: &Path) -> Result<SparseMatrix, ImportError> {
+    let bad = |message: String| ImportError::MatrixMarket {
+        path: path.to_path_buf(),
+        message,
+    };
+    let coo: CooMatrix<f64> = match load_coo_from_matrix_market_str::<f64>(text) {
+        Ok(coo) => coo,
+        // An `integer` file: read as integers, converted.
+        Err(e) if e.kind() == MatrixMarketErrorKind::TypeMismatch => {
+            let ints = load_coo_from_matrix_market_str::<i64>(text)
+                .map_err(|_| bad(e.message().trim().to_string()))?;
+            let (rows, cols) = (ints.nrows(), ints.ncols());
+            let (r, c, v) = ints.disassemble();
+            let v = v.into_iter().map(|v| v as f64).collect();
+            CooMatrix::try_from_triplets(rows, cols, r, c, v).map_err(|e| bad(e.to_string()))?
+        }
+        Err(e) => return Err(bad(reader_message(e.message(), text))),
+    };
+    let mut triplets = Vec::with_capacity(coo.nnz());
+    for (i, j, &v) in coo.triplet_iter() {
+        if !v.is_finite() {
+            return Err(ImportError::NonFinite {
+                path: path.to_path_buf(),
+                row: i + 1,
+                col: j + 1,
+                value: v,
+            });
+        }
+        triplets.push(Triplet::new(i, j, v));
+    }
+    SparseMatrix::try_new_from_triplets(coo.nrows(), coo.ncols(), &triplets)
+        .map_err(|e| bad(format!("{e:?}")))
+}
+
+/// The reader's message on one line: `line L, column C: `text`` when it locates the
+/// defect (its parser reports ` --> L:C` and a drawing of the line), else as it is.
+fn reader_message(message: &str, text: &str) -> String {
+    let located = message.split_once("--> ").and_then(|(_, rest)| {
+        let (line, rest) = rest.split_once(':')?;
+        let column: String = rest.chars().take_while(char::is_ascii_digit).collect();
+        let line: usize = line.trim().parse().ok()?;
+        let content = text.lines().nth(line.checked_sub(1)?)?;
+        Some(format!(
+            "line {line}, column {column}: `{}` is not an entry of this header's format",
+            content.trim()
+        ))
+    });
+    located.unwrap_or_else(|| message.split_whitespace().collect::<Vec<_>>().join(" "))
+}
+
+/// `(A + A^T) / 2` after checking `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`.
+fn symmetrized(
+    a: &SparseMatrix,
+    path: &Path,
+    what: &'static str,
+) -> Result<SparseMatrix, ImportError> {
+    let n = a.nrows();
+    let r = a.as_ref();
+    let max = a.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let tolerance = SYMMETRY_TOLERANCE * max;
+    let entry = |i: usize, j: usize| -> f64 {
+        r.row_idx_of_col(j)
+            .zip(r.val_of_col(j))
+            .find(|(row, _)| *row == i)
+            .map_or(0.0, |(_, v)| *v)
+    };
+    let mut triplets = Vec::with_capacity(2 * a.val().len());
+    for j in 0..n {
+        for (i, &v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
+            let t = entry(j, i);
+            if (v - t).abs() > tolerance {
+                return Err(ImportError::NotSymmetric {
+                    path: path.to_path_buf(),
+                    what,
+                    row: i + 1,
+                    col: j + 1,
+                    value: v,
+                    transposed: t,
+                    tolerance,
+                });
+            }
+            triplets.push(Triplet::new(i, j, 0.5 * v));
+            triplets.push(Triplet::new(j, i, 0.5 * v));
+        }
+    }
+    SparseMatrix::try_new_from_triplets(n, n, &triplets).map_err(|e| ImportError::MatrixMarket {
+        path: path.to_path_buf(),
+        message: format!("{e:?}"),
+    })
+}
+
+fn check_square(
+    a: &SparseMatrix,
+    n: usize,
+    path: &Path,
+    what: &'static str,
+) -> Result<(), ImportError> {
+    if a.nrows() == n && a.ncols() == n {
+        return Ok(());
+    }
+    Err(ImportError::Size {
+        path: path.to_path_buf(),
+        what,
+        rows: a.nrows(),
+        cols: a.ncols(),
+        expected: format!("{n} x {n} (the stiffness matrix' size)"),
+    })
+}
+
+/// Reads and checks the files of `spec` and assembles the structure (module documentation).
+pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
+    let stiffness = read_matrix(&spec.stiffness)?;
+    let n = stiffness.nrows();
+    if n == 0 || stiffness.ncols() != n {
+        return Err(ImportError::Size {
+            path: spec.stiffness.clone(),
+            what: "stiffness matrix",
+            rows: n,
+            cols: stiffness.ncols(),
+            expected: "N x N with N >= 1".into(),
+        });
+    }
+    let stiffness = symmetrized(&stiffness, &spec.stiffness, "stiffness matrix")?;
+    let mass = read_matrix(&spec.mass)?;
+    check_square(&mass, n, &spec.mass, "mass matrix")?;
+    let mass = symmetrized(&mass, &spec.mass, "mass matrix")?;
+    for dof in 0..n {
+        let m = crate::model::diagonal_entry(&mass, dof);
+        if m < 0.0 {
+            return Err(ImportError::NegativeMass {
+                path: spec.mass.clone(),
+                dof: dof + 1,
+                value: m,
+            });
+        }
+    }
+    let damping = match &spec.damping_matrix {
+        Some(path) => {
+            let d = read_matrix(path)?;
+            check_square(&d, n, path, "damping matrix")?;
+            Some(d)
+        }
+        None => None,
+    };
+    let load = read_matrix(&spec.forcing_vector)?;
+    if load.nrows() != n || load.ncols() != 1 {
+        return Err(ImportError::Size {
+            path: spec.forcing_vector.clone(),
+            what: "load vector",
+            rows: load.nrows(),
+            cols: load.ncols(),
+            expected: format!("{n} x 1 (one entry per dof)"),
+        });
+    }
+    let mut amplitude = vec![0.0; n];
+    for (i, v) in load.row_idx_of_col(0).zip(load.val_of_col(0)) {
+        amplitude[i] += spec.amplitude * v;
+    }
+    let dof_in_range = |key: &'static str, dof: usize| {
+        if dof < n {
+            Ok(dof)
+        } else {
+            Err(ImportError::DofOutOfRange {
+                scene: spec.scene.clone(),
+                key,
+                value: dof + 1,
+                dofs: n,
+            })
+        }
+    };
+    let mut contacts = Vec::with_capacity(spec.contacts.len());
+    for c in &spec.contacts {
+        dof_in_range("contact.point.dof", c.dof)?;
+        contacts.push(ContactPoint {
+            dof: c.dof,
+            gap: c.gap,
+            direction: c.direction,
+        });
+    }
+    let observed_dof = match spec.observed_dof {
+        Some(dof) => dof_in_range("output.dof", dof)?,
+        None => match contacts.first() {
+            Some(c) => c.dof,
+            None => largest_entry(&amplitude),
+        },
+    };
+    let stiffness_error = |reason: String| ImportError::Stiffness {
+        path: spec.stiffness.clone(),
+        reason,
+    };
+    FaerSparseLu::new().factor(&stiffness).map_err(|e| {
+        stiffness_error(format!(
+            "the stiffness matrix is singular on the free dofs ({e}): remove the rigid-body \
+             motions (constrain dofs) before exporting"
+        ))
+    })?;
+    let mut model = StructuralModel {
+        mass,
+        damping,
+        stiffness,
+        forcing: HarmonicForcing {
+            amplitude,
+            omega: 1.0,
+        },
+        contacts,
+    };
+    let omega_1 = natural_frequencies(&model, 1)
+        .map_err(|e| stiffness_error(format!("no lowest natural frequency of (K, M): {e}")))?[0];
+    if let Some(d) = spec.damping {
+        model.damping = Some(match d {
+            DampingSpec::StiffnessProportional { zeta } => {
+                UnionPattern::linear_combination(n, &[&model.stiffness], &[2.0 * zeta / omega_1])
+            }
+            DampingSpec::Rayleigh { alpha, beta } => UnionPattern::linear_combination(
+                n,
+                &[&model.stiffness, &model.mass],
+                &[beta, alpha],
+            ),
+        });
+    }
+    model.forcing.omega = match spec.frequency {
+        FrequencySpec::Ratio(r) => r * omega_1,
+        FrequencySpec::Absolute(w) => w,
+    };
+    model.validate().map_err(|e| ImportError::Model {
+        scene: spec.scene.clone(),
+        reason: e.to_string(),
+    })?;
+    Ok(Structure {
+        model,
+        omega_1,
+        observed_dof,
+    })
+}
+
+/// Index of the entry of largest magnitude (0 for an all-zero vector).
+fn largest_entry(v: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, x) in v.iter().enumerate() {
+        if x.abs() > v[best].abs() {
+            best = i;
+        }
+    }
+    best
+}
+
+/// A sparse matrix as Matrix Market text (coordinate, real, general; every stored entry,
+/// values in Rust's shortest round-trip notation, so reading it back is exact).
+pub fn matrix_market_text(a: &SparseMatrix) -> String {
+    let r = a.as_ref();
+    let mut coo = CooMatrix::new(a.nrows(), a.ncols());
+    for j in 0..a.ncols() {
+        for (i, &v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
+            coo.push(i, j, v);
+        }
+    }
+    nalgebra_sparse::io::save_to_matrix_market_str(&coo)
+}
+
+/// A vector as an `n x 1` Matrix Market matrix (its nonzero entries).
+pub fn vector_market_text(v: &[f64]) -> String {
+    let mut coo = CooMatrix::new(v.len(), 1);
+    for (i, &x) in v.iter().enumerate() {
+        if x != 0.0 {
+            coo.push(i, 0, x);
+        }
+    }
+    nalgebra_sparse::io::save_to_matrix_market_str(&coo)
+}
+
+/// The Matrix Market files of a structure built in code for a `[model]` scene: `K.mtx`,
+/// `M.mtx` and the load shape `f.mtx`, as `(file name, text)`.
+pub fn model_matrix_files(
+    stiffness: &SparseMatrix,
+    mass: &SparseMatrix,
+    load: &[f64],
+) -> [(&'static str, String); 3] {
+    [
+        ("K.mtx", matrix_market_text(stiffness)),
+        ("M.mtx", matrix_market_text(mass)),
+        ("f.mtx", vector_market_text(load)),
+    ]
+}

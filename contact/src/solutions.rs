@@ -1,0 +1,189 @@
+//! Every periodic response at one forcing frequency, with its stability.
+//!
+//! Inside an overhang of a frequency response a forced structure with contact has several
+//! periodic responses at the same frequency `w*`; which one a machine settles on depends on
+//! its history. The branch of the scene's harmonic-balance problem holds all of them that
+//! are connected to the linear response: [`find_solutions`] follows it in frequency with
+//! the core's continuation over a window around `w*` (the scene's `[sweep]` range, or
+//! `[0.5, 2] w*` without one), takes every pair of neighbouring branch points on either
+//! side of `w*`, corrects the interpolated state by Newton at exactly `w*` (the runner's
+//! solve with that warm start), merges corrections that land on the same solution
+//! (relative distance of the unknowns below [`SAME_SOLUTION`]) and computes the stability
+//! of each ([`crate::stability::hb_stability`]).
+//!
+//! Isolated branches (not connected to the linear response) are not found; nor are
+//! solutions outside the window.
+
+use std::time::Instant;
+
+use crate::contacts::ContactSummary;
+use crate::model::Structure;
+use crate::settings::{Method, SolverSettings, SweepSettings};
+use crate::solve::StateShape;
+use crate::solve::{solve_rod, RunError, Solution};
+use crate::stability::{hb_stability, Stability, StabilityOptions};
+use crate::sweep::follow_branch;
+use crate::sweep::Reconstruction;
+
+/// Relative distance of the unknowns below which two corrected solutions are the same.
+pub const SAME_SOLUTION: f64 = 1e-6;
+
+/// One periodic solution at the frequency.
+#[derive(Debug, Clone)]
+pub struct PeriodicSolution {
+    /// The corrected solve at exactly the frequency (tip series, statistics, unknowns).
+    pub solution: Solution,
+    /// Per contact.
+    pub contacts: Vec<ContactSummary>,
+    /// Floquet multipliers and the verdict.
+    pub stability: Stability,
+    /// Index of the branch point after the crossing it was corrected from.
+    pub branch_index: usize,
+}
+
+/// The answer of [`find_solutions`].
+#[derive(Debug, Clone)]
+pub struct SolutionSet {
+    /// The forcing frequency `w*`.
+    pub omega: f64,
+    /// First natural frequency.
+    pub omega_1: f64,
+    /// The shape of every solution's unknowns (method, harmonics, dofs, contacts).
+    pub shape: StateShape,
+    /// The distinct solutions, in branch order.
+    pub solutions: Vec<PeriodicSolution>,
+    /// The window searched, in units of `omega_1`.
+    pub window: (f64, f64),
+    /// Branch points followed.
+    pub branch_points: usize,
+    /// Whether the branch crossed the whole window.
+    pub branch_converged: bool,
+    /// The continuation's termination in words.
+    pub branch_termination: String,
+    /// Crossings of `w*` found on the branch.
+    pub crossings: usize,
+    /// Crossings whose correction did not converge (listed as their termination).
+    pub failed_corrections: Vec<String>,
+    /// Wall time.
+    pub seconds: f64,
+}
+
+/// All periodic solutions at the model's forcing frequency (module documentation).
+/// `sweep`: the window and continuation settings (`None`: `[0.5, 2] w* / omega_1` with the
+/// scene defaults).
+pub fn find_solutions(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: Option<&SweepSettings>,
+) -> Result<SolutionSet, RunError> {
+    let started = Instant::now();
+    if !matches!(settings.method, Method::SsnHb | Method::PenaltyHb) {
+        return Err(RunError::Unsupported {
+            method: settings.method.name(),
+            what: "a harmonic-balance method (ssn-hb or penalty-hb) to follow the branch \
+                   through the frequency and correct each crossing",
+        });
+    }
+    let omega = rod.model.forcing.omega;
+    let ratio = omega / rod.omega_1;
+    let window = match sweep {
+        Some(s) => s.clone(),
+        None => SweepSettings::new(0.5 * ratio, 2.0 * ratio),
+    };
+    let (lo, hi) = (
+        window.omega_ratio_from.min(window.omega_ratio_to),
+        window.omega_ratio_from.max(window.omega_ratio_to),
+    );
+    if !(lo <= ratio && ratio <= hi) {
+        return Err(RunError::InvalidSetting {
+            name: "forcing.omega_ratio",
+            value: ratio,
+            allowed: "a frequency inside the [sweep] range searched for solutions",
+        });
+    }
+    let branch = follow_branch(rod, settings, &window, None)?;
+    let mut at_omega = rod.clone();
+    at_omega.model.forcing.omega = omega;
+    let reconstruction = Reconstruction::new(&rod.model, settings)?;
+    let len = rod.model.dofs() * (2 * settings.harmonics + 1);
+    let mut set = SolutionSet {
+        omega,
+        omega_1: rod.omega_1,
+        shape: StateShape {
+            method: settings.method,
+            harmonics: settings.harmonics,
+            dofs: rod.model.dofs(),
+            contacts: rod.model.contacts.len(),
+        },
+        solutions: Vec::new(),
+        window: (window.omega_ratio_from, window.omega_ratio_to),
+        branch_points: branch.points(),
+        branch_converged: branch.converged,
+        branch_termination: branch.termination.clone(),
+        crossings: 0,
+        failed_corrections: Vec::new(),
+        seconds: 0.0,
+    };
+    for i in 1..branch.points() {
+        let (w0, w1) = (branch.omega[i - 1], branch.omega[i]);
+        // Each crossing once: the left point strictly on one side (or exactly at w*).
+        let crosses = (w0 - omega) * (w1 - omega) < 0.0 || w1 == omega;
+        if !crosses {
+            continue;
+        }
+        set.crossings += 1;
+        let t = if w1 != w0 {
+            (omega - w0) / (w1 - w0)
+        } else {
+            1.0
+        };
+        let start: Vec<f64> = branch.states[i - 1]
+            .iter()
+            .zip(&branch.states[i])
+            .map(|(a, b)| a + t * (b - a))
+            .collect();
+        let solution = solve_rod(&at_omega, settings, Some(&start))?;
+        if !solution.converged {
+            set.failed_corrections.push(format!(
+                "crossing between points {} and {i}: {} (|F| = {:e})",
+                i - 1,
+                solution.termination,
+                solution.residual_norm
+            ));
+            continue;
+        }
+        let x = &solution.state;
+        let scale = x.iter().map(|v| v * v).sum::<f64>().sqrt().max(1e-300);
+        let duplicate = set.solutions.iter().any(|s| {
+            let d = s
+                .solution
+                .state
+                .iter()
+                .zip(x)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            d <= SAME_SOLUTION * scale
+        });
+        if duplicate {
+            continue;
+        }
+        let stability = hb_stability(
+            &rod.model,
+            settings.harmonics,
+            omega,
+            &x[..len],
+            &StabilityOptions::default(),
+        )
+        .unwrap_or_else(|e| Stability::undecided(format!("stability not computed: {e}"), 0));
+        let contacts = reconstruction.contacts(&rod.model, x)?;
+        set.solutions.push(PeriodicSolution {
+            solution,
+            contacts,
+            stability,
+            branch_index: i,
+        });
+    }
+    set.seconds = started.elapsed().as_secs_f64();
+    Ok(set)
+}

@@ -1,0 +1,811 @@
+//! Runs a scene's method on a rod: builds the formulation, drives it with the core's solvers
+//! and reduces the answer to what users compare (the tip over one period, contact
+//! diagnostics, work counters).
+//!
+//! A run that could not start (bad settings, a singular model) is an [`RunError`]; a run that
+//! started but did not converge is an `Ok` [`Solution`] with `converged = false` and the
+//! termination reason, so callers can still print what happened.
+
+use std::time::Instant;
+
+use semismooth::continuation::{homotopy, HomotopySchedule};
+use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::{
+    self, Globalization, NewtonError, NewtonOptions, NewtonReport, WorkCounters,
+};
+use semismooth::{GeneralizedJacobian, Residual};
+
+use crate::contacts::{contact_reports, ContactReport};
+use crate::contacts::{period_statistics, PeriodStatistics};
+use crate::hb::{
+    CondensedSolve, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
+    StructuredHbSolver,
+};
+use crate::lcp::{
+    ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
+    DEFAULT_ACTIVE_SET_REGULARIZATION,
+};
+use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
+use crate::model::Structure;
+use crate::model::DEFAULT_C_FACTOR;
+use crate::rod::ModelError;
+use crate::settings::{GlobalizationChoice, Method, SolverSettings};
+
+/// Number of reconstruction points per period for harmonic-balance outputs.
+pub const HB_OUTPUT_POINTS: usize = 1024;
+
+/// Why a run could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The rod could not be built.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The harmonic-balance problem could not be built.
+    #[error(transparent)]
+    HarmonicBalance(#[from] HbError),
+    /// The periodic LCP could not be built.
+    #[error(transparent)]
+    Lcp(#[from] LcpError),
+    /// Lemke's algorithm could not run.
+    #[error(transparent)]
+    Lemke(#[from] semismooth::lemke::LemkeError),
+    /// Newton's method could not run.
+    #[error(transparent)]
+    Newton(#[from] newton::NewtonError),
+    /// Time marching could not run (or did not reach a steady state).
+    #[error(transparent)]
+    March(#[from] MarchError),
+    /// A run setting (e.g. a `sweep.*` field) is outside its allowed range.
+    #[error("invalid {name} = {value}: allowed {allowed}")]
+    InvalidSetting {
+        /// Which setting (the scene's field name).
+        name: &'static str,
+        /// The value received.
+        value: f64,
+        /// The allowed range, in words.
+        allowed: &'static str,
+    },
+    /// The method needs something the scene does not declare.
+    #[error("method {method} needs {what}")]
+    Unsupported {
+        /// The method.
+        method: &'static str,
+        /// What is missing.
+        what: &'static str,
+    },
+}
+
+/// Work done by a run (the JSON `counters` object).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunCounters {
+    /// Residual evaluations.
+    pub residual_evaluations: u64,
+    /// Generalized Jacobian evaluations.
+    pub jacobian_evaluations: u64,
+    /// Factorizations requested from the linear solver.
+    pub factorizations: u64,
+    /// Linear solves.
+    pub linear_solves: u64,
+    /// Line-search backtracks.
+    pub line_search_backtracks: u64,
+    /// Fast Fourier transforms in the residual/Jacobian evaluations.
+    pub ffts: u64,
+    /// Lemke pivots (LCP by Lemke).
+    pub lemke_pivots: u64,
+    /// Time steps (time marching).
+    pub time_steps: u64,
+}
+
+impl From<WorkCounters> for RunCounters {
+    fn from(c: WorkCounters) -> Self {
+        RunCounters {
+            residual_evaluations: c.residual_evaluations,
+            jacobian_evaluations: c.jacobian_evaluations,
+            factorizations: c.factorizations,
+            linear_solves: c.linear_solves,
+            line_search_backtracks: c.line_search_backtracks,
+            ffts: c.problem.get("ffts"),
+            ..RunCounters::default()
+        }
+    }
+}
+
+/// The answer of one run, reduced to one period of the tip.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// Method used.
+    pub method: Method,
+    /// Harmonics (HB methods only).
+    pub harmonics: Option<usize>,
+    /// AFT samples (HB), time steps per period (LCP, time marching).
+    pub time_samples: usize,
+    /// Time discretisation of the periodic LCP (LCP methods only).
+    pub lcp_scheme: Option<LcpScheme>,
+    /// What is known to make a run that did not converge hard, and what to change (`None`
+    /// when it converged or nothing is known).
+    pub diagnosis: Option<String>,
+    /// Complementarity constant `c` (SSN-HB only).
+    pub c: Option<f64>,
+    /// Forcing frequency.
+    pub omega: f64,
+    /// First natural frequency of the rod.
+    pub omega_1: f64,
+    /// Whether the method converged.
+    pub converged: bool,
+    /// Termination reason in words (`converged`, `max-iterations`, `ray`, ...).
+    pub termination: String,
+    /// Newton iterations or Lemke pivots or periods marched.
+    pub iterations: usize,
+    /// Final residual norm (Newton methods), complementarity error (Lemke), period change
+    /// (time marching).
+    pub residual_norm: f64,
+    /// The tolerance the run was judged against (Newton methods: the scene's tolerance, or
+    /// the model's round-off floor when that is larger; the march tolerance for time
+    /// marching; `None` for Lemke, which ends on a basis, not a tolerance).
+    pub effective_tolerance: Option<f64>,
+    /// The strategy of the Newton run that produced the answer (`newton`, `smoothing`,
+    /// `newton-homotopy`, `line-search`; Newton methods).
+    pub strategy: Option<&'static str>,
+    /// Every strategy the Newton run tried, in order (Newton methods).
+    pub attempts: Vec<semismooth::newton::Attempt>,
+    /// Convergence order observed over the last Newton iterations (Newton methods).
+    pub observed_order: Option<f64>,
+    /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
+    pub residual_history: Vec<f64>,
+    /// Wall time of the solve (not the set-up of the rod).
+    pub solve_seconds: f64,
+    /// Times over one period, `[0, T)` (the forcing is `cos(omega t)`).
+    pub times: Vec<f64>,
+    /// Tip displacement at `times`.
+    pub tip: Vec<f64>,
+    /// Contact forces at `times`, one series per contact.
+    pub contact_forces: Vec<Vec<f64>>,
+    /// Tip statistics (penetration over all contacts; the mean contact force is the sum of
+    /// the contacts' mean forces).
+    pub stats: PeriodStatistics,
+    /// Every contact point over the period.
+    pub contacts: Vec<ContactReport>,
+    /// Work counters.
+    pub counters: RunCounters,
+    /// The method's unknowns (HB coefficients, LCP z), for warm starts.
+    pub state: Vec<f64>,
+}
+
+/// The shape of a harmonic-balance method's unknowns: what a starting state must match.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StateShape {
+    /// The scene's method.
+    pub method: Method,
+    /// The scene's harmonics.
+    pub harmonics: usize,
+    /// The structure's dofs.
+    pub dofs: usize,
+    /// The structure's contacts.
+    pub contacts: usize,
+}
+
+/// SSN-HB options from scene settings.
+pub(crate) fn hb_options(settings: &SolverSettings) -> HbOptions {
+    HbOptions {
+        harmonics: settings.harmonics,
+        time_samples: Some(settings.time_samples),
+        c: settings.c,
+    }
+}
+
+/// Penalty-HB options from scene settings (the default penalty relative to the model's
+/// contact stiffness scale).
+pub(crate) fn penalty_options(
+    settings: &SolverSettings,
+    model: &crate::model::StructuralModel,
+) -> PenaltyHbOptions {
+    PenaltyHbOptions {
+        harmonics: settings.harmonics,
+        time_samples: Some(settings.time_samples),
+        penalty_stiffness: settings
+            .penalty_stiffness
+            .unwrap_or_else(|| PenaltyHbOptions::default_penalty_stiffness(model)),
+    }
+}
+
+/// The periodic LCP's options of a scene and the index of the tip's contact: the tip is
+/// observed (its history kept) when it is not a contact.
+pub(crate) fn lcp_options(
+    rod: &Structure,
+    settings: &SolverSettings,
+) -> (PeriodicLcpOptions, Option<usize>) {
+    let tip = rod.observed_dof;
+    let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
+    let options = PeriodicLcpOptions {
+        time_samples: settings.time_samples,
+        observed_dofs: if tip_contact.is_some() {
+            Vec::new()
+        } else {
+            vec![tip]
+        },
+        scheme: settings.lcp_scheme,
+    };
+    (options, tip_contact)
+}
+
+/// Newton options from scene settings.
+pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
+    let globalization = match settings.globalization {
+        GlobalizationChoice::None => Globalization::None,
+        GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
+        GlobalizationChoice::Nonmonotone => Globalization::non_monotone(),
+        GlobalizationChoice::Hybrid => Globalization::hybrid(),
+        GlobalizationChoice::Auto => Globalization::polyalgorithm(),
+    };
+    NewtonOptions {
+        absolute_tolerance: settings.tolerance,
+        max_iterations: settings.max_iterations,
+        globalization,
+        ..NewtonOptions::default()
+    }
+}
+
+/// A Newton solve with the linear solver chosen by the settings, converged or not.
+///
+/// The residual floor of the Newton options is the round-off level of the model
+/// (`eps max K_ii sqrt(n) max|g|`: 4e-8 for 10^5 elements at H = 20, far below 1e-10 for
+/// the shipped scenes): the tolerance is raised to it, and a run that stalls within 100
+/// times of it has converged as far as floating point allows.
+fn newton_hb<P>(
+    problem: &mut P,
+    x: &mut [f64],
+    settings: &SolverSettings,
+    model: &crate::model::StructuralModel,
+    extra_stiffness: f64,
+) -> Result<NewtonReport, RunError>
+where
+    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+{
+    let mut options = newton_options(settings);
+    let gap_scale = model
+        .contacts
+        .iter()
+        .fold(0.0f64, |a, c| a.max(c.gap.abs()))
+        .max(f64::MIN_POSITIVE);
+    options.residual_floor = roundoff_floor(model, problem.dim(), gap_scale, extra_stiffness);
+    let report = match settings.linear_solver.condensed() {
+        Some(condensed) => {
+            let mut solver = structured_solver(condensed, settings.tolerance);
+            newton::solve(problem, &mut solver, x, &options)
+        }
+        None => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
+    };
+    Ok(report.or_else(NewtonError::into_report)?)
+}
+
+/// The structured solver of a Newton run with absolute tolerance `tolerance`: a
+/// matrix-free condensed solve stops at `tolerance / 100` (or `1e-10` relative), so that a
+/// step on the right piece leaves a residual well below the Newton tolerance.
+pub fn structured_solver(condensed: CondensedSolve, tolerance: f64) -> StructuredHbSolver {
+    StructuredHbSolver::new()
+        .with_condensed_solve(condensed)
+        .with_krylov_tolerance(0.01 * tolerance)
+}
+
+/// Round-off level of a harmonic-balance residual: one ulp of the largest force term,
+/// `eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
+/// the iterate) within 100 times of it has converged as far as floating point allows:
+/// large models (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
+fn roundoff_floor(
+    model: &crate::model::StructuralModel,
+    dim: usize,
+    u_max: f64,
+    extra_stiffness: f64,
+) -> f64 {
+    let k_max = (0..model.dofs())
+        .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
+        .fold(extra_stiffness, f64::max);
+    f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
+}
+
+/// Reconstruction a harmonic-balance problem offers for the outputs.
+pub(crate) trait HbReconstruction {
+    fn contact_count(&self) -> usize;
+    fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+}
+
+/// Both harmonic-balance problems reconstruct through the same inherent methods.
+macro_rules! hb_reconstruction {
+    ($($problem:ty),*) => {$(
+        impl HbReconstruction for $problem {
+            fn contact_count(&self) -> usize {
+                self.contacts()
+            }
+            fn displacement(
+                &self,
+                x: &[f64],
+                dof: usize,
+                points: usize,
+            ) -> Result<Vec<f64>, HbError> {
+                self.displacement_samples(x, dof, points)
+            }
+            fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
+                self.contact_force_samples(x, i, points)
+            }
+        }
+    )*};
+}
+
+hb_reconstruction!(SsnHb, PenaltyHb);
+
+/// How a run ended, as its outputs report it.
+struct Outcome<'a> {
+    converged: bool,
+    termination: String,
+    iterations: usize,
+    residual_norm: f64,
+    effective_tolerance: Option<f64>,
+    counters: RunCounters,
+    solve_seconds: f64,
+    /// The Newton report of a Newton method (order and residual history).
+    newton: Option<&'a NewtonReport>,
+}
+
+impl<'a> Outcome<'a> {
+    fn of_newton(report: &'a NewtonReport, solve_seconds: f64) -> Self {
+        Self {
+            converged: report.converged(),
+            termination: report.termination.to_string(),
+            iterations: report.iterations,
+            residual_norm: report.residual_norm(),
+            effective_tolerance: Some(report.effective_tolerance),
+            counters: report.counters.into(),
+            solve_seconds,
+            newton: Some(report),
+        }
+    }
+}
+
+/// One period of a run's answer.
+struct Period {
+    times: Vec<f64>,
+    tip: Vec<f64>,
+    contact_forces: Vec<Vec<f64>>,
+    contact_displacements: Vec<Vec<f64>>,
+}
+
+/// The solution record of a run of the scene's method.
+fn solution(
+    rod: &Structure,
+    settings: &SolverSettings,
+    time_samples: usize,
+    outcome: Outcome<'_>,
+    period: Period,
+    state: Vec<f64>,
+) -> Solution {
+    let method = settings.method;
+    let contacts = contact_reports(
+        &rod.model
+            .contacts
+            .iter()
+            .map(|c| (c.dof, c.gap))
+            .collect::<Vec<_>>(),
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    let mut stats = statistics(
+        rod,
+        &period.tip,
+        &period.contact_forces,
+        &period.contact_displacements,
+    );
+    stats.mean_contact_force = contacts.iter().map(|c| c.force_mean).sum();
+    Solution {
+        method,
+        contacts,
+        harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
+        time_samples,
+        lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
+        diagnosis: None,
+        c: None,
+        omega: rod.model.forcing.omega,
+        omega_1: rod.omega_1,
+        converged: outcome.converged,
+        termination: outcome.termination,
+        iterations: outcome.iterations,
+        residual_norm: outcome.residual_norm,
+        effective_tolerance: outcome.effective_tolerance,
+        strategy: outcome.newton.map(|r| r.strategy.name()),
+        attempts: outcome.newton.map_or_else(Vec::new, |r| r.attempts.clone()),
+        observed_order: outcome.newton.and_then(|r| r.observed_order),
+        residual_history: outcome
+            .newton
+            .map_or_else(Vec::new, |r| r.residual_norms.clone()),
+        solve_seconds: outcome.solve_seconds,
+        stats,
+        times: period.times,
+        tip: period.tip,
+        contact_forces: period.contact_forces,
+        counters: outcome.counters,
+        state,
+    }
+}
+
+/// The tip, the contact forces and the statistics of an HB solution on `points` times.
+fn hb_outputs(
+    problem: &impl HbReconstruction,
+    rod: &Structure,
+    settings: &SolverSettings,
+    outcome: Outcome<'_>,
+    x: Vec<f64>,
+    points: usize,
+) -> Result<Solution, RunError> {
+    let tip = problem.displacement(&x, rod.observed_dof, points)?;
+    let contact_forces = (0..problem.contact_count())
+        .map(|i| problem.contact_force(&x, i, points))
+        .collect::<Result<Vec<_>, _>>()?;
+    let contact_displacements = rod
+        .model
+        .contacts
+        .iter()
+        .map(|c| problem.displacement(&x, c.dof, points))
+        .collect::<Result<Vec<_>, _>>()?;
+    let period = 2.0 * std::f64::consts::PI / rod.model.forcing.omega;
+    let times = (0..points)
+        .map(|n| period * n as f64 / points as f64)
+        .collect();
+    let period = Period {
+        times,
+        tip,
+        contact_forces,
+        contact_displacements,
+    };
+    Ok(solution(
+        rod,
+        settings,
+        settings.time_samples,
+        outcome,
+        period,
+        x,
+    ))
+}
+
+/// Tip statistics; the penetration is the largest over all contacts (and the tip's).
+fn statistics(
+    rod: &Structure,
+    tip: &[f64],
+    forces: &[Vec<f64>],
+    contact_displacements: &[Vec<f64>],
+) -> PeriodStatistics {
+    let tip_dof = rod.observed_dof;
+    let contacts = &rod.model.contacts;
+    let tip_contact = contacts
+        .iter()
+        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
+    let mut stats = match (tip_contact, forces.first()) {
+        (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
+        (None, Some(f)) => {
+            let mut s = period_statistics(tip, None);
+            s.mean_contact_force = f.iter().sum::<f64>() / f.len().max(1) as f64;
+            s
+        }
+        _ => period_statistics(tip, None),
+    };
+    // A contact that never closes has a mean force of zero up to round-off (Newton lands on
+    // +-1e-32): report it as 0 (never as a non-physical positive pull).
+    let force_scale = forces.iter().flatten().fold(1.0f64, |a, f| a.max(f.abs()));
+    if stats.mean_contact_force.abs() <= 1e-14 * force_scale {
+        stats.mean_contact_force = 0.0;
+    }
+    for (c, u) in contacts.iter().zip(contact_displacements) {
+        let p = u
+            .iter()
+            .map(|v| (c.sign() * v - c.gap).max(0.0))
+            .fold(0.0, f64::max);
+        stats.max_penetration = stats.max_penetration.max(p);
+    }
+    stats
+}
+
+/// Solves the rod with the scene's method, from a zero initial guess (or `warm_start`).
+pub fn solve_rod(
+    rod: &Structure,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let tip = rod.observed_dof;
+    let scale = model.contact_stiffness_scale();
+    match settings.method {
+        Method::SsnHb => {
+            let mut problem = SsnHb::new(model, &hb_options(settings))?;
+            let mut x = initial_state(problem.dim(), warm_start);
+            let start = Instant::now();
+            let report = newton_hb(&mut problem, &mut x, settings, model, 0.0)?;
+            let seconds = start.elapsed().as_secs_f64();
+            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+            let outcome = Outcome::of_newton(&report, seconds);
+            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
+            sol.c = (problem.contacts() > 0).then(|| problem.c());
+            Ok(sol)
+        }
+        Method::PenaltyHb => {
+            let options = penalty_options(settings, model);
+            let target = options.penalty_stiffness;
+            let mut problem = PenaltyHb::new(model, &options)?;
+            let mut x = initial_state(problem.dim(), warm_start);
+            let start = Instant::now();
+            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+            // is the linear response, deep in the obstacle), so without a warm start the
+            // stiffness is raised in log k_p from 10 x the static contact stiffness
+            // (mesh-independent; the local one grows with the mesh and is already too stiff
+            // a start on fine meshes) by factors of 10, a failed stage going back to the
+            // last converged stiffness with the square root of the factor.
+            let mut counters = WorkCounters::default();
+            let mut homotopy_iterations = 0;
+            if warm_start.is_none() {
+                let k0 = model
+                    .static_contact_stiffness()
+                    .map(|s| DEFAULT_C_FACTOR * s)
+                    .unwrap_or(scale);
+                let stages = homotopy(
+                    k0.ln(),
+                    target.ln(),
+                    &HomotopySchedule::default(),
+                    &mut x,
+                    |log_k, x| {
+                        let k = log_k.exp();
+                        problem.set_penalty_stiffness(k)?;
+                        newton_hb(&mut problem, x, settings, model, k)
+                    },
+                )?;
+                counters += stages.counters;
+                homotopy_iterations = stages.iterations;
+                problem.set_penalty_stiffness(target)?;
+            }
+            let mut report = newton_hb(&mut problem, &mut x, settings, model, target)?;
+            counters += report.counters;
+            report.counters = counters;
+            // Iterations of the whole homotopy, so that costs compare across methods.
+            report.iterations += homotopy_iterations;
+            let seconds = start.elapsed().as_secs_f64();
+            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+            let outcome = Outcome::of_newton(&report, seconds);
+            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
+            // The mean penalty force as the equations see it: over the Nt AFT samples (a
+            // finer grid resolves narrow force peaks the quadrature does not).
+            if problem.contacts() > 0 {
+                let summary = problem.summary(&sol.state, tip, points)?;
+                for (c, mean) in sol.contacts.iter_mut().zip(&summary.contact_force_mean) {
+                    // (+0 for a contact that never closes, not -0.)
+                    c.force_mean = if *mean == 0.0 { 0.0 } else { *mean };
+                }
+                sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
+            }
+            Ok(sol)
+        }
+        Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
+        Method::March => solve_march(rod, settings),
+    }
+}
+
+fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
+    match warm_start {
+        Some(w) if w.len() == dim => w.to_vec(),
+        _ => vec![0.0; dim],
+    }
+}
+
+fn solve_lcp(
+    rod: &Structure,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let method = settings.method;
+    if model.contacts.is_empty() {
+        return Err(RunError::Unsupported {
+            method: method.name(),
+            what: "a [contact] section (the periodic LCP is posed on the contact forces)",
+        });
+    }
+    let (options, tip_contact) = lcp_options(rod, settings);
+    let start = Instant::now();
+    let lcp = PeriodicLcp::new(model, options)?;
+    let (z, converged, termination, iterations, residual, counters, effective_tolerance, finest) =
+        match method {
+            Method::LcpLemke => {
+                let mut lemke = Lemke::new(lcp.dim());
+                let lemke_options = LemkeOptions::default();
+                let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
+                let termination = match report.termination {
+                    LemkeTermination::Solved => "converged".to_string(),
+                    LemkeTermination::Ray => {
+                        let (min_eig, _) = lcp.symmetric_part_spectrum();
+                        format!(
+                        "ray after {} pivots (smallest eigenvalue of the symmetric part of A: {min_eig:e})",
+                        report.pivots
+                    )
+                    }
+                    LemkeTermination::PivotLimit => format!(
+                        "pivot-limit ({} pivots done, the limit {} = 50 n + 100 for n = {}): the \
+                         tip values are those of the unfinished path's last basis, not of a \
+                         solution",
+                        report.pivots,
+                        lemke_options.pivot_limit(lcp.dim()),
+                        lcp.dim()
+                    ),
+                };
+                let counters = RunCounters {
+                    lemke_pivots: report.pivots as u64,
+                    ..RunCounters::default()
+                };
+                (
+                    report.z.clone(),
+                    report.solved(),
+                    termination,
+                    report.pivots,
+                    report.complementarity_error,
+                    counters,
+                    None,
+                    None,
+                )
+            }
+            _ => {
+                // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+                // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+                // creeps one time node per iteration. Residual floor: the min-map residual
+                // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
+                // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
+                let mut options = newton_options(settings);
+                let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                options.residual_floor = f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale;
+                let (z, report_list) = match warm_start {
+                    Some(w) if w.len() == lcp.dim() => {
+                        let mut problem = lcp.min_map();
+                        let mut z = w.to_vec();
+                        let mut solver = ActiveSetSolver::new()
+                            .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
+                        let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
+                            .or_else(NewtonError::into_report)?;
+                        (z, vec![report])
+                    }
+                    _ => {
+                        let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
+                        let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                        (sequenced.z, reports)
+                    }
+                };
+                let last = report_list.last().expect("at least one level");
+                let mut counters = RunCounters::default();
+                for r in &report_list {
+                    let c: RunCounters = r.counters.into();
+                    counters.residual_evaluations += c.residual_evaluations;
+                    counters.jacobian_evaluations += c.jacobian_evaluations;
+                    counters.factorizations += c.factorizations;
+                    counters.linear_solves += c.linear_solves;
+                    counters.line_search_backtracks += c.line_search_backtracks;
+                }
+                (
+                    z,
+                    last.converged(),
+                    last.termination.to_string(),
+                    report_list.iter().map(|r| r.iterations).sum(),
+                    last.residual_norm(),
+                    counters,
+                    Some(last.effective_tolerance),
+                    // The finest level's run: its strategy, attempts and residual history
+                    // are the answer's (the iterations and counters are the levels' sums).
+                    report_list.last().cloned(),
+                )
+            }
+        };
+    let seconds = start.elapsed().as_secs_f64();
+    let contact_u = lcp.contact_displacements(&z)?;
+    let forces = lcp.contact_forces(&z)?;
+    let tip_series = match tip_contact {
+        Some(i) => contact_u[i].clone(),
+        None => lcp.displacements(&z)?.remove(0),
+    };
+    let outcome = Outcome {
+        converged,
+        termination,
+        iterations,
+        residual_norm: residual,
+        effective_tolerance,
+        counters,
+        solve_seconds: seconds,
+        newton: finest.as_ref(),
+    };
+    let period = Period {
+        times: lcp.times(),
+        tip: tip_series,
+        contact_forces: forces,
+        contact_displacements: contact_u,
+    };
+    let mut sol = solution(rod, settings, settings.time_samples, outcome, period, z);
+    sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
+    if !sol.converged && lcp.has_alternating_null_vector() {
+        sol.diagnosis = Some(
+            "every contact dof has mass or damping, so the trapezoidal LCP's Nyquist receptance \
+             is 0 and a contact force alternating node to node moves nothing (a null vector of \
+             A): solutions chatter and are nearly degenerate; lcp_scheme = \"bdf2\" has no such \
+             vector"
+                .into(),
+        );
+    }
+    Ok(sol)
+}
+
+fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let tip = rod.observed_dof;
+    let options = MarchOptions {
+        steps_per_period: settings.steps_per_period,
+        max_periods: settings.max_periods,
+        tolerance: settings.march_tolerance,
+        scheme: if settings.restitution > 0.0 {
+            MarchScheme::MoreauJean {
+                theta: 0.5,
+                restitution: settings.restitution,
+            }
+        } else {
+            MarchScheme::Auto
+        },
+    };
+    let mut observed = vec![tip];
+    observed.extend(model.contacts.iter().map(|c| c.dof));
+    let start = Instant::now();
+    // A march that does not settle is a run that did not converge: its last period is
+    // reported with the last period-to-period change.
+    let (period, steady) = match march_to_steady_state(model, &options, &observed) {
+        Ok(period) => (period, true),
+        Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
+        Err(e) => return Err(e.into()),
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    // Drop the closing sample (t = T repeats t = 0).
+    let keep = period.times.len().saturating_sub(1).max(1);
+    let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
+    let tip_series = cut(&period.displacements[0]);
+    let contact_u: Vec<Vec<f64>> = period.displacements[1..].iter().map(cut).collect();
+    let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
+    let start_time = period.times[0];
+    let times = period.times[..keep]
+        .iter()
+        .map(|t| t - start_time)
+        .collect();
+    let outcome = Outcome {
+        converged: steady,
+        termination: if steady {
+            "converged".into()
+        } else {
+            format!(
+                "not-steady: period-to-period change {:.3e} above the tolerance {:e} after {} \
+                 periods (solver.max_periods)",
+                period.period_change, settings.march_tolerance, period.periods
+            )
+        },
+        iterations: period.periods,
+        residual_norm: period.period_change,
+        effective_tolerance: Some(settings.march_tolerance),
+        counters: RunCounters {
+            time_steps: period.counters.steps,
+            factorizations: period.counters.factorizations,
+            ..RunCounters::default()
+        },
+        solve_seconds: seconds,
+        newton: None,
+    };
+    let period = Period {
+        times,
+        tip: tip_series,
+        contact_forces: forces,
+        contact_displacements: contact_u,
+    };
+    Ok(solution(
+        rod,
+        settings,
+        settings.steps_per_period,
+        outcome,
+        period,
+        Vec::new(),
+    ))
+}

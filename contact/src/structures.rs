@@ -1,0 +1,232 @@
+//! Structures built in code for the shipped `[model]` scenes, their generating examples and
+//! tests: a (mistuned) bladed disk with any number of blades, and an Euler–Bernoulli
+//! cantilever with a contact pad at its tip.
+//!
+//! **Bladed disk.** `B` sectors in a ring; sector `j` has a disk dof `d_j` (0-based `3j`)
+//! and a blade tip dof `b_j` (`3j + 1`), both of unit mass, and a massless contact pad
+//! `p_j` (`3j + 2`). Springs: `k_g = 1` from each disk dof to the ground, `k_d = 1` between
+//! neighbouring disk dofs (cyclic), the blade `k_b (1 + delta_j)` between `d_j` and `b_j`
+//! with `k_b = 1` and the deterministic mistuning `delta_j = mistuning sin(2.3 j)`, and the
+//! pad `k_c = 10` between `b_j` and `p_j` (a free massless pad carries no force: the pads
+//! change no natural frequency). The load shape is a unit force on every blade tip, in
+//! phase (engine order 0).
+//!
+//! **Cantilever.** Beam units `L = EI = rhoA = 1`; `n` Hermite-cubic elements of length
+//! `h = 1/n`, node 0 clamped; node `i = 1..=n` has the deflection `w_i` (0-based dof
+//! `2i - 2`) and the rotation `theta_i` (`2i - 1`). Element matrices (dofs `w_a, theta_a,
+//! w_b, theta_b`):
+//!
+//! ```text
+//! K_e = EI/h^3 [[12, 6h, -12, 6h], [6h, 4h^2, -6h, 2h^2], [-12, -6h, 12, -6h], [6h, 2h^2, -6h, 4h^2]]
+//! M_e = rhoA h/420 [[156, 22h, 54, -13h], [22h, 4h^2, 13h, -3h^2], [54, 13h, 156, -22h],
+//!                   [-13h, -3h^2, -22h, 4h^2]]
+//! ```
+//!
+//! The natural frequencies converge to `(beta_k L)^2 sqrt(EI / (rhoA L^4))` with
+//! `beta_k L = 1.8751, 4.6941, 7.8548, 10.9955, ...` (`cos(b) cosh(b) = -1`), at the rate
+//! `h^4`. Dof `2n` is a massless pad joined to the tip deflection by a spring
+//! `k_c = 10 x 3 EI / L^3` (ten times the static tip stiffness); a stop acts on the pad. A
+//! massless pad carries no force when free, so the beam's frequencies are unchanged, and
+//! the contact is well posed for every method (no impact law needed). The load is a uniform
+//! transverse load of unit intensity (consistent nodal forces and moments).
+
+use faer::sparse::Triplet;
+
+use crate::dynamic::UnionPattern;
+use crate::model::{ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure};
+use crate::rod::{natural_frequencies, ModelError};
+
+/// Mistuning amplitude of the shipped disk (`scenes/bladed_disk_casing.toml`).
+pub const SHIPPED_MISTUNING: f64 = 0.02;
+
+/// A bladed disk of `blades` sectors (module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BladedDisk {
+    /// Number of sectors `B >= 1` (`3 B` dofs).
+    pub blades: usize,
+    /// Mistuning amplitude of the blade stiffnesses (0: tuned, cyclically symmetric).
+    pub mistuning: f64,
+}
+
+/// How a [`BladedDisk`] is loaded, damped and stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiskLoading {
+    /// Blades (0-based) whose pad meets the casing.
+    pub stops: Vec<usize>,
+    /// Casing clearance of every stop.
+    pub gap: f64,
+    /// Load amplitude (times the unit blade-tip load shape).
+    pub amplitude: f64,
+    /// Stiffness-proportional damping `D = (2 zeta / omega_1) K`.
+    pub zeta: f64,
+    /// Forcing frequency in units of `omega_1`.
+    pub omega_ratio: f64,
+}
+
+impl BladedDisk {
+    /// Number of dofs `3 B`.
+    pub fn dofs(&self) -> usize {
+        3 * self.blades
+    }
+
+    /// The pad dof (0-based) of blade `j`.
+    pub fn pad(j: usize) -> usize {
+        3 * j + 2
+    }
+
+    /// The blade tip dof (0-based) of blade `j`.
+    pub fn tip(j: usize) -> usize {
+        3 * j + 1
+    }
+
+    /// Stiffness, mass and load shape.
+    pub fn matrices(&self) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
+        let (blades, n) = (self.blades, self.dofs());
+        let (k_g, k_d, k_b, k_c) = (1.0, 1.0, 1.0, 10.0);
+        let mut k = Vec::new();
+        let mut spring = |i: usize, j: Option<usize>, s: f64| {
+            k.push(Triplet::new(i, i, s));
+            if let Some(j) = j {
+                k.push(Triplet::new(j, j, s));
+                k.push(Triplet::new(i, j, -s));
+                k.push(Triplet::new(j, i, -s));
+            }
+        };
+        for j in 0..blades {
+            let (d, b, p) = (3 * j, Self::tip(j), Self::pad(j));
+            spring(d, None, k_g);
+            if blades > 1 {
+                spring(d, Some(3 * ((j + 1) % blades)), k_d);
+            }
+            let delta = self.mistuning * (2.3 * j as f64).sin();
+            spring(d, Some(b), k_b * (1.0 + delta));
+            spring(b, Some(p), k_c);
+        }
+        let m: Vec<Triplet<usize, usize, f64>> = (0..n)
+            .filter(|i| i % 3 != 2)
+            .map(|i| Triplet::new(i, i, 1.0))
+            .collect();
+        let k = SparseMatrix::try_new_from_triplets(n, n, &k).expect("entries within 3B x 3B");
+        let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("entries within 3B x 3B");
+        let f = (0..n).map(|i| if i % 3 == 1 { 1.0 } else { 0.0 }).collect();
+        (k, m, f)
+    }
+
+    /// The disk as a structure: `omega_1` its lowest natural frequency, the observed dof the
+    /// first stop's pad (blade 0's tip without stops). A stop out of range or no blade is
+    /// [`ModelError::InvalidParameter`].
+    pub fn structure(&self, loading: &DiskLoading) -> Result<Structure, ModelError> {
+        if self.blades == 0 {
+            return Err(ModelError::InvalidParameter {
+                name: "blades",
+                value: 0.0,
+                allowed: "at least 1",
+            });
+        }
+        if let Some(&j) = loading.stops.iter().find(|&&j| j >= self.blades) {
+            return Err(ModelError::InvalidParameter {
+                name: "stop blade",
+                value: j as f64,
+                allowed: "a blade index below the number of blades",
+            });
+        }
+        let (stiffness, mass, shape) = self.matrices();
+        let n = self.dofs();
+        let mut model = StructuralModel {
+            mass,
+            damping: None,
+            stiffness,
+            forcing: HarmonicForcing {
+                amplitude: shape.iter().map(|f| loading.amplitude * f).collect(),
+                omega: 1.0,
+            },
+            contacts: loading
+                .stops
+                .iter()
+                .map(|&j| ContactPoint::new(Self::pad(j), loading.gap))
+                .collect(),
+        };
+        let omega_1 = natural_frequencies(&model, 1)?[0];
+        model.damping = Some(UnionPattern::linear_combination(
+            n,
+            &[&model.stiffness],
+            &[2.0 * loading.zeta / omega_1],
+        ));
+        model.forcing.omega = loading.omega_ratio * omega_1;
+        let observed_dof = model.contacts.first().map_or(Self::tip(0), |c| c.dof);
+        Ok(Structure {
+            model,
+            omega_1,
+            observed_dof,
+        })
+    }
+}
+
+/// The pad's spring, relative to the static tip stiffness `3 EI / L^3`.
+pub const PAD_STIFFNESS_FACTOR: f64 = 10.0;
+
+/// Stiffness, mass and unit uniform load of the `elements`-element cantilever with a tip
+/// pad (`2 elements + 1` dofs; module documentation).
+pub fn cantilever_with_tip_pad(elements: usize) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
+    let h = 1.0 / elements as f64;
+    let n = 2 * elements + 1;
+    let ke = {
+        let c = 1.0 / (h * h * h);
+        [
+            [12.0, 6.0 * h, -12.0, 6.0 * h],
+            [6.0 * h, 4.0 * h * h, -6.0 * h, 2.0 * h * h],
+            [-12.0, -6.0 * h, 12.0, -6.0 * h],
+            [6.0 * h, 2.0 * h * h, -6.0 * h, 4.0 * h * h],
+        ]
+        .map(|row| row.map(|v| c * v))
+    };
+    let me = {
+        let c = h / 420.0;
+        [
+            [156.0, 22.0 * h, 54.0, -13.0 * h],
+            [22.0 * h, 4.0 * h * h, 13.0 * h, -3.0 * h * h],
+            [54.0, 13.0 * h, 156.0, -22.0 * h],
+            [-13.0 * h, -3.0 * h * h, -22.0 * h, 4.0 * h * h],
+        ]
+        .map(|row| row.map(|v| c * v))
+    };
+    // Uniform load q = 1: nodal forces q h / 2 and moments +-q h^2 / 12.
+    let fe = [h / 2.0, h * h / 12.0, h / 2.0, -h * h / 12.0];
+    let (mut k, mut m) = (Vec::new(), Vec::new());
+    let mut f = vec![0.0; n];
+    for e in 0..elements {
+        // Element e joins nodes e and e + 1; node i >= 1 has dofs 2(i - 1), 2(i - 1) + 1.
+        let dofs: [Option<usize>; 4] = if e == 0 {
+            [None, None, Some(0), Some(1)]
+        } else {
+            [
+                Some(2 * e - 2),
+                Some(2 * e - 1),
+                Some(2 * e),
+                Some(2 * e + 1),
+            ]
+        };
+        for a in 0..4 {
+            let Some(i) = dofs[a] else { continue };
+            f[i] += fe[a];
+            for b in 0..4 {
+                let Some(j) = dofs[b] else { continue };
+                k.push(Triplet::new(i, j, ke[a][b]));
+                m.push(Triplet::new(i, j, me[a][b]));
+            }
+        }
+    }
+    let (tip, pad) = (2 * elements - 2, 2 * elements);
+    let kc = PAD_STIFFNESS_FACTOR * 3.0;
+    for (i, j, v) in [
+        (tip, tip, kc),
+        (tip, pad, -kc),
+        (pad, tip, -kc),
+        (pad, pad, kc),
+    ] {
+        k.push(Triplet::new(i, j, v));
+    }
+    let k = SparseMatrix::try_new_from_triplets(n, n, &k).expect("entries within the dofs");
+    let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("entries within the dofs");
+    (k, m, f)
+}

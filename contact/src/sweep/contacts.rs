@@ -1,0 +1,97 @@
+//! Every contact of every point of a branch ([`FrequencyResponse::contacts`]), with the
+//! numbers `ssn solve` reports for one solution ([`ContactReport`]): gap, mean force,
+//! largest penetration, fraction of the period in contact, displacement range.
+//!
+//! Harmonic-balance branches reconstruct the contact displacements and forces on
+//! [`FrequencyResponse::output_points`] equally spaced times, as `ssn solve` does; an LCP
+//! branch (`lcp-ssn`) has them at its `Nt` time nodes: the state is `(w, z)`, time-major,
+//! so contact `c` has displacement `u = g - w[n m + c]` and force `-z[n m + c]` at node `n`.
+
+use crate::contacts::{contact_reports, ContactReport};
+use crate::hb::{PenaltyHb, SsnHb};
+use crate::model::Structure;
+use crate::settings::{Method, SolverSettings};
+use crate::solve::{hb_options, penalty_options, HbReconstruction, RunError};
+
+use super::FrequencyResponse;
+
+/// The per-contact reports of each point of `response` (one list per point, the contacts
+/// in the scene's order). Methods that do not sweep give no points and no lists.
+pub(super) fn branch_contacts(
+    rod: &Structure,
+    settings: &SolverSettings,
+    response: &FrequencyResponse,
+) -> Result<Vec<Vec<ContactReport>>, RunError> {
+    let model = &rod.model;
+    let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof, c.gap)).collect();
+    let points = response.output_points;
+    let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<ContactReport>>, RunError> {
+        response
+            .states
+            .iter()
+            .map(|x| {
+                let forces = (0..contacts.len())
+                    .map(|i| problem.contact_force(x, i, points))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let displacements = contacts
+                    .iter()
+                    .map(|&(dof, _)| problem.displacement(x, dof, points))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Ok(contact_reports(&contacts, &forces, &displacements))
+            })
+            .collect()
+    };
+    match settings.method {
+        Method::SsnHb => hb(&SsnHb::new(model, &hb_options(settings))?),
+        Method::PenaltyHb => hb(&PenaltyHb::new(model, &penalty_options(settings, model))?),
+        Method::LcpSsn => {
+            let m = contacts.len();
+            Ok(response
+                .states
+                .iter()
+                .map(|y| lcp_point_contacts(&contacts, y, m))
+                .collect())
+        }
+        Method::LcpLemke | Method::March => Ok(Vec::new()),
+    }
+}
+
+/// The reports of an LCP state `y = (w, z)` with `m` contacts (module documentation).
+fn lcp_point_contacts(contacts: &[(usize, f64)], y: &[f64], m: usize) -> Vec<ContactReport> {
+    let half = y.len() / 2;
+    let (w, z) = y.split_at(half);
+    let nodes = half.checked_div(m).unwrap_or(0);
+    let forces: Vec<Vec<f64>> = (0..m)
+        .map(|c| (0..nodes).map(|n| -z[n * m + c]).collect())
+        .collect();
+    let displacements: Vec<Vec<f64>> = contacts
+        .iter()
+        .enumerate()
+        .map(|(c, &(_, gap))| (0..nodes).map(|n| gap - w[n * m + c]).collect())
+        .collect();
+    contact_reports(contacts, &forces, &displacements)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lcp_states_give_each_contact_its_own_displacements_and_forces() {
+        // Two contacts (gaps 0.5 and 0.3), two nodes, time-major: w = (w00, w01, w10, w11).
+        let w = [0.0, 0.1, 0.2, 0.3];
+        let z = [4.0, 0.0, 0.0, 0.0];
+        let y: Vec<f64> = w.iter().chain(&z).copied().collect();
+        let r = lcp_point_contacts(&[(19, 0.5), (9, 0.3)], &y, 2);
+        assert_eq!(r.len(), 2);
+        // Contact 0: u = 0.5 - (0.0, 0.2), force (-4, 0).
+        assert_eq!((r[0].displacement_max, r[0].displacement_min), (0.5, 0.3));
+        assert_eq!((r[0].force_mean, r[0].contact_fraction), (-2.0, 0.5));
+        // Contact 1: u = 0.3 - (0.1, 0.3), no force.
+        assert_eq!(
+            (r[1].displacement_max, r[1].displacement_min),
+            (0.3 - 0.1, 0.0)
+        );
+        assert_eq!((r[1].force_mean, r[1].contact_fraction), (0.0, 0.0));
+    }
+}

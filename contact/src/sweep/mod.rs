@@ -1,0 +1,731 @@
+//! Frequency-response curves: pseudo-arclength continuation in the forcing frequency of a
+//! scene's periodic problem.
+//!
+//! [`frequency_response`] solves at `omega_from = omega_ratio_from * omega_1` by globalized
+//! Newton from zero, then follows the branch with the core's
+//! [`Continuation`](semismooth::continuation::Continuation) until the frequency leaves
+//! `[omega_from, omega_to]` (through folds, where the frequency turns back). Each point is
+//! reduced to the tip over one period: `tip_max`, `tip_min` and the amplitude
+//! `max_t |u_tip(t)|` (with contact the maximum sits at the gap along the contact branch, so
+//! the negative excursion carries the information).
+//!
+//! # What a step length means
+//!
+//! The continuation measures steps in its θ-weighted norm. Here it is given a state scale
+//! `s_i` and a frequency scale `s_ω` such that with `θ = 1/2` a step `ds` is the Euclidean
+//! arclength in the plane
+//!
+//! ```text
+//! ds² = (Δω / ω_1)² + |ΔX|² / (N u_ref²),
+//! ```
+//!
+//! `N` the number of dofs, `|ΔX|` the 2-norm of the change of all displacement coefficients
+//! (SSN-HB's force coefficients count divided by `c`, LCP forces divided by `κ`, LCP gaps
+//! as displacements), and `u_ref` the root-mean-square over the dofs of the linear response
+//! (contacts removed) at `ω_1` ([`FrequencyResponse::reference_amplitude`]): `s_i = u_i
+//! sqrt(θ N / n) u_ref` (`u_i` = 1, `c` or `κ`, `n` unknowns) and `s_ω = sqrt(1 - θ) ω_1`.
+//! The linear resonance is thus at distance about 1 from zero in both directions, whatever
+//! `H`, `Nt` or the mesh: `[sweep] step = 0.01` means about one percent of `ω_1` on flat
+//! parts of the curve and one percent of the resonant amplitude on steep ones.
+//!
+//! # Robustness on piecewise-smooth branches
+//!
+//! The contact branches are only piecewise smooth (the set of active AFT samples or time
+//! nodes changes along them), with corners and folds at corners. The sweep turns on the
+//! core continuation's measures for such branches:
+//!
+//! - a trust ball of [`TRUST_FACTOR`] times the largest next step around the last point
+//!   ([`ContinuationOptions::trust_factor`]): without it Newton sometimes converged on the
+//!   far side of an overhang and skipped both folds;
+//! - the corner passes ([`ContinuationOptions::pass_corners`]) and restarts with a
+//!   state-heavy metric ([`RestartPolicy`], its defaults), whose retrace test ends a sweep
+//!   that could only go back along the branch ("stalled at omega_ratio ...");
+//! - penalty HB is [`PiecewiseAffine`](semismooth::continuation::PiecewiseAffine) (its
+//!   switching functions are the gaps at the AFT samples): its corners are crossed exactly
+//!   ([`Continuation::with_affine_pieces`]), and its folds are corners.
+//!
+//! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
+//! tolerance for SSN-HB and lcp-ssn, so each point is a fixed point of a Newton solve at
+//! that tolerance. For penalty HB it is the scene's tolerance or the rounding floor of
+//! `|F|`, `ε k_p max(|g|, u_ref)` (the penalty force is `k_p` times gaps computed to
+//! `ε |u|`), whichever is larger.
+//!
+//! # Methods
+//!
+//! - `ssn-hb`, `penalty-hb`: the harmonic-balance problems ([`SsnHb`], [`PenaltyHb`]) with the
+//!   scene's linear solver (`structured`: [`StructuredHbSolver`], `dense`: [`FaerDenseLu`]).
+//! - `lcp-ssn`: the periodic LCP as the equation [`FrequencyLcp`] in the gaps and forces
+//!   `y = (w, z)` at the `Nt` time nodes, `w - q(ω) - A(ω) z = 0`, `min(z, κ w) = 0`
+//!   (`κ` = the scene's `c`, default the contact stiffness scale; the force unit of the
+//!   arclength), with the active-block solver [`FrequencyLcpSolver`] and the analytic
+//!   `dF/dω`. It starts from the runner's mesh-sequenced min-map solve at `omega_from`.
+//!   The tip extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a
+//!   contact, else from the LCP of the point's frequency with the tip observed). The
+//!   discrete LCP branch has a small fold at many changes of the active set (a node
+//!   entering or leaving contact), reported in `corner_folds` (see below). Known limit: a contact on a
+//!   node with mass (the ill-posed case without an impact law, module `lcp`): the branch
+//!   has a corner right after the contact onset that neither the arclength, the corner
+//!   passes nor the restarts turn, and the sweep stops there with `converged = false`.
+//! - `lcp-lemke`, `march`: [`RunError::Unsupported`]. Lemke's pivoting and time
+//!   marching are no equation in `ω` to continue; solve frequency by frequency with
+//!   `ssn solve`.
+//!
+//! # Folds and corners
+//!
+//! The continuation reports every reversal of the frequency. On piecewise-smooth branches
+//! most of them are corners, not turning points: fine steps resolve micro-zigzags of about
+//! 1e-4 `ω_1` where AFT samples enter contact, and a penalty branch turns back a little at
+//! many of its corners. [`separate_turning_points`] keeps as `folds` the reversals whose
+//! frequency excursion is at least [`TURNING_POINT_EXCURSION`] `ω_1` and lists the others
+//! as `corner_folds`.
+//!
+//! Measured branch sizes, timings and limits are in the README (*Sweeps*) and
+//! `examples/lcp_sweep.rs`.
+
+pub mod branch;
+mod contacts;
+mod response;
+
+use std::time::Instant;
+
+use semismooth::continuation::{
+    Continuation, ContinuationError, ContinuationEvent, ContinuationOptions,
+    ContinuationTermination, Direction, Predictor, RestartPolicy,
+};
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::{self, NewtonError, WorkCounters};
+use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+
+use response::{extremes, HbTip};
+pub use response::{separate_turning_points, FrequencyResponse, TURNING_POINT_EXCURSION};
+
+use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
+use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
+use crate::model::Structure;
+use crate::settings::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
+use crate::solve::{
+    hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
+    HB_OUTPUT_POINTS,
+};
+use crate::stability::StabilityOptions;
+use branch::branch_stability;
+pub(crate) use branch::Reconstruction;
+pub use branch::{BifurcationEvent, BranchStability};
+
+/// Weight `θ` of the state in the arclength (module documentation: with the scaling used
+/// here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the θ-norm
+/// of order one).
+pub const THETA: f64 = 0.5;
+
+/// Largest number of corrector iterations per attempted step.
+pub const MAX_CORRECTOR_ITERATIONS: usize = 12;
+
+/// The corrector's tolerance on `|F|` relative to the scene's Newton tolerance: one decade
+/// tighter, so that every branch point is a fixed point of a Newton solve at the scene's
+/// tolerance even where the Jacobian is ill-conditioned (near folds).
+pub const CORRECTOR_TOLERANCE_FACTOR: f64 = 0.1;
+
+/// Corrector iterations the step control aims at.
+pub const TARGET_ITERATIONS: usize = 4;
+
+/// The corrector may not leave the θ-ball of this many largest next steps around the last
+/// accepted point ([`ContinuationOptions::trust_factor`]).
+pub const TRUST_FACTOR: f64 = 3.0;
+
+/// Failed steps in a row (each halving the step) after which a penalty-HB branch crosses
+/// the corner ahead exactly.
+pub const PENALTY_MAX_FAILURES: usize = 3;
+
+/// The structured or dense linear solver of a harmonic-balance scene.
+fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
+    match choice.condensed() {
+        Some(condensed) => Box::new(StructuredHbSolver::new().with_condensed_solve(condensed)),
+        None => Box::new(FaerDenseLu::new()),
+    }
+}
+
+/// Root mean square over the dofs of the linear response (contacts removed) at `ω_1`
+/// (`0.95 ω_1`, then `0.5 ω_1` if that is singular, e.g. undamped); `1` if all fail.
+fn reference_amplitude(rod: &Structure) -> f64 {
+    let mut model = rod.model.clone();
+    model.contacts.clear();
+    let dofs = model.dofs().max(1);
+    for ratio in [1.0, 0.95, 0.5] {
+        model.forcing.omega = ratio * rod.omega_1;
+        let options = PenaltyHbOptions {
+            harmonics: 1,
+            time_samples: None,
+            penalty_stiffness: 1.0,
+        };
+        let Ok(mut problem) = PenaltyHb::new(&model, &options) else {
+            continue;
+        };
+        let n = problem.dim();
+        let x = vec![0.0; n];
+        let mut r = vec![0.0; n];
+        let mut jac = problem.new_jacobian();
+        if problem.jacobian(&x, &mut jac).is_err() || problem.residual(&x, &mut r).is_err() {
+            continue;
+        }
+        let mut solver = StructuredHbSolver::new();
+        if solver.factor(&jac).is_err() || solver.solve_in_place(&mut r).is_err() {
+            continue;
+        }
+        let rms = (r.iter().map(|v| v * v).sum::<f64>() / dofs as f64).sqrt();
+        if rms.is_finite() && rms > 0.0 {
+            return rms;
+        }
+    }
+    1.0
+}
+
+fn invalid(name: &'static str, value: f64, allowed: &'static str) -> RunError {
+    RunError::InvalidSetting {
+        name,
+        value,
+        allowed,
+    }
+}
+
+fn check_sweep(sweep: &SweepSettings) -> Result<(), RunError> {
+    for (name, value) in [
+        ("sweep.omega_ratio_from", sweep.omega_ratio_from),
+        ("sweep.omega_ratio_to", sweep.omega_ratio_to),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(invalid(name, value, "finite and > 0"));
+        }
+    }
+    if sweep.omega_ratio_to == sweep.omega_ratio_from {
+        return Err(invalid(
+            "sweep.omega_ratio_to",
+            sweep.omega_ratio_to,
+            "a value different from omega_ratio_from",
+        ));
+    }
+    Ok(())
+}
+
+/// What a method's branch needs from the continuation beyond the common settings.
+struct MethodContinuation {
+    /// Per unknown: 1 for displacements, the force unit for forces.
+    units: Vec<f64>,
+    /// Rounding floor of `|F|` (0 where negligible): the corrector tolerance is at least
+    /// this.
+    residual_floor: f64,
+    /// The branch is piecewise affine and its corners are crossed exactly.
+    affine_pieces: bool,
+}
+
+/// Maps the sweep settings onto continuation options in `ω` (absolute).
+fn continuation_options(
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    omega_1: f64,
+    dofs: usize,
+    u_ref: f64,
+    method: &MethodContinuation,
+) -> Result<ContinuationOptions, RunError> {
+    let (lo, hi) = if sweep.omega_ratio_to > sweep.omega_ratio_from {
+        (sweep.omega_ratio_from, sweep.omega_ratio_to)
+    } else {
+        (sweep.omega_ratio_to, sweep.omega_ratio_from)
+    };
+    // Halving from max_step down to min_step, plus one attempt at min_step.
+    let halvings = (sweep.max_step / sweep.min_step).log2().ceil().max(0.0) as usize + 2;
+    let n = method.units.len().max(1);
+    // s_i = u_i sqrt(θ N / n) u_ref: (θ/n)|ΔX/s|² = |ΔX|² / (N u_ref²).
+    let base = (THETA * dofs as f64 / n as f64).sqrt() * u_ref;
+    let options = ContinuationOptions {
+        initial_step: sweep.step,
+        min_step: sweep.min_step,
+        max_step: sweep.max_step,
+        target_iterations: TARGET_ITERATIONS,
+        max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
+        corrector_tolerance: if method.affine_pieces {
+            // |F| cannot be computed below its rounding floor (a stiff penalty puts it
+            // near the scene's tolerance).
+            settings.tolerance.max(method.residual_floor)
+        } else {
+            CORRECTOR_TOLERANCE_FACTOR * settings.tolerance
+        },
+        parameter_min: lo * omega_1,
+        parameter_max: hi * omega_1,
+        max_points: sweep.max_points,
+        max_consecutive_failures: if method.affine_pieces {
+            // A failed step on a piecewise-affine branch is a corner, crossed exactly.
+            PENALTY_MAX_FAILURES
+        } else {
+            halvings.clamp(3, 64)
+        },
+        theta: THETA,
+        state_scale: Some(method.units.iter().map(|u| u * base).collect()),
+        // (1 - θ) Δω² / s_ω² = (Δω / ω_1)².
+        parameter_scale: (1.0 - THETA).sqrt() * omega_1,
+        direction: if sweep.omega_ratio_to > sweep.omega_ratio_from {
+            Direction::Increasing
+        } else {
+            Direction::Decreasing
+        },
+        predictor: Predictor::Secant,
+        refine_folds: true,
+        trust_factor: Some(TRUST_FACTOR),
+        restarts: Some(RestartPolicy::default()),
+        ..ContinuationOptions::default()
+    };
+    options.validate().map_err(continuation_error)?;
+    Ok(options)
+}
+
+fn continuation_error(e: ContinuationError) -> RunError {
+    match e {
+        ContinuationError::InvalidOption {
+            name,
+            value,
+            allowed,
+        } => {
+            let name = match name {
+                "initial_step" => "sweep.step",
+                "min_step" => "sweep.min_step",
+                "max_step" => "sweep.max_step",
+                "max_points" => "sweep.max_points",
+                "corrector_tolerance" => "solver.tolerance",
+                "parameter_max" | "parameter_min" => "sweep.omega_ratio_to",
+                other => other,
+            };
+            invalid(name, value, allowed)
+        }
+        ContinuationError::DimensionMismatch { expected, found } => {
+            RunError::HarmonicBalance(HbError::DimensionMismatch {
+                what: "continuation state",
+                expected,
+                found,
+            })
+        }
+        ContinuationError::Newton(e) => RunError::Newton(e),
+        ContinuationError::InvalidStart { parameter, .. } => invalid(
+            "sweep.omega_ratio_from",
+            parameter,
+            "within the sweep interval",
+        ),
+        // Handled by the caller (a non-converged curve); kept total here.
+        ContinuationError::StartNotConverged { parameter, .. } => invalid(
+            "sweep.omega_ratio_from",
+            parameter,
+            "a frequency where the start point can be corrected",
+        ),
+    }
+}
+
+/// Reduces a state to `(tip_max, tip_min)` over one period.
+type TipMeasure<'m, P> = dyn FnMut(&P, &[f64], f64) -> Result<(f64, f64), RunError> + 'm;
+
+/// Everything [`follow`] needs besides the problem, the solver and the measure.
+struct Setup<'a> {
+    settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    omega_1: f64,
+    u_ref: f64,
+    dofs: usize,
+    method: MethodContinuation,
+    output_points: usize,
+    started: Instant,
+    /// Starting guess of the Newton solve at `omega_from` (zero when `None`) and the work
+    /// spent computing it.
+    start: Option<(Vec<f64>, WorkCounters)>,
+}
+
+/// Newton at `omega_from`, then the continuation to the end of the sweep (module
+/// documentation); every accepted point is measured and reported to `progress`.
+fn follow<P, S>(
+    problem: &mut P,
+    solver: &mut S,
+    setup: Setup<'_>,
+    measure: &mut TipMeasure<'_, P>,
+    configure: impl FnOnce(Continuation<'_, P, S>) -> Continuation<'_, P, S>,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError>
+where
+    P: GeneralizedJacobian + ParameterDependent + ?Sized,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    let (settings, sweep, omega_1) = (setup.settings, setup.sweep, setup.omega_1);
+    let n = problem.dim();
+    let options = continuation_options(
+        settings,
+        sweep,
+        omega_1,
+        setup.dofs,
+        setup.u_ref,
+        &setup.method,
+    )?;
+
+    let omega_from = sweep.omega_ratio_from * omega_1;
+    problem.set_parameter(omega_from);
+    let (mut x, mut work) = setup
+        .start
+        .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
+    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))
+        .or_else(NewtonError::into_report)?;
+    work += report.counters;
+    let mut response = FrequencyResponse {
+        method: settings.method,
+        omega_1,
+        omega: Vec::new(),
+        tip_max: Vec::new(),
+        tip_min: Vec::new(),
+        amplitude: Vec::new(),
+        iterations: Vec::new(),
+        folds: Vec::new(),
+        fold_indices: Vec::new(),
+        corner_folds: Vec::new(),
+        corner_fold_indices: Vec::new(),
+        converged: false,
+        termination: String::new(),
+        solve_seconds: 0.0,
+        counters: RunCounters::from(work),
+        continuation: Default::default(),
+        initial_iterations: report.iterations,
+        restarts: 0,
+        corners: 0,
+        reference_amplitude: setup.u_ref,
+        output_points: setup.output_points,
+        states: Vec::new(),
+        stability: BranchStability::default(),
+        stability_seconds: 0.0,
+        contacts: Vec::new(),
+    };
+    if !report.converged() {
+        response.termination = format!(
+            "the start at omega_ratio {} did not converge: {} after {} iterations (|F| = {:e})",
+            sweep.omega_ratio_from,
+            report.termination,
+            report.iterations,
+            report.residual_norm()
+        );
+        response.solve_seconds = setup.started.elapsed().as_secs_f64();
+        return Ok(response);
+    }
+
+    let to = sweep.omega_ratio_to * omega_1;
+    let mut continuation = configure(
+        Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
+    );
+    let mut start_failure = None;
+    while let Some(item) = continuation.next() {
+        let point = match item {
+            Ok(point) => point,
+            Err(ContinuationError::StartNotConverged { failure, .. }) => {
+                start_failure = Some(failure);
+                break;
+            }
+            Err(e) => return Err(continuation_error(e)),
+        };
+        let omega = point.parameter;
+        let (max, min) = measure(continuation.problem(), &point.state, omega)?;
+        response.push(omega, max, min, point.iterations, point.state);
+        if let Some(report) = progress {
+            report(response.points() - 1, omega / omega_1);
+        }
+    }
+    let c = continuation.counters();
+    let reversals: Vec<(f64, usize)> = continuation
+        .events()
+        .iter()
+        .filter_map(|event| match event {
+            ContinuationEvent::Fold { index, parameter } => Some((*parameter, *index)),
+            _ => None,
+        })
+        .collect();
+    if let (Some(&first), Some(&last)) = (response.omega.first(), response.omega.last()) {
+        let (folds, corners) =
+            separate_turning_points(first, last, &reversals, TURNING_POINT_EXCURSION * omega_1);
+        (response.folds, response.fold_indices) = folds.into_iter().unzip();
+        (response.corner_folds, response.corner_fold_indices) = corners.into_iter().unzip();
+    }
+    let termination = continuation.termination().cloned();
+    drop(continuation);
+    response.counters.residual_evaluations += c.work.residual_evaluations;
+    response.counters.jacobian_evaluations += c.work.jacobian_evaluations;
+    response.counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
+    response.counters.linear_solves += c.work.linear_solves;
+    response.counters.ffts += c.work.problem.get("ffts");
+    response.restarts = c.restarts as usize;
+    response.corners = c.corners as usize;
+    response.continuation = c;
+    let ratio = |omega: f64| omega / omega_1;
+    let (converged, words) = match (&termination, start_failure) {
+        (_, Some(failure)) => (
+            false,
+            format!("the start point could not be corrected: {failure}"),
+        ),
+        (Some(ContinuationTermination::SegmentStartFailed { failure, .. }), None) => (
+            false,
+            format!("the start point could not be corrected: {failure}"),
+        ),
+        (Some(ContinuationTermination::Retraced { parameter }), None) => (
+            false,
+            format!(
+                "stalled at omega_ratio {}: no step ahead (a corner the continuation cannot \
+                 turn), and the only step found goes back along the branch",
+                ratio(*parameter)
+            ),
+        ),
+        (Some(ContinuationTermination::ReachedBound { parameter, bound }), None) => {
+            let reached_end = *bound == to;
+            let at_bound = *parameter == *bound;
+            (
+                reached_end,
+                format!(
+                    "reached omega_ratio {}{}",
+                    ratio(*bound),
+                    if reached_end {
+                        if at_bound {
+                            " (the end of the sweep)".to_string()
+                        } else {
+                            format!(
+                                " (the end of the sweep; last point at {} not re-solved on it)",
+                                ratio(*parameter)
+                            )
+                        }
+                    } else {
+                        " (the start of the sweep: the branch turned back)".to_string()
+                    }
+                ),
+            )
+        }
+        (Some(ContinuationTermination::IterationBudgetSpent { parameter, budget }), None) => (
+            false,
+            format!(
+                "the {budget} corrector iterations allowed were spent at omega_ratio {}",
+                ratio(*parameter)
+            ),
+        ),
+        (Some(ContinuationTermination::MaxPoints { points }), None) => (
+            false,
+            format!(
+                "point limit ({points} points) at omega_ratio {}",
+                response.omega.last().map_or(f64::NAN, |w| w / omega_1)
+            ),
+        ),
+        (
+            Some(ContinuationTermination::StepTooSmall {
+                parameter,
+                step,
+                failure,
+                ..
+            }),
+            None,
+        ) => (
+            false,
+            format!(
+                "step too small at omega_ratio {}: the attempt with step {step:e} failed: {failure}",
+                ratio(*parameter)
+            ),
+        ),
+        (
+            Some(ContinuationTermination::TooManyFailures {
+                parameter,
+                failures,
+                failure,
+                ..
+            }),
+            None,
+        ) => (
+            false,
+            format!(
+                "{failures} failed steps in a row at omega_ratio {}: {failure}",
+                ratio(*parameter)
+            ),
+        ),
+        (None, None) => (false, "stopped without a reason".to_string()),
+    };
+    response.converged = converged;
+    response.termination = words;
+    response.solve_seconds = setup.started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+/// Frequency-response curve of the rod with the scene's method (module documentation):
+/// globalized Newton at `omega_ratio_from`, then pseudo-arclength continuation in `ω` up to
+/// `omega_ratio_to`. `progress(index, omega_ratio)` is called after each accepted point.
+///
+/// `Err` when the sweep could not start (bad settings, unsupported method, a model the
+/// method cannot build); a branch that stopped early is an `Ok` curve with
+/// `converged = false` and the reason in `termination`.
+///
+/// Each point then gets its stability and contact diagnostics
+/// ([`crate::sweep::branch::branch_stability`], in [`FrequencyResponse::stability`]); a failure
+/// there leaves the points undecided with the reason in its `note`.
+pub fn frequency_response(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    let mut response = follow_branch(rod, settings, sweep, progress)?;
+    response.contacts = contacts::branch_contacts(rod, settings, &response)?;
+    let started = Instant::now();
+    let options = StabilityOptions::default();
+    response.stability =
+        branch_stability(rod, settings, &response, &options).unwrap_or_else(|err| {
+            BranchStability::undecided(response.points(), format!("stability not computed: {err}"))
+        });
+    response.stability_seconds = started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+/// The branch of [`frequency_response`] without its stability.
+pub(crate) fn follow_branch(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    check_sweep(sweep)?;
+    let started = Instant::now();
+    let model = &rod.model;
+    let tip = rod.observed_dof;
+    let dofs = model.dofs();
+    let omega_1 = rod.omega_1;
+    let u_ref = reference_amplitude(rod);
+    let output_points = HB_OUTPUT_POINTS.max(settings.time_samples);
+    let setup = |method: MethodContinuation, output_points: usize| Setup {
+        settings,
+        sweep,
+        omega_1,
+        u_ref,
+        dofs,
+        method,
+        output_points,
+        started,
+        start: None,
+    };
+    match settings.method {
+        Method::SsnHb => {
+            let mut problem = SsnHb::new(model, &hb_options(settings))?;
+            let split = problem.displacement_len();
+            let c = problem.c();
+            let units = (0..problem.dim())
+                .map(|i| if i < split { 1.0 } else { c })
+                .collect();
+            let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
+            let mut measure = |_: &SsnHb, x: &[f64], _: f64| tip_rec.extremes(x);
+            let method = MethodContinuation {
+                units,
+                residual_floor: 0.0,
+                affine_pieces: false,
+            };
+            follow(
+                &mut problem,
+                &mut *hb_solver(settings.linear_solver),
+                setup(method, output_points),
+                &mut measure,
+                |c| c,
+                progress,
+            )
+        }
+        Method::PenaltyHb => {
+            let options = penalty_options(settings, model);
+            let mut problem = PenaltyHb::new(model, &options)?;
+            let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
+            let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
+            // The penalty force is k_p times gaps computed to ε |u| (|u| ~ the gap in contact).
+            let gap = model
+                .contacts
+                .iter()
+                .map(|c| c.gap.abs())
+                .fold(u_ref, f64::max);
+            let method = MethodContinuation {
+                units: vec![1.0; problem.dim()],
+                residual_floor: f64::EPSILON * options.penalty_stiffness * gap,
+                affine_pieces: true,
+            };
+            follow(
+                &mut problem,
+                &mut *hb_solver(settings.linear_solver),
+                setup(method, output_points),
+                &mut measure,
+                |c| c.with_affine_pieces(),
+                progress,
+            )
+        }
+        Method::LcpSsn => {
+            if model.contacts.is_empty() {
+                return Err(RunError::Unsupported {
+                    method: "lcp-ssn",
+                    what: "a [contact] section (the periodic LCP is posed on the contact \
+                           forces; sweep a linear scene with ssn-hb or penalty-hb)",
+                });
+            }
+            let kappa = settings.c.unwrap_or(model.contact_stiffness_scale());
+            // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip is
+            // observed by the LCPs the problem builds.
+            let contacts = model.contact_count();
+            let (lcp_options, tip_contact) = lcp_options(rod, settings);
+            // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
+            let mut start_model = model.clone();
+            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
+            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
+            let finest = problem.current()?;
+            let sequenced =
+                solve_min_map_sequenced(&start_model, &finest, &newton_options(settings))?;
+            let mut start_counters = WorkCounters::default();
+            for level in &sequenced.levels {
+                start_counters += level.report.counters;
+            }
+            let y0 = problem.state_from_forces(&sequenced.z)?;
+            let half = problem.half();
+            let units = (0..problem.dim())
+                .map(|i| if i < half { 1.0 } else { kappa })
+                .collect();
+            let gap = tip_contact.map_or(0.0, |c| model.contacts[c].gap);
+            let time_samples = settings.time_samples;
+            let mut measure =
+                |p: &FrequencyLcp, y: &[f64], omega: f64| -> Result<(f64, f64), RunError> {
+                    match tip_contact {
+                        Some(c) => {
+                            let tip: Vec<f64> = (0..time_samples)
+                                .map(|n| gap - y[n * contacts + c])
+                                .collect();
+                            Ok(extremes(&tip))
+                        }
+                        None => {
+                            let lcp = p.lcp_at(omega)?;
+                            let u = lcp.displacements(&y[half..])?;
+                            Ok(extremes(&u[0]))
+                        }
+                    }
+                };
+            let method = MethodContinuation {
+                units,
+                residual_floor: 0.0,
+                affine_pieces: false,
+            };
+            let setup = Setup {
+                start: Some((y0, start_counters)),
+                ..setup(method, settings.time_samples)
+            };
+            follow(
+                &mut problem,
+                &mut FrequencyLcpSolver::new(),
+                setup,
+                &mut measure,
+                |c| c,
+                progress,
+            )
+        }
+        Method::LcpLemke => Err(RunError::Unsupported {
+            method: "lcp-lemke",
+            what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
+                   sweep with ssn-hb or penalty-hb, or solve frequency by frequency \
+                   with `ssn solve`",
+        }),
+        Method::March => Err(RunError::Unsupported {
+            method: "march",
+            what: "a method continuable in omega (time marching has no equation to continue): \
+                   sweep with ssn-hb or penalty-hb, or march frequency by frequency \
+                   with `ssn solve`",
+        }),
+    }
+}

@@ -1,0 +1,299 @@
+//! The result of a sweep: a frequency-response curve and its JSON form.
+
+use semismooth::continuation::ContinuationCounters;
+use semismooth::harmonic::{Aft, FourierBasis};
+
+use crate::contacts::ContactReport;
+use crate::hb::HbError;
+use crate::settings::Method;
+use crate::solve::{RunCounters, RunError};
+use crate::sweep::branch::BranchStability;
+
+/// One number of a [`ContactReport`].
+type ContactField = fn(&ContactReport) -> f64;
+
+/// A frequency-response curve: one entry per branch point, in branch order (the frequency
+/// is not monotone across folds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrequencyResponse {
+    /// Method used.
+    pub method: Method,
+    /// First natural frequency of the rod (the curve's frequency unit).
+    pub omega_1: f64,
+    /// Forcing frequency `ω` of each point (absolute).
+    pub omega: Vec<f64>,
+    /// `max_t u_tip(t)` over one period.
+    pub tip_max: Vec<f64>,
+    /// `min_t u_tip(t)` over one period.
+    pub tip_min: Vec<f64>,
+    /// `max_t |u_tip(t)|` over one period.
+    pub amplitude: Vec<f64>,
+    /// Corrector iterations of each point (the first: those of the start correction).
+    pub iterations: Vec<usize>,
+    /// Frequencies `ω` (absolute) where the branch turns back, in branch order: the turning
+    /// points whose frequency excursion to the next one is at least
+    /// [`TURNING_POINT_EXCURSION`] `ω_1` ([`separate_turning_points`]).
+    pub folds: Vec<f64>,
+    /// Index of the extreme point at each fold (same order as `folds`).
+    pub fold_indices: Vec<usize>,
+    /// Frequencies `ω` of the smaller reversals, in branch order: the corners of a
+    /// piecewise-smooth branch where the frequency goes back by less than
+    /// [`TURNING_POINT_EXCURSION`] `ω_1` (an AFT sample or time node entering contact, the
+    /// pieces of a penalty branch).
+    pub corner_folds: Vec<f64>,
+    /// Index of the extreme point at each corner reversal (same order as `corner_folds`).
+    pub corner_fold_indices: Vec<usize>,
+    /// Whether the branch reached `omega_ratio_to` (the bound at the end of the sweep).
+    pub converged: bool,
+    /// Why the continuation stopped, in words.
+    pub termination: String,
+    /// Wall time of the whole computation after the rod was built (reference amplitude,
+    /// initial Newton solve, continuation, tip reconstructions).
+    pub solve_seconds: f64,
+    /// Work counters (initial Newton solve + continuation).
+    pub counters: RunCounters,
+    /// The continuation's own counters (corrector iterations, rejected steps).
+    pub continuation: ContinuationCounters,
+    /// Iterations of the initial globalized Newton solve at `omega_from`.
+    pub initial_iterations: usize,
+    /// Continuation restarts after failed steps (the core's restart policy).
+    pub restarts: usize,
+    /// Corners of a piecewise-affine (penalty) branch crossed exactly.
+    pub corners: usize,
+    /// `u_ref` of the step scaling (module documentation).
+    pub reference_amplitude: f64,
+    /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
+    pub output_points: usize,
+    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
+    /// `[w; z]`), unscaled, for warm starts and re-solves.
+    pub states: Vec<Vec<f64>>,
+    /// Stability, contact diagnostics and bifurcations of the points.
+    pub stability: BranchStability,
+    /// Wall time of the stability analysis (not in `solve_seconds`).
+    pub stability_seconds: f64,
+    /// Every contact of each point, in the scene's order (as `ssn solve` reports them).
+    pub contacts: Vec<Vec<ContactReport>>,
+}
+
+impl FrequencyResponse {
+    pub(super) fn push(
+        &mut self,
+        omega: f64,
+        max: f64,
+        min: f64,
+        iterations: usize,
+        state: Vec<f64>,
+    ) {
+        self.omega.push(omega);
+        self.tip_max.push(max);
+        self.tip_min.push(min);
+        self.amplitude.push(max.abs().max(min.abs()));
+        self.iterations.push(iterations);
+        self.states.push(state);
+    }
+
+    /// Number of branch points.
+    pub fn points(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// `ω / ω_1` of each point.
+    pub fn omega_ratio(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / self.omega_1).collect()
+    }
+
+    /// The mean contact force of each point: the sum of its contacts' mean forces (the
+    /// stability diagnostics' value, NaN, where the contacts were not computed).
+    pub fn contact_force_mean(&self) -> Vec<f64> {
+        (0..self.points())
+            .map(|i| match self.contacts.get(i) {
+                Some(point) => point.iter().map(|c| c.force_mean).sum(),
+                None => self
+                    .stability
+                    .contact_force_mean
+                    .get(i)
+                    .copied()
+                    .unwrap_or(f64::NAN),
+            })
+            .collect()
+    }
+
+    /// The CSV columns of the contacts: for contact `k` (the scene's order, from 0, as the
+    /// `lambda_k` of `ssn solve --csv`) `contact{k}_force_mean`, `contact{k}_max_penetration`,
+    /// `contact{k}_contact_fraction`, `contact{k}_displacement_min` and
+    /// `contact{k}_displacement_max`, one value per point (NaN where not computed).
+    pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
+        let count = self.contacts.iter().map(Vec::len).max().unwrap_or(0);
+        let fields: [(&str, ContactField); 5] = [
+            ("force_mean", |c| c.force_mean),
+            ("max_penetration", |c| c.max_penetration),
+            ("contact_fraction", |c| c.contact_fraction),
+            ("displacement_min", |c| c.displacement_min),
+            ("displacement_max", |c| c.displacement_max),
+        ];
+        let mut columns = Vec::with_capacity(count * fields.len());
+        for k in 0..count {
+            for (name, field) in fields {
+                let values = self
+                    .contacts
+                    .iter()
+                    .map(|point| point.get(k).map_or(f64::NAN, field))
+                    .collect();
+                columns.push((format!("contact{k}_{name}"), values));
+            }
+        }
+        columns
+    }
+
+    /// Index and value of the largest amplitude (`None` for an empty curve).
+    pub fn peak(&self) -> Option<(usize, f64)> {
+        self.amplitude
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(None, |best, (i, a)| match best {
+                Some((_, b)) if b >= a => best,
+                _ => Some((i, a)),
+            })
+    }
+}
+
+/// Reconstructs one dof over a period from HB coefficients (index `j N + dof`).
+pub(super) struct HbTip {
+    aft: Aft,
+    coeffs: Vec<f64>,
+    samples: Vec<f64>,
+    dofs: usize,
+    dof: usize,
+}
+
+impl HbTip {
+    pub(super) fn new(
+        harmonics: usize,
+        points: usize,
+        dofs: usize,
+        dof: usize,
+    ) -> Result<Self, RunError> {
+        let basis = FourierBasis::new(harmonics, points).map_err(HbError::from)?;
+        Ok(Self {
+            aft: Aft::new(basis),
+            coeffs: vec![0.0; 2 * harmonics + 1],
+            samples: vec![0.0; points],
+            dofs,
+            dof,
+        })
+    }
+
+    /// `(max, min)` of the dof over a period.
+    pub(super) fn extremes(&mut self, x: &[f64]) -> Result<(f64, f64), RunError> {
+        for (j, c) in self.coeffs.iter_mut().enumerate() {
+            *c = x[j * self.dofs + self.dof];
+        }
+        self.aft
+            .to_time(&self.coeffs, &mut self.samples)
+            .map_err(HbError::from)?;
+        Ok(extremes(&self.samples))
+    }
+}
+
+/// `(max, min)` of samples.
+pub(super) fn extremes(samples: &[f64]) -> (f64, f64) {
+    samples
+        .iter()
+        .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), v| {
+            (hi.max(*v), lo.min(*v))
+        })
+}
+
+/// Smallest frequency excursion, in units of `ω_1`, that makes a pair of reversals of a
+/// branch two turning points (folds) rather than corners. Measured on the 20-element rod at
+/// `H = 20`: the micro-zigzags of fine steps (step 0.002) go back by at most 1.1e-3 `ω_1`,
+/// the corners of a penalty branch at `k_p = 1000` by at most 6e-4 `ω_1`; the overhangs of
+/// the paper's forcings are 9.8e-3 (p0 = 0.04) and 8.6e-2 (p0 = 0.2) `ω_1` wide.
+pub const TURNING_POINT_EXCURSION: f64 = 2e-3;
+
+/// Frequency reversals of a branch: `(ω, index of the extreme point)` in branch order.
+pub type Reversals = Vec<(f64, usize)>;
+
+/// Splits the frequency reversals of a branch into turning points and corners.
+///
+/// `reversals` are `(ω, index)` in branch order (the continuation's fold events), between
+/// the branch's first and last frequencies `first` and `last`. The frequencies at the ends
+/// and the reversals form a zigzag sequence `v_0, v_1, ..., v_{k+1}` (local extremes in
+/// turn). Repeatedly, the adjacent pair of reversals `(v_i, v_{i+1})` (`1 <= i < k`) with
+/// the smallest `|v_i - v_{i+1}| < min_excursion` is removed; the sequence stays a zigzag
+/// and each removal keeps the larger excursion around it, so what remains are the branch's
+/// turning points with excursions of at least `min_excursion`, independent of how finely
+/// the branch was stepped. Returns `(turning points, corners)`, both in branch order.
+pub fn separate_turning_points(
+    first: f64,
+    last: f64,
+    reversals: &[(f64, usize)],
+    min_excursion: f64,
+) -> (Reversals, Reversals) {
+    // Positions into `reversals` of the kept ones, with the ends as `None`.
+    let mut kept: Vec<Option<usize>> = std::iter::once(None)
+        .chain((0..reversals.len()).map(Some))
+        .chain(std::iter::once(None))
+        .collect();
+    let value = |k: Option<usize>, end: f64| k.map_or(end, |k| reversals[k].0);
+    loop {
+        let mut smallest: Option<(f64, usize)> = None;
+        for i in 1..kept.len().saturating_sub(2) {
+            let a = value(kept[i], first);
+            let b = value(kept[i + 1], last);
+            let d = (a - b).abs();
+            if d < min_excursion && smallest.is_none_or(|(s, _)| d < s) {
+                smallest = Some((d, i));
+            }
+        }
+        match smallest {
+            Some((_, i)) => {
+                kept.drain(i..i + 2);
+            }
+            None => break,
+        }
+    }
+    let turning: Vec<usize> = kept.iter().flatten().copied().collect();
+    let (mut folds, mut corners) = (Vec::new(), Vec::new());
+    for (k, r) in reversals.iter().enumerate() {
+        if turning.contains(&k) {
+            folds.push(*r);
+        } else {
+            corners.push(*r);
+        }
+    }
+    (folds, corners)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::separate_turning_points;
+
+    #[test]
+    fn small_reversals_are_corners_and_the_extremes_stay_turning_points() {
+        // Up to 1.0276 with two small zigzags, back to 1.0178 with one, then on to 2.
+        let reversals = [
+            (1.0272, 3),
+            (1.0271, 4),
+            (1.0276, 7),
+            (1.0275, 8),
+            (1.0276, 9),
+            (1.0263, 12),
+            (1.0264, 13),
+            (1.0178, 20),
+        ];
+        let (folds, corners) = separate_turning_points(0.5, 2.0, &reversals, 2e-3);
+        assert_eq!(folds, [(1.0276, 9), (1.0178, 20)]);
+        assert_eq!(corners.len(), 6);
+        // A monotone branch with only corner reversals has no fold.
+        let (folds, corners) = separate_turning_points(0.5, 2.0, &[(1.0, 1), (0.9999, 2)], 2e-3);
+        assert!(folds.is_empty());
+        assert_eq!(corners.len(), 2);
+        // Nothing to separate.
+        assert_eq!(
+            separate_turning_points(0.5, 2.0, &[], 2e-3),
+            (vec![], vec![])
+        );
+    }
+}

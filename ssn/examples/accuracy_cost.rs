@@ -1,0 +1,65 @@
+//! Accuracy versus cost of every method on the canonical rod with the modified mass
+//! (massless contact node), or on a scene given as the first argument: the table, the
+//! cheapest setting of each method for 1e-3 and 1e-4 relative accuracy on the tip minimum,
+//! and `accuracy_cost.csv` / `accuracy_cost.svg` in `out/accuracy_cost/`.
+//!
+//! `cargo run --release --example accuracy_cost [SCENE.toml]`
+
+use std::path::PathBuf;
+
+use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+use semismooth_contact::settings::SolverSettings;
+use ssn::output::prepare_directory;
+use ssn::study::accuracy_cost;
+
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let (rod, base) = match std::env::args().nth(1) {
+        // A rod or a [model] scene, as `ssn compare` reads it.
+        Some(path) => {
+            use ssn::cli::{load, CliError};
+            let (scene, structure) = load(path.as_ref()).map_err(|e| match e {
+                CliError::BadInput(m) | CliError::Output(m) => m,
+                CliError::NotConverged => "not converged".to_string(),
+            })?;
+            (structure, scene.solver)
+        }
+        None => {
+            let spec = RodSpec {
+                mass: MassModel::Modified,
+                ..RodSpec::canonical()
+            };
+            (
+                build_rod(&spec)?.structure,
+                SolverSettings::with_harmonics(20),
+            )
+        }
+    };
+    let progress = |s: &str| eprintln!("  {s}");
+    let study = accuracy_cost(&rod, &base, Some(&progress))?;
+    println!("{}", study.table());
+    for accuracy in [1e-3, 1e-4] {
+        println!("cheapest setting for {accuracy:.0e} on the tip minimum:");
+        print!("{}", study.cheapest_table(accuracy));
+    }
+    // The README's table (`ms`: wall time of one cold solve, the problem already built).
+    print!("\n{}", ssn::tables::cheapest_settings(&study).markdown());
+    let out = PathBuf::from("out/accuracy_cost");
+    prepare_directory(&out)?;
+    study.write_files(&out)?;
+    println!(
+        "\nWrote {0}/accuracy_cost.csv and {0}/accuracy_cost.svg",
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,677 @@
+//! The `ssn` command-line program's commands, as library functions (so tests and examples
+//! can call them): `solve`, `sweep`, `compare`, `scene-check` and `export-model`, their JSON documents and
+//! printed summaries. The default run (the paper's figures) is in [`crate::figures`].
+//!
+//! Every command maps its failure onto [`CliError`], whose variants are the documented exit
+//! codes: 1 when the solver ran and did not converge (its output is still printed), 2 for
+//! bad input (the message names the file, the key and what is allowed), 3 when an output
+//! could not be written (nothing half-written is left).
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Value};
+
+use crate::describe::describe;
+pub use crate::exit::CliError;
+use crate::io::{printable, write_text, OutputSet};
+use crate::output::{
+    csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
+};
+use crate::progress::progress_spinner;
+use crate::scene::{Method, Scene};
+use semismooth_contact::matrix_market::build_imported;
+use semismooth_contact::model::Structure;
+use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
+use semismooth_contact::solve::{solve_rod, Solution};
+
+/// Bad input found in the scene file `path`: the message starts with the file.
+fn input_error(path: &Path, e: impl Display) -> CliError {
+    CliError::BadInput(format!("{}: {e}", path.display()))
+}
+
+/// Loads a scene and builds its structure (the rod of a `[rod]` scene, the Matrix Market
+/// files of a `[model]` scene; `[output] dof` chooses the observed dof), after checking
+/// that one run of its method fits in memory ([`crate::limits`]).
+pub fn load(path: &Path) -> Result<(Scene, Structure), CliError> {
+    load_checked(path, false)
+}
+
+/// [`load`], with the memory of `ssn compare`'s runs when `compare`.
+fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliError> {
+    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
+    let limit = crate::limits::memory_limit();
+    // A rod is estimated before it is built; an imported model once its size is read.
+    if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
+        crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+    }
+    if let Some(work) = crate::limits::rod_scene_work(&scene, compare) {
+        crate::limits::check_work(&work, crate::limits::work_limit())
+            .map_err(|e| input_error(path, e))?;
+    }
+    let structure = match &scene.model {
+        // Import errors name the scene or the matrix file themselves.
+        Some(spec) => {
+            let structure = build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?;
+            let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
+            crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+            let work = crate::limits::structure_work(&structure, &scene.solver, compare);
+            crate::limits::check_work(&work, crate::limits::work_limit())
+                .map_err(|e| input_error(path, e))?;
+            structure
+        }
+        None => {
+            let mut rod = build_rod(&scene.rod)
+                .map_err(|e| input_error(path, e))?
+                .structure;
+            if let Some(dof) = scene.output_dof {
+                rod.observed_dof = dof;
+            }
+            rod
+        }
+    };
+    Ok((scene, structure))
+}
+
+/// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
+/// (the help texts are those of `solve`; `main` words them for `sweep`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Print the result as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the tip displacement and contact force over one period as CSV (`-`: standard
+    /// output).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write a plot of the tip displacement over one period as SVG (`-`: standard output).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+}
+
+/// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
+/// or to start from ([`crate::state`]).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SolveArgs {
+    /// The scene and the outputs every run has.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Write the solution's harmonic coefficients as JSON (method, harmonics, dofs,
+    /// contacts, omega and the coefficients: a state for --start; `-`: standard output).
+    #[arg(long)]
+    pub state: Option<PathBuf>,
+    /// Start Newton from a state written by --state, or from one solution of
+    /// `ssn solutions --json` (choose it with --entry). Only harmonics may differ: the state
+    /// is then lifted (zero higher harmonics) or truncated.
+    #[arg(long)]
+    pub start: Option<PathBuf>,
+    /// The solution of an `ssn solutions --json` file to start from (1 = the first listed).
+    #[arg(long, requires = "start")]
+    pub entry: Option<usize>,
+}
+
+/// The curve of a run's SVG: titled by the scene, or `untitled` when it has no title.
+struct Plot {
+    untitled: &'static str,
+    x_label: &'static str,
+    y_label: &'static str,
+    series: Vec<Series>,
+}
+
+impl RunArgs {
+    /// Claims the run's outputs before it starts: the scene is an input no output may
+    /// replace, standard output carries the JSON (or the text summary unless `--quiet`),
+    /// and every file target must be new or a regular file.
+    pub(crate) fn plan(&self) -> Result<OutputSet, CliError> {
+        let mut set = OutputSet::new();
+        set.input(&self.scene, "the scene");
+        if self.json {
+            set.stdout("--json")?;
+        } else if !crate::io::quiet() {
+            set.stdout("the text summary (add --quiet or --json)")?;
+        }
+        if let Some(csv) = &self.csv {
+            set.target(csv, "--csv")?;
+        }
+        if let Some(svg) = &self.svg {
+            set.target(svg, "--svg")?;
+        }
+        Ok(set)
+    }
+
+    /// Queues the requested outputs: the CSV of `columns` under `headers`, and the SVG of
+    /// `plot` (built only when an SVG is requested).
+    fn queue_outputs(
+        &self,
+        set: &mut OutputSet,
+        scene: &Scene,
+        headers: &[&str],
+        columns: &[&[f64]],
+        plot: impl FnOnce() -> Plot,
+    ) -> Result<(), CliError> {
+        if let Some(csv) = &self.csv {
+            set.add(csv, csv_table(headers, columns).into_bytes());
+        }
+        if let Some(svg) = &self.svg {
+            let plot = plot();
+            let spec = PlotSpec {
+                title: scene.title.clone().unwrap_or_else(|| plot.untitled.into()),
+                x_label: plot.x_label.into(),
+                y_label: plot.y_label.into(),
+                log_log: false,
+            };
+            set.add(svg, line_plot_svg(&spec, &plot.series)?.into_bytes());
+        }
+        Ok(())
+    }
+
+    /// Writes the outputs (all or none), then the result on standard output, as JSON
+    /// (`--json`) or as the text `text` returns (nothing with `--quiet`), and maps
+    /// convergence onto the outcome.
+    pub(crate) fn finish(
+        &self,
+        mut set: OutputSet,
+        json: impl FnOnce() -> Value,
+        text: impl FnOnce() -> String,
+        converged: bool,
+    ) -> Result<(), CliError> {
+        if self.json {
+            let doc = serde_json::to_string_pretty(&json())
+                .map_err(|e| CliError::Output(format!("cannot format the JSON: {e}")))?;
+            set.add(
+                Path::new(crate::io::STDOUT_NAME),
+                format!("{doc}\n").into_bytes(),
+            );
+        }
+        set.commit()?;
+        if !self.json {
+            write_text(&text())?;
+        }
+        if converged {
+            Ok(())
+        } else {
+            Err(CliError::NotConverged)
+        }
+    }
+}
+
+/// Largest number of folds listed one by one in the human-readable sweep summary.
+const LISTED_FOLDS: usize = 8;
+
+/// The folds of a sweep in words (units of omega_1): all of them when there are few; else
+/// their count, range, first and last (LCP and stiff-penalty branches have tens to
+/// hundreds of small folds where the contact moves from node to node; `--json` and
+/// `--csv` keep every one).
+fn folds_summary(folds: &[f64], omega_1: f64) -> String {
+    let ratio: Vec<f64> = folds.iter().map(|w| w / omega_1).collect();
+    match ratio.len() {
+        0 => "none".into(),
+        n if n <= LISTED_FOLDS => ratio
+            .iter()
+            .map(|r| format!("{r:.4}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        n => {
+            let lo = ratio.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = ratio.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            format!(
+                "{n} between {lo:.4} and {hi:.4} (first {:.4}, last {:.4}; all in --json)",
+                ratio[0],
+                ratio[n - 1]
+            )
+        }
+    }
+}
+
+/// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
+/// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
+pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
+    use crate::state::{read_state, HbState, StateShape};
+    let args = &solve_args.run;
+    let mut outputs = args.plan()?;
+    // The start is an input: no output may replace it.
+    if let Some(start) = &solve_args.start {
+        outputs.input(start, "the --start state");
+    }
+    if let Some(state) = &solve_args.state {
+        outputs.target(state, "--state")?;
+    }
+    let (scene, rod) = load(&args.scene)?;
+    let shape = StateShape {
+        method: scene.solver.method,
+        harmonics: scene.solver.harmonics,
+        dofs: rod.model.dofs(),
+        contacts: rod.model.contacts.len(),
+    };
+    for (given, option) in [
+        (solve_args.state.is_some(), "--state"),
+        (solve_args.start.is_some(), "--start"),
+    ] {
+        if given {
+            crate::state::check_method(shape.method, option)
+                .map_err(|e| input_error(&args.scene, e))?;
+        }
+    }
+    let start = match &solve_args.start {
+        Some(path) => {
+            let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
+            let (x, note) = state.unknowns_for(shape).map_err(|e| {
+                CliError::BadInput(format!("{}: {e}", printable(&path.display().to_string())))
+            })?;
+            Some(StartedFrom {
+                file: printable(&path.display().to_string()),
+                entry: solve_args.entry,
+                omega_ratio: state.omega / state.omega_1,
+                note,
+                unknowns: x,
+            })
+        }
+        None => None,
+    };
+    // Time marching to a steady state is the long one: a spinner while it runs.
+    let bar = if scene.solver.method == Method::March {
+        progress_spinner("time marching to a steady state", quiet)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let solution = solve_rod(
+        &rod,
+        &scene.solver,
+        start.as_ref().map(|s| s.unknowns.as_slice()),
+    )
+    .map_err(|e| input_error(&args.scene, e))?;
+    bar.finish_and_clear();
+    let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
+    let mut headers = vec!["t".to_string(), "u_tip".to_string()];
+    for (i, f) in solution.contact_forces.iter().enumerate() {
+        columns.push(f);
+        headers.push(format!("lambda_{i}"));
+    }
+    let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
+        let period = 2.0 * std::f64::consts::PI / solution.omega;
+        let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
+        let mut series = vec![Series::new(
+            describe_method(&solution),
+            t.clone(),
+            solution.tip.clone(),
+        )];
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
+        Plot {
+            untitled: "tip displacement",
+            x_label: "time t / T (T: forcing period)",
+            y_label: "tip displacement u_tip",
+            series,
+        }
+    })?;
+    if let Some(path) = &solve_args.state {
+        let mut doc =
+            HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
+                .to_json();
+        doc["converged"] = json!(solution.converged);
+        doc["residual_norm"] = crate::json::finite_or_null(solution.residual_norm);
+        let text = serde_json::to_string_pretty(&doc)
+            .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
+        outputs.add(path, format!("{text}\n").into_bytes());
+    }
+    args.finish(
+        outputs,
+        || {
+            let mut v = crate::json::solution_json(&args.scene, &solution);
+            if let Some(s) = &start {
+                v["started_from"] = s.to_json();
+            }
+            v
+        },
+        || {
+            let mut t = solution_text(&solution, &scene.solver);
+            if let Some(s) = &start {
+                t += &format!("started from      {}\n", s.describe());
+            }
+            t
+        },
+        solution.converged,
+    )
+}
+
+/// The state `ssn solve --start` began from.
+struct StartedFrom {
+    file: String,
+    entry: Option<usize>,
+    omega_ratio: f64,
+    note: Option<String>,
+    unknowns: Vec<f64>,
+}
+
+impl StartedFrom {
+    fn to_json(&self) -> Value {
+        json!({
+            "file": self.file,
+            "entry": self.entry,
+            "omega_ratio": self.omega_ratio,
+            "note": self.note,
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "{}{} (a state at omega/omega_1 = {:.6}){}",
+            self.file,
+            self.entry
+                .map(|k| format!(", entry {k}"))
+                .unwrap_or_default(),
+            self.omega_ratio,
+            self.note
+                .as_ref()
+                .map(|n| format!("; {n}"))
+                .unwrap_or_default()
+        )
+    }
+}
+
+fn describe_method(s: &Solution) -> String {
+    match (s.harmonics, s.lcp_scheme) {
+        (Some(h), _) => format!("{} H={h} Nt={}", s.method.name(), s.time_samples),
+        (None, Some(scheme)) if scheme != semismooth_contact::lcp::LcpScheme::Trapezoidal => {
+            format!(
+                "{} Nt={} {}",
+                s.method.name(),
+                s.time_samples,
+                scheme.name()
+            )
+        }
+        (None, _) => format!("{} Nt={}", s.method.name(), s.time_samples),
+    }
+}
+
+/// The text of `ssn solve`; `settings` gives the tolerance the scene asked for, which the
+/// text compares with the effective one.
+fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
+    let c = &s.counters;
+    // Writing into a String cannot fail.
+    let _ = (|| -> std::fmt::Result {
+        writeln!(t, "method            {}", describe_method(s))?;
+        writeln!(
+            t,
+            "omega             {:.6} ({:.4} omega_1)",
+            s.omega,
+            s.omega / s.omega_1
+        )?;
+        writeln!(
+            t,
+            "converged         {} ({}), {} iterations, residual {:.3e}",
+            s.converged, s.termination, s.iterations, s.residual_norm
+        )?;
+        if let Some(diagnosis) = &s.diagnosis {
+            writeln!(t, "diagnosis         {diagnosis}")?;
+        }
+        let asked = if s.method == Method::March {
+            settings.march_tolerance
+        } else {
+            settings.tolerance
+        };
+        if let Some(effective) = s.effective_tolerance.filter(|&e| e > asked) {
+            writeln!(
+                t,
+                "tolerance         {effective:.3e} effective: the scene's {asked:e} is below the \
+                 round-off floor of this formulation"
+            )?;
+        }
+        writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
+        writeln!(
+            t,
+            "tip max / min     {:.6} / {:.6}",
+            s.stats.max, s.stats.min
+        )?;
+        writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
+        writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        if s.contacts.len() > 1 {
+            for c in &s.contacts {
+                writeln!(
+                    t,
+                    "  contact node {:<4} mean force {:.6e}, in contact {:.1} % of the period, \
+                     max penetration {:.3e}",
+                    c.node,
+                    c.force_mean,
+                    100.0 * c.contact_fraction,
+                    c.max_penetration
+                )?;
+            }
+        }
+        writeln!(
+            t,
+            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",
+            c.residual_evaluations,
+            c.jacobian_evaluations,
+            c.factorizations,
+            c.linear_solves,
+            c.ffts
+        )
+    })();
+    t
+}
+
+/// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
+/// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
+pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+    let mut outputs = args.plan()?;
+    let (scene, rod) = load(&args.scene)?;
+    let Some(settings) = scene.sweep.as_ref() else {
+        return Err(input_error(
+            &args.scene,
+            "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
+        ));
+    };
+    let bar = progress_spinner("sweep", quiet);
+    let progress = |points: usize, omega: f64| {
+        bar.set_message(format!(
+            "sweep: {points} points, omega/omega_1 = {:.4}",
+            omega / rod.omega_1
+        ));
+        bar.tick();
+    };
+    let response = semismooth_contact::sweep::frequency_response(
+        &rod,
+        &scene.solver,
+        settings,
+        Some(&progress),
+    )
+    .map_err(|e| input_error(&args.scene, e))?;
+    bar.finish_and_clear();
+    let ratio = response.omega_ratio();
+    let st = &response.stability;
+    // stable: 1 / 0, NaN when undecided.
+    let stable: Vec<f64> = st
+        .stable
+        .iter()
+        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
+        .collect();
+    let floquet: Vec<f64> = st
+        .floquet_max_abs
+        .iter()
+        .map(|a| a.unwrap_or(f64::NAN))
+        .collect();
+    let force_mean = response.contact_force_mean();
+    let contact_columns = response.contact_columns();
+    let mut headers = vec![
+        "omega",
+        "omega_ratio",
+        "tip_max",
+        "tip_min",
+        "amplitude",
+        "stable",
+        "floquet_max_abs",
+        "contact_force_mean",
+        "max_penetration",
+    ];
+    let mut columns: Vec<&[f64]> = vec![
+        &response.omega,
+        &ratio,
+        &response.tip_max,
+        &response.tip_min,
+        &response.amplitude,
+        &stable,
+        &floquet,
+        &force_mean,
+        &st.max_penetration,
+    ];
+    for (name, values) in &contact_columns {
+        headers.push(name);
+        columns.push(values);
+    }
+    args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
+        let label = format!(
+            "{} H = {}",
+            scene.solver.method.name(),
+            scene.solver.harmonics
+        );
+        let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
+        series.extend(stability_key(&st.stable));
+        Plot {
+            untitled: "frequency response",
+            x_label: "forcing frequency omega / omega_1",
+            y_label: "tip amplitude max_t |u_tip(t)|",
+            series,
+        }
+    })?;
+    let text = || {
+        let mut t = format!(
+            "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",
+            response.points(),
+            ratio.first().copied().unwrap_or(f64::NAN),
+            ratio.last().copied().unwrap_or(f64::NAN)
+        );
+        if let Some((i, a)) = response.peak() {
+            t += &format!(
+                "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
+                ratio[i]
+            );
+        }
+        t += &format!(
+            "folds             {}\n",
+            folds_summary(&response.folds, rod.omega_1)
+        );
+        if !response.corner_folds.is_empty() {
+            t += &format!(
+                "corner reversals  {} (the frequency goes back by less than {} omega_1; in \
+                 --json as corner_folds)\n",
+                response.corner_folds.len(),
+                semismooth_contact::sweep::TURNING_POINT_EXCURSION
+            );
+        }
+        let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
+        let undecided = st.stable.iter().filter(|s| s.is_none()).count();
+        t += &format!(
+            "stability         {} stable, {unstable} unstable, {undecided} undecided{}\n",
+            st.stable.len() - unstable - undecided,
+            st.note
+                .as_ref()
+                .map(|n| format!(" ({n})"))
+                .unwrap_or_default()
+        );
+        for e in &st.events {
+            t += &format!(
+                "  {:<15} at omega/omega_1 = {:.4}\n",
+                e.kind.name(),
+                e.omega / rod.omega_1
+            );
+        }
+        t += &format!(
+            "converged         {} ({}), {:.3} s\n",
+            response.converged, response.termination, response.solve_seconds
+        );
+        t
+    };
+    args.finish(
+        outputs,
+        || crate::json::response_json(&response),
+        text,
+        response.converged,
+    )
+}
+
+/// `ssn compare SCENE`: accuracy against cost of every applicable method on the scene's rod
+/// (error of the tip minimum against a converged reference versus wall time); prints the
+/// table and the cheapest setting of each method for `accuracy`, writes
+/// `accuracy_cost.csv` and `accuracy_cost.svg` into `out`.
+pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<(), CliError> {
+    if !(accuracy.is_finite() && accuracy > 0.0) {
+        return Err(CliError::BadInput(format!(
+            "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
+        )));
+    }
+    let (scene, rod) = load_checked(path, true)?;
+    prepare_directory(out)?;
+    let bar = progress_spinner("compare", quiet);
+    let say = |line: &str| {
+        bar.set_message(line.to_string());
+        bar.tick();
+    };
+    let study = crate::study::accuracy_cost(&rod, &scene.solver, Some(&say))
+        .map_err(|e| input_error(path, e))?;
+    bar.finish_and_clear();
+    study.write_files(out)?;
+    write_text(&format!(
+        "{}\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip \
+         minimum:\n{}\nWrote {}/accuracy_cost.csv and accuracy_cost.svg\n",
+        study.table(),
+        study.cheapest_table(accuracy),
+        printable(&out.display().to_string())
+    ))?;
+    Ok(())
+}
+
+/// `ssn export-model SCENE DIR`: writes the scene's structure as Matrix Market files and a
+/// `[model]` scene (`DIR/scene.toml`) that solves the same problem.
+pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
+    let (scene, structure) = load(path)?;
+    prepare_directory(dir)?;
+    // All files or none: every target is claimed before anything is written.
+    let mut set = OutputSet::new();
+    set.input(path, "the scene");
+    let mut written = String::new();
+    for (name, text) in crate::import::export_files(&scene, &structure) {
+        let target = dir.join(&name);
+        set.target(&target, "export-model")?;
+        set.add(&target, text.into_bytes());
+        written += &format!("wrote {}\n", printable(&target.display().to_string()));
+    }
+    set.commit()?;
+    write_text(&written)?;
+    Ok(())
+}
+
+/// `ssn scene-check SCENE`: validates the scene and prints the resolved model with up to
+/// five natural frequencies (massless dofs have none: a modified-mass rod has one fewer).
+pub fn scene_check(path: &Path) -> Result<(), CliError> {
+    let (scene, rod) = load(path)?;
+    let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
+        Err(ModelError::TooManyModes { available, .. }) => {
+            natural_frequencies(&rod.model, available)
+        }
+        other => other,
+    }
+    .map_err(|e| input_error(path, e))?;
+    write_text(&describe(&scene, &rod, &modes))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::folds_summary;
+
+    #[test]
+    fn few_folds_are_listed_and_many_are_summarised_by_count_and_range() {
+        assert_eq!(folds_summary(&[], 2.0), "none");
+        assert_eq!(folds_summary(&[2.1, 2.05], 2.0), "1.0500, 1.0250");
+        let many: Vec<f64> = (0..20).map(|k| 2.0 + 0.001 * k as f64).collect();
+        assert_eq!(
+            folds_summary(&many, 2.0),
+            "20 between 1.0000 and 1.0095 (first 1.0000, last 1.0095; all in --json)"
+        );
+    }
+}

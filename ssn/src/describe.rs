@@ -1,0 +1,214 @@
+//! A scene's resolved structure and run in words (`ssn scene-check`).
+
+use semismooth_contact::matrix_market::{ContactDirection, ModelSpec};
+use semismooth_contact::model::Structure;
+use semismooth_contact::rod::DampingSpec;
+
+use crate::io::printable;
+use crate::scene::{Method, Scene};
+
+/// The resolved model of a scene, in words (`ssn scene-check`).
+pub fn describe(scene: &Scene, rod: &Structure, modes: &[f64]) -> String {
+    use semismooth_contact::rod::{DampingSpec, FrequencySpec, LoadKind};
+    if let Some(spec) = &scene.model {
+        return describe_imported(scene, spec, rod, modes);
+    }
+    let s = &scene.rod;
+    let mut out = String::new();
+    let mut line = |t: String| {
+        out.push_str(&t);
+        out.push('\n');
+    };
+    line(format!(
+        "scene             {}",
+        printable(&scene.path.display().to_string())
+    ));
+    if let Some(t) = &scene.title {
+        line(format!("title             {}", printable(t)));
+    }
+    line(format!(
+        "rod               {} elements, L = {}, EA = {}, rhoA = {}, {:?} mass",
+        s.elements, s.length, s.axial_stiffness, s.mass_per_length, s.mass
+    ));
+    line(format!(
+        "unknowns          {} dofs (node 0 clamped)",
+        rod.model.dofs()
+    ));
+    let freqs: Vec<String> = modes.iter().map(|w| format!("{w:.6}")).collect();
+    line(format!("natural freqs     {}", freqs.join(", ")));
+    line(match s.damping {
+        None => "damping           none (no damping matrix)".into(),
+        Some(DampingSpec::StiffnessProportional { zeta }) => format!(
+            "damping           D = beta K, beta = 2 zeta / omega_1 = {:.6e} (zeta = {zeta})",
+            2.0 * zeta / rod.omega_1
+        ),
+        Some(DampingSpec::Rayleigh { alpha, beta }) => {
+            format!("damping           D = {alpha} M + {beta} K")
+        }
+    });
+    let ratio = match s.frequency {
+        FrequencySpec::Ratio(r) => r,
+        FrequencySpec::Absolute(w) => w / rod.omega_1,
+    };
+    line(format!(
+        "forcing           {} p0 = {}, omega = {:.6} ({:.4} omega_1)",
+        match s.load {
+            LoadKind::Distributed => "distributed",
+            LoadKind::Tip => "tip force",
+        },
+        s.amplitude,
+        rod.model.forcing.omega,
+        ratio
+    ));
+    if s.contacts.is_empty() {
+        line("contact           none: linear problem (one factorization, no FFT)".into());
+    } else {
+        for c in &s.contacts {
+            line(format!(
+                "contact           node {} (dof {}), gap {}{}",
+                c.node,
+                c.node - 1,
+                c.gap,
+                if c.node == s.elements { " (tip)" } else { "" }
+            ));
+        }
+        line(format!(
+            "contact stiffness static {:.6e}, shared {:.6e} (default c = 10 x shared = {:.6e}), local K[dof,dof] = {:.6e} (penalty unit)",
+            rod.model.static_contact_stiffness().unwrap_or(f64::NAN),
+            rod.model.shared_contact_stiffness().unwrap_or(f64::NAN),
+            rod.model.default_complementarity_constant(),
+            rod.model.contact_stiffness_scale()
+        ));
+    }
+    out.push_str(&describe_run(scene, rod));
+    out
+}
+
+/// The solver, sweep and contact-mass lines of [`describe`] (rod and imported scenes).
+pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
+    let mut out = String::new();
+    let mut line = |t: String| {
+        out.push_str(&t);
+        out.push('\n');
+    };
+    let v = &scene.solver;
+    line(match v.method {
+        m if m.is_harmonic_balance() => format!(
+            "solver            {} H = {}, Nt = {}, {:?} linear solver, {:?} globalization",
+            m.name(),
+            v.harmonics,
+            v.time_samples,
+            v.linear_solver,
+            v.globalization
+        ),
+        Method::March => format!(
+            "solver            march, {} steps per period, tolerance {:e}",
+            v.steps_per_period, v.march_tolerance
+        ),
+        m => format!(
+            "solver            {}, Nt = {} steps per period",
+            m.name(),
+            v.time_samples
+        ),
+    });
+    if let Some(sw) = &scene.sweep {
+        line(format!(
+            "sweep             omega/omega_1 from {} to {}, step {} in [{}, {}], at most {} points",
+            sw.omega_ratio_from,
+            sw.omega_ratio_to,
+            sw.step,
+            sw.min_step,
+            sw.max_step,
+            sw.max_points
+        ));
+    }
+    let massive: Vec<String> = rod
+        .model
+        .contacts
+        .iter()
+        .filter(|c| semismooth_contact::model::diagonal_entry(&rod.model.mass, c.dof) > 0.0)
+        .map(|c| (c.dof + 1).to_string())
+        .collect();
+    if !massive.is_empty() {
+        line(format!(
+            "note              contact node(s) {} carry mass: time marching then needs an impact \
+             law and harmonic balance imposes none, so the two need not agree, and the periodic \
+             LCP may be hard for Lemke; mass = \"modified\" makes the tip contact massless",
+            massive.join(", ")
+        ));
+    }
+    out
+}
+
+/// The resolved structure of a `[model]` scene in words (`ssn scene-check`), followed by
+/// the solver lines every scene has.
+pub fn describe_imported(
+    scene: &crate::scene::Scene,
+    spec: &ModelSpec,
+    structure: &Structure,
+    modes: &[f64],
+) -> String {
+    let model = &structure.model;
+    let mut out = String::new();
+    let mut line = |t: String| {
+        out.push_str(&t);
+        out.push('\n');
+    };
+    line(format!("scene             {}", scene.path.display()));
+    if let Some(t) = &scene.title {
+        line(format!("title             {t}"));
+    }
+    let massless = (0..model.dofs())
+        .filter(|&i| semismooth_contact::model::diagonal_entry(&model.mass, i) == 0.0)
+        .count();
+    line(format!(
+        "model             M = {}, K = {}{}",
+        spec.mass.display(),
+        spec.stiffness.display(),
+        spec.damping_matrix
+            .as_ref()
+            .map_or(String::new(), |d| format!(", D = {}", d.display()))
+    ));
+    line(format!(
+        "unknowns          {} dofs ({massless} with a zero mass diagonal), {} stored entries in K",
+        model.dofs(),
+        model.stiffness.val().len()
+    ));
+    let freqs: Vec<String> = modes.iter().map(|w| format!("{w:.6}")).collect();
+    line(format!("natural freqs     {}", freqs.join(", ")));
+    line(match spec.damping {
+        None if spec.damping_matrix.is_some() => "damping           from the damping file".into(),
+        None => "damping           none (no damping matrix)".into(),
+        Some(DampingSpec::StiffnessProportional { zeta }) => format!(
+            "damping           D = beta K, beta = 2 zeta / omega_1 = {:.6e} (zeta = {zeta})",
+            2.0 * zeta / structure.omega_1
+        ),
+        Some(DampingSpec::Rayleigh { alpha, beta }) => {
+            format!("damping           D = {alpha} M + {beta} K")
+        }
+    });
+    line(format!(
+        "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
+        spec.amplitude,
+        spec.forcing_vector.display(),
+        model.forcing.omega,
+        model.forcing.omega / structure.omega_1
+    ));
+    if spec.contacts.is_empty() {
+        line("contact           none: linear problem (one factorization, no FFT)".into());
+    }
+    for c in &spec.contacts {
+        line(format!(
+            "contact           dof {}, gap {}, obstacle on the {} side",
+            c.dof + 1,
+            c.gap,
+            match c.direction {
+                ContactDirection::Positive => "positive",
+                ContactDirection::Negative => "negative",
+            }
+        ));
+    }
+    line(format!("observed dof      {}", structure.observed_dof + 1));
+    out.push_str(&describe_run(scene, structure));
+    out
+}

@@ -1,0 +1,94 @@
+//! Any scene's structure exported as a `[model]` scene (`ssn export-model`).
+
+use semismooth_contact::matrix_market::{matrix_market_text, vector_market_text};
+use semismooth_contact::model::Structure;
+use semismooth_contact::rod::FrequencySpec;
+
+/// Name of the scene file [`export_files`] writes.
+pub const EXPORTED_SCENE: &str = "scene.toml";
+
+/// The files of a scene's structure as a `[model]` scene: `M.mtx`, `K.mtx`, `D.mtx` (when
+/// damped), `f.mtx` (the load vector at unit amplitude) and [`EXPORTED_SCENE`], whose
+/// forcing, contacts, observed dof, solver and sweep are the scene's. Reading them back
+/// gives the same matrices bit for bit, hence the same answers.
+pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(String, String)> {
+    use std::fmt::Write;
+    let model = &structure.model;
+    let mut files = vec![
+        ("M.mtx".to_string(), matrix_market_text(&model.mass)),
+        ("K.mtx".to_string(), matrix_market_text(&model.stiffness)),
+    ];
+    if let Some(d) = &model.damping {
+        files.push(("D.mtx".to_string(), matrix_market_text(d)));
+    }
+    files.push((
+        "f.mtx".to_string(),
+        vector_market_text(&model.forcing.amplitude),
+    ));
+    let frequency = scene
+        .model
+        .as_ref()
+        .map_or(scene.rod.frequency, |m| m.frequency);
+    let mut t = String::new();
+    let title = scene.title.as_deref().unwrap_or("untitled");
+    let _ = writeln!(t, "title = {:?}", format!("{title} (exported)"));
+    let _ = writeln!(t, "\n[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"");
+    if model.damping.is_some() {
+        let _ = writeln!(t, "damping = \"D.mtx\"");
+    }
+    let _ = writeln!(t, "\n[forcing]\nvector = \"f.mtx\"\namplitude = 1.0");
+    let _ = match frequency {
+        FrequencySpec::Ratio(r) => writeln!(t, "omega_ratio = {r:?}"),
+        FrequencySpec::Absolute(w) => writeln!(t, "omega = {w:?}"),
+    };
+    for c in &model.contacts {
+        let _ = writeln!(
+            t,
+            "\n[[contact.point]]\ndof = {}\ngap = {:?}\ndirection = {}",
+            c.dof + 1,
+            c.gap,
+            c.sign() as i32
+        );
+    }
+    let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);
+    let v = &scene.solver;
+    let _ = writeln!(t, "\n[solver]\nmethod = \"{}\"", v.method.name());
+    let _ = writeln!(
+        t,
+        "harmonics = {}\ntime_samples = {}",
+        v.harmonics, v.time_samples
+    );
+    if let Some(c) = v.c {
+        let _ = writeln!(t, "c = {c:?}");
+    }
+    if let Some(k) = v.penalty_stiffness {
+        let _ = writeln!(t, "penalty_stiffness = {k:?}");
+    }
+    let lower = |d: String| d.to_lowercase();
+    let _ = writeln!(
+        t,
+        "linear_solver = \"{}\"\nmax_iterations = {}\nglobalization = \"{}\"\ntolerance = {:?}",
+        v.linear_solver.name(),
+        v.max_iterations,
+        lower(format!("{:?}", v.globalization)),
+        v.tolerance
+    );
+    let _ = writeln!(
+        t,
+        "steps_per_period = {}\nmax_periods = {}\nmarch_tolerance = {:?}\nrestitution = {:?}\nlcp_scheme = \"{}\"",
+        v.steps_per_period,
+        v.max_periods,
+        v.march_tolerance,
+        v.restitution,
+        v.lcp_scheme.name()
+    );
+    if let Some(sw) = &scene.sweep {
+        let _ = writeln!(
+            t,
+            "\n[sweep]\nomega_ratio_from = {:?}\nomega_ratio_to = {:?}\nstep = {:?}\nmin_step = {:?}\nmax_step = {:?}\nmax_points = {}",
+            sw.omega_ratio_from, sw.omega_ratio_to, sw.step, sw.min_step, sw.max_step, sw.max_points
+        );
+    }
+    files.push((EXPORTED_SCENE.to_string(), t));
+    files
+}

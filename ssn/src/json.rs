@@ -1,0 +1,232 @@
+//! The JSON documents of the program: `ssn solve --json`, `ssn sweep --json`,
+//! `ssn solutions --json` (every field is listed in README.md). Non-finite numbers are
+//! written as `null`.
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+
+use semismooth_contact::contacts::ContactReport;
+use semismooth_contact::solutions::SolutionSet;
+use semismooth_contact::solve::{RunCounters, Solution};
+use semismooth_contact::sweep::FrequencyResponse;
+
+use crate::state::HbState;
+
+/// The JSON object of one contact (non-finite numbers as null).
+pub fn contact_json(c: &ContactReport) -> Value {
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    json!({
+        "node": c.node,
+        "dof": c.dof,
+        "gap": num(c.gap),
+        "force_mean": num(c.force_mean),
+        "max_penetration": num(c.max_penetration),
+        "contact_fraction": num(c.contact_fraction),
+        "displacement_min": num(c.displacement_min),
+        "displacement_max": num(c.displacement_max),
+    })
+}
+
+/// The JSON fields of the Newton-style counters: `residual_evaluations`,
+/// `jacobian_evaluations`, `factorizations`, `linear_solves`, `line_search_backtracks`,
+/// `ffts`.
+pub fn newton_counters(c: &RunCounters) -> serde_json::Map<String, Value> {
+    let mut map = serde_json::Map::new();
+    for (name, value) in [
+        ("residual_evaluations", c.residual_evaluations),
+        ("jacobian_evaluations", c.jacobian_evaluations),
+        ("factorizations", c.factorizations),
+        ("linear_solves", c.linear_solves),
+        ("line_search_backtracks", c.line_search_backtracks),
+        ("ffts", c.ffts),
+    ] {
+        map.insert(name.to_string(), value.into());
+    }
+    map
+}
+
+/// The JSON object of the work counters.
+pub fn counters_json(c: &RunCounters) -> Value {
+    let mut map = newton_counters(c);
+    map.insert("lemke_pivots".into(), c.lemke_pivots.into());
+    map.insert("time_steps".into(), c.time_steps.into());
+    Value::Object(map)
+}
+
+/// The JSON document of `ssn solve --json` (documented in README.md). `harmonics` is absent
+/// for the LCP and time marching; `time_samples` is then the number of steps per period.
+pub fn solution_json(scene: &Path, s: &Solution) -> Value {
+    let mut v = json!({
+        "scene": scene.display().to_string(),
+        "method": s.method.name(),
+        "time_samples": s.time_samples,
+        "omega": s.omega,
+        "omega_ratio": s.omega / s.omega_1,
+        "converged": s.converged,
+        "termination": s.termination,
+        "iterations": s.iterations,
+        "residual_norm": finite_or_null(s.residual_norm),
+        "effective_tolerance": s.effective_tolerance,
+        "solve_seconds": s.solve_seconds,
+        "tip_max": finite_or_null(s.stats.max),
+        "tip_min": finite_or_null(s.stats.min),
+        "max_penetration": finite_or_null(s.stats.max_penetration),
+        "contact_force_mean": finite_or_null(s.stats.mean_contact_force),
+        "contacts": s.contacts.iter().map(contact_json).collect::<Vec<_>>(),
+        "counters": counters_json(&s.counters),
+    });
+    if let Some(h) = s.harmonics {
+        v["harmonics"] = json!(h);
+    }
+    if let Some(scheme) = s.lcp_scheme {
+        v["lcp_scheme"] = json!(scheme.name());
+    }
+    if let Some(diagnosis) = &s.diagnosis {
+        v["diagnosis"] = json!(diagnosis);
+    }
+    if let Some(strategy) = s.strategy {
+        v["strategy"] = json!(strategy);
+        v["attempts"] = s
+            .attempts
+            .iter()
+            .map(|a| {
+                json!({
+                    "strategy": a.strategy.name(),
+                    "iterations": a.iterations,
+                    "converged": a.converged,
+                    "outcome": a.outcome,
+                })
+            })
+            .collect();
+    }
+    if let Some(c) = s.c {
+        v["c"] = json!(c);
+    }
+    v
+}
+
+pub fn finite_or_null(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+/// The JSON object of `ssn sweep --json`: `points`, `omega`, `omega_ratio`, `tip_max`,
+/// `tip_min`, `amplitude`, per point `stable` (true / false / null), `floquet_max_abs`,
+/// `contact_force_mean` (the sum over the contacts), `max_penetration`, `contacts` (per
+/// point, the list of [`ContactReport`]s), then `stability_note` (why points are
+/// undecided), `stability_seconds`, `events` ({`kind`, `omega`, `omega_ratio`,
+/// `index`}), `folds`, `corner_folds`, `converged`, `solve_seconds`, `termination`, `counters`.
+/// Non-finite numbers become `null`.
+pub fn response_json(r: &FrequencyResponse) -> Value {
+    let mut counters = newton_counters(&r.counters);
+    for (name, value) in [
+        ("corrector_iterations", r.continuation.corrector_iterations),
+        ("rejected_steps", r.continuation.rejected_steps),
+        ("corner_passes", r.continuation.corner_passes),
+        ("restarts", r.restarts as u64),
+        ("corners", r.corners as u64),
+    ] {
+        counters.insert(name.to_string(), value.into());
+    }
+    let st = &r.stability;
+    let events: Vec<serde_json::Value> = st
+        .events
+        .iter()
+        .map(|e| {
+            json!({
+                "kind": e.kind.name(),
+                "omega": e.omega,
+                "omega_ratio": e.omega / r.omega_1,
+                "index": e.index,
+            })
+        })
+        .collect();
+    json!({
+        "points": r.points(),
+        "omega": r.omega,
+        "omega_ratio": r.omega_ratio(),
+        "tip_max": r.tip_max,
+        "tip_min": r.tip_min,
+        "amplitude": r.amplitude,
+        "stable": st.stable,
+        "floquet_max_abs": st.floquet_max_abs,
+        "contact_force_mean": r.contact_force_mean(),
+        "max_penetration": st.max_penetration,
+        "contacts": r
+            .contacts
+            .iter()
+            .map(|point| point.iter().map(contact_json).collect::<Vec<_>>())
+            .collect::<Vec<_>>(),
+        "stability_note": st.note,
+        "stability_seconds": r.stability_seconds,
+        "events": events,
+        "folds": r.folds,
+        "corner_folds": r.corner_folds,
+        "converged": r.converged,
+        "solve_seconds": r.solve_seconds,
+        "termination": r.termination,
+        "counters": counters,
+    })
+}
+
+/// The JSON of `ssn solutions --json`: `omega`, `omega_ratio`, `window`,
+/// `branch_points`, `branch_converged`, `crossings`, `failed_corrections`, `seconds` and
+/// `solutions`, each {`tip_min`, `tip_max`, `contact_force_mean`, `max_penetration`,
+/// `contacts` [{`dof`, `gap`, `contact_force_mean`, `max_penetration`}], `stable`
+/// (true / false / null), `floquet_max_abs`, `stability_note`, `iterations`,
+/// `residual_norm`, `state` (the harmonic coefficients, [`crate::state`]: start
+/// `ssn solve` from it with `--start FILE --entry K`)}.
+pub fn solutions_json(set: &SolutionSet) -> Value {
+    let solutions: Vec<serde_json::Value> = set
+        .solutions
+        .iter()
+        .map(|s| {
+            let contacts: Vec<serde_json::Value> = s
+                .contacts
+                .iter()
+                .map(|c| {
+                    json!({
+                        "dof": c.dof,
+                        "gap": c.gap,
+                        "contact_force_mean": c.contact_force_mean,
+                        "max_penetration": c.max_penetration,
+                    })
+                })
+                .collect();
+            json!({
+                "tip_min": s.solution.stats.min,
+                "tip_max": s.solution.stats.max,
+                "contact_force_mean": s.solution.stats.mean_contact_force,
+                "max_penetration": s.solution.stats.max_penetration,
+                "contacts": contacts,
+                "stable": s.stability.stable,
+                "floquet_max_abs": s.stability.floquet_max_abs,
+                "stability_note": s.stability.reason,
+                "iterations": s.solution.iterations,
+                "residual_norm": s.solution.residual_norm,
+                "state": HbState::from_unknowns(
+                    set.shape,
+                    set.omega,
+                    set.omega_1,
+                    &s.solution.state
+                )
+                .to_json(),
+            })
+        })
+        .collect();
+    json!({
+        "omega": set.omega,
+        "omega_ratio": set.omega / set.omega_1,
+        "window": [set.window.0, set.window.1],
+        "branch_points": set.branch_points,
+        "branch_converged": set.branch_converged,
+        "crossings": set.crossings,
+        "failed_corrections": set.failed_corrections,
+        "seconds": set.seconds,
+        "solutions": solutions,
+    })
+}

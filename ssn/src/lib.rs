@@ -1,0 +1,20 @@
+//! # ssn
+//!
+//! The application of `semismooth-contact`: scenes (TOML problem files), runs, studies,
+//! figures, tables, outputs and the `ssn` program.
+
+pub mod cli;
+pub mod describe;
+pub mod exit;
+pub mod figures;
+pub mod import;
+pub mod io;
+pub mod json;
+pub mod limits;
+pub mod output;
+pub mod progress;
+pub mod scene;
+pub mod solutions;
+pub mod state;
+pub mod study;
+pub mod tables;

@@ -1,0 +1,549 @@
+//! Up-front memory estimates of a run, so that a scene too large for the machine is refused
+//! before anything is allocated (exit code 2, naming the keys, the need and the limit)
+//! instead of aborting on an allocation failure or being killed half-way.
+//!
+//! The estimates are upper bounds fitted to peak resident sizes measured on the rod
+//! (`/usr/bin/time -f %M`, release build), with `N` elements, `m` contacts, `S = 2H + 1`
+//! harmonic functions and `Nt` time samples:
+//!
+//! | method | estimate (bytes) | measured |
+//! |---|---|---|
+//! | HB, structured solver, dense condensed system | `300 N S + 8 (2 S Nt + 3 m S^2 + 2 (m S)^2) + 16 (H + 1) N m` | 86 MB at N = 10^4, H = 20; 289 MB at H = 80 |
+//! | SSN-HB, structured solver, matrix-free condensed system (more than `KRYLOV_THRESHOLD` condensed unknowns `m S`, or `condensed-krylov`) | `600 N S + 8 (2 S Nt + 3 m S^2) + 3300 m S` (GMRES basis of up to 201 vectors), plus `8 (m S)^2 + 16 (H + 1) m^2` up to `DENSE_PRECONDITIONER_LIMIT` condensed unknowns (the dense preconditioner GMRES may fall back on) | see `examples/contact_scaling.rs` |
+//! | HB, dense solver | `10 n^2` more, `n = (N + m) S` (SSN-HB) or `N S` (penalty) | 156 MB at N = 100, H = 20 (n = 4141); 570 MB at N = 200 (n = 8241) |
+//! | periodic LCP | `24 (m Nt)^2 + 1000 N` | 71 MB (Lemke), 48 MB (Newton) at Nt = 2048, m = 1 |
+//! | time marching | `1000 N` | 12 MB at N = 10^4 |
+//!
+//! plus `400 N` for the rod itself (`N` the dofs of an imported `[model]`, whose size is
+//! known once its files are read: [`structure_memory`]). The limit is the memory available to new processes
+//! (`MemAvailable` of `/proc/meminfo`), or the number of bytes in the environment variable
+//! `SSN_MEMORY_LIMIT` when it is set; where neither is known nothing is refused.
+//!
+//! A run that fits in memory can still take hours: [`run_work`] estimates the operations of
+//! its dense factorizations, refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
+
+use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
+use semismooth_contact::model::Structure;
+
+/// The dense condensed matrix (and full receptance) the matrix-free path may factor as
+/// GMRES's preconditioner: `8 (m S)^2 + 16 (H + 1) m^2` bytes up to
+/// [`DENSE_PRECONDITIONER_LIMIT`](semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT) condensed unknowns,
+/// none above.
+fn dense_preconditioner_bytes(m: f64, s: f64) -> f64 {
+    if m * s <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64 {
+        8.0 * (m * s).powi(2) + 8.0 * (s + 1.0) * m * m
+    } else {
+        0.0
+    }
+}
+
+/// What a run needs, in words and bytes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MemoryEstimate {
+    /// Estimated peak memory in bytes (a float: hostile settings overflow any integer).
+    pub bytes: f64,
+    /// The dominant storage, in words.
+    pub what: String,
+    /// The scene keys that drive it (what to reduce).
+    pub keys: &'static str,
+}
+
+/// Bytes of the rod model itself (sparse K, M, D, load vectors) per element.
+const ROD_BYTES_PER_ELEMENT: f64 = 400.0;
+
+/// Estimated peak memory of one run of `settings` on a rod of `elements` elements with
+/// `contacts` contact points.
+pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -> MemoryEstimate {
+    let n = elements as f64;
+    let m = contacts as f64;
+    let rod = ROD_BYTES_PER_ELEMENT * n;
+    match settings.method {
+        Method::SsnHb | Method::PenaltyHb => {
+            let h = settings.harmonics as f64;
+            let s = 2.0 * h + 1.0;
+            let nt = settings.time_samples as f64;
+            let aft = 8.0 * (2.0 * s * nt + 3.0 * m * s * s + 2.0 * (m * s).powi(2));
+            let structured = 300.0 * n * s + aft + 16.0 * (h + 1.0) * n * m;
+            let condensed = settings.linear_solver.condensed();
+            let krylov = condensed.is_some_and(|c| {
+                c.uses_krylov(
+                    contacts,
+                    settings.harmonics,
+                    settings.method == Method::SsnHb,
+                )
+            });
+            match settings.linear_solver {
+                _ if krylov => MemoryEstimate {
+                    bytes: rod
+                        + 600.0 * n * s
+                        + 8.0 * (2.0 * s * nt + 3.0 * m * s * s)
+                        + 3300.0 * m * s
+                        + dense_preconditioner_bytes(m, s)
+                        // The static compliance between contacts behind the default `c`.
+                        + 8.0 * m * m,
+                    what: format!(
+                        "per-harmonic factorizations of {elements} dofs x {} harmonic functions \
+                         (matrix-free condensed system of {:.0} unknowns)",
+                        2 * settings.harmonics as u128 + 1,
+                        m * s
+                    ),
+                    keys: "rod.elements or the model's size, solver.harmonics",
+                },
+                LinearSolverChoice::Structured
+                | LinearSolverChoice::CondensedDense
+                | LinearSolverChoice::CondensedKrylov => MemoryEstimate {
+                    bytes: rod + structured,
+                    what: format!(
+                        "per-harmonic factorizations of {elements} dofs x {} harmonic functions",
+                        2 * settings.harmonics as u128 + 1
+                    ),
+                    keys: "rod.elements, solver.harmonics (and the number of contacts)",
+                },
+                LinearSolverChoice::Dense => {
+                    let unknowns = match settings.method {
+                        Method::SsnHb => (n + m) * s,
+                        _ => n * s,
+                    };
+                    MemoryEstimate {
+                        bytes: rod + structured + 10.0 * unknowns * unknowns,
+                        what: format!(
+                            "a dense Jacobian and its LU on {unknowns:.0} unknowns \
+                             (solver.linear_solver = \"dense\"; \"structured\" needs about {})",
+                            human(rod + structured)
+                        ),
+                        keys: "solver.linear_solver, solver.harmonics, rod.elements",
+                    }
+                }
+            }
+        }
+        Method::LcpLemke | Method::LcpSsn => {
+            let dim = m * settings.time_samples as f64;
+            MemoryEstimate {
+                bytes: rod + 24.0 * dim * dim + 1000.0 * n,
+                what: format!(
+                    "the dense periodic LCP matrix of {dim:.0} = contacts x time samples unknowns"
+                ),
+                keys: "solver.time_samples (and the number of contacts)",
+            }
+        }
+        Method::March => MemoryEstimate {
+            bytes: rod + 1000.0 * n,
+            what: format!("time-stepping matrices of {elements} dofs"),
+            keys: "rod.elements",
+        },
+    }
+}
+
+/// Estimated peak memory of `ssn compare` on the scene: the largest of its runs (SSN-HB up
+/// to the reference's 320 harmonics, penalty HB up to 80, the LCP up to Nt = 1024, time
+/// marching), each with the scene's other settings.
+pub fn compare_memory(elements: usize, contacts: usize, base: &SolverSettings) -> MemoryEstimate {
+    let hb = |method, harmonics: usize| SolverSettings {
+        method,
+        harmonics,
+        time_samples: default_hb_time_samples(harmonics),
+        ..base.clone()
+    };
+    let runs = [
+        hb(Method::SsnHb, crate::study::REFERENCE_HARMONICS),
+        hb(Method::PenaltyHb, 80),
+        SolverSettings {
+            method: Method::LcpSsn,
+            time_samples: 1024,
+            ..base.clone()
+        },
+        SolverSettings {
+            method: Method::March,
+            ..base.clone()
+        },
+    ];
+    runs.iter()
+        .map(|s| run_memory(elements, contacts, s))
+        .fold(None::<MemoryEstimate>, |best, e| match best {
+            Some(b) if b.bytes >= e.bytes => Some(b),
+            _ => Some(e),
+        })
+        .expect("four runs")
+}
+
+/// The memory a run may use: `SSN_MEMORY_LIMIT` (bytes) when set, else `MemAvailable`.
+pub fn memory_limit() -> Option<f64> {
+    if let Ok(v) = std::env::var("SSN_MEMORY_LIMIT") {
+        if let Ok(b) = v.trim().parse::<f64>() {
+            if b.is_finite() && b > 0.0 {
+                return Some(b);
+            }
+        }
+    }
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: f64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
+/// limit.
+pub fn check(need: &MemoryEstimate, limit: Option<f64>) -> Result<(), String> {
+    match limit {
+        Some(limit) if need.bytes.is_nan() || need.bytes > limit => Err(format!(
+            "these settings need about {} of memory ({}), more than the {} available \
+             (MemAvailable, or SSN_MEMORY_LIMIT when set): allowed are settings whose estimate \
+             fits; reduce {}",
+            human(need.bytes),
+            need.what,
+            human(limit),
+            need.keys
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The estimate of the command run on the rod of a `[rod]` scene (`compare` runs several
+/// settings), before the rod is built. `None` for a `[model]` scene, whose size is known
+/// only from its files: estimate it with [`structure_memory`] once imported.
+pub fn rod_scene_memory(scene: &Scene, compare: bool) -> Option<MemoryEstimate> {
+    if scene.model.is_some() {
+        return None;
+    }
+    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+    Some(size_memory(n, m, &scene.solver, compare))
+}
+
+/// The estimate of the command run with `settings` on a built structure (its dofs and
+/// contacts; `compare` runs several settings).
+pub fn structure_memory(
+    structure: &Structure,
+    settings: &SolverSettings,
+    compare: bool,
+) -> MemoryEstimate {
+    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+    size_memory(n, m, settings, compare)
+}
+
+fn size_memory(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+    compare: bool,
+) -> MemoryEstimate {
+    if compare {
+        compare_memory(dofs, contacts, settings)
+    } else {
+        run_memory(dofs, contacts, settings)
+    }
+}
+
+/// Bytes in words: `1.5 GB`.
+pub fn human(bytes: f64) -> String {
+    const UNITS: [&str; 7] = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = bytes;
+    let mut unit = 0;
+    while v >= 1000.0 && unit + 1 < UNITS.len() {
+        v /= 1000.0;
+        unit += 1;
+    }
+    if v.is_finite() {
+        format!("{v:.1} {}", UNITS[unit])
+    } else {
+        "more than can be counted".into()
+    }
+}
+
+// Work (floating-point operations), next to memory: a run that fits in memory can still
+// run for hours (a dense LU is cubic in its size).
+
+/// What a run costs in floating-point operations, in words and numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorkEstimate {
+    /// Estimated floating-point operations (a float: hostile settings overflow integers).
+    pub flops: f64,
+    /// The dominant work, in words.
+    pub what: String,
+    /// The scene keys that drive it (what to reduce).
+    pub keys: &'static str,
+}
+
+/// Factorizations counted for a Newton solve: the solves from zero on the rod take 12 to 13
+/// (measured with the dense solver at 100 and 200 elements, H = 20).
+const NEWTON_FACTORIZATIONS: f64 = 10.0;
+
+/// Default limit of [`work_limit`]: 1e14 operations, about 70 minutes at the 2.3e10
+/// operations per second that faer's dense LU reached on a 2-core machine (a factorization
+/// of 8241 unknowns, 3.7e11 operations, in 16 s).
+pub const DEFAULT_WORK_LIMIT: f64 = 1e14;
+
+/// Estimated work of one run: `NEWTON_FACTORIZATIONS` dense LU factorizations of
+/// `(2/3) n^3` operations each, `n` the unknowns of the dense Jacobian (the dense solver:
+/// `(N + m) S` for SSN-HB, `N S` for penalty HB) or of the condensed contact system (the
+/// structured solver: `m S`), `S = 2H + 1`. The sparse per-harmonic factorizations, the
+/// FFTs, the LCP and time marching are not the danger here and count as 0.
+pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
+    size_work(
+        elements,
+        contacts,
+        settings,
+        "solver.linear_solver, solver.harmonics, rod.elements",
+    )
+}
+
+/// [`run_work`] for a model of `dofs` dofs and `contacts` contacts; `dense_keys`: the keys a
+/// refusal of the dense solver names.
+fn size_work(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+    dense_keys: &'static str,
+) -> WorkEstimate {
+    let (n, m) = (dofs as f64, contacts as f64);
+    let s = 2.0 * settings.harmonics as f64 + 1.0;
+    let lu = |unknowns: f64| NEWTON_FACTORIZATIONS * 2.0 / 3.0 * unknowns.powi(3);
+    match (settings.method, settings.linear_solver) {
+        (Method::SsnHb | Method::PenaltyHb, LinearSolverChoice::Dense) => {
+            let unknowns = if settings.method == Method::SsnHb {
+                (n + m) * s
+            } else {
+                n * s
+            };
+            WorkEstimate {
+                flops: lu(unknowns),
+                what: format!(
+                    "{NEWTON_FACTORIZATIONS} LU factorizations of a dense Jacobian on \
+                     {unknowns:.0} unknowns (solver.linear_solver = \"dense\"; \"structured\" \
+                     factors per harmonic)"
+                ),
+                keys: dense_keys,
+            }
+        }
+        // Above the threshold the automatic choice solves the condensed system matrix-free.
+        (Method::SsnHb, LinearSolverChoice::Structured)
+            if contacts * (2 * settings.harmonics + 1)
+                > semismooth_contact::hb::KRYLOV_THRESHOLD =>
+        {
+            // At most one dense factorization per iteration where GMRES may fall back on
+            // the dense preconditioner; none above its limit.
+            let unknowns = m * s;
+            if unknowns <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64 {
+                WorkEstimate {
+                    flops: lu(unknowns),
+                    what: format!(
+                        "{NEWTON_FACTORIZATIONS} LU factorizations at most of the condensed \
+                         contact system on {unknowns:.0} unknowns (the matrix-free solve's \
+                         dense preconditioner)"
+                    ),
+                    keys: "solver.harmonics and the number of contacts",
+                }
+            } else {
+                WorkEstimate {
+                    flops: 0.0,
+                    what: "no dense factorization (matrix-free condensed solve)".into(),
+                    keys: "",
+                }
+            }
+        }
+        (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {
+            WorkEstimate {
+                flops: lu(m * s),
+                what: format!(
+                    "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
+                 on {:.0} unknowns",
+                    m * s
+                ),
+                keys: "solver.harmonics and the number of contacts",
+            }
+        }
+        _ => WorkEstimate {
+            flops: 0.0,
+            what: "no dense factorization".into(),
+            keys: "",
+        },
+    }
+}
+
+/// The operations a run may take: `SSN_WORK_LIMIT` when set to a number > 0, else
+/// [`DEFAULT_WORK_LIMIT`].
+pub fn work_limit() -> f64 {
+    std::env::var("SSN_WORK_LIMIT")
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|b| b.is_finite() && *b > 0.0)
+        .unwrap_or(DEFAULT_WORK_LIMIT)
+}
+
+/// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
+/// limit, and how to lift it.
+pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
+    if need.flops.is_nan() || need.flops > limit {
+        Err(format!(
+            "these settings need about {:.1e} floating-point operations ({}), more than the \
+             limit of {limit:.1e} (SSN_WORK_LIMIT, default {DEFAULT_WORK_LIMIT:.0e}: about 70 \
+             minutes on 2 cores): allowed are settings whose estimate is within the limit; \
+             reduce {}, or raise SSN_WORK_LIMIT",
+            need.flops, need.what, need.keys
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// The work estimate of the command run on a rod `scene` (`compare`: its SSN-HB reference
+/// run at 320 harmonics, the largest); `None` for a `[model]` scene, estimated once imported
+/// ([`structure_work`]).
+pub fn rod_scene_work(scene: &Scene, compare: bool) -> Option<WorkEstimate> {
+    if scene.model.is_some() {
+        return None;
+    }
+    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+    Some(run_work(n, m, &compared(&scene.solver, compare)))
+}
+
+/// The work estimate of `settings` (or of the comparison's reference run) on an imported
+/// `structure`.
+pub fn structure_work(
+    structure: &Structure,
+    settings: &SolverSettings,
+    compare: bool,
+) -> WorkEstimate {
+    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+    size_work(
+        n,
+        m,
+        &compared(settings, compare),
+        "solver.linear_solver, solver.harmonics, the model's size",
+    )
+}
+
+/// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
+fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
+    let mut settings = settings.clone();
+    if compare {
+        settings.method = Method::SsnHb;
+        settings.harmonics = crate::study::REFERENCE_HARMONICS;
+    }
+    settings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(method: Method, h: usize, dense: bool) -> SolverSettings {
+        let mut s = crate::scene::Scene::from_toml(
+            "[rod]\nelements = 20\n[forcing]\namplitude = 0.1\n[contact]\ngap = 0.5\n",
+            "t.toml",
+        )
+        .unwrap()
+        .solver;
+        s.method = method;
+        s.harmonics = h;
+        s.time_samples = default_hb_time_samples(h);
+        if dense {
+            s.linear_solver = LinearSolverChoice::Dense;
+        }
+        s
+    }
+
+    #[test]
+    fn estimates_bound_the_measured_peaks_within_a_factor_three() {
+        // Peak resident sizes measured with /usr/bin/time (see the module table).
+        for (elements, method, h, dense, measured) in [
+            (10_000, Method::SsnHb, 20, false, 86e6),
+            (10_000, Method::SsnHb, 80, false, 289e6),
+            (10_000, Method::PenaltyHb, 20, false, 90e6),
+            (100, Method::SsnHb, 20, true, 156e6),
+            (200, Method::SsnHb, 20, true, 570e6),
+        ] {
+            let e = run_memory(elements, 1, &settings(method, h, dense)).bytes;
+            assert!(
+                e >= measured && e <= 3.0 * measured,
+                "{elements} {method:?} H={h}: estimate {e:e} against {measured:e}"
+            );
+        }
+        // The matrix-free condensed path (SSN-HB, 1,000 contacts on the 10,002-dof disk of
+        // examples/contact_scaling.rs, H = 20): VmHWM 200 MB.
+        let krylov = run_memory(10_002, 1000, &settings(Method::SsnHb, 20, false)).bytes;
+        assert!((200e6..3.0 * 200e6).contains(&krylov), "{krylov:e}");
+        let mut lcp = settings(Method::LcpLemke, 5, false);
+        lcp.time_samples = 2048;
+        let e = run_memory(20, 1, &lcp).bytes;
+        assert!((71e6..3.0 * 71e6).contains(&e), "{e:e}");
+    }
+
+    #[test]
+    fn a_refusal_names_the_keys_the_need_and_the_limit() {
+        let dense = run_memory(400, 1, &settings(Method::SsnHb, 2000, true));
+        let e = check(&dense, Some(16e9)).unwrap_err();
+        for word in [
+            "solver.linear_solver",
+            "TB",
+            "16.0 GB",
+            "\"structured\" needs",
+        ] {
+            assert!(e.contains(word), "{word}: {e}");
+        }
+        let structured = run_memory(400, 1, &settings(Method::SsnHb, 20, false));
+        assert!(check(&structured, Some(16e9)).is_ok());
+        assert!(
+            check(&dense, None).is_ok(),
+            "no limit known: nothing refused"
+        );
+        // Hostile sizes give a large estimate (the matrix-free path: about 1e24 bytes), never
+        // an overflowed small one.
+        let huge = run_memory(usize::MAX, usize::MAX, &settings(Method::SsnHb, 20, false));
+        assert!(check(&huge, Some(1e20)).is_err());
+    }
+
+    #[test]
+    fn the_dense_solver_on_400_elements_at_h_40_is_refused_for_its_work() {
+        // n = 401 x 81 = 32481 unknowns: (2/3) n^3 = 2.28e13 operations per factorization.
+        let dense = run_work(400, 1, &settings(Method::SsnHb, 40, true));
+        let n = 401.0 * 81.0;
+        assert!((dense.flops - 10.0 * 2.0 / 3.0 * n * n * n).abs() <= 1e-12 * dense.flops);
+        let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
+        for word in [
+            "solver.linear_solver",
+            "2.3e14",
+            "1.0e14",
+            "SSN_WORK_LIMIT",
+            "32481",
+        ] {
+            assert!(e.contains(word), "{word}: {e}");
+        }
+        // What the tests and examples run stays allowed: the dense solver at 200 elements,
+        // H = 20 (3.7e12), the structured one at 10,000 elements with 100 contacts.
+        assert!(check_work(&run_work(200, 1, &settings(Method::SsnHb, 20, true)), 1e14).is_ok());
+        let many = run_work(10_000, 100, &settings(Method::SsnHb, 20, false));
+        assert!(check_work(&many, DEFAULT_WORK_LIMIT).is_ok(), "{many:?}");
+        assert!(
+            check_work(&dense, 1e15).is_ok(),
+            "a raised limit lets it run"
+        );
+    }
+
+    #[test]
+    fn imported_models_are_estimated_by_their_size_and_the_matrix_free_path_by_none() {
+        // A model of 32,481 dofs with the dense solver at H = 1: (32481 + 1) x 3 unknowns,
+        // 10 x (2/3) n^3 = 6.2e14 operations, refused, naming the model's size.
+        let dense = size_work(
+            32_481,
+            1,
+            &settings(Method::SsnHb, 1, true),
+            "the model's size",
+        );
+        let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
+        assert!(e.contains("the model's size"), "{e}");
+        // 1,000 contacts at H = 20: 41,000 condensed unknowns, solved matrix-free (a dense
+        // estimate would be 4.6e14 and refuse a run that takes seconds).
+        let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "");
+        assert_eq!(many.flops, 0.0, "{many:?}");
+        // At the threshold the condensed system is still factored dense.
+        let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "");
+        let n: f64 = 40.0 * 41.0;
+        assert!((dense_condensed.flops - 10.0 * 2.0 / 3.0 * n.powi(3)).abs() <= 1e-9 * n.powi(3));
+    }
+}

@@ -1,0 +1,229 @@
+//! `ssn`: periodic vibrations of structures with unilateral contact, from scene files.
+//!
+//! Without a subcommand it reproduces the paper's figures into `./out/`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use ssn::cli::{self, CliError, RunArgs};
+use ssn::{figures, io};
+
+const EXIT_CODES: &str = "\
+Examples:
+  ssn                                         reproduce the paper's figures into ./out/
+  ssn solve scenes/paper_fig1_modified_mass.toml --json
+  ssn sweep scenes/paper_fig2.toml --csv fig2.csv --svg fig2.svg
+  ssn compare scenes/paper_fig1_modified_mass.toml --out out/compare
+  ssn scene-check scenes/two_contacts.toml
+  ssn export-model scenes/paper_fig1.toml out/rod   (matrices and a [model] scene)
+
+Exit codes:
+  0  converged (or, for scene-check, a valid scene)
+  1  the solver ran but did not converge (its JSON is still printed, with converged = false)
+  2  bad input (scene file, option): the message names the file, the key and what is allowed
+  3  an output file or directory could not be written (nothing half-written is left)";
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "ssn",
+    version,
+    about = "Periodic vibrations of structures with unilateral contact (semismooth Newton \
+             harmonic balance, penalty HB, periodic LCP, time marching)",
+    long_about = "Periodic vibrations of structures with unilateral contact.\n\n\
+        Without a subcommand, reproduces the paper's Fig. 1 (tip displacement over a period, \
+        H = 10/15/20 against the time-marching reference) and Fig. 2 (frequency responses \
+        for gaps 0.25/0.5/0.75 and the linear rod), writing SVG and CSV files to ./out/.",
+    after_help = EXIT_CODES
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Output directory of the default run and of `compare` [default: out].
+    #[arg(long, global = true)]
+    out: Option<PathBuf>,
+    /// Nothing on stdout or stderr but errors (no progress, no text summary; `--json` is
+    /// still printed).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Solve one periodic response at the scene's forcing frequency.
+    #[command(
+        after_help = "Examples:\n  ssn solve scenes/paper_fig1_modified_mass.toml\n  \
+        ssn solve scenes/paper_fig1.toml --json --csv tip.csv --svg tip.svg\n  \
+        ssn solve SCENE.toml --state state.json     (write the harmonic coefficients)\n  \
+        ssn solve SCENE.toml --start state.json     (Newton from them)\n  \
+        ssn solve SCENE.toml --start solutions.json --entry 2   (from ssn solutions --json)\n\n\
+        JSON fields: scene, method, harmonics (HB only), time_samples, lcp_scheme (LCP\n  \
+        only), omega, omega_ratio, converged, termination, diagnosis (when known),\n  \
+        iterations, residual_norm, effective_tolerance, strategy and attempts (Newton\n  \
+        methods), solve_seconds, tip_max, tip_min,\n  \
+        max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
+        gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
+        displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \
+        jacobian_evaluations, factorizations, linear_solves, ffts, ...}, started_from\n  \
+        {file, entry, omega_ratio, note} (with --start)\n\n\
+        State file (--state): format, version, method, harmonics, dofs, contacts, omega,\n  \
+        omega_ratio, layout, displacement [(2H+1) dofs], contact_force [(2H+1) contacts]\n  \
+        (ssn-hb), converged, residual_norm\n\n"
+    )]
+    Solve(cli::SolveArgs),
+    /// Follow the response in frequency (pseudo-arclength continuation) over the scene's
+    /// [sweep] range.
+    #[command(
+        after_help = "Examples:\n  ssn sweep scenes/paper_fig2.toml\n  \
+        ssn sweep scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
+        JSON fields: points, omega, omega_ratio, tip_max, tip_min, amplitude, stable,\n  \
+        floquet_max_abs, contact_force_mean (sum over the contacts), max_penetration,\n  \
+        contacts (per point, the list of ssn solve) (arrays in branch order),\n  \
+        stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
+        branch turns), corner_folds (reversals of less than 2e-3 omega_1: corners),\n  \
+        converged, termination, solve_seconds, counters\n\n\
+        CSV: one row per point; contact k (from 0) adds contact{k}_force_mean,\n  \
+        contact{k}_max_penetration, contact{k}_contact_fraction, contact{k}_displacement_min,\n  \
+        contact{k}_displacement_max\n\n",
+        mut_arg("scene", |a| a.help("Scene file (TOML) with a [sweep] section")),
+        mut_arg("json", |a| a.help("Print the branch as JSON on stdout")),
+        mut_arg("csv", |a| a.help("Write the branch as CSV")),
+        mut_arg("svg", |a| a.help("Write the frequency response as SVG"))
+    )]
+    Sweep(RunArgs),
+    /// Every periodic solution at the scene's forcing frequency, with its stability (follows
+    /// the branch through the frequency and corrects each crossing there).
+    #[command(
+        after_help = "Example:\n  ssn solutions SCENE.toml --json --csv solutions.csv --svg solutions.svg\n\n\
+        JSON fields: omega, omega_ratio, window, branch_points, branch_converged, crossings,\n  \
+        failed_corrections, seconds, solutions [{tip_min, tip_max, contact_force_mean,\n  \
+        max_penetration, contacts, stable, floquet_max_abs, stability_note, iterations,\n  \
+        residual_norm, state}]; start a solve from solution K with\n  \
+        ssn solve SCENE.toml --start solutions.json --entry K\n\n",
+        mut_arg("json", |a| a.help("Print the solutions as JSON on stdout")),
+        mut_arg("csv", |a| a.help("Write one CSV row per solution")),
+        mut_arg("svg", |a| a.help("Write the tip over one period of every solution as SVG"))
+    )]
+    Solutions(RunArgs),
+    /// Accuracy against cost: every method over its discretisation settings, error against a
+    /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
+    #[command(
+        after_help = "Example:\n  ssn compare scenes/paper_fig1_modified_mass.toml --out out/compare\n\n"
+    )]
+    Compare {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Requested relative accuracy on the tip minimum: the cheapest setting of each
+        /// method reaching it is reported.
+        #[arg(long, default_value_t = 1e-3)]
+        accuracy: f64,
+    },
+    /// Write a scene's structure as Matrix Market files (M, K, D, f) and a [model] scene
+    /// that solves the same problem.
+    #[command(
+        after_help = "Example:\n  ssn export-model scenes/paper_fig1_modified_mass.toml out/rod\n  \
+        ssn solve out/rod/scene.toml\n\n"
+    )]
+    ExportModel {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Directory to write M.mtx, K.mtx, D.mtx (when damped), f.mtx and scene.toml into.
+        dir: PathBuf,
+    },
+    /// Validate a scene and print the resolved model (natural frequencies, effects present).
+    #[command(after_help = "Example:\n  ssn scene-check scenes/two_contacts.toml\n\n")]
+    SceneCheck {
+        /// Scene file (TOML).
+        scene: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    io::guard_standard_streams();
+    let args = match Cli::try_parse() {
+        Ok(args) => args,
+        Err(e) => return clap_exit(&e),
+    };
+    io::set_quiet(args.quiet);
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
+    let result = match &args.command {
+        None => in_new_directory(&out, || figures::default_run(&out, args.quiet)),
+        Some(Command::Compare { scene, accuracy }) => {
+            in_new_directory(&out, || cli::compare(scene, &out, *accuracy, args.quiet))
+        }
+        Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
+            "--out applies only to the default run and `ssn compare`; `ssn {}` writes the \
+             files named by --csv and --svg",
+            command.name()
+        ))),
+        Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
+        Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
+        Some(Command::Solve(solve)) => cli::solve(solve, args.quiet),
+        Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
+        Some(Command::Solutions(run)) => ssn::solutions::command(run),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::NotConverged) => ExitCode::from(1),
+        Err(CliError::BadInput(m)) => {
+            io::write_stderr(&format!("error: {m}\n"));
+            ExitCode::from(2)
+        }
+        Err(CliError::Output(m)) => {
+            io::write_stderr(&format!("error: {m}\n"));
+            ExitCode::from(3)
+        }
+    }
+}
+
+/// Runs `run`, which writes into the directory `out`; when `out` did not exist before and
+/// the run fails, the directories it created (from the outermost one that did not exist)
+/// are removed with what was written into them, so a failed run leaves nothing behind.
+fn in_new_directory(
+    out: &Path,
+    run: impl FnOnce() -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    // The outermost ancestor of `out` that does not exist yet (the run creates it).
+    let created = out
+        .ancestors()
+        .filter(|a| !a.as_os_str().is_empty())
+        .take_while(|a| std::fs::symlink_metadata(a).is_err())
+        .last()
+        .map(Path::to_path_buf);
+    let result = run();
+    if let (Err(_), Some(created)) = (&result, created) {
+        let _ = std::fs::remove_dir_all(created);
+    }
+    result
+}
+
+impl Command {
+    fn name(&self) -> &'static str {
+        match self {
+            Command::Solve(_) => "solve",
+            Command::Sweep(_) => "sweep",
+            Command::Solutions(_) => "solutions",
+            Command::ExportModel { .. } => "export-model",
+            Command::Compare { .. } => "compare",
+            Command::SceneCheck { .. } => "scene-check",
+        }
+    }
+}
+
+/// Help and version go to standard output (exit code 0, or 3 when it cannot be written);
+/// a usage error goes to standard error (exit code 2).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let text = e.render().to_string();
+    if e.use_stderr() {
+        io::write_stderr(&text);
+        ExitCode::from(2)
+    } else {
+        match io::write_stdout(&text) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(err) => {
+                io::write_stderr(&format!("error: {err}\n"));
+                ExitCode::from(3)
+            }
+        }
+    }
+}

@@ -1,0 +1,633 @@
+//! Validation of a parsed scene, section by section: every refusal names the file, the key,
+//! the value and what is allowed.
+
+use std::path::Path;
+
+use super::*;
+
+struct Check<'a> {
+    path: &'a Path,
+}
+
+impl Check<'_> {
+    fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_path_buf(),
+            key: key.to_string(),
+            value: value.to_string(),
+            allowed: allowed.to_string(),
+        }
+    }
+
+    fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, v, "a finite number > 0"))
+        }
+    }
+
+    fn non_negative(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, v, "a finite number >= 0"))
+        }
+    }
+
+    /// A length or force of the response: `|v| <= MAX_RESPONSE_SCALE`, so that residuals
+    /// and their squares (merit functions) stay finite.
+    fn response_scale(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+        if v.is_finite() && v.abs() <= MAX_RESPONSE_SCALE {
+            Ok(v)
+        } else {
+            Err(self.invalid(
+                key,
+                format!("{v:e}"),
+                "a finite number with |value| <= 1e100",
+            ))
+        }
+    }
+
+    fn count(&self, key: &str, v: i64, min: usize, max: usize) -> Result<usize, SceneError> {
+        if v >= min as i64 && v <= max as i64 {
+            Ok(v as usize)
+        } else {
+            Err(self.invalid(key, v, &format!("an integer in {min}..={max}")))
+        }
+    }
+
+    /// `count` of `v` when given, else `default`.
+    fn count_or(
+        &self,
+        key: &str,
+        v: Option<i64>,
+        min: usize,
+        max: usize,
+        default: usize,
+    ) -> Result<usize, SceneError> {
+        v.map_or(Ok(default), |v| self.count(key, v, min, max))
+    }
+}
+
+/// Validates a parsed scene section by section, in file order; the first invalid value is
+/// the error.
+pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
+    let ck = Check { path };
+    let (rod, model, output_dof) = match (&raw.rod, raw.model) {
+        (Some(raw_rod), None) => {
+            let mut rod = ck.rod(raw_rod)?;
+            if raw.forcing.vector.is_some() {
+                return Err(ck.invalid(
+                    "forcing.vector",
+                    "given in a [rod] scene",
+                    "`load` (\"distributed\" or \"tip\"); `vector` belongs to [model] scenes",
+                ));
+            }
+            rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
+            (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
+            if let Some(c) = raw.contact {
+                rod.contacts = ck.contacts(c, rod.elements)?;
+            }
+            let output_dof = raw
+                .output
+                .map(|o| ck.count("output.dof", o.dof, 1, rod.elements))
+                .transpose()?
+                .map(|dof| dof - 1);
+            (rod, None, output_dof)
+        }
+        (None, Some(m)) => {
+            let model = ck.model(m, raw.damping, &raw.forcing, raw.contact, raw.output)?;
+            let output_dof = model.observed_dof;
+            (RodSpec::canonical(), Some(model), output_dof)
+        }
+        (Some(_), Some(_)) => {
+            return Err(ck.invalid(
+                "model",
+                "given together with [rod]",
+                "either [rod] (the built-in rod) or [model] (Matrix Market files)",
+            ))
+        }
+        (None, None) => {
+            return Err(ck.invalid(
+                "rod",
+                "missing",
+                "a [rod] section (the built-in rod) or a [model] section (Matrix Market files)",
+            ))
+        }
+    };
+    // An LCP without contact is empty: allowed, solved as the linear response.
+    let solver = ck.solver(&raw.solver)?;
+    let contacts = model
+        .as_ref()
+        .map_or(rod.contacts.len(), |m| m.contacts.len());
+    ck.lcp_size(&solver, contacts, raw.solver.time_samples.is_some())?;
+    let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
+    Ok(Scene {
+        path: path.to_path_buf(),
+        title: raw.title,
+        rod,
+        model,
+        output_dof,
+        solver,
+        sweep,
+    })
+}
+
+impl Check<'_> {
+    /// `[rod]`: the mesh and the material; the other sections fill in damping, forcing and
+    /// contacts (none until they do).
+    fn rod(&self, r: &RawRod) -> Result<RodSpec, SceneError> {
+        let spec = RodSpec {
+            elements: self.count(
+                "rod.elements",
+                r.elements,
+                1,
+                semismooth_contact::rod::MAX_ELEMENTS,
+            )?,
+            length: self.positive("rod.length", r.length.unwrap_or(1.0))?,
+            axial_stiffness: self
+                .positive("rod.axial_stiffness", r.axial_stiffness.unwrap_or(1.0))?,
+            mass_per_length: self
+                .positive("rod.mass_per_length", r.mass_per_length.unwrap_or(1.0))?,
+            mass: match r.mass {
+                RawMass::Consistent => MassModel::Consistent,
+                RawMass::Lumped => MassModel::Lumped,
+                RawMass::Modified => MassModel::Modified,
+            },
+            damping: None,
+            load: LoadKind::Distributed,
+            amplitude: 0.0,
+            frequency: FrequencySpec::Ratio(1.0),
+            contacts: Vec::new(),
+        };
+        self.rod_scales(&spec)?;
+        Ok(spec)
+    }
+
+    /// The rod must vibrate at a representable frequency: the modified mass needs a node
+    /// with mass besides the massless tip, and the element length `h = L / elements`, the
+    /// element stiffness `EA / h`, mass `rhoA h` and the first frequency
+    /// `(pi / 2) sqrt(EA / rhoA) / L` must stay within `[1e-100, 1e100]` (far inside
+    /// floating point, so that squares and products of them neither overflow nor vanish).
+    fn rod_scales(&self, s: &RodSpec) -> Result<(), SceneError> {
+        if s.mass == MassModel::Modified && s.elements < 2 {
+            return Err(self.invalid(
+                "rod.elements",
+                format!("{} with mass = \"modified\"", s.elements),
+                "at least 2 with the modified mass (the tip node is massless, so a one-element \
+                 rod has no vibration mode)",
+            ));
+        }
+        let h = s.length / s.elements as f64;
+        let omega_1 =
+            0.5 * std::f64::consts::PI * (s.axial_stiffness / s.mass_per_length).sqrt() / s.length;
+        let in_range = |v: f64| (1e-100..=1e100).contains(&v);
+        for (what, v) in [
+            ("the element length L / elements", h),
+            (
+                "the element stiffness EA elements / L",
+                s.axial_stiffness / h,
+            ),
+            ("the element mass rhoA L / elements", s.mass_per_length * h),
+            (
+                "the first natural frequency (pi / 2) sqrt(EA / rhoA) / L",
+                omega_1,
+            ),
+        ] {
+            if !in_range(v) {
+                return Err(self.invalid(
+                    "rod.length",
+                    format!(
+                        "{:?} (with axial_stiffness = {:?}, mass_per_length = {:?}, elements = {}: \
+                         {what} is {v:e})",
+                        s.length, s.axial_stiffness, s.mass_per_length, s.elements
+                    ),
+                    "length, axial_stiffness and mass_per_length whose element length, element \
+                     stiffness, element mass and first natural frequency lie in [1e-100, 1e100]",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `[damping]`: stiffness-proportional (`zeta`) or Rayleigh (`alpha`, `beta`), chosen by
+    /// `model` or by the keys present.
+    fn damping(&self, d: &RawDamping) -> Result<DampingSpec, SceneError> {
+        let model = match (d.model, d.zeta, d.alpha, d.beta) {
+            (Some(m), _, _, _) => m,
+            (None, Some(_), None, None) => RawDampingModel::StiffnessProportional,
+            (None, None, a, b) if a.is_some() || b.is_some() => RawDampingModel::Rayleigh,
+            (None, None, None, None) => {
+                return Err(self.invalid(
+                    "damping",
+                    "an empty section",
+                    "`zeta` (stiffness-proportional) or `alpha`/`beta` (Rayleigh); omit [damping] for none",
+                ))
+            }
+            _ => {
+                return Err(self.invalid(
+                    "damping.zeta",
+                    "given together with alpha/beta",
+                    "either `zeta` (model = \"stiffness-proportional\") or `alpha`/`beta` (model = \"rayleigh\")",
+                ))
+            }
+        };
+        match model {
+            RawDampingModel::StiffnessProportional => {
+                if d.alpha.is_some() || d.beta.is_some() {
+                    return Err(self.invalid(
+                        "damping.alpha",
+                        "given with model = \"stiffness-proportional\"",
+                        "only `zeta` for this model",
+                    ));
+                }
+                let zeta = d.zeta.ok_or_else(|| {
+                    self.invalid(
+                        "damping.zeta",
+                        "missing",
+                        "a finite number >= 0 (required by model = \"stiffness-proportional\")",
+                    )
+                })?;
+                Ok(DampingSpec::StiffnessProportional {
+                    zeta: self.non_negative("damping.zeta", zeta)?,
+                })
+            }
+            RawDampingModel::Rayleigh => {
+                if d.zeta.is_some() {
+                    return Err(self.invalid(
+                        "damping.zeta",
+                        "given with model = \"rayleigh\"",
+                        "only `alpha` and `beta` for this model",
+                    ));
+                }
+                if d.alpha.is_none() && d.beta.is_none() {
+                    return Err(self.invalid(
+                        "damping.model",
+                        "\"rayleigh\" without alpha or beta",
+                        "model = \"rayleigh\" with `alpha` and/or `beta` (D = alpha M + beta K); \
+                         omit [damping] for no damping",
+                    ));
+                }
+                Ok(DampingSpec::Rayleigh {
+                    alpha: self.non_negative("damping.alpha", d.alpha.unwrap_or(0.0))?,
+                    beta: self.non_negative("damping.beta", d.beta.unwrap_or(0.0))?,
+                })
+            }
+        }
+    }
+
+    /// `[forcing]`: the load, its amplitude and its frequency (`omega_1` by default).
+    fn forcing(&self, f: &RawForcing) -> Result<(LoadKind, f64, FrequencySpec), SceneError> {
+        let amplitude = self.response_scale("forcing.amplitude", f.amplitude)?;
+        let frequency = match (f.omega_ratio, f.omega) {
+            (Some(r), None) => FrequencySpec::Ratio(self.positive("forcing.omega_ratio", r)?),
+            (None, Some(w)) => FrequencySpec::Absolute(self.positive("forcing.omega", w)?),
+            (None, None) => FrequencySpec::Ratio(1.0),
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    "forcing.omega",
+                    "given together with omega_ratio",
+                    "either `omega_ratio` (units of omega_1) or `omega` (rad per unit time)",
+                ))
+            }
+        };
+        let load = match f.load.unwrap_or_default() {
+            RawLoad::Distributed => LoadKind::Distributed,
+            RawLoad::Tip => LoadKind::Tip,
+        };
+        Ok((load, amplitude, frequency))
+    }
+
+    /// `[contact]`: one contact (`gap`, at `node` or the tip) or a list of
+    /// `[[contact.point]]` at distinct nodes of the `elements`-element rod.
+    fn contacts(&self, c: RawContact, elements: usize) -> Result<Vec<RodContact>, SceneError> {
+        match (c.gap, c.point) {
+            (Some(gap), None) => Ok(vec![RodContact {
+                node: self.count_or("contact.node", c.node, 1, elements, elements)?,
+                gap: self.response_scale("contact.gap", gap)?,
+            }]),
+            (None, Some(points)) if c.node.is_none() => {
+                if points.is_empty() {
+                    return Err(self.invalid(
+                        "contact.point",
+                        "an empty list",
+                        "at least one [[contact.point]] with node and gap",
+                    ));
+                }
+                let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
+                for p in points {
+                    if p.dof.is_some() || p.direction.is_some() {
+                        return Err(self.invalid(
+                            "contact.point.dof",
+                            "given in a [rod] scene",
+                            "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                        ));
+                    }
+                    let node = p.node.ok_or_else(|| {
+                        self.invalid("contact.point.node", "missing", "an integer node number")
+                    })?;
+                    let node = self.count("contact.point.node", node, 1, elements)?;
+                    if contacts.iter().any(|c| c.node == node) {
+                        return Err(self.invalid(
+                            "contact.point.node",
+                            node,
+                            "distinct nodes (one contact per node)",
+                        ));
+                    }
+                    contacts.push(RodContact {
+                        node,
+                        gap: self.response_scale("contact.point.gap", p.gap)?,
+                    });
+                }
+                Ok(contacts)
+            }
+            (None, None) => Err(self.invalid(
+                "contact",
+                "a section without gap",
+                "`gap` (and optional `node`) or [[contact.point]] entries; omit [contact] for a linear problem",
+            )),
+            _ => Err(self.invalid(
+                "contact.gap",
+                "given together with [[contact.point]] or node",
+                "either `gap` (+ optional `node`) or [[contact.point]] entries",
+            )),
+        }
+    }
+
+    /// `[model]` and the sections an imported structure reads: `[damping]` (unless a
+    /// damping file is given), `[forcing]` with a load `vector` file, `[[contact.point]]`
+    /// with 1-based `dof`, `gap` and `direction` (+1 or -1), `[output] dof`. File names are
+    /// relative to the scene's directory; dof upper bounds are checked when the files are
+    /// read.
+    fn model(
+        &self,
+        m: RawModel,
+        damping: Option<RawDamping>,
+        f: &RawForcing,
+        contact: Option<RawContact>,
+        output: Option<RawOutput>,
+    ) -> Result<ModelSpec, SceneError> {
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        let file = |key: &str, name: &str| {
+            if name.trim().is_empty() {
+                Err(self.invalid(
+                    key,
+                    "\"\"",
+                    "a file name (relative to the scene's directory)",
+                ))
+            } else {
+                Ok(dir.join(name))
+            }
+        };
+        let mass = file("model.mass", &m.mass)?;
+        let stiffness = file("model.stiffness", &m.stiffness)?;
+        let damping_matrix = m.damping.map(|d| file("model.damping", &d)).transpose()?;
+        let damping = damping.map(|d| self.damping(&d)).transpose()?;
+        if damping_matrix.is_some() && damping.is_some() {
+            return Err(self.invalid(
+                "damping",
+                "a [damping] section together with model.damping",
+                "either a damping matrix file or a [damping] section",
+            ));
+        }
+        if f.load.is_some() {
+            return Err(self.invalid(
+                "forcing.load",
+                "given in a [model] scene",
+                "`vector` (a Matrix Market file of the load shape, N x 1)",
+            ));
+        }
+        let vector = f.vector.as_deref().ok_or_else(|| {
+            self.invalid(
+                "forcing.vector",
+                "missing",
+                "a Matrix Market file of the load shape, N x 1 (relative to the scene)",
+            )
+        })?;
+        let forcing_vector = file("forcing.vector", vector)?;
+        let (_, amplitude, frequency) = self.forcing(f)?;
+        let contacts = contact
+            .map(|c| self.dof_contacts(c))
+            .transpose()?
+            .unwrap_or_default();
+        let observed_dof = output
+            .map(|o| self.count("output.dof", o.dof, 1, usize::MAX >> 1))
+            .transpose()?
+            .map(|dof| dof - 1);
+        Ok(ModelSpec {
+            scene: self.path.to_path_buf(),
+            mass,
+            stiffness,
+            damping_matrix,
+            damping,
+            forcing_vector,
+            amplitude,
+            frequency,
+            contacts,
+            observed_dof,
+        })
+    }
+
+    /// `[[contact.point]]` entries of a `[model]` scene: `dof` (1-based), `gap`, `direction`
+    /// (+1, the default, or -1); one contact per dof and direction.
+    fn dof_contacts(&self, c: RawContact) -> Result<Vec<DofContact>, SceneError> {
+        let allowed = "[[contact.point]] entries with dof, gap and optional direction";
+        let points = match (c.gap, c.node, c.point) {
+            (None, None, Some(points)) if !points.is_empty() => points,
+            (None, None, _) => return Err(self.invalid("contact.point", "an empty list", allowed)),
+            (Some(_), _, _) => {
+                return Err(self.invalid("contact.gap", "given in a [model] scene", allowed))
+            }
+            (None, Some(_), _) => {
+                return Err(self.invalid("contact.node", "given in a [model] scene", allowed))
+            }
+        };
+        let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
+        for p in points {
+            if p.node.is_some() {
+                return Err(self.invalid(
+                    "contact.point.node",
+                    "given in a [model] scene",
+                    "`dof` (1-based, as in Matrix Market)",
+                ));
+            }
+            let dof = p.dof.ok_or_else(|| {
+                self.invalid("contact.point.dof", "missing", "a 1-based dof number")
+            })?;
+            let dof = self.count("contact.point.dof", dof, 1, usize::MAX >> 1)? - 1;
+            let direction = match p.direction.unwrap_or(1) {
+                1 => ContactDirection::Positive,
+                -1 => ContactDirection::Negative,
+                d => return Err(self.invalid(
+                    "contact.point.direction",
+                    d,
+                    "1 (obstacle on the positive side: u <= gap) or -1 (negative side: -u <= gap)",
+                )),
+            };
+            if contacts
+                .iter()
+                .any(|c| c.dof == dof && c.direction == direction)
+            {
+                return Err(self.invalid(
+                    "contact.point.dof",
+                    dof + 1,
+                    "one contact per dof and direction (two contacts on one dof need opposite directions)",
+                ));
+            }
+            contacts.push(DofContact {
+                dof,
+                gap: self.response_scale("contact.point.gap", p.gap)?,
+                direction,
+            });
+        }
+        Ok(contacts)
+    }
+
+    /// The periodic LCP's matrix is dense, of order `contacts x time_samples`: that order
+    /// must not exceed [`semismooth_contact::lcp::MAX_LCP_SIZE`], so `solver.time_samples` is refused
+    /// above `MAX_LCP_SIZE / contacts` for `lcp-lemke` and `lcp-ssn`.
+    fn lcp_size(
+        &self,
+        solver: &SolverSettings,
+        contacts: usize,
+        given: bool,
+    ) -> Result<(), SceneError> {
+        let nt = solver.time_samples;
+        if !matches!(solver.method, Method::LcpLemke | Method::LcpSsn)
+            || contacts.saturating_mul(nt) <= semismooth_contact::lcp::MAX_LCP_SIZE
+        {
+            return Ok(());
+        }
+        let most = semismooth_contact::lcp::MAX_LCP_SIZE / contacts;
+        let value = if given {
+            nt.to_string()
+        } else {
+            format!("{nt} (the default)")
+        };
+        let allowed = if most >= 8 {
+            format!(
+                "an integer in 8..={most} for {} with {contacts} contacts (contacts x \
+                 time_samples <= {}: the LCP matrix is dense)",
+                solver.method.name(),
+                semismooth_contact::lcp::MAX_LCP_SIZE
+            )
+        } else {
+            format!(
+                "none for {} with {contacts} contacts (contacts x time_samples <= {} with \
+                 time_samples >= 8: the LCP matrix is dense); use ssn-hb or penalty-hb",
+                solver.method.name(),
+                semismooth_contact::lcp::MAX_LCP_SIZE
+            )
+        };
+        Err(self.invalid("solver.time_samples", value, &allowed))
+    }
+
+    /// `[solver]`: the method and its discretisation and iteration settings, defaults filled
+    /// in (an HB method needs more AFT samples than `2 H`).
+    fn solver(&self, s: &RawSolver) -> Result<SolverSettings, SceneError> {
+        let method = s.method;
+        let harmonics = self.count_or(
+            "solver.harmonics",
+            s.harmonics,
+            1,
+            MAX_HARMONICS,
+            DEFAULT_HARMONICS,
+        )?;
+        let time_samples = match (s.time_samples, method.is_harmonic_balance()) {
+            (Some(n), true) => {
+                let n = self.count("solver.time_samples", n, 1, MAX_TIME_SAMPLES)?;
+                if n <= 2 * harmonics {
+                    return Err(self.invalid(
+                        "solver.time_samples",
+                        n,
+                        &format!(
+                            "an integer > 2 * harmonics = {} (the AFT needs more samples than basis functions)",
+                            2 * harmonics
+                        ),
+                    ));
+                }
+                n
+            }
+            (Some(n), false) => self.count("solver.time_samples", n, 8, MAX_TIME_SAMPLES)?,
+            (None, true) => default_hb_time_samples(harmonics),
+            (None, false) => DEFAULT_LCP_TIME_SAMPLES,
+        };
+        let c = s.c.map(|c| self.positive("solver.c", c)).transpose()?;
+        let penalty_stiffness = s
+            .penalty_stiffness
+            .map(|k| self.positive("solver.penalty_stiffness", k))
+            .transpose()?;
+        let max_iterations =
+            self.count_or("solver.max_iterations", s.max_iterations, 1, 100_000, 200)?;
+        let tolerance = self.positive("solver.tolerance", s.tolerance.unwrap_or(1e-10))?;
+        let steps_per_period = self.count_or(
+            "solver.steps_per_period",
+            s.steps_per_period,
+            8,
+            MAX_TIME_SAMPLES,
+            2000,
+        )?;
+        let max_periods = self.count_or("solver.max_periods", s.max_periods, 1, 1_000_000, 2000)?;
+        let march_tolerance =
+            self.positive("solver.march_tolerance", s.march_tolerance.unwrap_or(1e-8))?;
+        let restitution = s.restitution.unwrap_or(0.0);
+        if !(0.0..=1.0).contains(&restitution) {
+            return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
+        }
+        Ok(SolverSettings {
+            method,
+            harmonics,
+            time_samples,
+            c,
+            penalty_stiffness,
+            linear_solver: s.linear_solver,
+            max_iterations,
+            globalization: s.globalization,
+            tolerance,
+            steps_per_period,
+            max_periods,
+            march_tolerance,
+            restitution,
+            lcp_scheme: s.lcp_scheme,
+        })
+    }
+
+    /// `[sweep]`: a non-empty frequency interval and arclength steps with
+    /// `min_step <= step <= max_step`.
+    fn sweep(&self, sw: &RawSweep) -> Result<SweepSettings, SceneError> {
+        let from = self.positive("sweep.omega_ratio_from", sw.omega_ratio_from)?;
+        let to = self.positive("sweep.omega_ratio_to", sw.omega_ratio_to)?;
+        if to == from {
+            return Err(self.invalid(
+                "sweep.omega_ratio_to",
+                to,
+                "a value different from omega_ratio_from",
+            ));
+        }
+        let defaults = SweepSettings::new(from, to);
+        let step = self.positive("sweep.step", sw.step.unwrap_or(defaults.step))?;
+        let min_step = self.positive("sweep.min_step", sw.min_step.unwrap_or(defaults.min_step))?;
+        let max_step = self.positive("sweep.max_step", sw.max_step.unwrap_or(defaults.max_step))?;
+        if step < min_step || step > max_step {
+            return Err(self.invalid(
+                "sweep.step",
+                step,
+                &format!("min_step ({min_step}) <= step <= max_step ({max_step})"),
+            ));
+        }
+        Ok(SweepSettings {
+            step,
+            min_step,
+            max_step,
+            max_points: self.count_or(
+                "sweep.max_points",
+                sw.max_points,
+                2,
+                1_000_000,
+                defaults.max_points,
+            )?,
+            ..defaults
+        })
+    }
+}

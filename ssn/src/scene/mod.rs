@@ -1,0 +1,276 @@
+//! Scenes: TOML problem descriptions, validated into a rod spec and solver settings.
+//!
+//! Only what a scene declares is simulated: no `[damping]` section means no damping matrix,
+//! no `[contact]` section means a linear problem. Every key, its unit, default and allowed
+//! values are listed in README.md ("Scene format"); unknown keys are errors.
+//!
+//! ```toml
+//! [rod]
+//! elements = 20              # required, integer >= 1
+//! mass = "modified"          # consistent | lumped | modified (default consistent)
+//! [damping]
+//! zeta = 0.01                # or alpha/beta (Rayleigh)
+//! [forcing]
+//! amplitude = 0.04
+//! omega_ratio = 1.0          # or omega (absolute)
+//! [contact]
+//! gap = 0.5                  # tip contact; or [[contact.point]] node/gap entries
+//! [solver]
+//! method = "ssn-hb"
+//! harmonics = 20
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use semismooth_contact::matrix_market::{ContactDirection, DofContact, ModelSpec};
+use semismooth_contact::rod::{
+    DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
+};
+
+mod check;
+
+pub use semismooth_contact::settings::{
+    default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,
+    SolverSettings, SweepSettings, DEFAULT_HARMONICS, DEFAULT_LCP_TIME_SAMPLES,
+    DEFAULT_RELATIVE_PENALTY,
+};
+
+/// Why a scene could not be used. Every variant names the file; `Invalid` also names the
+/// key, the value found and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scene: {source}")]
+    Io {
+        /// The scene file.
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// Malformed TOML, an unknown key, a wrong type or a missing required key.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The scene file.
+        path: PathBuf,
+        /// The parser's message (with line and column, key and expected type).
+        message: String,
+    },
+    /// A value of the right type outside its allowed range, or conflicting keys.
+    #[error("{path}: invalid `{key}` = {value}: allowed {allowed}")]
+    Invalid {
+        /// The scene file.
+        path: PathBuf,
+        /// The offending key, as `section.key`.
+        key: String,
+        /// The value found.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+}
+
+/// A validated scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// Where it came from (`<built-in>` for scenes built in code).
+    pub path: PathBuf,
+    /// Optional title (`title = "..."`).
+    pub title: Option<String>,
+    /// The rod of a `[rod]` scene (for a `[model]` scene: unused, the canonical rod).
+    pub rod: RodSpec,
+    /// The imported structure of a `[model]` scene (`None` for a `[rod]` scene).
+    pub model: Option<ModelSpec>,
+    /// `[output] dof`, 0-based: the dof that `tip_*` outputs and plots describe (default: the
+    /// rod's tip; for a `[model]` scene the first contact dof).
+    pub output_dof: Option<usize>,
+    /// Solver settings.
+    pub solver: SolverSettings,
+    /// Frequency sweep, if declared.
+    pub sweep: Option<SweepSettings>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    title: Option<String>,
+    rod: Option<RawRod>,
+    model: Option<RawModel>,
+    damping: Option<RawDamping>,
+    forcing: RawForcing,
+    contact: Option<RawContact>,
+    output: Option<RawOutput>,
+    #[serde(default)]
+    solver: RawSolver,
+    sweep: Option<RawSweep>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRod {
+    elements: i64,
+    length: Option<f64>,
+    axial_stiffness: Option<f64>,
+    mass_per_length: Option<f64>,
+    #[serde(default)]
+    mass: RawMass,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    mass: String,
+    stiffness: String,
+    damping: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    dof: i64,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawMass {
+    #[default]
+    Consistent,
+    Lumped,
+    Modified,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDamping {
+    model: Option<RawDampingModel>,
+    zeta: Option<f64>,
+    alpha: Option<f64>,
+    beta: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum RawDampingModel {
+    StiffnessProportional,
+    Rayleigh,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawLoad {
+    #[default]
+    Distributed,
+    Tip,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawForcing {
+    load: Option<RawLoad>,
+    vector: Option<String>,
+    amplitude: f64,
+    omega_ratio: Option<f64>,
+    omega: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContact {
+    gap: Option<f64>,
+    node: Option<i64>,
+    point: Option<Vec<RawContactPoint>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawContactPoint {
+    node: Option<i64>,
+    dof: Option<i64>,
+    gap: f64,
+    direction: Option<i64>,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSolver {
+    #[serde(default)]
+    method: Method,
+    harmonics: Option<i64>,
+    time_samples: Option<i64>,
+    c: Option<f64>,
+    penalty_stiffness: Option<f64>,
+    #[serde(default)]
+    linear_solver: LinearSolverChoice,
+    max_iterations: Option<i64>,
+    #[serde(default)]
+    globalization: GlobalizationChoice,
+    tolerance: Option<f64>,
+    steps_per_period: Option<i64>,
+    max_periods: Option<i64>,
+    march_tolerance: Option<f64>,
+    restitution: Option<f64>,
+    #[serde(default)]
+    lcp_scheme: LcpScheme,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSweep {
+    omega_ratio_from: f64,
+    omega_ratio_to: f64,
+    step: Option<f64>,
+    min_step: Option<f64>,
+    max_step: Option<f64>,
+    max_points: Option<i64>,
+}
+
+/// Largest harmonic count accepted.
+pub const MAX_HARMONICS: usize = 2000;
+/// Largest sample / step count accepted.
+pub const MAX_TIME_SAMPLES: usize = 1 << 20;
+/// Largest accepted magnitude of a forcing amplitude or a gap: the response scales with
+/// them, and a residual's square must stay below the largest double (1.8e308).
+pub const MAX_RESPONSE_SCALE: f64 = 1e100;
+
+impl Scene {
+    /// Reads and validates a scene file (a regular file of at most
+    /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        // Only a regular file of at most 1 MiB: a FIFO would block, a device never end.
+        let text =
+            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
+                SceneError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
+        Scene::from_toml(&text, path)
+    }
+
+    /// Parses and validates scene text; `path` is only used in messages.
+    pub fn from_toml(text: &str, path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let raw: RawScene = toml::from_str(text)
+            .map_err(|e| {
+                let mut message = e.to_string().trim_end().to_string();
+                // toml's words for a number outside f64 or i64: say what is allowed.
+                if message.contains("overflow") || message.contains("as i128") {
+                    message.push_str(
+                        "\nallowed: floats of magnitude at most 1.7976931348623157e308, integers \
+                     within 64 bits (each key's own range is in the README's scene table)",
+                    );
+                }
+                message
+            })
+            .map_err(|message| SceneError::Parse {
+                path: path.to_path_buf(),
+                message,
+            })?;
+        check::resolve(raw, path)
+    }
+}
+
+#[cfg(test)]
+mod tests;

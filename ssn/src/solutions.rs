@@ -1,0 +1,126 @@
+//! `ssn solutions SCENE`: every periodic response at the scene's frequency with its
+//! stability ([`semismooth_contact::solutions::find_solutions`]).
+
+use semismooth_contact::solutions::{find_solutions, PeriodicSolution};
+use semismooth_contact::solve::RunError;
+
+/// `ssn solutions SCENE`: every periodic solution at the scene's frequency (module
+/// documentation); text or JSON on stdout, a CSV row per solution, an SVG of the tip over
+/// one period (stable solid, unstable dashed, undecided dotted).
+pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> {
+    use crate::exit::CliError;
+    use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
+    let (scene, rod) = crate::cli::load(&args.scene)?;
+    let mut outputs = args.plan()?;
+    let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
+    let set = find_solutions(&rod, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
+    let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
+        set.solutions.iter().map(f).collect()
+    };
+    if let Some(csv) = &args.csv {
+        let columns = [
+            column(&|s| s.solution.stats.min),
+            column(&|s| s.solution.stats.max),
+            column(&|s| s.solution.stats.mean_contact_force),
+            column(&|s| s.solution.stats.max_penetration),
+            column(&|s| {
+                s.stability
+                    .stable
+                    .map_or(f64::NAN, |b| f64::from(u8::from(b)))
+            }),
+            column(&|s| s.stability.floquet_max_abs.unwrap_or(f64::NAN)),
+        ];
+        let refs: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect();
+        let headers = [
+            "tip_min",
+            "tip_max",
+            "contact_force_mean",
+            "max_penetration",
+            "stable",
+            "floquet_max_abs",
+        ];
+        outputs.add(csv, csv_table(&headers, &refs).into_bytes());
+    }
+    if let Some(svg) = &args.svg {
+        let mut series: Vec<Series> = set
+            .solutions
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let t: Vec<f64> = s
+                    .solution
+                    .times
+                    .iter()
+                    .map(|t| t * set.omega / (2.0 * std::f64::consts::PI))
+                    .collect();
+                let label = match s.stability.stable {
+                    Some(true) => format!("solution {} (stable)", k + 1),
+                    Some(false) => format!("solution {} (unstable)", k + 1),
+                    None => format!("solution {} (stability undecided)", k + 1),
+                };
+                // The stability styles of the sweeps: solid, dashed, dotted.
+                let style = match s.stability.stable {
+                    Some(true) => LineStyle::Solid,
+                    Some(false) => LineStyle::Dashed,
+                    None => LineStyle::Dotted,
+                };
+                Series {
+                    style,
+                    ..Series::new(label, t, s.solution.tip.clone())
+                }
+            })
+            .collect();
+        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
+        let spec = PlotSpec {
+            title: format!(
+                "periodic solutions at omega/omega_1 = {:.4}",
+                set.omega / set.omega_1
+            ),
+            x_label: "time t / T (T: forcing period)".into(),
+            y_label: "tip displacement u_tip".into(),
+            log_log: false,
+        };
+        outputs.add(svg, line_plot_svg(&spec, &series)?.into_bytes());
+    }
+    let text = || {
+        let mut t = format!(
+            "omega/omega_1     {:.6}: {} solution(s) from {} crossing(s) of a {}-point branch \
+             over [{}, {}]\n",
+            set.omega / set.omega_1,
+            set.solutions.len(),
+            set.crossings,
+            set.branch_points,
+            set.window.0,
+            set.window.1
+        );
+        for (k, s) in set.solutions.iter().enumerate() {
+            t += &format!(
+                "  {}: tip min {:.6} max {:.6}, mean contact force {:.4e}, {} (max |mu| {})\n",
+                k + 1,
+                s.solution.stats.min,
+                s.solution.stats.max,
+                s.solution.stats.mean_contact_force,
+                match s.stability.stable {
+                    Some(true) => "stable".to_string(),
+                    Some(false) => "unstable".to_string(),
+                    None => format!(
+                        "undecided: {}",
+                        s.stability.reason.clone().unwrap_or_default()
+                    ),
+                },
+                s.stability
+                    .floquet_max_abs
+                    .map_or("-".to_string(), |m| format!("{m:.4}"))
+            );
+        }
+        for f in &set.failed_corrections {
+            t += &format!("  not corrected: {f}\n");
+        }
+        if !set.solutions.is_empty() {
+            t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
+                  starts from solution K)\n";
+        }
+        t
+    };
+    args.finish(outputs, || crate::json::solutions_json(&set), text, true)
+}
