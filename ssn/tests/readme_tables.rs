@@ -12,7 +12,7 @@ use ssn::study::accuracy_cost;
 use ssn::tables::{self, Table};
 
 fn readme() -> String {
-    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"))
+    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md"))
         .expect("README.md is readable")
 }
 
