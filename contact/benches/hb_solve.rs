@@ -29,7 +29,7 @@ use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
 use semismooth_contact::hb::{HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_contact::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_contact::settings::{default_hb_time_samples, Method, SolverSettings};
-use semismooth_contact::solve::{newton_options, solve_rod};
+use semismooth_contact::solve::newton_options;
 
 const H: usize = 20;
 
@@ -56,7 +56,7 @@ fn hb_options(h: usize, c: Option<f64>) -> HbOptions {
 
 /// SSN-HB on `rod` (`c`: `None` for the default) solved from zero with `solver`; returns
 /// the problem and its solution.
-fn solve<S: Factorize<HbJacobian>>(
+fn solve_hb<S: Factorize<HbJacobian>>(
     rod: &RodModel,
     h: usize,
     c: Option<f64>,
@@ -72,7 +72,7 @@ fn solve<S: Factorize<HbJacobian>>(
 /// One SSN-HB solve from zero with the structured solver (`c`: `None` for the default);
 /// returns the solution's first entry.
 fn solve_structured(rod: &RodModel, h: usize, c: Option<f64>) -> f64 {
-    solve(rod, h, c, StructuredHbSolver::new()).1[0]
+    solve_hb(rod, h, c, StructuredHbSolver::new()).1[0]
 }
 
 /// Factors `jac` with `solver` and solves for `rhs` in `work`; returns `work[0]`.
@@ -128,12 +128,12 @@ fn newton_solver(c: &mut Criterion) {
         b.iter(|| black_box(solve_structured(&rod, H, None)))
     });
     group.bench_function("dense", |b| {
-        b.iter(|| black_box(solve(&rod, H, None, FaerDenseLu::new()).1[0]))
+        b.iter(|| black_box(solve_hb(&rod, H, None, FaerDenseLu::new()).1[0]))
     });
     group.finish();
 
     // One Newton system at the converged state (an active set with contact).
-    let (mut problem, x) = solve(&rod, H, None, StructuredHbSolver::new());
+    let (mut problem, x) = solve_hb(&rod, H, None, StructuredHbSolver::new());
     let mut jac = problem.new_jacobian();
     problem.jacobian(&x, &mut jac).expect("evaluates");
     let rhs: Vec<f64> = (0..problem.dim())
@@ -207,9 +207,9 @@ fn first_accurate(
     accuracy: f64,
 ) -> SolverSettings {
     for s in candidates {
-        if let Ok(sol) = solve_rod(rod, s, None) {
+        if let Ok(sol) = semismooth_contact::solve(rod, s, None) {
             let err = (sol.stats.min - reference).abs() / reference.abs();
-            if sol.converged && err <= accuracy {
+            if sol.converged() && err <= accuracy {
                 return s.clone();
             }
         }
@@ -221,7 +221,7 @@ fn march_vs_hb(c: &mut Criterion) {
     faer::set_global_parallelism(faer::Par::Seq);
     let rod = rod(MassModel::Modified, 20);
     let base = SolverSettings::with_harmonics(H);
-    let reference = solve_rod(
+    let reference = semismooth_contact::solve(
         &rod,
         &SolverSettings {
             method: Method::March,
@@ -256,7 +256,14 @@ fn march_vs_hb(c: &mut Criterion) {
     let mut group = configured_group(c, "march_vs_hb", 10, 300, 3);
     for (name, settings) in [("march", &march), ("ssn_hb", &hb)] {
         group.bench_function(name, |b| {
-            b.iter(|| black_box(solve_rod(&rod, settings, None).expect("runs").stats.min))
+            b.iter(|| {
+                black_box(
+                    semismooth_contact::solve(&rod, settings, None)
+                        .expect("runs")
+                        .stats
+                        .min,
+                )
+            })
         });
     }
     group.finish();

@@ -38,7 +38,7 @@ fn sweep(c: &mut Criterion) {
             b.iter(|| {
                 let response =
                     frequency_response(&rod, &settings, &sweep, None).expect("the sweep runs");
-                assert!(response.converged, "{}", response.termination);
+                assert!(response.converged(), "{}", response.termination);
                 black_box(response.points())
             })
         });

@@ -14,7 +14,7 @@ use std::time::Instant;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
 use semismooth_contact::hb::{CondensedSolve, HbOptions, SsnHb};
 use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
-use semismooth_contact::solve::{solve_rod, structured_solver};
+use semismooth_contact::solve::{solve, structured_solver};
 use semismooth_contact::structures::{BladedDisk, DiskLoading, SHIPPED_MISTUNING};
 
 struct Args {
@@ -88,7 +88,7 @@ fn run_one(args: &Args, count: usize) {
         linear_solver: choice,
         ..SolverSettings::with_harmonics(args.harmonics)
     };
-    let solution = solve_rod(&structure, &settings, None).expect("a run");
+    let solution = solve(&structure, &settings, None).expect("a run");
     if std::env::var_os("SCALING_HISTORY").is_some() {
         eprintln!(
             "{:?} {:?} {:?}",
@@ -138,7 +138,7 @@ fn run_one(args: &Args, count: usize) {
             format!("{step:?}")
         },
         solution.stats.max,
-        if solution.converged {
+        if solution.converged() {
             peak_rss_kb().to_string()
         } else {
             format!(

@@ -23,3 +23,5 @@ pub mod solve;
 pub mod stability;
 pub mod structures;
 pub mod sweep;
+
+pub use solve::solve;

@@ -65,10 +65,7 @@ pub enum GlobalizationChoice {
     Auto,
 }
 
-/// Default number of harmonics.
-pub const DEFAULT_HARMONICS: usize = 20;
 pub use crate::hb::DEFAULT_RELATIVE_PENALTY;
-pub use crate::lcp::DEFAULT_LCP_TIME_SAMPLES;
 
 /// Default AFT sample count for `H` harmonics: the next power of two >= max(64, 4 (2H + 1))
 /// ([`semismooth::harmonic::default_time_samples`]).
@@ -110,29 +107,51 @@ pub struct SolverSettings {
 }
 
 impl Default for SolverSettings {
-    /// SSN-HB with [`DEFAULT_HARMONICS`] harmonics and the default of every other setting
-    /// (the scenes' defaults).
+    /// SSN-HB with the formulations' own defaults: harmonics and AFT samples of
+    /// [`HbOptions`](crate::hb::HbOptions), time steps of
+    /// [`PeriodicLcpOptions`](crate::lcp::PeriodicLcpOptions), iterations and tolerance of the
+    /// core's [`NewtonOptions`](semismooth::newton::NewtonOptions), steps, periods and
+    /// tolerance of [`MarchOptions`](crate::march::MarchOptions) (the scenes' defaults).
     fn default() -> Self {
+        let hb = crate::hb::HbOptions::default();
+        let lcp = crate::lcp::PeriodicLcpOptions::default();
+        let newton = semismooth::newton::NewtonOptions::default();
+        let march = crate::march::MarchOptions::default();
         Self {
             method: Method::SsnHb,
-            harmonics: DEFAULT_HARMONICS,
-            time_samples: default_hb_time_samples(DEFAULT_HARMONICS),
-            c: None,
+            harmonics: hb.harmonics,
+            time_samples: hb
+                .time_samples
+                .unwrap_or_else(|| default_hb_time_samples(hb.harmonics)),
+            c: hb.c,
             penalty_stiffness: None,
             linear_solver: LinearSolverChoice::default(),
-            max_iterations: 200,
+            max_iterations: newton.max_iterations,
             globalization: GlobalizationChoice::default(),
-            tolerance: 1e-10,
-            steps_per_period: 2000,
-            max_periods: 2000,
-            march_tolerance: 1e-8,
+            tolerance: newton.absolute_tolerance,
+            steps_per_period: march.steps_per_period,
+            max_periods: march.max_periods,
+            march_tolerance: march.tolerance,
             restitution: 0.0,
-            lcp_scheme: LcpScheme::default(),
+            lcp_scheme: lcp.scheme,
         }
     }
 }
 
 impl SolverSettings {
+    /// The defaults for `method`, with its own time discretisation: the AFT samples of
+    /// harmonic balance, the time steps per period of the periodic LCP.
+    pub fn for_method(method: Method) -> Self {
+        let mut settings = Self {
+            method,
+            ..Self::default()
+        };
+        if method.is_lcp() {
+            settings.time_samples = crate::lcp::PeriodicLcpOptions::default().time_samples;
+        }
+        settings
+    }
+
     /// The defaults ([`SolverSettings::default`]) with `harmonics` harmonics and the default
     /// AFT sample count for them.
     pub fn with_harmonics(harmonics: usize) -> Self {

@@ -20,10 +20,10 @@ use crate::contacts::ContactSummary;
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::StateShape;
-use crate::solve::{solve_rod, RunError, Solution};
-use crate::stability::{hb_stability, Stability, StabilityOptions};
-use crate::sweep::follow_branch;
+use crate::solve::{solve, RunError, Solution, Termination};
+use crate::stability::{hb_stability, Stability, StabilityOptions, Undecided};
 use crate::sweep::Reconstruction;
+use crate::sweep::{follow_branch, SweepTermination};
 
 /// Relative distance of the unknowns below which two corrected solutions are the same.
 pub const SAME_SOLUTION: f64 = 1e-6;
@@ -39,6 +39,17 @@ pub struct PeriodicSolution {
     pub stability: Stability,
     /// Index of the branch point after the crossing it was corrected from.
     pub branch_index: usize,
+}
+
+/// A crossing of the frequency whose correction did not converge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailedCorrection {
+    /// Index of the branch point after the crossing.
+    pub branch_index: usize,
+    /// How the correction ended.
+    pub termination: Termination,
+    /// Its final residual norm.
+    pub residual_norm: f64,
 }
 
 /// The answer of [`find_solutions`].
@@ -58,12 +69,12 @@ pub struct SolutionSet {
     pub branch_points: usize,
     /// Whether the branch crossed the whole window.
     pub branch_converged: bool,
-    /// The continuation's termination in words.
-    pub branch_termination: String,
+    /// Why the branch stopped.
+    pub branch_termination: SweepTermination,
     /// Crossings of `w*` found on the branch.
     pub crossings: usize,
-    /// Crossings whose correction did not converge (listed as their termination).
-    pub failed_corrections: Vec<String>,
+    /// Crossings whose correction did not converge.
+    pub failed_corrections: Vec<FailedCorrection>,
     /// Wall time.
     pub seconds: f64,
 }
@@ -118,7 +129,7 @@ pub fn find_solutions(
         solutions: Vec::new(),
         window: (window.omega_ratio_from, window.omega_ratio_to),
         branch_points: branch.points(),
-        branch_converged: branch.converged,
+        branch_converged: branch.converged(),
         branch_termination: branch.termination.clone(),
         crossings: 0,
         failed_corrections: Vec::new(),
@@ -142,14 +153,13 @@ pub fn find_solutions(
             .zip(&branch.states[i])
             .map(|(a, b)| a + t * (b - a))
             .collect();
-        let solution = solve_rod(&at_omega, settings, Some(&start))?;
-        if !solution.converged {
-            set.failed_corrections.push(format!(
-                "crossing between points {} and {i}: {} (|F| = {:e})",
-                i - 1,
-                solution.termination,
-                solution.residual_norm
-            ));
+        let solution = solve(&at_omega, settings, Some(&start))?;
+        if !solution.converged() {
+            set.failed_corrections.push(FailedCorrection {
+                branch_index: i,
+                termination: solution.termination,
+                residual_norm: solution.residual_norm,
+            });
             continue;
         }
         let x = &solution.state;
@@ -175,7 +185,7 @@ pub fn find_solutions(
             &x[..len],
             &StabilityOptions::default(),
         )
-        .unwrap_or_else(|e| Stability::undecided(format!("stability not computed: {e}"), 0));
+        .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e), 0));
         let contacts = reconstruction.contacts(&rod.model, x)?;
         set.solutions.push(PeriodicSolution {
             solution,

@@ -1,10 +1,11 @@
-//! Runs a scene's method on a rod: builds the formulation, drives it with the core's solvers
-//! and reduces the answer to what users compare (the tip over one period, contact
-//! diagnostics, work counters).
+//! One-call solves: [`solve`] runs the chosen method on a [`Structure`], drives it with the
+//! core's solvers and reduces the answer to what users compare (the observed dof over one
+//! period, every contact, work counters).
 //!
 //! A run that could not start (bad settings, a singular model) is an [`RunError`]; a run that
-//! started but did not converge is an `Ok` [`Solution`] with `converged = false` and the
-//! termination reason, so callers can still print what happened.
+//! started and stopped is an `Ok` [`Solution`] whose typed [`Termination`] says how
+//! ([`Solution::converged`]), with the best answer it reached, so callers can still report
+//! what happened.
 
 use std::time::Instant;
 
@@ -12,7 +13,7 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonError, NewtonOptions, NewtonReport, WorkCounters,
+    self, Globalization, NewtonError, NewtonOptions, NewtonReport, Strategy, WorkCounters,
 };
 use semismooth::{GeneralizedJacobian, Residual};
 
@@ -97,6 +98,28 @@ pub struct RunCounters {
     pub time_steps: u64,
 }
 
+impl std::ops::AddAssign for RunCounters {
+    fn add_assign(&mut self, rhs: Self) {
+        self.residual_evaluations += rhs.residual_evaluations;
+        self.jacobian_evaluations += rhs.jacobian_evaluations;
+        self.factorizations += rhs.factorizations;
+        self.linear_solves += rhs.linear_solves;
+        self.line_search_backtracks += rhs.line_search_backtracks;
+        self.ffts += rhs.ffts;
+        self.lemke_pivots += rhs.lemke_pivots;
+        self.time_steps += rhs.time_steps;
+    }
+}
+
+impl std::iter::Sum for RunCounters {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |mut total, c| {
+            total += c;
+            total
+        })
+    }
+}
+
 impl From<WorkCounters> for RunCounters {
     fn from(c: WorkCounters) -> Self {
         RunCounters {
@@ -111,7 +134,82 @@ impl From<WorkCounters> for RunCounters {
     }
 }
 
-/// The answer of one run, reduced to one period of the tip.
+/// How a run ended: the reason its driver stopped, with the numbers that explain it.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Termination {
+    /// A Newton method (SSN-HB, penalty HB, the LCP by semismooth Newton): the core's
+    /// termination of the run that produced the answer.
+    Newton(newton::Termination),
+    /// Lemke's algorithm on the periodic LCP.
+    Lemke {
+        /// Solved, ray or pivot limit.
+        outcome: LemkeTermination,
+        /// Pivots done.
+        pivots: usize,
+        /// The pivot limit of the LCP's order ([`LemkeOptions::pivot_limit`]).
+        pivot_limit: usize,
+        /// The LCP's order `m Nt`.
+        order: usize,
+        /// On a ray: the smallest eigenvalue of the symmetric part of the LCP matrix (a
+        /// negative one means the matrix is not copositive-plus and a ray may end the path).
+        smallest_symmetric_eigenvalue: Option<f64>,
+    },
+    /// Time marching to a steady state.
+    March {
+        /// Whether the period-to-period change fell below the tolerance.
+        steady: bool,
+        /// The last period-to-period change.
+        period_change: f64,
+        /// The tolerance it was compared with.
+        tolerance: f64,
+        /// Periods marched.
+        periods: usize,
+    },
+}
+
+impl Termination {
+    /// Whether the run converged (a Newton run to its tolerance, Lemke to a solution, time
+    /// marching to a steady period).
+    pub fn converged(&self) -> bool {
+        match self {
+            Termination::Newton(t) => t.converged(),
+            Termination::Lemke { outcome, .. } => *outcome == LemkeTermination::Solved,
+            Termination::March { steady, .. } => *steady,
+        }
+    }
+}
+
+/// The short name of a termination: `converged`, the core's name of a Newton termination
+/// (`max-iterations`, `line-search-failed`, ...), `ray`, `pivot-limit`, `not-steady`.
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Termination::Newton(t) => write!(f, "{t}"),
+            Termination::Lemke { outcome, .. } => f.write_str(match outcome {
+                LemkeTermination::Solved => "converged",
+                LemkeTermination::Ray => "ray",
+                LemkeTermination::PivotLimit => "pivot-limit",
+            }),
+            Termination::March { steady, .. } => {
+                f.write_str(if *steady { "converged" } else { "not-steady" })
+            }
+        }
+    }
+}
+
+/// What is known to make a run that did not converge hard, and what to change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Diagnosis {
+    /// Every contact dof has mass or damping, so the trapezoidal LCP's Nyquist receptance
+    /// is 0 and a contact force alternating node to node moves nothing (a null vector of
+    /// the LCP matrix): its solutions chatter and are nearly degenerate;
+    /// [`LcpScheme::Bdf2`] has no such vector.
+    AlternatingNullVector,
+}
+
+/// The answer of one run, reduced to one period of the observed dof.
 #[derive(Debug, Clone)]
 pub struct Solution {
     /// Method used.
@@ -122,19 +220,17 @@ pub struct Solution {
     pub time_samples: usize,
     /// Time discretisation of the periodic LCP (LCP methods only).
     pub lcp_scheme: Option<LcpScheme>,
-    /// What is known to make a run that did not converge hard, and what to change (`None`
-    /// when it converged or nothing is known).
-    pub diagnosis: Option<String>,
+    /// What is known to make a run that did not converge hard (`None` when it converged or
+    /// nothing is known).
+    pub diagnosis: Option<Diagnosis>,
     /// Complementarity constant `c` (SSN-HB only).
     pub c: Option<f64>,
     /// Forcing frequency.
     pub omega: f64,
     /// First natural frequency of the rod.
     pub omega_1: f64,
-    /// Whether the method converged.
-    pub converged: bool,
-    /// Termination reason in words (`converged`, `max-iterations`, `ray`, ...).
-    pub termination: String,
+    /// How the run ended ([`Solution::converged`]).
+    pub termination: Termination,
     /// Newton iterations or Lemke pivots or periods marched.
     pub iterations: usize,
     /// Final residual norm (Newton methods), complementarity error (Lemke), period change
@@ -144,9 +240,8 @@ pub struct Solution {
     /// the model's round-off floor when that is larger; the march tolerance for time
     /// marching; `None` for Lemke, which ends on a basis, not a tolerance).
     pub effective_tolerance: Option<f64>,
-    /// The strategy of the Newton run that produced the answer (`newton`, `smoothing`,
-    /// `newton-homotopy`, `line-search`; Newton methods).
-    pub strategy: Option<&'static str>,
+    /// The strategy of the Newton run that produced the answer (Newton methods).
+    pub strategy: Option<Strategy>,
     /// Every strategy the Newton run tried, in order (Newton methods).
     pub attempts: Vec<semismooth::newton::Attempt>,
     /// Convergence order observed over the last Newton iterations (Newton methods).
@@ -170,6 +265,13 @@ pub struct Solution {
     pub counters: RunCounters,
     /// The method's unknowns (HB coefficients, LCP z), for warm starts.
     pub state: Vec<f64>,
+}
+
+impl Solution {
+    /// Whether the run converged ([`Termination::converged`]).
+    pub fn converged(&self) -> bool {
+        self.termination.converged()
+    }
 }
 
 /// The shape of a harmonic-balance method's unknowns: what a starting state must match.
@@ -337,8 +439,7 @@ hb_reconstruction!(SsnHb, PenaltyHb);
 
 /// How a run ended, as its outputs report it.
 struct Outcome<'a> {
-    converged: bool,
-    termination: String,
+    termination: Termination,
     iterations: usize,
     residual_norm: f64,
     effective_tolerance: Option<f64>,
@@ -351,8 +452,7 @@ struct Outcome<'a> {
 impl<'a> Outcome<'a> {
     fn of_newton(report: &'a NewtonReport, solve_seconds: f64) -> Self {
         Self {
-            converged: report.converged(),
-            termination: report.termination.to_string(),
+            termination: Termination::Newton(report.termination),
             iterations: report.iterations,
             residual_norm: report.residual_norm(),
             effective_tolerance: Some(report.effective_tolerance),
@@ -407,12 +507,11 @@ fn solution(
         c: None,
         omega: rod.model.forcing.omega,
         omega_1: rod.omega_1,
-        converged: outcome.converged,
         termination: outcome.termination,
         iterations: outcome.iterations,
         residual_norm: outcome.residual_norm,
         effective_tolerance: outcome.effective_tolerance,
-        strategy: outcome.newton.map(|r| r.strategy.name()),
+        strategy: outcome.newton.map(|r| r.strategy),
         attempts: outcome.newton.map_or_else(Vec::new, |r| r.attempts.clone()),
         observed_order: outcome.newton.and_then(|r| r.observed_order),
         residual_history: outcome
@@ -505,7 +604,7 @@ fn statistics(
 }
 
 /// Solves the rod with the scene's method, from a zero initial guess (or `warm_start`).
-pub fn solve_rod(
+pub fn solve(
     rod: &Structure,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
@@ -609,94 +708,74 @@ fn solve_lcp(
     let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
     let lcp = PeriodicLcp::new(model, options)?;
-    let (z, converged, termination, iterations, residual, counters, effective_tolerance, finest) =
-        match method {
-            Method::LcpLemke => {
-                let mut lemke = Lemke::new(lcp.dim());
-                let lemke_options = LemkeOptions::default();
-                let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
-                let termination = match report.termination {
-                    LemkeTermination::Solved => "converged".to_string(),
-                    LemkeTermination::Ray => {
-                        let (min_eig, _) = lcp.symmetric_part_spectrum();
-                        format!(
-                        "ray after {} pivots (smallest eigenvalue of the symmetric part of A: {min_eig:e})",
-                        report.pivots
-                    )
-                    }
-                    LemkeTermination::PivotLimit => format!(
-                        "pivot-limit ({} pivots done, the limit {} = 50 n + 100 for n = {}): the \
-                         tip values are those of the unfinished path's last basis, not of a \
-                         solution",
-                        report.pivots,
-                        lemke_options.pivot_limit(lcp.dim()),
-                        lcp.dim()
-                    ),
-                };
-                let counters = RunCounters {
-                    lemke_pivots: report.pivots as u64,
-                    ..RunCounters::default()
-                };
-                (
-                    report.z.clone(),
-                    report.solved(),
-                    termination,
-                    report.pivots,
-                    report.complementarity_error,
-                    counters,
-                    None,
-                    None,
-                )
-            }
-            _ => {
-                // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
-                // one) unless a warm start is given: from z = 0 the active set of a fine LCP
-                // creeps one time node per iteration. Residual floor: the min-map residual
-                // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
-                // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
-                let mut options = newton_options(settings);
-                let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                options.residual_floor = f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale;
-                let (z, report_list) = match warm_start {
-                    Some(w) if w.len() == lcp.dim() => {
-                        let mut problem = lcp.min_map();
-                        let mut z = w.to_vec();
-                        let mut solver = ActiveSetSolver::new()
-                            .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
-                        let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
-                            .or_else(NewtonError::into_report)?;
-                        (z, vec![report])
-                    }
-                    _ => {
-                        let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
-                        let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
-                        (sequenced.z, reports)
-                    }
-                };
-                let last = report_list.last().expect("at least one level");
-                let mut counters = RunCounters::default();
-                for r in &report_list {
-                    let c: RunCounters = r.counters.into();
-                    counters.residual_evaluations += c.residual_evaluations;
-                    counters.jacobian_evaluations += c.jacobian_evaluations;
-                    counters.factorizations += c.factorizations;
-                    counters.linear_solves += c.linear_solves;
-                    counters.line_search_backtracks += c.line_search_backtracks;
+    let (z, termination, iterations, residual, counters, effective_tolerance, finest) = match method
+    {
+        Method::LcpLemke => {
+            let mut lemke = Lemke::new(lcp.dim());
+            let lemke_options = LemkeOptions::default();
+            let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
+            let termination = Termination::Lemke {
+                outcome: report.termination,
+                pivots: report.pivots,
+                pivot_limit: lemke_options.pivot_limit(lcp.dim()),
+                order: lcp.dim(),
+                smallest_symmetric_eigenvalue: (report.termination == LemkeTermination::Ray)
+                    .then(|| lcp.symmetric_part_spectrum().0),
+            };
+            let counters = RunCounters {
+                lemke_pivots: report.pivots as u64,
+                ..RunCounters::default()
+            };
+            (
+                report.z.clone(),
+                termination,
+                report.pivots,
+                report.complementarity_error,
+                counters,
+                None,
+                None,
+            )
+        }
+        _ => {
+            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+            // creeps one time node per iteration. Residual floor: the min-map residual
+            // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
+            // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
+            let mut options = newton_options(settings);
+            let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            options.residual_floor = f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale;
+            let (z, report_list) = match warm_start {
+                Some(w) if w.len() == lcp.dim() => {
+                    let mut problem = lcp.min_map();
+                    let mut z = w.to_vec();
+                    let mut solver = ActiveSetSolver::new()
+                        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
+                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
+                        .or_else(NewtonError::into_report)?;
+                    (z, vec![report])
                 }
-                (
-                    z,
-                    last.converged(),
-                    last.termination.to_string(),
-                    report_list.iter().map(|r| r.iterations).sum(),
-                    last.residual_norm(),
-                    counters,
-                    Some(last.effective_tolerance),
-                    // The finest level's run: its strategy, attempts and residual history
-                    // are the answer's (the iterations and counters are the levels' sums).
-                    report_list.last().cloned(),
-                )
-            }
-        };
+                _ => {
+                    let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
+                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+                    (sequenced.z, reports)
+                }
+            };
+            let last = report_list.last().expect("at least one level");
+            let counters = report_list.iter().map(|r| r.counters.into()).sum();
+            (
+                z,
+                Termination::Newton(last.termination),
+                report_list.iter().map(|r| r.iterations).sum(),
+                last.residual_norm(),
+                counters,
+                Some(last.effective_tolerance),
+                // The finest level's run: its strategy, attempts and residual history
+                // are the answer's (the iterations and counters are the levels' sums).
+                report_list.last().cloned(),
+            )
+        }
+    };
     let seconds = start.elapsed().as_secs_f64();
     let contact_u = lcp.contact_displacements(&z)?;
     let forces = lcp.contact_forces(&z)?;
@@ -705,7 +784,6 @@ fn solve_lcp(
         None => lcp.displacements(&z)?.remove(0),
     };
     let outcome = Outcome {
-        converged,
         termination,
         iterations,
         residual_norm: residual,
@@ -722,14 +800,8 @@ fn solve_lcp(
     };
     let mut sol = solution(rod, settings, settings.time_samples, outcome, period, z);
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
-    if !sol.converged && lcp.has_alternating_null_vector() {
-        sol.diagnosis = Some(
-            "every contact dof has mass or damping, so the trapezoidal LCP's Nyquist receptance \
-             is 0 and a contact force alternating node to node moves nothing (a null vector of \
-             A): solutions chatter and are nearly degenerate; lcp_scheme = \"bdf2\" has no such \
-             vector"
-                .into(),
-        );
+    if !sol.converged() && lcp.has_alternating_null_vector() {
+        sol.diagnosis = Some(Diagnosis::AlternatingNullVector);
     }
     Ok(sol)
 }
@@ -773,15 +845,11 @@ fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, R
         .map(|t| t - start_time)
         .collect();
     let outcome = Outcome {
-        converged: steady,
-        termination: if steady {
-            "converged".into()
-        } else {
-            format!(
-                "not-steady: period-to-period change {:.3e} above the tolerance {:e} after {} \
-                 periods (solver.max_periods)",
-                period.period_change, settings.march_tolerance, period.periods
-            )
+        termination: Termination::March {
+            steady,
+            period_change: period.period_change,
+            tolerance: settings.march_tolerance,
+            periods: period.periods,
         },
         iterations: period.periods,
         residual_norm: period.period_change,

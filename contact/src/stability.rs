@@ -66,6 +66,7 @@ use crate::march::{
     resolve_scheme, MarchError, MarchOptions, MarchScheme, MarchState, TimeMarcher,
 };
 use crate::model::StructuralModel;
+use crate::settings::Method;
 
 /// Largest number of dofs for which the dense monodromy is formed.
 pub const MAX_DOFS: usize = 400;
@@ -122,18 +123,51 @@ pub enum StabilityError {
     Hb(#[from] crate::hb::HbError),
 }
 
+/// Why a periodic solution's stability is not decided.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Undecided {
+    /// A contact dof carries mass: the flow has impacts and its monodromy needs the impact
+    /// law's saltation matrices, which are not implemented (a massless contact dof, e.g.
+    /// the modified mass, is decided).
+    MassCarryingContact,
+    /// The dense monodromy is formed only up to `limit` dofs (it is `2N x 2N`).
+    TooManyDofs {
+        /// The model's dofs.
+        dofs: usize,
+        /// [`MAX_DOFS`].
+        limit: usize,
+    },
+    /// No periodic orbit of the time-stepping map was found near the harmonic-balance
+    /// solution: Newton on the period map stopped.
+    OrbitNotFound {
+        /// Its termination.
+        termination: semismooth::newton::Termination,
+        /// Its iterations.
+        iterations: usize,
+        /// Its last `|F|`.
+        residual_norm: f64,
+    },
+    /// Newton on the period map could not run.
+    ShootingNotRun(NewtonError),
+    /// Stability is computed for harmonic-balance solutions only.
+    NotHarmonicBalance(Method),
+    /// The analysis failed.
+    Failed(StabilityError),
+}
+
 /// The stability of one periodic solution.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stability {
     /// `Some(true)`: every multiplier inside the unit circle; `Some(false)`: one outside;
-    /// `None`: not decided (see `reason`).
+    /// `None`: not decided (see `undecided`).
     pub stable: Option<bool>,
     /// Largest modulus of the multipliers (`None` when not computed).
     pub floquet_max_abs: Option<f64>,
     /// The multipliers, by decreasing modulus (empty when not computed).
     pub multipliers: Multipliers,
     /// Why `stable` is `None`.
-    pub reason: Option<String>,
+    pub undecided: Option<Undecided>,
     /// Steps per period of the map.
     pub steps_per_period: usize,
     /// Steps of the orbit with at least one closed contact.
@@ -152,12 +186,12 @@ pub struct Stability {
 
 impl Stability {
     /// Not decided, for `reason`.
-    pub fn undecided(reason: String, steps_per_period: usize) -> Self {
+    pub fn not_decided(reason: Undecided, steps_per_period: usize) -> Self {
         Self {
             stable: None,
             floquet_max_abs: None,
             multipliers: Multipliers::default(),
-            reason: Some(reason),
+            undecided: Some(reason),
             steps_per_period,
             contact_steps: 0,
             orbit_distance: None,
@@ -263,16 +297,14 @@ pub fn hb_stability(
         });
     }
     if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
-        return Ok(Stability::undecided(
-            "a contact dof has mass: the flow has impacts and the monodromy needs the impact \
-             law's saltation matrices, which are not implemented (use a modified mass)"
-                .to_string(),
-            spp,
-        ));
+        return Ok(Stability::not_decided(Undecided::MassCarryingContact, spp));
     }
     if n > MAX_DOFS {
-        return Ok(Stability::undecided(
-            format!("{n} dofs: the dense monodromy is formed only up to {MAX_DOFS} dofs (2N x 2N)"),
+        return Ok(Stability::not_decided(
+            Undecided::TooManyDofs {
+                dofs: n,
+                limit: MAX_DOFS,
+            },
             spp,
         ));
     }
@@ -296,7 +328,7 @@ pub fn hb_stability(
             stable: Some(multipliers.is_stable()),
             floquet_max_abs: Some(multipliers.max_abs()),
             multipliers,
-            reason: None,
+            undecided: None,
             steps_per_period: spp,
             contact_steps: 0,
             orbit_distance: None,
@@ -333,24 +365,16 @@ pub fn hb_stability(
     let report = match outcome {
         Ok(report) => report,
         Err(NewtonError::NotConverged(report)) => {
-            return Ok(Stability::undecided(
-                format!(
-                    "the periodic orbit of the time-stepping map was not found near the \
-                     harmonic-balance solution: Newton on the period map stopped ({:?}) after \
-                     {} iterations with |F| = {:e}",
-                    report.termination,
-                    report.iterations,
-                    report.residual_norms.last().copied().unwrap_or(f64::NAN)
-                ),
+            return Ok(Stability::not_decided(
+                Undecided::OrbitNotFound {
+                    termination: report.termination,
+                    iterations: report.iterations,
+                    residual_norm: report.residual_norms.last().copied().unwrap_or(f64::NAN),
+                },
                 spp,
             ))
         }
-        Err(err) => {
-            return Ok(Stability::undecided(
-                format!("Newton on the period map could not run: {err}"),
-                spp,
-            ))
-        }
+        Err(err) => return Ok(Stability::not_decided(Undecided::ShootingNotRun(err), spp)),
     };
     shooting.period(&x)?;
     let keep = &shooting.keep;
@@ -387,7 +411,7 @@ pub fn hb_stability(
         stable: Some(multipliers.is_stable()),
         floquet_max_abs: Some(multipliers.max_abs()),
         multipliers,
-        reason: None,
+        undecided: None,
         steps_per_period: spp,
         contact_steps,
         orbit_distance: Some(distance),
@@ -631,7 +655,7 @@ mod tests {
         let u = vec![0.0; rod.model.dofs() * 3];
         let s = hb_stability(&rod.model, 1, rod.omega_1, &u, &StabilityOptions::default()).unwrap();
         assert_eq!(s.stable, None);
-        assert!(s.reason.unwrap().contains("saltation"));
+        assert_eq!(s.undecided, Some(Undecided::MassCarryingContact));
     }
 
     #[test]

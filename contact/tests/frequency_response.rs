@@ -30,7 +30,7 @@ fn curve(
     to: f64,
 ) -> FrequencyResponse {
     let r = frequency_response(rod, &settings(method, harmonics), &sweep(from, to), None).unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     r
 }
 
@@ -43,7 +43,7 @@ fn linear_curve_equals_the_exact_frequency_response_at_every_branch_point() {
     let mut s = settings(Method::SsnHb, h);
     s.tolerance = 1e-12;
     let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     let n = rod.model.dofs();
     let tip = rod.tip_dof();
     assert!(r.points() > 20);
@@ -275,7 +275,7 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
         let rod = rod(Some(gap), 0.04, MassModel::Consistent);
         let s = settings(Method::PenaltyHb, h);
         let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
-        assert!(r.converged, "gap {gap}, H = {h}: {}", r.termination);
+        assert!(r.converged(), "gap {gap}, H = {h}: {}", r.termination);
         assert!((r.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
         let (fold, peak) = jump_down_and_peak(&r);
         println!(
@@ -347,8 +347,8 @@ fn penalty_folds_do_not_depend_on_the_continuation_step() {
         ..sweep(0.5, 2.0)
     };
     let fine = frequency_response(&rod, &s, &fine_steps, None).unwrap();
-    assert!(coarse.converged, "{}", coarse.termination);
-    assert!(fine.converged, "{}", fine.termination);
+    assert!(coarse.converged(), "{}", coarse.termination);
+    assert!(fine.converged(), "{}", fine.termination);
     assert!(fine.points() > 10 * coarse.points());
     assert_eq!(coarse.folds.len(), fine.folds.len());
     let worst = coarse
@@ -384,7 +384,7 @@ fn penalty_branch_converges_like_one_over_the_penalty_and_meets_ssn_as_h_grows()
         s.penalty_stiffness = Some(relative * scale);
         let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
         assert!(
-            r.converged,
+            r.converged(),
             "H = {h}, k_p = {relative:e}: {}",
             r.termination
         );

@@ -6,7 +6,7 @@ use common::{relative, solve_converged};
 
 use semismooth_contact::rod::{build_rod, MassModel, RodContact, RodSpec};
 use semismooth_contact::settings::SolverSettings;
-use semismooth_contact::solve::{solve_rod, Solution};
+use semismooth_contact::solve::{solve, Solution};
 
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
@@ -18,7 +18,7 @@ fn march(spec: &RodSpec, steps: usize) -> Solution {
         max_periods: 5000,
         ..common::march(steps, 1e-10)
     };
-    solve_rod(&rod, &settings, None).unwrap()
+    solve(&rod, &settings, None).unwrap()
 }
 
 /// Exact steady response of the tip, `Re(U e^{i w t})` with `(K - w^2 M + i w D) U = f`,
@@ -52,8 +52,8 @@ fn without_contact_the_hb_answer_is_the_exact_linear_response_after_one_newton_s
             ..RodSpec::canonical()
         };
         let rod = build_rod(&spec).unwrap();
-        let s = solve_rod(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
-        assert!(s.converged, "{label}");
+        let s = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+        assert!(s.converged(), "{label}");
         assert_eq!(s.iterations, 1, "{label}: Newton must stop after one step");
         let exact = exact_linear_tip(&spec, &s.times);
         let scale = exact.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -75,9 +75,9 @@ fn canonical_case_converges_from_zero_for_every_harmonic_count_from_5_to_40() {
     for mass in [MassModel::Consistent, MassModel::Modified] {
         let rod = build_rod(&common::canonical(mass)).unwrap();
         for h in [5, 10, 15, 20, 25, 30, 35, 40] {
-            let s = solve_rod(&rod, &SolverSettings::with_harmonics(h), None).unwrap();
+            let s = solve(&rod, &SolverSettings::with_harmonics(h), None).unwrap();
             assert!(
-                s.converged && s.residual_norm <= 1e-10,
+                s.converged() && s.residual_norm <= 1e-10,
                 "{mass:?} H = {h}: {} after {} iterations, residual {:e}",
                 s.termination,
                 s.iterations,

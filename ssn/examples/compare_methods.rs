@@ -45,7 +45,7 @@ fn compare(mass: MassModel, out: &std::path::Path) -> Result<(), Box<dyn std::er
                 .unwrap_or(f64::NAN);
             labels.push(row.label.clone());
             for (column, v) in csv_rows.iter_mut().zip([
-                if s.converged { 1.0 } else { 0.0 },
+                if s.converged() { 1.0 } else { 0.0 },
                 s.iterations as f64,
                 s.solve_seconds,
                 s.stats.max,
@@ -56,7 +56,7 @@ fn compare(mass: MassModel, out: &std::path::Path) -> Result<(), Box<dyn std::er
             ]) {
                 column.push(v);
             }
-            if s.converged
+            if s.converged()
                 && (row.label.starts_with("march")
                     || row.label == "ssn-hb H=40"
                     || row.label.starts_with("penalty-hb H=40 kp=1e2")

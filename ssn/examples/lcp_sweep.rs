@@ -53,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!(
             "{label:<16} {:>7} {:>9} {:>6} {:>9.3} {:>12.7} {:>10.6}  {:?}",
             r.points(),
-            r.converged,
+            r.converged(),
             r.restarts,
             r.solve_seconds,
             peak,
@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.folds.iter().copied().fold(f64::NEG_INFINITY, f64::max) / rod.omega_1
             )
         );
-        if !r.converged {
+        if !r.converged() {
             println!("    {}", r.termination);
         }
         println!(

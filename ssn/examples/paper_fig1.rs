@@ -13,7 +13,7 @@ mod common;
 
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 use semismooth_contact::settings::SolverSettings;
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use ssn::figures::{fig1_table, figure_1};
 use ssn::output::{write_line_plot, PlotSpec, Series};
 
@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..RodSpec::canonical()
         })?;
         for h in (5..=40).step_by(5) {
-            let s = solve_rod(&rod, &SolverSettings::with_harmonics(h), None)?;
+            let s = solve(&rod, &SolverSettings::with_harmonics(h), None)?;
             println!(
                 "{:<11} {:>4} {:>5} {:>11.2e} {:>11.6}  {}{}",
                 format!("{mass:?}").to_lowercase(),
@@ -52,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .map(|r| format!("{r:.1e}"))
                     .collect::<Vec<_>>()
                     .join(" "),
-                if s.converged { "" } else { "  NOT CONVERGED" }
+                if s.converged() { "" } else { "  NOT CONVERGED" }
             );
             if h == 20 {
                 let period = 2.0 * std::f64::consts::PI / s.omega;

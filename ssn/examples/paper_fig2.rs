@@ -94,7 +94,11 @@ fn print_row(c: &Curve) {
         r.continuation.rejected_steps,
         r.counters.factorizations,
         folds.join(", "),
-        if r.converged { "" } else { &r.termination },
+        if r.converged() {
+            String::new()
+        } else {
+            ssn::words::sweep_termination(r)
+        },
     );
 }
 

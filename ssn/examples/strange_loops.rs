@@ -23,7 +23,7 @@
 //! `cargo run --release --example strange_loops` (about a minute on 2 cores).
 
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use semismooth_contact::sweep::frequency_response;
 use ssn::figures::fig2_rod;
 use ssn::scene::{Method, SolverSettings, SweepSettings};
@@ -71,7 +71,11 @@ fn main() {
                 } else {
                     folds.join(", ")
                 },
-                if r.converged { "" } else { " (stopped early)" }
+                if r.converged() {
+                    ""
+                } else {
+                    " (stopped early)"
+                }
             );
             for k in 1..r.folds.len() {
                 let (a, b) = (r.fold_indices[k - 1], r.fold_indices[k]);
@@ -115,19 +119,19 @@ fn main() {
             ..SolverSettings::with_harmonics(h)
         };
         // Newton on the min map first; Lemke's pivoting where it does not converge.
-        let lcp = match solve_rod(&at.structure, &lcp_settings, None) {
-            Ok(s) if s.converged => Ok(s),
+        let lcp = match solve(&at.structure, &lcp_settings, None) {
+            Ok(s) if s.converged() => Ok(s),
             _ => {
                 let lemke = SolverSettings {
                     method: Method::LcpLemke,
                     ..lcp_settings.clone()
                 };
-                solve_rod(&at.structure, &lemke, None)
+                solve(&at.structure, &lemke, None)
             }
         };
         let amplitudes: Vec<String> = crossings.iter().map(|a| format!("{a:.4}")).collect();
         let lcp_text = match lcp {
-            Ok(s) if s.converged => {
+            Ok(s) if s.converged() => {
                 let amplitude = s.stats.max.abs().max(s.stats.min.abs());
                 let nearest = crossings
                     .iter()

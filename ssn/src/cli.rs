@@ -23,7 +23,7 @@ use crate::scene::{Method, Scene};
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
-use semismooth_contact::solve::{solve_rod, Solution};
+use semismooth_contact::solve::Solution;
 
 /// Bad input found in the scene file `path`: the message starts with the file.
 fn input_error(path: &Path, e: impl Display) -> CliError {
@@ -276,7 +276,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let solution = solve_rod(
+    let solution = semismooth_contact::solve(
         &rod,
         &scene.solver,
         start.as_ref().map(|s| s.unknowns.as_slice()),
@@ -310,7 +310,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
         let mut doc =
             HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
                 .to_json();
-        doc["converged"] = json!(solution.converged);
+        doc["converged"] = json!(solution.converged());
         doc["residual_norm"] = crate::json::finite_or_null(solution.residual_norm);
         let text = serde_json::to_string_pretty(&doc)
             .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
@@ -332,7 +332,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
             }
             t
         },
-        solution.converged,
+        solution.converged(),
     )
 }
 
@@ -404,10 +404,17 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
         writeln!(
             t,
             "converged         {} ({}), {} iterations, residual {:.3e}",
-            s.converged, s.termination, s.iterations, s.residual_norm
+            s.converged(),
+            crate::words::termination(&s.termination),
+            s.iterations,
+            s.residual_norm
         )?;
-        if let Some(diagnosis) = &s.diagnosis {
-            writeln!(t, "diagnosis         {diagnosis}")?;
+        if let Some(diagnosis) = s.diagnosis {
+            writeln!(
+                t,
+                "diagnosis         {}",
+                crate::words::diagnosis(diagnosis)
+            )?;
         }
         let asked = if s.method == Method::March {
             settings.march_tolerance
@@ -568,9 +575,9 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         t += &format!(
             "stability         {} stable, {unstable} unstable, {undecided} undecided{}\n",
             st.stable.len() - unstable - undecided,
-            st.note
+            st.undecided
                 .as_ref()
-                .map(|n| format!(" ({n})"))
+                .map(|u| format!(" ({})", crate::words::undecided(u)))
                 .unwrap_or_default()
         );
         for e in &st.events {
@@ -582,7 +589,9 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         }
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
-            response.converged, response.termination, response.solve_seconds
+            response.converged(),
+            crate::words::sweep_termination(&response),
+            response.solve_seconds
         );
         t
     };
@@ -590,7 +599,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         outputs,
         || crate::json::response_json(&response),
         text,
-        response.converged,
+        response.converged(),
     )
 }
 

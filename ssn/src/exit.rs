@@ -4,13 +4,16 @@
 use crate::io::{OutputError, TargetError};
 
 /// How a command failed, mapped by `main` onto the documented exit codes.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// The solver ran but did not converge (exit code 1); its output was printed.
+    #[error("the solver did not converge")]
     NotConverged,
     /// Bad input: scene, option (exit code 2).
+    #[error("{0}")]
     BadInput(String),
     /// An output could not be written (exit code 3).
+    #[error("{0}")]
     Output(String),
 }
 

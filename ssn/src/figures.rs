@@ -24,7 +24,7 @@ use crate::progress::progress_bar;
 use crate::scene::{Method, SolverSettings, SweepSettings};
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 
 fn bad_input(e: impl std::fmt::Display) -> CliError {
     CliError::BadInput(e.to_string())
@@ -93,7 +93,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         },
         ..SolverSettings::with_harmonics(20)
     };
-    let reference = solve_rod(&rod, &reference_settings, None).map_err(bad_input)?;
+    let reference = solve(&rod, &reference_settings, None).map_err(bad_input)?;
     bar.inc(1);
     let period = 2.0 * std::f64::consts::PI / reference.omega;
     let mut series = Vec::new();
@@ -101,7 +101,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
     let mut rows = Vec::new();
     for h in [10usize, 15, 20] {
         let settings = SolverSettings::with_harmonics(h);
-        let s = solve_rod(&rod, &settings, None).map_err(bad_input)?;
+        let s = solve(&rod, &settings, None).map_err(bad_input)?;
         bar.inc(1);
         let phase: Vec<f64> = s.times.iter().map(|t| t / period).collect();
         series.push(Series::new(
@@ -370,7 +370,7 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel, quiet: bool) -> Result
             folds: r.folds.iter().map(|w| w / rod.omega_1).collect(),
             peak,
             seconds: r.solve_seconds + r.stability_seconds,
-            converged: r.converged,
+            converged: r.converged(),
             unstable: stable.iter().filter(|s| **s == Some(false)).count(),
             undecided: stable.iter().filter(|s| s.is_none()).count(),
         });

@@ -63,8 +63,8 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "time_samples": s.time_samples,
         "omega": s.omega,
         "omega_ratio": s.omega / s.omega_1,
-        "converged": s.converged,
-        "termination": s.termination,
+        "converged": s.converged(),
+        "termination": crate::words::termination(&s.termination),
         "iterations": s.iterations,
         "residual_norm": finite_or_null(s.residual_norm),
         "effective_tolerance": s.effective_tolerance,
@@ -82,11 +82,11 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     if let Some(scheme) = s.lcp_scheme {
         v["lcp_scheme"] = json!(scheme.name());
     }
-    if let Some(diagnosis) = &s.diagnosis {
-        v["diagnosis"] = json!(diagnosis);
+    if let Some(diagnosis) = s.diagnosis {
+        v["diagnosis"] = json!(crate::words::diagnosis(diagnosis));
     }
     if let Some(strategy) = s.strategy {
-        v["strategy"] = json!(strategy);
+        v["strategy"] = json!(strategy.name());
         v["attempts"] = s
             .attempts
             .iter()
@@ -161,14 +161,14 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
             .iter()
             .map(|point| point.iter().map(contact_json).collect::<Vec<_>>())
             .collect::<Vec<_>>(),
-        "stability_note": st.note,
+        "stability_note": st.undecided.as_ref().map(crate::words::undecided),
         "stability_seconds": r.stability_seconds,
         "events": events,
         "folds": r.folds,
         "corner_folds": r.corner_folds,
-        "converged": r.converged,
+        "converged": r.converged(),
         "solve_seconds": r.solve_seconds,
-        "termination": r.termination,
+        "termination": crate::words::sweep_termination(r),
         "counters": counters,
     })
 }
@@ -205,7 +205,7 @@ pub fn solutions_json(set: &SolutionSet) -> Value {
                 "contacts": contacts,
                 "stable": s.stability.stable,
                 "floquet_max_abs": s.stability.floquet_max_abs,
-                "stability_note": s.stability.reason,
+                "stability_note": s.stability.undecided.as_ref().map(crate::words::undecided),
                 "iterations": s.solution.iterations,
                 "residual_norm": s.solution.residual_norm,
                 "state": HbState::from_unknowns(
@@ -225,7 +225,7 @@ pub fn solutions_json(set: &SolutionSet) -> Value {
         "branch_points": set.branch_points,
         "branch_converged": set.branch_converged,
         "crossings": set.crossings,
-        "failed_corrections": set.failed_corrections,
+        "failed_corrections": set.failed_corrections.iter().map(crate::words::failed_correction).collect::<Vec<_>>(),
         "seconds": set.seconds,
         "solutions": solutions,
     })

@@ -18,3 +18,4 @@ pub mod solutions;
 pub mod state;
 pub mod study;
 pub mod tables;
+pub mod words;

@@ -105,7 +105,11 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
                     Some(false) => "unstable".to_string(),
                     None => format!(
                         "undecided: {}",
-                        s.stability.reason.clone().unwrap_or_default()
+                        s.stability
+                            .undecided
+                            .as_ref()
+                            .map(crate::words::undecided)
+                            .unwrap_or_default()
                     ),
                 },
                 s.stability
@@ -114,7 +118,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
             );
         }
         for f in &set.failed_corrections {
-            t += &format!("  not corrected: {f}\n");
+            t += &format!("  not corrected: {}\n", crate::words::failed_correction(f));
         }
         if !set.solutions.is_empty() {
             t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \

@@ -25,7 +25,7 @@ use std::path::Path;
 use crate::output::{write_atomically, write_line_plot, OutputError, PlotSpec, Series};
 use crate::scene::{default_hb_time_samples, Method, SolverSettings};
 use semismooth_contact::model::Structure;
-use semismooth_contact::solve::{solve_rod, RunError, Solution};
+use semismooth_contact::solve::{solve, RunError, Solution};
 
 /// Steps per period of the time-marching reference.
 pub const REFERENCE_STEPS: usize = 8000;
@@ -311,13 +311,13 @@ fn table_line(s: &mut String, c: [String; 8]) {
 
 /// Runs `settings`, repeating fast runs and keeping the median wall time.
 fn timed(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
-    let first = solve_rod(rod, settings, None)?;
+    let first = solve(rod, settings, None)?;
     if first.solve_seconds >= REPEAT_BELOW_SECONDS {
         return Ok(first);
     }
     let mut times = vec![first.solve_seconds];
     for _ in 1..REPEATS {
-        times.push(solve_rod(rod, settings, None)?.solve_seconds);
+        times.push(solve(rod, settings, None)?.solve_seconds);
     }
     times.sort_by(f64::total_cmp);
     let mut sol = first;
@@ -421,7 +421,7 @@ fn reference(
     say: &dyn Fn(&str),
 ) -> Result<Reference, RunError> {
     let march = |steps: usize, tolerance: f64, periods: usize| {
-        solve_rod(
+        solve(
             rod,
             &SolverSettings {
                 method: Method::March,
@@ -436,15 +436,15 @@ fn reference(
     say(&format!(
         "cross-check: SSN-HB, {REFERENCE_HARMONICS} harmonics"
     ));
-    let hb = solve_rod(rod, &hb_settings(base, REFERENCE_HARMONICS), None)
+    let hb = solve(rod, &hb_settings(base, REFERENCE_HARMONICS), None)
         .ok()
-        .filter(|s| s.converged);
+        .filter(|s| s.converged());
     for (tolerance, periods) in REFERENCE_TOLERANCES {
         say(&format!(
             "reference: time marching, {REFERENCE_STEPS} steps per period, tolerance {tolerance:e}"
         ));
         // A march that does not settle reports converged = false.
-        let steady = |r: Result<Solution, RunError>| r.ok().filter(|s| s.converged);
+        let steady = |r: Result<Solution, RunError>| r.ok().filter(|s| s.converged());
         let Some(fine) = steady(march(REFERENCE_STEPS, tolerance, periods)) else {
             continue;
         };
@@ -473,8 +473,8 @@ fn reference(
     }
     let mut h = REFERENCE_HARMONICS / 2;
     while runs.len() < 2 && h >= 10 {
-        if let Ok(s) = solve_rod(rod, &hb_settings(base, h), None) {
-            if s.converged {
+        if let Ok(s) = solve(rod, &hb_settings(base, h), None) {
+            if s.converged() {
                 runs.push((h, s));
             }
         }
@@ -538,8 +538,8 @@ pub fn accuracy_cost(
                     .then(|| relative(sol.stats.mean_contact_force, reference.mean_force)),
                 seconds: sol.solve_seconds,
                 iterations: sol.iterations,
-                converged: sol.converged,
-                failure: (!sol.converged).then(|| sol.termination.clone()),
+                converged: sol.converged(),
+                failure: (!sol.converged()).then(|| crate::words::termination(&sol.termination)),
             },
             Err(e) => Entry {
                 method,

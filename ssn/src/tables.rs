@@ -14,7 +14,7 @@ use crate::scene::{GlobalizationChoice, Method, SolverSettings, SweepSettings};
 use crate::study::{AccuracyCost, Entry};
 use semismooth_contact::from_zero::GridCase;
 use semismooth_contact::rod::{build_rod, MassModel, ModelError, RodModel, RodSpec};
-use semismooth_contact::solve::{solve_rod, RunError, Solution};
+use semismooth_contact::solve::{solve, RunError, Solution};
 use semismooth_contact::sweep::frequency_response;
 
 /// A markdown table: a header, rows of cells, and the columns that hold wall times.
@@ -187,7 +187,7 @@ pub fn method_comparison(mass: MassModel) -> Result<(Table, Vec<ComparisonRow>),
         .into_iter()
         .map(|(label, settings)| ComparisonRow {
             label,
-            result: solve_rod(&rod, &settings, None).map_err(|e| e.to_string()),
+            result: solve(&rod, &settings, None).map_err(|e| e.to_string()),
         })
         .collect();
     let reference_min = rows[0].result.as_ref().ok().map(|r| r.stats.min);
@@ -208,10 +208,14 @@ pub fn method_comparison(mass: MassModel) -> Result<(Table, Vec<ComparisonRow>),
         table.rows.push(match &row.result {
             Ok(s) => {
                 let diff = reference_min.map_or(f64::NAN, |r| (s.stats.min - r).abs() / r.abs());
-                let label = if s.converged {
+                let label = if s.converged() {
                     row.label.clone()
                 } else {
-                    format!("{} (not converged: {})", row.label, s.termination)
+                    format!(
+                        "{} (not converged: {})",
+                        row.label,
+                        crate::words::termination(&s.termination)
+                    )
                 };
                 vec![
                     label,
@@ -343,10 +347,14 @@ pub fn sweeps(cases: &[SweepCase]) -> Result<Table, TableError> {
         let r = frequency_response(&rod, &case.settings, &case.sweep, None)?;
         let (ip, peak) = r.peak().unwrap_or((0, f64::NAN));
         let highest = r.folds.iter().copied().fold(f64::NAN, f64::max) / rod.omega_1;
-        let label = if r.converged {
+        let label = if r.converged() {
             case.label.clone()
         } else {
-            format!("{} (not converged: {})", case.label, r.termination)
+            format!(
+                "{} (not converged: {})",
+                case.label,
+                crate::words::sweep_termination(&r)
+            )
         };
         table.rows.push(vec![
             label,
@@ -430,7 +438,7 @@ pub fn solve_group(
     for case in cases {
         let mut settings = case.solver_settings();
         settings.globalization = globalization;
-        let sol = match solve_rod(&case.rod, &settings, None) {
+        let sol = match solve(&case.rod, &settings, None) {
             Ok(sol) => sol,
             Err(e) => {
                 g.failures.push(format!("{}: {e}", case.label));
@@ -442,7 +450,7 @@ pub fn solve_group(
         };
         g.backtracks += sol.counters.line_search_backtracks;
         g.largest = g.largest.max(sol.iterations);
-        if !sol.converged || sol.iterations > 60 {
+        if !sol.converged() || sol.iterations > 60 {
             let mut d = format!("{} ({} iterations):", case.label, sol.iterations);
             for a in &sol.attempts {
                 d.push_str(&format!(
@@ -454,15 +462,15 @@ pub fn solve_group(
             }
             g.details.push(d);
         }
-        let strategy = if sol.converged {
+        let strategy = if sol.converged() {
             g.converged += 1;
             iterations.push(sol.iterations);
-            sol.strategy.unwrap_or("-").to_string()
+            sol.strategy.map_or("-", |s| s.name()).to_string()
         } else {
-            g.failures
-                .push(format!("{} ({})", case.label, sol.termination));
-            if !g.terminations.contains(&sol.termination) {
-                g.terminations.push(sol.termination.clone());
+            let termination = crate::words::termination(&sol.termination);
+            g.failures.push(format!("{} ({termination})", case.label));
+            if !g.terminations.contains(&termination) {
+                g.terminations.push(termination);
             }
             "failed".to_string()
         };
@@ -553,7 +561,7 @@ pub fn performance() -> Result<Table, TableError> {
             mass,
             ..RodSpec::canonical()
         })?;
-        let s = solve_rod(&rod, &SolverSettings::with_harmonics(20), None)?;
+        let s = solve(&rod, &SolverSettings::with_harmonics(20), None)?;
         table.rows.push(vec![
             format!(
                 "canonical rod, {} mass, H = 20, from zero, one cold solve",
@@ -581,7 +589,7 @@ pub fn performance() -> Result<Table, TableError> {
         mass: MassModel::Modified,
         ..RodSpec::canonical()
     })?;
-    let march = solve_rod(
+    let march = solve(
         &rod,
         &SolverSettings {
             method: Method::March,
@@ -595,7 +603,7 @@ pub fn performance() -> Result<Table, TableError> {
         format!("{} periods", march.iterations),
         format!("{:.3}", march.solve_seconds),
     ]);
-    let lemke = solve_rod(
+    let lemke = solve(
         &rod,
         &SolverSettings {
             method: Method::LcpLemke,

@@ -6,7 +6,7 @@
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::natural_frequencies;
-use semismooth_contact::solve::{solve_rod, Solution};
+use semismooth_contact::solve::Solution;
 use semismooth_contact::sweep::frequency_response;
 use ssn::scene::{Method, Scene, SolverSettings};
 
@@ -69,8 +69,13 @@ fn natural_frequencies_are_the_analytic_ones_within_the_discretisation_error() {
 fn solve(s: &Structure, base: &SolverSettings, edit: impl Fn(&mut SolverSettings)) -> Solution {
     let mut settings = base.clone();
     edit(&mut settings);
-    let sol = solve_rod(s, &settings, None).unwrap();
-    assert!(sol.converged, "{:?}: {}", settings.method, sol.termination);
+    let sol = semismooth_contact::solve(s, &settings, None).unwrap();
+    assert!(
+        sol.converged(),
+        "{:?}: {}",
+        settings.method,
+        sol.termination
+    );
     sol
 }
 
@@ -113,7 +118,7 @@ fn a_sweep_through_the_first_resonance_folds_at_the_stop_and_is_linear_off_conta
     settings.time_samples = ssn::scene::default_hb_time_samples(10);
     let sweep = scene.sweep.clone().unwrap();
     let r = frequency_response(&s, &settings, &sweep, None).unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     let gap = s.model.contacts[0].gap;
     let ratio = r.omega_ratio();
     eprintln!(

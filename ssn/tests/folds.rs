@@ -25,7 +25,7 @@ fn sweep(method: &str, step: f64, max_step: Option<f64>) -> FrequencyResponse {
     let scene = Scene::from_toml(&text, "<test>").unwrap();
     let rod = build_rod(&scene.rod).unwrap();
     let r = frequency_response(&rod, &scene.solver, scene.sweep.as_ref().unwrap(), None).unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     r
 }
 

@@ -22,7 +22,7 @@ use semismooth_contact::from_zero::{
     forty_element_rod, grid_frequency_ratios, grid_rod, many_contacts_rod, GRID_GAPS,
 };
 use semismooth_contact::rod::{build_rod, MassModel};
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use semismooth_contact::sweep::frequency_response;
 use ssn::scene::{Method, SolverSettings, SweepSettings};
 
@@ -65,7 +65,7 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                 };
                 let branch = frequency_response(&base, &sweep_settings, &sweep, None).unwrap();
                 assert!(
-                    branch.converged,
+                    branch.converged(),
                     "{mass:?} H={harmonics} p0={p0} gap={gap}: sweep {}",
                     branch.termination
                 );
@@ -73,8 +73,8 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                     branch.omega.iter().map(|w| w / base.omega_1).collect();
                 for &ratio in &ratios {
                     let rod = build_rod(&grid_rod(mass, p0, gap, ratio)).unwrap();
-                    let sol = solve_rod(&rod, &settings, None).unwrap();
-                    if !sol.converged {
+                    let sol = solve(&rod, &settings, None).unwrap();
+                    if !sol.converged() {
                         failures.push(format!(
                             "{mass:?} H={harmonics} p0={p0} gap={gap} omega={ratio:.2}: {}",
                             sol.termination
@@ -93,7 +93,7 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                         "{mass:?} H={harmonics} p0={p0} gap={gap} omega={ratio:.2}: tip max {} \
                          ({}) is not on the branch (crossings {on_branch:?})",
                         sol.stats.max,
-                        sol.strategy.unwrap_or("-"),
+                        sol.strategy.map_or("-", |s| s.name()),
                     );
                 }
             }
@@ -154,7 +154,7 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
             )
             .unwrap();
             assert!(
-                branch.converged,
+                branch.converged(),
                 "p0={p0} gap={gap}: {}",
                 branch.termination
             );
@@ -164,11 +164,11 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
                     continue;
                 }
                 let rod = build_rod(&grid_rod(MassModel::Modified, p0, gap, ratio)).unwrap();
-                let coarse = solve_rod(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
-                let fine = solve_rod(&rod, &SolverSettings::with_harmonics(40), None).unwrap();
-                let reference = solve_rod(&rod, &march, None).unwrap();
+                let coarse = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+                let fine = solve(&rod, &SolverSettings::with_harmonics(40), None).unwrap();
+                let reference = solve(&rod, &march, None).unwrap();
                 assert!(
-                    coarse.converged && fine.converged && reference.converged,
+                    coarse.converged() && fine.converged() && reference.converged(),
                     "p0={p0} gap={gap} omega={ratio}: H=20 {}, H=40 {}, march {}",
                     coarse.termination,
                     fine.termination,
@@ -182,7 +182,7 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
                      tolerance {tolerance:.2e} ({} from zero in {} iterations)",
                     fine.stats.max,
                     reference.stats.max,
-                    fine.strategy.unwrap_or("-"),
+                    fine.strategy.map_or("-", |s| s.name()),
                     fine.iterations
                 );
                 assert!(
@@ -207,9 +207,9 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
 #[test]
 fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
     let rod = build_rod(&many_contacts_rod(10)).unwrap();
-    let sol = solve_rod(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+    let sol = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
     assert!(
-        sol.converged && sol.iterations <= 60,
+        sol.converged() && sol.iterations <= 60,
         "{} after {} iterations",
         sol.termination,
         sol.iterations
@@ -221,7 +221,7 @@ fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
     };
     let branch =
         frequency_response(&rod, &common::sweep_solver(Method::SsnHb, 20), &sweep, None).unwrap();
-    assert!(branch.converged, "sweep: {}", branch.termination);
+    assert!(branch.converged(), "sweep: {}", branch.termination);
     let ratio: Vec<f64> = branch.omega.iter().map(|w| w / rod.omega_1).collect();
     let on_branch = branch_tip_max_at(&ratio, &branch.tip_max, 1.0);
     let distance = on_branch
@@ -231,7 +231,7 @@ fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
     println!(
         "10 contacts: {} iterations ({}), tip max {} vs branch {on_branch:?}",
         sol.iterations,
-        sol.strategy.unwrap_or("-"),
+        sol.strategy.map_or("-", |s| s.name()),
         sol.stats.max
     );
     assert!(
@@ -263,16 +263,16 @@ fn forty_element_rod_converges_from_zero_at_high_harmonic_counts_and_refines_wit
     let mut penetration = Vec::new();
     let mut force = Vec::new();
     for (harmonics, measured) in [(20, 40), (40, 47), (80, 48), (160, 192)] {
-        let sol = solve_rod(&rod, &SolverSettings::with_harmonics(harmonics), None).unwrap();
+        let sol = solve(&rod, &SolverSettings::with_harmonics(harmonics), None).unwrap();
         println!(
             "H = {harmonics}: {} after {} iterations ({}), tip max {}, mean force {}",
             sol.termination,
             sol.iterations,
-            sol.strategy.unwrap_or("-"),
+            sol.strategy.map_or("-", |s| s.name()),
             sol.stats.max,
             sol.contacts[0].force_mean
         );
-        assert!(sol.converged, "H = {harmonics}: {}", sol.termination);
+        assert!(sol.converged(), "H = {harmonics}: {}", sol.termination);
         assert!(
             sol.iterations.abs_diff(measured) <= measured / 10,
             "H = {harmonics}: {} iterations, measured {measured}",
@@ -310,17 +310,17 @@ fn many_contacts_converge_from_zero_in_iterations_that_do_not_grow_with_their_nu
     let mut totals = Vec::new();
     for (points, measured) in [(10, 40), (25, 41), (50, 42), (100, 42)] {
         let rod = build_rod(&many_contacts_rod(points)).unwrap();
-        let sol = solve_rod(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+        let sol = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
         println!(
             "{points} contacts: {} after {} iterations ({}), total mean force {:e}, tip max {}",
             sol.termination,
             sol.iterations,
-            sol.strategy.unwrap_or("-"),
+            sol.strategy.map_or("-", |s| s.name()),
             sol.stats.mean_contact_force,
             sol.stats.max
         );
         assert!(
-            sol.converged && sol.iterations <= 60,
+            sol.converged() && sol.iterations <= 60,
             "{points} contacts: {} after {} iterations",
             sol.termination,
             sol.iterations

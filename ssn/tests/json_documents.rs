@@ -16,7 +16,7 @@ fn sweep_json_has_the_documented_fields_one_entry_per_point() {
         None,
     )
     .unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     let v = ssn::json::response_json(&r);
     for key in common::json_fields::SWEEP {
         assert!(v.get(key).is_some(), "{key}");

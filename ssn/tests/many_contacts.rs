@@ -5,7 +5,7 @@
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{ContactPoint, HarmonicForcing, StructuralModel, Structure};
 use semismooth_contact::rod::natural_frequencies;
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use semismooth_contact::structures::BladedDisk;
 use ssn::scene::Scene;
 
@@ -24,10 +24,10 @@ fn a_hundred_contacts_converge_and_the_linear_limit_is_exact() {
     let (scene, s) = shipped(|t| t);
     assert_eq!(s.model.contacts.len(), 100);
     assert_eq!(s.model.dofs(), 300);
-    let sol = solve_rod(&s, &scene.solver, None).unwrap();
+    let sol = solve(&s, &scene.solver, None).unwrap();
     // Measured: 13 iterations from zero at H = 5 (0.7 s on the 2-core machine).
     assert!(
-        sol.converged && sol.iterations <= 30,
+        sol.converged() && sol.iterations <= 30,
         "{} {}",
         sol.termination,
         sol.iterations
@@ -49,8 +49,8 @@ fn a_hundred_contacts_converge_and_the_linear_limit_is_exact() {
     );
     // Far casing: the exact linear response (dense complex solve of the 300 dofs).
     let (scene, far) = shipped(|t| t.replace("gap = 1.0", "gap = 1000.0"));
-    let sol = solve_rod(&far, &scene.solver, None).unwrap();
-    assert!(sol.converged);
+    let sol = solve(&far, &scene.solver, None).unwrap();
+    assert!(sol.converged());
     let (diff, z) = common::linear_history_error(&far.model, far.observed_dof, &sol);
     assert!(diff < 1e-9 * z, "{diff:e}");
 }
@@ -109,10 +109,10 @@ fn a_tuned_disk_with_a_hundred_contacts_answers_as_one_sector_with_one_contact()
     // static stiffness at one contact with the others free, which the ring changes).
     let mut settings = scene.solver.clone();
     settings.c = Some(one.model.default_complementarity_constant());
-    let a = solve_rod(&one, &settings, None).unwrap();
-    let b = solve_rod(&all, &settings, None).unwrap();
+    let a = solve(&one, &settings, None).unwrap();
+    let b = solve(&all, &settings, None).unwrap();
     assert!(
-        a.converged && b.converged,
+        a.converged() && b.converged(),
         "{} / {}",
         a.termination,
         b.termination

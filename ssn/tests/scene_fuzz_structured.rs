@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 use proptest::prelude::*;
 use proptest::test_runner::{RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use semismooth_contact::rod::{build_rod, natural_frequencies};
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use semismooth_contact::sweep::frequency_response;
 use ssn::limits::{check, rod_scene_memory};
 use ssn::scene::{Method, Scene, SolverSettings};
@@ -284,10 +284,10 @@ fn run_case(text: &str, reached: &Reached) -> Result<(), TestCaseError> {
     }
     let settings = clamped(&scene);
     reached.solved.fetch_add(1, Relaxed);
-    if let Ok(sol) = solve_rod(&rod, &settings, None) {
+    if let Ok(sol) = solve(&rod, &settings, None) {
         let json = ssn::json::solution_json(Path::new("fuzz.toml"), &sol);
         prop_assert!(serde_json::to_string(&json).is_ok());
-        if sol.converged {
+        if sol.converged() {
             prop_assert!(
                 sol.stats.max.is_finite() && sol.stats.min.is_finite(),
                 "converged with non-finite tip values: {text}"

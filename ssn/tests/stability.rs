@@ -9,7 +9,7 @@ use semismooth_contact::march::{
 };
 use semismooth_contact::rod::{build_rod, RodModel};
 use semismooth_contact::solutions::find_solutions;
-use semismooth_contact::solve::solve_rod;
+use semismooth_contact::solve::solve;
 use semismooth_contact::stability::{hb_stability, hb_state, Stability, StabilityOptions};
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 use ssn::scene::Scene;
@@ -41,7 +41,7 @@ fn strong_sweep() -> (RodModel, Scene, FrequencyResponse) {
     let scene = scene(STRONG);
     let rod = build_rod(&scene.rod).unwrap();
     let r = frequency_response(&rod, &scene.solver, scene.sweep.as_ref().unwrap(), None).unwrap();
-    assert!(r.converged, "{}", r.termination);
+    assert!(r.converged(), "{}", r.termination);
     (rod, scene, r)
 }
 
@@ -240,8 +240,8 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
     let mut stable_tips = Vec::new();
     for range in [0..upper_fold, lower_fold..r.points()] {
         let i = nearest(&r, w1, range, omega / w1);
-        let sol = solve_rod(&at_omega, &scene.solver, Some(&r.states[i])).unwrap();
-        assert!(sol.converged, "{}", sol.termination);
+        let sol = solve(&at_omega, &scene.solver, Some(&r.states[i])).unwrap();
+        assert!(sol.converged(), "{}", sol.termination);
         let st = stability_of(&rod, h, omega, &sol.state);
         assert_eq!(st.stable, Some(true));
         stable_tips.push(sol.stats.min);
@@ -405,7 +405,7 @@ fn three_solutions_inside_the_overhang_two_stable() {
     let h = scene.solver.harmonics;
     let len = rod.model.dofs() * (2 * h + 1);
     for s in &set.solutions {
-        assert!(s.solution.converged);
+        assert!(s.solution.converged());
         assert_eq!(rod.model.forcing.omega, set.omega);
         if s.stability.stable != Some(true) {
             continue;

@@ -4,7 +4,7 @@
 
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{ContactDirection, InvalidModel, Structure};
-use semismooth_contact::solve::{solve_rod, Solution};
+use semismooth_contact::solve::Solution;
 use ssn::scene::{default_hb_time_samples, Method, Scene, SolverSettings};
 
 mod common;
@@ -37,8 +37,8 @@ fn solve(s: &Structure, base: &SolverSettings, method: Method, harmonics: usize)
     settings.harmonics = harmonics;
     settings.time_samples = default_hb_time_samples(harmonics);
     settings.steps_per_period = 2000;
-    let sol = solve_rod(s, &settings, None).unwrap();
-    assert!(sol.converged, "{method:?}: {}", sol.termination);
+    let sol = semismooth_contact::solve(s, &settings, None).unwrap();
+    assert!(sol.converged(), "{method:?}: {}", sol.termination);
     sol
 }
 
@@ -138,7 +138,9 @@ fn stops_on_one_side_twice_or_without_clearance_are_rejected() {
     let (scene, _) = beam(|t| t);
     let mut solver = scene.solver.clone();
     solver.method = Method::LcpLemke;
-    let err = solve_rod(&s, &solver, None).unwrap_err().to_string();
+    let err = semismooth_contact::solve(&s, &solver, None)
+        .unwrap_err()
+        .to_string();
     assert!(
         err.contains("negative side") && err.contains("dof 41"),
         "{err}"

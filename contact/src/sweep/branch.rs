@@ -20,7 +20,7 @@ use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{Method, SolverSettings};
 use crate::solve::{hb_options, penalty_options, RunError};
-use crate::stability::{hb_stability, Stability, StabilityError, StabilityOptions};
+use crate::stability::{hb_stability, Stability, StabilityError, StabilityOptions, Undecided};
 use crate::sweep::FrequencyResponse;
 
 /// Reconstruction points per period for the contact diagnostics.
@@ -51,19 +51,19 @@ pub struct BranchStability {
     /// Stability changes in branch order.
     pub events: Vec<BifurcationEvent>,
     /// Why points are undecided (the first reason met), `None` when all are decided.
-    pub note: Option<String>,
+    pub undecided: Option<Undecided>,
 }
 
 impl BranchStability {
-    /// `points` undecided points with `note` as the reason.
-    pub fn undecided(points: usize, note: String) -> Self {
+    /// `points` undecided points, all for `reason`.
+    pub fn not_decided(points: usize, reason: Undecided) -> Self {
         Self {
             stable: vec![None; points],
             floquet_max_abs: vec![None; points],
             contact_force_mean: vec![f64::NAN; points],
             max_penetration: vec![f64::NAN; points],
             events: Vec::new(),
-            note: Some(note),
+            undecided: Some(reason),
         }
     }
 }
@@ -163,13 +163,9 @@ pub fn branch_stability(
             PenaltyHb::new(model, &penalty_options(settings, model)).map(Reconstruction::Penalty)
         }
         _ => {
-            return Ok(BranchStability::undecided(
+            return Ok(BranchStability::not_decided(
                 points,
-                format!(
-                    "stability is computed for harmonic-balance branches (ssn-hb, penalty-hb), \
-                     not {}",
-                    settings.method.name()
-                ),
+                Undecided::NotHarmonicBalance(settings.method),
             ))
         }
     };
@@ -179,8 +175,8 @@ pub fn branch_stability(
     let mut analyses: Vec<Option<Stability>> = Vec::with_capacity(points);
     for (i, x) in response.states.iter().enumerate() {
         let s = hb_stability(model, harmonics, response.omega[i], &x[..len], options)?;
-        if s.stable.is_none() && out.note.is_none() {
-            out.note.clone_from(&s.reason);
+        if s.stable.is_none() && out.undecided.is_none() {
+            out.undecided.clone_from(&s.undecided);
         }
         out.stable.push(s.stable);
         out.floquet_max_abs.push(s.floquet_max_abs);

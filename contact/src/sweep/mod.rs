@@ -97,7 +97,9 @@ use semismooth::newton::{self, NewtonError, WorkCounters};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
-pub use response::{separate_turning_points, FrequencyResponse, TURNING_POINT_EXCURSION};
+pub use response::{
+    separate_turning_points, FrequencyResponse, SweepTermination, TURNING_POINT_EXCURSION,
+};
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
@@ -107,7 +109,7 @@ use crate::solve::{
     hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
     HB_OUTPUT_POINTS,
 };
-use crate::stability::StabilityOptions;
+use crate::stability::{StabilityOptions, Undecided};
 use branch::branch_stability;
 pub(crate) use branch::Reconstruction;
 pub use branch::{BifurcationEvent, BranchStability};
@@ -380,8 +382,9 @@ where
         fold_indices: Vec::new(),
         corner_folds: Vec::new(),
         corner_fold_indices: Vec::new(),
-        converged: false,
-        termination: String::new(),
+        omega_from,
+        omega_to: sweep.omega_ratio_to * omega_1,
+        termination: SweepTermination::Unexplained,
         solve_seconds: 0.0,
         counters: RunCounters::from(work),
         continuation: Default::default(),
@@ -396,18 +399,15 @@ where
         contacts: Vec::new(),
     };
     if !report.converged() {
-        response.termination = format!(
-            "the start at omega_ratio {} did not converge: {} after {} iterations (|F| = {:e})",
-            sweep.omega_ratio_from,
-            report.termination,
-            report.iterations,
-            report.residual_norm()
-        );
+        response.termination = SweepTermination::StartNotConverged {
+            termination: report.termination,
+            iterations: report.iterations,
+            residual_norm: report.residual_norm(),
+        };
         response.solve_seconds = setup.started.elapsed().as_secs_f64();
         return Ok(response);
     }
 
-    let to = sweep.omega_ratio_to * omega_1;
     let mut continuation = configure(
         Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
     );
@@ -453,95 +453,14 @@ where
     response.restarts = c.restarts as usize;
     response.corners = c.corners as usize;
     response.continuation = c;
-    let ratio = |omega: f64| omega / omega_1;
-    let (converged, words) = match (&termination, start_failure) {
-        (_, Some(failure)) => (
-            false,
-            format!("the start point could not be corrected: {failure}"),
-        ),
-        (Some(ContinuationTermination::SegmentStartFailed { failure, .. }), None) => (
-            false,
-            format!("the start point could not be corrected: {failure}"),
-        ),
-        (Some(ContinuationTermination::Retraced { parameter }), None) => (
-            false,
-            format!(
-                "stalled at omega_ratio {}: no step ahead (a corner the continuation cannot \
-                 turn), and the only step found goes back along the branch",
-                ratio(*parameter)
-            ),
-        ),
-        (Some(ContinuationTermination::ReachedBound { parameter, bound }), None) => {
-            let reached_end = *bound == to;
-            let at_bound = *parameter == *bound;
-            (
-                reached_end,
-                format!(
-                    "reached omega_ratio {}{}",
-                    ratio(*bound),
-                    if reached_end {
-                        if at_bound {
-                            " (the end of the sweep)".to_string()
-                        } else {
-                            format!(
-                                " (the end of the sweep; last point at {} not re-solved on it)",
-                                ratio(*parameter)
-                            )
-                        }
-                    } else {
-                        " (the start of the sweep: the branch turned back)".to_string()
-                    }
-                ),
-            )
+    response.termination = match (termination, start_failure) {
+        (_, Some(failure)) => SweepTermination::StartNotCorrected(failure),
+        (Some(ContinuationTermination::SegmentStartFailed { failure, .. }), None) => {
+            SweepTermination::StartNotCorrected(failure)
         }
-        (Some(ContinuationTermination::IterationBudgetSpent { parameter, budget }), None) => (
-            false,
-            format!(
-                "the {budget} corrector iterations allowed were spent at omega_ratio {}",
-                ratio(*parameter)
-            ),
-        ),
-        (Some(ContinuationTermination::MaxPoints { points }), None) => (
-            false,
-            format!(
-                "point limit ({points} points) at omega_ratio {}",
-                response.omega.last().map_or(f64::NAN, |w| w / omega_1)
-            ),
-        ),
-        (
-            Some(ContinuationTermination::StepTooSmall {
-                parameter,
-                step,
-                failure,
-                ..
-            }),
-            None,
-        ) => (
-            false,
-            format!(
-                "step too small at omega_ratio {}: the attempt with step {step:e} failed: {failure}",
-                ratio(*parameter)
-            ),
-        ),
-        (
-            Some(ContinuationTermination::TooManyFailures {
-                parameter,
-                failures,
-                failure,
-                ..
-            }),
-            None,
-        ) => (
-            false,
-            format!(
-                "{failures} failed steps in a row at omega_ratio {}: {failure}",
-                ratio(*parameter)
-            ),
-        ),
-        (None, None) => (false, "stopped without a reason".to_string()),
+        (Some(t), None) => SweepTermination::Branch(t),
+        (None, None) => SweepTermination::Unexplained,
     };
-    response.converged = converged;
-    response.termination = words;
     response.solve_seconds = setup.started.elapsed().as_secs_f64();
     Ok(response)
 }
@@ -569,7 +488,7 @@ pub fn frequency_response(
     let options = StabilityOptions::default();
     response.stability =
         branch_stability(rod, settings, &response, &options).unwrap_or_else(|err| {
-            BranchStability::undecided(response.points(), format!("stability not computed: {err}"))
+            BranchStability::not_decided(response.points(), Undecided::Failed(err))
         });
     response.stability_seconds = started.elapsed().as_secs_f64();
     Ok(response)

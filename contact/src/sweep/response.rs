@@ -1,6 +1,6 @@
 //! The result of a sweep: a frequency-response curve and its JSON form.
 
-use semismooth::continuation::ContinuationCounters;
+use semismooth::continuation::{ContinuationCounters, ContinuationTermination, CorrectorFailure};
 use semismooth::harmonic::{Aft, FourierBasis};
 
 use crate::contacts::ContactReport;
@@ -43,10 +43,12 @@ pub struct FrequencyResponse {
     pub corner_folds: Vec<f64>,
     /// Index of the extreme point at each corner reversal (same order as `corner_folds`).
     pub corner_fold_indices: Vec<usize>,
-    /// Whether the branch reached `omega_ratio_to` (the bound at the end of the sweep).
-    pub converged: bool,
-    /// Why the continuation stopped, in words.
-    pub termination: String,
+    /// The start of the sweep (`omega_ratio_from omega_1`).
+    pub omega_from: f64,
+    /// The end of the sweep (`omega_ratio_to omega_1`).
+    pub omega_to: f64,
+    /// Why the sweep stopped ([`FrequencyResponse::converged`]).
+    pub termination: SweepTermination,
     /// Wall time of the whole computation after the rod was built (reference amplitude,
     /// initial Newton solve, continuation, tip reconstructions).
     pub solve_seconds: f64,
@@ -75,7 +77,56 @@ pub struct FrequencyResponse {
     pub contacts: Vec<Vec<ContactReport>>,
 }
 
+/// Why a sweep stopped.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SweepTermination {
+    /// The globalized Newton solve at the start frequency did not converge.
+    StartNotConverged {
+        /// The Newton run's termination.
+        termination: semismooth::newton::Termination,
+        /// Its iterations.
+        iterations: usize,
+        /// Its final `|F|`.
+        residual_norm: f64,
+    },
+    /// The continuation could not correct its start point (or a segment's start after a
+    /// restart).
+    StartNotCorrected(CorrectorFailure),
+    /// The continuation's own termination: the branch reached a bound, or stopped with
+    /// the numbers that explain why.
+    Branch(ContinuationTermination),
+    /// The continuation ended without saying why.
+    Unexplained,
+}
+
+/// The short name of a sweep's termination: the core's words for the branch, or
+/// `start-not-converged (...)`, `start-not-corrected (...)`, `unexplained`.
+impl std::fmt::Display for SweepTermination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SweepTermination::StartNotConverged { termination, .. } => {
+                write!(f, "start-not-converged ({termination})")
+            }
+            SweepTermination::StartNotCorrected(failure) => {
+                write!(f, "start-not-corrected ({failure})")
+            }
+            SweepTermination::Branch(t) => write!(f, "{t}"),
+            SweepTermination::Unexplained => f.write_str("unexplained"),
+        }
+    }
+}
+
 impl FrequencyResponse {
+    /// Whether the branch reached the end of the sweep (`omega_to`).
+    pub fn converged(&self) -> bool {
+        matches!(
+            self.termination,
+            SweepTermination::Branch(ContinuationTermination::ReachedBound { bound, .. })
+                if bound == self.omega_to
+        )
+    }
+
     pub(super) fn push(
         &mut self,
         omega: f64,

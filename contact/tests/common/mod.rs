@@ -15,7 +15,7 @@ use semismooth_contact::rod::{build_rod, MassModel, RodContact, RodModel, RodSpe
 use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, Method, SolverSettings, SweepSettings,
 };
-use semismooth_contact::solve::{solve_rod, RunError, Solution};
+use semismooth_contact::solve::{solve, RunError, Solution};
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
 /// The canonical rod of the paper's Fig. 1 (20 elements, tip gap 0.5, forced at
@@ -76,9 +76,9 @@ pub fn march(steps: usize, tolerance: f64) -> SolverSettings {
 
 /// Solves `rod` with `settings`; fails the test unless the solve converged.
 pub fn solve_converged(rod: &RodModel, settings: &SolverSettings) -> Solution {
-    let s = solve_rod(rod, settings, None).unwrap();
+    let s = solve(rod, settings, None).unwrap();
     assert!(
-        s.converged,
+        s.converged(),
         "{} H = {} Nt = {} c = {:?}: {} ({} iterations)",
         settings.method.name(),
         settings.harmonics,

@@ -527,12 +527,13 @@ impl Check<'_> {
     /// in (an HB method needs more AFT samples than `2 H`).
     fn solver(&self, s: &RawSolver) -> Result<SolverSettings, SceneError> {
         let method = s.method;
+        let default = SolverSettings::default();
         let harmonics = self.count_or(
             "solver.harmonics",
             s.harmonics,
             1,
             MAX_HARMONICS,
-            DEFAULT_HARMONICS,
+            default.harmonics,
         )?;
         let time_samples = match (s.time_samples, method.is_harmonic_balance()) {
             (Some(n), true) => {
@@ -551,27 +552,41 @@ impl Check<'_> {
             }
             (Some(n), false) => self.count("solver.time_samples", n, 8, MAX_TIME_SAMPLES)?,
             (None, true) => default_hb_time_samples(harmonics),
-            (None, false) => DEFAULT_LCP_TIME_SAMPLES,
+            (None, false) => SolverSettings::for_method(method).time_samples,
         };
         let c = s.c.map(|c| self.positive("solver.c", c)).transpose()?;
         let penalty_stiffness = s
             .penalty_stiffness
             .map(|k| self.positive("solver.penalty_stiffness", k))
             .transpose()?;
-        let max_iterations =
-            self.count_or("solver.max_iterations", s.max_iterations, 1, 100_000, 200)?;
-        let tolerance = self.positive("solver.tolerance", s.tolerance.unwrap_or(1e-10))?;
+        let max_iterations = self.count_or(
+            "solver.max_iterations",
+            s.max_iterations,
+            1,
+            100_000,
+            default.max_iterations,
+        )?;
+        let tolerance =
+            self.positive("solver.tolerance", s.tolerance.unwrap_or(default.tolerance))?;
         let steps_per_period = self.count_or(
             "solver.steps_per_period",
             s.steps_per_period,
             8,
             MAX_TIME_SAMPLES,
-            2000,
+            default.steps_per_period,
         )?;
-        let max_periods = self.count_or("solver.max_periods", s.max_periods, 1, 1_000_000, 2000)?;
-        let march_tolerance =
-            self.positive("solver.march_tolerance", s.march_tolerance.unwrap_or(1e-8))?;
-        let restitution = s.restitution.unwrap_or(0.0);
+        let max_periods = self.count_or(
+            "solver.max_periods",
+            s.max_periods,
+            1,
+            1_000_000,
+            default.max_periods,
+        )?;
+        let march_tolerance = self.positive(
+            "solver.march_tolerance",
+            s.march_tolerance.unwrap_or(default.march_tolerance),
+        )?;
+        let restitution = s.restitution.unwrap_or(default.restitution);
         if !(0.0..=1.0).contains(&restitution) {
             return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
         }

@@ -33,8 +33,7 @@ mod check;
 
 pub use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,
-    SolverSettings, SweepSettings, DEFAULT_HARMONICS, DEFAULT_LCP_TIME_SAMPLES,
-    DEFAULT_RELATIVE_PENALTY,
+    SolverSettings, SweepSettings, DEFAULT_RELATIVE_PENALTY,
 };
 
 /// Why a scene could not be used. Every variant names the file; `Invalid` also names the
