@@ -59,8 +59,12 @@ pub enum GlobalizationChoice {
     /// Full steps for 30 iterations (active-set behaviour), then the non-monotone line
     /// search from the initial guess.
     Hybrid,
-    /// Full steps for 30 iterations, then the Newton homotopy from the initial guess, then
-    /// the non-monotone line search; the report names the strategy that converged.
+    /// The polyalgorithm (`semismooth::newton::Globalization::Polyalgorithm`): up to 30 full
+    /// steps (stopped early when they stagnate and the problem offers a smoothing); then,
+    /// each from the initial guess, the smoothing path where the problem offers one (SSN-HB
+    /// and the LCP's min map; penalty HB does not), the non-monotone line search on at most
+    /// half of the iterations left, and the Newton homotopy `F(x) - (1 - t) F(x_0) = 0`; the
+    /// report names the strategy that converged.
     #[default]
     Auto,
 }
@@ -82,7 +86,8 @@ pub struct SolverSettings {
     pub harmonics: usize,
     /// AFT samples (HB) or time steps per period (LCP).
     pub time_samples: usize,
-    /// Complementarity constant `c`; `None`: the contact stiffness scale.
+    /// Complementarity constant `c`; `None`: 10 x the static contact stiffness shared by
+    /// the contacts that close together (`StructuralModel::default_complementarity_constant`).
     pub c: Option<f64>,
     /// Penalty stiffness `k_p` (absolute); `None`: 1e5 times the contact stiffness scale.
     pub penalty_stiffness: Option<f64>,

@@ -24,7 +24,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows = figure_1(&out, MassModel::Modified, quiet).map_err(map)?;
     rows.extend(figure_1(&out, MassModel::Consistent, quiet).map_err(map)?);
     print!("{}", fig1_table(&rows));
-    println!("\nNewton from zero, H = 5..40 (hybrid globalization, structured solver)");
+    println!(
+        "\nNewton from zero, H = 5..40 (the default `auto` globalization: full steps, then the \
+         smoothing path, the non-monotone line search, the Newton homotopy; structured solver)"
+    );
     println!(
         "{:<11} {:>4} {:>5} {:>11} {:>11}  last residual norms",
         "mass", "H", "iter", "residual", "tip min"

@@ -491,7 +491,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
     let st = &response.stability;
-    // stable: 1 / 0, NaN when undecided.
+    // stable: 1 / 0, NaN when undecided (an empty cell in the CSV).
     let stable: Vec<f64> = st
         .stable
         .iter()

@@ -130,10 +130,22 @@ pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
         .map(|c| (c.dof + 1).to_string())
         .collect();
     if !massive.is_empty() {
+        let (what, remedy) = if scene.model.is_some() {
+            (
+                "contact dof(s)",
+                "put each contact on a massless pad dof (a zero row and column of M) joined to \
+                 the structure by a stiff spring (about 10 x the static stiffness there)",
+            )
+        } else {
+            (
+                "contact node(s)",
+                "mass = \"modified\" makes the tip contact massless",
+            )
+        };
         line(format!(
-            "note              contact node(s) {} carry mass: time marching then needs an impact \
-             law and harmonic balance imposes none, so the two need not agree, and the periodic \
-             LCP may be hard for Lemke; mass = \"modified\" makes the tip contact massless",
+            "note              {what} {} carry mass: time marching then needs an impact \
+             law and harmonic balance imposes none, so the two need not agree, the periodic \
+             LCP may be hard for Lemke and the stability is undecided; {remedy}",
             massive.join(", ")
         ));
     }

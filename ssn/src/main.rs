@@ -39,8 +39,9 @@ Exit codes:
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Output directory of the default run and of `compare` [default: out].
-    #[arg(long, global = true)]
+    /// Output directory of the default run [default: out] (`ssn compare` takes its own
+    /// --out; the other commands write the files named by --csv, --svg and --state).
+    #[arg(long)]
     out: Option<PathBuf>,
     /// Nothing on stdout or stderr but errors (no progress, no text summary; `--json` is
     /// still printed).
@@ -117,6 +118,9 @@ enum Command {
         /// method reaching it is reported.
         #[arg(long, default_value_t = 1e-3)]
         accuracy: f64,
+        /// Output directory of the table, CSV and SVG [default: out].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Write a scene's structure as Matrix Market files (M, K, D, f) and a [model] scene
     /// that solves the same problem.
@@ -145,10 +149,19 @@ fn main() -> ExitCode {
         Err(e) => return clap_exit(&e),
     };
     io::set_quiet(args.quiet);
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out"));
+    let default_out = || PathBuf::from("out");
     let result = match &args.command {
-        None => in_new_directory(&out, || figures::default_run(&out, args.quiet)),
-        Some(Command::Compare { scene, accuracy }) => {
+        None => {
+            let out = args.out.clone().unwrap_or_else(default_out);
+            in_new_directory(&out, || figures::default_run(&out, args.quiet))
+        }
+        // `ssn --out DIR compare SCENE` and `ssn compare SCENE --out DIR` both work.
+        Some(Command::Compare {
+            scene,
+            accuracy,
+            out,
+        }) => {
+            let out = out.clone().or(args.out.clone()).unwrap_or_else(default_out);
             in_new_directory(&out, || cli::compare(scene, &out, *accuracy, args.quiet))
         }
         Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(

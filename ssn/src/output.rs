@@ -7,7 +7,8 @@ pub use crate::io::{prepare_directory, write_atomically, OutputError};
 use plotters::prelude::*;
 
 /// A CSV table from named columns of equal length (shorter columns are padded with empty
-/// cells). Numbers are written with full precision.
+/// cells). Numbers are written with full precision; a non-finite value (an undecided
+/// stability, a quantity that does not apply) is an empty cell, never `NaN` or `inf`.
 pub fn csv_table(headers: &[&str], columns: &[&[f64]]) -> String {
     let rows = columns.iter().map(|c| c.len()).max().unwrap_or(0);
     let mut out = headers.join(",");
@@ -15,7 +16,12 @@ pub fn csv_table(headers: &[&str], columns: &[&[f64]]) -> String {
     for r in 0..rows {
         let cells: Vec<String> = columns
             .iter()
-            .map(|c| c.get(r).map(|v| format!("{v:e}")).unwrap_or_default())
+            .map(|c| {
+                c.get(r)
+                    .filter(|v| v.is_finite())
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default()
+            })
             .collect();
         out.push_str(&cells.join(","));
         out.push('\n');
@@ -388,6 +394,13 @@ mod tests {
         let v: f64 = lines[2].split(',').next().unwrap().parse().unwrap();
         assert_eq!(v, 1.0 / 3.0);
         assert!(lines[2].ends_with(','));
+    }
+
+    #[test]
+    fn csv_table_writes_non_finite_values_as_empty_cells() {
+        let a = [1.0, f64::NAN, f64::INFINITY, 0.0];
+        let text = csv_table(&["stable"], &[&a]);
+        assert_eq!(text, "stable\n1e0\n\n\n0e0\n");
     }
 
     #[test]

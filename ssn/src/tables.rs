@@ -1,12 +1,13 @@
-//! The measured tables of the README, each computed by one function of this module and
-//! printed as markdown, in the README's format, by
-//! `cargo run --release --example readme_tables [-- SECTION ...]`.
+//! The measured tables of the documentation (`docs/`), each computed by one function of
+//! this module. `cargo run --release -p ssn --example docs_tables [-- SECTION ...]` prints
+//! them as markdown, and with `--write` replaces each section's generated block in its
+//! docs file ([`SECTIONS`], [`replace_block`]).
 //!
 //! A [`Table`] knows which of its columns are wall times (they vary from machine to
 //! machine and run to run); every other cell is deterministic (iteration counts, points,
-//! folds, errors rounded as printed), and `tests/readme_tables.rs` recomputes the cheap
-//! tables and asserts that README.md holds exactly those cells, so a README number cannot
-//! drift from the code unnoticed.
+//! folds, errors rounded as printed), and `tests/docs_tables.rs` recomputes the cheap
+//! tables and asserts that the docs files hold exactly those cells, so a documented number
+//! cannot drift from the code unnoticed.
 
 use std::time::Instant;
 
@@ -16,6 +17,97 @@ use semismooth_contact::from_zero::GridCase;
 use semismooth_contact::rod::{build_rod, MassModel, ModelError, RodModel, RodSpec};
 use semismooth_contact::solve::{solve, RunError, Solution};
 use semismooth_contact::sweep::frequency_response;
+
+/// A section of the generated tables: its name (the argument of the `docs_tables`
+/// example) and the docs file, relative to the workspace root, that holds its block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Section {
+    /// The section's name (`methods`, `sweeps`, ...).
+    pub name: &'static str,
+    /// The docs file holding the section's generated block.
+    pub file: &'static str,
+}
+
+/// Every section, in the order the example computes them: the method comparison, the
+/// cheapest setting per accuracy, the frequency sweeps, the public grid from zero, what the
+/// examples time, and the hard cases from zero (minutes).
+pub const SECTIONS: [Section; 6] = [
+    Section {
+        name: "methods",
+        file: "docs/method-comparison.md",
+    },
+    Section {
+        name: "accuracy",
+        file: "docs/accuracy-cost.md",
+    },
+    Section {
+        name: "sweeps",
+        file: "docs/sweeps.md",
+    },
+    Section {
+        name: "from-zero",
+        file: "docs/solving-from-zero.md",
+    },
+    Section {
+        name: "performance",
+        file: "docs/performance.md",
+    },
+    Section {
+        name: "hard",
+        file: "docs/solving-from-zero.md",
+    },
+];
+
+/// The section called `name`.
+pub fn section(name: &str) -> Option<Section> {
+    SECTIONS.iter().copied().find(|s| s.name == name)
+}
+
+/// The line that opens the generated block of `section` in its docs file.
+pub fn block_start(section: &str) -> String {
+    format!("<!-- docs_tables {section}: generated, do not edit -->")
+}
+
+/// The line that closes the generated block of `section`.
+pub fn block_end(section: &str) -> String {
+    format!("<!-- docs_tables {section}: end -->")
+}
+
+/// `text` with the generated block of `section` (the lines between [`block_start`] and
+/// [`block_end`]) replaced by `content`; `None` when `text` has no such block.
+pub fn replace_block(text: &str, section: &str, content: &str) -> Option<String> {
+    let (start, end) = (block_start(section), block_end(section));
+    let open = text.find(&start)? + start.len();
+    let close = open + text[open..].find(&end)?;
+    let mut out = String::with_capacity(text.len() + content.len());
+    out.push_str(&text[..open]);
+    out.push_str("\n\n");
+    out.push_str(content.trim());
+    out.push_str("\n\n");
+    out.push_str(&text[close..]);
+    Some(out)
+}
+
+/// The machine the wall times of a generated block were measured on: the processor
+/// model, the cores and the load average when the tables were computed (Linux; `unknown`
+/// where the system does not say).
+pub fn machine_note() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown processor".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|t| t.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into());
+    format!("{cpu}, {cores} cores, load average {load}")
+}
 
 /// A markdown table: a header, rows of cells, and the columns that hold wall times.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,7 +183,7 @@ impl Table {
                 let have = found.get(i).map_or("", String::as_str);
                 if have != cell {
                     out.push(format!(
-                        "row {:?}, column {:?}: README has {have:?}, the code gives {cell:?}",
+                        "row {:?}, column {:?}: the docs have {have:?}, the code gives {cell:?}",
                         row[0], self.header[i]
                     ));
                 }
@@ -175,7 +267,7 @@ pub fn comparison_settings(rod: &RodModel, mass: MassModel) -> Vec<(String, Solv
 }
 
 /// The method comparison on the canonical rod with the given mass model: every method of
-/// [`comparison_settings`] solved once from zero, and the README's table of them (`ms`, the
+/// [`comparison_settings`] solved once from zero, and the table of them (`ms`, the
 /// wall time of one cold solve, is the timing column; `diff. tip min` is relative to the
 /// reference, the first row).
 pub fn method_comparison(mass: MassModel) -> Result<(Table, Vec<ComparisonRow>), TableError> {
@@ -255,7 +347,7 @@ pub fn cheapest_settings(study: &AccuracyCost) -> Table {
     table
 }
 
-/// One frequency sweep of the README's sweep table.
+/// One frequency sweep of the sweep table.
 #[derive(Debug, Clone)]
 pub struct SweepCase {
     /// The row's name.
@@ -271,7 +363,7 @@ pub struct SweepCase {
     pub slow: bool,
 }
 
-/// The sweeps of the README over `[0.5, 2] omega_1` on the canonical rod (gap 0.5, load
+/// The sweeps of the sweep table over `[0.5, 2] omega_1` on the canonical rod (gap 0.5, load
 /// 0.04): SSN-HB at H = 20 and 40 and the periodic LCP by semismooth Newton at Nt = 128,
 /// 256, 512 with the modified mass (scene defaults, up to 5000 points), and penalty HB at
 /// the default penalty at H = 5 and 20 with the consistent mass (at most 100 Newton
@@ -321,7 +413,7 @@ pub fn sweep_cases() -> Vec<SweepCase> {
     cases
 }
 
-/// The README's sweep table for `cases`: points, corrector iterations, corners crossed
+/// The sweep table for `cases`: points, corrector iterations, corners crossed
 /// exactly, folds (turning points), reversals at corners, the highest fold and the peak
 /// amplitude with its frequency, and the wall time of the sweep (the timing column).
 pub fn sweeps(cases: &[SweepCase]) -> Result<Table, TableError> {
@@ -486,9 +578,9 @@ pub fn solve_group(
     g
 }
 
-/// The README's table of the public grid solved from zero: per group converged points /
-/// worst iteration count and the strategies that converged, with the default `auto`, and
-/// converged / worst with `hybrid` (the default before the polyalgorithm); `auto` and
+/// The table of the public grid solved from zero: per group converged points / worst
+/// iteration count and the strategies that converged, with the default `auto`, and
+/// converged / worst with `hybrid` (full steps, then the non-monotone line search); `auto` and
 /// `hybrid` are the two groups' summaries, in the same order.
 pub fn from_zero_grid(auto: &[GroupSummary], hybrid: &[GroupSummary]) -> Table {
     let mut table = Table::new(
@@ -515,7 +607,7 @@ pub fn from_zero_grid(auto: &[GroupSummary], hybrid: &[GroupSummary]) -> Table {
     table
 }
 
-/// The README's table of the hard cases solved from zero (`auto`): per case (a group of
+/// The table of the hard cases solved from zero (`auto`): per case (a group of
 /// cases for the LCP) the cases that converged, the largest iteration count (converged or
 /// not), the strategies that converged or the terminations of those that did not, and the
 /// wall time (the timing column).
@@ -541,8 +633,8 @@ pub fn from_zero_hard(groups: &[GroupSummary]) -> Table {
     table
 }
 
-/// The README's table of what the examples time (criterion's medians are in a table of
-/// their own): one cold solve of the canonical rod from zero with SSN-HB at H = 20 (the
+/// The table of what the examples time (criterion's medians are in a table of their
+/// own): one cold solve of the canonical rod from zero with SSN-HB at H = 20 (the
 /// Newton iterations, including the first Jacobian and factorization, not the assembly of
 /// the rod), the four Fig. 2 sweeps at H = 5 and one at H = 20 (continuation from the
 /// first point to the last; the consistent mass, so no stability), time marching from rest
@@ -618,4 +710,43 @@ pub fn performance() -> Result<Table, TableError> {
         format!("{:.3}", lemke.solve_seconds),
     ]);
     Ok(table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn replace_block_replaces_only_the_named_block() {
+        let text = format!(
+            "intro\n{}\nold a\n{}\nmiddle\n{}\nold b\n{}\nend\n",
+            block_start("a"),
+            block_end("a"),
+            block_start("b"),
+            block_end("b")
+        );
+        let new = replace_block(&text, "b", "| x |\n|---|\n| 1 |\n").unwrap();
+        assert!(new.contains("old a") && !new.contains("old b"), "{new}");
+        assert!(new.contains(&format!(
+            "{}\n\n| x |\n|---|\n| 1 |\n\n{}",
+            block_start("b"),
+            block_end("b")
+        )));
+        assert!(new.ends_with("end\n"));
+        assert_eq!(replace_block(&text, "c", "x"), None);
+        // Replacing twice gives the same text.
+        assert_eq!(
+            replace_block(&new, "b", "| x |\n|---|\n| 1 |").unwrap(),
+            new
+        );
+    }
+
+    #[test]
+    fn every_section_has_a_file_and_a_distinct_name() {
+        for (i, s) in SECTIONS.iter().enumerate() {
+            assert!(s.file.starts_with("docs/") && s.file.ends_with(".md"));
+            assert_eq!(section(s.name), Some(*s));
+            assert!(SECTIONS[..i].iter().all(|t| t.name != s.name));
+        }
+    }
 }

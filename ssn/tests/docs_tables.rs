@@ -1,9 +1,10 @@
-//! README.md's measured tables hold what the code computes: the cheap tables are recomputed
-//! here (`ssn::tables`, the functions `examples/readme_tables.rs` prints)
-//! and every deterministic cell (iteration counts, points, folds, errors rounded as printed)
-//! must be in README.md exactly; wall-time columns are not compared. A README number that
-//! drifts from the code fails here: regenerate the table with
-//! `cargo run --release --example readme_tables -- SECTION` and paste it.
+//! The measured tables of `docs/` hold what the code computes: the cheap tables are
+//! recomputed here (`ssn::tables`, the functions `examples/docs_tables.rs` prints) and
+//! every deterministic cell (iteration counts, points, folds, errors rounded as printed)
+//! must be in the section's docs file exactly, inside its generated block; wall-time
+//! columns are not compared. A documented number that drifts from the code fails here:
+//! regenerate the block with
+//! `cargo run --release -p ssn --example docs_tables -- --write SECTION`.
 
 use semismooth_contact::from_zero::{hard_cases, public_grid};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
@@ -11,27 +12,41 @@ use ssn::scene::{GlobalizationChoice, SolverSettings};
 use ssn::study::accuracy_cost;
 use ssn::tables::{self, Table};
 
-fn readme() -> String {
-    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md"))
-        .expect("README.md is readable")
+/// The generated block of `section` in its docs file (the lines between its markers).
+fn block(section: &str) -> String {
+    let file = tables::section(section)
+        .unwrap_or_else(|| panic!("no section {section:?}"))
+        .file;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../").to_string() + file;
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let (start, end) = (tables::block_start(section), tables::block_end(section));
+    let open = text
+        .find(&start)
+        .unwrap_or_else(|| panic!("{file}: no line {start:?}"));
+    let close = text[open..]
+        .find(&end)
+        .unwrap_or_else(|| panic!("{file}: no line {end:?} after {start:?}"));
+    text[open..open + close].to_string()
 }
 
-/// Every row of `table` is in README.md's table of the same header with the same
-/// deterministic cells; with `complete`, README's table has no other rows either.
-fn assert_in_readme(section: &str, table: &Table, complete: bool) {
-    let mut differences = table.differences_in(&readme());
-    let rows = table.rows_in(&readme()).unwrap_or_default();
+/// Every row of `table` is in the section's block, in its table of the same header, with
+/// the same deterministic cells; with `complete`, that table has no other rows either.
+fn assert_in_docs(section: &str, table: &Table, complete: bool) {
+    let text = block(section);
+    let mut differences = table.differences_in(&text);
+    let rows = table.rows_in(&text).unwrap_or_default();
     if complete && rows.len() != table.rows.len() {
         differences.push(format!(
-            "README has {} rows, the code {}",
+            "the docs have {} rows, the code {}",
             rows.len(),
             table.rows.len()
         ));
     }
     assert!(
         differences.is_empty(),
-        "README.md differs from the code (`cargo run --release --example readme_tables -- \
-         {section}` prints the table):\n{}\n\nthe code's table:\n{}",
+        "{} differs from the code (`cargo run --release -p ssn --example docs_tables -- \
+         --write {section}` rewrites it):\n{}\n\nthe code's table:\n{}",
+        tables::section(section).unwrap().file,
         differences.join("\n"),
         table.markdown()
     );
@@ -41,7 +56,7 @@ fn assert_in_readme(section: &str, table: &Table, complete: bool) {
 fn method_comparison_tables_are_the_codes() {
     for mass in [MassModel::Modified, MassModel::Consistent] {
         let (table, _) = tables::method_comparison(mass).unwrap();
-        assert_in_readme("methods", &table, true);
+        assert_in_docs("methods", &table, true);
     }
 }
 
@@ -53,9 +68,9 @@ fn sweep_table_is_the_codes_for_the_sweeps_under_a_second() {
         .collect();
     assert!(cheap.len() >= 5);
     let table = tables::sweeps(&cheap).unwrap();
-    assert_in_readme("sweeps", &table, false);
+    assert_in_docs("sweeps", &table, false);
     // The slow rows are there too, one per sweep.
-    let rows = table.rows_in(&readme()).unwrap();
+    let rows = table.rows_in(&block("sweeps")).unwrap();
     assert_eq!(rows.len(), tables::sweep_cases().len(), "{rows:?}");
 }
 
@@ -72,19 +87,19 @@ fn from_zero_grid_table_is_the_codes() {
         &run(GlobalizationChoice::Auto),
         &run(GlobalizationChoice::Hybrid),
     );
-    assert_in_readme("from-zero", &table, true);
+    assert_in_docs("from-zero", &table, true);
 }
 
 #[test]
 fn performance_counts_are_the_codes() {
-    assert_in_readme("performance", &tables::performance().unwrap(), true);
+    assert_in_docs("performance", &tables::performance().unwrap(), true);
 }
 
 /// Which setting is cheapest depends on the times, so the cells are not compared as text:
-/// each setting the README names must be one the study ran, converged, and reach the
-/// accuracy of its column; and the README lists every method of the study.
+/// each setting the docs name must be one the study ran, converged, and reach the accuracy
+/// of its column; and the docs list every method of the study.
 #[test]
-fn cheapest_settings_in_the_readme_reach_their_accuracy() {
+fn cheapest_settings_in_the_docs_reach_their_accuracy() {
     let rod = build_rod(&RodSpec {
         mass: MassModel::Modified,
         ..RodSpec::canonical()
@@ -93,8 +108,8 @@ fn cheapest_settings_in_the_readme_reach_their_accuracy() {
     let study = accuracy_cost(&rod.structure, &SolverSettings::with_harmonics(20), None).unwrap();
     let table = tables::cheapest_settings(&study);
     let rows = table
-        .rows_in(&readme())
-        .expect("README has the cheapest-settings table");
+        .rows_in(&block("accuracy"))
+        .expect("the docs have the cheapest-settings table");
     assert_eq!(rows.len(), table.rows.len(), "{rows:?}");
     for (row, ours) in rows.iter().zip(&table.rows) {
         assert_eq!(row[0], ours[0], "methods in the study's order");
@@ -134,7 +149,29 @@ fn hard_cases_table_is_the_codes_for_the_cases_under_a_second() {
         .collect();
     assert_eq!(groups.len(), 5);
     let table = tables::from_zero_hard(&groups);
-    assert_in_readme("hard", &table, false);
-    let rows = table.rows_in(&readme()).unwrap();
+    assert_in_docs("hard", &table, false);
+    let rows = table.rows_in(&block("hard")).unwrap();
     assert_eq!(rows.len(), hard_cases().unwrap().len(), "{rows:?}");
+}
+
+/// The check itself fails when a deterministic cell drifts: one iteration count changed
+/// in a copy of the method comparison's block is reported.
+#[test]
+fn a_drifted_cell_is_reported() {
+    let (table, _) = tables::method_comparison(MassModel::Modified).unwrap();
+    let text = block("methods");
+    assert!(table.differences_in(&text).is_empty());
+    let row = &table.rows[1];
+    let line = format!("| {} |", row.join(" | "));
+    let mut cells = row.clone();
+    cells[1] = format!("{}0", cells[1]);
+    let drifted = text.replacen(
+        &line[..line.find(" | ").unwrap() + 3 + row[1].len()],
+        &format!("| {} | {}", cells[0], cells[1]),
+        1,
+    );
+    assert_ne!(drifted, text, "the row {line:?} is in the block");
+    let differences = table.differences_in(&drifted);
+    assert_eq!(differences.len(), 1, "{differences:?}");
+    assert!(differences[0].contains("iterations"), "{differences:?}");
 }
