@@ -125,8 +125,24 @@ pub struct LineSearchFailure {
     pub backtracks: u64,
 }
 
+/// Why a backtracking search ended without a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Backtrack<E> {
+    /// No acceptable step at or above `min_step`.
+    Failed(LineSearchFailure),
+    /// The merit could not be evaluated at all (the closure's error), after `backtracks`
+    /// rejected trials.
+    Aborted {
+        /// The closure's error.
+        error: E,
+        /// Rejected trials before it.
+        backtracks: u64,
+    },
+}
+
 /// Backtracking from `alpha = 1`: accepts the first `alpha = shrink^k >= min_step` with
-/// a finite `merit(alpha) <= reference + sufficient_decrease * alpha * slope`.
+/// a finite `merit(alpha) <= reference + sufficient_decrease * alpha * slope`; a merit the
+/// closure cannot give (`Err`) ends the search ([`Backtrack::Aborted`]).
 ///
 /// `reference` is `m(0)` for Armijo or [`NonMonotoneHistory::reference`]; `slope` is the
 /// directional derivative `m'(0) < 0`. The loop ends for any options (it also stops
@@ -137,20 +153,23 @@ pub struct LineSearchFailure {
 /// use semismooth::linesearch::{backtrack, LineSearchOptions};
 /// // m(alpha) = 0.5 (1 - 3 alpha)^2: the full step overshoots (m(1) = 2 > m(0) = 0.5);
 /// // alpha = 0.5 gives m = 0.125 <= 0.5 - 1e-4 * 0.5 * 1.0, accepted after 1 backtrack.
-/// let merit = |alpha: f64| 0.5 * (1.0 - 3.0 * alpha).powi(2);
+/// let merit = |alpha: f64| Ok::<_, ()>(0.5 * (1.0 - 3.0 * alpha).powi(2));
 /// let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), merit).unwrap();
 /// assert_eq!((step.step, step.backtracks), (0.5, 1));
 /// ```
-pub fn backtrack(
+pub fn backtrack<E>(
     reference: f64,
     slope: f64,
     options: &LineSearchOptions,
-    mut merit: impl FnMut(f64) -> f64,
-) -> Result<AcceptedStep, LineSearchFailure> {
+    mut merit: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<AcceptedStep, Backtrack<E>> {
     let mut alpha = 1.0_f64;
     let mut backtracks = 0u64;
     loop {
-        let m = merit(alpha);
+        let m = match merit(alpha) {
+            Ok(m) => m,
+            Err(error) => return Err(Backtrack::Aborted { error, backtracks }),
+        };
         if m.is_finite() && m <= reference + options.sufficient_decrease * alpha * slope {
             return Ok(AcceptedStep {
                 step: alpha,
@@ -163,11 +182,11 @@ pub fn backtrack(
         // Not strictly smaller (shrink >= 1) or incomparable (NaN): stop as well.
         let decreasing = next.partial_cmp(&alpha) == Some(std::cmp::Ordering::Less);
         if next < options.min_step || !decreasing {
-            return Err(LineSearchFailure {
+            return Err(Backtrack::Failed(LineSearchFailure {
                 last_step: alpha,
                 last_merit: m,
                 backtracks,
-            });
+            }));
         }
         alpha = next;
     }
@@ -230,7 +249,7 @@ mod tests {
     fn full_step_is_accepted_without_backtracking_when_it_decreases_enough() {
         // m(alpha) = 0.5 (1 - alpha)^2, the exact Newton model: m(1) = 0.
         let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), |a: f64| {
-            0.5 * (1.0 - a).powi(2)
+            Ok::<_, ()>(0.5 * (1.0 - a).powi(2))
         })
         .unwrap();
         assert_eq!(
@@ -248,11 +267,7 @@ mod tests {
         let mut calls = 0;
         let step = backtrack(1.0, -2.0, &LineSearchOptions::default(), |a: f64| {
             calls += 1;
-            if a > 0.2 {
-                f64::NAN
-            } else {
-                0.0
-            }
+            Ok::<_, ()>(if a > 0.2 { f64::NAN } else { 0.0 })
         })
         .unwrap();
         // 1, 0.5, 0.25 rejected; 0.125 accepted.
@@ -265,9 +280,41 @@ mod tests {
             min_step: 0.1,
             ..Default::default()
         };
-        let fail = backtrack(1.0, -2.0, &options, |_| 5.0).unwrap_err();
+        let fail = backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).unwrap_err();
         // Tried 1, 0.5, 0.25, 0.125; next 0.0625 < 0.1.
-        assert_eq!((fail.last_step, fail.backtracks), (0.125, 4));
+        assert_eq!(
+            fail,
+            Backtrack::Failed(LineSearchFailure {
+                last_step: 0.125,
+                last_merit: 5.0,
+                backtracks: 4
+            })
+        );
+    }
+
+    #[test]
+    fn a_merit_that_cannot_be_evaluated_ends_the_search() {
+        let mut calls = 0;
+        let fail = backtrack(1.0, -2.0, &LineSearchOptions::default(), |a: f64| {
+            calls += 1;
+            if a < 0.3 {
+                Err("failed")
+            } else {
+                Ok(5.0)
+            }
+        })
+        .unwrap_err();
+        // 1, 0.5 rejected; the evaluation at 0.25 fails.
+        assert_eq!(
+            (fail, calls),
+            (
+                Backtrack::Aborted {
+                    error: "failed",
+                    backtracks: 2
+                },
+                3
+            )
+        );
     }
 
     #[test]
@@ -276,12 +323,12 @@ mod tests {
             shrink: 1.0,
             ..Default::default()
         };
-        assert!(backtrack(1.0, -2.0, &options, |_| 5.0).is_err());
+        assert!(backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).is_err());
         let options = LineSearchOptions {
             shrink: f64::NAN,
             ..Default::default()
         };
-        assert!(backtrack(1.0, -2.0, &options, |_| 5.0).is_err());
+        assert!(backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).is_err());
     }
 
     #[test]
@@ -319,7 +366,7 @@ mod tests {
         h.push(1.0); // drops 10
         assert_eq!(h.reference(), 4.0);
         let opts = LineSearchOptions::default();
-        let trial = |_: f64| 3.0; // above the current merit 1.0, below 4.0
+        let trial = |_: f64| Ok::<_, ()>(3.0); // above the current merit 1.0, below 4.0
         assert!(backtrack(h.reference(), -2.0, &opts, trial).is_ok());
         assert!(backtrack(
             1.0,

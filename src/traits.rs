@@ -2,15 +2,36 @@
 //! parameter for continuation, and linear solvers split into a factorization and the
 //! solves that reuse it.
 
+use std::sync::Arc;
+
 use crate::linalg::LinearSolveError;
 
 /// Why a problem could not evaluate its residual, Jacobian or parameter derivative at `x`.
 ///
-/// The drivers treat it like an infinite merit: a line search shortens the step, a
-/// continuation corrector rejects the attempt (and the step is halved), a Newton run that
-/// cannot evaluate its initial guess stops with
-/// [`Termination::OutsideDomain`](crate::newton::Termination::OutsideDomain).
-#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+/// Two kinds, treated differently by the drivers:
+/// - [`EvaluationError::OutsideDomain`]: `x` lies where the problem is not defined. The
+///   drivers treat it like an infinite merit: a line search shortens the step, a
+///   continuation corrector rejects the attempt (and the step is halved); a Newton run that
+///   cannot evaluate its initial guess stops with
+///   [`Termination::Evaluation`](crate::newton::Termination::Evaluation).
+/// - [`EvaluationError::Problem`]: the problem itself failed (an inner solve, a time step
+///   that could not be taken). The run stops at once and hands the error back in its
+///   termination ([`Termination::Evaluation`](crate::newton::Termination::Evaluation),
+///   [`ContinuationTermination::ProblemFailed`](crate::continuation::ContinuationTermination::ProblemFailed)),
+///   where [`EvaluationError::downcast_ref`] reads the problem's own error type back.
+///
+/// ```
+/// use semismooth::EvaluationError;
+/// #[derive(Debug, thiserror::Error)]
+/// #[error("the inner solve diverged after {0} steps")]
+/// struct Diverged(usize);
+///
+/// let e = EvaluationError::problem(Diverged(7));
+/// assert_eq!(e.downcast_ref::<Diverged>().map(|d| d.0), Some(7));
+/// assert_eq!(e.to_string(), "the inner solve diverged after 7 steps");
+/// assert_eq!(e.kind(), "problem-error");
+/// ```
+#[derive(Clone, Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum EvaluationError {
     /// `x` (or the problem's parameter) lies outside the set where the problem is defined.
@@ -21,6 +42,55 @@ pub enum EvaluationError {
         /// Its value.
         value: f64,
     },
+    /// The problem's own error, built by [`EvaluationError::problem`].
+    #[error(transparent)]
+    Problem(Arc<dyn std::error::Error + Send + Sync>),
+}
+
+impl EvaluationError {
+    /// The problem's own `error`, handed back to the caller in the run's termination.
+    pub fn problem(error: impl std::error::Error + Send + Sync + 'static) -> Self {
+        Self::Problem(Arc::new(error))
+    }
+
+    /// The problem's error as its own type `E` (`None` for another type or kind).
+    pub fn downcast_ref<E: std::error::Error + 'static>(&self) -> Option<&E> {
+        match self {
+            Self::Problem(error) => error.downcast_ref::<E>(),
+            Self::OutsideDomain { .. } => None,
+        }
+    }
+
+    /// A short name of the kind: `outside-domain` or `problem-error`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::OutsideDomain { .. } => "outside-domain",
+            Self::Problem(_) => "problem-error",
+        }
+    }
+
+    /// Whether the error ends the run ([`EvaluationError::Problem`]) rather than a step.
+    pub(crate) fn ends_run(&self) -> bool {
+        matches!(self, Self::Problem(_))
+    }
+}
+
+/// Two domain errors are equal when they name the same quantity and value; two problem
+/// errors when they are the same error (one `Arc`).
+impl PartialEq for EvaluationError {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Self::OutsideDomain { what, value },
+                Self::OutsideDomain {
+                    what: other_what,
+                    value: other_value,
+                },
+            ) => what == other_what && value == other_value,
+            (Self::Problem(a), Self::Problem(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 /// Capacity of [`ProblemCounters`].

@@ -1476,3 +1476,119 @@ fn fold_detector_confirms_reversals_and_ignores_unconfirmed_tangent_flips() {
         }]
     );
 }
+
+/// The problem's own failure, met beyond a parameter.
+#[derive(Debug)]
+struct FailsBeyond(f64);
+
+impl std::fmt::Display for FailsBeyond {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot evaluate at p = {}", self.0)
+    }
+}
+
+impl std::error::Error for FailsBeyond {}
+
+/// `x - p = 0`, whose evaluation fails with the problem's own error beyond `p = 0.5`, or
+/// with a domain error when `domain` is set.
+struct Line {
+    p: f64,
+    domain: bool,
+}
+
+impl Residual for Line {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        if self.p > 0.5 {
+            return Err(if self.domain {
+                EvaluationError::OutsideDomain {
+                    what: "p",
+                    value: self.p,
+                }
+            } else {
+                EvaluationError::problem(FailsBeyond(self.p))
+            });
+        }
+        out[0] = x[0] - self.p;
+        Ok(())
+    }
+}
+
+impl GeneralizedJacobian for Line {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(1, 1)
+    }
+    fn jacobian(&mut self, _: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+        jac[(0, 0)] = 1.0;
+        Ok(())
+    }
+}
+
+impl ParameterDependent for Line {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+    }
+}
+
+/// Past `p = 0.5` a domain error only shortens the steps (the run ends after failed steps
+/// just below 0.5), while the problem's own error ends the run at the first attempt that
+/// meets it, with the error in the termination.
+#[test]
+fn the_problems_own_error_ends_the_branch_with_it() {
+    let options = ContinuationOptions {
+        initial_step: 0.1,
+        max_step: 0.1,
+        min_step: 1e-3,
+        theta: 0.999,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    let mut line = Line {
+        p: 0.0,
+        domain: true,
+    };
+    let branch = Continuation::new(&mut line, &mut solver, &[0.0], 0.0, options.clone())
+        .unwrap()
+        .run()
+        .unwrap();
+    assert!(
+        matches!(
+            branch.termination,
+            ContinuationTermination::StepTooSmall {
+                failure: CorrectorFailure::Evaluation { .. },
+                ..
+            } | ContinuationTermination::TooManyFailures {
+                failure: CorrectorFailure::Evaluation { .. },
+                ..
+            }
+        ),
+        "{:?}",
+        branch.termination
+    );
+    assert!(branch.counters.rejected_steps >= 3);
+    let mut line = Line {
+        p: 0.0,
+        domain: false,
+    };
+    let branch = Continuation::new(&mut line, &mut solver, &[0.0], 0.0, options)
+        .unwrap()
+        .run()
+        .unwrap();
+    let last = branch.points.last().unwrap().parameter;
+    let ContinuationTermination::ProblemFailed { parameter, error } = &branch.termination else {
+        panic!("{:?}", branch.termination);
+    };
+    assert_eq!(*parameter, last);
+    assert!(error.downcast_ref::<FailsBeyond>().unwrap().0 > 0.5);
+    assert!(last <= 0.5 && last > 0.3, "{last}");
+    // Nothing after the failed attempt: one rejected step.
+    assert_eq!(branch.counters.rejected_steps, 1);
+    assert_eq!(line.p, last);
+}

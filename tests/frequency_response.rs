@@ -223,7 +223,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
         sweep
             .failure
             .as_ref()
-            .map(|f| (f.parameter / rod.omega_1, f.termination)),
+            .map(|f| (f.parameter / rod.omega_1, f.termination.clone())),
         at / rod.omega_1,
         arc.folds
             .iter()

@@ -480,6 +480,93 @@ fn atan_from_10_fails_without_globalization_and_converges_with_line_search() {
     }
 }
 
+/// The problem's own failure (an inner solve that diverged at `x`).
+#[derive(Debug, PartialEq)]
+struct InnerFailure(f64);
+
+impl std::fmt::Display for InnerFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the inner solve diverged at x = {}", self.0)
+    }
+}
+
+impl std::error::Error for InnerFailure {}
+
+/// atan(x) = 0 from x0 = 10, the problem failing beyond |x| = 20 (where the first full step,
+/// x_1 = 10 - 101 atan(10) = -138.6, lands): an error outside the domain is an infinite
+/// merit that the line search shortens (and converges), the problem's own error ends the
+/// run at once and comes back in the termination, with any globalization.
+#[test]
+fn the_problems_own_error_ends_the_run_and_comes_back_in_the_termination() {
+    struct Atan {
+        own_error: bool,
+    }
+    impl Residual for Atan {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+            if x[0].abs() > 20.0 {
+                return Err(if self.own_error {
+                    EvaluationError::problem(InnerFailure(x[0]))
+                } else {
+                    EvaluationError::OutsideDomain {
+                        what: "|x|",
+                        value: x[0].abs(),
+                    }
+                });
+            }
+            out[0] = x[0].atan();
+            Ok(())
+        }
+    }
+    impl GeneralizedJacobian for Atan {
+        type Jacobian = Mat<f64>;
+        fn new_jacobian(&self) -> Mat<f64> {
+            Mat::zeros(1, 1)
+        }
+        fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+            jac[(0, 0)] = 1.0 / (1.0 + x[0] * x[0]);
+            Ok(())
+        }
+    }
+    let mut x = [10.0];
+    let report = solve(
+        &mut Atan { own_error: false },
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &options(armijo()),
+    )
+    .unwrap();
+    assert!(report.converged() && x[0].abs() < 1e-10);
+    for globalization in [armijo(), Globalization::None, Globalization::default()] {
+        let mut x = [10.0];
+        let report = not_converged(solve(
+            &mut Atan { own_error: true },
+            &mut FaerDenseLu::new(),
+            &mut x,
+            &options(globalization),
+        ));
+        let Termination::Evaluation(error) = &report.termination else {
+            panic!("{globalization:?}: {:?}", report.termination);
+        };
+        let first_step = 10.0 - 101.0 * 10f64.atan();
+        let failure = error.downcast_ref::<InnerFailure>().unwrap();
+        assert!((failure.0 - first_step).abs() < 1e-12, "{failure:?}");
+        assert!(report
+            .termination
+            .to_string()
+            .starts_with("problem-error: the inner solve diverged at x = -138.5"));
+        // Nothing after the failed evaluation: one attempt, no step, x kept.
+        assert_eq!(
+            (report.iterations, report.attempts.len(), x),
+            (0, 1, [10.0]),
+            "{globalization:?}"
+        );
+        assert_eq!(report.counters.residual_evaluations, 2);
+    }
+}
+
 /// A linear problem F(x) = A x - b with a problem counter of fake transforms (2 per
 /// evaluation): one Newton step solves it, so exactly 2 residual evaluations, 1 Jacobian,
 /// 1 factorization, 1 solve, 0 backtracks, 4 transforms; the same again on a second solve with

@@ -59,7 +59,7 @@
 use semismooth::faer::Mat;
 use semismooth::floquet::{FloquetError, Multipliers};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonError, NewtonOptions};
+use semismooth::newton::{self, NewtonError, NewtonOptions, Termination};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use crate::march::{
@@ -318,7 +318,6 @@ pub fn hb_stability(
         full,
         runs: Vec::new(),
         evaluated: None,
-        failure: None,
     };
     let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let options = NewtonOptions {
@@ -327,7 +326,16 @@ pub fn hb_stability(
         ..NewtonOptions::default()
     };
     let outcome = newton::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options);
-    if let Some(err) = shooting.failure.take() {
+    // A march that failed inside the solve ended it and comes back in its termination.
+    let failed = |termination: &Termination| match termination {
+        Termination::Evaluation(e) => e.downcast_ref::<StabilityError>().cloned(),
+        _ => None,
+    };
+    if let Some(err) = match &outcome {
+        Ok(report) => failed(&report.termination),
+        Err(NewtonError::NotConverged(report)) => failed(&report.termination),
+        Err(_) => None,
+    } {
         return Err(err);
     }
     let report = match outcome {
@@ -482,8 +490,6 @@ struct Shooting<'a> {
     runs: Vec<(Vec<usize>, usize)>,
     /// The `x` the runs belong to and the period's end state.
     evaluated: Option<(Vec<f64>, Vec<f64>)>,
-    /// A march error met inside the Newton solve (reported after it).
-    failure: Option<StabilityError>,
 }
 
 impl Shooting<'_> {
@@ -536,14 +542,6 @@ impl Shooting<'_> {
         self.evaluated = Some((x.to_vec(), end.clone()));
         Ok(end)
     }
-
-    fn record(&mut self, err: StabilityError) -> EvaluationError {
-        self.failure = Some(err);
-        EvaluationError::OutsideDomain {
-            what: "a state the time-stepping map cannot march",
-            value: f64::NAN,
-        }
-    }
 }
 
 impl Residual for Shooting<'_> {
@@ -552,7 +550,7 @@ impl Residual for Shooting<'_> {
     }
 
     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        let end = self.period(x).map_err(|e| self.record(e))?;
+        let end = self.period(x).map_err(EvaluationError::problem)?;
         for ((o, e), xi) in out.iter_mut().zip(&end).zip(x) {
             *o = e - xi;
         }
@@ -568,8 +566,8 @@ impl GeneralizedJacobian for Shooting<'_> {
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-        self.period(x).map_err(|e| self.record(e))?;
-        let full = monodromy(&mut self.marcher, &self.runs).map_err(|e| self.record(e))?;
+        self.period(x).map_err(EvaluationError::problem)?;
+        let full = monodromy(&mut self.marcher, &self.runs).map_err(EvaluationError::problem)?;
         let keep = &self.keep;
         for (j, &cj) in keep.iter().enumerate() {
             for (i, &ci) in keep.iter().enumerate() {

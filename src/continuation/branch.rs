@@ -100,10 +100,10 @@ pub enum CorrectorFailure {
         /// The last step length tried.
         last_step: f64,
     },
-    /// The problem could not be evaluated at an iterate (outside its domain, or outside
-    /// the trust ball around the last point).
-    #[error("outside the domain at iteration {iteration}: {error}")]
-    OutsideDomain {
+    /// The problem could not be evaluated at an iterate (outside its domain, outside the
+    /// trust ball around the last point, or the problem's own error).
+    #[error("the problem could not be evaluated at iteration {iteration}: {error}")]
+    Evaluation {
         /// Iteration at which it happened.
         iteration: usize,
         /// The problem's error.
@@ -183,6 +183,13 @@ pub enum ContinuationTermination {
         /// Why the corrector failed.
         failure: CorrectorFailure,
     },
+    /// The problem's own error ([`EvaluationError::Problem`]) ended the run.
+    ProblemFailed {
+        /// Parameter of the last accepted point (the start's, before the first).
+        parameter: f64,
+        /// The error.
+        error: EvaluationError,
+    },
 }
 
 impl std::fmt::Display for ContinuationTermination {
@@ -228,6 +235,10 @@ impl std::fmt::Display for ContinuationTermination {
             Self::SegmentStartFailed { parameter, failure } => write!(
                 f,
                 "a new segment could not be corrected at p = {parameter}: {failure}"
+            ),
+            Self::ProblemFailed { parameter, error } => write!(
+                f,
+                "the problem failed after the point at p = {parameter}: {error}"
             ),
         }
     }

@@ -442,7 +442,7 @@ where
                 Err(CorrectorFailure::SingularBorder { iteration, pivot })
             }
             Stop::Direction(BorderedFailure::Evaluation(error)) | Stop::OutsideDomain(error) => {
-                Err(CorrectorFailure::OutsideDomain { iteration, error })
+                Err(CorrectorFailure::Evaluation { iteration, error })
             }
             Stop::Direction(BorderedFailure::NonFinite) | Stop::NonFinite => {
                 Err(CorrectorFailure::NonFinite { iteration })

@@ -1,17 +1,22 @@
 //! The one Newton iteration of the crate: `y <- y + alpha d` with a pluggable direction `d`
 //! (a plain solve `J d = -F` for [`crate::newton`], the bordered solve of the continuation
-//! corrector) and one set of rules for the step length and for stopping.
+//! corrector) and a step-length rule ([`StepRule`]: the full step or a backtracking line
+//! search), with one set of rules for stopping.
 //!
 //! The system `G(y) = 0` is seen through [`NewtonSystem`]: an evaluation (which may fail
 //! outside the problem's domain) and a direction. The kernel owns the loop, the merit
 //! `m(y) = |G(y)|^2 / 2`, the line search ([`crate::linesearch`]), the termination tests,
 //! the best iterate and the counters of residual evaluations and backtracks; directions
 //! count their own Jacobians, factorizations and solves.
+//!
+//! A run is [`Kernel::start`], one or more [`Kernel::iterate`] (with the same or another
+//! step rule, possibly after [`Kernel::restart`] from the initial guess), then
+//! [`Kernel::finish`]; [`Kernel::run`] is the common case of one rule throughout.
 
-use crate::linesearch::{backtrack, LineSearchOptions, NonMonotoneHistory};
+use crate::linesearch::{backtrack, Backtrack, LineSearchOptions, NonMonotoneHistory};
 use crate::EvaluationError;
 
-use super::{Globalization, WorkCounters};
+use super::WorkCounters;
 
 /// A system `G(y) = 0` on `R^N` with a way to compute Newton directions.
 pub(crate) trait NewtonSystem {
@@ -36,6 +41,36 @@ pub(crate) trait NewtonSystem {
     }
 }
 
+/// How the step length `alpha` along a direction is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum StepRule {
+    /// `alpha = 1`; a step where `G` cannot be evaluated or is not finite ends the run.
+    Full,
+    /// Backtracking from `alpha = 1` against the largest merit of the last `memory`
+    /// iterates (Grippo–Lampariello–Lucidi; `memory = 1` is Armijo).
+    Backtracking {
+        memory: usize,
+        line_search: LineSearchOptions,
+    },
+    /// `alpha = 1` while the full step can be evaluated and is finite; at the first one
+    /// that is not, [`StepRule::Backtracking`] from the current iterate (the rule then
+    /// becomes that one).
+    FullWhileFinite {
+        memory: usize,
+        line_search: LineSearchOptions,
+    },
+}
+
+impl StepRule {
+    /// Merits remembered by the rule's reference (1 for the full step).
+    fn memory(&self) -> usize {
+        match *self {
+            Self::Full => 1,
+            Self::Backtracking { memory, .. } | Self::FullWhileFinite { memory, .. } => memory,
+        }
+    }
+}
+
 /// The rules of one run (validated by the callers' options).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct KernelRules {
@@ -49,7 +84,8 @@ pub(crate) struct KernelRules {
     /// Steps taken before convergence may be declared (the continuation corrector takes
     /// at least one, for its tangent).
     pub min_iterations: usize,
-    pub globalization: Globalization,
+    /// The step-length rule of [`Kernel::run`].
+    pub step: StepRule,
     /// Return the iterate of smallest `|G|` rather than the last one.
     pub restore_best: bool,
     /// Stop a run that stopped making progress ([`Stagnation`]); `None`: never.
@@ -82,10 +118,14 @@ impl Stagnation {
 
 /// A run that stalls with `|G| <= FLOOR_STALL_FACTOR * residual_floor` has converged as far
 /// as floating point allows.
-pub const FLOOR_STALL_FACTOR: f64 = 100.0;
+pub(crate) const FLOOR_STALL_FACTOR: f64 = 100.0;
+
+/// Iterations of a run whose histories are reserved once and for all (longer runs grow
+/// them).
+const RESERVED_ITERATIONS: usize = 1000;
 
 /// Why the kernel stopped.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Stop<E> {
     Converged,
     /// Stalled within [`FLOOR_STALL_FACTOR`] of the residual floor.
@@ -101,11 +141,13 @@ pub(crate) enum Stop<E> {
     },
     Direction(E),
     NonFinite,
+    /// `G` could not be evaluated: at the initial guess, at a full step, or anywhere for an
+    /// error that ends the run ([`EvaluationError::Problem`]).
     OutsideDomain(EvaluationError),
 }
 
 /// What a run did (the histories live in the [`Kernel`] until the next run).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Run<E> {
     pub stop: Stop<E>,
     pub iterations: usize,
@@ -113,6 +155,19 @@ pub(crate) struct Run<E> {
     pub tolerance: f64,
     /// Smallest finite `|G|` over the iterates (`inf` if none was finite).
     pub smallest: f64,
+}
+
+/// Where a run stands between [`Kernel::start`] and [`Kernel::finish`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Progress {
+    /// `|G|` at the current iterate.
+    norm: f64,
+    /// The smallest `|G|` accepted so far (the best iterate's).
+    best_norm: f64,
+    /// Smallest finite `|G|` over the iterates.
+    smallest: f64,
+    iterations: usize,
+    tolerance: f64,
 }
 
 /// Buffers of the iteration, kept between runs (nothing is allocated once sizes settle).
@@ -126,6 +181,7 @@ pub(crate) struct Kernel {
     best_g: Vec<f64>,
     start: Vec<f64>,
     history: Option<NonMonotoneHistory>,
+    progress: Progress,
     /// `|G|` at the initial guess and after each accepted step.
     pub residual_norms: Vec<f64>,
     /// Accepted step lengths.
@@ -176,9 +232,18 @@ impl Kernel {
         Ok(norm2(g))
     }
 
-    /// Runs the iteration from `y` (initial guess in; the returned iterate out, see
-    /// [`KernelRules::restore_best`]). On return `self.g` holds `G` at the returned `y`
-    /// (unless it could not be evaluated).
+    /// The non-monotone history reset to `memory` values.
+    fn reset_history(&mut self, memory: usize) -> &mut NonMonotoneHistory {
+        let history = self
+            .history
+            .get_or_insert_with(|| NonMonotoneHistory::new(memory));
+        history.reset(memory);
+        history
+    }
+
+    /// Runs the iteration from `y` with `rules.step` throughout (initial guess in; the
+    /// returned iterate out, see [`KernelRules::restore_best`]). On return `self.g` holds
+    /// `G` at the returned `y` (unless it could not be evaluated).
     pub(crate) fn run<S: NewtonSystem + ?Sized>(
         &mut self,
         system: &mut S,
@@ -186,6 +251,23 @@ impl Kernel {
         rules: &KernelRules,
         counters: &mut WorkCounters,
     ) -> Run<S::Failure> {
+        let mut step = rules.step;
+        let stop = self
+            .start(system, y, rules, counters)
+            .or_else(|| self.iterate(system, y, rules, &mut step, rules.max_iterations, counters));
+        self.finish(y, rules, stop.unwrap_or(Stop::MaxIterations))
+    }
+
+    /// Begins a run at `y`: evaluates `G`, sets the tolerance, resets the histories (the
+    /// line-search reference with `rules.step`'s memory). `Some(stop)` when the run ends
+    /// there (converged, or `G` could not be evaluated or is not finite).
+    pub(crate) fn start<S: NewtonSystem + ?Sized>(
+        &mut self,
+        system: &mut S,
+        y: &[f64],
+        rules: &KernelRules,
+        counters: &mut WorkCounters,
+    ) -> Option<Stop<S::Failure>> {
         let n = y.len();
         for v in [
             &mut self.g,
@@ -198,8 +280,8 @@ impl Kernel {
         ] {
             v.resize(n, 0.0);
         }
-        // Room for a run of up to 1000 iterations once and for all (no allocation per run).
-        let capacity = rules.max_iterations.min(1000) + 1;
+        // Room for a long run once and for all (no allocation per run).
+        let capacity = rules.max_iterations.min(RESERVED_ITERATIONS) + 1;
         for v in [
             &mut self.residual_norms,
             &mut self.step_lengths,
@@ -208,178 +290,210 @@ impl Kernel {
             v.clear();
             v.reserve(capacity);
         }
-        let (memory, line_search, mut full_steps) = match rules.globalization {
-            Globalization::None => (1, None, 0),
-            Globalization::Armijo(ls) => (1, Some(ls), 0),
-            Globalization::NonMonotone {
-                memory,
-                line_search,
-            } => (memory, Some(line_search), 0),
-            Globalization::Hybrid {
-                full_steps,
-                memory,
-                line_search,
-            }
-            | Globalization::Polyalgorithm {
-                full_steps,
-                memory,
-                line_search,
-            } => (memory, Some(line_search), full_steps),
+        self.progress = Progress {
+            norm: f64::INFINITY,
+            best_norm: f64::INFINITY,
+            smallest: f64::INFINITY,
+            iterations: 0,
+            tolerance: rules.absolute_tolerance,
         };
-        let history = self
-            .history
-            .get_or_insert_with(|| NonMonotoneHistory::new(memory));
-
-        let mut norm = match Self::evaluate(system, y, &mut self.g, counters) {
+        let norm = match Self::evaluate(system, y, &mut self.g, counters) {
             Ok(norm) => norm,
-            Err(e) => {
-                return Run {
-                    stop: Stop::OutsideDomain(e),
-                    iterations: 0,
-                    tolerance: rules.absolute_tolerance,
-                    smallest: f64::INFINITY,
-                }
-            }
+            Err(e) => return Some(Stop::OutsideDomain(e)),
         };
         self.residual_norms.push(norm);
         let tolerance = rules
             .absolute_tolerance
             .max(rules.relative_tolerance * norm)
             .max(rules.residual_floor);
-        history.reset(memory);
-        history.push(merit_of(norm));
+        self.reset_history(rules.step.memory()).push(merit_of(norm));
         self.best.copy_from_slice(y);
         self.best_g.copy_from_slice(&self.g);
         self.start.copy_from_slice(y);
-        let mut best_norm = norm;
-        let mut smallest = if norm.is_finite() {
-            norm
-        } else {
-            f64::INFINITY
+        self.progress = Progress {
+            norm,
+            best_norm: norm,
+            smallest: if norm.is_finite() {
+                norm
+            } else {
+                f64::INFINITY
+            },
+            iterations: 0,
+            tolerance,
         };
-        let mut iterations = 0;
+        if !norm.is_finite() {
+            return Some(Stop::NonFinite);
+        }
+        (rules.min_iterations == 0 && norm <= tolerance).then_some(Stop::Converged)
+    }
 
-        let stop = 'newton: {
-            if !norm.is_finite() {
-                break 'newton Stop::NonFinite;
-            }
-            if rules.min_iterations == 0 && norm <= tolerance {
-                break 'newton Stop::Converged;
-            }
-            while iterations < rules.max_iterations {
-                if full_steps > 0 && iterations == full_steps {
-                    // End of the full-step phase: start again from the initial guess with the
-                    // line search (the full steps may have wandered into a region where
-                    // descent stalls; the best iterate so far is kept).
-                    full_steps = 0;
-                    y.copy_from_slice(&self.start);
-                    norm = match Self::evaluate(system, y, &mut self.g, counters) {
-                        Ok(norm) => norm,
-                        Err(e) => break 'newton Stop::OutsideDomain(e),
-                    };
-                    history.reset(memory);
-                    history.push(merit_of(norm));
-                }
-                if let Err(e) = system.direction(y, &self.g, &mut self.d, counters) {
-                    break 'newton Stop::Direction(e);
-                }
-                if self.d.iter().any(|v| !v.is_finite()) {
-                    break 'newton Stop::NonFinite;
-                }
+    /// Goes back to the run's initial guess (`y` overwritten) and resets the line-search
+    /// reference for `step`; the iteration count, the best iterate and the histories go
+    /// on. `Some(stop)` when `G` can no longer be evaluated there.
+    pub(crate) fn restart<S: NewtonSystem + ?Sized>(
+        &mut self,
+        system: &mut S,
+        y: &mut [f64],
+        step: &StepRule,
+        counters: &mut WorkCounters,
+    ) -> Option<Stop<S::Failure>> {
+        y.copy_from_slice(&self.start);
+        let norm = match Self::evaluate(system, y, &mut self.g, counters) {
+            Ok(norm) => norm,
+            Err(e) => return Some(Stop::OutsideDomain(e)),
+        };
+        self.progress.norm = norm;
+        self.reset_history(step.memory()).push(merit_of(norm));
+        None
+    }
 
-                let merit0 = merit_of(norm);
-                let (g_trial, trial, d) = (&mut self.g_trial, &mut self.trial, &self.d);
-                let mut domain_error = None;
-                let mut merit = |alpha: f64| {
-                    for ((t, yi), di) in trial.iter_mut().zip(y.iter()).zip(d) {
-                        *t = yi + alpha * di;
+    /// Iterates with the step rule `step` until the run has made `until` iterations in all
+    /// (`None`) or it stops (`Some`). A [`StepRule::FullWhileFinite`] that had to backtrack
+    /// is [`StepRule::Backtracking`] on return.
+    pub(crate) fn iterate<S: NewtonSystem + ?Sized>(
+        &mut self,
+        system: &mut S,
+        y: &mut [f64],
+        rules: &KernelRules,
+        step: &mut StepRule,
+        until: usize,
+        counters: &mut WorkCounters,
+    ) -> Option<Stop<S::Failure>> {
+        while self.progress.iterations < until {
+            if let Err(e) = system.direction(y, &self.g, &mut self.d, counters) {
+                return Some(Stop::Direction(e));
+            }
+            if self.d.iter().any(|v| !v.is_finite()) {
+                return Some(Stop::NonFinite);
+            }
+
+            let merit0 = merit_of(self.progress.norm);
+            let (g_trial, trial, d) = (&mut self.g_trial, &mut self.trial, &self.d);
+            // A domain error is an infinite merit (the step is shortened); an error that
+            // ends the run ends the search.
+            let mut domain_error = None;
+            let mut merit = |alpha: f64| {
+                for ((t, yi), di) in trial.iter_mut().zip(y.iter()).zip(d) {
+                    *t = yi + alpha * di;
+                }
+                match Self::evaluate(system, trial, g_trial, counters) {
+                    Ok(norm) => Ok(merit_of(norm)),
+                    Err(e) if e.ends_run() => Err(e),
+                    Err(e) => {
+                        domain_error = Some(e);
+                        Ok(f64::INFINITY)
                     }
-                    match Self::evaluate(system, trial, g_trial, counters) {
-                        Ok(norm) => merit_of(norm),
-                        Err(e) => {
-                            domain_error = Some(e);
-                            f64::INFINITY
-                        }
+                }
+            };
+            let line_search = match *step {
+                StepRule::Full => match merit(1.0) {
+                    Ok(m) if m.is_finite() => None,
+                    Ok(_) => {
+                        return Some(domain_error.map_or(Stop::NonFinite, Stop::OutsideDomain))
                     }
-                };
-                let mut alpha = 1.0;
-                let full_step_phase = iterations < full_steps;
-                if full_step_phase && merit(1.0).is_finite() {
-                    // Full step accepted without a merit test.
-                } else if let Some(ls) = line_search {
-                    if full_step_phase {
-                        // A full step that cannot be evaluated ends the full-step phase.
-                        full_steps = 0;
+                    Err(e) => return Some(Stop::OutsideDomain(e)),
+                },
+                StepRule::FullWhileFinite {
+                    memory,
+                    line_search,
+                } => match merit(1.0) {
+                    Ok(m) if m.is_finite() => None,
+                    Ok(_) => {
+                        // A full step that cannot be evaluated ends the full steps.
+                        *step = StepRule::Backtracking {
+                            memory,
+                            line_search,
+                        };
+                        let history = self.history.as_mut().expect("reset by start");
                         history.reset(memory);
                         history.push(merit0);
+                        Some(line_search)
                     }
-                    match backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit) {
-                        Ok(step) => {
-                            counters.line_search_backtracks += step.backtracks;
-                            alpha = step.step;
-                        }
-                        Err(fail) => {
-                            counters.line_search_backtracks += fail.backtracks;
-                            break 'newton Stop::LineSearchFailed {
-                                last_step: fail.last_step,
-                            };
-                        }
+                    Err(e) => return Some(Stop::OutsideDomain(e)),
+                },
+                StepRule::Backtracking { line_search, .. } => Some(line_search),
+            };
+            let mut alpha = 1.0;
+            if let Some(ls) = line_search {
+                let history = self.history.as_ref().expect("reset by start");
+                match backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit) {
+                    Ok(accepted) => {
+                        counters.line_search_backtracks += accepted.backtracks;
+                        alpha = accepted.step;
                     }
-                } else if !merit(1.0).is_finite() {
-                    break 'newton match domain_error {
-                        Some(e) => Stop::OutsideDomain(e),
-                        None => Stop::NonFinite,
-                    };
-                }
-
-                // Accept: y <- trial, G <- G(trial).
-                y.copy_from_slice(&self.trial);
-                std::mem::swap(&mut self.g, &mut self.g_trial);
-                norm = norm2(&self.g);
-                iterations += 1;
-                let step_norm = alpha * system.step_norm(&self.d);
-                self.residual_norms.push(norm);
-                self.step_lengths.push(alpha);
-                self.step_norms.push(step_norm);
-                history.push(merit_of(norm));
-                smallest = smallest.min(norm);
-                if norm < best_norm {
-                    best_norm = norm;
-                    if rules.restore_best {
-                        self.best.copy_from_slice(y);
-                        self.best_g.copy_from_slice(&self.g);
+                    Err(Backtrack::Failed(failure)) => {
+                        counters.line_search_backtracks += failure.backtracks;
+                        return Some(Stop::LineSearchFailed {
+                            last_step: failure.last_step,
+                        });
                     }
-                }
-                if iterations >= rules.min_iterations && norm <= tolerance {
-                    break 'newton Stop::Converged;
-                }
-                if rules
-                    .stagnation
-                    .is_some_and(|rule| rule.holds(&self.residual_norms))
-                {
-                    break 'newton Stop::Stagnated;
-                }
-                if step_norm <= rules.step_tolerance * (1.0 + system.step_norm(y)) {
-                    break 'newton if norm <= FLOOR_STALL_FACTOR * rules.residual_floor {
-                        Stop::ConvergedAtFloor
-                    } else {
-                        Stop::Stalled { step_norm }
-                    };
+                    Err(Backtrack::Aborted { error, backtracks }) => {
+                        counters.line_search_backtracks += backtracks;
+                        return Some(Stop::OutsideDomain(error));
+                    }
                 }
             }
-            Stop::MaxIterations
-        };
 
-        // Return the best iterate (non-monotone steps and failures may end elsewhere).
-        if rules.restore_best && (norm.is_nan() || best_norm < norm) {
+            // Accept: y <- trial, G <- G(trial).
+            y.copy_from_slice(&self.trial);
+            std::mem::swap(&mut self.g, &mut self.g_trial);
+            let norm = norm2(&self.g);
+            let progress = &mut self.progress;
+            progress.norm = norm;
+            progress.iterations += 1;
+            let step_norm = alpha * system.step_norm(&self.d);
+            self.residual_norms.push(norm);
+            self.step_lengths.push(alpha);
+            self.step_norms.push(step_norm);
+            if let Some(history) = self.history.as_mut() {
+                history.push(merit_of(norm));
+            }
+            progress.smallest = progress.smallest.min(norm);
+            if norm < progress.best_norm {
+                progress.best_norm = norm;
+                if rules.restore_best {
+                    self.best.copy_from_slice(y);
+                    self.best_g.copy_from_slice(&self.g);
+                }
+            }
+            if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
+                return Some(Stop::Converged);
+            }
+            if rules
+                .stagnation
+                .is_some_and(|rule| rule.holds(&self.residual_norms))
+            {
+                return Some(Stop::Stagnated);
+            }
+            if step_norm <= rules.step_tolerance * (1.0 + system.step_norm(y)) {
+                return Some(if norm <= FLOOR_STALL_FACTOR * rules.residual_floor {
+                    Stop::ConvergedAtFloor
+                } else {
+                    Stop::Stalled { step_norm }
+                });
+            }
+        }
+        None
+    }
+
+    /// Ends the run with `stop`: the best iterate goes to `y` (non-monotone steps and
+    /// failures may end elsewhere) when `rules.restore_best`.
+    pub(crate) fn finish<E>(
+        &mut self,
+        y: &mut [f64],
+        rules: &KernelRules,
+        stop: Stop<E>,
+    ) -> Run<E> {
+        let progress = self.progress;
+        if rules.restore_best && (progress.norm.is_nan() || progress.best_norm < progress.norm) {
             y.copy_from_slice(&self.best);
             self.g.copy_from_slice(&self.best_g);
         }
         Run {
             stop,
-            iterations,
-            tolerance,
-            smallest,
+            iterations: progress.iterations,
+            tolerance: progress.tolerance,
+            smallest: progress.smallest,
         }
     }
 
@@ -392,13 +506,5 @@ impl Kernel {
     pub(crate) fn set_residual(&mut self, g: &[f64]) {
         self.g.clear();
         self.g.extend_from_slice(g);
-    }
-}
-
-/// The line search of an Armijo rule (used by the continuation's corrector option).
-pub(crate) fn armijo(line_search: Option<LineSearchOptions>) -> Globalization {
-    match line_search {
-        Some(ls) => Globalization::Armijo(ls),
-        None => Globalization::None,
     }
 }

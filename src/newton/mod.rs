@@ -122,8 +122,8 @@ use std::ops::AddAssign;
 use crate::linalg::LinearSolveError;
 pub use crate::linesearch::{InvalidLineSearchOption, LineSearchOptions};
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters};
-pub use kernel::FLOOR_STALL_FACTOR;
-use kernel::{Kernel, KernelRules, NewtonSystem, Stop};
+use kernel::FLOOR_STALL_FACTOR;
+use kernel::{Kernel, KernelRules, NewtonSystem, StepRule, Stop};
 
 /// How the step length is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -288,7 +288,8 @@ impl NewtonOptions {
         Ok(())
     }
 
-    fn rules(&self) -> KernelRules {
+    /// The kernel's rules of a run with the step rule `step`.
+    fn rules(&self, step: StepRule) -> KernelRules {
         KernelRules {
             absolute_tolerance: self.absolute_tolerance,
             relative_tolerance: self.relative_tolerance,
@@ -296,7 +297,7 @@ impl NewtonOptions {
             step_tolerance: self.step_tolerance,
             max_iterations: self.max_iterations,
             min_iterations: 0,
-            globalization: self.globalization,
+            step,
             restore_best: true,
             stagnation: None,
         }
@@ -304,7 +305,7 @@ impl NewtonOptions {
 }
 
 /// Why the iteration stopped.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Termination {
     /// `|F| <= max(absolute, relative |F(x_0)|, residual_floor)`.
     Converged,
@@ -327,9 +328,10 @@ pub enum Termination {
     LinearSolve(LinearSolveError),
     /// `F` or the Newton direction had a NaN or infinite component.
     NonFinite,
-    /// The problem could not be evaluated (at the initial guess, at a full step without
-    /// line search, or for its Jacobian).
-    OutsideDomain(EvaluationError),
+    /// The problem could not be evaluated: at the initial guess, at a full step without
+    /// line search, for its Jacobian, or anywhere for its own error
+    /// ([`EvaluationError::Problem`], which ends the run at once).
+    Evaluation(EvaluationError),
 }
 
 /// A way of reaching a root, as a report names it.
@@ -409,9 +411,10 @@ impl Termination {
     }
 }
 
-/// Short names: `converged`, `max-iterations`, `stalled`, `line-search-failed`,
-/// `singular-jacobian: ...` (or `out-of-memory: ...` and the like for other linear-solver
-/// failures), `non-finite`, `outside-domain: ...`.
+/// Short names: `converged` (`converged (stalled at the round-off floor ...)`),
+/// `max-iterations`, `stagnated`, `stalled`, `line-search-failed`, `singular-jacobian: ...`
+/// (or `out-of-memory: ...` and the like for other linear-solver failures), `non-finite`,
+/// `outside-domain: ...` (or `problem-error: ...` for the problem's own error).
 impl std::fmt::Display for Termination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -426,7 +429,7 @@ impl std::fmt::Display for Termination {
             Self::LineSearchFailed => write!(f, "line-search-failed"),
             Self::LinearSolve(e) => write!(f, "{}: {e}", e.kind()),
             Self::NonFinite => write!(f, "non-finite"),
-            Self::OutsideDomain(e) => write!(f, "outside-domain: {e}"),
+            Self::Evaluation(e) => write!(f, "{}: {e}", e.kind()),
         }
     }
 }
@@ -720,23 +723,58 @@ impl<J> NewtonSolver<J> {
                 &mut counters,
                 &mut log,
             ),
+            Globalization::Hybrid {
+                full_steps,
+                memory,
+                line_search,
+            } => {
+                let rules = self.options.rules(StepRule::Backtracking {
+                    memory,
+                    line_search,
+                });
+                let (termination, run) = self.run_with(
+                    problem,
+                    linear,
+                    x,
+                    &rules,
+                    (&mut counters, &mut log),
+                    |kernel, system, x, rules, counters| {
+                        hybrid(kernel, system, x, rules, full_steps, counters)
+                    },
+                );
+                let strategy = if run.iterations <= full_steps {
+                    Strategy::FullSteps
+                } else {
+                    Strategy::LineSearch
+                };
+                let attempt = Attempt::new(strategy, run.iterations, &termination);
+                (termination, strategy, vec![attempt], run.tolerance)
+            }
             globalization => {
-                let rules = self.options.rules();
+                let (step, strategy) = match globalization {
+                    Globalization::Armijo(line_search) => (
+                        StepRule::Backtracking {
+                            memory: 1,
+                            line_search,
+                        },
+                        Strategy::LineSearch,
+                    ),
+                    Globalization::NonMonotone {
+                        memory,
+                        line_search,
+                    } => (
+                        StepRule::Backtracking {
+                            memory,
+                            line_search,
+                        },
+                        Strategy::LineSearch,
+                    ),
+                    _ => (StepRule::Full, Strategy::FullSteps),
+                };
+                let rules = self.options.rules(step);
                 let (termination, run) =
                     self.phase(problem, linear, x, &rules, &mut counters, &mut log);
-                let strategy = match globalization {
-                    Globalization::None => Strategy::FullSteps,
-                    Globalization::Hybrid { full_steps, .. } if run.iterations <= full_steps => {
-                        Strategy::FullSteps
-                    }
-                    _ => Strategy::LineSearch,
-                };
-                let attempt = Attempt {
-                    strategy,
-                    iterations: run.iterations,
-                    converged: termination.converged(),
-                    outcome: termination.to_string(),
-                };
+                let attempt = Attempt::new(strategy, run.iterations, &termination);
                 (termination, strategy, vec![attempt], run.tolerance)
             }
         };
@@ -760,7 +798,8 @@ impl<J> NewtonSolver<J> {
         }
     }
 
-    /// One run of the kernel with the plain direction; its histories are appended to `log`.
+    /// One run of the kernel with the plain direction and `rules.step` throughout; its
+    /// histories are appended to `log`.
     fn phase<P, S>(
         &mut self,
         problem: &mut P,
@@ -774,13 +813,44 @@ impl<J> NewtonSolver<J> {
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
+        self.run_with(
+            problem,
+            linear,
+            x,
+            rules,
+            (counters, log),
+            |kernel, system, x, rules, counters| kernel.run(system, x, rules, counters),
+        )
+    }
+
+    /// One run of the kernel with the plain direction, driven by `drive`; its histories
+    /// are appended to `log`.
+    fn run_with<P, S>(
+        &mut self,
+        problem: &mut P,
+        linear: &mut S,
+        x: &mut [f64],
+        rules: &KernelRules,
+        (counters, log): (&mut WorkCounters, &mut Log),
+        drive: impl FnOnce(
+            &mut Kernel,
+            &mut PlainNewton<'_, P, S>,
+            &mut [f64],
+            &KernelRules,
+            &mut WorkCounters,
+        ) -> kernel::Run<PlainFailure>,
+    ) -> (Termination, kernel::Run<PlainFailure>)
+    where
+        P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
+    {
         let jacobian = self.jacobian.get_or_insert_with(|| problem.new_jacobian());
         let mut system = PlainNewton {
             problem,
             solver: linear,
             jacobian,
         };
-        let run = self.kernel.run(&mut system, x, rules, counters);
+        let run = drive(&mut self.kernel, &mut system, x, rules, counters);
         log.residual_norms
             .extend_from_slice(&self.kernel.residual_norms);
         log.step_lengths
@@ -790,6 +860,55 @@ impl<J> NewtonSolver<J> {
         (termination, run)
     }
 }
+
+/// [`Globalization::Hybrid`] on the kernel: full steps while they can be evaluated for
+/// `full_steps` iterations, then `rules.step` (the backtracking) from the initial guess for
+/// the rest of the budget; a full step that cannot be evaluated hands over to the
+/// backtracking from where it is instead.
+fn hybrid<S: NewtonSystem + ?Sized>(
+    kernel: &mut Kernel,
+    system: &mut S,
+    x: &mut [f64],
+    rules: &KernelRules,
+    full_steps: usize,
+    counters: &mut WorkCounters,
+) -> kernel::Run<S::Failure> {
+    let StepRule::Backtracking {
+        memory,
+        line_search,
+    } = rules.step
+    else {
+        return kernel.run(system, x, rules, counters);
+    };
+    if full_steps == 0 {
+        return kernel.run(system, x, rules, counters);
+    }
+    let mut step = StepRule::FullWhileFinite {
+        memory,
+        line_search,
+    };
+    let max = rules.max_iterations;
+    let stop = kernel
+        .start(system, x, rules, counters)
+        .or_else(|| kernel.iterate(system, x, rules, &mut step, full_steps.min(max), counters))
+        .or_else(|| {
+            if full_steps >= max {
+                return None;
+            }
+            if matches!(step, StepRule::FullWhileFinite { .. }) {
+                // The full steps have not converged: start again from the initial guess with
+                // the line search (they may have wandered where descent stalls; the best
+                // iterate so far is kept).
+                step = rules.step;
+                if let Some(stop) = kernel.restart(system, x, &step, counters) {
+                    return Some(stop);
+                }
+            }
+            kernel.iterate(system, x, rules, &mut step, max, counters)
+        });
+    kernel.finish(x, rules, stop.unwrap_or(Stop::MaxIterations))
+}
+
 /// The termination a kernel stop means for a run on `F` with `residual_floor`.
 fn termination_of(stop: &Stop<PlainFailure>, residual_floor: f64) -> Termination {
     match stop {
@@ -803,7 +922,7 @@ fn termination_of(stop: &Stop<PlainFailure>, residual_floor: f64) -> Termination
         Stop::LineSearchFailed { .. } => Termination::LineSearchFailed,
         Stop::Direction(PlainFailure::Linear(e)) => Termination::LinearSolve(*e),
         Stop::Direction(PlainFailure::Evaluation(e)) | Stop::OutsideDomain(e) => {
-            Termination::OutsideDomain(*e)
+            Termination::Evaluation(e.clone())
         }
         Stop::NonFinite => Termination::NonFinite,
     }

@@ -222,7 +222,7 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
 }
 
 /// How a path-following attempt ended.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub(crate) struct PathOutcome {
     /// The end of the path was reached (`x` is then on the path there, to the accuracy).
     pub reached: bool,
@@ -232,6 +232,8 @@ pub(crate) struct PathOutcome {
     pub furthest: f64,
     /// Why the path ended when it did not reach its end.
     pub reason: Option<String>,
+    /// The problem's own error, when it ended the path ([`EvaluationError::Problem`]).
+    pub error: Option<EvaluationError>,
     /// Work done.
     pub counters: WorkCounters,
 }
@@ -309,13 +311,7 @@ where
 {
     let n = x.len();
     let options = path_options(n, plan);
-    let mut outcome = PathOutcome {
-        reached: false,
-        iterations: 0,
-        furthest: 0.0,
-        reason: None,
-        counters: WorkCounters::default(),
-    };
+    let mut outcome = PathOutcome::default();
     if plan.budget == 0 {
         outcome.reason = Some("no iterations left".into());
         return outcome;
@@ -350,6 +346,10 @@ where
             if *bound == plan.end && *parameter == plan.end =>
         {
             outcome.reached = true;
+        }
+        Some(ContinuationTermination::ProblemFailed { error, .. }) => {
+            outcome.reason = Some(error.to_string());
+            outcome.error = Some(error.clone());
         }
         Some(t) if outcome.reason.is_none() => outcome.reason = Some(t.to_string()),
         _ => {}

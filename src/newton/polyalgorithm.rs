@@ -6,8 +6,8 @@ use crate::continuation::Predictor;
 use crate::linesearch::LineSearchOptions;
 use crate::{Factorize, GeneralizedJacobian, Residual};
 
-use super::kernel::{self, KernelRules, Stagnation};
-use super::{path, Attempt, Globalization, Log, NewtonSolver, Strategy, Termination, WorkCounters};
+use super::kernel::{self, KernelRules, Stagnation, StepRule};
+use super::{path, Attempt, Log, NewtonSolver, Strategy, Termination, WorkCounters};
 
 impl<J> NewtonSolver<J> {
     /// Full steps, then the smoothing path, the line search and the Newton homotopy (see
@@ -51,9 +51,8 @@ impl<J> NewtonSolver<J> {
     {
         let max_iterations = self.options.max_iterations;
         let base = KernelRules {
-            globalization: Globalization::None,
             max_iterations: full_steps.min(max_iterations),
-            ..self.options.rules()
+            ..self.options.rules(StepRule::Full)
         };
         // With a smoothing to fall back on, the full steps stop as soon as they stagnate.
         let first = KernelRules {
@@ -75,7 +74,7 @@ impl<J> NewtonSolver<J> {
             &termination,
         ));
         used += run.iterations;
-        if termination.converged() {
+        if termination.converged() || ends_run(&termination) {
             return (termination, Strategy::FullSteps, attempts, tolerance);
         }
         let mut best = Best::new(x, self.kernel.residual(), run.smallest);
@@ -147,13 +146,21 @@ impl<J> NewtonSolver<J> {
                         outcome.iterations + run.iterations,
                         &termination,
                     ));
-                    if termination.converged() {
+                    if termination.converged() || ends_run(&termination) {
                         return (termination, Strategy::Smoothing, attempts, tolerance);
                     }
                     best.update(x, self.kernel.residual(), run.smallest);
                     last = termination;
                 } else {
                     attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
+                    if let Some(error) = outcome.error {
+                        return (
+                            Termination::Evaluation(error),
+                            Strategy::Smoothing,
+                            attempts,
+                            tolerance,
+                        );
+                    }
                 }
             }
         }
@@ -164,7 +171,7 @@ impl<J> NewtonSolver<J> {
         if budget > 0 {
             x.copy_from_slice(start);
             let rules = KernelRules {
-                globalization: Globalization::NonMonotone {
+                step: StepRule::Backtracking {
                     memory,
                     line_search,
                 },
@@ -178,7 +185,7 @@ impl<J> NewtonSolver<J> {
                 run.iterations,
                 &termination,
             ));
-            if termination.converged() {
+            if termination.converged() || ends_run(&termination) {
                 return (termination, Strategy::LineSearch, attempts, tolerance);
             }
             best.update(x, self.kernel.residual(), run.smallest);
@@ -191,7 +198,14 @@ impl<J> NewtonSolver<J> {
         if budget > 0 {
             let mut f0 = vec![0.0; start.len()];
             counters.residual_evaluations += 1;
-            if problem.residual(start, &mut f0).is_ok() && f0.iter().all(|v| v.is_finite()) {
+            let evaluated = problem.residual(start, &mut f0);
+            if let Err(error) = evaluated.as_ref() {
+                if error.ends_run() {
+                    let termination = Termination::Evaluation(error.clone());
+                    return (termination, strategy, attempts, tolerance);
+                }
+            }
+            if evaluated.is_ok() && f0.iter().all(|v| v.is_finite()) {
                 x.copy_from_slice(start);
                 let plan = path::PathPlan {
                     end: 1.0,
@@ -222,13 +236,21 @@ impl<J> NewtonSolver<J> {
                         outcome.iterations + run.iterations,
                         &termination,
                     ));
-                    if termination.converged() {
+                    if termination.converged() || ends_run(&termination) {
                         return (termination, Strategy::Homotopy, attempts, tolerance);
                     }
                     best.update(x, self.kernel.residual(), run.smallest);
                     last = termination;
                 } else {
                     attempts.push(Attempt::failed_path(Strategy::Homotopy, &outcome));
+                    if let Some(error) = outcome.error {
+                        return (
+                            Termination::Evaluation(error),
+                            Strategy::Homotopy,
+                            attempts,
+                            tolerance,
+                        );
+                    }
                 }
             }
         }
@@ -253,13 +275,7 @@ impl<J> NewtonSolver<J> {
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
-        let mut failed = path::PathOutcome {
-            reached: false,
-            iterations: 0,
-            furthest: 0.0,
-            reason: None,
-            counters: WorkCounters::default(),
-        };
+        let mut failed = path::PathOutcome::default();
         let SmoothingSetup {
             mu0,
             state_scale,
@@ -273,8 +289,9 @@ impl<J> NewtonSolver<J> {
         };
         let mut f = vec![0.0; x.len()];
         counters.residual_evaluations += 1;
-        if smoothed.residual(x, &mut f).is_err() {
+        if let Err(error) = smoothed.residual(x, &mut f) {
             failed.reason = Some("the smoothed residual cannot be evaluated at the start".into());
+            failed.error = error.ends_run().then_some(error);
             return failed;
         }
         let accuracy = tolerance.max(SMOOTHING_ACCURACY * kernel::norm2(&f));
@@ -282,9 +299,11 @@ impl<J> NewtonSolver<J> {
         let rules = KernelRules {
             absolute_tolerance: accuracy,
             relative_tolerance: 0.0,
-            globalization: Globalization::Armijo(line_search),
             max_iterations: budget.min(SMOOTHING_START_ITERATIONS),
-            ..self.options.rules()
+            ..self.options.rules(StepRule::Backtracking {
+                memory: 1,
+                line_search,
+            })
         };
         let mut scratch = Log::default();
         // The smoothed iterates are not iterates of F: their histories are not reported.
@@ -293,6 +312,9 @@ impl<J> NewtonSolver<J> {
         failed.iterations = run.iterations;
         if !termination.converged() {
             failed.reason = Some(format!("the smoothed problem at the start: {termination}"));
+            if let Termination::Evaluation(error) = termination {
+                failed.error = error.ends_run().then_some(error);
+            }
             return failed;
         }
         let plan = path::PathPlan {
@@ -316,6 +338,11 @@ impl<J> NewtonSolver<J> {
         outcome.iterations += run.iterations;
         outcome
     }
+}
+
+/// Whether `termination` is the problem's own error, which ends the polyalgorithm too.
+fn ends_run(termination: &Termination) -> bool {
+    matches!(termination, Termination::Evaluation(e) if e.ends_run())
 }
 
 /// What the smoothing path starts from: `mu0`, the state scale of the path, the run's

@@ -535,6 +535,7 @@ where
                 ratio(*parameter)
             ),
         ),
+        (Some(other), None) => (false, other.to_string()),
         (None, None) => (false, "stopped without a reason".to_string()),
     };
     response.converged = converged;

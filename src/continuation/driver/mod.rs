@@ -263,7 +263,7 @@ where
         })
     }
 
-    fn finished(&self) -> bool {
+    pub(super) fn finished(&self) -> bool {
         matches!(self.phase, Phase::Finished)
     }
 
@@ -289,7 +289,7 @@ where
         spent
     }
 
-    fn finish(&mut self, termination: ContinuationTermination) {
+    pub(super) fn finish(&mut self, termination: ContinuationTermination) {
         if !self.finished() {
             self.termination = Some(termination);
             self.phase = Phase::Finished;
@@ -569,6 +569,9 @@ where
                 Err(failure) => failure,
             };
             self.reject(before, last.parameter);
+            if self.finished() {
+                return;
+            }
             self.consecutive_failures += 1;
             let too_small = ds <= self.options.min_step;
             let too_many = self.consecutive_failures >= self.options.max_consecutive_failures;
@@ -581,6 +584,9 @@ where
                     if let Some((point, chord)) = accepted {
                         self.after_accept(point, chord);
                     }
+                    return;
+                }
+                if self.finished() {
                     return;
                 }
             }

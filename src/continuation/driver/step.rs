@@ -6,7 +6,7 @@ use super::{Accepted, Continuation};
 use crate::continuation::{
     BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
-use crate::newton::kernel::{armijo, KernelRules};
+use crate::newton::kernel::{KernelRules, StepRule};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 impl<P, S> Continuation<'_, P, S>
@@ -77,7 +77,13 @@ where
                 step_tolerance: self.options.step_tolerance,
                 max_iterations,
                 min_iterations: 1,
-                globalization: armijo(self.options.corrector_line_search),
+                step: match self.options.corrector_line_search {
+                    Some(line_search) => StepRule::Backtracking {
+                        memory: 1,
+                        line_search,
+                    },
+                    None => StepRule::Full,
+                },
                 restore_best: false,
                 stagnation: None,
             },
@@ -88,6 +94,15 @@ where
             &mut self.work,
             &mut self.corrector_counts,
         );
+        if let Err(CorrectorFailure::Evaluation { error, .. }) = &outcome.0 {
+            if error.ends_run() {
+                let parameter = self.last.as_ref().map_or(*p, |l| l.parameter);
+                self.finish(ContinuationTermination::ProblemFailed {
+                    parameter,
+                    error: error.clone(),
+                });
+            }
+        }
         x.copy_from_slice(&y[..n]);
         *p = y[n];
         outcome
@@ -175,7 +190,12 @@ where
                     let step = self.metric.norm(&dx, p - last.parameter);
                     return Some(self.accept(last, x, p, step, c, Some(&along)));
                 }
-                Err(_) => self.reject(before, last.parameter),
+                Err(_) => {
+                    self.reject(before, last.parameter);
+                    if self.finished() {
+                        return None;
+                    }
+                }
             }
         }
         None
