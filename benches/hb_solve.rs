@@ -65,7 +65,8 @@ fn solve<S: Factorize<HbJacobian>>(
     let options = newton_options(&default_settings(h));
     let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
-    newton::solve(&mut problem, &mut solver, &mut x, &options).expect("converges");
+    let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
+    assert!(report.converged(), "{:?}", report.termination);
     (problem, x)
 }
 

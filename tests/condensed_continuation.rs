@@ -41,6 +41,7 @@ fn condensed_frequency_derivative_matches_central_differences() {
         &NewtonOptions::default(),
     )
     .unwrap();
+    assert!(report.converged(), "{:?}", report.termination);
     assert!(report.iterations > 1, "contact: more than one Newton step");
     let omega = problem.parameter();
     let mut analytic = vec![0.0; problem.dim()];
@@ -90,8 +91,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
     let mut dense = FaerDenseLu::new();
     let branch = Continuation::new(&mut condensed, &mut dense, &start, omega_from, steps)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     let last = branch.points.last().unwrap();
     assert_eq!(last.parameter, omega_1, "{}", branch.termination);
     let onset = branch.points.iter().position(|p| p.state[0] < 0.0).unwrap();
@@ -111,13 +111,14 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
 
     let mut direct = CondensedSsnHb::new(&rod.model, &options(h)).unwrap();
     let mut lambda = vec![0.0; direct.dim()];
-    solve(
+    let report = solve(
         &mut direct,
         &mut FaerDenseLu::new(),
         &mut lambda,
         &NewtonOptions::default(),
     )
     .unwrap();
+    assert!(report.converged(), "{:?}", report.termination);
     let scale = lambda.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     for (a, b) in last.state.iter().zip(&lambda) {
         assert!((a - b).abs() <= 1e-8 * scale, "{a} vs {b}");

@@ -11,9 +11,7 @@ use std::time::Instant;
 use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{
-    self, Globalization, NewtonError, NewtonOptions, NewtonReport, WorkCounters,
-};
+use semismooth::newton::{self, Globalization, NewtonOptions, NewtonReport, WorkCounters};
 use semismooth::{GeneralizedJacobian, Residual};
 
 use crate::contacts::{contact_reports, ContactReport};
@@ -283,7 +281,7 @@ where
         }
         None => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
     };
-    Ok(report.or_else(NewtonError::into_report)?)
+    Ok(report?)
 }
 
 /// The structured solver of a Newton run with absolute tolerance `tolerance`: a
@@ -670,8 +668,7 @@ fn solve_lcp(
                         let mut z = w.to_vec();
                         let mut solver = ActiveSetSolver::new()
                             .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
-                        let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
-                            .or_else(NewtonError::into_report)?;
+                        let report = newton::solve(&mut problem, &mut solver, &mut z, &options)?;
                         (z, vec![report])
                     }
                     _ => {

@@ -59,7 +59,7 @@
 use semismooth::faer::Mat;
 use semismooth::floquet::{FloquetError, Multipliers};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonError, NewtonOptions, Termination};
+use semismooth::newton::{self, NewtonOptions, Termination};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use crate::march::{
@@ -325,34 +325,8 @@ pub fn hb_stability(
         max_iterations: 50,
         ..NewtonOptions::default()
     };
-    let outcome = newton::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options);
-    // A march that failed inside the solve ended it and comes back in its termination.
-    let failed = |termination: &Termination| match termination {
-        Termination::Evaluation(e) => e.downcast_ref::<StabilityError>().cloned(),
-        _ => None,
-    };
-    if let Some(err) = match &outcome {
-        Ok(report) => failed(&report.termination),
-        Err(NewtonError::NotConverged(report)) => failed(&report.termination),
-        Err(_) => None,
-    } {
-        return Err(err);
-    }
-    let report = match outcome {
+    let report = match newton::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
         Ok(report) => report,
-        Err(NewtonError::NotConverged(report)) => {
-            return Ok(Stability::undecided(
-                format!(
-                    "the periodic orbit of the time-stepping map was not found near the \
-                     harmonic-balance solution: Newton on the period map stopped ({:?}) after \
-                     {} iterations with |F| = {:e}",
-                    report.termination,
-                    report.iterations,
-                    report.residual_norms.last().copied().unwrap_or(f64::NAN)
-                ),
-                spp,
-            ))
-        }
         Err(err) => {
             return Ok(Stability::undecided(
                 format!("Newton on the period map could not run: {err}"),
@@ -360,6 +334,25 @@ pub fn hb_stability(
             ))
         }
     };
+    if !report.converged() {
+        // A march that failed inside the solve ended it and comes back in its termination.
+        if let Termination::Evaluation(e) = &report.termination {
+            if let Some(err) = e.downcast_ref::<StabilityError>() {
+                return Err(err.clone());
+            }
+        }
+        return Ok(Stability::undecided(
+            format!(
+                "the periodic orbit of the time-stepping map was not found near the \
+                 harmonic-balance solution: Newton on the period map stopped ({:?}) after \
+                 {} iterations with |F| = {:e}",
+                report.termination,
+                report.iterations,
+                report.residual_norms.last().copied().unwrap_or(f64::NAN)
+            ),
+            spp,
+        ));
+    }
     shooting.period(&x)?;
     let keep = &shooting.keep;
     let multipliers =

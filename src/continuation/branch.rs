@@ -122,6 +122,14 @@ pub enum CorrectorFailure {
 /// Why a continuation run stopped.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ContinuationTermination {
+    /// The starting point could not be corrected at the starting parameter (the branch has
+    /// no point).
+    StartFailed {
+        /// The starting parameter.
+        parameter: f64,
+        /// Why the corrector failed.
+        failure: CorrectorFailure,
+    },
     /// The branch left `[parameter_min, parameter_max]`; the last point was re-solved at
     /// the bound when possible (then `parameter == bound`).
     ReachedBound {
@@ -195,6 +203,10 @@ pub enum ContinuationTermination {
 impl std::fmt::Display for ContinuationTermination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Self::StartFailed { parameter, failure } => write!(
+                f,
+                "the starting point could not be corrected at p = {parameter}: {failure}"
+            ),
             Self::ReachedBound { parameter, bound } => {
                 write!(
                     f,
@@ -333,7 +345,8 @@ impl Branch {
     }
 }
 
-/// Why a continuation could not run.
+/// Why a continuation could not run (a run that ran and stopped has a
+/// [`ContinuationTermination`]).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ContinuationError {
     /// An option is out of range.
@@ -368,12 +381,4 @@ pub enum ContinuationError {
     /// length).
     #[error(transparent)]
     Newton(#[from] NewtonError),
-    /// The starting point could not be corrected at fixed parameter.
-    #[error("the starting point could not be corrected at p = {parameter}: {failure}")]
-    StartNotConverged {
-        /// The starting parameter.
-        parameter: f64,
-        /// Why the corrector failed.
-        failure: CorrectorFailure,
-    },
 }

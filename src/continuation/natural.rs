@@ -2,7 +2,7 @@
 //! solution. It fails or jumps at folds; it exists to be compared with pseudo-arclength.
 
 use super::ContinuationError;
-use crate::newton::{NewtonError, NewtonOptions, NewtonSolver, Termination, WorkCounters};
+use crate::newton::{NewtonOptions, NewtonSolver, Termination, WorkCounters};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 /// One solved point of a natural-parameter sweep.
@@ -82,9 +82,7 @@ where
     let mut failure = None;
     for (index, &parameter) in parameters.iter().enumerate() {
         problem.set_parameter(parameter);
-        let report = newton
-            .solve(problem, solver, &mut x)
-            .or_else(NewtonError::into_report)?;
+        let report = newton.solve(problem, solver, &mut x)?;
         counters += report.counters;
         if report.converged() {
             points.push(SweepPoint {

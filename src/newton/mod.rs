@@ -18,10 +18,11 @@
 //!
 //! # Outcome
 //!
-//! [`solve`] returns `Ok(report)` only when the run converged; a run that stopped without
-//! converging is [`NewtonError::NotConverged`], which carries the whole report (the best
-//! iterate is still written to `x`). Callers that want the report either way say so:
-//! `solve(..).or_else(NewtonError::into_report)`.
+//! `Err` ([`NewtonError`]) only when the solver could not run: invalid options, an initial
+//! guess of the wrong length. A run that ran returns `Ok(report)` whatever it ended with:
+//! its typed [`NewtonReport::termination`] says why it stopped
+//! ([`NewtonReport::converged`] whether it converged), and the best iterate is written to
+//! `x`.
 //!
 //! # Options and defaults ([`NewtonOptions`])
 //!
@@ -512,7 +513,8 @@ impl NewtonReport {
     }
 }
 
-/// The solver could not run, or it ran and did not converge.
+/// Why the solver could not run (a run that ran and stopped is an `Ok` report, see
+/// [`NewtonReport::termination`]).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum NewtonError {
     /// An option is outside its allowed range.
@@ -533,35 +535,6 @@ pub enum NewtonError {
         /// `x.len()`.
         found: usize,
     },
-    /// The run stopped without convergence; the report has every number (the best
-    /// iterate was written to `x`).
-    #[error(
-        "Newton did not converge ({}) after {} iterations: |F| = {:e} (initial {:e})",
-        .0.termination,
-        .0.iterations,
-        .0.residual_norm(),
-        .0.residual_norms.first().copied().unwrap_or(f64::NAN)
-    )]
-    NotConverged(Box<NewtonReport>),
-}
-
-impl NewtonError {
-    /// The report of a run that did not converge, `Err(self)` for the errors that kept it
-    /// from running: `solve(..).or_else(NewtonError::into_report)` accepts both outcomes.
-    pub fn into_report(self) -> Result<NewtonReport, NewtonError> {
-        match self {
-            Self::NotConverged(report) => Ok(*report),
-            other => Err(other),
-        }
-    }
-
-    /// The report of a run that did not converge (`None` for the other errors).
-    pub fn report(&self) -> Option<&NewtonReport> {
-        match self {
-            Self::NotConverged(report) => Some(report),
-            _ => None,
-        }
-    }
 }
 
 /// `log(r3/r2) / log(r2/r1)` from the last three norms, see
@@ -682,10 +655,9 @@ impl<J> NewtonSolver<J> {
 
     /// Runs semismooth Newton from `x` (initial guess in, best iterate out).
     ///
-    /// `Ok(report)` when it converged; [`NewtonError::NotConverged`] (with the report)
-    /// when it ran and stopped without converging; [`NewtonError::DimensionMismatch`] when
-    /// `x` does not fit the problem. `x` always holds finite values on return if it did
-    /// on entry.
+    /// `Ok(report)` when it ran, converged or not ([`NewtonReport::converged`]);
+    /// [`NewtonError::DimensionMismatch`] when `x` does not fit the problem. `x` always
+    /// holds finite values on return if it did on entry.
     pub fn solve<P, S>(
         &mut self,
         problem: &mut P,
@@ -791,11 +763,7 @@ impl<J> NewtonSolver<J> {
             step_norms: log.step_norms,
             counters,
         };
-        if report.converged() {
-            Ok(report)
-        } else {
-            Err(NewtonError::NotConverged(Box::new(report)))
-        }
+        Ok(report)
     }
 
     /// One run of the kernel with the plain direction and `rules.step` throughout; its
@@ -937,9 +905,9 @@ struct Log {
 
 /// One-shot semismooth Newton: validates `options`, runs [`NewtonSolver::solve`].
 ///
-/// `x`: initial guess in, best iterate out. `Ok(report)` when it converged;
-/// [`NewtonError::NotConverged`] (with the report) when it ran without converging; the
-/// other errors when it could not run (invalid options, dimension mismatch).
+/// `x`: initial guess in, best iterate out. `Ok(report)` when it ran, converged or not
+/// ([`NewtonReport::converged`]); `Err` when it could not run (invalid options, dimension
+/// mismatch).
 pub fn solve<P, S>(
     problem: &mut P,
     solver: &mut S,

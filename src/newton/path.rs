@@ -325,18 +325,10 @@ where
         }
     };
     let mut last = 0.0;
-    for item in continuation.by_ref() {
-        match item {
-            Ok(point) => {
-                outcome.furthest = outcome.furthest.max(point.parameter);
-                last = point.parameter;
-                x.copy_from_slice(&point.state);
-            }
-            Err(e) => {
-                outcome.reason = Some(e.to_string());
-                break;
-            }
-        }
+    for point in continuation.by_ref() {
+        outcome.furthest = outcome.furthest.max(point.parameter);
+        last = point.parameter;
+        x.copy_from_slice(&point.state);
     }
     let counters = continuation.counters();
     outcome.iterations = counters.corrector_iterations as usize;

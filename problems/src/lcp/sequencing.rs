@@ -1,7 +1,7 @@
 //! Mesh sequencing for the semismooth Newton method on the periodic LCP: coarse levels
 //! first, each finer level warm-started by the interpolated coarser solution.
 
-use semismooth::newton::{self, NewtonError, NewtonOptions, NewtonReport};
+use semismooth::newton::{self, NewtonOptions, NewtonReport};
 
 use super::{
     ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -120,8 +120,7 @@ pub fn solve_min_map_sequenced(
             Some(coarse) => (lcp.interpolate_forces(coarse)?, lcp.min_map()),
             None => (vec![0.0; lcp.dim()], lcp.min_map().with_smoothing()),
         };
-        let report = newton::solve(&mut problem, &mut solver, &mut z, newton_options)
-            .or_else(NewtonError::into_report)?;
+        let report = newton::solve(&mut problem, &mut solver, &mut z, newton_options)?;
         levels.push(SequencingLevel {
             time_samples: lcp.time_samples(),
             report,

@@ -92,7 +92,7 @@ use semismooth::continuation::{
     ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonError, WorkCounters};
+use semismooth::newton::{self, WorkCounters};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
@@ -305,12 +305,6 @@ fn continuation_error(e: ContinuationError) -> RunError {
             parameter,
             "within the sweep interval",
         ),
-        // Handled by the caller (a non-converged curve); kept total here.
-        ContinuationError::StartNotConverged { parameter, .. } => invalid(
-            "sweep.omega_ratio_from",
-            parameter,
-            "a frequency where the start point can be corrected",
-        ),
     }
 }
 
@@ -362,8 +356,7 @@ where
     let (mut x, mut work) = setup
         .start
         .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
-    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))
-        .or_else(NewtonError::into_report)?;
+    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
     work += report.counters;
     let mut response = FrequencyResponse {
         method: settings.method,
@@ -408,16 +401,7 @@ where
     let mut continuation = configure(
         Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
     );
-    let mut start_failure = None;
-    while let Some(item) = continuation.next() {
-        let point = match item {
-            Ok(point) => point,
-            Err(ContinuationError::StartNotConverged { failure, .. }) => {
-                start_failure = Some(failure);
-                break;
-            }
-            Err(e) => return Err(continuation_error(e)),
-        };
+    while let Some(point) = continuation.next() {
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
         response.push(omega, max, min, point.iterations, point.state);
@@ -451,16 +435,15 @@ where
     response.corners = c.corners as usize;
     response.continuation = c;
     let ratio = |omega: f64| omega / omega_1;
-    let (converged, words) = match (&termination, start_failure) {
-        (_, Some(failure)) => (
+    let (converged, words) = match &termination {
+        Some(
+            ContinuationTermination::StartFailed { failure, .. }
+            | ContinuationTermination::SegmentStartFailed { failure, .. },
+        ) => (
             false,
             format!("the start point could not be corrected: {failure}"),
         ),
-        (Some(ContinuationTermination::SegmentStartFailed { failure, .. }), None) => (
-            false,
-            format!("the start point could not be corrected: {failure}"),
-        ),
-        (Some(ContinuationTermination::Retraced { parameter }), None) => (
+        Some(ContinuationTermination::Retraced { parameter }) => (
             false,
             format!(
                 "stalled at omega_ratio {}: no step ahead (a corner the continuation cannot \
@@ -468,7 +451,7 @@ where
                 ratio(*parameter)
             ),
         ),
-        (Some(ContinuationTermination::ReachedBound { parameter, bound }), None) => {
+        Some(ContinuationTermination::ReachedBound { parameter, bound }) => {
             let reached_end = *bound == to;
             let at_bound = *parameter == *bound;
             (
@@ -491,52 +474,46 @@ where
                 ),
             )
         }
-        (Some(ContinuationTermination::IterationBudgetSpent { parameter, budget }), None) => (
+        Some(ContinuationTermination::IterationBudgetSpent { parameter, budget }) => (
             false,
             format!(
                 "the {budget} corrector iterations allowed were spent at omega_ratio {}",
                 ratio(*parameter)
             ),
         ),
-        (Some(ContinuationTermination::MaxPoints { points }), None) => (
+        Some(ContinuationTermination::MaxPoints { points }) => (
             false,
             format!(
                 "point limit ({points} points) at omega_ratio {}",
                 response.omega.last().map_or(f64::NAN, |w| w / omega_1)
             ),
         ),
-        (
-            Some(ContinuationTermination::StepTooSmall {
+        Some(ContinuationTermination::StepTooSmall {
                 parameter,
                 step,
                 failure,
                 ..
-            }),
-            None,
-        ) => (
+        }) => (
             false,
             format!(
                 "step too small at omega_ratio {}: the attempt with step {step:e} failed: {failure}",
                 ratio(*parameter)
             ),
         ),
-        (
-            Some(ContinuationTermination::TooManyFailures {
+        Some(ContinuationTermination::TooManyFailures {
                 parameter,
                 failures,
                 failure,
                 ..
-            }),
-            None,
-        ) => (
+        }) => (
             false,
             format!(
                 "{failures} failed steps in a row at omega_ratio {}: {failure}",
                 ratio(*parameter)
             ),
         ),
-        (Some(other), None) => (false, other.to_string()),
-        (None, None) => (false, "stopped without a reason".to_string()),
+        Some(other) => (false, other.to_string()),
+        None => (false, "stopped without a reason".to_string()),
     };
     response.converged = converged;
     response.termination = words;

@@ -76,8 +76,9 @@ enum Resume {
 /// The first item is the starting point corrected at fixed `p0` by the continuation's own
 /// corrector (Newton, with the line search of
 /// [`ContinuationOptions::corrector_line_search`] if set; from a poor guess, solve first
-/// with [`crate::newton`]). An `Err` item (the start could not be corrected) ends the
-/// iteration. When the iteration ends, [`Continuation::termination`] says why,
+/// with [`crate::newton`]); when it cannot be corrected there is no item and the
+/// termination is [`ContinuationTermination::StartFailed`]. When the iteration ends,
+/// [`Continuation::termination`] says why,
 /// [`Continuation::events`] lists the folds and corners, and the problem's parameter is
 /// that of the last accepted point.
 pub struct Continuation<'a, P, S>
@@ -211,7 +212,7 @@ where
         })
     }
 
-    /// Why the run stopped (`None` while it runs, or after a start failure).
+    /// Why the run stopped (`None` while it runs).
     pub fn termination(&self) -> Option<&ContinuationTermination> {
         self.termination.as_ref()
     }
@@ -244,23 +245,20 @@ where
     }
 
     /// Runs to the end and collects the branch.
-    pub fn run(mut self) -> Result<super::Branch, ContinuationError> {
-        let mut points = Vec::new();
-        for item in self.by_ref() {
-            points.push(item?);
-        }
+    pub fn run(mut self) -> super::Branch {
+        let points: Vec<BranchPoint> = self.by_ref().collect();
         let termination = self
             .termination
             .clone()
             .unwrap_or(ContinuationTermination::MaxPoints {
                 points: points.len(),
             });
-        Ok(super::Branch {
+        super::Branch {
             points,
             events: std::mem::take(&mut self.events),
             termination,
             counters: self.counters(),
-        })
+        }
     }
 
     pub(super) fn finished(&self) -> bool {
@@ -296,24 +294,23 @@ where
         }
     }
 
-    fn start(&mut self, x0: Vec<f64>, p0: f64) -> Result<(), ContinuationError> {
+    fn start(&mut self, x0: Vec<f64>, p0: f64) {
         let mut x = x0;
         let mut p = p0;
         let corrected = match self.correct_start(&mut x, &mut p, self.options.direction) {
             Ok(c) => c,
             Err(failure) => {
                 self.problem.set_parameter(p0);
-                self.phase = Phase::Finished;
-                return Err(ContinuationError::StartNotConverged {
+                self.finish(ContinuationTermination::StartFailed {
                     parameter: p0,
                     failure,
                 });
+                return;
             }
         };
         self.phase = Phase::Running;
         let point = self.start_point(x, p, corrected);
         self.after_accept(point, 0.0);
-        Ok(())
     }
 
     /// Begins a new segment of the branch at `(x, p)`: a correction at fixed `p`, the
@@ -714,23 +711,19 @@ where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
-    type Item = Result<BranchPoint, ContinuationError>;
+    type Item = BranchPoint;
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
             if let Some(point) = self.pending.pop_front() {
-                return Some(Ok(point));
+                return Some(point);
             }
             match std::mem::replace(&mut self.phase, Phase::Running) {
                 Phase::Finished => {
                     self.phase = Phase::Finished;
                     return None;
                 }
-                Phase::NotStarted { x0, p0 } => {
-                    if let Err(e) = self.start(x0, p0) {
-                        return Some(Err(e));
-                    }
-                }
+                Phase::NotStarted { x0, p0 } => self.start(x0, p0),
                 Phase::Running => self.advance(),
             }
         }
