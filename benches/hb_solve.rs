@@ -23,7 +23,7 @@ use std::time::Duration;
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton;
+use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
 use semismooth_problems::figures::default_settings;
 use semismooth_problems::hb::{HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
@@ -65,7 +65,9 @@ fn solve<S: Factorize<HbJacobian>>(
     let options = newton_options(&default_settings(h));
     let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
-    let report = newton::solve(&mut problem, &mut solver, &mut x, &options).expect("runs");
+    let report = options
+        .solve(&mut problem, &mut solver, &mut x, Some(SmoothingOf::new()))
+        .expect("runs");
     assert!(report.converged(), "{:?}", report.termination);
     (problem, x)
 }

@@ -61,10 +61,12 @@ pub mod complementarity;
 pub mod continuation;
 pub mod floquet;
 pub mod harmonic;
+mod iteration;
 pub mod lemke;
 pub mod linalg;
 pub mod linesearch;
 pub mod newton;
+pub mod polyalgorithm;
 mod traits;
 
 pub use traits::{

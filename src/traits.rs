@@ -201,12 +201,6 @@ pub trait Residual {
     fn problem_counters(&self) -> ProblemCounters {
         ProblemCounters::new()
     }
-
-    /// The smoothing of its nonsmooth terms the problem offers ([`Smoothing`]), `None` (the
-    /// default) when it offers none. Problems that do return `Some(self)`.
-    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
-        None
-    }
 }
 
 /// A smoothing of a problem's nonsmooth terms by a parameter `mu >= 0`: `F_mu` is
@@ -215,9 +209,41 @@ pub trait Residual {
 /// lies within `mu` of it. While `mu > 0` is set, [`Residual::residual`] evaluates `F_mu`
 /// and [`GeneralizedJacobian::jacobian`] its Jacobian.
 ///
-/// The Newton driver's polyalgorithm follows the smoothing path `F_mu(x) = 0` from a large
-/// `mu` (where the problem is nearly affine) to `mu = 0` ([`crate::newton`], *Polyalgorithm*).
-pub trait Smoothing {
+/// A capability known from the problem's type: the polyalgorithm follows the smoothing path
+/// `F_mu(x) = 0` from a large `mu` (where the problem is nearly affine) to `mu = 0` when it
+/// is called through [`polyalgorithm::solve_smoothing`](crate::polyalgorithm::solve_smoothing)
+/// ([`crate::polyalgorithm`], attempt 2).
+///
+/// ```
+/// use semismooth::{EvaluationError, Residual, Smoothing};
+/// /// F(x) = x - max(0, 2 - x) (root x = 1), smoothed by the CHKS function.
+/// struct Ramp { mu: f64 }
+/// fn phi(s: f64, mu: f64) -> f64 { (s + (s * s + 4.0 * mu * mu).sqrt()) / 2.0 }
+/// impl Residual for Ramp {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0] - phi(2.0 - x[0], self.mu);
+///         Ok(())
+///     }
+/// }
+/// impl Smoothing for Ramp {
+///     fn smoothing_scale(&self) -> f64 { 2.0 } // |2 - x| at the guess x = 0
+///     fn set_smoothing(&mut self, mu: f64) { self.mu = mu; }
+///     fn residual_smoothing_derivative(&mut self, x: &[f64], d: &mut [f64]) -> Result<(), EvaluationError> {
+///         let s = 2.0 - x[0];
+///         d[0] = -2.0 * self.mu / (s * s + 4.0 * self.mu * self.mu).sqrt();
+///         Ok(())
+///     }
+/// }
+/// let mut ramp = Ramp { mu: 0.0 };
+/// let mut f = [0.0];
+/// ramp.residual(&[1.0], &mut f).unwrap();
+/// assert_eq!(f[0], 0.0);
+/// ramp.set_smoothing(0.5);
+/// ramp.residual(&[1.0], &mut f).unwrap();
+/// assert!(f[0] < 0.0 && f[0] > -0.5); // within mu of F
+/// ```
+pub trait Smoothing: Residual {
     /// The scale of `mu` at which the smoothing blurs the problem's switching quantities
     /// over their whole range at the initial guess (e.g. `c |g|` for `max(0, c (u - g))`).
     fn smoothing_scale(&self) -> f64;

@@ -4,7 +4,7 @@
 
 use semismooth::continuation::{Continuation, ContinuationOptions};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{solve, NewtonOptions};
+use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
 use semismooth::{ParameterDependent, Residual};
 use semismooth_problems::hb::{CondensedSsnHb, HbOptions, SsnHb};
 use semismooth_problems::rod::{build_rod, MassModel, RodModel, RodSpec};
@@ -38,7 +38,7 @@ fn condensed_frequency_derivative_matches_central_differences() {
         &mut problem,
         &mut FaerDenseLu::new(),
         &mut lambda,
-        &NewtonOptions::default(),
+        &PolyalgorithmOptions::default(),
     )
     .unwrap();
     assert!(report.converged(), "{:?}", report.termination);
@@ -115,7 +115,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
         &mut direct,
         &mut FaerDenseLu::new(),
         &mut lambda,
-        &NewtonOptions::default(),
+        &PolyalgorithmOptions::default(),
     )
     .unwrap();
     assert!(report.converged(), "{:?}", report.termination);

@@ -9,7 +9,8 @@ use semismooth::continuation::{
     ContinuationTermination, CorrectorFailure, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{self, Globalization, NewtonOptions};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver};
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
 
 type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
@@ -792,8 +793,11 @@ fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
             globalization,
             ..Default::default()
         };
-        let sweep =
-            natural_sweep(&mut problem, &mut solver, &[-1.3], &parameters, &options).unwrap();
+        let mut newton = NewtonSolver::new(options).unwrap();
+        let sweep = natural_sweep(&mut problem, &[-1.3], &parameters, |p, x| {
+            newton.solve(p, &mut solver, x)
+        })
+        .unwrap();
         let xs: Vec<f64> = sweep.points.iter().map(|q| q.state[0]).collect();
         let jumps: Vec<usize> = (1..xs.len())
             .filter(|&i| (xs[i] - xs[i - 1]).abs() > 0.5)
@@ -840,7 +844,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
     // Re-solve each point at its own parameter, from itself, with the library's Newton
     // driver and a tolerance 100x tighter than the continuation's, so that a Newton step is
     // taken: the correction is about |J^{-1}| |F| <= 1e-10 / σ_min(J).
-    let strict = NewtonOptions {
+    let strict = PolyalgorithmOptions {
         absolute_tolerance: 1e-12,
         ..Default::default()
     };
@@ -853,7 +857,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
         for q in &branch.points {
             let mut x = q.state.clone();
             problem.set_parameter(q.parameter);
-            let report = newton::solve(&mut problem, &mut solver, &mut x, &strict).unwrap();
+            let report = polyalgorithm::solve(&mut problem, &mut solver, &mut x, &strict).unwrap();
             assert!(
                 report.converged(),
                 "p = {}: {:?}",

@@ -14,8 +14,9 @@ use semismooth::complementarity::{fischer_burmeister, max_form, min_function, Ph
 use semismooth::linalg::{FaerDenseLu, FaerSparseLu, LinearSolveError, NalgebraLu};
 use semismooth::newton::{
     solve, Globalization, LineSearchOptions, NewtonError, NewtonOptions, NewtonReport,
-    NewtonSolver, Termination, WorkCounters,
+    NewtonSolver, Termination, WorkCounters, EXACT_RESIDUAL,
 };
+use semismooth::polyalgorithm::{self, Polyalgorithm, PolyalgorithmOptions};
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ProblemCounters, Residual,
 };
@@ -29,6 +30,32 @@ fn options(globalization: Globalization) -> NewtonOptions {
 
 fn armijo() -> Globalization {
     Globalization::Armijo(LineSearchOptions::default())
+}
+
+/// Plain Newton with its default globalization, then the polyalgorithm, on `problem()`
+/// from `x0`: each report with the returned `x`.
+fn both_drivers<P>(
+    mut problem: impl FnMut() -> P,
+    mut linear: impl FnMut() -> Box<dyn semismooth::Factorize<Mat<f64>>>,
+    x0: [f64; 1],
+) -> [(Result<NewtonReport, NewtonError>, [f64; 1]); 2]
+where
+    P: GeneralizedJacobian<Jacobian = Mat<f64>>,
+{
+    let (mut x, mut y) = (x0, x0);
+    let plain = solve(
+        &mut problem(),
+        &mut *linear(),
+        &mut x,
+        &NewtonOptions::default(),
+    );
+    let poly = polyalgorithm::solve(
+        &mut problem(),
+        &mut *linear(),
+        &mut y,
+        &PolyalgorithmOptions::default(),
+    );
+    [(plain, x), (poly, y)]
 }
 
 /// The report of a run that must have run and stopped without converging.
@@ -410,7 +437,7 @@ fn nonsmooth_lcp_terminates_finitely_with_min_and_max_form_and_quadratically_wit
         let before = norms[norms.len() - 2];
         match phi {
             Phi::Min | Phi::Max(_) => {
-                let exact = last < 1e-300;
+                let exact = last < EXACT_RESIDUAL;
                 if exact {
                     assert_eq!(report.observed_order, None);
                 } else {
@@ -478,6 +505,9 @@ fn atan_from_10_fails_without_globalization_and_converges_with_line_search() {
     }
 }
 
+/// A solve from the guess it is given.
+type Driver = dyn Fn(&mut [f64]) -> Result<NewtonReport, NewtonError>;
+
 /// The problem's own failure (an inner solve that diverged at `x`).
 #[derive(Debug, PartialEq)]
 struct InnerFailure(f64);
@@ -537,14 +567,47 @@ fn the_problems_own_error_ends_the_run_and_comes_back_in_the_termination() {
     )
     .unwrap();
     assert!(report.converged() && x[0].abs() < 1e-10);
-    for globalization in [armijo(), Globalization::None, Globalization::default()] {
+    let drivers: [(&str, &Driver); 4] = [
+        ("armijo", &|x| {
+            let options = options(armijo());
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("full steps", &|x| {
+            let options = options(Globalization::None);
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("hybrid", &|x| {
+            let options = options(Globalization::hybrid());
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("polyalgorithm", &|x| {
+            let options = PolyalgorithmOptions::default();
+            polyalgorithm::solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+    ];
+    for (globalization, driver) in drivers {
         let mut x = [10.0];
-        let report = not_converged(solve(
-            &mut Atan { own_error: true },
-            &mut FaerDenseLu::new(),
-            &mut x,
-            &options(globalization),
-        ));
+        let report = not_converged(driver(&mut x));
         let Termination::Evaluation(error) = &report.termination else {
             panic!("{globalization:?}: {:?}", report.termination);
         };
@@ -668,26 +731,26 @@ fn line_search_failure_is_reported_with_exact_trial_count() {
 }
 
 /// F(x) = x^2 + 1 at x0 = 0 has J = 0: a linear-solve termination carrying the solver's
-/// `Singular` error.
+/// `Singular` error (plain Newton and the polyalgorithm).
 #[test]
 fn singular_jacobian_is_a_termination_carrying_the_linear_solver_error() {
-    let mut p = scalar(|x| x * x + 1.0, |x| 2.0 * x);
-    let mut x = [0.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut FaerDenseLu::new(),
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert!(matches!(
-        report.termination,
-        Termination::LinearSolve(LinearSolveError::Singular { index: 0, .. })
-    ));
-    assert!(report
-        .termination
-        .to_string()
-        .starts_with("singular-jacobian"));
-    assert_eq!(x, [0.0]);
+    let runs = both_drivers(
+        || scalar(|x| x * x + 1.0, |x| 2.0 * x),
+        || Box::new(FaerDenseLu::new()),
+        [0.0],
+    );
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert!(matches!(
+            report.termination,
+            Termination::LinearSolve(LinearSolveError::Singular { index: 0, .. })
+        ));
+        assert!(report
+            .termination
+            .to_string()
+            .starts_with("singular-jacobian"));
+        assert_eq!(x, [0.0]);
+    }
 }
 
 /// A linear solver that cannot allocate its factors: every `factor` is `OutOfMemory`.
@@ -708,45 +771,46 @@ impl semismooth::Factorize<Mat<f64>> for NoMemory {
 }
 
 /// A factorization that runs out of memory ends the run with its own termination,
-/// `out-of-memory`, not as a singular Jacobian; x is kept.
+/// `out-of-memory`, not as a singular Jacobian; x is kept (plain Newton and the
+/// polyalgorithm).
 #[test]
 fn an_allocation_failure_is_its_own_termination_not_a_singular_jacobian() {
-    let mut p = scalar(|x| x * x - 4.0, |x| 2.0 * x);
-    let mut x = [1.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut NoMemory,
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert_eq!(
-        report.termination,
-        Termination::LinearSolve(LinearSolveError::OutOfMemory {
-            during: "the dense factors"
-        })
+    let runs = both_drivers(
+        || scalar(|x| x * x - 4.0, |x| 2.0 * x),
+        || Box::new(NoMemory),
+        [1.0],
     );
-    let text = report.termination.to_string();
-    assert!(text.starts_with("out-of-memory"), "{text}");
-    assert!(!text.contains("singular"), "{text}");
-    assert_eq!(x, [1.0]);
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert_eq!(
+            report.termination,
+            Termination::LinearSolve(LinearSolveError::OutOfMemory {
+                during: "the dense factors"
+            })
+        );
+        let text = report.termination.to_string();
+        assert!(text.starts_with("out-of-memory"), "{text}");
+        assert!(!text.contains("singular"), "{text}");
+        assert_eq!(x, [1.0]);
+    }
 }
 
 /// A NaN residual at the start (sqrt of a negative number) is NonFinite with x
-/// unchanged; the reported norm is infinite, not NaN.
+/// unchanged; the reported norm is infinite, not NaN (plain Newton and the polyalgorithm).
 #[test]
 fn non_finite_residual_is_reported_and_x_kept() {
-    let mut p = scalar(|x: f64| x.sqrt() - 1.0, |x: f64| 0.5 / x.sqrt());
-    let mut x = [-1.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut FaerDenseLu::new(),
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert_eq!(report.termination, Termination::NonFinite);
-    assert_eq!(report.iterations, 0);
-    assert_eq!(x, [-1.0]);
-    assert_eq!(report.residual_norm(), f64::INFINITY);
+    let runs = both_drivers(
+        || scalar(|x: f64| x.sqrt() - 1.0, |x: f64| 0.5 / x.sqrt()),
+        || Box::new(FaerDenseLu::new()),
+        [-1.0],
+    );
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert_eq!(report.termination, Termination::NonFinite);
+        assert_eq!(report.iterations, 0);
+        assert_eq!(x, [-1.0]);
+        assert_eq!(report.residual_norm(), f64::INFINITY);
+    }
 }
 
 /// F(x) = x^3 converges linearly with steps x_k / 3; with step_tolerance 0.01 the run
@@ -933,15 +997,15 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     }
     let mut sparse: Obstacle<SparseColMat<usize, f64>> = make(n);
     let mut dense: Obstacle<Mat<f64>> = make(n);
-    let opts = NewtonOptions {
+    let opts = PolyalgorithmOptions {
         absolute_tolerance: 1e-12,
         ..Default::default()
     };
     let mut us = vec![0.0; n];
     let mut slu = FaerSparseLu::new();
-    let rs = solve(&mut sparse, &mut slu, &mut us, &opts).unwrap();
+    let rs = polyalgorithm::solve(&mut sparse, &mut slu, &mut us, &opts).unwrap();
     let mut ud = vec![0.0; n];
-    let rd = solve(&mut dense, &mut FaerDenseLu::new(), &mut ud, &opts).unwrap();
+    let rd = polyalgorithm::solve(&mut dense, &mut FaerDenseLu::new(), &mut ud, &opts).unwrap();
     println!(
         "obstacle: sparse {} it, dense {} it, norms {:?}",
         rs.iterations, rd.iterations, rs.residual_norms
@@ -975,21 +1039,16 @@ static GLOBAL: common::CountingAllocator = common::CountingAllocator;
 /// solve converges in >= 3 iterations and makes exactly 5 allocations (the report's
 /// residual, step-length and step-norm histories, its list of attempts and the outcome
 /// text of the one attempt).
-fn warm_then_count_allocations<P, S>(
-    newton: &mut NewtonSolver<P::Jacobian>,
-    problem: &mut P,
-    lu: &mut S,
+fn warm_then_count_allocations(
+    mut solve: impl FnMut(&mut [f64]) -> Result<NewtonReport, NewtonError>,
     x: &mut [f64],
     starts: &[f64],
-) where
-    P: GeneralizedJacobian,
-    S: semismooth::Factorize<P::Jacobian>,
-{
-    assert!(newton.solve(problem, lu, x).unwrap().converged());
+) {
+    assert!(solve(x).unwrap().converged());
     for &start in starts {
         x.fill(start);
         let before = allocations();
-        let report = newton.solve(problem, lu, x).unwrap();
+        let report = solve(x).unwrap();
         let made = allocations() - before;
         assert!(
             report.converged() && report.iterations >= 3,
@@ -1003,17 +1062,21 @@ fn warm_then_count_allocations<P, S>(
     }
 }
 
-/// A reused `NewtonSolver` with a reused faer solver (dense or sparse) allocates only
-/// the report (three history vectors, the attempt list and its text) per solve, however many iterations it takes:
-/// nothing per iteration. Measured with a counting global allocator on this thread.
+/// A reused `NewtonSolver` or `Polyalgorithm` with a reused faer solver (dense or sparse)
+/// allocates only the report (three history vectors, the attempt list and its text) per
+/// solve, however many iterations it takes: nothing per iteration. Measured with a
+/// counting global allocator on this thread.
 #[test]
 fn repeated_solves_allocate_nothing_per_iteration() {
     faer::set_global_parallelism(faer::Par::Seq);
     let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let mut poly = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
     let (mut lcp, _) = strictly_complementary_lcp(Phi::FischerBurmeister);
     let mut lu = FaerDenseLu::new();
     let mut z = vec![1.0; 8];
-    warm_then_count_allocations(&mut newton, &mut lcp, &mut lu, &mut z, &[1.0, 3.0, -2.0]);
+    let starts = [1.0, 3.0, -2.0];
+    warm_then_count_allocations(|z| newton.solve(&mut lcp, &mut lu, z), &mut z, &starts);
+    warm_then_count_allocations(|z| poly.solve(&mut lcp, &mut lu, z), &mut z, &starts);
 
     let n = 200;
     let mut t = Vec::new();
@@ -1061,12 +1124,17 @@ fn repeated_solves_allocate_nothing_per_iteration() {
     let mut slu = FaerSparseLu::new();
     let mut u = vec![0.0; n];
     let mut newton_sparse = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let mut poly_sparse = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
+    let starts = [0.0, 5.0];
     warm_then_count_allocations(
-        &mut newton_sparse,
-        &mut chain,
-        &mut slu,
+        |u| newton_sparse.solve(&mut chain, &mut slu, u),
         &mut u,
-        &[0.0, 5.0],
+        &starts,
+    );
+    warm_then_count_allocations(
+        |u| poly_sparse.solve(&mut chain, &mut slu, u),
+        &mut u,
+        &starts,
     );
     assert_eq!(slu.symbolic_analyses(), 1);
 }

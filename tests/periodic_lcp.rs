@@ -9,6 +9,7 @@ use common::{dense, dense_kmd, exact_linear, max_abs_diff, thread_cpu_seconds};
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions};
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions, SolveOptions};
 use semismooth_problems::lcp::{
     solve_min_map_sequenced, ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
     DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -371,7 +372,7 @@ fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonRepo
         .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
         .unwrap();
     let report =
-        newton::solve(&mut problem, &mut solver, &mut z, &NewtonOptions::default()).unwrap();
+        polyalgorithm::solve(&mut problem, &mut solver, &mut z, &Default::default()).unwrap();
     (z, report)
 }
 
@@ -477,7 +478,7 @@ fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass
         // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
         // interpolated previous Newton solution); Lemke independently on the finest LCP.
         let lcp = &PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
-        let sequenced = solve_min_map_sequenced(&model, lcp, &NewtonOptions::default()).unwrap();
+        let sequenced = solve_min_map_sequenced(&model, lcp, &SolveOptions::default()).unwrap();
         assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
         assert_eq!(
             sequenced.levels.len(),
@@ -825,10 +826,10 @@ fn every_sequencing_level_stays_within_the_iteration_budget_when_it_fails() {
     let model = &rod.structure.model;
     for (nt, budget) in [(512, 200), (1024, 200), (1024, 60)] {
         let lcp = PeriodicLcp::new(model, options(nt, vec![])).unwrap();
-        let newton_options = NewtonOptions {
+        let newton_options = SolveOptions::Polyalgorithm(PolyalgorithmOptions {
             max_iterations: budget,
-            ..NewtonOptions::default()
-        };
+            ..PolyalgorithmOptions::default()
+        });
         let solved = solve_min_map_sequenced(model, &lcp, &newton_options).unwrap();
         assert!(!solved.converged(), "Nt = {nt}");
         for level in &solved.levels {

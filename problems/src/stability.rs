@@ -59,7 +59,8 @@
 use semismooth::faer::Mat;
 use semismooth::floquet::{FloquetError, Multipliers};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonOptions, Termination};
+use semismooth::newton::Termination;
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use crate::march::{
@@ -320,20 +321,21 @@ pub fn hb_stability(
         evaluated: None,
     };
     let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let options = NewtonOptions {
+    let options = PolyalgorithmOptions {
         absolute_tolerance: SHOOTING_TOLERANCE * scale,
         max_iterations: 50,
-        ..NewtonOptions::default()
+        ..PolyalgorithmOptions::default()
     };
-    let report = match newton::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
-        Ok(report) => report,
-        Err(err) => {
-            return Ok(Stability::undecided(
-                format!("Newton on the period map could not run: {err}"),
-                spp,
-            ))
-        }
-    };
+    let report =
+        match polyalgorithm::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
+            Ok(report) => report,
+            Err(err) => {
+                return Ok(Stability::undecided(
+                    format!("Newton on the period map could not run: {err}"),
+                    spp,
+                ))
+            }
+        };
     if !report.converged() {
         // A march that failed inside the solve ended it and comes back in its termination.
         if let Termination::Evaluation(e) = &report.termination {

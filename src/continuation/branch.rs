@@ -377,8 +377,8 @@ pub enum ContinuationError {
         /// Upper bound.
         max: f64,
     },
-    /// The Newton options of a natural sweep are invalid (or the state has the wrong
-    /// length).
+    /// A solve of a natural sweep could not run (its options are invalid, or the state has
+    /// the wrong length).
     #[error(transparent)]
     Newton(#[from] NewtonError),
 }

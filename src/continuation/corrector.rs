@@ -6,8 +6,8 @@ use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut};
 
 use super::{CorrectorFailure, BORDER_PIVOT_THRESHOLD};
+use crate::iteration::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::linalg::{check_finite_dense, check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use crate::newton::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::newton::WorkCounters;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent};
 

@@ -121,7 +121,8 @@
 //! start (bad options, a start of the wrong length or out of bounds); a run that ran says
 //! why it stopped in its [`ContinuationTermination`] (a start that cannot be corrected
 //! included: [`ContinuationTermination::StartFailed`], and no point). [`natural_sweep`] solves at a list of parameters with
-//! [`crate::newton`] from the previous solution, for comparison: it fails or jumps at folds.
+//! the solver it is given ([`crate::newton`] or [`crate::polyalgorithm`]) from the previous
+//! solution, for comparison: it fails or jumps at folds.
 //!
 //! References: H. B. Keller, *Numerical solution of bifurcation and nonlinear eigenvalue
 //! problems* (1977); E. Allgower & K. Georg, *Numerical Continuation Methods* (1990), for

@@ -92,7 +92,8 @@ use semismooth::continuation::{
     ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, WorkCounters};
+use semismooth::newton::WorkCounters;
+use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
@@ -326,10 +327,11 @@ struct Setup<'a> {
     start: Option<(Vec<f64>, WorkCounters)>,
 }
 
-/// Newton at `omega_from`, then the continuation to the end of the sweep (module
-/// documentation); every accepted point is measured and reported to `progress`.
+/// Newton at `omega_from` (the problem's `smoothing` offered to the polyalgorithm), then the
+/// continuation to the end of the sweep (module documentation); every accepted point is
+/// measured and reported to `progress`.
 fn follow<P, S>(
-    problem: &mut P,
+    (problem, smoothing): (&mut P, Option<SmoothingOf<P>>),
     solver: &mut S,
     setup: Setup<'_>,
     measure: &mut TipMeasure<'_, P>,
@@ -356,7 +358,7 @@ where
     let (mut x, mut work) = setup
         .start
         .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
-    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))?;
+    let report = newton_options(settings).solve(problem, solver, &mut x, smoothing)?;
     work += report.counters;
     let mut response = FrequencyResponse {
         method: settings.method,
@@ -592,7 +594,7 @@ pub(crate) fn follow_branch(
                 affine_pieces: false,
             };
             follow(
-                &mut problem,
+                (&mut problem, Some(SmoothingOf::new())),
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
@@ -617,7 +619,7 @@ pub(crate) fn follow_branch(
                 affine_pieces: true,
             };
             follow(
-                &mut problem,
+                (&mut problem, None),
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
@@ -682,7 +684,7 @@ pub(crate) fn follow_branch(
                 ..setup(method, settings.time_samples)
             };
             follow(
-                &mut problem,
+                (&mut problem, None),
                 &mut FrequencyLcpSolver::new(),
                 setup,
                 &mut measure,

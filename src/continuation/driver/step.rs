@@ -6,7 +6,7 @@ use super::{Accepted, Continuation};
 use crate::continuation::{
     BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
-use crate::newton::kernel::{KernelRules, StepRule};
+use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 impl<P, S> Continuation<'_, P, S>
