@@ -139,6 +139,7 @@ pub struct InvalidComplementarityConstant {
 
 /// A choice of complementarity function, for problems that let the user pick one.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ComplementarityFunction {
     /// [`min_function`] (convention `a >= 0, b >= 0`).
     Min,

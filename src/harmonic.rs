@@ -38,6 +38,7 @@ use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
 /// Why a Fourier basis or a transform could not be set up or carried out.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum HarmonicError {
     /// `Nt <= 2H`: the samples cannot resolve the highest harmonic (`P E = I` fails).
     #[error(

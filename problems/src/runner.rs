@@ -52,6 +52,9 @@ pub enum RunError {
     /// Newton's method could not run.
     #[error(transparent)]
     Newton(#[from] newton::NewtonError),
+    /// The continuation could not run (an error the sweep settings do not name).
+    #[error(transparent)]
+    Continuation(semismooth::continuation::ContinuationError),
     /// Time marching could not run (or did not reach a steady state).
     #[error(transparent)]
     March(#[from] MarchError),
@@ -644,13 +647,15 @@ fn solve_lcp(
                     )
                     }
                     LemkeTermination::PivotLimit => format!(
-                        "pivot-limit ({} pivots done, the limit {} = 50 n + 100 for n = {}): the \
+                        "pivot-limit ({} pivots done, the limit {} = {} for n = {}): the \
                          tip values are those of the unfinished path's last basis, not of a \
                          solution",
                         report.pivots,
                         lemke_options.pivot_limit(lcp.dim()),
+                        lemke_options.pivot_limit_rule(),
                         lcp.dim()
                     ),
+                    other => format!("{other:?} after {} pivots", report.pivots),
                 };
                 let counters = RunCounters {
                     lemke_pivots: report.pivots as u64,
@@ -692,15 +697,11 @@ fn solve_lcp(
                     }
                 };
                 let last = report_list.last().expect("at least one level");
-                let mut counters = RunCounters::default();
-                for r in &report_list {
-                    let c: RunCounters = r.counters.into();
-                    counters.residual_evaluations += c.residual_evaluations;
-                    counters.jacobian_evaluations += c.jacobian_evaluations;
-                    counters.factorizations += c.factorizations;
-                    counters.linear_solves += c.linear_solves;
-                    counters.line_search_backtracks += c.line_search_backtracks;
-                }
+                let counters: RunCounters = report_list
+                    .iter()
+                    .map(|r| r.counters)
+                    .sum::<WorkCounters>()
+                    .into();
                 (
                     z,
                     last.converged(),

@@ -54,6 +54,7 @@ pub enum ContinuationEvent {
 
 /// Why a corrector attempt failed (the step is then rejected).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CorrectorFailure {
     /// No convergence within `max_corrector_iterations`.
     #[error("no convergence in {iterations} iterations (|F| = {residual_norm:e})")]
@@ -121,6 +122,7 @@ pub enum CorrectorFailure {
 
 /// Why a continuation run stopped.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ContinuationTermination {
     /// The starting point could not be corrected at the starting parameter (the branch has
     /// no point).
@@ -348,6 +350,7 @@ impl Branch {
 /// Why a continuation could not run (a run that ran and stopped has a
 /// [`ContinuationTermination`]).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ContinuationError {
     /// An option is out of range.
     #[error("invalid option {name} = {value}: allowed {allowed}")]

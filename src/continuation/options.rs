@@ -29,6 +29,7 @@ impl Direction {
 
 /// How the next point is predicted from the last accepted one.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Predictor {
     /// Along the secant through the last two accepted points (default; the first step
     /// always uses the tangent).

@@ -37,6 +37,7 @@ pub const DEFAULT_PIVOT_THRESHOLD: f64 = 1e-13;
 
 /// Why a factorization or a solve could not be carried out.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum LinearSolveError {
     /// A pivot is zero or negligible relative to the largest pivot.
     #[error(

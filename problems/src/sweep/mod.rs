@@ -306,6 +306,7 @@ fn continuation_error(e: ContinuationError) -> RunError {
             parameter,
             "within the sweep interval",
         ),
+        other => RunError::Continuation(other),
     }
 }
 
@@ -428,11 +429,10 @@ where
     }
     let termination = continuation.termination().cloned();
     drop(continuation);
-    response.counters.residual_evaluations += c.work.residual_evaluations;
-    response.counters.jacobian_evaluations += c.work.jacobian_evaluations;
-    response.counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
-    response.counters.linear_solves += c.work.linear_solves;
-    response.counters.ffts += c.work.problem.get("ffts");
+    let mut total = work;
+    total += c.work;
+    total.factorizations += c.dense_bordered_factorizations;
+    response.counters = RunCounters::from(total);
     response.restarts = c.restarts as usize;
     response.corners = c.corners as usize;
     response.continuation = c;
@@ -647,10 +647,7 @@ pub(crate) fn follow_branch(
             let finest = problem.current()?;
             let sequenced =
                 solve_min_map_sequenced(&start_model, &finest, &newton_options(settings))?;
-            let mut start_counters = WorkCounters::default();
-            for level in &sequenced.levels {
-                start_counters += level.report.counters;
-            }
+            let start_counters = sequenced.levels.iter().map(|l| l.report.counters).sum();
             let y0 = problem.state_from_forces(&sequenced.z)?;
             let half = problem.half();
             let units = (0..problem.dim())
