@@ -1,12 +1,13 @@
 //! Backtracking line searches on a merit function, seen only through a closure
-//! `alpha -> merit(x + alpha d)`.
+//! `alpha -> merit(x + alpha d)`: their options ([`LineSearchOptions`]) are public, the
+//! search itself runs inside the crate's Newton iteration.
 //!
 //! - **Armijo**: accept the first `alpha = shrink^k` with
 //!   `m(alpha) <= m(0) + sigma alpha m'(0)`.
 //! - **Non-monotone** (Grippo, Lampariello & Lucidi 1986, SIAM J. Numer. Anal. 23(4)):
 //!   the same test with `m(0)` replaced by the largest merit among the last `memory`
-//!   accepted iterates ([`NonMonotoneHistory`]), which lets the iteration climb out of
-//!   narrow valleys and accepts more full steps; `memory = 1` is Armijo.
+//!   accepted iterates, which lets the iteration climb out of narrow valleys and accepts
+//!   more full steps; `memory = 1` is Armijo.
 //!
 //! For Newton's direction `d = -J^{-1} F` on the merit `m = 0.5 |F|^2` the slope is
 //! `m'(0) = F^T J d = -|F|^2 = -2 m(0)`, so callers pass `slope = -2 m(0)`. For
@@ -54,7 +55,7 @@ pub struct InvalidLineSearchOption {
 impl InvalidLineSearchOption {
     /// The field's name inside the options field `within` (`"line_search"` gives
     /// `"line_search.shrink"`); the bare name for other prefixes.
-    pub fn qualified_name(&self, within: &'static str) -> &'static str {
+    pub(crate) fn qualified_name(&self, within: &'static str) -> &'static str {
         match (within, self.name) {
             ("line_search", "sufficient_decrease") => "line_search.sufficient_decrease",
             ("line_search", "shrink") => "line_search.shrink",
@@ -105,7 +106,7 @@ impl LineSearchOptions {
 
 /// An accepted step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AcceptedStep {
+pub(crate) struct AcceptedStep {
     /// The accepted step length `alpha`.
     pub step: f64,
     /// `merit(alpha)`; the closure's last call was at this `alpha`.
@@ -116,7 +117,7 @@ pub struct AcceptedStep {
 
 /// No acceptable step at or above `min_step`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LineSearchFailure {
+pub(crate) struct LineSearchFailure {
     /// The last step length tried.
     pub last_step: f64,
     /// Its merit (may be infinite).
@@ -127,7 +128,7 @@ pub struct LineSearchFailure {
 
 /// Why a backtracking search ended without a step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Backtrack<E> {
+pub(crate) enum Backtrack<E> {
     /// No acceptable step at or above `min_step`.
     Failed(LineSearchFailure),
     /// The merit could not be evaluated at all (the closure's error), after `backtracks`
@@ -148,16 +149,7 @@ pub enum Backtrack<E> {
 /// directional derivative `m'(0) < 0`. The loop ends for any options (it also stops
 /// if `alpha` fails to decrease), so invalid options cannot hang it; validate them
 /// with [`LineSearchOptions::validate`] for meaningful results.
-///
-/// ```
-/// use semismooth::linesearch::{backtrack, LineSearchOptions};
-/// // m(alpha) = 0.5 (1 - 3 alpha)^2: the full step overshoots (m(1) = 2 > m(0) = 0.5);
-/// // alpha = 0.5 gives m = 0.125 <= 0.5 - 1e-4 * 0.5 * 1.0, accepted after 1 backtrack.
-/// let merit = |alpha: f64| Ok::<_, ()>(0.5 * (1.0 - 3.0 * alpha).powi(2));
-/// let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), merit).unwrap();
-/// assert_eq!((step.step, step.backtracks), (0.5, 1));
-/// ```
-pub fn backtrack<E>(
+pub(crate) fn backtrack<E>(
     reference: f64,
     slope: f64,
     options: &LineSearchOptions,
@@ -195,7 +187,7 @@ pub fn backtrack<E>(
 /// The last `memory` accepted merit values, for the Grippo–Lampariello–Lucidi
 /// reference `max_{0 <= j < memory} m_{k-j}`. A ring buffer allocated once.
 #[derive(Clone, Debug)]
-pub struct NonMonotoneHistory {
+pub(crate) struct NonMonotoneHistory {
     values: Vec<f64>,
     memory: usize,
     next: usize,
@@ -260,6 +252,15 @@ mod tests {
                 backtracks: 0
             }
         );
+    }
+
+    #[test]
+    fn an_overshooting_full_step_is_halved() {
+        // m(alpha) = 0.5 (1 - 3 alpha)^2: the full step overshoots (m(1) = 2 > m(0) = 0.5);
+        // alpha = 0.5 gives m = 0.125 <= 0.5 - 1e-4 * 0.5 * 1.0, accepted after 1 backtrack.
+        let merit = |alpha: f64| Ok::<_, ()>(0.5 * (1.0 - 3.0 * alpha).powi(2));
+        let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), merit).unwrap();
+        assert_eq!((step.step, step.backtracks), (0.5, 1));
     }
 
     #[test]

@@ -264,6 +264,34 @@ pub trait Smoothing: Residual {
 /// structured), so that the linear solver can be chosen without touching the problem.
 ///
 /// Where `F` is differentiable at `x`, `J` must be the ordinary Jacobian.
+///
+/// ```
+/// use semismooth::faer::Mat;
+/// use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
+/// /// F(x) = max(x, 0) - 1 on R^1: J = 1 for x > 0, 0 for x < 0; at the kink either is an
+/// /// element of the B-subdifferential (this one takes 0).
+/// struct Hinge;
+/// impl Residual for Hinge {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0].max(0.0) - 1.0;
+///         Ok(())
+///     }
+/// }
+/// impl GeneralizedJacobian for Hinge {
+///     type Jacobian = Mat<f64>;
+///     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(1, 1) }
+///     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+///         jac[(0, 0)] = if x[0] > 0.0 { 1.0 } else { 0.0 };
+///         Ok(())
+///     }
+/// }
+/// let mut j = Hinge.new_jacobian();
+/// Hinge.jacobian(&[2.0], &mut j).unwrap();
+/// assert_eq!(j[(0, 0)], 1.0);
+/// Hinge.jacobian(&[-2.0], &mut j).unwrap();
+/// assert_eq!(j[(0, 0)], 0.0);
+/// ```
 pub trait GeneralizedJacobian: Residual {
     /// The matrix type the Jacobian is written into.
     type Jacobian;
@@ -277,6 +305,28 @@ pub trait GeneralizedJacobian: Residual {
 
 /// A residual that depends on a scalar parameter `p` (a forcing frequency, a load
 /// factor): `F(x, p)`. Needed by continuation.
+///
+/// ```
+/// use semismooth::{EvaluationError, ParameterDependent, Residual};
+/// /// F(x, p) = x^2 - p.
+/// struct Root { p: f64 }
+/// impl Residual for Root {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0] * x[0] - self.p;
+///         Ok(())
+///     }
+/// }
+/// impl ParameterDependent for Root {
+///     fn parameter(&self) -> f64 { self.p }
+///     fn set_parameter(&mut self, p: f64) { self.p = p; }
+/// }
+/// // dF/dp = -1 by the default central difference, the parameter left as it was.
+/// let mut root = Root { p: 2.0 };
+/// let (mut dfdp, mut scratch) = ([0.0], [0.0]);
+/// root.residual_parameter_derivative(&[1.5], &mut dfdp, &mut scratch).unwrap();
+/// assert!((dfdp[0] + 1.0).abs() < 1e-8 && root.parameter() == 2.0);
+/// ```
 pub trait ParameterDependent: Residual {
     /// Current value of the parameter.
     fn parameter(&self) -> f64;
@@ -294,44 +344,94 @@ pub trait ParameterDependent: Residual {
         1.0
     }
 
-    /// Writes `∂F/∂p (x, p)` into `out`.
+    /// Writes `∂F/∂p (x, p)` into `out`; `scratch` (of the length of `out`) is workspace
+    /// the caller owns, so that no call allocates.
     ///
-    /// The default is a central finite difference with step `1e-7 (1 + |p|)` (it allocates
-    /// one vector per call); problems with an analytic derivative should override it.
+    /// The default is a central finite difference with step `1e-7 (1 + |p|)`, which uses
+    /// `scratch` (and leaves the parameter at `p`); problems with an analytic derivative
+    /// should override it and may ignore `scratch`.
     fn residual_parameter_derivative(
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         let p = self.parameter();
-        let h = 1e-7 * (1.0 + p.abs());
-        let mut minus = vec![0.0; out.len()];
+        let h = PARAMETER_STEP * (1.0 + p.abs());
         self.set_parameter(p + h);
         let plus = self.residual(x, out);
         self.set_parameter(p - h);
-        let below = self.residual(x, &mut minus);
+        let below = self.residual(x, scratch);
         self.set_parameter(p);
         plus?;
         below?;
-        for (o, m) in out.iter_mut().zip(&minus) {
+        for (o, m) in out.iter_mut().zip(scratch.iter()) {
             *o = (*o - m) / (2.0 * h);
         }
         Ok(())
     }
 }
 
+/// Relative step of the default central difference of
+/// [`ParameterDependent::residual_parameter_derivative`].
+const PARAMETER_STEP: f64 = 1e-7;
+
 /// The solve half of a linear solver: `rhs <- J^{-1} rhs` with the factorization made by
 /// the last successful [`Factorize::factor`] (Newton step, continuation tangent and
 /// bordered solves all reuse one factorization).
+///
+/// ```
+/// use semismooth::linalg::LinearSolveError;
+/// use semismooth::{Factorize, LinearSolve};
+/// /// A solver for diagonal Jacobians stored as their diagonal.
+/// #[derive(Default)]
+/// struct Diagonal(Vec<f64>);
+/// impl LinearSolve for Diagonal {
+///     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+///         for (r, d) in rhs.iter_mut().zip(&self.0) {
+///             *r /= d;
+///         }
+///         Ok(())
+///     }
+/// }
+/// impl Factorize<Vec<f64>> for Diagonal {
+///     fn factor(&mut self, jac: &Vec<f64>) -> Result<(), LinearSolveError> {
+///         if let Some(index) = jac.iter().position(|d| *d == 0.0) {
+///             self.0.clear();
+///             return Err(LinearSolveError::Singular { index, pivot: 0.0, max_pivot: f64::NAN });
+///         }
+///         self.0.clone_from(jac);
+///         Ok(())
+///     }
+/// }
+/// let mut solver = Diagonal::default();
+/// solver.factor(&vec![2.0, 4.0]).unwrap();
+/// let mut rhs = [1.0, 1.0];
+/// solver.solve_in_place(&mut rhs).unwrap(); // one factorization, many solves
+/// assert_eq!(rhs, [0.5, 0.25]);
+/// assert!(solver.factor(&vec![1.0, 0.0]).is_err());
+/// ```
 pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
 }
 
-/// The factorization half of a linear solver for Jacobians of type `J`.
+/// The factorization half of a linear solver for Jacobians of type `J` (an example with
+/// [`LinearSolve`]).
 ///
 /// `factor` may be called again with a new matrix of the same shape; implementations
 /// reuse their storage (and any symbolic analysis of a sparsity pattern).
+///
+/// ```
+/// use semismooth::faer::Mat;
+/// use semismooth::linalg::FaerDenseLu;
+/// use semismooth::{Factorize, LinearSolve};
+/// let mut lu = FaerDenseLu::new();
+/// lu.factor(&Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 1.0 })).unwrap();
+/// let mut x = [3.0, 3.0];
+/// lu.solve_in_place(&mut x).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15);
+/// ```
 pub trait Factorize<J: ?Sized>: LinearSolve {
     /// Factors `jac`. A singular or non-finite matrix is a typed error, after which the
     /// solver holds no factorization.

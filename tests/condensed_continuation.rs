@@ -46,7 +46,7 @@ fn condensed_frequency_derivative_matches_central_differences() {
     let omega = problem.parameter();
     let mut analytic = vec![0.0; problem.dim()];
     problem
-        .residual_parameter_derivative(&lambda, &mut analytic)
+        .residual_parameter_derivative(&lambda, &mut analytic, &mut vec![0.0; problem.dim()])
         .unwrap();
     let h = 1e-6 * omega;
     let (mut plus, mut minus) = (vec![0.0; problem.dim()], vec![0.0; problem.dim()]);

@@ -58,16 +58,16 @@ impl ParameterDependent for Closure {
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        minus: &mut [f64],
     ) -> Result<(), EvaluationError> {
         match &self.fp {
             Some(fp) => fp(x, self.p, out),
             None => {
                 let p = self.p;
                 let h = 1e-7 * (1.0 + p.abs());
-                let mut minus = vec![0.0; out.len()];
                 (self.f)(x, p + h, out);
-                (self.f)(x, p - h, &mut minus);
-                for (o, m) in out.iter_mut().zip(&minus) {
+                (self.f)(x, p - h, minus);
+                for (o, m) in out.iter_mut().zip(minus.iter()) {
                     *o = (*o - m) / (2.0 * h);
                 }
             }

@@ -87,6 +87,7 @@ impl ParameterDependent for Kinks {
         &mut self,
         _: &[f64],
         out: &mut [f64],
+        _: &mut [f64],
     ) -> Result<(), EvaluationError> {
         out[0] = 1.0;
         Ok(())

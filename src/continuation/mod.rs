@@ -184,9 +184,7 @@ pub use driver::Continuation;
 pub use folds::FoldDetector;
 pub use homotopy::{homotopy, HomotopyReport, HomotopySchedule};
 pub use natural::{natural_sweep, NaturalSweep, SweepFailure, SweepPoint};
-pub use options::{
-    ContinuationOptions, Direction, Predictor, RestartPolicy, BORDER_PIVOT_THRESHOLD,
-};
+pub use options::{ContinuationOptions, Direction, Predictor, RestartPolicy};
 pub use pieces::PiecewiseAffine;
 
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};

@@ -143,7 +143,7 @@ pub(crate) enum Stop<E> {
     NonFinite,
     /// `G` could not be evaluated: at the initial guess, at a full step, or anywhere for an
     /// error that ends the run ([`EvaluationError::Problem`]).
-    OutsideDomain(EvaluationError),
+    Evaluation(EvaluationError),
 }
 
 /// What a run did (the histories live in the [`Kernel`] until the next run).
@@ -299,7 +299,7 @@ impl Kernel {
         };
         let norm = match Self::evaluate(system, y, &mut self.g, counters) {
             Ok(norm) => norm,
-            Err(e) => return Some(Stop::OutsideDomain(e)),
+            Err(e) => return Some(Stop::Evaluation(e)),
         };
         self.residual_norms.push(norm);
         let tolerance = rules
@@ -340,7 +340,7 @@ impl Kernel {
         y.copy_from_slice(&self.start);
         let norm = match Self::evaluate(system, y, &mut self.g, counters) {
             Ok(norm) => norm,
-            Err(e) => return Some(Stop::OutsideDomain(e)),
+            Err(e) => return Some(Stop::Evaluation(e)),
         };
         self.progress.norm = norm;
         self.reset_history(step.memory()).push(merit_of(norm));
@@ -388,10 +388,8 @@ impl Kernel {
             let line_search = match *step {
                 StepRule::Full => match merit(1.0) {
                     Ok(m) if m.is_finite() => None,
-                    Ok(_) => {
-                        return Some(domain_error.map_or(Stop::NonFinite, Stop::OutsideDomain))
-                    }
-                    Err(e) => return Some(Stop::OutsideDomain(e)),
+                    Ok(_) => return Some(domain_error.map_or(Stop::NonFinite, Stop::Evaluation)),
+                    Err(e) => return Some(Stop::Evaluation(e)),
                 },
                 StepRule::FullWhileFinite {
                     memory,
@@ -409,7 +407,7 @@ impl Kernel {
                         history.push(merit0);
                         Some(line_search)
                     }
-                    Err(e) => return Some(Stop::OutsideDomain(e)),
+                    Err(e) => return Some(Stop::Evaluation(e)),
                 },
                 StepRule::Backtracking { line_search, .. } => Some(line_search),
             };
@@ -429,7 +427,7 @@ impl Kernel {
                     }
                     Err(Backtrack::Aborted { error, backtracks }) => {
                         counters.line_search_backtracks += backtracks;
-                        return Some(Stop::OutsideDomain(error));
+                        return Some(Stop::Evaluation(error));
                     }
                 }
             }

@@ -184,12 +184,6 @@ impl Sum for WorkCounters {
     }
 }
 
-impl<'a> Sum<&'a WorkCounters> for WorkCounters {
-    fn sum<I: Iterator<Item = &'a Self>>(iter: I) -> Self {
-        iter.copied().sum()
-    }
-}
-
 /// What a Newton run did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewtonReport {

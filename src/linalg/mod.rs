@@ -120,19 +120,6 @@ impl LinearSolveError {
         }
     }
 
-    /// The error of a faer sparse LU `during` something: a structurally singular matrix
-    /// is [`LinearSolveError::Singular`] (pivot 0 at the failing column).
-    pub fn from_sparse_lu(error: faer::sparse::linalg::LuError, during: &'static str) -> Self {
-        match error {
-            faer::sparse::linalg::LuError::SymbolicSingular { index } => Self::Singular {
-                index,
-                pivot: 0.0,
-                max_pivot: f64::NAN,
-            },
-            faer::sparse::linalg::LuError::Generic(e) => Self::from_faer(e, during),
-        }
-    }
-
     /// The error of building a faer sparse matrix `during` something (an entry out of
     /// bounds is a [`LinearSolveError::DimensionMismatch`] on its row).
     pub fn from_creation(error: faer::sparse::CreationError, during: &'static str) -> Self {

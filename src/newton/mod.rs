@@ -594,7 +594,7 @@ pub(crate) fn termination_of(stop: &Stop<PlainFailure>, residual_floor: f64) -> 
         Stop::Stalled { .. } => Termination::Stalled,
         Stop::LineSearchFailed { .. } => Termination::LineSearchFailed,
         Stop::Direction(PlainFailure::Linear(e)) => Termination::LinearSolve(*e),
-        Stop::Direction(PlainFailure::Evaluation(e)) | Stop::OutsideDomain(e) => {
+        Stop::Direction(PlainFailure::Evaluation(e)) | Stop::Evaluation(e) => {
             Termination::Evaluation(e.clone())
         }
         Stop::NonFinite => Termination::NonFinite,

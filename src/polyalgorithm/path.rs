@@ -89,6 +89,7 @@ impl<P: Residual + ?Sized> ParameterDependent for NewtonHomotopy<'_, P> {
         &mut self,
         _x: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         out.copy_from_slice(&self.start_residual);
         Ok(())
@@ -206,6 +207,7 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         let factor = -std::f64::consts::LN_10 * self.mu();
         (self.smoothing.derivative)(self.problem, x, out)?;

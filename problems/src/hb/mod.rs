@@ -135,6 +135,7 @@ macro_rules! omega_parameter {
                 &mut self,
                 x: &[f64],
                 out: &mut [f64],
+                _scratch: &mut [f64],
             ) -> Result<(), semismooth::EvaluationError> {
                 self.state.omega_derivative(x, self.displacement_len(), out);
                 Ok(())

@@ -239,11 +239,6 @@ where
         self.problem
     }
 
-    /// The step length the next attempt will use.
-    pub fn next_step(&self) -> f64 {
-        self.step
-    }
-
     /// Runs to the end and collects the branch.
     pub fn run(mut self) -> super::Branch {
         let points: Vec<BranchPoint> = self.by_ref().collect();

@@ -9,6 +9,10 @@ use crate::continuation::{
 use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
+/// The squared θ-norm of the state (parameter) part of a unit direction below which a
+/// corner pass along that part is not tried.
+const NEGLIGIBLE_PART: f64 = 1e-6;
+
 impl<P, S> Continuation<'_, P, S>
 where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
@@ -141,7 +145,7 @@ where
                 return None;
             }
             let (scale, along, constraint) = if on_state {
-                if state_part < 1e-6 {
+                if state_part < NEGLIGIBLE_PART {
                     continue;
                 }
                 self.direction_weights();
@@ -162,7 +166,7 @@ where
                 };
                 (ds, along, constraint)
             } else {
-                if parameter_part < 1e-6 {
+                if parameter_part < NEGLIGIBLE_PART {
                     continue;
                 }
                 let step_p = ds / self.metric.parameter_dot(1.0, 1.0).sqrt() * d[n].signum();
