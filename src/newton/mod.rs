@@ -471,57 +471,54 @@ impl<J> NewtonSolver<J> {
         let start = self.work.begin(problem, x)?;
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
-        let (step, strategy) = match self.options.globalization {
-            Globalization::None => (StepRule::Full, Strategy::FullSteps),
+        let (step, full_steps) = match self.options.globalization {
+            Globalization::None => (StepRule::Full, 0),
             Globalization::Armijo(line_search) => (
                 StepRule::Backtracking {
                     memory: 1,
                     line_search,
                 },
-                Strategy::LineSearch,
+                0,
             ),
             Globalization::NonMonotone {
                 memory,
                 line_search,
-            }
-            | Globalization::Hybrid {
-                memory,
-                line_search,
-                ..
             } => (
                 StepRule::Backtracking {
                     memory,
                     line_search,
                 },
-                Strategy::LineSearch,
+                0,
+            ),
+            Globalization::Hybrid {
+                full_steps,
+                memory,
+                line_search,
+            } => (
+                StepRule::Backtracking {
+                    memory,
+                    line_search,
+                },
+                full_steps,
             ),
         };
         let rules = self.options.rules(step);
-        let (termination, run, strategy) = match self.options.globalization {
-            Globalization::Hybrid { full_steps, .. } => {
-                let (termination, run) = self.work.run_with(
-                    problem,
-                    linear,
-                    x,
-                    &rules,
-                    (&mut counters, &mut log),
-                    |kernel, system, x, rules, counters| {
-                        hybrid(kernel, system, x, rules, full_steps, counters)
-                    },
-                );
-                let strategy = if run.iterations <= full_steps {
-                    Strategy::FullSteps
-                } else {
-                    Strategy::LineSearch
-                };
-                (termination, run, strategy)
+        let (termination, run) = self.work.run_with(
+            problem,
+            linear,
+            x,
+            &rules,
+            (&mut counters, &mut log),
+            |kernel, system, x, rules, counters| {
+                full_steps_first(kernel, system, x, rules, full_steps, counters)
+            },
+        );
+        let strategy = match self.options.globalization {
+            Globalization::None => Strategy::FullSteps,
+            Globalization::Hybrid { full_steps, .. } if run.iterations <= full_steps => {
+                Strategy::FullSteps
             }
-            _ => {
-                let (termination, run) =
-                    self.work
-                        .phase(problem, linear, x, &rules, &mut counters, &mut log);
-                (termination, run, strategy)
-            }
+            _ => Strategy::LineSearch,
         };
         counters.problem = problem.problem_counters().since(&start);
         let outcome = Outcome {
@@ -534,11 +531,12 @@ impl<J> NewtonSolver<J> {
     }
 }
 
-/// [`Globalization::Hybrid`] on the kernel: full steps while they can be evaluated for
-/// `full_steps` iterations, then `rules.step` (the backtracking) from the initial guess for
-/// the rest of the budget; a full step that cannot be evaluated hands over to the
-/// backtracking from where it is instead.
-fn hybrid<S: NewtonSystem + ?Sized>(
+/// A run of the kernel with `rules.step` throughout, or ([`Globalization::Hybrid`],
+/// `full_steps > 0` and a backtracking `rules.step`) full steps while they can be evaluated
+/// for `full_steps` iterations, then `rules.step` from the initial guess for the rest of the
+/// budget; a full step that cannot be evaluated hands over to the backtracking from where
+/// it is instead.
+fn full_steps_first<S: NewtonSystem + ?Sized>(
     kernel: &mut Kernel,
     system: &mut S,
     x: &mut [f64],
