@@ -15,7 +15,7 @@ use semismooth::complementarity::min_function;
 use semismooth::faer::Mat;
 use semismooth::lemke::{solve_lcp, LemkeOptions};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{solve, NewtonOptions};
+use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
 use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
 
 /// The spring chain between two walls.
@@ -99,7 +99,11 @@ pub fn newton_and_lemke(chain: &mut SpringChain) -> Result<[Vec<f64>; 2], String
     let n = chain.force.len();
     let mut x = vec![0.0; n + 2];
     let mut lu = FaerDenseLu::new();
-    solve(chain, &mut lu, &mut x, &NewtonOptions::default()).map_err(|e| e.to_string())?;
+    let report = solve(chain, &mut lu, &mut x, &PolyalgorithmOptions::default())
+        .map_err(|e| e.to_string())?;
+    if !report.converged() {
+        return Err(format!("Newton did not converge: {}", report.termination));
+    }
     // Condensed LCP: K^{-1} f, K^{-1} C_0^T (C_0^T = e_0), K^{-1} C_1^T (C_1^T = -e_{N-1}).
     lu.factor(&chain.stiffness).map_err(|e| e.to_string())?;
     let mut v = [chain.force.clone(), vec![0.0; n], vec![0.0; n]];

@@ -139,6 +139,7 @@ pub struct InvalidComplementarityConstant {
 
 /// A choice of complementarity function, for problems that let the user pick one.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ComplementarityFunction {
     /// [`min_function`] (convention `a >= 0, b >= 0`).
     Min,
@@ -191,9 +192,13 @@ mod tests {
         ]
     }
 
+    /// A nonzero argument far below any other value, on either side of a kink.
+    const BESIDE_KINK: f64 = 1e-300;
+
     /// Grid of points including exact zeros, negatives and kinks.
     fn grid() -> Vec<f64> {
-        vec![-3.0, -1.0, -0.25, -1e-300, 0.0, 1e-300, 0.25, 1.0, 2.0, 3.0]
+        let t = BESIDE_KINK;
+        vec![-3.0, -1.0, -0.25, -t, 0.0, t, 0.25, 1.0, 2.0, 3.0]
     }
 
     fn is_complementary(f: &ComplementarityFunction, a: f64, b: f64) -> bool {

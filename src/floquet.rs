@@ -31,6 +31,7 @@ use faer::MatRef;
 
 /// Why the multipliers could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum FloquetError {
     /// The monodromy matrix is not square.
     #[error("monodromy matrix is {rows} x {cols}, expected a square matrix")]

@@ -38,6 +38,7 @@ use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
 /// Why a Fourier basis or a transform could not be set up or carried out.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum HarmonicError {
     /// `Nt <= 2H`: the samples cannot resolve the highest harmonic (`P E = I` fails).
     #[error(
@@ -129,37 +130,9 @@ impl FourierBasis {
         2 * self.harmonics + 1
     }
 
-    /// Index of `cos(k omega t)` (`k >= 1`): `2k - 1`.
-    pub fn cos_index(k: usize) -> usize {
-        2 * k - 1
-    }
-
-    /// Index of `sin(k omega t)` (`k >= 1`): `2k`.
-    pub fn sin_index(k: usize) -> usize {
-        2 * k
-    }
-
-    /// Harmonic number of basis function `j`: `0` for the constant, `k` for `cos k`/`sin k`.
-    pub fn harmonic_of(j: usize) -> usize {
-        j.div_ceil(2)
-    }
-
     /// Phase `theta_n = 2 pi n / Nt` of sample `n` (time `t_n = theta_n / omega`).
     pub fn phase(&self, n: usize) -> f64 {
         2.0 * PI * n as f64 / self.time_samples as f64
-    }
-
-    /// Value of basis function `j` at phase `theta = omega t`.
-    pub fn function_at_phase(j: usize, theta: f64) -> f64 {
-        if j == 0 {
-            return 1.0;
-        }
-        let k = Self::harmonic_of(j) as f64;
-        if j % 2 == 1 {
-            (k * theta).cos()
-        } else {
-            (k * theta).sin()
-        }
     }
 
     /// `u(theta)` at phase `theta = omega t` from the coefficients of one signal.

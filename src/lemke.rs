@@ -65,11 +65,16 @@ const NONBASIC: usize = usize::MAX;
 /// Number of iterative-refinement steps applied to a solved basis.
 const REFINEMENT_STEPS: usize = 2;
 
+/// Pivots per unknown of the default pivot limit `50 n + 100`.
+pub const PIVOTS_PER_UNKNOWN: usize = 50;
+/// Pivots on top of [`PIVOTS_PER_UNKNOWN`] `n` in the default pivot limit `50 n + 100`.
+pub const EXTRA_PIVOTS: usize = 100;
+
 /// Options of [`Lemke::solve`]. Every field has a default ([`LemkeOptions::default`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LemkeOptions {
     /// Maximum number of pivots, the initial pivot on `z0` included.
-    /// `None` (default) means `50 n + 100`. Lemke's path is short for P-matrices met in
+    /// `None` (default) means `50 n + 100` ([`PIVOTS_PER_UNKNOWN`], [`EXTRA_PIVOTS`]). Lemke's path is short for P-matrices met in
     /// practice but can be very long otherwise (measured: the periodic LCP of a rod with
     /// a massive contact node, `n = 512`, still running after 5 million pivots while `z0`
     /// decreased slowly and steadily, no cycling); the limit turns that into
@@ -120,14 +125,35 @@ impl LemkeOptions {
     }
 
     /// The pivot limit used for an LCP of size `n`: `max_pivots`, or `50 n + 100`.
+    ///
+    /// ```
+    /// use semismooth::lemke::LemkeOptions;
+    /// let default = LemkeOptions::default();
+    /// assert_eq!(default.pivot_limit(128), 6500);
+    /// assert_eq!(default.pivot_limit_rule(), "50 n + 100");
+    /// let set = LemkeOptions { max_pivots: Some(7), ..LemkeOptions::default() };
+    /// assert_eq!((set.pivot_limit(128), set.pivot_limit_rule().as_str()), (7, "max_pivots"));
+    /// ```
     pub fn pivot_limit(&self, n: usize) -> usize {
-        self.max_pivots
-            .unwrap_or_else(|| n.saturating_mul(50).saturating_add(100))
+        self.max_pivots.unwrap_or_else(|| {
+            n.saturating_mul(PIVOTS_PER_UNKNOWN)
+                .saturating_add(EXTRA_PIVOTS)
+        })
+    }
+
+    /// How [`LemkeOptions::pivot_limit`] is set, in words: `50 n + 100` by default,
+    /// `max_pivots` when given.
+    pub fn pivot_limit_rule(&self) -> String {
+        match self.max_pivots {
+            None => format!("{PIVOTS_PER_UNKNOWN} n + {EXTRA_PIVOTS}"),
+            Some(_) => "max_pivots".to_string(),
+        }
     }
 }
 
 /// How a run of Lemke's method ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LemkeTermination {
     /// The artificial variable left the basis (or `q >= 0`): `z` solves the LCP up to the
     /// reported complementarity error.
@@ -196,6 +222,7 @@ impl LemkeReport {
 /// Why [`Lemke::solve`] could not run (or, from [`LemkeReport::into_result`], did not
 /// solve).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum LemkeError {
     /// `M` is not square, or `q` / the covering vector does not have length `n`.
     #[error("dimension mismatch in {what}: expected {expected}, found {found}")]

@@ -34,8 +34,10 @@
 //! }
 //!
 //! let mut x = [0.0, 0.0];
+//! // Err only if the solver could not run (bad options, x of the wrong length).
 //! let report = solve(&mut Spring, &mut FaerDenseLu::new(), &mut x, &NewtonOptions::default())
-//!     .unwrap(); // Err(NewtonError::NotConverged(report)) if it had not converged
+//!     .unwrap();
+//! assert!(report.converged());
 //! assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
 //! assert!(report.iterations <= 3);
 //! ```
@@ -46,11 +48,25 @@
 //! - the **linear algebra**: [`Factorize`] factors a Jacobian once and [`LinearSolve`]
 //!   solves many right-hand sides with it (Newton step, continuation tangent, bordered
 //!   solves);
-//! - the **drivers**: semismooth Newton with line-search globalization (one iteration kernel,
-//!   also the continuation's corrector), pseudo-arclength continuation (trust ball,
-//!   restarts, exact corners of piecewise-affine branches) and a natural-parameter
-//!   homotopy, Lemke's algorithm for linear complementarity problems, and Floquet
+//! - the **drivers**, in layers, each using only those below it:
+//!   - one Newton iteration kernel with a pluggable direction and step rule (internal),
+//!     the [`WorkCounters`](newton::WorkCounters) every driver keeps and the
+//!     [`NewtonReport`](newton::NewtonReport) of a run;
+//!   - [`newton`]: semismooth Newton with line-search globalization ([`newton::solve`]);
+//!   - [`continuation`]: pseudo-arclength continuation (its corrector is the same kernel
+//!     on the bordered system; trust ball, restarts, exact corners of piecewise-affine
+//!     branches), a natural-parameter sweep and homotopy;
+//!   - [`polyalgorithm`]: solving from a poor guess by Newton runs and continuation paths
+//!     ([`polyalgorithm::solve`], and [`polyalgorithm::solve_smoothing`] for a problem that
+//!     implements [`Smoothing`]);
+//!
+//!   and beside them Lemke's algorithm for linear complementarity problems ([`lemke`]),
+//!   complementarity functions, the harmonic machinery (Fourier basis, AFT) and Floquet
 //!   multipliers of a periodic orbit's monodromy matrix ([`floquet`]).
+//!
+//! Every driver returns `Err` only when it could not run (invalid options, inputs of the
+//! wrong size); a run that ran returns its report, whose typed termination says why it
+//! stopped.
 //!
 //! Nothing in this crate knows about rods, contact or any particular model: those live
 //! in the `semismooth-problems` crate, which uses only this crate's public API.
@@ -59,10 +75,12 @@ pub mod complementarity;
 pub mod continuation;
 pub mod floquet;
 pub mod harmonic;
+mod iteration;
 pub mod lemke;
 pub mod linalg;
 pub mod linesearch;
 pub mod newton;
+pub mod polyalgorithm;
 mod traits;
 
 pub use traits::{

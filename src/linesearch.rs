@@ -1,12 +1,13 @@
 //! Backtracking line searches on a merit function, seen only through a closure
-//! `alpha -> merit(x + alpha d)`.
+//! `alpha -> merit(x + alpha d)`: their options ([`LineSearchOptions`]) are public, the
+//! search itself runs inside the crate's Newton iteration.
 //!
 //! - **Armijo**: accept the first `alpha = shrink^k` with
 //!   `m(alpha) <= m(0) + sigma alpha m'(0)`.
 //! - **Non-monotone** (Grippo, Lampariello & Lucidi 1986, SIAM J. Numer. Anal. 23(4)):
 //!   the same test with `m(0)` replaced by the largest merit among the last `memory`
-//!   accepted iterates ([`NonMonotoneHistory`]), which lets the iteration climb out of
-//!   narrow valleys and accepts more full steps; `memory = 1` is Armijo.
+//!   accepted iterates, which lets the iteration climb out of narrow valleys and accepts
+//!   more full steps; `memory = 1` is Armijo.
 //!
 //! For Newton's direction `d = -J^{-1} F` on the merit `m = 0.5 |F|^2` the slope is
 //! `m'(0) = F^T J d = -|F|^2 = -2 m(0)`, so callers pass `slope = -2 m(0)`. For
@@ -54,7 +55,7 @@ pub struct InvalidLineSearchOption {
 impl InvalidLineSearchOption {
     /// The field's name inside the options field `within` (`"line_search"` gives
     /// `"line_search.shrink"`); the bare name for other prefixes.
-    pub fn qualified_name(&self, within: &'static str) -> &'static str {
+    pub(crate) fn qualified_name(&self, within: &'static str) -> &'static str {
         match (within, self.name) {
             ("line_search", "sufficient_decrease") => "line_search.sufficient_decrease",
             ("line_search", "shrink") => "line_search.shrink",
@@ -105,7 +106,7 @@ impl LineSearchOptions {
 
 /// An accepted step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AcceptedStep {
+pub(crate) struct AcceptedStep {
     /// The accepted step length `alpha`.
     pub step: f64,
     /// `merit(alpha)`; the closure's last call was at this `alpha`.
@@ -116,7 +117,7 @@ pub struct AcceptedStep {
 
 /// No acceptable step at or above `min_step`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LineSearchFailure {
+pub(crate) struct LineSearchFailure {
     /// The last step length tried.
     pub last_step: f64,
     /// Its merit (may be infinite).
@@ -125,32 +126,42 @@ pub struct LineSearchFailure {
     pub backtracks: u64,
 }
 
+/// Why a backtracking search ended without a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Backtrack<E> {
+    /// No acceptable step at or above `min_step`.
+    Failed(LineSearchFailure),
+    /// The merit could not be evaluated at all (the closure's error), after `backtracks`
+    /// rejected trials.
+    Aborted {
+        /// The closure's error.
+        error: E,
+        /// Rejected trials before it.
+        backtracks: u64,
+    },
+}
+
 /// Backtracking from `alpha = 1`: accepts the first `alpha = shrink^k >= min_step` with
-/// a finite `merit(alpha) <= reference + sufficient_decrease * alpha * slope`.
+/// a finite `merit(alpha) <= reference + sufficient_decrease * alpha * slope`; a merit the
+/// closure cannot give (`Err`) ends the search ([`Backtrack::Aborted`]).
 ///
 /// `reference` is `m(0)` for Armijo or [`NonMonotoneHistory::reference`]; `slope` is the
 /// directional derivative `m'(0) < 0`. The loop ends for any options (it also stops
 /// if `alpha` fails to decrease), so invalid options cannot hang it; validate them
 /// with [`LineSearchOptions::validate`] for meaningful results.
-///
-/// ```
-/// use semismooth::linesearch::{backtrack, LineSearchOptions};
-/// // m(alpha) = 0.5 (1 - 3 alpha)^2: the full step overshoots (m(1) = 2 > m(0) = 0.5);
-/// // alpha = 0.5 gives m = 0.125 <= 0.5 - 1e-4 * 0.5 * 1.0, accepted after 1 backtrack.
-/// let merit = |alpha: f64| 0.5 * (1.0 - 3.0 * alpha).powi(2);
-/// let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), merit).unwrap();
-/// assert_eq!((step.step, step.backtracks), (0.5, 1));
-/// ```
-pub fn backtrack(
+pub(crate) fn backtrack<E>(
     reference: f64,
     slope: f64,
     options: &LineSearchOptions,
-    mut merit: impl FnMut(f64) -> f64,
-) -> Result<AcceptedStep, LineSearchFailure> {
+    mut merit: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<AcceptedStep, Backtrack<E>> {
     let mut alpha = 1.0_f64;
     let mut backtracks = 0u64;
     loop {
-        let m = merit(alpha);
+        let m = match merit(alpha) {
+            Ok(m) => m,
+            Err(error) => return Err(Backtrack::Aborted { error, backtracks }),
+        };
         if m.is_finite() && m <= reference + options.sufficient_decrease * alpha * slope {
             return Ok(AcceptedStep {
                 step: alpha,
@@ -163,11 +174,11 @@ pub fn backtrack(
         // Not strictly smaller (shrink >= 1) or incomparable (NaN): stop as well.
         let decreasing = next.partial_cmp(&alpha) == Some(std::cmp::Ordering::Less);
         if next < options.min_step || !decreasing {
-            return Err(LineSearchFailure {
+            return Err(Backtrack::Failed(LineSearchFailure {
                 last_step: alpha,
                 last_merit: m,
                 backtracks,
-            });
+            }));
         }
         alpha = next;
     }
@@ -176,7 +187,7 @@ pub fn backtrack(
 /// The last `memory` accepted merit values, for the Grippo–Lampariello–Lucidi
 /// reference `max_{0 <= j < memory} m_{k-j}`. A ring buffer allocated once.
 #[derive(Clone, Debug)]
-pub struct NonMonotoneHistory {
+pub(crate) struct NonMonotoneHistory {
     values: Vec<f64>,
     memory: usize,
     next: usize,
@@ -230,7 +241,7 @@ mod tests {
     fn full_step_is_accepted_without_backtracking_when_it_decreases_enough() {
         // m(alpha) = 0.5 (1 - alpha)^2, the exact Newton model: m(1) = 0.
         let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), |a: f64| {
-            0.5 * (1.0 - a).powi(2)
+            Ok::<_, ()>(0.5 * (1.0 - a).powi(2))
         })
         .unwrap();
         assert_eq!(
@@ -244,15 +255,20 @@ mod tests {
     }
 
     #[test]
+    fn an_overshooting_full_step_is_halved() {
+        // m(alpha) = 0.5 (1 - 3 alpha)^2: the full step overshoots (m(1) = 2 > m(0) = 0.5);
+        // alpha = 0.5 gives m = 0.125 <= 0.5 - 1e-4 * 0.5 * 1.0, accepted after 1 backtrack.
+        let merit = |alpha: f64| Ok::<_, ()>(0.5 * (1.0 - 3.0 * alpha).powi(2));
+        let step = backtrack(0.5, -1.0, &LineSearchOptions::default(), merit).unwrap();
+        assert_eq!((step.step, step.backtracks), (0.5, 1));
+    }
+
+    #[test]
     fn non_finite_trials_are_rejected_and_counted() {
         let mut calls = 0;
         let step = backtrack(1.0, -2.0, &LineSearchOptions::default(), |a: f64| {
             calls += 1;
-            if a > 0.2 {
-                f64::NAN
-            } else {
-                0.0
-            }
+            Ok::<_, ()>(if a > 0.2 { f64::NAN } else { 0.0 })
         })
         .unwrap();
         // 1, 0.5, 0.25 rejected; 0.125 accepted.
@@ -265,9 +281,41 @@ mod tests {
             min_step: 0.1,
             ..Default::default()
         };
-        let fail = backtrack(1.0, -2.0, &options, |_| 5.0).unwrap_err();
+        let fail = backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).unwrap_err();
         // Tried 1, 0.5, 0.25, 0.125; next 0.0625 < 0.1.
-        assert_eq!((fail.last_step, fail.backtracks), (0.125, 4));
+        assert_eq!(
+            fail,
+            Backtrack::Failed(LineSearchFailure {
+                last_step: 0.125,
+                last_merit: 5.0,
+                backtracks: 4
+            })
+        );
+    }
+
+    #[test]
+    fn a_merit_that_cannot_be_evaluated_ends_the_search() {
+        let mut calls = 0;
+        let fail = backtrack(1.0, -2.0, &LineSearchOptions::default(), |a: f64| {
+            calls += 1;
+            if a < 0.3 {
+                Err("failed")
+            } else {
+                Ok(5.0)
+            }
+        })
+        .unwrap_err();
+        // 1, 0.5 rejected; the evaluation at 0.25 fails.
+        assert_eq!(
+            (fail, calls),
+            (
+                Backtrack::Aborted {
+                    error: "failed",
+                    backtracks: 2
+                },
+                3
+            )
+        );
     }
 
     #[test]
@@ -276,12 +324,12 @@ mod tests {
             shrink: 1.0,
             ..Default::default()
         };
-        assert!(backtrack(1.0, -2.0, &options, |_| 5.0).is_err());
+        assert!(backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).is_err());
         let options = LineSearchOptions {
             shrink: f64::NAN,
             ..Default::default()
         };
-        assert!(backtrack(1.0, -2.0, &options, |_| 5.0).is_err());
+        assert!(backtrack(1.0, -2.0, &options, |_| Ok::<_, ()>(5.0)).is_err());
     }
 
     #[test]
@@ -319,7 +367,7 @@ mod tests {
         h.push(1.0); // drops 10
         assert_eq!(h.reference(), 4.0);
         let opts = LineSearchOptions::default();
-        let trial = |_: f64| 3.0; // above the current merit 1.0, below 4.0
+        let trial = |_: f64| Ok::<_, ()>(3.0); // above the current merit 1.0, below 4.0
         assert!(backtrack(h.reference(), -2.0, &opts, trial).is_ok());
         assert!(backtrack(
             1.0,

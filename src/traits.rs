@@ -2,15 +2,36 @@
 //! parameter for continuation, and linear solvers split into a factorization and the
 //! solves that reuse it.
 
+use std::sync::Arc;
+
 use crate::linalg::LinearSolveError;
 
 /// Why a problem could not evaluate its residual, Jacobian or parameter derivative at `x`.
 ///
-/// The drivers treat it like an infinite merit: a line search shortens the step, a
-/// continuation corrector rejects the attempt (and the step is halved), a Newton run that
-/// cannot evaluate its initial guess stops with
-/// [`Termination::OutsideDomain`](crate::newton::Termination::OutsideDomain).
-#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+/// Two kinds, treated differently by the drivers:
+/// - [`EvaluationError::OutsideDomain`]: `x` lies where the problem is not defined. The
+///   drivers treat it like an infinite merit: a line search shortens the step, a
+///   continuation corrector rejects the attempt (and the step is halved); a Newton run that
+///   cannot evaluate its initial guess stops with
+///   [`Termination::Evaluation`](crate::newton::Termination::Evaluation).
+/// - [`EvaluationError::Problem`]: the problem itself failed (an inner solve, a time step
+///   that could not be taken). The run stops at once and hands the error back in its
+///   termination ([`Termination::Evaluation`](crate::newton::Termination::Evaluation),
+///   [`ContinuationTermination::ProblemFailed`](crate::continuation::ContinuationTermination::ProblemFailed)),
+///   where [`EvaluationError::downcast_ref`] reads the problem's own error type back.
+///
+/// ```
+/// use semismooth::EvaluationError;
+/// #[derive(Debug, thiserror::Error)]
+/// #[error("the inner solve diverged after {0} steps")]
+/// struct Diverged(usize);
+///
+/// let e = EvaluationError::problem(Diverged(7));
+/// assert_eq!(e.downcast_ref::<Diverged>().map(|d| d.0), Some(7));
+/// assert_eq!(e.to_string(), "the inner solve diverged after 7 steps");
+/// assert_eq!(e.kind(), "problem-error");
+/// ```
+#[derive(Clone, Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum EvaluationError {
     /// `x` (or the problem's parameter) lies outside the set where the problem is defined.
@@ -21,6 +42,55 @@ pub enum EvaluationError {
         /// Its value.
         value: f64,
     },
+    /// The problem's own error, built by [`EvaluationError::problem`].
+    #[error(transparent)]
+    Problem(Arc<dyn std::error::Error + Send + Sync>),
+}
+
+impl EvaluationError {
+    /// The problem's own `error`, handed back to the caller in the run's termination.
+    pub fn problem(error: impl std::error::Error + Send + Sync + 'static) -> Self {
+        Self::Problem(Arc::new(error))
+    }
+
+    /// The problem's error as its own type `E` (`None` for another type or kind).
+    pub fn downcast_ref<E: std::error::Error + 'static>(&self) -> Option<&E> {
+        match self {
+            Self::Problem(error) => error.downcast_ref::<E>(),
+            Self::OutsideDomain { .. } => None,
+        }
+    }
+
+    /// A short name of the kind: `outside-domain` or `problem-error`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::OutsideDomain { .. } => "outside-domain",
+            Self::Problem(_) => "problem-error",
+        }
+    }
+
+    /// Whether the error ends the run ([`EvaluationError::Problem`]) rather than a step.
+    pub(crate) fn ends_run(&self) -> bool {
+        matches!(self, Self::Problem(_))
+    }
+}
+
+/// Two domain errors are equal when they name the same quantity and value; two problem
+/// errors when they are the same error (one `Arc`).
+impl PartialEq for EvaluationError {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Self::OutsideDomain { what, value },
+                Self::OutsideDomain {
+                    what: other_what,
+                    value: other_value,
+                },
+            ) => what == other_what && value == other_value,
+            (Self::Problem(a), Self::Problem(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 /// Capacity of [`ProblemCounters`].
@@ -131,12 +201,6 @@ pub trait Residual {
     fn problem_counters(&self) -> ProblemCounters {
         ProblemCounters::new()
     }
-
-    /// The smoothing of its nonsmooth terms the problem offers ([`Smoothing`]), `None` (the
-    /// default) when it offers none. Problems that do return `Some(self)`.
-    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
-        None
-    }
 }
 
 /// A smoothing of a problem's nonsmooth terms by a parameter `mu >= 0`: `F_mu` is
@@ -145,9 +209,41 @@ pub trait Residual {
 /// lies within `mu` of it. While `mu > 0` is set, [`Residual::residual`] evaluates `F_mu`
 /// and [`GeneralizedJacobian::jacobian`] its Jacobian.
 ///
-/// The Newton driver's polyalgorithm follows the smoothing path `F_mu(x) = 0` from a large
-/// `mu` (where the problem is nearly affine) to `mu = 0` ([`crate::newton`], *Polyalgorithm*).
-pub trait Smoothing {
+/// A capability known from the problem's type: the polyalgorithm follows the smoothing path
+/// `F_mu(x) = 0` from a large `mu` (where the problem is nearly affine) to `mu = 0` when it
+/// is called through [`polyalgorithm::solve_smoothing`](crate::polyalgorithm::solve_smoothing)
+/// ([`crate::polyalgorithm`], attempt 2).
+///
+/// ```
+/// use semismooth::{EvaluationError, Residual, Smoothing};
+/// /// F(x) = x - max(0, 2 - x) (root x = 1), smoothed by the CHKS function.
+/// struct Ramp { mu: f64 }
+/// fn phi(s: f64, mu: f64) -> f64 { (s + (s * s + 4.0 * mu * mu).sqrt()) / 2.0 }
+/// impl Residual for Ramp {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0] - phi(2.0 - x[0], self.mu);
+///         Ok(())
+///     }
+/// }
+/// impl Smoothing for Ramp {
+///     fn smoothing_scale(&self) -> f64 { 2.0 } // |2 - x| at the guess x = 0
+///     fn set_smoothing(&mut self, mu: f64) { self.mu = mu; }
+///     fn residual_smoothing_derivative(&mut self, x: &[f64], d: &mut [f64]) -> Result<(), EvaluationError> {
+///         let s = 2.0 - x[0];
+///         d[0] = -2.0 * self.mu / (s * s + 4.0 * self.mu * self.mu).sqrt();
+///         Ok(())
+///     }
+/// }
+/// let mut ramp = Ramp { mu: 0.0 };
+/// let mut f = [0.0];
+/// ramp.residual(&[1.0], &mut f).unwrap();
+/// assert_eq!(f[0], 0.0);
+/// ramp.set_smoothing(0.5);
+/// ramp.residual(&[1.0], &mut f).unwrap();
+/// assert!(f[0] < 0.0 && f[0] > -0.5); // within mu of F
+/// ```
+pub trait Smoothing: Residual {
     /// The scale of `mu` at which the smoothing blurs the problem's switching quantities
     /// over their whole range at the initial guess (e.g. `c |g|` for `max(0, c (u - g))`).
     fn smoothing_scale(&self) -> f64;
@@ -168,6 +264,34 @@ pub trait Smoothing {
 /// structured), so that the linear solver can be chosen without touching the problem.
 ///
 /// Where `F` is differentiable at `x`, `J` must be the ordinary Jacobian.
+///
+/// ```
+/// use semismooth::faer::Mat;
+/// use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
+/// /// F(x) = max(x, 0) - 1 on R^1: J = 1 for x > 0, 0 for x < 0; at the kink either is an
+/// /// element of the B-subdifferential (this one takes 0).
+/// struct Hinge;
+/// impl Residual for Hinge {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0].max(0.0) - 1.0;
+///         Ok(())
+///     }
+/// }
+/// impl GeneralizedJacobian for Hinge {
+///     type Jacobian = Mat<f64>;
+///     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(1, 1) }
+///     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+///         jac[(0, 0)] = if x[0] > 0.0 { 1.0 } else { 0.0 };
+///         Ok(())
+///     }
+/// }
+/// let mut j = Hinge.new_jacobian();
+/// Hinge.jacobian(&[2.0], &mut j).unwrap();
+/// assert_eq!(j[(0, 0)], 1.0);
+/// Hinge.jacobian(&[-2.0], &mut j).unwrap();
+/// assert_eq!(j[(0, 0)], 0.0);
+/// ```
 pub trait GeneralizedJacobian: Residual {
     /// The matrix type the Jacobian is written into.
     type Jacobian;
@@ -181,6 +305,28 @@ pub trait GeneralizedJacobian: Residual {
 
 /// A residual that depends on a scalar parameter `p` (a forcing frequency, a load
 /// factor): `F(x, p)`. Needed by continuation.
+///
+/// ```
+/// use semismooth::{EvaluationError, ParameterDependent, Residual};
+/// /// F(x, p) = x^2 - p.
+/// struct Root { p: f64 }
+/// impl Residual for Root {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0] * x[0] - self.p;
+///         Ok(())
+///     }
+/// }
+/// impl ParameterDependent for Root {
+///     fn parameter(&self) -> f64 { self.p }
+///     fn set_parameter(&mut self, p: f64) { self.p = p; }
+/// }
+/// // dF/dp = -1 by the default central difference, the parameter left as it was.
+/// let mut root = Root { p: 2.0 };
+/// let (mut dfdp, mut scratch) = ([0.0], [0.0]);
+/// root.residual_parameter_derivative(&[1.5], &mut dfdp, &mut scratch).unwrap();
+/// assert!((dfdp[0] + 1.0).abs() < 1e-8 && root.parameter() == 2.0);
+/// ```
 pub trait ParameterDependent: Residual {
     /// Current value of the parameter.
     fn parameter(&self) -> f64;
@@ -198,44 +344,94 @@ pub trait ParameterDependent: Residual {
         1.0
     }
 
-    /// Writes `∂F/∂p (x, p)` into `out`.
+    /// Writes `∂F/∂p (x, p)` into `out`; `scratch` (of the length of `out`) is workspace
+    /// the caller owns, so that no call allocates.
     ///
-    /// The default is a central finite difference with step `1e-7 (1 + |p|)` (it allocates
-    /// one vector per call); problems with an analytic derivative should override it.
+    /// The default is a central finite difference with step `1e-7 (1 + |p|)`, which uses
+    /// `scratch` (and leaves the parameter at `p`); problems with an analytic derivative
+    /// should override it and may ignore `scratch`.
     fn residual_parameter_derivative(
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         let p = self.parameter();
-        let h = 1e-7 * (1.0 + p.abs());
-        let mut minus = vec![0.0; out.len()];
+        let h = PARAMETER_STEP * (1.0 + p.abs());
         self.set_parameter(p + h);
         let plus = self.residual(x, out);
         self.set_parameter(p - h);
-        let below = self.residual(x, &mut minus);
+        let below = self.residual(x, scratch);
         self.set_parameter(p);
         plus?;
         below?;
-        for (o, m) in out.iter_mut().zip(&minus) {
+        for (o, m) in out.iter_mut().zip(scratch.iter()) {
             *o = (*o - m) / (2.0 * h);
         }
         Ok(())
     }
 }
 
+/// Relative step of the default central difference of
+/// [`ParameterDependent::residual_parameter_derivative`].
+const PARAMETER_STEP: f64 = 1e-7;
+
 /// The solve half of a linear solver: `rhs <- J^{-1} rhs` with the factorization made by
 /// the last successful [`Factorize::factor`] (Newton step, continuation tangent and
 /// bordered solves all reuse one factorization).
+///
+/// ```
+/// use semismooth::linalg::LinearSolveError;
+/// use semismooth::{Factorize, LinearSolve};
+/// /// A solver for diagonal Jacobians stored as their diagonal.
+/// #[derive(Default)]
+/// struct Diagonal(Vec<f64>);
+/// impl LinearSolve for Diagonal {
+///     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+///         for (r, d) in rhs.iter_mut().zip(&self.0) {
+///             *r /= d;
+///         }
+///         Ok(())
+///     }
+/// }
+/// impl Factorize<Vec<f64>> for Diagonal {
+///     fn factor(&mut self, jac: &Vec<f64>) -> Result<(), LinearSolveError> {
+///         if let Some(index) = jac.iter().position(|d| *d == 0.0) {
+///             self.0.clear();
+///             return Err(LinearSolveError::Singular { index, pivot: 0.0, max_pivot: f64::NAN });
+///         }
+///         self.0.clone_from(jac);
+///         Ok(())
+///     }
+/// }
+/// let mut solver = Diagonal::default();
+/// solver.factor(&vec![2.0, 4.0]).unwrap();
+/// let mut rhs = [1.0, 1.0];
+/// solver.solve_in_place(&mut rhs).unwrap(); // one factorization, many solves
+/// assert_eq!(rhs, [0.5, 0.25]);
+/// assert!(solver.factor(&vec![1.0, 0.0]).is_err());
+/// ```
 pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
 }
 
-/// The factorization half of a linear solver for Jacobians of type `J`.
+/// The factorization half of a linear solver for Jacobians of type `J` (an example with
+/// [`LinearSolve`]).
 ///
 /// `factor` may be called again with a new matrix of the same shape; implementations
 /// reuse their storage (and any symbolic analysis of a sparsity pattern).
+///
+/// ```
+/// use semismooth::faer::Mat;
+/// use semismooth::linalg::FaerDenseLu;
+/// use semismooth::{Factorize, LinearSolve};
+/// let mut lu = FaerDenseLu::new();
+/// lu.factor(&Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 1.0 })).unwrap();
+/// let mut x = [3.0, 3.0];
+/// lu.solve_in_place(&mut x).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15);
+/// ```
 pub trait Factorize<J: ?Sized>: LinearSolve {
     /// Factors `jac`. A singular or non-finite matrix is a typed error, after which the
     /// solver holds no factorization.

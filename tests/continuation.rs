@@ -9,7 +9,8 @@ use semismooth::continuation::{
     ContinuationTermination, CorrectorFailure, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{self, Globalization, NewtonOptions};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver};
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
 
 type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
@@ -57,16 +58,16 @@ impl ParameterDependent for Closure {
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        minus: &mut [f64],
     ) -> Result<(), EvaluationError> {
         match &self.fp {
             Some(fp) => fp(x, self.p, out),
             None => {
                 let p = self.p;
                 let h = 1e-7 * (1.0 + p.abs());
-                let mut minus = vec![0.0; out.len()];
                 (self.f)(x, p + h, out);
-                (self.f)(x, p - h, &mut minus);
-                for (o, m) in out.iter_mut().zip(&minus) {
+                (self.f)(x, p - h, minus);
+                for (o, m) in out.iter_mut().zip(minus.iter()) {
                     *o = (*o - m) / (2.0 * h);
                 }
             }
@@ -251,8 +252,7 @@ fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
         },
     )
     .unwrap()
-    .run()
-    .unwrap();
+    .run();
     let folds = coarse.fold_parameters();
     assert_eq!(folds.len(), 2);
     assert!((folds[0] - FOLD_S).abs() < 0.05 && (folds[1] + FOLD_S).abs() < 0.05);
@@ -270,8 +270,7 @@ fn s_curve_followed_downwards_ends_at_the_lower_root() {
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[1.3], 1.0, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     let folds = branch.fold_parameters();
     assert_eq!(folds.len(), 2);
     // Same interpolation bound as upwards.
@@ -293,8 +292,7 @@ fn s_curve_followed_downwards_ends_at_the_lower_root() {
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     assert_eq!(branch.points.len(), 1);
     assert_eq!(
         branch.termination,
@@ -318,8 +316,7 @@ fn once_around_the_circle(predictor: Predictor) -> (Vec<(f64, f64)>, Vec<f64>) {
         Continuation::new(&mut problem, &mut solver, &[1.05], 0.0, options).unwrap();
     let mut points = Vec::new();
     let mut angle = 0.0_f64;
-    for item in continuation.by_ref() {
-        let q = item.unwrap();
+    for q in continuation.by_ref() {
         let phi = q.parameter.atan2(q.state[0]);
         // Unwrap: the increment between consecutive points is small and positive.
         let mut d = phi - angle.rem_euclid(2.0 * std::f64::consts::PI);
@@ -411,7 +408,6 @@ fn s_curve_branch() -> Branch {
     Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
         .unwrap()
         .run()
-        .unwrap()
 }
 
 fn duffing_branch() -> Branch {
@@ -425,7 +421,6 @@ fn duffing_branch() -> Branch {
     Continuation::new(&mut problem, &mut solver, &[0.13, 0.0], 0.5, options)
         .unwrap()
         .run()
-        .unwrap()
 }
 
 #[test]
@@ -501,8 +496,7 @@ fn kinked_piecewise_linear_branch_is_followed_through_the_kink() {
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[0.2], 0.2, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     // Piecewise linear: Newton with the generalized Jacobian is exact on each piece, so
     // every point matches the closed form to rounding (1e-12 on O(1) values).
     for q in &branch.points {
@@ -535,8 +529,7 @@ fn singular_jacobian_plateau_needs_the_dense_bordered_fallback() {
     let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options.clone())
         .unwrap()
         .with_dense_fallback()
-        .run()
-        .unwrap();
+        .run();
     for q in &branch.points {
         assert!((q.parameter - q.state[0].clamp(0.0, 1.0)).abs() < 1e-12);
     }
@@ -559,8 +552,7 @@ fn singular_jacobian_plateau_needs_the_dense_bordered_fallback() {
     let mut problem = plateau();
     let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     let last = branch.points.last().unwrap();
     println!("without fallback: {:?}", branch.termination);
     assert!(last.state[0] <= 1.0 + 1e-12 && last.state[0] > 0.9);
@@ -589,8 +581,7 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[0.5], 0.5, options.clone())
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     println!("{}", branch.termination);
     assert!(branch.termination.to_string().contains("step too small"));
     let ContinuationTermination::StepTooSmall {
@@ -627,8 +618,7 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
     let mut problem = ends_at_one();
     let branch = Continuation::new(&mut problem, &mut solver, &[1.0], 1.0, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     assert_eq!(branch.points.len(), 1);
     assert_eq!(branch.counters.rejected_steps, 6);
     assert_eq!(branch.counters.corner_passes, 0);
@@ -647,8 +637,7 @@ fn step_halving_ends_with_step_too_small_where_the_residual_turns_nan() {
         ContinuationOptions::default(),
     )
     .unwrap()
-    .run()
-    .unwrap();
+    .run();
     assert_eq!(
         branch.termination,
         ContinuationTermination::TooManyFailures {
@@ -679,31 +668,31 @@ fn a_run_never_spends_more_corrector_iterations_than_its_budget() {
         Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(budget))
             .unwrap()
             .run()
-            .unwrap()
     };
     let reference = run(None);
     let total = reference.counters.corrector_iterations as usize;
     assert!(total > 20, "{total}");
     assert_eq!(run(Some(total)), reference);
     // The start takes its own iterations: a smaller budget is a start that did not
-    // converge, a typed error.
+    // converge, a typed termination and no point.
     let start = reference.points[0].iterations;
     assert!(start > 1, "{start}");
     let mut problem = s_curve();
     let mut solver = FaerDenseLu::new();
-    let error = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(Some(1)))
+    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options(Some(1)))
         .unwrap()
-        .run()
-        .unwrap_err();
+        .run();
+    assert!(branch.points.is_empty());
     assert!(
         matches!(
-            error,
-            ContinuationError::StartNotConverged {
+            branch.termination,
+            ContinuationTermination::StartFailed {
                 failure: CorrectorFailure::MaxIterations { iterations: 1, .. },
                 ..
             }
         ),
-        "{error:?}"
+        "{:?}",
+        branch.termination
     );
     for budget in [start, start + 1, start + 4, total / 3, total / 2, total - 1] {
         let branch = run(Some(budget));
@@ -760,7 +749,6 @@ fn a_run_never_spends_more_corrector_iterations_than_its_budget() {
         Continuation::new(&mut problem, &mut solver, &[0.9], 0.9, options)
             .unwrap()
             .run()
-            .unwrap()
     };
     let unlimited = failing(None);
     assert!(unlimited.counters.corrector_iterations > 60);
@@ -805,8 +793,11 @@ fn natural_sweep_jumps_at_the_fold_where_arclength_follows_the_branch() {
             globalization,
             ..Default::default()
         };
-        let sweep =
-            natural_sweep(&mut problem, &mut solver, &[-1.3], &parameters, &options).unwrap();
+        let mut newton = NewtonSolver::new(options).unwrap();
+        let sweep = natural_sweep(&mut problem, &[-1.3], &parameters, |p, x| {
+            newton.solve(p, &mut solver, x)
+        })
+        .unwrap();
         let xs: Vec<f64> = sweep.points.iter().map(|q| q.state[0]).collect();
         let jumps: Vec<usize> = (1..xs.len())
             .filter(|&i| (xs[i] - xs[i - 1]).abs() > 0.5)
@@ -853,7 +844,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
     // Re-solve each point at its own parameter, from itself, with the library's Newton
     // driver and a tolerance 100x tighter than the continuation's, so that a Newton step is
     // taken: the correction is about |J^{-1}| |F| <= 1e-10 / σ_min(J).
-    let strict = NewtonOptions {
+    let strict = PolyalgorithmOptions {
         absolute_tolerance: 1e-12,
         ..Default::default()
     };
@@ -866,7 +857,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
         for q in &branch.points {
             let mut x = q.state.clone();
             problem.set_parameter(q.parameter);
-            let report = newton::solve(&mut problem, &mut solver, &mut x, &strict).unwrap();
+            let report = polyalgorithm::solve(&mut problem, &mut solver, &mut x, &strict).unwrap();
             assert!(
                 report.converged(),
                 "p = {}: {:?}",
@@ -913,15 +904,16 @@ fn corrector_line_search_rescues_a_far_start_that_full_steps_cannot() {
     let mut solver = FaerDenseLu::new();
     // Full Newton steps from x = 3 at p = 0 diverge (|x| grows each step and overflows).
     let mut problem = arctangent();
-    let start = Continuation::new(&mut problem, &mut solver, &[3.0], 0.0, options.clone())
-        .unwrap()
-        .next();
+    let mut far =
+        Continuation::new(&mut problem, &mut solver, &[3.0], 0.0, options.clone()).unwrap();
+    assert_eq!(far.next(), None);
     assert!(
         matches!(
-            start,
-            Some(Err(ContinuationError::StartNotConverged { .. }))
+            far.termination(),
+            Some(ContinuationTermination::StartFailed { .. })
         ),
-        "{start:?}"
+        "{:?}",
+        far.termination()
     );
     // With backtracking the start converges to x = 0 and the branch follows x = tan(p).
     let mut problem = arctangent();
@@ -936,8 +928,7 @@ fn corrector_line_search_rescues_a_far_start_that_full_steps_cannot() {
         },
     )
     .unwrap()
-    .run()
-    .unwrap();
+    .run();
     // |F| <= 1e-10 and |dF/dx| = 1/(1 + x^2) >= 1/(1 + tan(1)^2) ≈ 0.29: |x - tan p| < 4e-10.
     for q in &branch.points {
         assert!((q.state[0] - q.parameter.tan()).abs() < 4e-10);
@@ -1004,7 +995,7 @@ fn bad_input_is_a_typed_error_with_the_numbers() {
         Some(ContinuationError::InvalidStart { parameter, .. }) if parameter == 1.5
     ));
     // x^2 + 1 + p^2 has no real root: the start cannot be corrected; the iterator yields
-    // one Err and then stops.
+    // nothing and says why.
     let mut none = Closure {
         n: 1,
         p: 0.0,
@@ -1014,9 +1005,10 @@ fn bad_input_is_a_typed_error_with_the_numbers() {
     };
     let mut it =
         Continuation::new(&mut none, &mut solver, &[1.0], 0.0, Default::default()).unwrap();
+    assert!(it.next().is_none());
     assert!(matches!(
-        it.next(),
-        Some(Err(ContinuationError::StartNotConverged { parameter, .. })) if parameter == 0.0
+        it.termination(),
+        Some(ContinuationTermination::StartFailed { parameter, .. }) if *parameter == 0.0
     ));
     assert!(it.next().is_none());
 }
@@ -1184,14 +1176,12 @@ fn structured_jacobian_branch_equals_the_dense_one_and_passes_the_folds() {
         options.clone(),
     )
     .unwrap()
-    .run()
-    .unwrap();
+    .run();
     let mut dense = DenseDecoupled(DecoupledCurves { n, p: -1.0 });
     let mut lu = FaerDenseLu::new();
     let reference = Continuation::new(&mut dense, &mut lu, &x0, -1.0, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     // Same arithmetic up to the LU's rounding on a diagonal matrix: the branches agree
     // point by point to 1e-12 (on O(1) values).
     assert_eq!(branch.points.len(), reference.points.len());
@@ -1254,8 +1244,7 @@ fn state_scale_equals_continuing_the_rescaled_problem() {
     let z0 = [x0[0] / scale[0], x0[1] / scale[1]];
     let reference = Continuation::new(&mut rescaled, &mut solver, &z0, 0.5, options.clone())
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     let mut problem = duffing();
     let branch = Continuation::new(
         &mut problem,
@@ -1268,8 +1257,7 @@ fn state_scale_equals_continuing_the_rescaled_problem() {
         },
     )
     .unwrap()
-    .run()
-    .unwrap();
+    .run();
     assert_eq!(branch.points.len(), reference.points.len());
     // The same Newton iterates in both coordinates up to the rounding of S z: the points
     // agree to rounding, amplified by at most the corrector's conditioning; 1e-10 leaves
@@ -1344,8 +1332,7 @@ fn corner_fold_of_a_piecewise_linear_branch_is_reported_within_one_step_of_the_c
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[-1.0], -1.0, options.clone())
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     // Up the left side, over the corner, down the right side to the bound p = -1 at x = 1.
     let last = branch.points.last().unwrap();
     assert_eq!(
@@ -1399,8 +1386,7 @@ fn sharp_corner_of_a_graph_over_the_parameter_is_passed_without_a_fold() {
         };
         let branch = Continuation::new(&mut problem, &mut solver, &[-STEEP], -1.0, options)
             .unwrap()
-            .run()
-            .unwrap();
+            .run();
         let parameters = branch.parameters();
         println!(
             "{predictor:?}: {} points, corner passes {}, rejected steps {}",
@@ -1433,8 +1419,7 @@ fn sharp_corner_of_a_graph_over_the_parameter_is_passed_without_a_fold() {
     };
     let branch = Continuation::new(&mut problem, &mut solver, &[-STEEP], -1.0, options)
         .unwrap()
-        .run()
-        .unwrap();
+        .run();
     let end = branch.points.last().unwrap().parameter;
     assert!(end < 0.0 && end > -0.01, "{:?}", branch.termination);
     assert!(matches!(
@@ -1475,4 +1460,118 @@ fn fold_detector_confirms_reversals_and_ignores_unconfirmed_tangent_flips() {
             parameter: 0.3
         }]
     );
+}
+
+/// The problem's own failure, met beyond a parameter.
+#[derive(Debug)]
+struct FailsBeyond(f64);
+
+impl std::fmt::Display for FailsBeyond {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "cannot evaluate at p = {}", self.0)
+    }
+}
+
+impl std::error::Error for FailsBeyond {}
+
+/// `x - p = 0`, whose evaluation fails with the problem's own error beyond `p = 0.5`, or
+/// with a domain error when `domain` is set.
+struct Line {
+    p: f64,
+    domain: bool,
+}
+
+impl Residual for Line {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        if self.p > 0.5 {
+            return Err(if self.domain {
+                EvaluationError::OutsideDomain {
+                    what: "p",
+                    value: self.p,
+                }
+            } else {
+                EvaluationError::problem(FailsBeyond(self.p))
+            });
+        }
+        out[0] = x[0] - self.p;
+        Ok(())
+    }
+}
+
+impl GeneralizedJacobian for Line {
+    type Jacobian = Mat<f64>;
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(1, 1)
+    }
+    fn jacobian(&mut self, _: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+        jac[(0, 0)] = 1.0;
+        Ok(())
+    }
+}
+
+impl ParameterDependent for Line {
+    fn parameter(&self) -> f64 {
+        self.p
+    }
+    fn set_parameter(&mut self, p: f64) {
+        self.p = p;
+    }
+}
+
+/// Past `p = 0.5` a domain error only shortens the steps (the run ends after failed steps
+/// just below 0.5), while the problem's own error ends the run at the first attempt that
+/// meets it, with the error in the termination.
+#[test]
+fn the_problems_own_error_ends_the_branch_with_it() {
+    let options = ContinuationOptions {
+        initial_step: 0.1,
+        max_step: 0.1,
+        min_step: 1e-3,
+        theta: 0.999,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    let mut solver = FaerDenseLu::new();
+    let mut line = Line {
+        p: 0.0,
+        domain: true,
+    };
+    let branch = Continuation::new(&mut line, &mut solver, &[0.0], 0.0, options.clone())
+        .unwrap()
+        .run();
+    assert!(
+        matches!(
+            branch.termination,
+            ContinuationTermination::StepTooSmall {
+                failure: CorrectorFailure::Evaluation { .. },
+                ..
+            } | ContinuationTermination::TooManyFailures {
+                failure: CorrectorFailure::Evaluation { .. },
+                ..
+            }
+        ),
+        "{:?}",
+        branch.termination
+    );
+    assert!(branch.counters.rejected_steps >= 3);
+    let mut line = Line {
+        p: 0.0,
+        domain: false,
+    };
+    let branch = Continuation::new(&mut line, &mut solver, &[0.0], 0.0, options)
+        .unwrap()
+        .run();
+    let last = branch.points.last().unwrap().parameter;
+    let ContinuationTermination::ProblemFailed { parameter, error } = &branch.termination else {
+        panic!("{:?}", branch.termination);
+    };
+    assert_eq!(*parameter, last);
+    assert!(error.downcast_ref::<FailsBeyond>().unwrap().0 > 0.5);
+    assert!(last <= 0.5 && last > 0.3, "{last}");
+    // Nothing after the failed attempt: one rejected step.
+    assert_eq!(branch.counters.rejected_steps, 1);
+    assert_eq!(line.p, last);
 }

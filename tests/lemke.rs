@@ -14,7 +14,7 @@ use semismooth::lemke::{
     LemkeTermination,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{solve, NewtonOptions};
+use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 #[global_allocator]
@@ -599,9 +599,9 @@ impl GeneralizedJacobian for MinMap<'_> {
 /// solution is of the same order, far below the 1e-10 agreement tolerance.
 #[test]
 fn lemke_agrees_with_semismooth_newton_on_the_min_map() {
-    let options = NewtonOptions {
+    let options = PolyalgorithmOptions {
         absolute_tolerance: 1e-13,
-        ..NewtonOptions::default()
+        ..PolyalgorithmOptions::default()
     };
     let mut lemke = Lemke::new(8);
     for seed in 0..60u64 {

@@ -14,8 +14,9 @@ use semismooth::complementarity::{fischer_burmeister, max_form, min_function, Ph
 use semismooth::linalg::{FaerDenseLu, FaerSparseLu, LinearSolveError, NalgebraLu};
 use semismooth::newton::{
     solve, Globalization, LineSearchOptions, NewtonError, NewtonOptions, NewtonReport,
-    NewtonSolver, Termination, WorkCounters,
+    NewtonSolver, Termination, WorkCounters, EXACT_RESIDUAL,
 };
+use semismooth::polyalgorithm::{self, Polyalgorithm, PolyalgorithmOptions};
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ProblemCounters, Residual,
 };
@@ -31,10 +32,36 @@ fn armijo() -> Globalization {
     Globalization::Armijo(LineSearchOptions::default())
 }
 
-/// The report of a run that must have stopped without converging.
+/// Plain Newton with its default globalization, then the polyalgorithm, on `problem()`
+/// from `x0`: each report with the returned `x`.
+fn both_drivers<P>(
+    mut problem: impl FnMut() -> P,
+    mut linear: impl FnMut() -> Box<dyn semismooth::Factorize<Mat<f64>>>,
+    x0: [f64; 1],
+) -> [(Result<NewtonReport, NewtonError>, [f64; 1]); 2]
+where
+    P: GeneralizedJacobian<Jacobian = Mat<f64>>,
+{
+    let (mut x, mut y) = (x0, x0);
+    let plain = solve(
+        &mut problem(),
+        &mut *linear(),
+        &mut x,
+        &NewtonOptions::default(),
+    );
+    let poly = polyalgorithm::solve(
+        &mut problem(),
+        &mut *linear(),
+        &mut y,
+        &PolyalgorithmOptions::default(),
+    );
+    [(plain, x), (poly, y)]
+}
+
+/// The report of a run that must have run and stopped without converging.
 fn not_converged(result: Result<NewtonReport, NewtonError>) -> NewtonReport {
     match result {
-        Err(NewtonError::NotConverged(report)) => *report,
+        Ok(report) if !report.converged() => report,
         other => panic!("expected a run that did not converge, got {other:?}"),
     }
 }
@@ -79,9 +106,7 @@ fn cube() -> Scalar<impl Fn(f64) -> f64, impl Fn(f64) -> f64> {
 /// Newton on [`cube`] from x0 = 1 with the dense LU: the report and the final x.
 fn newton_on_cube(opts: &NewtonOptions) -> (semismooth::newton::NewtonReport, [f64; 1]) {
     let mut x = [1.0];
-    let report = solve(&mut cube(), &mut FaerDenseLu::new(), &mut x, opts)
-        .or_else(NewtonError::into_report)
-        .unwrap();
+    let report = solve(&mut cube(), &mut FaerDenseLu::new(), &mut x, opts).unwrap();
     (report, x)
 }
 
@@ -412,7 +437,7 @@ fn nonsmooth_lcp_terminates_finitely_with_min_and_max_form_and_quadratically_wit
         let before = norms[norms.len() - 2];
         match phi {
             Phi::Min | Phi::Max(_) => {
-                let exact = last < 1e-300;
+                let exact = last < EXACT_RESIDUAL;
                 if exact {
                     assert_eq!(report.observed_order, None);
                 } else {
@@ -477,6 +502,132 @@ fn atan_from_10_fails_without_globalization_and_converges_with_line_search() {
         assert!(report.converged());
         assert!(x[0].abs() < 1e-10);
         assert!(report.counters.line_search_backtracks > 0);
+    }
+}
+
+/// An absolute tolerance no run reaches (the run ends on another test).
+const UNREACHABLE_TOLERANCE: f64 = 1e-300;
+
+/// A solve from the guess it is given.
+type Driver = dyn Fn(&mut [f64]) -> Result<NewtonReport, NewtonError>;
+
+/// The problem's own failure (an inner solve that diverged at `x`).
+#[derive(Debug, PartialEq)]
+struct InnerFailure(f64);
+
+impl std::fmt::Display for InnerFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the inner solve diverged at x = {}", self.0)
+    }
+}
+
+impl std::error::Error for InnerFailure {}
+
+/// atan(x) = 0 from x0 = 10, the problem failing beyond |x| = 20 (where the first full step,
+/// x_1 = 10 - 101 atan(10) = -138.6, lands): an error outside the domain is an infinite
+/// merit that the line search shortens (and converges), the problem's own error ends the
+/// run at once and comes back in the termination, with any globalization.
+#[test]
+fn the_problems_own_error_ends_the_run_and_comes_back_in_the_termination() {
+    struct Atan {
+        own_error: bool,
+    }
+    impl Residual for Atan {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+            if x[0].abs() > 20.0 {
+                return Err(if self.own_error {
+                    EvaluationError::problem(InnerFailure(x[0]))
+                } else {
+                    EvaluationError::OutsideDomain {
+                        what: "|x|",
+                        value: x[0].abs(),
+                    }
+                });
+            }
+            out[0] = x[0].atan();
+            Ok(())
+        }
+    }
+    impl GeneralizedJacobian for Atan {
+        type Jacobian = Mat<f64>;
+        fn new_jacobian(&self) -> Mat<f64> {
+            Mat::zeros(1, 1)
+        }
+        fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+            jac[(0, 0)] = 1.0 / (1.0 + x[0] * x[0]);
+            Ok(())
+        }
+    }
+    let mut x = [10.0];
+    let report = solve(
+        &mut Atan { own_error: false },
+        &mut FaerDenseLu::new(),
+        &mut x,
+        &options(armijo()),
+    )
+    .unwrap();
+    assert!(report.converged() && x[0].abs() < 1e-10);
+    let drivers: [(&str, &Driver); 4] = [
+        ("armijo", &|x| {
+            let options = options(armijo());
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("full steps", &|x| {
+            let options = options(Globalization::None);
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("hybrid", &|x| {
+            let options = options(Globalization::hybrid());
+            solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+        ("polyalgorithm", &|x| {
+            let options = PolyalgorithmOptions::default();
+            polyalgorithm::solve(
+                &mut Atan { own_error: true },
+                &mut FaerDenseLu::new(),
+                x,
+                &options,
+            )
+        }),
+    ];
+    for (globalization, driver) in drivers {
+        let mut x = [10.0];
+        let report = not_converged(driver(&mut x));
+        let Termination::Evaluation(error) = &report.termination else {
+            panic!("{globalization:?}: {:?}", report.termination);
+        };
+        let first_step = 10.0 - 101.0 * 10f64.atan();
+        let failure = error.downcast_ref::<InnerFailure>().unwrap();
+        assert!((failure.0 - first_step).abs() < 1e-12, "{failure:?}");
+        assert!(report
+            .termination
+            .to_string()
+            .starts_with("problem-error: the inner solve diverged at x = -138.5"));
+        // Nothing after the failed evaluation: one attempt, no step, x kept.
+        assert_eq!(
+            (report.iterations, report.attempts.len(), x),
+            (0, 1, [10.0]),
+            "{globalization:?}"
+        );
+        assert_eq!(report.counters.residual_evaluations, 2);
     }
 }
 
@@ -548,6 +699,7 @@ fn counters_are_exact_on_a_linear_problem_and_jacobian_is_reused() {
     // Already at the solution: converged with 0 iterations and one evaluation.
     let mut x = [1.0, 2.0];
     let report = newton.solve(&mut problem, &mut lu, &mut x).unwrap();
+    assert!(report.converged());
     assert_eq!(
         (report.iterations, report.counters.residual_evaluations),
         (0, 1)
@@ -582,26 +734,26 @@ fn line_search_failure_is_reported_with_exact_trial_count() {
 }
 
 /// F(x) = x^2 + 1 at x0 = 0 has J = 0: a linear-solve termination carrying the solver's
-/// `Singular` error.
+/// `Singular` error (plain Newton and the polyalgorithm).
 #[test]
 fn singular_jacobian_is_a_termination_carrying_the_linear_solver_error() {
-    let mut p = scalar(|x| x * x + 1.0, |x| 2.0 * x);
-    let mut x = [0.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut FaerDenseLu::new(),
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert!(matches!(
-        report.termination,
-        Termination::LinearSolve(LinearSolveError::Singular { index: 0, .. })
-    ));
-    assert!(report
-        .termination
-        .to_string()
-        .starts_with("singular-jacobian"));
-    assert_eq!(x, [0.0]);
+    let runs = both_drivers(
+        || scalar(|x| x * x + 1.0, |x| 2.0 * x),
+        || Box::new(FaerDenseLu::new()),
+        [0.0],
+    );
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert!(matches!(
+            report.termination,
+            Termination::LinearSolve(LinearSolveError::Singular { index: 0, .. })
+        ));
+        assert!(report
+            .termination
+            .to_string()
+            .starts_with("singular-jacobian"));
+        assert_eq!(x, [0.0]);
+    }
 }
 
 /// A linear solver that cannot allocate its factors: every `factor` is `OutOfMemory`.
@@ -622,45 +774,46 @@ impl semismooth::Factorize<Mat<f64>> for NoMemory {
 }
 
 /// A factorization that runs out of memory ends the run with its own termination,
-/// `out-of-memory`, not as a singular Jacobian; x is kept.
+/// `out-of-memory`, not as a singular Jacobian; x is kept (plain Newton and the
+/// polyalgorithm).
 #[test]
 fn an_allocation_failure_is_its_own_termination_not_a_singular_jacobian() {
-    let mut p = scalar(|x| x * x - 4.0, |x| 2.0 * x);
-    let mut x = [1.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut NoMemory,
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert_eq!(
-        report.termination,
-        Termination::LinearSolve(LinearSolveError::OutOfMemory {
-            during: "the dense factors"
-        })
+    let runs = both_drivers(
+        || scalar(|x| x * x - 4.0, |x| 2.0 * x),
+        || Box::new(NoMemory),
+        [1.0],
     );
-    let text = report.termination.to_string();
-    assert!(text.starts_with("out-of-memory"), "{text}");
-    assert!(!text.contains("singular"), "{text}");
-    assert_eq!(x, [1.0]);
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert_eq!(
+            report.termination,
+            Termination::LinearSolve(LinearSolveError::OutOfMemory {
+                during: "the dense factors"
+            })
+        );
+        let text = report.termination.to_string();
+        assert!(text.starts_with("out-of-memory"), "{text}");
+        assert!(!text.contains("singular"), "{text}");
+        assert_eq!(x, [1.0]);
+    }
 }
 
 /// A NaN residual at the start (sqrt of a negative number) is NonFinite with x
-/// unchanged; the reported norm is infinite, not NaN.
+/// unchanged; the reported norm is infinite, not NaN (plain Newton and the polyalgorithm).
 #[test]
 fn non_finite_residual_is_reported_and_x_kept() {
-    let mut p = scalar(|x: f64| x.sqrt() - 1.0, |x: f64| 0.5 / x.sqrt());
-    let mut x = [-1.0];
-    let report = not_converged(solve(
-        &mut p,
-        &mut FaerDenseLu::new(),
-        &mut x,
-        &NewtonOptions::default(),
-    ));
-    assert_eq!(report.termination, Termination::NonFinite);
-    assert_eq!(report.iterations, 0);
-    assert_eq!(x, [-1.0]);
-    assert_eq!(report.residual_norm(), f64::INFINITY);
+    let runs = both_drivers(
+        || scalar(|x: f64| x.sqrt() - 1.0, |x: f64| 0.5 / x.sqrt()),
+        || Box::new(FaerDenseLu::new()),
+        [-1.0],
+    );
+    for (result, x) in runs {
+        let report = not_converged(result);
+        assert_eq!(report.termination, Termination::NonFinite);
+        assert_eq!(report.iterations, 0);
+        assert_eq!(x, [-1.0]);
+        assert_eq!(report.residual_norm(), f64::INFINITY);
+    }
 }
 
 /// F(x) = x^3 converges linearly with steps x_k / 3; with step_tolerance 0.01 the run
@@ -669,7 +822,7 @@ fn non_finite_residual_is_reported_and_x_kept() {
 #[test]
 fn small_steps_without_convergence_are_reported_as_stalled() {
     let (report, x) = newton_on_cube(&NewtonOptions {
-        absolute_tolerance: 1e-300,
+        absolute_tolerance: UNREACHABLE_TOLERANCE,
         step_tolerance: 0.01,
         ..options(Globalization::None)
     });
@@ -847,15 +1000,15 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     }
     let mut sparse: Obstacle<SparseColMat<usize, f64>> = make(n);
     let mut dense: Obstacle<Mat<f64>> = make(n);
-    let opts = NewtonOptions {
+    let opts = PolyalgorithmOptions {
         absolute_tolerance: 1e-12,
         ..Default::default()
     };
     let mut us = vec![0.0; n];
     let mut slu = FaerSparseLu::new();
-    let rs = solve(&mut sparse, &mut slu, &mut us, &opts).unwrap();
+    let rs = polyalgorithm::solve(&mut sparse, &mut slu, &mut us, &opts).unwrap();
     let mut ud = vec![0.0; n];
-    let rd = solve(&mut dense, &mut FaerDenseLu::new(), &mut ud, &opts).unwrap();
+    let rd = polyalgorithm::solve(&mut dense, &mut FaerDenseLu::new(), &mut ud, &opts).unwrap();
     println!(
         "obstacle: sparse {} it, dense {} it, norms {:?}",
         rs.iterations, rd.iterations, rs.residual_norms
@@ -889,21 +1042,16 @@ static GLOBAL: common::CountingAllocator = common::CountingAllocator;
 /// solve converges in >= 3 iterations and makes exactly 5 allocations (the report's
 /// residual, step-length and step-norm histories, its list of attempts and the outcome
 /// text of the one attempt).
-fn warm_then_count_allocations<P, S>(
-    newton: &mut NewtonSolver<P::Jacobian>,
-    problem: &mut P,
-    lu: &mut S,
+fn warm_then_count_allocations(
+    mut solve: impl FnMut(&mut [f64]) -> Result<NewtonReport, NewtonError>,
     x: &mut [f64],
     starts: &[f64],
-) where
-    P: GeneralizedJacobian,
-    S: semismooth::Factorize<P::Jacobian>,
-{
-    newton.solve(problem, lu, x).unwrap();
+) {
+    assert!(solve(x).unwrap().converged());
     for &start in starts {
         x.fill(start);
         let before = allocations();
-        let report = newton.solve(problem, lu, x).unwrap();
+        let report = solve(x).unwrap();
         let made = allocations() - before;
         assert!(
             report.converged() && report.iterations >= 3,
@@ -917,17 +1065,21 @@ fn warm_then_count_allocations<P, S>(
     }
 }
 
-/// A reused `NewtonSolver` with a reused faer solver (dense or sparse) allocates only
-/// the report (three history vectors, the attempt list and its text) per solve, however many iterations it takes:
-/// nothing per iteration. Measured with a counting global allocator on this thread.
+/// A reused `NewtonSolver` or `Polyalgorithm` with a reused faer solver (dense or sparse)
+/// allocates only the report (three history vectors, the attempt list and its text) per
+/// solve, however many iterations it takes: nothing per iteration. Measured with a
+/// counting global allocator on this thread.
 #[test]
 fn repeated_solves_allocate_nothing_per_iteration() {
     faer::set_global_parallelism(faer::Par::Seq);
     let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let mut poly = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
     let (mut lcp, _) = strictly_complementary_lcp(Phi::FischerBurmeister);
     let mut lu = FaerDenseLu::new();
     let mut z = vec![1.0; 8];
-    warm_then_count_allocations(&mut newton, &mut lcp, &mut lu, &mut z, &[1.0, 3.0, -2.0]);
+    let starts = [1.0, 3.0, -2.0];
+    warm_then_count_allocations(|z| newton.solve(&mut lcp, &mut lu, z), &mut z, &starts);
+    warm_then_count_allocations(|z| poly.solve(&mut lcp, &mut lu, z), &mut z, &starts);
 
     let n = 200;
     let mut t = Vec::new();
@@ -975,12 +1127,17 @@ fn repeated_solves_allocate_nothing_per_iteration() {
     let mut slu = FaerSparseLu::new();
     let mut u = vec![0.0; n];
     let mut newton_sparse = NewtonSolver::new(NewtonOptions::default()).unwrap();
+    let mut poly_sparse = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
+    let starts = [0.0, 5.0];
     warm_then_count_allocations(
-        &mut newton_sparse,
-        &mut chain,
-        &mut slu,
+        |u| newton_sparse.solve(&mut chain, &mut slu, u),
         &mut u,
-        &[0.0, 5.0],
+        &starts,
+    );
+    warm_then_count_allocations(
+        |u| poly_sparse.solve(&mut chain, &mut slu, u),
+        &mut u,
+        &starts,
     );
     assert_eq!(slu.symbolic_analyses(), 1);
 }

@@ -23,7 +23,7 @@ use std::time::Duration;
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton;
+use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, Residual};
 
 use semismooth_contact::hb::{HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
@@ -65,7 +65,10 @@ fn solve_hb<S: Factorize<HbJacobian>>(
     let options = newton_options(&SolverSettings::with_harmonics(h));
     let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
-    newton::solve(&mut problem, &mut solver, &mut x, &options).expect("converges");
+    let report = options
+        .solve(&mut problem, &mut solver, &mut x, Some(SmoothingOf::new()))
+        .expect("runs");
+    assert!(report.converged(), "{:?}", report.termination);
     (problem, x)
 }
 

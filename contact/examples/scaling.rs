@@ -19,7 +19,7 @@
 
 use std::time::Instant;
 
-use semismooth::newton::{self, NewtonOptions};
+use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::Residual;
 
 use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
@@ -67,10 +67,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             c: Some(spec.axial_stiffness / spec.length),
         };
         let rod = build_rod(&spec)?;
-        let options = NewtonOptions {
-            absolute_tolerance: 1e-10 * n as f64 / 20.0,
-            ..newton_options(&SolverSettings::with_harmonics(H))
-        };
+        let options = newton_options(&SolverSettings {
+            tolerance: 1e-10 * n as f64 / 20.0,
+            ..SolverSettings::with_harmonics(H)
+        });
         // Median of 3 solves below 10,000 elements, one above; each from zero, problem and
         // solver built inside the timed region.
         let repeats = if n < 10_000 { 3 } else { 1 };
@@ -82,7 +82,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut problem = SsnHb::new(&rod.model, &hb)?;
             let mut x = vec![0.0; problem.dim()];
             let mut solver = StructuredHbSolver::new();
-            let report = newton::solve(&mut problem, &mut solver, &mut x, &options)?;
+            let report =
+                options.solve(&mut problem, &mut solver, &mut x, Some(SmoothingOf::new()))?;
             times.push(start.elapsed().as_secs_f64());
             if !report.converged() {
                 return Err(format!(

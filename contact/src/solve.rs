@@ -13,8 +13,9 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonError, NewtonOptions, NewtonReport, Strategy, WorkCounters,
+    self, Globalization, NewtonOptions, NewtonReport, Strategy, WorkCounters,
 };
+use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
 
 use crate::contacts::{contact_reports, ContactReport};
@@ -54,6 +55,9 @@ pub enum RunError {
     /// Newton's method could not run.
     #[error(transparent)]
     Newton(#[from] newton::NewtonError),
+    /// The continuation could not run (an error the sweep settings do not name).
+    #[error(transparent)]
+    Continuation(semismooth::continuation::ContinuationError),
     /// Time marching could not run (or did not reach a steady state).
     #[error(transparent)]
     March(#[from] MarchError),
@@ -96,28 +100,6 @@ pub struct RunCounters {
     pub lemke_pivots: u64,
     /// Time steps (time marching).
     pub time_steps: u64,
-}
-
-impl std::ops::AddAssign for RunCounters {
-    fn add_assign(&mut self, rhs: Self) {
-        self.residual_evaluations += rhs.residual_evaluations;
-        self.jacobian_evaluations += rhs.jacobian_evaluations;
-        self.factorizations += rhs.factorizations;
-        self.linear_solves += rhs.linear_solves;
-        self.line_search_backtracks += rhs.line_search_backtracks;
-        self.ffts += rhs.ffts;
-        self.lemke_pivots += rhs.lemke_pivots;
-        self.time_steps += rhs.time_steps;
-    }
-}
-
-impl std::iter::Sum for RunCounters {
-    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
-        iter.fold(Self::default(), |mut total, c| {
-            total += c;
-            total
-        })
-    }
 }
 
 impl From<WorkCounters> for RunCounters {
@@ -190,6 +172,7 @@ impl std::fmt::Display for Termination {
                 LemkeTermination::Solved => "converged",
                 LemkeTermination::Ray => "ray",
                 LemkeTermination::PivotLimit => "pivot-limit",
+                _ => "lemke-stopped",
             }),
             Termination::March { steady, .. } => {
                 f.write_str(if *steady { "converged" } else { "not-steady" })
@@ -331,24 +314,32 @@ pub(crate) fn lcp_options(
     (options, tip_contact)
 }
 
-/// Newton options from scene settings.
-pub fn newton_options(settings: &SolverSettings) -> NewtonOptions {
-    let globalization = match settings.globalization {
-        GlobalizationChoice::None => Globalization::None,
-        GlobalizationChoice::Armijo => Globalization::Armijo(Default::default()),
-        GlobalizationChoice::Nonmonotone => Globalization::non_monotone(),
-        GlobalizationChoice::Hybrid => Globalization::hybrid(),
-        GlobalizationChoice::Auto => Globalization::polyalgorithm(),
+/// Newton options from scene settings: one plain Newton run with the scene's globalization,
+/// or (`auto`) the core's polyalgorithm.
+pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
+    let plain = |globalization| {
+        SolveOptions::Newton(NewtonOptions {
+            absolute_tolerance: settings.tolerance,
+            max_iterations: settings.max_iterations,
+            globalization,
+            ..NewtonOptions::default()
+        })
     };
-    NewtonOptions {
-        absolute_tolerance: settings.tolerance,
-        max_iterations: settings.max_iterations,
-        globalization,
-        ..NewtonOptions::default()
+    match settings.globalization {
+        GlobalizationChoice::None => plain(Globalization::None),
+        GlobalizationChoice::Armijo => plain(Globalization::Armijo(Default::default())),
+        GlobalizationChoice::Nonmonotone => plain(Globalization::non_monotone()),
+        GlobalizationChoice::Hybrid => plain(Globalization::hybrid()),
+        GlobalizationChoice::Auto => SolveOptions::Polyalgorithm(PolyalgorithmOptions {
+            absolute_tolerance: settings.tolerance,
+            max_iterations: settings.max_iterations,
+            ..PolyalgorithmOptions::default()
+        }),
     }
 }
 
-/// A Newton solve with the linear solver chosen by the settings, converged or not.
+/// A Newton solve with the linear solver chosen by the settings (and the problem's
+/// `smoothing` offered to the polyalgorithm), converged or not.
 ///
 /// The residual floor of the Newton options is the round-off level of the model
 /// (`eps max K_ii sqrt(n) max|g|`: 4e-8 for 10^5 elements at H = 20, far below 1e-10 for
@@ -359,26 +350,30 @@ fn newton_hb<P>(
     x: &mut [f64],
     settings: &SolverSettings,
     model: &crate::model::StructuralModel,
-    extra_stiffness: f64,
+    (extra_stiffness, smoothing): (f64, Option<SmoothingOf<P>>),
 ) -> Result<NewtonReport, RunError>
 where
     P: GeneralizedJacobian<Jacobian = HbJacobian>,
 {
-    let mut options = newton_options(settings);
     let gap_scale = model
         .contacts
         .iter()
         .fold(0.0f64, |a, c| a.max(c.gap.abs()))
         .max(f64::MIN_POSITIVE);
-    options.residual_floor = roundoff_floor(model, problem.dim(), gap_scale, extra_stiffness);
+    let options = newton_options(settings).with_residual_floor(roundoff_floor(
+        model,
+        problem.dim(),
+        gap_scale,
+        extra_stiffness,
+    ));
     let report = match settings.linear_solver.condensed() {
         Some(condensed) => {
             let mut solver = structured_solver(condensed, settings.tolerance);
-            newton::solve(problem, &mut solver, x, &options)
+            options.solve(problem, &mut solver, x, smoothing)
         }
-        None => newton::solve(problem, &mut FaerDenseLu::new(), x, &options),
+        None => options.solve(problem, &mut FaerDenseLu::new(), x, smoothing),
     };
-    Ok(report.or_else(NewtonError::into_report)?)
+    Ok(report?)
 }
 
 /// The structured solver of a Newton run with absolute tolerance `tolerance`: a
@@ -452,7 +447,7 @@ struct Outcome<'a> {
 impl<'a> Outcome<'a> {
     fn of_newton(report: &'a NewtonReport, solve_seconds: f64) -> Self {
         Self {
-            termination: Termination::Newton(report.termination),
+            termination: Termination::Newton(report.termination.clone()),
             iterations: report.iterations,
             residual_norm: report.residual_norm(),
             effective_tolerance: Some(report.effective_tolerance),
@@ -617,7 +612,8 @@ pub fn solve(
             let mut problem = SsnHb::new(model, &hb_options(settings))?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
-            let report = newton_hb(&mut problem, &mut x, settings, model, 0.0)?;
+            let smoothing = Some(SmoothingOf::new());
+            let report = newton_hb(&mut problem, &mut x, settings, model, (0.0, smoothing))?;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let outcome = Outcome::of_newton(&report, seconds);
@@ -652,14 +648,14 @@ pub fn solve(
                     |log_k, x| {
                         let k = log_k.exp();
                         problem.set_penalty_stiffness(k)?;
-                        newton_hb(&mut problem, x, settings, model, k)
+                        newton_hb(&mut problem, x, settings, model, (k, None))
                     },
                 )?;
                 counters += stages.counters;
                 homotopy_iterations = stages.iterations;
                 problem.set_penalty_stiffness(target)?;
             }
-            let mut report = newton_hb(&mut problem, &mut x, settings, model, target)?;
+            let mut report = newton_hb(&mut problem, &mut x, settings, model, (target, None))?;
             counters += report.counters;
             report.counters = counters;
             // Iterations of the whole homotopy, so that costs compare across methods.
@@ -742,17 +738,16 @@ fn solve_lcp(
             // creeps one time node per iteration. Residual floor: the min-map residual
             // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
             // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
-            let mut options = newton_options(settings);
             let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            options.residual_floor = f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale;
+            let options = newton_options(settings)
+                .with_residual_floor(f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale);
             let (z, report_list) = match warm_start {
                 Some(w) if w.len() == lcp.dim() => {
                     let mut problem = lcp.min_map();
                     let mut z = w.to_vec();
                     let mut solver = ActiveSetSolver::new()
                         .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
-                    let report = newton::solve(&mut problem, &mut solver, &mut z, &options)
-                        .or_else(NewtonError::into_report)?;
+                    let report = options.solve(&mut problem, &mut solver, &mut z, None)?;
                     (z, vec![report])
                 }
                 _ => {
@@ -762,10 +757,14 @@ fn solve_lcp(
                 }
             };
             let last = report_list.last().expect("at least one level");
-            let counters = report_list.iter().map(|r| r.counters.into()).sum();
+            let counters = report_list
+                .iter()
+                .map(|r| r.counters)
+                .sum::<WorkCounters>()
+                .into();
             (
                 z,
-                Termination::Newton(last.termination),
+                Termination::Newton(last.termination.clone()),
                 report_list.iter().map(|r| r.iterations).sum(),
                 last.residual_norm(),
                 counters,

@@ -59,7 +59,8 @@
 use semismooth::faer::Mat;
 use semismooth::floquet::{FloquetError, Multipliers};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonError, NewtonOptions};
+use semismooth::newton::Termination;
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use crate::march::{
@@ -149,7 +150,7 @@ pub enum Undecided {
         residual_norm: f64,
     },
     /// Newton on the period map could not run.
-    ShootingNotRun(NewtonError),
+    ShootingNotRun(semismooth::newton::NewtonError),
     /// Stability is computed for harmonic-balance solutions only.
     NotHarmonicBalance(Method),
     /// The analysis failed.
@@ -350,32 +351,34 @@ pub fn hb_stability(
         full,
         runs: Vec::new(),
         evaluated: None,
-        failure: None,
     };
     let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let options = NewtonOptions {
+    let options = PolyalgorithmOptions {
         absolute_tolerance: SHOOTING_TOLERANCE * scale,
         max_iterations: 50,
-        ..NewtonOptions::default()
+        ..PolyalgorithmOptions::default()
     };
-    let outcome = newton::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options);
-    if let Some(err) = shooting.failure.take() {
-        return Err(err);
-    }
-    let report = match outcome {
-        Ok(report) => report,
-        Err(NewtonError::NotConverged(report)) => {
-            return Ok(Stability::not_decided(
-                Undecided::OrbitNotFound {
-                    termination: report.termination,
-                    iterations: report.iterations,
-                    residual_norm: report.residual_norms.last().copied().unwrap_or(f64::NAN),
-                },
-                spp,
-            ))
+    let report =
+        match polyalgorithm::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
+            Ok(report) => report,
+            Err(err) => return Ok(Stability::not_decided(Undecided::ShootingNotRun(err), spp)),
+        };
+    if !report.converged() {
+        // A march that failed inside the solve ended it and comes back in its termination.
+        if let Termination::Evaluation(e) = &report.termination {
+            if let Some(err) = e.downcast_ref::<StabilityError>() {
+                return Err(err.clone());
+            }
         }
-        Err(err) => return Ok(Stability::not_decided(Undecided::ShootingNotRun(err), spp)),
-    };
+        return Ok(Stability::not_decided(
+            Undecided::OrbitNotFound {
+                termination: report.termination.clone(),
+                iterations: report.iterations,
+                residual_norm: report.residual_norms.last().copied().unwrap_or(f64::NAN),
+            },
+            spp,
+        ));
+    }
     shooting.period(&x)?;
     let keep = &shooting.keep;
     let multipliers =
@@ -506,8 +509,6 @@ struct Shooting<'a> {
     runs: Vec<(Vec<usize>, usize)>,
     /// The `x` the runs belong to and the period's end state.
     evaluated: Option<(Vec<f64>, Vec<f64>)>,
-    /// A march error met inside the Newton solve (reported after it).
-    failure: Option<StabilityError>,
 }
 
 impl Shooting<'_> {
@@ -560,14 +561,6 @@ impl Shooting<'_> {
         self.evaluated = Some((x.to_vec(), end.clone()));
         Ok(end)
     }
-
-    fn record(&mut self, err: StabilityError) -> EvaluationError {
-        self.failure = Some(err);
-        EvaluationError::OutsideDomain {
-            what: "a state the time-stepping map cannot march",
-            value: f64::NAN,
-        }
-    }
 }
 
 impl Residual for Shooting<'_> {
@@ -576,7 +569,7 @@ impl Residual for Shooting<'_> {
     }
 
     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        let end = self.period(x).map_err(|e| self.record(e))?;
+        let end = self.period(x).map_err(EvaluationError::problem)?;
         for ((o, e), xi) in out.iter_mut().zip(&end).zip(x) {
             *o = e - xi;
         }
@@ -592,8 +585,8 @@ impl GeneralizedJacobian for Shooting<'_> {
     }
 
     fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-        self.period(x).map_err(|e| self.record(e))?;
-        let full = monodromy(&mut self.marcher, &self.runs).map_err(|e| self.record(e))?;
+        self.period(x).map_err(EvaluationError::problem)?;
+        let full = monodromy(&mut self.marcher, &self.runs).map_err(EvaluationError::problem)?;
         let keep = &self.keep;
         for (j, &cj) in keep.iter().enumerate() {
             for (i, &ci) in keep.iter().enumerate() {

@@ -8,7 +8,7 @@ mod common;
 
 use common::{exact_linear, fig2_rod_model as rod, norm, sweep_solver as settings};
 use semismooth::continuation::natural_sweep;
-use semismooth::newton::NewtonOptions;
+use semismooth::polyalgorithm::{Polyalgorithm, PolyalgorithmOptions};
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 use semismooth_contact::hb::{PenaltyHb, PenaltyHbOptions, StructuredHbSolver};
 use semismooth_contact::rod::{MassModel, RodModel};
@@ -157,7 +157,7 @@ fn every_branch_point_is_a_fixed_point_of_plain_newton() {
             problem.set_parameter(r.omega[i]);
             let mut x = x0.clone();
             let what = format!("w = {}", r.omega[i]);
-            common::newton_converged(&what, &mut problem, &mut solver, &mut x, &newton);
+            common::newton_converged(&what, &mut problem, &mut solver, &mut x, (&newton, None));
             let dx: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
             let moved = norm(&dx) / norm(x0);
             worst = worst.max(moved);
@@ -183,20 +183,17 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
     let jump_down = arc.folds.iter().copied().fold(f64::NAN, f64::max);
     let mut problem = common::ssn_hb(&rod.model, h);
     let mut solver = StructuredHbSolver::new();
+    let mut newton = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
     let count = 300;
     let (w0, w1) = (0.9, 1.2);
     let dw = (w1 - w0) / count as f64;
     let omegas: Vec<f64> = (0..=count)
         .map(|i| (w0 + dw * i as f64) * rod.omega_1)
         .collect();
-    let sweep = natural_sweep(
-        &mut problem,
-        &mut solver,
-        &arc.states[0],
-        &omegas,
-        // Globalized Newton from the previous point, as a user stepping in omega would.
-        &NewtonOptions::default(),
-    )
+    // Globalized Newton from the previous point, as a user stepping in omega would.
+    let sweep = natural_sweep(&mut problem, &arc.states[0], &omegas, |p, x| {
+        newton.solve_smoothing(p, &mut solver, x)
+    })
     .unwrap();
     let tip = rod.tip_dof();
     let n = rod.model.dofs();
@@ -223,7 +220,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
         sweep
             .failure
             .as_ref()
-            .map(|f| (f.parameter / rod.omega_1, f.termination)),
+            .map(|f| (f.parameter / rod.omega_1, f.termination.clone())),
         at / rod.omega_1,
         arc.folds
             .iter()

@@ -13,8 +13,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::linalg::{DenseAssemble, FaerDenseLu};
-use semismooth::newton::{NewtonOptions, NewtonReport};
-use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
+use semismooth::newton::NewtonReport;
+use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
+use semismooth::{
+    Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual, Smoothing,
+};
 use semismooth_contact::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
@@ -296,7 +299,8 @@ fn omega_derivative_matches_central_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mut analytic = vec![0.0; hb.dim()];
-    hb.residual_parameter_derivative(&x, &mut analytic).unwrap();
+    hb.residual_parameter_derivative(&x, &mut analytic, &mut vec![0.0; hb.dim()])
+        .unwrap();
     let (mut fp, mut fm) = (vec![0.0; hb.dim()], vec![0.0; hb.dim()]);
     let step = 1e-5;
     hb.set_parameter(1.1 + step);
@@ -609,11 +613,11 @@ fn newton_iteration_work_is_allocation_free() {
     );
 }
 
-fn newton_options() -> NewtonOptions {
-    NewtonOptions {
+fn newton_options() -> SolveOptions {
+    SolveOptions::Polyalgorithm(PolyalgorithmOptions {
         max_iterations: 300,
-        ..NewtonOptions::default()
-    }
+        ..PolyalgorithmOptions::default()
+    })
 }
 
 /// Solves SSN-HB from zero with the structured solver; returns the solution and the report.
@@ -622,7 +626,14 @@ fn solve_ssn(model: &StructuralModel, options: &HbOptions) -> (SsnHb, Vec<f64>, 
     let mut x = vec![0.0; hb.dim()];
     let mut solver = StructuredHbSolver::new();
     let what = format!("SSN-HB, H = {}", options.harmonics);
-    let report = newton_converged(&what, &mut hb, &mut solver, &mut x, &newton_options());
+    let smoothing = Some(SmoothingOf::new());
+    let report = newton_converged(
+        &what,
+        &mut hb,
+        &mut solver,
+        &mut x,
+        (&newton_options(), smoothing),
+    );
     // The dynamic blocks are factored once per frequency, the condensed system once per
     // Newton iteration.
     assert_eq!(solver.dynamic_factorizations(), 1);
@@ -647,7 +658,7 @@ fn solve_condensed(
         &mut condensed,
         &mut FaerDenseLu::new(),
         &mut lambda,
-        &newton_options(),
+        (&newton_options(), None),
     );
     (condensed, lambda, report)
 }
@@ -791,7 +802,7 @@ fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
                 &mut p,
                 &mut StructuredHbSolver::new(),
                 &mut u,
-                &newton_options(),
+                (&newton_options(), None),
             );
             let s = p.summary(&u, 19, nt).unwrap();
             let d: Vec<f64> = u.iter().zip(&reference).map(|(a, b)| a - b).collect();
@@ -824,7 +835,14 @@ fn timed_solve<S: Factorize<HbJacobian>>(
     let mut hb = SsnHb::new(model, options).unwrap();
     let mut x = vec![0.0; hb.dim()];
     let start = Instant::now();
-    let report = newton_converged("SSN-HB", &mut hb, &mut solver, &mut x, &newton_options());
+    let smoothing = Some(SmoothingOf::new());
+    let report = newton_converged(
+        "SSN-HB",
+        &mut hb,
+        &mut solver,
+        &mut x,
+        (&newton_options(), smoothing),
+    );
     (x, report, start.elapsed())
 }
 
@@ -944,7 +962,7 @@ fn smoothed_ssn_jacobian_and_mu_derivative_match_central_differences() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mu = 0.05;
-    hb.smoothing().unwrap().set_smoothing(mu);
+    hb.set_smoothing(mu);
     // F_mu is smooth everywhere (no kink to avoid); its second derivative is at most of
     // order c^2 / mu = 80, so the central difference with step 1e-6 errs by ~1e-10
     // relative, and rounding (eps |F| / step) by ~1e-10 too. Measured 3.3e-11 (Jacobian) and
@@ -959,15 +977,12 @@ fn smoothed_ssn_jacobian_and_mu_derivative_match_central_differences() {
 
     let n = hb.dim();
     let mut analytic = vec![0.0; n];
-    hb.smoothing()
-        .unwrap()
-        .residual_smoothing_derivative(&x, &mut analytic)
-        .unwrap();
+    hb.residual_smoothing_derivative(&x, &mut analytic).unwrap();
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
     let step = 1e-6;
-    hb.smoothing().unwrap().set_smoothing(mu + step);
+    hb.set_smoothing(mu + step);
     hb.residual(&x, &mut fp).unwrap();
-    hb.smoothing().unwrap().set_smoothing(mu - step);
+    hb.set_smoothing(mu - step);
     hb.residual(&x, &mut fm).unwrap();
     let diff: Vec<f64> = analytic
         .iter()
@@ -997,16 +1012,16 @@ fn zero_smoothing_is_the_formulation_itself_and_small_smoothing_is_within_mu() {
     let n = plain.dim();
     let (mut f0, mut f) = (vec![0.0; n], vec![0.0; n]);
     plain.residual(&x, &mut f0).unwrap();
-    smoothed.smoothing().unwrap().set_smoothing(0.3);
+    smoothed.set_smoothing(0.3);
     smoothed.residual(&x, &mut f).unwrap();
     assert!(f != f0);
-    smoothed.smoothing().unwrap().set_smoothing(0.0);
+    smoothed.set_smoothing(0.0);
     smoothed.residual(&x, &mut f).unwrap();
     assert_eq!(f, f0);
     // 0 <= phi_mu(s) - max(0, s) <= mu at every sample, so each force coefficient moves by
     // at most mu times the 1-norm of a row of P (<= 2) and the displacement rows not at all.
     let mu = 1e-3;
-    smoothed.smoothing().unwrap().set_smoothing(mu);
+    smoothed.set_smoothing(mu);
     smoothed.residual(&x, &mut f).unwrap();
     let largest = f
         .iter()

@@ -164,7 +164,7 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
         let mut problem = lcp.min_map();
         let mut solver = ActiveSetSolver::new().without_regularization();
         let what = format!("w = {}", r.omega[i]);
-        common::newton_converged(&what, &mut problem, &mut solver, &mut z, &newton);
+        common::newton_converged(&what, &mut problem, &mut solver, &mut z, (&newton, None));
         let moved: f64 = z
             .iter()
             .zip(z0)

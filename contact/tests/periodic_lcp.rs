@@ -9,6 +9,7 @@ use common::{dense, dense_kmd, exact_linear, max_abs_diff, thread_cpu_seconds};
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions, Strategy};
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions, SolveOptions};
 use semismooth_contact::lcp::{
     solve_min_map_sequenced, ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
     DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -372,7 +373,7 @@ fn ssn_from(lcp: &PeriodicLcp, mut z: Vec<f64>) -> (Vec<f64>, newton::NewtonRepo
         .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
         .unwrap();
     let report =
-        newton::solve(&mut problem, &mut solver, &mut z, &NewtonOptions::default()).unwrap();
+        polyalgorithm::solve(&mut problem, &mut solver, &mut z, &Default::default()).unwrap();
     (z, report)
 }
 
@@ -478,7 +479,7 @@ fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass
         // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
         // interpolated previous Newton solution); Lemke independently on the finest LCP.
         let lcp = &PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
-        let sequenced = solve_min_map_sequenced(&model, lcp, &NewtonOptions::default()).unwrap();
+        let sequenced = solve_min_map_sequenced(&model, lcp, &SolveOptions::default()).unwrap();
         assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
         assert_eq!(
             sequenced.levels.len(),
@@ -747,9 +748,7 @@ fn strongly_forced_rod_has_a_chattering_nearly_degenerate_lcp_solution_with_a_ti
             .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)
             .unwrap();
         let mut x = start;
-        newton::solve(&mut problem, &mut solver, &mut x, &options)
-            .or_else(newton::NewtonError::into_report)
-            .unwrap()
+        newton::solve(&mut problem, &mut solver, &mut x, &options).unwrap()
     };
     let near = newton_from(1e-6);
     assert!(near.converged() && near.iterations <= 2, "{near:?}");
@@ -836,10 +835,10 @@ fn every_sequencing_level_stays_within_the_iteration_budget_when_it_fails() {
     let model = &rod.structure.model;
     for (nt, budget) in [(512, 200), (1024, 200), (1024, 60)] {
         let lcp = PeriodicLcp::new(model, options(nt, vec![])).unwrap();
-        let newton_options = NewtonOptions {
+        let newton_options = SolveOptions::Polyalgorithm(PolyalgorithmOptions {
             max_iterations: budget,
-            ..NewtonOptions::default()
-        };
+            ..PolyalgorithmOptions::default()
+        });
         let solved = solve_min_map_sequenced(model, &lcp, &newton_options).unwrap();
         assert!(!solved.converged(), "Nt = {nt}");
         for level in &solved.levels {

@@ -562,7 +562,7 @@ fn ssn_hb_tip(
     semismooth::newton::NewtonReport,
     semismooth_contact::hb::ResponseSummary,
 ) {
-    use semismooth::newton::{solve, NewtonOptions};
+    use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
     use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
     let mut hb = SsnHb::new(
         model,
@@ -573,11 +573,12 @@ fn ssn_hb_tip(
     )
     .unwrap();
     let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
-    let options = NewtonOptions {
+    let options = PolyalgorithmOptions {
         max_iterations: 1000,
-        ..NewtonOptions::default()
+        ..PolyalgorithmOptions::default()
     };
-    let report = solve(&mut hb, &mut StructuredHbSolver::new(), &mut x, &options).unwrap();
+    let report =
+        solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &options).unwrap();
     (report, hb.summary(&x, tip, 4096).unwrap())
 }
 

@@ -54,6 +54,7 @@ pub enum ContinuationEvent {
 
 /// Why a corrector attempt failed (the step is then rejected).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum CorrectorFailure {
     /// No convergence within `max_corrector_iterations`.
     #[error("no convergence in {iterations} iterations (|F| = {residual_norm:e})")]
@@ -100,10 +101,10 @@ pub enum CorrectorFailure {
         /// The last step length tried.
         last_step: f64,
     },
-    /// The problem could not be evaluated at an iterate (outside its domain, or outside
-    /// the trust ball around the last point).
-    #[error("outside the domain at iteration {iteration}: {error}")]
-    OutsideDomain {
+    /// The problem could not be evaluated at an iterate (outside its domain, outside the
+    /// trust ball around the last point, or the problem's own error).
+    #[error("the problem could not be evaluated at iteration {iteration}: {error}")]
+    Evaluation {
         /// Iteration at which it happened.
         iteration: usize,
         /// The problem's error.
@@ -121,7 +122,16 @@ pub enum CorrectorFailure {
 
 /// Why a continuation run stopped.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ContinuationTermination {
+    /// The starting point could not be corrected at the starting parameter (the branch has
+    /// no point).
+    StartFailed {
+        /// The starting parameter.
+        parameter: f64,
+        /// Why the corrector failed.
+        failure: CorrectorFailure,
+    },
     /// The branch left `[parameter_min, parameter_max]`; the last point was re-solved at
     /// the bound when possible (then `parameter == bound`).
     ReachedBound {
@@ -183,11 +193,22 @@ pub enum ContinuationTermination {
         /// Why the corrector failed.
         failure: CorrectorFailure,
     },
+    /// The problem's own error ([`EvaluationError::Problem`]) ended the run.
+    ProblemFailed {
+        /// Parameter of the last accepted point (the start's, before the first).
+        parameter: f64,
+        /// The error.
+        error: EvaluationError,
+    },
 }
 
 impl std::fmt::Display for ContinuationTermination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Self::StartFailed { parameter, failure } => write!(
+                f,
+                "the starting point could not be corrected at p = {parameter}: {failure}"
+            ),
             Self::ReachedBound { parameter, bound } => {
                 write!(
                     f,
@@ -228,6 +249,10 @@ impl std::fmt::Display for ContinuationTermination {
             Self::SegmentStartFailed { parameter, failure } => write!(
                 f,
                 "a new segment could not be corrected at p = {parameter}: {failure}"
+            ),
+            Self::ProblemFailed { parameter, error } => write!(
+                f,
+                "the problem failed after the point at p = {parameter}: {error}"
             ),
         }
     }
@@ -322,8 +347,10 @@ impl Branch {
     }
 }
 
-/// Why a continuation could not run.
+/// Why a continuation could not run (a run that ran and stopped has a
+/// [`ContinuationTermination`]).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ContinuationError {
     /// An option is out of range.
     #[error("invalid option {name} = {value}: allowed {allowed}")]
@@ -353,16 +380,8 @@ pub enum ContinuationError {
         /// Upper bound.
         max: f64,
     },
-    /// The Newton options of a natural sweep are invalid (or the state has the wrong
-    /// length).
+    /// A solve of a natural sweep could not run (its options are invalid, or the state has
+    /// the wrong length).
     #[error(transparent)]
     Newton(#[from] NewtonError),
-    /// The starting point could not be corrected at fixed parameter.
-    #[error("the starting point could not be corrected at p = {parameter}: {failure}")]
-    StartNotConverged {
-        /// The starting parameter.
-        parameter: f64,
-        /// Why the corrector failed.
-        failure: CorrectorFailure,
-    },
 }

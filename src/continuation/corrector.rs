@@ -5,9 +5,10 @@
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut};
 
-use super::{CorrectorFailure, BORDER_PIVOT_THRESHOLD};
+use super::options::BORDER_PIVOT_THRESHOLD;
+use super::CorrectorFailure;
+use crate::iteration::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::linalg::{check_finite_dense, check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
-use crate::newton::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::newton::WorkCounters;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent};
 
@@ -128,6 +129,8 @@ pub(super) struct Corrected {
 pub(super) struct Bordered<J> {
     pub jac: J,
     fp: Vec<f64>,
+    /// Workspace of `F_p` (the default central difference's second residual).
+    fp_scratch: Vec<f64>,
     a: Vec<f64>,
     /// θ-weighted constraint row `w_x`.
     pub w: Vec<f64>,
@@ -144,6 +147,7 @@ impl<J> Bordered<J> {
         Self {
             jac,
             fp: vec![0.0; n],
+            fp_scratch: vec![0.0; n],
             a: vec![0.0; n],
             w: vec![0.0; n],
             tangent: vec![0.0; n + 1],
@@ -222,9 +226,9 @@ where
             .jacobian(x, &mut self.ws.jac)
             .map_err(BorderedFailure::Evaluation)?;
         self.counts.parameter_derivatives += 1;
-        let fp = self
-            .problem
-            .residual_parameter_derivative(x, &mut self.ws.fp);
+        let fp =
+            self.problem
+                .residual_parameter_derivative(x, &mut self.ws.fp, &mut self.ws.fp_scratch);
         // The default F_p moves the parameter and restores it; make sure it is ours.
         self.problem.set_parameter(p);
         fp.map_err(BorderedFailure::Evaluation)?;
@@ -441,8 +445,8 @@ where
             Stop::Direction(BorderedFailure::SingularBorder(pivot)) => {
                 Err(CorrectorFailure::SingularBorder { iteration, pivot })
             }
-            Stop::Direction(BorderedFailure::Evaluation(error)) | Stop::OutsideDomain(error) => {
-                Err(CorrectorFailure::OutsideDomain { iteration, error })
+            Stop::Direction(BorderedFailure::Evaluation(error)) | Stop::Evaluation(error) => {
+                Err(CorrectorFailure::Evaluation { iteration, error })
             }
             Stop::Direction(BorderedFailure::NonFinite) | Stop::NonFinite => {
                 Err(CorrectorFailure::NonFinite { iteration })

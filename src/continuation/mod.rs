@@ -117,8 +117,12 @@
 //!
 //! [`Continuation`] is an [`Iterator`] over accepted points (BifurcationKit's style); the
 //! first item is the starting point corrected at fixed `p0`. [`Continuation::run`] collects a
-//! whole [`Branch`]. [`natural_sweep`] solves at a list of parameters with
-//! [`crate::newton`] from the previous solution, for comparison: it fails or jumps at folds.
+//! whole [`Branch`]. As for Newton, `Err` ([`ContinuationError`]) only when the run cannot
+//! start (bad options, a start of the wrong length or out of bounds); a run that ran says
+//! why it stopped in its [`ContinuationTermination`] (a start that cannot be corrected
+//! included: [`ContinuationTermination::StartFailed`], and no point). [`natural_sweep`] solves at a list of parameters with
+//! the solver it is given ([`crate::newton`] or [`crate::polyalgorithm`]) from the previous
+//! solution, for comparison: it fails or jumps at folds.
 //!
 //! References: H. B. Keller, *Numerical solution of bifurcation and nonlinear eigenvalue
 //! problems* (1977); E. Allgower & K. Georg, *Numerical Continuation Methods* (1990), for
@@ -157,9 +161,8 @@
 //! let mut solver = FaerDenseLu::new();
 //! let options = ContinuationOptions { parameter_min: -1.0, parameter_max: 1.0, ..Default::default() };
 //! let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
-//!     .unwrap()
-//!     .run()
-//!     .unwrap();
+//!     .unwrap() // Err only for bad options or a start of the wrong length
+//!     .run();
 //! assert_eq!(branch.fold_parameters().len(), 2);
 //! assert!(matches!(branch.termination, ContinuationTermination::ReachedBound { .. }));
 //! ```
@@ -181,14 +184,14 @@ pub use driver::Continuation;
 pub use folds::FoldDetector;
 pub use homotopy::{homotopy, HomotopyReport, HomotopySchedule};
 pub use natural::{natural_sweep, NaturalSweep, SweepFailure, SweepPoint};
-pub use options::{
-    ContinuationOptions, Direction, Predictor, RestartPolicy, BORDER_PIVOT_THRESHOLD,
-};
+pub use options::{ContinuationOptions, Direction, Predictor, RestartPolicy};
 pub use pieces::PiecewiseAffine;
 
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
-/// Runs a whole continuation: [`Continuation::new`] then [`Continuation::run`].
+/// Runs a whole continuation: [`Continuation::new`] then [`Continuation::run`] (`Err`
+/// only when it could not start: bad options, a start of the wrong length or out of
+/// bounds).
 pub fn run<P, S>(
     problem: &mut P,
     solver: &mut S,
@@ -200,5 +203,5 @@ where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
-    Continuation::new(problem, solver, x0, p0, options)?.run()
+    Ok(Continuation::new(problem, solver, x0, p0, options)?.run())
 }

@@ -1,9 +1,10 @@
-//! Natural-parameter continuation: Newton at a list of parameters, each from the previous
-//! solution. It fails or jumps at folds; it exists to be compared with pseudo-arclength.
+//! Natural-parameter continuation: a solve at each of a list of parameters, each from the
+//! previous solution. It fails or jumps at folds; it exists to be compared with
+//! pseudo-arclength.
 
 use super::ContinuationError;
-use crate::newton::{NewtonError, NewtonOptions, NewtonSolver, Termination, WorkCounters};
-use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
+use crate::newton::{NewtonError, NewtonReport, Termination, WorkCounters};
+use crate::{GeneralizedJacobian, ParameterDependent};
 
 /// One solved point of a natural-parameter sweep.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,27 +42,68 @@ pub struct NaturalSweep {
     pub points: Vec<SweepPoint>,
     /// The first failure, if any.
     pub failure: Option<SweepFailure>,
-    /// Work done (summed over the Newton solves).
+    /// Work done (summed over the solves).
     pub counters: WorkCounters,
 }
 
-/// Natural-parameter continuation: for each `p` in `parameters`, semismooth Newton
-/// ([`crate::newton`], with `options`) at fixed `p` from the previous solution (`x0` for
-/// the first). At a fold it fails or jumps to another branch; it exists to be compared with
-/// the pseudo-arclength [`Continuation`](super::Continuation). Stops at the first failure; the problem's
-/// parameter is then left at the last solved point.
-pub fn natural_sweep<P, S>(
+/// Natural-parameter continuation: for each `p` in `parameters`, `solve(problem, x)` at
+/// fixed `p` from the previous solution (`x0` for the first): a Newton run
+/// ([`NewtonSolver::solve`](crate::newton::NewtonSolver::solve)) or the polyalgorithm
+/// ([`Polyalgorithm::solve`](crate::polyalgorithm::Polyalgorithm::solve)), with the linear
+/// solver the closure holds. At a fold it fails or jumps to another branch; it exists to be
+/// compared with the pseudo-arclength [`Continuation`](super::Continuation). Stops at the
+/// first point that does not converge ([`NaturalSweep::failure`]); the problem's parameter
+/// is then left at the last solved point. `Err` when it could not run: a start of the wrong
+/// length, a parameter that is not finite, or a solve that could not run
+/// ([`ContinuationError::Newton`]).
+///
+/// ```
+/// use faer::Mat;
+/// use semismooth::continuation::natural_sweep;
+/// use semismooth::linalg::FaerDenseLu;
+/// use semismooth::newton::{NewtonOptions, NewtonSolver};
+/// use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
+///
+/// /// x^2 - p = 0 from x = 1: the root sqrt(p).
+/// struct Root { p: f64 }
+/// impl Residual for Root {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         f[0] = x[0] * x[0] - self.p;
+///         Ok(())
+///     }
+/// }
+/// impl GeneralizedJacobian for Root {
+///     type Jacobian = Mat<f64>;
+///     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(1, 1) }
+///     fn jacobian(&mut self, x: &[f64], j: &mut Mat<f64>) -> Result<(), EvaluationError> {
+///         j[(0, 0)] = 2.0 * x[0];
+///         Ok(())
+///     }
+/// }
+/// impl ParameterDependent for Root {
+///     fn parameter(&self) -> f64 { self.p }
+///     fn set_parameter(&mut self, p: f64) { self.p = p; }
+/// }
+///
+/// let mut newton = NewtonSolver::new(NewtonOptions::default()).unwrap();
+/// let mut lu = FaerDenseLu::new();
+/// let sweep = natural_sweep(&mut Root { p: 1.0 }, &[1.0], &[1.0, 4.0, 9.0], |p, x| {
+///     newton.solve(p, &mut lu, x)
+/// })
+/// .unwrap();
+/// assert!(sweep.failure.is_none());
+/// assert!((sweep.points[2].state[0] - 3.0).abs() < 1e-12);
+/// ```
+pub fn natural_sweep<P>(
     problem: &mut P,
-    solver: &mut S,
     x0: &[f64],
     parameters: &[f64],
-    options: &NewtonOptions,
+    mut solve: impl FnMut(&mut P, &mut [f64]) -> Result<NewtonReport, NewtonError>,
 ) -> Result<NaturalSweep, ContinuationError>
 where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
-    S: Factorize<P::Jacobian> + ?Sized,
 {
-    let mut newton = NewtonSolver::<P::Jacobian>::new(*options)?;
     let n = problem.dim();
     if x0.len() != n {
         return Err(ContinuationError::DimensionMismatch {
@@ -82,9 +124,7 @@ where
     let mut failure = None;
     for (index, &parameter) in parameters.iter().enumerate() {
         problem.set_parameter(parameter);
-        let report = newton
-            .solve(problem, solver, &mut x)
-            .or_else(NewtonError::into_report)?;
+        let report = solve(problem, &mut x)?;
         counters += report.counters;
         if report.converged() {
             points.push(SweepPoint {

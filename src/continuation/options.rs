@@ -5,7 +5,7 @@ use crate::linesearch::LineSearchOptions;
 
 /// Relative size below which the block-elimination pivot `w_p - w_x·a` is treated as zero:
 /// `|w_p - w_x·a| <= BORDER_PIVOT_THRESHOLD (|w_p| + |w_x| |a|)`.
-pub const BORDER_PIVOT_THRESHOLD: f64 = 1e-12;
+pub(crate) const BORDER_PIVOT_THRESHOLD: f64 = 1e-12;
 
 /// In which direction of the parameter the branch is followed from the starting point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -29,6 +29,7 @@ impl Direction {
 
 /// How the next point is predicted from the last accepted one.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Predictor {
     /// Along the secant through the last two accepted points (default; the first step
     /// always uses the tangent).

@@ -32,6 +32,65 @@ use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent}
 /// With [`Continuation::with_affine_pieces`](super::Continuation::with_affine_pieces) the
 /// continuation crosses the corners of such a branch exactly (module documentation of
 /// [`crate::continuation`], *Piecewise-affine branches*).
+///
+/// ```
+/// use semismooth::continuation::{Continuation, ContinuationOptions};
+/// use semismooth::faer::Mat;
+/// use semismooth::linalg::FaerDenseLu;
+/// use semismooth::continuation::PiecewiseAffine;
+/// use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
+///
+/// /// A spring against a stiffer one beyond x = 1: x + 3 max(0, x - 1) = p, one switching
+/// /// function s = x - 1; the branch x(p) has a corner at p = 1.
+/// struct Springs { p: f64, held: Option<bool> }
+/// impl Springs {
+///     fn closed(&self, x: f64) -> bool { self.held.unwrap_or(x > 1.0) }
+/// }
+/// impl Residual for Springs {
+///     fn dim(&self) -> usize { 1 }
+///     fn residual(&mut self, x: &[f64], f: &mut [f64]) -> Result<(), EvaluationError> {
+///         let stiff = if self.closed(x[0]) { 3.0 * (x[0] - 1.0) } else { 0.0 };
+///         f[0] = x[0] + stiff - self.p;
+///         Ok(())
+///     }
+/// }
+/// impl GeneralizedJacobian for Springs {
+///     type Jacobian = Mat<f64>;
+///     fn new_jacobian(&self) -> Mat<f64> { Mat::zeros(1, 1) }
+///     fn jacobian(&mut self, x: &[f64], j: &mut Mat<f64>) -> Result<(), EvaluationError> {
+///         j[(0, 0)] = if self.closed(x[0]) { 4.0 } else { 1.0 };
+///         Ok(())
+///     }
+/// }
+/// impl ParameterDependent for Springs {
+///     fn parameter(&self) -> f64 { self.p }
+///     fn set_parameter(&mut self, p: f64) { self.p = p; }
+///     fn residual_parameter_derivative(
+///         &mut self, _: &[f64], d: &mut [f64], _: &mut [f64],
+///     ) -> Result<(), EvaluationError> {
+///         d[0] = -1.0;
+///         Ok(())
+///     }
+/// }
+/// impl PiecewiseAffine for Springs {
+///     fn switching_count(&self) -> usize { 1 }
+///     fn switching(&mut self, x: &[f64], s: &mut [f64]) -> Result<(), EvaluationError> {
+///         s[0] = x[0] - 1.0;
+///         Ok(())
+///     }
+///     fn hold_piece(&mut self, piece: Option<&[bool]>) { self.held = piece.map(|h| h[0]); }
+/// }
+///
+/// let mut springs = Springs { p: 0.0, held: None };
+/// let options = ContinuationOptions { parameter_max: 3.0, ..Default::default() };
+/// let branch = Continuation::new(&mut springs, &mut FaerDenseLu::new(), &[0.0], 0.0, options)
+///     .unwrap()
+///     .with_affine_pieces()
+///     .run();
+/// let corners = branch.corner_parameters();
+/// assert_eq!(corners.len(), 1);
+/// assert!((corners[0] - 1.0).abs() < 1e-9, "{corners:?}");
+/// ```
 pub trait PiecewiseAffine: GeneralizedJacobian + ParameterDependent {
     /// Number `m` of switching functions.
     fn switching_count(&self) -> usize;
@@ -262,8 +321,9 @@ where
                 *a -= d;
             }
         }
+        let mut scratch = vec![0.0; u.len()];
         self.problem
-            .residual_parameter_derivative(&u, &mut r)
+            .residual_parameter_derivative(&u, &mut r, &mut scratch)
             .ok()?;
         self.problem.set_parameter(p);
         self.work.linear_solves += 1;

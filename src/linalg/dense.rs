@@ -3,7 +3,7 @@
 
 use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve};
 use faer::perm::PermRef;
-use faer::{Mat, MatMut, Par};
+use faer::{Mat, MatMut};
 
 use super::scratch::Scratch;
 use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
@@ -12,6 +12,29 @@ use crate::{Factorize, LinearSolve};
 /// A Jacobian type that can be written out as a dense `n x n` matrix.
 ///
 /// Structured Jacobians implement this so the dense solvers can check structured ones.
+///
+/// ```
+/// use semismooth::faer::MatMut;
+/// use semismooth::linalg::{DenseAssemble, FaerDenseLu};
+/// use semismooth::{Factorize, LinearSolve};
+/// /// A diagonal Jacobian kept as its diagonal.
+/// struct Diagonal(Vec<f64>);
+/// impl DenseAssemble for Diagonal {
+///     fn dim(&self) -> usize { self.0.len() }
+///     fn assemble_dense(&self, mut out: MatMut<'_, f64>) {
+///         out.fill(0.0);
+///         for (i, d) in self.0.iter().enumerate() {
+///             out[(i, i)] = *d;
+///         }
+///     }
+/// }
+/// // Every dense solver factors it.
+/// let mut lu = FaerDenseLu::new();
+/// lu.factor(&Diagonal(vec![2.0, 4.0])).unwrap();
+/// let mut x = [1.0, 1.0];
+/// lu.solve_in_place(&mut x).unwrap();
+/// assert_eq!(x, [0.5, 0.25]);
+/// ```
 pub trait DenseAssemble {
     /// Number of rows (= columns).
     fn dim(&self) -> usize;
@@ -88,7 +111,6 @@ pub struct FaerDenseLu {
     scratch: Scratch,
     factored: bool,
     pivot_threshold: f64,
-    parallelism: Option<Par>,
 }
 
 impl FaerDenseLu {
@@ -101,7 +123,6 @@ impl FaerDenseLu {
             scratch: Scratch::new(),
             factored: false,
             pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
-            parallelism: None,
         }
     }
 
@@ -111,24 +132,6 @@ impl FaerDenseLu {
             pivot_threshold: threshold,
             ..Self::new()
         }
-    }
-
-    /// Uses `par` for the factorization and solves instead of faer's global setting
-    /// (`faer::get_global_parallelism()`, which panics if a program called
-    /// `faer::disable_global_parallelism()`: such programs must set `par` here).
-    pub fn with_parallelism(mut self, par: Par) -> Self {
-        self.parallelism = Some(par);
-        self
-    }
-
-    /// Dimension of the last factored matrix.
-    pub fn dim(&self) -> usize {
-        self.factors.nrows()
-    }
-
-    fn par(&self) -> Par {
-        self.parallelism
-            .unwrap_or_else(faer::get_global_parallelism)
     }
 }
 
@@ -161,7 +164,7 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for FaerDenseLu {
         }
         jac.assemble_dense(self.factors.as_mut());
         check_finite_dense(n, n, |i, j| self.factors[(i, j)])?;
-        let par = self.par();
+        let par = faer::get_global_parallelism();
         let req = lu_factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default());
         let stack = self.scratch.stack(req)?;
         lu_factor::lu_in_place(
@@ -184,7 +187,7 @@ impl LinearSolve for FaerDenseLu {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         let n = self.factors.nrows();
         check_solve(self.factored, n, rhs.len())?;
-        let par = self.par();
+        let par = faer::get_global_parallelism();
         let req = lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, par);
         let stack = self.scratch.stack(req)?;
         let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);

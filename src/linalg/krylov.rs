@@ -20,6 +20,33 @@
 use super::LinearSolveError;
 
 /// A square linear operator given by products, with an optional preconditioner.
+///
+/// ```
+/// use semismooth::linalg::{Gmres, GmresOptions, KrylovOperator, LinearSolveError};
+/// /// tridiag(-1, 4, -1) on R^n, applied without a matrix; Jacobi preconditioner.
+/// struct Chain(usize);
+/// impl KrylovOperator for Chain {
+///     fn dim(&self) -> usize { self.0 }
+///     fn apply(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), LinearSolveError> {
+///         for i in 0..self.0 {
+///             let left = if i > 0 { x[i - 1] } else { 0.0 };
+///             let right = if i + 1 < self.0 { x[i + 1] } else { 0.0 };
+///             y[i] = 4.0 * x[i] - left - right;
+///         }
+///         Ok(())
+///     }
+///     fn precondition(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), LinearSolveError> {
+///         for (yi, xi) in y.iter_mut().zip(x) {
+///             *yi = xi / 4.0;
+///         }
+///         Ok(())
+///     }
+/// }
+/// let b = vec![1.0; 50];
+/// let mut x = vec![0.0; 50];
+/// let report = Gmres::new().solve(&mut Chain(50), &b, &mut x, &GmresOptions::default()).unwrap();
+/// assert!(report.residual_norm <= report.tolerance && report.iterations < 50);
+/// ```
 pub trait KrylovOperator {
     /// Dimension `n` of the operator.
     fn dim(&self) -> usize;

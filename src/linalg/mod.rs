@@ -37,6 +37,7 @@ pub const DEFAULT_PIVOT_THRESHOLD: f64 = 1e-13;
 
 /// Why a factorization or a solve could not be carried out.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum LinearSolveError {
     /// A pivot is zero or negligible relative to the largest pivot.
     #[error(
@@ -116,19 +117,6 @@ impl LinearSolveError {
         match error {
             faer::sparse::FaerError::OutOfMemory => Self::OutOfMemory { during },
             _ => Self::IndexOverflow { during },
-        }
-    }
-
-    /// The error of a faer sparse LU `during` something: a structurally singular matrix
-    /// is [`LinearSolveError::Singular`] (pivot 0 at the failing column).
-    pub fn from_sparse_lu(error: faer::sparse::linalg::LuError, during: &'static str) -> Self {
-        match error {
-            faer::sparse::linalg::LuError::SymbolicSingular { index } => Self::Singular {
-                index,
-                pivot: 0.0,
-                max_pivot: f64::NAN,
-            },
-            faer::sparse::linalg::LuError::Generic(e) => Self::from_faer(e, during),
         }
     }
 

@@ -42,7 +42,7 @@ enum State {
 impl std::fmt::Debug for NalgebraLu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NalgebraLu")
-            .field("dim", &self.dim())
+            .field("dim", &self.dim)
             .field("factored", &matches!(self.state, State::Factored(_)))
             .field("pivot_threshold", &self.pivot_threshold)
             .finish()
@@ -62,11 +62,6 @@ impl NalgebraLu {
             dim: 0,
             pivot_threshold,
         }
-    }
-
-    /// Dimension of the last factored (or assembled) matrix.
-    pub fn dim(&self) -> usize {
-        self.dim
     }
 }
 
@@ -119,7 +114,7 @@ impl<J: DenseAssemble + ?Sized> Factorize<J> for NalgebraLu {
 impl LinearSolve for NalgebraLu {
     /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        let n = self.dim();
+        let n = self.dim;
         check_solve(matches!(self.state, State::Factored(_)), n, rhs.len())?;
         let State::Factored(lu) = &self.state else {
             return Err(LinearSolveError::NotFactored);

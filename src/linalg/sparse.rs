@@ -100,11 +100,6 @@ impl FaerSparseLu {
         }
     }
 
-    /// Dimension of the last analysed matrix.
-    pub fn dim(&self) -> usize {
-        self.dim
-    }
-
     /// How many symbolic analyses (column orderings) have been computed: 1 for any
     /// number of factorizations of matrices sharing one sparsity pattern.
     pub fn symbolic_analyses(&self) -> u64 {

@@ -3,7 +3,7 @@
 //! the tables print them.
 
 use semismooth::continuation::ContinuationTermination;
-use semismooth::lemke::LemkeTermination;
+use semismooth::lemke::{LemkeOptions, LemkeTermination};
 use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
 use semismooth_contact::solve::{Diagnosis, Termination};
@@ -29,10 +29,20 @@ pub fn termination(t: &Termination) -> String {
             pivot_limit,
             order,
             ..
-        } => format!(
-            "pivot-limit ({pivots} pivots done, the limit {pivot_limit} for n = {order}): the \
-             tip values are those of the unfinished path's last basis, not of a solution"
-        ),
+        } => {
+            // The run used Lemke's default options: name their rule when it gave the limit.
+            let default = LemkeOptions::default();
+            let rule = if default.pivot_limit(*order) == *pivot_limit {
+                format!(" = {}", default.pivot_limit_rule())
+            } else {
+                String::new()
+            };
+            format!(
+                "pivot-limit ({pivots} pivots done, the limit {pivot_limit}{rule} for n = \
+                 {order}): the tip values are those of the unfinished path's last basis, not of \
+                 a solution"
+            )
+        }
         Termination::March {
             steady: false,
             period_change,
@@ -129,9 +139,11 @@ fn branch_termination(r: &FrequencyResponse, t: &ContinuationTermination) -> Str
             "{failures} failed steps in a row at omega_ratio {}: {failure}",
             ratio(*parameter)
         ),
-        ContinuationTermination::SegmentStartFailed { failure, .. } => {
+        ContinuationTermination::StartFailed { failure, .. }
+        | ContinuationTermination::SegmentStartFailed { failure, .. } => {
             format!("the start point could not be corrected: {failure}")
         }
+        other => other.to_string(),
     }
 }
 

@@ -10,7 +10,7 @@ use proptest::prelude::*;
 
 use semismooth::lemke::{Lemke, LemkeOptions};
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonOptions};
+use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 use semismooth_contact::rod::build_rod;
 use semismooth_contact::solve::solve;
@@ -127,8 +127,8 @@ proptest! {
         let mut problem = MinMap { m: m.clone(), q: q.clone() };
         let mut z = vec![0.0; n];
         let mut solver = FaerDenseLu::new();
-        let options = NewtonOptions { max_iterations: 100, ..NewtonOptions::default() };
-        let newton = newton::solve(&mut problem, &mut solver, &mut z, &options).unwrap();
+        let options = PolyalgorithmOptions { max_iterations: 100, ..PolyalgorithmOptions::default() };
+        let newton = polyalgorithm::solve(&mut problem, &mut solver, &mut z, &options).unwrap();
         prop_assert!(newton.converged(), "SSN: {:?} after {} iterations", newton.termination, newton.iterations);
 
         let kappa = (1.0 / beta).max(1.0);

@@ -293,6 +293,7 @@ impl ParameterDependent for CondensedSsnHb {
         &mut self,
         lambda: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();

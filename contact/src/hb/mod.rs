@@ -33,7 +33,7 @@
 //!
 //! ```
 //! use semismooth::linalg::FaerDenseLu;
-//! use semismooth::newton::{solve, NewtonOptions};
+//! use semismooth::polyalgorithm::{solve, solve_smoothing, PolyalgorithmOptions};
 //! use semismooth::Residual;
 //! use semismooth_contact::hb::{CondensedSsnHb, HbOptions, SsnHb, StructuredHbSolver};
 //! use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
@@ -46,8 +46,8 @@
 //! // Full unknowns [U; Lambda], structured (condensed) linear solves.
 //! let mut hb = SsnHb::new(&rod.model, &options).unwrap();
 //! let mut x = vec![0.0; hb.dim()];
-//! let report = solve(&mut hb, &mut StructuredHbSolver::new(), &mut x, &NewtonOptions::default())
-//!     .unwrap();
+//! let newton = PolyalgorithmOptions::default();
+//! let report = solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &newton).unwrap();
 //! assert!(report.converged());
 //! let summary = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
 //! assert!(summary.displacement_min < -0.5 && summary.contact_force_mean[0] < 0.0);
@@ -55,8 +55,7 @@
 //! // Newton on the force coefficients alone: same solution, far fewer iterations.
 //! let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
 //! let mut lambda = vec![0.0; condensed.dim()];
-//! let reduced = solve(&mut condensed, &mut FaerDenseLu::new(), &mut lambda, &NewtonOptions::default())
-//!     .unwrap();
+//! let reduced = solve(&mut condensed, &mut FaerDenseLu::new(), &mut lambda, &newton).unwrap();
 //! assert!(reduced.converged() && reduced.iterations < report.iterations);
 //! let same = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
 //! assert!((same.displacement_min - summary.displacement_min).abs() < 1e-9);
@@ -136,6 +135,7 @@ macro_rules! omega_parameter {
                 &mut self,
                 x: &[f64],
                 out: &mut [f64],
+                _scratch: &mut [f64],
             ) -> Result<(), semismooth::EvaluationError> {
                 self.state.omega_derivative(x, self.displacement_len(), out);
                 Ok(())

@@ -235,10 +235,6 @@ impl Residual for SsnHb {
     fn problem_counters(&self) -> ProblemCounters {
         ProblemCounters::new().with("ffts", self.state.aft.fft_count())
     }
-
-    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
-        Some(self)
-    }
 }
 
 impl GeneralizedJacobian for SsnHb {

@@ -207,6 +207,7 @@ impl ParameterDependent for FrequencyLcp {
         &mut self,
         y: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         let n = self.half();
         let lcp = self.current_in_domain()?;
@@ -435,7 +436,8 @@ mod tests {
         let y = state(&p);
         let omega = p.parameter();
         let mut analytic = vec![0.0; p.dim()];
-        p.residual_parameter_derivative(&y, &mut analytic).unwrap();
+        p.residual_parameter_derivative(&y, &mut analytic, &mut vec![0.0; p.dim()])
+            .unwrap();
         // Central differences at the resonance (zeta = 0.01: F varies on the scale
         // zeta omega): truncation (h / (zeta omega))^2 ~ 1e-8 relative, rounding
         // 1e-16 |F| / h ~ 1e-10 of the derivative (|F| ~ 1, |F'| ~ 1e2).

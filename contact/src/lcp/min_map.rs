@@ -9,8 +9,9 @@
 //! `A_II d_I = r_I - A_IJ r_J`: one `|I| x |I|` LU instead of an `m Nt` one. Newton on this
 //! equation is the primal-dual active-set method.
 //!
-//! On request ([`MinMapLcp::with_smoothing`]) the equation offers the core's
-//! [`Smoothing`]: `min(z, w) = z - max(0, z - w)` with the max replaced by the
+//! The equation offers the core's [`Smoothing`] (the polyalgorithm's smoothing path, through
+//! `semismooth::polyalgorithm::solve_smoothing`): `min(z, w) = z - max(0, z - w)` with the
+//! max replaced by the
 //! Chen–Harker–Kanzow–Smale function, `min_mu(z, w) = z - (s + sqrt(s^2 + 4 mu^2)) / 2`,
 //! `s = z - w`; its Jacobian rows are `(1 - t_i) e_i + t_i A_i` with weights
 //! `t_i in (0, 1)`, solved by a dense LU (the active-set split needs 0/1 rows).
@@ -59,8 +60,8 @@ pub struct MinMapLcp<'a> {
     matrix: MatRef<'a, f64>,
     q: &'a [f64],
     w: Vec<f64>,
-    /// `None`: no smoothing offered; `Some(mu)`: offered, `mu >= 0` set (0: `F` itself).
-    smoothing: Option<f64>,
+    /// The smoothing `mu >= 0` set (0: `F` itself).
+    mu: f64,
 }
 
 impl<'a> MinMapLcp<'a> {
@@ -87,23 +88,8 @@ impl<'a> MinMapLcp<'a> {
             matrix,
             q,
             w: vec![0.0; q.len()],
-            smoothing: None,
+            mu: 0.0,
         }
-    }
-
-    /// The same equation offering the smoothing `min_mu(z, w) = z - phi_mu(z - w)`,
-    /// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2` (within `mu` of `min`; `mu = 0` is `F`
-    /// exactly), so that the polyalgorithm can follow the smoothing path from `mu = max |q|`.
-    /// Its Jacobians at `mu > 0` have fractional rows: solve them with the
-    /// [`ActiveSetSolver`] (dense LU for those) or a dense solver.
-    pub fn with_smoothing(mut self) -> Self {
-        self.smoothing = Some(0.0);
-        self
-    }
-
-    /// The smoothing set (0 when none is offered or set).
-    fn mu(&self) -> f64 {
-        self.smoothing.unwrap_or(0.0)
     }
 
     /// `w = q + A z` into `w`.
@@ -120,7 +106,7 @@ impl Residual for MinMapLcp<'_> {
 
     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.gap(x);
-        let mu = self.mu();
+        let mu = self.mu;
         for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
             *o = if mu == 0.0 {
                 min_function(*z, *w).value
@@ -130,16 +116,12 @@ impl Residual for MinMapLcp<'_> {
         }
         Ok(())
     }
-
-    fn smoothing(&mut self) -> Option<&mut dyn Smoothing> {
-        if self.smoothing.is_some() {
-            Some(self)
-        } else {
-            None
-        }
-    }
 }
 
+/// The smoothing `min_mu(z, w) = z - phi_mu(z - w)`, `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2))
+/// / 2` (within `mu` of `min`; `mu = 0` is `F` exactly), so that the polyalgorithm can
+/// follow the smoothing path from `mu = max |q|`. Its Jacobians at `mu > 0` have fractional
+/// rows: solve them with the [`ActiveSetSolver`] (dense LU for those) or a dense solver.
 impl Smoothing for MinMapLcp<'_> {
     /// `max |q|`: the spread of the switching quantity `z - w = -q` at `z = 0`.
     fn smoothing_scale(&self) -> f64 {
@@ -150,9 +132,7 @@ impl Smoothing for MinMapLcp<'_> {
     }
 
     fn set_smoothing(&mut self, mu: f64) {
-        if self.smoothing.is_some() {
-            self.smoothing = Some(mu.max(0.0));
-        }
+        self.mu = mu.max(0.0);
     }
 
     /// `d min_mu(z, w) / d mu = -2 mu / sqrt(s^2 + 4 mu^2)`, `s = z - w`.
@@ -162,7 +142,7 @@ impl Smoothing for MinMapLcp<'_> {
         out: &mut [f64],
     ) -> Result<(), EvaluationError> {
         self.gap(x);
-        let mu = self.mu();
+        let mu = self.mu;
         for ((o, z), w) in out.iter_mut().zip(x).zip(&self.w) {
             *o = if mu == 0.0 {
                 0.0
@@ -187,7 +167,7 @@ impl<'a> GeneralizedJacobian for MinMapLcp<'a> {
 
     fn jacobian(&mut self, x: &[f64], jac: &mut MinMapJacobian<'a>) -> Result<(), EvaluationError> {
         self.gap(x);
-        let mu = self.mu();
+        let mu = self.mu;
         if mu == 0.0 {
             jac.weights.clear();
             for ((a, z), w) in jac.active.iter_mut().zip(x).zip(&self.w) {
@@ -213,7 +193,7 @@ impl<'a> GeneralizedJacobian for MinMapLcp<'a> {
 
 /// An element of the generalized Jacobian of `min(z, q + A z)`: row `i` of `A` where
 /// `active[i]`, the unit row `e_i` elsewhere; of a smoothed equation
-/// ([`MinMapLcp::with_smoothing`]), the rows `(1 - t_i) e_i + t_i A_i`.
+/// (at `mu > 0`, [`Smoothing::set_smoothing`]), the rows `(1 - t_i) e_i + t_i A_i`.
 #[derive(Debug, Clone)]
 pub struct MinMapJacobian<'a> {
     matrix: MatRef<'a, f64>,
@@ -671,8 +651,8 @@ mod tests {
         let q: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
         let z: Vec<f64> = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
         let mut plain = MinMapLcp::new(a.as_ref(), &q).unwrap();
-        let mut smooth = MinMapLcp::new(a.as_ref(), &q).unwrap().with_smoothing();
-        assert!(plain.smoothing().is_none());
+        let mut smooth = MinMapLcp::new(a.as_ref(), &q).unwrap();
+        smooth.set_smoothing(0.0);
         let (mut f0, mut f1) = (vec![0.0; n], vec![0.0; n]);
         plain.residual(&z, &mut f0).unwrap();
         smooth.residual(&z, &mut f1).unwrap();
@@ -685,7 +665,7 @@ mod tests {
         // At mu > 0: F_mu within mu of F, its Jacobian and mu-derivative against central
         // differences (smooth, step 1e-6: error O(1e-12 / mu^2) plus round-off 1e-10).
         let mu = 0.3;
-        smooth.smoothing().unwrap().set_smoothing(mu);
+        smooth.set_smoothing(mu);
         smooth.residual(&z, &mut f1).unwrap();
         assert!(f0.iter().zip(&f1).all(|(a, b)| a - b > 0.0 && a - b <= mu));
         smooth.jacobian(&z, &mut j1).unwrap();
@@ -706,15 +686,16 @@ mod tests {
             }
         }
         let mut dmu = vec![0.0; n];
-        smooth
-            .smoothing()
-            .unwrap()
-            .residual_smoothing_derivative(&z, &mut dmu)
-            .unwrap();
+        smooth.residual_smoothing_derivative(&z, &mut dmu).unwrap();
         for (sign, out) in [(1.0, &mut fp), (-1.0, &mut fm)] {
-            smooth.smoothing().unwrap().set_smoothing(mu + sign * h);
+            smooth.set_smoothing(mu + sign * h);
             smooth.residual(&z, out).unwrap();
         }
+        // Back at mu = 0: the min map again, bitwise.
+        smooth.set_smoothing(0.0);
+        smooth.residual(&z, &mut f1).unwrap();
+        assert_eq!(f0, f1);
+        smooth.set_smoothing(mu);
         for i in 0..n {
             assert!(((fp[i] - fm[i]) / (2.0 * h) - dmu[i]).abs() < 1e-8, "{i}");
         }

@@ -1,7 +1,8 @@
 //! Mesh sequencing for the semismooth Newton method on the periodic LCP: coarse levels
 //! first, each finer level warm-started by the interpolated coarser solution.
 
-use semismooth::newton::{self, NewtonError, NewtonOptions, NewtonReport};
+use semismooth::newton::NewtonReport;
+use semismooth::polyalgorithm::{SmoothingOf, SolveOptions};
 
 use super::{
     ActiveSetSolver, LcpError, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -78,7 +79,7 @@ impl SequencedSolution {
 /// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
 /// `"lcp-ssn"` at large `Nt`): the LCP of `model` is solved at `Nt / 2^j` (halving while
 /// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0` (offering the
-/// polyalgorithm the min-map's smoothing, [`super::MinMapLcp::with_smoothing`]), then each finer
+/// polyalgorithm the min-map's smoothing, [`super::MinMapLcp`]'s `Smoothing`), then each finer
 /// level starts from the previous solution interpolated in time
 /// ([`PeriodicLcp::interpolate_forces`]); the last level is `finest` itself (built by the
 /// caller, with whatever observed dofs it needs; only the coarser levels are built here).
@@ -97,7 +98,7 @@ impl SequencedSolution {
 pub fn solve_min_map_sequenced(
     model: &StructuralModel,
     finest: &PeriodicLcp,
-    newton_options: &NewtonOptions,
+    newton_options: &SolveOptions,
 ) -> Result<SequencedSolution, LcpError> {
     newton_options.validate()?;
     check_same_model(model, finest)?;
@@ -116,12 +117,12 @@ pub fn solve_min_map_sequenced(
     let mut solve_level = |lcp: &PeriodicLcp, previous: Option<Vec<f64>>| {
         // The level started from zero offers the smoothing path to the polyalgorithm; the
         // finer ones start near their solution.
-        let (mut z, mut problem) = match &previous {
-            Some(coarse) => (lcp.interpolate_forces(coarse)?, lcp.min_map()),
-            None => (vec![0.0; lcp.dim()], lcp.min_map().with_smoothing()),
+        let (mut z, smoothing) = match &previous {
+            Some(coarse) => (lcp.interpolate_forces(coarse)?, None),
+            None => (vec![0.0; lcp.dim()], Some(SmoothingOf::new())),
         };
-        let report = newton::solve(&mut problem, &mut solver, &mut z, newton_options)
-            .or_else(NewtonError::into_report)?;
+        let mut problem = lcp.min_map();
+        let report = newton_options.solve(&mut problem, &mut solver, &mut z, smoothing)?;
         levels.push(SequencingLevel {
             time_samples: lcp.time_samples(),
             report,
@@ -181,7 +182,7 @@ mod tests {
             ..Default::default()
         };
         let lcp = PeriodicLcp::new(&model, options).unwrap();
-        let newton = NewtonOptions::default();
+        let newton = SolveOptions::default();
         let solved = solve_min_map_sequenced(&model, &lcp, &newton).unwrap();
         // Nt = 16 is below the coarsest level: one level, the caller's LCP.
         assert_eq!(solved.levels.len(), 1);

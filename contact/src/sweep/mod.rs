@@ -93,7 +93,8 @@ use semismooth::continuation::{
     ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::{self, NewtonError, WorkCounters};
+use semismooth::newton::WorkCounters;
+use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
@@ -310,12 +311,7 @@ fn continuation_error(e: ContinuationError) -> RunError {
             parameter,
             "within the sweep interval",
         ),
-        // Handled by the caller (a non-converged curve); kept total here.
-        ContinuationError::StartNotConverged { parameter, .. } => invalid(
-            "sweep.omega_ratio_from",
-            parameter,
-            "a frequency where the start point can be corrected",
-        ),
+        other => RunError::Continuation(other),
     }
 }
 
@@ -337,10 +333,11 @@ struct Setup<'a> {
     start: Option<(Vec<f64>, WorkCounters)>,
 }
 
-/// Newton at `omega_from`, then the continuation to the end of the sweep (module
-/// documentation); every accepted point is measured and reported to `progress`.
+/// Newton at `omega_from` (the problem's `smoothing` offered to the polyalgorithm), then the
+/// continuation to the end of the sweep (module documentation); every accepted point is
+/// measured and reported to `progress`.
 fn follow<P, S>(
-    problem: &mut P,
+    (problem, smoothing): (&mut P, Option<SmoothingOf<P>>),
     solver: &mut S,
     setup: Setup<'_>,
     measure: &mut TipMeasure<'_, P>,
@@ -367,8 +364,7 @@ where
     let (mut x, mut work) = setup
         .start
         .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
-    let report = newton::solve(problem, solver, &mut x, &newton_options(settings))
-        .or_else(NewtonError::into_report)?;
+    let report = newton_options(settings).solve(problem, solver, &mut x, smoothing)?;
     work += report.counters;
     let mut response = FrequencyResponse {
         method: settings.method,
@@ -400,7 +396,7 @@ where
     };
     if !report.converged() {
         response.termination = SweepTermination::StartNotConverged {
-            termination: report.termination,
+            termination: report.termination.clone(),
             iterations: report.iterations,
             residual_norm: report.residual_norm(),
         };
@@ -411,16 +407,7 @@ where
     let mut continuation = configure(
         Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
     );
-    let mut start_failure = None;
-    while let Some(item) = continuation.next() {
-        let point = match item {
-            Ok(point) => point,
-            Err(ContinuationError::StartNotConverged { failure, .. }) => {
-                start_failure = Some(failure);
-                break;
-            }
-            Err(e) => return Err(continuation_error(e)),
-        };
+    while let Some(point) = continuation.next() {
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
         response.push(omega, max, min, point.iterations, point.state);
@@ -445,21 +432,20 @@ where
     }
     let termination = continuation.termination().cloned();
     drop(continuation);
-    response.counters.residual_evaluations += c.work.residual_evaluations;
-    response.counters.jacobian_evaluations += c.work.jacobian_evaluations;
-    response.counters.factorizations += c.work.factorizations + c.dense_bordered_factorizations;
-    response.counters.linear_solves += c.work.linear_solves;
-    response.counters.ffts += c.work.problem.get("ffts");
+    let mut total = work;
+    total += c.work;
+    total.factorizations += c.dense_bordered_factorizations;
+    response.counters = RunCounters::from(total);
     response.restarts = c.restarts as usize;
     response.corners = c.corners as usize;
     response.continuation = c;
-    response.termination = match (termination, start_failure) {
-        (_, Some(failure)) => SweepTermination::StartNotCorrected(failure),
-        (Some(ContinuationTermination::SegmentStartFailed { failure, .. }), None) => {
-            SweepTermination::StartNotCorrected(failure)
-        }
-        (Some(t), None) => SweepTermination::Branch(t),
-        (None, None) => SweepTermination::Unexplained,
+    response.termination = match termination {
+        Some(
+            ContinuationTermination::StartFailed { failure, .. }
+            | ContinuationTermination::SegmentStartFailed { failure, .. },
+        ) => SweepTermination::StartNotCorrected(failure),
+        Some(t) => SweepTermination::Branch(t),
+        None => SweepTermination::Unexplained,
     };
     response.solve_seconds = setup.started.elapsed().as_secs_f64();
     Ok(response)
@@ -536,7 +522,7 @@ pub(crate) fn follow_branch(
                 affine_pieces: false,
             };
             follow(
-                &mut problem,
+                (&mut problem, Some(SmoothingOf::new())),
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
@@ -561,7 +547,7 @@ pub(crate) fn follow_branch(
                 affine_pieces: true,
             };
             follow(
-                &mut problem,
+                (&mut problem, None),
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
@@ -589,10 +575,7 @@ pub(crate) fn follow_branch(
             let finest = problem.current()?;
             let sequenced =
                 solve_min_map_sequenced(&start_model, &finest, &newton_options(settings))?;
-            let mut start_counters = WorkCounters::default();
-            for level in &sequenced.levels {
-                start_counters += level.report.counters;
-            }
+            let start_counters = sequenced.levels.iter().map(|l| l.report.counters).sum();
             let y0 = problem.state_from_forces(&sequenced.z)?;
             let half = problem.half();
             let units = (0..problem.dim())
@@ -626,7 +609,7 @@ pub(crate) fn follow_branch(
                 ..setup(method, settings.time_samples)
             };
             follow(
-                &mut problem,
+                (&mut problem, None),
                 &mut FrequencyLcpSolver::new(),
                 setup,
                 &mut measure,

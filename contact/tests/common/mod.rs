@@ -7,7 +7,8 @@
 #![allow(dead_code)]
 
 use nalgebra::{Complex, DMatrix, DVector};
-use semismooth::newton::{self, Globalization, NewtonOptions, NewtonReport};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonReport};
+use semismooth::polyalgorithm::{SmoothingOf, SolveOptions};
 use semismooth::{Factorize, GeneralizedJacobian};
 use semismooth_contact::hb::{HbOptions, SsnHb};
 use semismooth_contact::model::{SparseMatrix, StructuralModel};
@@ -90,21 +91,22 @@ pub fn solve_converged(rod: &RodModel, settings: &SolverSettings) -> Solution {
     s
 }
 
-/// Newton from `x` (overwritten by the root); fails the test, naming `what`, unless it
-/// converged.
+/// Newton (plain or the polyalgorithm, with the problem's `smoothing` when given) from `x`
+/// (overwritten by the root); fails the test, naming `what`, unless it converged.
 pub fn newton_converged<P, S>(
     what: &str,
     problem: &mut P,
     solver: &mut S,
     x: &mut [f64],
-    options: &NewtonOptions,
+    (options, smoothing): (&SolveOptions, Option<SmoothingOf<P>>),
 ) -> NewtonReport
 where
     P: GeneralizedJacobian + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
-    let report =
-        newton::solve(problem, solver, x, options).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let report = options
+        .solve(problem, solver, x, smoothing)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
     assert!(report.converged(), "{what}: {:?}", report.termination);
     report
 }
@@ -213,13 +215,13 @@ pub fn ssn_hb(model: &StructuralModel, harmonics: usize) -> SsnHb {
 
 /// Plain Newton (full steps, at most 20 iterations) to `|F| <= 1e-12`: re-solving from a
 /// point already on a branch must converge at once and not move it.
-pub fn plain_newton() -> NewtonOptions {
-    NewtonOptions {
+pub fn plain_newton() -> SolveOptions {
+    SolveOptions::Newton(NewtonOptions {
         absolute_tolerance: 1e-12,
         max_iterations: 20,
         globalization: Globalization::None,
         ..NewtonOptions::default()
-    }
+    })
 }
 
 /// The frequency response of `rod` with `settings` over `omega / omega_1` in `[0.5, 2]`

@@ -76,8 +76,9 @@ enum Resume {
 /// The first item is the starting point corrected at fixed `p0` by the continuation's own
 /// corrector (Newton, with the line search of
 /// [`ContinuationOptions::corrector_line_search`] if set; from a poor guess, solve first
-/// with [`crate::newton`]). An `Err` item (the start could not be corrected) ends the
-/// iteration. When the iteration ends, [`Continuation::termination`] says why,
+/// with [`crate::newton`]); when it cannot be corrected there is no item and the
+/// termination is [`ContinuationTermination::StartFailed`]. When the iteration ends,
+/// [`Continuation::termination`] says why,
 /// [`Continuation::events`] lists the folds and corners, and the problem's parameter is
 /// that of the last accepted point.
 pub struct Continuation<'a, P, S>
@@ -211,7 +212,7 @@ where
         })
     }
 
-    /// Why the run stopped (`None` while it runs, or after a start failure).
+    /// Why the run stopped (`None` while it runs).
     pub fn termination(&self) -> Option<&ContinuationTermination> {
         self.termination.as_ref()
     }
@@ -238,32 +239,24 @@ where
         self.problem
     }
 
-    /// The step length the next attempt will use.
-    pub fn next_step(&self) -> f64 {
-        self.step
-    }
-
     /// Runs to the end and collects the branch.
-    pub fn run(mut self) -> Result<super::Branch, ContinuationError> {
-        let mut points = Vec::new();
-        for item in self.by_ref() {
-            points.push(item?);
-        }
+    pub fn run(mut self) -> super::Branch {
+        let points: Vec<BranchPoint> = self.by_ref().collect();
         let termination = self
             .termination
             .clone()
             .unwrap_or(ContinuationTermination::MaxPoints {
                 points: points.len(),
             });
-        Ok(super::Branch {
+        super::Branch {
             points,
             events: std::mem::take(&mut self.events),
             termination,
             counters: self.counters(),
-        })
+        }
     }
 
-    fn finished(&self) -> bool {
+    pub(super) fn finished(&self) -> bool {
         matches!(self.phase, Phase::Finished)
     }
 
@@ -289,31 +282,30 @@ where
         spent
     }
 
-    fn finish(&mut self, termination: ContinuationTermination) {
+    pub(super) fn finish(&mut self, termination: ContinuationTermination) {
         if !self.finished() {
             self.termination = Some(termination);
             self.phase = Phase::Finished;
         }
     }
 
-    fn start(&mut self, x0: Vec<f64>, p0: f64) -> Result<(), ContinuationError> {
+    fn start(&mut self, x0: Vec<f64>, p0: f64) {
         let mut x = x0;
         let mut p = p0;
         let corrected = match self.correct_start(&mut x, &mut p, self.options.direction) {
             Ok(c) => c,
             Err(failure) => {
                 self.problem.set_parameter(p0);
-                self.phase = Phase::Finished;
-                return Err(ContinuationError::StartNotConverged {
+                self.finish(ContinuationTermination::StartFailed {
                     parameter: p0,
                     failure,
                 });
+                return;
             }
         };
         self.phase = Phase::Running;
         let point = self.start_point(x, p, corrected);
         self.after_accept(point, 0.0);
-        Ok(())
     }
 
     /// Begins a new segment of the branch at `(x, p)`: a correction at fixed `p`, the
@@ -569,6 +561,9 @@ where
                 Err(failure) => failure,
             };
             self.reject(before, last.parameter);
+            if self.finished() {
+                return;
+            }
             self.consecutive_failures += 1;
             let too_small = ds <= self.options.min_step;
             let too_many = self.consecutive_failures >= self.options.max_consecutive_failures;
@@ -581,6 +576,9 @@ where
                     if let Some((point, chord)) = accepted {
                         self.after_accept(point, chord);
                     }
+                    return;
+                }
+                if self.finished() {
                     return;
                 }
             }
@@ -708,23 +706,19 @@ where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
-    type Item = Result<BranchPoint, ContinuationError>;
+    type Item = BranchPoint;
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
             if let Some(point) = self.pending.pop_front() {
-                return Some(Ok(point));
+                return Some(point);
             }
             match std::mem::replace(&mut self.phase, Phase::Running) {
                 Phase::Finished => {
                     self.phase = Phase::Finished;
                     return None;
                 }
-                Phase::NotStarted { x0, p0 } => {
-                    if let Err(e) = self.start(x0, p0) {
-                        return Some(Err(e));
-                    }
-                }
+                Phase::NotStarted { x0, p0 } => self.start(x0, p0),
                 Phase::Running => self.advance(),
             }
         }

@@ -6,8 +6,12 @@ use super::{Accepted, Continuation};
 use crate::continuation::{
     BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
-use crate::newton::kernel::{armijo, KernelRules};
+use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
+
+/// The squared θ-norm of the state (parameter) part of a unit direction below which a
+/// corner pass along that part is not tried.
+const NEGLIGIBLE_PART: f64 = 1e-6;
 
 impl<P, S> Continuation<'_, P, S>
 where
@@ -77,7 +81,13 @@ where
                 step_tolerance: self.options.step_tolerance,
                 max_iterations,
                 min_iterations: 1,
-                globalization: armijo(self.options.corrector_line_search),
+                step: match self.options.corrector_line_search {
+                    Some(line_search) => StepRule::Backtracking {
+                        memory: 1,
+                        line_search,
+                    },
+                    None => StepRule::Full,
+                },
                 restore_best: false,
                 stagnation: None,
             },
@@ -88,6 +98,15 @@ where
             &mut self.work,
             &mut self.corrector_counts,
         );
+        if let Err(CorrectorFailure::Evaluation { error, .. }) = &outcome.0 {
+            if error.ends_run() {
+                let parameter = self.last.as_ref().map_or(*p, |l| l.parameter);
+                self.finish(ContinuationTermination::ProblemFailed {
+                    parameter,
+                    error: error.clone(),
+                });
+            }
+        }
         x.copy_from_slice(&y[..n]);
         *p = y[n];
         outcome
@@ -126,7 +145,7 @@ where
                 return None;
             }
             let (scale, along, constraint) = if on_state {
-                if state_part < 1e-6 {
+                if state_part < NEGLIGIBLE_PART {
                     continue;
                 }
                 self.direction_weights();
@@ -147,7 +166,7 @@ where
                 };
                 (ds, along, constraint)
             } else {
-                if parameter_part < 1e-6 {
+                if parameter_part < NEGLIGIBLE_PART {
                     continue;
                 }
                 let step_p = ds / self.metric.parameter_dot(1.0, 1.0).sqrt() * d[n].signum();
@@ -175,7 +194,12 @@ where
                     let step = self.metric.norm(&dx, p - last.parameter);
                     return Some(self.accept(last, x, p, step, c, Some(&along)));
                 }
-                Err(_) => self.reject(before, last.parameter),
+                Err(_) => {
+                    self.reject(before, last.parameter);
+                    if self.finished() {
+                        return None;
+                    }
+                }
             }
         }
         None

@@ -1,26 +1,28 @@
-//! The polyalgorithm of [`Globalization::Polyalgorithm`]: full steps, the smoothing path,
-//! the non-monotone line search and the Newton homotopy, each from the initial guess, within
-//! one iteration budget (module docs of [`crate::newton`], *Polyalgorithm*).
+//! The attempts of the polyalgorithm (module docs of [`crate::polyalgorithm`]): full steps,
+//! the smoothing path, the non-monotone line search and the Newton homotopy, each from the
+//! initial guess, within one iteration budget.
 
 use crate::continuation::Predictor;
+use crate::iteration::kernel::{norm2, KernelRules, Stagnation, StepRule};
+use crate::iteration::{Attempt, Log, Outcome};
 use crate::linesearch::LineSearchOptions;
+use crate::newton::{Strategy, Termination, WorkCounters};
 use crate::{Factorize, GeneralizedJacobian, Residual};
 
-use super::kernel::{self, KernelRules, Stagnation};
-use super::{path, Attempt, Globalization, Log, NewtonSolver, Strategy, Termination, WorkCounters};
+use super::path::{self, PathShape};
+use super::{ends_run, Polyalgorithm, SmoothingOf};
 
-impl<J> NewtonSolver<J> {
-    /// Full steps, then the smoothing path, the line search and the Newton homotopy (see
-    /// [`Globalization::Polyalgorithm`]); the best iterate of all attempts is returned.
-    pub(super) fn polyalgorithm<P, S>(
+impl<J> Polyalgorithm<J> {
+    /// Full steps, then the smoothing path (when `smoothing` is given), the line search and
+    /// the Newton homotopy; the best iterate of all attempts is returned.
+    pub(super) fn run<P, S>(
         &mut self,
         problem: &mut P,
         linear: &mut S,
         x: &mut [f64],
-        settings: (usize, usize, LineSearchOptions),
-        counters: &mut WorkCounters,
-        log: &mut Log,
-    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+        smoothing: Option<SmoothingOf<P>>,
+        work: (&mut WorkCounters, &mut Log),
+    ) -> Outcome
     where
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
@@ -29,9 +31,9 @@ impl<J> NewtonSolver<J> {
         let mut start = std::mem::take(&mut self.start);
         start.clear();
         start.extend_from_slice(x);
-        let result = self.attempts(problem, linear, x, &start, settings, (counters, log));
+        let outcome = self.attempts(problem, linear, x, &start, smoothing, work);
         self.start = start;
-        result
+        outcome
     }
 
     /// The attempts of the polyalgorithm from `start` (= `x` on entry), with the run's
@@ -42,32 +44,33 @@ impl<J> NewtonSolver<J> {
         linear: &mut S,
         x: &mut [f64],
         start: &[f64],
-        (full_steps, memory, line_search): (usize, usize, LineSearchOptions),
+        smoothing: Option<SmoothingOf<P>>,
         (counters, log): (&mut WorkCounters, &mut Log),
-    ) -> (Termination, Strategy, Vec<Attempt>, f64)
+    ) -> Outcome
     where
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
+        let (full_steps, memory, line_search) = (
+            self.options.full_steps,
+            self.options.memory,
+            self.options.line_search,
+        );
         let max_iterations = self.options.max_iterations;
         let base = KernelRules {
-            globalization: Globalization::None,
             max_iterations: full_steps.min(max_iterations),
-            ..self.options.rules()
+            ..self.options.rules(StepRule::Full)
         };
         // With a smoothing to fall back on, the full steps stop as soon as they stagnate.
         let first = KernelRules {
-            stagnation: problem
-                .smoothing()
-                .is_some()
-                .then_some(FULL_STEP_STAGNATION),
+            stagnation: smoothing.is_some().then_some(FULL_STEP_STAGNATION),
             ..base
         };
         let mut attempts = Vec::new();
         let mut used = 0;
 
         // 1. Full steps.
-        let (termination, run) = self.phase(problem, linear, x, &first, counters, log);
+        let (termination, run) = self.work.phase(problem, linear, x, &first, counters, log);
         let tolerance = run.tolerance;
         attempts.push(Attempt::new(
             Strategy::FullSteps,
@@ -75,11 +78,17 @@ impl<J> NewtonSolver<J> {
             &termination,
         ));
         used += run.iterations;
-        if termination.converged() {
-            return (termination, Strategy::FullSteps, attempts, tolerance);
+        if termination.converged() || ends_run(&termination) {
+            return ended(termination, Strategy::FullSteps, attempts, tolerance);
         }
-        let mut best = Best::new(x, self.kernel.residual(), run.smallest);
-        let first_step = self.kernel.step_norms.first().copied().unwrap_or(f64::NAN);
+        let mut best = Best::new(x, self.work.kernel.residual(), run.smallest);
+        let first_step = self
+            .work
+            .kernel
+            .step_norms
+            .first()
+            .copied()
+            .unwrap_or(f64::NAN);
         let scale = path::state_scale(first_step, x.len());
         let mut last = termination;
         let mut strategy = Strategy::FullSteps;
@@ -102,17 +111,16 @@ impl<J> NewtonSolver<J> {
                 stagnation: (!reached && first.stagnation.is_some()).then_some(FINISH_STAGNATION),
                 ..base
             };
-            solver.phase(problem, linear, x, &rules, counters, log)
+            solver.work.phase(problem, linear, x, &rules, counters, log)
         };
 
         // 2. The smoothing path, when the problem offers a smoothing; a path that stops
         // after `SMOOTHING_PARTIAL` decades still hands its last point to Newton on `F`.
         // When it fails, it is followed once more with the points' tolerance shrinking with
         // `mu` (`SmoothingPath::with_tolerance_decay`).
-        if let Some(mu0) = problem
-            .smoothing()
-            .map(|s| SMOOTHING_START * s.smoothing_scale())
-            .filter(|mu| mu.is_finite() && *mu > 0.0)
+        if let Some((ops, mu0)) = smoothing
+            .map(|ops| (ops, SMOOTHING_START * (ops.scale)(problem)))
+            .filter(|(_, mu)| mu.is_finite() && *mu > 0.0)
         {
             for tolerance_rate in [0.0, TIGHTENED_TOLERANCE_RATE] {
                 let budget = max_iterations.saturating_sub(used);
@@ -121,6 +129,7 @@ impl<J> NewtonSolver<J> {
                 }
                 x.copy_from_slice(start);
                 let setup = SmoothingSetup {
+                    ops,
                     mu0,
                     state_scale: scale,
                     tolerance,
@@ -147,13 +156,21 @@ impl<J> NewtonSolver<J> {
                         outcome.iterations + run.iterations,
                         &termination,
                     ));
-                    if termination.converged() {
-                        return (termination, Strategy::Smoothing, attempts, tolerance);
+                    if termination.converged() || ends_run(&termination) {
+                        return ended(termination, Strategy::Smoothing, attempts, tolerance);
                     }
-                    best.update(x, self.kernel.residual(), run.smallest);
+                    best.update(x, self.work.kernel.residual(), run.smallest);
                     last = termination;
                 } else {
-                    attempts.push(Attempt::failed_path(Strategy::Smoothing, &outcome));
+                    attempts.push(failed_path(Strategy::Smoothing, &outcome));
+                    if let Some(error) = outcome.error {
+                        return ended(
+                            Termination::Evaluation(error),
+                            Strategy::Smoothing,
+                            attempts,
+                            tolerance,
+                        );
+                    }
                 }
             }
         }
@@ -164,24 +181,24 @@ impl<J> NewtonSolver<J> {
         if budget > 0 {
             x.copy_from_slice(start);
             let rules = KernelRules {
-                globalization: Globalization::NonMonotone {
+                step: StepRule::Backtracking {
                     memory,
                     line_search,
                 },
                 max_iterations: budget,
                 ..base
             };
-            let (termination, run) = self.phase(problem, linear, x, &rules, counters, log);
+            let (termination, run) = self.work.phase(problem, linear, x, &rules, counters, log);
             used += run.iterations;
             attempts.push(Attempt::new(
                 Strategy::LineSearch,
                 run.iterations,
                 &termination,
             ));
-            if termination.converged() {
-                return (termination, Strategy::LineSearch, attempts, tolerance);
+            if termination.converged() || ends_run(&termination) {
+                return ended(termination, Strategy::LineSearch, attempts, tolerance);
             }
-            best.update(x, self.kernel.residual(), run.smallest);
+            best.update(x, self.work.kernel.residual(), run.smallest);
             last = termination;
             strategy = Strategy::LineSearch;
         }
@@ -191,22 +208,19 @@ impl<J> NewtonSolver<J> {
         if budget > 0 {
             let mut f0 = vec![0.0; start.len()];
             counters.residual_evaluations += 1;
-            if problem.residual(start, &mut f0).is_ok() && f0.iter().all(|v| v.is_finite()) {
+            let evaluated = problem.residual(start, &mut f0);
+            if let Err(error) = evaluated.as_ref() {
+                if error.ends_run() {
+                    let termination = Termination::Evaluation(error.clone());
+                    return ended(termination, strategy, attempts, tolerance);
+                }
+            }
+            if evaluated.is_ok() && f0.iter().all(|v| v.is_finite()) {
                 x.copy_from_slice(start);
                 let plan = path::PathPlan {
-                    end: 1.0,
-                    // Ten steps over an affine path; small enough that a corner of the path (a
-                    // contact closing) is approached before it is overshot.
-                    steps: 10.0,
-                    growth: 1.0,
-                    // The state dominates the arclength: at a corner where t turns back
-                    // while the state moves on (a contact closing inside an overhang), the
-                    // arclength hyperplane still cuts the far piece.
-                    theta: 0.99,
-                    target_iterations: 5,
-                    predictor: Predictor::Secant,
+                    shape: NEWTON_HOMOTOPY,
                     state_scale: scale,
-                    accuracy: tolerance.max(path::PATH_ACCURACY * kernel::norm2(&f0)),
+                    accuracy: tolerance.max(path::PATH_ACCURACY * norm2(&f0)),
                     budget,
                 };
                 let mut homotopy = path::NewtonHomotopy::new(&mut *problem, &f0);
@@ -222,21 +236,29 @@ impl<J> NewtonSolver<J> {
                         outcome.iterations + run.iterations,
                         &termination,
                     ));
-                    if termination.converged() {
-                        return (termination, Strategy::Homotopy, attempts, tolerance);
+                    if termination.converged() || ends_run(&termination) {
+                        return ended(termination, Strategy::Homotopy, attempts, tolerance);
                     }
-                    best.update(x, self.kernel.residual(), run.smallest);
+                    best.update(x, self.work.kernel.residual(), run.smallest);
                     last = termination;
                 } else {
-                    attempts.push(Attempt::failed_path(Strategy::Homotopy, &outcome));
+                    attempts.push(failed_path(Strategy::Homotopy, &outcome));
+                    if let Some(error) = outcome.error {
+                        return ended(
+                            Termination::Evaluation(error),
+                            Strategy::Homotopy,
+                            attempts,
+                            tolerance,
+                        );
+                    }
                 }
             }
         }
 
         if best.restore(x) {
-            self.kernel.set_residual(&best.f);
+            self.work.kernel.set_residual(&best.f);
         }
-        (last, strategy, attempts, tolerance)
+        ended(last, strategy, attempts, tolerance)
     }
 
     /// The smoothing path from `x`: `F_mu0(x) = 0` solved by Newton with an Armijo search
@@ -246,21 +268,16 @@ impl<J> NewtonSolver<J> {
         problem: &mut P,
         linear: &mut S,
         x: &mut [f64],
-        setup: &SmoothingSetup,
+        setup: &SmoothingSetup<P>,
         counters: &mut WorkCounters,
     ) -> path::PathOutcome
     where
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
-        let mut failed = path::PathOutcome {
-            reached: false,
-            iterations: 0,
-            furthest: 0.0,
-            reason: None,
-            counters: WorkCounters::default(),
-        };
+        let mut failed = path::PathOutcome::default();
         let SmoothingSetup {
+            ops,
             mu0,
             state_scale,
             tolerance,
@@ -268,45 +285,40 @@ impl<J> NewtonSolver<J> {
             line_search,
             tolerance_rate,
         } = *setup;
-        let Some(mut smoothed) = path::SmoothingPath::new(&mut *problem, mu0) else {
-            return failed;
-        };
+        let mut smoothed = path::SmoothingPath::new(&mut *problem, ops, mu0);
         let mut f = vec![0.0; x.len()];
         counters.residual_evaluations += 1;
-        if smoothed.residual(x, &mut f).is_err() {
+        if let Err(error) = smoothed.residual(x, &mut f) {
             failed.reason = Some("the smoothed residual cannot be evaluated at the start".into());
+            failed.error = error.ends_run().then_some(error);
             return failed;
         }
-        let accuracy = tolerance.max(SMOOTHING_ACCURACY * kernel::norm2(&f));
+        let accuracy = tolerance.max(SMOOTHING_ACCURACY * norm2(&f));
         let mut smoothed = smoothed.with_tolerance_decay(tolerance_rate, tolerance / accuracy);
         let rules = KernelRules {
             absolute_tolerance: accuracy,
             relative_tolerance: 0.0,
-            globalization: Globalization::Armijo(line_search),
             max_iterations: budget.min(SMOOTHING_START_ITERATIONS),
-            ..self.options.rules()
+            ..self.options.rules(StepRule::Backtracking {
+                memory: 1,
+                line_search,
+            })
         };
         let mut scratch = Log::default();
         // The smoothed iterates are not iterates of F: their histories are not reported.
         let (termination, run) =
-            self.phase(&mut smoothed, linear, x, &rules, counters, &mut scratch);
+            self.work
+                .phase(&mut smoothed, linear, x, &rules, counters, &mut scratch);
         failed.iterations = run.iterations;
         if !termination.converged() {
             failed.reason = Some(format!("the smoothed problem at the start: {termination}"));
+            if let Termination::Evaluation(error) = termination {
+                failed.error = error.ends_run().then_some(error);
+            }
             return failed;
         }
         let plan = path::PathPlan {
-            end: SMOOTHING_DECADES,
-            steps: SMOOTHING_DECADES,
-            // A smooth path, followed along its tangent (the corrector's factorization gives
-            // it free); steps of one decade at first, at most two; state and parameter
-            // weigh alike. Measured on the public grid: the tangent predictor and the
-            // cap of two decades save a fifth of the corrector iterations against the
-            // secant and a cap of four (fewer rejected steps where contacts form).
-            growth: 2.0,
-            theta: 0.5,
-            target_iterations: 3,
-            predictor: Predictor::Tangent,
+            shape: SMOOTHING_PATH,
             state_scale,
             accuracy,
             budget: budget.saturating_sub(run.iterations),
@@ -318,10 +330,70 @@ impl<J> NewtonSolver<J> {
     }
 }
 
-/// What the smoothing path starts from: `mu0`, the state scale of the path, the run's
-/// tolerance, the iterations left and the line search of the smoothed start.
-#[derive(Clone, Copy, Debug)]
-struct SmoothingSetup {
+/// The outcome of the attempts.
+fn ended(
+    termination: Termination,
+    strategy: Strategy,
+    attempts: Vec<Attempt>,
+    tolerance: f64,
+) -> Outcome {
+    Outcome {
+        termination,
+        strategy,
+        attempts,
+        tolerance,
+    }
+}
+
+/// The attempt of a path that stopped short of its end.
+fn failed_path(strategy: Strategy, path: &path::PathOutcome) -> Attempt {
+    Attempt {
+        strategy,
+        iterations: path.iterations,
+        converged: false,
+        outcome: format!(
+            "the path stopped at {:.6} of its length: {}",
+            path.furthest,
+            path.reason.as_deref().unwrap_or("no reason given")
+        ),
+    }
+}
+
+/// The Newton homotopy of attempt 4, from `t = 0` to `t = 1`.
+const NEWTON_HOMOTOPY: PathShape = PathShape {
+    end: 1.0,
+    // Ten steps over an affine path; small enough that a corner of the path (a contact
+    // closing) is approached before it is overshot.
+    steps: 10.0,
+    growth: 1.0,
+    // The state dominates the arclength: at a corner where t turns back while the state
+    // moves on (a contact closing inside an overhang), the arclength hyperplane still cuts
+    // the far piece.
+    theta: 0.99,
+    target_iterations: 5,
+    predictor: Predictor::Secant,
+};
+
+/// The smoothing path of attempt 2, over [`SMOOTHING_DECADES`] decades of `mu`: a smooth
+/// path, followed along its tangent (the corrector's factorization gives it free); steps of
+/// one decade at first, at most two; state and parameter weigh alike. Measured on the public
+/// grid: the tangent predictor and the cap of two decades save a fifth of the corrector
+/// iterations against the secant and a cap of four (fewer rejected steps where contacts
+/// form).
+const SMOOTHING_PATH: PathShape = PathShape {
+    end: SMOOTHING_DECADES,
+    steps: SMOOTHING_DECADES,
+    growth: 2.0,
+    theta: 0.5,
+    target_iterations: 3,
+    predictor: Predictor::Tangent,
+};
+
+/// What the smoothing path starts from: the problem's smoothing, `mu0`, the state scale of
+/// the path, the run's tolerance, the iterations left and the line search of the smoothed
+/// start.
+struct SmoothingSetup<P: ?Sized> {
+    ops: SmoothingOf<P>,
     mu0: f64,
     state_scale: f64,
     tolerance: f64,

@@ -20,7 +20,7 @@
 //!
 //! # The smoothing path
 //!
-//! For a problem with a [`Smoothing`], `F_mu(x) = 0` followed from `mu_0` down to
+//! For a problem with a [`Smoothing`](crate::Smoothing), `F_mu(x) = 0` followed from `mu_0` down to
 //! `mu_0 10^(-decades)` in the parameter `p = log10(mu_0 / mu)` (so
 //! `dF/dp = -ln(10) mu dF_mu/dmu`). The path is smooth (every kink of `F` is rounded off over
 //! a width `mu`), so its steps are long; near its end the iterate lies within `O(mu)` of a
@@ -31,12 +31,12 @@
 use crate::continuation::{
     Continuation, ContinuationOptions, ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
+use crate::newton::WorkCounters;
 use crate::{
     EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
-    Smoothing,
 };
 
-use super::WorkCounters;
+use super::SmoothingOf;
 
 /// `H(x, t) = F(x) - (1 - t) F(x_0)` around a problem `F`.
 pub(crate) struct NewtonHomotopy<'a, P: ?Sized> {
@@ -89,6 +89,7 @@ impl<P: Residual + ?Sized> ParameterDependent for NewtonHomotopy<'_, P> {
         &mut self,
         _x: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         out.copy_from_slice(&self.start_residual);
         Ok(())
@@ -110,6 +111,7 @@ impl<'a, P: Residual + ?Sized> NewtonHomotopy<'a, P> {
 /// sets the problem's smoothing back to 0.
 pub(crate) struct SmoothingPath<'a, P: Residual + ?Sized> {
     problem: &'a mut P,
+    smoothing: SmoothingOf<P>,
     mu0: f64,
     p: f64,
     /// Decades of the tolerance per decade of `mu` ([`ParameterDependent::tolerance_scale`]
@@ -121,17 +123,17 @@ pub(crate) struct SmoothingPath<'a, P: Residual + ?Sized> {
 }
 
 impl<'a, P: Residual + ?Sized> SmoothingPath<'a, P> {
-    /// The path of `problem` at `p = 0` (`mu = mu0`); `None` when the problem offers no
-    /// smoothing.
-    pub(crate) fn new(problem: &'a mut P, mu0: f64) -> Option<Self> {
-        problem.smoothing()?.set_smoothing(mu0);
-        Some(Self {
+    /// The path of `problem` with its `smoothing` at `p = 0` (`mu = mu0`).
+    pub(crate) fn new(problem: &'a mut P, smoothing: SmoothingOf<P>, mu0: f64) -> Self {
+        (smoothing.set)(problem, mu0);
+        Self {
             problem,
+            smoothing,
             mu0,
             p: 0.0,
             tolerance_rate: 0.0,
             smallest_scale: 0.0,
-        })
+        }
     }
 
     /// Points at `mu` are corrected to the path's accuracy times `(mu / mu_0)^rate`, but
@@ -145,17 +147,11 @@ impl<'a, P: Residual + ?Sized> SmoothingPath<'a, P> {
     fn mu(&self) -> f64 {
         self.mu0 * 10f64.powf(-self.p)
     }
-
-    fn smoothing(&mut self) -> &mut dyn Smoothing {
-        self.problem
-            .smoothing()
-            .expect("a SmoothingPath is only built for a problem with a smoothing")
-    }
 }
 
 impl<P: Residual + ?Sized> Drop for SmoothingPath<'_, P> {
     fn drop(&mut self) {
-        self.smoothing().set_smoothing(0.0);
+        (self.smoothing.set)(self.problem, 0.0);
     }
 }
 
@@ -193,7 +189,7 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
     fn set_parameter(&mut self, p: f64) {
         self.p = p;
         let mu = self.mu();
-        self.smoothing().set_smoothing(mu);
+        (self.smoothing.set)(self.problem, mu);
     }
 
     /// `(mu / mu_0)^rate = 10^(-rate p)`: with rate 1, points are corrected to
@@ -211,9 +207,10 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
         &mut self,
         x: &[f64],
         out: &mut [f64],
+        _scratch: &mut [f64],
     ) -> Result<(), EvaluationError> {
         let factor = -std::f64::consts::LN_10 * self.mu();
-        self.smoothing().residual_smoothing_derivative(x, out)?;
+        (self.smoothing.derivative)(self.problem, x, out)?;
         for o in out.iter_mut() {
             *o *= factor;
         }
@@ -222,7 +219,7 @@ impl<P: Residual + ?Sized> ParameterDependent for SmoothingPath<'_, P> {
 }
 
 /// How a path-following attempt ended.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub(crate) struct PathOutcome {
     /// The end of the path was reached (`x` is then on the path there, to the accuracy).
     pub reached: bool,
@@ -232,52 +229,66 @@ pub(crate) struct PathOutcome {
     pub furthest: f64,
     /// Why the path ended when it did not reach its end.
     pub reason: Option<String>,
+    /// The problem's own error, when it ended the path ([`EvaluationError::Problem`]).
+    pub error: Option<EvaluationError>,
     /// Work done.
     pub counters: WorkCounters,
 }
 
-/// Where a path goes and how: from parameter 0 to `end`, first steps of `1 / steps` of the
-/// path's length, growing up to `growth` times that; the state lengths measured in
-/// `state_scale` with the weight `theta`; points to `accuracy` (the corrector aims at
-/// `target_iterations` and rejects a step after one more) from `predictor`; at most `budget`
-/// corrector iterations.
+/// How a path is followed: from parameter 0 to `end`, first steps of `1 / steps` of the
+/// path's length, growing up to `growth` times that; the state weighted by `theta` in the
+/// arclength; the corrector aims at `target_iterations` (and rejects a step after one more)
+/// from `predictor`.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct PathPlan {
+pub(crate) struct PathShape {
     pub end: f64,
     pub steps: f64,
     pub growth: f64,
     pub theta: f64,
     pub target_iterations: usize,
     pub predictor: Predictor,
+}
+
+/// A path of `shape` with the state lengths measured in `state_scale`, points corrected to
+/// `accuracy`, at most `budget` corrector iterations.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathPlan {
+    pub shape: PathShape,
     pub state_scale: f64,
     pub accuracy: f64,
     pub budget: usize,
 }
 
+/// The smallest step of a path, relative to its first.
+const MIN_STEP_FRACTION: f64 = 1e-4;
+/// Failed attempts in a row after which a path gives up (before a restart).
+const MAX_CONSECUTIVE_FAILURES: usize = 8;
+
 /// Continuation settings of a path (lengths in the θ-norm of [`crate::continuation`]: the
 /// parameter measured in units of the whole path, the state in `plan.state_scale`).
 fn path_options(n: usize, plan: &PathPlan) -> ContinuationOptions {
-    let step = 1.0 / plan.steps;
+    let shape = &plan.shape;
+    let step = 1.0 / shape.steps;
     ContinuationOptions {
         // Small enough that a corner of the path (a contact closing) is approached before
         // it is overshot.
         initial_step: step,
-        max_step: step * plan.growth,
-        min_step: 1e-4 * step,
-        max_consecutive_failures: 8,
-        max_corrector_iterations: plan.target_iterations + 1,
-        target_iterations: plan.target_iterations,
-        theta: plan.theta,
+        max_step: step * shape.growth,
+        min_step: MIN_STEP_FRACTION * step,
+        max_consecutive_failures: MAX_CONSECUTIVE_FAILURES,
+        max_corrector_iterations: shape.target_iterations + 1,
+        target_iterations: shape.target_iterations,
+        theta: shape.theta,
         corrector_tolerance: plan.accuracy,
-        parameter_min: -plan.end,
-        parameter_max: plan.end,
-        parameter_scale: plan.end,
+        parameter_min: -shape.end,
+        parameter_max: shape.end,
+        parameter_scale: shape.end,
         state_scale: Some(vec![plan.state_scale; n]),
         direction: Direction::Increasing,
         refine_folds: false,
         restarts: Some(RestartPolicy::default()),
         max_total_corrector_iterations: Some(plan.budget),
-        predictor: plan.predictor,
+        predictor: shape.predictor,
         ..ContinuationOptions::default()
     }
 }
@@ -295,7 +306,7 @@ pub(crate) fn state_scale(first_step_norm: f64, n: usize) -> f64 {
     }
 }
 
-/// Follows `homotopy` from `(x, 0)` to the parameter `plan.end` within `plan.budget`
+/// Follows `homotopy` from `(x, 0)` to the parameter `plan.shape.end` within `plan.budget`
 /// corrector iterations; on success `x` is the end of the path.
 pub(crate) fn follow<H, S>(
     homotopy: &mut H,
@@ -309,13 +320,7 @@ where
 {
     let n = x.len();
     let options = path_options(n, plan);
-    let mut outcome = PathOutcome {
-        reached: false,
-        iterations: 0,
-        furthest: 0.0,
-        reason: None,
-        counters: WorkCounters::default(),
-    };
+    let mut outcome = PathOutcome::default();
     if plan.budget == 0 {
         outcome.reason = Some("no iterations left".into());
         return outcome;
@@ -329,27 +334,23 @@ where
         }
     };
     let mut last = 0.0;
-    for item in continuation.by_ref() {
-        match item {
-            Ok(point) => {
-                outcome.furthest = outcome.furthest.max(point.parameter);
-                last = point.parameter;
-                x.copy_from_slice(&point.state);
-            }
-            Err(e) => {
-                outcome.reason = Some(e.to_string());
-                break;
-            }
-        }
+    for point in continuation.by_ref() {
+        outcome.furthest = outcome.furthest.max(point.parameter);
+        last = point.parameter;
+        x.copy_from_slice(&point.state);
     }
     let counters = continuation.counters();
     outcome.iterations = counters.corrector_iterations as usize;
     outcome.counters = counters.work;
     match continuation.termination() {
         Some(ContinuationTermination::ReachedBound { parameter, bound })
-            if *bound == plan.end && *parameter == plan.end =>
+            if *bound == plan.shape.end && *parameter == plan.shape.end =>
         {
             outcome.reached = true;
+        }
+        Some(ContinuationTermination::ProblemFailed { error, .. }) => {
+            outcome.reason = Some(error.to_string());
+            outcome.error = Some(error.clone());
         }
         Some(t) if outcome.reason.is_none() => outcome.reason = Some(t.to_string()),
         _ => {}

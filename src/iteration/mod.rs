@@ -1,0 +1,345 @@
+//! The layer under the drivers: the one Newton iteration of the crate ([`kernel`]), the
+//! work counters every driver keeps, and the report a Newton-type run returns.
+//!
+//! [`crate::newton`] (plain globalized Newton), [`crate::continuation`] (its corrector) and
+//! [`crate::polyalgorithm`] (strategies from a poor guess) build on it; nothing here knows
+//! about them. The public types are re-exported by [`crate::newton`].
+
+pub(crate) mod kernel;
+
+use std::iter::Sum;
+use std::ops::AddAssign;
+
+use crate::linalg::LinearSolveError;
+use crate::{EvaluationError, ProblemCounters};
+
+/// `|F|` below which a run has ended on an exact root (the active set was found and the
+/// remaining system was linear): no convergence order is estimated from such a norm.
+pub const EXACT_RESIDUAL: f64 = 1e-300;
+
+/// Why the iteration stopped.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Termination {
+    /// `|F| <= max(absolute, relative |F(x_0)|, residual_floor)`.
+    Converged,
+    /// The step stalled with `|F|` within 100 times the residual floor of
+    /// [`NewtonOptions::residual_floor`](crate::newton::NewtonOptions::residual_floor):
+    /// converged as far as floating point allows.
+    ConvergedAtRoundoff {
+        /// `100 residual_floor`.
+        floor: f64,
+    },
+    /// `max_iterations` reached without convergence.
+    MaxIterations,
+    /// The full steps of the [polyalgorithm](crate::polyalgorithm) made no progress: `|F|`
+    /// fell by less than a factor 10 over their last iterations.
+    Stagnated,
+    /// The accepted step `alpha |d|` fell below `step_tolerance (1 + |x|)`.
+    Stalled,
+    /// No step length `>= min_step` gave sufficient decrease.
+    LineSearchFailed,
+    /// The Jacobian could not be factored, or the solve failed (singular, out of memory).
+    LinearSolve(LinearSolveError),
+    /// `F` or the Newton direction had a NaN or infinite component.
+    NonFinite,
+    /// The problem could not be evaluated: at the initial guess, at a full step without
+    /// line search, for its Jacobian, or anywhere for its own error
+    /// ([`EvaluationError::Problem`], which ends the run at once).
+    Evaluation(EvaluationError),
+}
+
+/// A way of reaching a root, as a report names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Strategy {
+    /// Newton with full steps (`newton`).
+    FullSteps,
+    /// Newton with a line search on the merit (`line-search`).
+    LineSearch,
+    /// The Newton homotopy followed to `t = 1`, then Newton (`newton-homotopy`).
+    Homotopy,
+    /// The smoothing path followed to a small smoothing, then Newton (`smoothing`).
+    Smoothing,
+}
+
+impl Strategy {
+    /// The name used in reports: `newton`, `line-search`, `newton-homotopy`, `smoothing`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::FullSteps => "newton",
+            Self::LineSearch => "line-search",
+            Self::Homotopy => "newton-homotopy",
+            Self::Smoothing => "smoothing",
+        }
+    }
+}
+
+impl std::fmt::Display for Strategy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One strategy tried by a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attempt {
+    /// The strategy.
+    pub strategy: Strategy,
+    /// Its iterations (for the homotopy: corrector iterations along the path, failed
+    /// steps included, plus the Newton iterations at `t = 1`).
+    pub iterations: usize,
+    /// Whether it converged.
+    pub converged: bool,
+    /// How it ended, in words.
+    pub outcome: String,
+}
+
+impl Attempt {
+    /// The attempt of `strategy` that ended with `termination` after `iterations`.
+    pub(crate) fn new(strategy: Strategy, iterations: usize, termination: &Termination) -> Self {
+        Self {
+            strategy,
+            iterations,
+            converged: termination.converged(),
+            outcome: termination.to_string(),
+        }
+    }
+}
+
+impl Termination {
+    /// Whether the run converged ([`Termination::Converged`] or
+    /// [`Termination::ConvergedAtRoundoff`]).
+    pub fn converged(&self) -> bool {
+        matches!(self, Self::Converged | Self::ConvergedAtRoundoff { .. })
+    }
+}
+
+/// Short names: `converged` (`converged (stalled at the round-off floor ...)`),
+/// `max-iterations`, `stagnated`, `stalled`, `line-search-failed`, `singular-jacobian: ...`
+/// (or `out-of-memory: ...` and the like for other linear-solver failures), `non-finite`,
+/// `outside-domain: ...` (or `problem-error: ...` for the problem's own error).
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Converged => write!(f, "converged"),
+            Self::ConvergedAtRoundoff { floor } => write!(
+                f,
+                "converged (stalled at the round-off floor {floor:.1e} of this model)"
+            ),
+            Self::MaxIterations => write!(f, "max-iterations"),
+            Self::Stagnated => write!(f, "stagnated"),
+            Self::Stalled => write!(f, "stalled"),
+            Self::LineSearchFailed => write!(f, "line-search-failed"),
+            Self::LinearSolve(e) => write!(f, "{}: {e}", e.kind()),
+            Self::NonFinite => write!(f, "non-finite"),
+            Self::Evaluation(e) => write!(f, "{}: {e}", e.kind()),
+        }
+    }
+}
+
+/// Work done by a driver (a Newton run, the polyalgorithm, a continuation, a homotopy, a
+/// natural sweep): the one counter type of the crate's drivers, summed over runs by `+=`
+/// or [`Sum`].
+///
+/// ```
+/// use semismooth::newton::WorkCounters;
+/// let run = WorkCounters { residual_evaluations: 3, linear_solves: 2, ..Default::default() };
+/// let total: WorkCounters = [run, run].into_iter().sum();
+/// assert_eq!((total.residual_evaluations, total.linear_solves), (6, 4));
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WorkCounters {
+    /// Calls to `Residual::residual` (including line-search trials).
+    pub residual_evaluations: u64,
+    /// Calls to `GeneralizedJacobian::jacobian`.
+    pub jacobian_evaluations: u64,
+    /// Calls to `Factorize::factor` (successful or not).
+    pub factorizations: u64,
+    /// Calls to `LinearSolve::solve_in_place`.
+    pub linear_solves: u64,
+    /// Rejected line-search trials.
+    pub line_search_backtracks: u64,
+    /// The problem's own counters over the solve ([`crate::Residual::problem_counters`]).
+    pub problem: ProblemCounters,
+}
+
+impl AddAssign for WorkCounters {
+    fn add_assign(&mut self, rhs: Self) {
+        self.residual_evaluations += rhs.residual_evaluations;
+        self.jacobian_evaluations += rhs.jacobian_evaluations;
+        self.factorizations += rhs.factorizations;
+        self.linear_solves += rhs.linear_solves;
+        self.line_search_backtracks += rhs.line_search_backtracks;
+        self.problem += rhs.problem;
+    }
+}
+
+impl Sum for WorkCounters {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |mut total, c| {
+            total += c;
+            total
+        })
+    }
+}
+
+/// What a Newton run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewtonReport {
+    /// Why it stopped.
+    pub termination: Termination,
+    /// The strategy of the last attempt (the one that converged, when one did).
+    pub strategy: Strategy,
+    /// Every strategy tried, in order (one entry for a plain Newton run, one per attempt of
+    /// the [polyalgorithm](crate::polyalgorithm)).
+    pub attempts: Vec<Attempt>,
+    /// Newton iterations over all attempts (corrector iterations of a homotopy included).
+    pub iterations: usize,
+    /// The tolerance the run was judged against: `max(absolute, relative |F(x_0)|,
+    /// residual_floor)`.
+    pub effective_tolerance: f64,
+    /// `|F|_2` at the initial guess and after each accepted step of the attempts that
+    /// iterate on `F` (`iterations + 1` values with a single attempt; a homotopy's corrector
+    /// iterates on the homotopy, and its iterations are not listed).
+    pub residual_norms: Vec<f64>,
+    /// Accepted step lengths `alpha_k`, as `residual_norms`.
+    pub step_lengths: Vec<f64>,
+    /// Accepted step norms `alpha_k |d_k|_2`, as `residual_norms`.
+    pub step_norms: Vec<f64>,
+    /// Estimated order `q` from the last three residual norms,
+    /// `log(r_{k+1}/r_k) / log(r_k/r_{k-1})` (also for runs that did not converge: a
+    /// stalled or capped run shows its rate); `None` with fewer than three norms, when
+    /// one of them is below [`EXACT_RESIDUAL`] (exact termination), or when the estimate
+    /// is undefined.
+    pub observed_order: Option<f64>,
+    /// Work counters.
+    pub counters: WorkCounters,
+}
+
+impl NewtonReport {
+    /// Whether the run converged (see [`Termination::converged`]).
+    pub fn converged(&self) -> bool {
+        self.termination.converged()
+    }
+
+    /// `|F|_2` at the returned `x`, the best accepted iterate (the smallest entry of
+    /// [`residual_norms`](Self::residual_norms)); `NaN` only if `F(x_0)` was not finite.
+    pub fn residual_norm(&self) -> f64 {
+        self.residual_norms
+            .iter()
+            .copied()
+            .reduce(f64::min)
+            .unwrap_or(f64::NAN)
+    }
+}
+
+/// Why the solver could not run (a run that ran and stopped is an `Ok` report, see
+/// [`NewtonReport::termination`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum NewtonError {
+    /// An option is outside its allowed range.
+    #[error("invalid Newton option {name} = {value}: allowed {allowed}")]
+    InvalidOption {
+        /// Field name (dotted for nested fields).
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+        /// Allowed range.
+        allowed: &'static str,
+    },
+    /// `x` does not have the problem's dimension.
+    #[error("initial guess has length {found}, the problem has dimension {expected}")]
+    DimensionMismatch {
+        /// `problem.dim()`.
+        expected: usize,
+        /// `x.len()`.
+        found: usize,
+    },
+}
+
+/// `log(r3/r2) / log(r2/r1)` from the last three norms, see
+/// [`NewtonReport::observed_order`].
+fn observed_order(norms: &[f64]) -> Option<f64> {
+    let [r1, r2, r3] = norms.get(norms.len().checked_sub(3)?..)? else {
+        return None;
+    };
+    if [r1, r2, r3]
+        .iter()
+        .any(|r| !(r.is_finite() && **r >= EXACT_RESIDUAL))
+    {
+        return None;
+    }
+    let q = (r3 / r2).ln() / (r2 / r1).ln();
+    q.is_finite().then_some(q)
+}
+
+/// Histories of the attempts of a run that iterate on `F`.
+#[derive(Debug, Default)]
+pub(crate) struct Log {
+    pub residual_norms: Vec<f64>,
+    pub step_lengths: Vec<f64>,
+    pub step_norms: Vec<f64>,
+}
+
+impl Log {
+    /// Appends the histories of the kernel's last run.
+    pub fn extend(&mut self, kernel: &kernel::Kernel) {
+        self.residual_norms
+            .extend_from_slice(&kernel.residual_norms);
+        self.step_lengths.extend_from_slice(&kernel.step_lengths);
+        self.step_norms.extend_from_slice(&kernel.step_norms);
+    }
+}
+
+/// How a run on `F` ended, before its report is written.
+pub(crate) struct Outcome {
+    pub termination: Termination,
+    /// The strategy of the last attempt.
+    pub strategy: Strategy,
+    pub attempts: Vec<Attempt>,
+    /// `max(absolute, relative |F(x_0)|, residual_floor)`.
+    pub tolerance: f64,
+}
+
+impl NewtonReport {
+    /// The report of a run that ended with `outcome`, its histories and its counters.
+    pub(crate) fn new(outcome: Outcome, log: Log, counters: WorkCounters) -> Self {
+        Self {
+            observed_order: observed_order(&log.residual_norms),
+            termination: outcome.termination,
+            strategy: outcome.strategy,
+            iterations: outcome.attempts.iter().map(|a| a.iterations).sum(),
+            attempts: outcome.attempts,
+            effective_tolerance: outcome.tolerance,
+            residual_norms: log.residual_norms,
+            step_lengths: log.step_lengths,
+            step_norms: log.step_norms,
+            counters,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::kernel::norm2;
+    use super::*;
+
+    #[test]
+    fn observed_order_from_last_three_norms() {
+        let q = observed_order(&[1.0, 1e-2, 1e-4, 1e-8]).unwrap();
+        assert!((q - 2.0).abs() < 1e-12);
+        assert_eq!(observed_order(&[1.0, 1e-2]), None);
+        assert_eq!(observed_order(&[1.0, 1e-2, 0.0]), None);
+        assert_eq!(observed_order(&[1.0, 1.0, 0.5]), None);
+    }
+
+    #[test]
+    fn norm_does_not_overflow_and_flags_non_finite() {
+        assert!((norm2(&[3e200, 4e200]) / 5e200 - 1.0).abs() < 1e-15);
+        assert_eq!(norm2(&[0.0, 0.0]), 0.0);
+        assert_eq!(norm2(&[1.0, f64::NAN]), f64::INFINITY);
+        assert_eq!(norm2(&[f64::INFINITY]), f64::INFINITY);
+    }
+}
