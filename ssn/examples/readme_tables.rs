@@ -51,7 +51,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mass: MassModel::Modified,
             ..RodSpec::canonical()
         })?;
-        let study = accuracy_cost(&rod.structure, &SolverSettings::with_harmonics(20), None)?;
+        let settings = SolverSettings::with_harmonics(20);
+        let study = accuracy_cost(&rod.structure, rod.omega(), &settings, None)?;
         print!("{}", tables::cheapest_settings(&study).markdown());
     }
     if wanted("sweeps") {
