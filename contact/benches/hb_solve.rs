@@ -63,7 +63,8 @@ fn solve_hb<S: Factorize<HbJacobian>>(
     mut solver: S,
 ) -> (SsnHb, Vec<f64>) {
     let options = newton_options(&SolverSettings::with_harmonics(h));
-    let mut problem = SsnHb::new(&rod.model, &hb_options(h, c)).expect("valid HB problem");
+    let mut problem =
+        SsnHb::new(&rod.model, rod.omega(), &hb_options(h, c)).expect("valid HB problem");
     let mut x = vec![0.0; problem.dim()];
     let report = options
         .solve(&mut problem, &mut solver, &mut x, Some(SmoothingOf::new()))
@@ -210,7 +211,7 @@ fn first_accurate(
     accuracy: f64,
 ) -> SolverSettings {
     for s in candidates {
-        if let Ok(sol) = semismooth_contact::solve(rod, s, None) {
+        if let Ok(sol) = semismooth_contact::solve(rod, rod.omega(), s, None) {
             let err = (sol.stats.min - reference).abs() / reference.abs();
             if sol.converged() && err <= accuracy {
                 return s.clone();
@@ -226,6 +227,7 @@ fn march_vs_hb(c: &mut Criterion) {
     let base = SolverSettings::with_harmonics(H);
     let reference = semismooth_contact::solve(
         &rod,
+        rod.omega(),
         &SolverSettings {
             method: Method::March,
             steps_per_period: 8000,
@@ -261,7 +263,7 @@ fn march_vs_hb(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 black_box(
-                    semismooth_contact::solve(&rod, settings, None)
+                    semismooth_contact::solve(&rod, rod.omega(), settings, None)
                         .expect("runs")
                         .stats
                         .min,

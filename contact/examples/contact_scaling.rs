@@ -75,20 +75,20 @@ fn run_one(args: &Args, count: usize) {
         mistuning: SHIPPED_MISTUNING,
     };
     let stops = (0..count).map(|i| i * args.blades / count).collect();
-    let structure = disk
-        .structure(&DiskLoading {
-            stops,
-            gap: 1.0,
-            amplitude: 0.02,
-            zeta: 0.01,
-            omega_ratio: 1.0,
-        })
-        .expect("valid disk");
+    let loading = DiskLoading {
+        stops,
+        gap: 1.0,
+        amplitude: 0.02,
+        zeta: 0.01,
+        omega_ratio: 1.0,
+    };
+    let structure = disk.structure(&loading).expect("valid disk");
+    let omega = loading.omega(structure.omega_1);
     let settings = SolverSettings {
         linear_solver: choice,
         ..SolverSettings::with_harmonics(args.harmonics)
     };
-    let solution = solve(&structure, &settings, None).expect("a run");
+    let solution = solve(&structure, omega, &settings, None).expect("a run");
     if std::env::var_os("SCALING_HISTORY").is_some() {
         eprintln!(
             "{:?} {:?} {:?}",
@@ -101,7 +101,7 @@ fn run_one(args: &Args, count: usize) {
         time_samples: Some(settings.time_samples),
         c: settings.c,
     };
-    let mut problem = SsnHb::new(&structure.model, &options).expect("valid problem");
+    let mut problem = SsnHb::new(&structure.model, omega, &options).expect("valid problem");
     let x = &solution.state;
     let mut rhs = vec![0.0; problem.dim()];
     let mut jac = problem.new_jacobian();

@@ -78,7 +78,7 @@ fn main() {
             time_samples: n,
             ..PeriodicLcpOptions::default()
         };
-        let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
+        let lcp = PeriodicLcp::new(&rod.model, rod.omega(), options).unwrap();
         timed(
             &format!("canonical rod, {mass:?} mass"),
             lcp.matrix(),

@@ -79,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut unknowns = 0;
         for _ in 0..repeats {
             let start = Instant::now();
-            let mut problem = SsnHb::new(&rod.model, &hb)?;
+            let mut problem = SsnHb::new(&rod.model, rod.omega(), &hb)?;
             let mut x = vec![0.0; problem.dim()];
             let mut solver = StructuredHbSolver::new();
             let report =

@@ -9,36 +9,27 @@
 //!   (so that the LU can pivot on it), with the position of every stored entry of every
 //!   source in it, computed once; a combination `sum_i c_i A_i` is then a fill of the value
 //!   array in source order (`O(nnz)`, no search, no allocation).
-//! - [`DynamicStiffness`]: a fill-reducing column ordering (COLAMD) of that pattern computed
-//!   once, then a numeric sparse LU with partial pivoting (faer's simplicial LU) per
-//!   coefficient pair into one of a fixed number of slots whose storage is reused, and
-//!   solves with a scratch buffer sized once.
+//! - [`DynamicStiffness`]: the core's complex sparse LU ([`SparseLu<c64>`]: a fill-reducing
+//!   column ordering of that pattern computed once, then a numeric LU with partial pivoting
+//!   per coefficient pair into one of a fixed number of slots whose storage is reused, and
+//!   solves with scratch memory sized once).
 //!
 //! **Singularity.** A factorization is rejected ([`LinearSolveError::Singular`], carrying
-//! the original column of the pivot, the pivot and the largest pivot) when faer finds no
-//! pivot for a column (structural singularity) or a pivot of `U` is zero or not finite:
-//! the LU broke down and its solves would be infinite or NaN. A merely small pivot (an
-//! undamped resonance) is accepted: the callers' condensed systems have their own,
-//! relative, pivot checks, and the contact may keep the whole Jacobian regular where the
-//! linear part alone is singular.
+//! the original column of the pivot, the pivot and the largest pivot, both squared moduli)
+//! when faer finds no pivot for a column (structural singularity) or a pivot of `U` is zero
+//! or not finite ([`PivotRule::Breakdown`]): the LU broke down and its solves would be
+//! infinite or NaN. A merely small pivot (an undamped resonance) is accepted: the callers'
+//! condensed systems have their own, relative, pivot checks, and the contact may keep the
+//! whole Jacobian regular where the linear part alone is singular.
 
 use std::ops::{AddAssign, Mul};
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::perm::Perm;
-use faer::sparse::linalg::colamd;
-use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
-use faer::sparse::linalg::LuError;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
-use faer::{c64, Conj, MatMut, Par};
+use faer::{c64, MatMut};
 use num_traits::Zero;
-use semismooth::linalg::{check_pivots, diagonal_entry, LinearSolveError};
+use semismooth::linalg::{LinearSolveError, PivotRule, SparseLu};
 
 use crate::model::SparseMatrix;
-
-/// Relative pivot threshold of [`DynamicStiffness`]: only a zero (or non-finite) pivot
-/// makes a dynamic stiffness singular (module documentation).
-const PIVOT_THRESHOLD: f64 = 0.0;
 
 /// The union sparsity pattern of `N x N` source matrices and the diagonal, with the
 /// position in it of every stored entry of every source.
@@ -129,43 +120,23 @@ impl UnionPattern {
     }
 }
 
-/// The row permutation of a slot: validated once per factorization (a checked
-/// [`Perm`], so that solves need not check it again), or its storage while unfactored.
-#[derive(Debug)]
-enum RowPerm {
-    Factored(Perm<usize>),
-    Unfactored(Box<[usize]>, Box<[usize]>),
-}
-
-/// One numeric LU of [`DynamicStiffness`]: row permutation and factors.
-#[derive(Debug)]
-struct Slot {
-    row_perm: RowPerm,
-    lu: SimplicialLu<usize, c64>,
-}
-
 /// `Z = K + a M + b D` (complex `a`, `b`) over the union pattern of `K`, `M`, `D`: column
 /// ordering once, numeric LU per coefficient pair into one of `slots` reusable slots
 /// (module documentation).
 pub(crate) struct DynamicStiffness {
-    n: usize,
     pattern: UnionPattern,
     /// `[K, M, D]` (`D` absent without damping).
     sources: Vec<SparseMatrix>,
     values: Vec<c64>,
-    col_perm: Perm<usize>,
-    slots: Vec<Slot>,
-    mem: MemBuffer,
-    /// Right-hand sides solved at once with `mem` (wider blocks are split).
-    max_columns: usize,
+    lu: SparseLu<c64>,
 }
 
 impl std::fmt::Debug for DynamicStiffness {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DynamicStiffness")
-            .field("n", &self.n)
+            .field("n", &self.lu.dim())
             .field("nnz", &self.pattern.nnz())
-            .field("slots", &self.slots.len())
+            .field("slots", &self.lu.slots())
             .finish_non_exhaustive()
     }
 }
@@ -186,41 +157,16 @@ impl DynamicStiffness {
         sources.extend(damping.cloned());
         let refs: Vec<&SparseMatrix> = sources.iter().collect();
         let pattern = UnionPattern::new(n, &refs);
-        let nnz = pattern.nnz();
-        let max_columns = max_columns.max(1);
-        let req = StackReq::any_of(&[
-            colamd::order_scratch::<usize>(n, n, nnz),
-            simplicial::factorize_simplicial_numeric_lu_scratch::<usize, c64>(n, n),
-            simplicial::solve_in_place_scratch::<usize, c64>(n, max_columns, Par::Seq),
-        ]);
-        let mut mem = MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-            during: "allocating the dynamic stiffness workspace",
-        })?;
-        let mut col_perm_fwd = vec![0; n].into_boxed_slice();
-        let mut col_perm_inv = vec![0; n].into_boxed_slice();
-        colamd::order(
-            &mut col_perm_fwd,
-            &mut col_perm_inv,
-            pattern.symbolic.as_ref(),
-            colamd::Control::default(),
-            MemStack::new(&mut mem),
-        )
-        .map_err(|e| LinearSolveError::from_faer(e, "ordering the dynamic stiffness"))?;
-        let slots = (0..slots)
-            .map(|_| Slot {
-                row_perm: RowPerm::Unfactored(vec![0; n].into(), vec![0; n].into()),
-                lu: SimplicialLu::new(),
-            })
-            .collect();
+        let mut lu = SparseLu::new()
+            .with_pivot_rule(PivotRule::Breakdown)
+            .with_slots(slots)
+            .with_solve_columns(max_columns);
+        lu.analyze_pattern(pattern.symbolic.as_ref())?;
         Ok(Self {
-            n,
-            values: vec![c64::new(0.0, 0.0); nnz],
+            values: vec![c64::new(0.0, 0.0); pattern.nnz()],
             pattern,
             sources,
-            col_perm: Perm::new_checked(col_perm_fwd, col_perm_inv, n),
-            slots,
-            mem,
-            max_columns,
+            lu,
         })
     }
 
@@ -233,67 +179,21 @@ impl DynamicStiffness {
         mass: c64,
         damping: c64,
     ) -> Result<(), LinearSolveError> {
-        let Some(s) = self.slots.get_mut(slot) else {
-            return Err(LinearSolveError::NotFactored);
-        };
-        let (mut fwd, mut inv) = match std::mem::replace(
-            &mut s.row_perm,
-            RowPerm::Unfactored(Box::default(), Box::default()),
-        ) {
-            RowPerm::Factored(perm) => perm.into_arrays(),
-            RowPerm::Unfactored(fwd, inv) => (fwd, inv),
-        };
         let coefficients = [c64::new(1.0, 0.0), mass, damping];
         self.pattern
             .combine(self.sources.iter().zip(coefficients), &mut self.values);
-        let n = self.n;
-        let result = simplicial::factorize_simplicial_numeric_lu(
-            &mut fwd,
-            &mut inv,
-            &mut s.lu,
-            self.pattern.matrix(&self.values),
-            self.col_perm.as_ref(),
-            MemStack::new(&mut self.mem),
-        );
-        let col_perm = self.col_perm.arrays().0;
-        let checked = match result {
-            Ok(()) => {
-                let u = s.lu.u_factor_unsorted();
-                // Squared moduli (no square root per pivot): zero and non-finite alike.
-                let diagonal = (0..n).map(|j| diagonal_entry(u, j).map_or(0.0, |v| v.norm_sqr()));
-                check_pivots(diagonal, PIVOT_THRESHOLD * PIVOT_THRESHOLD)
-            }
-            Err(LuError::SymbolicSingular { index }) => Err(LinearSolveError::Singular {
+        match self.lu.factor_slot(slot, self.pattern.matrix(&self.values)) {
+            // The pivot's position in the factorization is a column of the ordering.
+            Err(LinearSolveError::Singular {
                 index,
-                pivot: 0.0,
-                max_pivot: f64::NAN,
+                pivot,
+                max_pivot,
+            }) => Err(LinearSolveError::Singular {
+                index: self.lu.pivot_column(index),
+                pivot,
+                max_pivot,
             }),
-            Err(LuError::Generic(e)) => Err(LinearSolveError::from_faer(
-                e,
-                "factoring a dynamic stiffness",
-            )),
-        };
-        match checked {
-            Ok(()) => {
-                s.row_perm = RowPerm::Factored(Perm::new_checked(fwd, inv, n));
-                Ok(())
-            }
-            Err(e) => {
-                s.row_perm = RowPerm::Unfactored(fwd, inv);
-                // The pivot's position in the factorization is column col_perm[index].
-                Err(match e {
-                    LinearSolveError::Singular {
-                        index,
-                        pivot,
-                        max_pivot,
-                    } => LinearSolveError::Singular {
-                        index: col_perm.get(index).copied().unwrap_or(index),
-                        pivot,
-                        max_pivot,
-                    },
-                    other => other,
-                })
-            }
+            other => other,
         }
     }
 
@@ -301,36 +201,9 @@ impl DynamicStiffness {
     pub(crate) fn solve_in_place(
         &mut self,
         slot: usize,
-        mut rhs: MatMut<'_, c64>,
+        rhs: MatMut<'_, c64>,
     ) -> Result<(), LinearSolveError> {
-        let n = self.n;
-        let Some(Slot {
-            row_perm: RowPerm::Factored(row_perm),
-            lu,
-        }) = self.slots.get(slot)
-        else {
-            return Err(LinearSolveError::NotFactored);
-        };
-        if rhs.nrows() != n {
-            return Err(LinearSolveError::DimensionMismatch {
-                expected: n,
-                found: rhs.nrows(),
-            });
-        }
-        let mut start = 0;
-        while start < rhs.ncols() {
-            let width = self.max_columns.min(rhs.ncols() - start);
-            lu.solve_in_place_with_conj(
-                row_perm.as_ref(),
-                self.col_perm.as_ref(),
-                Conj::No,
-                rhs.as_mut().subcols_mut(start, width),
-                Par::Seq,
-                MemStack::new(&mut self.mem),
-            );
-            start += width;
-        }
-        Ok(())
+        self.lu.solve_slot_in_place(slot, rhs)
     }
 
     /// `y += (a K + b M + c D) x` for complex vectors (`x`, `y` of length `N`), the values

@@ -21,7 +21,8 @@
 //! - `K` is nonsingular on the free dofs (its sparse LU has no zero pivot) and the pencil
 //!   `(K, M)` has a lowest finite natural frequency `omega_1` (Rayleigh–Ritz / subspace
 //!   iteration of [`natural_frequencies`]);
-//! - contact and observed dofs exist (`1..=N` in the scene, 1-based as in Matrix Market).
+//! - contact and observed dofs exist (`1..=N` in the scene, 1-based as in Matrix Market);
+//! - the forcing frequency ([`ModelSpec::omega`]) is finite and `> 0`.
 //!
 //! `[damping] zeta` gives `D = (2 zeta / omega_1) K`, `alpha`/`beta` give
 //! `D = alpha M + beta K`, exactly as for the rod; a `damping` file and a `[damping]`
@@ -36,7 +37,7 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::Factorize;
 
 use crate::dynamic::UnionPattern;
-use crate::model::{ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure};
+use crate::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
 use crate::rod::{natural_frequencies, DampingSpec, FrequencySpec};
 
 /// Relative tolerance of the symmetry check of `K` and `M`.
@@ -81,6 +82,14 @@ pub struct ModelSpec {
     pub contacts: Vec<DofContact>,
     /// Observed dof (0-based); `None`: the first contact dof, else the largest load entry.
     pub observed_dof: Option<usize>,
+}
+
+impl ModelSpec {
+    /// The forcing frequency for the imported structure's first natural frequency
+    /// `omega_1` ([`Structure::omega_1`] of [`build_imported`], which checks it).
+    pub fn omega(&self, omega_1: f64) -> f64 {
+        self.frequency.omega(omega_1)
+    }
 }
 
 /// Why an imported model could not be built.
@@ -380,9 +389,10 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
             expected: format!("{n} x 1 (one entry per dof)"),
         });
     }
-    let mut amplitude = vec![0.0; n];
-    for (i, v) in load.row_idx_of_col(0).zip(load.val_of_col(0)) {
-        amplitude[i] += spec.amplitude * v;
+    let shape = load;
+    let mut load = vec![0.0; n];
+    for (i, v) in shape.row_idx_of_col(0).zip(shape.val_of_col(0)) {
+        load[i] += spec.amplitude * v;
     }
     let dof_in_range = |key: &'static str, dof: usize| {
         if dof < n {
@@ -409,7 +419,7 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
         Some(dof) => dof_in_range("output.dof", dof)?,
         None => match contacts.first() {
             Some(c) => c.dof,
-            None => largest_entry(&amplitude),
+            None => largest_entry(&load),
         },
     };
     let stiffness_error = |reason: String| ImportError::Stiffness {
@@ -426,10 +436,7 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
         mass,
         damping,
         stiffness,
-        forcing: HarmonicForcing {
-            amplitude,
-            omega: 1.0,
-        },
+        load,
         contacts,
     };
     let omega_1 = natural_frequencies(&model, 1)
@@ -446,14 +453,17 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
             ),
         });
     }
-    model.forcing.omega = match spec.frequency {
-        FrequencySpec::Ratio(r) => r * omega_1,
-        FrequencySpec::Absolute(w) => w,
-    };
     model.validate().map_err(|e| ImportError::Model {
         scene: spec.scene.clone(),
         reason: e.to_string(),
     })?;
+    let omega = spec.omega(omega_1);
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(ImportError::Model {
+            scene: spec.scene.clone(),
+            reason: format!("forcing omega = {omega}: allowed a finite angular frequency > 0"),
+        });
+    }
     Ok(Structure {
         model,
         omega_1,

@@ -4,10 +4,14 @@
 //! `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0` (lambda is the force the obstacle
 //! applies, non-positive: it pushes the structure back).
 //!
+//! The external force is `f(t) = load cos(omega t)`: the model holds the spatial shape
+//! `load`, and every formulation takes the angular frequency `omega` as an argument where it
+//! is built (and checks it: finite and `> 0`), so that one model serves every frequency of a
+//! sweep without being copied.
+//!
 //! [`StructuralModel::validate`] is the one check every formulation makes before using a
-//! model: square matrices of one size `N >= 1`, a forcing of length `N`, finite entries, a
-//! finite `omega > 0`, and contacts on existing dofs with finite gaps, at most one per dof
-//! and side (two contacts on one side of a dof would make the rows of `G` equal: the
+//! model: square matrices of one size `N >= 1`, a load of length `N`, finite entries, and
+//! contacts on existing dofs with finite gaps, at most one per dof and side (two contacts on one side of a dof would make the rows of `G` equal: the
 //! harmonic-balance Jacobian and the time-marching contact problem are then singular). Two
 //! contacts on one dof from opposite sides are a two-sided clearance (backlash): their
 //! gaps must leave room between the obstacles (sum > 0), so that at most one is closed at a
@@ -72,15 +76,6 @@ impl ContactDirection {
     }
 }
 
-/// Periodic external force `f(t) = amplitude * cos(omega t)` (a fixed spatial shape).
-#[derive(Debug, Clone, PartialEq)]
-pub struct HarmonicForcing {
-    /// Nodal amplitude vector (length `N`).
-    pub amplitude: Vec<f64>,
-    /// Angular frequency `omega` (rad per unit time); the period is `2 pi / omega`.
-    pub omega: f64,
-}
-
 /// The whole semi-discrete model: only the effects it declares are present
 /// (`damping = None` means no damping matrix; empty `contacts` means a linear problem).
 #[derive(Debug, Clone)]
@@ -91,18 +86,20 @@ pub struct StructuralModel {
     pub damping: Option<SparseMatrix>,
     /// Stiffness matrix `K` (N x N, symmetric positive definite).
     pub stiffness: SparseMatrix,
-    /// External periodic force.
-    pub forcing: HarmonicForcing,
+    /// Nodal amplitudes of the external force `f(t) = load cos(omega t)` (length `N`); the
+    /// angular frequency `omega` is an argument of each formulation.
+    pub load: Vec<f64>,
     /// Unilateral contacts (rows of `G` and gaps `g`).
     pub contacts: Vec<ContactPoint>,
 }
 
 /// A structure ready for every method: the model, its first finite natural frequency
 /// `omega_1` (the unit of `omega_ratio` in scenes and sweeps) and the dof whose displacement
-/// outputs describe (`tip_*` fields, plots): the rod's tip, or a scene's `[output] dof`.
+/// outputs describe (`tip_*` fields, plots): the rod's tip, or a scene's `[output] dof`. The
+/// forcing frequency is not part of it: runs take it as an argument.
 #[derive(Debug, Clone)]
 pub struct Structure {
-    /// The semi-discrete model `M, D, K, f, G, g`.
+    /// The semi-discrete model `M, D, K, load, G, g`.
     pub model: StructuralModel,
     /// First finite natural frequency (rad per unit time).
     pub omega_1: f64,
@@ -128,26 +125,20 @@ pub enum InvalidModel {
         /// `N`.
         dofs: usize,
     },
-    /// The forcing amplitude does not have one entry per dof.
-    #[error("model forcing amplitude has length {found}: allowed {dofs} (one entry per dof)")]
-    ForcingLength {
+    /// The load does not have one entry per dof.
+    #[error("model load has length {found}: allowed {dofs} (one entry per dof)")]
+    LoadLength {
         /// Length found.
         found: usize,
         /// `N`.
         dofs: usize,
     },
-    /// A matrix entry, a forcing entry or a gap is NaN or infinite.
+    /// A matrix entry, a load entry or a gap is NaN or infinite.
     #[error("model {part} holds a non-finite value {value}: allowed finite numbers")]
     NonFinite {
         /// `"stiffness matrix"`, `"mass matrix"`, `"damping matrix"`,
-        /// `"forcing amplitude"` or `"contact gap"`.
+        /// `"load"` or `"contact gap"`.
         part: &'static str,
-        /// The value found.
-        value: f64,
-    },
-    /// The forcing frequency is not a finite positive number.
-    #[error("model forcing omega = {value}: allowed a finite angular frequency > 0")]
-    Omega {
         /// The value found.
         value: f64,
     },
@@ -239,18 +230,13 @@ impl StructuralModel {
             }
             first_non_finite(part, matrix.val())?;
         }
-        let amplitude = &self.forcing.amplitude;
-        if amplitude.len() != n {
-            return Err(InvalidModel::ForcingLength {
-                found: amplitude.len(),
+        if self.load.len() != n {
+            return Err(InvalidModel::LoadLength {
+                found: self.load.len(),
                 dofs: n,
             });
         }
-        first_non_finite("forcing amplitude", amplitude)?;
-        let omega = self.forcing.omega;
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(InvalidModel::Omega { value: omega });
-        }
+        first_non_finite("load", &self.load)?;
         for (contact, c) in self.contacts.iter().enumerate() {
             if c.dof >= n {
                 return Err(InvalidModel::ContactDofOutOfRange {
@@ -506,10 +492,7 @@ mod tests {
             mass: matrix(2.0, 0.5),
             damping: Some(matrix(0.2, -0.1)),
             stiffness: matrix(2.0, -1.0),
-            forcing: HarmonicForcing {
-                amplitude: vec![0.0, 0.0, 1.0],
-                omega: 1.0,
-            },
+            load: vec![0.0, 0.0, 1.0],
             contacts: vec![ContactPoint::new(2, 0.1)],
         }
     }
@@ -529,23 +512,20 @@ mod tests {
             })
         );
         let mut m = chain();
-        m.forcing.amplitude.push(0.0);
+        m.load.push(0.0);
         assert_eq!(
             m.validate(),
-            Err(InvalidModel::ForcingLength { found: 4, dofs: 3 })
+            Err(InvalidModel::LoadLength { found: 4, dofs: 3 })
         );
         let mut m = chain();
-        m.forcing.amplitude[1] = f64::INFINITY;
+        m.load[1] = f64::INFINITY;
         assert_eq!(
             m.validate(),
             Err(InvalidModel::NonFinite {
-                part: "forcing amplitude",
+                part: "load",
                 value: f64::INFINITY
             })
         );
-        let mut m = chain();
-        m.forcing.omega = -1.0;
-        assert_eq!(m.validate(), Err(InvalidModel::Omega { value: -1.0 }));
         let mut m = chain();
         m.contacts.push(ContactPoint::new(3, 0.0));
         assert_eq!(
@@ -576,9 +556,11 @@ mod tests {
         let mut m = chain();
         m.stiffness = SparseMatrix::try_new_from_triplets(0, 0, &[]).unwrap();
         assert_eq!(m.validate(), Err(InvalidModel::NoDofs));
-        let mut m = chain();
-        m.forcing.omega = 0.0;
-        let message = m.validate().unwrap_err().to_string();
+        // The frequency is the formulations' argument: each names it in its own error.
+        let options = crate::hb::HbOptions::default();
+        let message = crate::hb::SsnHb::new(&chain(), 0.0, &options)
+            .unwrap_err()
+            .to_string();
         assert!(
             message.contains("omega = 0") && message.contains("allowed"),
             "{message}"

@@ -19,9 +19,7 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
 use crate::dynamic::UnionPattern;
-use crate::model::{
-    sparse_mul_add, ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure,
-};
+use crate::model::{sparse_mul_add, ContactPoint, SparseMatrix, StructuralModel, Structure};
 
 /// How the rod's mass is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -70,6 +68,23 @@ pub enum FrequencySpec {
     Ratio(f64),
     /// `omega` in rad per unit time.
     Absolute(f64),
+}
+
+impl FrequencySpec {
+    /// The angular frequency for a structure whose first natural frequency is `omega_1`.
+    pub fn omega(self, omega_1: f64) -> f64 {
+        match self {
+            FrequencySpec::Ratio(r) => r * omega_1,
+            FrequencySpec::Absolute(w) => w,
+        }
+    }
+
+    /// The number the spec gives: the ratio or the absolute frequency.
+    fn value(self) -> f64 {
+        match self {
+            FrequencySpec::Ratio(r) | FrequencySpec::Absolute(r) => r,
+        }
+    }
 }
 
 /// A unilateral contact at a node: `u_node - gap <= 0`.
@@ -154,6 +169,12 @@ impl RodModel {
     /// Dof index of the tip node.
     pub fn tip_dof(&self) -> usize {
         self.spec.elements - 1
+    }
+
+    /// The forcing frequency of the spec, resolved against the rod's `omega_1` (finite and
+    /// `> 0`: [`build_rod`] checks it).
+    pub fn omega(&self) -> f64 {
+        self.spec.frequency.omega(self.structure.omega_1)
     }
 }
 
@@ -321,12 +342,14 @@ fn assemble_elements(
     })
 }
 
-/// Builds the structural model of a rod and its first natural frequency.
+/// Builds the structural model of a rod and its first natural frequency; the spec's forcing
+/// frequency, resolved against it, is [`RodModel::omega`].
 ///
 /// ```
 /// use semismooth_contact::rod::{build_rod, RodSpec};
 /// let rod = build_rod(&RodSpec::canonical()).unwrap();
 /// assert!((rod.omega_1 - 1.571200).abs() < 1e-6);
+/// assert_eq!(rod.omega(), rod.omega_1); // the canonical rod is forced at omega_1
 /// assert_eq!(rod.model.contacts[0].dof, 19);
 /// ```
 pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
@@ -342,18 +365,18 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         MassModel::Modified if e + 1 == n => [m_e, 0.0, 0.0],
         MassModel::Modified => [m_e / 3.0, m_e / 6.0, m_e / 3.0],
     })?;
-    let mut amplitude = vec![0.0; n];
+    let mut load = vec![0.0; n];
     match spec.load {
         LoadKind::Distributed => {
             for e in 0..n {
                 let half = 0.5 * spec.amplitude * h;
                 if e > 0 {
-                    amplitude[e - 1] += half;
+                    load[e - 1] += half;
                 }
-                amplitude[e] += half;
+                load[e] += half;
             }
         }
-        LoadKind::Tip => amplitude[n - 1] = spec.amplitude,
+        LoadKind::Tip => load[n - 1] = spec.amplitude,
     }
     let contacts = spec
         .contacts
@@ -364,10 +387,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         mass,
         damping: None,
         stiffness,
-        forcing: HarmonicForcing {
-            amplitude,
-            omega: 1.0,
-        },
+        load,
         contacts,
     };
     let omega_1 = natural_frequencies(&model, 1)?[0];
@@ -382,18 +402,10 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
             &[beta, alpha],
         )),
     };
-    model.forcing.omega = match spec.frequency {
-        FrequencySpec::Ratio(r) => r * omega_1,
-        FrequencySpec::Absolute(w) => w,
-    };
-    if !model.forcing.omega.is_finite() {
-        let value = match spec.frequency {
-            FrequencySpec::Ratio(r) => r,
-            FrequencySpec::Absolute(w) => w,
-        };
+    if !spec.frequency.omega(omega_1).is_finite() {
         return Err(ModelError::InvalidParameter {
             name: "omega_ratio",
-            value,
+            value: spec.frequency.value(),
             allowed: "a ratio whose frequency omega_ratio * omega_1 is finite",
         });
     }
@@ -672,12 +684,12 @@ mod tests {
     #[test]
     fn distributed_load_is_consistent_and_sums_to_the_resultant() {
         let rod = build_rod(&RodSpec::canonical()).unwrap();
-        let f = &rod.model.forcing.amplitude;
+        let f = &rod.model.load;
         // Resultant of p0 over (0, L] minus the clamped node's half element.
         let total: f64 = f.iter().sum();
         assert!((total - 0.04 * (1.0 - 0.5 / 20.0)).abs() < 1e-15);
         assert!((f[19] - 0.04 / 40.0).abs() < 1e-15);
-        assert!((rod.model.forcing.omega - rod.omega_1).abs() < 1e-15);
+        assert!((rod.omega() - rod.omega_1).abs() < 1e-15);
     }
 
     #[test]

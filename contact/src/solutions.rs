@@ -79,11 +79,12 @@ pub struct SolutionSet {
     pub seconds: f64,
 }
 
-/// All periodic solutions at the model's forcing frequency (module documentation).
-/// `sweep`: the window and continuation settings (`None`: `[0.5, 2] w* / omega_1` with the
-/// scene defaults).
+/// All periodic solutions of `rod` at the forcing frequency `omega` (module
+/// documentation). `sweep`: the window and continuation settings (`None`:
+/// `[0.5, 2] w* / omega_1` with the scene defaults).
 pub fn find_solutions(
     rod: &Structure,
+    omega: f64,
     settings: &SolverSettings,
     sweep: Option<&SweepSettings>,
 ) -> Result<SolutionSet, RunError> {
@@ -95,7 +96,13 @@ pub fn find_solutions(
                    through the frequency and correct each crossing",
         });
     }
-    let omega = rod.model.forcing.omega;
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(RunError::InvalidSetting {
+            name: "omega",
+            value: omega,
+            allowed: "a finite angular frequency > 0",
+        });
+    }
     let ratio = omega / rod.omega_1;
     let window = match sweep {
         Some(s) => s.clone(),
@@ -113,9 +120,7 @@ pub fn find_solutions(
         });
     }
     let branch = follow_branch(rod, settings, &window, None)?;
-    let mut at_omega = rod.clone();
-    at_omega.model.forcing.omega = omega;
-    let reconstruction = Reconstruction::new(&rod.model, settings)?;
+    let reconstruction = Reconstruction::new(&rod.model, omega, settings)?;
     let len = rod.model.dofs() * (2 * settings.harmonics + 1);
     let mut set = SolutionSet {
         omega,
@@ -153,7 +158,7 @@ pub fn find_solutions(
             .zip(&branch.states[i])
             .map(|(a, b)| a + t * (b - a))
             .collect();
-        let solution = solve(&at_omega, settings, Some(&start))?;
+        let solution = solve(rod, omega, settings, Some(&start))?;
         if !solution.converged() {
             set.failed_corrections.push(FailedCorrection {
                 branch_index: i,

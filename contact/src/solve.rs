@@ -1,6 +1,7 @@
-//! One-call solves: [`solve`] runs the chosen method on a [`Structure`], drives it with the
-//! core's solvers and reduces the answer to what users compare (the observed dof over one
-//! period, every contact, work counters).
+//! One-call solves: [`solve`] runs the chosen method on a [`Structure`] forced at a given
+//! angular frequency, drives it with the core's solvers and reduces the answer to what
+//! users compare (the observed dof over one period, every contact, work counters; the
+//! frequency is the [`Solution`]'s `omega`).
 //!
 //! A run that could not start (bad settings, a singular model) is an [`RunError`]; a run that
 //! started and stopped is an `Ok` [`Solution`] whose typed [`Termination`] says how
@@ -466,9 +467,10 @@ struct Period {
     contact_displacements: Vec<Vec<f64>>,
 }
 
-/// The solution record of a run of the scene's method.
+/// The solution record of a run of the scene's method at `omega`.
 fn solution(
     rod: &Structure,
+    omega: f64,
     settings: &SolverSettings,
     time_samples: usize,
     outcome: Outcome<'_>,
@@ -500,7 +502,7 @@ fn solution(
         lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
         diagnosis: None,
         c: None,
-        omega: rod.model.forcing.omega,
+        omega,
         omega_1: rod.omega_1,
         termination: outcome.termination,
         iterations: outcome.iterations,
@@ -526,6 +528,7 @@ fn solution(
 fn hb_outputs(
     problem: &impl HbReconstruction,
     rod: &Structure,
+    omega: f64,
     settings: &SolverSettings,
     outcome: Outcome<'_>,
     x: Vec<f64>,
@@ -541,7 +544,7 @@ fn hb_outputs(
         .iter()
         .map(|c| problem.displacement(&x, c.dof, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let period = 2.0 * std::f64::consts::PI / rod.model.forcing.omega;
+    let period = 2.0 * std::f64::consts::PI / omega;
     let times = (0..points)
         .map(|n| period * n as f64 / points as f64)
         .collect();
@@ -553,6 +556,7 @@ fn hb_outputs(
     };
     Ok(solution(
         rod,
+        omega,
         settings,
         settings.time_samples,
         outcome,
@@ -598,9 +602,12 @@ fn statistics(
     stats
 }
 
-/// Solves the rod with the scene's method, from a zero initial guess (or `warm_start`).
+/// Solves the rod forced at the angular frequency `omega` with the scene's method, from a
+/// zero initial guess (or `warm_start`). An `omega` that is not finite and `> 0` is the
+/// formulation's typed error.
 pub fn solve(
     rod: &Structure,
+    omega: f64,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
@@ -609,7 +616,7 @@ pub fn solve(
     let scale = model.contact_stiffness_scale();
     match settings.method {
         Method::SsnHb => {
-            let mut problem = SsnHb::new(model, &hb_options(settings))?;
+            let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
             let smoothing = Some(SmoothingOf::new());
@@ -617,14 +624,14 @@ pub fn solve(
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let outcome = Outcome::of_newton(&report, seconds);
-            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
+            let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
             sol.c = (problem.contacts() > 0).then(|| problem.c());
             Ok(sol)
         }
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
             let target = options.penalty_stiffness;
-            let mut problem = PenaltyHb::new(model, &options)?;
+            let mut problem = PenaltyHb::new(model, omega, &options)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
             // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
@@ -663,7 +670,7 @@ pub fn solve(
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let outcome = Outcome::of_newton(&report, seconds);
-            let mut sol = hb_outputs(&problem, rod, settings, outcome, x, points)?;
+            let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
             // The mean penalty force as the equations see it: over the Nt AFT samples (a
             // finer grid resolves narrow force peaks the quadrature does not).
             if problem.contacts() > 0 {
@@ -676,8 +683,8 @@ pub fn solve(
             }
             Ok(sol)
         }
-        Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, settings, warm_start),
-        Method::March => solve_march(rod, settings),
+        Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, omega, settings, warm_start),
+        Method::March => solve_march(rod, omega, settings),
     }
 }
 
@@ -690,6 +697,7 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
 
 fn solve_lcp(
     rod: &Structure,
+    omega: f64,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
@@ -703,7 +711,7 @@ fn solve_lcp(
     }
     let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
-    let lcp = PeriodicLcp::new(model, options)?;
+    let lcp = PeriodicLcp::new(model, omega, options)?;
     let (z, termination, iterations, residual, counters, effective_tolerance, finest) = match method
     {
         Method::LcpLemke => {
@@ -751,7 +759,8 @@ fn solve_lcp(
                     (z, vec![report])
                 }
                 _ => {
-                    let sequenced = crate::lcp::solve_min_map_sequenced(model, &lcp, &options)?;
+                    let sequenced =
+                        crate::lcp::solve_min_map_sequenced(model, omega, &lcp, &options)?;
                     let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
                     (sequenced.z, reports)
                 }
@@ -797,7 +806,15 @@ fn solve_lcp(
         contact_forces: forces,
         contact_displacements: contact_u,
     };
-    let mut sol = solution(rod, settings, settings.time_samples, outcome, period, z);
+    let mut sol = solution(
+        rod,
+        omega,
+        settings,
+        settings.time_samples,
+        outcome,
+        period,
+        z,
+    );
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
     if !sol.converged() && lcp.has_alternating_null_vector() {
         sol.diagnosis = Some(Diagnosis::AlternatingNullVector);
@@ -805,7 +822,11 @@ fn solve_lcp(
     Ok(sol)
 }
 
-fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
+fn solve_march(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+) -> Result<Solution, RunError> {
     let model = &rod.model;
     let tip = rod.observed_dof;
     let options = MarchOptions {
@@ -826,7 +847,7 @@ fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, R
     let start = Instant::now();
     // A march that does not settle is a run that did not converge: its last period is
     // reported with the last period-to-period change.
-    let (period, steady) = match march_to_steady_state(model, &options, &observed) {
+    let (period, steady) = match march_to_steady_state(model, omega, &options, &observed) {
         Ok(period) => (period, true),
         Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
         Err(e) => return Err(e.into()),
@@ -869,6 +890,7 @@ fn solve_march(rod: &Structure, settings: &SolverSettings) -> Result<Solution, R
     };
     Ok(solution(
         rod,
+        omega,
         settings,
         settings.steps_per_period,
         outcome,

@@ -309,18 +309,16 @@ pub fn hb_stability(
             spp,
         ));
     }
-    let mut at_omega = model.clone();
-    at_omega.forcing.omega = omega;
     let march = MarchOptions {
         steps_per_period: spp,
         scheme: MarchScheme::MasslessContactTrapezoidal,
         ..MarchOptions::default()
     };
-    let mut marcher = TimeMarcher::new(&at_omega, &march, &MarchState::rest(&at_omega))?;
+    let mut marcher = TimeMarcher::new(model, omega, &march, &MarchState::rest(model))?;
     marcher.set_closed_contact_velocity_reset(true);
     let keep = influential(&marcher);
-    let start = hb_state(&at_omega, harmonics, omega, u, 0.0)?;
-    if orbit_stays_open(&at_omega, harmonics, u) {
+    let start = hb_state(model, harmonics, omega, u, 0.0)?;
+    if orbit_stays_open(model, harmonics, u) {
         // No contact closes along the orbit: the map is affine with the linear part of the
         // open contacts, whatever the orbit; its monodromy needs no shooting.
         let runs = vec![(Vec::new(), spp)];
@@ -383,7 +381,7 @@ pub fn hb_stability(
     let keep = &shooting.keep;
     let multipliers =
         reduced_multipliers(&monodromy(&mut shooting.marcher, &shooting.runs)?, keep)?;
-    let n = at_omega.dofs();
+    let n = model.dofs();
     let displacements = |x: &[f64]| -> Vec<f64> {
         keep.iter()
             .zip(x)
@@ -419,7 +417,7 @@ pub fn hb_stability(
         contact_steps,
         orbit_distance: Some(distance),
         shooting_iterations: report.iterations,
-        orbit: Some(shooting.state(&x, at_omega.contact_count())),
+        orbit: Some(shooting.state(&x, model.contact_count())),
     })
 }
 

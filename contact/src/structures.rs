@@ -33,7 +33,7 @@
 use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
-use crate::model::{ContactPoint, HarmonicForcing, SparseMatrix, StructuralModel, Structure};
+use crate::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
 use crate::rod::{natural_frequencies, ModelError};
 
 /// Mistuning amplitude of the shipped disk (`scenes/bladed_disk_casing.toml`).
@@ -59,8 +59,16 @@ pub struct DiskLoading {
     pub amplitude: f64,
     /// Stiffness-proportional damping `D = (2 zeta / omega_1) K`.
     pub zeta: f64,
-    /// Forcing frequency in units of `omega_1`.
+    /// Forcing frequency in units of `omega_1` ([`DiskLoading::omega`]).
     pub omega_ratio: f64,
+}
+
+impl DiskLoading {
+    /// The forcing frequency for a disk whose first natural frequency is `omega_1`
+    /// ([`Structure::omega_1`] of [`BladedDisk::structure`]).
+    pub fn omega(&self, omega_1: f64) -> f64 {
+        self.omega_ratio * omega_1
+    }
 }
 
 impl BladedDisk {
@@ -113,7 +121,8 @@ impl BladedDisk {
     }
 
     /// The disk as a structure: `omega_1` its lowest natural frequency, the observed dof the
-    /// first stop's pad (blade 0's tip without stops). A stop out of range or no blade is
+    /// first stop's pad (blade 0's tip without stops); its forcing frequency is
+    /// [`DiskLoading::omega`]. A stop out of range or no blade is
     /// [`ModelError::InvalidParameter`].
     pub fn structure(&self, loading: &DiskLoading) -> Result<Structure, ModelError> {
         if self.blades == 0 {
@@ -136,10 +145,7 @@ impl BladedDisk {
             mass,
             damping: None,
             stiffness,
-            forcing: HarmonicForcing {
-                amplitude: shape.iter().map(|f| loading.amplitude * f).collect(),
-                omega: 1.0,
-            },
+            load: shape.iter().map(|f| loading.amplitude * f).collect(),
             contacts: loading
                 .stops
                 .iter()
@@ -152,7 +158,6 @@ impl BladedDisk {
             &[&model.stiffness],
             &[2.0 * loading.zeta / omega_1],
         ));
-        model.forcing.omega = loading.omega_ratio * omega_1;
         let observed_dof = model.contacts.first().map_or(Self::tip(0), |c| c.dof);
         Ok(Structure {
             model,

@@ -15,15 +15,14 @@ use semismooth_contact::lcp::{
     ActiveSetSolver, FrequencyLcp, FrequencyLcpSolver, MinMapJacobian, PeriodicLcp,
     PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use semismooth_contact::model::StructuralModel;
-use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+use semismooth_contact::rod::{build_rod, MassModel, RodModel, RodSpec};
 
-fn modified_rod() -> StructuralModel {
+fn modified_rod() -> RodModel {
     let spec = RodSpec {
         mass: MassModel::Modified,
         ..RodSpec::canonical()
     };
-    build_rod(&spec).unwrap().structure.model
+    build_rod(&spec).unwrap()
 }
 
 /// A deterministic state with contact activity at some samples.
@@ -58,23 +57,25 @@ where
 
 #[test]
 fn structured_solver_refactors_at_a_new_frequency_without_allocating() {
-    let model = modified_rod();
-    let omega = model.forcing.omega;
+    let rod = modified_rod();
+    let (model, omega) = (&rod.model, rod.omega());
     let omegas: Vec<f64> = (0..5).map(|i| omega * (0.9 + 0.05 * i as f64)).collect();
-    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
+    let mut ssn = SsnHb::new(model, omega, &HbOptions::default()).unwrap();
     assert_eq!(sweep_frequencies(&mut ssn, &omegas), 0, "SSN-HB");
-    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::for_model(&model)).unwrap();
+    let options = PenaltyHbOptions::for_model(model);
+    let mut penalty = PenaltyHb::new(model, omega, &options).unwrap();
     assert_eq!(sweep_frequencies(&mut penalty, &omegas), 0, "penalty HB");
 }
 
 #[test]
 fn active_set_factorizations_reuse_their_storage() {
-    let model = modified_rod();
+    let rod = modified_rod();
+    let (model, omega) = (&rod.model, rod.omega());
     let options = PeriodicLcpOptions {
         time_samples: 64,
         ..Default::default()
     };
-    let lcp = PeriodicLcp::new(&model, options.clone()).unwrap();
+    let lcp = PeriodicLcp::new(model, omega, options.clone()).unwrap();
     let n = lcp.dim();
     // Warm-up with the largest block (all rows; singular, regularised) and the largest
     // coupling `A_IJ` (half the rows), then other sizes.
@@ -98,7 +99,8 @@ fn active_set_factorizations_reuse_their_storage() {
     }
     assert_eq!(allocations() - before, 0, "min-map active set");
 
-    let mut problem = FrequencyLcp::new(&model, options, model.contact_stiffness_scale()).unwrap();
+    let kappa = model.contact_stiffness_scale();
+    let mut problem = FrequencyLcp::new(model, omega, options, kappa).unwrap();
     let mut jac = problem.new_jacobian();
     let mut solver = FrequencyLcpSolver::new();
     let mut rhs = state(problem.dim());

@@ -32,7 +32,7 @@ fn options(h: usize) -> HbOptions {
 #[test]
 fn condensed_frequency_derivative_matches_central_differences() {
     let rod = rod();
-    let mut problem = CondensedSsnHb::new(&rod.model, &options(10)).unwrap();
+    let mut problem = CondensedSsnHb::new(&rod.model, rod.omega(), &options(10)).unwrap();
     let mut lambda = vec![0.0; problem.dim()];
     let report = solve(
         &mut problem,
@@ -85,7 +85,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
         parameter_scale: 0.5f64.sqrt() * omega_1,
         ..ContinuationOptions::with_step(1e-2)
     };
-    let mut condensed = CondensedSsnHb::new(&rod.model, &options(h)).unwrap();
+    let mut condensed = CondensedSsnHb::new(&rod.model, rod.omega(), &options(h)).unwrap();
     condensed.set_parameter(omega_from);
     let start = vec![0.0; condensed.dim()];
     let mut dense = FaerDenseLu::new();
@@ -97,7 +97,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
     let onset = branch.points.iter().position(|p| p.state[0] < 0.0).unwrap();
     assert!(onset > 1 && branch.points[onset - 1].state[0] == 0.0);
 
-    let mut full = SsnHb::new(&rod.model, &options(h)).unwrap();
+    let mut full = SsnHb::new(&rod.model, rod.omega(), &options(h)).unwrap();
     let mut residual = vec![0.0; full.dim()];
     let mut worst = 0.0f64;
     for point in &branch.points {
@@ -109,7 +109,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
     }
     assert!(worst < 1e-8, "full residual at condensed points {worst:e}");
 
-    let mut direct = CondensedSsnHb::new(&rod.model, &options(h)).unwrap();
+    let mut direct = CondensedSsnHb::new(&rod.model, rod.omega(), &options(h)).unwrap();
     let mut lambda = vec![0.0; direct.dim()];
     let report = solve(
         &mut direct,

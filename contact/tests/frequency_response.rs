@@ -149,7 +149,7 @@ fn every_branch_point_is_a_fixed_point_of_plain_newton() {
         let rod = rod(Some(gap), amplitude, mass);
         let h = 5;
         let r = curve(&rod, Method::SsnHb, h, 0.5, 2.0);
-        let mut problem = common::ssn_hb(&rod.model, h);
+        let mut problem = common::ssn_hb(&rod.model, rod.omega(), h);
         let mut solver = StructuredHbSolver::new();
         let newton = common::plain_newton();
         let mut worst: f64 = 0.0;
@@ -181,7 +181,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
     let arc = curve(&rod, Method::SsnHb, h, 0.9, 1.2);
     assert!(arc.folds.len() >= 2, "{:?}", arc.folds);
     let jump_down = arc.folds.iter().copied().fold(f64::NAN, f64::max);
-    let mut problem = common::ssn_hb(&rod.model, h);
+    let mut problem = common::ssn_hb(&rod.model, rod.omega(), h);
     let mut solver = StructuredHbSolver::new();
     let mut newton = Polyalgorithm::new(PolyalgorithmOptions::default()).unwrap();
     let count = 300;
@@ -299,7 +299,7 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
             time_samples: Some(default_hb_time_samples(h)),
             penalty_stiffness: kp,
         };
-        let mut problem = PenaltyHb::new(&rod.model, &options).unwrap();
+        let mut problem = PenaltyHb::new(&rod.model, rod.omega(), &options).unwrap();
         let mut solver = StructuredHbSolver::new();
         let mut jac = problem.new_jacobian();
         let mut f = vec![0.0; problem.dim()];

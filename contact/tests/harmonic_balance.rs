@@ -22,12 +22,17 @@ use semismooth_contact::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
 };
-use semismooth_contact::model::{ContactPoint, HarmonicForcing, InvalidModel, StructuralModel};
+use semismooth_contact::model::{ContactPoint, InvalidModel, StructuralModel};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
-/// `D = beta K` (or none), forcing `amplitude` on every dof at `omega`.
-fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -> StructuralModel {
+/// `D = beta K` (or none), a load on every dof; returned with the forcing frequency `omega`.
+fn chain(
+    n: usize,
+    beta: Option<f64>,
+    omega: f64,
+    contacts: Vec<ContactPoint>,
+) -> (StructuralModel, f64) {
     let k = [3.0, 2.0, 1.5, 1.2, 1.0];
     let mass = [1.0, 0.7, 0.5, 0.4, 0.3];
     let mut kt = Vec::new();
@@ -51,16 +56,14 @@ fn chain(n: usize, beta: Option<f64>, omega: f64, contacts: Vec<ContactPoint>) -
             .collect();
         SparseColMat::try_new_from_triplets(n, n, &dt).unwrap()
     });
-    StructuralModel {
+    let model = StructuralModel {
         mass,
         damping,
         stiffness,
-        forcing: HarmonicForcing {
-            amplitude: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
-            omega,
-        },
+        load: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
         contacts,
-    }
+    };
+    (model, omega)
 }
 
 /// Contact points `(dof, gap)`.
@@ -91,14 +94,14 @@ fn penalty_options(harmonics: usize, time_samples: Option<usize>, kp: f64) -> Pe
     }
 }
 
-/// Penalty HB on `model` with the default harmonics and `k_p = relative` times the contact
-/// stiffness scale.
-fn penalty_hb(model: &StructuralModel, relative: f64) -> PenaltyHb {
+/// Penalty HB on `model` at `omega` with the default harmonics and `k_p = relative` times the
+/// contact stiffness scale.
+fn penalty_hb(model: &StructuralModel, omega: f64, relative: f64) -> PenaltyHb {
     let options = PenaltyHbOptions {
         penalty_stiffness: relative * model.contact_stiffness_scale(),
         ..PenaltyHbOptions::for_model(model)
     };
-    PenaltyHb::new(model, &options).unwrap()
+    PenaltyHb::new(model, omega, &options).unwrap()
 }
 
 fn random_vector(rng: &mut ChaCha8Rng, len: usize, scale: f64) -> Vec<f64> {
@@ -147,9 +150,9 @@ fn max_abs(m: &Mat<f64>) -> f64 {
 fn dynamic_blocks_match_time_domain_equation_of_motion() {
     // R = A(w) U - F with F = 0 and no contact, against M u'' + D u' + K u evaluated at
     // the samples (derivatives from the coefficient-space operator) and projected by P.
-    let mut model = chain(3, Some(0.05), 1.3, vec![]);
-    model.forcing.amplitude = vec![0.0; 3];
-    let mut hb = SsnHb::new(&model, &hb_options(4, Some(32), None)).unwrap();
+    let (mut model, omega) = chain(3, Some(0.05), 1.3, vec![]);
+    model.load = vec![0.0; 3];
+    let mut hb = SsnHb::new(&model, omega, &hb_options(4, Some(32), None)).unwrap();
     let basis = FourierBasis::new(4, 32).unwrap();
     let size = basis.basis_size();
     let mut rng = ChaCha8Rng::seed_from_u64(1);
@@ -271,18 +274,18 @@ where
 
 #[test]
 fn ssn_jacobian_matches_central_differences_away_from_kinks() {
-    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
+    let (model, omega) = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
     let (h, nt) = (3, 16);
-    let mut hb = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut hb = SsnHb::new(&model, omega, &hb_options(h, Some(nt), Some(2.0))).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.5, |x| ssn_switching(&model, 2.0, x, h, nt));
     assert_jacobian_matches_central_differences(&mut hb, &x);
 }
 
 #[test]
 fn penalty_jacobian_matches_central_differences_away_from_kinks() {
-    let model = chain(3, Some(0.02), 0.9, contacts(&[(0, 0.05), (2, 0.1)]));
+    let (model, omega) = chain(3, Some(0.02), 0.9, contacts(&[(0, 0.05), (2, 0.1)]));
     let (h, nt) = (3, 16);
-    let mut hb = PenaltyHb::new(&model, &penalty_options(h, Some(nt), 50.0)).unwrap();
+    let mut hb = PenaltyHb::new(&model, omega, &penalty_options(h, Some(nt), 50.0)).unwrap();
     let x = point_away_from_kinks(hb.dim(), 0.3, |x| {
         // Penalty switching function: G u - g (c = 1, no force unknowns).
         let mut padded = x.to_vec();
@@ -294,8 +297,8 @@ fn penalty_jacobian_matches_central_differences_away_from_kinks() {
 
 #[test]
 fn omega_derivative_matches_central_differences() {
-    let model = chain(3, Some(0.03), 1.1, vec![ContactPoint::new(2, 0.1)]);
-    let mut hb = SsnHb::new(&model, &hb_options(3, Some(16), None)).unwrap();
+    let (model, omega) = chain(3, Some(0.03), 1.1, vec![ContactPoint::new(2, 0.1)]);
+    let mut hb = SsnHb::new(&model, omega, &hb_options(3, Some(16), None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mut analytic = vec![0.0; hb.dim()];
@@ -327,10 +330,10 @@ fn omega_derivative_matches_central_differences() {
     );
 }
 
-/// Exact linear response at the model's frequency, `u(t) = c cos(w t) + s sin(w t)`:
+/// Exact linear response at the frequency `w`, `u(t) = c cos(w t) + s sin(w t)`:
 /// `(c, s) = (Re z, -Im z)` with `(K - w^2 M + i w D) z = f`.
-fn exact_linear_response(model: &StructuralModel) -> (Vec<f64>, Vec<f64>) {
-    let z = exact_linear(model, model.forcing.omega);
+fn exact_linear_response(model: &StructuralModel, w: f64) -> (Vec<f64>, Vec<f64>) {
+    let z = exact_linear(model, w);
     (
         z.iter().map(|c| c.re).collect(),
         z.iter().map(|c| -c.im).collect(),
@@ -340,8 +343,8 @@ fn exact_linear_response(model: &StructuralModel) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
     for damping in [Some(0.04), None] {
-        let model = chain(4, damping, 1.7, vec![]);
-        let mut hb = SsnHb::new(&model, &HbOptions::default()).unwrap();
+        let (model, omega) = chain(4, damping, 1.7, vec![]);
+        let mut hb = SsnHb::new(&model, omega, &HbOptions::default()).unwrap();
         let mut x = vec![0.0; hb.dim()];
         let mut r = vec![0.0; hb.dim()];
         hb.residual(&x, &mut r).unwrap();
@@ -355,7 +358,7 @@ fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
         }
         solver.solve_in_place(&mut r).unwrap();
         x.copy_from_slice(&r);
-        let (cos, sin) = exact_linear_response(&model);
+        let (cos, sin) = exact_linear_response(&model, omega);
         let n = model.dofs();
         let scale = norm(&cos).max(norm(&sin));
         for dof in 0..n {
@@ -369,7 +372,7 @@ fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
             }
         }
         hb.residual(&x, &mut r).unwrap();
-        assert!(norm(&r) < 1e-12 * norm(&model.forcing.amplitude));
+        assert!(norm(&r) < 1e-12 * norm(&model.load));
         assert_eq!(hb.problem_counters().get("ffts"), 0, "no contact: no FFT");
     }
 }
@@ -411,22 +414,22 @@ where
 
 #[test]
 fn structured_and_dense_newton_steps_agree_ssn() {
-    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.2), (3, 0.1)]));
-    let mut hb = SsnHb::new(&model, &hb_options(6, None, Some(3.0))).unwrap();
+    let (model, omega) = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.2), (3, 0.1)]));
+    let mut hb = SsnHb::new(&model, omega, &hb_options(6, None, Some(3.0))).unwrap();
     assert_steps_agree_at_random_points(&mut hb);
 }
 
 #[test]
 fn structured_and_dense_newton_steps_agree_penalty() {
-    let model = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.05), (3, 0.02)]));
-    let mut hb = PenaltyHb::new(&model, &penalty_options(6, None, 100.0)).unwrap();
+    let (model, omega) = chain(5, Some(0.02), 1.2, contacts(&[(1, 0.05), (3, 0.02)]));
+    let mut hb = PenaltyHb::new(&model, omega, &penalty_options(6, None, 100.0)).unwrap();
     assert_steps_agree_at_random_points(&mut hb);
 }
 
 #[test]
 fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
-    let model = chain(3, Some(0.02), 1.2, vec![ContactPoint::new(2, 0.1)]);
-    let mut hb = SsnHb::new(&model, &hb_options(4, None, None)).unwrap();
+    let (model, omega) = chain(3, Some(0.02), 1.2, vec![ContactPoint::new(2, 0.1)]);
+    let mut hb = SsnHb::new(&model, omega, &hb_options(4, None, None)).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let mut jac = hb.new_jacobian();
     let mut solver = StructuredHbSolver::new();
@@ -448,8 +451,8 @@ fn structured_solver_factors_dynamic_blocks_once_per_frequency() {
 
 #[test]
 fn bad_options_are_typed_errors_with_the_numbers() {
-    let model = chain(3, None, 1.0, vec![ContactPoint::new(2, 0.1)]);
-    let err = SsnHb::new(&model, &hb_options(10, Some(20), None)).unwrap_err();
+    let (model, omega) = chain(3, None, 1.0, vec![ContactPoint::new(2, 0.1)]);
+    let err = SsnHb::new(&model, omega, &hb_options(10, Some(20), None)).unwrap_err();
     assert!(matches!(
         err,
         HbError::Harmonic(HarmonicError::TooFewSamples {
@@ -462,7 +465,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         c: Some(-1.0),
         ..HbOptions::default()
     };
-    let err = SsnHb::new(&model, &negative_c).unwrap_err();
+    let err = SsnHb::new(&model, omega, &negative_c).unwrap_err();
     assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
     let nan_penalty = PenaltyHbOptions {
         penalty_stiffness: f64::NAN,
@@ -470,11 +473,11 @@ fn bad_options_are_typed_errors_with_the_numbers() {
     };
     for (err, option) in [
         (
-            SsnHb::new(&model, &hb_options(0, None, None)).unwrap_err(),
+            SsnHb::new(&model, omega, &hb_options(0, None, None)).unwrap_err(),
             "harmonics",
         ),
         (
-            PenaltyHb::new(&model, &nan_penalty).unwrap_err(),
+            PenaltyHb::new(&model, omega, &nan_penalty).unwrap_err(),
             "penalty_stiffness",
         ),
     ] {
@@ -483,8 +486,8 @@ fn bad_options_are_typed_errors_with_the_numbers() {
             "{option}: {err:?}"
         );
     }
-    let bad = chain(3, None, 1.0, vec![ContactPoint::new(7, 0.1)]);
-    let err = SsnHb::new(&bad, &HbOptions::default()).unwrap_err();
+    let (bad, omega) = chain(3, None, 1.0, vec![ContactPoint::new(7, 0.1)]);
+    let err = SsnHb::new(&bad, omega, &HbOptions::default()).unwrap_err();
     assert!(matches!(
         err,
         HbError::Model(InvalidModel::ContactDofOutOfRange {
@@ -493,19 +496,18 @@ fn bad_options_are_typed_errors_with_the_numbers() {
             ..
         })
     ));
-    let mut bad = chain(3, None, 1.0, vec![]);
-    bad.forcing.omega = 0.0;
+    let (model, _) = chain(3, None, 1.0, vec![]);
     assert!(matches!(
-        SsnHb::new(&bad, &HbOptions::default()).unwrap_err(),
-        HbError::Model(InvalidModel::Omega { .. })
+        SsnHb::new(&model, 0.0, &HbOptions::default()).unwrap_err(),
+        HbError::InvalidOption { name: "omega", value, .. } if value == 0.0
     ));
 }
 
-fn canonical_modified_rod() -> StructuralModel {
-    build_rod(&common::canonical(MassModel::Modified))
-        .unwrap()
-        .structure
-        .model
+/// The canonical modified-mass rod's model and forcing frequency.
+fn canonical_modified_rod() -> (StructuralModel, f64) {
+    let rod = build_rod(&common::canonical(MassModel::Modified)).unwrap();
+    let omega = rod.omega();
+    (rod.structure.model, omega)
 }
 
 /// Displacement coefficients (H = 20) where the tip overshoots the gap over part of the
@@ -525,9 +527,9 @@ fn overshooting_displacement(model: &StructuralModel) -> Vec<f64> {
 
 #[test]
 fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
-    let model = canonical_modified_rod();
-    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
-    let mut penalty = penalty_hb(&model, 1e3);
+    let (model, omega) = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, omega, &HbOptions::default()).unwrap();
+    let mut penalty = penalty_hb(&model, omega, 1e3);
     let u = overshooting_displacement(&model);
     let mut x = u.clone();
     x.extend((0..41).map(|j| if j == 0 { -0.1 } else { 0.01 }));
@@ -542,10 +544,10 @@ fn structured_and_dense_newton_steps_agree_on_the_canonical_rod() {
 /// dense LU, up to `k_p = 1e5` times the contact stiffness scale (the scenes' default penalty).
 #[test]
 fn structured_solve_stays_backward_stable_for_stiff_penalties() {
-    let model = canonical_modified_rod();
+    let (model, omega) = canonical_modified_rod();
     let u = overshooting_displacement(&model);
     for relative in [1e1, 1e3, 1e5] {
-        let mut penalty = penalty_hb(&model, relative);
+        let mut penalty = penalty_hb(&model, omega, relative);
         let mut r = vec![0.0; u.len()];
         penalty.residual(&u, &mut r).unwrap();
         let mut jac = penalty.new_jacobian();
@@ -578,9 +580,9 @@ static ALLOCATOR: common::CountingAllocator = common::CountingAllocator;
 /// frequency allocates nothing once the workspaces exist.
 #[test]
 fn newton_iteration_work_is_allocation_free() {
-    let model = canonical_modified_rod();
-    let mut ssn = SsnHb::new(&model, &HbOptions::default()).unwrap();
-    let mut penalty = PenaltyHb::new(&model, &PenaltyHbOptions::for_model(&model)).unwrap();
+    let (model, omega) = canonical_modified_rod();
+    let mut ssn = SsnHb::new(&model, omega, &HbOptions::default()).unwrap();
+    let mut penalty = PenaltyHb::new(&model, omega, &PenaltyHbOptions::for_model(&model)).unwrap();
     fn iterate<P: GeneralizedJacobian<Jacobian = HbJacobian>>(p: &mut P, seed: u64) -> u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let x = random_vector(&mut rng, p.dim(), 0.5);
@@ -621,8 +623,12 @@ fn newton_options() -> SolveOptions {
 }
 
 /// Solves SSN-HB from zero with the structured solver; returns the solution and the report.
-fn solve_ssn(model: &StructuralModel, options: &HbOptions) -> (SsnHb, Vec<f64>, NewtonReport) {
-    let mut hb = SsnHb::new(model, options).unwrap();
+fn solve_ssn(
+    model: &StructuralModel,
+    omega: f64,
+    options: &HbOptions,
+) -> (SsnHb, Vec<f64>, NewtonReport) {
+    let mut hb = SsnHb::new(model, omega, options).unwrap();
     let mut x = vec![0.0; hb.dim()];
     let mut solver = StructuredHbSolver::new();
     let what = format!("SSN-HB, H = {}", options.harmonics);
@@ -648,9 +654,10 @@ fn solve_ssn(model: &StructuralModel, options: &HbOptions) -> (SsnHb, Vec<f64>, 
 /// LU; returns the problem, the solution and the report.
 fn solve_condensed(
     model: &StructuralModel,
+    omega: f64,
     options: &HbOptions,
 ) -> (CondensedSsnHb, Vec<f64>, NewtonReport) {
-    let mut condensed = CondensedSsnHb::new(model, options).unwrap();
+    let mut condensed = CondensedSsnHb::new(model, omega, options).unwrap();
     let mut lambda = vec![0.0; condensed.dim()];
     let what = format!("condensed SSN-HB, c = {:?}", options.c);
     let report = newton_converged(
@@ -688,14 +695,14 @@ fn sample_complementarity(hb: &SsnHb, x: &[f64], contact: ContactPoint) -> (f64,
 /// convergence for the same chain with mass 0.5 on the contact node).
 #[test]
 fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
-    let mut model = chain(3, Some(0.02), 0.5, vec![ContactPoint::new(2, 0.3)]);
+    let (mut model, omega) = chain(3, Some(0.02), 0.5, vec![ContactPoint::new(2, 0.3)]);
     let masses = [
         Triplet::new(0, 0, 1.0),
         Triplet::new(1, 1, 0.7),
         Triplet::new(2, 2, 0.0),
     ];
     model.mass = SparseColMat::try_new_from_triplets(3, 3, &masses).unwrap();
-    let free = exact_linear_response(&model);
+    let free = exact_linear_response(&model, omega);
     let free_amplitude = free.0[2].hypot(free.1[2]);
     assert!(
         free_amplitude > 0.6,
@@ -709,7 +716,7 @@ fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
             harmonics: h,
             ..HbOptions::default()
         };
-        let (hb, x, report) = solve_ssn(&model, &options);
+        let (hb, x, report) = solve_ssn(&model, omega, &options);
         let s = hb.summary(&x, 2, 4096).unwrap();
         let (penetration, positive, largest) = sample_complementarity(&hb, &x, model.contacts[0]);
         println!(
@@ -737,7 +744,7 @@ fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
 /// the AFT samples shrinks as H grows (H = 5, 10, 20, 40).
 #[test]
 fn canonical_modified_rod_ssn_hb_converges_from_zero() {
-    let model = canonical_modified_rod();
+    let (model, omega) = canonical_modified_rod();
     let mut tip_min = Vec::new();
     let mut penetrations = Vec::new();
     for h in [5, 10, 20, 40] {
@@ -746,7 +753,7 @@ fn canonical_modified_rod_ssn_hb_converges_from_zero() {
             ..HbOptions::default()
         };
         let start = std::time::Instant::now();
-        let (hb, x, report) = solve_ssn(&model, &options);
+        let (hb, x, report) = solve_ssn(&model, omega, &options);
         let elapsed = start.elapsed();
         let s = hb.summary(&x, 19, 1024).unwrap();
         let (penetration, _, _) = sample_complementarity(&hb, &x, model.contacts[0]);
@@ -785,18 +792,22 @@ fn canonical_modified_rod_ssn_hb_converges_from_zero() {
 /// (below 1e-2 relative at H = 20, less at H = 40).
 #[test]
 fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
-    let model = canonical_modified_rod();
+    let (model, omega) = canonical_modified_rod();
     let scale = model.contact_stiffness_scale();
     for (h, limit) in [(20, 1e-2), (40, 2e-3)] {
         let nt = 1024;
-        let (_, x, _) = solve_ssn(&model, &hb_options(h, Some(nt), None));
+        let (_, x, _) = solve_ssn(&model, omega, &hb_options(h, Some(nt), None));
         let reference = x[..model.dofs() * (2 * h + 1)].to_vec();
         let mut u = vec![0.0; reference.len()];
         let mut penetrations = Vec::new();
         let mut distance = f64::NAN;
         for relative in [1e1, 1e2, 1e3, 1e4, 1e5] {
-            let mut p =
-                PenaltyHb::new(&model, &penalty_options(h, Some(nt), relative * scale)).unwrap();
+            let mut p = PenaltyHb::new(
+                &model,
+                omega,
+                &penalty_options(h, Some(nt), relative * scale),
+            )
+            .unwrap();
             let report = newton_converged(
                 &format!("k_p = {relative:e}"),
                 &mut p,
@@ -829,10 +840,11 @@ fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
 /// wall time.
 fn timed_solve<S: Factorize<HbJacobian>>(
     model: &StructuralModel,
+    omega: f64,
     options: &HbOptions,
     mut solver: S,
 ) -> (Vec<f64>, NewtonReport, Duration) {
-    let mut hb = SsnHb::new(model, options).unwrap();
+    let mut hb = SsnHb::new(model, omega, options).unwrap();
     let mut x = vec![0.0; hb.dim()];
     let start = Instant::now();
     let smoothing = Some(SmoothingOf::new());
@@ -850,10 +862,10 @@ fn timed_solve<S: Factorize<HbJacobian>>(
 /// same solution (1e-10 relative).
 #[test]
 fn structured_and_dense_newton_solves_agree_on_the_canonical_rod() {
-    let model = canonical_modified_rod();
+    let (model, omega) = canonical_modified_rod();
     let options = HbOptions::default();
-    let (xs, rs, ts) = timed_solve(&model, &options, StructuredHbSolver::new());
-    let (xd, rd, td) = timed_solve(&model, &options, FaerDenseLu::new());
+    let (xs, rs, ts) = timed_solve(&model, omega, &options, StructuredHbSolver::new());
+    let (xd, rd, td) = timed_solve(&model, omega, &options, FaerDenseLu::new());
     println!(
         "H = 20: structured {} iterations in {ts:?}, dense {} iterations in {td:?} (ratio {:.1})",
         rs.iterations,
@@ -882,7 +894,8 @@ fn report_iterations_and_time_versus_elements() {
                 ..HbOptions::default()
             };
             let start = Instant::now();
-            let (mut condensed, lambda, reduced) = solve_condensed(&rod.model, &options);
+            let (mut condensed, lambda, reduced) =
+                solve_condensed(&rod.model, rod.omega(), &options);
             let reduced_time = start.elapsed();
             let sc = condensed.summary(&lambda, rod.tip_dof(), 1024).unwrap();
             println!(
@@ -892,8 +905,9 @@ fn report_iterations_and_time_versus_elements() {
             if elements > 1000 {
                 continue;
             }
-            let (x, report, elapsed) = timed_solve(&rod.model, &options, StructuredHbSolver::new());
-            let hb = SsnHb::new(&rod.model, &options).unwrap();
+            let (x, report, elapsed) =
+                timed_solve(&rod.model, rod.omega(), &options, StructuredHbSolver::new());
+            let hb = SsnHb::new(&rod.model, rod.omega(), &options).unwrap();
             let s = hb.summary(&x, rod.tip_dof(), 1024).unwrap();
             println!(
                 "elements {elements}, c = {c}: {:?} after {} iterations, {} residual evaluations, \
@@ -913,10 +927,10 @@ fn report_iterations_and_time_versus_elements() {
 /// answer (both satisfy |F| <= 1e-10; the root is isolated, so they agree to ~1e-10).
 #[test]
 fn condensed_ssn_hb_matches_the_full_problem_on_the_canonical_rod() {
-    let model = canonical_modified_rod();
+    let (model, omega) = canonical_modified_rod();
     let options = HbOptions::default();
-    let (mut full, x_full, full_report) = solve_ssn(&model, &options);
-    let (mut condensed, lambda, report) = solve_condensed(&model, &options);
+    let (mut full, x_full, full_report) = solve_ssn(&model, omega, &options);
+    let (mut condensed, lambda, report) = solve_condensed(&model, omega, &options);
     let x = condensed.expand(&lambda).unwrap();
     let mut r = vec![0.0; full.dim()];
     full.residual(&x, &mut r).unwrap();
@@ -947,7 +961,8 @@ fn static_contact_stiffness_of_the_rod_is_ea_over_l_for_any_mesh() {
         spec.elements = elements;
         spec.contacts[0].node = elements;
         let rod = build_rod(&spec).unwrap();
-        let condensed = CondensedSsnHb::new(&rod.model, &HbOptions::default()).unwrap();
+        let condensed =
+            CondensedSsnHb::new(&rod.model, rod.omega(), &HbOptions::default()).unwrap();
         let k = condensed.static_contact_stiffness();
         assert!((k - 1.0).abs() < 1e-12, "{elements} elements: {k}");
         assert!((rod.model.contact_stiffness_scale() - elements as f64).abs() < 1e-9);
@@ -956,9 +971,9 @@ fn static_contact_stiffness_of_the_rod_is_ea_over_l_for_any_mesh() {
 
 #[test]
 fn smoothed_ssn_jacobian_and_mu_derivative_match_central_differences() {
-    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
+    let (model, omega) = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
     let (h, nt) = (3, 16);
-    let mut hb = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut hb = SsnHb::new(&model, omega, &hb_options(h, Some(nt), Some(2.0))).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let x = random_vector(&mut rng, hb.dim(), 0.5);
     let mu = 0.05;
@@ -1003,10 +1018,10 @@ fn smoothed_ssn_jacobian_and_mu_derivative_match_central_differences() {
 
 #[test]
 fn zero_smoothing_is_the_formulation_itself_and_small_smoothing_is_within_mu() {
-    let model = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
+    let (model, omega) = chain(3, Some(0.02), 0.9, contacts(&[(1, 0.2), (2, 0.1)]));
     let (h, nt) = (3, 16);
-    let mut plain = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
-    let mut smoothed = SsnHb::new(&model, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut plain = SsnHb::new(&model, omega, &hb_options(h, Some(nt), Some(2.0))).unwrap();
+    let mut smoothed = SsnHb::new(&model, omega, &hb_options(h, Some(nt), Some(2.0))).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(12);
     let x = random_vector(&mut rng, plain.dim(), 0.5);
     let n = plain.dim();

@@ -139,14 +139,12 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
     let newton = common::plain_newton();
     let mut worst: f64 = 0.0;
     let mut worst_gap: f64 = 0.0;
-    let mut model = rod.model.clone();
     for (i, y) in r.states.iter().enumerate() {
-        model.forcing.omega = r.omega[i];
         let options = PeriodicLcpOptions {
             time_samples: 128,
             ..Default::default()
         };
-        let lcp = PeriodicLcp::new(&model, options).unwrap();
+        let lcp = PeriodicLcp::new(&rod.model, r.omega[i], options).unwrap();
         let n = lcp.dim();
         assert_eq!(y.len(), 2 * n);
         let (w, z0) = y.split_at(n);

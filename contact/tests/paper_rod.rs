@@ -18,16 +18,16 @@ fn march(spec: &RodSpec, steps: usize) -> Solution {
         max_periods: 5000,
         ..common::march(steps, 1e-10)
     };
-    solve(&rod, &settings, None).unwrap()
+    solve(&rod, rod.omega(), &settings, None).unwrap()
 }
 
 /// Exact steady response of the tip, `Re(U e^{i w t})` with `(K - w^2 M + i w D) U = f`,
 /// solved densely in complex arithmetic (independent of the HB code).
 fn exact_linear_tip(spec: &RodSpec, times: &[f64]) -> Vec<f64> {
     use nalgebra::Complex;
-    let model = build_rod(spec).unwrap().structure.model;
-    let w = model.forcing.omega;
-    let tip = common::exact_linear(&model, w)[model.dofs() - 1];
+    let rod = build_rod(spec).unwrap();
+    let (model, w) = (&rod.model, rod.omega());
+    let tip = common::exact_linear(model, w)[model.dofs() - 1];
     times
         .iter()
         .map(|t| (tip * Complex::new((w * t).cos(), (w * t).sin())).re)
@@ -52,7 +52,7 @@ fn without_contact_the_hb_answer_is_the_exact_linear_response_after_one_newton_s
             ..RodSpec::canonical()
         };
         let rod = build_rod(&spec).unwrap();
-        let s = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+        let s = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(20), None).unwrap();
         assert!(s.converged(), "{label}");
         assert_eq!(s.iterations, 1, "{label}: Newton must stop after one step");
         let exact = exact_linear_tip(&spec, &s.times);
@@ -75,7 +75,7 @@ fn canonical_case_converges_from_zero_for_every_harmonic_count_from_5_to_40() {
     for mass in [MassModel::Consistent, MassModel::Modified] {
         let rod = build_rod(&common::canonical(mass)).unwrap();
         for h in [5, 10, 15, 20, 25, 30, 35, 40] {
-            let s = solve(&rod, &SolverSettings::with_harmonics(h), None).unwrap();
+            let s = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(h), None).unwrap();
             assert!(
                 s.converged() && s.residual_norm <= 1e-10,
                 "{mass:?} H = {h}: {} after {} iterations, residual {:e}",

@@ -18,8 +18,9 @@ use semismooth_contact::model::{InvalidModel, SparseMatrix, StructuralModel};
 use semismooth_contact::rod::{build_rod, MassModel, RodContact, RodModel, RodSpec};
 use semismooth_contact::solve::{Diagnosis, Termination};
 
-/// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5).
-fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
+/// The canonical rod with contacts at node `inner` (gap 0.3) and at the tip (gap 0.5): its
+/// model and forcing frequency.
+fn two_contact_rod(mass: MassModel, inner: usize) -> (StructuralModel, f64) {
     let mut spec = RodSpec::canonical();
     spec.mass = mass;
     spec.contacts = vec![
@@ -29,16 +30,25 @@ fn two_contact_rod(mass: MassModel, inner: usize) -> StructuralModel {
         },
         RodContact { node: 20, gap: 0.5 },
     ];
-    build_rod(&spec).unwrap().structure.model
+    model_and_omega(&spec)
 }
 
-fn rod(mass: MassModel, damped: bool) -> StructuralModel {
+/// The canonical rod (damped or not) with the mass model `mass`: its model and forcing
+/// frequency.
+fn rod(mass: MassModel, damped: bool) -> (StructuralModel, f64) {
     let mut spec = RodSpec::canonical();
     spec.mass = mass;
     if !damped {
         spec.damping = None;
     }
-    build_rod(&spec).unwrap().structure.model
+    model_and_omega(&spec)
+}
+
+/// The model built from `spec` and the spec's forcing frequency.
+fn model_and_omega(spec: &RodSpec) -> (StructuralModel, f64) {
+    let rod = build_rod(spec).unwrap();
+    let omega = rod.omega();
+    (rod.structure.model, omega)
 }
 
 fn options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
@@ -70,12 +80,11 @@ fn at_nodes(x: &DVector<Complex<f64>>, nt: usize) -> Vec<Vec<f64>> {
 
 #[test]
 fn linear_response_is_the_frequency_response_at_the_warped_frequency_with_second_order_error() {
-    let model = rod(MassModel::Consistent, true);
+    let (model, omega) = rod(MassModel::Consistent, true);
     let dofs: Vec<usize> = (0..model.dofs()).collect();
-    let omega = model.forcing.omega;
     let mut errors = Vec::new();
     for nt in [32usize, 64, 128, 256, 512] {
-        let lcp = PeriodicLcp::new(&model, options(nt, dofs.clone())).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, dofs.clone())).unwrap();
         let zero = vec![0.0; lcp.dim()];
         let u = lcp.displacements(&zero).unwrap();
         // The discrete answer is exactly the frequency response at the warped frequency
@@ -114,9 +123,9 @@ fn assert_second_order(errors: &[f64]) {
 fn block_row_sums_of_a_are_the_static_compliance_of_the_contacts() {
     // Two contacts (mid-rod and tip): exercises the m x m blocks.
     for mass in [MassModel::Modified, MassModel::Consistent] {
-        let model = two_contact_rod(mass, 10);
+        let (model, omega) = two_contact_rod(mass, 10);
         let nt = 64;
-        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
         let m = 2;
         let k = dense(&model.stiffness);
@@ -153,12 +162,13 @@ fn block_row_sums_of_a_are_the_static_compliance_of_the_contacts() {
 /// For odd `Nt` the system is regular (no Nyquist bin).
 fn trapezoidal_contact_displacement(
     model: &StructuralModel,
+    omega: f64,
     nt: usize,
     lambda: &[f64],
 ) -> Vec<f64> {
     let n = model.dofs();
     let (k, m, d) = dense_kmd(model);
-    let dt = 2.0 * std::f64::consts::PI / model.forcing.omega / nt as f64;
+    let dt = 2.0 * std::f64::consts::PI / omega / nt as f64;
     let size = 2 * n * nt;
     let u = |step: usize, i: usize| (step % nt) * 2 * n + i;
     let v = |step: usize, i: usize| (step % nt) * 2 * n + n + i;
@@ -182,8 +192,8 @@ fn trapezoidal_contact_displacement(
             }
             let t0 = step as f64 * dt;
             let t1 = t0 + dt;
-            let w = model.forcing.omega;
-            let mut rhs = model.forcing.amplitude[i] * ((w * t0).cos() + (w * t1).cos());
+            let w = omega;
+            let mut rhs = model.load[i] * ((w * t0).cos() + (w * t1).cos());
             if i == tip {
                 rhs += lambda[step] + lambda[(step + 1) % nt];
             }
@@ -201,14 +211,14 @@ fn lcp_gap_equals_the_time_domain_trapezoidal_rule_for_odd_nt() {
         spec.elements = 4;
         spec.mass = mass;
         spec.contacts = vec![RodContact { node: 4, gap: 0.5 }];
-        let model = build_rod(&spec).unwrap().structure.model;
+        let (model, omega) = model_and_omega(&spec);
         let nt = 15; // odd, not a power of two: the direct-DFT path
-        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         let z: Vec<f64> = (0..nt)
             .map(|n| (0.3 + (1.7 * n as f64).sin()).max(0.0) * 0.05)
             .collect();
         let lambda: Vec<f64> = z.iter().map(|v| -v).collect();
-        let reference = trapezoidal_contact_displacement(&model, nt, &lambda);
+        let reference = trapezoidal_contact_displacement(&model, omega, nt, &lambda);
         let from_lcp = &lcp.contact_displacements(&z).unwrap()[0];
         let by_fft = &lcp.contact_displacements_by_fft(&z).unwrap()[0];
         let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -247,13 +257,14 @@ fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem
     let nt = 128;
     for mass in [MassModel::Modified, MassModel::Consistent] {
         // Undamped: every H_k = G (K - s_k^2 M)^{-1} G^T is real, the kernel is even in time.
-        let undamped = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+        let (undamped, omega) = rod(mass, false);
+        let undamped = PeriodicLcp::new(&undamped, omega, options(nt, vec![])).unwrap();
         let a = undamped.matrix();
         assert!(transpose_distance(a, a) < 1e-13 * max_entry(a), "{mass:?}");
 
         // Damped: H_k has an imaginary part, odd in k, so the kernel has an odd part.
-        let model = rod(mass, true);
-        let damped = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let (model, omega) = rod(mass, true);
+        let damped = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         let a = damped.matrix();
         let asymmetry = transpose_distance(a, a) / max_entry(a);
         assert!(
@@ -269,7 +280,7 @@ fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem
             symbolic,
             values.iter().map(|v| -v).collect(),
         ));
-        let time_reversed = PeriodicLcp::new(&reversed, options(nt, vec![])).unwrap();
+        let time_reversed = PeriodicLcp::new(&reversed, omega, options(nt, vec![])).unwrap();
         assert!(
             transpose_distance(a, time_reversed.matrix()) < 1e-12 * max_entry(a),
             "{mass:?}"
@@ -279,9 +290,9 @@ fn a_is_symmetric_without_damping_and_its_transpose_is_the_time_reversed_problem
 
 #[test]
 fn symmetric_part_spectrum_from_the_bins_matches_a_dense_eigensolver() {
-    let model = two_contact_rod(MassModel::Consistent, 12);
+    let (model, omega) = two_contact_rod(MassModel::Consistent, 12);
     for nt in [16usize, 21] {
-        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         let a = lcp.matrix();
         let n = lcp.dim();
         let s = DMatrix::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
@@ -300,8 +311,8 @@ fn symmetric_part_spectrum_from_the_bins_matches_a_dense_eigensolver() {
 fn nyquist_bin_is_the_static_receptance_of_the_massless_undamped_dofs() {
     let nt = 64;
     // Undamped modified mass: the tip has neither mass nor damping, H_{Nt/2} = 1 / K_tt.
-    let model = rod(MassModel::Modified, false);
-    let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+    let (model, omega) = rod(MassModel::Modified, false);
+    let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
     assert_eq!(lcp.static_dof_count(), 1);
     let h = lcp.receptance(nt / 2)[0];
     let k_tt = dense(&model.stiffness)[(19, 19)];
@@ -311,7 +322,8 @@ fn nyquist_bin_is_the_static_receptance_of_the_massless_undamped_dofs() {
     assert!((near.re - 1.0 / k_tt).abs() < 0.05 / k_tt, "{near}");
     // Damped (stiffness-proportional, the tip is damped) or massive tip: the limit is 0.
     for (mass, damped) in [(MassModel::Modified, true), (MassModel::Consistent, false)] {
-        let lcp = PeriodicLcp::new(&rod(mass, damped), options(nt, vec![])).unwrap();
+        let (model, omega) = rod(mass, damped);
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         assert_eq!(lcp.static_dof_count(), 0);
         assert_eq!(lcp.receptance(nt / 2)[0].norm(), 0.0);
     }
@@ -319,9 +331,9 @@ fn nyquist_bin_is_the_static_receptance_of_the_massless_undamped_dofs() {
 
 #[test]
 fn bad_options_and_models_are_typed_errors() {
-    let model = rod(MassModel::Modified, true);
+    let (model, omega) = rod(MassModel::Modified, true);
     for nt in [0usize, 1, 7, 8193] {
-        match PeriodicLcp::new(&model, options(nt, vec![])) {
+        match PeriodicLcp::new(&model, omega, options(nt, vec![])) {
             Err(LcpError::InvalidOption { name, value, .. }) => {
                 assert_eq!(name, "time_samples");
                 assert_eq!(value, nt as f64);
@@ -329,24 +341,22 @@ fn bad_options_and_models_are_typed_errors() {
             other => panic!("Nt = {nt}: {other:?}"),
         }
     }
-    assert!(PeriodicLcp::new(&model, options(8, vec![])).is_ok());
+    assert!(PeriodicLcp::new(&model, omega, options(8, vec![])).is_ok());
     assert_eq!(
-        PeriodicLcp::new(&model, options(16, vec![20])).unwrap_err(),
+        PeriodicLcp::new(&model, omega, options(16, vec![20])).unwrap_err(),
         LcpError::Model(InvalidModel::ObservedDofOutOfRange { dof: 20, dofs: 20 })
     );
     let mut free = model.clone();
     free.contacts.clear();
     assert_eq!(
-        PeriodicLcp::new(&free, options(16, vec![])).unwrap_err(),
+        PeriodicLcp::new(&free, omega, options(16, vec![])).unwrap_err(),
         LcpError::NoContacts
     );
-    let mut bad = model.clone();
-    bad.forcing.omega = f64::NAN;
     assert!(matches!(
-        PeriodicLcp::new(&bad, options(16, vec![])),
-        Err(LcpError::Model(InvalidModel::Omega { .. }))
+        PeriodicLcp::new(&model, f64::NAN, options(16, vec![])),
+        Err(LcpError::InvalidOption { name: "omega", value, .. }) if value.is_nan()
     ));
-    let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
+    let lcp = PeriodicLcp::new(&model, omega, options(16, vec![])).unwrap();
     assert_eq!(
         lcp.gap(&[0.0; 3]).unwrap_err(),
         LcpError::WrongLength {
@@ -415,7 +425,8 @@ fn report_lcp_numbers() {
     let minimum = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
     for mass in [MassModel::Modified, MassModel::Consistent] {
         for nt in [256usize, 1024] {
-            let lcp = PeriodicLcp::new(&rod(mass, false), options(nt, vec![])).unwrap();
+            let (model, omega) = rod(mass, false);
+            let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
             let (lo, hi) = lcp.symmetric_part_spectrum();
             let lemke = lemke_solution(&lcp);
             println!(
@@ -432,11 +443,11 @@ fn report_lcp_numbers() {
         MassModel::Consistent,
         MassModel::Lumped,
     ] {
-        let model = rod(mass, true);
+        let (model, omega) = rod(mass, true);
         let mut previous: Option<Vec<f64>> = None;
         for nt in [128usize, 256, 512, 1024, 2048] {
             let start = std::time::Instant::now();
-            let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+            let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
             let build = start.elapsed().as_secs_f64();
             let (lo, hi) = lcp.symmetric_part_spectrum();
             let start = std::time::Instant::now();
@@ -474,12 +485,13 @@ fn report_lcp_numbers() {
 
 #[test]
 fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass() {
-    let model = rod(MassModel::Modified, true);
+    let (model, omega) = rod(MassModel::Modified, true);
     for nt in [256usize, 1024] {
         // Newton by mesh sequencing (128 -> ... -> Nt, each level warm-started from the
         // interpolated previous Newton solution); Lemke independently on the finest LCP.
-        let lcp = &PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
-        let sequenced = solve_min_map_sequenced(&model, lcp, &SolveOptions::default()).unwrap();
+        let lcp = &PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
+        let sequenced =
+            solve_min_map_sequenced(&model, omega, lcp, &SolveOptions::default()).unwrap();
         assert!(sequenced.converged(), "Nt = {nt}: {:?}", sequenced.levels);
         assert_eq!(
             sequenced.levels.len(),
@@ -511,13 +523,14 @@ fn lemke_and_semismooth_newton_give_the_same_lcp_solution_with_the_modified_mass
 
 #[test]
 fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much_longer() {
-    let model = rod(MassModel::Consistent, true);
-    let lcp = PeriodicLcp::new(&model, options(256, vec![])).unwrap();
+    let (model, omega) = rod(MassModel::Consistent, true);
+    let lcp = PeriodicLcp::new(&model, omega, options(256, vec![])).unwrap();
     // The symmetric part of A is indefinite (its eigenvalues are Re H_k: negative above
     // a resonance), here by much more than with the modified mass.
     let (lo, hi) = lcp.symmetric_part_spectrum();
     assert!(lo < -1e-2 && hi > 0.0, "[{lo}, {hi}]");
-    let modified = PeriodicLcp::new(&rod(MassModel::Modified, true), options(256, vec![])).unwrap();
+    let (modified, omega) = rod(MassModel::Modified, true);
+    let modified = PeriodicLcp::new(&modified, omega, options(256, vec![])).unwrap();
     assert!(modified.symmetric_part_spectrum().0 > lo / 2.0);
     // With the default pivot limit 50 n + 100 Lemke stops without a solution (no ray):
     assert_not_solved(&lcp, LemkeTermination::PivotLimit, 50 * lcp.dim() + 100);
@@ -553,15 +566,16 @@ fn consistent_mass_makes_the_symmetric_part_more_indefinite_and_lemke_paths_much
 #[test]
 fn lcp_solution_is_the_steady_state_of_the_massless_contact_trapezoidal_march_with_the_same_step() {
     use semismooth_contact::march::{march_to_steady_state, MarchOptions, MarchScheme};
-    let model = rod(MassModel::Modified, true);
+    let (model, omega) = rod(MassModel::Modified, true);
     let tip = model.dofs() - 1;
     for nt in [128usize, 512] {
-        let lcp = PeriodicLcp::new(&model, options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, options(nt, vec![])).unwrap();
         let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
         let u = &lcp.contact_displacements(&lemke.z).unwrap()[0];
         let lambda = &lcp.contact_forces(&lemke.z).unwrap()[0];
         let march = march_to_steady_state(
             &model,
+            omega,
             &MarchOptions {
                 steps_per_period: nt,
                 max_periods: 5000,
@@ -589,8 +603,8 @@ fn lcp_solution_is_the_steady_state_of_the_massless_contact_trapezoidal_march_wi
 
 #[test]
 fn force_interpolation_reproduces_periodic_piecewise_linear_histories() {
-    let model = two_contact_rod(MassModel::Modified, 10);
-    let lcp = PeriodicLcp::new(&model, options(16, vec![])).unwrap();
+    let (model, omega) = two_contact_rod(MassModel::Modified, 10);
+    let lcp = PeriodicLcp::new(&model, omega, options(16, vec![])).unwrap();
     // A coarse history of 4 nodes, 2 contacts (time-major): a triangle wave per contact.
     let coarse = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 2.0, 3.0];
     let fine = lcp.interpolate_forces(&coarse).unwrap();
@@ -616,7 +630,8 @@ fn undamped_forcing_at_resonance_ends_lemke_on_a_ray_reported_with_the_numbers()
     // Without damping, forcing at omega_1 puts bin 1 (warped just above omega_1) next to
     // the resonance: H_1 is large and negative, so the symmetric part of A (eigenvalues
     // Re H_k) is strongly indefinite; Lemke's method ends on a secondary ray.
-    let lcp = PeriodicLcp::new(&rod(MassModel::Modified, false), options(256, vec![])).unwrap();
+    let (model, omega) = rod(MassModel::Modified, false);
+    let lcp = PeriodicLcp::new(&model, omega, options(256, vec![])).unwrap();
     let (lo, _) = lcp.symmetric_part_spectrum();
     let h1 = lcp.receptance(1)[0];
     assert_eq!(h1.im, 0.0);
@@ -647,7 +662,7 @@ fn forty_element_lcp_with(
         scheme,
         ..options(nt, vec![])
     };
-    let lcp = PeriodicLcp::new(&rod.structure.model, lcp_options).unwrap();
+    let lcp = PeriodicLcp::new(&rod.structure.model, rod.omega(), lcp_options).unwrap();
     (lcp, lcp_ssn_from_zero(&rod, nt, scheme, 200))
 }
 
@@ -675,7 +690,7 @@ fn lcp_ssn_from_zero(
         max_iterations,
         ..semismooth_contact::settings::SolverSettings::with_harmonics(20)
     };
-    semismooth_contact::solve::solve(rod, &settings, None).unwrap()
+    semismooth_contact::solve::solve(rod, rod.omega(), &settings, None).unwrap()
 }
 
 /// Why `lcp-ssn` does not converge from zero on the strongly forced 40-element rod with its
@@ -760,7 +775,7 @@ fn strongly_forced_rod_has_a_chattering_nearly_degenerate_lcp_solution_with_a_ti
         time_samples: nt,
         ..semismooth_contact::settings::SolverSettings::with_harmonics(20)
     };
-    let lemke_run = semismooth_contact::solve::solve(&rod, &settings, None).unwrap();
+    let lemke_run = semismooth_contact::solve::solve(&rod, rod.omega(), &settings, None).unwrap();
     assert!(
         matches!(
             lemke_run.termination,
@@ -834,12 +849,12 @@ fn every_sequencing_level_stays_within_the_iteration_budget_when_it_fails() {
     let rod = forty_element_rod_with(MassModel::Modified);
     let model = &rod.structure.model;
     for (nt, budget) in [(512, 200), (1024, 200), (1024, 60)] {
-        let lcp = PeriodicLcp::new(model, options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(model, rod.omega(), options(nt, vec![])).unwrap();
         let newton_options = SolveOptions::Polyalgorithm(PolyalgorithmOptions {
             max_iterations: budget,
             ..PolyalgorithmOptions::default()
         });
-        let solved = solve_min_map_sequenced(model, &lcp, &newton_options).unwrap();
+        let solved = solve_min_map_sequenced(model, rod.omega(), &lcp, &newton_options).unwrap();
         assert!(!solved.converged(), "Nt = {nt}");
         for level in &solved.levels {
             assert!(
@@ -861,9 +876,7 @@ fn response_at_symbol(model: &StructuralModel, s: Complex<f64>) -> DVector<Compl
     let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
         s * s * m[(i, j)] + s * d[(i, j)] + k[(i, j)]
     });
-    let f = DVector::from_fn(k.nrows(), |i, _| {
-        Complex::new(model.forcing.amplitude[i], 0.0)
-    });
+    let f = DVector::from_fn(k.nrows(), |i, _| Complex::new(model.load[i], 0.0));
     z.lu().solve(&f).unwrap()
 }
 
@@ -883,12 +896,11 @@ fn bdf2_options(nt: usize, observed: Vec<usize>) -> PeriodicLcpOptions {
 
 #[test]
 fn bdf2_linear_response_is_the_response_at_its_symbol_and_converges_at_second_order() {
-    let model = rod(MassModel::Consistent, true);
+    let (model, omega) = rod(MassModel::Consistent, true);
     let dofs: Vec<usize> = (0..model.dofs()).collect();
-    let omega = model.forcing.omega;
     let mut errors = Vec::new();
     for nt in [128usize, 256, 512, 1024] {
-        let lcp = PeriodicLcp::new(&model, bdf2_options(nt, dofs.clone())).unwrap();
+        let lcp = PeriodicLcp::new(&model, omega, bdf2_options(nt, dofs.clone())).unwrap();
         let u = lcp.displacements(&vec![0.0; lcp.dim()]).unwrap();
         let dt = lcp.time_step();
         let symbol = bdf2(2.0 * std::f64::consts::PI / nt as f64, dt);
@@ -921,9 +933,9 @@ fn bdf2_nyquist_receptance_is_positive_so_the_alternating_force_is_no_null_vecto
         let model = &rod.structure.model;
         let tip = model.contacts[0].dof;
         let nt = 128;
-        let trapezoidal = PeriodicLcp::new(model, options(nt, vec![])).unwrap();
+        let trapezoidal = PeriodicLcp::new(model, rod.omega(), options(nt, vec![])).unwrap();
         assert_eq!(trapezoidal.receptance(nt / 2)[0].re, 0.0);
-        let lcp = PeriodicLcp::new(model, bdf2_options(nt, vec![])).unwrap();
+        let lcp = PeriodicLcp::new(model, rod.omega(), bdf2_options(nt, vec![])).unwrap();
         let s = 4.0 / lcp.time_step();
         let (k, m, d) = dense_kmd(model);
         let z = &k + &d * s + &m * (s * s);
@@ -1043,7 +1055,8 @@ fn bdf2_tip_minimum_converges_at_second_order_to_the_trapezoidal_lcps() {
         .into_iter()
         .map(|nt| {
             let rod = forty_element_rod_with(MassModel::Modified);
-            let lcp = PeriodicLcp::new(&rod.structure.model, options(nt, vec![])).unwrap();
+            let lcp =
+                PeriodicLcp::new(&rod.structure.model, rod.omega(), options(nt, vec![])).unwrap();
             let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
             tip_min(&lcp, &lemke.z)
         })
@@ -1079,7 +1092,8 @@ fn bdf2_with_a_massive_contact_node_solves_up_to_nt_512_and_not_at_1024() {
             "Nt = {nt}: {}",
             sol.iterations
         );
-        let lcp = PeriodicLcp::new(&rod.structure.model, bdf2_options(nt, vec![])).unwrap();
+        let lcp =
+            PeriodicLcp::new(&rod.structure.model, rod.omega(), bdf2_options(nt, vec![])).unwrap();
         let lemke = lcp.check_lemke(lemke_solution(&lcp)).unwrap();
         let zmax = lemke.z.iter().cloned().fold(0.0, f64::max);
         assert!(

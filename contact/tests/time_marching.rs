@@ -28,19 +28,19 @@ fn modified_rod() -> RodModel {
     build_rod(&common::canonical(MassModel::Modified)).unwrap()
 }
 
-/// Exact steady response of `M u'' + D u' + K u = f cos(omega t)` without contact:
-/// `u(t) = u_c cos(omega t) + u_s sin(omega t)`, `u_c - i u_s = z` with
+/// Exact steady response of `M u'' + D u' + K u = f cos(w t)` without contact:
+/// `u(t) = u_c cos(w t) + u_s sin(w t)`, `u_c - i u_s = z` with
 /// `(K - w^2 M + i w D) z = f` (dense complex LU, nalgebra).
-fn linear_response(model: &StructuralModel) -> (DVector<f64>, DVector<f64>) {
-    let z = common::exact_linear(model, model.forcing.omega);
+fn linear_response(model: &StructuralModel, w: f64) -> (DVector<f64>, DVector<f64>) {
+    let z = common::exact_linear(model, w);
     (z.map(|c| c.re), z.map(|c| -c.im))
 }
 
-/// Largest error of the marched period against the exact response on the observed dofs,
-/// relative to the largest exact displacement.
+/// Largest error of the marched period against the exact response at its frequency on the
+/// observed dofs, relative to the largest exact displacement.
 fn linear_error(model: &StructuralModel, period: &SteadyPeriod) -> f64 {
-    let (uc, us) = linear_response(model);
-    let w = model.forcing.omega;
+    let w = period.omega;
+    let (uc, us) = linear_response(model, w);
     let mut err = 0.0_f64;
     let mut scale = 0.0_f64;
     for (o, &dof) in period.observed_dofs.iter().enumerate() {
@@ -72,7 +72,7 @@ fn trapezoidal_without_contact_converges_at_second_order_to_the_exact_linear_res
             tolerance: 1e-11,
             ..MarchOptions::default()
         };
-        let period = march_to_steady_state(&rod.model, &options, &observed).unwrap();
+        let period = march_to_steady_state(&rod.model, rod.omega(), &options, &observed).unwrap();
         assert_eq!(period.scheme, MarchScheme::MasslessContactTrapezoidal);
         assert_eq!(period.counters.factorizations, 1);
         assert_eq!(period.counters.contact_solves, 0);
@@ -105,7 +105,8 @@ fn massless_contact_trapezoidal_never_penetrates_and_is_complementary_at_every_s
         steps_per_period: 1000,
         ..MarchOptions::default()
     };
-    let mut marcher = TimeMarcher::new(model, &options, &MarchState::rest(model)).unwrap();
+    let mut marcher =
+        TimeMarcher::new(model, rod.omega(), &options, &MarchState::rest(model)).unwrap();
     assert_eq!(marcher.scheme(), MarchScheme::MasslessContactTrapezoidal);
     let mut contact_steps = 0;
     for _ in 0..30 * 1000 {
@@ -141,7 +142,8 @@ fn canonical_modified_period(spp: usize, tolerance: f64) -> (SteadyPeriod, f64) 
         ..MarchOptions::default()
     };
     let start = Instant::now();
-    let period = march_to_steady_state(&rod.model, &options, &[rod.tip_dof()]).unwrap();
+    let period =
+        march_to_steady_state(&rod.model, rod.omega(), &options, &[rod.tip_dof()]).unwrap();
     (period, start.elapsed().as_secs_f64())
 }
 
@@ -220,8 +222,13 @@ fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
             steps_per_period: 500,
             ..MarchOptions::default()
         };
-        let mut marcher =
-            TimeMarcher::new(&rod.model, &options, &MarchState::rest(&rod.model)).unwrap();
+        let mut marcher = TimeMarcher::new(
+            &rod.model,
+            rod.omega(),
+            &options,
+            &MarchState::rest(&rod.model),
+        )
+        .unwrap();
         for _ in 0..20 * 500 {
             let (before, solves) = (allocations(), marcher.counters().contact_solves);
             marcher.step().unwrap();
@@ -251,9 +258,15 @@ fn warm_start_from_a_steady_state_is_steady_after_two_periods() {
         steps_per_period: 400,
         ..MarchOptions::default()
     };
-    let first = march_to_steady_state(&rod.model, &options, &[rod.tip_dof()]).unwrap();
-    let second =
-        march_from_state(&rod.model, &options, &[rod.tip_dof()], &first.final_state).unwrap();
+    let first = march_to_steady_state(&rod.model, rod.omega(), &options, &[rod.tip_dof()]).unwrap();
+    let second = march_from_state(
+        &rod.model,
+        rod.omega(),
+        &options,
+        &[rod.tip_dof()],
+        &first.final_state,
+    )
+    .unwrap();
     assert_eq!(second.periods, 2);
     let diff = first.displacements[0]
         .iter()
@@ -287,8 +300,13 @@ fn moreau_jean_statistics(restitution: f64, spp: usize) -> ImpactStatistics {
         scheme: moreau_jean(0.5, restitution),
         ..MarchOptions::default()
     };
-    let mut marcher =
-        TimeMarcher::new(&rod.model, &options, &MarchState::rest(&rod.model)).unwrap();
+    let mut marcher = TimeMarcher::new(
+        &rod.model,
+        rod.omega(),
+        &options,
+        &MarchState::rest(&rod.model),
+    )
+    .unwrap();
     let h = marcher.step_size();
     let (transient, measured) = (300, 50);
     let mut stats = ImpactStatistics {
@@ -359,7 +377,8 @@ fn moreau_jean_on_consistent_mass_penetrates_at_most_one_step_and_depends_on_res
         scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
         ..MarchOptions::default()
     };
-    let period = march_to_steady_state(&rod.model, &options, &[rod.tip_dof()]).unwrap();
+    let period =
+        march_to_steady_state(&rod.model, rod.omega(), &options, &[rod.tip_dof()]).unwrap();
     let (lo, _) = extremes(&period.displacements[0]);
     assert!(
         (lo - plastic.tip_min).abs() < 1e-6,
@@ -409,7 +428,7 @@ fn undamped_massless_contact_trapezoidal_balances_energy_exactly_at_every_step()
             steps_per_period: spp,
             ..MarchOptions::default()
         };
-        let mut marcher = TimeMarcher::new(model, &options, &initial).unwrap();
+        let mut marcher = TimeMarcher::new(model, rod.omega(), &options, &initial).unwrap();
         let e0 = energy(&initial.displacement, &initial.velocity);
         let (mut e_prev, mut u_prev, mut l_prev) = (e0, u0[n - 1], 0.0);
         let (mut transitions, mut excursion, mut worst_identity) = (0, 0.0_f64, 0.0_f64);
@@ -469,14 +488,21 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
     for (spoil, field) in cases {
         let mut options = MarchOptions::default();
         spoil(&mut options);
-        let err = march_to_steady_state(model, &options, &[19]).unwrap_err();
+        let err = march_to_steady_state(model, rod.omega(), &options, &[19]).unwrap_err();
         assert!(
             matches!(err, MarchError::InvalidOption { name, .. } if name == field),
             "{err}"
         );
         assert!(err.to_string().contains(field), "{err}");
     }
-    let err = march_to_steady_state(model, &MarchOptions::default(), &[20]).unwrap_err();
+    // The frequency is the march's argument, checked like an option.
+    let err = march_to_steady_state(model, -1.0, &MarchOptions::default(), &[19]).unwrap_err();
+    assert!(
+        matches!(err, MarchError::InvalidOption { name: "omega", value, .. } if value == -1.0),
+        "{err}"
+    );
+    let err =
+        march_to_steady_state(model, rod.omega(), &MarchOptions::default(), &[20]).unwrap_err();
     assert_eq!(
         err,
         MarchError::Model(InvalidModel::ObservedDofOutOfRange { dof: 20, dofs: 20 })
@@ -485,7 +511,8 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         displacement: vec![0.0; 3],
         ..MarchState::rest(model)
     };
-    let err = march_from_state(model, &MarchOptions::default(), &[], &short).unwrap_err();
+    let err =
+        march_from_state(model, rod.omega(), &MarchOptions::default(), &[], &short).unwrap_err();
     assert_eq!(
         err,
         MarchError::StateDimension {
@@ -500,7 +527,8 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         scheme: MarchScheme::MasslessContactTrapezoidal,
         ..MarchOptions::default()
     };
-    let err = march_to_steady_state(&consistent.model, &options, &[]).unwrap_err();
+    let err =
+        march_to_steady_state(&consistent.model, consistent.omega(), &options, &[]).unwrap_err();
     assert!(
         matches!(err, MarchError::MassiveContactDof { dof: 19, .. }),
         "{err}"
@@ -511,7 +539,7 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         max_periods: 3,
         ..MarchOptions::default()
     };
-    match march_to_steady_state(model, &options, &[19]).unwrap_err() {
+    match march_to_steady_state(model, rod.omega(), &options, &[19]).unwrap_err() {
         MarchError::NotSteady {
             periods,
             change,
@@ -556,6 +584,7 @@ fn report_canonical_modified_mass_refinement_table() {
 /// report and the tip summary on 4096 points.
 fn ssn_hb_tip(
     model: &StructuralModel,
+    omega: f64,
     harmonics: usize,
     tip: usize,
 ) -> (
@@ -566,6 +595,7 @@ fn ssn_hb_tip(
     use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
     let mut hb = SsnHb::new(
         model,
+        omega,
         &HbOptions {
             harmonics,
             ..HbOptions::default()
@@ -597,7 +627,7 @@ fn report_harmonic_balance_against_the_reference() {
     let reference_mean = period_mean(&period.contact_forces[0]);
     println!("reference: tip min {reference_min:.9} rms {reference_rms:.9} mean lambda {reference_mean:.9e}");
     for harmonics in [10, 20, 40] {
-        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
+        let (report, s) = ssn_hb_tip(&rod.model, rod.omega(), harmonics, tip);
         println!(
             "H {harmonics}: converged {} in {} iterations; tip min {:.9} ({:.2e} rel), rms {:.9} \
              ({:.2e} rel), mean lambda {:.9e} ({:.2e} rel)",
@@ -623,7 +653,7 @@ fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
     let tip = rod.tip_dof();
     let mut summaries = Vec::new();
     for harmonics in [20, 40] {
-        let (report, s) = ssn_hb_tip(&rod.model, harmonics, tip);
+        let (report, s) = ssn_hb_tip(&rod.model, rod.omega(), harmonics, tip);
         println!(
             "SSN-HB H {harmonics} ({:?} after {} iterations, |F| {:.1e}): tip min {:.7} rms {:.7} \
              mean lambda {:.6e}",
@@ -645,7 +675,7 @@ fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
                 scheme: moreau_jean(0.5, e),
                 ..MarchOptions::default()
             };
-            let period = match march_to_steady_state(&rod.model, &options, &[tip]) {
+            let period = match march_to_steady_state(&rod.model, rod.omega(), &options, &[tip]) {
                 Ok(p) => p,
                 Err(MarchError::NotSteady { last_period, .. }) => *last_period,
                 Err(other) => panic!("{other}"),

@@ -1,15 +1,20 @@
 //! Linear solvers behind the [`Factorize`](crate::Factorize) and
 //! [`LinearSolve`](crate::LinearSolve) traits.
 //!
-//! Every implementation checks its pivots against a relative threshold and returns
-//! [`LinearSolveError::Singular`] instead of dividing by a (near) zero pivot: a singular
-//! generalized Jacobian is an expected event in semismooth Newton, not a bug.
+//! Every implementation checks its pivots (against a relative threshold unless told
+//! otherwise) and returns [`LinearSolveError::Singular`] instead of dividing by a (near) zero
+//! pivot: a singular generalized Jacobian is an expected event in semismooth Newton, not a
+//! bug.
 //!
 //! | solver | matrix types | storage between factorizations |
 //! |---|---|---|
 //! | [`FaerDenseLu`] | any [`DenseAssemble`] (`faer::Mat`, `nalgebra::DMatrix`, structured types) | reused: no allocation after the first call of a size |
 //! | [`NalgebraLu`] | any [`DenseAssemble`] | matrix reused; nalgebra allocates its permutation and the U copy for the pivot check |
-//! | [`FaerSparseLu`] | `faer::sparse::SparseColMat<usize, f64>` | column ordering once per pattern, factor storage reused |
+//! | [`FaerSparseLu`] = [`SparseLu<f64>`] | `faer::sparse::SparseColMat<usize, f64>` | column ordering once per pattern, factor storage reused |
+//!
+//! [`SparseLu`] also factors complex matrices ([`SparseLu<faer::c64>`]), keeps several
+//! factorizations of one pattern (slots) and takes the rule for singular pivots as an
+//! option ([`PivotRule`]).
 //!
 //! For systems too large to factor, [`Gmres`] solves `A x = b` matrix-free from products
 //! with `A` and a preconditioner ([`KrylovOperator`]); a problem's structured solver can
@@ -29,7 +34,7 @@ mod sparse;
 pub use dense::{check_finite_dense, DenseAssemble, FaerDenseLu};
 pub use krylov::{Gmres, GmresOptions, GmresReport, KrylovOperator};
 pub use nalgebra_lu::NalgebraLu;
-pub use sparse::{diagonal_entry, FaerSparseLu};
+pub use sparse::{diagonal_entry, FaerSparseLu, LuScalar, PivotRule, SparseLu};
 
 /// Default relative pivot threshold: a pivot `|u_ii| <= threshold * max_j |u_jj|` is
 /// treated as zero.
@@ -113,7 +118,7 @@ impl LinearSolveError {
     }
 
     /// The error of a faer sparse operation `during` something.
-    pub fn from_faer(error: faer::sparse::FaerError, during: &'static str) -> Self {
+    pub(crate) fn from_faer(error: faer::sparse::FaerError, during: &'static str) -> Self {
         match error {
             faer::sparse::FaerError::OutOfMemory => Self::OutOfMemory { during },
             _ => Self::IndexOverflow { during },

@@ -1,14 +1,15 @@
-//! Sparse LU (faer): a fill-reducing column ordering computed once per sparsity
-//! pattern, then a left-looking (Gilbert–Peierls) numeric LU with partial pivoting per
-//! factorization, into storage that is reused.
+//! Sparse LU (faer), real or complex: a fill-reducing column ordering computed once per
+//! sparsity pattern, then a left-looking (Gilbert–Peierls) numeric LU with partial pivoting
+//! per factorization, into storage that is reused.
 
 use faer::dyn_stack::StackReq;
-use faer::perm::PermRef;
+use faer::perm::Perm;
 use faer::sparse::linalg::colamd;
 use faer::sparse::linalg::lu::simplicial::{self, SimplicialLu};
 use faer::sparse::linalg::LuError;
-use faer::sparse::{SparseColMat, SparseColMatRef};
-use faer::{Conj, MatMut, Par};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef};
+use faer::traits::ComplexField;
+use faer::{c64, Conj, MatMut, Par};
 
 use super::scratch::Scratch;
 use super::{check_pivots, check_solve, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
@@ -24,22 +25,141 @@ pub fn diagonal_entry<T: Copy>(m: SparseColMatRef<'_, usize, T>, j: usize) -> Op
         .map(|(_, &v)| v)
 }
 
-/// faer sparse LU for [`SparseColMat<usize, f64>`]: `P A Q = L U` with a COLAMD column
-/// ordering `Q` and partial row pivoting `P`.
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f64 {}
+    impl Sealed for faer::c64 {}
+}
+
+/// The scalars [`SparseLu`] factors: `f64` and [`faer::c64`].
+pub trait LuScalar: ComplexField + Copy + std::fmt::Debug + sealed::Sealed {
+    /// `|x|`.
+    fn modulus(self) -> f64;
+    /// `|x|^2` (no square root).
+    fn modulus_squared(self) -> f64;
+    /// The number an error reports for an entry: `x` itself when real, `|x|` when complex.
+    fn reported(self) -> f64;
+}
+
+impl LuScalar for f64 {
+    fn modulus(self) -> f64 {
+        self.abs()
+    }
+
+    fn modulus_squared(self) -> f64 {
+        self * self
+    }
+
+    fn reported(self) -> f64 {
+        self
+    }
+}
+
+impl LuScalar for c64 {
+    fn modulus(self) -> f64 {
+        self.norm()
+    }
+
+    fn modulus_squared(self) -> f64 {
+        self.norm_sqr()
+    }
+
+    fn reported(self) -> f64 {
+        self.norm()
+    }
+}
+
+/// When [`SparseLu`] reports a factorization as singular ([`LinearSolveError::Singular`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PivotRule {
+    /// The rule of the other solvers of this module: the entries of the matrix are checked
+    /// first ([`LinearSolveError::NonFiniteEntry`]), then a pivot with
+    /// `|u_ii| <= threshold * max_j |u_jj|` (zero or not finite included) is singular.
+    /// A structurally singular matrix reports the largest absolute entry as `max_pivot`.
+    Relative(f64),
+    /// Only a breakdown of the LU: a pivot whose squared modulus is zero or not finite (no
+    /// square root per pivot); the entries are not scanned and a merely small pivot is
+    /// accepted. For matrices whose closeness to singularity the caller judges itself
+    /// (e.g. a dynamic stiffness near an undamped resonance, whose condensed systems have
+    /// their own relative checks). `pivot` and `max_pivot` of the error are squared moduli;
+    /// a structurally singular matrix has `max_pivot` NaN.
+    Breakdown,
+}
+
+impl Default for PivotRule {
+    /// [`PivotRule::Relative`] with [`DEFAULT_PIVOT_THRESHOLD`].
+    fn default() -> Self {
+        Self::Relative(DEFAULT_PIVOT_THRESHOLD)
+    }
+}
+
+/// The row permutation of a slot: validated once per factorization (so that solves need not
+/// check it again), or its storage while unfactored.
+#[derive(Debug)]
+enum RowPerm {
+    Factored(Perm<usize>),
+    Unfactored(Box<[usize]>, Box<[usize]>),
+}
+
+impl RowPerm {
+    /// The permutation's storage, resized to `n` (allocates only when the size changes).
+    fn storage(self, n: usize) -> (Box<[usize]>, Box<[usize]>) {
+        let (fwd, inv) = match self {
+            RowPerm::Factored(perm) => perm.into_arrays(),
+            RowPerm::Unfactored(fwd, inv) => (fwd, inv),
+        };
+        if fwd.len() == n && inv.len() == n {
+            return (fwd, inv);
+        }
+        (vec![0; n].into_boxed_slice(), vec![0; n].into_boxed_slice())
+    }
+}
+
+/// One numeric LU: row permutation and factors.
+#[derive(Debug)]
+struct Slot<T: LuScalar> {
+    row_perm: RowPerm,
+    lu: SimplicialLu<usize, T>,
+}
+
+impl<T: LuScalar> Slot<T> {
+    fn new() -> Self {
+        Self {
+            row_perm: RowPerm::Unfactored(Box::default(), Box::default()),
+            lu: SimplicialLu::new(),
+        }
+    }
+
+    /// Unfactored, with row-permutation storage of size `n`.
+    fn reset(&mut self, n: usize) {
+        let empty = RowPerm::Unfactored(Box::default(), Box::default());
+        let (fwd, inv) = std::mem::replace(&mut self.row_perm, empty).storage(n);
+        self.row_perm = RowPerm::Unfactored(fwd, inv);
+    }
+}
+
+/// faer sparse LU of a [`SparseColMat<usize, T>`] (`T` = `f64` or [`faer::c64`]):
+/// `P A Q = L U` with a COLAMD column ordering `Q` and partial row pivoting `P`.
 ///
 /// - **Symbolic analysis explicit and cached.** The column ordering is computed by
-///   [`FaerSparseLu::analyze`], or by the first [`factor`](Factorize::factor) of a new
-///   dimension, and reused by every later factorization: `factor` does not compare
-///   patterns. An ordering computed for another pattern is still a valid column
-///   permutation (the row pivoting keeps the factorization correct), only possibly a
-///   worse one for fill: call `analyze` when the pattern changes for good.
-///   [`FaerSparseLu::symbolic_analyses`] counts the orderings computed.
-/// - **Numeric refactorization per `factor`** into the factor storage of the previous
-///   call (it grows only if the fill grows), so repeated factorizations of one pattern
-///   allocate nothing once the storage has settled.
-/// - **Singularity is detected**: faer's sparse LU reports only structural
-///   singularity; the diagonal of `U` is scanned against the same relative threshold as
-///   the dense solvers ([`LinearSolveError::Singular`]).
+///   [`SparseLu::analyze`] (or [`SparseLu::analyze_pattern`]), or by the first
+///   factorization of a new dimension, and reused by every later factorization: a
+///   factorization does not compare patterns. An ordering computed for another pattern is
+///   still a valid column permutation (the row pivoting keeps the factorization correct),
+///   only possibly a worse one for fill: analyse again when the pattern changes for good.
+///   [`SparseLu::symbolic_analyses`] counts the orderings computed.
+/// - **Numeric refactorization per factorization** into the factor storage of the previous
+///   one (it grows only if the fill grows), so repeated factorizations of one pattern
+///   allocate nothing once the storage has settled; nor do solves, the scratch memory
+///   being sized when the pattern is analysed.
+/// - **Singularity is detected**: faer's sparse LU reports only structural singularity;
+///   the diagonal of `U` is scanned by the [`PivotRule`] (by default the same relative
+///   threshold as the dense solvers). The `index` of [`LinearSolveError::Singular`] is the
+///   pivot's position in the factorization ([`SparseLu::pivot_column`] gives its column).
+/// - **Slots**: [`SparseLu::with_slots`] keeps several numeric factorizations of matrices
+///   of one pattern (e.g. one per frequency of a dynamic stiffness), sharing the column
+///   ordering and the scratch memory ([`SparseLu::factor_slot`],
+///   [`SparseLu::solve_slot_in_place`]); [`Factorize`] and [`LinearSolve`] use slot 0.
 ///
 /// The simplicial (column-by-column) variant of faer's sparse LU is used because its
 /// factors are accessible for the pivot check; it is the efficient variant for the
@@ -59,45 +179,103 @@ pub fn diagonal_entry<T: Copy>(m: SparseColMatRef<'_, usize, T>, j: usize) -> Op
 /// lu.solve_in_place(&mut x).unwrap();
 /// assert!(x.iter().all(|xi| (xi - 1.0).abs() < 1e-14));
 /// ```
+///
+/// Complex matrices, two factorizations of one pattern:
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use faer::{c64, Mat};
+/// use semismooth::linalg::SparseLu;
+/// let z = |d: c64| {
+///     let t = [(0, 0, d), (1, 0, c64::new(-1.0, 0.0)), (0, 1, c64::new(-1.0, 0.0)), (1, 1, d)];
+///     let t: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+///     SparseColMat::<usize, c64>::try_new_from_triplets(2, 2, &t).unwrap()
+/// };
+/// let mut lu = SparseLu::<c64>::new().with_slots(2);
+/// lu.factor_slot(0, z(c64::new(2.0, 1.0)).as_ref()).unwrap();
+/// lu.factor_slot(1, z(c64::new(3.0, 0.0)).as_ref()).unwrap();
+/// assert_eq!(lu.symbolic_analyses(), 1);
+/// // [3 -1; -1 3] [1, 1] = [2, 2].
+/// let mut x = Mat::<c64>::from_fn(2, 1, |_, _| c64::new(2.0, 0.0));
+/// lu.solve_slot_in_place(1, x.as_mut()).unwrap();
+/// assert!((x[(0, 0)] - c64::new(1.0, 0.0)).norm() < 1e-15);
+/// ```
 #[derive(Debug)]
-pub struct FaerSparseLu {
+pub struct SparseLu<T: LuScalar = f64> {
     dim: usize,
-    col_perm_fwd: Vec<usize>,
-    col_perm_inv: Vec<usize>,
-    row_perm_fwd: Vec<usize>,
-    row_perm_inv: Vec<usize>,
-    lu: SimplicialLu<usize, f64>,
+    /// The column ordering, `None` until a pattern is analysed.
+    col_perm: Option<Perm<usize>>,
+    slots: Vec<Slot<T>>,
     scratch: Scratch,
-    analyzed: bool,
-    factored: bool,
-    pivot_threshold: f64,
+    rule: PivotRule,
+    /// Right-hand sides solved at once (wider blocks are split).
+    solve_columns: usize,
     symbolic_analyses: u64,
 }
 
-impl FaerSparseLu {
-    /// A solver with the default pivot threshold [`DEFAULT_PIVOT_THRESHOLD`].
+/// The real sparse LU, [`SparseLu<f64>`]: a [`Factorize`] and [`LinearSolve`] for
+/// [`SparseColMat<usize, f64>`] Jacobians.
+pub type FaerSparseLu = SparseLu<f64>;
+
+impl<T: LuScalar> SparseLu<T> {
+    /// A solver with one slot, the default pivot rule ([`PivotRule::Relative`] with
+    /// [`DEFAULT_PIVOT_THRESHOLD`]) and solves of one right-hand side at a time.
     pub fn new() -> Self {
         Self {
             dim: 0,
-            col_perm_fwd: Vec::new(),
-            col_perm_inv: Vec::new(),
-            row_perm_fwd: Vec::new(),
-            row_perm_inv: Vec::new(),
-            lu: SimplicialLu::new(),
+            col_perm: None,
+            slots: vec![Slot::new()],
             scratch: Scratch::new(),
-            analyzed: false,
-            factored: false,
-            pivot_threshold: DEFAULT_PIVOT_THRESHOLD,
+            rule: PivotRule::default(),
+            solve_columns: 1,
             symbolic_analyses: 0,
         }
     }
 
     /// A solver that treats `|u_ii| <= threshold * max |u_jj|` as a zero pivot.
     pub fn with_pivot_threshold(threshold: f64) -> Self {
-        Self {
-            pivot_threshold: threshold,
-            ..Self::new()
-        }
+        Self::new().with_pivot_rule(PivotRule::Relative(threshold))
+    }
+
+    /// The same solver with the pivot rule `rule`.
+    pub fn with_pivot_rule(mut self, rule: PivotRule) -> Self {
+        self.rule = rule;
+        self
+    }
+
+    /// The same solver with `slots` numeric factorizations (at least 1), unfactored.
+    pub fn with_slots(mut self, slots: usize) -> Self {
+        let n = self.dim;
+        self.slots = (0..slots.max(1))
+            .map(|_| {
+                let mut slot = Slot::new();
+                slot.reset(n);
+                slot
+            })
+            .collect();
+        self
+    }
+
+    /// The same solver with scratch memory for solves of `columns` right-hand sides at once
+    /// (at least 1; wider blocks are solved `columns` at a time).
+    pub fn with_solve_columns(mut self, columns: usize) -> Self {
+        self.solve_columns = columns.max(1);
+        self
+    }
+
+    /// Dimension of the last analysed matrix.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of slots (numeric factorizations kept).
+    pub fn slots(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// The pivot rule.
+    pub fn pivot_rule(&self) -> PivotRule {
+        self.rule
     }
 
     /// How many symbolic analyses (column orderings) have been computed: 1 for any
@@ -106,128 +284,245 @@ impl FaerSparseLu {
         self.symbolic_analyses
     }
 
+    /// The column of the factored matrix whose pivot is at position `index` of the
+    /// factorization (the `index` of [`LinearSolveError::Singular`]); `index` itself before
+    /// any analysis or out of range.
+    pub fn pivot_column(&self, index: usize) -> usize {
+        self.col_perm
+            .as_ref()
+            .and_then(|p| p.arrays().0.get(index).copied())
+            .unwrap_or(index)
+    }
+
     /// Computes the fill-reducing column ordering of `a`'s sparsity pattern, used by the
-    /// following factorizations (square matrices only).
-    pub fn analyze(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
-        let s = a.symbolic();
-        let (n, ncols) = (s.nrows(), s.ncols());
+    /// following factorizations (square matrices only). Every slot is then unfactored.
+    pub fn analyze(&mut self, a: &SparseColMat<usize, T>) -> Result<(), LinearSolveError> {
+        self.analyze_pattern(a.symbolic())
+    }
+
+    /// [`SparseLu::analyze`] of a sparsity pattern.
+    pub fn analyze_pattern(
+        &mut self,
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Result<(), LinearSolveError> {
+        let (n, ncols) = (pattern.nrows(), pattern.ncols());
         if n != ncols {
             return Err(LinearSolveError::DimensionMismatch {
                 expected: n,
                 found: ncols,
             });
         }
-        self.analyzed = false;
-        self.factored = false;
-        self.col_perm_fwd.resize(n, 0);
-        self.col_perm_inv.resize(n, 0);
-        self.row_perm_fwd.resize(n, 0);
-        self.row_perm_inv.resize(n, 0);
-        let req = colamd::order_scratch::<usize>(n, n, s.compute_nnz());
+        for slot in &mut self.slots {
+            slot.reset(n);
+        }
+        let (mut fwd, mut inv) = match self.col_perm.take() {
+            Some(perm) => {
+                let (fwd, inv) = perm.into_arrays();
+                (Vec::from(fwd), Vec::from(inv))
+            }
+            None => (Vec::new(), Vec::new()),
+        };
+        fwd.resize(n, 0);
+        inv.resize(n, 0);
+        let req = colamd::order_scratch::<usize>(n, n, pattern.compute_nnz());
         let stack = self.scratch.stack(req)?;
         colamd::order(
-            &mut self.col_perm_fwd,
-            &mut self.col_perm_inv,
-            s,
+            &mut fwd,
+            &mut inv,
+            pattern,
             colamd::Control::default(),
             stack,
         )
         .map_err(|e| LinearSolveError::from_faer(e, "ordering the columns"))?;
+        self.col_perm = Some(Perm::new_checked(
+            fwd.into_boxed_slice(),
+            inv.into_boxed_slice(),
+            n,
+        ));
         self.dim = n;
-        self.analyzed = true;
         self.symbolic_analyses += 1;
+        // Sized now, so that neither factorizations nor solves allocate scratch later.
+        self.scratch.stack(StackReq::or(
+            simplicial::factorize_simplicial_numeric_lu_scratch::<usize, T>(n, n),
+            simplicial::solve_in_place_scratch::<usize, T>(n, self.solve_columns, Par::Seq),
+        ))?;
         Ok(())
     }
-}
 
-impl Default for FaerSparseLu {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Factorize<SparseColMat<usize, f64>> for FaerSparseLu {
-    /// Factors `a` (square), analysing its pattern first when no analysis of this
-    /// dimension is cached. Errors: [`LinearSolveError::DimensionMismatch`] for a
-    /// non-square matrix, [`LinearSolveError::NonFiniteEntry`],
-    /// [`LinearSolveError::Singular`] for a structurally singular matrix (then `pivot`
-    /// is 0 and `max_pivot` is the largest absolute entry of `a`, the pivots not being
-    /// available) or a negligible pivot, [`LinearSolveError::OutOfMemory`]. After an
-    /// error the solver is unfactored.
-    fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
-        self.factored = false;
+    /// Factors `a` (square) into `slot`, analysing its pattern first when no analysis of
+    /// this dimension is cached. Errors: [`LinearSolveError::NotFactored`] for a slot out of
+    /// range, [`LinearSolveError::DimensionMismatch`] for a non-square matrix,
+    /// [`LinearSolveError::NonFiniteEntry`] (with [`PivotRule::Relative`]; a complex entry
+    /// reports its modulus), [`LinearSolveError::Singular`] for a structurally singular matrix
+    /// (then `pivot` is 0) or a pivot the [`PivotRule`] rejects,
+    /// [`LinearSolveError::OutOfMemory`]. After an error the slot is unfactored.
+    pub fn factor_slot(
+        &mut self,
+        slot: usize,
+        a: SparseColMatRef<'_, usize, T>,
+    ) -> Result<(), LinearSolveError> {
+        if slot >= self.slots.len() {
+            return Err(LinearSolveError::NotFactored);
+        }
         let (nrows, ncols) = (a.nrows(), a.ncols());
         if nrows != ncols {
+            self.slots[slot].reset(self.dim);
             return Err(LinearSolveError::DimensionMismatch {
                 expected: nrows,
                 found: ncols,
             });
         }
-        let mut max_entry = 0.0_f64;
-        for col in 0..ncols {
-            for (&row, &value) in a.row_idx_of_col_raw(col).iter().zip(a.val_of_col(col)) {
-                if !value.is_finite() {
-                    return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+        // The largest absolute entry (the `max_pivot` of a structurally singular matrix).
+        let max_entry = match self.rule {
+            PivotRule::Relative(_) => match max_finite_entry(a) {
+                Ok(max) => max,
+                Err(e) => {
+                    self.slots[slot].reset(self.dim);
+                    return Err(e);
                 }
-                max_entry = max_entry.max(value.abs());
-            }
-        }
-        if !self.analyzed || self.dim != nrows {
-            self.analyze(a)?;
+            },
+            PivotRule::Breakdown => f64::NAN,
+        };
+        if self.col_perm.is_none() || self.dim != nrows {
+            self.analyze_pattern(a.symbolic())?;
         }
         let n = self.dim;
-        let req = StackReq::or(
-            simplicial::factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n),
-            simplicial::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
-        );
-        let stack = self.scratch.stack(req)?;
-        let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
-        let result = simplicial::factorize_simplicial_numeric_lu(
-            &mut self.row_perm_fwd,
-            &mut self.row_perm_inv,
-            &mut self.lu,
-            a.as_ref(),
-            col_perm,
-            stack,
-        );
-        match result {
-            Ok(()) => {}
-            Err(LuError::SymbolicSingular { index }) => {
-                return Err(LinearSolveError::Singular {
-                    index,
-                    pivot: 0.0,
-                    max_pivot: max_entry,
-                })
+        let Some(col_perm) = self.col_perm.as_ref() else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let s = &mut self.slots[slot];
+        let empty = RowPerm::Unfactored(Box::default(), Box::default());
+        let (mut fwd, mut inv) = std::mem::replace(&mut s.row_perm, empty).storage(n);
+        let req = simplicial::factorize_simplicial_numeric_lu_scratch::<usize, T>(n, n);
+        let result = match self.scratch.stack(req) {
+            Ok(stack) => simplicial::factorize_simplicial_numeric_lu(
+                &mut fwd,
+                &mut inv,
+                &mut s.lu,
+                a,
+                col_perm.as_ref(),
+                stack,
+            ),
+            Err(e) => {
+                s.row_perm = RowPerm::Unfactored(fwd, inv);
+                return Err(e);
             }
+        };
+        let checked = match result {
+            Ok(()) => {
+                let u = s.lu.u_factor_unsorted();
+                let diagonal = |j| diagonal_entry(u, j);
+                match self.rule {
+                    PivotRule::Relative(threshold) => check_pivots(
+                        (0..n).map(|j| diagonal(j).map_or(0.0, T::modulus)),
+                        threshold,
+                    ),
+                    PivotRule::Breakdown => check_pivots(
+                        (0..n).map(|j| diagonal(j).map_or(0.0, T::modulus_squared)),
+                        0.0,
+                    ),
+                }
+            }
+            Err(LuError::SymbolicSingular { index }) => Err(LinearSolveError::Singular {
+                index,
+                pivot: 0.0,
+                max_pivot: max_entry,
+            }),
             Err(LuError::Generic(e)) => {
-                return Err(LinearSolveError::from_faer(e, "factoring a sparse matrix"))
+                Err(LinearSolveError::from_faer(e, "factoring a sparse matrix"))
             }
+        };
+        s.row_perm = match checked {
+            Ok(()) => RowPerm::Factored(Perm::new_checked(fwd, inv, n)),
+            Err(_) => RowPerm::Unfactored(fwd, inv),
+        };
+        checked
+    }
+
+    /// `rhs <- A^{-1} rhs` with the factorization in `slot` (`rhs` has `N` rows and any
+    /// number of columns).
+    pub fn solve_slot_in_place(
+        &mut self,
+        slot: usize,
+        mut rhs: MatMut<'_, T>,
+    ) -> Result<(), LinearSolveError> {
+        let n = self.dim;
+        let (
+            Some(col_perm),
+            Some(Slot {
+                row_perm: RowPerm::Factored(row_perm),
+                lu,
+            }),
+        ) = (self.col_perm.as_ref(), self.slots.get(slot))
+        else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        check_solve(true, n, rhs.nrows())?;
+        let mut start = 0;
+        while start < rhs.ncols() {
+            let width = self.solve_columns.min(rhs.ncols() - start);
+            let req = simplicial::solve_in_place_scratch::<usize, T>(n, width, Par::Seq);
+            lu.solve_in_place_with_conj(
+                row_perm.as_ref(),
+                col_perm.as_ref(),
+                Conj::No,
+                rhs.as_mut().subcols_mut(start, width),
+                Par::Seq,
+                self.scratch.stack(req)?,
+            );
+            start += width;
         }
-        let u = self.lu.u_factor_unsorted();
-        let diagonal = (0..n).map(|j| diagonal_entry(u, j).unwrap_or(0.0));
-        check_pivots(diagonal, self.pivot_threshold)?;
-        self.factored = true;
         Ok(())
     }
 }
 
-impl LinearSolve for FaerSparseLu {
-    /// Overwrites `rhs` with `A^{-1} rhs` using the last successful factorization.
+/// The largest absolute entry of `a`, or `Err(NonFiniteEntry)` with the first entry (column
+/// by column) that is not finite.
+fn max_finite_entry<T: LuScalar>(
+    a: SparseColMatRef<'_, usize, T>,
+) -> Result<f64, LinearSolveError> {
+    let mut max_entry = 0.0_f64;
+    for col in 0..a.ncols() {
+        for (&row, &value) in a.row_idx_of_col_raw(col).iter().zip(a.val_of_col(col)) {
+            let modulus = value.modulus();
+            if !modulus.is_finite() {
+                return Err(LinearSolveError::NonFiniteEntry {
+                    row,
+                    col,
+                    value: value.reported(),
+                });
+            }
+            max_entry = max_entry.max(modulus);
+        }
+    }
+    Ok(max_entry)
+}
+
+impl<T: LuScalar> Default for SparseLu<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Factorize<SparseColMat<usize, f64>> for SparseLu<f64> {
+    /// Factors `a` (square) into slot 0 ([`SparseLu::factor_slot`]).
+    fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), LinearSolveError> {
+        self.factor_slot(0, a.as_ref())
+    }
+}
+
+impl LinearSolve for SparseLu<f64> {
+    /// Overwrites `rhs` with `A^{-1} rhs` using the factorization in slot 0.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
-        let n = self.dim;
-        check_solve(self.factored, n, rhs.len())?;
-        let req = simplicial::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq);
-        let stack = self.scratch.stack(req)?;
-        let row_perm = PermRef::new_checked(&self.row_perm_fwd, &self.row_perm_inv, n);
-        let col_perm = PermRef::new_checked(&self.col_perm_fwd, &self.col_perm_inv, n);
-        self.lu.solve_in_place_with_conj(
-            row_perm,
-            col_perm,
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            stack,
+        let factored = matches!(
+            self.slots.first(),
+            Some(Slot {
+                row_perm: RowPerm::Factored(_),
+                ..
+            })
         );
-        Ok(())
+        check_solve(factored, self.dim, rhs.len())?;
+        let n = self.dim;
+        self.solve_slot_in_place(0, MatMut::from_column_major_slice_mut(rhs, n, 1))
     }
 }

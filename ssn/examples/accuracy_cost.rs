@@ -24,29 +24,32 @@ fn main() -> std::process::ExitCode {
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     faer::set_global_parallelism(faer::Par::Seq);
-    let (rod, base) = match std::env::args().nth(1) {
+    let (rod, omega, base) = match std::env::args().nth(1) {
         // A rod or a [model] scene, as `ssn compare` reads it.
         Some(path) => {
-            use ssn::cli::{load, CliError};
-            let (scene, structure) = load(path.as_ref()).map_err(|e| match e {
+            use ssn::cli::{load, CliError, Loaded};
+            let Loaded {
+                scene,
+                structure,
+                omega,
+            } = load(path.as_ref()).map_err(|e| match e {
                 CliError::BadInput(m) | CliError::Output(m) => m,
                 CliError::NotConverged => "not converged".to_string(),
             })?;
-            (structure, scene.solver)
+            (structure, omega, scene.solver)
         }
         None => {
             let spec = RodSpec {
                 mass: MassModel::Modified,
                 ..RodSpec::canonical()
             };
-            (
-                build_rod(&spec)?.structure,
-                SolverSettings::with_harmonics(20),
-            )
+            let rod = build_rod(&spec)?;
+            let omega = rod.omega();
+            (rod.structure, omega, SolverSettings::with_harmonics(20))
         }
     };
     let progress = |s: &str| eprintln!("  {s}");
-    let study = accuracy_cost(&rod, &base, Some(&progress))?;
+    let study = accuracy_cost(&rod, omega, &base, Some(&progress))?;
     println!("{}", study.table());
     for accuracy in [1e-3, 1e-4] {
         println!("cheapest setting for {accuracy:.0e} on the tip minimum:");

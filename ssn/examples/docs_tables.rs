@@ -45,7 +45,8 @@ fn compute(section: &str) -> Result<String, Box<dyn std::error::Error>> {
                 mass: MassModel::Modified,
                 ..RodSpec::canonical()
             })?;
-            let study = accuracy_cost(&rod.structure, &SolverSettings::with_harmonics(20), None)?;
+            let settings = SolverSettings::with_harmonics(20);
+            let study = accuracy_cost(&rod.structure, rod.omega(), &settings, None)?;
             out.push_str(&tables::cheapest_settings(&study).markdown());
         }
         "sweeps" => out.push_str(&tables::sweeps(&tables::sweep_cases())?.markdown()),

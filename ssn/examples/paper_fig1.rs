@@ -39,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..RodSpec::canonical()
         })?;
         for h in (5..=40).step_by(5) {
-            let s = solve(&rod, &SolverSettings::with_harmonics(h), None)?;
+            let s = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(h), None)?;
             println!(
                 "{:<11} {:>4} {:>5} {:>11.2e} {:>11.6}  {}{}",
                 format!("{mass:?}").to_lowercase(),

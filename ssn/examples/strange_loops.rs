@@ -111,22 +111,21 @@ fn main() {
         "H", "gap", "w*/w_1", "HB pen/g", "HB amplitudes at w*", "crossings"
     );
     for (h, gap, ratio, crossings, between, rod) in intervals {
-        let mut at = rod.clone();
-        at.model.forcing.omega = ratio * rod.omega_1;
+        let omega = ratio * rod.omega_1;
         let lcp_settings = SolverSettings {
             method: Method::LcpSsn,
             time_samples: LCP_NODES,
             ..SolverSettings::with_harmonics(h)
         };
         // Newton on the min map first; Lemke's pivoting where it does not converge.
-        let lcp = match solve(&at.structure, &lcp_settings, None) {
+        let lcp = match solve(&rod.structure, omega, &lcp_settings, None) {
             Ok(s) if s.converged() => Ok(s),
             _ => {
                 let lemke = SolverSettings {
                     method: Method::LcpLemke,
                     ..lcp_settings.clone()
                 };
-                solve(&at.structure, &lemke, None)
+                solve(&rod.structure, omega, &lemke, None)
             }
         };
         let amplitudes: Vec<String> = crossings.iter().map(|a| format!("{a:.4}")).collect();

@@ -30,15 +30,28 @@ fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
+/// A scene ready to run: the scene, its structure and its `[forcing]` frequency resolved
+/// once against the structure's `omega_1` ([`Scene::omega`]).
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The validated scene.
+    pub scene: Scene,
+    /// Its structure (no frequency).
+    pub structure: Structure,
+    /// The forcing frequency every run of the scene takes.
+    pub omega: f64,
+}
+
 /// Loads a scene and builds its structure (the rod of a `[rod]` scene, the Matrix Market
 /// files of a `[model]` scene; `[output] dof` chooses the observed dof), after checking
-/// that one run of its method fits in memory ([`crate::limits`]).
-pub fn load(path: &Path) -> Result<(Scene, Structure), CliError> {
+/// that one run of its method fits in memory ([`crate::limits`]), and resolves its forcing
+/// frequency.
+pub fn load(path: &Path) -> Result<Loaded, CliError> {
     load_checked(path, false)
 }
 
 /// [`load`], with the memory of `ssn compare`'s runs when `compare`.
-fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliError> {
+fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let limit = crate::limits::memory_limit();
     // A rod is estimated before it is built; an imported model once its size is read.
@@ -70,7 +83,12 @@ fn load_checked(path: &Path, compare: bool) -> Result<(Scene, Structure), CliErr
             rod
         }
     };
-    Ok((scene, structure))
+    let omega = scene.omega(structure.omega_1);
+    Ok(Loaded {
+        scene,
+        structure,
+        omega,
+    })
 }
 
 /// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
@@ -238,7 +256,11 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     if let Some(state) = &solve_args.state {
         outputs.target(state, "--state")?;
     }
-    let (scene, rod) = load(&args.scene)?;
+    let Loaded {
+        scene,
+        structure: rod,
+        omega,
+    } = load(&args.scene)?;
     let shape = StateShape {
         method: scene.solver.method,
         harmonics: scene.solver.harmonics,
@@ -278,6 +300,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     };
     let solution = semismooth_contact::solve(
         &rod,
+        omega,
         &scene.solver,
         start.as_ref().map(|s| s.unknowns.as_slice()),
     )
@@ -466,7 +489,11 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
 pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
     let mut outputs = args.plan()?;
-    let (scene, rod) = load(&args.scene)?;
+    let Loaded {
+        scene,
+        structure: rod,
+        ..
+    } = load(&args.scene)?;
     let Some(settings) = scene.sweep.as_ref() else {
         return Err(input_error(
             &args.scene,
@@ -613,14 +640,18 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
         )));
     }
-    let (scene, rod) = load_checked(path, true)?;
+    let Loaded {
+        scene,
+        structure: rod,
+        omega,
+    } = load_checked(path, true)?;
     prepare_directory(out)?;
     let bar = progress_spinner("compare", quiet);
     let say = |line: &str| {
         bar.set_message(line.to_string());
         bar.tick();
     };
-    let study = crate::study::accuracy_cost(&rod, &scene.solver, Some(&say))
+    let study = crate::study::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
         .map_err(|e| input_error(path, e))?;
     bar.finish_and_clear();
     study.write_files(out)?;
@@ -637,7 +668,9 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
 /// `ssn export-model SCENE DIR`: writes the scene's structure as Matrix Market files and a
 /// `[model]` scene (`DIR/scene.toml`) that solves the same problem.
 pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
-    let (scene, structure) = load(path)?;
+    let Loaded {
+        scene, structure, ..
+    } = load(path)?;
     prepare_directory(dir)?;
     // All files or none: every target is claimed before anything is written.
     let mut set = OutputSet::new();
@@ -657,7 +690,11 @@ pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
 /// `ssn scene-check SCENE`: validates the scene and prints the resolved model with up to
 /// five natural frequencies (massless dofs have none: a modified-mass rod has one fewer).
 pub fn scene_check(path: &Path) -> Result<(), CliError> {
-    let (scene, rod) = load(path)?;
+    let Loaded {
+        scene,
+        structure: rod,
+        omega,
+    } = load(path)?;
     let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
         Err(ModelError::TooManyModes { available, .. }) => {
             natural_frequencies(&rod.model, available)
@@ -665,7 +702,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         other => other,
     }
     .map_err(|e| input_error(path, e))?;
-    write_text(&describe(&scene, &rod, &modes))?;
+    write_text(&describe(&scene, &rod, omega, &modes))?;
     Ok(())
 }
 

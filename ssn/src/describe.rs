@@ -7,11 +7,11 @@ use semismooth_contact::rod::DampingSpec;
 use crate::io::printable;
 use crate::scene::{Method, Scene};
 
-/// The resolved model of a scene, in words (`ssn scene-check`).
-pub fn describe(scene: &Scene, rod: &Structure, modes: &[f64]) -> String {
+/// The resolved model of a scene forced at `omega`, in words (`ssn scene-check`).
+pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> String {
     use semismooth_contact::rod::{DampingSpec, FrequencySpec, LoadKind};
     if let Some(spec) = &scene.model {
-        return describe_imported(scene, spec, rod, modes);
+        return describe_imported(scene, spec, rod, omega, modes);
     }
     let s = &scene.rod;
     let mut out = String::new();
@@ -57,7 +57,7 @@ pub fn describe(scene: &Scene, rod: &Structure, modes: &[f64]) -> String {
             LoadKind::Tip => "tip force",
         },
         s.amplitude,
-        rod.model.forcing.omega,
+        omega,
         ratio
     ));
     if s.contacts.is_empty() {
@@ -152,12 +152,13 @@ pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
     out
 }
 
-/// The resolved structure of a `[model]` scene in words (`ssn scene-check`), followed by
-/// the solver lines every scene has.
+/// The resolved structure of a `[model]` scene forced at `omega` in words
+/// (`ssn scene-check`), followed by the solver lines every scene has.
 pub fn describe_imported(
     scene: &crate::scene::Scene,
     spec: &ModelSpec,
     structure: &Structure,
+    omega: f64,
     modes: &[f64],
 ) -> String {
     let model = &structure.model;
@@ -203,8 +204,8 @@ pub fn describe_imported(
         "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
         spec.amplitude,
         spec.forcing_vector.display(),
-        model.forcing.omega,
-        model.forcing.omega / structure.omega_1
+        omega,
+        omega / structure.omega_1
     ));
     if spec.contacts.is_empty() {
         line("contact           none: linear problem (one factorization, no FFT)".into());

@@ -93,7 +93,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
         },
         ..SolverSettings::with_harmonics(20)
     };
-    let reference = solve(&rod, &reference_settings, None).map_err(bad_input)?;
+    let reference = solve(&rod, rod.omega(), &reference_settings, None).map_err(bad_input)?;
     bar.inc(1);
     let period = 2.0 * std::f64::consts::PI / reference.omega;
     let mut series = Vec::new();
@@ -101,7 +101,7 @@ pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>
     let mut rows = Vec::new();
     for h in [10usize, 15, 20] {
         let settings = SolverSettings::with_harmonics(h);
-        let s = solve(&rod, &settings, None).map_err(bad_input)?;
+        let s = solve(&rod, rod.omega(), &settings, None).map_err(bad_input)?;
         bar.inc(1);
         let phase: Vec<f64> = s.times.iter().map(|t| t / period).collect();
         series.push(Series::new(

@@ -21,14 +21,8 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     if let Some(d) = &model.damping {
         files.push(("D.mtx".to_string(), matrix_market_text(d)));
     }
-    files.push((
-        "f.mtx".to_string(),
-        vector_market_text(&model.forcing.amplitude),
-    ));
-    let frequency = scene
-        .model
-        .as_ref()
-        .map_or(scene.rod.frequency, |m| m.frequency);
+    files.push(("f.mtx".to_string(), vector_market_text(&model.load)));
+    let frequency = scene.frequency();
     let mut t = String::new();
     let title = scene.title.as_deref().unwrap_or("untitled");
     let _ = writeln!(t, "title = {:?}", format!("{title} (exported)"));

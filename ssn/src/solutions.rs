@@ -10,10 +10,14 @@ use semismooth_contact::solve::RunError;
 pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> {
     use crate::exit::CliError;
     use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
-    let (scene, rod) = crate::cli::load(&args.scene)?;
+    let crate::cli::Loaded {
+        scene,
+        structure: rod,
+        omega,
+    } = crate::cli::load(&args.scene)?;
     let mut outputs = args.plan()?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
-    let set = find_solutions(&rod, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
+    let set = find_solutions(&rod, omega, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
     let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
         set.solutions.iter().map(f).collect()
     };

@@ -309,15 +309,15 @@ fn table_line(s: &mut String, c: [String; 8]) {
     );
 }
 
-/// Runs `settings`, repeating fast runs and keeping the median wall time.
-fn timed(rod: &Structure, settings: &SolverSettings) -> Result<Solution, RunError> {
-    let first = solve(rod, settings, None)?;
+/// Runs `settings` at `omega`, repeating fast runs and keeping the median wall time.
+fn timed(rod: &Structure, omega: f64, settings: &SolverSettings) -> Result<Solution, RunError> {
+    let first = solve(rod, omega, settings, None)?;
     if first.solve_seconds >= REPEAT_BELOW_SECONDS {
         return Ok(first);
     }
     let mut times = vec![first.solve_seconds];
     for _ in 1..REPEATS {
-        times.push(solve(rod, settings, None)?.solve_seconds);
+        times.push(solve(rod, omega, settings, None)?.solve_seconds);
     }
     times.sort_by(f64::total_cmp);
     let mut sol = first;
@@ -417,12 +417,14 @@ fn hb_settings(base: &SolverSettings, harmonics: usize) -> SolverSettings {
 /// at [`REFERENCE_HARMONICS`] (uncertainty: the change from half the harmonics).
 fn reference(
     rod: &Structure,
+    omega: f64,
     base: &SolverSettings,
     say: &dyn Fn(&str),
 ) -> Result<Reference, RunError> {
     let march = |steps: usize, tolerance: f64, periods: usize| {
         solve(
             rod,
+            omega,
             &SolverSettings {
                 method: Method::March,
                 steps_per_period: steps,
@@ -436,7 +438,7 @@ fn reference(
     say(&format!(
         "cross-check: SSN-HB, {REFERENCE_HARMONICS} harmonics"
     ));
-    let hb = solve(rod, &hb_settings(base, REFERENCE_HARMONICS), None)
+    let hb = solve(rod, omega, &hb_settings(base, REFERENCE_HARMONICS), None)
         .ok()
         .filter(|s| s.converged());
     for (tolerance, periods) in REFERENCE_TOLERANCES {
@@ -473,7 +475,7 @@ fn reference(
     }
     let mut h = REFERENCE_HARMONICS / 2;
     while runs.len() < 2 && h >= 10 {
-        if let Ok(s) = solve(rod, &hb_settings(base, h), None) {
+        if let Ok(s) = solve(rod, omega, &hb_settings(base, h), None) {
             if s.converged() {
                 runs.push((h, s));
             }
@@ -501,8 +503,9 @@ fn reference(
     })
 }
 
-/// The accuracy-vs-cost study of `rod`: the reference (see the module documentation), then
-/// every applicable method over its discretisation (LCP and penalty HB only with contact).
+/// The accuracy-vs-cost study of `rod` forced at `omega`: the reference (see the module
+/// documentation), then every applicable method over its discretisation (LCP and penalty HB
+/// only with contact).
 /// `base` supplies the Newton tolerance, iteration limit, globalization, linear solver and
 /// time-marching limits; `progress` receives one line per run.
 ///
@@ -511,6 +514,7 @@ fn reference(
 /// reference is an error.
 pub fn accuracy_cost(
     rod: &Structure,
+    omega: f64,
     base: &SolverSettings,
     progress: Option<&dyn Fn(&str)>,
 ) -> Result<AccuracyCost, RunError> {
@@ -520,14 +524,14 @@ pub fn accuracy_cost(
         }
     };
     let contact = !rod.model.contacts.is_empty();
-    let reference = reference(rod, base, &say)?;
+    let reference = reference(rod, omega, base, &say)?;
     let mut entries = Vec::new();
     let march_tolerance = reference
         .march_tolerance
         .map_or(base.march_tolerance, |t| t.max(base.march_tolerance));
     for (method, setting, settings) in sweep_settings(rod, base, march_tolerance) {
         say(&format!("{} {setting}", method.name()));
-        let entry = match timed(rod, &settings) {
+        let entry = match timed(rod, omega, &settings) {
             Ok(sol) => Entry {
                 method,
                 setting,
@@ -657,6 +661,7 @@ mod tests {
         .unwrap();
         let study = accuracy_cost(
             &rod,
+            rod.omega(),
             &crate::scene::SolverSettings::with_harmonics(20),
             None,
         )

@@ -279,7 +279,7 @@ pub fn method_comparison(mass: MassModel) -> Result<(Table, Vec<ComparisonRow>),
         .into_iter()
         .map(|(label, settings)| ComparisonRow {
             label,
-            result: solve(&rod, &settings, None).map_err(|e| e.to_string()),
+            result: solve(&rod, rod.omega(), &settings, None).map_err(|e| e.to_string()),
         })
         .collect();
     let reference_min = rows[0].result.as_ref().ok().map(|r| r.stats.min);
@@ -530,7 +530,7 @@ pub fn solve_group(
     for case in cases {
         let mut settings = case.solver_settings();
         settings.globalization = globalization;
-        let sol = match solve(&case.rod, &settings, None) {
+        let sol = match solve(&case.rod, case.rod.omega(), &settings, None) {
             Ok(sol) => sol,
             Err(e) => {
                 g.failures.push(format!("{}: {e}", case.label));
@@ -653,7 +653,7 @@ pub fn performance() -> Result<Table, TableError> {
             mass,
             ..RodSpec::canonical()
         })?;
-        let s = solve(&rod, &SolverSettings::with_harmonics(20), None)?;
+        let s = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(20), None)?;
         table.rows.push(vec![
             format!(
                 "canonical rod, {} mass, H = 20, from zero, one cold solve",
@@ -683,6 +683,7 @@ pub fn performance() -> Result<Table, TableError> {
     })?;
     let march = solve(
         &rod,
+        rod.omega(),
         &SolverSettings {
             method: Method::March,
             ..SolverSettings::with_harmonics(20)
@@ -697,6 +698,7 @@ pub fn performance() -> Result<Table, TableError> {
     ]);
     let lemke = solve(
         &rod,
+        rod.omega(),
         &SolverSettings {
             method: Method::LcpLemke,
             time_samples: 2048,

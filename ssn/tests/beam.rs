@@ -66,10 +66,12 @@ fn natural_frequencies_are_the_analytic_ones_within_the_discretisation_error() {
     assert!((s.omega_1 - freqs[0]).abs() < 1e-14 * freqs[0]);
 }
 
-fn solve(s: &Structure, base: &SolverSettings, edit: impl Fn(&mut SolverSettings)) -> Solution {
-    let mut settings = base.clone();
+/// `s` solved at `scene`'s frequency with its settings changed by `edit`.
+fn solve(s: &Structure, scene: &Scene, edit: impl Fn(&mut SolverSettings)) -> Solution {
+    let mut settings = scene.solver.clone();
     edit(&mut settings);
-    let sol = semismooth_contact::solve(s, &settings, None).unwrap();
+    let omega = scene.omega(s.omega_1);
+    let sol = semismooth_contact::solve(s, omega, &settings, None).unwrap();
     assert!(
         sol.converged(),
         "{:?}: {}",
@@ -82,7 +84,7 @@ fn solve(s: &Structure, base: &SolverSettings, edit: impl Fn(&mut SolverSettings
 #[test]
 fn ssn_hb_agrees_with_time_marching_within_the_truncation_error() {
     let (scene, s) = beam();
-    let march = solve(&s, &scene.solver, |v| {
+    let march = solve(&s, &scene, |v| {
         v.method = Method::March;
         v.steps_per_period = 2000;
     });
@@ -90,7 +92,7 @@ fn ssn_hb_agrees_with_time_marching_within_the_truncation_error() {
     assert!(march.stats.max > gap, "the tip must reach the stop");
     let mut errors = Vec::new();
     for h in [10, 20, 40] {
-        let hb = solve(&s, &scene.solver, |v| {
+        let hb = solve(&s, &scene, |v| {
             v.harmonics = h;
             v.time_samples = ssn::scene::default_hb_time_samples(h);
         });

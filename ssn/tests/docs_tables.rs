@@ -105,7 +105,8 @@ fn cheapest_settings_in_the_docs_reach_their_accuracy() {
         ..RodSpec::canonical()
     })
     .unwrap();
-    let study = accuracy_cost(&rod.structure, &SolverSettings::with_harmonics(20), None).unwrap();
+    let settings = SolverSettings::with_harmonics(20);
+    let study = accuracy_cost(&rod.structure, rod.omega(), &settings, None).unwrap();
     let table = tables::cheapest_settings(&study);
     let rows = table
         .rows_in(&block("accuracy"))

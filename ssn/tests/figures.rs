@@ -52,7 +52,13 @@ fn modified_mass_branch_is_fine_and_dashed_between_its_folds() {
         ..fig2_rod(None)
     })
     .unwrap();
-    let linear = solve(&linear_rod, &SolverSettings::with_harmonics(20), None).unwrap();
+    let linear = solve(
+        &linear_rod,
+        linear_rod.omega(),
+        &SolverSettings::with_harmonics(20),
+        None,
+    )
+    .unwrap();
     assert!(linear.converged());
     let y_range = 0.98 * linear.stats.max.abs().max(linear.stats.min.abs());
     let step = longest_plotted_step_on(&series, 1.5, y_range);

@@ -73,7 +73,7 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                     branch.omega.iter().map(|w| w / base.omega_1).collect();
                 for &ratio in &ratios {
                     let rod = build_rod(&grid_rod(mass, p0, gap, ratio)).unwrap();
-                    let sol = solve(&rod, &settings, None).unwrap();
+                    let sol = solve(&rod, rod.omega(), &settings, None).unwrap();
                     if !sol.converged() {
                         failures.push(format!(
                             "{mass:?} H={harmonics} p0={p0} gap={gap} omega={ratio:.2}: {}",
@@ -164,9 +164,11 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
                     continue;
                 }
                 let rod = build_rod(&grid_rod(MassModel::Modified, p0, gap, ratio)).unwrap();
-                let coarse = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
-                let fine = solve(&rod, &SolverSettings::with_harmonics(40), None).unwrap();
-                let reference = solve(&rod, &march, None).unwrap();
+                let coarse =
+                    solve(&rod, rod.omega(), &SolverSettings::with_harmonics(20), None).unwrap();
+                let fine =
+                    solve(&rod, rod.omega(), &SolverSettings::with_harmonics(40), None).unwrap();
+                let reference = solve(&rod, rod.omega(), &march, None).unwrap();
                 assert!(
                     coarse.converged() && fine.converged() && reference.converged(),
                     "p0={p0} gap={gap} omega={ratio}: H=20 {}, H=40 {}, march {}",
@@ -207,7 +209,7 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
 #[test]
 fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
     let rod = build_rod(&many_contacts_rod(10)).unwrap();
-    let sol = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+    let sol = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(20), None).unwrap();
     assert!(
         sol.converged() && sol.iterations <= 60,
         "{} after {} iterations",
@@ -263,7 +265,13 @@ fn forty_element_rod_converges_from_zero_at_high_harmonic_counts_and_refines_wit
     let mut penetration = Vec::new();
     let mut force = Vec::new();
     for (harmonics, measured) in [(20, 40), (40, 47), (80, 48), (160, 192)] {
-        let sol = solve(&rod, &SolverSettings::with_harmonics(harmonics), None).unwrap();
+        let sol = solve(
+            &rod,
+            rod.omega(),
+            &SolverSettings::with_harmonics(harmonics),
+            None,
+        )
+        .unwrap();
         println!(
             "H = {harmonics}: {} after {} iterations ({}), tip max {}, mean force {}",
             sol.termination,
@@ -310,7 +318,7 @@ fn many_contacts_converge_from_zero_in_iterations_that_do_not_grow_with_their_nu
     let mut totals = Vec::new();
     for (points, measured) in [(10, 40), (25, 41), (50, 42), (100, 42)] {
         let rod = build_rod(&many_contacts_rod(points)).unwrap();
-        let sol = solve(&rod, &SolverSettings::with_harmonics(20), None).unwrap();
+        let sol = solve(&rod, rod.omega(), &SolverSettings::with_harmonics(20), None).unwrap();
         println!(
             "{points} contacts: {} after {} iterations ({}), total mean force {:e}, tip max {}",
             sol.termination,

@@ -374,7 +374,7 @@ fn assert_plausible(
 
 /// Solves once under `catch_unwind`; a panic fails the test with the case named.
 fn solve_once(case: &str, rod: &RodModel, settings: &SolverSettings) -> Result<Solution, String> {
-    let run = catch_unwind(AssertUnwindSafe(|| solve(rod, settings, None)));
+    let run = catch_unwind(AssertUnwindSafe(|| solve(rod, rod.omega(), settings, None)));
     match run {
         Err(p) => {
             let msg = p
@@ -829,7 +829,9 @@ fn stiff_penalty_kp_1e8() {
 /// The `c` SSN-HB uses on the canonical rod when the scene leaves it out.
 fn default_c() -> f64 {
     let rod = build_rod(&canonical()).unwrap();
-    SsnHb::new(&rod.model, &HbOptions::default()).unwrap().c()
+    SsnHb::new(&rod.model, rod.omega(), &HbOptions::default())
+        .unwrap()
+        .c()
 }
 
 /// SSN-HB with `c` from 1e-3 to 1e3 times the default (10 EA/L = 10 here): every factor

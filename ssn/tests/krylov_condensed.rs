@@ -13,23 +13,30 @@ use ssn::scene::{default_hb_time_samples, LinearSolverChoice, Scene};
 mod common;
 
 /// The shipped disk's 100 mistuned blades with stops on `count` of them, evenly spaced,
-/// and the shipped load, damping and frequency.
-fn disk_with_stops(count: usize) -> Structure {
+/// and the shipped load and damping; returned with the shipped forcing frequency.
+fn disk_with_stops(count: usize) -> (Structure, f64) {
     let disk = BladedDisk {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,
     };
-    disk.structure(&DiskLoading {
+    let loading = DiskLoading {
         stops: (0..count).map(|i| i * 100 / count).collect(),
         gap: 1.0,
         amplitude: 0.02,
         zeta: 0.01,
         omega_ratio: 1.0,
-    })
-    .unwrap()
+    };
+    let structure = disk.structure(&loading).unwrap();
+    let omega = loading.omega(structure.omega_1);
+    (structure, omega)
 }
 
-fn solve(structure: &Structure, choice: LinearSolverChoice, harmonics: usize) -> Solution {
+fn solve(
+    structure: &Structure,
+    omega: f64,
+    choice: LinearSolverChoice,
+    harmonics: usize,
+) -> Solution {
     let mut settings = Scene::from_toml(
         "[rod]\nelements = 2\n[forcing]\namplitude = 0.1\n[contact]\ngap = 0.5\n",
         "t.toml",
@@ -40,7 +47,7 @@ fn solve(structure: &Structure, choice: LinearSolverChoice, harmonics: usize) ->
     settings.time_samples = default_hb_time_samples(harmonics);
     settings.linear_solver = choice;
     settings.max_iterations = 200;
-    semismooth_contact::solve(structure, &settings, None).unwrap()
+    semismooth_contact::solve(structure, omega, &settings, None).unwrap()
 }
 
 #[test]
@@ -53,9 +60,9 @@ fn krylov_path_gives_the_dense_answer_in_the_same_iterations() {
 }
 
 fn compare_paths(stops: usize) {
-    let structure = disk_with_stops(stops);
-    let dense = solve(&structure, LinearSolverChoice::CondensedDense, 5);
-    let krylov = solve(&structure, LinearSolverChoice::CondensedKrylov, 5);
+    let (structure, omega) = disk_with_stops(stops);
+    let dense = solve(&structure, omega, LinearSolverChoice::CondensedDense, 5);
+    let krylov = solve(&structure, omega, LinearSolverChoice::CondensedKrylov, 5);
     for s in [&dense, &krylov] {
         assert!(s.converged(), "{} after {}", s.termination, s.iterations);
         // Both end below the Newton tolerance 1e-10 (or the round-off floor).
@@ -95,14 +102,14 @@ fn one_matrix_free_step_solves_the_full_newton_system_to_its_tolerance() {
     // At the converged active set, one step with a generic right-hand side: the full
     // residual |J d - r| (structured product of the dense path's Jacobian, assembled here
     // densely) meets the GMRES tolerance, and the step matches the dense condensed LU's.
-    let structure = disk_with_stops(30);
-    let solution = solve(&structure, LinearSolverChoice::CondensedDense, 3);
+    let (structure, omega) = disk_with_stops(30);
+    let solution = solve(&structure, omega, LinearSolverChoice::CondensedDense, 3);
     let options = HbOptions {
         harmonics: 3,
         time_samples: Some(default_hb_time_samples(3)),
         c: None,
     };
-    let mut problem = SsnHb::new(&structure.model, &options).unwrap();
+    let mut problem = SsnHb::new(&structure.model, omega, &options).unwrap();
     let mut jac = problem.new_jacobian();
     problem.jacobian(&solution.state, &mut jac).unwrap();
     let r: Vec<f64> = (0..problem.dim())
@@ -167,7 +174,7 @@ fn strongly_coupled_contacts_switch_to_the_dense_preconditioner_and_keep_the_den
         time_samples: Some(default_hb_time_samples(harmonics)),
         c: None,
     };
-    let mut problem = SsnHb::new(&rod.model, &options).unwrap();
+    let mut problem = SsnHb::new(&rod.model, rod.omega(), &options).unwrap();
     let n = problem.dim();
     // x1 = -J(0)^-1 F(0): the first full step from zero.
     let mut x = vec![0.0; n];

@@ -3,7 +3,7 @@
 //! symmetry makes every blade answer exactly as one sector with one contact.
 
 use semismooth_contact::matrix_market::build_imported;
-use semismooth_contact::model::{ContactPoint, HarmonicForcing, StructuralModel, Structure};
+use semismooth_contact::model::{ContactPoint, StructuralModel, Structure};
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::solve::solve;
 use semismooth_contact::structures::BladedDisk;
@@ -24,7 +24,7 @@ fn a_hundred_contacts_converge_and_the_linear_limit_is_exact() {
     let (scene, s) = shipped(|t| t);
     assert_eq!(s.model.contacts.len(), 100);
     assert_eq!(s.model.dofs(), 300);
-    let sol = solve(&s, &scene.solver, None).unwrap();
+    let sol = solve(&s, scene.omega(s.omega_1), &scene.solver, None).unwrap();
     // Measured: 13 iterations from zero at H = 5 (0.7 s on the 2-core machine).
     assert!(
         sol.converged() && sol.iterations <= 30,
@@ -49,17 +49,17 @@ fn a_hundred_contacts_converge_and_the_linear_limit_is_exact() {
     );
     // Far casing: the exact linear response (dense complex solve of the 300 dofs).
     let (scene, far) = shipped(|t| t.replace("gap = 1.0", "gap = 1000.0"));
-    let sol = solve(&far, &scene.solver, None).unwrap();
+    let sol = solve(&far, scene.omega(far.omega_1), &scene.solver, None).unwrap();
     assert!(sol.converged());
     let (diff, z) = common::linear_history_error(&far.model, far.observed_dof, &sol);
     assert!(diff < 1e-9 * z, "{diff:e}");
 }
 
 /// The tuned disk of `semismooth_contact::structures` (no mistuning) with `blades` sectors
-/// and a stop of gap `gap` on every pad, at the forcing frequency `omega`; the load is 0.02
-/// on every blade tip, the damping `beta K` with `beta = 2 zeta / omega_1` of one sector
-/// (`zeta = 0.01`), the same for every disk size.
-fn tuned(blades: usize, gap: f64, omega: f64) -> StructuralModel {
+/// and a stop of gap `gap` on every pad; the load is 0.02 on every blade tip, the damping
+/// `beta K` with `beta = 2 zeta / omega_1` of one sector (`zeta = 0.01`), the same for every
+/// disk size.
+fn tuned(blades: usize, gap: f64) -> StructuralModel {
     let (stiffness, mass, shape) = BladedDisk {
         blades,
         mistuning: 0.0,
@@ -69,10 +69,7 @@ fn tuned(blades: usize, gap: f64, omega: f64) -> StructuralModel {
         mass,
         damping: Some(stiffness.clone()),
         stiffness,
-        forcing: HarmonicForcing {
-            amplitude: shape.iter().map(|f| 0.02 * f).collect(),
-            omega,
-        },
+        load: shape.iter().map(|f| 0.02 * f).collect(),
         contacts: (0..blades)
             .map(|j| ContactPoint::new(BladedDisk::pad(j), gap))
             .collect(),
@@ -90,9 +87,10 @@ fn tuned(blades: usize, gap: f64, omega: f64) -> StructuralModel {
 #[test]
 fn a_tuned_disk_with_a_hundred_contacts_answers_as_one_sector_with_one_contact() {
     let (scene, shipped) = shipped(|t| t);
-    let omega = shipped.model.forcing.omega;
-    let sector = tuned(1, 1.0, omega);
-    let disk = tuned(100, 1.0, omega);
+    // Both at the shipped scene's frequency.
+    let omega = scene.omega(shipped.omega_1);
+    let sector = tuned(1, 1.0);
+    let disk = tuned(100, 1.0);
     // In phase (engine order 0) the ring springs carry no force: each sector is the
     // one-sector model. Its damping is the same beta K (omega_1 is the sector's).
     let one = Structure {
@@ -109,8 +107,8 @@ fn a_tuned_disk_with_a_hundred_contacts_answers_as_one_sector_with_one_contact()
     // static stiffness at one contact with the others free, which the ring changes).
     let mut settings = scene.solver.clone();
     settings.c = Some(one.model.default_complementarity_constant());
-    let a = solve(&one, &settings, None).unwrap();
-    let b = solve(&all, &settings, None).unwrap();
+    let a = solve(&one, omega, &settings, None).unwrap();
+    let b = solve(&all, omega, &settings, None).unwrap();
     assert!(
         a.converged() && b.converged(),
         "{} / {}",

@@ -202,7 +202,7 @@ proptest! {
                 return Ok(());
             }
         };
-        match solve(&rod, &scene.solver, None) {
+        match solve(&rod, rod.omega(), &scene.solver, None) {
             Err(e) => prop_assert!(!e.to_string().is_empty(), "an error without a message"),
             Ok(s) => {
                 let st = &s.stats;
@@ -286,7 +286,7 @@ proptest! {
                 prop_assert!(rod.omega_1.is_finite() && rod.omega_1 > 0.0, "omega_1 = {}", rod.omega_1);
                 // (An overflowing omega = ratio * omega_1 is accepted here today and
                 // rejected by the solver: see `build_rod_rejects_an_overflowing_frequency`.)
-                prop_assert!(rod.model.forcing.amplitude.iter().all(|a| a.is_finite()));
+                prop_assert!(rod.model.load.iter().all(|a| a.is_finite()));
                 prop_assert!(rod.model.contacts.iter().all(|c| c.gap.is_finite()));
                 if let Ok(w) = natural_frequencies(&rod.model, 1) {
                     prop_assert!(w[0].is_finite() && w[0] > 0.0);
@@ -294,7 +294,7 @@ proptest! {
                 // And a small SSN-HB solve reports finite numbers or an error.
                 let mut settings = semismooth_contact::settings::SolverSettings::with_harmonics(3);
                 settings.max_iterations = 20;
-                match solve(&rod, &settings, None) {
+                match solve(&rod, rod.omega(), &settings, None) {
                     Err(e) => prop_assert!(!e.to_string().is_empty()),
                     Ok(s) => {
                         let st = &s.stats;
@@ -330,6 +330,6 @@ fn build_rod_rejects_an_overflowing_frequency() {
     };
     match build_rod(&spec) {
         Err(e) => assert!(e.to_string().contains("omega"), "{e}"),
-        Ok(rod) => panic!("accepted omega = {}", rod.model.forcing.omega),
+        Ok(rod) => panic!("accepted omega = {}", rod.omega()),
     }
 }

@@ -284,7 +284,7 @@ fn run_case(text: &str, reached: &Reached) -> Result<(), TestCaseError> {
     }
     let settings = clamped(&scene);
     reached.solved.fetch_add(1, Relaxed);
-    if let Ok(sol) = solve(&rod, &settings, None) {
+    if let Ok(sol) = solve(&rod, rod.omega(), &settings, None) {
         let json = ssn::json::solution_json(Path::new("fuzz.toml"), &sol);
         prop_assert!(serde_json::to_string(&json).is_ok());
         if sol.converged() {

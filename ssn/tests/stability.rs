@@ -57,8 +57,6 @@ fn march_changes(
     periods: usize,
     reset: bool,
 ) -> Vec<f64> {
-    let mut model = rod.model.clone();
-    model.forcing.omega = omega;
     let mut state = start.clone();
     for (i, x) in state.displacement.iter_mut().enumerate() {
         *x += perturbation * ((i + 1) as f64 * 0.7).sin();
@@ -68,7 +66,7 @@ fn march_changes(
         scheme: MarchScheme::MasslessContactTrapezoidal,
         ..MarchOptions::default()
     };
-    let mut marcher = TimeMarcher::new(&model, &options, &state).unwrap();
+    let mut marcher = TimeMarcher::new(&rod.model, omega, &options, &state).unwrap();
     marcher.set_closed_contact_velocity_reset(reset);
     let snapshot = |m: &TimeMarcher| -> Vec<f64> {
         m.displacement()
@@ -97,10 +95,11 @@ fn march_changes(
 }
 
 /// Marches (with the closed-contact velocity reset of the stability analysis) until the
-/// change of the state over a period is below `tolerance` relative; returns the periods
-/// marched and the tip minimum over the last one.
+/// change of the state over a period is below `tolerance` relative (forced at `omega`);
+/// returns the periods marched and the tip minimum over the last one.
 fn march_until_steady(
     rod: &RodModel,
+    omega: f64,
     start: &MarchState,
     steps_per_period: usize,
     max_periods: usize,
@@ -111,7 +110,7 @@ fn march_until_steady(
         scheme: MarchScheme::MasslessContactTrapezoidal,
         ..MarchOptions::default()
     };
-    let mut marcher = TimeMarcher::new(&rod.model, &options, start).unwrap();
+    let mut marcher = TimeMarcher::new(&rod.model, omega, &options, start).unwrap();
     marcher.set_closed_contact_velocity_reset(true);
     let tip = rod.tip_dof();
     let mut previous = marcher.displacement().to_vec();
@@ -235,12 +234,10 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
     assert_eq!(s.stable, Some(false));
     // The two stable solutions at exactly this frequency: Newton from the nearest points of
     // the upper and lower branches.
-    let mut at_omega = rod.clone();
-    at_omega.model.forcing.omega = omega;
     let mut stable_tips = Vec::new();
     for range in [0..upper_fold, lower_fold..r.points()] {
         let i = nearest(&r, w1, range, omega / w1);
-        let sol = solve(&at_omega, &scene.solver, Some(&r.states[i])).unwrap();
+        let sol = solve(&rod, omega, &scene.solver, Some(&r.states[i])).unwrap();
         assert!(sol.converged(), "{}", sol.termination);
         let st = stability_of(&rod, h, omega, &sol.state);
         assert_eq!(st.stable, Some(true));
@@ -256,7 +253,7 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
         for (i, x) in start.displacement.iter_mut().enumerate() {
             *x += sign * 1e-6 * (i + 1) as f64 / rod.model.dofs() as f64;
         }
-        let (periods, tip_min) = march_until_steady(&at_omega, &start, 2000, 3000, 1e-9);
+        let (periods, tip_min) = march_until_steady(&rod, omega, &start, 2000, 3000, 1e-9);
         let branch = stable_tips
             .iter()
             .position(|t| (t - tip_min).abs() < 5e-3 * t.abs())
@@ -394,7 +391,7 @@ fn report_stability_cost_per_point() {
 fn three_solutions_inside_the_overhang_two_stable() {
     let scene = scene(STRONG);
     let rod = build_rod(&scene.rod).unwrap();
-    let set = find_solutions(&rod, &scene.solver, scene.sweep.as_ref()).unwrap();
+    let set = find_solutions(&rod, rod.omega(), &scene.solver, scene.sweep.as_ref()).unwrap();
     assert_eq!(set.solutions.len(), 3, "{:?}", set.failed_corrections);
     let verdicts: Vec<Option<bool>> = set.solutions.iter().map(|s| s.stability.stable).collect();
     assert_eq!(verdicts, [Some(true), Some(false), Some(true)]);
@@ -406,7 +403,7 @@ fn three_solutions_inside_the_overhang_two_stable() {
     let len = rod.model.dofs() * (2 * h + 1);
     for s in &set.solutions {
         assert!(s.solution.converged());
-        assert_eq!(rod.model.forcing.omega, set.omega);
+        assert_eq!(rod.omega(), set.omega);
         if s.stability.stable != Some(true) {
             continue;
         }
@@ -417,7 +414,8 @@ fn three_solutions_inside_the_overhang_two_stable() {
             tolerance: 1e-9,
             scheme: MarchScheme::MasslessContactTrapezoidal,
         };
-        let period = march_from_state(&rod.model, &options, &[rod.tip_dof()], &start).unwrap();
+        let period =
+            march_from_state(&rod.model, set.omega, &options, &[rod.tip_dof()], &start).unwrap();
         let tip_min = period.displacements[0]
             .iter()
             .copied()

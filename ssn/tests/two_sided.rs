@@ -5,7 +5,7 @@
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{ContactDirection, InvalidModel, Structure};
 use semismooth_contact::solve::Solution;
-use ssn::scene::{default_hb_time_samples, Method, Scene, SolverSettings};
+use ssn::scene::{default_hb_time_samples, Method, Scene};
 
 mod common;
 
@@ -31,13 +31,15 @@ fn only(direction: &'static str, amplitude: &'static str) -> impl Fn(String) -> 
     }
 }
 
-fn solve(s: &Structure, base: &SolverSettings, method: Method, harmonics: usize) -> Solution {
-    let mut settings = base.clone();
+/// `s` solved at `scene`'s frequency with its settings, `method` and `harmonics`.
+fn solve(s: &Structure, scene: &Scene, method: Method, harmonics: usize) -> Solution {
+    let mut settings = scene.solver.clone();
     settings.method = method;
     settings.harmonics = harmonics;
     settings.time_samples = default_hb_time_samples(harmonics);
     settings.steps_per_period = 2000;
-    let sol = semismooth_contact::solve(s, &settings, None).unwrap();
+    let omega = scene.omega(s.omega_1);
+    let sol = semismooth_contact::solve(s, omega, &settings, None).unwrap();
     assert!(sol.converged(), "{method:?}: {}", sol.termination);
     sol
 }
@@ -52,7 +54,7 @@ fn rattling_between_two_stops_ssn_hb_agrees_with_time_marching() {
     assert_eq!(s.model.contacts.len(), 2);
     assert_eq!(s.model.contacts[1].direction, ContactDirection::Negative);
     let gap = s.model.contacts[0].gap;
-    let march = solve(&s, &scene.solver, Method::March, 20);
+    let march = solve(&s, &scene, Method::March, 20);
     // Both stops are hit (the tip passes +-gap by the pad's compliance).
     assert!(
         march.stats.max > gap && march.stats.min < -gap,
@@ -63,7 +65,7 @@ fn rattling_between_two_stops_ssn_hb_agrees_with_time_marching() {
     assert!(march_forces.iter().all(|f| *f < 0.0), "{march_forces:?}");
     let mut errors = Vec::new();
     for h in [10, 20, 40] {
-        let hb = solve(&s, &scene.solver, Method::SsnHb, h);
+        let hb = solve(&s, &scene, Method::SsnHb, h);
         // A cos forcing and symmetric stops: the response has half-period symmetry
         // u(t + T/2) = -u(t), so the extremes are opposite and the two contacts carry the
         // same mean force (to the Newton tolerance).
@@ -93,11 +95,11 @@ fn rattling_between_two_stops_ssn_hb_agrees_with_time_marching() {
 #[test]
 fn an_obstacle_on_the_negative_side_mirrors_one_on_the_positive_side() {
     // One stop above with load f, against one stop below with load -f: u -> -u exactly.
-    let (scene, up) = beam(only("1", "0.01"));
-    let (_, down) = beam(only("-1", "-0.01"));
+    let (up_scene, up) = beam(only("1", "0.01"));
+    let (down_scene, down) = beam(only("-1", "-0.01"));
     for method in [Method::SsnHb, Method::PenaltyHb, Method::March] {
-        let a = solve(&up, &scene.solver, method, 20);
-        let b = solve(&down, &scene.solver, method, 20);
+        let a = solve(&up, &up_scene, method, 20);
+        let b = solve(&down, &down_scene, method, 20);
         let mirrored: Vec<f64> = b.tip.iter().map(|v| -v).collect();
         let diff = common::max_abs_diff(&a.tip, &mirrored);
         assert!(diff < 1e-10, "{method:?}: {diff:e}");
@@ -138,7 +140,7 @@ fn stops_on_one_side_twice_or_without_clearance_are_rejected() {
     let (scene, _) = beam(|t| t);
     let mut solver = scene.solver.clone();
     solver.method = Method::LcpLemke;
-    let err = semismooth_contact::solve(&s, &solver, None)
+    let err = semismooth_contact::solve(&s, scene.omega(s.omega_1), &solver, None)
         .unwrap_err()
         .to_string();
     assert!(

@@ -51,10 +51,10 @@ pub struct CondensedSsnHb {
 }
 
 impl CondensedSsnHb {
-    /// Builds the problem and factors `A(w)` (validates like [`SsnHb::new`]; a singular
-    /// dynamic block is [`HbError::Linear`]).
-    pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
-        let full = SsnHb::new(model, options)?;
+    /// Builds the problem at the forcing frequency `omega` and factors `A(w)` (validates
+    /// like [`SsnHb::new`]; a singular dynamic block is [`HbError::Linear`]).
+    pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
+        let full = SsnHb::new(model, omega, options)?;
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
         let mut this = Self {
@@ -84,7 +84,7 @@ impl CondensedSsnHb {
         let lin = self.full.state.linear.clone();
         let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
         self.linear_response.fill(0.0);
-        self.linear_response[n..2 * n].copy_from_slice(&lin.forcing);
+        self.linear_response[n..2 * n].copy_from_slice(&lin.load);
         self.solver
             .apply_dynamic_inverse(&mut self.linear_response)?;
         for (i, &dof) in lin.contact_dofs.iter().enumerate() {

@@ -1,6 +1,8 @@
 //! Harmonic balance for periodic contact problems: the semismooth formulation of Shi &
 //! Legrand (SSN-HB, their equations (5)-(6)) and penalty harmonic balance.
 //!
+//! Both are built for a model and a forcing frequency `w` (`f(t) = load cos(w t)`; a new
+//! frequency is [`SsnHb::set_omega`] or the continuation parameter, not a new problem).
 //! Both expand the displacements of the [`StructuralModel`] with `H` harmonics in the real
 //! basis of [`semismooth::harmonic`] (`u(t) = u_0 + sum_k u_ck cos(k w t) + u_sk sin(k w t)`),
 //! harmonic-major: unknown `j * N + dof` is coefficient `j` of `dof`. The linear dynamics
@@ -44,7 +46,7 @@
 //! let options = HbOptions { harmonics: 20, ..HbOptions::default() };
 //!
 //! // Full unknowns [U; Lambda], structured (condensed) linear solves.
-//! let mut hb = SsnHb::new(&rod.model, &options).unwrap();
+//! let mut hb = SsnHb::new(&rod.model, rod.omega(), &options).unwrap();
 //! let mut x = vec![0.0; hb.dim()];
 //! let newton = PolyalgorithmOptions::default();
 //! let report = solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &newton).unwrap();
@@ -53,7 +55,7 @@
 //! assert!(summary.displacement_min < -0.5 && summary.contact_force_mean[0] < 0.0);
 //!
 //! // Newton on the force coefficients alone: same solution, far fewer iterations.
-//! let mut condensed = CondensedSsnHb::new(&rod.model, &options).unwrap();
+//! let mut condensed = CondensedSsnHb::new(&rod.model, rod.omega(), &options).unwrap();
 //! let mut lambda = vec![0.0; condensed.dim()];
 //! let reduced = solve(&mut condensed, &mut FaerDenseLu::new(), &mut lambda, &newton).unwrap();
 //! assert!(reduced.converged() && reduced.iterations < report.iterations);
@@ -182,7 +184,7 @@ pub enum HbError {
         /// The allowed range, in words.
         allowed: &'static str,
     },
-    /// The model is not usable (sizes, non-finite data, frequency, contacts).
+    /// The model is not usable (sizes, non-finite data, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),
     /// A degree of freedom or contact index is out of range.
@@ -234,7 +236,7 @@ pub struct ResponseSummary {
 }
 
 /// The linear data shared by the formulations and their Jacobians (immutable, behind an
-/// `Arc`): matrices, forcing, contact rows and the Fourier basis.
+/// `Arc`): matrices, load, contact rows and the Fourier basis.
 #[derive(Debug)]
 pub(crate) struct LinearData {
     pub(crate) dofs: usize,
@@ -242,7 +244,7 @@ pub(crate) struct LinearData {
     pub(crate) mass: SparseMatrix,
     pub(crate) damping: Option<SparseMatrix>,
     pub(crate) stiffness: SparseMatrix,
-    pub(crate) forcing: Vec<f64>,
+    pub(crate) load: Vec<f64>,
     pub(crate) contact_dofs: Vec<usize>,
     pub(crate) gaps: Vec<f64>,
     /// `s_i = +-1`: the entry of contact `i`'s row of `G` (its dof `contact_dofs[i]`).
@@ -268,7 +270,7 @@ impl LinearData {
             mass: model.mass.clone(),
             damping: model.damping.clone(),
             stiffness: model.stiffness.clone(),
-            forcing: model.forcing.amplitude.clone(),
+            load: model.load.clone(),
             contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
             contact_signs: model.contacts.iter().map(|c| c.sign()).collect(),
@@ -287,7 +289,7 @@ impl LinearData {
     pub(crate) fn dynamic_residual(&self, omega: f64, u: &[f64], out: &mut [f64]) {
         self.apply_dynamic(omega, u, out);
         let n = self.dofs;
-        for (o, f) in out[n..2 * n].iter_mut().zip(&self.forcing) {
+        for (o, f) in out[n..2 * n].iter_mut().zip(&self.load) {
             *o -= f;
         }
     }
@@ -395,6 +397,7 @@ pub(crate) fn check_positive(
     }
 }
 
+/// `Err(InvalidOption { name: "omega" })` unless the forcing frequency is finite and `> 0`.
 pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
     check_positive("omega", omega, "a finite angular frequency > 0")
 }

@@ -108,13 +108,19 @@ impl PenaltyHb {
         Ok(u)
     }
 
-    /// Builds the problem; validates the model and the options.
-    pub fn new(model: &StructuralModel, options: &PenaltyHbOptions) -> Result<Self, HbError> {
+    /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
+    /// model, the frequency and the options.
+    pub fn new(
+        model: &StructuralModel,
+        omega: f64,
+        options: &PenaltyHbOptions,
+    ) -> Result<Self, HbError> {
         options.validate()?;
+        super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         Ok(Self {
-            state: HbState::new(linear, model.forcing.omega),
+            state: HbState::new(linear, omega),
             stiffness: kp,
             frozen: Vec::new(),
             holding: false,

@@ -6,8 +6,8 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_positive, displacement_summary, validate_basis, HbError, HbState, LinearData,
-    ResponseSummary,
+    check_len, check_omega, check_positive, displacement_summary, validate_basis, HbError, HbState,
+    LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -84,9 +84,11 @@ impl SsnHb {
         self.displacement_coefficients(x)
     }
 
-    /// Builds the problem; validates the model and the options.
-    pub fn new(model: &StructuralModel, options: &HbOptions) -> Result<Self, HbError> {
+    /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
+    /// model, the frequency and the options.
+    pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
         options.validate()?;
+        check_omega(omega)?;
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let c = match options.c {
             Some(c) => c,
@@ -94,7 +96,7 @@ impl SsnHb {
         };
         check_c(c)?;
         Ok(Self {
-            state: HbState::new(linear, model.forcing.omega),
+            state: HbState::new(linear, omega),
             c,
             smoothing: 0.0,
         })

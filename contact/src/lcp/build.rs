@@ -26,14 +26,19 @@ struct Bins {
 }
 
 impl PeriodicLcp {
-    /// Builds `A` and `q` for `model` with `options.time_samples` steps per period.
+    /// Builds `A` and `q` for `model` forced at `omega` (finite, `> 0`:
+    /// [`LcpError::InvalidOption`] otherwise) with `options.time_samples` steps per period.
     ///
     /// Cost: `Nt/2 + 1` sparse complex LU factorizations of size `N` (one column ordering),
     /// `m` solves each, and `m^2` FFTs of length `Nt` for the kernel. A dynamic stiffness
     /// whose LU breaks down (a zero pivot: a warped bin frequency on a natural frequency of
     /// an undamped model) is [`LcpError::SingularBin`].
-    pub fn new(model: &StructuralModel, options: PeriodicLcpOptions) -> Result<Self, LcpError> {
-        Self::build(model, options, false)
+    pub fn new(
+        model: &StructuralModel,
+        omega: f64,
+        options: PeriodicLcpOptions,
+    ) -> Result<Self, LcpError> {
+        Self::build(model, omega, options, false)
     }
 
     /// [`PeriodicLcp::new`] that also computes the derivatives with respect to `omega` of
@@ -44,17 +49,26 @@ impl PeriodicLcp {
     /// column with the same LU (the Nyquist limit does not depend on `omega`).
     pub fn with_frequency_derivative(
         model: &StructuralModel,
+        omega: f64,
         options: PeriodicLcpOptions,
     ) -> Result<Self, LcpError> {
-        Self::build(model, options, true)
+        Self::build(model, omega, options, true)
     }
 
     fn build(
         model: &StructuralModel,
+        omega: f64,
         options: PeriodicLcpOptions,
         with_derivative: bool,
     ) -> Result<Self, LcpError> {
         model.validate()?;
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(LcpError::InvalidOption {
+                name: "omega",
+                value: omega,
+                allowed: "a finite angular frequency > 0",
+            });
+        }
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);
         }
@@ -73,7 +87,6 @@ impl PeriodicLcp {
         let m = model.contact_count();
         options.validate(m, n)?;
         let nt = options.time_samples;
-        let omega = model.forcing.omega;
         let contact_dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
         let gaps: Vec<f64> = model.contacts.iter().map(|c| c.gap).collect();
         let rows: Vec<usize> = contact_dofs
@@ -87,7 +100,7 @@ impl PeriodicLcp {
             mut transfer,
             linear_amplitude,
             derivative,
-        } = bin_transfers(model, nt, options.scheme, &rows, with_derivative)?;
+        } = bin_transfers(model, omega, nt, options.scheme, &rows, with_derivative)?;
 
         // Nyquist limit: static receptance of the dofs with neither mass nor damping.
         let static_set: Vec<usize> = (0..n)
@@ -145,13 +158,13 @@ impl PeriodicLcp {
 /// frequency derivatives.
 fn bin_transfers(
     model: &StructuralModel,
+    omega: f64,
     nt: usize,
     scheme: LcpScheme,
     rows: &[usize],
     with_derivative: bool,
 ) -> Result<Bins, LcpError> {
     let (n, m, nr) = (model.dofs(), model.contact_count(), rows.len());
-    let omega = model.forcing.omega;
     let dt = 2.0 * std::f64::consts::PI / omega / nt as f64;
     let bins = nt / 2 + 1;
     let zero = c64::new(0.0, 0.0);
@@ -171,7 +184,7 @@ fn bin_transfers(
         m + 1,
     )
     .map_err(|source| LcpError::Factorization { bin: 0, source })?;
-    // Columns: the contact unit vectors G^T, then the forcing (bin 1 only).
+    // Columns: the contact unit vectors G^T, then the load (bin 1 only).
     let mut x = Mat::<c64>::zeros(n, m + 1);
     let mut y = Mat::<c64>::zeros(n, m + 1);
     let mut values = Vec::new();
@@ -206,7 +219,7 @@ fn bin_transfers(
             x[(dof, c)] = c64::new(1.0, 0.0);
         }
         if with_forcing {
-            for (i, a) in model.forcing.amplitude.iter().enumerate() {
+            for (i, a) in model.load.iter().enumerate() {
                 x[(i, m)] = c64::new(*a, 0.0);
             }
         }

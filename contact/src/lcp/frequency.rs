@@ -54,11 +54,14 @@ pub struct FrequencyLcp {
 }
 
 impl FrequencyLcp {
-    /// The problem for `model` at its forcing frequency, with `options.time_samples` steps
-    /// per period and the force scale `kappa` (finite, `> 0`). Builds the first LCP, so
-    /// that a model the LCP cannot handle (no contact, bad option) is reported here.
+    /// The problem for `model` starting at the forcing frequency `omega`, with
+    /// `options.time_samples` steps per period and the force scale `kappa` (finite, `> 0`).
+    /// Builds the first LCP, so that a model the LCP cannot handle (no contact, bad option or
+    /// frequency) is reported here. The model is kept (one copy); every frequency's LCP is
+    /// built from it.
     pub fn new(
         model: &StructuralModel,
+        omega: f64,
         options: PeriodicLcpOptions,
         kappa: f64,
     ) -> Result<Self, LcpError> {
@@ -69,13 +72,13 @@ impl FrequencyLcp {
                 allowed: "a finite number > 0",
             });
         }
-        let lcp = PeriodicLcp::with_frequency_derivative(model, options.clone())?;
+        let lcp = PeriodicLcp::with_frequency_derivative(model, omega, options.clone())?;
         let n = lcp.dim();
         Ok(Self {
             model: model.clone(),
             options,
             kappa,
-            omega: model.forcing.omega,
+            omega,
             cache: vec![Rc::new(lcp)],
             scratch: vec![0.0; n],
         })
@@ -105,10 +108,9 @@ impl FrequencyLcp {
         if let Some(lcp) = self.cache.iter().find(|l| l.omega() == omega) {
             return Ok(lcp.clone());
         }
-        let mut model = self.model.clone();
-        model.forcing.omega = omega;
         Ok(Rc::new(PeriodicLcp::with_frequency_derivative(
-            &model,
+            &self.model,
+            omega,
             self.options.clone(),
         )?))
     }
@@ -120,10 +122,9 @@ impl FrequencyLcp {
             self.cache.insert(0, lcp.clone());
             return Ok(lcp);
         }
-        let mut model = self.model.clone();
-        model.forcing.omega = self.omega;
         let lcp = Rc::new(PeriodicLcp::with_frequency_derivative(
-            &model,
+            &self.model,
+            self.omega,
             self.options.clone(),
         )?);
         self.cache.insert(0, lcp.clone());
@@ -385,7 +386,7 @@ mod tests {
             ..Default::default()
         };
         let kappa = rod.model.contact_stiffness_scale();
-        FrequencyLcp::new(&rod.model, options, kappa).unwrap()
+        FrequencyLcp::new(&rod.model, rod.omega(), options, kappa).unwrap()
     }
 
     /// A state with both active and inactive rows: `z` positive on half of the nodes.
@@ -471,7 +472,7 @@ mod tests {
             time_samples: 16,
             ..Default::default()
         };
-        let mut p = FrequencyLcp::new(&rod.model, options, 1.0).unwrap();
+        let mut p = FrequencyLcp::new(&rod.model, rod.omega(), options, 1.0).unwrap();
         let n = p.half();
         let mut y = vec![0.0; 2 * n];
         y[n..].fill(1.0); // z = 1 > kappa w = 0 everywhere

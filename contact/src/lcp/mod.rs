@@ -107,7 +107,7 @@
 //! spec.mass = MassModel::Modified;
 //! let rod = build_rod(&spec).unwrap();
 //! let options = PeriodicLcpOptions { time_samples: 128, ..Default::default() };
-//! let lcp = PeriodicLcp::new(&rod.model, options).unwrap();
+//! let lcp = PeriodicLcp::new(&rod.model, rod.omega(), options).unwrap();
 //! let mut lemke = Lemke::new(lcp.dim());
 //! let report = lcp.solve_with_lemke(&mut lemke, &LemkeOptions::default()).unwrap();
 //! let report = lcp.check_lemke(report).unwrap(); // a ray or pivot limit would be an Err
@@ -129,7 +129,7 @@
 //!     scheme: MarchScheme::MasslessContactTrapezoidal,
 //! };
 //! let tip_dof = rod.model.dofs() - 1;
-//! let march = march_to_steady_state(&rod.model, &march_options, &[tip_dof]).unwrap();
+//! let march = march_to_steady_state(&rod.model, rod.omega(), &march_options, &[tip_dof]).unwrap();
 //! let marched = march.displacements[0][..128].iter().cloned().fold(f64::INFINITY, f64::min);
 //! assert!((lowest - marched).abs() < 2e-11);
 //! ```

@@ -77,7 +77,8 @@ impl SequencedSolution {
 }
 
 /// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
-/// `"lcp-ssn"` at large `Nt`): the LCP of `model` is solved at `Nt / 2^j` (halving while
+/// `"lcp-ssn"` at large `Nt`): the LCP of `model` forced at `omega` is solved at `Nt / 2^j`
+/// (halving while
 /// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0` (offering the
 /// polyalgorithm the min-map's smoothing, [`super::MinMapLcp`]'s `Smoothing`), then each finer
 /// level starts from the previous solution interpolated in time
@@ -87,7 +88,7 @@ impl SequencedSolution {
 /// [`DEFAULT_ACTIVE_SET_REGULARIZATION`], so that a singular first Jacobian (every node
 /// in contact at `z = 0`) does not stop the run. A level that does not converge still
 /// passes its best iterate on; `Ok` whenever every level ran (check
-/// [`SequencedSolution::converged`]). `finest` must be an LCP of `model`
+/// [`SequencedSolution::converged`]). `finest` must be an LCP of `model` at `omega`
 /// ([`LcpError::ForeignLcp`] otherwise).
 ///
 /// Why: with a damped massless contact node the high-frequency receptances tend to 0, so
@@ -97,11 +98,12 @@ impl SequencedSolution {
 /// 2048); from the interpolated coarser solution 5 / 7 / 8 / 42 iterations.
 pub fn solve_min_map_sequenced(
     model: &StructuralModel,
+    omega: f64,
     finest: &PeriodicLcp,
     newton_options: &SolveOptions,
 ) -> Result<SequencedSolution, LcpError> {
     newton_options.validate()?;
-    check_same_model(model, finest)?;
+    check_same_model(model, omega, finest)?;
     // The coarser levels, finest first: Nt / 2, Nt / 4, ... (the finest is the caller's).
     let mut sizes = Vec::new();
     let mut nt = finest.time_samples();
@@ -135,17 +137,22 @@ pub fn solve_min_map_sequenced(
             observed_dofs: Vec::new(),
             scheme: finest.scheme(),
         };
-        z = Some(solve_level(&PeriodicLcp::new(model, options)?, z)?);
+        z = Some(solve_level(&PeriodicLcp::new(model, omega, options)?, z)?);
     }
     let z = solve_level(finest, z)?;
     Ok(SequencedSolution { z, levels })
 }
 
-/// `Err(ForeignLcp)` unless `lcp` was built for `model` (same frequency and contacts).
-fn check_same_model(model: &StructuralModel, lcp: &PeriodicLcp) -> Result<(), LcpError> {
+/// `Err(ForeignLcp)` unless `lcp` was built for `model` at `omega` (same frequency and
+/// contacts).
+fn check_same_model(
+    model: &StructuralModel,
+    omega: f64,
+    lcp: &PeriodicLcp,
+) -> Result<(), LcpError> {
     let foreign = |what, lcp: f64, model: f64| Err(LcpError::ForeignLcp { what, lcp, model });
-    if lcp.omega() != model.forcing.omega {
-        return foreign("omega", lcp.omega(), model.forcing.omega);
+    if lcp.omega() != omega {
+        return foreign("omega", lcp.omega(), omega);
     }
     if lcp.contact_count() != model.contact_count() {
         let (a, b) = (lcp.contact_count(), model.contact_count());
@@ -176,14 +183,15 @@ mod tests {
     fn the_finest_lcp_must_be_the_models() {
         let mut spec = RodSpec::canonical();
         spec.mass = MassModel::Modified;
-        let model = build_rod(&spec).unwrap().structure.model;
+        let rod = build_rod(&spec).unwrap();
+        let (model, omega) = (&rod.model, rod.omega());
         let options = PeriodicLcpOptions {
             time_samples: 16,
             ..Default::default()
         };
-        let lcp = PeriodicLcp::new(&model, options).unwrap();
+        let lcp = PeriodicLcp::new(model, omega, options).unwrap();
         let newton = SolveOptions::default();
-        let solved = solve_min_map_sequenced(&model, &lcp, &newton).unwrap();
+        let solved = solve_min_map_sequenced(model, omega, &lcp, &newton).unwrap();
         // Nt = 16 is below the coarsest level: one level, the caller's LCP.
         assert_eq!(solved.levels.len(), 1);
         assert_eq!(solved.levels[0].time_samples, 16);
@@ -193,25 +201,23 @@ mod tests {
             time_samples: 512,
             ..Default::default()
         };
-        let fine = PeriodicLcp::new(&model, options).unwrap();
-        let solved = solve_min_map_sequenced(&model, &fine, &newton).unwrap();
+        let fine = PeriodicLcp::new(model, omega, options).unwrap();
+        let solved = solve_min_map_sequenced(model, omega, &fine, &newton).unwrap();
         let sizes: Vec<usize> = solved.levels.iter().map(|l| l.time_samples).collect();
         assert_eq!(sizes, [128, 256, 512]);
         assert!(solved.converged());
-        let mut other = model.clone();
-        other.forcing.omega *= 2.0;
         assert_eq!(
-            solve_min_map_sequenced(&other, &lcp, &newton).unwrap_err(),
+            solve_min_map_sequenced(model, 2.0 * omega, &lcp, &newton).unwrap_err(),
             LcpError::ForeignLcp {
                 what: "omega",
-                lcp: model.forcing.omega,
-                model: other.forcing.omega
+                lcp: omega,
+                model: 2.0 * omega
             }
         );
         let mut other = model.clone();
         other.contacts[0].gap = 0.25;
         assert!(matches!(
-            solve_min_map_sequenced(&other, &lcp, &newton),
+            solve_min_map_sequenced(&other, omega, &lcp, &newton),
             Err(LcpError::ForeignLcp {
                 what: "contact gap",
                 ..

@@ -60,8 +60,8 @@
 //!
 //! # Steady state
 //!
-//! The forcing is `f(t) = amplitude cos(omega t)`, `T = 2 pi / omega`, `h = T /
-//! steps_per_period`; the march starts at `t = 0` (the forcing's cosine peak), so every
+//! The forcing is `f(t) = load cos(omega t)` (the model's load, `omega` an argument of the
+//! march), `T = 2 pi / omega`, `h = T / steps_per_period`; the march starts at `t = 0` (the forcing's cosine peak), so every
 //! period starts at a multiple of `T` and the reported period has the same phase as a
 //! harmonic-balance solution. After each period the relative period-to-period change is
 //! the larger of (a) the change of the full state `(u, v / omega)` sampled at the period
@@ -110,7 +110,8 @@
 //! use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 //! let rod = build_rod(&RodSpec { mass: MassModel::Modified, ..RodSpec::canonical() }).unwrap();
 //! let options = MarchOptions { steps_per_period: 200, tolerance: 1e-6, ..MarchOptions::default() };
-//! let period = march_to_steady_state(&rod.model, &options, &[rod.tip_dof()]).unwrap();
+//! let period = march_to_steady_state(&rod.model, rod.omega(), &options, &[rod.tip_dof()]).unwrap();
+//! assert_eq!(period.omega, rod.omega());
 //! let tip = &period.displacements[0];
 //! assert!(tip.iter().all(|u| *u <= 0.5 + 1e-12)); // never beyond the gap
 //! assert!(period.contact_forces[0].iter().all(|l| *l <= 0.0));
@@ -454,32 +455,39 @@ fn relative_change(a: &[f64], b: &[f64]) -> f64 {
     }
 }
 
-/// Marches from rest until the period-to-period change is below the tolerance and returns
-/// the last period (see the module docs).
+/// Marches `model` forced at `omega` (finite, `> 0`) from rest until the period-to-period
+/// change is below the tolerance and returns the last period (see the module docs).
 pub fn march_to_steady_state(
     model: &StructuralModel,
+    omega: f64,
     options: &MarchOptions,
     observed_dofs: &[usize],
 ) -> Result<SteadyPeriod, MarchError> {
-    march_from_state(model, options, observed_dofs, &MarchState::rest(model))
+    march_from_state(
+        model,
+        omega,
+        options,
+        observed_dofs,
+        &MarchState::rest(model),
+    )
 }
 
 /// Like [`march_to_steady_state`] but from a given state at `t = 0` (a warm start, e.g.
 /// [`SteadyPeriod::final_state`] of a previous march).
 pub fn march_from_state(
     model: &StructuralModel,
+    omega: f64,
     options: &MarchOptions,
     observed_dofs: &[usize],
     initial: &MarchState,
 ) -> Result<SteadyPeriod, MarchError> {
-    let mut marcher = TimeMarcher::new(model, options, initial)?;
+    let mut marcher = TimeMarcher::new(model, omega, options, initial)?;
     let n = model.dofs();
     let m = model.contact_count();
     model.check_observed(observed_dofs)?;
     let spp = options.steps_per_period;
     let samples = spp + 1;
     let nobs = observed_dofs.len();
-    let omega = model.forcing.omega;
     // Observed series of the current and previous periods, sample-major, and the
     // contact forces of the current period.
     let mut series = vec![0.0; nobs * samples];

@@ -142,15 +142,24 @@ pub struct TimeMarcher<'a> {
 }
 
 impl<'a> TimeMarcher<'a> {
-    /// Validates the options, the model and the initial state, factors the iteration
-    /// matrix and prepares `Y`, `W` and the initial inertial force. The time starts at 0.
+    /// Validates the options, the model, the forcing frequency `omega` (finite, `> 0`) and
+    /// the initial state, factors the iteration matrix and prepares `Y`, `W` and the initial
+    /// inertial force. The time starts at 0.
     pub fn new(
         model: &'a StructuralModel,
+        omega: f64,
         options: &MarchOptions,
         initial: &MarchState,
     ) -> Result<Self, MarchError> {
         options.validate()?;
         model.validate()?;
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(MarchError::InvalidOption {
+                name: "omega",
+                value: omega,
+                allowed: "a finite angular frequency > 0",
+            });
+        }
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
@@ -159,7 +168,7 @@ impl<'a> TimeMarcher<'a> {
             .map(|j| column_max_abs(&model.mass, j) == 0.0)
             .collect();
         let spp = options.steps_per_period;
-        let h = 2.0 * PI / model.forcing.omega / spp as f64;
+        let h = 2.0 * PI / omega / spp as f64;
         // a K + b D + c M, summed in the order K, D, M.
         let (a, b, c) = match scheme {
             Scheme::Trapezoidal => {
@@ -237,7 +246,7 @@ impl<'a> TimeMarcher<'a> {
     fn equilibrium_inertia(&mut self, j: usize) {
         let model = self.model;
         let c = self.cosines[j];
-        for (ri, ai) in self.r.iter_mut().zip(&model.forcing.amplitude) {
+        for (ri, ai) in self.r.iter_mut().zip(&model.load) {
             *ri = c * ai;
         }
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
@@ -392,7 +401,7 @@ impl<'a> TimeMarcher<'a> {
         let c = self.cosines[j + 1];
         // rhs = f_{n+1} + r_n + M (4/h^2 u + 4/h v) + D (2/h u + v)
         for i in 0..n {
-            self.rhs[i] = c * model.forcing.amplitude[i] + self.r[i];
+            self.rhs[i] = c * model.load[i] + self.r[i];
             self.tmp[i] = 4.0 / (h * h) * self.u[i] + 4.0 / h * self.v[i];
         }
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.tmp, &mut self.rhs);
@@ -439,7 +448,7 @@ impl<'a> TimeMarcher<'a> {
         let f_theta = theta * self.cosines[j + 1] + (1.0 - theta) * self.cosines[j];
         // rhs = M v - h D (1 - theta) v - h K (u + h theta (1 - theta) v) + h f_theta
         for i in 0..n {
-            self.rhs[i] = h * f_theta * model.forcing.amplitude[i];
+            self.rhs[i] = h * f_theta * model.load[i];
         }
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.v, &mut self.rhs);
         if let Some(d) = &model.damping {

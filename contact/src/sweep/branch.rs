@@ -75,16 +75,20 @@ pub(crate) enum Reconstruction {
 }
 
 impl Reconstruction {
-    /// The scene's harmonic-balance problem (`Unsupported` for other methods).
+    /// The scene's harmonic-balance problem at `omega` (`Unsupported` for other methods);
+    /// its reconstructions over one period do not depend on the frequency.
     pub(crate) fn new(
         model: &StructuralModel,
+        omega: f64,
         settings: &SolverSettings,
     ) -> Result<Self, RunError> {
         Ok(match settings.method {
-            Method::SsnHb => Self::Ssn(SsnHb::new(model, &hb_options(settings))?),
-            Method::PenaltyHb => {
-                Self::Penalty(PenaltyHb::new(model, &penalty_options(settings, model))?)
-            }
+            Method::SsnHb => Self::Ssn(SsnHb::new(model, omega, &hb_options(settings))?),
+            Method::PenaltyHb => Self::Penalty(PenaltyHb::new(
+                model,
+                omega,
+                &penalty_options(settings, model),
+            )?),
             other => {
                 return Err(RunError::Unsupported {
                     method: other.name(),
@@ -157,11 +161,12 @@ pub fn branch_stability(
     let points = response.points();
     let mut out = BranchStability::default();
     let model = &rod.model;
+    // The reconstructions over one period do not depend on the frequency: any valid one.
+    let omega = rod.omega_1;
     let reconstruction = match settings.method {
-        Method::SsnHb => SsnHb::new(model, &hb_options(settings)).map(Reconstruction::Ssn),
-        Method::PenaltyHb => {
-            PenaltyHb::new(model, &penalty_options(settings, model)).map(Reconstruction::Penalty)
-        }
+        Method::SsnHb => SsnHb::new(model, omega, &hb_options(settings)).map(Reconstruction::Ssn),
+        Method::PenaltyHb => PenaltyHb::new(model, omega, &penalty_options(settings, model))
+            .map(Reconstruction::Penalty),
         _ => {
             return Ok(BranchStability::not_decided(
                 points,

@@ -41,9 +41,15 @@ pub(super) fn branch_contacts(
             })
             .collect()
     };
+    // The reconstructions over one period do not depend on the frequency: any valid one.
+    let omega = rod.omega_1;
     match settings.method {
-        Method::SsnHb => hb(&SsnHb::new(model, &hb_options(settings))?),
-        Method::PenaltyHb => hb(&PenaltyHb::new(model, &penalty_options(settings, model))?),
+        Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
+        Method::PenaltyHb => hb(&PenaltyHb::new(
+            model,
+            omega,
+            &penalty_options(settings, model),
+        )?),
         Method::LcpSsn => {
             let m = contacts.len();
             Ok(response

@@ -153,16 +153,18 @@ fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
     let dofs = model.dofs().max(1);
+    let options = PenaltyHbOptions {
+        harmonics: 1,
+        time_samples: None,
+        penalty_stiffness: 1.0,
+    };
+    let Ok(mut problem) = PenaltyHb::new(&model, rod.omega_1, &options) else {
+        return 1.0;
+    };
     for ratio in [1.0, 0.95, 0.5] {
-        model.forcing.omega = ratio * rod.omega_1;
-        let options = PenaltyHbOptions {
-            harmonics: 1,
-            time_samples: None,
-            penalty_stiffness: 1.0,
-        };
-        let Ok(mut problem) = PenaltyHb::new(&model, &options) else {
+        if problem.set_omega(ratio * rod.omega_1).is_err() {
             continue;
-        };
+        }
         let n = problem.dim();
         let x = vec![0.0; n];
         let mut r = vec![0.0; n];
@@ -493,6 +495,8 @@ pub(crate) fn follow_branch(
     let tip = rod.observed_dof;
     let dofs = model.dofs();
     let omega_1 = rod.omega_1;
+    // The problems are built at the start of the branch (`follow` solves there first).
+    let omega_from = sweep.omega_ratio_from * omega_1;
     let u_ref = reference_amplitude(rod);
     let output_points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let setup = |method: MethodContinuation, output_points: usize| Setup {
@@ -508,7 +512,7 @@ pub(crate) fn follow_branch(
     };
     match settings.method {
         Method::SsnHb => {
-            let mut problem = SsnHb::new(model, &hb_options(settings))?;
+            let mut problem = SsnHb::new(model, omega_from, &hb_options(settings))?;
             let split = problem.displacement_len();
             let c = problem.c();
             let units = (0..problem.dim())
@@ -532,7 +536,7 @@ pub(crate) fn follow_branch(
         }
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
-            let mut problem = PenaltyHb::new(model, &options)?;
+            let mut problem = PenaltyHb::new(model, omega_from, &options)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
             // The penalty force is k_p times gaps computed to ε |u| (|u| ~ the gap in contact).
@@ -569,12 +573,10 @@ pub(crate) fn follow_branch(
             let contacts = model.contact_count();
             let (lcp_options, tip_contact) = lcp_options(rod, settings);
             // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
-            let mut start_model = model.clone();
-            start_model.forcing.omega = sweep.omega_ratio_from * omega_1;
-            let mut problem = FrequencyLcp::new(&start_model, lcp_options, kappa)?;
+            let mut problem = FrequencyLcp::new(model, omega_from, lcp_options, kappa)?;
             let finest = problem.current()?;
             let sequenced =
-                solve_min_map_sequenced(&start_model, &finest, &newton_options(settings))?;
+                solve_min_map_sequenced(model, omega_from, &finest, &newton_options(settings))?;
             let start_counters = sequenced.levels.iter().map(|l| l.report.counters).sum();
             let y0 = problem.state_from_forces(&sequenced.z)?;
             let half = problem.half();

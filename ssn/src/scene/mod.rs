@@ -269,6 +269,20 @@ impl Scene {
             })?;
         check::resolve(raw, path)
     }
+
+    /// The scene's `[forcing]` frequency (ratio or absolute): the `[model]`'s for an
+    /// imported structure, the `[rod]`'s otherwise.
+    pub fn frequency(&self) -> FrequencySpec {
+        self.model
+            .as_ref()
+            .map_or(self.rod.frequency, |m| m.frequency)
+    }
+
+    /// [`Scene::frequency`] resolved for a structure whose first natural frequency is
+    /// `omega_1` (the structure holds no frequency; the runs take this one).
+    pub fn omega(&self, omega_1: f64) -> f64 {
+        self.frequency().omega(omega_1)
+    }
 }
 
 #[cfg(test)]
