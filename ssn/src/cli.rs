@@ -53,13 +53,14 @@ pub fn load(path: &Path) -> Result<Loaded, CliError> {
 /// [`load`], with the memory of `ssn compare`'s runs when `compare`.
 fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
     let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
-    let limit = crate::limits::memory_limit();
+    let limit = crate::limits::memory_limit().map_err(CliError::BadInput)?;
+    let work_limit = crate::limits::work_limit().map_err(CliError::BadInput)?;
     // A rod is estimated before it is built; an imported model once its size is read.
     if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
         crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
     }
     if let Some(work) = crate::limits::rod_scene_work(&scene, compare) {
-        crate::limits::check_work(&work, crate::limits::work_limit())
+        crate::limits::check_work(&work, work_limit)
             .map_err(|e| input_error(path, e))?;
     }
     let structure = match &scene.model {
@@ -69,7 +70,7 @@ fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
             let work = crate::limits::structure_work(&structure, &scene.solver, compare);
-            crate::limits::check_work(&work, crate::limits::work_limit())
+            crate::limits::check_work(&work, work_limit)
                 .map_err(|e| input_error(path, e))?;
             structure
         }
@@ -89,6 +90,25 @@ fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
         structure,
         omega,
     })
+}
+
+/// Claims the files a `[model]` scene names (its matrices and load vector) as inputs of
+/// `set`: no output may replace them.
+pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<(), CliError> {
+    if let Some(spec) = &scene.model {
+        let mut files = vec![
+            (&spec.mass, "[model] mass"),
+            (&spec.stiffness, "[model] stiffness"),
+            (&spec.forcing_vector, "[forcing] vector"),
+        ];
+        if let Some(d) = &spec.damping_matrix {
+            files.push((d, "[model] damping"));
+        }
+        for (path, key) in files {
+            set.input(path, &format!("the scene's {key} file"))?;
+        }
+    }
+    Ok(())
 }
 
 /// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
@@ -144,7 +164,7 @@ impl RunArgs {
     /// and every file target must be new or a regular file.
     pub(crate) fn plan(&self) -> Result<OutputSet, CliError> {
         let mut set = OutputSet::new();
-        set.input(&self.scene, "the scene");
+        set.input(&self.scene, "the scene")?;
         if self.json {
             set.stdout("--json")?;
         } else if !crate::io::quiet() {
@@ -203,10 +223,11 @@ impl RunArgs {
                 format!("{doc}\n").into_bytes(),
             );
         }
-        set.commit()?;
-        if !self.json {
-            write_text(&text())?;
+        if !self.json && !crate::io::quiet() {
+            // The summary goes with the files: a summary that cannot be written leaves none.
+            set.add(Path::new(crate::io::STDOUT_NAME), text().into_bytes());
         }
+        set.commit()?;
         if converged {
             Ok(())
         } else {
@@ -251,7 +272,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     let mut outputs = args.plan()?;
     // The start is an input: no output may replace it.
     if let Some(start) = &solve_args.start {
-        outputs.input(start, "the --start state");
+        outputs.input(start, "the --start state")?;
     }
     if let Some(state) = &solve_args.state {
         outputs.target(state, "--state")?;
@@ -261,6 +282,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
         structure: rod,
         omega,
     } = load(&args.scene)?;
+    claim_model_files(&mut outputs, &scene)?;
     let shape = StateShape {
         method: scene.solver.method,
         harmonics: scene.solver.harmonics,
@@ -494,6 +516,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         structure: rod,
         ..
     } = load(&args.scene)?;
+    claim_model_files(&mut outputs, &scene)?;
     let Some(settings) = scene.sweep.as_ref() else {
         return Err(input_error(
             &args.scene,
@@ -646,6 +669,13 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
         omega,
     } = load_checked(path, true)?;
     prepare_directory(out)?;
+    // Every target is checked before the study runs (the files are written after it).
+    let mut targets = OutputSet::new();
+    targets.input(path, "the scene")?;
+    claim_model_files(&mut targets, &scene)?;
+    for name in crate::study::STUDY_FILES {
+        targets.target(&out.join(name), "ssn compare --out")?;
+    }
     let bar = progress_spinner("compare", quiet);
     let say = |line: &str| {
         bar.set_message(line.to_string());
@@ -674,7 +704,8 @@ pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
     prepare_directory(dir)?;
     // All files or none: every target is claimed before anything is written.
     let mut set = OutputSet::new();
-    set.input(path, "the scene");
+    set.input(path, "the scene")?;
+    claim_model_files(&mut set, &scene)?;
     let mut written = String::new();
     for (name, text) in crate::import::export_files(&scene, &structure) {
         let target = dir.join(&name);

@@ -16,6 +16,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         omega,
     } = crate::cli::load(&args.scene)?;
     let mut outputs = args.plan()?;
+    crate::cli::claim_model_files(&mut outputs, &scene)?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
     let set = find_solutions(&rod, omega, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
     let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
