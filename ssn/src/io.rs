@@ -174,7 +174,10 @@ pub enum TargetError {
         kind: &'static str,
     },
     /// Two outputs, or an output and an input, name one file (exit code 2).
-    #[error("{path}: named as both {first} and {second}: give each output its own file")]
+    #[error(
+        "{path}: named as both {first} and {second}: an input is never replaced, and each \
+         output needs a file of its own"
+    )]
     Clash {
         /// The path.
         path: PathBuf,

@@ -349,7 +349,7 @@ pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> 
 
 /// [`run_work`] for a model of `dofs` dofs and `contacts` contacts; `dense_keys`: the keys a
 /// refusal of the dense solver names.
-fn size_work(
+pub(crate) fn size_work(
     dofs: usize,
     contacts: usize,
     settings: &SolverSettings,
@@ -401,6 +401,20 @@ fn size_work(
                 }
             }
         }
+        (Method::PenaltyHb, _) if contacts > 0 => {
+            // Penalty HB factors the condensed system at every iteration and stiff
+            // penalties take hundreds of them: counted at solver.max_iterations.
+            let unknowns = m * s;
+            let count = settings.max_iterations as f64;
+            WorkEstimate {
+                flops: count * 2.0 / 3.0 * unknowns.powi(3),
+                what: format!(
+                    "up to {count} LU factorizations (solver.max_iterations) of the condensed \
+                     penalty system on {unknowns:.0} unknowns"
+                ),
+                keys: "solver.harmonics, solver.max_iterations and the number of contacts",
+            }
+        }
         (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {
             WorkEstimate {
                 flops: lu(m * s),
@@ -423,8 +437,10 @@ fn size_work(
 /// The operations a run may take: `SSN_WORK_LIMIT` when set, else [`DEFAULT_WORK_LIMIT`];
 /// `Err` for a value that is not a number > 0.
 pub fn work_limit() -> Result<f64, String> {
-    Ok(limit_from_env("SSN_WORK_LIMIT", "floating-point operations")?
-        .unwrap_or(DEFAULT_WORK_LIMIT))
+    Ok(
+        limit_from_env("SSN_WORK_LIMIT", "floating-point operations")?
+            .unwrap_or(DEFAULT_WORK_LIMIT),
+    )
 }
 
 /// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
@@ -443,35 +459,8 @@ pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
     }
 }
 
-/// The work estimate of the command run on a rod `scene` (`compare`: its SSN-HB reference
-/// run at 320 harmonics, the largest); `None` for a `[model]` scene, estimated once imported
-/// ([`structure_work`]).
-pub fn rod_scene_work(scene: &Scene, compare: bool) -> Option<WorkEstimate> {
-    if scene.model.is_some() {
-        return None;
-    }
-    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
-    Some(run_work(n, m, &compared(&scene.solver, compare)))
-}
-
-/// The work estimate of `settings` (or of the comparison's reference run) on an imported
-/// `structure`.
-pub fn structure_work(
-    structure: &Structure,
-    settings: &SolverSettings,
-    compare: bool,
-) -> WorkEstimate {
-    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
-    size_work(
-        n,
-        m,
-        &compared(settings, compare),
-        "solver.linear_solver, solver.harmonics, the model's size",
-    )
-}
-
 /// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
-fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
+pub(crate) fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
     let mut settings = settings.clone();
     if compare {
         settings.method = Method::SsnHb;

@@ -113,7 +113,9 @@ pub enum ImportError {
         source: std::io::Error,
     },
     /// A file is larger than [`MAX_MATRIX_FILE_BYTES`] (noticed as it is read).
-    #[error("{path}: more than {limit} bytes: allowed at most {limit} bytes for a Matrix Market file")]
+    #[error(
+        "{path}: more than {limit} bytes: allowed at most {limit} bytes for a Matrix Market file"
+    )]
     TooLarge {
         /// The file.
         path: PathBuf,

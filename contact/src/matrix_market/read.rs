@@ -50,8 +50,8 @@ enum Symmetry {
     SkewSymmetric,
 }
 
-/// Reads the Matrix Market file `path` (module documentation) as a sparse matrix; stored
-/// zeros are dropped, duplicate coordinate entries summed.
+/// Reads the Matrix Market file `path` (module documentation) as a sparse matrix; the
+/// zeros of an array file are dropped, duplicate coordinate entries summed.
 pub fn read_matrix(path: &Path) -> Result<SparseMatrix, ImportError> {
     let io = |source| ImportError::Io {
         path: path.to_path_buf(),
@@ -234,7 +234,10 @@ fn value(word: &str, field: Field) -> Result<f64, String> {
 }
 
 /// Appends to `v` without aborting when memory runs out.
-fn push(v: &mut Vec<Triplet<usize, usize, f64>>, t: Triplet<usize, usize, f64>) -> Result<(), String> {
+fn push(
+    v: &mut Vec<Triplet<usize, usize, f64>>,
+    t: Triplet<usize, usize, f64>,
+) -> Result<(), String> {
     if v.len() == v.capacity() {
         v.try_reserve(1)
             .map_err(|_| format!("out of memory after {} entries", v.len()))?;
@@ -400,7 +403,9 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
             ));
         }
         stored += 1;
-        if v == 0.0 {
+        // A dense array's zeros are not entries; a coordinate file's stored zeros are kept
+        // (its pattern reads back as written).
+        if v == 0.0 && format == Format::Array {
             continue;
         }
         push(&mut triplets, Triplet::new(i, j, v)).map_err(|m| lines.error(path, m))?;
@@ -490,25 +495,76 @@ mod tests {
         for (text, words) in [
             ("", &["empty file"][..]),
             ("%%matrix market\n", &["line 1", "banner"]),
-            ("%%MatrixMarket matrix coordinate pattern general\n2 2 1\n1 1\n", &["line 1", "field `pattern`", "real|integer"]),
-            ("%%MatrixMarket matrix coordinate complex general\n", &["line 1", "`complex`"]),
-            ("%%MatrixMarket matrix coordinate real hermitian\n", &["line 1", "`hermitian`"]),
+            (
+                "%%MatrixMarket matrix coordinate pattern general\n2 2 1\n1 1\n",
+                &["line 1", "field `pattern`", "real|integer"],
+            ),
+            (
+                "%%MatrixMarket matrix coordinate complex general\n",
+                &["line 1", "`complex`"],
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real hermitian\n",
+                &["line 1", "`hermitian`"],
+            ),
             (&format!("{c}2 2\n"), &["line 2", "`rows columns entries`"]),
-            (&format!("{c}1000000000 1000000000 1\n1 1 1\n"), &["line 2", "1000000000 rows", "at most 10000000"]),
-            (&format!("{c}2 2 5\n"), &["line 2", "5 entries", "at most 4"]),
+            (
+                &format!("{c}1000000000 1000000000 1\n1 1 1\n"),
+                &["line 2", "1000000000 rows", "at most 10000000"],
+            ),
+            (
+                &format!("{c}2 2 5\n"),
+                &["line 2", "5 entries", "at most 4"],
+            ),
             (&format!("{c}-1 2 1\n"), &["line 2", "rows `-1`"]),
-            (&format!("{c}99999999999999999999 2 1\n"), &["line 2", "non-negative integer"]),
-            (&format!("{c}2 2 1\n0 1 1.0\n"), &["line 3", "row index `0`", "1..=2"]),
-            (&format!("{c}2 2 1\n1 3 1.0\n"), &["line 3", "column index `3`", "1..=2"]),
-            (&format!("{c}2 2 1\n1 1 x\n"), &["line 3", "value `x`", "real number"]),
-            (&format!("{c}2 2 1\n1 1 inf\n"), &["line 3", "entry (1, 1)", "finite"]),
-            (&format!("{c}2 2 1\n1 1 1e300\n"), &["line 3", "1e300", "at most 1e100"]),
-            (&format!("{c}2 2 1\n1 1\n"), &["line 3", "`1 1`", "row column value"]),
-            (&format!("{c}2 2 1\n1 1 1\n2 2 1\n"), &["line 4", "more entries than the 1"]),
-            (&format!("{c}2 2 3\n1 1 1\n"), &["line 3", "after 1 of the 3"]),
-            ("%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 1.5\n", &["line 3", "`1.5`", "integer"]),
-            ("%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 2 1\n", &["line 3", "(1, 2)", "lower triangle"]),
-            ("%%MatrixMarket matrix array real general\n100000 100000\n", &["line 2", "coordinate format"]),
+            (
+                &format!("{c}99999999999999999999 2 1\n"),
+                &["line 2", "non-negative integer"],
+            ),
+            (
+                &format!("{c}2 2 1\n0 1 1.0\n"),
+                &["line 3", "row index `0`", "1..=2"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 3 1.0\n"),
+                &["line 3", "column index `3`", "1..=2"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 1 x\n"),
+                &["line 3", "value `x`", "real number"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 1 inf\n"),
+                &["line 3", "entry (1, 1)", "finite"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 1 1e300\n"),
+                &["line 3", "1e300", "at most 1e100"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 1\n"),
+                &["line 3", "`1 1`", "row column value"],
+            ),
+            (
+                &format!("{c}2 2 1\n1 1 1\n2 2 1\n"),
+                &["line 4", "more entries than the 1"],
+            ),
+            (
+                &format!("{c}2 2 3\n1 1 1\n"),
+                &["line 3", "after 1 of the 3"],
+            ),
+            (
+                "%%MatrixMarket matrix coordinate integer general\n1 1 1\n1 1 1.5\n",
+                &["line 3", "`1.5`", "integer"],
+            ),
+            (
+                "%%MatrixMarket matrix coordinate real symmetric\n2 2 1\n1 2 1\n",
+                &["line 3", "(1, 2)", "lower triangle"],
+            ),
+            (
+                "%%MatrixMarket matrix array real general\n100000 100000\n",
+                &["line 2", "coordinate format"],
+            ),
         ] {
             let e = error(text);
             for w in words {
@@ -561,6 +617,9 @@ mod tests {
         let b = parse_matrix(&text, Path::new("a.mtx")).unwrap();
         assert_eq!(a.val(), b.val());
         let v = vector_market_text(&[0.0, 2.5, 0.0]);
-        assert_eq!(v, "%%MatrixMarket matrix coordinate real general\n3 1 1\n2 1 2.5e0\n");
+        assert_eq!(
+            v,
+            "%%MatrixMarket matrix coordinate real general\n3 1 1\n2 1 2.5e0\n"
+        );
     }
 }
