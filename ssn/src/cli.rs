@@ -117,7 +117,7 @@ fn check_scales(scene: &Scene, omega_1: f64, omega: f64) -> Result<(), String> {
             FrequencySpec::Absolute(w) => ("forcing.omega", w),
         };
         return Err(format!(
-            "invalid `{key}` = {value} (omega / omega_1 = {ratio:e}): allowed frequencies \
+            "invalid `{key}` = {value:e} (omega / omega_1 = {ratio:e}): allowed frequencies \
              between {:e} and {:e} times omega_1 = {omega_1:e}",
             range.start(),
             range.end()
@@ -149,7 +149,7 @@ fn check_scales(scene: &Scene, omega_1: f64, omega: f64) -> Result<(), String> {
         ),
         None => ("", 0.0),
     };
-    if !(zeta <= MAX_DAMPING_RATIO) {
+    if zeta.is_nan() || zeta > MAX_DAMPING_RATIO {
         return Err(format!(
             "invalid `{keys}`: a damping ratio of {zeta:e} at omega_1 = {omega_1:e}: allowed at \
              most {MAX_DAMPING_RATIO:e}"
@@ -171,7 +171,7 @@ fn check_resonance(scene: &Scene, structure: &Structure, omega: f64) -> Result<(
         return Ok(());
     }
     match model.undamped_amplification(omega) {
-        Some(a) if !(a <= RESONANCE_AMPLIFICATION) => {
+        Some(a) if a.is_nan() || a > RESONANCE_AMPLIFICATION => {
             let key = match scene.frequency() {
                 semismooth_contact::rod::FrequencySpec::Ratio(_) => "forcing.omega_ratio",
                 semismooth_contact::rod::FrequencySpec::Absolute(_) => "forcing.omega",

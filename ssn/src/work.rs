@@ -60,7 +60,7 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
     estimates
         .into_iter()
         .fold(None::<WorkEstimate>, |best, e| match best {
-            Some(b) if !(e.flops > b.flops) => Some(b),
+            Some(b) if e.flops.is_nan() || e.flops <= b.flops => Some(b),
             _ => Some(e),
         })
         .expect("at least one estimate")

@@ -336,7 +336,7 @@ pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
     let mut load = vec![0.0; n];
     for (i, v) in shape.row_idx_of_col(0).zip(shape.val_of_col(0)) {
         load[i] += spec.amplitude * v;
-        if !(load[i].abs() <= MAX_ENTRY_MAGNITUDE) {
+        if !load[i].is_finite() || load[i].abs() > MAX_ENTRY_MAGNITUDE {
             return Err(ImportError::Model {
                 scene: spec.scene.clone(),
                 reason: format!(

@@ -487,7 +487,7 @@ impl Check<'_> {
             };
             if let Some(&other) = seen.get(&(dof, opposite)) {
                 let clearance = gap + contacts[other - 1].gap;
-                if !(clearance > 0.0) {
+                if clearance.is_nan() || clearance <= 0.0 {
                     return Err(self.invalid(
                         "contact.point.gap",
                         format!(
