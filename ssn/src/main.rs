@@ -154,9 +154,7 @@ fn main() -> ExitCode {
     let result = match &args.command {
         None => {
             let out = args.out.clone().unwrap_or_else(default_out);
-            in_new_directory(&out, || {
-                io::all_or_nothing(|| figures::default_run(&out, args.quiet))
-            })
+            in_new_directory(&out, || io::all_or_nothing(|| figures::default_run(&out)))
         }
         // `ssn --out DIR compare SCENE` and `ssn compare SCENE --out DIR` both work.
         Some(Command::Compare {
@@ -166,7 +164,7 @@ fn main() -> ExitCode {
         }) => {
             let out = out.clone().or(args.out.clone()).unwrap_or_else(default_out);
             in_new_directory(&out, || {
-                io::all_or_nothing(|| cli::compare(scene, &out, *accuracy, args.quiet))
+                io::all_or_nothing(|| cli::compare(scene, &out, *accuracy))
             })
         }
         Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
@@ -176,8 +174,8 @@ fn main() -> ExitCode {
         ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
-        Some(Command::Solve(solve)) => cli::solve(solve, args.quiet),
-        Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
+        Some(Command::Solve(solve)) => cli::solve(solve),
+        Some(Command::Sweep(run)) => cli::sweep(run),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
     };
     match result {
