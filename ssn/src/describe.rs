@@ -167,20 +167,23 @@ pub fn describe_imported(
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!("scene             {}", scene.path.display()));
+    line(format!(
+        "scene             {}",
+        printable(&scene.path.display().to_string())
+    ));
     if let Some(t) = &scene.title {
-        line(format!("title             {t}"));
+        line(format!("title             {}", printable(t)));
     }
     let massless = (0..model.dofs())
         .filter(|&i| semismooth_contact::model::diagonal_entry(&model.mass, i) == 0.0)
         .count();
     line(format!(
         "model             M = {}, K = {}{}",
-        spec.mass.display(),
-        spec.stiffness.display(),
-        spec.damping_matrix
-            .as_ref()
-            .map_or(String::new(), |d| format!(", D = {}", d.display()))
+        printable(&spec.mass.display().to_string()),
+        printable(&spec.stiffness.display().to_string()),
+        spec.damping_matrix.as_ref().map_or(String::new(), |d| {
+            format!(", D = {}", printable(&d.display().to_string()))
+        })
     ));
     line(format!(
         "unknowns          {} dofs ({massless} with a zero mass diagonal), {} stored entries in K",
@@ -203,7 +206,7 @@ pub fn describe_imported(
     line(format!(
         "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
         spec.amplitude,
-        spec.forcing_vector.display(),
+        printable(&spec.forcing_vector.display().to_string()),
         omega,
         omega / structure.omega_1
     ));
