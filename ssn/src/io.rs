@@ -359,22 +359,29 @@ impl Drop for Staged {
 fn lock_directories<'a>(
     paths: impl Iterator<Item = &'a Path>,
 ) -> Result<Vec<std::fs::File>, OutputError> {
-    let mut dirs: Vec<PathBuf> = paths
+    // Each directory once, with the first file written into it (the one an error names).
+    let mut dirs: Vec<(PathBuf, &Path)> = paths
         .map(|p| {
             let dir = match p.parent() {
                 Some(d) if !d.as_os_str().is_empty() => d,
                 _ => Path::new("."),
             };
-            std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf())
+            (
+                std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()),
+                p,
+            )
         })
         .collect();
-    dirs.sort();
-    dirs.dedup();
+    dirs.sort_by(|a, b| a.0.cmp(&b.0));
+    dirs.dedup_by(|a, b| a.0 == b.0);
     let mut locks = Vec::with_capacity(dirs.len());
-    for dir in dirs {
-        let io = |source| OutputError::Io {
-            path: dir.clone(),
-            source,
+    for (dir, file) in dirs {
+        let io = |source: std::io::Error| OutputError::Io {
+            path: file.to_path_buf(),
+            source: std::io::Error::new(
+                source.kind(),
+                format!("its directory {}: {source}", dir.display()),
+            ),
         };
         let handle = File::open(&dir).map_err(io)?;
         rustix::fs::flock(&handle, rustix::fs::FlockOperation::LockExclusive)
