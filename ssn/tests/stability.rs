@@ -10,7 +10,9 @@ use semismooth_contact::march::{
 use semismooth_contact::rod::{build_rod, RodModel};
 use semismooth_contact::solutions::find_solutions;
 use semismooth_contact::solve::solve;
-use semismooth_contact::stability::{hb_stability, hb_state, Stability, StabilityOptions};
+use semismooth_contact::stability::{
+    hb_stability, hb_state, map_stability, MapStability, Stability, StabilityOptions,
+};
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 use ssn::scene::Scene;
 
@@ -149,9 +151,15 @@ fn fitted_rate(changes: &[f64], from: usize, to: usize) -> f64 {
     (sxy / sxx).exp()
 }
 
-fn stability_of(rod: &RodModel, harmonics: usize, omega: f64, x: &[f64]) -> Stability {
+fn stability_of(rod: &RodModel, scene: &Scene, omega: f64, x: &[f64]) -> Stability {
+    hb_stability(&rod.model, &scene.solver, omega, x).unwrap()
+}
+
+/// The discrete monodromy of the time-stepping map along its own orbit next to `x` (whose
+/// orbit is the start of the marches).
+fn map_stability_of(rod: &RodModel, harmonics: usize, omega: f64, x: &[f64]) -> MapStability {
     let n = rod.model.dofs() * (2 * harmonics + 1);
-    hb_stability(
+    map_stability(
         &rod.model,
         harmonics,
         omega,
@@ -193,10 +201,11 @@ fn largest_multiplier_predicts_the_decay_and_growth_rates_of_time_marching() {
     ];
     for (i, stable) in cases {
         let omega = r.omega[i];
-        let s = stability_of(&rod, h, omega, &r.states[i]);
+        let s = stability_of(&rod, &scene, omega, &r.states[i]);
         assert_eq!(s.stable, Some(stable), "point {i} at {}: {s:?}", omega / w1);
         let mu = s.floquet_max_abs.unwrap();
-        let orbit = s.orbit.clone().unwrap();
+        let map = map_stability_of(&rod, h, omega, &r.states[i]);
+        let orbit = map.orbit.clone().unwrap();
         // Stable: the march decays towards the orbit from 1e-4; unstable: it leaves it from
         // 1e-9 (the growth stays linear over the periods fitted: 1e-9 mu^40 < 1e-5).
         let (delta, periods) = if stable { (1e-4, 45) } else { (1e-9, 45) };
@@ -204,10 +213,11 @@ fn largest_multiplier_predicts_the_decay_and_growth_rates_of_time_marching() {
         let rate = fitted_rate(&changes, 5, periods);
         let plain = march_changes(&rod, omega, &orbit, delta, 2000, periods, false);
         println!(
-            "omega_ratio {:.5}: |mu|max {mu:.5} (dominant {:?}), march rate {rate:.5} \
-             (plain trapezoidal velocity: {:.5})",
+            "omega_ratio {:.5}: |mu|max {mu:.5} (dominant {:?}; time-stepping map {:.5}), \
+             march rate {rate:.5} (plain trapezoidal velocity: {:.5})",
             omega / w1,
             s.dominant(),
+            map.floquet_max_abs.unwrap(),
             fitted_rate(&plain, 5, periods)
         );
         assert!(
@@ -230,8 +240,9 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
     let middle = nearest(&r, w1, upper_fold..lower_fold, 1.14);
     let omega = r.omega[middle];
-    let s = stability_of(&rod, h, omega, &r.states[middle]);
+    let s = stability_of(&rod, &scene, omega, &r.states[middle]);
     assert_eq!(s.stable, Some(false));
+    let map = map_stability_of(&rod, h, omega, &r.states[middle]);
     // The two stable solutions at exactly this frequency: Newton from the nearest points of
     // the upper and lower branches.
     let mut stable_tips = Vec::new();
@@ -239,7 +250,7 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
         let i = nearest(&r, w1, range, omega / w1);
         let sol = solve(&rod, omega, &scene.solver, Some(&r.states[i])).unwrap();
         assert!(sol.converged(), "{}", sol.termination);
-        let st = stability_of(&rod, h, omega, &sol.state);
+        let st = stability_of(&rod, &scene, omega, &sol.state);
         assert_eq!(st.stable, Some(true));
         stable_tips.push(sol.stats.min);
     }
@@ -249,7 +260,7 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
     // on the upper branch at this forcing, measured).
     let mut landed = Vec::new();
     for sign in [1.0, -1.0] {
-        let mut start = s.orbit.clone().unwrap();
+        let mut start = map.orbit.clone().unwrap();
         for (i, x) in start.displacement.iter_mut().enumerate() {
             *x += sign * 1e-6 * (i + 1) as f64 / rod.model.dofs() as f64;
         }
@@ -378,11 +389,18 @@ fn report_stability_cost_per_point() {
     let h = scene.solver.harmonics;
     for i in [5usize, 19, 35, 60] {
         let t = std::time::Instant::now();
-        let s = stability_of(&rod, h, r.omega[i], &r.states[i]);
+        let s = stability_of(&rod, &scene, r.omega[i], &r.states[i]);
+        let phases = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let map = map_stability_of(&rod, h, r.omega[i], &r.states[i]);
         println!(
-            "{i}: {:.2} ms, {} shooting iterations",
+            "{i}: contact phases {:.3} ms (|mu| {:?}), time-stepping map {:.2} ms (|mu| {:?}, \
+             {} shooting iterations)",
+            phases * 1e3,
+            s.floquet_max_abs,
             t.elapsed().as_secs_f64() * 1e3,
-            s.shooting_iterations
+            map.floquet_max_abs,
+            map.shooting_iterations
         );
     }
 }
