@@ -67,7 +67,7 @@ use crate::solve::{hb_options, penalty_options};
 
 use phases::PhaseModel;
 pub use phases::{ClosedContact, PhaseError};
-pub use shooting::{map_stability, monodromy, MapStability, SHOOTING_TOLERANCE};
+pub use shooting::{map_stability, monodromy, MapStability};
 
 /// Largest number of dofs for which a dense monodromy is formed.
 pub const MAX_DOFS: usize = 400;
