@@ -128,9 +128,22 @@ fn modified_mass_hb_converges_to_the_time_marching_reference() {
         let e_min = relative(s.stats.min, fine.stats.min);
         let e_rms = relative(rms(&s.tip), rms(&fine.tip));
         let e_force = relative(s.stats.mean_contact_force, fine.stats.mean_contact_force);
+        // The fraction of the period in contact: SSN-HB's is the measure of its contact
+        // law's active set, the march's that of its compressive samples.
+        let fraction = s.contacts[0].contact_fraction;
+        let exact = fine.contacts[0].contact_fraction;
         println!(
-            "H = {h}: {} iterations, tip min {:.8} (rel. error {e_min:.2e}), rms error {e_rms:.2e}, mean force error {e_force:.2e}",
+            "H = {h}: {} iterations, tip min {:.8} (rel. error {e_min:.2e}), rms error {e_rms:.2e}, mean force error {e_force:.2e}, contact fraction {fraction:.4} (march {exact:.4})",
             s.iterations, s.stats.min
+        );
+        // Within two AFT sample spacings (1 / Nt) of the march's, where the force
+        // reconstructed from the truncated series (which rings and is partly tensile) would
+        // give about 0.5.
+        let spacing = 1.0 / s.time_samples as f64;
+        assert!(
+            (fraction - exact).abs() <= 2.0 * spacing,
+            "H = {h}: contact fraction {fraction} against {exact} (Nt = {})",
+            s.time_samples
         );
         errors.push(e_min);
         if h == 40 {
