@@ -30,12 +30,16 @@ pub fn positive_intervals(
     samples: usize,
 ) -> Result<Vec<(f64, f64)>, HarmonicError> {
     let grid = FourierBasis::new(basis.harmonics(), samples)?;
+    if coeffs.len() != grid.basis_size() {
+        // The basis's own error for a wrong length.
+        grid.evaluate_at_phase(coeffs, 0.0)?;
+    }
     let value = |fraction: f64| -> Result<f64, HarmonicError> {
-        grid.evaluate_at_phase(coeffs, 2.0 * PI * fraction)
+        Ok(sum_by_rotation(coeffs, 2.0 * PI * fraction))
     };
-    let values = (0..samples)
-        .map(|n| value(n as f64 / samples as f64))
-        .collect::<Result<Vec<_>, _>>()?;
+    let values: Vec<f64> = (0..samples)
+        .map(|n| sum_by_rotation(coeffs, 2.0 * PI * n as f64 / samples as f64))
+        .collect();
     let positive = |v: f64| v > 0.0;
     if values.iter().all(|&v| positive(v)) {
         return Ok(vec![(0.0, 1.0)]);
@@ -69,6 +73,20 @@ pub fn positive_intervals(
     }
     intervals.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(intervals)
+}
+
+/// `a_0 + sum_k (a_k cos k theta + b_k sin k theta)` for `coeffs = (a_0, a_1, b_1, ...)`,
+/// with `(cos k theta, sin k theta)` by rotation from `(cos theta, sin theta)`: one `sin_cos`
+/// per evaluation (round-off grows like `k` times the machine epsilon).
+fn sum_by_rotation(coeffs: &[f64], theta: f64) -> f64 {
+    let (s1, c1) = theta.sin_cos();
+    let (mut s, mut c) = (s1, c1);
+    let mut value = coeffs[0];
+    for pair in coeffs[1..].chunks_exact(2) {
+        value += pair[0] * c + pair[1] * s;
+        (c, s) = (c * c1 - s * s1, s * c1 + c * s1);
+    }
+    value
 }
 
 /// The root of `f` in `[lo, hi]` with `f(lo) = fa`, `f(hi) = fb` of opposite signs

@@ -18,7 +18,7 @@ pub struct ContactReport {
     /// Fraction of the period in contact: for harmonic balance the measure of the set where
     /// the contact law is active (its switching function positive on the truncated series,
     /// the samples the generalized Jacobian treats as active, ends refined between
-    /// samples: [`closed_fraction`]); for the exact methods the fraction of the time
+    /// samples: [`semismooth::trigonometric::covered_fraction`]); for the exact methods the fraction of the time
     /// samples with a compressive force larger than `1e-9` times the largest force
     /// magnitude of the run.
     pub contact_fraction: f64,
@@ -81,16 +81,6 @@ pub fn contact_reports(
             }
         })
         .collect()
-}
-
-/// The fraction of the period covered by closed intervals `(start, end)` (fractions of the
-/// period, as [`crate::hb::SsnHb::closed_intervals`] gives them).
-pub fn closed_fraction(intervals: &[(f64, f64)]) -> f64 {
-    intervals
-        .iter()
-        .map(|(a, b)| (b - a).clamp(0.0, 1.0))
-        .sum::<f64>()
-        .min(1.0)
 }
 
 /// Summary of one period of a contact response, from samples at equal time steps.

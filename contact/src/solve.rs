@@ -576,11 +576,10 @@ fn hb_outputs(
 }
 
 /// The contact fractions of harmonic-balance reports from the contact law's own closed
-/// intervals ([`crate::contacts::closed_fraction`]) instead of the reconstructed force,
-/// which rings between the samples.
+/// intervals instead of the reconstructed force, which rings between the samples.
 pub(crate) fn set_closed_fractions(reports: &mut [ContactReport], closed: &[Vec<(f64, f64)>]) {
     for (report, intervals) in reports.iter_mut().zip(closed) {
-        report.contact_fraction = crate::contacts::closed_fraction(intervals);
+        report.contact_fraction = semismooth::trigonometric::covered_fraction(intervals).min(1.0);
     }
 }
 

@@ -121,15 +121,19 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
     let w1 = rod.omega_1;
     assert_eq!(r.fold_indices.len(), 2, "folds {:?}", r.folds);
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
-    let options = MarchOptions {
-        steps_per_period: STEPS,
+    // Stable points with contact on the upper branch: march to the Moreau–Jean orbit, then
+    // perturb it by 1e-2 and fit the decay over 8 periods with 10 times finer steps. The
+    // perturbation must move the impact instants by more than a step (`h |v|`, 8e-5 here):
+    // a smaller one leaves the impact in its step, and Moreau–Jean's velocity projection
+    // then keeps the contact dof's position perturbation where the flow's impact removes
+    // it (its linearisation decays about 10 % slower, measured with 1e-6 at 4000 steps).
+    let fine = MarchOptions {
+        steps_per_period: 10 * STEPS,
         scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
         ..MarchOptions::default()
     };
-    // Stable points with contact on the upper branch: march to the Moreau–Jean orbit, then
-    // perturb it by 1e-6 and fit the decay over 18 periods (it stays above round-off).
     let mut checked = 0;
-    for i in (upper_fold / 2..upper_fold).step_by(8) {
+    for i in (upper_fold / 2..upper_fold).step_by(12) {
         let omega = r.omega[i];
         let s = hb_stability(&rod.model, &settings, omega, &r.states[i]).unwrap();
         assert!(s.closings > 0, "point {i} at {}: no contact", omega / w1);
@@ -140,19 +144,21 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
         let mut start = marcher.state();
         let settled = settle[199] < 1e-9;
         for (k, u) in start.displacement.iter_mut().enumerate() {
-            *u += 1e-6 * ((k + 1) as f64 * 0.7).sin();
+            *u += 1e-2 * ((k + 1) as f64 * 0.7).sin();
         }
-        let mut perturbed = TimeMarcher::new(&rod.model, omega, &options, &start).unwrap();
-        let decay = changes(&mut perturbed, omega, STEPS, 20);
-        let rate = fitted_rate(&decay, 2, 20);
+        let mut perturbed = TimeMarcher::new(&rod.model, omega, &fine, &start).unwrap();
+        let decay = changes(&mut perturbed, omega, 10 * STEPS, 9);
+        let rate = fitted_rate(&decay, 1, 9);
         println!(
-            "{i} at {:.4}: |mu| {mu:.4} ({} phases), march settled to {:.1e}, decay rate {rate:.4}",
+            "{i} at {:.4}: |mu| {mu:.4} ({} phases), march settled to {:.1e}, decay rate {rate:.4} ({:.1e} -> {:.1e})",
             omega / w1,
             s.phases,
             settle[199],
+            decay[1],
+            decay[8]
         );
-        // Measured: 3.5-7 % above |mu| (Moreau–Jean is first order at the impacts, and
-        // the switching instants carry the harmonic-balance error at H = 20). A march that
+        // Measured within 4 % (Moreau–Jean is first order at the impacts, and the
+        // switching instants carry the harmonic-balance error at H = 20). A march that
         // keeps a chatter of the tip node above 1e-9 after 200 periods has no orbit to
         // perturb: not checked.
         if settled {
@@ -163,7 +169,7 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
             checked += 1;
         }
     }
-    assert!(checked >= 3, "only {checked} marches settled");
+    assert!(checked >= 2, "only {checked} marches settled");
     // An unstable point in the middle of the branch between its folds: from the
     // harmonic-balance orbit plus 1e-8 the march leaves at the rate of the largest
     // multiplier (the orbits differ by about 1e-2, so the growth is fitted from the start).

@@ -313,9 +313,17 @@ fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
         }
         let expected = !(upper_fold < i && i < lower_fold);
         assert_eq!(*s, Some(expected), "point {i} at omega_ratio {ratio:.5}");
+        // The largest modulus agrees with the verdict unless the real multiplier nearest
+        // +1 was placed by the fold parity (module `sweep::branch`).
         let mu = st.floquet_max_abs[i].unwrap();
-        assert_eq!(mu < 1.0, expected);
+        assert!(
+            (mu < 1.0) == expected || st.placed_by_fold[i],
+            "point {i} at omega_ratio {ratio:.5}: |mu| {mu}"
+        );
     }
+    let placed = st.placed_by_fold.iter().filter(|p| **p).count();
+    println!("{placed} points placed by the fold parity");
+    assert!(placed <= 4, "{placed} points placed by the fold parity");
     // Two fold events, where the continuation found the folds (1.1846 and 1.0982): the
     // interpolated crossing of |mu| = 1 lies between the neighbouring points, which are at
     // most 1.1e-3 omega_1 from the fold here.

@@ -506,7 +506,8 @@ impl Phase {
                 values,
                 inverse,
             } => {
-                let scaled = Mat::from_fn(d, d, |i, j| vectors[(i, j)] * (values[j] * tau).exp());
+                let growth: Vec<c64> = values.iter().map(|l| (l * tau).exp()).collect();
+                let scaled = Mat::from_fn(d, d, |i, j| vectors[(i, j)] * growth[j]);
                 let product = &scaled * inverse;
                 Mat::from_fn(d, d, |i, j| product[(i, j)].re)
             }
