@@ -169,8 +169,9 @@ mod tests {
         let iv = positive_intervals(&basis, &raised, 64).unwrap();
         assert_eq!(iv.len(), 3, "{iv:?}");
         let shift = (1e-3f64).asin() / (2.0 * PI * 3.0);
+        // Starts in increasing order: 1/3 - shift, 2/3 - shift, 1 - shift.
         for (k, (a, b)) in iv.iter().enumerate() {
-            let start = (k as f64 / 3.0 - shift).rem_euclid(1.0);
+            let start = ((k + 1) as f64 / 3.0 - shift).rem_euclid(1.0);
             assert!((a - start).abs() < 1e-12, "{iv:?}");
             assert!((b - a - (1.0 / 6.0 + 2.0 * shift)).abs() < 1e-12, "{iv:?}");
         }

@@ -6,15 +6,14 @@
 //! For the branches of the default run's Fig. 2 (gaps 0.25, 0.5, 0.75; consistent mass at
 //! H = 5, modified mass at H = 20) it sweeps each twice, with and without stability, best
 //! of `REPEATS` runs each, and prints the time of both and their ratio (measured in the
-//! same run). For the modified-mass branches it then compares every point's verdict with
+//! same run). Times are the process's CPU time (user + system, from `/proc/self/stat`,
+//! 10 ms ticks), which the load of a shared machine does not inflate as it does wall time. For the modified-mass branches it then compares every point's verdict with
 //! the shooting verdict ([`map_stability`]) and prints how many agree, the points where they
 //! differ, and the time per point of both analyses.
 
-use std::time::Instant;
-
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
-use semismooth_contact::stability::{map_stability, StabilityOptions};
+use semismooth_contact::stability::{map_stability, HbStability, StabilityOptions};
 use semismooth_contact::sweep::frequency_response;
 
 /// Runs per configuration; the fastest is reported.
@@ -24,6 +23,15 @@ fn main() {
     println!(
         "{:<8} {:>4} {:>7} {:>7} {:>12} {:>12} {:>6}",
         "mass", "H", "gap", "points", "no stab. ms", "with ms", "ratio"
+    );
+    println!(
+        "(CPU time, best of {REPEATS}; {})",
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|l| format!(
+                "load average {}",
+                l.split_whitespace().next().unwrap_or("?")
+            ))
+            .unwrap_or_default()
     );
     let mut comparisons = Vec::new();
     for (mass, harmonics) in [(MassModel::Consistent, 5), (MassModel::Modified, 20)] {
@@ -44,10 +52,10 @@ fn main() {
                 let sweep = SweepSettings { stability, ..sweep };
                 (0..REPEATS)
                     .map(|_| {
-                        let t = Instant::now();
+                        let t = cpu_seconds();
                         let r = frequency_response(&rod, &settings, &sweep, None)
                             .expect("the sweep runs");
-                        (t.elapsed().as_secs_f64(), r)
+                        (cpu_seconds() - t, r)
                     })
                     .min_by(|a, b| a.0.total_cmp(&b.0))
                     .expect("at least one run")
@@ -72,7 +80,7 @@ fn main() {
     println!("\nAgainst the shooting verdict (modified mass, H = 20, every point):");
     for (gap, rod, settings, r) in comparisons {
         let (mut agree, mut differ, mut undecided) = (0, Vec::new(), 0);
-        let t = Instant::now();
+        let t = cpu_seconds();
         let n = rod.model.dofs() * (2 * settings.harmonics + 1);
         for i in 0..r.points() {
             let map = map_stability(
@@ -89,7 +97,16 @@ fn main() {
                 _ => undecided += 1,
             }
         }
-        let shooting = t.elapsed().as_secs_f64();
+        let shooting = cpu_seconds() - t;
+        let t = cpu_seconds();
+        let mut analysis =
+            HbStability::new(&rod.model, &settings).expect("a harmonic-balance method");
+        for i in 0..r.points() {
+            analysis
+                .of(r.omega[i], &r.states[i])
+                .expect("the phases run");
+        }
+        let phases = cpu_seconds() - t;
         println!(
             "gap {gap}: {} points, {agree} agree, {} differ at omega/omega_1 {:.4?}, {undecided} \
              undecided by one of them; shooting {:.2} ms per point, contact phases {:.3} ms",
@@ -97,7 +114,25 @@ fn main() {
             differ.len(),
             differ,
             1e3 * shooting / r.points() as f64,
-            1e3 * r.stability_seconds / r.points() as f64
+            1e3 * phases / r.points() as f64
         );
     }
+}
+
+/// CPU time of this process (user + system), from `/proc/self/stat` (Linux; 0 elsewhere).
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which is in parentheses): utime and stime are the
+    // 12th and 13th of them, in clock ticks of 1/100 s.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |k: usize| {
+        fields
+            .get(k)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
 }

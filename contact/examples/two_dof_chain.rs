@@ -63,11 +63,14 @@ fn main() {
         if std::env::var("DUMP").is_ok() {
             for i in 0..r.points() {
                 println!(
-                    "{i} {:.6} {:.6} {:.6} it {}",
+                    "{i} {:.6} {:.6} {:.6} it {} stable {:?} mu {:?} placed {}",
                     r.omega[i] / omega_1,
                     r.tip_max[i],
                     r.tip_min[i],
-                    r.iterations[i]
+                    r.iterations[i],
+                    r.stability.stable[i],
+                    r.stability.floquet_max_abs[i],
+                    r.stability.placed_by_fold[i]
                 );
             }
         }

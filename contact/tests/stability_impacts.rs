@@ -122,18 +122,15 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
     assert_eq!(r.fold_indices.len(), 2, "folds {:?}", r.folds);
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
     // Stable points with contact on the upper branch: march to the Moreau–Jean orbit, then
-    // perturb it by 1e-2 and fit the decay over 8 periods with 10 times finer steps. The
-    // perturbation must move the impact instants by more than a step (`h |v|`, 8e-5 here):
-    // a smaller one leaves the impact in its step, and Moreau–Jean's velocity projection
-    // then keeps the contact dof's position perturbation where the flow's impact removes
-    // it (its linearisation decays about 10 % slower, measured with 1e-6 at 4000 steps).
-    let fine = MarchOptions {
-        steps_per_period: 10 * STEPS,
+    // perturb it by 1e-6 per dof and fit the decay over periods 2 to 20 (the dominant mode
+    // by then, still above round-off).
+    let options = MarchOptions {
+        steps_per_period: STEPS,
         scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
         ..MarchOptions::default()
     };
     let mut checked = 0;
-    for i in (upper_fold / 2..upper_fold).step_by(12) {
+    for i in (upper_fold / 2..upper_fold).step_by(8) {
         let omega = r.omega[i];
         let s = hb_stability(&rod.model, &settings, omega, &r.states[i]).unwrap();
         assert!(s.closings > 0, "point {i} at {}: no contact", omega / w1);
@@ -144,32 +141,33 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
         let mut start = marcher.state();
         let settled = settle[199] < 1e-9;
         for (k, u) in start.displacement.iter_mut().enumerate() {
-            *u += 1e-2 * ((k + 1) as f64 * 0.7).sin();
+            *u += 1e-6 * ((k + 1) as f64 * 0.7).sin();
         }
-        let mut perturbed = TimeMarcher::new(&rod.model, omega, &fine, &start).unwrap();
-        let decay = changes(&mut perturbed, omega, 10 * STEPS, 9);
-        let rate = fitted_rate(&decay, 1, 9);
+        let mut perturbed = TimeMarcher::new(&rod.model, omega, &options, &start).unwrap();
+        let decay = changes(&mut perturbed, omega, STEPS, 20);
+        let rate = fitted_rate(&decay, 2, 20);
         println!(
-            "{i} at {:.4}: |mu| {mu:.4} ({} phases), march settled to {:.1e}, decay rate {rate:.4} ({:.1e} -> {:.1e})",
+            "{i} at {:.4}: |mu| {mu:.4} ({} phases), march settled to {:.1e}, decay rate {rate:.4}",
             omega / w1,
             s.phases,
             settle[199],
-            decay[1],
-            decay[8]
         );
-        // Measured within 4 % (Moreau–Jean is first order at the impacts, and the
-        // switching instants carry the harmonic-balance error at H = 20). A march that
-        // keeps a chatter of the tip node above 1e-9 after 200 periods has no orbit to
-        // perturb: not checked.
+        // Measured from 3 % below to 11 % above |mu|. A perturbation this small leaves each
+        // impact in its step (the tip travels 8e-4 in a step), and Moreau–Jean's velocity
+        // projection then keeps the contact dof's position perturbation through the closed
+        // phase where the flow's impact removes it: its linearisation differs by a little.
+        // Larger perturbations leave the linear regime before the dominant mode shows. A
+        // march that keeps a chatter of the tip node above 1e-9 after 200 periods has no
+        // orbit to perturb: not checked.
         if settled {
             assert!(
-                (rate - mu).abs() <= 0.1 * mu,
+                (rate - mu).abs() <= 0.15 * mu,
                 "point {i}: decay rate {rate} against the largest multiplier {mu}"
             );
             checked += 1;
         }
     }
-    assert!(checked >= 2, "only {checked} marches settled");
+    assert!(checked >= 3, "only {checked} marches settled");
     // An unstable point in the middle of the branch between its folds: from the
     // harmonic-balance orbit plus 1e-8 the march leaves at the rate of the largest
     // multiplier (the orbits differ by about 1e-2, so the growth is fitted from the start).

@@ -168,6 +168,20 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
     Ok(rows)
 }
 
+/// `series` in palette colour `color`, solid for the first solution (`index` 0) and dashed
+/// for the others (the references).
+fn styled(series: Series, color: usize, index: usize) -> Series {
+    let style = if index == 0 {
+        LineStyle::Solid
+    } else {
+        LineStyle::Dashed
+    };
+    Series {
+        style,
+        ..series.with_color(color)
+    }
+}
+
 /// The contact force of every contact over one period (`<stem>_contact_force.svg`) and the
 /// orbit of the observed dof, displacement against velocity (`<stem>_orbit.svg`, the
 /// velocity by central differences of the periodic samples), of each solution.
@@ -188,15 +202,11 @@ fn period_figures(
             } else {
                 label.to_string()
             };
-            let series = Series::new(curve, phase.clone(), f.clone()).with_color(color + k);
-            forces.push(if color > 0 {
-                Series {
-                    style: LineStyle::Dashed,
-                    ..series
-                }
-            } else {
-                series
-            });
+            forces.push(styled(
+                Series::new(curve, phase.clone(), f.clone()),
+                color + k,
+                color,
+            ));
         }
         let u = &s.tip;
         let m = u.len();
@@ -210,15 +220,11 @@ fn period_figures(
             closed_u.push(u[0]);
             closed_v.push(closed_v[0]);
         }
-        let series = Series::new(label.to_string(), closed_u, closed_v).with_color(color);
-        orbits.push(if color > 0 {
-            Series {
-                style: LineStyle::Dashed,
-                ..series
-            }
-        } else {
-            series
-        });
+        orbits.push(styled(
+            Series::new(*label, closed_u, closed_v),
+            color,
+            color,
+        ));
     }
     write_line_plot(
         &out.join(format!("{stem}_contact_force.svg")),

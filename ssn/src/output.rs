@@ -4,6 +4,7 @@ use std::path::Path;
 
 pub use crate::io::{prepare_directory, write_atomically, OutputError};
 
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 
 /// A CSV table from named columns of equal length (shorter columns are padded with empty
@@ -303,12 +304,24 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
     };
     let (x0, x1) = pad(x0, x1);
     let (y0, mut y1) = pad(y0, y1);
-    // Room above the curves for the legend (upper right): 22 px per entry and 16 px of
-    // frame on a plot area of about 400 px, so that it hides no curve.
+    // Room for the legend (upper right: 22 px per entry and 16 px of frame on a plot area
+    // of about 400 px high, about 200 px of 750 wide) above the curves that pass under it,
+    // so that it hides none and the axis is no taller than that needs.
     let entries = series.iter().filter(|s| !s.label.is_empty()).count();
     if entries > 0 {
         let fraction = ((22 * entries + 16) as f64 / 400.0).min(0.6);
-        y1 += (y1 - y0) * fraction / (1.0 - fraction);
+        let legend_left = x1 - 0.3 * (x1 - x0);
+        let under_legend = curves
+            .iter()
+            .flat_map(|(_, p)| p.iter())
+            .filter(|(x, _)| to_axis(*x) >= legend_left)
+            .map(|(_, y)| to_axis(*y))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if under_legend.is_finite() {
+            // The legend's bottom at `y1 - fraction (y1 - y0)` above the highest of them.
+            let needed = (under_legend + 0.02 * (y1 - y0) - fraction * y0) / (1.0 - fraction);
+            y1 = y1.max(needed);
+        }
     }
     let (x0, x1, y0, y1) = (from_axis(x0), from_axis(x1), from_axis(y0), from_axis(y1));
     let mut svg = String::new();
@@ -323,42 +336,20 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
                 .y_label_area_size(px(64));
             b
         };
+        let log_tick = |v: &f64| format!("{v:.0e}");
+        let (x_range, y_range) = (x1 - x0, y1 - y0);
+        let x_tick = move |v: &f64| tick_label(*v, x_range);
+        let y_tick = move |v: &f64| tick_label(*v, y_range);
         if spec.log_log {
             let mut chart = builder(&root)
                 .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
                 .map_err(|e| fail(e.to_string()))?;
-            let tick = |v: &f64| format!("{v:.0e}");
-            chart
-                .configure_mesh()
-                .x_desc(spec.x_label.as_str())
-                .y_desc(spec.y_label.as_str())
-                .x_label_formatter(&tick)
-                .y_label_formatter(&tick)
-                .label_style(("sans-serif", px(12)))
-                .axis_desc_style(("sans-serif", px(14)))
-                .light_line_style(WHITE.mix(0.0))
-                .draw()
-                .map_err(|e| fail(e.to_string()))?;
-            draw_curves(&mut chart, curves, entries).map_err(fail)?;
+            draw_chart(&mut chart, spec, (&log_tick, &log_tick), curves, entries).map_err(fail)?;
         } else {
             let mut chart = builder(&root)
                 .build_cartesian_2d(x0..x1, y0..y1)
                 .map_err(|e| fail(e.to_string()))?;
-            let (x_range, y_range) = (x1 - x0, y1 - y0);
-            let x_tick = move |v: &f64| tick_label(*v, x_range);
-            let y_tick = move |v: &f64| tick_label(*v, y_range);
-            chart
-                .configure_mesh()
-                .x_desc(spec.x_label.as_str())
-                .y_desc(spec.y_label.as_str())
-                .x_label_formatter(&x_tick)
-                .y_label_formatter(&y_tick)
-                .label_style(("sans-serif", px(12)))
-                .axis_desc_style(("sans-serif", px(14)))
-                .light_line_style(WHITE.mix(0.0))
-                .draw()
-                .map_err(|e| fail(e.to_string()))?;
-            draw_curves(&mut chart, curves, entries).map_err(fail)?;
+            draw_chart(&mut chart, spec, (&x_tick, &y_tick), curves, entries).map_err(fail)?;
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
@@ -368,17 +359,34 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
     Ok(svg.replacen(&drawn, &shown, 1))
 }
 
-/// Draws the curves (with their legend entries, `entries` of them) on `chart`.
-fn draw_curves<'a, X, Y>(
+/// The tick label formatters of the two axes.
+type Ticks<'t> = (&'t dyn Fn(&f64) -> String, &'t dyn Fn(&f64) -> String);
+
+/// Draws the axes (labelled by `ticks`) and the curves (with their legend entries,
+/// `entries` of them) on `chart`.
+fn draw_chart<'a, X, Y>(
     chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<X, Y>>,
+    spec: &PlotSpec,
+    ticks: Ticks<'_>,
     curves: Vec<(&Series, Vec<(f64, f64)>)>,
     entries: usize,
 ) -> Result<(), String>
 where
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
 {
     let fail = |e: DrawingAreaErrorKind<_>| e.to_string();
+    chart
+        .configure_mesh()
+        .x_desc(spec.x_label.as_str())
+        .y_desc(spec.y_label.as_str())
+        .x_label_formatter(ticks.0)
+        .y_label_formatter(ticks.1)
+        .label_style(("sans-serif", px(12)))
+        .axis_desc_style(("sans-serif", px(14)))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(fail)?;
     for (i, (s, pts)) in curves.into_iter().enumerate() {
         let color = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
         let style = ShapeStyle {

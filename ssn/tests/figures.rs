@@ -10,7 +10,7 @@ use ssn::figures::{fig2_rod, figure_2_branch, figure_2_curves, FIG2_PLOTTED_STEP
 use ssn::output::{longest_plotted_step, longest_plotted_step_on, stability_series, LineStyle};
 
 /// The paper's Fig. 2 (consistent mass, H = 5): fine steps, equal CSV columns per curve,
-/// and every contact branch dotted (stability undecided: the contact node has mass).
+/// no contact branch dotted (every point decided, the contact node having mass).
 #[test]
 fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
     let fig = figure_2_curves(5, MassModel::Consistent).unwrap();
@@ -27,11 +27,48 @@ fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
         assert!(curve.iter().all(|(_, c)| c.len() == len), "{}", curve[0].0);
     }
     for s in &fig.series {
-        if s.label.starts_with("gap") {
-            assert_eq!(s.style, LineStyle::Dotted, "{}", s.label);
-        }
+        assert_ne!(s.style, LineStyle::Dotted, "{}", s.label);
     }
-    assert!(fig.curves.iter().all(|c| c.converged));
+    assert!(fig.curves.iter().all(|c| c.converged && c.undecided == 0));
+}
+
+/// The paper's Fig. 2 branch with gap 0.5 (consistent mass, H = 5): stable before its
+/// first reversal of the frequency and after its last, and between them stable and
+/// unstable by turns, the boundaries at the reversals (its folds and the corners where
+/// it turns back).
+#[test]
+fn paper_fig2_branch_changes_stability_at_its_folds() {
+    let (rod, r) = figure_2_branch(Some(0.5), 5, MassModel::Consistent).unwrap();
+    assert!(r.converged());
+    let mut reversals: Vec<usize> = r
+        .fold_indices
+        .iter()
+        .chain(&r.corner_fold_indices)
+        .copied()
+        .collect();
+    reversals.sort_unstable();
+    println!(
+        "folds {:?}, corner folds {}",
+        r.folds.iter().map(|w| w / rod.omega_1).collect::<Vec<_>>(),
+        r.corner_fold_indices.len()
+    );
+    assert!(!reversals.is_empty());
+    let st = &r.stability;
+    for (i, s) in st.stable.iter().enumerate() {
+        if reversals.binary_search(&i).is_ok() {
+            continue;
+        }
+        let before = reversals.iter().filter(|&&k| k < i).count();
+        assert_eq!(
+            *s,
+            Some(before % 2 == 0),
+            "point {i} at {:.5} after {before} reversals",
+            r.omega[i] / rod.omega_1
+        );
+    }
+    let placed = st.placed_by_fold.iter().filter(|p| **p).count();
+    let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
+    println!("{unstable} unstable points, {placed} placed by the fold parity");
 }
 
 /// The modified-mass branch with gap 0.25 at H = 20 (its contact loss is the sharpest bend
