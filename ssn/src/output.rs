@@ -176,10 +176,11 @@ pub fn longest_plotted_step(series: &[Series]) -> f64 {
     longest_plotted_step_on(series, range(&|s| &s.x), range(&|s| &s.y))
 }
 
-/// [`longest_plotted_step`] on axes of the ranges `rx` and `ry`.
+/// [`longest_plotted_step`] on axes of the ranges `rx` and `ry` (markers join nothing).
 pub fn longest_plotted_step_on(series: &[Series], rx: f64, ry: f64) -> f64 {
     series
         .iter()
+        .filter(|s| s.style != LineStyle::Markers)
         .flat_map(|s| {
             s.x.windows(2)
                 .zip(s.y.windows(2))

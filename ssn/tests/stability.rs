@@ -459,3 +459,28 @@ fn three_solutions_inside_the_overhang_two_stable() {
         serde_json::Value::Bool(false)
     );
 }
+
+/// `[sweep] stability = false` (the scene key): the branch is the same, every point is
+/// undecided with that reason, and no event is reported.
+#[test]
+fn a_sweep_without_stability_leaves_every_point_undecided_with_the_reason() {
+    let text = STRONG.replace(
+        "omega_ratio_to = 1.6",
+        "omega_ratio_to = 1.0\nstability = false",
+    );
+    let scene = scene(&text);
+    let sweep = scene.sweep.as_ref().unwrap();
+    assert!(!sweep.stability);
+    let rod = build_rod(&scene.rod).unwrap();
+    let r = frequency_response(&rod, &scene.solver, sweep, None).unwrap();
+    assert!(r.converged(), "{}", r.termination);
+    let st = &r.stability;
+    assert!(st.stable.iter().all(|s| s.is_none()));
+    assert_eq!(
+        st.undecided,
+        Some(semismooth_contact::stability::Undecided::NotRequested)
+    );
+    assert!(st.events.is_empty());
+    // The contact diagnostics are still computed.
+    assert_eq!(st.contact_force_mean.len(), r.points());
+}

@@ -502,6 +502,3 @@ fn monodromy_of_phases(
     }
     Ok((y, closings))
 }
-
-#[cfg(test)]
-mod tests;
