@@ -183,12 +183,14 @@ pub struct SweepSettings {
     pub max_step: f64,
     /// Point limit.
     pub max_points: usize,
+    /// Whether each point gets its Floquet multipliers (`[sweep] stability`).
+    pub stability: bool,
 }
 
 impl SweepSettings {
     /// A sweep from `omega_ratio_from` to `omega_ratio_to` (units of omega_1) with the
     /// scene defaults: `step = 0.01`, `min_step = 1e-5`, `max_step = 0.05`,
-    /// `max_points = 2000` (not validated; the sweep checks).
+    /// `max_points = 2000`, `stability = true` (not validated; the sweep checks).
     pub fn new(omega_ratio_from: f64, omega_ratio_to: f64) -> Self {
         Self {
             omega_ratio_from,
@@ -197,6 +199,7 @@ impl SweepSettings {
             min_step: 1e-5,
             max_step: 0.05,
             max_points: 2000,
+            stability: true,
         }
     }
 }

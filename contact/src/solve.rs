@@ -407,6 +407,8 @@ pub(crate) trait HbReconstruction {
     fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// The fractions of the period where contact `i`'s law is active (closed).
+    fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError>;
 }
 
 /// Both harmonic-balance problems reconstruct through the same inherent methods.
@@ -426,6 +428,9 @@ macro_rules! hb_reconstruction {
             }
             fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
                 self.contact_force_samples(x, i, points)
+            }
+            fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError> {
+                self.closed_intervals(x, i)
             }
         }
     )*};
@@ -548,13 +553,16 @@ fn hb_outputs(
     let times = (0..points)
         .map(|n| period * n as f64 / points as f64)
         .collect();
+    let closed = (0..problem.contact_count())
+        .map(|i| problem.closed_intervals(&x, i))
+        .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
         times,
         tip,
         contact_forces,
         contact_displacements,
     };
-    Ok(solution(
+    let mut solution = solution(
         rod,
         omega,
         settings,
@@ -562,7 +570,17 @@ fn hb_outputs(
         outcome,
         period,
         x,
-    ))
+    );
+    set_closed_fractions(&mut solution.contacts, &closed);
+    Ok(solution)
+}
+
+/// The contact fractions of harmonic-balance reports from the contact law's own closed
+/// intervals instead of the reconstructed force, which rings between the samples.
+pub(crate) fn set_closed_fractions(reports: &mut [ContactReport], closed: &[Vec<(f64, f64)>]) {
+    for (report, intervals) in reports.iter_mut().zip(closed) {
+        report.contact_fraction = semismooth::trigonometric::covered_fraction(intervals).min(1.0);
+    }
 }
 
 /// Tip statistics; the penetration is the largest over all contacts (and the tip's).

@@ -25,6 +25,7 @@ use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::Solution;
+use semismooth_contact::sweep::SweepProgress;
 
 /// Bad input found in the scene file `path`: the message starts with the file.
 fn input_error(path: &Path, e: impl Display) -> CliError {
@@ -223,6 +224,19 @@ pub struct RunArgs {
     /// Write a plot of the tip displacement over one period as SVG (`-`: standard output).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+}
+
+/// What `ssn sweep` reads and writes: [`RunArgs`], and whether the points get their
+/// stability.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SweepArgs {
+    /// The scene and the outputs every run has.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Skip the Floquet multipliers of the points (as `[sweep] stability = false`): every
+    /// point is undecided, the branch costs only its continuation.
+    #[arg(long)]
+    pub no_stability: bool,
 }
 
 /// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
@@ -617,7 +631,8 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
-pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
+pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
+    let args = &sweep_args.run;
     let mut outputs = args.plan()?;
     let Loaded {
         scene,
@@ -625,24 +640,33 @@ pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
         ..
     } = load_for(&args.scene, Workload::Branch)?;
     claim_model_files(&mut outputs, &scene)?;
-    let Some(settings) = scene.sweep.as_ref() else {
+    let Some(mut settings) = scene.sweep.clone() else {
         return Err(input_error(
             &args.scene,
             "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
         ));
     };
+    settings.stability &= !sweep_args.no_stability;
     let bar = progress_spinner("sweep");
-    let progress = |points: usize, omega: f64| {
-        bar.set_message(format!(
-            "sweep: {points} points, omega/omega_1 = {:.4}",
-            omega / rod.omega_1
-        ));
+    let progress = |p: SweepProgress| {
+        match p {
+            SweepProgress::Branch {
+                points,
+                omega_ratio,
+            } => bar.set_message(format!(
+                "sweep: {points} points, omega/omega_1 = {omega_ratio:.4}"
+            )),
+            SweepProgress::Stability { done, total } => {
+                bar.set_message(format!("stability: {done} of {total} points"))
+            }
+            _ => {}
+        }
         bar.tick();
     };
     let response = semismooth_contact::sweep::frequency_response(
         &rod,
         &scene.solver,
-        settings,
+        &settings,
         Some(&progress),
     )
     .map_err(|e| input_error(&args.scene, e))?;

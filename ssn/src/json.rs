@@ -154,6 +154,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "amplitude": r.amplitude,
         "stable": st.stable,
         "floquet_max_abs": st.floquet_max_abs,
+        "placed_by_fold": st.placed_by_fold,
         "contact_force_mean": r.contact_force_mean(),
         "max_penetration": st.max_penetration,
         "contacts": r

@@ -236,7 +236,8 @@ impl AccuracyCost {
     pub fn write_svg(&self, path: &Path) -> Result<(), OutputError> {
         let series: Vec<Series> = METHODS
             .iter()
-            .filter_map(|&m| {
+            .enumerate()
+            .filter_map(|(color, &m)| {
                 let mut points: Vec<(f64, f64)> = self
                     .entries
                     .iter()
@@ -247,9 +248,13 @@ impl AccuracyCost {
                     return None;
                 }
                 points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let (x, y) = points.into_iter().unzip();
-                Some(Series::new(m.name(), x, y))
+                let (x, y): (Vec<f64>, Vec<f64>) = points.into_iter().unzip();
+                Some([
+                    Series::new(m.name(), x.clone(), y.clone()).with_color(color),
+                    Series::markers("", x, y).with_color(color),
+                ])
             })
+            .flatten()
             .collect();
         let spec = PlotSpec {
             title: "Accuracy vs cost (tip minimum)".into(),

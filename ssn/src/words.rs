@@ -151,12 +151,26 @@ fn branch_termination(r: &FrequencyResponse, t: &ContinuationTermination) -> Str
 pub fn undecided(u: &Undecided) -> String {
     match u {
         Undecided::MassCarryingContact => {
-            "a contact dof has mass: the flow has impacts and the monodromy needs the impact \
-             law's saltation matrices, which are not implemented (use a modified mass)"
+            "a contact dof has mass: the time-stepping map of the discrete monodromy has no \
+             impact law (the monodromy along the harmonic-balance contact phases decides it)"
                 .to_string()
         }
         Undecided::TooManyDofs { dofs, limit } => {
             format!("{dofs} dofs: the dense monodromy is formed only up to {limit} dofs (2N x 2N)")
+        }
+        Undecided::TooCostly { phases, work } => format!(
+            "{phases} contact phases per period: the monodromy would take about {work:.1e} \
+             floating-point operations (limit {:.0e})",
+            semismooth_contact::stability::MAX_WORK
+        ),
+        Undecided::Marginal { max_abs } => format!(
+            "the largest Floquet multiplier has modulus {max_abs} (on the unit circle to within \
+             {:e}: an undamped model)",
+            semismooth_contact::stability::MARGINAL
+        ),
+        Undecided::Phases(err) => format!("the contact phases' dynamics: {err}"),
+        Undecided::NotRequested => {
+            "stability not computed ([sweep] stability = false or --no-stability)".to_string()
         }
         Undecided::OrbitNotFound {
             termination,

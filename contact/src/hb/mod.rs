@@ -423,6 +423,19 @@ pub(crate) fn fine_samples(
     Ok(samples)
 }
 
+/// Where the switching function with coefficients `coeffs` (one contact's, `2H + 1`) is
+/// positive over a period, its sign changes bracketed on the `Nt` AFT samples.
+pub(crate) fn switching_intervals(
+    lin: &LinearData,
+    coeffs: &[f64],
+) -> Result<Vec<(f64, f64)>, HbError> {
+    Ok(semismooth::trigonometric::positive_intervals(
+        &lin.basis,
+        coeffs,
+        lin.basis.time_samples(),
+    )?)
+}
+
 /// Displacement extremes, RMS and penetration from the displacement coefficients `u`.
 pub(crate) fn displacement_summary(
     lin: &LinearData,

@@ -667,6 +667,7 @@ impl Check<'_> {
                 1_000_000,
                 defaults.max_points,
             )?,
+            stability: sw.stability.unwrap_or(defaults.stability),
             ..defaults
         })
     }

@@ -222,6 +222,7 @@ struct RawSweep {
     min_step: Option<f64>,
     max_step: Option<f64>,
     max_points: Option<i64>,
+    stability: Option<bool>,
 }
 
 /// Largest harmonic count accepted.
