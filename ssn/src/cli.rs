@@ -276,6 +276,12 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
                 .map_err(|e| input_error(&args.scene, e))?;
         }
     }
+    if solve_args.start.is_some() && scene.solver.accuracy.is_some() {
+        return Err(input_error(
+            &args.scene,
+            "--start with solver.accuracy: the search chooses the harmonics and solves from zero (remove one of the two)",
+        ));
+    }
     let start = match &solve_args.start {
         Some(path) => {
             let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
@@ -330,6 +336,11 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
         }
     })?;
     if let Some(path) = &solve_args.state {
+        // With an accuracy target the harmonics are the search's.
+        let shape = StateShape {
+            harmonics: solution.harmonics.unwrap_or(shape.harmonics),
+            ..shape
+        };
         let mut doc =
             HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
                 .to_json();
@@ -355,7 +366,8 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
             }
             t
         },
-        solution.converged(),
+        // An accuracy target not met is a run that did not converge (exit code 1).
+        solution.converged() && solution.search.as_ref().is_none_or(|s| s.met()),
     )
 }
 
@@ -459,6 +471,7 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
         )?;
         writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
         writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        t += &crate::words::estimate_lines(s);
         if s.contacts.len() > 1 {
             for c in &s.contacts {
                 writeln!(

@@ -142,7 +142,8 @@ mod sequencing;
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
 pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
 pub use sequencing::{
-    solve_min_map_sequenced, SequencedSolution, SequencingLevel, SEQUENCING_COARSEST_TIME_SAMPLES,
+    interpolate_periodic, solve_min_map_sequenced, SequencedSolution, SequencingLevel,
+    SEQUENCING_COARSEST_TIME_SAMPLES,
 };
 
 use std::sync::Arc;

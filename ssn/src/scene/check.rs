@@ -590,6 +590,20 @@ impl Check<'_> {
         if !(0.0..=1.0).contains(&restitution) {
             return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
         }
+        let accuracy = s
+            .accuracy
+            .map(|a| {
+                if (MIN_ACCURACY..=MAX_ACCURACY).contains(&a) {
+                    Ok(a)
+                } else {
+                    Err(self.invalid(
+                        "solver.accuracy",
+                        a,
+                        &format!("a relative accuracy in [{MIN_ACCURACY:e}, {MAX_ACCURACY}]"),
+                    ))
+                }
+            })
+            .transpose()?;
         Ok(SolverSettings {
             method,
             harmonics,
@@ -605,6 +619,8 @@ impl Check<'_> {
             march_tolerance,
             restitution,
             lcp_scheme: s.lcp_scheme,
+            accuracy,
+            estimate_error: default.estimate_error,
         })
     }
 
