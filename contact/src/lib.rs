@@ -9,6 +9,7 @@
 //! marching), stability, frequency responses and the solutions at one frequency.
 
 pub mod accuracy;
+pub mod builder;
 pub mod contacts;
 mod dynamic;
 pub mod from_zero;
