@@ -355,6 +355,25 @@ pub(crate) fn carried_start(
     }
 }
 
+/// Solves with `settings` from `start`, the answer of another discretisation carried
+/// over, and again from zero when that did not converge (a carried start can lead Newton
+/// astray where the method's own start, e.g. the LCP's mesh sequencing, does not); a
+/// solve that did not converge is passed to `failed` before the retry.
+pub(crate) fn solve_carried(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    start: Option<&[f64]>,
+    mut failed: impl FnMut(&Solution),
+) -> Result<Solution, RunError> {
+    let first = crate::solve::solve_as_given(rod, omega, settings, start)?;
+    if first.converged() || start.is_none() {
+        return Ok(first);
+    }
+    failed(&first);
+    crate::solve::solve_as_given(rod, omega, settings, None)
+}
+
 /// Runs the comparison `coarse` from `start` and returns the change of the reported
 /// quantities of `solution` against it, with its time and work.
 fn change_against(
@@ -364,7 +383,7 @@ fn change_against(
     coarse: &SolverSettings,
     start: Option<&[f64]>,
 ) -> Result<(RelativeErrors, f64, RunCounters), NoEstimate> {
-    let other = crate::solve::solve_as_given(rod, omega, coarse, start)
+    let other = solve_carried(rod, omega, coarse, start, |_| {})
         .map_err(|_: RunError| NoEstimate::ComparisonFailed)?;
     if !other.converged() {
         return Err(NoEstimate::ComparisonNotConverged(other.termination));

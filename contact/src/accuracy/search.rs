@@ -414,7 +414,9 @@ fn pair(
 ) -> Result<Result<(Rung, RelativeErrors), Solution>, RunError> {
     let fine_settings = ladder.settings(settings, level);
     let start = carried_start(rod, &current.solution, &fine_settings);
-    let fine = solve_as_given(rod, omega, &fine_settings, start.as_deref())?;
+    let fine = super::solve_carried(rod, omega, &fine_settings, start.as_deref(), |failed| {
+        record.push(failed, None);
+    })?;
     if !fine.converged() {
         let step = record.push(&fine, None);
         let at = record.steps[step].discretisation;
@@ -497,7 +499,9 @@ fn check_samples(
 ) -> Result<(Rung, RelativeErrors, EstimateBasis, bool), RunError> {
     let mut finer = ladder.settings(settings, chosen.level);
     finer.time_samples = 2 * chosen.solution.time_samples;
-    let doubled = solve_as_given(rod, omega, &finer, Some(&chosen.solution.state))?;
+    let doubled = super::solve_carried(rod, omega, &finer, Some(&chosen.solution.state), |f| {
+        record.push(f, None);
+    })?;
     if !doubled.converged() {
         record.push(&doubled, None);
         // The samples cannot be checked: the chosen rung stands on its H estimate.
