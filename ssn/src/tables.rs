@@ -29,15 +29,20 @@ pub struct Section {
 }
 
 /// Every section, in the order the example computes them: the method comparison, the
-/// cheapest setting per accuracy, the frequency sweeps, the public grid from zero, what the
+/// cheapest setting per accuracy, the discretisation chosen for an accuracy target, the
+/// frequency sweeps, the public grid from zero, what the
 /// examples time, and the hard cases from zero (minutes).
-pub const SECTIONS: [Section; 6] = [
+pub const SECTIONS: [Section; 7] = [
     Section {
         name: "methods",
         file: "docs/method-comparison.md",
     },
     Section {
         name: "accuracy",
+        file: "docs/accuracy-cost.md",
+    },
+    Section {
+        name: "accuracy-targets",
         file: "docs/accuracy-cost.md",
     },
     Section {
