@@ -379,3 +379,49 @@ pub fn accuracy_targets() -> Result<(String, Table), TableError> {
     }
     Ok((notes, table))
 }
+
+/// `ssn compare --accuracy`: each method applicable to `structure` (the LCP and penalty HB
+/// only with contact) solved at the discretisation its own search chose for `target`,
+/// without a reference (`base` gives the rest of the settings), one line each: the choice,
+/// whether the estimate met the target, the estimate, the change of the tip minimum
+/// against `reference_tip_min` (the study's error, for comparison) and the search's wall
+/// time.
+pub fn self_chosen_lines(
+    structure: &semismooth_contact::model::Structure,
+    omega: f64,
+    base: &SolverSettings,
+    target: f64,
+    reference_tip_min: f64,
+) -> Result<String, semismooth_contact::solve::RunError> {
+    let contact = !structure.model.contacts.is_empty();
+    let mut out = String::new();
+    for method in METHODS {
+        if !contact && !matches!(method, Method::SsnHb | Method::March) {
+            continue;
+        }
+        let settings = SolverSettings {
+            method,
+            accuracy: Some(target),
+            ..base.clone()
+        };
+        let s = solve(structure, omega, &settings, None)?;
+        let Some(search) = &s.search else { continue };
+        let chosen = discretisation(method, &search.steps[search.chosen].discretisation);
+        let estimate = s
+            .error_estimate
+            .as_ref()
+            .map_or("none".into(), |e| format!("{:.1e}", e.relative));
+        let tip_min_error = (s.stats.min - reference_tip_min).abs() / reference_tip_min.abs();
+        out += &format!(
+            "  {:<11} {:<18} {:<4} estimate {:<8} tip-min error {:.1e}  search {:.3} ms ({} solves)\n",
+            method.name(),
+            chosen,
+            if search.met() { "met" } else { "not" },
+            estimate,
+            tip_min_error,
+            1e3 * search.seconds,
+            search.steps.len()
+        );
+    }
+    Ok(out)
+}

@@ -604,6 +604,22 @@ impl Check<'_> {
                 }
             })
             .transpose()?;
+        if accuracy.is_some() {
+            // The search chooses the discretisation: one given as well would be ignored.
+            for (key, given) in [
+                ("solver.harmonics", s.harmonics.is_some()),
+                ("solver.time_samples", s.time_samples.is_some()),
+                ("solver.steps_per_period", s.steps_per_period.is_some()),
+            ] {
+                if given {
+                    return Err(self.invalid(
+                        key,
+                        "given with solver.accuracy",
+                        "not both: with an accuracy the method chooses its discretisation",
+                    ));
+                }
+            }
+        }
         Ok(SolverSettings {
             method,
             harmonics,
