@@ -6,7 +6,7 @@
 //! they are computed (every method without arguments).
 
 use ssn::accuracy_targets::{
-    reference, scan, target_cases, target_row, target_table, METHODS, TARGETS,
+    reference, scan, target_cases, target_row, target_table, targets_of, METHODS,
 };
 use ssn::scene::Method;
 
@@ -34,7 +34,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             case.name, reference.uncertainty
         );
         for &method in &methods {
-            let scanned = scan(&rod, method, &reference, TARGETS[TARGETS.len() - 1])?;
+            let targets = targets_of(method);
+            let scanned = scan(&rod, method, &reference, targets[targets.len() - 1])?;
             for s in &scanned {
                 println!(
                     "  {} level {} error {:.2e} {:.2} ms",
@@ -44,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     1e3 * s.seconds
                 );
             }
-            for target in TARGETS {
+            for &target in targets {
                 let row = target_row(&rod, method, target, &reference, &scanned)?;
                 print!(
                     "{}",
