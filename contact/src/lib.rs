@@ -8,7 +8,6 @@
 //! solve it (harmonic balance with exact or penalty contact, the periodic LCP, time
 //! marching), stability, frequency responses and the solutions at one frequency.
 
-pub mod accuracy;
 pub mod builder;
 pub mod contacts;
 mod dynamic;
@@ -26,4 +25,5 @@ pub mod stability;
 pub mod structures;
 pub mod sweep;
 
+pub use solve::accuracy;
 pub use solve::solve;

@@ -8,6 +8,8 @@
 //! ([`Solution::converged`]), with the best answer it reached, so callers can still report
 //! what happened.
 
+pub mod accuracy;
+
 use std::time::Instant;
 
 use semismooth::continuation::{homotopy, HomotopySchedule};
@@ -19,7 +21,6 @@ use semismooth::newton::{
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
 
-use crate::accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
 use crate::contacts::{contact_reports, ContactReport};
 use crate::contacts::{period_statistics, PeriodStatistics};
 use crate::hb::{
@@ -35,6 +36,7 @@ use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
 use crate::rod::ModelError;
 use crate::settings::{GlobalizationChoice, Method, SolverSettings};
+use accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
@@ -643,13 +645,11 @@ pub fn solve(
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
     if let Some(target) = settings.accuracy {
-        return crate::accuracy::search::solve_to_accuracy(
-            rod, omega, settings, target, warm_start,
-        );
+        return accuracy::search::solve_to_accuracy(rod, omega, settings, target, warm_start);
     }
     let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
     if settings.estimate_error {
-        solution.error_estimate = crate::accuracy::estimate(rod, omega, settings, &solution);
+        solution.error_estimate = accuracy::estimate(rod, omega, settings, &solution);
     }
     Ok(solution)
 }

@@ -1,7 +1,8 @@
 //! The cheapest discretisation for an accuracy target ([`SolverSettings::accuracy`]).
 //!
 //! The method is solved on a ladder of discretisations, each solve started from the
-//! previous answer carried over ([`super::carried_start`]): harmonic balance over `H` (with
+//! previous answer carried over (harmonic-balance coefficients lifted, the LCP's forces
+//! interpolated, the march's final state): harmonic balance over `H` (with
 //! the default AFT samples for `H`, times a factor the search may double), the periodic
 //! LCP over its time steps `Nt`, time marching over its steps per period. Each new solve
 //! closes a pair with the previous one; the change of the reported quantities between them

@@ -40,8 +40,8 @@
 //! - Time marching: `steps/2` steps per period marched from the final state, order 2 for
 //!   the trapezoidal scheme of a massless contact dof, 1 for Moreau–Jean.
 //!
-//! `ssn/src/tables.rs` (`accuracy-targets`, docs/accuracy-cost.md) checks the estimate
-//! against converged references.
+//! `ssn::accuracy_targets` (the `accuracy-targets` table of docs/accuracy-cost.md) and
+//! `contact/tests/error_estimate.rs` check the estimate against converged references.
 
 pub mod search;
 
