@@ -302,7 +302,7 @@ pub(crate) fn lcp_options(
     settings: &SolverSettings,
 ) -> (PeriodicLcpOptions, Option<usize>) {
     let tip = rod.observed_dof;
-    let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
+    let tip_contact = rod.model.contacts.iter().position(|c| c.dof() == tip);
     let options = PeriodicLcpOptions {
         time_samples: settings.time_samples,
         observed_dofs: if tip_contact.is_some() {
@@ -404,18 +404,16 @@ fn roundoff_floor(
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
 pub(crate) trait HbReconstruction {
-    fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// `g_i . u` of row `i` of `G`.
+    fn row_displacement(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
 }
 
 /// Both harmonic-balance problems reconstruct through the same inherent methods.
 macro_rules! hb_reconstruction {
     ($($problem:ty),*) => {$(
         impl HbReconstruction for $problem {
-            fn contact_count(&self) -> usize {
-                self.contacts()
-            }
             fn displacement(
                 &self,
                 x: &[f64],
@@ -426,6 +424,14 @@ macro_rules! hb_reconstruction {
             }
             fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
                 self.contact_force_samples(x, i, points)
+            }
+            fn row_displacement(
+                &self,
+                x: &[f64],
+                i: usize,
+                points: usize,
+            ) -> Result<Vec<f64>, HbError> {
+                self.row_displacement_samples(x, i, points)
             }
         }
     )*};
@@ -482,7 +488,7 @@ fn solution(
         &rod.model
             .contacts
             .iter()
-            .map(|c| (c.dof, c.gap))
+            .map(|c| (c.dof(), c.gap))
             .collect::<Vec<_>>(),
         &period.contact_forces,
         &period.contact_displacements,
@@ -535,14 +541,12 @@ fn hb_outputs(
     points: usize,
 ) -> Result<Solution, RunError> {
     let tip = problem.displacement(&x, rod.observed_dof, points)?;
-    let contact_forces = (0..problem.contact_count())
+    let contacts = rod.model.contacts.len();
+    let contact_forces = (0..contacts)
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let contact_displacements = rod
-        .model
-        .contacts
-        .iter()
-        .map(|c| problem.displacement(&x, c.dof, points))
+    let contact_displacements = (0..contacts)
+        .map(|i| problem.row_displacement(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
     let period = 2.0 * std::f64::consts::PI / omega;
     let times = (0..points)
@@ -576,7 +580,7 @@ fn statistics(
     let contacts = &rod.model.contacts;
     let tip_contact = contacts
         .iter()
-        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
+        .position(|c| c.row.single() == Some((tip_dof, 1.0)));
     let mut stats = match (tip_contact, forces.first()) {
         (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
         (None, Some(f)) => {
@@ -593,10 +597,7 @@ fn statistics(
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
-        let p = u
-            .iter()
-            .map(|v| (c.sign() * v - c.gap).max(0.0))
-            .fold(0.0, f64::max);
+        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
         stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
@@ -842,8 +843,14 @@ fn solve_march(
             MarchScheme::Auto
         },
     };
+    // The tip, then every dof of the contacts' rows (their gap closures `g . u` are
+    // combined from these series).
     let mut observed = vec![tip];
-    observed.extend(model.contacts.iter().map(|c| c.dof));
+    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
+        if !observed[1..].contains(dof) {
+            observed.push(*dof);
+        }
+    }
     let start = Instant::now();
     // A march that does not settle is a run that did not converge: its last period is
     // reported with the last period-to-period change.
@@ -857,7 +864,25 @@ fn solve_march(
     let keep = period.times.len().saturating_sub(1).max(1);
     let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
     let tip_series = cut(&period.displacements[0]);
-    let contact_u: Vec<Vec<f64>> = period.displacements[1..].iter().map(cut).collect();
+    let series = |dof: usize| {
+        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
+        cut(&period.displacements[k])
+    };
+    let contact_u: Vec<Vec<f64>> = model
+        .contacts
+        .iter()
+        .map(|c| {
+            let mut entries = c.row.entries();
+            let (d, a) = entries.next().expect("a row has at least one dof");
+            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
+            for (d, a) in entries {
+                for (ui, v) in u.iter_mut().zip(series(d)) {
+                    *ui += a * v;
+                }
+            }
+            u
+        })
+        .collect();
     let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
     let start_time = period.times[0];
     let times = period.times[..keep]

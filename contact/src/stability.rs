@@ -439,9 +439,12 @@ fn orbit_stays_open(model: &StructuralModel, harmonics: usize, u: &[f64]) -> boo
     let n = model.dofs();
     model.contacts.iter().all(|c| {
         let amplitude: f64 = (1..=harmonics)
-            .map(|k| u[(2 * k - 1) * n + c.dof].hypot(u[2 * k * n + c.dof]))
+            .map(|k| {
+                let (a, b) = (c.row.dot_at(u, (2 * k - 1) * n), c.row.dot_at(u, 2 * k * n));
+                a.hypot(b)
+            })
             .sum();
-        let highest = c.direction.sign() * u[c.dof] + amplitude;
+        let highest = c.row.dot(u) + amplitude;
         highest <= c.gap - OPEN_MARGIN * (c.gap.abs() + amplitude)
     })
 }

@@ -421,9 +421,9 @@ pub fn resolve_scheme(model: &StructuralModel, scheme: MarchScheme) -> MarchSche
     match scheme {
         MarchScheme::Auto => {
             if model
-                .contacts
-                .iter()
-                .all(|c| column_max_abs(&model.mass, c.dof) == 0.0)
+                .rows()
+                .flat_map(|row| row.dofs())
+                .all(|&dof| column_max_abs(&model.mass, dof) == 0.0)
             {
                 MarchScheme::MasslessContactTrapezoidal
             } else {

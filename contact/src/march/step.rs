@@ -17,6 +17,33 @@ use super::{
 use crate::dynamic::UnionPattern;
 use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
 
+/// A dof of a contact row (or of a friction point's tangential row) that carries mass, if
+/// any.
+pub(super) fn massive_contact_dof(model: &StructuralModel, massless: &[bool]) -> Option<usize> {
+    model
+        .rows()
+        .flat_map(|row| row.dofs().iter().copied())
+        .find(|&dof| !massless[dof])
+}
+
+/// `v -= g (g . v) / (g . g)` on the entries of the row `g` (`entry(v, dof)` is the
+/// entry of dof `dof`): the motion along the row removed (a closed contact's massless dofs
+/// at rest; for a one-dof row its velocity set to 0).
+pub(super) fn remove_row_component<V: ?Sized>(
+    row: &crate::model::ContactRow,
+    v: &mut V,
+    entry: impl Fn(&mut V, usize) -> &mut f64,
+) {
+    let (mut along, mut norm) = (0.0, 0.0);
+    for (dof, a) in row.entries() {
+        along += a * *entry(v, dof);
+        norm += a * a;
+    }
+    for (dof, a) in row.entries() {
+        *entry(v, dof) -= a * along / norm;
+    }
+}
+
 /// The scheme actually marched (`Auto` resolved).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Scheme {
@@ -160,6 +187,13 @@ impl<'a> TimeMarcher<'a> {
                 allowed: "a finite angular frequency > 0",
             });
         }
+        if !model.friction.is_empty() {
+            return Err(MarchError::InvalidOption {
+                name: "friction points",
+                value: model.friction.len() as f64,
+                allowed: "none",
+            });
+        }
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
@@ -172,10 +206,10 @@ impl<'a> TimeMarcher<'a> {
         // a K + b D + c M, summed in the order K, D, M.
         let (a, b, c) = match scheme {
             Scheme::Trapezoidal => {
-                if let Some(c) = model.contacts.iter().find(|c| !massless[c.dof]) {
+                if let Some(dof) = massive_contact_dof(model, &massless) {
                     return Err(MarchError::MassiveContactDof {
-                        dof: c.dof,
-                        mass: column_max_abs(&model.mass, c.dof),
+                        dof,
+                        mass: column_max_abs(&model.mass, dof),
                     });
                 }
                 (1.0, 2.0 / h, 4.0 / (h * h))
@@ -198,10 +232,10 @@ impl<'a> TimeMarcher<'a> {
         let mut w = Mat::zeros(m, m);
         for (k, c) in model.contacts.iter().enumerate() {
             let col = &mut y[k * n..(k + 1) * n];
-            col[c.dof] = c.sign();
+            c.row.add_transpose_at(1.0, col, 0);
             lu.solve_in_place(col).map_err(failed)?;
             for (i, ci) in model.contacts.iter().enumerate() {
-                w[(i, k)] = ci.sign() * col[ci.dof];
+                w[(i, k)] = ci.row.dot(col);
             }
         }
         let cosines = (0..=spp)
@@ -250,7 +284,7 @@ impl<'a> TimeMarcher<'a> {
             *ri = c * ai;
         }
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
-            self.r[ct.dof] += ct.sign() * l;
+            ct.row.add_transpose_at(*l, &mut self.r, 0);
         }
         if let Some(d) = &model.damping {
             sparse_mul_add(d.as_ref(), -1.0, &self.v, &mut self.r);
@@ -416,7 +450,7 @@ impl<'a> TimeMarcher<'a> {
         self.active.clear();
         let mut closed = false;
         for (k, ct) in model.contacts.iter().enumerate() {
-            self.q[k] = ct.gap - ct.sign() * self.rhs[ct.dof];
+            self.q[k] = ct.gap - ct.row.dot(&self.rhs);
             closed |= self.q[k] < 0.0;
         }
         if closed {
@@ -432,7 +466,7 @@ impl<'a> TimeMarcher<'a> {
         if self.reset_closed_velocity {
             for (ct, l) in model.contacts.iter().zip(&self.lambda) {
                 if *l < 0.0 {
-                    self.v[ct.dof] = 0.0;
+                    remove_row_component(&ct.row, &mut self.v, |v, i| &mut v[i]);
                 }
             }
         }
@@ -462,9 +496,9 @@ impl<'a> TimeMarcher<'a> {
         // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
         self.active.clear();
         for (k, ct) in model.contacts.iter().enumerate() {
-            let s = ct.sign();
-            if ct.gap - s * (self.u[ct.dof] + 0.5 * h * self.v[ct.dof]) <= 0.0 {
-                self.q[self.active.len()] = -s * (self.rhs[ct.dof] + e * self.v[ct.dof]);
+            let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
+            if ct.gap - (gu + 0.5 * h * gv) <= 0.0 {
+                self.q[self.active.len()] = -(ct.row.dot(&self.rhs) + e * gv);
                 self.active.push(k);
             }
         }

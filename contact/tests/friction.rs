@@ -1,0 +1,169 @@
+//! Coulomb friction in SSN-HB against exact solutions.
+//!
+//! Den Hartog (1931): the single-dof oscillator `m x'' + c x' + k x + F sign(x') =
+//! F0 cos(w t)` in continuous sliding has an exact periodic solution, symmetric over half
+//! periods, made of the closed-form solutions of the linear equation with the constant
+//! friction force `-F` between velocity reversals. [`den_hartog`] computes it from the two
+//! matching conditions at the reversals; its amplitude is checked against Den Hartog's own
+//! formula for the undamped case, and harmonic balance converges to it as `H` grows.
+
+use semismooth::linalg::FaerDenseLu;
+use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
+use semismooth::Residual;
+use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
+use semismooth_contact::model::{ContactRow, FrictionPoint, SparseMatrix, StructuralModel};
+
+/// The single-dof oscillator `m x'' + c x' + k x = F0 cos(w t) + lambda_t` with Coulomb
+/// friction `|lambda_t| <= mu N` on its dof.
+fn oscillator(m: f64, c: f64, k: f64, f0: f64, friction: f64) -> StructuralModel {
+    let one = |v: f64| {
+        SparseMatrix::try_new_from_triplets(1, 1, &[faer::sparse::Triplet::new(0, 0, v)]).unwrap()
+    };
+    StructuralModel {
+        mass: one(m),
+        damping: (c > 0.0).then(|| one(c)),
+        stiffness: one(k),
+        load: vec![f0],
+        contacts: Vec::new(),
+        // mu = 0.5 under N = 2 friction: the slip limit `friction`.
+        friction: vec![FrictionPoint::prescribed(
+            ContactRow::unit(0, 1.0),
+            0.5,
+            2.0 * friction,
+        )],
+    }
+}
+
+/// The exact amplitude `X` of Den Hartog's continuous-sliding solution of
+/// `m x'' + c x' + k x + F sign(x') = F0 cos(w t)` (`c` below critical).
+///
+/// Over the half period `(0, T/2)` after a velocity reversal at `x(0) = -X`, `x' > 0` and
+/// `x = x_p + x_h`: the particular solution `x_p = A cos(w t + phi) + B sin(w t + phi) - F/k`
+/// of the linear response `(A, B)` to `F0`, and the free damped motion `x_h` from
+/// `x_h(0) = -X - x_p(0)`, `x_h'(0) = -x_p'(0)`. The half-period symmetry asks
+/// `x(T/2) = X`, `x'(T/2) = 0`. With `p = A cos(phi) + B sin(phi)`,
+/// `q = B cos(phi) - A sin(phi)` (so `p^2 + q^2 = A^2 + B^2`) and `Phi` the free motion's
+/// transition matrix over `T/2`, both conditions are linear in `Y = X + p` and `q`; then
+/// `X = Y - p` with `p = +sqrt(A^2 + B^2 - q^2)` (the root with `x' > 0` inside).
+fn den_hartog(m: f64, c: f64, k: f64, f0: f64, friction: f64, w: f64) -> f64 {
+    let wn = (k / m).sqrt();
+    let zeta = c / (2.0 * (k * m).sqrt());
+    let wd = wn * (1.0 - zeta * zeta).sqrt();
+    let d = (k - m * w * w).powi(2) + (c * w).powi(2);
+    let (a, b) = (f0 * (k - m * w * w) / d, f0 * c * w / d);
+    let tau = std::f64::consts::PI / w;
+    let s = friction / k;
+    let (e, cs, sn) = ((-zeta * wn * tau).exp(), (wd * tau).cos(), (wd * tau).sin());
+    let p11 = e * (cs + zeta * wn / wd * sn);
+    let p12 = e * sn / wd;
+    let p21 = -e * wn * wn / wd * sn;
+    let p22 = e * (cs - zeta * wn / wd * sn);
+    // -(P11 + 1) Y - P12 w q = -(P11 - 1) s;  -P21 Y - (P22 + 1) w q = -P21 s.
+    let (a11, a12, b1) = (-(p11 + 1.0), -p12 * w, -(p11 - 1.0) * s);
+    let (a21, a22, b2) = (-p21, -(p22 + 1.0) * w, -p21 * s);
+    let det = a11 * a22 - a12 * a21;
+    let y = (b1 * a22 - a12 * b2) / det;
+    let q = (a11 * b2 - a21 * b1) / det;
+    let r2 = a * a + b * b;
+    assert!(r2 > q * q, "no continuous sliding at w = {w}");
+    y - (r2 - q * q).sqrt()
+}
+
+/// Den Hartog's closed form of the undamped case:
+/// `X k / F0 = sqrt(1 / (1 - beta^2)^2 - (F U / F0)^2)`,
+/// `U = sin(pi / beta) / (beta (1 + cos(pi / beta)))`, `beta = w / w_n`.
+fn den_hartog_undamped(m: f64, k: f64, f0: f64, friction: f64, w: f64) -> f64 {
+    let beta = w / (k / m).sqrt();
+    let pi_b = std::f64::consts::PI / beta;
+    let u = pi_b.sin() / (beta * (1.0 + pi_b.cos()));
+    let r = friction * u / f0;
+    f0 / k * (1.0 / (1.0 - beta * beta).powi(2) - r * r).sqrt()
+}
+
+/// The amplitude `max |x|` of the SSN-HB solution with `h` harmonics, reconstructed on
+/// 4096 points, and the Newton iterations it took from zero.
+fn hb_amplitude(model: &StructuralModel, w: f64, h: usize) -> (f64, usize) {
+    let options = HbOptions {
+        harmonics: h,
+        ..HbOptions::default()
+    };
+    let mut hb = SsnHb::new(model, w, &options).unwrap();
+    let mut x = vec![0.0; hb.dim()];
+    let newton = PolyalgorithmOptions::default();
+    let report = solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &newton).unwrap();
+    assert!(report.converged(), "H = {h}: {:?}", report.termination);
+    let u = hb.displacement_samples(&x, 0, 4096).unwrap();
+    let amplitude = u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    // The friction force never exceeds the slip limit by more than the Gibbs overshoot of
+    // its truncated series (it is a square wave in continuous sliding).
+    let force = hb.contact_force_samples(&x, 0, 4096).unwrap();
+    assert!(force.iter().all(|f| f.abs() < 1.2 * 0.3), "H = {h}");
+    (amplitude, report.iterations)
+}
+
+#[test]
+fn the_exact_continuous_sliding_solution_is_den_hartogs() {
+    // The closed form of the two matching conditions against Den Hartog's formula (no
+    // viscous damping), below and above resonance: equal to round-off.
+    for w in [0.6, 0.7, 1.3, 2.0] {
+        let general = den_hartog(1.0, 0.0, 1.0, 1.0, 0.3, w);
+        let formula = den_hartog_undamped(1.0, 1.0, 1.0, 0.3, w);
+        assert!(
+            (general - formula).abs() < 1e-12 * formula,
+            "w = {w}: {general} vs {formula}"
+        );
+    }
+    // Friction lowers the amplitude below the linear response's.
+    assert!(den_hartog(1.0, 0.02, 1.0, 1.0, 0.3, 0.7) < 1.0 / (1.0 - 0.49));
+}
+
+#[test]
+fn harmonic_balance_converges_to_den_hartog_as_the_harmonics_grow() {
+    // F = 0.3 F0, below (0.7) and above (1.3) resonance, with light viscous damping
+    // (zeta = 0.01) and without.
+    for (w, c) in [(0.7, 0.0), (1.3, 0.0), (0.7, 0.02)] {
+        let model = oscillator(1.0, c, 1.0, 1.0, 0.3);
+        let exact = den_hartog(1.0, c, 1.0, 1.0, 0.3, w);
+        let mut errors = Vec::new();
+        for h in [5, 10, 20, 40] {
+            let (amplitude, _) = hb_amplitude(&model, w, h);
+            errors.push((amplitude - exact).abs() / exact);
+        }
+        eprintln!(
+            "w = {w}, c = {c}: X = {exact}, relative errors at H = 5, 10, 20, 40: {errors:?}"
+        );
+        // Converging: each doubling of H divides the error.
+        for pair in errors.windows(2) {
+            assert!(pair[1] < 0.6 * pair[0], "w = {w}: {errors:?}");
+        }
+        assert!(errors[3] < 1e-3, "w = {w}: {errors:?}");
+    }
+}
+
+#[test]
+fn the_dense_and_structured_solves_agree_with_friction() {
+    let model = oscillator(1.0, 0.02, 1.0, 1.0, 0.3);
+    let options = HbOptions {
+        harmonics: 10,
+        ..HbOptions::default()
+    };
+    let newton = PolyalgorithmOptions::default();
+    let mut structured = SsnHb::new(&model, 0.7, &options).unwrap();
+    let mut xs = vec![0.0; structured.dim()];
+    let rs = solve_smoothing(
+        &mut structured,
+        &mut StructuredHbSolver::new(),
+        &mut xs,
+        &newton,
+    )
+    .unwrap();
+    let mut dense = SsnHb::new(&model, 0.7, &options).unwrap();
+    let mut xd = vec![0.0; dense.dim()];
+    let rd = solve_smoothing(&mut dense, &mut FaerDenseLu::new(), &mut xd, &newton).unwrap();
+    assert!(rs.converged() && rd.converged());
+    let diff = xs
+        .iter()
+        .zip(&xd)
+        .fold(0.0f64, |a, (s, d)| a.max((s - d).abs()));
+    assert!(diff < 1e-9, "{diff:e}");
+}
