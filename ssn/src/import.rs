@@ -116,7 +116,7 @@ fn row_keys(row: &ContactRow, with_direction: bool) -> String {
         Some((dof, a)) if with_direction && a.abs() == 1.0 => {
             format!("dof = {}\ndirection = {}\n", dof + 1, a as i32)
         }
-        Some((dof, a)) if a == 1.0 => format!("dof = {}\n", dof + 1),
+        Some((dof, 1.0)) => format!("dof = {}\n", dof + 1),
         _ => {
             let (dofs, coefficients) = row_lists(row);
             format!("dofs = {dofs}\ncoefficients = {coefficients}\n")

@@ -348,9 +348,7 @@ impl LinearData {
         if first == m {
             return;
         }
-        for i in first..m {
-            out[i] = 0.0;
-        }
+        out[first..m].fill(0.0);
         for k in 1..=self.basis.harmonics() {
             let (c, s) = ((2 * k - 1) * m, 2 * k * m);
             let kf = k as f64;

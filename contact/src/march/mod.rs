@@ -117,6 +117,7 @@
 //! assert!(period.contact_forces[0].iter().all(|l| *l <= 0.0));
 //! ```
 
+mod friction;
 mod step;
 
 pub use step::TimeMarcher;
@@ -384,6 +385,21 @@ pub enum MarchError {
         step: usize,
         /// Lemke's error.
         source: LemkeError,
+    },
+    /// The semismooth Newton of a step's contact and friction problem did not converge.
+    #[error(
+        "contact and friction problem at period {period}, step {step} not solved: residual \
+         {residual:e} above the tolerance {tolerance:e}"
+    )]
+    FrictionSolve {
+        /// Period (1-based).
+        period: usize,
+        /// Step within the period (1-based).
+        step: usize,
+        /// `|F|_2` reached.
+        residual: f64,
+        /// The tolerance asked.
+        tolerance: f64,
     },
     /// A non-finite value appeared in the state.
     #[error("non-finite state at period {period}, step {step}")]

@@ -10,6 +10,7 @@ use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
+use super::friction::CoulombStep;
 use super::{
     column_max_abs, resolve_scheme, MarchCounters, MarchError, MarchOptions, MarchScheme,
     MarchState,
@@ -165,6 +166,14 @@ pub struct TimeMarcher<'a> {
     q: Vec<f64>,
     z: Vec<f64>,
     active: Vec<usize>,
+    /// The step's contact and friction problem (Moreau–Jean with friction points).
+    coulomb: Option<Box<CoulombStep>>,
+    /// Friction forces of the last step (impulse / h), one per friction point.
+    friction_force: Vec<f64>,
+    /// `G v_free` of every row, `e g . v_n` and the predicted state of every contact.
+    row_free: Vec<f64>,
+    restitution: Vec<f64>,
+    closed: Vec<bool>,
     counters: MarchCounters,
 }
 
@@ -187,17 +196,19 @@ impl<'a> TimeMarcher<'a> {
                 allowed: "a finite angular frequency > 0",
             });
         }
-        if !model.friction.is_empty() {
-            return Err(MarchError::InvalidOption {
-                name: "friction points",
-                value: model.friction.len() as f64,
-                allowed: "none",
-            });
-        }
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
         let scheme = Scheme::resolve(model, options.scheme);
+        if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
+            return Err(MarchError::InvalidOption {
+                name: "scheme",
+                value: model.friction.len() as f64,
+                allowed: "MoreauJean with friction points (Coulomb's law acts on velocities; \
+                          the trapezoidal scheme imposes positions)",
+            });
+        }
+        let rows = m + model.friction_count();
         let massless: Vec<bool> = (0..n)
             .map(|j| column_max_abs(&model.mass, j) == 0.0)
             .collect();
@@ -227,17 +238,19 @@ impl<'a> TimeMarcher<'a> {
         };
         let mut lu = FaerSparseLu::new();
         lu.factor(&matrix).map_err(failed)?;
-        // Y = A^{-1} G^T, column k for contact k; W = G Y.
-        let mut y = vec![0.0; n * m];
-        let mut w = Mat::zeros(m, m);
-        for (k, c) in model.contacts.iter().enumerate() {
+        // Y = A^{-1} G^T, column k for row k (contacts, then friction points); W = G Y.
+        let mut y = vec![0.0; n * rows];
+        let mut w = Mat::zeros(rows, rows);
+        for (k, row_k) in model.rows().enumerate() {
             let col = &mut y[k * n..(k + 1) * n];
-            c.row.add_transpose_at(1.0, col, 0);
+            row_k.add_transpose_at(1.0, col, 0);
             lu.solve_in_place(col).map_err(failed)?;
-            for (i, ci) in model.contacts.iter().enumerate() {
-                w[(i, k)] = ci.row.dot(col);
+            for (i, row_i) in model.rows().enumerate() {
+                w[(i, k)] = row_i.dot(col);
             }
         }
+        let coulomb =
+            (!model.friction.is_empty()).then(|| Box::new(CoulombStep::new(model, w.clone(), h)));
         let cosines = (0..=spp)
             .map(|j| (2.0 * PI * j as f64 / spp as f64).cos())
             .collect();
@@ -264,9 +277,14 @@ impl<'a> TimeMarcher<'a> {
             q: vec![0.0; m],
             z: vec![0.0; m],
             active: Vec::with_capacity(m),
+            coulomb,
+            friction_force: vec![0.0; model.friction_count()],
+            row_free: vec![0.0; rows],
+            restitution: vec![0.0; m],
+            closed: vec![false; m],
             counters: MarchCounters {
                 factorizations: 1,
-                linear_solves: m as u64 + 1,
+                linear_solves: rows as u64 + 1,
                 ..MarchCounters::default()
             },
         };
@@ -330,6 +348,11 @@ impl<'a> TimeMarcher<'a> {
     /// Contact forces of the last step (`lambda <= 0`; impulse / h for Moreau–Jean).
     pub fn contact_force(&self) -> &[f64] {
         &self.lambda
+    }
+
+    /// Friction forces of the last step (impulse / h), one per friction point.
+    pub fn friction_force(&self) -> &[f64] {
+        &self.friction_force
     }
 
     /// Work so far.
@@ -487,7 +510,24 @@ impl<'a> TimeMarcher<'a> {
         }
         sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
         self.solve_rhs()?;
-        // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
+        if self.coulomb.is_some() {
+            self.solve_contacts_with_friction(j, e)?;
+        } else {
+            self.solve_impacts(j, e)?;
+        }
+        // u_{n+1} = u_n + h (theta v_{n+1} + (1 - theta) v_n)
+        for i in 0..n {
+            self.u[i] += h * (theta * self.rhs[i] + (1.0 - theta) * self.v[i]);
+        }
+        std::mem::swap(&mut self.v, &mut self.rhs);
+        Ok(())
+    }
+
+    /// The frictionless Moreau–Jean contact step on `rhs = v_free`: the active set from the
+    /// predicted gap `g - G (u + h/2 v)`, the impact LCP by Lemke.
+    fn solve_impacts(&mut self, j: usize, e: f64) -> Result<(), MarchError> {
+        let model = self.model;
+        let h = self.h;
         self.active.clear();
         for (k, ct) in model.contacts.iter().enumerate() {
             let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
@@ -496,12 +536,51 @@ impl<'a> TimeMarcher<'a> {
                 self.active.push(k);
             }
         }
-        self.solve_contacts(j, 1.0 / h)?;
-        // u_{n+1} = u_n + h (theta v_{n+1} + (1 - theta) v_n)
-        for i in 0..n {
-            self.u[i] += h * (theta * self.rhs[i] + (1.0 - theta) * self.v[i]);
+        self.solve_contacts(j, 1.0 / h)
+    }
+
+    /// The Moreau–Jean contact and friction step on `rhs = v_free` (module
+    /// [`super::friction`]): contacts closed by the predicted gap, the impulses by the
+    /// core's semismooth Newton, `rhs += Y r`.
+    fn solve_contacts_with_friction(&mut self, j: usize, e: f64) -> Result<(), MarchError> {
+        let model = self.model;
+        let (n, h) = (self.u.len(), self.h);
+        for (k, row) in model.rows().enumerate() {
+            self.row_free[k] = row.dot(&self.rhs);
         }
-        std::mem::swap(&mut self.v, &mut self.rhs);
+        for (k, ct) in model.contacts.iter().enumerate() {
+            let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
+            self.closed[k] = ct.gap - (gu + 0.5 * h * gv) <= 0.0;
+            self.restitution[k] = e * gv;
+        }
+        let coulomb = self.coulomb.as_mut().expect("friction points present");
+        let solved = coulomb.solve(&self.row_free, &self.restitution, &self.closed);
+        solved.map_err(|unsolved| MarchError::FrictionSolve {
+            period: self.completed_periods + 1,
+            step: j + 1,
+            residual: unsolved.residual,
+            tolerance: unsolved.tolerance,
+        })?;
+        self.counters.contact_solves += 1;
+        let m = model.contact_count();
+        let mut any = false;
+        for (k, r) in coulomb.impulses().enumerate() {
+            if k < m {
+                self.lambda[k] = r / h;
+            } else {
+                self.friction_force[k - m] = r / h;
+            }
+            if r != 0.0 {
+                any = true;
+                let col = &self.y[k * n..(k + 1) * n];
+                for (xi, yi) in self.rhs.iter_mut().zip(col) {
+                    *xi += yi * r;
+                }
+            }
+        }
+        if any {
+            self.counters.active_steps += 1;
+        }
         Ok(())
     }
 }

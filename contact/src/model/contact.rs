@@ -200,8 +200,8 @@ impl ContactPoint {
     /// The side of a one-dof contact with coefficient `+-1`; `None` for any other row.
     pub fn direction(&self) -> Option<ContactDirection> {
         match self.row.single() {
-            Some((_, a)) if a == 1.0 => Some(ContactDirection::Positive),
-            Some((_, a)) if a == -1.0 => Some(ContactDirection::Negative),
+            Some((_, 1.0)) => Some(ContactDirection::Positive),
+            Some((_, -1.0)) => Some(ContactDirection::Negative),
             _ => None,
         }
     }

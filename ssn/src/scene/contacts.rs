@@ -178,7 +178,7 @@ impl Check<'_> {
 
     /// A Coulomb coefficient: finite and `>= 0`.
     fn friction_coefficient(&self, key: &str, mu: f64) -> Result<f64, SceneError> {
-        if mu.is_finite() && mu >= 0.0 && mu <= MAX_RESPONSE_SCALE {
+        if (0.0..=MAX_RESPONSE_SCALE).contains(&mu) {
             Ok(mu)
         } else {
             Err(self.invalid(

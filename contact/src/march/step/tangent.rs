@@ -170,7 +170,7 @@ impl TimeMarcher<'_> {
             }
             if self.reset_closed_velocity {
                 for row in &rows {
-                    super::remove_row_component(*row, &mut tangent, |t, d| &mut t[(n + d, c)]);
+                    super::remove_row_component(row, &mut tangent, |t, d| &mut t[(n + d, c)]);
                 }
             }
         }
