@@ -132,6 +132,13 @@ pub enum Undecided {
     /// law's saltation matrices, which are not implemented (a massless contact dof, e.g.
     /// the modified mass, is decided).
     MassCarryingContact,
+    /// The model has Coulomb friction: the stepping map switches between stick and slip,
+    /// and its monodromy through those switches is not validated (its shooting uses the
+    /// trapezoidal scheme on positions, which has no friction law).
+    Friction {
+        /// The friction points.
+        points: usize,
+    },
     /// The dense monodromy is formed only up to `limit` dofs (it is `2N x 2N`).
     TooManyDofs {
         /// The model's dofs.
@@ -296,6 +303,10 @@ pub fn hb_stability(
             expected: n * (2 * harmonics + 1),
             found: u.len(),
         });
+    }
+    if !model.friction.is_empty() {
+        let points = model.friction.len();
+        return Ok(Stability::not_decided(Undecided::Friction { points }, spp));
     }
     if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
         return Ok(Stability::not_decided(Undecided::MassCarryingContact, spp));

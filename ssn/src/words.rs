@@ -155,6 +155,10 @@ pub fn undecided(u: &Undecided) -> String {
              law's saltation matrices, which are not implemented (use a modified mass)"
                 .to_string()
         }
+        Undecided::Friction { points } => format!(
+            "{points} friction points: the monodromy of the stepping map through stick and \
+             slip is not implemented"
+        ),
         Undecided::TooManyDofs { dofs, limit } => {
             format!("{dofs} dofs: the dense monodromy is formed only up to {limit} dofs (2N x 2N)")
         }

@@ -18,7 +18,9 @@
 //! `proj_[-b, b](z) = z - max(0, z - b) + max(0, -z - b)`.
 //!
 //! Generalized Jacobian, with `h+ = [z - b > 0]`, `h- = [-z - b > 0]`, `stick = 1 - h+ - h-`:
-//! `dR_t/dLambda_t = I - P diag(stick) E`, `dR_t/dU = c P diag(stick) E D G_t`, and on a
+//! `dR_t/dLambda_t = I - P diag(stick) E`, `dR_t/dU = c P diag(stick) E D G_t` (`D` the
+//! phase derivative, with the mean-slip anchor `delta` on the constant: a point stuck all
+//! period is otherwise free to carry any constant force), and on a
 //! contact's force `dR_t/dLambda_n = P diag(mu [lambda_n < 0] (h+ - h-)) E`: the same
 //! structure as the normal law (a `Q` block per row, the row measuring `D G_t u` instead of
 //! `G u`), so the structured solve, its condensation onto the contact unknowns, the
@@ -108,7 +110,7 @@ impl SsnHb {
         let row = &lin.rows[i];
         let c = self.c();
         let coeffs = self.state.aft.coefficients_mut();
-        coeffs[0] = x[offset + i];
+        coeffs[0] = x[offset + i] - c * super::MEAN_SLIP_ANCHOR * row.dot_at(x, 0);
         for k in 1..=lin.basis.harmonics() {
             let (jc, js) = (2 * k - 1, 2 * k);
             let ck = c * k as f64;

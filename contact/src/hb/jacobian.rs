@@ -153,7 +153,7 @@ impl DenseAssemble for HbJacobian {
                 if !velocity {
                     q[(j, l)]
                 } else if l == 0 {
-                    0.0
+                    super::MEAN_SLIP_ANCHOR * q[(j, 0)]
                 } else {
                     let k = l.div_ceil(2) as f64;
                     if l % 2 == 1 {

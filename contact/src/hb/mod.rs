@@ -341,14 +341,17 @@ impl LinearData {
     /// `out[j m + i]`: the measured quantity of each row from the harmonic-major
     /// coefficients `u`: `g_i . U_j` for a contact, and for a friction point the phase
     /// velocity `y = d (g_i . u) / d(w t)`, whose harmonic `k` is `(k b_k, -k a_k)` for the
-    /// row's displacement `(a_k, b_k)` (0 for the constant).
+    /// row's displacement `(a_k, b_k)`, and whose constant is the anchor
+    /// [`MEAN_SLIP_ANCHOR`]` (g_i . U_0)`.
     pub(crate) fn gather_measured(&self, u: &[f64], out: &mut [f64]) {
         self.gather_rows(u, out);
         let (m, first) = (self.contacts(), self.normal_rows());
         if first == m {
             return;
         }
-        out[first..m].fill(0.0);
+        for o in &mut out[first..m] {
+            *o *= MEAN_SLIP_ANCHOR;
+        }
         for k in 1..=self.basis.harmonics() {
             let (c, s) = ((2 * k - 1) * m, 2 * k * m);
             let kf = k as f64;
@@ -362,12 +365,12 @@ impl LinearData {
 
     /// A receptance entry of row `i` at harmonic `k` (complex form `a - i b`) as its
     /// measured quantity sees it: unchanged for a contact, times `i k` (the phase
-    /// derivative) for a friction point.
+    /// derivative) for a friction point, and times [`MEAN_SLIP_ANCHOR`] for its constant.
     pub(crate) fn measured(&self, i: usize, k: usize, value: c64) -> c64 {
-        if self.is_velocity_row(i) {
-            value * c64::new(0.0, k as f64)
-        } else {
-            value
+        match (self.is_velocity_row(i), k) {
+            (false, _) => value,
+            (true, 0) => value * MEAN_SLIP_ANCHOR,
+            (true, k) => value * c64::new(0.0, k as f64),
         }
     }
 
@@ -464,6 +467,16 @@ impl LinearData {
         Ok(())
     }
 }
+
+/// The weight of the mean slip `g_t . U_0` in the constant term of a friction point's
+/// measured velocity. The velocity form fixes no mean slip: while a point sticks over the
+/// whole period, every constant tangential force inside the cone gives a periodic
+/// solution (the state depends on history), and the Jacobian is singular. With this
+/// weight the constant term of the law reads `Lambda_0 - mean proj(z) = 0` with
+/// `z = lambda - c (y + delta g_t . U_0)`: a point stuck all period is anchored at zero
+/// mean slip (no locked-in force), and a slipping one sees its slip direction shifted by
+/// `delta` times its mean slip, far below the truncation error.
+pub(crate) const MEAN_SLIP_ANCHOR: f64 = 1e-6;
 
 /// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
 pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> Result<(), HbError> {
