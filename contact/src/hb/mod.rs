@@ -331,6 +331,9 @@ impl LinearData {
     /// coefficients `u` (index `j N + dof`), harmonic-major out (index `j m + i`).
     pub(crate) fn gather_rows(&self, u: &[f64], out: &mut [f64]) {
         let (n, m) = (self.dofs, self.contacts());
+        if m == 0 {
+            return;
+        }
         for (j, block) in out.chunks_exact_mut(m).enumerate() {
             for (o, row) in block.iter_mut().zip(&self.rows) {
                 *o = row.dot_at(u, j * n);
@@ -377,6 +380,9 @@ impl LinearData {
     /// `u[j N + .] += alpha G^T p_j`: the row forces `p` (index `j m + i`) on the dofs.
     pub(crate) fn scatter_rows(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
         let (n, m) = (self.dofs, self.contacts());
+        if m == 0 {
+            return;
+        }
         for (j, block) in p.chunks_exact(m).enumerate() {
             for (pi, row) in block.iter().zip(&self.rows) {
                 row.add_transpose_at(alpha * pi, u, j * n);

@@ -202,10 +202,10 @@ impl<'a> TimeMarcher<'a> {
         let scheme = Scheme::resolve(model, options.scheme);
         if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
             return Err(MarchError::InvalidOption {
-                name: "scheme",
+                name: "friction points marched by the trapezoidal scheme (every row dof massless)",
                 value: model.friction.len() as f64,
-                allowed: "MoreauJean with friction points (Coulomb's law acts on velocities; \
-                          the trapezoidal scheme imposes positions)",
+                allowed: "none: Coulomb's law acts on velocities, the trapezoidal scheme imposes \
+                          positions; march with MoreauJean",
             });
         }
         let rows = m + model.friction_count();
