@@ -7,11 +7,10 @@ use semismooth_contact::model::Structure;
 use semismooth_contact::solve::Solution;
 use ssn::scene::Scene;
 
-mod common;
-
 /// The shipped scene with `edit` applied to its text, or the error it gives.
 fn scene(edit: impl Fn(String) -> String) -> Result<Scene, String> {
-    let path = common::scenes_dir().join("friction_damper.toml");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/friction_damper.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     Scene::from_toml(&edit(text), &path).map_err(|e| e.to_string())
 }
