@@ -125,20 +125,32 @@ impl SsnHb {
     /// `out_l[j m + i] = Lambda_t - P proj(z)` for every friction point (rows after the
     /// contacts; `out_l` the force equations).
     pub(super) fn friction_residual(&mut self, x: &[f64], out_l: &mut [f64]) {
+        let offset = self.state.linear.dofs * self.state.linear.size();
+        self.project_friction_samples(x, out_l, projection, |index, p| x[offset + index] - p);
+    }
+
+    /// For every friction point `f` (row `i`): its samples `z_n` mapped by `law(z_n, b_n,
+    /// mu_s)`, projected on the harmonics, and `out_l[j m + i] = equation(j m + i, P_j)`.
+    fn project_friction_samples(
+        &mut self,
+        x: &[f64],
+        out_l: &mut [f64],
+        law: fn(f64, f64, f64) -> f64,
+        equation: impl Fn(usize, f64) -> f64,
+    ) {
         let lin = self.state.linear.clone();
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
-        let offset = n * size;
+        let m = lin.contacts();
         let mut samples = std::mem::take(&mut self.friction);
         let mu = self.smoothing();
         for f in 0..lin.friction.len() {
             let i = lin.normal_rows() + f;
             self.friction_samples(x, f, &mut samples);
             for (z, b) in self.state.aft.samples_mut().iter_mut().zip(&samples.bound) {
-                *z = projection(*z, *b, mu);
+                *z = law(*z, *b, mu);
             }
             self.state.aft.samples_to_coefficients();
             for (j, p) in self.state.aft.coefficients().iter().enumerate() {
-                out_l[j * m + i] = x[offset + j * m + i] - p;
+                out_l[j * m + i] = equation(j * m + i, *p);
             }
         }
         self.friction = samples;
@@ -188,22 +200,7 @@ impl SsnHb {
 
     /// `dR_t / d mu_s = -P d proj / d mu` of every friction point into `out_l`.
     pub(super) fn friction_smoothing_derivative(&mut self, x: &[f64], out_l: &mut [f64]) {
-        let lin = self.state.linear.clone();
-        let m = lin.contacts();
-        let mut samples = std::mem::take(&mut self.friction);
-        let mu = self.smoothing();
-        for f in 0..lin.friction.len() {
-            let i = lin.normal_rows() + f;
-            self.friction_samples(x, f, &mut samples);
-            for (z, b) in self.state.aft.samples_mut().iter_mut().zip(&samples.bound) {
-                *z = projection_mu_derivative(*z, *b, mu);
-            }
-            self.state.aft.samples_to_coefficients();
-            for (j, p) in self.state.aft.coefficients().iter().enumerate() {
-                out_l[j * m + i] = -p;
-            }
-        }
-        self.friction = samples;
+        self.project_friction_samples(x, out_l, projection_mu_derivative, |_, p| -p);
     }
 
     /// The largest slip limit under a prescribed normal load (0 without one): a force
