@@ -44,15 +44,19 @@ pub(crate) fn projection(z: f64, b: f64, mu: f64) -> f64 {
     z - smoothed_max(z - b, mu) + smoothed_max(-z - b, mu)
 }
 
-/// The slopes `(w+, w-)` of the two `max` terms of [`projection`] (the indicators
-/// `[z - b > 0]`, `[-z - b > 0]` at `mu = 0`): `d proj / dz = 1 - w+ - w-`,
+/// The slopes `(w+, w-)` of the two `max` terms of [`projection`] (at `mu = 0` the
+/// indicators of `z >= b` and `z <= -b` outside the open interval `|z| < b`):
+/// `d proj / dz = 1 - w+ - w-`,
 /// `d proj / db = w+ - w-`.
 pub(crate) fn projection_slopes(z: f64, b: f64, mu: f64) -> (f64, f64) {
     if mu == 0.0 {
-        (
-            f64::from(u8::from(z - b > 0.0)),
-            f64::from(u8::from(-z - b > 0.0)),
-        )
+        // Strictly inside the interval: stick; else the side of the boundary reached (on
+        // an interval of zero width, b = 0, every z is on it: slope 0).
+        match (z.abs() < b, z >= 0.0) {
+            (true, _) => (0.0, 0.0),
+            (false, true) => (1.0, 0.0),
+            (false, false) => (0.0, 1.0),
+        }
     } else {
         (
             smoothed_max_slope(z - b, mu),
