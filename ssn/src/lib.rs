@@ -19,3 +19,4 @@ pub mod state;
 pub mod study;
 pub mod tables;
 pub mod words;
+pub mod work;

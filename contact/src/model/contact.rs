@@ -208,7 +208,7 @@ impl ContactPoint {
 }
 
 /// Which side of a contact dof the obstacle is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum ContactDirection {
     /// Obstacle on the positive side: `u[dof] - gap <= 0`.
     #[default]

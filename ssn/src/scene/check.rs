@@ -340,12 +340,17 @@ impl Check<'_> {
                 }
                 let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
                 for p in points {
-                    if p.dof.is_some() || p.direction.is_some() {
-                        return Err(self.invalid(
-                            "contact.point.dof",
-                            "given in a [rod] scene",
-                            "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
-                        ));
+                    for (key, given) in [
+                        ("contact.point.dof", p.dof.is_some()),
+                        ("contact.point.direction", p.direction.is_some()),
+                    ] {
+                        if given {
+                            return Err(self.invalid(
+                                key,
+                                "given in a [rod] scene",
+                                "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                            ));
+                        }
                     }
                     let node = p.node.ok_or_else(|| {
                         self.invalid("contact.point.node", "missing", "an integer node number")
@@ -564,7 +569,7 @@ impl Check<'_> {
         let max_periods = self.count_or(
             "solver.max_periods",
             s.max_periods,
-            1,
+            2,
             1_000_000,
             default.max_periods,
         )?;

@@ -37,7 +37,8 @@ impl Check<'_> {
             }
         };
         let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
-        for p in points {
+        for (index, p) in points.into_iter().enumerate() {
+            let entry = index + 1;
             if p.node.is_some() {
                 return Err(self.invalid(
                     "contact.point.node",
@@ -52,22 +53,38 @@ impl Check<'_> {
                 dofs: p.dofs.as_deref(),
                 coefficients: p.coefficients.as_deref(),
             })?;
-            if let Some((dof, _)) = row.single() {
-                if contacts.iter().any(|c| c.row == row) {
+            let gap = self.response_scale("contact.point.gap", p.gap)?;
+            if let Some((dof, sign)) = row.single() {
+                let same = |c: &DofContact| c.row.single() == Some((dof, sign));
+                if let Some(first) = contacts.iter().position(same) {
                     return Err(self.invalid(
                         "contact.point.dof",
-                        dof + 1,
+                        format!("{} in entries {} and {entry}", dof + 1, first + 1),
                         "one contact per dof and direction (two contacts on one dof need \
                          opposite directions)",
                     ));
                 }
+                let opposite = |c: &DofContact| c.row.single() == Some((dof, -sign));
+                if let Some(other) = contacts.iter().position(opposite) {
+                    let clearance = gap + contacts[other].gap;
+                    if clearance.is_nan() || clearance <= 0.0 {
+                        return Err(self.invalid(
+                            "contact.point.gap",
+                            format!(
+                                "{gap} in entry {entry} and {} in entry {} (both on dof {}, \
+                                 opposite directions: clearance {clearance})",
+                                contacts[other].gap,
+                                other + 1,
+                                dof + 1
+                            ),
+                            "two gaps on one dof whose sum is > 0 (room between the two \
+                             obstacles)",
+                        ));
+                    }
+                }
             }
             let friction = self.contact_friction(&p)?;
-            contacts.push(DofContact {
-                row,
-                gap: self.response_scale("contact.point.gap", p.gap)?,
-                friction,
-            });
+            contacts.push(DofContact { row, gap, friction });
         }
         Ok(contacts)
     }
