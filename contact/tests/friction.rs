@@ -9,12 +9,17 @@
 
 use semismooth::linalg::FaerDenseLu;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
-use semismooth::Residual;
-use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
+use semismooth::{ParameterDependent, Residual};
+use semismooth_contact::hb::{
+    CondensedSolve, CondensedSsnHb, HbOptions, SsnHb, StructuredHbSolver,
+};
 use semismooth_contact::march::{march_to_steady_state, MarchOptions, MarchScheme};
 use semismooth_contact::model::{
     ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel,
 };
+use semismooth_contact::settings::SolverSettings;
+use semismooth_contact::stability::{hb_stability, Undecided};
+use semismooth_contact::structures::{BladedDisk, DiskLoading, SHIPPED_MISTUNING};
 
 /// The single-dof oscillator `m x'' + c x' + k x = F0 cos(w t) + lambda_t` with Coulomb
 /// friction `|lambda_t| <= mu N` on its dof.
@@ -270,19 +275,8 @@ fn harmonic_balance_converges_to_the_exact_march_through_stick_slip() {
 /// normal force reaches zero (liftoff) for part of each period, and friction `mu = 0.4`
 /// acts through the contact's varying normal force.
 fn liftoff_model(fx: f64, fy: f64) -> StructuralModel {
-    let diag = |a: f64, b: f64| {
-        SparseMatrix::try_new_from_triplets(
-            2,
-            2,
-            &[
-                faer::sparse::Triplet::new(0, 0, a),
-                faer::sparse::Triplet::new(1, 1, b),
-            ],
-        )
-        .unwrap()
-    };
-    StructuralModel::new(diag(1.0, 0.0), diag(1.0, 10.0), vec![fx, fy])
-        .with_damping(diag(0.1, 0.0))
+    StructuralModel::new(diagonal(1.0, 0.0), diagonal(1.0, 10.0), vec![fx, fy])
+        .with_damping(diagonal(0.1, 0.0))
         .with_contact(ContactPoint::new(1, -0.05))
         .with_friction(FrictionPoint::on_contact(ContactRow::unit(0, 1.0), 0.4, 0))
 }
@@ -362,19 +356,8 @@ fn a_damper_stuck_all_period_moves_the_two_parts_as_one() {
     // k w meets a natural frequency of the free parts (1 and sqrt 2).
     let w = 0.45;
     let amplitude = 1.0 / (3.0 - 2.0 * w * w);
-    let diag = |a: f64, b: f64| {
-        SparseMatrix::try_new_from_triplets(
-            2,
-            2,
-            &[
-                faer::sparse::Triplet::new(0, 0, a),
-                faer::sparse::Triplet::new(1, 1, b),
-            ],
-        )
-        .unwrap()
-    };
     let link = ContactRow::new(vec![0, 1], vec![1.0, -1.0]).unwrap();
-    let model = StructuralModel::new(diag(1.0, 1.0), diag(1.0, 2.0), vec![1.0, 0.0])
+    let model = StructuralModel::new(diagonal(1.0, 1.0), diagonal(1.0, 2.0), vec![1.0, 0.0])
         .with_friction(FrictionPoint::prescribed(link, 0.5, 20.0));
     for h in [1, 5] {
         let (hb, x) = hb_solve(&model, w, h);
@@ -390,4 +373,201 @@ fn a_damper_stuck_all_period_moves_the_two_parts_as_one() {
             }
         }
     }
+}
+
+/// The 2 x 2 diagonal matrix `diag(a, b)`.
+fn diagonal(a: f64, b: f64) -> SparseMatrix {
+    SparseMatrix::try_new_from_triplets(
+        2,
+        2,
+        &[
+            faer::sparse::Triplet::new(0, 0, a),
+            faer::sparse::Triplet::new(1, 1, b),
+        ],
+    )
+    .unwrap()
+}
+
+/// The largest entry of `a - b`.
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// The full SSN-HB solution with `solver` and the condensed one (force coefficients only,
+/// dense LU, the polyalgorithm with its smoothing path from zero) expanded to `[U; Lambda]`.
+fn full_and_condensed(
+    model: &StructuralModel,
+    w: f64,
+    h: usize,
+    solver: &mut StructuredHbSolver,
+) -> (Vec<f64>, Vec<f64>) {
+    let options = HbOptions {
+        harmonics: h,
+        ..HbOptions::default()
+    };
+    let newton = PolyalgorithmOptions::default();
+    let mut full = SsnHb::new(model, w, &options).unwrap();
+    let mut x = vec![0.0; full.dim()];
+    let report = solve_smoothing(&mut full, solver, &mut x, &newton).unwrap();
+    assert!(report.converged(), "full: {:?}", report.termination);
+    let mut condensed = CondensedSsnHb::new(model, w, &options).unwrap();
+    // The full solution's forces are a root of the condensed residual.
+    let n = condensed.dim();
+    let mut r = vec![0.0; n];
+    condensed.residual(&x[x.len() - n..], &mut r).unwrap();
+    let residual = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        residual < 1e-9,
+        "condensed residual at the full root: {residual:e}"
+    );
+    let mut lambda = vec![0.0; n];
+    let report = solve_smoothing(
+        &mut condensed,
+        &mut FaerDenseLu::new(),
+        &mut lambda,
+        &newton,
+    )
+    .unwrap();
+    assert!(report.converged(), "condensed: {:?}", report.termination);
+    (x, condensed.expand(&lambda).unwrap())
+}
+
+#[test]
+fn the_condensed_solve_agrees_with_the_full_one_with_friction() {
+    // Stick-slip under a prescribed load, and liftoff (friction on a contact's varying
+    // normal force: the cross block X). The two formulations have the same roots; both
+    // Newton runs stop at a residual below 1e-10 on well-conditioned systems (forces and
+    // displacements of order 1), so they agree to 1e-9.
+    for (name, model, w) in [
+        ("stick-slip", oscillator(1.0, 0.1, 1.0, 1.0, 0.7), 0.6),
+        ("liftoff", liftoff_model(0.3, 0.8), 0.8),
+    ] {
+        let (full, condensed) = full_and_condensed(&model, w, 10, &mut StructuredHbSolver::new());
+        let diff = max_difference(&full, &condensed);
+        assert!(diff < 1e-9, "{name}: {diff:e}");
+    }
+}
+
+/// The mistuned disk of `blades` blades with a Coulomb friction point (`mu = 0.3`, load
+/// `normal_load`) on every blade's pad, and its first resonance frequency.
+fn disk_with_friction(blades: usize, normal_load: f64) -> (StructuralModel, f64) {
+    let disk = BladedDisk {
+        blades,
+        mistuning: SHIPPED_MISTUNING,
+    };
+    let loading = DiskLoading {
+        stops: Vec::new(),
+        gap: 1.0,
+        amplitude: 0.02,
+        zeta: 0.01,
+        omega_ratio: 1.0,
+    };
+    let mut structure = disk.structure(&loading).unwrap();
+    for j in 0..blades {
+        let pad = ContactRow::unit(BladedDisk::pad(j), 1.0);
+        structure
+            .model
+            .friction
+            .push(FrictionPoint::prescribed(pad, 0.3, normal_load));
+    }
+    (structure.model, loading.omega(structure.omega_1))
+}
+
+#[test]
+fn condensed_dense_and_matrix_free_solves_agree_on_a_bladed_disk_with_friction() {
+    // 12 blades, H = 5, N = 1e-2: each pad sticks for part of the period (about half of
+    // the pads' samples slip). Condensed (dense LU on the 132 force coefficients), full
+    // with the structured solve's dense condensed LU, and full with its matrix-free GMRES
+    // (relative tolerance 1e-12 per Newton step, far below Newton's 1e-10 stop): the same
+    // roots to 1e-9.
+    let (model, w) = disk_with_friction(12, 1e-2);
+    let (dense, condensed) = full_and_condensed(&model, w, 5, &mut StructuredHbSolver::new());
+    let diff = max_difference(&dense, &condensed);
+    assert!(diff < 1e-9, "condensed: {diff:e}");
+    let mut krylov = StructuredHbSolver::new()
+        .with_condensed_solve(CondensedSolve::Krylov)
+        .with_krylov_tolerance(1e-12);
+    let (matrix_free, _) = full_and_condensed(&model, w, 5, &mut krylov);
+    assert!(krylov.krylov_iterations() > 0);
+    let diff = max_difference(&dense, &matrix_free);
+    assert!(diff < 1e-9, "matrix-free: {diff:e}");
+    // Some pads stick and some samples slip: both branches of the law are exercised.
+    let hb = SsnHb::new(
+        &model,
+        w,
+        &HbOptions {
+            harmonics: 5,
+            ..HbOptions::default()
+        },
+    )
+    .unwrap();
+    let force = hb.contact_force_samples(&dense, 0, 256).unwrap();
+    let limit = 0.3 * 1e-2;
+    assert!(force.iter().any(|f| f.abs() < 0.9 * limit), "{force:?}");
+    assert!(force.iter().any(|f| f.abs() > 0.99 * limit), "{force:?}");
+}
+
+#[test]
+fn the_condensed_frequency_derivative_with_friction_is_the_central_difference() {
+    // dR/dw of the condensed problem (one structured solve) against (R(w + d) - R(w - d))
+    // / 2d at the liftoff solution with the force coefficients held: the residual is
+    // smooth in w there (no sample at a switch), the difference's error O(d^2) ~ 1e-12.
+    let model = liftoff_model(0.3, 0.8);
+    let (w, d) = (0.8, 1e-6);
+    let options = HbOptions {
+        harmonics: 6,
+        ..HbOptions::default()
+    };
+    let (_, x) = full_and_condensed(&model, w, 6, &mut StructuredHbSolver::new());
+    let mut condensed = CondensedSsnHb::new(&model, w, &options).unwrap();
+    let lambda = x[x.len() - condensed.dim()..].to_vec();
+    let n = condensed.dim();
+    let mut derivative = vec![0.0; n];
+    condensed
+        .residual_parameter_derivative(&lambda, &mut derivative, &mut vec![0.0; n])
+        .unwrap();
+    let mut at = |omega: f64| {
+        condensed.set_parameter(omega);
+        let mut r = vec![0.0; n];
+        condensed.residual(&lambda, &mut r).unwrap();
+        r
+    };
+    let (plus, minus) = (at(w + d), at(w - d));
+    let scale = derivative.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 1e-3, "{scale}");
+    for (j, (g, (p, m))) in derivative.iter().zip(plus.iter().zip(&minus)).enumerate() {
+        let fd = (p - m) / (2.0 * d);
+        assert!((g - fd).abs() < 1e-6 * scale, "{j}: {g} vs {fd}");
+    }
+}
+
+#[test]
+fn harmonic_balance_stability_with_friction_or_a_general_contact_row_is_undecided() {
+    // Neither the contact phases nor the stepping map carry a friction law, and the
+    // phases hold single dofs fixed: the verdict is `stable: None` with the reason, for a
+    // converged solution of each kind (the liftoff case has a contact and a friction point
+    // on it; the second a contact on the relative displacement of two masses).
+    let settings = SolverSettings::with_harmonics(6);
+    let model = liftoff_model(0.3, 0.8);
+    let (_, x) = hb_solve(&model, 0.8, 6);
+    let s = hb_stability(&model, &settings, 0.8, &x).unwrap();
+    assert_eq!(s.stable, None);
+    assert_eq!(s.undecided, Some(Undecided::Friction { points: 1 }));
+    assert_eq!(s.floquet_max_abs, None);
+
+    // u0 - u1 <= 0.1 against a relative amplitude of about 1.2 when free: it closes.
+    let link = ContactRow::new(vec![0, 1], vec![1.0, -1.0]).unwrap();
+    let model = StructuralModel::new(diagonal(1.0, 1.0), diagonal(1.0, 2.0), vec![1.0, 0.0])
+        .with_damping(diagonal(0.05, 0.05))
+        .with_contact(ContactPoint::on_row(link, 0.1));
+    let (hb, x) = hb_solve(&model, 0.45, 6);
+    assert!(!hb.closed_intervals(&x, 0).unwrap().is_empty());
+    let s = hb_stability(&model, &settings, 0.45, &x).unwrap();
+    assert_eq!(s.stable, None);
+    assert_eq!(
+        s.undecided,
+        Some(Undecided::GeneralContactRow { contact: 0 })
+    );
 }

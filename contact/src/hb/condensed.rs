@@ -4,16 +4,18 @@ use faer::{c64, Mat};
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
+    Smoothing,
 };
 
+use super::friction::{self, FrictionSamples};
 use super::jacobian::{ContactCoupling, HbJacobian};
-use super::ssn::{HbOptions, SsnHb};
+use super::ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope, HbOptions, SsnHb};
 use super::structured::{condensed_matrix, CondensedSolve, CrossBlocks, StructuredHbSolver};
 use super::{check_len, indicator, HbError, ResponseSummary};
-use crate::model::{mean_stiffness, StructuralModel};
+use crate::model::{mean_stiffness, NormalForce, StructuralModel};
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
-/// index `j m + contact`).
+/// index `j m + row`, the contacts' rows then the friction points' tangential rows).
 ///
 /// At fixed `w` the equation of motion `A(w) U = F + G^T Lambda` gives
 /// `G U = y_lin + R Lambda` with `y_lin = G A^{-1} F` and the receptance
@@ -21,7 +23,10 @@ use crate::model::{mean_stiffness, StructuralModel};
 /// per-harmonic sparse LU of [`StructuredHbSolver`]. The residual is
 /// `Lambda + P max(0, c (E (y_lin + R Lambda) - g) - E Lambda)` and its generalized Jacobian
 /// the dense `I - Q + c Q R` (`Q = P diag(h) E` per contact): solve it with a dense LU
-/// (`semismooth::linalg::FaerDenseLu`). The full solution `[U; Lambda]` of [`SsnHb`] is
+/// (`semismooth::linalg::FaerDenseLu`). A friction point's row measures its slip `y_t`
+/// (the phase velocity of its row, [`super::friction`]) in `y_lin + R Lambda`, and its
+/// equation `Lambda_t - P proj(Lambda_t - c y_t)` has the same Jacobian form with
+/// `Q_t = P diag(stick) E`, plus its block `X` on its contact's force. The full solution `[U; Lambda]` of [`SsnHb`] is
 /// recovered by [`CondensedSsnHb::expand`], and is a root of the full residual.
 ///
 /// The parameter of [`ParameterDependent`] is `w`: setting it marks the factorization stale
@@ -44,8 +49,15 @@ pub struct CondensedSsnHb {
     /// Full-size workspace for `U` and `(dA/dw) U`.
     full_u: Vec<f64>,
     full_w: Vec<f64>,
-    /// Indicator `h_n` of the active samples (for `dR/dw`).
+    /// Indicator `h_n` of the active samples, or a friction point's stick weights (for
+    /// `dR/dw`).
     mask: Vec<f64>,
+    /// Sample buffers of the friction law.
+    friction: FrictionSamples,
+    /// Smoothing parameter `mu >= 0` of the laws' `max` terms (0: the formulation itself).
+    smoothing: f64,
+    /// The friction points' blocks `X` on their contacts' forces.
+    cross: CrossBlocks,
     /// `w` of the last factorization differs from the problem's.
     stale: bool,
 }
@@ -54,12 +66,6 @@ impl CondensedSsnHb {
     /// Builds the problem at the forcing frequency `omega` and factors `A(w)` (validates
     /// like [`SsnHb::new`]; a singular dynamic block is [`HbError::Linear`]).
     pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
-        if !model.friction.is_empty() {
-            return Err(HbError::Unsupported {
-                formulation: "condensed SSN-HB",
-                what: "friction points (use SsnHb with the structured solver)",
-            });
-        }
         let full = SsnHb::new(model, omega, options)?;
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
@@ -76,6 +82,9 @@ impl CondensedSsnHb {
             full_u: vec![0.0; full.displacement_len()],
             full_w: vec![0.0; full.displacement_len()],
             mask: vec![0.0; basis.time_samples()],
+            friction: FrictionSamples::new(basis.time_samples()),
+            smoothing: 0.0,
+            cross: CrossBlocks::new(&full.state.linear),
             stale: false,
             full,
         };
@@ -93,7 +102,7 @@ impl CondensedSsnHb {
         self.linear_response[n..2 * n].copy_from_slice(&lin.load);
         self.solver
             .apply_dynamic_inverse(&mut self.linear_response)?;
-        lin.gather_rows(&self.linear_response, &mut self.contact_linear);
+        lin.gather_measured(&self.linear_response, &mut self.contact_linear);
         self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
         for (k, r) in self.receptance.iter_mut().enumerate() {
             if let Some(factored) = self.solver.receptance(k) {
@@ -213,6 +222,48 @@ impl CondensedSsnHb {
         coeffs[0] -= c * lin.gaps[i];
         self.aft.coefficients_to_samples();
     }
+
+    /// [`friction::point_samples`] of friction point `f` from `y = y_lin + R Lambda`.
+    fn friction_samples(&mut self, lambda: &[f64], f: usize) {
+        let lin = &self.full.state.linear;
+        let i = lin.normal_rows() + f;
+        let (m, y) = (lin.contacts(), &self.y);
+        let c = self.full.c();
+        friction::point_samples(
+            &mut self.aft,
+            lin,
+            f,
+            c,
+            lambda,
+            |j| y[j * m + i],
+            &mut self.friction,
+        );
+    }
+
+    /// The weights of row `i`'s block `Q_i = P diag(w) E` into the AFT's samples: the
+    /// indicator `h` of a contact's switching function (its smoothed slope when
+    /// smoothing), a friction point's stick weights (its block `X`'s weights then in
+    /// `self.friction`).
+    fn activity_weights(&mut self, lambda: &[f64], i: usize) {
+        let lin = self.full.state.linear.clone();
+        let mu = self.smoothing;
+        match i.checked_sub(lin.normal_rows()) {
+            None if mu > 0.0 => {
+                self.switching_samples(lambda, i);
+                for s in self.aft.samples_mut() {
+                    *s = smoothed_max_slope(*s, mu);
+                }
+            }
+            None => {
+                self.switching_samples(lambda, i);
+                indicator(self.aft.samples_mut());
+            }
+            Some(f) => {
+                self.friction_samples(lambda, f);
+                friction::point_jacobian_weights(&mut self.aft, &lin, f, &mut self.friction, mu);
+            }
+        }
+    }
 }
 
 impl Residual for CondensedSsnHb {
@@ -222,17 +273,24 @@ impl Residual for CondensedSsnHb {
 
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
-        let m = self.full.contacts();
+        let lin = self.full.state.linear.clone();
+        let m = lin.contacts();
         self.contact_displacements(lambda);
-        for i in 0..m {
+        for i in 0..lin.normal_rows() {
             self.switching_samples(lambda, i);
+            let mu = self.smoothing;
             for s in self.aft.samples_mut() {
-                *s = s.max(0.0);
+                *s = smoothed_max(*s, mu);
             }
             self.aft.samples_to_coefficients();
             for (j, c) in self.aft.coefficients().iter().enumerate() {
                 out[j * m + i] = lambda[j * m + i] + c;
             }
+        }
+        for f in 0..lin.friction.len() {
+            self.friction_samples(lambda, f);
+            let mu = self.smoothing;
+            friction::point_residual(&mut self.aft, &lin, f, lambda, &self.friction, mu, out);
         }
         Ok(())
     }
@@ -253,17 +311,25 @@ impl GeneralizedJacobian for CondensedSsnHb {
 
     fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
-        let m = self.full.contacts();
+        let lin = self.full.state.linear.clone();
+        let m = lin.contacts();
         self.contact_displacements(lambda);
         for i in 0..m {
-            self.switching_samples(lambda, i);
-            indicator(self.aft.samples_mut());
+            self.activity_weights(lambda, i);
             self.aft.samples_multiplication_matrix(&mut self.q[i]);
+            if let Some(f) = i.checked_sub(lin.normal_rows()) {
+                if matches!(lin.friction[f].1, NormalForce::Contact(_)) {
+                    let weights = self.friction.cross_weights();
+                    self.aft.samples_mut().copy_from_slice(weights);
+                    self.aft
+                        .samples_multiplication_matrix(self.cross.block_mut(f));
+                }
+            }
         }
         condensed_matrix(
             &self.receptance,
             &self.q,
-            &CrossBlocks::default(),
+            &self.cross,
             ContactCoupling::Complementarity { c: self.full.c() },
             m,
             jac.as_mut(),
@@ -294,7 +360,7 @@ impl ParameterDependent for CondensedSsnHb {
     ) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();
-        let (n, m) = (lin.dofs, lin.contacts());
+        let m = lin.contacts();
         // U = A^{-1} F + A^{-1} G^T Lambda.
         self.full_u.copy_from_slice(&self.linear_response);
         self.solver.add_response(lambda, 1.0, &mut self.full_u);
@@ -308,13 +374,10 @@ impl ParameterDependent for CondensedSsnHb {
         self.contact_displacements(lambda);
         let c = self.full.c();
         for i in 0..m {
-            self.switching_samples(lambda, i);
-            for (h, s) in self.mask.iter_mut().zip(self.aft.samples()) {
-                *h = if *s > 0.0 { 1.0 } else { 0.0 };
-            }
-            let row = &lin.rows[i];
+            self.activity_weights(lambda, i);
+            self.mask.copy_from_slice(self.aft.samples());
             for (j, coeff) in self.aft.coefficients_mut().iter_mut().enumerate() {
-                *coeff = -c * row.dot_at(&self.full_w, j * n);
+                *coeff = -c * lin.measured_coefficient(i, &self.full_w, j);
             }
             self.aft.coefficients_to_samples();
             for (s, h) in self.aft.samples_mut().iter_mut().zip(&self.mask) {
@@ -323,6 +386,53 @@ impl ParameterDependent for CondensedSsnHb {
             self.aft.samples_to_coefficients();
             for (j, coeff) in self.aft.coefficients().iter().enumerate() {
                 out[j * m + i] = *coeff;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The smoothing path of [`SsnHb`] on the condensed unknowns: each `max` of the laws
+/// becomes `phi_mu` (the polyalgorithm's start from far away).
+impl Smoothing for CondensedSsnHb {
+    fn smoothing_scale(&self) -> f64 {
+        self.full.smoothing_scale()
+    }
+
+    fn set_smoothing(&mut self, mu: f64) {
+        self.smoothing = mu.max(0.0);
+    }
+
+    /// `dR/dmu`: `P phi_mu'` of the switching samples for a contact, `-P d proj / d mu` of
+    /// a friction point's.
+    fn residual_smoothing_derivative(
+        &mut self,
+        lambda: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), EvaluationError> {
+        self.ensure_factored()?;
+        let lin = self.full.state.linear.clone();
+        let (m, mu) = (lin.contacts(), self.smoothing);
+        self.contact_displacements(lambda);
+        for i in 0..m {
+            match i.checked_sub(lin.normal_rows()) {
+                None => {
+                    self.switching_samples(lambda, i);
+                    for s in self.aft.samples_mut() {
+                        *s = smoothed_max_mu_derivative(*s, mu);
+                    }
+                }
+                Some(f) => {
+                    self.friction_samples(lambda, f);
+                    let bounds = self.friction.bounds();
+                    for (z, b) in self.aft.samples_mut().iter_mut().zip(bounds) {
+                        *z = -friction::projection_mu_derivative(*z, *b, mu);
+                    }
+                }
+            }
+            self.aft.samples_to_coefficients();
+            for (j, c) in self.aft.coefficients().iter().enumerate() {
+                out[j * m + i] = *c;
             }
         }
         Ok(())

@@ -36,7 +36,10 @@
 //! F. Thouverez, L. Jézéquel, J. Sound Vib. 265 (2003) 201–219; J. P. Den Hartog, Trans.
 //! ASME 53 (1931) 107–115 (the exact single-dof solution in continuous sliding).
 
+use semismooth::harmonic::Aft;
+
 use super::ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope, SsnHb};
+use super::LinearData;
 use crate::model::NormalForce;
 
 /// `proj_[-b, b](z)` as `z - phi_mu(z - b) + phi_mu(-z - b)` (exact clamp at `mu = 0`).
@@ -66,7 +69,7 @@ pub(crate) fn projection_slopes(z: f64, b: f64, mu: f64) -> (f64, f64) {
 }
 
 /// `d proj / d mu`.
-fn projection_mu_derivative(z: f64, b: f64, mu: f64) -> f64 {
+pub(crate) fn projection_mu_derivative(z: f64, b: f64, mu: f64) -> f64 {
     -smoothed_max_mu_derivative(z - b, mu) + smoothed_max_mu_derivative(-z - b, mu)
 }
 
@@ -88,42 +91,122 @@ impl FrictionSamples {
     }
 }
 
-impl SsnHb {
-    /// Samples of friction point `f` (row `i = m_n + f`): `z_n = lambda_t - c y_t` into
-    /// the AFT's samples, the slip limits `b_n` (and the normal force) into `samples`.
-    fn friction_samples(&mut self, x: &[f64], f: usize, samples: &mut FrictionSamples) {
-        let lin = self.state.linear.clone();
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
-        let offset = n * size;
-        let i = lin.normal_rows() + f;
-        let (mu, normal) = lin.friction[f];
-        match normal {
-            NormalForce::Prescribed(load) => samples.bound.fill(mu * load),
-            NormalForce::Contact(p) => {
-                let coeffs = self.state.aft.coefficients_mut();
-                for (j, coeff) in coeffs.iter_mut().enumerate() {
-                    *coeff = x[offset + j * m + p];
-                }
-                self.state.aft.coefficients_to_samples();
-                samples.normal.copy_from_slice(self.state.aft.samples());
-                for (b, l) in samples.bound.iter_mut().zip(&samples.normal) {
-                    *b = mu * (-l).max(0.0);
-                }
+/// Samples of friction point `f` (row `i = m_n + f`) into `aft`'s samples,
+/// `z_n = lambda_t - c y_t`, and its slip limits `b_n` (and the normal force on a contact)
+/// into `samples`; `forces` are the rows' force coefficients (index `j m + i`) and
+/// `measured(j)` the coefficient `j` of the row's measured slip `y_t`
+/// ([`LinearData::gather_measured`]).
+pub(crate) fn point_samples(
+    aft: &mut Aft,
+    lin: &LinearData,
+    f: usize,
+    c: f64,
+    forces: &[f64],
+    measured: impl Fn(usize) -> f64,
+    samples: &mut FrictionSamples,
+) {
+    let m = lin.contacts();
+    let i = lin.normal_rows() + f;
+    let (mu, normal) = lin.friction[f];
+    match normal {
+        NormalForce::Prescribed(load) => samples.bound.fill(mu * load),
+        NormalForce::Contact(p) => {
+            for (j, coeff) in aft.coefficients_mut().iter_mut().enumerate() {
+                *coeff = forces[j * m + p];
+            }
+            aft.coefficients_to_samples();
+            samples.normal.copy_from_slice(aft.samples());
+            for (b, l) in samples.bound.iter_mut().zip(&samples.normal) {
+                *b = mu * (-l).max(0.0);
             }
         }
-        let row = &lin.rows[i];
+    }
+    for (j, coeff) in aft.coefficients_mut().iter_mut().enumerate() {
+        *coeff = forces[j * m + i] - c * measured(j);
+    }
+    aft.coefficients_to_samples();
+}
+
+/// `R_t = Lambda_t - P proj(z)` of friction point `f` into `out` (index `j m + i`), from
+/// its samples `z_n` in `aft` ([`point_samples`]) and the smoothing `mu_s`.
+pub(crate) fn point_residual(
+    aft: &mut Aft,
+    lin: &LinearData,
+    f: usize,
+    forces: &[f64],
+    samples: &FrictionSamples,
+    mu_s: f64,
+    out: &mut [f64],
+) {
+    let (m, i) = (lin.contacts(), lin.normal_rows() + f);
+    for (z, b) in aft.samples_mut().iter_mut().zip(&samples.bound) {
+        *z = projection(*z, *b, mu_s);
+    }
+    aft.samples_to_coefficients();
+    for (j, p) in aft.coefficients().iter().enumerate() {
+        out[j * m + i] = forces[j * m + i] - p;
+    }
+}
+
+/// Turns friction point `f`'s samples `z_n` in `aft` into its stick weights
+/// `1 - w+ - w-` (then `Q = P diag(stick) E`) and `samples.normal` into the weights
+/// `mu [lambda_n < 0] (w+ - w-)` of its block `X` on its contact's force (zero under a
+/// prescribed load); true when the point has a contact (a block `X`).
+pub(crate) fn point_jacobian_weights(
+    aft: &mut Aft,
+    lin: &LinearData,
+    f: usize,
+    samples: &mut FrictionSamples,
+    mu_s: f64,
+) -> bool {
+    let (coefficient, normal) = lin.friction[f];
+    let on_contact = matches!(normal, NormalForce::Contact(_));
+    for ((z, b), l) in aft
+        .samples_mut()
+        .iter_mut()
+        .zip(&samples.bound)
+        .zip(samples.normal.iter_mut())
+    {
+        let (plus, minus) = projection_slopes(*z, *b, mu_s);
+        *z = 1.0 - plus - minus;
+        *l = if on_contact && *l < 0.0 {
+            coefficient * (plus - minus)
+        } else {
+            0.0
+        };
+    }
+    on_contact
+}
+
+impl FrictionSamples {
+    /// The weights of the block `X` left by [`point_jacobian_weights`].
+    pub(crate) fn cross_weights(&self) -> &[f64] {
+        &self.normal
+    }
+
+    /// The slip limits `b_n` left by [`point_samples`].
+    pub(crate) fn bounds(&self) -> &[f64] {
+        &self.bound
+    }
+}
+
+impl SsnHb {
+    /// [`point_samples`] of friction point `f` from the full unknowns `x = [U; Lambda]`.
+    fn friction_samples(&mut self, x: &[f64], f: usize, samples: &mut FrictionSamples) {
+        let lin = self.state.linear.clone();
+        let offset = lin.dofs * lin.size();
+        let i = lin.normal_rows() + f;
+        let (u, forces) = x.split_at(offset);
         let c = self.c();
-        let coeffs = self.state.aft.coefficients_mut();
-        coeffs[0] = x[offset + i] - c * super::MEAN_SLIP_ANCHOR * row.dot_at(x, 0);
-        for k in 1..=lin.basis.harmonics() {
-            let (jc, js) = (2 * k - 1, 2 * k);
-            let ck = c * k as f64;
-            // y = D g.u: harmonic k of (a, b) is (k b, -k a).
-            let (a, b) = (row.dot_at(x, jc * n), row.dot_at(x, js * n));
-            coeffs[jc] = x[offset + jc * m + i] - ck * b;
-            coeffs[js] = x[offset + js * m + i] + ck * a;
-        }
-        self.state.aft.coefficients_to_samples();
+        point_samples(
+            &mut self.state.aft,
+            &lin,
+            f,
+            c,
+            forces,
+            |j| lin.measured_coefficient(i, u, j),
+            samples,
+        );
     }
 
     /// `out_l[j m + i] = Lambda_t - P proj(z)` for every friction point (rows after the
@@ -169,31 +252,13 @@ impl SsnHb {
         for f in 0..lin.friction.len() {
             let i = lin.normal_rows() + f;
             self.friction_samples(x, f, &mut samples);
-            let (coefficient, normal) = lin.friction[f];
-            // Keep (w+ - w-) in `normal` for the cross block; stick weights in the samples.
-            for ((z, b), l) in self
-                .state
-                .aft
-                .samples_mut()
-                .iter_mut()
-                .zip(&samples.bound)
-                .zip(samples.normal.iter_mut())
-            {
-                let (plus, minus) = projection_slopes(*z, *b, mu);
-                *z = 1.0 - plus - minus;
-                let closed = matches!(normal, NormalForce::Contact(_)) && *l < 0.0;
-                *l = if closed {
-                    coefficient * (plus - minus)
-                } else {
-                    0.0
-                };
-            }
+            let on_contact = point_jacobian_weights(&mut self.state.aft, &lin, f, &mut samples, mu);
             self.state.write_weighted_contact_block(jac, i);
-            if matches!(normal, NormalForce::Contact(_)) {
+            if on_contact {
                 self.state
                     .aft
                     .samples_mut()
-                    .copy_from_slice(&samples.normal);
+                    .copy_from_slice(samples.cross_weights());
                 self.state
                     .aft
                     .samples_multiplication_matrix(&mut jac.cross[f]);

@@ -366,6 +366,20 @@ impl LinearData {
         }
     }
 
+    /// Coefficient `j` of row `i`'s measured quantity ([`LinearData::gather_measured`])
+    /// from the displacement coefficients `u` (index `j N + dof`).
+    pub(crate) fn measured_coefficient(&self, i: usize, u: &[f64], j: usize) -> f64 {
+        let n = self.dofs;
+        let row = &self.rows[i];
+        match (self.is_velocity_row(i), j) {
+            (false, _) => row.dot_at(u, j * n),
+            (true, 0) => MEAN_SLIP_ANCHOR * row.dot_at(u, 0),
+            // Harmonic k of (a, b) is (k b, -k a).
+            (true, j) if j % 2 == 1 => j.div_ceil(2) as f64 * row.dot_at(u, (j + 1) * n),
+            (true, j) => -((j / 2) as f64) * row.dot_at(u, (j - 1) * n),
+        }
+    }
+
     /// A receptance entry of row `i` at harmonic `k` (complex form `a - i b`) as its
     /// measured quantity sees it: unchanged for a contact, times `i k` (the phase
     /// derivative) for a friction point, and times [`MEAN_SLIP_ANCHOR`] for its constant.

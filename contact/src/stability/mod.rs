@@ -361,7 +361,8 @@ impl HbStability {
     /// period ([`SsnHb::closed_intervals`], [`PenaltyHb::closed_intervals`]).
     pub fn closed_intervals(&self, x: &[f64]) -> Result<Vec<Vec<(f64, f64)>>, StabilityError> {
         match &self.formulation {
-            Formulation::Ssn(p) => (0..p.contacts())
+            // The friction points' rows follow the contacts' and have no closed phase.
+            Formulation::Ssn(p) => (0..p.contacts() - p.friction_points())
                 .map(|i| p.closed_intervals(x, i))
                 .collect::<Result<Vec<_>, _>>(),
             Formulation::Penalty(p) => (0..p.contacts())

@@ -532,6 +532,11 @@ impl CrossBlocks {
         Ok(())
     }
 
+    /// The block `X` of friction point `f` (unused under a prescribed load).
+    pub(crate) fn block_mut(&mut self, f: usize) -> &mut Mat<f64> {
+        &mut self.blocks[f]
+    }
+
     /// The `(t, p, X)` of each friction point on a contact.
     fn each(&self) -> impl Iterator<Item = (usize, usize, &Mat<f64>)> + '_ {
         self.rows
