@@ -99,3 +99,54 @@ fn friction_keys_a_user_gets_wrong_are_named_with_what_is_allowed() {
         .to_string();
     assert!(err.contains("43") || err.contains("42"), "{err}");
 }
+
+#[test]
+fn the_condensed_solve_of_the_damper_scene_is_the_full_one() {
+    // The shipped scene (its H = 7, mu N = 1.5e-3, the pads sticking for part of the
+    // period) by the full SSN-HB with the structured solve and by the SSN-HB condensed onto
+    // its one friction row (15 force coefficients, dense LU), each from rest with the
+    // smoothing polyalgorithm: the same root, to 1e-9 relative to the largest unknown
+    // (Newton stops both at a residual below 1e-10 on the same equations).
+    use semismooth::linalg::FaerDenseLu;
+    use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
+    use semismooth::Residual;
+    use semismooth_contact::hb::{CondensedSsnHb, HbOptions, SsnHb, StructuredHbSolver};
+
+    let scene = scene(|t| t).unwrap();
+    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
+    let omega = scene.omega(structure.omega_1);
+    let options = HbOptions {
+        harmonics: scene.solver.harmonics,
+        ..HbOptions::default()
+    };
+    let newton = PolyalgorithmOptions::default();
+    let mut full = SsnHb::new(&structure.model, omega, &options).unwrap();
+    let mut x = vec![0.0; full.dim()];
+    let report = solve_smoothing(&mut full, &mut StructuredHbSolver::new(), &mut x, &newton);
+    assert!(report.unwrap().converged());
+    let mut condensed = CondensedSsnHb::new(&structure.model, omega, &options).unwrap();
+    let mut lambda = vec![0.0; condensed.dim()];
+    let report = solve_smoothing(
+        &mut condensed,
+        &mut FaerDenseLu::new(),
+        &mut lambda,
+        &newton,
+    );
+    assert!(report.unwrap().converged());
+    let expanded = condensed.expand(&lambda).unwrap();
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = x
+        .iter()
+        .zip(&expanded)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff < 1e-9 * scale, "{diff:e} of {scale:e}");
+    // The friction force reaches its slip limit mu N (within the Gibbs overshoot of its
+    // truncated series, as a square wave has 9 %).
+    let force = full.contact_force_samples(&x, 0, 256).unwrap();
+    let limit = 0.5 * 0.003;
+    let largest = force.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    assert!(
+        (largest - limit).abs() < 0.2 * limit,
+        "{largest} vs {limit}"
+    );
+}
