@@ -703,10 +703,14 @@ mod tests {
     /// K = tridiag(-1, 2, -1) on 3 dofs: `K^-1 = [[3, 2, 1], [2, 4, 2], [1, 2, 3]] / 4`.
     /// Contacts on dofs 0 and 2 pushing the same way: `C = [[3, 1], [1, 3]] / 4`, Perron
     /// root 1, so the load is shared by `1 / (3/4) = 4/3` contacts and the shared stiffness
-    /// is `(4/3) (3/4) / 1 = 1`; from opposite sides they push each other away (`C_02 < 0`)
-    /// and share nothing: the static stiffness 4/3 again. One contact: the static stiffness.
+    /// is `(4/3) (3/4) / 1 = 1` when they close together: equal gaps under the symmetric load
+    /// `f = (1, 0, 1)` (`K^-1 f = (1, 1, 1)`), or gaps 1/30 and 0.1 under a load on dof 2
+    /// (`K^-1 f = (1, 2, 3) / 4`, both close at the load factor 0.4/3). Equal gaps under the
+    /// load on dof 2 close at load factors 0.4 and 0.4/3, one after the other: no sharing,
+    /// the static stiffness 4/3. From opposite sides they push each other away (`C_02 < 0`)
+    /// and share nothing: 4/3 again. One contact: the static stiffness.
     #[test]
-    fn shared_stiffness_divides_by_the_contacts_that_push_the_same_way() {
+    fn shared_stiffness_divides_by_the_contacts_that_close_together() {
         let mut model = chain();
         assert_eq!(
             model.shared_contact_stiffness(),
@@ -717,6 +721,13 @@ mod tests {
         for (got, want) in compliance.iter().zip([0.75, 0.25, 0.25, 0.75]) {
             assert!((got - want).abs() < 1e-15, "{compliance:?}");
         }
+        let one_after_the_other = model.shared_contact_stiffness().unwrap();
+        assert!((one_after_the_other - 4.0 / 3.0).abs() < 1e-12);
+        model.contacts[0].gap = 0.1 / 3.0;
+        let shared = model.shared_contact_stiffness().unwrap();
+        assert!((shared - 1.0).abs() < 1e-12, "{shared}");
+        model.contacts[0].gap = 0.1;
+        model.load = vec![1.0, 0.0, 1.0];
         let shared = model.shared_contact_stiffness().unwrap();
         assert!((shared - 1.0).abs() < 1e-12, "{shared}");
         model.contacts[1].direction = ContactDirection::Negative;
