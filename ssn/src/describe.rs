@@ -7,6 +7,18 @@ use semismooth_contact::rod::DampingSpec;
 use crate::io::printable;
 use crate::scene::{Method, Scene};
 
+/// The first lines of a description: the scene's file and its title.
+fn scene_header(path: &std::path::Path, title: Option<&str>) -> String {
+    let mut out = format!(
+        "scene             {}\n",
+        printable(&path.display().to_string())
+    );
+    if let Some(t) = title {
+        out.push_str(&format!("title             {}\n", printable(t)));
+    }
+    out
+}
+
 /// The resolved model of a scene forced at `omega`, in words (`ssn scene-check`).
 pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> String {
     use semismooth_contact::rod::{DampingSpec, FrequencySpec, LoadKind};
@@ -14,18 +26,11 @@ pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> St
         return describe_imported(scene, spec, rod, omega, modes);
     }
     let s = &scene.rod;
-    let mut out = String::new();
+    let mut out = scene_header(&scene.path, scene.title.as_deref());
     let mut line = |t: String| {
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!(
-        "scene             {}",
-        printable(&scene.path.display().to_string())
-    ));
-    if let Some(t) = &scene.title {
-        line(format!("title             {}", printable(t)));
-    }
     line(format!(
         "rod               {} elements, L = {}, EA = {}, rhoA = {}, {:?} mass",
         s.elements, s.length, s.axial_stiffness, s.mass_per_length, s.mass
@@ -162,18 +167,11 @@ pub fn describe_imported(
     modes: &[f64],
 ) -> String {
     let model = &structure.model;
-    let mut out = String::new();
+    let mut out = scene_header(&scene.path, scene.title.as_deref());
     let mut line = |t: String| {
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!(
-        "scene             {}",
-        printable(&scene.path.display().to_string())
-    ));
-    if let Some(t) = &scene.title {
-        line(format!("title             {}", printable(t)));
-    }
     let massless = (0..model.dofs())
         .filter(|&i| semismooth_contact::model::diagonal_entry(&model.mass, i) == 0.0)
         .count();
