@@ -359,21 +359,25 @@ impl Drop for Staged {
 fn lock_directories<'a>(
     paths: impl Iterator<Item = &'a Path>,
 ) -> Result<Vec<std::fs::File>, OutputError> {
-    let mut dirs: Vec<PathBuf> = paths
+    // Each directory with the first output in it, which a failure names.
+    let mut dirs: Vec<(PathBuf, &Path)> = paths
         .map(|p| {
             let dir = match p.parent() {
                 Some(d) if !d.as_os_str().is_empty() => d,
                 _ => Path::new("."),
             };
-            std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf())
+            (
+                std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()),
+                p,
+            )
         })
         .collect();
-    dirs.sort();
-    dirs.dedup();
+    dirs.sort_by(|a, b| a.0.cmp(&b.0));
+    dirs.dedup_by(|a, b| a.0 == b.0);
     let mut locks = Vec::with_capacity(dirs.len());
-    for dir in dirs {
+    for (dir, file) in dirs {
         let io = |source| OutputError::Io {
-            path: dir.clone(),
+            path: file.to_path_buf(),
             source,
         };
         let handle = File::open(&dir).map_err(io)?;
