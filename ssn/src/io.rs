@@ -359,7 +359,7 @@ impl Drop for Staged {
 fn lock_directories<'a>(
     paths: impl Iterator<Item = &'a Path>,
 ) -> Result<Vec<std::fs::File>, OutputError> {
-    // Each directory with the first output in it, which a failure names.
+    // Each directory once, with the first file written into it (the one an error names).
     let mut dirs: Vec<(PathBuf, &Path)> = paths
         .map(|p| {
             let dir = match p.parent() {
@@ -376,9 +376,12 @@ fn lock_directories<'a>(
     dirs.dedup_by(|a, b| a.0 == b.0);
     let mut locks = Vec::with_capacity(dirs.len());
     for (dir, file) in dirs {
-        let io = |source| OutputError::Io {
+        let io = |source: std::io::Error| OutputError::Io {
             path: file.to_path_buf(),
-            source,
+            source: std::io::Error::new(
+                source.kind(),
+                format!("its directory {}: {source}", dir.display()),
+            ),
         };
         let handle = File::open(&dir).map_err(io)?;
         rustix::fs::flock(&handle, rustix::fs::FlockOperation::LockExclusive)

@@ -3,6 +3,7 @@
 //! The application of `semismooth-contact`: scenes (TOML problem files), runs, studies,
 //! figures, tables, outputs and the `ssn` program.
 
+pub mod accuracy_targets;
 pub mod cli;
 pub mod describe;
 pub mod exit;

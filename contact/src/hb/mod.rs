@@ -402,6 +402,32 @@ pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
     check_positive("omega", omega, "a finite angular frequency > 0")
 }
 
+/// Harmonic-balance unknowns of `from` harmonics carried to `to` harmonics: the
+/// displacement coefficients (`(2 from + 1) dofs`, harmonic-major) and then, when `x` has
+/// them, the contact-force coefficients (`(2 from + 1) contacts`), each block lifted with
+/// zero higher harmonics or truncated (the Galerkin projection onto `to` harmonics). A
+/// block that `x` is too short for is taken as zero.
+pub fn resize_harmonics(
+    x: &[f64],
+    from: usize,
+    to: usize,
+    dofs: usize,
+    contacts: usize,
+) -> Vec<f64> {
+    let block = |start: usize, width: usize| {
+        let have = ((2 * from + 1) * width).min(x.len().saturating_sub(start));
+        let mut out = vec![0.0; (2 * to + 1) * width];
+        let keep = out.len().min(have);
+        out[..keep].copy_from_slice(&x[start..start + keep]);
+        out
+    };
+    let mut out = block(0, dofs);
+    if contacts > 0 {
+        out.extend(block((2 * from + 1) * dofs, contacts));
+    }
+    out
+}
+
 pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {
     Ok(semismooth::harmonic::check_length(what, expected, found)?)
 }
@@ -421,6 +447,19 @@ pub(crate) fn fine_samples(
     let mut samples = vec![0.0; points];
     aft.to_time(&coeffs, &mut samples)?;
     Ok(samples)
+}
+
+/// Where the switching function with coefficients `coeffs` (one contact's, `2H + 1`) is
+/// positive over a period, its sign changes bracketed on the `Nt` AFT samples.
+pub(crate) fn switching_intervals(
+    lin: &LinearData,
+    coeffs: &[f64],
+) -> Result<Vec<(f64, f64)>, HbError> {
+    Ok(semismooth::trigonometric::positive_intervals(
+        &lin.basis,
+        coeffs,
+        lin.basis.time_samples(),
+    )?)
 }
 
 /// Displacement extremes, RMS and penetration from the displacement coefficients `u`.

@@ -139,6 +139,22 @@ impl PenaltyHb {
         Ok(())
     }
 
+    /// The intervals of the period where contact `i` is closed, as fractions of the period
+    /// (module [`semismooth::trigonometric`]): where the penetration `s u_dof(t) - g_i` of
+    /// the truncated Fourier series is positive (the penalty spring acts), with the
+    /// interval ends refined between the `Nt` samples.
+    pub fn closed_intervals(&self, u: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let lin = &self.state.linear;
+        lin.check_contact(contact)?;
+        let mut coeffs = vec![0.0; lin.size()];
+        lin.gather(u, lin.contact_dofs[contact], &mut coeffs);
+        let sign = lin.contact_signs[contact];
+        coeffs.iter_mut().for_each(|c| *c *= sign);
+        coeffs[0] -= lin.gaps[contact];
+        super::switching_intervals(lin, &coeffs)
+    }
+
     /// Penalty force `lambda_i(t_n) = -k_p max(0, u(t_n) - g_i)` at `points` equally spaced
     /// times (evaluated pointwise on the fine grid, not through the `H`-harmonic projection).
     pub fn contact_force_samples(

@@ -181,6 +181,28 @@ impl SsnHb {
         displacement_summary(&self.state.linear, u, dof, points, means)
     }
 
+    /// The intervals of the period where contact `i` is closed, as fractions of the period
+    /// (module [`semismooth::trigonometric`]): where the contact law's switching function
+    /// `s_i(t) = c (s u_dof(t) - g_i) - lambda_i(t)` is positive, the set whose samples
+    /// the generalized Jacobian treats as active (`h_n = 1`), with the interval ends
+    /// refined between the `Nt` samples on the truncated Fourier series.
+    pub fn closed_intervals(&self, x: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
+        check_len("HB unknowns", self.dim(), x.len())?;
+        let lin = &self.state.linear;
+        lin.check_contact(contact)?;
+        let (n, m) = (lin.dofs, lin.contacts());
+        let offset = n * lin.size();
+        let (dof, sc) = (
+            lin.contact_dofs[contact],
+            self.c * lin.contact_signs[contact],
+        );
+        let mut coeffs: Vec<f64> = (0..lin.size())
+            .map(|j| sc * x[j * n + dof] - x[offset + j * m + contact])
+            .collect();
+        coeffs[0] -= self.c * lin.gaps[contact];
+        super::switching_intervals(lin, &coeffs)
+    }
+
     fn contact_coefficients(&self, lambda: &[f64], contact: usize) -> Vec<f64> {
         let m = self.contacts();
         (0..self.state.linear.size())

@@ -141,6 +141,7 @@ mod sequencing;
 
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
 pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
+pub(crate) use sequencing::interpolate_periodic;
 pub use sequencing::{solve_min_map_sequenced, SequencedSolution, SequencingLevel};
 
 use std::sync::Arc;

@@ -11,7 +11,7 @@ use crate::contacts::{contact_reports, ContactReport};
 use crate::hb::{PenaltyHb, SsnHb};
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, HbReconstruction, RunError};
+use crate::solve::{hb_options, penalty_options, set_closed_fractions, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
@@ -37,7 +37,12 @@ pub(super) fn branch_contacts(
                     .iter()
                     .map(|&(dof, _)| problem.displacement(x, dof, points))
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(contact_reports(&contacts, &forces, &displacements))
+                let closed = (0..contacts.len())
+                    .map(|i| problem.closed_intervals(x, i))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let mut reports = contact_reports(&contacts, &forces, &displacements);
+                set_closed_fractions(&mut reports, &closed);
+                Ok(reports)
             })
             .collect()
     };

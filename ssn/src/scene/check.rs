@@ -615,6 +615,36 @@ impl Check<'_> {
         if !(0.0..=1.0).contains(&restitution) {
             return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
         }
+        let accuracy = s
+            .accuracy
+            .map(|a| {
+                if (MIN_ACCURACY..=MAX_ACCURACY).contains(&a) {
+                    Ok(a)
+                } else {
+                    Err(self.invalid(
+                        "solver.accuracy",
+                        a,
+                        &format!("a relative accuracy in [{MIN_ACCURACY:e}, {MAX_ACCURACY}]"),
+                    ))
+                }
+            })
+            .transpose()?;
+        if accuracy.is_some() {
+            // The search chooses the discretisation: one given as well would be ignored.
+            for (key, given) in [
+                ("solver.harmonics", s.harmonics.is_some()),
+                ("solver.time_samples", s.time_samples.is_some()),
+                ("solver.steps_per_period", s.steps_per_period.is_some()),
+            ] {
+                if given {
+                    return Err(self.invalid(
+                        key,
+                        "given with solver.accuracy",
+                        "not both: with an accuracy the method chooses its discretisation",
+                    ));
+                }
+            }
+        }
         Ok(SolverSettings {
             method,
             harmonics,
@@ -630,6 +660,8 @@ impl Check<'_> {
             march_tolerance,
             restitution,
             lcp_scheme: s.lcp_scheme,
+            accuracy,
+            estimate_error: default.estimate_error,
         })
     }
 
@@ -667,6 +699,7 @@ impl Check<'_> {
                 1_000_000,
                 defaults.max_points,
             )?,
+            stability: sw.stability.unwrap_or(defaults.stability),
             ..defaults
         })
     }

@@ -211,6 +211,7 @@ struct RawSolver {
     restitution: Option<f64>,
     #[serde(default)]
     lcp_scheme: LcpScheme,
+    accuracy: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -222,12 +223,19 @@ struct RawSweep {
     min_step: Option<f64>,
     max_step: Option<f64>,
     max_points: Option<i64>,
+    stability: Option<bool>,
 }
 
 /// Largest harmonic count accepted.
 pub const MAX_HARMONICS: usize = 2000;
 /// Largest sample / step count accepted.
 pub const MAX_TIME_SAMPLES: usize = 1 << 20;
+/// Smallest `[solver] accuracy` accepted: below it the iterations' own stopping rules limit
+/// the answers (time marching stops at a period-to-period change of 1e-8, an error of
+/// about 1.6e-7 on the paper's rod, module `semismooth_contact::march`).
+pub const MIN_ACCURACY: f64 = 1e-7;
+/// Largest `[solver] accuracy` accepted.
+pub const MAX_ACCURACY: f64 = 0.1;
 /// Largest accepted magnitude of a forcing amplitude or a gap: the response scales with
 /// them, and a residual's square must stay below the largest double (1.8e308).
 pub const MAX_RESPONSE_SCALE: f64 = 1e100;
