@@ -39,6 +39,7 @@ fn main() {
         stiffness: k,
         load: vec![arg(3, 0.0), arg(4, 0.1)],
         contacts: vec![ContactPoint::new(1, gap)],
+        friction: Vec::new(),
     };
     let structure = Structure {
         model,

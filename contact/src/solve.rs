@@ -330,7 +330,7 @@ pub(crate) fn lcp_options(
     settings: &SolverSettings,
 ) -> (PeriodicLcpOptions, Option<usize>) {
     let tip = rod.observed_dof;
-    let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
+    let tip_contact = rod.model.contacts.iter().position(|c| c.dof() == tip);
     let options = PeriodicLcpOptions {
         time_samples: settings.time_samples,
         observed_dofs: if tip_contact.is_some() {
@@ -432,20 +432,18 @@ pub(crate) fn roundoff_floor(
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
 pub(crate) trait HbReconstruction {
-    fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
     /// The fractions of the period where contact `i`'s law is active (closed).
     fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError>;
+    /// `g_i . u` of row `i` of `G`.
+    fn row_displacement(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
 }
 
 /// Both harmonic-balance problems reconstruct through the same inherent methods.
 macro_rules! hb_reconstruction {
     ($($problem:ty),*) => {$(
         impl HbReconstruction for $problem {
-            fn contact_count(&self) -> usize {
-                self.contacts()
-            }
             fn displacement(
                 &self,
                 x: &[f64],
@@ -459,6 +457,14 @@ macro_rules! hb_reconstruction {
             }
             fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError> {
                 self.closed_intervals(x, i)
+            }
+            fn row_displacement(
+                &self,
+                x: &[f64],
+                i: usize,
+                points: usize,
+            ) -> Result<Vec<f64>, HbError> {
+                self.row_displacement_samples(x, i, points)
             }
         }
     )*};
@@ -515,7 +521,7 @@ fn solution(
         &rod.model
             .contacts
             .iter()
-            .map(|c| (c.dof, c.gap))
+            .map(|c| (c.dof(), c.gap))
             .collect::<Vec<_>>(),
         &period.contact_forces,
         &period.contact_displacements,
@@ -570,20 +576,18 @@ fn hb_outputs(
     points: usize,
 ) -> Result<Solution, RunError> {
     let tip = problem.displacement(&x, rod.observed_dof, points)?;
-    let contact_forces = (0..problem.contact_count())
+    let contacts = rod.model.contacts.len();
+    let contact_forces = (0..contacts)
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let contact_displacements = rod
-        .model
-        .contacts
-        .iter()
-        .map(|c| problem.displacement(&x, c.dof, points))
+    let contact_displacements = (0..contacts)
+        .map(|i| problem.row_displacement(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
     let period = 2.0 * std::f64::consts::PI / omega;
     let times = (0..points)
         .map(|n| period * n as f64 / points as f64)
         .collect();
-    let closed = (0..problem.contact_count())
+    let closed = (0..contacts)
         .map(|i| problem.closed_intervals(&x, i))
         .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
@@ -624,7 +628,7 @@ fn statistics(
     let contacts = &rod.model.contacts;
     let tip_contact = contacts
         .iter()
-        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
+        .position(|c| c.row.single() == Some((tip_dof, 1.0)));
     let mut stats = match (tip_contact, forces.first()) {
         (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
         (None, Some(f)) => {
@@ -641,10 +645,7 @@ fn statistics(
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
-        let p = u
-            .iter()
-            .map(|v| (c.sign() * v - c.gap).max(0.0))
-            .fold(0.0, f64::max);
+        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
         stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
@@ -930,8 +931,14 @@ fn solve_march(
         tolerance: settings.march_tolerance,
         scheme: march_scheme(settings),
     };
+    // The tip, then every dof of the contacts' rows (their gap closures `g . u` are
+    // combined from these series).
     let mut observed = vec![tip];
-    observed.extend(model.contacts.iter().map(|c| c.dof));
+    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
+        if !observed[1..].contains(dof) {
+            observed.push(*dof);
+        }
+    }
     let initial = warm_start
         .and_then(|w| march_state(model, w))
         .unwrap_or_else(|| MarchState::rest(model));
@@ -948,7 +955,25 @@ fn solve_march(
     let keep = period.times.len().saturating_sub(1).max(1);
     let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
     let tip_series = cut(&period.displacements[0]);
-    let contact_u: Vec<Vec<f64>> = period.displacements[1..].iter().map(cut).collect();
+    let series = |dof: usize| {
+        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
+        cut(&period.displacements[k])
+    };
+    let contact_u: Vec<Vec<f64>> = model
+        .contacts
+        .iter()
+        .map(|c| {
+            let mut entries = c.row.entries();
+            let (d, a) = entries.next().expect("a row has at least one dof");
+            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
+            for (d, a) in entries {
+                for (ui, v) in u.iter_mut().zip(series(d)) {
+                    *ui += a * v;
+                }
+            }
+            u
+        })
+        .collect();
     let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
     let start_time = period.times[0];
     let times = period.times[..keep]

@@ -240,7 +240,7 @@ fn period_figures(
         .model
         .contacts
         .iter()
-        .filter(|c| c.dof == rod.observed_dof)
+        .filter(|c| c.dof() == rod.observed_dof)
         .map(|c| c.gap);
     let (v_lo, v_hi) = orbits
         .iter()
@@ -275,14 +275,14 @@ pub fn obstacle_lines(structure: &Structure, x0: f64, x1: f64) -> Vec<Series> {
         .model
         .contacts
         .iter()
-        .filter(|c| c.dof == structure.observed_dof)
-        .map(|c| {
-            Series::horizontal(
+        .filter_map(|c| match c.row.single() {
+            Some((dof, sign)) if dof == structure.observed_dof => Some(Series::horizontal(
                 format!("obstacle (gap {})", c.gap),
-                c.sign() * c.gap,
+                sign * c.gap,
                 x0,
                 x1,
-            )
+            )),
+            _ => None,
         })
         .collect()
 }

@@ -156,6 +156,10 @@ pub fn undecided(u: &Undecided) -> String {
              impact law (the monodromy along the harmonic-balance contact phases decides it)"
                 .to_string()
         }
+        Undecided::Friction { points } => format!(
+            "{points} friction points: the monodromy of the stepping map through stick and \
+             slip is not implemented"
+        ),
         Undecided::TooManyDofs { dofs, limit } => {
             format!("{dofs} dofs: the dense monodromy is formed only up to {limit} dofs (2N x 2N)")
         }

@@ -5,8 +5,8 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_positive, displacement_summary, fine_samples, validate_basis, HbError,
-    HbState, LinearData, ResponseSummary,
+    check_len, check_positive, displacement_summary, row_samples, validate_basis, HbError, HbState,
+    LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -118,6 +118,12 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
+        if !model.friction.is_empty() {
+            return Err(HbError::Unsupported {
+                formulation: "penalty harmonic balance",
+                what: "friction points (use ssn-hb)",
+            });
+        }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         Ok(Self {
             state: HbState::new(linear, omega),
@@ -146,11 +152,11 @@ impl PenaltyHb {
     pub fn closed_intervals(&self, u: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
-        lin.check_contact(contact)?;
-        let mut coeffs = vec![0.0; lin.size()];
-        lin.gather(u, lin.contact_dofs[contact], &mut coeffs);
-        let sign = lin.contact_signs[contact];
-        coeffs.iter_mut().for_each(|c| *c *= sign);
+        lin.check_normal_row(contact)?;
+        let row = &lin.rows[contact];
+        let mut coeffs: Vec<f64> = (0..lin.size())
+            .map(|j| row.dot_at(u, j * lin.dofs))
+            .collect();
         coeffs[0] -= lin.gaps[contact];
         super::switching_intervals(lin, &coeffs)
     }
@@ -166,11 +172,11 @@ impl PenaltyHb {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
         lin.check_contact(contact)?;
-        let (gap, sign) = (lin.gaps[contact], lin.contact_signs[contact]);
-        let samples = fine_samples(lin, u, lin.contact_dofs[contact], points)?;
+        let gap = lin.gaps[contact];
+        let samples = row_samples(lin, u, contact, points)?;
         Ok(samples
             .into_iter()
-            .map(|x| -self.stiffness * (sign * x - gap).max(0.0))
+            .map(|x| -self.stiffness * (x - gap).max(0.0))
             .collect())
     }
 
@@ -225,10 +231,9 @@ impl PenaltyHb {
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
         let coeffs = self.state.aft.coefficients_mut();
-        lin.gather(u, lin.contact_dofs[i], coeffs);
-        let sign = lin.contact_signs[i];
-        for c in coeffs.iter_mut() {
-            *c *= sign;
+        let row = &lin.rows[i];
+        for (j, c) in coeffs.iter_mut().enumerate() {
+            *c = row.dot_at(u, j * lin.dofs);
         }
         coeffs[0] -= lin.gaps[i];
         self.state.aft.coefficients_to_samples();
@@ -252,9 +257,9 @@ impl Residual for PenaltyHb {
             }
             self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
-            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
+            let row = &lin.rows[i];
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                out[j * n + dof] += sign * c;
+                row.add_transpose_at(*c, out, j * n);
             }
         }
         Ok(())

@@ -169,8 +169,8 @@ fn check_same_model(
         .zip(lcp.gaps())
         .zip(&model.contacts)
     {
-        if dof != c.dof {
-            return foreign("contact dof", dof as f64, c.dof as f64);
+        if dof != c.dof() {
+            return foreign("contact dof", dof as f64, c.dof() as f64);
         }
         if *gap != c.gap {
             return foreign("contact gap", *gap, c.gap);

@@ -141,6 +141,19 @@ pub enum Undecided {
     /// A contact dof carries mass: the time-stepping map of [`map_stability`] has no
     /// impact law ([`hb_stability`] decides such solutions).
     MassCarryingContact,
+    /// The model has Coulomb friction: the flow switches between stick and slip, and
+    /// neither the contact phases of [`hb_stability`] nor the trapezoidal map of
+    /// [`map_stability`] carry a friction law.
+    Friction {
+        /// The friction points.
+        points: usize,
+    },
+    /// Contact `contact` acts on a general row of `G` (a combination of dofs): the contact
+    /// phases hold single dofs fixed.
+    GeneralContactRow {
+        /// Its index.
+        contact: usize,
+    },
     /// The dense monodromy is formed only up to `limit` dofs.
     TooManyDofs {
         /// The model's dofs.
@@ -317,7 +330,16 @@ impl HbStability {
             }
         };
         let n = model.dofs();
-        let (phases, refused) = if n > MAX_DOFS {
+        let (phases, refused) = if !model.friction.is_empty() {
+            (
+                None,
+                Some(Undecided::Friction {
+                    points: model.friction.len(),
+                }),
+            )
+        } else if let Some(contact) = model.contacts.iter().position(|c| c.direction().is_none()) {
+            (None, Some(Undecided::GeneralContactRow { contact }))
+        } else if n > MAX_DOFS {
             (
                 None,
                 Some(Undecided::TooManyDofs {

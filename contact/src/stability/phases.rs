@@ -198,7 +198,7 @@ impl PhaseModel {
             mass,
             massless,
             first_order_massless,
-            contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
+            contact_dofs: model.contacts.iter().map(|c| c.dof()).collect(),
             closed,
             phases: HashMap::new(),
         }

@@ -169,6 +169,13 @@ pub fn map_stability(
             found: u.len(),
         });
     }
+    if !model.friction.is_empty() {
+        let points = model.friction.len();
+        return Ok(MapStability::not_decided(
+            Undecided::Friction { points },
+            spp,
+        ));
+    }
     if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
         return Ok(MapStability::not_decided(
             Undecided::MassCarryingContact,
@@ -319,9 +326,12 @@ fn orbit_stays_open(model: &StructuralModel, harmonics: usize, u: &[f64]) -> boo
     let n = model.dofs();
     model.contacts.iter().all(|c| {
         let amplitude: f64 = (1..=harmonics)
-            .map(|k| u[(2 * k - 1) * n + c.dof].hypot(u[2 * k * n + c.dof]))
+            .map(|k| {
+                let (a, b) = (c.row.dot_at(u, (2 * k - 1) * n), c.row.dot_at(u, 2 * k * n));
+                a.hypot(b)
+            })
             .sum();
-        let highest = c.direction.sign() * u[c.dof] + amplitude;
+        let highest = c.row.dot(u) + amplitude;
         highest <= c.gap - OPEN_MARGIN * (c.gap.abs() + amplitude)
     })
 }

@@ -109,23 +109,21 @@ impl Reconstruction {
         model: &StructuralModel,
         x: &[f64],
     ) -> Result<Vec<ContactSummary>, HbError> {
-        let first = model.contacts.first().map_or(0, |c| c.dof);
+        let first = model.contacts.first().map_or(0, |c| c.dof());
         // Both formulations offer the same summary and reconstruction.
         let gather = |summary: Result<ResponseSummary, HbError>,
                       samples: &dyn Fn(usize) -> Result<Vec<f64>, HbError>| {
-            let samples = model
-                .contacts
-                .iter()
-                .map(|c| samples(c.dof))
+            let samples = (0..model.contacts.len())
+                .map(samples)
                 .collect::<Result<Vec<_>, _>>()?;
             Ok::<_, HbError>((summary?, samples))
         };
         let (summary, samples) = match self {
-            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
-                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
+                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
             })?,
-            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
-                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
+                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
             })?,
         };
         Ok(model
@@ -134,7 +132,7 @@ impl Reconstruction {
             .zip(samples)
             .enumerate()
             .map(|(k, (c, u))| ContactSummary {
-                dof: c.dof,
+                dof: c.dof(),
                 gap: c.gap,
                 contact_force_mean: summary.contact_force_mean.get(k).copied().unwrap_or(0.0),
                 max_penetration: u.iter().fold(0.0f64, |a, v| a.max(v - c.gap)),

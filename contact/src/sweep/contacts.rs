@@ -23,7 +23,7 @@ pub(super) fn branch_contacts(
     response: &FrequencyResponse,
 ) -> Result<Vec<Vec<ContactReport>>, RunError> {
     let model = &rod.model;
-    let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof, c.gap)).collect();
+    let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
     let points = response.output_points;
     let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<ContactReport>>, RunError> {
         response
@@ -33,9 +33,8 @@ pub(super) fn branch_contacts(
                 let forces = (0..contacts.len())
                     .map(|i| problem.contact_force(x, i, points))
                     .collect::<Result<Vec<_>, _>>()?;
-                let displacements = contacts
-                    .iter()
-                    .map(|&(dof, _)| problem.displacement(x, dof, points))
+                let displacements = (0..contacts.len())
+                    .map(|i| problem.row_displacement(x, i, points))
                     .collect::<Result<Vec<_>, _>>()?;
                 let closed = (0..contacts.len())
                     .map(|i| problem.closed_intervals(x, i))

@@ -24,12 +24,13 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use semismooth_contact::matrix_market::{ContactDirection, DofContact, ModelSpec};
+use semismooth_contact::matrix_market::{DofContact, DofFriction, ModelSpec};
 use semismooth_contact::rod::{
     DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
 };
 
 mod check;
+mod contacts;
 
 pub use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,
@@ -99,6 +100,7 @@ struct RawScene {
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
+    friction: Option<RawFrictionSection>,
     output: Option<RawOutput>,
     #[serde(default)]
     solver: RawSolver,
@@ -188,6 +190,28 @@ struct RawContactPoint {
     dof: Option<i64>,
     gap: f64,
     direction: Option<i64>,
+    dofs: Option<Vec<i64>>,
+    coefficients: Option<Vec<f64>>,
+    friction: Option<f64>,
+    tangent_dofs: Option<Vec<i64>>,
+    tangent_coefficients: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFrictionSection {
+    point: Option<Vec<RawFrictionPoint>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFrictionPoint {
+    node: Option<i64>,
+    dof: Option<i64>,
+    dofs: Option<Vec<i64>>,
+    coefficients: Option<Vec<f64>>,
+    normal_load: Option<f64>,
+    friction: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Default)]
