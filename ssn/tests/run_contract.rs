@@ -1,9 +1,9 @@
 //! The program's contract on whole runs: memory refused up front within the process's
 //! address-space limit (`ulimit -v`), limits given in the environment checked, work
-//! estimates of time marching, branches, penalty HB and scene-check, interrupted runs and failing outputs leave
-//! nothing, a search that did not finish exits 1, and numbers out of the floating-point
-//! range or a structure without a periodic solution are refused before they reach an
-//! output.
+//! estimates of time marching, branches, penalty HB and scene-check, interrupted runs and
+//! failing outputs leave nothing, a search that did not finish exits 1, and numbers out of
+//! the floating-point range or a structure without a periodic solution are refused before
+//! they reach an output.
 
 use std::path::Path;
 #[path = "common/exit_status.rs"]
