@@ -886,7 +886,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         scene,
         structure: rod,
         omega,
-    } = load(path)?;
+    } = load_for(path, Workload::Check)?;
     let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
         Err(ModelError::TooManyModes { available, .. }) => {
             natural_frequencies(&rod.model, available)

@@ -507,6 +507,15 @@ pub fn printable(text: &str) -> String {
         .collect()
 }
 
+/// `text` with its control characters escaped but its line breaks kept: an error message
+/// prints a file name or a value from the input (a raw ESC would drive the terminal).
+pub fn printable_message(text: &str) -> String {
+    text.split('\n')
+        .map(printable)
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Why an output could not be produced.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {

@@ -182,11 +182,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(CliError::NotConverged) => ExitCode::from(1),
         Err(CliError::BadInput(m)) => {
-            io::write_stderr(&format!("error: {m}\n"));
+            io::write_stderr(&format!("error: {}\n", io::printable_message(&m)));
             ExitCode::from(2)
         }
         Err(CliError::Output(m)) => {
-            io::write_stderr(&format!("error: {m}\n"));
+            io::write_stderr(&format!("error: {}\n", io::printable_message(&m)));
             ExitCode::from(3)
         }
     }

@@ -183,7 +183,16 @@ impl HbState {
                 .ok_or_else(|| field_error(name, "missing or not a finite number > 0"))
         };
         let omega = number("omega")?;
-        let omega_1 = omega / number("omega_ratio")?;
+        let ratio = number("omega_ratio")?;
+        let omega_1 = omega / ratio;
+        if !(omega_1.is_finite() && omega_1 > 0.0) {
+            return Err(field_error(
+                "omega_ratio",
+                format!(
+                    "{ratio:e}: omega / omega_ratio = {omega_1:e} is no natural frequency                      (allowed a ratio that leaves it finite and > 0)"
+                ),
+            ));
+        }
         let functions = 2 * harmonics + 1;
         let list = |name: &str, len: usize| -> Result<Vec<f64>, StateError> {
             let items = v

@@ -346,3 +346,23 @@ fn scene_keys_are_named_as_the_scene_writes_them() {
     assert_mentions(&o, &["forcing.omega` = 3", "[0.5, 0.9]"]);
     assert!(!err(&o).contains("omega_ratio` ="), "{}", err(&o));
 }
+
+#[test]
+fn a_missing_file_with_control_characters_and_a_deep_table_are_named_printably() {
+    // A matrix file named with an ESC that does not exist: the name is escaped.
+    let (dir, scene) = chain("");
+    let text = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("\"M.mtx\"", "\"M\\u001b[31m.mtx\"");
+    std::fs::write(&scene, text).unwrap();
+    let o = ssn(&["scene-check", s(&scene)]);
+    assert_exit(&o, 2, "missing file with ESC");
+    assert!(!o.stderr.contains(&0x1b), "raw ESC: {}", err(&o));
+    assert_mentions(&o, &["M\\u{1b}[31m.mtx"]);
+    // A table header nested 5,000 deep: toml's limit, placed on its line.
+    let deep = dir.path().join("deep.toml");
+    std::fs::write(&deep, format!("title = \"t\"\n[{}a]\n", "a.".repeat(5000))).unwrap();
+    let o = ssn(&["solve", s(&deep)]);
+    assert_exit(&o, 2, "deep header");
+    assert_mentions(&o, &["deep.toml", "at line 2", "5001 deep"]);
+}

@@ -1,9 +1,9 @@
 //! The program's contract on whole runs: memory refused up front within the process's
 //! address-space limit (`ulimit -v`), limits given in the environment checked, work
-//! estimates of time marching and branches, interrupted runs and failing outputs leave
-//! nothing, a search that did not finish exits 1, and numbers out of the floating-point
-//! range or a structure without a periodic solution are refused before they reach an
-//! output.
+//! estimates of time marching, branches, penalty HB and scene-check, interrupted runs and
+//! failing outputs leave nothing, a search that did not finish exits 1, and numbers out of
+//! the floating-point range or a structure without a periodic solution are refused before
+//! they reach an output.
 
 use std::path::Path;
 #[path = "common/exit_status.rs"]
@@ -318,4 +318,50 @@ fn an_undamped_structure_without_contact_at_a_natural_frequency_is_refused_up_fr
         "omega_ratio = 1.0\n[damping]\nzeta = 0.01",
     );
     assert_exit(&ssn(&["solve", &damped]), 0, "damped at resonance");
+}
+
+/// Penalty HB at H = 2000 on 1,000 elements is refused before it runs (measured 37.8 s at
+/// H = 200 and more than 400 s at H = 400; estimated 1.2e15 operations, hours), naming the
+/// keys and the estimate; H = 200 is within the limit (`limits`' unit test).
+#[test]
+fn penalty_hb_at_h_2000_on_1000_elements_is_refused_naming_harmonics_and_iterations() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = rod_scene(
+        dir.path(),
+        "penalty.toml",
+        "elements = 1000\nmass = \"modified\"",
+        "[contact]\ngap = 0.5\n[solver]\nmethod = \"penalty-hb\"\nharmonics = 2000",
+    );
+    let o = ssn(&["solve", &big]);
+    assert_exit(&o, 2, "penalty HB at H = 2000");
+    assert_mentions(
+        &o,
+        &[
+            "penalty.toml",
+            "solver.harmonics",
+            "solver.max_iterations",
+            "1.2e15",
+        ],
+    );
+}
+
+/// `scene-check` counts the natural frequencies it prints: 1e6 elements need 2.6e12
+/// operations (measured 88 s), refused under a limit of 1e11; 1e4 elements (2.6e10) run.
+#[test]
+fn scene_check_counts_the_natural_frequencies_in_its_work_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = |name: &str, elements: usize| {
+        let rod = format!("elements = {elements}\nmass = \"modified\"");
+        rod_scene(dir.path(), name, &rod, "[contact]\ngap = 0.5")
+    };
+    let big = scene("big.toml", 1_000_000);
+    let o = ssn_env(&["scene-check", &big], "SSN_WORK_LIMIT", "1e11");
+    assert_exit(&o, 2, "scene-check of 1e6 elements");
+    assert_mentions(
+        &o,
+        &["big.toml", "rod.elements", "natural frequencies", "2.6e12"],
+    );
+    let small = scene("small.toml", 10_000);
+    let o = ssn_env(&["scene-check", &small], "SSN_WORK_LIMIT", "1e11");
+    assert_exit(&o, 0, "1e4 elements");
 }

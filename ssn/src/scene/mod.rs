@@ -264,6 +264,38 @@ pub const MAX_ACCURACY: f64 = 0.1;
 /// them, and a residual's square must stay below the largest double (1.8e308).
 pub const MAX_RESPONSE_SCALE: f64 = 1e100;
 
+/// The 1-based line of `text` nested deepest and its depth: the dots of a line (of a table
+/// header or a dotted key) plus the most brackets and braces open on it (at least 1),
+/// strings and comments skipped.
+/// `None` for empty text. Only used to place a parse error that toml gives no position.
+fn deepest_line(text: &str) -> Option<(usize, usize)> {
+    let mut open = 0usize;
+    let mut deepest = None::<(usize, usize)>;
+    for (index, line) in text.lines().enumerate() {
+        let (mut dots, mut quote, mut peak) = (0usize, None::<char>, open);
+        for c in line.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '"' | '\'') => quote = Some(c),
+                (None, '#') => break,
+                (None, '[' | '{') => {
+                    open += 1;
+                    peak = peak.max(open);
+                }
+                (None, ']' | '}') => open = open.saturating_sub(1),
+                (None, '.') => dots += 1,
+                _ => {}
+            }
+        }
+        let depth = dots + peak.max(1);
+        if deepest.is_none_or(|(_, d)| depth > d) {
+            deepest = Some((index + 1, depth));
+        }
+    }
+    deepest
+}
+
 impl Scene {
     /// Reads and validates a scene file (a regular file of at most
     /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
@@ -292,6 +324,15 @@ impl Scene {
                         "\nallowed: floats of magnitude at most 1.7976931348623157e308, integers \
                      within 64 bits (each key's own range is in the README's scene table)",
                     );
+                }
+                // toml gives no position when the nesting exceeds its limit: name the line.
+                if e.span().is_none() {
+                    if let Some((line, depth)) = deepest_line(text) {
+                        message.push_str(&format!(
+                            " at line {line} (nested {depth} deep): allowed tables and values \
+                             nested a few levels, as the README's scene table"
+                        ));
+                    }
                 }
                 message
             })
