@@ -25,6 +25,7 @@ use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::Solution;
+use semismooth_contact::sweep::fold_accuracy::{refine_folds, MAX_FOLD_HARMONICS};
 use semismooth_contact::sweep::SweepProgress;
 
 /// Bad input found in the scene file `path`: the message starts with the file.
@@ -683,6 +684,23 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         Some(&progress),
     )
     .map_err(|e| input_error(&args.scene, e))?;
+    // With an accuracy target the folds are located again with the harmonics it needs.
+    let fold_accuracy = match scene.solver.accuracy {
+        Some(target) if response.converged() => {
+            bar.set_message("folds to the accuracy target");
+            Some(
+                refine_folds(
+                    &rod,
+                    &scene.solver,
+                    &settings,
+                    &response,
+                    (target, MAX_FOLD_HARMONICS),
+                )
+                .map_err(|e| input_error(&args.scene, e))?,
+            )
+        }
+        _ => None,
+    };
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
     let st = &response.stability;
@@ -782,6 +800,9 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
                 e.omega / rod.omega_1
             );
         }
+        for fold in fold_accuracy.iter().flatten() {
+            t += &crate::words::fold_accuracy(fold, rod.omega_1);
+        }
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
             response.converged(),
@@ -790,11 +811,18 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         );
         t
     };
+    let folds_met = fold_accuracy.iter().flatten().all(|f| f.met());
     args.finish(
         outputs,
-        || crate::json::response_json(&response),
+        || {
+            let mut json = crate::json::response_json(&response);
+            if let Some(folds) = &fold_accuracy {
+                json["fold_accuracy"] = crate::json::fold_accuracy_json(folds, rod.omega_1);
+            }
+            json
+        },
         text,
-        response.converged(),
+        response.converged() && folds_met,
     )
 }
 

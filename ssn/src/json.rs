@@ -10,6 +10,7 @@ use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::ContactReport;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
+use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
 use semismooth_contact::sweep::FrequencyResponse;
 
 use crate::state::HbState;
@@ -289,4 +290,28 @@ pub fn search_json(s: &Solution, search: &DiscretisationSearch) -> Value {
         "seconds": search.seconds,
         "counters": counters_json(&search.counters),
     })
+}
+
+/// The folds of a sweep located to an accuracy target: frequency, uncertainty (absolute,
+/// in units of `omega_1`), harmonics, whether the target is met, and each rung.
+pub fn fold_accuracy_json(folds: &[FoldAccuracy], omega_1: f64) -> Value {
+    folds
+        .iter()
+        .map(|f| {
+            json!({
+                "omega_ratio": f.omega / omega_1,
+                "uncertainty_ratio": f.uncertainty.map(|u| u / omega_1),
+                "harmonics": f.harmonics(),
+                "met": f.met(),
+                "sweep_omega_ratio": f.sweep_omega / omega_1,
+                "rungs": f.rungs.iter().map(|r| json!({
+                    "harmonics": r.harmonics,
+                    "time_samples": r.time_samples,
+                    "omega_ratio": r.omega / omega_1,
+                    "points": r.points,
+                    "seconds": r.seconds,
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
 }

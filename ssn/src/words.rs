@@ -9,6 +9,7 @@ use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
 use semismooth_contact::solve::{Diagnosis, Solution, Termination};
 use semismooth_contact::stability::Undecided;
+use semismooth_contact::sweep::fold_accuracy::{FoldAccuracy, FoldStop};
 use semismooth_contact::sweep::{FrequencyResponse, SweepTermination};
 
 /// How a run ended: `converged`, the core's name of a Newton termination, or a sentence
@@ -313,4 +314,42 @@ pub fn estimate_lines(s: &Solution) -> String {
         );
     }
     t
+}
+
+/// One line for a fold located to an accuracy target: where, how sure, with which
+/// harmonics, and why the ladder stopped short when it did.
+pub fn fold_accuracy(fold: &FoldAccuracy, omega_1: f64) -> String {
+    let uncertainty = fold.uncertainty.map_or("no estimate".to_string(), |u| {
+        format!(
+            "+- {:.1e} (relative {:.1e})",
+            u / omega_1,
+            u / fold.omega.abs()
+        )
+    });
+    let stop = match &fold.stop {
+        FoldStop::Met => String::new(),
+        FoldStop::Limit { harmonics } => {
+            format!(", target not met: the next rung needs H = {harmonics}, beyond the limit")
+        }
+        FoldStop::StartFailed {
+            harmonics,
+            termination,
+        } => format!(
+            ", target not met: at H = {harmonics} the branch point before the fold could not \
+             be corrected ({termination})"
+        ),
+        FoldStop::NotFound { harmonics, points } => format!(
+            ", target not met: at H = {harmonics} the branch did not turn back near the fold \
+             in {points} points"
+        ),
+        _ => ", target not met".to_string(),
+    };
+    format!(
+        "fold              omega/omega_1 = {:.6} {uncertainty} at H = {} (the sweep's H = {} \
+         gave {:.6}){stop}\n",
+        fold.omega / omega_1,
+        fold.harmonics(),
+        fold.rungs.first().map_or(0, |r| r.harmonics),
+        fold.sweep_omega / omega_1,
+    )
 }

@@ -95,3 +95,38 @@ fn an_accuracy_with_a_discretisation_given_too_is_bad_input_naming_both() {
         "{message}"
     );
 }
+
+#[test]
+fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics() {
+    let path = scene("sweep", "method = \"ssn-hb\"\naccuracy = 1e-3\n");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("amplitude = 0.04", "amplitude = 0.2")
+        + "\n[sweep]\nomega_ratio_from = 0.9\nomega_ratio_to = 1.3\nstability = false\n";
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(SSN)
+        .args(["sweep", path.to_str().unwrap(), "--json", "--quiet"])
+        .output()
+        .unwrap();
+    let json: Value = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
+    assert_eq!(out.status.code(), Some(0), "{json}");
+    let folds = json["fold_accuracy"].as_array().expect("fold_accuracy");
+    let swept = json["folds"].as_array().unwrap();
+    assert_eq!(folds.len(), swept.len());
+    assert_eq!(folds.len(), 2, "{json}");
+    for fold in folds {
+        assert_eq!(fold["met"], true, "{fold}");
+        let omega = fold["omega_ratio"].as_f64().unwrap();
+        let uncertainty = fold["uncertainty_ratio"].as_f64().unwrap();
+        assert!(uncertainty <= 1e-3 * omega, "{fold}");
+        let rungs = fold["rungs"].as_array().unwrap();
+        assert!(rungs.len() >= 2, "{fold}");
+        assert_eq!(
+            fold["harmonics"],
+            rungs.last().unwrap()["harmonics"],
+            "{fold}"
+        );
+        // The refinement starts from the sweep's own fold at the scene's harmonics.
+        assert_eq!(rungs[0]["omega_ratio"], fold["sweep_omega_ratio"], "{fold}");
+    }
+}

@@ -85,6 +85,7 @@
 
 pub mod branch;
 mod contacts;
+pub mod fold_accuracy;
 mod response;
 
 use std::time::Instant;
@@ -105,7 +106,7 @@ pub use response::{
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
-use crate::model::Structure;
+use crate::model::{StructuralModel, Structure};
 use crate::settings::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
 use crate::solve::{
     hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
@@ -221,6 +222,50 @@ struct MethodContinuation {
     residual_floor: f64,
     /// The branch is piecewise affine and its corners are crossed exactly.
     affine_pieces: bool,
+}
+
+/// SSN-HB's units (force coefficients count divided by `c`) and the round-off floor that
+/// `ssn solve` judges a solve against (large models reach 1e-10 in force units).
+fn ssn_continuation(model: &StructuralModel, problem: &SsnHb, u_ref: f64) -> MethodContinuation {
+    let split = problem.displacement_len();
+    let c = problem.c();
+    let units = (0..problem.dim())
+        .map(|i| if i < split { 1.0 } else { c })
+        .collect();
+    MethodContinuation {
+        units,
+        residual_floor: crate::solve::roundoff_floor(
+            model,
+            problem.dim(),
+            largest_gap(model, u_ref),
+            0.0,
+        ),
+        affine_pieces: false,
+    }
+}
+
+/// Penalty HB's units and rounding floor: the penalty force is `k_p` times gaps computed
+/// to `ε |u|` (`|u|` about the gap in contact); its branch is piecewise affine.
+fn penalty_continuation(
+    model: &StructuralModel,
+    problem: &PenaltyHb,
+    options: &PenaltyHbOptions,
+    u_ref: f64,
+) -> MethodContinuation {
+    MethodContinuation {
+        units: vec![1.0; problem.dim()],
+        residual_floor: f64::EPSILON * options.penalty_stiffness * largest_gap(model, u_ref),
+        affine_pieces: true,
+    }
+}
+
+/// The largest contact gap, and at least `u_ref`.
+fn largest_gap(model: &StructuralModel, u_ref: f64) -> f64 {
+    model
+        .contacts
+        .iter()
+        .map(|c| c.gap.abs())
+        .fold(u_ref, f64::max)
 }
 
 /// Maps the sweep settings onto continuation options in `ω` (absolute).
@@ -556,25 +601,9 @@ pub(crate) fn follow_branch(
     match settings.method {
         Method::SsnHb => {
             let mut problem = SsnHb::new(model, omega_from, &hb_options(settings))?;
-            let split = problem.displacement_len();
-            let c = problem.c();
-            let units = (0..problem.dim())
-                .map(|i| if i < split { 1.0 } else { c })
-                .collect();
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64], _: f64| tip_rec.extremes(x);
-            // The round-off floor `ssn solve` judges a solve against (large models reach
-            // 1e-10 in force units).
-            let gap = model
-                .contacts
-                .iter()
-                .map(|c| c.gap.abs())
-                .fold(u_ref, f64::max);
-            let method = MethodContinuation {
-                units,
-                residual_floor: crate::solve::roundoff_floor(model, problem.dim(), gap, 0.0),
-                affine_pieces: false,
-            };
+            let method = ssn_continuation(model, &problem, u_ref);
             follow(
                 (&mut problem, Some(SmoothingOf::new())),
                 &mut *hb_solver(settings.linear_solver),
@@ -589,17 +618,7 @@ pub(crate) fn follow_branch(
             let mut problem = PenaltyHb::new(model, omega_from, &options)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
-            // The penalty force is k_p times gaps computed to ε |u| (|u| ~ the gap in contact).
-            let gap = model
-                .contacts
-                .iter()
-                .map(|c| c.gap.abs())
-                .fold(u_ref, f64::max);
-            let method = MethodContinuation {
-                units: vec![1.0; problem.dim()],
-                residual_floor: f64::EPSILON * options.penalty_stiffness * gap,
-                affine_pieces: true,
-            };
+            let method = penalty_continuation(model, &problem, &options, u_ref);
             follow(
                 (&mut problem, None),
                 &mut *hb_solver(settings.linear_solver),
