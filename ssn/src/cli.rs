@@ -19,9 +19,9 @@ use crate::output::{
     csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
 };
 use crate::progress::progress_spinner;
-use crate::scene::{Method, Scene};
-use semismooth_contact::matrix_market::build_imported;
-use semismooth_contact::model::Structure;
+use crate::scene::{Method, Override, Scene};
+use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
+use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::Solution;
 
@@ -47,12 +47,31 @@ pub struct Loaded {
 /// that one run of its method fits in memory ([`crate::limits`]), and resolves its forcing
 /// frequency.
 pub fn load(path: &Path) -> Result<Loaded, CliError> {
-    load_checked(path, false)
+    load_with(path, &[])
 }
 
-/// [`load`], with the memory of `ssn compare`'s runs when `compare`.
-fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
-    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
+/// [`load`] with `overrides` (`--set key=value`) applied to the scene before it is
+/// validated ([`Scene::from_toml_with`]).
+pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Loaded, CliError> {
+    let scene =
+        Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
+    prepare(scene, false, None)
+}
+
+/// The matrices of a `[model]` scene held in memory: each path the scene names to its
+/// matrix (the checks of [`build_imported`] apply as to files).
+pub type MatrixSource<'a> = &'a dyn Fn(&Path) -> Result<SparseMatrix, ImportError>;
+
+/// Builds a validated scene's structure as [`load`] does (the memory and work limits
+/// checked first; those of `ssn compare`'s runs when `compare`), reading the `[model]`'s
+/// matrices from `matrices` when given, else from their files.
+pub fn prepare(
+    scene: Scene,
+    compare: bool,
+    matrices: Option<MatrixSource>,
+) -> Result<Loaded, CliError> {
+    let path = scene.path.clone();
+    let path = path.as_path();
     let limit = crate::limits::memory_limit();
     // A rod is estimated before it is built; an imported model once its size is read.
     if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
@@ -65,7 +84,11 @@ fn load_checked(path: &Path, compare: bool) -> Result<Loaded, CliError> {
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
         Some(spec) => {
-            let structure = build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?;
+            let structure = match matrices {
+                Some(read) => build_imported_with(spec, read),
+                None => build_imported(spec),
+            }
+            .map_err(|e| CliError::BadInput(e.to_string()))?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
             let work = crate::limits::structure_work(&structure, &scene.solver, compare);
@@ -107,6 +130,16 @@ pub struct RunArgs {
     /// Write a plot of the tip displacement over one period as SVG (`-`: standard output).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Replace a scene key before the scene is checked, e.g. `--set
+    /// forcing.omega_ratio=1.1 --set solver.harmonics=40` (repeatable; the keys, defaults
+    /// and errors of the scene file; `contact.point.0.gap` indexes a list).
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_override)]
+    pub set: Vec<Override>,
+}
+
+/// `--set KEY=VALUE` as an [`Override`].
+fn parse_override(text: &str) -> Result<Override, String> {
+    Override::parse(text).map_err(|e| e.to_string())
 }
 
 /// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
@@ -260,7 +293,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
         scene,
         structure: rod,
         omega,
-    } = load(&args.scene)?;
+    } = load_with(&args.scene, &args.set)?;
     let shape = StateShape {
         method: scene.solver.method,
         harmonics: scene.solver.harmonics,
@@ -493,7 +526,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
         scene,
         structure: rod,
         ..
-    } = load(&args.scene)?;
+    } = load_with(&args.scene, &args.set)?;
     let Some(settings) = scene.sweep.as_ref() else {
         return Err(input_error(
             &args.scene,
@@ -640,18 +673,19 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
         )));
     }
+    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let Loaded {
         scene,
         structure: rod,
         omega,
-    } = load_checked(path, true)?;
+    } = prepare(scene, true, None)?;
     prepare_directory(out)?;
     let bar = progress_spinner("compare", quiet);
     let say = |line: &str| {
         bar.set_message(line.to_string());
         bar.tick();
     };
-    let study = crate::study::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
+    let study = crate::accuracy_cost::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
         .map_err(|e| input_error(path, e))?;
     bar.finish_and_clear();
     study.write_files(out)?;

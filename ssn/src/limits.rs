@@ -145,7 +145,7 @@ pub fn compare_memory(elements: usize, contacts: usize, base: &SolverSettings) -
         ..base.clone()
     };
     let runs = [
-        hb(Method::SsnHb, crate::study::REFERENCE_HARMONICS),
+        hb(Method::SsnHb, crate::accuracy_cost::REFERENCE_HARMONICS),
         hb(Method::PenaltyHb, 80),
         SolverSettings {
             method: Method::LcpSsn,
@@ -423,7 +423,7 @@ fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
     let mut settings = settings.clone();
     if compare {
         settings.method = Method::SsnHb;
-        settings.harmonics = crate::study::REFERENCE_HARMONICS;
+        settings.harmonics = crate::accuracy_cost::REFERENCE_HARMONICS;
     }
     settings
 }

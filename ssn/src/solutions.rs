@@ -14,7 +14,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         scene,
         structure: rod,
         omega,
-    } = crate::cli::load(&args.scene)?;
+    } = crate::cli::load_with(&args.scene, &args.set)?;
     let mut outputs = args.plan()?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
     let set = find_solutions(&rod, omega, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;

@@ -30,6 +30,9 @@ use semismooth_contact::rod::{
 };
 
 mod check;
+mod overrides;
+
+pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
 
 pub use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,
@@ -236,16 +239,7 @@ impl Scene {
     /// Reads and validates a scene file (a regular file of at most
     /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
     pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
-        let path = path.as_ref();
-        // Only a regular file of at most 1 MiB: a FIFO would block, a device never end.
-        let text =
-            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
-                SceneError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
-        Scene::from_toml(&text, path)
+        Scene::from_path_with(path, &[])
     }
 
     /// Parses and validates scene text; `path` is only used in messages.
