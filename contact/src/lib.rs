@@ -8,6 +8,7 @@
 //! solve it (harmonic balance with exact or penalty contact, the periodic LCP, time
 //! marching), stability, frequency responses and the solutions at one frequency.
 
+pub mod builder;
 pub mod contacts;
 mod dynamic;
 pub mod from_zero;

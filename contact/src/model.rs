@@ -180,6 +180,26 @@ pub enum InvalidModel {
         /// The sum of the two gaps.
         clearance: f64,
     },
+    /// A matrix entry given in code lies outside the `N x N` matrix.
+    #[error("matrix entry ({row}, {col}) is outside the {dofs} x {dofs} matrix")]
+    EntryOutOfRange {
+        /// Its row (0-based).
+        row: usize,
+        /// Its column (0-based).
+        col: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// A matrix given in code could not be assembled (its storage could not be allocated).
+    #[error(
+        "a {dofs} x {dofs} matrix of {entries} entries could not be assembled (out of memory)"
+    )]
+    Assembly {
+        /// `N`.
+        dofs: usize,
+        /// The entries given.
+        entries: usize,
+    },
     /// A dof asked to be observed does not exist.
     #[error("observed dof {dof} is out of range: the model has {dofs} dofs")]
     ObservedDofOutOfRange {
@@ -379,7 +399,7 @@ impl StructuralModel {
 }
 
 /// Ratio of the default complementarity constant `c` to the static contact stiffness.
-pub const DEFAULT_C_FACTOR: f64 = 10.0;
+pub(crate) const DEFAULT_C_FACTOR: f64 = 10.0;
 
 /// Entry `(i, i)` of a column-compressed matrix (0 when not stored).
 pub fn diagonal_entry(matrix: &SparseMatrix, i: usize) -> f64 {
@@ -432,7 +452,7 @@ fn perron_root(a: &[f64], m: usize) -> f64 {
         }
         for (xi, yi) in x.iter_mut().zip(&y) {
             // Floored so that a contact that no other one feels keeps a positive entry.
-            *xi = (yi / norm).max(1e-300);
+            *xi = (yi / norm).max(f64::MIN_POSITIVE);
         }
     }
     upper

@@ -168,7 +168,12 @@ pub fn find_solutions(
             continue;
         }
         let x = &solution.state;
-        let scale = x.iter().map(|v| v * v).sum::<f64>().sqrt().max(1e-300);
+        let scale = x
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
+            .sqrt()
+            .max(f64::MIN_POSITIVE);
         let duplicate = set.solutions.iter().any(|s| {
             let d = s
                 .solution

@@ -450,7 +450,7 @@ fn orbit_stays_open(model: &StructuralModel, harmonics: usize, u: &[f64]) -> boo
 const OPEN_MARGIN: f64 = 1e-3;
 
 /// `|F|` of the period map's Newton solve relative to the largest state entry.
-pub const SHOOTING_TOLERANCE: f64 = 1e-9;
+pub(crate) const SHOOTING_TOLERANCE: f64 = 1e-9;
 
 /// The state components that influence the map: every displacement, the velocities of
 /// dofs with mass, and those of massless dofs with a damping entry on a massless row
@@ -538,10 +538,12 @@ impl Shooting<'_> {
         for _ in 0..spp {
             self.marcher.step()?;
             let forces = self.marcher.contact_force();
-            let active: Vec<usize> = (0..contacts).filter(|&k| forces[k] < 0.0).collect();
+            // The closed contacts of this step, compared with the last run's without a new
+            // set: a set is allocated only where it changes (a few times per period).
+            let closed = (0..contacts).filter(|&k| forces[k] < 0.0);
             match self.runs.last_mut() {
-                Some((set, count)) if *set == active => *count += 1,
-                _ => self.runs.push((active, 1)),
+                Some((set, count)) if set.iter().copied().eq(closed.clone()) => *count += 1,
+                _ => self.runs.push((closed.collect(), 1)),
             }
         }
         let n = self.full.len() / 2;

@@ -273,11 +273,6 @@ impl<T: LuScalar> SparseLu<T> {
         self.slots.len()
     }
 
-    /// The pivot rule.
-    pub fn pivot_rule(&self) -> PivotRule {
-        self.rule
-    }
-
     /// How many symbolic analyses (column orderings) have been computed: 1 for any
     /// number of factorizations of matrices sharing one sparsity pattern.
     pub fn symbolic_analyses(&self) -> u64 {

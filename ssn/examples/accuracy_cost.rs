@@ -55,7 +55,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         println!("cheapest setting for {accuracy:.0e} on the tip minimum:");
         print!("{}", study.cheapest_table(accuracy));
     }
-    // The README's table (`ms`: wall time of one cold solve, the problem already built).
+    // The table of `docs/accuracy-cost.md` (`ms`: wall time of one cold solve, the problem already built).
     print!("\n{}", ssn::tables::cheapest_settings(&study).markdown());
     let out = PathBuf::from("out/accuracy_cost");
     prepare_directory(&out)?;

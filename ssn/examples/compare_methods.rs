@@ -31,7 +31,7 @@ fn compare(mass: MassModel, out: &std::path::Path) -> Result<(), Box<dyn std::er
         "\n{} mass (canonical rod, gap 0.5, omega = omega_1). Reference: {}",
         name, rows[0].label
     );
-    // The README's table (`ms`: wall time of the Newton iterations / pivots / periods of one
+    // The table of `docs/method-comparison.md` (`ms`: wall time of the Newton iterations / pivots / periods of one
     // cold solve, the problem already built).
     print!("\n{}", table.markdown());
     let mut csv_rows: Vec<Vec<f64>> = vec![Vec::new(); 8];

@@ -14,8 +14,8 @@
 //! ```
 //!
 //! The second argument names the globalization as a scene does (`auto`, the default;
-//! `hybrid`, the default before the polyalgorithm; `none`, `armijo`, `nonmonotone`); the
-//! third keeps the groups whose name contains one of its comma-separated parts. Points that
+//! `hybrid`: full steps, then the line search from the initial guess; `none`, `armijo`,
+//! `nonmonotone`); the third keeps the groups whose name contains one of its comma-separated parts. Points that
 //! fail or take more than 60 iterations are listed with their attempts.
 
 use semismooth_contact::from_zero::{hard_cases, public_grid};

@@ -19,10 +19,9 @@ use ssn::output::{write_line_plot, PlotSpec, Series};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = common::output_directory("out/paper_fig1")?;
-    let quiet = true;
-    let map = |e: ssn::cli::CliError| format!("{e:?}");
-    let mut rows = figure_1(&out, MassModel::Modified, quiet).map_err(map)?;
-    rows.extend(figure_1(&out, MassModel::Consistent, quiet).map_err(map)?);
+    ssn::io::set_quiet(true);
+    let mut rows = figure_1(&out, MassModel::Modified)?;
+    rows.extend(figure_1(&out, MassModel::Consistent)?);
     print!("{}", fig1_table(&rows));
     println!(
         "\nNewton from zero, H = 5..40 (the default `auto` globalization: full steps, then the \

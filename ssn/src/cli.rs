@@ -278,7 +278,7 @@ fn folds_summary(folds: &[f64], omega_1: f64) -> String {
 
 /// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
 /// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
-pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
+pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     use crate::state::{read_state, HbState, StateShape};
     let args = &solve_args.run;
     let mut outputs = args.plan()?;
@@ -327,7 +327,7 @@ pub fn solve(solve_args: &SolveArgs, quiet: bool) -> Result<(), CliError> {
     };
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
-        progress_spinner("time marching to a steady state", quiet)
+        progress_spinner("time marching to a steady state")
     } else {
         indicatif::ProgressBar::hidden()
     };
@@ -520,7 +520,7 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
-pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
+pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
     let mut outputs = args.plan()?;
     let Loaded {
         scene,
@@ -533,7 +533,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
             "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
         ));
     };
-    let bar = progress_spinner("sweep", quiet);
+    let bar = progress_spinner("sweep");
     let progress = |points: usize, omega: f64| {
         bar.set_message(format!(
             "sweep: {points} points, omega/omega_1 = {:.4}",
@@ -667,7 +667,7 @@ pub fn sweep(args: &RunArgs, quiet: bool) -> Result<(), CliError> {
 /// (error of the tip minimum against a converged reference versus wall time); prints the
 /// table and the cheapest setting of each method for `accuracy`, writes
 /// `accuracy_cost.csv` and `accuracy_cost.svg` into `out`.
-pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<(), CliError> {
+pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
     if !(accuracy.is_finite() && accuracy > 0.0) {
         return Err(CliError::BadInput(format!(
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
@@ -680,7 +680,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64, quiet: bool) -> Result<()
         omega,
     } = prepare(scene, true, None)?;
     prepare_directory(out)?;
-    let bar = progress_spinner("compare", quiet);
+    let bar = progress_spinner("compare");
     let say = |line: &str| {
         bar.set_message(line.to_string());
         bar.tick();

@@ -69,14 +69,14 @@ fn write_figure(
 
 /// Fig. 1 of the paper for one mass model: SSN-HB at H = 10, 15, 20 against the time-marching
 /// reference; writes `fig1_<mass>.svg` and `.csv` into `out`.
-pub fn figure_1(out: &Path, mass: MassModel, quiet: bool) -> Result<Vec<Fig1Row>, CliError> {
+pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
     let spec = RodSpec {
         mass,
         ..RodSpec::canonical()
     };
     let rod = build_rod(&spec).map_err(bad_input)?;
     let name = mass_name(mass);
-    let bar = progress_bar(4, &format!("Fig. 1 ({name} mass)"), quiet);
+    let bar = progress_bar(4, &format!("Fig. 1 ({name} mass)"));
     // Reference: energy-conserving trapezoidal steps with a massless contact node; the
     // Moreau–Jean scheme (restitution 0) otherwise, with finer steps (first order).
     let reference_settings = SolverSettings {
@@ -289,13 +289,8 @@ pub struct Fig2 {
 /// Stability is known for the modified mass (a massless contact node); with the consistent
 /// mass the contact node has mass, the monodromy would need the impact law's saltation, and
 /// the branches are drawn dotted (undecided).
-pub fn figure_2(
-    out: &Path,
-    harmonics: usize,
-    mass: MassModel,
-    quiet: bool,
-) -> Result<Vec<Fig2Curve>, CliError> {
-    let fig = figure_2_curves(harmonics, mass, quiet)?;
+pub fn figure_2(out: &Path, harmonics: usize, mass: MassModel) -> Result<Vec<Fig2Curve>, CliError> {
+    let fig = figure_2_curves(harmonics, mass)?;
     write_figure(
         out,
         &fig.stem,
@@ -348,8 +343,8 @@ pub fn figure_2_branch(
 }
 
 /// The sweeps and series of [`figure_2`], without writing them.
-pub fn figure_2_curves(harmonics: usize, mass: MassModel, quiet: bool) -> Result<Fig2, CliError> {
-    let bar = progress_bar(4, &format!("Fig. 2 (H = {harmonics})"), quiet);
+pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliError> {
+    let bar = progress_bar(4, &format!("Fig. 2 (H = {harmonics})"));
     let mut curves = Vec::new();
     let mut series = Vec::new();
     let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
@@ -408,11 +403,11 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel, quiet: bool) -> Result
 }
 
 /// The default run (`ssn` without a subcommand): the paper's figures into `out`.
-pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
+pub fn default_run(out: &Path) -> Result<(), CliError> {
     prepare_directory(out)?;
     let start = Instant::now();
-    let mut rows = figure_1(out, MassModel::Modified, quiet)?;
-    rows.extend(figure_1(out, MassModel::Consistent, quiet)?);
+    let mut rows = figure_1(out, MassModel::Modified)?;
+    rows.extend(figure_1(out, MassModel::Consistent)?);
     crate::io::write_text(&fig1_table(&rows))?;
     crate::outln!(
         "With the modified mass (massless contact node) harmonic balance converges to the \
@@ -428,7 +423,7 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
             "massless contact node: stability known, fig2_H20_modified_mass.svg",
         ),
     ] {
-        let curves = figure_2(out, harmonics, mass, quiet)?;
+        let curves = figure_2(out, harmonics, mass)?;
         crate::outln!(
             "Fig. 2 ({} mass, H = {harmonics}): frequency response max|u_tip| on \
              omega/omega_1 in [0.5, 2] ({setting})",
@@ -473,7 +468,7 @@ pub fn default_run(out: &Path, quiet: bool) -> Result<(), CliError> {
          paper's rod, fig2_H5.svg) the contact node has mass, the monodromy would need the \
          impact law's saltation, and the branches are dotted (undecided). At H = 5 the gap \
          0.25 branch turns several times: the contact holds only in the Galerkin sense \
-         (examples/strange_loops.rs)."
+         (ssn/examples/strange_loops.rs)."
     )?;
     crate::outln!(
         "\nWrote {} in {:.1} s.",

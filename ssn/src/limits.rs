@@ -269,8 +269,8 @@ pub struct WorkEstimate {
     pub keys: &'static str,
 }
 
-/// Factorizations counted for a Newton solve: the solves from zero on the rod take 12 to 13
-/// (measured with the dense solver at 100 and 200 elements, H = 20).
+/// Factorizations counted for a Newton solve (an estimate: the solves from zero of the shipped
+/// scenes take 7 to 14 Newton iterations, one factorization each).
 const NEWTON_FACTORIZATIONS: f64 = 10.0;
 
 /// Default limit of [`work_limit`]: 1e14 operations, about 70 minutes at the 2.3e10

@@ -165,7 +165,7 @@ fn main() -> ExitCode {
     let result = match &args.command {
         None => {
             let out = args.out.clone().unwrap_or_else(default_out);
-            in_new_directory(&out, || figures::default_run(&out, args.quiet))
+            in_new_directory(&out, || figures::default_run(&out))
         }
         // `ssn --out DIR compare SCENE` and `ssn compare SCENE --out DIR` both work.
         Some(Command::Compare {
@@ -174,7 +174,7 @@ fn main() -> ExitCode {
             out,
         }) => {
             let out = out.clone().or(args.out.clone()).unwrap_or_else(default_out);
-            in_new_directory(&out, || cli::compare(scene, &out, *accuracy, args.quiet))
+            in_new_directory(&out, || cli::compare(scene, &out, *accuracy))
         }
         Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
             "--out applies only to the default run and `ssn compare`; `ssn {}` writes the \
@@ -183,8 +183,8 @@ fn main() -> ExitCode {
         ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
-        Some(Command::Solve(solve)) => cli::solve(solve, args.quiet),
-        Some(Command::Sweep(run)) => cli::sweep(run, args.quiet),
+        Some(Command::Solve(solve)) => cli::solve(solve),
+        Some(Command::Sweep(run)) => cli::sweep(run),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
         Some(Command::Study(study)) => ssn::study::command::command(study, args.quiet),
     };

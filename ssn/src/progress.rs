@@ -1,11 +1,11 @@
-//! Progress on standard error: bars and spinners, shown only on a terminal and when not
-//! quiet.
+//! Progress on standard error: bars and spinners, shown only on a terminal and when the
+//! run is not quiet ([`crate::io::quiet`]).
 
 use std::io::IsTerminal;
 
-/// A spinner on stderr when it is a terminal and not `quiet`.
-pub fn progress_spinner(message: &str, quiet: bool) -> indicatif::ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
+/// A spinner on stderr when it is a terminal and the run is not quiet.
+pub fn progress_spinner(message: &str) -> indicatif::ProgressBar {
+    if crate::io::quiet() || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new_spinner();
@@ -14,9 +14,9 @@ pub fn progress_spinner(message: &str, quiet: bool) -> indicatif::ProgressBar {
     bar
 }
 
-/// A progress bar on stderr when it is a terminal and not `quiet`.
-pub fn progress_bar(len: u64, message: &str, quiet: bool) -> indicatif::ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
+/// A progress bar on stderr when it is a terminal and the run is not quiet.
+pub fn progress_bar(len: u64, message: &str) -> indicatif::ProgressBar {
+    if crate::io::quiet() || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new(len);

@@ -663,7 +663,7 @@ pub fn performance() -> Result<Table, TableError> {
             format!("{:.5}", s.solve_seconds),
         ]);
     }
-    let fig2 = crate::figures::figure_2_curves(5, MassModel::Consistent, true).map_err(figure)?;
+    let fig2 = crate::figures::figure_2_curves(5, MassModel::Consistent).map_err(figure)?;
     let points: Vec<String> = fig2.curves.iter().map(|c| c.points.to_string()).collect();
     table.rows.push(vec![
         "Fig. 2, four curves at H = 5 (gaps 0.25, 0.5, 0.75, none)".into(),

@@ -13,7 +13,7 @@ use ssn::output::{longest_plotted_step, longest_plotted_step_on, stability_serie
 /// and every contact branch dotted (stability undecided: the contact node has mass).
 #[test]
 fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
-    let fig = figure_2_curves(5, MassModel::Consistent, true).unwrap();
+    let fig = figure_2_curves(5, MassModel::Consistent).unwrap();
     let step = longest_plotted_step(&fig.series);
     println!(
         "consistent mass H = 5: longest plotted step {:.4} of the axis ranges",

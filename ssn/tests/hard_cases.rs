@@ -789,8 +789,8 @@ fn two_thousand_elements_lcp_converges() {
     let l = run_converged("2000 elements", &spec, &hb(20), Method::LcpSsn);
     let tol = hb_vs_lcp_tolerance(&e, 256);
     // Not measured (LCP-SSN does not converge): the difference on the 20-element rod,
-    // 4.6e-5 (SSN-HB H = 20 -0.523163 against the LCP at Nt = 256 -0.523209, the README's
-    // method comparison), stands in.
+    // 4.6e-5 (SSN-HB H = 20 -0.523163 against the LCP at Nt = 256 -0.523209, the method
+    // comparison of `docs/method-comparison.md`), stands in.
     assert_tip_min_close("2000 elements, SSN-HB vs LCP-SSN", &e, &l, tol, 4.6e-5);
 }
 

@@ -114,11 +114,6 @@ impl CondensedSsnHb {
         })
     }
 
-    /// The full SSN-HB problem (for reconstruction and summaries of expanded solutions).
-    pub fn full_problem(&self) -> &SsnHb {
-        &self.full
-    }
-
     /// The Fourier basis (`H`, `Nt`).
     pub fn basis(&self) -> FourierBasis {
         self.full.basis()

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use faer::{Mat, MatMut, MatRef};
+use faer::{Mat, MatMut};
 use semismooth::linalg::DenseAssemble;
 
 use super::LinearData;
@@ -78,16 +78,6 @@ impl HbJacobian {
     /// How the contact unknowns enter.
     pub fn coupling(&self) -> ContactCoupling {
         self.coupling
-    }
-
-    /// `Q_i = P diag(h_i) E` of contact `i` (`(2H + 1)` square), or `None` if out of range.
-    pub fn contact_block(&self, contact: usize) -> Option<MatRef<'_, f64>> {
-        self.q.get(contact).map(|q| q.as_ref())
-    }
-
-    /// Number of time samples where contact `i` is active (`h_n = 1`).
-    pub fn active_samples(&self, contact: usize) -> Option<usize> {
-        self.active.get(contact).copied()
     }
 
     /// True when `other` has the same dynamic part `A(w)` (same model data and same `w`),

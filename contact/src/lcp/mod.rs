@@ -89,7 +89,7 @@
 //! # Measured on the canonical rod (20 elements, `zeta = 0.01`, `omega = omega_1`, gap 0.5)
 //!
 //! Modified mass (massless tip): Lemke solves at every `Nt` (61 / 172 / 529 / 1894 / 7118
-//! pivots at `Nt` = 128 / 256 / 512 / 1024 / 2048; README for the time), tip minimum
+//! pivots at `Nt` = 128 / 256 / 512 / 1024 / 2048; `docs/performance.md` for the time), tip minimum
 //! -0.5234851 / -0.5232093 / -0.5231566 / -0.5231539 / -0.5231508, identical (to 1e-13)
 //! to semismooth Newton and to the steady state of the massless-contact trapezoidal march
 //! with the same step. `(A + A^T)/2` is slightly indefinite (smallest eigenvalue about
@@ -141,9 +141,7 @@ mod sequencing;
 
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
 pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
-pub use sequencing::{
-    solve_min_map_sequenced, SequencedSolution, SequencingLevel, SEQUENCING_COARSEST_TIME_SAMPLES,
-};
+pub use sequencing::{solve_min_map_sequenced, SequencedSolution, SequencingLevel};
 
 use std::sync::Arc;
 

@@ -43,7 +43,7 @@ impl PeriodicLcp {
 }
 
 /// Coarsest `Nt` of [`solve_min_map_sequenced`]'s level sequence.
-pub const SEQUENCING_COARSEST_TIME_SAMPLES: usize = 128;
+pub(crate) const SEQUENCING_COARSEST_TIME_SAMPLES: usize = 128;
 
 /// One level of [`solve_min_map_sequenced`].
 #[derive(Debug, Clone, PartialEq)]
@@ -68,11 +68,6 @@ impl SequencedSolution {
     /// `true` when Newton converged on the finest level.
     pub fn converged(&self) -> bool {
         self.levels.last().is_some_and(|l| l.report.converged())
-    }
-
-    /// Newton iterations summed over the levels.
-    pub fn total_iterations(&self) -> usize {
-        self.levels.iter().map(|l| l.report.iterations).sum()
     }
 }
 

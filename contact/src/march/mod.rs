@@ -75,7 +75,7 @@
 //! # What to expect (measured on the canonical rod)
 //!
 //! - Modified mass (trapezoidal): steady after 79 periods at tolerance 1e-8 from rest at
-//!   2000 steps per period (README for the time it takes). The tip touches the gap exactly
+//!   2000 steps per period (`docs/performance.md` for the time it takes). The tip touches the gap exactly
 //!   (`tip max = 0.5`), the tip minimum is -0.5231507 (it varies by 2e-7 over 1000..8000
 //!   steps per period, without a clean order: contact onsets are quantised by the step),
 //!   the mean contact force -9.24379e-3 converges at order 2.2. SSN-HB with `H = 40`

@@ -298,12 +298,6 @@ impl<'a> TimeMarcher<'a> {
         &self.lambda
     }
 
-    /// The contact compliance `W = G A^{-1} G^T` of the per-step LCP (`A = K_eff` for the
-    /// trapezoidal scheme, `M_hat` for Moreau–Jean).
-    pub fn contact_compliance(&self) -> faer::MatRef<'_, f64> {
-        self.w.as_ref()
-    }
-
     /// Work so far.
     pub fn counters(&self) -> MarchCounters {
         self.counters

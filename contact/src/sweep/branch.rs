@@ -144,7 +144,11 @@ impl Reconstruction {
         };
         let mean = s.contact_force_mean.first().copied().unwrap_or(0.0);
         Ok((
-            if mean.abs() < 1e-300 { 0.0 } else { mean },
+            if mean.abs() < f64::MIN_POSITIVE {
+                0.0
+            } else {
+                mean
+            },
             s.max_penetration,
         ))
     }

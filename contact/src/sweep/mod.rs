@@ -79,7 +79,7 @@
 //! frequency excursion is at least [`TURNING_POINT_EXCURSION`] `ω_1` and lists the others
 //! as `corner_folds`.
 //!
-//! Measured branch sizes, timings and limits are in the README (*Sweeps*) and
+//! Measured branch sizes, timings and limits are in `docs/sweeps.md` and
 //! `examples/lcp_sweep.rs`.
 
 pub mod branch;
@@ -118,26 +118,26 @@ pub use branch::{BifurcationEvent, BranchStability};
 /// Weight `θ` of the state in the arclength (module documentation: with the scaling used
 /// here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the θ-norm
 /// of order one).
-pub const THETA: f64 = 0.5;
+pub(crate) const THETA: f64 = 0.5;
 
 /// Largest number of corrector iterations per attempted step.
-pub const MAX_CORRECTOR_ITERATIONS: usize = 12;
+pub(crate) const MAX_CORRECTOR_ITERATIONS: usize = 12;
 
 /// The corrector's tolerance on `|F|` relative to the scene's Newton tolerance: one decade
 /// tighter, so that every branch point is a fixed point of a Newton solve at the scene's
 /// tolerance even where the Jacobian is ill-conditioned (near folds).
-pub const CORRECTOR_TOLERANCE_FACTOR: f64 = 0.1;
+pub(crate) const CORRECTOR_TOLERANCE_FACTOR: f64 = 0.1;
 
 /// Corrector iterations the step control aims at.
-pub const TARGET_ITERATIONS: usize = 4;
+pub(crate) const TARGET_ITERATIONS: usize = 4;
 
 /// The corrector may not leave the θ-ball of this many largest next steps around the last
 /// accepted point ([`ContinuationOptions::trust_factor`]).
-pub const TRUST_FACTOR: f64 = 3.0;
+pub(crate) const TRUST_FACTOR: f64 = 3.0;
 
 /// Failed steps in a row (each halving the step) after which a penalty-HB branch crosses
 /// the corner ahead exactly.
-pub const PENALTY_MAX_FAILURES: usize = 3;
+pub(crate) const PENALTY_MAX_FAILURES: usize = 3;
 
 /// The structured or dense linear solver of a harmonic-balance scene.
 fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {

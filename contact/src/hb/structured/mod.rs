@@ -234,14 +234,6 @@ impl StructuredHbSolver {
         self.dense_preconditioner_factorizations
     }
 
-    /// Sets the maximum number of iterative-refinement steps after each solve (default 1;
-    /// 0 gives the bare condensed solve). Each step costs one structured product, and one
-    /// more solve unless the relative residual is already below `1e-14`.
-    pub fn with_refinement_steps(mut self, steps: usize) -> Self {
-        self.refinement_steps = steps;
-        self
-    }
-
     /// Number of times the per-harmonic dynamic blocks were factored (once per frequency).
     pub fn dynamic_factorizations(&self) -> u64 {
         self.dynamic_factorizations
