@@ -186,7 +186,7 @@ fn main() -> ExitCode {
         Some(Command::Solve(solve)) => cli::solve(solve),
         Some(Command::Sweep(run)) => cli::sweep(run),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
-        Some(Command::Study(study)) => ssn::study::command::command(study, args.quiet),
+        Some(Command::Study(study)) => ssn::study::command::command(study),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

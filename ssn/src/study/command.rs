@@ -56,7 +56,7 @@ fn parse_override(text: &str) -> Result<Override, String> {
 /// Runs `ssn study`: exit 0 when every case converged, 1 when some did not (the table is
 /// written all the same), 2 for a bad scene, study or case, 3 when a record or a table
 /// could not be written.
-pub fn command(args: &StudyArgs, quiet: bool) -> Result<(), CliError> {
+pub fn command(args: &StudyArgs) -> Result<(), CliError> {
     if let Some(StudyCommand::Merge { dir }) = &args.command {
         let table = merge(dir)?;
         let failed = table.column("converged").map_or(0, |c| {
@@ -106,7 +106,6 @@ pub fn command(args: &StudyArgs, quiet: bool) -> Result<(), CliError> {
         RunOptions {
             shard,
             jobs: args.jobs.map(usize::from),
-            quiet,
         },
     )?;
     let mut text = format!(
@@ -135,9 +134,7 @@ pub fn command(args: &StudyArgs, quiet: bool) -> Result<(), CliError> {
             printable(&out.display().to_string())
         )
     };
-    if !quiet {
-        write_text(&text)?;
-    }
+    write_text(&text)?;
     if outcome.not_converged == 0 {
         Ok(())
     } else {

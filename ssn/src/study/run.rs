@@ -228,8 +228,6 @@ pub struct RunOptions {
     pub shard: Shard,
     /// Worker threads (`None`: every core).
     pub jobs: Option<usize>,
-    /// No progress bar.
-    pub quiet: bool,
 }
 
 /// Runs the cases of `shard` not yet done into `dir`, on `jobs` threads of a rayon pool
@@ -258,7 +256,6 @@ pub fn run_study(
     let bar = crate::progress::progress_bar_with_estimate(
         pending.len() as u64,
         &format!("study ({} already done)", skipped),
-        options.quiet,
     );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs.unwrap_or(0))
