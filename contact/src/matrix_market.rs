@@ -492,6 +492,15 @@ fn largest_entry(v: &[f64]) -> usize {
     best
 }
 
+/// The banner as the Matrix Market format spells it (`%%MatrixMarket`): readers such as
+/// scipy's `mmread` refuse the lower-case banner that nalgebra-sparse writes.
+fn standard_banner(text: String) -> String {
+    match text.strip_prefix("%%matrixmarket") {
+        Some(rest) => format!("%%MatrixMarket{rest}"),
+        None => text,
+    }
+}
+
 /// A sparse matrix as Matrix Market text (coordinate, real, general; every stored entry,
 /// values in Rust's shortest round-trip notation, so reading it back is exact).
 pub fn matrix_market_text(a: &SparseMatrix) -> String {
@@ -502,7 +511,7 @@ pub fn matrix_market_text(a: &SparseMatrix) -> String {
             coo.push(i, j, v);
         }
     }
-    nalgebra_sparse::io::save_to_matrix_market_str(&coo)
+    standard_banner(nalgebra_sparse::io::save_to_matrix_market_str(&coo))
 }
 
 /// A vector as an `n x 1` Matrix Market matrix (its nonzero entries).
@@ -513,7 +522,7 @@ pub fn vector_market_text(v: &[f64]) -> String {
             coo.push(i, 0, x);
         }
     }
-    nalgebra_sparse::io::save_to_matrix_market_str(&coo)
+    standard_banner(nalgebra_sparse::io::save_to_matrix_market_str(&coo))
 }
 
 /// The Matrix Market files of a structure built in code for a `[model]` scene: `K.mtx`,

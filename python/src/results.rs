@@ -118,8 +118,6 @@ impl Solution {
         structure: &Structure,
     ) -> Solution {
         let doc = ssn::json::solution_json(scene, s);
-        let mut doc = doc;
-        doc["observed_dof"] = json!(structure.observed_dof);
         Solution {
             converged: s.converged(),
             stored: Stored {
@@ -128,6 +126,7 @@ impl Solution {
                     vector("displacement", &s.tip),
                     matrix("contact_forces", &s.contact_forces),
                     vector("state", &s.state),
+                    vector("observed_dof", &[structure.observed_dof as f64]),
                 ],
                 doc,
             },
@@ -140,6 +139,16 @@ result_methods!(Solution, "Solution", {
     #[getter]
     fn times<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.stored.array(py, "times")
+    }
+
+    /// The dof (0-based) whose displacement `displacement` is (`[output] dof`).
+    #[getter]
+    fn observed_dof(&self) -> usize {
+        self.stored
+            .arrays
+            .iter()
+            .find(|(n, _, _)| n == "observed_dof")
+            .map_or(0, |(_, _, v)| v[0] as usize)
     }
 
     /// Displacement of the observed dof at `times` (`tip_*` of the JSON).

@@ -71,6 +71,7 @@ class Solution:
     iterations: int
     residual_norm: Optional[float]
     omega: float
+    observed_dof: int
     times: npt.NDArray[np.float64]
     displacement: npt.NDArray[np.float64]
     contact_forces: npt.NDArray[np.float64]

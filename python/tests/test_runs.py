@@ -39,7 +39,7 @@ def test_solve_of_a_scene_file_equals_the_command_line():
     assert solution.displacement.max() == doc["tip_max"]
     assert solution.displacement.min() == doc["tip_min"]
     assert solution.contact_forces.shape == (1, len(solution.times))
-    return doc
+    assert solution.observed_dof == 19  # the rod's tip: 20 elements, dofs 0..=19
 
 
 def test_solve_sweep_and_solutions_equal_the_command_line(cli):

@@ -461,3 +461,6 @@ pub fn words(values: &[Override]) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+#[cfg(test)]
+mod tests;

@@ -68,7 +68,8 @@ pub struct Column {
 }
 
 impl Column {
-    /// The column's type ([`ColumnType`]); a column of nulls only is numbers.
+    /// The column's type ([`ColumnType`]); a column of nulls only is text (as the `error`
+    /// column of a study where every case ran: Parquet readers give None, not NaN).
     pub fn column_type(&self) -> ColumnType {
         let mut kind: Option<ColumnType> = None;
         for c in &self.cells {
@@ -87,7 +88,7 @@ impl Column {
                 _ => ColumnType::Text,
             });
         }
-        kind.unwrap_or(ColumnType::Float)
+        kind.unwrap_or(ColumnType::Text)
     }
 
     /// The cell of `row` as text: shortest round-trip numbers, `true`/`false`, empty for
