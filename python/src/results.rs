@@ -225,17 +225,7 @@ pub struct FrequencyResponse {
 
 impl FrequencyResponse {
     pub fn new(r: &LibResponse) -> FrequencyResponse {
-        let st = &r.stability;
-        let stable: Vec<f64> = st
-            .stable
-            .iter()
-            .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
-            .collect();
-        let floquet: Vec<f64> = st
-            .floquet_max_abs
-            .iter()
-            .map(|a| a.unwrap_or(f64::NAN))
-            .collect();
+        let (stable, floquet) = ssn::output::stability_numbers(&r.stability);
         FrequencyResponse {
             converged: r.converged(),
             stored: Stored {

@@ -108,6 +108,17 @@ def test_a_model_from_matrices_equals_the_exported_scene(cli, ssn_bin, tmp_path,
         m, k, f, contacts=[{"row": row, "gap": 0.5}], damping=d, values=values
     )
     assert_same_document(ssn.solve(by_row).to_dict(), python | {"scene": "<matrices>"})
+    # A sweep and the solutions at one frequency of the structure given as matrices equal
+    # those of the program on the exported scene with the same keys set.
+    more = {"solver.harmonics": 10, "sweep.omega_ratio_from": 0.9, "sweep.omega_ratio_to": 1.1}
+    sweep_scene = scene.with_values(more)
+    response = ssn.sweep(sweep_scene).to_dict()
+    assert_same_document(response, cli("sweep", out / "scene.toml", *set_args(more)))
+    assert response["points"] > 5 and response["converged"]
+    at = {"forcing.omega_ratio": 1.05}
+    found = ssn.solutions(sweep_scene.with_values(at)).to_dict()
+    assert_same_document(found, cli("solutions", out / "scene.toml", *set_args(more | at)))
+    assert len(found["solutions"]) >= 1
 
 
 def test_a_bad_value_raises_a_scene_error_naming_the_key():

@@ -551,17 +551,7 @@ pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
     let st = &response.stability;
-    // stable: 1 / 0, NaN when undecided (an empty cell in the CSV).
-    let stable: Vec<f64> = st
-        .stable
-        .iter()
-        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
-        .collect();
-    let floquet: Vec<f64> = st
-        .floquet_max_abs
-        .iter()
-        .map(|a| a.unwrap_or(f64::NAN))
-        .collect();
+    let (stable, floquet) = crate::output::stability_numbers(st);
     let force_mean = response.contact_force_mean();
     let contact_columns = response.contact_columns();
     let mut headers = vec![

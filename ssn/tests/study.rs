@@ -394,3 +394,45 @@ fn bad_studies_cases_and_directories_are_refused_naming_them() {
         text(&o.stderr)
     );
 }
+
+/// The generated block of `docs/studies.md` written by the `study_throughput` example.
+fn throughput_block() -> String {
+    let page =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/studies.md"))
+            .expect("docs/studies.md");
+    let start = ssn::tables::block_start("study-throughput");
+    let end = ssn::tables::block_end("study-throughput");
+    let open = page.find(&start).expect("the block's opening line") + start.len();
+    let close = open + page[open..].find(&end).expect("the block's closing line");
+    page[open..close].to_string()
+}
+
+#[test]
+fn the_throughput_page_holds_the_table_of_its_example() {
+    let block = throughput_block();
+    assert!(
+        block.contains("cargo run --release -p ssn --example study_throughput -- --write"),
+        "{block}"
+    );
+    // Every case of the measured study converged, and each row has a positive per-case
+    // time and rate (the wall times themselves vary from run to run and are not compared).
+    assert!(
+        block.contains("1000 solves of the canonical rod"),
+        "{block}"
+    );
+    assert!(block.contains("; 1000 converged."), "{block}");
+    let rows: Vec<&str> = block
+        .lines()
+        .filter(|l| {
+            l.starts_with("| ") && !l.starts_with("| measurement") && !l.starts_with("| ---")
+        })
+        .collect();
+    assert_eq!(rows.len(), 4, "{block}");
+    for row in rows {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let ms: f64 = cells[2].trim_end_matches(" ms").parse().expect("a time");
+        let rate: f64 = cells[3].parse().expect("a rate");
+        assert!(ms > 0.0 && rate > 0.0, "{row}");
+    }
+    assert!(block.contains("Speed-up of 2 threads over 1"), "{block}");
+}

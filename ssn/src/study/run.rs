@@ -137,6 +137,28 @@ pub fn case_file(dir: &Path, case: usize) -> PathBuf {
     dir.join("cases").join(format!("case-{case:06}.json"))
 }
 
+/// Writes a case's record atomically (a temporary file beside it, renamed into place), so
+/// that a killed run leaves whole records only. Unlike the other outputs it is not synced to
+/// the disk: a record is checked when it is read ([`finished_record`]), so one damaged by a
+/// machine crash is run again, and a sync per case would cost more than a small solve.
+fn write_record(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
+    use std::io::Write;
+    use std::os::unix::fs::PermissionsExt;
+    let io = |e: std::io::Error| {
+        CliError::Output(format!("{}: {e}", printable(&path.display().to_string())))
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".case.")
+        .suffix(".tmp")
+        .permissions(std::fs::Permissions::from_mode(0o644))
+        .tempfile_in(dir)
+        .map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
 /// The record of `case` in `dir` when it is there and is the record of these values.
 fn finished_record(dir: &Path, case: &Case) -> Option<Value> {
     let text = std::fs::read_to_string(case_file(dir, case.index)).ok()?;
@@ -268,7 +290,7 @@ pub fn run_study(
             let record = run_case(scene, case, study.run);
             let text = serde_json::to_string_pretty(&record)
                 .map_err(|e| CliError::Output(format!("cannot format a record: {e}")))?;
-            write_atomically(&case_file(dir, case.index), format!("{text}\n").as_bytes())?;
+            write_record(&case_file(dir, case.index), format!("{text}\n").as_bytes())?;
             ran.fetch_add(1, Ordering::Relaxed);
             bar.inc(1);
             Ok(())

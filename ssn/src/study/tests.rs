@@ -94,7 +94,7 @@ fn normal_samples_have_the_mean_and_spread_asked_for() {
 }
 
 #[test]
-fn a_list_valued_random_key_gives_a_list_per_sample() {
+fn a_list_drawn_for_a_number_key_is_refused_by_the_scene_naming_it() {
     let s = study(
         "[random]\nsamples = 2\nseed = 3\n[random.keys.\"contact.gap\"]\n\
          distribution = \"normal\"\nmean = 0.5\nstd = 0.01\nsize = 4\n",
