@@ -87,10 +87,13 @@ def test_a_model_from_matrices_equals_the_exported_scene(cli, ssn_bin, tmp_path,
     structure: files read by scipy, COO triplets, no scene file)."""
     out = tmp_path / "rod"
     subprocess.run([ssn_bin, "export-model", str(FIG1), str(out)], check=True, capture_output=True)
-    m, k, d = (read_matrix_market(out / f"{name}.mtx") for name in "MKD")
     f = read_matrix_market(out / "f.mtx").ravel()
     if kind == "scipy":
-        m, k, d = scipy.sparse.csr_matrix(m), scipy.sparse.csc_matrix(k), scipy.sparse.coo_matrix(d)
+        # The stored entries of the files, in three sparse formats.
+        m, k, d = (scipy.io.mmread(out / f"{name}.mtx") for name in "MKD")
+        m, k = scipy.sparse.csr_matrix(m), scipy.sparse.csc_matrix(k)
+    else:
+        m, k, d = (read_matrix_market(out / f"{name}.mtx") for name in "MKD")
     n = k.shape[0]
     # The exported scene: the tip (1-based dof n) against a stop at 0.5, H = 20.
     exported = (out / "scene.toml").read_text()
@@ -109,8 +112,14 @@ def test_a_model_from_matrices_equals_the_exported_scene(cli, ssn_bin, tmp_path,
     )
     assert_same_document(ssn.solve(by_row).to_dict(), python | {"scene": "<matrices>"})
     # A sweep and the solutions at one frequency of the structure given as matrices equal
-    # those of the program on the exported scene with the same keys set.
-    more = {"solver.harmonics": 10, "sweep.omega_ratio_from": 0.9, "sweep.omega_ratio_to": 1.1}
+    # those of the program on the exported scene with the same keys set (the exported scene
+    # states every solver key, the time samples too: set them for the new H on both sides).
+    more = {
+        "solver.harmonics": 10,
+        "solver.time_samples": 128,
+        "sweep.omega_ratio_from": 0.9,
+        "sweep.omega_ratio_to": 1.1,
+    }
     sweep_scene = scene.with_values(more)
     response = ssn.sweep(sweep_scene).to_dict()
     assert_same_document(response, cli("sweep", out / "scene.toml", *set_args(more)))

@@ -126,8 +126,7 @@ enum Command {
     /// random samples), each case a solve, sweep or solutions run, on every core; one row
     /// per case in DIR/results.csv (and .parquet), each case's JSON in DIR/cases/.
     #[command(
-        after_help = "Examples:\n  ssn study scenes/bladed_disk_mistuning.toml \
-        scenes/studies/mistuning_monte_carlo.toml --out out/mistuning\n  \
+        after_help = "Examples:\n  ssn study scenes/paper_fig2.toml GAPS.toml --out out/gaps\n  \
         ssn study SCENE.toml STUDY.toml --out DIR --shard 3/8   (one task of a job array)\n  \
         ssn study merge DIR                                       (when every shard is done)\n\n\
         A run into a directory that holds records of the same study skips the cases done.\n\

@@ -11,11 +11,12 @@
 //! [random]                           # seeded samples (each combined with every case above)
 //! samples = 200
 //! seed = 2026
-//! [random.keys."bladed_disk.mistuning"]
+//! [random.keys."damping.zeta"]
 //! distribution = "normal"            # or "uniform" (low, high)
-//! mean = 0.0
-//! std = 0.02
-//! size = 100                         # a list of 100 values per sample (absent: one number)
+//! mean = 0.01
+//! std = 0.002
+//! # size = 100                       # a list of 100 values per sample, for a key that takes a
+//! #                                  # list (absent: one number)
 //! ```
 //!
 //! Cases are numbered from 0: the grid point outermost, then the listed case, then the

@@ -1,6 +1,6 @@
 //! The results table of a study: one row per case, made from the case records alone (so a
 //! merged sharded run and a whole run give the same table). Columns: `case`, the varied
-//! scene keys (a list-valued key such as a per-blade mistuning becomes `key[0]`,
+//! scene keys (a list value, as drawn by `size = N`, becomes `key[0]`,
 //! `key[1]`, ...), `converged`, `termination`, `error`, then the quantities of the run
 //! kind ([`quantities`]). Wall times are left out, so two runs of one study give equal
 //! tables. Written as CSV (numbers in shortest round-trip notation, an empty cell for a
