@@ -325,10 +325,7 @@ impl Aft {
         signals: usize,
         samples: &mut [f64],
     ) -> Result<(), HarmonicError> {
-        let size = self.basis.basis_size();
-        let nt = self.basis.time_samples();
-        check_length("harmonic-major coefficients", size * signals, coeffs.len())?;
-        check_length("signal-major samples", nt * signals, samples.len())?;
+        let nt = self.check_batch(signals, coeffs.len(), samples.len())?;
         let mut gathered = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
             for (j, g) in gathered.iter_mut().enumerate() {
@@ -348,10 +345,7 @@ impl Aft {
         signals: usize,
         coeffs: &mut [f64],
     ) -> Result<(), HarmonicError> {
-        let size = self.basis.basis_size();
-        let nt = self.basis.time_samples();
-        check_length("signal-major samples", nt * signals, samples.len())?;
-        check_length("harmonic-major coefficients", size * signals, coeffs.len())?;
+        let nt = self.check_batch(signals, coeffs.len(), samples.len())?;
         let mut projected = std::mem::take(&mut self.coefficients);
         for s in 0..signals {
             self.time.copy_from_slice(&samples[s * nt..(s + 1) * nt]);
@@ -363,6 +357,21 @@ impl Aft {
         }
         self.coefficients = projected;
         Ok(())
+    }
+
+    /// `Nt`, once the lengths of the harmonic-major coefficients (`coeffs`) and the
+    /// signal-major samples (`samples`) of `signals` signals are checked.
+    fn check_batch(
+        &self,
+        signals: usize,
+        coeffs: usize,
+        samples: usize,
+    ) -> Result<usize, HarmonicError> {
+        let size = self.basis.basis_size();
+        let nt = self.basis.time_samples();
+        check_length("harmonic-major coefficients", size * signals, coeffs)?;
+        check_length("signal-major samples", nt * signals, samples)?;
+        Ok(nt)
     }
 
     /// The `(2H + 1) x (2H + 1)` matrix `P diag(w) E` of multiplication by a sampled

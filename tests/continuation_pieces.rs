@@ -1,8 +1,14 @@
-//! The continuation's exact corner crossing on piecewise-affine branches
-//! (`Continuation::with_affine_pieces`), against branches known in closed form.
+//! Corners of piecewise-affine branches, against branches known in closed form: crossed
+//! exactly with the pieces known (`Continuation::with_affine_pieces`), and located within
+//! one step by the plain continuation, which tells a corner fold from a sharp corner.
+
+mod common;
+
+use common::branches::*;
 
 use semismooth::continuation::{
     Continuation, ContinuationEvent, ContinuationOptions, ContinuationTermination, PiecewiseAffine,
+    Predictor,
 };
 use semismooth::faer::Mat;
 use semismooth::linalg::FaerDenseLu;
@@ -227,4 +233,172 @@ fn chain_of_close_corners_is_walked_in_one_go() {
         e,
         ContinuationEvent::Fold { .. } | ContinuationEvent::Corner { .. }
     )));
+}
+
+/// `p + |x| = 0`: the branch `p = -|x|` turns back at a corner (`x = 0`, `p = 0`), where
+/// the generalized Jacobian jumps from `-1` to `1` and no tangent exists.
+fn roof() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = p + x[0].abs()),
+        j: Box::new(|x, _, jac| jac[(0, 0)] = if x[0] >= 0.0 { 1.0 } else { -1.0 }),
+        fp: Some(Box::new(|_, _, out| out[0] = 1.0)),
+    }
+}
+
+/// Slope of [`steep_corner`]'s two pieces.
+const STEEP: f64 = 20.0;
+
+/// `x + STEEP |p| = 0`: a graph over `p` (so no fold) with a corner at `p = 0` where the
+/// branch turns by nearly 180° in the `(x, p)` plane.
+fn steep_corner() -> Closure {
+    Closure {
+        n: 1,
+        p: 0.0,
+        f: Box::new(|x, p, out| out[0] = x[0] + STEEP * p.abs()),
+        j: Box::new(|_, _, jac| jac[(0, 0)] = 1.0),
+        fp: Some(Box::new(|_, p, out| out[0] = STEEP * p.signum())),
+    }
+}
+
+#[test]
+fn corner_fold_of_a_piecewise_linear_branch_is_reported_within_one_step_of_the_corner() {
+    let mut problem = roof();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[-1.0], -1.0, options.clone())
+        .unwrap()
+        .run();
+    // Up the left side, over the corner, down the right side to the bound p = -1 at x = 1.
+    let last = branch.points.last().unwrap();
+    assert_eq!(
+        branch.termination,
+        ContinuationTermination::ReachedBound {
+            parameter: -1.0,
+            bound: -1.0
+        }
+    );
+    assert!((last.state[0] - 1.0).abs() < 1e-12, "{}", last.state[0]);
+    for point in &branch.points {
+        assert!((point.parameter + point.state[0].abs()).abs() < 1e-10);
+    }
+    let folds = branch.fold_parameters();
+    println!(
+        "roof: {} points, folds {folds:?}, corner passes {}, rejected steps {}",
+        branch.points.len(),
+        branch.counters.corner_passes,
+        branch.counters.rejected_steps
+    );
+    assert_eq!(folds.len(), 1, "{folds:?}");
+    // The fold is at p = 0; the neighbouring points are within one (θ-norm) step, i.e.
+    // |Δp| <= max_step / sqrt(1 - θ), of it, and the report is never past the corner.
+    let reach = options.max_step / (1.0 - options.theta).sqrt();
+    assert!(folds[0] <= 1e-12 && folds[0] > -reach, "{}", folds[0]);
+    let ContinuationEvent::Fold { index, .. } = branch.events[0] else {
+        unreachable!()
+    };
+    // The highest point of the branch is the fold's extreme point or its neighbour.
+    let top = branch
+        .points
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.parameter.total_cmp(&b.1.parameter))
+        .unwrap()
+        .0;
+    assert!(index.abs_diff(top) <= 1, "fold at {index}, top at {top}");
+    assert!(branch.counters.corner_passes >= 1);
+}
+
+#[test]
+fn sharp_corner_of_a_graph_over_the_parameter_is_passed_without_a_fold() {
+    for predictor in [Predictor::Secant, Predictor::Tangent] {
+        let mut problem = steep_corner();
+        let mut solver = FaerDenseLu::new();
+        let options = ContinuationOptions {
+            parameter_min: -1.0,
+            parameter_max: 1.0,
+            predictor,
+            ..Default::default()
+        };
+        let branch = Continuation::new(&mut problem, &mut solver, &[-STEEP], -1.0, options)
+            .unwrap()
+            .run();
+        let parameters = branch.parameters();
+        println!(
+            "{predictor:?}: {} points, corner passes {}, rejected steps {}",
+            parameters.len(),
+            branch.counters.corner_passes,
+            branch.counters.rejected_steps
+        );
+        // The branch is a graph over p: p increases at every point, to the bound p = 1.
+        assert!(parameters.windows(2).all(|w| w[1] > w[0]));
+        assert_eq!(
+            branch.termination,
+            ContinuationTermination::ReachedBound {
+                parameter: 1.0,
+                bound: 1.0
+            }
+        );
+        assert!((branch.points.last().unwrap().state[0] + STEEP).abs() < 1e-10);
+        assert_eq!(fold_count(&branch), 0, "{:?}", branch.events);
+        assert!(branch.counters.corner_passes >= 1);
+    }
+    // Pseudo-arclength alone cannot cut the far side of a corner turning by more than 90°
+    // in the θ-norm: without the corner passes the run stops there.
+    let mut problem = steep_corner();
+    let mut solver = FaerDenseLu::new();
+    let options = ContinuationOptions {
+        parameter_min: -1.0,
+        parameter_max: 1.0,
+        pass_corners: false,
+        ..Default::default()
+    };
+    let branch = Continuation::new(&mut problem, &mut solver, &[-STEEP], -1.0, options)
+        .unwrap()
+        .run();
+    let end = branch.points.last().unwrap().parameter;
+    assert!(end < 0.0 && end > -0.01, "{:?}", branch.termination);
+    assert!(matches!(
+        branch.termination,
+        ContinuationTermination::TooManyFailures { .. }
+            | ContinuationTermination::StepTooSmall { .. }
+    ));
+}
+
+#[test]
+fn fold_detector_confirms_reversals_and_ignores_unconfirmed_tangent_flips() {
+    use semismooth::continuation::FoldDetector;
+    // p = sin(s) sampled every 0.3 with exact tangents: one fold at p = 1 (s = π/2).
+    let mut detector = FoldDetector::new(true);
+    let mut events = Vec::new();
+    for k in 0..12 {
+        let s = 0.3 * k as f64;
+        events.extend(detector.push(s.sin(), s.cos(), 0.3));
+    }
+    assert_eq!(events.len(), 1, "{events:?}");
+    let ContinuationEvent::Fold { index, parameter } = events[0] else {
+        unreachable!()
+    };
+    // Between s = 1.5 (k = 5) and 1.8 (k = 6); Hermite error over h = 0.3 ~ h^4/384.
+    assert_eq!(index, 6);
+    assert!((parameter - 1.0).abs() < 1e-4, "{parameter}");
+    // A tangent that flips sign without the parameter turning back is no fold; a reversal
+    // with no sign change of the tangent (a corner) is a fold at the extreme point.
+    let mut detector = FoldDetector::new(true);
+    let pushed: Vec<_> = [(0.0, 1.0), (0.1, -1.0), (0.2, 1.0), (0.3, 1.0), (0.25, 1.0)]
+        .iter()
+        .filter_map(|&(p, t)| detector.push(p, t, 0.1))
+        .collect();
+    assert_eq!(
+        pushed,
+        vec![ContinuationEvent::Fold {
+            index: 3,
+            parameter: 0.3
+        }]
+    );
 }

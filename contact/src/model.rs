@@ -57,7 +57,7 @@ impl ContactPoint {
 }
 
 /// Which side of a contact dof the obstacle is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum ContactDirection {
     /// Obstacle on the positive side: `u[dof] - gap <= 0`.
     #[default]
@@ -395,6 +395,42 @@ impl StructuralModel {
         self.shared_contact_stiffness()
             .map(|k| DEFAULT_C_FACTOR * k)
             .unwrap_or_else(|| self.contact_stiffness_scale())
+    }
+}
+
+impl StructuralModel {
+    /// How much the undamped linear response at `omega` exceeds the static one:
+    /// `max |(K - omega^2 M)^{-1} f| / max |K^{-1} f|`, infinite when `K - omega^2 M` is
+    /// singular (forced at a natural frequency: an undamped structure without contact then
+    /// has no periodic solution); `None` when `K` cannot be factored or the load is zero.
+    /// Ignores damping and contacts.
+    pub fn undamped_amplification(&self, omega: f64) -> Option<f64> {
+        use semismooth::linalg::FaerSparseLu;
+        let n = self.dofs();
+        let response = |matrix: &SparseMatrix| -> Option<f64> {
+            let mut lu = FaerSparseLu::new();
+            if lu.factor(matrix).is_err() {
+                return Some(f64::INFINITY);
+            }
+            let mut u = self.load.clone();
+            lu.solve_in_place(&mut u).ok()?;
+            Some(u.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+        };
+        let static_response = response(&self.stiffness)?;
+        if !(static_response > 0.0 && static_response.is_finite()) {
+            return None;
+        }
+        let dynamic = crate::dynamic::UnionPattern::linear_combination(
+            n,
+            &[&self.stiffness, &self.mass],
+            &[1.0, -omega * omega],
+        );
+        let amplification = response(&dynamic)? / static_response;
+        Some(if amplification.is_nan() {
+            f64::INFINITY
+        } else {
+            amplification
+        })
     }
 }
 

@@ -114,7 +114,7 @@ pub fn find_solutions(
     );
     if !(lo <= ratio && ratio <= hi) {
         return Err(RunError::InvalidSetting {
-            name: "forcing.omega_ratio",
+            name: "omega / omega_1",
             value: ratio,
             allowed: "a frequency inside the [sweep] range searched for solutions",
         });

@@ -390,7 +390,7 @@ pub fn structured_solver(condensed: CondensedSolve, tolerance: f64) -> Structure
 /// `eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
 /// the iterate) within 100 times of it has converged as far as floating point allows:
 /// large models (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
-fn roundoff_floor(
+pub(crate) fn roundoff_floor(
     model: &crate::model::StructuralModel,
     dim: usize,
     u_max: f64,

@@ -84,13 +84,20 @@ fn canonical_case_converges_from_zero_for_every_harmonic_count_from_5_to_40() {
                 s.residual_norm
             );
             // Physically plausible: the contact pushes (mean force <= 0) and the obstacle
-            // is respected up to the quadrature's resolution (a few 1e-3 of the gap).
+            // is respected up to the resolution of H harmonics: the penetration between
+            // the AFT samples shrinks like 1/H (measured H x penetration / gap from 0.063
+            // to 0.124 over both masses and H = 5..40), asserted below 0.2 gap / H.
             assert!(s.stats.mean_contact_force < 0.0);
             println!(
                 "{mass:?} H = {h}: {} iterations, tip min {:.6}, penetration {:.2e}",
                 s.iterations, s.stats.min, s.stats.max_penetration
             );
-            assert!(s.stats.max_penetration < 0.05 * 0.5, "{mass:?} H = {h}");
+            let bound = 0.2 * 0.5 / h as f64;
+            assert!(
+                s.stats.max_penetration < bound,
+                "{mass:?} H = {h}: penetration {:e} above {bound:e}",
+                s.stats.max_penetration
+            );
         }
     }
 }

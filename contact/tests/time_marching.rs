@@ -5,8 +5,9 @@
 
 mod common;
 
-use std::time::Instant;
-
+use common::periodic::{
+    canonical_modified_period, extremes, modified_rod, parabolic_min, period_mean,
+};
 use common::{allocations, dense};
 use nalgebra::DVector;
 use semismooth_contact::march::{
@@ -24,8 +25,15 @@ fn moreau_jean(theta: f64, restitution: f64) -> MarchScheme {
     MarchScheme::MoreauJean { theta, restitution }
 }
 
-fn modified_rod() -> RodModel {
-    build_rod(&common::canonical(MassModel::Modified)).unwrap()
+/// A marcher of `rod` forced at its frequency, starting at rest.
+fn from_rest<'a>(rod: &'a RodModel, options: &MarchOptions) -> TimeMarcher<'a> {
+    TimeMarcher::new(
+        &rod.model,
+        rod.omega(),
+        options,
+        &MarchState::rest(&rod.model),
+    )
+    .unwrap()
 }
 
 /// Exact steady response of `M u'' + D u' + K u = f cos(w t)` without contact:
@@ -105,8 +113,7 @@ fn massless_contact_trapezoidal_never_penetrates_and_is_complementary_at_every_s
         steps_per_period: 1000,
         ..MarchOptions::default()
     };
-    let mut marcher =
-        TimeMarcher::new(model, rod.omega(), &options, &MarchState::rest(model)).unwrap();
+    let mut marcher = from_rest(&rod, &options);
     assert_eq!(marcher.scheme(), MarchScheme::MasslessContactTrapezoidal);
     let mut contact_steps = 0;
     for _ in 0..30 * 1000 {
@@ -132,45 +139,6 @@ fn massless_contact_trapezoidal_never_penetrates_and_is_complementary_at_every_s
     assert!(contact_steps > 1000, "the tip does reach the obstacle");
     assert_eq!(marcher.counters().factorizations, 1);
     assert_eq!(marcher.counters().active_steps, contact_steps);
-}
-
-fn canonical_modified_period(spp: usize, tolerance: f64) -> (SteadyPeriod, f64) {
-    let rod = modified_rod();
-    let options = MarchOptions {
-        steps_per_period: spp,
-        tolerance,
-        ..MarchOptions::default()
-    };
-    let start = Instant::now();
-    let period =
-        march_to_steady_state(&rod.model, rod.omega(), &options, &[rod.tip_dof()]).unwrap();
-    (period, start.elapsed().as_secs_f64())
-}
-
-fn extremes(x: &[f64]) -> (f64, f64) {
-    x.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(*v), hi.max(*v))
-        })
-}
-
-/// Minimum of a periodic sampled signal (last sample = first), refined by the parabola
-/// through the smallest sample and its neighbours (removes the O(h^2) sampling error).
-fn parabolic_min(x: &[f64]) -> f64 {
-    let n = x.len() - 1;
-    let i = (0..n).min_by(|&a, &b| x[a].total_cmp(&x[b])).unwrap();
-    let (a, b, c) = (x[(i + n - 1) % n], x[i], x[(i + 1) % n]);
-    let curvature = a - 2.0 * b + c;
-    if curvature > 0.0 {
-        b - (c - a) * (c - a) / (8.0 * curvature)
-    } else {
-        b
-    }
-}
-
-/// Mean over one period of a periodic sampled signal (trapezoidal rule).
-fn period_mean(x: &[f64]) -> f64 {
-    x.windows(2).map(|w| 0.5 * (w[0] + w[1])).sum::<f64>() / (x.len() - 1) as f64
 }
 
 #[test]
@@ -222,13 +190,7 @@ fn stepping_allocates_nothing_except_lemke_reports_on_contact_steps() {
             steps_per_period: 500,
             ..MarchOptions::default()
         };
-        let mut marcher = TimeMarcher::new(
-            &rod.model,
-            rod.omega(),
-            &options,
-            &MarchState::rest(&rod.model),
-        )
-        .unwrap();
+        let mut marcher = from_rest(&rod, &options);
         for _ in 0..20 * 500 {
             let (before, solves) = (allocations(), marcher.counters().contact_solves);
             marcher.step().unwrap();
@@ -300,13 +262,7 @@ fn moreau_jean_statistics(restitution: f64, spp: usize) -> ImpactStatistics {
         scheme: moreau_jean(0.5, restitution),
         ..MarchOptions::default()
     };
-    let mut marcher = TimeMarcher::new(
-        &rod.model,
-        rod.omega(),
-        &options,
-        &MarchState::rest(&rod.model),
-    )
-    .unwrap();
+    let mut marcher = from_rest(&rod, &options);
     let h = marcher.step_size();
     let (transient, measured) = (300, 50);
     let mut stats = ImpactStatistics {
@@ -552,147 +508,5 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
             assert!(last_period.displacements[0].iter().all(|u| u.is_finite()));
         }
         other => panic!("{other}"),
-    }
-}
-
-/// The numbers for the report: canonical modified-mass case at 1000..8000 steps per period.
-/// `cargo test --release --test time_marching -- --ignored --nocapture`
-#[test]
-#[ignore = "prints the refinement table for the README (about a minute); run with --ignored --nocapture"]
-fn report_canonical_modified_mass_refinement_table() {
-    for tolerance in [1e-8, 1e-11] {
-        println!("tolerance {tolerance:e}");
-        println!(
-            "spp | periods | tip max | tip min | tip min (parabola) | mean lambda \
-             | active steps | seconds"
-        );
-        for spp in [1000, 2000, 4000, 8000] {
-            let (period, seconds) = canonical_modified_period(spp, tolerance);
-            let (lo, hi) = extremes(&period.displacements[0]);
-            let mean = period_mean(&period.contact_forces[0]);
-            let refined = parabolic_min(&period.displacements[0]);
-            println!(
-                "{spp} | {} | {hi:.10} | {lo:.10} | {refined:.10} | {mean:.10e} | {} | \
-                 {seconds:.3}",
-                period.periods, period.counters.active_steps
-            );
-        }
-    }
-}
-
-/// SSN-HB from zero with the structured solver (up to 1000 Newton iterations): the Newton
-/// report and the tip summary on 4096 points.
-fn ssn_hb_tip(
-    model: &StructuralModel,
-    omega: f64,
-    harmonics: usize,
-    tip: usize,
-) -> (
-    semismooth::newton::NewtonReport,
-    semismooth_contact::hb::ResponseSummary,
-) {
-    use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
-    use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
-    let mut hb = SsnHb::new(
-        model,
-        omega,
-        &HbOptions {
-            harmonics,
-            ..HbOptions::default()
-        },
-    )
-    .unwrap();
-    let mut x = vec![0.0; semismooth::Residual::dim(&hb)];
-    let options = PolyalgorithmOptions {
-        max_iterations: 1000,
-        ..PolyalgorithmOptions::default()
-    };
-    let report =
-        solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &options).unwrap();
-    (report, hb.summary(&x, tip, 4096).unwrap())
-}
-
-/// Cross-check for the report: SSN-HB (H = 10, 20, 40, from zero, structured solver)
-/// against this reference at 8000 steps per period on the canonical modified-mass case.
-/// `cargo test --release --test time_marching -- --ignored --nocapture`
-#[test]
-#[ignore = "prints the HB-against-reference numbers for the README (8000 steps per period, slow); run with --ignored --nocapture"]
-fn report_harmonic_balance_against_the_reference() {
-    let rod = modified_rod();
-    let tip = rod.tip_dof();
-    let (period, _) = canonical_modified_period(8000, 1e-10);
-    let u = &period.displacements[0];
-    let reference_min = parabolic_min(u);
-    let reference_rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
-    let reference_mean = period_mean(&period.contact_forces[0]);
-    println!("reference: tip min {reference_min:.9} rms {reference_rms:.9} mean lambda {reference_mean:.9e}");
-    for harmonics in [10, 20, 40] {
-        let (report, s) = ssn_hb_tip(&rod.model, rod.omega(), harmonics, tip);
-        println!(
-            "H {harmonics}: converged {} in {} iterations; tip min {:.9} ({:.2e} rel), rms {:.9} \
-             ({:.2e} rel), mean lambda {:.9e} ({:.2e} rel)",
-            report.converged(),
-            report.iterations,
-            s.displacement_min,
-            ((s.displacement_min - reference_min) / reference_min).abs(),
-            s.displacement_rms,
-            ((s.displacement_rms - reference_rms) / reference_rms).abs(),
-            s.contact_force_mean[0],
-            ((s.contact_force_mean[0] - reference_mean) / reference_mean).abs()
-        );
-    }
-}
-
-/// Consistent mass, for the report: SSN-HB (H = 40) against Moreau–Jean (e = 0 and 0.5, at
-/// 1000 and 4000 steps per period; the last period when the march does not lock onto the
-/// forcing period). `cargo test --release --test time_marching -- --ignored --nocapture`
-#[test]
-#[ignore = "prints the consistent-mass comparison for the README (slow); run with --ignored --nocapture"]
-fn report_consistent_mass_harmonic_balance_against_moreau_jean() {
-    let rod = build_rod(&RodSpec::canonical()).unwrap();
-    let tip = rod.tip_dof();
-    let mut summaries = Vec::new();
-    for harmonics in [20, 40] {
-        let (report, s) = ssn_hb_tip(&rod.model, rod.omega(), harmonics, tip);
-        println!(
-            "SSN-HB H {harmonics} ({:?} after {} iterations, |F| {:.1e}): tip min {:.7} rms {:.7} \
-             mean lambda {:.6e}",
-            report.termination,
-            report.iterations,
-            report.residual_norm(),
-            s.displacement_min,
-            s.displacement_rms,
-            s.contact_force_mean[0]
-        );
-        summaries.push(s);
-    }
-    let s = summaries.pop().unwrap();
-    for e in [0.0, 0.5] {
-        for spp in [1000, 4000] {
-            let options = MarchOptions {
-                steps_per_period: spp,
-                max_periods: 400,
-                scheme: moreau_jean(0.5, e),
-                ..MarchOptions::default()
-            };
-            let period = match march_to_steady_state(&rod.model, rod.omega(), &options, &[tip]) {
-                Ok(p) => p,
-                Err(MarchError::NotSteady { last_period, .. }) => *last_period,
-                Err(other) => panic!("{other}"),
-            };
-            let u = &period.displacements[0];
-            let min = parabolic_min(u);
-            let rms = period_mean(&u.iter().map(|v| v * v).collect::<Vec<_>>()).sqrt();
-            let mean = period_mean(&period.contact_forces[0]);
-            println!(
-                "MJ e {e} spp {spp}: periods {} change {:.1e}; tip min {min:.7} ({:.2e} rel to HB) \
-                 rms {rms:.7} ({:.2e}) mean lambda {mean:.6e} ({:.2e})",
-                period.periods,
-                period.period_change,
-                ((min - s.displacement_min) / s.displacement_min).abs(),
-                ((rms - s.displacement_rms) / s.displacement_rms).abs(),
-                ((mean - s.contact_force_mean[0]) / s.contact_force_mean[0]).abs()
-            );
-        }
     }
 }

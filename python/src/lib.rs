@@ -20,6 +20,7 @@ use pyo3::types::{PyDict, PyList, PyTuple};
 
 use semismooth_contact::matrix_market::{matrix_market_text, parse_matrix};
 use semismooth_contact::model::SparseMatrix;
+use ssn::cli::Workload;
 use ssn::exit::CliError;
 use ssn::scene::Override;
 use ssn::source::SceneSource;
@@ -222,7 +223,7 @@ impl Scene {
         source.matrices = Some(Arc::new(matrices));
         let scene = Scene::checked(source.with(&Scene::overrides(values)?))?;
         // The matrices are checked when the structure is built: build it once now.
-        scene.source.load().map_err(run_error)?;
+        scene.source.load(Workload::Solve).map_err(run_error)?;
         Ok(scene)
     }
 
@@ -341,7 +342,7 @@ fn solve(py: Python<'_>, scene: &Scene) -> PyResult<Solution> {
     let source = scene.source.clone();
     let (solution, structure) = py
         .detach(move || -> Result<_, CliError> {
-            let loaded = source.load()?;
+            let loaded = source.load(Workload::Solve)?;
             let solution = semismooth_contact::solve(
                 &loaded.structure,
                 loaded.omega,
@@ -362,7 +363,7 @@ fn sweep(py: Python<'_>, scene: &Scene) -> PyResult<FrequencyResponse> {
     let source = scene.source.clone();
     let response = py
         .detach(move || -> Result<_, CliError> {
-            let loaded = source.load()?;
+            let loaded = source.load(Workload::Branch)?;
             let Some(settings) = loaded.scene.sweep.as_ref() else {
                 return Err(CliError::BadInput(format!(
                     "{}: no [sweep] section: add omega_ratio_from and omega_ratio_to (units of \
@@ -389,7 +390,7 @@ fn solutions(py: Python<'_>, scene: &Scene) -> PyResult<SolutionSet> {
     let source = scene.source.clone();
     let set = py
         .detach(move || -> Result<_, CliError> {
-            let loaded = source.load()?;
+            let loaded = source.load(Workload::Branch)?;
             semismooth_contact::solutions::find_solutions(
                 &loaded.structure,
                 loaded.omega,
@@ -410,7 +411,7 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
     let source = scene.source.clone();
     let (solution, stability) = py
         .detach(move || -> Result<_, CliError> {
-            let loaded = source.load()?;
+            let loaded = source.load(Workload::Solve)?;
             let settings = &loaded.scene.solver;
             let bad = |e: String| CliError::BadInput(format!("{}: {e}", source.path.display()));
             if !settings.method.is_harmonic_balance() {

@@ -471,36 +471,22 @@ impl<J> NewtonSolver<J> {
         let start = self.work.begin(problem, x)?;
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
+        let backtracking = |memory, line_search| StepRule::Backtracking {
+            memory,
+            line_search,
+        };
         let (step, full_steps) = match self.options.globalization {
             Globalization::None => (StepRule::Full, 0),
-            Globalization::Armijo(line_search) => (
-                StepRule::Backtracking {
-                    memory: 1,
-                    line_search,
-                },
-                0,
-            ),
+            Globalization::Armijo(line_search) => (backtracking(1, line_search), 0),
             Globalization::NonMonotone {
                 memory,
                 line_search,
-            } => (
-                StepRule::Backtracking {
-                    memory,
-                    line_search,
-                },
-                0,
-            ),
+            } => (backtracking(memory, line_search), 0),
             Globalization::Hybrid {
                 full_steps,
                 memory,
                 line_search,
-            } => (
-                StepRule::Backtracking {
-                    memory,
-                    line_search,
-                },
-                full_steps,
-            ),
+            } => (backtracking(memory, line_search), full_steps),
         };
         let rules = self.options.rules(step);
         let (termination, run) = self.work.run_with(

@@ -53,7 +53,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
 
     // The bare solves: the structure built once, only `solve` timed.
-    let loaded = scene.load().map_err(|e| e.to_string())?;
+    let loaded = scene
+        .load(ssn::cli::Workload::Solve)
+        .map_err(|e| e.to_string())?;
     let omega_1 = loaded.structure.omega_1;
     let started = Instant::now();
     let mut converged = 0;

@@ -222,11 +222,13 @@ impl AccuracyCost {
         s
     }
 
-    /// Writes the study into the directory `out` (which must exist): `accuracy_cost.csv`
-    /// ([`AccuracyCost::to_csv`]) and `accuracy_cost.svg` ([`AccuracyCost::write_svg`]).
+    /// Writes the study into the directory `out` (which must exist): [`STUDY_FILES`],
+    /// `accuracy_cost.csv` ([`AccuracyCost::to_csv`]) and `accuracy_cost.svg`
+    /// ([`AccuracyCost::write_svg`]).
     pub fn write_files(&self, out: &Path) -> Result<(), OutputError> {
-        write_atomically(&out.join("accuracy_cost.csv"), self.to_csv().as_bytes())?;
-        self.write_svg(&out.join("accuracy_cost.svg"))
+        let [csv, svg] = STUDY_FILES;
+        write_atomically(&out.join(csv), self.to_csv().as_bytes())?;
+        self.write_svg(&out.join(svg))
     }
 
     /// Log-log plot of the tip-minimum error against wall time, one curve per method
@@ -502,6 +504,9 @@ fn reference(
         march_tolerance: None,
     })
 }
+
+/// The files `ssn compare` writes into its `--out` directory.
+pub const STUDY_FILES: [&str; 2] = ["accuracy_cost.csv", "accuracy_cost.svg"];
 
 /// The accuracy-vs-cost study of `rod` forced at `omega`: the reference (see the module
 /// documentation), then every applicable method over its discretisation (LCP and penalty HB

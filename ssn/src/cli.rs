@@ -20,6 +20,7 @@ use crate::output::{
 };
 use crate::progress::progress_spinner;
 use crate::scene::{Method, Override, Scene};
+pub use crate::work::Workload;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
 use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
@@ -47,39 +48,52 @@ pub struct Loaded {
 /// that one run of its method fits in memory ([`crate::limits`]), and resolves its forcing
 /// frequency.
 pub fn load(path: &Path) -> Result<Loaded, CliError> {
-    load_with(path, &[])
+    load_for(path, Workload::Solve)
 }
 
-/// [`load`] with `overrides` (`--set key=value`) applied to the scene before it is
+/// [`load`], with the memory and work estimates of the command's `workload` (a branch
+/// for `sweep` and `solutions`, several runs for `compare`).
+pub fn load_for(path: &Path, workload: Workload) -> Result<Loaded, CliError> {
+    load_with(path, &[], workload)
+}
+
+/// [`load_for`] with `overrides` (`--set key=value`) applied to the scene before it is
 /// validated ([`Scene::from_toml_with`]).
-pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Loaded, CliError> {
+pub fn load_with(
+    path: &Path,
+    overrides: &[Override],
+    workload: Workload,
+) -> Result<Loaded, CliError> {
     let scene =
         Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
-    prepare(scene, false, None)
+    prepare(scene, workload, None)
 }
 
 /// The matrices of a `[model]` scene held in memory: each path the scene names to its
 /// matrix (the checks of [`build_imported`] apply as to files).
 pub type MatrixSource<'a> = &'a dyn Fn(&Path) -> Result<SparseMatrix, ImportError>;
 
-/// Builds a validated scene's structure as [`load`] does (the memory and work limits
-/// checked first; those of `ssn compare`'s runs when `compare`), reading the `[model]`'s
-/// matrices from `matrices` when given, else from their files.
+/// Builds a validated scene's structure as [`load`] does (the memory and work limits of
+/// `workload` checked first), reading the `[model]`'s matrices from `matrices` when given,
+/// else from their files.
 pub fn prepare(
     scene: Scene,
-    compare: bool,
+    workload: Workload,
     matrices: Option<MatrixSource>,
 ) -> Result<Loaded, CliError> {
     let path = scene.path.clone();
     let path = path.as_path();
-    let limit = crate::limits::memory_limit();
+    let compare = workload == Workload::Compare;
+    let limit = crate::limits::memory_limit().map_err(CliError::BadInput)?;
+    let work_limit = crate::limits::work_limit().map_err(CliError::BadInput)?;
     // A rod is estimated before it is built; an imported model once its size is read.
     if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
         crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
     }
-    if let Some(work) = crate::limits::rod_scene_work(&scene, compare) {
-        crate::limits::check_work(&work, crate::limits::work_limit())
-            .map_err(|e| input_error(path, e))?;
+    if scene.model.is_none() {
+        let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
+        let work = crate::work::scene_work(&scene, n, m, workload);
+        crate::limits::check_work(&work, work_limit).map_err(|e| input_error(path, e))?;
     }
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
@@ -91,9 +105,9 @@ pub fn prepare(
             .map_err(|e| CliError::BadInput(e.to_string()))?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
-            let work = crate::limits::structure_work(&structure, &scene.solver, compare);
-            crate::limits::check_work(&work, crate::limits::work_limit())
-                .map_err(|e| input_error(path, e))?;
+            let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+            let work = crate::work::scene_work(&scene, n, m, workload);
+            crate::limits::check_work(&work, work_limit).map_err(|e| input_error(path, e))?;
             structure
         }
         None => {
@@ -107,11 +121,122 @@ pub fn prepare(
         }
     };
     let omega = scene.omega(structure.omega_1);
+    check_scales(&scene, structure.omega_1, omega).map_err(|e| input_error(path, e))?;
+    check_resonance(&scene, &structure, omega).map_err(|e| input_error(path, e))?;
     Ok(Loaded {
         scene,
         structure,
         omega,
     })
+}
+
+/// Largest ratio of a forcing or sweep frequency to `omega_1` (and smallest, inverted):
+/// beyond it `(H omega)^2 M` leaves the floating-point range or the period the time steps.
+pub const MAX_FREQUENCY_RATIO: f64 = 1e6;
+
+/// Largest damping ratio at `omega_1` (`zeta`, or `alpha / (2 omega_1) + beta omega_1 / 2`).
+pub const MAX_DAMPING_RATIO: f64 = 1e6;
+
+/// Refuses frequencies and damping out of scale with the structure's `omega_1` (their
+/// products overflow into infinite matrices): the message names the key and the value.
+fn check_scales(scene: &Scene, omega_1: f64, omega: f64) -> Result<(), String> {
+    use semismooth_contact::rod::{DampingSpec, FrequencySpec};
+    let range = 1.0 / MAX_FREQUENCY_RATIO..=MAX_FREQUENCY_RATIO;
+    let ratio = omega / omega_1;
+    if !range.contains(&ratio) {
+        let (key, value) = match scene.frequency() {
+            FrequencySpec::Ratio(r) => ("forcing.omega_ratio", r),
+            FrequencySpec::Absolute(w) => ("forcing.omega", w),
+        };
+        return Err(format!(
+            "invalid `{key}` = {value:e} (omega / omega_1 = {ratio:e}): allowed frequencies \
+             between {:e} and {:e} times omega_1 = {omega_1:e}",
+            range.start(),
+            range.end()
+        ));
+    }
+    if let Some(sweep) = &scene.sweep {
+        for (key, r) in [
+            ("sweep.omega_ratio_from", sweep.omega_ratio_from),
+            ("sweep.omega_ratio_to", sweep.omega_ratio_to),
+        ] {
+            if !range.contains(&r) {
+                return Err(format!(
+                    "invalid `{key}` = {r}: allowed {:e}..={:e} (units of omega_1)",
+                    range.start(),
+                    range.end()
+                ));
+            }
+        }
+    }
+    let damping = match &scene.model {
+        Some(spec) => spec.damping,
+        None => scene.rod.damping,
+    };
+    let (keys, zeta) = match damping {
+        Some(DampingSpec::StiffnessProportional { zeta }) => ("damping.zeta", zeta),
+        Some(DampingSpec::Rayleigh { alpha, beta }) => (
+            "damping.alpha and damping.beta",
+            alpha / (2.0 * omega_1) + beta * omega_1 / 2.0,
+        ),
+        None => ("", 0.0),
+    };
+    if zeta.is_nan() || zeta > MAX_DAMPING_RATIO {
+        return Err(format!(
+            "invalid `{keys}`: a damping ratio of {zeta:e} at omega_1 = {omega_1:e}: allowed at \
+             most {MAX_DAMPING_RATIO:e}"
+        ));
+    }
+    Ok(())
+}
+
+/// Amplification of the undamped linear response over the static one above which a
+/// structure without damping and contact is taken as forced at a natural frequency (a
+/// damping ratio of 1e-9 bounds the resonant amplification near 5e8).
+pub const RESONANCE_AMPLIFICATION: f64 = 1e9;
+
+/// Refuses an undamped structure without contact forced at a natural frequency: it has no
+/// periodic solution (the response grows without bound), so nothing is run.
+fn check_resonance(scene: &Scene, structure: &Structure, omega: f64) -> Result<(), String> {
+    let model = &structure.model;
+    if !model.contacts.is_empty() || model.damping.is_some() {
+        return Ok(());
+    }
+    match model.undamped_amplification(omega) {
+        Some(a) if a.is_nan() || a > RESONANCE_AMPLIFICATION => {
+            let key = match scene.frequency() {
+                semismooth_contact::rod::FrequencySpec::Ratio(_) => "forcing.omega_ratio",
+                semismooth_contact::rod::FrequencySpec::Absolute(_) => "forcing.omega",
+            };
+            Err(format!(
+                "invalid `{key}`: omega / omega_1 = {} is a natural frequency of the undamped \
+                 structure without contact (its response would be {a:.1e} times the static \
+                 one): there is no periodic solution; allowed a frequency off the natural \
+                 frequencies, or add [damping] or a contact",
+                omega / structure.omega_1
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Claims the files a `[model]` scene names (its matrices and load vector) as inputs of
+/// `set`: no output may replace them.
+pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<(), CliError> {
+    if let Some(spec) = &scene.model {
+        let mut files = vec![
+            (&spec.mass, "[model] mass"),
+            (&spec.stiffness, "[model] stiffness"),
+            (&spec.forcing_vector, "[forcing] vector"),
+        ];
+        if let Some(d) = &spec.damping_matrix {
+            files.push((d, "[model] damping"));
+        }
+        for (path, key) in files {
+            set.input(path, &format!("the scene's {key} file"))?;
+        }
+    }
+    Ok(())
 }
 
 /// What `ssn solve` and `ssn sweep` read and write: the scene, and the optional outputs
@@ -159,8 +284,20 @@ pub struct SolveArgs {
     #[arg(long)]
     pub start: Option<PathBuf>,
     /// The solution of an `ssn solutions --json` file to start from (1 = the first listed).
-    #[arg(long, requires = "start")]
+    #[arg(long, requires = "start", allow_hyphen_values = true, value_parser = entry_number)]
     pub entry: Option<usize>,
+}
+
+/// `--entry K`: a solution counted from 1 (a negative or zero `K` is named as such, not
+/// taken for an option).
+fn entry_number(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(k) if k >= 1 => Ok(k),
+        _ => Err(format!(
+            "`{}`: allowed 1, 2, ... (the solutions of the file, counted from 1)",
+            printable(text)
+        )),
+    }
 }
 
 /// The curve of a run's SVG: titled by the scene, or `untitled` when it has no title.
@@ -177,7 +314,7 @@ impl RunArgs {
     /// and every file target must be new or a regular file.
     pub(crate) fn plan(&self) -> Result<OutputSet, CliError> {
         let mut set = OutputSet::new();
-        set.input(&self.scene, "the scene");
+        set.input(&self.scene, "the scene")?;
         if self.json {
             set.stdout("--json")?;
         } else if !crate::io::quiet() {
@@ -236,10 +373,11 @@ impl RunArgs {
                 format!("{doc}\n").into_bytes(),
             );
         }
-        set.commit()?;
-        if !self.json {
-            write_text(&text())?;
+        if !self.json && !crate::io::quiet() {
+            // The summary goes with the files: a summary that cannot be written leaves none.
+            set.add(Path::new(crate::io::STDOUT_NAME), text().into_bytes());
         }
+        set.commit()?;
         if converged {
             Ok(())
         } else {
@@ -284,7 +422,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     let mut outputs = args.plan()?;
     // The start is an input: no output may replace it.
     if let Some(start) = &solve_args.start {
-        outputs.input(start, "the --start state");
+        outputs.input(start, "the --start state")?;
     }
     if let Some(state) = &solve_args.state {
         outputs.target(state, "--state")?;
@@ -293,7 +431,8 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         scene,
         structure: rod,
         omega,
-    } = load_with(&args.scene, &args.set)?;
+    } = load_with(&args.scene, &args.set, Workload::Solve)?;
+    claim_model_files(&mut outputs, &scene)?;
     let shape = StateShape {
         method: scene.solver.method,
         harmonics: scene.solver.harmonics,
@@ -526,7 +665,8 @@ pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
         scene,
         structure: rod,
         ..
-    } = load_with(&args.scene, &args.set)?;
+    } = load_with(&args.scene, &args.set, Workload::Branch)?;
+    claim_model_files(&mut outputs, &scene)?;
     let Some(settings) = scene.sweep.as_ref() else {
         return Err(input_error(
             &args.scene,
@@ -663,13 +803,19 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
             "invalid --accuracy {accuracy}: allowed a finite number > 0 (relative error of the tip minimum)"
         )));
     }
-    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let Loaded {
         scene,
         structure: rod,
         omega,
-    } = prepare(scene, true, None)?;
+    } = load_for(path, Workload::Compare)?;
     prepare_directory(out)?;
+    // Every target is checked before the study runs (the files are written after it).
+    let mut targets = OutputSet::new();
+    targets.input(path, "the scene")?;
+    claim_model_files(&mut targets, &scene)?;
+    for name in crate::accuracy_cost::STUDY_FILES {
+        targets.target(&out.join(name), "ssn compare --out")?;
+    }
     let bar = progress_spinner("compare");
     let say = |line: &str| {
         bar.set_message(line.to_string());
@@ -698,7 +844,8 @@ pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
     prepare_directory(dir)?;
     // All files or none: every target is claimed before anything is written.
     let mut set = OutputSet::new();
-    set.input(path, "the scene");
+    set.input(path, "the scene")?;
+    claim_model_files(&mut set, &scene)?;
     let mut written = String::new();
     for (name, text) in crate::import::export_files(&scene, &structure) {
         let target = dir.join(&name);

@@ -7,6 +7,18 @@ use semismooth_contact::rod::DampingSpec;
 use crate::io::printable;
 use crate::scene::{Method, Scene};
 
+/// The first lines of a description: the scene's file and its title.
+fn scene_header(path: &std::path::Path, title: Option<&str>) -> String {
+    let mut out = format!(
+        "scene             {}\n",
+        printable(&path.display().to_string())
+    );
+    if let Some(t) = title {
+        out.push_str(&format!("title             {}\n", printable(t)));
+    }
+    out
+}
+
 /// The resolved model of a scene forced at `omega`, in words (`ssn scene-check`).
 pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> String {
     use semismooth_contact::rod::{DampingSpec, FrequencySpec, LoadKind};
@@ -14,18 +26,11 @@ pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> St
         return describe_imported(scene, spec, rod, omega, modes);
     }
     let s = &scene.rod;
-    let mut out = String::new();
+    let mut out = scene_header(&scene.path, scene.title.as_deref());
     let mut line = |t: String| {
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!(
-        "scene             {}",
-        printable(&scene.path.display().to_string())
-    ));
-    if let Some(t) = &scene.title {
-        line(format!("title             {}", printable(t)));
-    }
     line(format!(
         "rod               {} elements, L = {}, EA = {}, rhoA = {}, {:?} mass",
         s.elements, s.length, s.axial_stiffness, s.mass_per_length, s.mass
@@ -162,25 +167,21 @@ pub fn describe_imported(
     modes: &[f64],
 ) -> String {
     let model = &structure.model;
-    let mut out = String::new();
+    let mut out = scene_header(&scene.path, scene.title.as_deref());
     let mut line = |t: String| {
         out.push_str(&t);
         out.push('\n');
     };
-    line(format!("scene             {}", scene.path.display()));
-    if let Some(t) = &scene.title {
-        line(format!("title             {t}"));
-    }
     let massless = (0..model.dofs())
         .filter(|&i| semismooth_contact::model::diagonal_entry(&model.mass, i) == 0.0)
         .count();
     line(format!(
         "model             M = {}, K = {}{}",
-        spec.mass.display(),
-        spec.stiffness.display(),
-        spec.damping_matrix
-            .as_ref()
-            .map_or(String::new(), |d| format!(", D = {}", d.display()))
+        printable(&spec.mass.display().to_string()),
+        printable(&spec.stiffness.display().to_string()),
+        spec.damping_matrix.as_ref().map_or(String::new(), |d| {
+            format!(", D = {}", printable(&d.display().to_string()))
+        })
     ));
     line(format!(
         "unknowns          {} dofs ({massless} with a zero mass diagonal), {} stored entries in K",
@@ -203,7 +204,7 @@ pub fn describe_imported(
     line(format!(
         "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
         spec.amplitude,
-        spec.forcing_vector.display(),
+        printable(&spec.forcing_vector.display().to_string()),
         omega,
         omega / structure.omega_1
     ));

@@ -25,7 +25,9 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     let frequency = scene.frequency();
     let mut t = String::new();
     let title = scene.title.as_deref().unwrap_or("untitled");
-    let _ = writeln!(t, "title = {:?}", format!("{title} (exported)"));
+    // A TOML string (TOML's escapes, not Rust's `{:?}` ones, which TOML cannot read).
+    let title = toml::Value::String(format!("{title} (exported)"));
+    let _ = writeln!(t, "title = {title}");
     let _ = writeln!(t, "\n[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"");
     if model.damping.is_some() {
         let _ = writeln!(t, "damping = \"D.mtx\"");

@@ -174,7 +174,10 @@ pub enum TargetError {
         kind: &'static str,
     },
     /// Two outputs, or an output and an input, name one file (exit code 2).
-    #[error("{path}: named as both {first} and {second}: give each output its own file")]
+    #[error(
+        "{path}: named as both {first} and {second}: an input is never replaced, and each \
+         output needs a file of its own"
+    )]
     Clash {
         /// The path.
         path: PathBuf,
@@ -213,8 +216,8 @@ fn identity(path: &Path) -> Identity {
 /// The outputs of one run: checked before the run, written all or nothing after it.
 #[derive(Debug, Default)]
 pub struct OutputSet {
-    /// Files already claimed (inputs, outputs), with the name of their use.
-    claimed: Vec<(Identity, String)>,
+    /// Files already claimed, with the name of their use and whether it is an output.
+    claimed: Vec<(Identity, String, bool)>,
     /// Contents to write, in order.
     pending: Vec<(PathBuf, Vec<u8>)>,
 }
@@ -225,9 +228,19 @@ impl OutputSet {
         Self::default()
     }
 
-    /// Claims an input (the scene): no output may replace it.
-    pub fn input(&mut self, path: &Path, what: &str) {
-        self.claimed.push((identity(path), what.to_string()));
+    /// Claims an input (the scene, a file it names, a start state): no output may replace
+    /// it; `Err` when an output claimed before names it.
+    pub fn input(&mut self, path: &Path, what: &str) -> Result<(), TargetError> {
+        let id = identity(path);
+        if let Some((_, first, _)) = self.claimed.iter().find(|(i, _, out)| *out && *i == id) {
+            return Err(TargetError::Clash {
+                path: path.to_path_buf(),
+                first: first.clone(),
+                second: what.to_string(),
+            });
+        }
+        self.claimed.push((id, what.to_string(), false));
+        Ok(())
     }
 
     /// Claims standard output for `what` (e.g. `--json`).
@@ -249,14 +262,14 @@ impl OutputSet {
             }
         }
         let id = identity(path);
-        if let Some((_, first)) = self.claimed.iter().find(|(i, _)| *i == id) {
+        if let Some((_, first, _)) = self.claimed.iter().find(|(i, _, _)| *i == id) {
             return Err(TargetError::Clash {
                 path: path.to_path_buf(),
                 first: first.clone(),
                 second: what.to_string(),
             });
         }
-        self.claimed.push((id, what.to_string()));
+        self.claimed.push((id, what.to_string(), true));
         Ok(())
     }
 
@@ -265,43 +278,192 @@ impl OutputSet {
         self.pending.push((path.to_path_buf(), bytes));
     }
 
-    /// Writes every queued file to a temporary file beside it, then renames them all into
-    /// place; when one cannot be written, none is renamed and the temporary files are
-    /// removed. Standard-output contents are written after the files.
+    /// Writes every queued file to a temporary file beside it, checks every target again,
+    /// writes the standard-output contents, then renames the files into place; when a file
+    /// or standard output cannot be written, none is renamed and the temporary files are
+    /// removed. The directories written into are locked (`flock`) meanwhile, so two runs
+    /// writing into one directory at once leave one run's complete set, never a mix.
     pub fn commit(self) -> Result<(), OutputError> {
-        let mut staged = Vec::new();
         let mut to_stdout = Vec::new();
+        let mut files = Vec::new();
         for (path, bytes) in self.pending {
             if path.as_os_str() == STDOUT_NAME {
                 to_stdout.push(bytes);
             } else {
-                let tmp = stage(&path, &bytes)?;
-                staged.push((path, tmp));
+                files.push((path, bytes));
             }
         }
-        for (path, tmp) in staged {
-            // The target was checked before the run; check again just before replacing it.
-            if let Ok(meta) = std::fs::symlink_metadata(&path) {
+        let _locks = lock_directories(files.iter().map(|(p, _)| p.as_path()))?;
+        let mut staged = Vec::new();
+        for (path, bytes) in files {
+            let tmp = stage(&path, &bytes)?;
+            staged.push((path, Staged::new(tmp)));
+        }
+        // The targets were checked before the run; check them all again before replacing
+        // any.
+        for (path, _) in &staged {
+            if let Ok(meta) = std::fs::symlink_metadata(path) {
                 if !meta.is_file() {
                     return Err(OutputError::Io {
                         source: std::io::Error::other(format!(
                             "it became {} during the run: not replaced",
                             file_kind(&meta.file_type())
                         )),
-                        path,
+                        path: path.clone(),
                     });
                 }
             }
-            tmp.persist(&path).map_err(|e| OutputError::Io {
-                path: path.clone(),
-                source: e.error,
-            })?;
         }
         for bytes in to_stdout {
             write_stdout(&String::from_utf8_lossy(&bytes))?;
         }
+        for (path, tmp) in staged {
+            tmp.persist(&path)?;
+        }
         Ok(())
     }
+}
+
+/// A staged temporary file, registered for removal on an interrupt until it is renamed
+/// into place or dropped.
+struct Staged(Option<tempfile::NamedTempFile>);
+
+impl Staged {
+    fn new(tmp: tempfile::NamedTempFile) -> Self {
+        register_cleanup(tmp.path());
+        Self(Some(tmp))
+    }
+
+    fn persist(mut self, path: &Path) -> Result<(), OutputError> {
+        let tmp = self.0.take().expect("a staged file is persisted once");
+        let temporary = tmp.path().to_path_buf();
+        let result = tmp.persist(path).map_err(|e| OutputError::Io {
+            path: path.to_path_buf(),
+            source: e.error,
+        });
+        unregister_cleanup(&temporary);
+        result.map(|_| ())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if let Some(tmp) = self.0.take() {
+            unregister_cleanup(tmp.path());
+        }
+    }
+}
+
+/// Exclusive `flock`s on the distinct directories of `paths`, taken in a fixed order (no
+/// two runs wait on each other), released when dropped.
+fn lock_directories<'a>(
+    paths: impl Iterator<Item = &'a Path>,
+) -> Result<Vec<std::fs::File>, OutputError> {
+    // Each directory once, with the first file written into it (the one an error names).
+    let mut dirs: Vec<(PathBuf, &Path)> = paths
+        .map(|p| {
+            let dir = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            (
+                std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()),
+                p,
+            )
+        })
+        .collect();
+    dirs.sort_by(|a, b| a.0.cmp(&b.0));
+    dirs.dedup_by(|a, b| a.0 == b.0);
+    let mut locks = Vec::with_capacity(dirs.len());
+    for (dir, file) in dirs {
+        let io = |source: std::io::Error| OutputError::Io {
+            path: file.to_path_buf(),
+            source: std::io::Error::new(
+                source.kind(),
+                format!("its directory {}: {source}", dir.display()),
+            ),
+        };
+        let handle = File::open(&dir).map_err(io)?;
+        rustix::fs::flock(&handle, rustix::fs::FlockOperation::LockExclusive)
+            .map_err(|e| io(e.into()))?;
+        locks.push(handle);
+    }
+    Ok(locks)
+}
+
+/// Paths removed when the program is interrupted: staged temporary files and output
+/// directories a run created.
+static CLEANUP: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Registers `path` for removal on an interrupt ([`remove_on_interrupt`]).
+pub fn register_cleanup(path: &Path) {
+    if let Ok(mut list) = CLEANUP.lock() {
+        list.push(path.to_path_buf());
+    }
+}
+
+/// Forgets `path` (kept, or removed already).
+pub fn unregister_cleanup(path: &Path) {
+    if let Ok(mut list) = CLEANUP.lock() {
+        if let Some(k) = list.iter().rposition(|p| p == path) {
+            list.remove(k);
+        }
+    }
+}
+
+/// Exit code of a run ended by a signal (128 + SIGINT, as a shell reports it).
+pub const INTERRUPTED_EXIT_CODE: i32 = 130;
+
+/// On SIGINT, SIGTERM or SIGHUP: removes the registered staged files and created
+/// directories (so an interrupted run leaves nothing half-written behind), says so on
+/// standard error and exits with [`INTERRUPTED_EXIT_CODE`]. Called first thing by `main`;
+/// a failure to install the handler leaves the default behaviour.
+pub fn remove_on_interrupt() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    let spawned = std::thread::Builder::new()
+        .name("interrupt".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let paths = CLEANUP
+                    .lock()
+                    .map(|mut l| std::mem::take(&mut *l))
+                    .unwrap_or_default();
+                for path in paths.iter().rev() {
+                    let _ = if path.is_dir() {
+                        std::fs::remove_dir_all(path)
+                    } else {
+                        std::fs::remove_file(path)
+                    };
+                }
+                write_stderr(&format!(
+                    "interrupted (signal {signal}): no output written\n"
+                ));
+                std::process::exit(INTERRUPTED_EXIT_CODE);
+            }
+        });
+    drop(spawned);
+}
+
+/// The set [`write_atomically`] queues into while [`all_or_nothing`] runs.
+static COLLECTING: std::sync::Mutex<Option<OutputSet>> = std::sync::Mutex::new(None);
+
+/// Runs `run`, whose [`write_atomically`] calls are queued instead of written, and
+/// commits them together when it succeeds ([`OutputSet::commit`]): a run that fails, or
+/// whose last file cannot be written, leaves none of them.
+pub fn all_or_nothing<T, E: From<OutputError>>(run: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
+    if let Ok(mut c) = COLLECTING.lock() {
+        *c = Some(OutputSet::new());
+    }
+    let result = run();
+    let set = COLLECTING.lock().ok().and_then(|mut c| c.take());
+    let value = result?;
+    if let Some(set) = set {
+        set.commit()?;
+    }
+    Ok(value)
 }
 
 /// Writes `bytes` to a new exclusive temporary file in `path`'s directory (mode 0644
@@ -369,13 +531,22 @@ pub enum OutputError {
 /// Writes `bytes` to `path` through an exclusive temporary file in the same directory and a
 /// rename: readers see either the old file or the whole new one. A target that exists and
 /// is not a regular file (a symbolic link, a device, a FIFO, a directory) is not replaced
-/// (see [`OutputSet`], which writes several files all or nothing).
+/// (see [`OutputSet`], which writes several files all or nothing). Within
+/// [`all_or_nothing`] the file is queued and written with the run's other files.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let mut set = OutputSet::new();
-    set.target(path, "output").map_err(|e| OutputError::Io {
+    let refused = |e: TargetError| OutputError::Io {
         path: path.to_path_buf(),
         source: std::io::Error::other(e.to_string()),
-    })?;
+    };
+    if let Ok(mut collecting) = COLLECTING.lock() {
+        if let Some(set) = collecting.as_mut() {
+            set.target(path, "output").map_err(refused)?;
+            set.add(path, bytes.to_vec());
+            return Ok(());
+        }
+    }
+    let mut set = OutputSet::new();
+    set.target(path, "output").map_err(refused)?;
     set.add(path, bytes.to_vec());
     set.commit()
 }
@@ -429,7 +600,7 @@ mod tests {
         let scene = dir.path().join("s.toml");
         std::fs::write(&scene, "x").unwrap();
         let mut set = OutputSet::new();
-        set.input(&scene, "the scene");
+        set.input(&scene, "the scene").unwrap();
         let e = set.target(&scene, "--csv").unwrap_err().to_string();
         assert!(e.contains("the scene") && e.contains("--csv"), "{e}");
         let out = dir.path().join("o.csv");

@@ -21,3 +21,4 @@ pub mod state;
 pub mod study;
 pub mod tables;
 pub mod words;
+pub mod work;

@@ -17,7 +17,9 @@
 //! plus `400 N` for the rod itself (`N` the dofs of an imported `[model]`, whose size is
 //! known once its files are read: [`structure_memory`]). The limit is the memory available to new processes
 //! (`MemAvailable` of `/proc/meminfo`), or the number of bytes in the environment variable
-//! `SSN_MEMORY_LIMIT` when it is set; where neither is known nothing is refused.
+//! `SSN_MEMORY_LIMIT` when it is set (anything but a number > 0 is refused), and never
+//! more than the address space the process may still map (`RLIMIT_AS`, `ulimit -v`); where
+//! none is known nothing is refused.
 //!
 //! A run that fits in memory can still take hours: [`run_work`] estimates the operations of
 //! its dense factorizations, refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
@@ -166,19 +168,50 @@ pub fn compare_memory(elements: usize, contacts: usize, base: &SolverSettings) -
         .expect("four runs")
 }
 
-/// The memory a run may use: `SSN_MEMORY_LIMIT` (bytes) when set, else `MemAvailable`.
-pub fn memory_limit() -> Option<f64> {
-    if let Ok(v) = std::env::var("SSN_MEMORY_LIMIT") {
-        if let Ok(b) = v.trim().parse::<f64>() {
-            if b.is_finite() && b > 0.0 {
-                return Some(b);
-            }
-        }
+/// A limit given in the environment variable `name`: `Ok(None)` when unset, `Err` naming
+/// the variable and its value unless it is a finite number > 0.
+fn limit_from_env(name: &str, unit: &str) -> Result<Option<f64>, String> {
+    match std::env::var(name) {
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(format!(
+            "invalid {name} = {v:?}: allowed a finite number of {unit} > 0"
+        )),
+        Ok(v) => match v.trim().parse::<f64>() {
+            Ok(b) if b.is_finite() && b > 0.0 => Ok(Some(b)),
+            _ => Err(format!(
+                "invalid {name} = {:?}: allowed a finite number of {unit} > 0 (e.g. 8e9)",
+                crate::io::printable(&v)
+            )),
+        },
     }
+}
+
+/// The memory a run may use: `SSN_MEMORY_LIMIT` (bytes) when set, else `MemAvailable`;
+/// in both cases at most the address space the process may still map (`RLIMIT_AS`, as
+/// set by `ulimit -v`, less what is mapped already). `Err` for a `SSN_MEMORY_LIMIT` that
+/// is not a number > 0.
+pub fn memory_limit() -> Result<Option<f64>, String> {
+    let limit = match limit_from_env("SSN_MEMORY_LIMIT", "bytes")? {
+        Some(b) => Some(b),
+        None => meminfo_available(),
+    };
+    Ok(match (limit, address_space_left()) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    })
+}
+
+/// `MemAvailable` of `/proc/meminfo`, in bytes.
+fn meminfo_available() -> Option<f64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kb: f64 = info
+    proc_kilobytes(&info, "MemAvailable:")
+}
+
+/// The value of the `/proc` field `key` given in kB, in bytes.
+fn proc_kilobytes(text: &str, key: &str) -> Option<f64> {
+    let kb: f64 = text
         .lines()
-        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .find_map(|l| l.strip_prefix(key))?
         .trim()
         .trim_end_matches("kB")
         .trim()
@@ -187,13 +220,35 @@ pub fn memory_limit() -> Option<f64> {
     Some(kb * 1024.0)
 }
 
+/// Address space mapped beyond the resident peak the estimates bound: the allocator's
+/// per-thread arenas (64 MB of address space each) and the threads' stacks.
+const ADDRESS_SPACE_RESERVE: f64 = 256e6;
+
+/// Address space the process may still map: the soft `RLIMIT_AS` (`/proc/self/limits`)
+/// less the current `VmSize` and [`ADDRESS_SPACE_RESERVE`]; `None` when unlimited or
+/// unknown.
+fn address_space_left() -> Option<f64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let soft: f64 = limits
+        .lines()
+        .find_map(|l| l.strip_prefix("Max address space"))?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let mapped = proc_kilobytes(&status, "VmSize:").unwrap_or(0.0);
+    Some((soft - mapped - ADDRESS_SPACE_RESERVE).max(0.0))
+}
+
 /// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
 /// limit.
 pub fn check(need: &MemoryEstimate, limit: Option<f64>) -> Result<(), String> {
     match limit {
         Some(limit) if need.bytes.is_nan() || need.bytes > limit => Err(format!(
             "these settings need about {} of memory ({}), more than the {} available \
-             (MemAvailable, or SSN_MEMORY_LIMIT when set): allowed are settings whose estimate \
+             (MemAvailable, or SSN_MEMORY_LIMIT when set, within the address-space limit of \
+             ulimit -v): allowed are settings whose estimate \
              fits; reduce {}",
             human(need.bytes),
             need.what,
@@ -294,7 +349,7 @@ pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> 
 
 /// [`run_work`] for a model of `dofs` dofs and `contacts` contacts; `dense_keys`: the keys a
 /// refusal of the dense solver names.
-fn size_work(
+pub(crate) fn size_work(
     dofs: usize,
     contacts: usize,
     settings: &SolverSettings,
@@ -346,6 +401,20 @@ fn size_work(
                 }
             }
         }
+        (Method::PenaltyHb, _) if contacts > 0 => {
+            // Penalty HB factors the condensed system at every iteration and stiff
+            // penalties take hundreds of them: counted at solver.max_iterations.
+            let unknowns = m * s;
+            let count = settings.max_iterations as f64;
+            WorkEstimate {
+                flops: count * 2.0 / 3.0 * unknowns.powi(3),
+                what: format!(
+                    "up to {count} LU factorizations (solver.max_iterations) of the condensed \
+                     penalty system on {unknowns:.0} unknowns"
+                ),
+                keys: "solver.harmonics, solver.max_iterations and the number of contacts",
+            }
+        }
         (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {
             WorkEstimate {
                 flops: lu(m * s),
@@ -365,14 +434,13 @@ fn size_work(
     }
 }
 
-/// The operations a run may take: `SSN_WORK_LIMIT` when set to a number > 0, else
-/// [`DEFAULT_WORK_LIMIT`].
-pub fn work_limit() -> f64 {
-    std::env::var("SSN_WORK_LIMIT")
-        .ok()
-        .and_then(|v| v.trim().parse::<f64>().ok())
-        .filter(|b| b.is_finite() && *b > 0.0)
-        .unwrap_or(DEFAULT_WORK_LIMIT)
+/// The operations a run may take: `SSN_WORK_LIMIT` when set, else [`DEFAULT_WORK_LIMIT`];
+/// `Err` for a value that is not a number > 0.
+pub fn work_limit() -> Result<f64, String> {
+    Ok(
+        limit_from_env("SSN_WORK_LIMIT", "floating-point operations")?
+            .unwrap_or(DEFAULT_WORK_LIMIT),
+    )
 }
 
 /// Refuses `need` when it exceeds `limit`: the message names the keys, the need and the
@@ -391,35 +459,8 @@ pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
     }
 }
 
-/// The work estimate of the command run on a rod `scene` (`compare`: its SSN-HB reference
-/// run at 320 harmonics, the largest); `None` for a `[model]` scene, estimated once imported
-/// ([`structure_work`]).
-pub fn rod_scene_work(scene: &Scene, compare: bool) -> Option<WorkEstimate> {
-    if scene.model.is_some() {
-        return None;
-    }
-    let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
-    Some(run_work(n, m, &compared(&scene.solver, compare)))
-}
-
-/// The work estimate of `settings` (or of the comparison's reference run) on an imported
-/// `structure`.
-pub fn structure_work(
-    structure: &Structure,
-    settings: &SolverSettings,
-    compare: bool,
-) -> WorkEstimate {
-    let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
-    size_work(
-        n,
-        m,
-        &compared(settings, compare),
-        "solver.linear_solver, solver.harmonics, the model's size",
-    )
-}
-
 /// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
-fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
+pub(crate) fn compared(settings: &SolverSettings, compare: bool) -> SolverSettings {
     let mut settings = settings.clone();
     if compare {
         settings.method = Method::SsnHb;

@@ -155,6 +155,7 @@ enum Command {
 
 fn main() -> ExitCode {
     io::guard_standard_streams();
+    io::remove_on_interrupt();
     let args = match Cli::try_parse() {
         Ok(args) => args,
         Err(e) => return clap_exit(&e),
@@ -164,7 +165,7 @@ fn main() -> ExitCode {
     let result = match &args.command {
         None => {
             let out = args.out.clone().unwrap_or_else(default_out);
-            in_new_directory(&out, || figures::default_run(&out))
+            in_new_directory(&out, || io::all_or_nothing(|| figures::default_run(&out)))
         }
         // `ssn --out DIR compare SCENE` and `ssn compare SCENE --out DIR` both work.
         Some(Command::Compare {
@@ -173,7 +174,9 @@ fn main() -> ExitCode {
             out,
         }) => {
             let out = out.clone().or(args.out.clone()).unwrap_or_else(default_out);
-            in_new_directory(&out, || cli::compare(scene, &out, *accuracy))
+            in_new_directory(&out, || {
+                io::all_or_nothing(|| cli::compare(scene, &out, *accuracy))
+            })
         }
         Some(command) if args.out.is_some() => Err(CliError::BadInput(format!(
             "--out applies only to the default run and `ssn compare`; `ssn {}` writes the \
@@ -202,8 +205,9 @@ fn main() -> ExitCode {
 }
 
 /// Runs `run`, which writes into the directory `out`; when `out` did not exist before and
-/// the run fails, the directories it created (from the outermost one that did not exist)
-/// are removed with what was written into them, so a failed run leaves nothing behind.
+/// the run fails or is interrupted, the directories it created (from the outermost one
+/// that did not exist) are removed with what was written into them, so a failed run
+/// leaves nothing behind.
 fn in_new_directory(
     out: &Path,
     run: impl FnOnce() -> Result<(), CliError>,
@@ -215,9 +219,15 @@ fn in_new_directory(
         .take_while(|a| std::fs::symlink_metadata(a).is_err())
         .last()
         .map(Path::to_path_buf);
+    if let Some(created) = &created {
+        io::register_cleanup(created);
+    }
     let result = run();
-    if let (Err(_), Some(created)) = (&result, created) {
-        let _ = std::fs::remove_dir_all(created);
+    if let Some(created) = created {
+        io::unregister_cleanup(&created);
+        if result.is_err() {
+            let _ = std::fs::remove_dir_all(created);
+        }
     }
     result
 }

@@ -14,8 +14,10 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         scene,
         structure: rod,
         omega,
-    } = crate::cli::load_with(&args.scene, &args.set)?;
+    } = crate::cli::load_with(&args.scene, &args.set, crate::cli::Workload::Branch)?;
     let mut outputs = args.plan()?;
+    crate::cli::claim_model_files(&mut outputs, &scene)?;
+    check_window(&scene, omega / rod.omega_1)?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
     let set = find_solutions(&rod, omega, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
     let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
@@ -124,11 +126,77 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         for f in &set.failed_corrections {
             t += &format!("  not corrected: {}\n", crate::words::failed_correction(f));
         }
+        if let Some(missed) = incomplete(&set) {
+            t += &format!("  incomplete search: {missed}\n");
+        }
         if !set.solutions.is_empty() {
             t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
                   starts from solution K)\n";
         }
         t
     };
-    args.finish(outputs, || crate::json::solutions_json(&set), text, true)
+    let complete = incomplete(&set).is_none();
+    args.finish(
+        outputs,
+        || {
+            let mut v = crate::json::solutions_json(&set);
+            v["converged"] = complete.into();
+            v["incomplete"] = incomplete(&set).into();
+            v
+        },
+        text,
+        complete,
+    )
+}
+
+/// What a search that did not finish missed, in words; `None` when it finished: its
+/// branch crossed the whole window, every crossing was corrected and at least one was
+/// found (a branch through the window crosses the scene's frequency).
+fn incomplete(set: &semismooth_contact::solutions::SolutionSet) -> Option<String> {
+    let mut missed = Vec::new();
+    if !set.branch_converged {
+        missed.push(format!(
+            "the branch stopped after {} points before the end of the window [{}, {}]: \
+             solutions on the rest of it are missing",
+            set.branch_points, set.window.0, set.window.1
+        ));
+    }
+    if !set.failed_corrections.is_empty() {
+        missed.push(format!(
+            "{} crossing(s) could not be corrected",
+            set.failed_corrections.len()
+        ));
+    }
+    if set.branch_converged && set.solutions.is_empty() {
+        missed.push(
+            "no solution found, yet a branch through the window crosses the frequency".into(),
+        );
+    }
+    (!missed.is_empty()).then(|| missed.join("; "))
+}
+
+/// Refuses a forcing frequency outside the `[sweep]` window searched (exit code 2), naming
+/// the scene's own frequency key.
+fn check_window(scene: &crate::scene::Scene, ratio: f64) -> Result<(), crate::exit::CliError> {
+    use semismooth_contact::rod::FrequencySpec;
+    let Some(sweep) = &scene.sweep else {
+        return Ok(());
+    };
+    let (lo, hi) = (
+        sweep.omega_ratio_from.min(sweep.omega_ratio_to),
+        sweep.omega_ratio_from.max(sweep.omega_ratio_to),
+    );
+    if lo <= ratio && ratio <= hi {
+        return Ok(());
+    }
+    let (key, value) = match scene.frequency() {
+        FrequencySpec::Ratio(r) => ("forcing.omega_ratio", r),
+        FrequencySpec::Absolute(w) => ("forcing.omega", w),
+    };
+    Err(crate::exit::CliError::BadInput(format!(
+        "{}: invalid `{key}` = {value} (omega / omega_1 = {ratio}): allowed a frequency inside \
+         the [sweep] window omega_ratio_from..omega_ratio_to = [{lo}, {hi}] that ssn solutions \
+         searches",
+        crate::io::printable(&scene.path.display().to_string())
+    )))
 }

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use semismooth_contact::matrix_market::ImportError;
 use semismooth_contact::model::SparseMatrix;
 
-use crate::cli::{prepare, Loaded};
+use crate::cli::{prepare, Loaded, Workload};
 use crate::exit::CliError;
 use crate::scene::{read_scene_text, Override, Scene, SceneError};
 
@@ -63,8 +63,9 @@ impl SceneSource {
         Scene::from_toml_with(&self.text, &self.path, &self.overrides)
     }
 
-    /// The validated scene and its structure, as [`crate::cli::load`] builds them.
-    pub fn load(&self) -> Result<Loaded, CliError> {
+    /// The validated scene and its structure, as [`crate::cli::load_for`] builds them for a
+    /// run of `workload` (its memory and work limits).
+    pub fn load(&self, workload: Workload) -> Result<Loaded, CliError> {
         let scene = self
             .scene()
             .map_err(|e| CliError::BadInput(e.to_string()))?;
@@ -79,9 +80,9 @@ impl SceneSource {
                         ),
                     })
                 };
-                prepare(scene, false, Some(&read))
+                prepare(scene, workload, Some(&read))
             }
-            None => prepare(scene, false, None),
+            None => prepare(scene, workload, None),
         }
     }
 }

@@ -39,6 +39,10 @@ pub const STATE_VERSION: u64 = 1;
 /// Largest state file read (bytes): 10,000 dofs at H = 40 take about 20 MB.
 pub const STATE_FILE_LIMIT: u64 = 256 << 20;
 
+/// Largest magnitude of a coefficient read from a state (the scale rule of the scenes'
+/// amplitudes and gaps): larger ones overflow the residual.
+pub const MAX_COEFFICIENT: f64 = 1e100;
+
 /// The `layout` field of a state document, in words.
 const LAYOUT: &str = "harmonic-major: entry j*dofs + dof (j*contacts + contact) is the \
     coefficient of function j of 1, cos(w t), sin(w t), ..., cos(H w t), sin(H w t)";
@@ -163,6 +167,15 @@ impl HbState {
             }
         };
         let (harmonics, dofs, contacts) = (count("harmonics")?, count("dofs")?, count("contacts")?);
+        if harmonics > crate::scene::MAX_HARMONICS {
+            return Err(field_error(
+                "harmonics",
+                format!(
+                    "{harmonics}: allowed 0..={} (the largest solver.harmonics)",
+                    crate::scene::MAX_HARMONICS
+                ),
+            ));
+        }
         let number = |name: &str| -> Result<f64, StateError> {
             v.get(name)
                 .and_then(Value::as_f64)
@@ -196,14 +209,30 @@ impl HbState {
                 .enumerate()
                 .map(|(i, x)| {
                     x.as_f64()
-                        .filter(|x| x.is_finite())
-                        .ok_or_else(|| field_error(format!("{name}[{i}]"), "not a finite number"))
+                        .filter(|x| x.abs() <= MAX_COEFFICIENT)
+                        .ok_or_else(|| {
+                            field_error(
+                                format!("{name}[{i}]"),
+                                format!(
+                                    "{x}: allowed finite numbers of magnitude at most \
+                                     {MAX_COEFFICIENT:e}"
+                                ),
+                            )
+                        })
                 })
                 .collect()
         };
-        let displacement = list("displacement", functions * dofs)?;
+        let length = |name: &str, width: usize| {
+            functions.checked_mul(width).ok_or_else(|| {
+                field_error(
+                    name,
+                    format!("(2 harmonics + 1) x {width} overflows: allowed a size that fits"),
+                )
+            })
+        };
+        let displacement = list("displacement", length("dofs", dofs)?)?;
         let contact_force = match method {
-            Method::SsnHb => Some(list("contact_force", functions * contacts)?),
+            Method::SsnHb => Some(list("contact_force", length("contacts", contacts)?)?),
             _ => None,
         };
         Ok(Self {

@@ -372,22 +372,6 @@ fn sweep_json_and_csv_carry_the_stability_of_every_point() {
 }
 
 #[test]
-#[ignore = "timing report of the stability analysis per point, nothing asserted; run with --ignored --nocapture"]
-fn report_stability_cost_per_point() {
-    let (rod, scene, r) = strong_sweep();
-    let h = scene.solver.harmonics;
-    for i in [5usize, 19, 35, 60] {
-        let t = std::time::Instant::now();
-        let s = stability_of(&rod, h, r.omega[i], &r.states[i]);
-        println!(
-            "{i}: {:.2} ms, {} shooting iterations",
-            t.elapsed().as_secs_f64() * 1e3,
-            s.shooting_iterations
-        );
-    }
-}
-
-#[test]
 fn three_solutions_inside_the_overhang_two_stable() {
     let scene = scene(STRONG);
     let rod = build_rod(&scene.rod).unwrap();

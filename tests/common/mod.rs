@@ -1,6 +1,9 @@
-//! Helpers shared by the core's integration tests: a per-thread allocation counter.
+//! Helpers shared by the core's integration tests: a per-thread allocation counter and the
+//! continuation test problems ([`branches`]).
 
 #![allow(dead_code)]
+
+pub mod branches;
 
 use std::cell::Cell;
 

@@ -45,7 +45,8 @@
 //!   ([`Continuation::with_affine_pieces`]), and its folds are corners.
 //!
 //! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
-//! tolerance for SSN-HB and lcp-ssn, so each point is a fixed point of a Newton solve at
+//! tolerance for SSN-HB and lcp-ssn (for SSN-HB at least the round-off floor of its
+//! residual, which large models reach), so each point is a fixed point of a Newton solve at
 //! that tolerance. For penalty HB it is the scene's tolerance or the rounding floor of
 //! `|F|`, `ε k_p max(|g|, u_ref)` (the penalty force is `k_p` times gaps computed to
 //! `ε |u|`), whichever is larger.
@@ -252,7 +253,7 @@ fn continuation_options(
             // near the scene's tolerance).
             settings.tolerance.max(method.residual_floor)
         } else {
-            CORRECTOR_TOLERANCE_FACTOR * settings.tolerance
+            (CORRECTOR_TOLERANCE_FACTOR * settings.tolerance).max(method.residual_floor)
         },
         parameter_min: lo * omega_1,
         parameter_max: hi * omega_1,
@@ -520,9 +521,16 @@ pub(crate) fn follow_branch(
                 .collect();
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64], _: f64| tip_rec.extremes(x);
+            // The round-off floor `ssn solve` judges a solve against (large models reach
+            // 1e-10 in force units).
+            let gap = model
+                .contacts
+                .iter()
+                .map(|c| c.gap.abs())
+                .fold(u_ref, f64::max);
             let method = MethodContinuation {
                 units,
-                residual_floor: 0.0,
+                residual_floor: crate::solve::roundoff_floor(model, problem.dim(), gap, 0.0),
                 affine_pieces: false,
             };
             follow(

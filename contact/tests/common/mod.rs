@@ -6,6 +6,8 @@
 
 #![allow(dead_code)]
 
+pub mod periodic;
+
 use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::newton::{Globalization, NewtonOptions, NewtonReport};
 use semismooth::polyalgorithm::{SmoothingOf, SolveOptions};
@@ -192,15 +194,6 @@ pub fn relative(a: f64, b: f64) -> f64 {
 mod allocation;
 #[allow(unused_imports)]
 pub use allocation::*;
-
-/// CPU time of the current thread in seconds (Linux `/proc/thread-self/schedstat`; NaN
-/// elsewhere): on a shared machine wall time overstates the cost.
-pub fn thread_cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
-        .map_or(f64::NAN, |ns| ns * 1e-9)
-}
 
 /// SSN-HB on `model` forced at `omega` with `harmonics`, the default AFT samples for them
 /// and the default complementarity constant.

@@ -317,12 +317,17 @@ impl Check<'_> {
                 }
                 let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
                 for p in points {
-                    if p.dof.is_some() || p.direction.is_some() {
-                        return Err(self.invalid(
-                            "contact.point.dof",
-                            "given in a [rod] scene",
-                            "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
-                        ));
+                    for (key, given) in [
+                        ("contact.point.dof", p.dof.is_some()),
+                        ("contact.point.direction", p.direction.is_some()),
+                    ] {
+                        if given {
+                            return Err(self.invalid(
+                                key,
+                                "given in a [rod] scene",
+                                "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                            ));
+                        }
                     }
                     let node = p.node.ok_or_else(|| {
                         self.invalid("contact.point.node", "missing", "an integer node number")
@@ -444,7 +449,10 @@ impl Check<'_> {
             }
         };
         let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
-        for p in points {
+        // The entry (from 1) of each dof and direction seen.
+        let mut seen = std::collections::HashMap::with_capacity(points.len());
+        for (entry, p) in points.into_iter().enumerate() {
+            let entry = entry + 1;
             if p.node.is_some() {
                 return Err(self.invalid(
                     "contact.point.node",
@@ -465,19 +473,36 @@ impl Check<'_> {
                     "1 (obstacle on the positive side: u <= gap) or -1 (negative side: -u <= gap)",
                 )),
             };
-            if contacts
-                .iter()
-                .any(|c| c.dof == dof && c.direction == direction)
-            {
+            if let Some(first) = seen.insert((dof, direction), entry) {
                 return Err(self.invalid(
                     "contact.point.dof",
-                    dof + 1,
+                    format!("{} in entries {first} and {entry}", dof + 1),
                     "one contact per dof and direction (two contacts on one dof need opposite directions)",
                 ));
             }
+            let gap = self.response_scale("contact.point.gap", p.gap)?;
+            let opposite = match direction {
+                ContactDirection::Positive => ContactDirection::Negative,
+                ContactDirection::Negative => ContactDirection::Positive,
+            };
+            if let Some(&other) = seen.get(&(dof, opposite)) {
+                let clearance = gap + contacts[other - 1].gap;
+                if clearance.is_nan() || clearance <= 0.0 {
+                    return Err(self.invalid(
+                        "contact.point.gap",
+                        format!(
+                            "{gap} in entry {entry} and {} in entry {other} (both on dof {}, \
+                             opposite directions: clearance {clearance})",
+                            contacts[other - 1].gap,
+                            dof + 1
+                        ),
+                        "two gaps on one dof whose sum is > 0 (room between the two obstacles)",
+                    ));
+                }
+            }
             contacts.push(DofContact {
                 dof,
-                gap: self.response_scale("contact.point.gap", p.gap)?,
+                gap,
                 direction,
             });
         }
@@ -578,7 +603,7 @@ impl Check<'_> {
         let max_periods = self.count_or(
             "solver.max_periods",
             s.max_periods,
-            1,
+            2,
             1_000_000,
             default.max_periods,
         )?;

@@ -83,7 +83,10 @@ pub fn run_case(scene: &SceneSource, case: &Case, kind: RunKind) -> Value {
 /// Runs the scene as `kind` and returns the command line's JSON document and whether the
 /// run converged (the exit code 0 of the command).
 pub fn run_document(scene: &SceneSource, kind: RunKind) -> Result<(Value, bool), CliError> {
-    let loaded = scene.load()?;
+    let loaded = scene.load(match kind {
+        RunKind::Solve => crate::cli::Workload::Solve,
+        RunKind::Sweep | RunKind::Solutions => crate::cli::Workload::Branch,
+    })?;
     let path = &scene.path;
     let bad = |e: semismooth_contact::solve::RunError| {
         CliError::BadInput(format!("{}: {e}", path.display()))

@@ -374,29 +374,32 @@ impl StructuredHbSolver {
             return Err(LinearSolveError::NotFactored);
         };
         let n = lin.dofs;
-        for k in 0..=lin.basis.harmonics() {
-            let rhs = &mut self.complex_rhs;
-            if k == 0 {
-                for r in 0..n {
-                    rhs[(r, 0)] = c64::new(u[r], 0.0);
-                }
-            } else {
-                let (c, s) = ((2 * k - 1) * n, 2 * k * n);
-                for r in 0..n {
-                    rhs[(r, 0)] = c64::new(u[c + r], -u[s + r]);
-                }
+        // Harmonic k of `u` as one complex vector: `u_0` (k = 0), `u_ck - i u_sk` (k >= 1).
+        let (constant, harmonics) = u.split_at_mut(n);
+        for (z, &a) in first_column(&mut self.complex_rhs)
+            .iter_mut()
+            .zip(&*constant)
+        {
+            *z = c64::new(a, 0.0);
+        }
+        dynamic.solve_in_place(0, self.complex_rhs.as_mut())?;
+        for (a, z) in constant
+            .iter_mut()
+            .zip(first_column(&mut self.complex_rhs).iter())
+        {
+            *a = z.re;
+        }
+        for (k, pair) in harmonics.chunks_exact_mut(2 * n).enumerate() {
+            let (cosine, sine) = pair.split_at_mut(n);
+            let rhs = first_column(&mut self.complex_rhs);
+            for ((z, &a), &b) in rhs.iter_mut().zip(&*cosine).zip(&*sine) {
+                *z = c64::new(a, -b);
             }
-            dynamic.solve_in_place(k, rhs.as_mut())?;
-            if k == 0 {
-                for r in 0..n {
-                    u[r] = rhs[(r, 0)].re;
-                }
-            } else {
-                let (c, s) = ((2 * k - 1) * n, 2 * k * n);
-                for r in 0..n {
-                    u[c + r] = rhs[(r, 0)].re;
-                    u[s + r] = -rhs[(r, 0)].im;
-                }
+            dynamic.solve_in_place(k + 1, self.complex_rhs.as_mut())?;
+            let rhs = first_column(&mut self.complex_rhs);
+            for ((z, a), b) in rhs.iter().zip(cosine.iter_mut()).zip(sine.iter_mut()) {
+                *a = z.re;
+                *b = -z.im;
             }
         }
         Ok(())
@@ -429,6 +432,14 @@ impl StructuredHbSolver {
             }
         }
     }
+}
+
+/// The first column of `rhs` as a slice (an owned matrix's columns are contiguous).
+fn first_column(rhs: &mut Mat<c64>) -> &mut [c64] {
+    rhs.col_mut(0)
+        .try_as_col_major_mut()
+        .expect("a column of an owned matrix is contiguous")
+        .as_slice_mut()
 }
 
 /// `Z_k^{-1} G^T`, a block of contacts' columns at a time (as many as `block` has): calls

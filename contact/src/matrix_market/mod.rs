@@ -4,9 +4,12 @@
 //! The files hold the matrices of `M u'' + D u' + K u = f(t) + G^T lambda(t)` on the free
 //! dofs (the finite-element code has already removed the constrained ones): `M`, `K` and an
 //! optional `D`, `N x N`, and the load shape `f`, `N x 1`, applied as
-//! `amplitude * f * cos(omega t)`. Matrix Market coordinate (real or integer; general or
-//! symmetric, the lower triangle then mirrored) and array formats are read by
-//! nalgebra-sparse's reader; duplicate coordinate entries are summed (assembly).
+//! `amplitude * f * cos(omega t)`. Matrix Market coordinate (real or integer; general,
+//! symmetric or skew-symmetric, the lower triangle then mirrored) and array formats are
+//! read by [`read_matrix`] as the file goes, from regular files only, with the declared size
+//! checked before it is allocated and every defect named with its line (nalgebra-sparse's
+//! reader reads any file whole, allocates what the header declares and reports neither the
+//! line nor the value); duplicate coordinate entries are summed (assembly).
 //!
 //! Contract of [`build_imported`] (each violation is an [`ImportError`] naming the file, and
 //! the entry or the key with its value):
@@ -31,8 +34,6 @@
 use std::path::{Path, PathBuf};
 
 use faer::sparse::Triplet;
-use nalgebra_sparse::io::{load_coo_from_matrix_market_str, MatrixMarketErrorKind};
-use nalgebra_sparse::CooMatrix;
 use semismooth::linalg::FaerSparseLu;
 use semismooth::Factorize;
 
@@ -40,11 +41,19 @@ use crate::dynamic::UnionPattern;
 use crate::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
 use crate::rod::{natural_frequencies, DampingSpec, FrequencySpec};
 
+/// Smallest first natural frequency of an imported model (its inverse the largest): the
+/// rod's scale rule.
+pub const MIN_OMEGA_1: f64 = 1e-100;
+
 /// Relative tolerance of the symmetry check of `K` and `M`.
 pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 
-/// Largest Matrix Market file read (bytes).
-pub const MAX_MATRIX_FILE_BYTES: u64 = 1 << 30;
+mod read;
+
+pub use read::{
+    matrix_market_text, parse_matrix, read_matrix, vector_market_text, MAX_ENTRY_MAGNITUDE,
+    MAX_LINE_BYTES, MAX_MATRIX_DIMENSION, MAX_MATRIX_FILE_BYTES,
+};
 
 pub use crate::model::ContactDirection;
 
@@ -103,18 +112,25 @@ pub enum ImportError {
         /// The system error.
         source: std::io::Error,
     },
-    /// A file is larger than [`MAX_MATRIX_FILE_BYTES`].
-    #[error("{path}: {bytes} bytes: allowed at most {limit} bytes for a Matrix Market file")]
+    /// A file is larger than [`MAX_MATRIX_FILE_BYTES`] (noticed as it is read).
+    #[error(
+        "{path}: more than {limit} bytes: allowed at most {limit} bytes for a Matrix Market file"
+    )]
     TooLarge {
         /// The file.
         path: PathBuf,
-        /// Its size.
-        bytes: u64,
         /// The limit.
         limit: u64,
     },
-    /// The Matrix Market reader rejected the file (the message has the line and column of a
-    /// malformed line).
+    /// A file the scene names is not a regular file (a FIFO could block forever, a device
+    /// never end).
+    #[error("{path}: not a regular file: allowed a regular Matrix Market file")]
+    NotRegular {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The Matrix Market reader rejected the file (the message has the line, what was
+    /// found and what is allowed).
     #[error("{path}: not a valid Matrix Market file: {message}")]
     MatrixMarket {
         /// The file.
@@ -210,79 +226,6 @@ pub enum ImportError {
         /// What is wrong.
         reason: String,
     },
-}
-
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ImportError + '_ {
-    move |source| ImportError::Io {
-        path: path.to_path_buf(),
-        source,
-    }
-}
-
-/// Reads a real Matrix Market file (module documentation) as a sparse matrix, entries
-/// checked finite.
-pub fn read_matrix(path: &Path) -> Result<SparseMatrix, ImportError> {
-    let bytes = std::fs::metadata(path).map_err(io(path))?.len();
-    if bytes > MAX_MATRIX_FILE_BYTES {
-        return Err(ImportError::TooLarge {
-            path: path.to_path_buf(),
-            bytes,
-            limit: MAX_MATRIX_FILE_BYTES,
-        });
-    }
-    let text = std::fs::read_to_string(path).map_err(io(path))?;
-    parse_matrix(&text, path)
-}
-
-/// Parses Matrix Market text (`path` for messages only).
-pub fn parse_matrix(text: &str, path: &Path) -> Result<SparseMatrix, ImportError> {
-    let bad = |message: String| ImportError::MatrixMarket {
-        path: path.to_path_buf(),
-        message,
-    };
-    let coo: CooMatrix<f64> = match load_coo_from_matrix_market_str::<f64>(text) {
-        Ok(coo) => coo,
-        // An `integer` file: read as integers, converted.
-        Err(e) if e.kind() == MatrixMarketErrorKind::TypeMismatch => {
-            let ints = load_coo_from_matrix_market_str::<i64>(text)
-                .map_err(|_| bad(e.message().trim().to_string()))?;
-            let (rows, cols) = (ints.nrows(), ints.ncols());
-            let (r, c, v) = ints.disassemble();
-            let v = v.into_iter().map(|v| v as f64).collect();
-            CooMatrix::try_from_triplets(rows, cols, r, c, v).map_err(|e| bad(e.to_string()))?
-        }
-        Err(e) => return Err(bad(reader_message(e.message(), text))),
-    };
-    let mut triplets = Vec::with_capacity(coo.nnz());
-    for (i, j, &v) in coo.triplet_iter() {
-        if !v.is_finite() {
-            return Err(ImportError::NonFinite {
-                path: path.to_path_buf(),
-                row: i + 1,
-                col: j + 1,
-                value: v,
-            });
-        }
-        triplets.push(Triplet::new(i, j, v));
-    }
-    SparseMatrix::try_new_from_triplets(coo.nrows(), coo.ncols(), &triplets)
-        .map_err(|e| bad(format!("{e:?}")))
-}
-
-/// The reader's message on one line: `line L, column C: `text`` when it locates the
-/// defect (its parser reports ` --> L:C` and a drawing of the line), else as it is.
-fn reader_message(message: &str, text: &str) -> String {
-    let located = message.split_once("--> ").and_then(|(_, rest)| {
-        let (line, rest) = rest.split_once(':')?;
-        let column: String = rest.chars().take_while(char::is_ascii_digit).collect();
-        let line: usize = line.trim().parse().ok()?;
-        let content = text.lines().nth(line.checked_sub(1)?)?;
-        Some(format!(
-            "line {line}, column {column}: `{}` is not an entry of this header's format",
-            content.trim()
-        ))
-    });
-    located.unwrap_or_else(|| message.split_whitespace().collect::<Vec<_>>().join(" "))
 }
 
 /// `(A + A^T) / 2` after checking `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`.
@@ -403,6 +346,18 @@ pub fn build_imported_with(
     let mut load = vec![0.0; n];
     for (i, v) in shape.row_idx_of_col(0).zip(shape.val_of_col(0)) {
         load[i] += spec.amplitude * v;
+        if !load[i].is_finite() || load[i].abs() > MAX_ENTRY_MAGNITUDE {
+            return Err(ImportError::Model {
+                scene: spec.scene.clone(),
+                reason: format!(
+                    "the load amplitude x {} entry {} = {:e}: allowed magnitudes of at most \
+                     {MAX_ENTRY_MAGNITUDE:e} (as the rod's amplitude)",
+                    spec.forcing_vector.display(),
+                    i + 1,
+                    load[i]
+                ),
+            });
+        }
     }
     let dof_in_range = |key: &'static str, dof: usize| {
         if dof < n {
@@ -451,6 +406,13 @@ pub fn build_imported_with(
     };
     let omega_1 = natural_frequencies(&model, 1)
         .map_err(|e| stiffness_error(format!("no lowest natural frequency of (K, M): {e}")))?[0];
+    if !(MIN_OMEGA_1..=1.0 / MIN_OMEGA_1).contains(&omega_1) {
+        return Err(stiffness_error(format!(
+            "the first natural frequency of (K, M) is {omega_1:e}: allowed in [{MIN_OMEGA_1:e}, \
+             {:e}] (as the rod's; rescale the units of the model)",
+            1.0 / MIN_OMEGA_1
+        )));
+    }
     if let Some(d) = spec.damping {
         model.damping = Some(match d {
             DampingSpec::StiffnessProportional { zeta } => {
@@ -490,39 +452,6 @@ fn largest_entry(v: &[f64]) -> usize {
         }
     }
     best
-}
-
-/// The banner as the Matrix Market format spells it (`%%MatrixMarket`): readers such as
-/// scipy's `mmread` refuse the lower-case banner that nalgebra-sparse writes.
-fn standard_banner(text: String) -> String {
-    match text.strip_prefix("%%matrixmarket") {
-        Some(rest) => format!("%%MatrixMarket{rest}"),
-        None => text,
-    }
-}
-
-/// A sparse matrix as Matrix Market text (coordinate, real, general; every stored entry,
-/// values in Rust's shortest round-trip notation, so reading it back is exact).
-pub fn matrix_market_text(a: &SparseMatrix) -> String {
-    let r = a.as_ref();
-    let mut coo = CooMatrix::new(a.nrows(), a.ncols());
-    for j in 0..a.ncols() {
-        for (i, &v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            coo.push(i, j, v);
-        }
-    }
-    standard_banner(nalgebra_sparse::io::save_to_matrix_market_str(&coo))
-}
-
-/// A vector as an `n x 1` Matrix Market matrix (its nonzero entries).
-pub fn vector_market_text(v: &[f64]) -> String {
-    let mut coo = CooMatrix::new(v.len(), 1);
-    for (i, &x) in v.iter().enumerate() {
-        if x != 0.0 {
-            coo.push(i, 0, x);
-        }
-    }
-    standard_banner(nalgebra_sparse::io::save_to_matrix_market_str(&coo))
 }
 
 /// The Matrix Market files of a structure built in code for a `[model]` scene: `K.mtx`,
