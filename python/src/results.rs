@@ -334,10 +334,11 @@ impl SolutionSet {
             .iter()
             .map(|s| s.solution.tip.clone())
             .collect();
+        let doc = ssn::solutions::document(set);
         SolutionSet {
-            converged: set.branch_converged,
+            converged: doc["converged"] == true,
             stored: Stored {
-                doc: ssn::json::solutions_json(set),
+                doc,
                 arrays: vec![matrix("times", &times), matrix("displacements", &tips)],
             },
         }
@@ -472,7 +473,7 @@ pub fn _restore_result(
         "SolutionSet" => Py::new(
             py,
             SolutionSet {
-                converged: converged(&stored, "branch_converged"),
+                converged: converged(&stored, "converged"),
                 stored,
             },
         )?

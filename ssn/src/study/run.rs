@@ -130,7 +130,9 @@ pub fn run_document(scene: &SceneSource, kind: RunKind) -> Result<(Value, bool),
                 loaded.scene.sweep.as_ref(),
             )
             .map_err(bad)?;
-            Ok((crate::json::solutions_json(&set), set.branch_converged))
+            let document = crate::solutions::document(&set);
+            let complete = document["converged"] == true;
+            Ok((document, complete))
         }
     }
 }
