@@ -147,8 +147,26 @@ impl Multipliers {
         self.max_abs() < 1.0
     }
 
+    /// The real multiplier closest to `+1` (`None` when none is real).
+    pub fn nearest_real_to_one(&self) -> Option<f64> {
+        self.values
+            .iter()
+            .filter(|(re, im)| im.abs() <= REAL_TOLERANCE * re.hypot(*im))
+            .map(|z| z.0)
+            .min_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+    }
+
     /// The multipliers outside the unit circle: (real `> 1`, real `< -1`, complex).
-    fn outside(&self) -> (usize, usize, usize) {
+    pub fn outside(&self) -> Outside {
+        let (real_above_one, real_below_minus_one, complex) = self.outside_counts();
+        Outside {
+            real_above_one,
+            real_below_minus_one,
+            complex,
+        }
+    }
+
+    fn outside_counts(&self) -> (usize, usize, usize) {
         let mut counts = (0, 0, 0);
         for &(re, im) in &self.values {
             let r = re.hypot(im);
@@ -169,17 +187,39 @@ impl Multipliers {
     }
 }
 
+/// How many multipliers of an orbit lie outside the unit circle, by where they are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Outside {
+    /// Real multipliers above `+1`.
+    pub real_above_one: usize,
+    /// Real multipliers below `-1`.
+    pub real_below_minus_one: usize,
+    /// Complex multipliers (counted one by one, so a pair counts 2).
+    pub complex: usize,
+}
+
+impl Outside {
+    /// Whether none is outside.
+    pub fn is_stable(&self) -> bool {
+        self.real_above_one + self.real_below_minus_one + self.complex == 0
+    }
+}
+
 /// The bifurcation between two neighbouring orbits of a branch, from the number of
 /// multipliers outside the unit circle: a change of the real ones beyond `+1` is a fold,
 /// beyond `-1` a period doubling, of the complex ones a Neimark–Sacker bifurcation
 /// (checked in that order; `None` when nothing changed).
 pub fn crossing(before: &Multipliers, after: &Multipliers) -> Option<BifurcationKind> {
-    let (a, b) = (before.outside(), after.outside());
-    if a.0 != b.0 {
+    crossing_of(before.outside(), after.outside())
+}
+
+/// [`crossing`] from the counts of the multipliers outside the unit circle.
+pub fn crossing_of(a: Outside, b: Outside) -> Option<BifurcationKind> {
+    if a.real_above_one != b.real_above_one {
         Some(BifurcationKind::Fold)
-    } else if a.1 != b.1 {
+    } else if a.real_below_minus_one != b.real_below_minus_one {
         Some(BifurcationKind::PeriodDoubling)
-    } else if a.2 != b.2 {
+    } else if a.complex != b.complex {
         Some(BifurcationKind::NeimarkSacker)
     } else {
         None
@@ -207,7 +247,7 @@ mod tests {
         assert!((v[1].0 + 1.5).abs() < 1e-14);
         assert!((v[2].0 - 0.5).abs() < 1e-14 && (v[2].1.abs() - 0.4).abs() < 1e-14);
         assert!(!m.is_stable());
-        assert_eq!(m.outside(), (1, 1, 0));
+        assert_eq!(m.outside_counts(), (1, 1, 0));
     }
 
     #[test]

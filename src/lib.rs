@@ -82,6 +82,7 @@ pub mod linesearch;
 pub mod newton;
 pub mod polyalgorithm;
 mod traits;
+pub mod trigonometric;
 
 pub use traits::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,

@@ -19,10 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let pad = [(1, 2, -kp), (2, 1, -kp), (2, 2, kp)];
     let k = sparse_matrix(3, &[&kd[..], &kb, &pad].concat())?;
     let m = sparse_matrix(3, &[(0, 0, 1.0), (1, 1, 1.0)])?;
-    let below = ContactPoint {
-        direction: ContactDirection::Negative, // -u_pad <= 0.6
-        ..ContactPoint::new(2, 0.6)
-    };
+    let below = ContactPoint::on_side(2, 0.6, ContactDirection::Negative); // -u_pad <= 0.6
     let model = StructuralModel::new(m, k, vec![0.0, 0.01, 0.0]) // load on the blade
         .with_rayleigh_damping(0.0, 0.01)
         .with_contact(ContactPoint::new(2, 0.5)) // u_pad <= 0.5

@@ -19,7 +19,9 @@
 use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
-use crate::model::{ContactPoint, InvalidModel, SparseMatrix, StructuralModel, Structure};
+use crate::model::{
+    ContactPoint, FrictionPoint, InvalidModel, SparseMatrix, StructuralModel, Structure,
+};
 use crate::rod::{natural_frequencies, ModelError};
 
 /// Why a [`Structure`] could not be built from its model.
@@ -62,6 +64,7 @@ impl StructuralModel {
             stiffness,
             load,
             contacts: Vec::new(),
+            friction: Vec::new(),
         }
     }
 
@@ -86,6 +89,12 @@ impl StructuralModel {
     /// The model with one more contact.
     pub fn with_contact(mut self, contact: ContactPoint) -> Self {
         self.contacts.push(contact);
+        self
+    }
+
+    /// The model with one more Coulomb friction point.
+    pub fn with_friction(mut self, point: FrictionPoint) -> Self {
+        self.friction.push(point);
         self
     }
 }

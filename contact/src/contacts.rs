@@ -15,8 +15,12 @@ pub struct ContactReport {
     pub force_mean: f64,
     /// Largest penetration `max(0, u - gap)` over the period.
     pub max_penetration: f64,
-    /// Fraction of the period with a compressive force larger than `1e-9` times the
-    /// largest force magnitude of the run.
+    /// Fraction of the period in contact: for harmonic balance the measure of the set where
+    /// the contact law is active (its switching function positive on the truncated series,
+    /// the samples the generalized Jacobian treats as active, ends refined between
+    /// samples: [`semismooth::trigonometric::covered_fraction`]); for the exact methods the fraction of the time
+    /// samples with a compressive force larger than `1e-9` times the largest force
+    /// magnitude of the run.
     pub contact_fraction: f64,
     /// Smallest displacement of the contact dof.
     pub displacement_min: f64,

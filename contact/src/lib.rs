@@ -25,4 +25,5 @@ pub mod stability;
 pub mod structures;
 pub mod sweep;
 
+pub use solve::accuracy;
 pub use solve::solve;

@@ -350,7 +350,7 @@ fn assemble_elements(
 /// let rod = build_rod(&RodSpec::canonical()).unwrap();
 /// assert!((rod.omega_1 - 1.571200).abs() < 1e-6);
 /// assert_eq!(rod.omega(), rod.omega_1); // the canonical rod is forced at omega_1
-/// assert_eq!(rod.model.contacts[0].dof, 19);
+/// assert_eq!(rod.model.contacts[0].dof(), 19);
 /// ```
 pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
     validate(spec)?;
@@ -389,6 +389,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         stiffness,
         load,
         contacts,
+        friction: Vec::new(),
     };
     let omega_1 = natural_frequencies(&model, 1)?[0];
     model.damping = match spec.damping {

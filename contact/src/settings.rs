@@ -109,6 +109,15 @@ pub struct SolverSettings {
     pub restitution: f64,
     /// Time discretisation of the periodic LCP (`lcp-lemke`, `lcp-ssn`).
     pub lcp_scheme: LcpScheme,
+    /// Relative accuracy asked of the reported quantities (`[solver] accuracy`): the method
+    /// then chooses its discretisation (harmonics and AFT samples, time steps) instead of
+    /// taking `harmonics` / `time_samples` / `steps_per_period`
+    /// ([`crate::accuracy::search`]); `None`: the discretisation as given.
+    pub accuracy: Option<f64>,
+    /// Whether a solve estimates its error ([`crate::accuracy::ErrorEstimate`]) by a second
+    /// solve on a coarser discretisation (on by default; off where only the cost of the solve
+    /// itself is measured).
+    pub estimate_error: bool,
 }
 
 impl Default for SolverSettings {
@@ -139,6 +148,8 @@ impl Default for SolverSettings {
             march_tolerance: march.tolerance,
             restitution: 0.0,
             lcp_scheme: lcp.scheme,
+            accuracy: None,
+            estimate_error: true,
         }
     }
 }
@@ -183,12 +194,14 @@ pub struct SweepSettings {
     pub max_step: f64,
     /// Point limit.
     pub max_points: usize,
+    /// Whether each point gets its Floquet multipliers (`[sweep] stability`).
+    pub stability: bool,
 }
 
 impl SweepSettings {
     /// A sweep from `omega_ratio_from` to `omega_ratio_to` (units of omega_1) with the
     /// scene defaults: `step = 0.01`, `min_step = 1e-5`, `max_step = 0.05`,
-    /// `max_points = 2000` (not validated; the sweep checks).
+    /// `max_points = 2000`, `stability = true` (not validated; the sweep checks).
     pub fn new(omega_ratio_from: f64, omega_ratio_to: f64) -> Self {
         Self {
             omega_ratio_from,
@@ -197,6 +210,7 @@ impl SweepSettings {
             min_step: 1e-5,
             max_step: 0.05,
             max_points: 2000,
+            stability: true,
         }
     }
 }

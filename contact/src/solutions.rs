@@ -21,7 +21,7 @@ use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::StateShape;
 use crate::solve::{solve, RunError, Solution, Termination};
-use crate::stability::{hb_stability, Stability, StabilityOptions, Undecided};
+use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::Reconstruction;
 use crate::sweep::{follow_branch, SweepTermination};
 
@@ -121,7 +121,14 @@ pub fn find_solutions(
     }
     let branch = follow_branch(rod, settings, &window, None)?;
     let reconstruction = Reconstruction::new(&rod.model, omega, settings)?;
-    let len = rod.model.dofs() * (2 * settings.harmonics + 1);
+    // The method is a harmonic-balance one (checked above): only the model can fail here.
+    let mut analysis = HbStability::new(&rod.model, settings).map_err(|e| match e {
+        StabilityError::Hb(e) => RunError::HarmonicBalance(e),
+        _ => RunError::Unsupported {
+            method: settings.method.name(),
+            what: "a harmonic-balance method (ssn-hb or penalty-hb)",
+        },
+    })?;
     let mut set = SolutionSet {
         omega,
         omega_1: rod.omega_1,
@@ -188,14 +195,9 @@ pub fn find_solutions(
         if duplicate {
             continue;
         }
-        let stability = hb_stability(
-            &rod.model,
-            settings.harmonics,
-            omega,
-            &x[..len],
-            &StabilityOptions::default(),
-        )
-        .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e), 0));
+        let stability = analysis
+            .of(omega, x)
+            .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
         let contacts = reconstruction.contacts(&rod.model, x)?;
         set.solutions.push(PeriodicSolution {
             solution,

@@ -8,6 +8,8 @@
 //! ([`Solution::converged`]), with the best answer it reached, so callers can still report
 //! what happened.
 
+pub mod accuracy;
+
 use std::time::Instant;
 
 use semismooth::continuation::{homotopy, HomotopySchedule};
@@ -29,11 +31,12 @@ use crate::lcp::{
     ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
     DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use crate::march::{march_to_steady_state, MarchError, MarchOptions, MarchScheme};
+use crate::march::{march_from_state, MarchError, MarchOptions, MarchScheme, MarchState};
 use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
 use crate::rod::ModelError;
 use crate::settings::{GlobalizationChoice, Method, SolverSettings};
+use accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
@@ -101,6 +104,24 @@ pub struct RunCounters {
     pub lemke_pivots: u64,
     /// Time steps (time marching).
     pub time_steps: u64,
+}
+
+impl std::ops::Add for RunCounters {
+    type Output = Self;
+
+    /// The work of two runs together.
+    fn add(self, other: Self) -> Self {
+        Self {
+            residual_evaluations: self.residual_evaluations + other.residual_evaluations,
+            jacobian_evaluations: self.jacobian_evaluations + other.jacobian_evaluations,
+            factorizations: self.factorizations + other.factorizations,
+            linear_solves: self.linear_solves + other.linear_solves,
+            line_search_backtracks: self.line_search_backtracks + other.line_search_backtracks,
+            ffts: self.ffts + other.ffts,
+            lemke_pivots: self.lemke_pivots + other.lemke_pivots,
+            time_steps: self.time_steps + other.time_steps,
+        }
+    }
 }
 
 impl From<WorkCounters> for RunCounters {
@@ -247,8 +268,15 @@ pub struct Solution {
     pub contacts: Vec<ContactReport>,
     /// Work counters.
     pub counters: RunCounters,
-    /// The method's unknowns (HB coefficients, LCP z), for warm starts.
+    /// The method's unknowns, for warm starts: HB coefficients, the LCP's `z`, the state
+    /// `(u, v, lambda)` of time marching at the end of the reported period.
     pub state: Vec<f64>,
+    /// The estimated relative error of the reported quantities, or why there is none
+    /// ([`crate::accuracy`]).
+    pub error_estimate: Result<ErrorEstimate, NoEstimate>,
+    /// With an accuracy target ([`SolverSettings::accuracy`]): the discretisations tried,
+    /// what was chosen and what the search cost.
+    pub search: Option<DiscretisationSearch>,
 }
 
 impl Solution {
@@ -302,7 +330,7 @@ pub(crate) fn lcp_options(
     settings: &SolverSettings,
 ) -> (PeriodicLcpOptions, Option<usize>) {
     let tip = rod.observed_dof;
-    let tip_contact = rod.model.contacts.iter().position(|c| c.dof == tip);
+    let tip_contact = rod.model.contacts.iter().position(|c| c.dof() == tip);
     let options = PeriodicLcpOptions {
         time_samples: settings.time_samples,
         observed_dofs: if tip_contact.is_some() {
@@ -404,18 +432,18 @@ pub(crate) fn roundoff_floor(
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
 pub(crate) trait HbReconstruction {
-    fn contact_count(&self) -> usize;
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// The fractions of the period where contact `i`'s law is active (closed).
+    fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError>;
+    /// `g_i . u` of row `i` of `G`.
+    fn row_displacement(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
 }
 
 /// Both harmonic-balance problems reconstruct through the same inherent methods.
 macro_rules! hb_reconstruction {
     ($($problem:ty),*) => {$(
         impl HbReconstruction for $problem {
-            fn contact_count(&self) -> usize {
-                self.contacts()
-            }
             fn displacement(
                 &self,
                 x: &[f64],
@@ -426,6 +454,17 @@ macro_rules! hb_reconstruction {
             }
             fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
                 self.contact_force_samples(x, i, points)
+            }
+            fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError> {
+                self.closed_intervals(x, i)
+            }
+            fn row_displacement(
+                &self,
+                x: &[f64],
+                i: usize,
+                points: usize,
+            ) -> Result<Vec<f64>, HbError> {
+                self.row_displacement_samples(x, i, points)
             }
         }
     )*};
@@ -482,7 +521,7 @@ fn solution(
         &rod.model
             .contacts
             .iter()
-            .map(|c| (c.dof, c.gap))
+            .map(|c| (c.dof(), c.gap))
             .collect::<Vec<_>>(),
         &period.contact_forces,
         &period.contact_displacements,
@@ -521,6 +560,8 @@ fn solution(
         contact_forces: period.contact_forces,
         counters: outcome.counters,
         state,
+        error_estimate: Err(NoEstimate::Off),
+        search: None,
     }
 }
 
@@ -535,26 +576,27 @@ fn hb_outputs(
     points: usize,
 ) -> Result<Solution, RunError> {
     let tip = problem.displacement(&x, rod.observed_dof, points)?;
-    let contact_forces = (0..problem.contact_count())
+    let contacts = rod.model.contacts.len();
+    let contact_forces = (0..contacts)
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
-    let contact_displacements = rod
-        .model
-        .contacts
-        .iter()
-        .map(|c| problem.displacement(&x, c.dof, points))
+    let contact_displacements = (0..contacts)
+        .map(|i| problem.row_displacement(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
     let period = 2.0 * std::f64::consts::PI / omega;
     let times = (0..points)
         .map(|n| period * n as f64 / points as f64)
         .collect();
+    let closed = (0..contacts)
+        .map(|i| problem.closed_intervals(&x, i))
+        .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
         times,
         tip,
         contact_forces,
         contact_displacements,
     };
-    Ok(solution(
+    let mut solution = solution(
         rod,
         omega,
         settings,
@@ -562,7 +604,17 @@ fn hb_outputs(
         outcome,
         period,
         x,
-    ))
+    );
+    set_closed_fractions(&mut solution.contacts, &closed);
+    Ok(solution)
+}
+
+/// The contact fractions of harmonic-balance reports from the contact law's own closed
+/// intervals instead of the reconstructed force, which rings between the samples.
+pub(crate) fn set_closed_fractions(reports: &mut [ContactReport], closed: &[Vec<(f64, f64)>]) {
+    for (report, intervals) in reports.iter_mut().zip(closed) {
+        report.contact_fraction = semismooth::trigonometric::covered_fraction(intervals).min(1.0);
+    }
 }
 
 /// Tip statistics; the penetration is the largest over all contacts (and the tip's).
@@ -576,7 +628,7 @@ fn statistics(
     let contacts = &rod.model.contacts;
     let tip_contact = contacts
         .iter()
-        .position(|c| c.dof == tip_dof && c.sign() > 0.0);
+        .position(|c| c.row.single() == Some((tip_dof, 1.0)));
     let mut stats = match (tip_contact, forces.first()) {
         (Some(i), Some(_)) => period_statistics(tip, Some((contacts[i].gap, &forces[i]))),
         (None, Some(f)) => {
@@ -593,19 +645,36 @@ fn statistics(
         stats.mean_contact_force = 0.0;
     }
     for (c, u) in contacts.iter().zip(contact_displacements) {
-        let p = u
-            .iter()
-            .map(|v| (c.sign() * v - c.gap).max(0.0))
-            .fold(0.0, f64::max);
+        let p = u.iter().map(|v| (v - c.gap).max(0.0)).fold(0.0, f64::max);
         stats.max_penetration = stats.max_penetration.max(p);
     }
     stats
 }
 
 /// Solves the rod forced at the angular frequency `omega` with the scene's method, from a
-/// zero initial guess (or `warm_start`). An `omega` that is not finite and `> 0` is the
-/// formulation's typed error.
+/// zero initial guess (or `warm_start`, [`Solution::state`] of a solve with the same
+/// discretisation), with the error estimate of [`crate::accuracy::estimate`] when
+/// [`SolverSettings::estimate_error`] is on. With [`SolverSettings::accuracy`] the method
+/// chooses its discretisation ([`crate::accuracy::search`]). An `omega` that is not finite
+/// and `> 0` is the formulation's typed error.
 pub fn solve(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    if let Some(target) = settings.accuracy {
+        return accuracy::search::solve_to_accuracy(rod, omega, settings, target, warm_start);
+    }
+    let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
+    if settings.estimate_error {
+        solution.error_estimate = accuracy::estimate(rod, omega, settings, &solution);
+    }
+    Ok(solution)
+}
+
+/// [`solve`] with the settings' discretisation and no error estimate.
+pub(crate) fn solve_as_given(
     rod: &Structure,
     omega: f64,
     settings: &SolverSettings,
@@ -684,7 +753,7 @@ pub fn solve(
             Ok(sol)
         }
         Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, omega, settings, warm_start),
-        Method::March => solve_march(rod, omega, settings),
+        Method::March => solve_march(rod, omega, settings, warm_start),
     }
 }
 
@@ -822,10 +891,37 @@ fn solve_lcp(
     Ok(sol)
 }
 
+/// The time-marching scheme of `settings`: Moreau–Jean with the restitution when it is
+/// positive, else the model's choice ([`MarchScheme::Auto`]).
+pub(crate) fn march_scheme(settings: &SolverSettings) -> MarchScheme {
+    if settings.restitution > 0.0 {
+        MarchScheme::MoreauJean {
+            theta: 0.5,
+            restitution: settings.restitution,
+        }
+    } else {
+        MarchScheme::Auto
+    }
+}
+
+/// The march state `(u, v, lambda)` of [`Solution::state`] (`None` when `state` is not of
+/// the model's size).
+fn march_state(model: &crate::model::StructuralModel, state: &[f64]) -> Option<MarchState> {
+    let (n, m) = (model.dofs(), model.contact_count());
+    (state.len() == 2 * n + m).then(|| MarchState {
+        displacement: state[..n].to_vec(),
+        velocity: state[n..2 * n].to_vec(),
+        contact_force: state[2 * n..].to_vec(),
+    })
+}
+
+/// Time marching from rest (or from `warm_start`, the [`Solution::state`] of a march of
+/// the same model) to the steady state.
 fn solve_march(
     rod: &Structure,
     omega: f64,
     settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
     let model = &rod.model;
     let tip = rod.observed_dof;
@@ -833,21 +929,23 @@ fn solve_march(
         steps_per_period: settings.steps_per_period,
         max_periods: settings.max_periods,
         tolerance: settings.march_tolerance,
-        scheme: if settings.restitution > 0.0 {
-            MarchScheme::MoreauJean {
-                theta: 0.5,
-                restitution: settings.restitution,
-            }
-        } else {
-            MarchScheme::Auto
-        },
+        scheme: march_scheme(settings),
     };
+    // The tip, then every dof of the contacts' rows (their gap closures `g . u` are
+    // combined from these series).
     let mut observed = vec![tip];
-    observed.extend(model.contacts.iter().map(|c| c.dof));
+    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
+        if !observed[1..].contains(dof) {
+            observed.push(*dof);
+        }
+    }
+    let initial = warm_start
+        .and_then(|w| march_state(model, w))
+        .unwrap_or_else(|| MarchState::rest(model));
     let start = Instant::now();
     // A march that does not settle is a run that did not converge: its last period is
     // reported with the last period-to-period change.
-    let (period, steady) = match march_to_steady_state(model, omega, &options, &observed) {
+    let (period, steady) = match march_from_state(model, omega, &options, &observed, &initial) {
         Ok(period) => (period, true),
         Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
         Err(e) => return Err(e.into()),
@@ -857,7 +955,25 @@ fn solve_march(
     let keep = period.times.len().saturating_sub(1).max(1);
     let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
     let tip_series = cut(&period.displacements[0]);
-    let contact_u: Vec<Vec<f64>> = period.displacements[1..].iter().map(cut).collect();
+    let series = |dof: usize| {
+        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
+        cut(&period.displacements[k])
+    };
+    let contact_u: Vec<Vec<f64>> = model
+        .contacts
+        .iter()
+        .map(|c| {
+            let mut entries = c.row.entries();
+            let (d, a) = entries.next().expect("a row has at least one dof");
+            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
+            for (d, a) in entries {
+                for (ui, v) in u.iter_mut().zip(series(d)) {
+                    *ui += a * v;
+                }
+            }
+            u
+        })
+        .collect();
     let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
     let start_time = period.times[0];
     let times = period.times[..keep]
@@ -882,12 +998,19 @@ fn solve_march(
         solve_seconds: seconds,
         newton: None,
     };
+    let final_state = period.final_state;
     let period = Period {
         times,
         tip: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
     };
+    let state = [
+        final_state.displacement,
+        final_state.velocity,
+        final_state.contact_force,
+    ]
+    .concat();
     Ok(solution(
         rod,
         omega,
@@ -895,6 +1018,6 @@ fn solve_march(
         settings.steps_per_period,
         outcome,
         period,
-        Vec::new(),
+        state,
     ))
 }

@@ -151,6 +151,7 @@ impl BladedDisk {
                 .iter()
                 .map(|&j| ContactPoint::new(Self::pad(j), loading.gap))
                 .collect(),
+            friction: Vec::new(),
         };
         let omega_1 = natural_frequencies(&model, 1)?[0];
         model.damping = Some(UnionPattern::linear_combination(
@@ -158,7 +159,7 @@ impl BladedDisk {
             &[&model.stiffness],
             &[2.0 * loading.zeta / omega_1],
         ));
-        let observed_dof = model.contacts.first().map_or(Self::tip(0), |c| c.dof);
+        let observed_dof = model.contacts.first().map_or(Self::tip(0), |c| c.dof());
         Ok(Structure {
             model,
             omega_1,

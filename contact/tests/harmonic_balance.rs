@@ -62,6 +62,7 @@ fn chain(
         stiffness,
         load: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
         contacts,
+        friction: Vec::new(),
     };
     (model, omega)
 }
@@ -239,7 +240,7 @@ fn ssn_switching(
     let (mut min_abs, mut active) = (f64::INFINITY, 0);
     for (i, cp) in model.contacts.iter().enumerate() {
         let mut coeffs: Vec<f64> = (0..size)
-            .map(|j| c * x[j * n + cp.dof] - x[n * size + j * m + i])
+            .map(|j| c * x[j * n + cp.dof()] - x[n * size + j * m + i])
             .collect();
         coeffs[0] -= c * cp.gap;
         aft.to_time(&coeffs, &mut s).unwrap();
@@ -672,9 +673,9 @@ fn solve_condensed(
 
 /// Sample-wise complementarity of an SSN-HB solution at its own `Nt` samples:
 /// (max penetration `u - g`, max positive force `lambda`, max |lambda|) of the first contact.
-fn sample_complementarity(hb: &SsnHb, x: &[f64], contact: ContactPoint) -> (f64, f64, f64) {
+fn sample_complementarity(hb: &SsnHb, x: &[f64], contact: &ContactPoint) -> (f64, f64, f64) {
     let nt = hb.basis().time_samples();
-    let u = hb.displacement_samples(x, contact.dof, nt).unwrap();
+    let u = hb.displacement_samples(x, contact.dof(), nt).unwrap();
     let l = hb.contact_force_samples(x, 0, nt).unwrap();
     let penetration = u
         .iter()
@@ -718,7 +719,7 @@ fn ssn_hb_converges_from_zero_on_a_chain_and_refines_with_harmonics() {
         };
         let (hb, x, report) = solve_ssn(&model, omega, &options);
         let s = hb.summary(&x, 2, 4096).unwrap();
-        let (penetration, positive, largest) = sample_complementarity(&hb, &x, model.contacts[0]);
+        let (penetration, positive, largest) = sample_complementarity(&hb, &x, &model.contacts[0]);
         println!(
             "chain H = {h}: {} iterations, tip min {:.6} max {:.6}, sample penetration {penetration:.2e}, \
              positive force {positive:.2e} of max |lambda| {largest:.2e}, mean force {:.5e}",
@@ -756,7 +757,7 @@ fn canonical_modified_rod_ssn_hb_converges_from_zero() {
         let (hb, x, report) = solve_ssn(&model, omega, &options);
         let elapsed = start.elapsed();
         let s = hb.summary(&x, 19, 1024).unwrap();
-        let (penetration, _, _) = sample_complementarity(&hb, &x, model.contacts[0]);
+        let (penetration, _, _) = sample_complementarity(&hb, &x, &model.contacts[0]);
         println!(
             "rod (modified mass) H = {h}, Nt = {}, c = {}: {} iterations ({:?}), |F| = {:.1e}, \
              tip min {:.6} max {:.6} rms {:.6}, mean force {:.5e}, sample penetration {penetration:.2e}, \

@@ -174,7 +174,7 @@ fn trapezoidal_contact_displacement(
     let v = |step: usize, i: usize| (step % nt) * 2 * n + n + i;
     let mut a = DMatrix::<f64>::zeros(size, size);
     let mut b = DVector::<f64>::zeros(size);
-    let tip = model.contacts[0].dof;
+    let tip = model.contacts[0].dof();
     for step in 0..nt {
         let row0 = step * 2 * n;
         for i in 0..n {
@@ -867,7 +867,7 @@ fn bdf2_nyquist_receptance_is_positive_so_the_alternating_force_is_no_null_vecto
     for mass in [MassModel::Consistent, MassModel::Modified] {
         let rod = forty_element_rod_with(mass);
         let model = &rod.structure.model;
-        let tip = model.contacts[0].dof;
+        let tip = model.contacts[0].dof();
         let nt = 128;
         let trapezoidal = PeriodicLcp::new(model, rod.omega(), options(nt, vec![])).unwrap();
         assert_eq!(trapezoidal.receptance(nt / 2)[0].re, 0.0);

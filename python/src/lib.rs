@@ -427,10 +427,9 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
             let dofs = loaded.structure.model.dofs() * (2 * settings.harmonics + 1);
             let stability = semismooth_contact::stability::hb_stability(
                 &loaded.structure.model,
-                settings.harmonics,
+                settings,
                 loaded.omega,
                 &solution.state[..dofs.min(solution.state.len())],
-                &semismooth_contact::stability::StabilityOptions::default(),
             )
             .map_err(|e| bad(e.to_string()))?;
             Ok((solution, stability))

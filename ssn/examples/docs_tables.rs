@@ -10,7 +10,9 @@
 //!
 //! Sections (`ssn::tables::SECTIONS` names the file of each): `methods` (method
 //! comparison, both mass models, about 3 s), `accuracy` (cheapest setting per method,
-//! about 5 s), `sweeps` (about 10 s), `from-zero` (the public grid with `auto` and
+//! about 5 s), `accuracy-targets` (the discretisation search
+//! for 1e-3, 1e-4 and 1e-5 against the reference, about 10 minutes, most of it Lemke and
+//! harmonic balance at their finest), `sweeps` (about 10 s), `from-zero` (the public grid with `auto` and
 //! `hybrid`, about 6 s), `performance` (what the examples time, about 2 s), `hard` (the
 //! hard cases from zero, about 2 minutes, most of it the 100-contact rod). Wall times vary
 //! with the machine and its load (each block names the machine it was measured on); every
@@ -48,6 +50,12 @@ fn compute(section: &str) -> Result<String, Box<dyn std::error::Error>> {
             let settings = SolverSettings::with_harmonics(20);
             let study = accuracy_cost(&rod.structure, rod.omega(), &settings, None)?;
             out.push_str(&tables::cheapest_settings(&study).markdown());
+        }
+        "accuracy-targets" => {
+            let (notes, table) = ssn::accuracy_targets::accuracy_targets()?;
+            out.push_str(&notes);
+            out.push('\n');
+            out.push_str(&table.markdown());
         }
         "sweeps" => out.push_str(&tables::sweeps(&tables::sweep_cases())?.markdown()),
         "from-zero" => {

@@ -236,7 +236,8 @@ impl AccuracyCost {
     pub fn write_svg(&self, path: &Path) -> Result<(), OutputError> {
         let series: Vec<Series> = METHODS
             .iter()
-            .filter_map(|&m| {
+            .enumerate()
+            .filter_map(|(color, &m)| {
                 let mut points: Vec<(f64, f64)> = self
                     .entries
                     .iter()
@@ -247,9 +248,13 @@ impl AccuracyCost {
                     return None;
                 }
                 points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let (x, y) = points.into_iter().unzip();
-                Some(Series::new(m.name(), x, y))
+                let (x, y): (Vec<f64>, Vec<f64>) = points.into_iter().unzip();
+                Some([
+                    Series::new(m.name(), x.clone(), y.clone()).with_color(color),
+                    Series::markers("", x, y).with_color(color),
+                ])
             })
+            .flatten()
             .collect();
         let spec = PlotSpec {
             title: "Accuracy vs cost (tip minimum)".into(),
@@ -512,7 +517,7 @@ pub const STUDY_FILES: [&str; 2] = ["accuracy_cost.csv", "accuracy_cost.svg"];
 /// documentation), then every applicable method over its discretisation (LCP and penalty HB
 /// only with contact).
 /// `base` supplies the Newton tolerance, iteration limit, globalization, linear solver and
-/// time-marching limits; `progress` receives one line per run.
+/// time-marching limits (no run estimates its own error); `progress` receives one line per run.
 ///
 /// A run that fails to start is recorded as not converged with NaN errors and the error in
 /// [`Entry::failure`] (printed as missing values and the reason); only a failure of the
@@ -527,6 +532,11 @@ pub fn accuracy_cost(
         if let Some(p) = progress {
             p(s)
         }
+    };
+    // The study measures the error against its reference: no solve estimates its own.
+    let base = &SolverSettings {
+        estimate_error: false,
+        ..base.clone()
     };
     let contact = !rod.model.contacts.is_empty();
     let reference = reference(rod, omega, base, &say)?;

@@ -25,6 +25,7 @@ use semismooth_contact::matrix_market::{build_imported, build_imported_with, Imp
 use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::Solution;
+use semismooth_contact::sweep::SweepProgress;
 
 /// Bad input found in the scene file `path`: the message starts with the file.
 fn input_error(path: &Path, e: impl Display) -> CliError {
@@ -267,6 +268,19 @@ fn parse_override(text: &str) -> Result<Override, String> {
     Override::parse(text).map_err(|e| e.to_string())
 }
 
+/// What `ssn sweep` reads and writes: [`RunArgs`], and whether the points get their
+/// stability.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SweepArgs {
+    /// The scene and the outputs every run has.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Skip the Floquet multipliers of the points (as `[sweep] stability = false`): every
+    /// point is undecided, the branch costs only its continuation.
+    #[arg(long)]
+    pub no_stability: bool,
+}
+
 /// What `ssn solve` reads and writes: [`RunArgs`], and the harmonic-balance state to write
 /// or to start from ([`crate::state`]).
 #[derive(Debug, Clone, clap::Args)]
@@ -448,6 +462,12 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
                 .map_err(|e| input_error(&args.scene, e))?;
         }
     }
+    if solve_args.start.is_some() && scene.solver.accuracy.is_some() {
+        return Err(input_error(
+            &args.scene,
+            "--start with solver.accuracy: the search chooses the harmonics and solves from zero (remove one of the two)",
+        ));
+    }
     let start = match &solve_args.start {
         Some(path) => {
             let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
@@ -502,6 +522,11 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         }
     })?;
     if let Some(path) = &solve_args.state {
+        // With an accuracy target the harmonics are the search's.
+        let shape = StateShape {
+            harmonics: solution.harmonics.unwrap_or(shape.harmonics),
+            ..shape
+        };
         let mut doc =
             HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
                 .to_json();
@@ -527,7 +552,8 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
             }
             t
         },
-        solution.converged(),
+        // An accuracy target not met is a run that did not converge (exit code 1).
+        solution.converged() && solution.search.as_ref().is_none_or(|s| s.met()),
     )
 }
 
@@ -631,6 +657,7 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
         )?;
         writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
         writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        t += &crate::words::estimate_lines(s);
         if s.contacts.len() > 1 {
             for c in &s.contacts {
                 writeln!(
@@ -659,7 +686,8 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
 /// pseudo-arclength continuation; text or JSON on stdout, optional CSV/SVG.
-pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
+pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
+    let args = &sweep_args.run;
     let mut outputs = args.plan()?;
     let Loaded {
         scene,
@@ -667,24 +695,33 @@ pub fn sweep(args: &RunArgs) -> Result<(), CliError> {
         ..
     } = load_with(&args.scene, &args.set, Workload::Branch)?;
     claim_model_files(&mut outputs, &scene)?;
-    let Some(settings) = scene.sweep.as_ref() else {
+    let Some(mut settings) = scene.sweep.clone() else {
         return Err(input_error(
             &args.scene,
             "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
         ));
     };
+    settings.stability &= !sweep_args.no_stability;
     let bar = progress_spinner("sweep");
-    let progress = |points: usize, omega: f64| {
-        bar.set_message(format!(
-            "sweep: {points} points, omega/omega_1 = {:.4}",
-            omega / rod.omega_1
-        ));
+    let progress = |p: SweepProgress| {
+        match p {
+            SweepProgress::Branch {
+                points,
+                omega_ratio,
+            } => bar.set_message(format!(
+                "sweep: {points} points, omega/omega_1 = {omega_ratio:.4}"
+            )),
+            SweepProgress::Stability { done, total } => {
+                bar.set_message(format!("stability: {done} of {total} points"))
+            }
+            _ => {}
+        }
         bar.tick();
     };
     let response = semismooth_contact::sweep::frequency_response(
         &rod,
         &scene.solver,
-        settings,
+        &settings,
         Some(&progress),
     )
     .map_err(|e| input_error(&args.scene, e))?;
@@ -823,11 +860,27 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
     };
     let study = crate::accuracy_cost::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
         .map_err(|e| input_error(path, e))?;
+    say("each method's own search for the accuracy");
+    let chosen = (accuracy < 1.0)
+        .then(|| {
+            crate::accuracy_targets::self_chosen_lines(
+                &rod,
+                omega,
+                &scene.solver,
+                accuracy,
+                study.reference.tip_min,
+            )
+        })
+        .transpose()
+        .map_err(|e| input_error(path, e))?
+        .unwrap_or_default();
     bar.finish_and_clear();
     study.write_files(out)?;
     write_text(&format!(
         "{}\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip \
-         minimum:\n{}\nWrote {}/accuracy_cost.csv and accuracy_cost.svg\n",
+         minimum:\n{}\nThe setting each method chooses itself for {accuracy:e} (its estimate, on \
+         the tip extremes and mean contact forces, without the reference):\n{chosen}\nWrote \
+         {}/accuracy_cost.csv and accuracy_cost.svg\n",
         study.table(),
         study.cheapest_table(accuracy),
         printable(&out.display().to_string())

@@ -1,6 +1,6 @@
 //! A scene's resolved structure and run in words (`ssn scene-check`).
 
-use semismooth_contact::matrix_market::{ContactDirection, ModelSpec};
+use semismooth_contact::matrix_market::ModelSpec;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::DampingSpec;
 
@@ -131,9 +131,16 @@ pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
         .model
         .contacts
         .iter()
-        .filter(|c| semismooth_contact::model::diagonal_entry(&rod.model.mass, c.dof) > 0.0)
-        .map(|c| (c.dof + 1).to_string())
-        .collect();
+        .flat_map(|c| c.row.dofs())
+        .chain(rod.model.friction.iter().flat_map(|f| f.tangent.dofs()))
+        .filter(|&&dof| semismooth_contact::model::diagonal_entry(&rod.model.mass, dof) > 0.0)
+        .map(|dof| (dof + 1).to_string())
+        .fold(Vec::new(), |mut list, dof| {
+            if !list.contains(&dof) {
+                list.push(dof);
+            }
+            list
+        });
     if !massive.is_empty() {
         let (what, remedy) = if scene.model.is_some() {
             (
@@ -212,17 +219,42 @@ pub fn describe_imported(
         line("contact           none: linear problem (one factorization, no FFT)".into());
     }
     for c in &spec.contacts {
+        let row = match c.row.single() {
+            Some((dof, a)) if a.abs() == 1.0 => format!(
+                "dof {}, gap {}, obstacle on the {} side",
+                dof + 1,
+                c.gap,
+                if a > 0.0 { "positive" } else { "negative" }
+            ),
+            _ => format!("{} <= gap {}", row_words(&c.row), c.gap),
+        };
+        line(format!("contact           {row}"));
+        if let Some((mu, tangent)) = &c.friction {
+            line(format!(
+                "  friction        mu = {mu} on the slip {}",
+                row_words(tangent)
+            ));
+        }
+    }
+    for f in &spec.friction {
         line(format!(
-            "contact           dof {}, gap {}, obstacle on the {} side",
-            c.dof + 1,
-            c.gap,
-            match c.direction {
-                ContactDirection::Positive => "positive",
-                ContactDirection::Negative => "negative",
-            }
+            "friction          mu = {} under normal load {} (slip limit {}) on the slip {}",
+            f.coefficient,
+            f.normal_load,
+            f.coefficient * f.normal_load,
+            row_words(&f.tangent)
         ));
     }
     line(format!("observed dof      {}", structure.observed_dof + 1));
     out.push_str(&describe_run(scene, structure));
     out
+}
+
+/// A row of `G` in words: `1 u[41] - 1 u[83]` (1-based dofs).
+fn row_words(row: &semismooth_contact::model::ContactRow) -> String {
+    let terms: Vec<String> = row
+        .entries()
+        .map(|(dof, a)| format!("{a} u[{}]", dof + 1))
+        .collect();
+    terms.join(" + ").replace("+ -", "- ")
 }

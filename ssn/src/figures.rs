@@ -18,13 +18,13 @@ use std::time::Instant;
 use crate::exit::CliError;
 use crate::output::{
     csv_table, prepare_directory, stability_key, stability_series, write_atomically,
-    write_line_plot, PlotSpec, Series,
+    write_line_plot, LineStyle, PlotSpec, Series, BLACK_INDEX,
 };
 use crate::progress::progress_bar;
 use crate::scene::{Method, SolverSettings, SweepSettings};
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
-use semismooth_contact::solve::solve;
+use semismooth_contact::solve::{solve, Solution};
 
 fn bad_input(e: impl std::fmt::Display) -> CliError {
     CliError::BadInput(e.to_string())
@@ -99,6 +99,7 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
     let mut series = Vec::new();
     let mut csv_columns: Vec<(String, Vec<f64>)> = Vec::new();
     let mut rows = Vec::new();
+    let mut finest = None;
     for h in [10usize, 15, 20] {
         let settings = SolverSettings::with_harmonics(h);
         let s = solve(&rod, rod.omega(), &settings, None).map_err(bad_input)?;
@@ -120,6 +121,7 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
             tip_max: s.stats.max,
             difference: (s.stats.min - reference.stats.min).abs() / reference.stats.min.abs(),
         });
+        finest = Some(s);
     }
     let phase: Vec<f64> = reference.times.iter().map(|t| t / period).collect();
     series.push(Series::dashed(
@@ -154,7 +156,116 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
         &series,
         &csv_columns,
     )?;
+    if let Some(hb) = finest {
+        let stem = format!("fig1_{name}_mass");
+        period_figures(
+            out,
+            &stem,
+            &rod,
+            &[(&hb, "SSN-HB H = 20"), (&reference, "reference")],
+        )?;
+    }
     Ok(rows)
+}
+
+/// `series` in palette colour `color`, solid for the first solution (`index` 0) and dashed
+/// for the others (the references).
+fn styled(series: Series, color: usize, index: usize) -> Series {
+    let style = if index == 0 {
+        LineStyle::Solid
+    } else {
+        LineStyle::Dashed
+    };
+    Series {
+        style,
+        ..series.with_color(color)
+    }
+}
+
+/// The contact force of every contact over one period (`<stem>_contact_force.svg`) and the
+/// orbit of the observed dof, displacement against velocity (`<stem>_orbit.svg`, the
+/// velocity by central differences of the periodic samples), of each solution.
+fn period_figures(
+    out: &Path,
+    stem: &str,
+    rod: &Structure,
+    solutions: &[(&Solution, &str)],
+) -> Result<(), CliError> {
+    let mut forces = Vec::new();
+    let mut orbits = Vec::new();
+    for (color, (s, label)) in solutions.iter().enumerate() {
+        let period = 2.0 * std::f64::consts::PI / s.omega;
+        let phase: Vec<f64> = s.times.iter().map(|t| t / period).collect();
+        for (k, f) in s.contact_forces.iter().enumerate() {
+            let curve = if s.contact_forces.len() > 1 {
+                format!("{label}, contact {k}")
+            } else {
+                label.to_string()
+            };
+            forces.push(styled(
+                Series::new(curve, phase.clone(), f.clone()),
+                color + k,
+                color,
+            ));
+        }
+        let u = &s.tip;
+        let m = u.len();
+        let dt = period / m as f64;
+        let v: Vec<f64> = (0..m)
+            .map(|i| (u[(i + 1) % m] - u[(i + m - 1) % m]) / (2.0 * dt * s.omega))
+            .collect();
+        let mut closed_u = u.clone();
+        let mut closed_v = v;
+        if m > 0 {
+            closed_u.push(u[0]);
+            closed_v.push(closed_v[0]);
+        }
+        orbits.push(styled(
+            Series::new(*label, closed_u, closed_v),
+            color,
+            color,
+        ));
+    }
+    write_line_plot(
+        &out.join(format!("{stem}_contact_force.svg")),
+        &PlotSpec {
+            title: "contact force over one period (compressive < 0)".into(),
+            x_label: "time t / T".into(),
+            y_label: "contact force lambda".into(),
+            log_log: false,
+        },
+        &forces,
+    )?;
+    let gaps = rod
+        .model
+        .contacts
+        .iter()
+        .filter(|c| c.dof() == rod.observed_dof)
+        .map(|c| c.gap);
+    let (v_lo, v_hi) = orbits
+        .iter()
+        .flat_map(|s| s.y.iter().copied())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    for gap in gaps {
+        orbits.push(Series {
+            x: vec![gap, gap],
+            y: vec![v_lo, v_hi],
+            ..Series::horizontal("obstacle", 0.0, 0.0, 0.0)
+        });
+    }
+    write_line_plot(
+        &out.join(format!("{stem}_orbit.svg")),
+        &PlotSpec {
+            title: "orbit of the observed dof over one period".into(),
+            x_label: "displacement u".into(),
+            y_label: "velocity du/dt / omega".into(),
+            log_log: false,
+        },
+        &orbits,
+    )
+    .map_err(CliError::from)
 }
 
 /// Dashed black lines at the obstacles of the contacts on the observed dof, over
@@ -164,14 +275,14 @@ pub fn obstacle_lines(structure: &Structure, x0: f64, x1: f64) -> Vec<Series> {
         .model
         .contacts
         .iter()
-        .filter(|c| c.dof == structure.observed_dof)
-        .map(|c| {
-            Series::horizontal(
+        .filter_map(|c| match c.row.single() {
+            Some((dof, sign)) if dof == structure.observed_dof => Some(Series::horizontal(
                 format!("obstacle (gap {})", c.gap),
-                c.sign() * c.gap,
+                sign * c.gap,
                 x0,
                 x1,
-            )
+            )),
+            _ => None,
         })
         .collect()
 }
@@ -285,33 +396,71 @@ pub struct Fig2 {
 /// 0.75 and the linear rod, SSN-HB with `harmonics` harmonics and the `mass` model, by
 /// pseudo-arclength continuation, each branch drawn by stability
 /// ([`crate::output::STABILITY_KEY`]); writes `<stem>.svg` and `.csv` into `out`.
+/// Folds are marked by circles. `<stem>_resonance.svg` is the same figure around the
+/// resonance ([`resonance_window`]), where the folds and the unstable parts lie.
 ///
-/// Stability is known for the modified mass (a massless contact node); with the consistent
-/// mass the contact node has mass, the monodromy would need the impact law's saltation, and
-/// the branches are drawn dotted (undecided).
+/// With the consistent mass the contact node has mass: the verdict is that of the
+/// harmonic-balance orbit under a perfectly inelastic impact (module
+/// `semismooth_contact::stability`).
 pub fn figure_2(out: &Path, harmonics: usize, mass: MassModel) -> Result<Vec<Fig2Curve>, CliError> {
     let fig = figure_2_curves(harmonics, mass)?;
-    write_figure(
-        out,
-        &fig.stem,
-        &PlotSpec {
-            title: format!(
-                "Fig. 2: frequency response of the rod tip, H = {harmonics}, {} mass{}",
-                mass_name(mass),
-                if mass == MassModel::Consistent {
-                    " (stability undecided: massive contact node)"
-                } else {
-                    ""
-                }
-            ),
-            x_label: "forcing frequency omega / omega_1".into(),
-            y_label: "tip amplitude max_t |u_tip(t)|".into(),
-            log_log: false,
-        },
-        &fig.series,
-        &fig.columns,
-    )?;
+    let spec = PlotSpec {
+        title: format!(
+            "Fig. 2: frequency response of the rod tip, H = {harmonics}, {} mass",
+            mass_name(mass),
+        ),
+        x_label: "forcing frequency omega / omega_1".into(),
+        y_label: "tip amplitude max_t |u_tip(t)|".into(),
+        log_log: false,
+    };
+    write_figure(out, &fig.stem, &spec, &fig.series, &fig.columns)?;
+    if let Some((lo, hi)) = resonance_window(&fig.curves) {
+        let zoomed: Vec<Series> = fig.series.iter().map(|s| clipped(s, lo, hi)).collect();
+        let spec = PlotSpec {
+            title: format!("{} (resonance)", spec.title),
+            ..spec
+        };
+        write_line_plot(
+            &out.join(format!("{}_resonance.svg", fig.stem)),
+            &spec,
+            &zoomed,
+        )?;
+    }
     Ok(fig.curves)
+}
+
+/// The frequencies (units of omega_1) around the contact branches' peaks and folds: from
+/// the smallest to the largest of them, widened by half their spread and at least 0.02 on
+/// each side; `None` without a contact branch.
+pub fn resonance_window(curves: &[Fig2Curve]) -> Option<(f64, f64)> {
+    let marks: Vec<f64> = curves
+        .iter()
+        .filter(|c| c.gap.is_some())
+        .flat_map(|c| c.folds.iter().copied().chain([c.peak.1]))
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = marks.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = marks.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (lo <= hi).then(|| {
+        let margin = (0.5 * (hi - lo)).max(0.02);
+        (lo - margin, hi + margin)
+    })
+}
+
+/// The points of `series` with `lo <= x <= hi` (a legend entry without points stays).
+fn clipped(series: &Series, lo: f64, hi: f64) -> Series {
+    let (x, y) = series
+        .x
+        .iter()
+        .zip(&series.y)
+        .filter(|(x, _)| (lo..=hi).contains(*x))
+        .map(|(x, y)| (*x, *y))
+        .unzip();
+    Series {
+        x,
+        y,
+        ..series.clone()
+    }
 }
 
 /// One branch of Fig. 2: the rod with `gap` (`None`: without contact) and `mass`, swept by
@@ -349,6 +498,7 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
     let mut series = Vec::new();
     let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
     let mut verdicts = Vec::new();
+    let mut folds_marked = false;
     for (k, gap) in FIG2_GAPS.into_iter().enumerate() {
         let (rod, r) = figure_2_branch(gap, harmonics, mass)?;
         bar.inc(1);
@@ -379,7 +529,16 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
                 .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
                 .collect(),
         ));
-        let pieces = stability_series(&label, k, &ratio, &r.amplitude, stable);
+        let mut pieces = stability_series(&label, k, &ratio, &r.amplitude, stable);
+        if !r.fold_indices.is_empty() {
+            let (x, y) = r
+                .fold_indices
+                .iter()
+                .map(|&i| (ratio[i], r.amplitude[i]))
+                .unzip();
+            pieces.push(Series::markers("", x, y).with_color(k));
+            folds_marked = true;
+        }
         if gap.is_none() {
             // The linear rod underneath: off contact the contact branches coincide with it.
             series.splice(0..0, pieces);
@@ -389,6 +548,9 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
         verdicts.extend_from_slice(stable);
     }
     series.extend(stability_key(&verdicts));
+    if folds_marked {
+        series.push(Series::markers("fold", Vec::new(), Vec::new()).with_color(BLACK_INDEX));
+    }
     bar.finish_and_clear();
     let stem = match mass {
         MassModel::Consistent => format!("fig2_H{harmonics}"),
@@ -420,7 +582,7 @@ pub fn default_run(out: &Path) -> Result<(), CliError> {
         (
             20,
             MassModel::Modified,
-            "massless contact node: stability known, fig2_H20_modified_mass.svg",
+            "massless contact node, fig2_H20_modified_mass.svg",
         ),
     ] {
         let curves = figure_2(out, harmonics, mass)?;
@@ -463,12 +625,12 @@ pub fn default_run(out: &Path) -> Result<(), CliError> {
     crate::outln!(
         "Contact stiffens the rod: the peak moves to higher frequency and is bounded by the gap; \
          the branches fold over (the jump frequencies are the folds) and are unstable between \
-         their folds. Stability (solid stable, dashed unstable, dotted undecided) is known for \
-         the modified mass (fig2_H20_modified_mass.svg); with the consistent mass (the \
-         paper's rod, fig2_H5.svg) the contact node has mass, the monodromy would need the \
-         impact law's saltation, and the branches are dotted (undecided). At H = 5 the gap \
-         0.25 branch turns several times: the contact holds only in the Galerkin sense \
-         (ssn/examples/strange_loops.rs)."
+         their folds. Stability: solid stable, dashed unstable, dotted undecided. With the \
+         consistent mass (the paper's rod, fig2_H5.svg) the contact node has mass: the \
+         verdict is that of the harmonic-balance orbit under a perfectly inelastic impact \
+         (restitution 0), the law under which a closed interval follows an arrival with \
+         speed. At H = 5 the branches turn several times near their peaks: the contact \
+         holds only in the Galerkin sense (ssn/examples/strange_loops.rs)."
     )?;
     crate::outln!(
         "\nWrote {} in {:.1} s.",

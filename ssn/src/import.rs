@@ -1,7 +1,7 @@
 //! Any scene's structure exported as a `[model]` scene (`ssn export-model`).
 
 use semismooth_contact::matrix_market::{matrix_market_text, vector_market_text};
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{ContactRow, NormalForce, Structure};
 use semismooth_contact::rod::FrequencySpec;
 
 /// Name of the scene file [`export_files`] writes.
@@ -37,14 +37,35 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
         FrequencySpec::Ratio(r) => writeln!(t, "omega_ratio = {r:?}"),
         FrequencySpec::Absolute(w) => writeln!(t, "omega = {w:?}"),
     };
-    for c in &model.contacts {
+    for (i, c) in model.contacts.iter().enumerate() {
         let _ = writeln!(
             t,
-            "\n[[contact.point]]\ndof = {}\ngap = {:?}\ndirection = {}",
-            c.dof + 1,
-            c.gap,
-            c.sign() as i32
+            "\n[[contact.point]]\n{}gap = {:?}",
+            row_keys(&c.row, true),
+            c.gap
         );
+        let on_contact = model
+            .friction
+            .iter()
+            .find(|f| f.normal == NormalForce::Contact(i));
+        if let Some(f) = on_contact {
+            let (dofs, coefficients) = row_lists(&f.tangent);
+            let _ = writeln!(
+                t,
+                "friction = {:?}\ntangent_dofs = {dofs}\ntangent_coefficients = {coefficients}",
+                f.coefficient
+            );
+        }
+    }
+    for f in &model.friction {
+        if let NormalForce::Prescribed(load) = f.normal {
+            let _ = writeln!(
+                t,
+                "\n[[friction.point]]\n{}normal_load = {load:?}\nfriction = {:?}",
+                row_keys(&f.tangent, false),
+                f.coefficient
+            );
+        }
     }
     let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);
     let v = &scene.solver;
@@ -87,4 +108,34 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     }
     files.push((EXPORTED_SCENE.to_string(), t));
     files
+}
+
+/// The scene keys of a row, one per line: `dof` (with `direction` when `with_direction`:
+/// contacts take one, friction points none) for one dof with coefficient `+1` (or `-1`
+/// with a direction), else `dofs` and `coefficients`.
+fn row_keys(row: &ContactRow, with_direction: bool) -> String {
+    match row.single() {
+        Some((dof, a)) if with_direction && a.abs() == 1.0 => {
+            format!("dof = {}\ndirection = {}\n", dof + 1, a as i32)
+        }
+        Some((dof, 1.0)) => format!("dof = {}\n", dof + 1),
+        _ => {
+            let (dofs, coefficients) = row_lists(row);
+            format!("dofs = {dofs}\ncoefficients = {coefficients}\n")
+        }
+    }
+}
+
+/// A row's 1-based dofs and its coefficients as TOML arrays.
+fn row_lists(row: &ContactRow) -> (String, String) {
+    let dofs: Vec<String> = row.dofs().iter().map(|d| (d + 1).to_string()).collect();
+    let coefficients: Vec<String> = row
+        .coefficients()
+        .iter()
+        .map(|a| format!("{a:?}"))
+        .collect();
+    (
+        format!("[{}]", dofs.join(", ")),
+        format!("[{}]", coefficients.join(", ")),
+    )
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde_json::{json, Value};
 
+use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::ContactReport;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
@@ -103,6 +104,10 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     if let Some(c) = s.c {
         v["c"] = json!(c);
     }
+    (v["error_estimate"], v["error_estimate_note"]) = estimate_json(s);
+    if let Some(search) = &s.search {
+        v["accuracy"] = search_json(s, search);
+    }
     v
 }
 
@@ -154,6 +159,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "amplitude": r.amplitude,
         "stable": st.stable,
         "floquet_max_abs": st.floquet_max_abs,
+        "placed_by_fold": st.placed_by_fold,
         "contact_force_mean": r.contact_force_mean(),
         "max_penetration": st.max_penetration,
         "contacts": r
@@ -228,5 +234,59 @@ pub fn solutions_json(set: &SolutionSet) -> Value {
         "failed_corrections": set.failed_corrections.iter().map(crate::words::failed_correction).collect::<Vec<_>>(),
         "seconds": set.seconds,
         "solutions": solutions,
+    })
+}
+
+/// The `error_estimate` object of a solution (`null` without one) and the
+/// `error_estimate_note` saying why there is none (`null` with one).
+pub fn estimate_json(s: &Solution) -> (Value, Value) {
+    match &s.error_estimate {
+        Ok(e) => (
+            json!({
+                "relative": finite_or_null(e.relative),
+                "displacement_max": finite_or_null(e.parts.displacement_max),
+                "displacement_min": finite_or_null(e.parts.displacement_min),
+                "contact_force": e.parts.contact_force.map(finite_or_null),
+                "based_on": crate::words::estimate_basis(s.method, &e.basis),
+                "against": discretisation_json(&e.basis.against),
+                "order": e.basis.order,
+                "seconds": e.seconds,
+            }),
+            Value::Null,
+        ),
+        Err(n) => (Value::Null, json!(crate::words::no_estimate(n))),
+    }
+}
+
+/// `{harmonics, time_samples}` (`harmonics` null for the LCP and time marching).
+fn discretisation_json(d: &Discretisation) -> Value {
+    json!({"harmonics": d.harmonics, "time_samples": d.time_samples})
+}
+
+/// The `accuracy` object of a solve with an accuracy target: `target`, `met`, `stop`,
+/// `chosen` ({`harmonics`, `time_samples`}), `steps` (each {`harmonics`, `time_samples`,
+/// `converged`, `iterations`, `seconds`, `estimate`}), `seconds` and `counters` of the whole
+/// search.
+pub fn search_json(s: &Solution, search: &DiscretisationSearch) -> Value {
+    let steps: Vec<Value> = search
+        .steps
+        .iter()
+        .map(|step| {
+            let mut v = discretisation_json(&step.discretisation);
+            v["converged"] = json!(step.converged);
+            v["iterations"] = json!(step.iterations);
+            v["seconds"] = json!(step.seconds);
+            v["estimate"] = step.estimate.map_or(Value::Null, finite_or_null);
+            v
+        })
+        .collect();
+    json!({
+        "target": search.target,
+        "met": search.met(),
+        "stop": crate::words::search_stop(s.method, &search.stop),
+        "chosen": discretisation_json(&search.steps[search.chosen].discretisation),
+        "steps": steps,
+        "seconds": search.seconds,
+        "counters": counters_json(&search.counters),
     })
 }

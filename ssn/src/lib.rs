@@ -4,6 +4,7 @@
 //! figures, tables, outputs and the `ssn` program.
 
 pub mod accuracy_cost;
+pub mod accuracy_targets;
 pub mod cli;
 pub mod describe;
 pub mod exit;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use ssn::cli::{self, CliError, RunArgs};
+use ssn::cli::{self, CliError, RunArgs, SweepArgs};
 use ssn::{figures, io};
 
 const EXIT_CODES: &str = "\
@@ -91,7 +91,7 @@ enum Command {
         mut_arg("csv", |a| a.help("Write the branch as CSV")),
         mut_arg("svg", |a| a.help("Write the frequency response as SVG"))
     )]
-    Sweep(RunArgs),
+    Sweep(SweepArgs),
     /// Every periodic solution at the scene's forcing frequency, with its stability (follows
     /// the branch through the frequency and corrects each crossing there).
     #[command(
@@ -186,7 +186,7 @@ fn main() -> ExitCode {
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
         Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
         Some(Command::Solve(solve)) => cli::solve(solve),
-        Some(Command::Sweep(run)) => cli::sweep(run),
+        Some(Command::Sweep(sweep)) => cli::sweep(sweep),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
         Some(Command::Study(study)) => ssn::study::command::command(study),
     };

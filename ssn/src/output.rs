@@ -4,6 +4,7 @@ use std::path::Path;
 
 pub use crate::io::{prepare_directory, write_atomically, OutputError};
 
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 
 /// A CSV table from named columns of equal length (shorter columns are padded with empty
@@ -38,6 +39,9 @@ pub enum LineStyle {
     Dashed,
     /// Dots of 2 px with gaps of 4 px (branch parts whose stability is undecided).
     Dotted,
+    /// A filled circle of radius 4 px at each point, no line (folds, bifurcations, the
+    /// measured points of a study).
+    Markers,
 }
 
 /// One curve of a line plot.
@@ -80,6 +84,14 @@ impl Series {
         Series {
             color: Some(color),
             ..self
+        }
+    }
+
+    /// Filled circles at the points, no line.
+    pub fn markers(label: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series {
+            style: LineStyle::Markers,
+            ..Series::new(label, x, y)
         }
     }
 
@@ -180,10 +192,11 @@ pub fn longest_plotted_step(series: &[Series]) -> f64 {
     longest_plotted_step_on(series, range(&|s| &s.x), range(&|s| &s.y))
 }
 
-/// [`longest_plotted_step`] on axes of the ranges `rx` and `ry`.
+/// [`longest_plotted_step`] on axes of the ranges `rx` and `ry` (markers join nothing).
 pub fn longest_plotted_step_on(series: &[Series], rx: f64, ry: f64) -> f64 {
     series
         .iter()
+        .filter(|s| s.style != LineStyle::Markers)
         .flat_map(|s| {
             s.x.windows(2)
                 .zip(s.y.windows(2))
@@ -225,7 +238,7 @@ pub struct PlotSpec {
     pub x_label: String,
     /// Label of the vertical axis.
     pub y_label: String,
-    /// Plot log10 of both coordinates (non-positive values are dropped).
+    /// Logarithmic axes for both coordinates (non-positive values are dropped).
     pub log_log: bool,
 }
 
@@ -241,15 +254,32 @@ const PALETTE: [RGBColor; 8] = [
 ];
 
 /// Palette index of black.
-const BLACK_INDEX: usize = 7;
+pub const BLACK_INDEX: usize = 7;
 
-/// Draws the series as an SVG document (840 x 520 px) and returns it as a string.
+/// Size of the SVG documents in CSS pixels.
+const SIZE: (u32, u32) = (840, 520);
+
+/// The drawing is made at this multiple of [`SIZE`] and shown at [`SIZE`] (the document's
+/// `viewBox`): plotters rounds coordinates to whole units, which are then quarter pixels.
+const SUPERSAMPLING: u32 = 4;
+
+/// A length of `px` CSS pixels in drawing units.
+const fn px(px: u32) -> u32 {
+    px * SUPERSAMPLING
+}
+
+/// [`px`] as a signed coordinate.
+const fn ipx(v: i32) -> i32 {
+    v * SUPERSAMPLING as i32
+}
+
+/// Draws the series as an SVG document (840 x 520 px, coordinates to a quarter pixel) and
+/// returns it as a string.
 pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, OutputError> {
     let fail = |reason: String| OutputError::Plot {
         title: spec.title.clone(),
         reason,
     };
-    let transform = |v: f64| if spec.log_log { v.log10() } else { v };
     let curves: Vec<(&Series, Vec<(f64, f64)>)> = series
         .iter()
         .map(|s| {
@@ -260,7 +290,7 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
                 .filter(|(x, y)| {
                     x.is_finite() && y.is_finite() && (!spec.log_log || (**x > 0.0 && **y > 0.0))
                 })
-                .map(|(x, y)| (transform(*x), transform(*y)))
+                .map(|(x, y)| (*x, *y))
                 .collect();
             (s, pts)
         })
@@ -276,7 +306,12 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
     if x0 > x1 {
         return Err(fail("no finite points to plot".into()));
     }
+    // Padding and legend room are fractions of the axis, in log10 on log axes.
+    let log = spec.log_log;
+    let to_axis = |v: f64| if log { v.log10() } else { v };
+    let from_axis = |v: f64| if log { 10f64.powf(v) } else { v };
     let pad = |a: f64, b: f64| {
+        let (a, b) = (to_axis(a), to_axis(b));
         let d = if b > a {
             0.05 * (b - a)
         } else {
@@ -286,88 +321,147 @@ pub fn line_plot_svg(spec: &PlotSpec, series: &[Series]) -> Result<String, Outpu
     };
     let (x0, x1) = pad(x0, x1);
     let (y0, mut y1) = pad(y0, y1);
-    // Room above the curves for the legend (upper right): 22 px per entry and 16 px of
-    // frame on a plot area of about 400 px, so that it hides no curve.
+    // Room for the legend (upper right: 22 px per entry and 16 px of frame on a plot area
+    // of about 400 px high, about 200 px of 750 wide) above the curves that pass under it,
+    // so that it hides none and the axis is no taller than that needs.
     let entries = series.iter().filter(|s| !s.label.is_empty()).count();
     if entries > 0 {
         let fraction = ((22 * entries + 16) as f64 / 400.0).min(0.6);
-        y1 += (y1 - y0) * fraction / (1.0 - fraction);
+        let legend_left = x1 - 0.3 * (x1 - x0);
+        let under_legend = curves
+            .iter()
+            .flat_map(|(_, p)| p.iter())
+            .filter(|(x, _)| to_axis(*x) >= legend_left)
+            .map(|(_, y)| to_axis(*y))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if under_legend.is_finite() {
+            // The legend's bottom at `y1 - fraction (y1 - y0)` above the highest of them.
+            let needed = (under_legend + 0.02 * (y1 - y0) - fraction * y0) / (1.0 - fraction);
+            y1 = y1.max(needed);
+        }
     }
-    let (xl, yl) = if spec.log_log {
-        (
-            format!("log10 {}", spec.x_label),
-            format!("log10 {}", spec.y_label),
-        )
-    } else {
-        (spec.x_label.clone(), spec.y_label.clone())
-    };
-    let (x_range, y_range) = (x1 - x0, y1 - y0);
-    let x_tick = move |v: &f64| tick_label(*v, x_range);
-    let y_tick = move |v: &f64| tick_label(*v, y_range);
+    let (x0, x1, y0, y1) = (from_axis(x0), from_axis(x1), from_axis(y0), from_axis(y1));
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (840, 520)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (px(SIZE.0), px(SIZE.1))).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&spec.title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| fail(e.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc(xl)
-            .y_desc(yl)
-            .x_label_formatter(&x_tick)
-            .y_label_formatter(&y_tick)
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(|e| fail(e.to_string()))?;
-        for (i, (s, pts)) in curves.into_iter().enumerate() {
-            let color = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
-            let style = ShapeStyle {
-                color: color.to_rgba(),
-                filled: false,
-                stroke_width: 2,
-            };
-            let anno = match s.style {
-                LineStyle::Solid => chart.draw_series(LineSeries::new(pts, style)),
-                LineStyle::Dashed => chart.draw_series(DashedLineSeries::new(pts, 6, 4, style)),
-                LineStyle::Dotted => chart.draw_series(DashedLineSeries::new(pts, 2, 4, style)),
-            }
-            .map_err(|e| fail(e.to_string()))?;
-            if !s.label.is_empty() {
-                // The legend's glyph in the curve's stroke: three pieces of a 20 px line.
-                let pieces: [(i32, i32); 3] = match s.style {
-                    LineStyle::Solid => [(0, 7), (7, 14), (14, 20)],
-                    LineStyle::Dashed => [(0, 6), (10, 16), (20, 20)],
-                    LineStyle::Dotted => [(0, 2), (6, 8), (12, 14)],
-                };
-                // (The pieces are placed relative to the anchor of the composed element.)
-                anno.label(s.label.clone()).legend(move |(x, y)| {
-                    let piece = |(a, b): (i32, i32)| {
-                        PathElement::new(vec![(a, 0), (b, 0)], color.stroke_width(2))
-                    };
-                    EmptyElement::at((x, y))
-                        + piece(pieces[0])
-                        + piece(pieces[1])
-                        + piece(pieces[2])
-                });
-            }
-        }
-        if entries > 0 {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
+        let builder = |root| {
+            let mut b = ChartBuilder::on(root);
+            b.caption(&spec.title, ("sans-serif", px(18)))
+                .margin(px(12))
+                .x_label_area_size(px(44))
+                .y_label_area_size(px(64));
+            b
+        };
+        let log_tick = |v: &f64| format!("{v:.0e}");
+        let (x_range, y_range) = (x1 - x0, y1 - y0);
+        let x_tick = move |v: &f64| tick_label(*v, x_range);
+        let y_tick = move |v: &f64| tick_label(*v, y_range);
+        if spec.log_log {
+            let mut chart = builder(&root)
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
                 .map_err(|e| fail(e.to_string()))?;
+            draw_chart(&mut chart, spec, (&log_tick, &log_tick), curves, entries).map_err(fail)?;
+        } else {
+            let mut chart = builder(&root)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| fail(e.to_string()))?;
+            draw_chart(&mut chart, spec, (&x_tick, &y_tick), curves, entries).map_err(fail)?;
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
-    Ok(svg)
+    // Shown at SIZE: the drawing units become fractions of a pixel.
+    let drawn = format!(r#"width="{}" height="{}""#, px(SIZE.0), px(SIZE.1));
+    let shown = format!(r#"width="{}" height="{}""#, SIZE.0, SIZE.1);
+    Ok(svg.replacen(&drawn, &shown, 1))
+}
+
+/// The tick label formatters of the two axes.
+type Ticks<'t> = (&'t dyn Fn(&f64) -> String, &'t dyn Fn(&f64) -> String);
+
+/// Draws the axes (labelled by `ticks`) and the curves (with their legend entries,
+/// `entries` of them) on `chart`.
+fn draw_chart<'a, X, Y>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<X, Y>>,
+    spec: &PlotSpec,
+    ticks: Ticks<'_>,
+    curves: Vec<(&Series, Vec<(f64, f64)>)>,
+    entries: usize,
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let fail = |e: DrawingAreaErrorKind<_>| e.to_string();
+    chart
+        .configure_mesh()
+        .x_desc(spec.x_label.as_str())
+        .y_desc(spec.y_label.as_str())
+        .x_label_formatter(ticks.0)
+        .y_label_formatter(ticks.1)
+        .label_style(("sans-serif", px(12)))
+        .axis_desc_style(("sans-serif", px(14)))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(fail)?;
+    for (i, (s, pts)) in curves.into_iter().enumerate() {
+        let color = PALETTE[s.color.unwrap_or(i) % PALETTE.len()];
+        let style = ShapeStyle {
+            color: color.to_rgba(),
+            filled: false,
+            stroke_width: px(2),
+        };
+        let anno = match s.style {
+            LineStyle::Solid => chart.draw_series(LineSeries::new(pts, style)),
+            LineStyle::Dashed => chart.draw_series(DashedLineSeries::new(pts, px(6), px(4), style)),
+            LineStyle::Dotted => chart.draw_series(DashedLineSeries::new(pts, px(2), px(4), style)),
+            LineStyle::Markers => chart.draw_series(
+                pts.into_iter()
+                    .map(|p| Circle::new(p, px(4), color.filled())),
+            ),
+        }
+        .map_err(fail)?;
+        if !s.label.is_empty() {
+            // The legend's glyph in the curve's stroke: three pieces of a 20 px line, or
+            // a marker.
+            let pieces: [(i32, i32); 3] = match s.style {
+                LineStyle::Solid => [(0, 7), (7, 14), (14, 20)],
+                LineStyle::Dashed => [(0, 6), (10, 16), (20, 20)],
+                LineStyle::Dotted | LineStyle::Markers => [(0, 2), (6, 8), (12, 14)],
+            };
+            let markers = s.style == LineStyle::Markers;
+            // (The pieces are placed relative to the anchor of the composed element.)
+            anno.label(s.label.clone()).legend(move |(x, y)| {
+                let piece = |(a, b): (i32, i32)| {
+                    let (a, b) = if markers { (0, 0) } else { (ipx(a), ipx(b)) };
+                    PathElement::new(vec![(a, 0), (b, 0)], color.stroke_width(px(2)))
+                };
+                let marker = Circle::new(
+                    (ipx(10), 0),
+                    if markers { px(4) } else { 0 },
+                    color.filled(),
+                );
+                EmptyElement::at((x, y))
+                    + piece(pieces[0])
+                    + piece(pieces[1])
+                    + piece(pieces[2])
+                    + marker
+            });
+        }
+    }
+    if entries > 0 {
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", px(13)))
+            .legend_area_size(px(30))
+            .margin(px(10))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(fail)?;
+    }
+    Ok(())
 }
 
 /// Draws and writes an SVG plot atomically.

@@ -275,16 +275,21 @@ impl HbState {
                 ));
             }
         }
-        let resize = |coefficients: &[f64], width: usize| -> Vec<f64> {
-            let mut out = vec![0.0; (2 * shape.harmonics + 1) * width];
-            let keep = out.len().min(coefficients.len());
-            out[..keep].copy_from_slice(&coefficients[..keep]);
-            out
+        let mut stacked = self.displacement.clone();
+        let contacts = match &self.contact_force {
+            Some(l) => {
+                stacked.extend_from_slice(l);
+                self.contacts
+            }
+            None => 0,
         };
-        let mut x = resize(&self.displacement, self.dofs);
-        if let Some(l) = &self.contact_force {
-            x.extend(resize(l, self.contacts));
-        }
+        let x = semismooth_contact::hb::resize_harmonics(
+            &stacked,
+            self.harmonics,
+            shape.harmonics,
+            self.dofs,
+            contacts,
+        );
         let note = (self.harmonics != shape.harmonics).then(|| {
             format!(
                 "the state's H = {} {} to the scene's H = {}",

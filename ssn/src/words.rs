@@ -4,9 +4,10 @@
 
 use semismooth::continuation::ContinuationTermination;
 use semismooth::lemke::{LemkeOptions, LemkeTermination};
+use semismooth_contact::accuracy::{Discretisation, EstimateBasis, NoEstimate, SearchStop};
 use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
-use semismooth_contact::solve::{Diagnosis, Termination};
+use semismooth_contact::solve::{Diagnosis, Solution, Termination};
 use semismooth_contact::stability::Undecided;
 use semismooth_contact::sweep::{FrequencyResponse, SweepTermination};
 
@@ -151,12 +152,30 @@ fn branch_termination(r: &FrequencyResponse, t: &ContinuationTermination) -> Str
 pub fn undecided(u: &Undecided) -> String {
     match u {
         Undecided::MassCarryingContact => {
-            "a contact dof has mass: the flow has impacts and the monodromy needs the impact \
-             law's saltation matrices, which are not implemented (use a modified mass)"
+            "a contact dof has mass: the time-stepping map of the discrete monodromy has no \
+             impact law (the monodromy along the harmonic-balance contact phases decides it)"
                 .to_string()
         }
+        Undecided::Friction { points } => format!(
+            "{points} friction points: the monodromy of the stepping map through stick and \
+             slip is not implemented"
+        ),
         Undecided::TooManyDofs { dofs, limit } => {
             format!("{dofs} dofs: the dense monodromy is formed only up to {limit} dofs (2N x 2N)")
+        }
+        Undecided::TooCostly { phases, work } => format!(
+            "{phases} contact phases per period: the monodromy would take about {work:.1e} \
+             floating-point operations (limit {:.0e})",
+            semismooth_contact::stability::MAX_WORK
+        ),
+        Undecided::Marginal { max_abs } => format!(
+            "the largest Floquet multiplier has modulus {max_abs} (on the unit circle to within \
+             {:e}: an undamped model)",
+            semismooth_contact::stability::MARGINAL
+        ),
+        Undecided::Phases(err) => format!("the contact phases' dynamics: {err}"),
+        Undecided::NotRequested => {
+            "stability not computed ([sweep] stability = false or --no-stability)".to_string()
         }
         Undecided::OrbitNotFound {
             termination,
@@ -190,4 +209,108 @@ pub fn failed_correction(f: &FailedCorrection) -> String {
         termination(&f.termination),
         f.residual_norm
     )
+}
+
+/// A discretisation of `method` as the tables print it: `H=20 Nt=256` (harmonic balance),
+/// `Nt=512` (the periodic LCP), `steps=2000` (time marching).
+pub fn discretisation(method: Method, d: &Discretisation) -> String {
+    match (d.harmonics, method) {
+        (Some(h), _) => format!("H={h} Nt={}", d.time_samples),
+        (None, Method::March) => format!("steps={}", d.time_samples),
+        (None, _) => format!("Nt={}", d.time_samples),
+    }
+}
+
+/// What an error estimate is based on.
+pub fn estimate_basis(method: Method, b: &EstimateBasis) -> String {
+    let mut s = format!(
+        "the change against {} (Richardson, order {})",
+        discretisation(method, &b.against),
+        b.order
+    );
+    if let Some(k) = b.softer_penalty {
+        s += &format!(", plus the change against penalty_stiffness {k:e} (order 1 in 1/k_p)");
+    }
+    if let Some(nt) = b.time_samples_check {
+        s += &format!(", plus the change against Nt={nt} at the same H (order 2 in Nt)");
+    }
+    s
+}
+
+/// Why a solution has no error estimate.
+pub fn no_estimate(n: &NoEstimate) -> String {
+    match n {
+        NoEstimate::Off => "not asked for".to_string(),
+        NoEstimate::NotConverged => "the solve did not converge".to_string(),
+        NoEstimate::Coarsest { minimum } => format!(
+            "the discretisation has no coarser one to compare with (the coarsest is {minimum})"
+        ),
+        NoEstimate::ComparisonNotConverged(t) => format!(
+            "the comparison solve on another discretisation did not converge: {}",
+            termination(t)
+        ),
+        NoEstimate::ComparisonFailed => {
+            "the comparison solve on another discretisation could not run".to_string()
+        }
+        other => format!("{other:?}"),
+    }
+}
+
+/// Why an accuracy search stopped.
+pub fn search_stop(method: Method, s: &SearchStop) -> String {
+    match s {
+        SearchStop::Met => "met".to_string(),
+        SearchStop::Limit { limit } => format!(
+            "not met: the finest discretisation the search allows ({} = {limit}) was reached \
+             with a larger estimate",
+            if method.is_harmonic_balance() {
+                "harmonics"
+            } else if method == Method::March {
+                "steps_per_period"
+            } else {
+                "time_samples"
+            }
+        ),
+        SearchStop::NotConverged { at } => format!(
+            "not met: the solve at {} did not converge",
+            discretisation(method, at)
+        ),
+        SearchStop::PenaltyTooSoft { penalty_stiffness } => format!(
+            "not met: the penalty part of the estimate alone exceeds the target at \
+             penalty_stiffness = {penalty_stiffness:e} (raise it)"
+        ),
+        SearchStop::NoEstimate(n) => format!("not met: no estimate ({})", no_estimate(n)),
+        other => format!("{other:?}"),
+    }
+}
+
+/// The lines of `ssn solve`'s text on the error estimate and, with an accuracy target, on
+/// the search.
+pub fn estimate_lines(s: &Solution) -> String {
+    let mut t = match &s.error_estimate {
+        Ok(e) => format!(
+            "error estimate    {:.1e} relative (tip max {:.1e}, tip min {:.1e}{}): {}\n",
+            e.relative,
+            e.parts.displacement_max,
+            e.parts.displacement_min,
+            e.parts
+                .contact_force
+                .map(|f| format!(", mean force {f:.1e}"))
+                .unwrap_or_default(),
+            estimate_basis(s.method, &e.basis)
+        ),
+        Err(n) => format!("error estimate    none: {}\n", no_estimate(n)),
+    };
+    if let Some(search) = &s.search {
+        t += &format!(
+            "accuracy          {:e} asked: {}; chose {} of {} discretisations tried, search \
+             {:.3} s\n",
+            search.target,
+            search_stop(s.method, &search.stop),
+            discretisation(s.method, &search.steps[search.chosen].discretisation),
+            search.steps.len(),
+            search.seconds
+        );
+    }
+    t
 }

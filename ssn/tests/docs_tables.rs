@@ -176,3 +176,21 @@ fn a_drifted_cell_is_reported() {
     assert_eq!(differences.len(), 1, "{differences:?}");
     assert!(differences[0].contains("iterations"), "{differences:?}");
 }
+
+#[test]
+fn accuracy_target_rows_for_1e_3_on_the_paper_rod_are_the_codes_and_meet_it() {
+    use ssn::accuracy_targets::{case_rows, target_cases, target_table};
+    use ssn::scene::Method;
+    let case = &target_cases()[0];
+    let methods = [Method::SsnHb, Method::LcpSsn, Method::March];
+    let (_, rows) = case_rows(case, &methods, &[1e-3]).unwrap();
+    for r in &rows {
+        // The chosen setting meets the target against the reference, and the estimate is
+        // within a third and ten times the true error.
+        assert!(r.met, "{r:?}");
+        assert!(r.true_error <= r.target, "{r:?}");
+        let ratio = r.ratio().unwrap();
+        assert!((1.0 / 3.0..=10.0).contains(&ratio), "{r:?}");
+    }
+    assert_in_docs("accuracy-targets", &target_table(case.name, &rows), false);
+}

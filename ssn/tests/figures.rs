@@ -10,7 +10,7 @@ use ssn::figures::{fig2_rod, figure_2_branch, figure_2_curves, FIG2_PLOTTED_STEP
 use ssn::output::{longest_plotted_step, longest_plotted_step_on, stability_series, LineStyle};
 
 /// The paper's Fig. 2 (consistent mass, H = 5): fine steps, equal CSV columns per curve,
-/// and every contact branch dotted (stability undecided: the contact node has mass).
+/// no contact branch dotted (every point decided, the contact node having mass).
 #[test]
 fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
     let fig = figure_2_curves(5, MassModel::Consistent).unwrap();
@@ -27,11 +27,46 @@ fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
         assert!(curve.iter().all(|(_, c)| c.len() == len), "{}", curve[0].0);
     }
     for s in &fig.series {
-        if s.label.starts_with("gap") {
-            assert_eq!(s.style, LineStyle::Dotted, "{}", s.label);
-        }
+        assert_ne!(s.style, LineStyle::Dotted, "{}", s.label);
     }
-    assert!(fig.curves.iter().all(|c| c.converged));
+    assert!(fig.curves.iter().all(|c| c.converged && c.undecided == 0));
+}
+
+/// The paper's Fig. 2 branch with gap 0.5 (consistent mass, H = 5): stable before its
+/// first reversal of the frequency and after its last, unstable points between them only
+/// (the boundaries of its unstable parts are its folds and the corners where it turns).
+#[test]
+fn paper_fig2_branch_is_unstable_only_between_its_folds() {
+    let (rod, r) = figure_2_branch(Some(0.5), 5, MassModel::Consistent).unwrap();
+    assert!(r.converged());
+    let mut reversals: Vec<usize> = r
+        .fold_indices
+        .iter()
+        .chain(&r.corner_fold_indices)
+        .copied()
+        .collect();
+    reversals.sort_unstable();
+    println!(
+        "folds {:?}, corner folds {}",
+        r.folds.iter().map(|w| w / rod.omega_1).collect::<Vec<_>>(),
+        r.corner_fold_indices.len()
+    );
+    let (first, last) = (reversals[0], reversals[reversals.len() - 1]);
+    let st = &r.stability;
+    let unstable: Vec<usize> = (0..r.points())
+        .filter(|&i| st.stable[i] == Some(false))
+        .collect();
+    println!(
+        "{} unstable points, between indices {first} and {last} of {}",
+        unstable.len(),
+        r.points()
+    );
+    assert!(!unstable.is_empty());
+    assert!(
+        unstable.iter().all(|&i| first <= i && i <= last),
+        "{unstable:?} outside {first}..={last}"
+    );
+    assert!(st.stable.iter().all(|s| s.is_some()));
 }
 
 /// The modified-mass branch with gap 0.25 at H = 20 (its contact loss is the sharpest bend

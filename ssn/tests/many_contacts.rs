@@ -73,6 +73,7 @@ fn tuned(blades: usize, gap: f64) -> StructuralModel {
         contacts: (0..blades)
             .map(|j| ContactPoint::new(BladedDisk::pad(j), gap))
             .collect(),
+        friction: Vec::new(),
     };
     let omega_1 = natural_frequencies(&model, 1).unwrap()[0];
     let beta = 2.0 * 0.01 / omega_1;

@@ -6,7 +6,12 @@
 //! output.
 
 use std::path::Path;
+#[path = "common/exit_status.rs"]
+mod exit_status;
+
 use std::process::{Command, Output, Stdio};
+
+use exit_status::{assert_exit, assert_mentions, err};
 use std::time::{Duration, Instant};
 
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
@@ -21,21 +26,6 @@ fn ssn_env(args: &[&str], key: &str, value: &str) -> Output {
         .env(key, value)
         .output()
         .expect("ssn runs")
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn assert_exit(o: &Output, code: i32, what: &str) {
-    assert_eq!(o.status.code(), Some(code), "{what}: stderr {}", err(o));
-    assert!(!err(o).contains("panicked"), "{what}: {}", err(o));
-}
-
-fn assert_mentions(o: &Output, words: &[&str]) {
-    for w in words {
-        assert!(err(o).contains(w), "`{w}` not in: {}", err(o));
-    }
 }
 
 fn s(p: &Path) -> &str {

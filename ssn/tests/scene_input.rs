@@ -71,8 +71,10 @@ fn missing_required_keys_are_named() {
 fn unknown_keys_and_sections_are_named() {
     let err = error_of(&BASE.replace("[contact]", "[contact]\nstiffness = 3"));
     assert!(err.contains("stiffness"), "{err}");
+    let err = error_of(&format!("{BASE}\n[thermal]\nconductivity = 0.3\n"));
+    assert!(err.contains("thermal"), "{err}");
     let err = error_of(&format!("{BASE}\n[friction]\nmu = 0.3\n"));
-    assert!(err.contains("friction"), "{err}");
+    assert!(err.contains("mu"), "{err}");
 }
 
 #[test]

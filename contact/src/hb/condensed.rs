@@ -8,7 +8,7 @@ use semismooth::{
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::ssn::{HbOptions, SsnHb};
-use super::structured::{condensed_matrix, CondensedSolve, StructuredHbSolver};
+use super::structured::{condensed_matrix, CondensedSolve, CrossBlocks, StructuredHbSolver};
 use super::{check_len, indicator, HbError, ResponseSummary};
 use crate::model::{mean_stiffness, StructuralModel};
 
@@ -54,6 +54,12 @@ impl CondensedSsnHb {
     /// Builds the problem at the forcing frequency `omega` and factors `A(w)` (validates
     /// like [`SsnHb::new`]; a singular dynamic block is [`HbError::Linear`]).
     pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
+        if !model.friction.is_empty() {
+            return Err(HbError::Unsupported {
+                formulation: "condensed SSN-HB",
+                what: "friction points (use SsnHb with the structured solver)",
+            });
+        }
         let full = SsnHb::new(model, omega, options)?;
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
@@ -87,12 +93,7 @@ impl CondensedSsnHb {
         self.linear_response[n..2 * n].copy_from_slice(&lin.load);
         self.solver
             .apply_dynamic_inverse(&mut self.linear_response)?;
-        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-            let s = lin.contact_signs[i];
-            for j in 0..lin.size() {
-                self.contact_linear[j * m + i] = s * self.linear_response[j * n + dof];
-            }
-        }
+        lin.gather_rows(&self.linear_response, &mut self.contact_linear);
         self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
         for (k, r) in self.receptance.iter_mut().enumerate() {
             if let Some(factored) = self.solver.receptance(k) {
@@ -262,6 +263,7 @@ impl GeneralizedJacobian for CondensedSsnHb {
         condensed_matrix(
             &self.receptance,
             &self.q,
+            &CrossBlocks::default(),
             ContactCoupling::Complementarity { c: self.full.c() },
             m,
             jac.as_mut(),
@@ -310,9 +312,9 @@ impl ParameterDependent for CondensedSsnHb {
             for (h, s) in self.mask.iter_mut().zip(self.aft.samples()) {
                 *h = if *s > 0.0 { 1.0 } else { 0.0 };
             }
-            let (dof, s) = (lin.contact_dofs[i], lin.contact_signs[i]);
+            let row = &lin.rows[i];
             for (j, coeff) in self.aft.coefficients_mut().iter_mut().enumerate() {
-                *coeff = -c * s * self.full_w[j * n + dof];
+                *coeff = -c * row.dot_at(&self.full_w, j * n);
             }
             self.aft.coefficients_to_samples();
             for (s, h) in self.aft.samples_mut().iter_mut().zip(&self.mask) {

@@ -7,6 +7,7 @@ use faer::{Mat, MatMut};
 use semismooth::linalg::DenseAssemble;
 
 use super::LinearData;
+use crate::model::NormalForce;
 
 /// How the contact unknowns enter the Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,6 +29,11 @@ pub enum ContactCoupling {
 /// One element of the generalized Jacobian of [`SsnHb`](super::SsnHb) or
 /// [`PenaltyHb`](super::PenaltyHb).
 ///
+/// With friction (SSN-HB), row `i` of a friction point measures the phase velocity
+/// `y = D G_i u` (`D` the derivative in `w t`, per harmonic `(a, b) -> (k b, -k a)`):
+/// `dR_i/dU = c Q_i D G_i`, `dR_i/dLambda_i = I - Q_i` with `Q_i = P diag(stick) E`, and
+/// on its contact's force `dR_i/dLambda_n = X_i`.
+///
 /// The dynamic part `A(w)` is represented by the model matrices (shared with the problem
 /// through an `Arc`, never copied per iteration) and `w`; a solver can tell that it has not
 /// changed since its last factorization ([`HbJacobian::same_dynamic_part`]). The contact
@@ -37,8 +43,12 @@ pub struct HbJacobian {
     pub(crate) linear: Arc<LinearData>,
     pub(crate) omega: f64,
     pub(crate) coupling: ContactCoupling,
-    /// `Q_i` of each contact (`(2H + 1)` square).
+    /// `Q_i` of each row (`(2H + 1)` square): contacts, then friction points.
     pub(crate) q: Vec<Mat<f64>>,
+    /// `X_f = dR_t / dLambda_n` of each friction point on a contact (`(2H + 1)` square; zero
+    /// under a prescribed normal load): how its slip limit `mu max(0, -lambda_n)` moves with
+    /// the normal force.
+    pub(crate) cross: Vec<Mat<f64>>,
     pub(crate) active: Vec<usize>,
 }
 
@@ -48,6 +58,9 @@ impl HbJacobian {
         let m = linear.contacts();
         Self {
             q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
+            cross: (0..linear.friction.len())
+                .map(|_| Mat::zeros(size, size))
+                .collect(),
             active: vec![0; m],
             linear,
             omega,
@@ -132,29 +145,66 @@ impl DenseAssemble for HbJacobian {
         let lin = &self.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
-        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+        for (i, row) in lin.rows.iter().enumerate() {
             let q = &self.q[i];
-            // G's entry of contact i; the penalty block G^T Q G has s^2 = 1.
-            let s = lin.contact_signs[i];
+            // Q D for a friction point's row (its measured quantity is D G u).
+            let velocity = lin.is_velocity_row(i);
+            let coupling = |j: usize, l: usize| {
+                if !velocity {
+                    q[(j, l)]
+                } else if l == 0 {
+                    super::MEAN_SLIP_ANCHOR * q[(j, 0)]
+                } else {
+                    let k = l.div_ceil(2) as f64;
+                    if l % 2 == 1 {
+                        -k * q[(j, l + 1)]
+                    } else {
+                        k * q[(j, l - 1)]
+                    }
+                }
+            };
             match self.coupling {
                 ContactCoupling::Complementarity { c } => {
                     for j in 0..size {
-                        // dR_u / dLambda = -G^T.
-                        out[(j * n + dof, offset + j * m + i)] -= s;
+                        for (dof, a) in row.entries() {
+                            // dR_u / dLambda = -G^T.
+                            out[(j * n + dof, offset + j * m + i)] -= a;
+                            for l in 0..size {
+                                // dR_lambda / dU = c Q G.
+                                out[(offset + j * m + i, l * n + dof)] += c * a * coupling(j, l);
+                            }
+                        }
                         for l in 0..size {
-                            // dR_lambda / dU = c Q G, dR_lambda / dLambda = I - Q.
-                            out[(offset + j * m + i, l * n + dof)] += c * s * q[(j, l)];
+                            // dR_lambda / dLambda = I - Q.
                             out[(offset + j * m + i, offset + l * m + i)] -= q[(j, l)];
                         }
                         out[(offset + j * m + i, offset + j * m + i)] += 1.0;
                     }
                 }
                 ContactCoupling::Penalty { stiffness } => {
-                    for j in 0..size {
-                        for l in 0..size {
-                            out[(j * n + dof, l * n + dof)] += stiffness * q[(j, l)];
+                    // k_p G^T Q G (penalty HB has no friction row).
+                    for (r, a) in row.entries() {
+                        for (col, b) in row.entries() {
+                            for j in 0..size {
+                                for l in 0..size {
+                                    out[(j * n + r, l * n + col)] += stiffness * a * b * q[(j, l)];
+                                }
+                            }
                         }
                     }
+                }
+            }
+        }
+        // dR_t / dLambda_n = X of each friction point on a contact.
+        for (f, &(_, normal)) in lin.friction.iter().enumerate() {
+            let NormalForce::Contact(p) = normal else {
+                continue;
+            };
+            let t = lin.normal_rows() + f;
+            let x = &self.cross[f];
+            for j in 0..size {
+                for l in 0..size {
+                    out[(offset + j * m + t, offset + l * m + p)] += x[(j, l)];
                 }
             }
         }

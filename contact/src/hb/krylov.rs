@@ -43,7 +43,7 @@ use faer::perm::PermRef;
 use faer::{c64, Conj, Mat, Par};
 use semismooth::linalg::{check_pivots, KrylovOperator, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 
-use super::structured::{apply_coupling, FactoredCondensed};
+use super::structured::{apply_coupling, CrossBlocks, FactoredCondensed};
 use super::LinearData;
 use crate::dynamic::DynamicStiffness;
 
@@ -60,6 +60,8 @@ pub(crate) struct CondensedOperator<'a> {
     pub(crate) dynamic: &'a mut DynamicStiffness,
     pub(crate) lin: &'a LinearData,
     pub(crate) q: &'a [Mat<f64>],
+    /// The friction points' blocks on their contacts' forces.
+    pub(crate) cross: &'a CrossBlocks,
     pub(crate) c: f64,
     /// `N x 1` complex scratch.
     pub(crate) rhs: &'a mut Mat<c64>,
@@ -80,7 +82,7 @@ impl KrylovOperator for CondensedOperator<'_> {
         self.lin.contacts() * self.lin.size()
     }
 
-    /// `out = p - Q p + c Q R p = p + Q (c R p - p)`.
+    /// `out = p - Q p + c Q R p + X p = p + Q (c R p - p) + X p`.
     fn apply(&mut self, p: &[f64], out: &mut [f64]) -> Result<(), LinearSolveError> {
         let lin = self.lin;
         let m = lin.contacts();
@@ -88,17 +90,19 @@ impl KrylovOperator for CondensedOperator<'_> {
         for k in 0..=lin.basis.harmonics() {
             // G^T p_k in complex form p_c - i p_s.
             self.rhs.fill(c64::new(0.0, 0.0));
-            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
+            for (i, row) in lin.rows.iter().enumerate() {
                 let z = if k == 0 {
                     c64::new(p[i], 0.0)
                 } else {
                     c64::new(p[(2 * k - 1) * m + i], -p[2 * k * m + i])
                 };
-                self.rhs[(dof, 0)] += z * lin.contact_signs[i];
+                for (dof, a) in row.entries() {
+                    self.rhs[(dof, 0)] += z * a;
+                }
             }
             self.dynamic.solve_in_place(k, self.rhs.as_mut())?;
-            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                let v = self.rhs[(dof, 0)] * lin.contact_signs[i];
+            for (i, row) in lin.rows.iter().enumerate() {
+                let v = lin.measured(i, k, super::structured::row_of(row, self.rhs.as_ref(), 0));
                 if k == 0 {
                     t[i] = v.re;
                 } else {
@@ -114,6 +118,7 @@ impl KrylovOperator for CondensedOperator<'_> {
         for (o, pi) in out.iter_mut().zip(p) {
             *o += pi;
         }
+        self.cross.apply_add(m, p, out);
         Ok(())
     }
 

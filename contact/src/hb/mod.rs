@@ -107,6 +107,19 @@ macro_rules! shared_accessors {
             $crate::hb::fine_samples(&self.state.linear, u, dof, points)
         }
 
+        /// `g_i . u(t_n)` of row `i` of `G` (contacts, then friction points) at `points`
+        /// equally spaced times over one period (`points > 2H`): a contact's gap closure
+        /// `g . u`, or a friction point's slip.
+        pub fn row_displacement_samples(
+            &self,
+            x: &[f64],
+            row: usize,
+            points: usize,
+        ) -> Result<Vec<f64>, $crate::hb::HbError> {
+            let u = self.displacement_part(x)?;
+            $crate::hb::row_samples(&self.state.linear, u, row, points)
+        }
+
         /// `u_dof(t)` at arbitrary times.
         pub fn displacement_at(
             &self,
@@ -147,6 +160,7 @@ macro_rules! omega_parameter {
 }
 
 mod condensed;
+mod friction;
 mod jacobian;
 mod krylov;
 mod penalty;
@@ -155,9 +169,12 @@ mod structured;
 
 use std::sync::Arc;
 
+use faer::c64;
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 
-use crate::model::{sparse_mul_add, InvalidModel, SparseMatrix, StructuralModel};
+use crate::model::{
+    sparse_mul_add, ContactRow, InvalidModel, NormalForce, SparseMatrix, StructuralModel,
+};
 
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
@@ -210,6 +227,14 @@ pub enum HbError {
     /// The Fourier basis could not be built.
     #[error(transparent)]
     Harmonic(#[from] HarmonicError),
+    /// The formulation does not model something the model declares.
+    #[error("{formulation} does not model {what}")]
+    Unsupported {
+        /// The formulation.
+        formulation: &'static str,
+        /// What it does not model.
+        what: &'static str,
+    },
     /// The dynamic blocks `A(w)` could not be factored (e.g. an undamped resonance).
     #[error("dynamic blocks: {0}")]
     Linear(#[from] semismooth::linalg::LinearSolveError),
@@ -245,10 +270,14 @@ pub(crate) struct LinearData {
     pub(crate) damping: Option<SparseMatrix>,
     pub(crate) stiffness: SparseMatrix,
     pub(crate) load: Vec<f64>,
-    pub(crate) contact_dofs: Vec<usize>,
+    /// The rows of `G`: the contacts' normal rows (the first `gaps.len()`), then the
+    /// friction points' tangential rows.
+    pub(crate) rows: Vec<ContactRow>,
+    /// The gap of each contact (normal row).
     pub(crate) gaps: Vec<f64>,
-    /// `s_i = +-1`: the entry of contact `i`'s row of `G` (its dof `contact_dofs[i]`).
-    pub(crate) contact_signs: Vec<f64>,
+    /// The Coulomb coefficient and the normal force of each friction point (tangential
+    /// row `gaps.len() + f`).
+    pub(crate) friction: Vec<(f64, NormalForce)>,
 }
 
 impl LinearData {
@@ -271,14 +300,94 @@ impl LinearData {
             damping: model.damping.clone(),
             stiffness: model.stiffness.clone(),
             load: model.load.clone(),
-            contact_dofs: model.contacts.iter().map(|c| c.dof).collect(),
+            rows: model.rows().cloned().collect(),
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
-            contact_signs: model.contacts.iter().map(|c| c.sign()).collect(),
+            friction: model
+                .friction
+                .iter()
+                .map(|f| (f.coefficient, f.normal))
+                .collect(),
         })
     }
 
+    /// Number of rows of `G`, `m` (contacts, then friction points): the force unknowns per
+    /// basis function.
     pub(crate) fn contacts(&self) -> usize {
-        self.contact_dofs.len()
+        self.rows.len()
+    }
+
+    /// Number of contacts (normal rows, the first rows of `G`).
+    pub(crate) fn normal_rows(&self) -> usize {
+        self.gaps.len()
+    }
+
+    /// Whether row `i` is a friction point's tangential row: its measured quantity is the
+    /// slip velocity `d (g_i . u) / d(w t)`, not the displacement `g_i . u`.
+    pub(crate) fn is_velocity_row(&self, i: usize) -> bool {
+        i >= self.gaps.len()
+    }
+
+    /// `out[j m + i] = g_i . U_j`: the rows of `G` applied to the harmonic-major
+    /// coefficients `u` (index `j N + dof`), harmonic-major out (index `j m + i`).
+    pub(crate) fn gather_rows(&self, u: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.dofs, self.contacts());
+        if m == 0 {
+            return;
+        }
+        for (j, block) in out.chunks_exact_mut(m).enumerate() {
+            for (o, row) in block.iter_mut().zip(&self.rows) {
+                *o = row.dot_at(u, j * n);
+            }
+        }
+    }
+
+    /// `out[j m + i]`: the measured quantity of each row from the harmonic-major
+    /// coefficients `u`: `g_i . U_j` for a contact, and for a friction point the phase
+    /// velocity `y = d (g_i . u) / d(w t)`, whose harmonic `k` is `(k b_k, -k a_k)` for the
+    /// row's displacement `(a_k, b_k)`, and whose constant is the anchor
+    /// [`MEAN_SLIP_ANCHOR`]` (g_i . U_0)`.
+    pub(crate) fn gather_measured(&self, u: &[f64], out: &mut [f64]) {
+        self.gather_rows(u, out);
+        let (m, first) = (self.contacts(), self.normal_rows());
+        if first == m {
+            return;
+        }
+        for o in &mut out[first..m] {
+            *o *= MEAN_SLIP_ANCHOR;
+        }
+        for k in 1..=self.basis.harmonics() {
+            let (c, s) = ((2 * k - 1) * m, 2 * k * m);
+            let kf = k as f64;
+            for i in first..m {
+                let (a, b) = (out[c + i], out[s + i]);
+                out[c + i] = kf * b;
+                out[s + i] = -kf * a;
+            }
+        }
+    }
+
+    /// A receptance entry of row `i` at harmonic `k` (complex form `a - i b`) as its
+    /// measured quantity sees it: unchanged for a contact, times `i k` (the phase
+    /// derivative) for a friction point, and times [`MEAN_SLIP_ANCHOR`] for its constant.
+    pub(crate) fn measured(&self, i: usize, k: usize, value: c64) -> c64 {
+        match (self.is_velocity_row(i), k) {
+            (false, _) => value,
+            (true, 0) => value * MEAN_SLIP_ANCHOR,
+            (true, k) => value * c64::new(0.0, k as f64),
+        }
+    }
+
+    /// `u[j N + .] += alpha G^T p_j`: the row forces `p` (index `j m + i`) on the dofs.
+    pub(crate) fn scatter_rows(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
+        let (n, m) = (self.dofs, self.contacts());
+        if m == 0 {
+            return;
+        }
+        for (j, block) in p.chunks_exact(m).enumerate() {
+            for (pi, row) in block.iter().zip(&self.rows) {
+                row.add_transpose_at(alpha * pi, u, j * n);
+            }
+        }
     }
 
     pub(crate) fn size(&self) -> usize {
@@ -353,6 +462,18 @@ impl LinearData {
         Ok(())
     }
 
+    /// `Err` unless `contact` is a contact's normal row (not a friction point's).
+    pub(crate) fn check_normal_row(&self, contact: usize) -> Result<(), HbError> {
+        if contact >= self.normal_rows() {
+            return Err(HbError::IndexOutOfRange {
+                what: "contact",
+                index: contact,
+                count: self.normal_rows(),
+            });
+        }
+        Ok(())
+    }
+
     pub(crate) fn check_contact(&self, contact: usize) -> Result<(), HbError> {
         if contact >= self.contacts() {
             return Err(HbError::IndexOutOfRange {
@@ -364,6 +485,16 @@ impl LinearData {
         Ok(())
     }
 }
+
+/// The weight of the mean slip `g_t . U_0` in the constant term of a friction point's
+/// measured velocity. The velocity form fixes no mean slip: while a point sticks over the
+/// whole period, every constant tangential force inside the cone gives a periodic
+/// solution (the state depends on history), and the Jacobian is singular. With this
+/// weight the constant term of the law reads `Lambda_0 - mean proj(z) = 0` with
+/// `z = lambda - c (y + delta g_t . U_0)`: a point stuck all period is anchored at zero
+/// mean slip (no locked-in force), and a slipping one sees its slip direction shifted by
+/// `delta` times its mean slip, far below the truncation error.
+pub(crate) const MEAN_SLIP_ANCHOR: f64 = 1e-6;
 
 /// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
 pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> Result<(), HbError> {
@@ -402,6 +533,32 @@ pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
     check_positive("omega", omega, "a finite angular frequency > 0")
 }
 
+/// Harmonic-balance unknowns of `from` harmonics carried to `to` harmonics: the
+/// displacement coefficients (`(2 from + 1) dofs`, harmonic-major) and then, when `x` has
+/// them, the contact-force coefficients (`(2 from + 1) contacts`), each block lifted with
+/// zero higher harmonics or truncated (the Galerkin projection onto `to` harmonics). A
+/// block that `x` is too short for is taken as zero.
+pub fn resize_harmonics(
+    x: &[f64],
+    from: usize,
+    to: usize,
+    dofs: usize,
+    contacts: usize,
+) -> Vec<f64> {
+    let block = |start: usize, width: usize| {
+        let have = ((2 * from + 1) * width).min(x.len().saturating_sub(start));
+        let mut out = vec![0.0; (2 * to + 1) * width];
+        let keep = out.len().min(have);
+        out[..keep].copy_from_slice(&x[start..start + keep]);
+        out
+    };
+    let mut out = block(0, dofs);
+    if contacts > 0 {
+        out.extend(block((2 * from + 1) * dofs, contacts));
+    }
+    out
+}
+
 pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), HbError> {
     Ok(semismooth::harmonic::check_length(what, expected, found)?)
 }
@@ -423,6 +580,38 @@ pub(crate) fn fine_samples(
     Ok(samples)
 }
 
+/// Where the switching function with coefficients `coeffs` (one contact's, `2H + 1`) is
+/// positive over a period, its sign changes bracketed on the `Nt` AFT samples.
+pub(crate) fn switching_intervals(
+    lin: &LinearData,
+    coeffs: &[f64],
+) -> Result<Vec<(f64, f64)>, HbError> {
+    Ok(semismooth::trigonometric::positive_intervals(
+        &lin.basis,
+        coeffs,
+        lin.basis.time_samples(),
+    )?)
+}
+
+/// Samples of row `i` of `G` applied to the displacements, `g_i . u(t_n)`, at `points`
+/// equally spaced times over one period.
+pub(crate) fn row_samples(
+    lin: &LinearData,
+    u: &[f64],
+    row: usize,
+    points: usize,
+) -> Result<Vec<f64>, HbError> {
+    lin.check_contact(row)?;
+    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
+    let mut aft = Aft::new(basis);
+    let coeffs: Vec<f64> = (0..lin.size())
+        .map(|j| lin.rows[row].dot_at(u, j * lin.dofs))
+        .collect();
+    let mut samples = vec![0.0; points];
+    aft.to_time(&coeffs, &mut samples)?;
+    Ok(samples)
+}
+
 /// Displacement extremes, RMS and penetration from the displacement coefficients `u`.
 pub(crate) fn displacement_summary(
     lin: &LinearData,
@@ -439,15 +628,9 @@ pub(crate) fn displacement_summary(
     lin.gather(u, dof, &mut coeffs);
     let displacement_rms = lin.basis.mean_square(&coeffs)?.sqrt();
     let mut max_penetration = 0.0f64;
-    for ((&cdof, &gap), &sign) in lin
-        .contact_dofs
-        .iter()
-        .zip(&lin.gaps)
-        .zip(&lin.contact_signs)
-    {
-        let s = fine_samples(lin, u, cdof, points)?;
-        for x in s {
-            max_penetration = max_penetration.max(sign * x - gap);
+    for (i, &gap) in lin.gaps.iter().enumerate() {
+        for x in row_samples(lin, u, i, points)? {
+            max_penetration = max_penetration.max(x - gap);
         }
     }
     Ok(ResponseSummary {

@@ -5,8 +5,8 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
-    check_len, check_positive, displacement_summary, fine_samples, validate_basis, HbError,
-    HbState, LinearData, ResponseSummary,
+    check_len, check_positive, displacement_summary, row_samples, validate_basis, HbError, HbState,
+    LinearData, ResponseSummary,
 };
 use crate::model::StructuralModel;
 
@@ -118,6 +118,12 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
+        if !model.friction.is_empty() {
+            return Err(HbError::Unsupported {
+                formulation: "penalty harmonic balance",
+                what: "friction points (use ssn-hb)",
+            });
+        }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         Ok(Self {
             state: HbState::new(linear, omega),
@@ -139,6 +145,22 @@ impl PenaltyHb {
         Ok(())
     }
 
+    /// The intervals of the period where contact `i` is closed, as fractions of the period
+    /// (module [`semismooth::trigonometric`]): where the penetration `s u_dof(t) - g_i` of
+    /// the truncated Fourier series is positive (the penalty spring acts), with the
+    /// interval ends refined between the `Nt` samples.
+    pub fn closed_intervals(&self, u: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let lin = &self.state.linear;
+        lin.check_normal_row(contact)?;
+        let row = &lin.rows[contact];
+        let mut coeffs: Vec<f64> = (0..lin.size())
+            .map(|j| row.dot_at(u, j * lin.dofs))
+            .collect();
+        coeffs[0] -= lin.gaps[contact];
+        super::switching_intervals(lin, &coeffs)
+    }
+
     /// Penalty force `lambda_i(t_n) = -k_p max(0, u(t_n) - g_i)` at `points` equally spaced
     /// times (evaluated pointwise on the fine grid, not through the `H`-harmonic projection).
     pub fn contact_force_samples(
@@ -150,11 +172,11 @@ impl PenaltyHb {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
         lin.check_contact(contact)?;
-        let (gap, sign) = (lin.gaps[contact], lin.contact_signs[contact]);
-        let samples = fine_samples(lin, u, lin.contact_dofs[contact], points)?;
+        let gap = lin.gaps[contact];
+        let samples = row_samples(lin, u, contact, points)?;
         Ok(samples
             .into_iter()
-            .map(|x| -self.stiffness * (sign * x - gap).max(0.0))
+            .map(|x| -self.stiffness * (x - gap).max(0.0))
             .collect())
     }
 
@@ -209,10 +231,9 @@ impl PenaltyHb {
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
         let coeffs = self.state.aft.coefficients_mut();
-        lin.gather(u, lin.contact_dofs[i], coeffs);
-        let sign = lin.contact_signs[i];
-        for c in coeffs.iter_mut() {
-            *c *= sign;
+        let row = &lin.rows[i];
+        for (j, c) in coeffs.iter_mut().enumerate() {
+            *c = row.dot_at(u, j * lin.dofs);
         }
         coeffs[0] -= lin.gaps[i];
         self.state.aft.coefficients_to_samples();
@@ -236,9 +257,9 @@ impl Residual for PenaltyHb {
             }
             self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
-            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
+            let row = &lin.rows[i];
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                out[j * n + dof] += sign * c;
+                row.add_transpose_at(*c, out, j * n);
             }
         }
         Ok(())

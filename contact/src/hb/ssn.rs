@@ -4,6 +4,7 @@
 use semismooth::harmonic::FourierBasis;
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual, Smoothing};
 
+use super::friction::FrictionSamples;
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
     check_len, check_omega, check_positive, displacement_summary, validate_basis, HbError, HbState,
@@ -74,6 +75,8 @@ pub struct SsnHb {
     c: f64,
     /// Smoothing parameter `mu >= 0` of `max(0, s)` (0: the formulation itself).
     smoothing: f64,
+    /// Sample buffers of the friction law.
+    pub(super) friction: FrictionSamples,
 }
 
 impl SsnHb {
@@ -95,10 +98,12 @@ impl SsnHb {
             None => model.default_complementarity_constant(),
         };
         check_c(c)?;
+        let friction = FrictionSamples::new(linear.basis.time_samples());
         Ok(Self {
             state: HbState::new(linear, omega),
             c,
             smoothing: 0.0,
+            friction,
         })
     }
 
@@ -112,6 +117,16 @@ impl SsnHb {
         check_c(c)?;
         self.c = c;
         Ok(())
+    }
+
+    /// The smoothing parameter in use (0: the formulation itself).
+    pub(super) fn smoothing(&self) -> f64 {
+        self.smoothing
+    }
+
+    /// Number of friction points (their rows follow the contacts').
+    pub fn friction_points(&self) -> usize {
+        self.state.linear.friction.len()
     }
 
     /// Length of `U`, `N (2H + 1)`; `Lambda` starts here in `X`.
@@ -177,8 +192,27 @@ impl SsnHb {
     ) -> Result<ResponseSummary, HbError> {
         let u = self.displacement_coefficients(x)?;
         let lambda = self.force_coefficients(x)?;
-        let means = lambda[..self.contacts()].to_vec();
+        let means = lambda[..self.state.linear.normal_rows()].to_vec();
         displacement_summary(&self.state.linear, u, dof, points, means)
+    }
+
+    /// The intervals of the period where contact `i` is closed, as fractions of the period
+    /// (module [`semismooth::trigonometric`]): where the contact law's switching function
+    /// `s_i(t) = c (s u_dof(t) - g_i) - lambda_i(t)` is positive, the set whose samples
+    /// the generalized Jacobian treats as active (`h_n = 1`), with the interval ends
+    /// refined between the `Nt` samples on the truncated Fourier series.
+    pub fn closed_intervals(&self, x: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
+        check_len("HB unknowns", self.dim(), x.len())?;
+        let lin = &self.state.linear;
+        lin.check_normal_row(contact)?;
+        let (n, m) = (lin.dofs, lin.contacts());
+        let offset = n * lin.size();
+        let row = &lin.rows[contact];
+        let mut coeffs: Vec<f64> = (0..lin.size())
+            .map(|j| self.c * row.dot_at(x, j * n) - x[offset + j * m + contact])
+            .collect();
+        coeffs[0] -= self.c * lin.gaps[contact];
+        super::switching_intervals(lin, &coeffs)
     }
 
     fn contact_coefficients(&self, lambda: &[f64], contact: usize) -> Vec<f64> {
@@ -193,10 +227,10 @@ impl SsnHb {
         let lin = &self.state.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
-        let (dof, sc) = (lin.contact_dofs[i], self.c * lin.contact_signs[i]);
+        let (row, c) = (&lin.rows[i], self.c);
         let coeffs = self.state.aft.coefficients_mut();
-        for (j, c) in coeffs.iter_mut().enumerate() {
-            *c = sc * x[j * n + dof] - x[offset + j * m + i];
+        for (j, coeff) in coeffs.iter_mut().enumerate() {
+            *coeff = c * row.dot_at(x, j * n) - x[offset + j * m + i];
         }
         coeffs[0] -= self.c * lin.gaps[i];
         self.state.aft.coefficients_to_samples();
@@ -215,11 +249,8 @@ impl Residual for SsnHb {
         let offset = n * size;
         let (out_u, out_l) = out.split_at_mut(offset);
         lin.dynamic_residual(self.state.omega, &x[..offset], out_u);
-        for i in 0..m {
-            let (dof, sign) = (lin.contact_dofs[i], lin.contact_signs[i]);
-            for j in 0..size {
-                out_u[j * n + dof] -= sign * x[offset + j * m + i];
-            }
+        lin.scatter_rows(&x[offset..], -1.0, out_u);
+        for i in 0..lin.normal_rows() {
             self.switching_samples(x, i);
             let mu = self.smoothing;
             for s in self.state.aft.samples_mut() {
@@ -230,6 +261,7 @@ impl Residual for SsnHb {
                 out_l[j * m + i] = x[offset + j * m + i] + c;
             }
         }
+        self.friction_residual(x, out_l);
         Ok(())
     }
 
@@ -250,7 +282,7 @@ impl GeneralizedJacobian for SsnHb {
     fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
         self.state
             .prepare_jacobian(jac, ContactCoupling::Complementarity { c: self.c });
-        for i in 0..self.contacts() {
+        for i in 0..self.state.linear.normal_rows() {
             self.switching_samples(x, i);
             if self.smoothing > 0.0 {
                 let mu = self.smoothing;
@@ -262,6 +294,7 @@ impl GeneralizedJacobian for SsnHb {
                 self.state.write_contact_block(jac, i);
             }
         }
+        self.friction_jacobian(x, jac);
         Ok(())
     }
 }
@@ -294,7 +327,8 @@ impl Smoothing for SsnHb {
             .gaps
             .iter()
             .fold(0.0f64, |a, g| a.max(g.abs()));
-        self.c * g.max(f64::MIN_POSITIVE)
+        // A friction point under a prescribed load switches at its slip limit.
+        (self.c * g.max(f64::MIN_POSITIVE)).max(self.largest_prescribed_slip_limit())
     }
 
     fn set_smoothing(&mut self, mu: f64) {
@@ -311,7 +345,7 @@ impl Smoothing for SsnHb {
         let offset = n * size;
         out[..offset].fill(0.0);
         let mu = self.smoothing;
-        for i in 0..m {
+        for i in 0..lin.normal_rows() {
             self.switching_samples(x, i);
             for s in self.state.aft.samples_mut() {
                 *s = smoothed_max_mu_derivative(*s, mu);
@@ -321,6 +355,7 @@ impl Smoothing for SsnHb {
                 out[offset + j * m + i] = *c;
             }
         }
+        self.friction_smoothing_derivative(x, &mut out[offset..]);
         Ok(())
     }
 }

@@ -72,22 +72,33 @@ impl PeriodicLcp {
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);
         }
-        if let Some((contact, c)) = model
-            .contacts
-            .iter()
-            .enumerate()
-            .find(|(_, c)| c.direction != ContactDirection::Positive)
-        {
-            return Err(LcpError::NegativeDirection {
-                contact,
-                dof: c.dof,
+        if !model.friction.is_empty() {
+            return Err(LcpError::Friction {
+                points: model.friction.len(),
             });
+        }
+        for (contact, c) in model.contacts.iter().enumerate() {
+            match c.direction() {
+                Some(ContactDirection::Positive) => {}
+                Some(ContactDirection::Negative) => {
+                    return Err(LcpError::NegativeDirection {
+                        contact,
+                        dof: c.dof(),
+                    })
+                }
+                None => {
+                    return Err(LcpError::GeneralRow {
+                        contact,
+                        dof: c.dof(),
+                    })
+                }
+            }
         }
         let n = model.dofs();
         let m = model.contact_count();
         options.validate(m, n)?;
         let nt = options.time_samples;
-        let contact_dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof).collect();
+        let contact_dofs: Vec<usize> = model.contacts.iter().map(|c| c.dof()).collect();
         let gaps: Vec<f64> = model.contacts.iter().map(|c| c.gap).collect();
         let rows: Vec<usize> = contact_dofs
             .iter()
@@ -215,7 +226,7 @@ fn bin_transfers(
         let with_forcing = k == 1;
         let ncols = m + usize::from(with_forcing);
         x.fill(zero);
-        for (c, &dof) in model.contacts.iter().map(|c| &c.dof).enumerate() {
+        for (c, dof) in model.contacts.iter().map(|c| c.dof()).enumerate() {
             x[(dof, c)] = c64::new(1.0, 0.0);
         }
         if with_forcing {
@@ -263,10 +274,10 @@ fn bin_transfers(
                 .map_err(solve_failed)?;
             for (r, c) in model.contacts.iter().enumerate() {
                 for c2 in 0..m {
-                    d.transfer[(k * m + r) * m + c2] = -y[(c.dof, c2)];
+                    d.transfer[(k * m + r) * m + c2] = -y[(c.dof(), c2)];
                 }
                 if with_forcing {
-                    d.linear_amplitude[r] = -y[(c.dof, m)];
+                    d.linear_amplitude[r] = -y[(c.dof(), m)];
                 }
             }
         }

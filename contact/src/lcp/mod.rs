@@ -141,6 +141,7 @@ mod sequencing;
 
 pub use frequency::{FrequencyLcp, FrequencyLcpJacobian, FrequencyLcpSolver};
 pub use min_map::{ActiveSetSolver, MinMapJacobian, MinMapLcp, DEFAULT_ACTIVE_SET_REGULARIZATION};
+pub(crate) use sequencing::interpolate_periodic;
 pub use sequencing::{solve_min_map_sequenced, SequencedSolution, SequencingLevel};
 
 use std::sync::Arc;
@@ -257,6 +258,27 @@ pub enum LcpError {
         contact: usize,
         /// Its dof (0-based).
         dof: usize,
+    },
+    /// A contact's row of `G` is not one dof with coefficient `+1`.
+    #[error(
+        "contact {contact} (first dof {}, 1-based) is a combination of dofs: the periodic LCP \
+         allows one dof with direction = +1 per contact (solve it with ssn-hb or march)",
+        .dof + 1
+    )]
+    GeneralRow {
+        /// Index of the contact.
+        contact: usize,
+        /// Its first dof (0-based).
+        dof: usize,
+    },
+    /// The model has friction points.
+    #[error(
+        "the model has {points} friction points: the periodic LCP has no friction (solve it \
+         with ssn-hb or march)"
+    )]
+    Friction {
+        /// How many.
+        points: usize,
     },
     /// A model quantity has the wrong size.
     #[error("dimension mismatch in {what}: expected {expected}, found {found}")]

@@ -26,20 +26,30 @@ impl PeriodicLcp {
                 found: z_other.len(),
             });
         }
-        let other = z_other.len() / m;
-        let mut z = vec![0.0; self.dim()];
-        for n in 0..self.nt {
-            let position = n as f64 * other as f64 / self.nt as f64;
-            let left = (position.floor() as usize).min(other - 1);
-            let fraction = position - left as f64;
-            let right = (left + 1) % other;
-            for c in 0..m {
-                z[n * m + c] =
-                    (1.0 - fraction) * z_other[left * m + c] + fraction * z_other[right * m + c];
-            }
-        }
-        Ok(z)
+        Ok(interpolate_periodic(z_other, m, self.nt))
     }
+}
+
+/// A time-major history of `m` series over one period (`m Nt'` entries, `Nt' >= 1`)
+/// interpolated linearly and periodically onto `nt` equally spaced nodes (`m nt` entries):
+/// node `n` sits at `n Nt' / nt` of the given nodes.
+pub fn interpolate_periodic(z_other: &[f64], m: usize, nt: usize) -> Vec<f64> {
+    let other = z_other.len() / m.max(1);
+    let mut z = vec![0.0; m * nt];
+    if other == 0 {
+        return z;
+    }
+    for n in 0..nt {
+        let position = n as f64 * other as f64 / nt as f64;
+        let left = (position.floor() as usize).min(other - 1);
+        let fraction = position - left as f64;
+        let right = (left + 1) % other;
+        for c in 0..m {
+            z[n * m + c] =
+                (1.0 - fraction) * z_other[left * m + c] + fraction * z_other[right * m + c];
+        }
+    }
+    z
 }
 
 /// Coarsest `Nt` of [`solve_min_map_sequenced`]'s level sequence.
@@ -159,8 +169,8 @@ fn check_same_model(
         .zip(lcp.gaps())
         .zip(&model.contacts)
     {
-        if dof != c.dof {
-            return foreign("contact dof", dof as f64, c.dof as f64);
+        if dof != c.dof() {
+            return foreign("contact dof", dof as f64, c.dof() as f64);
         }
         if *gap != c.gap {
             return foreign("contact gap", *gap, c.gap);

@@ -117,6 +117,7 @@
 //! assert!(period.contact_forces[0].iter().all(|l| *l <= 0.0));
 //! ```
 
+mod friction;
 mod step;
 
 pub use step::TimeMarcher;
@@ -385,6 +386,21 @@ pub enum MarchError {
         /// Lemke's error.
         source: LemkeError,
     },
+    /// The semismooth Newton of a step's contact and friction problem did not converge.
+    #[error(
+        "contact and friction problem at period {period}, step {step} not solved: residual \
+         {residual:e} above the tolerance {tolerance:e}"
+    )]
+    FrictionSolve {
+        /// Period (1-based).
+        period: usize,
+        /// Step within the period (1-based).
+        step: usize,
+        /// `|F|_2` reached.
+        residual: f64,
+        /// The tolerance asked.
+        tolerance: f64,
+    },
     /// A non-finite value appeared in the state.
     #[error("non-finite state at period {period}, step {step}")]
     NonFinite {
@@ -421,9 +437,9 @@ pub fn resolve_scheme(model: &StructuralModel, scheme: MarchScheme) -> MarchSche
     match scheme {
         MarchScheme::Auto => {
             if model
-                .contacts
-                .iter()
-                .all(|c| column_max_abs(&model.mass, c.dof) == 0.0)
+                .rows()
+                .flat_map(|row| row.dofs())
+                .all(|&dof| column_max_abs(&model.mass, dof) == 0.0)
             {
                 MarchScheme::MasslessContactTrapezoidal
             } else {

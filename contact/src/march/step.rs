@@ -10,12 +10,40 @@ use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
+use super::friction::CoulombStep;
 use super::{
     column_max_abs, resolve_scheme, MarchCounters, MarchError, MarchOptions, MarchScheme,
     MarchState,
 };
 use crate::dynamic::UnionPattern;
 use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
+
+/// A dof of a contact row (or of a friction point's tangential row) that carries mass, if
+/// any.
+pub(super) fn massive_contact_dof(model: &StructuralModel, massless: &[bool]) -> Option<usize> {
+    model
+        .rows()
+        .flat_map(|row| row.dofs().iter().copied())
+        .find(|&dof| !massless[dof])
+}
+
+/// `v -= g (g . v) / (g . g)` on the entries of the row `g` (`entry(v, dof)` is the
+/// entry of dof `dof`): the motion along the row removed (a closed contact's massless dofs
+/// at rest; for a one-dof row its velocity set to 0).
+pub(super) fn remove_row_component<V: ?Sized>(
+    row: &crate::model::ContactRow,
+    v: &mut V,
+    entry: impl Fn(&mut V, usize) -> &mut f64,
+) {
+    let (mut along, mut norm) = (0.0, 0.0);
+    for (dof, a) in row.entries() {
+        along += a * *entry(v, dof);
+        norm += a * a;
+    }
+    for (dof, a) in row.entries() {
+        *entry(v, dof) -= a * along / norm;
+    }
+}
 
 /// The scheme actually marched (`Auto` resolved).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -138,6 +166,14 @@ pub struct TimeMarcher<'a> {
     q: Vec<f64>,
     z: Vec<f64>,
     active: Vec<usize>,
+    /// The step's contact and friction problem (Moreau–Jean with friction points).
+    coulomb: Option<Box<CoulombStep>>,
+    /// Friction forces of the last step (impulse / h), one per friction point.
+    friction_force: Vec<f64>,
+    /// `G v_free` of every row, `e g . v_n` and the predicted state of every contact.
+    row_free: Vec<f64>,
+    restitution: Vec<f64>,
+    closed: Vec<bool>,
     counters: MarchCounters,
 }
 
@@ -164,6 +200,15 @@ impl<'a> TimeMarcher<'a> {
         let m = model.contact_count();
         initial.check(n, m)?;
         let scheme = Scheme::resolve(model, options.scheme);
+        if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
+            return Err(MarchError::InvalidOption {
+                name: "friction points marched by the trapezoidal scheme (every row dof massless)",
+                value: model.friction.len() as f64,
+                allowed: "none: Coulomb's law acts on velocities, the trapezoidal scheme imposes \
+                          positions; march with MoreauJean",
+            });
+        }
+        let rows = m + model.friction_count();
         let massless: Vec<bool> = (0..n)
             .map(|j| column_max_abs(&model.mass, j) == 0.0)
             .collect();
@@ -172,10 +217,10 @@ impl<'a> TimeMarcher<'a> {
         // a K + b D + c M, summed in the order K, D, M.
         let (a, b, c) = match scheme {
             Scheme::Trapezoidal => {
-                if let Some(c) = model.contacts.iter().find(|c| !massless[c.dof]) {
+                if let Some(dof) = massive_contact_dof(model, &massless) {
                     return Err(MarchError::MassiveContactDof {
-                        dof: c.dof,
-                        mass: column_max_abs(&model.mass, c.dof),
+                        dof,
+                        mass: column_max_abs(&model.mass, dof),
                     });
                 }
                 (1.0, 2.0 / h, 4.0 / (h * h))
@@ -193,17 +238,19 @@ impl<'a> TimeMarcher<'a> {
         };
         let mut lu = FaerSparseLu::new();
         lu.factor(&matrix).map_err(failed)?;
-        // Y = A^{-1} G^T, column k for contact k; W = G Y.
-        let mut y = vec![0.0; n * m];
-        let mut w = Mat::zeros(m, m);
-        for (k, c) in model.contacts.iter().enumerate() {
+        // Y = A^{-1} G^T, column k for row k (contacts, then friction points); W = G Y.
+        let mut y = vec![0.0; n * rows];
+        let mut w = Mat::zeros(rows, rows);
+        for (k, row_k) in model.rows().enumerate() {
             let col = &mut y[k * n..(k + 1) * n];
-            col[c.dof] = c.sign();
+            row_k.add_transpose_at(1.0, col, 0);
             lu.solve_in_place(col).map_err(failed)?;
-            for (i, ci) in model.contacts.iter().enumerate() {
-                w[(i, k)] = ci.sign() * col[ci.dof];
+            for (i, row_i) in model.rows().enumerate() {
+                w[(i, k)] = row_i.dot(col);
             }
         }
+        let coulomb =
+            (!model.friction.is_empty()).then(|| Box::new(CoulombStep::new(model, w.clone(), h)));
         let cosines = (0..=spp)
             .map(|j| (2.0 * PI * j as f64 / spp as f64).cos())
             .collect();
@@ -230,9 +277,14 @@ impl<'a> TimeMarcher<'a> {
             q: vec![0.0; m],
             z: vec![0.0; m],
             active: Vec::with_capacity(m),
+            coulomb,
+            friction_force: vec![0.0; model.friction_count()],
+            row_free: vec![0.0; rows],
+            restitution: vec![0.0; m],
+            closed: vec![false; m],
             counters: MarchCounters {
                 factorizations: 1,
-                linear_solves: m as u64 + 1,
+                linear_solves: rows as u64 + 1,
                 ..MarchCounters::default()
             },
         };
@@ -250,7 +302,7 @@ impl<'a> TimeMarcher<'a> {
             *ri = c * ai;
         }
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
-            self.r[ct.dof] += ct.sign() * l;
+            ct.row.add_transpose_at(*l, &mut self.r, 0);
         }
         if let Some(d) = &model.damping {
             sparse_mul_add(d.as_ref(), -1.0, &self.v, &mut self.r);
@@ -296,6 +348,11 @@ impl<'a> TimeMarcher<'a> {
     /// Contact forces of the last step (`lambda <= 0`; impulse / h for Moreau–Jean).
     pub fn contact_force(&self) -> &[f64] {
         &self.lambda
+    }
+
+    /// Friction forces of the last step (impulse / h), one per friction point.
+    pub fn friction_force(&self) -> &[f64] {
+        &self.friction_force
     }
 
     /// Work so far.
@@ -410,7 +467,7 @@ impl<'a> TimeMarcher<'a> {
         self.active.clear();
         let mut closed = false;
         for (k, ct) in model.contacts.iter().enumerate() {
-            self.q[k] = ct.gap - ct.sign() * self.rhs[ct.dof];
+            self.q[k] = ct.gap - ct.row.dot(&self.rhs);
             closed |= self.q[k] < 0.0;
         }
         if closed {
@@ -426,7 +483,7 @@ impl<'a> TimeMarcher<'a> {
         if self.reset_closed_velocity {
             for (ct, l) in model.contacts.iter().zip(&self.lambda) {
                 if *l < 0.0 {
-                    self.v[ct.dof] = 0.0;
+                    remove_row_component(&ct.row, &mut self.v, |v, i| &mut v[i]);
                 }
             }
         }
@@ -453,21 +510,77 @@ impl<'a> TimeMarcher<'a> {
         }
         sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
         self.solve_rhs()?;
-        // rhs = v_free. Active set from the predicted gap g - G (u + h/2 v).
-        self.active.clear();
-        for (k, ct) in model.contacts.iter().enumerate() {
-            let s = ct.sign();
-            if ct.gap - s * (self.u[ct.dof] + 0.5 * h * self.v[ct.dof]) <= 0.0 {
-                self.q[self.active.len()] = -s * (self.rhs[ct.dof] + e * self.v[ct.dof]);
-                self.active.push(k);
-            }
+        if self.coulomb.is_some() {
+            self.solve_contacts_with_friction(j, e)?;
+        } else {
+            self.solve_impacts(j, e)?;
         }
-        self.solve_contacts(j, 1.0 / h)?;
         // u_{n+1} = u_n + h (theta v_{n+1} + (1 - theta) v_n)
         for i in 0..n {
             self.u[i] += h * (theta * self.rhs[i] + (1.0 - theta) * self.v[i]);
         }
         std::mem::swap(&mut self.v, &mut self.rhs);
+        Ok(())
+    }
+
+    /// The frictionless Moreau–Jean contact step on `rhs = v_free`: the active set from the
+    /// predicted gap `g - G (u + h/2 v)`, the impact LCP by Lemke.
+    fn solve_impacts(&mut self, j: usize, e: f64) -> Result<(), MarchError> {
+        let model = self.model;
+        let h = self.h;
+        self.active.clear();
+        for (k, ct) in model.contacts.iter().enumerate() {
+            let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
+            if ct.gap - (gu + 0.5 * h * gv) <= 0.0 {
+                self.q[self.active.len()] = -(ct.row.dot(&self.rhs) + e * gv);
+                self.active.push(k);
+            }
+        }
+        self.solve_contacts(j, 1.0 / h)
+    }
+
+    /// The Moreau–Jean contact and friction step on `rhs = v_free` (module
+    /// [`super::friction`]): contacts closed by the predicted gap, the impulses by the
+    /// core's semismooth Newton, `rhs += Y r`.
+    fn solve_contacts_with_friction(&mut self, j: usize, e: f64) -> Result<(), MarchError> {
+        let model = self.model;
+        let (n, h) = (self.u.len(), self.h);
+        for (k, row) in model.rows().enumerate() {
+            self.row_free[k] = row.dot(&self.rhs);
+        }
+        for (k, ct) in model.contacts.iter().enumerate() {
+            let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
+            self.closed[k] = ct.gap - (gu + 0.5 * h * gv) <= 0.0;
+            self.restitution[k] = e * gv;
+        }
+        let coulomb = self.coulomb.as_mut().expect("friction points present");
+        let solved = coulomb.solve(&self.row_free, &self.restitution, &self.closed);
+        solved.map_err(|unsolved| MarchError::FrictionSolve {
+            period: self.completed_periods + 1,
+            step: j + 1,
+            residual: unsolved.residual,
+            tolerance: unsolved.tolerance,
+        })?;
+        self.counters.contact_solves += 1;
+        let m = model.contact_count();
+        let mut any = false;
+        for (k, r) in coulomb.impulses().enumerate() {
+            if k < m {
+                self.lambda[k] = r / h;
+            } else {
+                self.friction_force[k - m] = r / h;
+            }
+            if r != 0.0 {
+                any = true;
+                let col = &self.y[k * n..(k + 1) * n];
+                for (xi, yi) in self.rhs.iter_mut().zip(col) {
+                    *xi += yi * r;
+                }
+            }
+        }
+        if any {
+            self.counters.active_steps += 1;
+        }
         Ok(())
     }
 }

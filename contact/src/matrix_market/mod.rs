@@ -38,7 +38,9 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::Factorize;
 
 use crate::dynamic::UnionPattern;
-use crate::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
+use crate::model::{
+    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
+};
 use crate::rod::{natural_frequencies, DampingSpec, FrequencySpec};
 
 /// Smallest first natural frequency of an imported model (its inverse the largest): the
@@ -57,15 +59,27 @@ pub use read::{
 
 pub use crate::model::ContactDirection;
 
-/// A contact of an imported model on one dof.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A contact of an imported model: its row of `G` on 0-based dofs (the scene's `dof` or
+/// `dofs` minus one, with `direction` or `coefficients`), its gap and its friction.
+#[derive(Debug, Clone, PartialEq)]
 pub struct DofContact {
-    /// The dof, 0-based (the scene's `dof` minus one).
-    pub dof: usize,
+    /// The row of `G`.
+    pub row: ContactRow,
     /// Gap (negative: preloaded).
     pub gap: f64,
-    /// Side of the obstacle.
-    pub direction: ContactDirection,
+    /// Coulomb friction on the contact: the coefficient `mu` and the tangential row.
+    pub friction: Option<(f64, ContactRow)>,
+}
+
+/// A friction point of an imported model under a prescribed normal load.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DofFriction {
+    /// The tangential row on 0-based dofs.
+    pub tangent: ContactRow,
+    /// The coefficient `mu`.
+    pub coefficient: f64,
+    /// The normal load `N > 0`.
+    pub normal_load: f64,
 }
 
 /// Everything a `[model]` scene declares (paths resolved against the scene's directory).
@@ -89,7 +103,10 @@ pub struct ModelSpec {
     pub frequency: FrequencySpec,
     /// Contacts.
     pub contacts: Vec<DofContact>,
-    /// Observed dof (0-based); `None`: the first contact dof, else the largest load entry.
+    /// Friction points under a prescribed normal load (`[[friction.point]]`).
+    pub friction: Vec<DofFriction>,
+    /// Observed dof (0-based); `None`: the first contact dof, else the first friction
+    /// point's, else the largest load entry.
     pub observed_dof: Option<usize>,
 }
 
@@ -211,7 +228,8 @@ pub enum ImportError {
     DofOutOfRange {
         /// The scene file.
         scene: PathBuf,
-        /// `contact.point.dof` or `output.dof`.
+        /// `contact.point.dof` (`dofs`, `tangent_dofs`), `friction.point.dof` (`dofs`) or
+        /// `output.dof`.
         key: &'static str,
         /// The 1-based value found.
         value: usize,
@@ -371,20 +389,37 @@ pub fn build_imported_with(
             })
         }
     };
+    let row_in_range = |one: &'static str, many: &'static str, row: &ContactRow| {
+        let key = if row.single().is_some() { one } else { many };
+        row.dofs()
+            .iter()
+            .try_for_each(|&d| dof_in_range(key, d).map(|_| ()))
+    };
     let mut contacts = Vec::with_capacity(spec.contacts.len());
-    for c in &spec.contacts {
-        dof_in_range("contact.point.dof", c.dof)?;
-        contacts.push(ContactPoint {
-            dof: c.dof,
-            gap: c.gap,
-            direction: c.direction,
-        });
+    let mut friction = Vec::new();
+    for (i, c) in spec.contacts.iter().enumerate() {
+        row_in_range("contact.point.dof", "contact.point.dofs", &c.row)?;
+        contacts.push(ContactPoint::on_row(c.row.clone(), c.gap));
+        if let Some((mu, tangent)) = &c.friction {
+            let key = "contact.point.tangent_dofs";
+            row_in_range(key, key, tangent)?;
+            friction.push(FrictionPoint::on_contact(tangent.clone(), *mu, i));
+        }
+    }
+    for f in &spec.friction {
+        row_in_range("friction.point.dof", "friction.point.dofs", &f.tangent)?;
+        friction.push(FrictionPoint::prescribed(
+            f.tangent.clone(),
+            f.coefficient,
+            f.normal_load,
+        ));
     }
     let observed_dof = match spec.observed_dof {
         Some(dof) => dof_in_range("output.dof", dof)?,
-        None => match contacts.first() {
-            Some(c) => c.dof,
-            None => largest_entry(&load),
+        None => match (contacts.first(), friction.first()) {
+            (Some(c), _) => c.dof(),
+            (None, Some(f)) => f.tangent.first_dof(),
+            (None, None) => largest_entry(&load),
         },
     };
     let stiffness_error = |reason: String| ImportError::Stiffness {
@@ -403,6 +438,7 @@ pub fn build_imported_with(
         stiffness,
         load,
         contacts,
+        friction,
     };
     let omega_1 = natural_frequencies(&model, 1)
         .map_err(|e| stiffness_error(format!("no lowest natural frequency of (K, M): {e}")))?[0];

@@ -13,14 +13,14 @@
 //! The LCP branches (`lcp-ssn`) carry gaps and forces at time nodes instead of harmonic
 //! coefficients: their points are undecided, with that reason.
 
-use semismooth::floquet::{crossing, BifurcationKind};
+use semismooth::floquet::{crossing_of, BifurcationKind, Outside};
 
 use crate::contacts::ContactSummary;
 use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{Method, SolverSettings};
 use crate::solve::{hb_options, penalty_options, RunError};
-use crate::stability::{hb_stability, Stability, StabilityError, StabilityOptions, Undecided};
+use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::FrequencyResponse;
 
 /// Reconstruction points per period for the contact diagnostics.
@@ -52,6 +52,10 @@ pub struct BranchStability {
     pub events: Vec<BifurcationEvent>,
     /// Why points are undecided (the first reason met), `None` when all are decided.
     pub undecided: Option<Undecided>,
+    /// Whether the point's verdict comes from the branch's fold count: its real multiplier
+    /// nearest `+1`, within [`FOLD_BAND`], lies on the other side of `+1` than the number
+    /// of folds before it requires, and is counted on that side (module documentation).
+    pub placed_by_fold: Vec<bool>,
 }
 
 impl BranchStability {
@@ -64,6 +68,7 @@ impl BranchStability {
             max_penetration: vec![f64::NAN; points],
             events: Vec::new(),
             undecided: Some(reason),
+            placed_by_fold: vec![false; points],
         }
     }
 }
@@ -104,23 +109,21 @@ impl Reconstruction {
         model: &StructuralModel,
         x: &[f64],
     ) -> Result<Vec<ContactSummary>, HbError> {
-        let first = model.contacts.first().map_or(0, |c| c.dof);
+        let first = model.contacts.first().map_or(0, |c| c.dof());
         // Both formulations offer the same summary and reconstruction.
         let gather = |summary: Result<ResponseSummary, HbError>,
                       samples: &dyn Fn(usize) -> Result<Vec<f64>, HbError>| {
-            let samples = model
-                .contacts
-                .iter()
-                .map(|c| samples(c.dof))
+            let samples = (0..model.contacts.len())
+                .map(samples)
                 .collect::<Result<Vec<_>, _>>()?;
             Ok::<_, HbError>((summary?, samples))
         };
         let (summary, samples) = match self {
-            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
-                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
+                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
             })?,
-            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|dof| {
-                p.displacement_samples(x, dof, DIAGNOSTIC_POINTS)
+            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
+                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
             })?,
         };
         Ok(model
@@ -129,7 +132,7 @@ impl Reconstruction {
             .zip(samples)
             .enumerate()
             .map(|(k, (c, u))| ContactSummary {
-                dof: c.dof,
+                dof: c.dof(),
                 gap: c.gap,
                 contact_force_mean: summary.contact_force_mean.get(k).copied().unwrap_or(0.0),
                 max_penetration: u.iter().fold(0.0f64, |a, v| a.max(v - c.gap)),
@@ -154,64 +157,108 @@ impl Reconstruction {
     }
 }
 
+/// Real multipliers within this distance of `+1` may be placed on the side of `+1` that
+/// the branch's fold count requires (module documentation); farther ones are left as
+/// computed. Near a fold the multiplier moves like the square root of the distance to it,
+/// so the harmonic-balance error of the switching instants moves it far: on the strongly
+/// forced modified-mass rod at `H = 20` the point `1.3e-3 omega_1` past the upper fold has
+/// its real multiplier at 0.88 (measured, `ssn/tests/stability.rs`).
+pub const FOLD_BAND: f64 = 0.25;
+
 /// Stability and diagnostics of every point of `response`, computed with the scene's
-/// settings (module documentation).
+/// settings (module documentation); `progress(points)` after each point. Without
+/// `multipliers` only the contact diagnostics are computed and every point is undecided
+/// ([`Undecided::NotRequested`]).
 pub fn branch_stability(
     rod: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
-    options: &StabilityOptions,
+    multipliers: bool,
+    progress: Option<&dyn Fn(usize)>,
 ) -> Result<BranchStability, StabilityError> {
     let points = response.points();
     let mut out = BranchStability::default();
     let model = &rod.model;
+    if !settings.method.is_harmonic_balance() {
+        return Ok(BranchStability::not_decided(
+            points,
+            Undecided::NotHarmonicBalance(settings.method),
+        ));
+    }
     // The reconstructions over one period do not depend on the frequency: any valid one.
-    let omega = rod.omega_1;
-    let reconstruction = match settings.method {
-        Method::SsnHb => SsnHb::new(model, omega, &hb_options(settings)).map(Reconstruction::Ssn),
-        Method::PenaltyHb => PenaltyHb::new(model, omega, &penalty_options(settings, model))
-            .map(Reconstruction::Penalty),
-        _ => {
-            return Ok(BranchStability::not_decided(
-                points,
-                Undecided::NotHarmonicBalance(settings.method),
-            ))
-        }
-    };
-    let reconstruction = reconstruction?;
-    let harmonics = settings.harmonics;
-    let len = model.dofs() * (2 * harmonics + 1);
-    let mut analyses: Vec<Option<Stability>> = Vec::with_capacity(points);
+    let reconstruction =
+        Reconstruction::new(model, rod.omega_1, settings).map_err(|e| match e {
+            RunError::HarmonicBalance(e) => StabilityError::Hb(e),
+            _ => StabilityError::InvalidOption {
+                name: "method",
+                value: f64::NAN,
+                allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
+            },
+        })?;
+    let mut analysis = HbStability::new(model, settings)?;
+    let mut analyses: Vec<Stability> = Vec::with_capacity(points);
     for (i, x) in response.states.iter().enumerate() {
-        let s = hb_stability(model, harmonics, response.omega[i], &x[..len], options)?;
-        if s.stable.is_none() && out.undecided.is_none() {
-            out.undecided.clone_from(&s.undecided);
-        }
-        out.stable.push(s.stable);
-        out.floquet_max_abs.push(s.floquet_max_abs);
+        let s = if multipliers {
+            analysis.of(response.omega[i], x)?
+        } else {
+            Stability::not_decided(Undecided::NotRequested)
+        };
         let (mean, penetration) = reconstruction
             .summary(x, rod.observed_dof)
             .unwrap_or((f64::NAN, f64::NAN));
         out.contact_force_mean.push(mean);
         out.max_penetration.push(penetration);
-        analyses.push(s.stable.is_some().then_some(s));
+        analyses.push(s);
+        if let Some(report) = progress {
+            report(i + 1);
+        }
+    }
+    let reversals: Vec<usize> = {
+        let mut r: Vec<usize> = response
+            .fold_indices
+            .iter()
+            .chain(&response.corner_fold_indices)
+            .copied()
+            .collect();
+        r.sort_unstable();
+        r
+    };
+    let outside = fold_consistent_counts(&analyses, &reversals);
+    for (s, counts) in analyses.iter().zip(&outside) {
+        if s.stable.is_none() && out.undecided.is_none() {
+            out.undecided.clone_from(&s.undecided);
+        }
+        out.stable.push(counts.map(|(c, _)| c.is_stable()));
+        out.floquet_max_abs.push(s.floquet_max_abs);
+        out.placed_by_fold
+            .push(counts.is_some_and(|(_, placed)| placed));
     }
     let mut last: Option<usize> = None;
     for i in 0..points {
-        let Some(after) = &analyses[i] else { continue };
+        let Some((after, _)) = outside[i] else {
+            continue;
+        };
         if let Some(j) = last {
-            let before = analyses[j].as_ref().expect("decided");
-            if let Some(kind) = crossing(&before.multipliers, &after.multipliers) {
-                let (a0, a1) = (before.multipliers.max_abs(), after.multipliers.max_abs());
+            let (before, _) = outside[j].expect("decided");
+            if let Some(kind) = crossing_of(before, after) {
                 let (w0, w1) = (response.omega[j], response.omega[i]);
-                let t = if (a1 - a0).abs() > 0.0 {
-                    ((1.0 - a0) / (a1 - a0)).clamp(0.0, 1.0)
-                } else {
-                    0.5
+                let omega = match reversals.iter().find(|&&r| j <= r && r <= i) {
+                    // A fold of the branch between the two: the crossing is the fold.
+                    Some(&r) if kind == BifurcationKind::Fold => response.omega[r],
+                    _ => {
+                        let a0 = analyses[j].floquet_max_abs.unwrap_or(1.0);
+                        let a1 = analyses[i].floquet_max_abs.unwrap_or(1.0);
+                        let t = if (a1 - a0).abs() > 0.0 {
+                            ((1.0 - a0) / (a1 - a0)).clamp(0.0, 1.0)
+                        } else {
+                            0.5
+                        };
+                        w0 + t * (w1 - w0)
+                    }
                 };
                 out.events.push(BifurcationEvent {
                     kind,
-                    omega: w0 + t * (w1 - w0),
+                    omega,
                     index: i,
                 });
             }
@@ -219,4 +266,48 @@ pub fn branch_stability(
         last = Some(i);
     }
     Ok(out)
+}
+
+/// The counts of multipliers outside the unit circle of each decided point, with the real
+/// multiplier nearest `+1` placed on the side that the parity of the number of reversals
+/// of the branch before the point requires when it is within [`FOLD_BAND`] of `+1` (the
+/// flag says where that changed the count). The parity of the first segment is the one
+/// most points agree with. Points at a reversal keep their own counts.
+fn fold_consistent_counts(
+    analyses: &[Stability],
+    reversals: &[usize],
+) -> Vec<Option<(Outside, bool)>> {
+    let segment = |i: usize| reversals.iter().filter(|&&r| r < i).count();
+    let at_reversal = |i: usize| reversals.binary_search(&i).is_ok();
+    let mut votes = [0usize; 2];
+    for (i, s) in analyses.iter().enumerate() {
+        if s.stable.is_some() && !at_reversal(i) {
+            let parity = (s.multipliers.outside().real_above_one + segment(i)) % 2;
+            votes[parity] += 1;
+        }
+    }
+    let offset = usize::from(votes[1] > votes[0]);
+    analyses
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.stable?;
+            let mut counts = s.multipliers.outside();
+            let wanted = (offset + segment(i)) % 2;
+            if at_reversal(i) || counts.real_above_one % 2 == wanted {
+                return Some((counts, false));
+            }
+            match s.multipliers.nearest_real_to_one() {
+                Some(mu) if (mu - 1.0).abs() <= FOLD_BAND => {
+                    if mu > 1.0 {
+                        counts.real_above_one -= 1;
+                    } else {
+                        counts.real_above_one += 1;
+                    }
+                    Some((counts, true))
+                }
+                _ => Some((counts, false)),
+            }
+        })
+        .collect()
 }

@@ -11,7 +11,7 @@ use crate::contacts::{contact_reports, ContactReport};
 use crate::hb::{PenaltyHb, SsnHb};
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, HbReconstruction, RunError};
+use crate::solve::{hb_options, penalty_options, set_closed_fractions, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
@@ -23,7 +23,7 @@ pub(super) fn branch_contacts(
     response: &FrequencyResponse,
 ) -> Result<Vec<Vec<ContactReport>>, RunError> {
     let model = &rod.model;
-    let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof, c.gap)).collect();
+    let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
     let points = response.output_points;
     let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<ContactReport>>, RunError> {
         response
@@ -33,11 +33,15 @@ pub(super) fn branch_contacts(
                 let forces = (0..contacts.len())
                     .map(|i| problem.contact_force(x, i, points))
                     .collect::<Result<Vec<_>, _>>()?;
-                let displacements = contacts
-                    .iter()
-                    .map(|&(dof, _)| problem.displacement(x, dof, points))
+                let displacements = (0..contacts.len())
+                    .map(|i| problem.row_displacement(x, i, points))
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(contact_reports(&contacts, &forces, &displacements))
+                let closed = (0..contacts.len())
+                    .map(|i| problem.closed_intervals(x, i))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let mut reports = contact_reports(&contacts, &forces, &displacements);
+                set_closed_fractions(&mut reports, &closed);
+                Ok(reports)
             })
             .collect()
     };

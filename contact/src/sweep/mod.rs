@@ -111,7 +111,7 @@ use crate::solve::{
     hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
     HB_OUTPUT_POINTS,
 };
-use crate::stability::{StabilityOptions, Undecided};
+use crate::stability::Undecided;
 use branch::branch_stability;
 pub(crate) use branch::Reconstruction;
 pub use branch::{BifurcationEvent, BranchStability};
@@ -454,31 +454,73 @@ where
     Ok(response)
 }
 
+/// What a sweep reports while it runs ([`frequency_response`]'s `progress`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum SweepProgress {
+    /// The branch has `points` points, the last at `omega_ratio` (units of `omega_1`).
+    Branch {
+        /// Points accepted so far.
+        points: usize,
+        /// Frequency of the last one, in units of `omega_1`.
+        omega_ratio: f64,
+    },
+    /// The stability of `done` of the branch's `total` points is known.
+    Stability {
+        /// Points analysed.
+        done: usize,
+        /// Points of the branch.
+        total: usize,
+    },
+}
+
 /// Frequency-response curve of the rod with the scene's method (module documentation):
 /// globalized Newton at `omega_ratio_from`, then pseudo-arclength continuation in `ω` up to
-/// `omega_ratio_to`. `progress(index, omega_ratio)` is called after each accepted point.
+/// `omega_ratio_to`. `progress` hears of each accepted point, then of each point whose
+/// stability is computed.
 ///
 /// `Err` when the sweep could not start (bad settings, unsupported method, a model the
 /// method cannot build); a branch that stopped early is an `Ok` curve with
 /// `converged = false` and the reason in `termination`.
 ///
 /// Each point then gets its stability and contact diagnostics
-/// ([`crate::sweep::branch::branch_stability`], in [`FrequencyResponse::stability`]); a failure
-/// there leaves the points undecided with the reason in its `note`.
+/// ([`crate::sweep::branch::branch_stability`], in [`FrequencyResponse::stability`]) unless
+/// [`SweepSettings::stability`] is off (the points are then undecided with
+/// [`Undecided::NotRequested`], their contact diagnostics still computed); a failure there
+/// leaves the points undecided with the reason.
 pub fn frequency_response(
     rod: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
-    progress: Option<&dyn Fn(usize, f64)>,
+    progress: Option<&dyn Fn(SweepProgress)>,
 ) -> Result<FrequencyResponse, RunError> {
-    let mut response = follow_branch(rod, settings, sweep, progress)?;
+    let branch_progress = progress.map(|report| {
+        move |points: usize, omega_ratio: f64| {
+            report(SweepProgress::Branch {
+                points: points + 1,
+                omega_ratio,
+            })
+        }
+    });
+    let mut response = follow_branch(
+        rod,
+        settings,
+        sweep,
+        branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64)),
+    )?;
     response.contacts = contacts::branch_contacts(rod, settings, &response)?;
     let started = Instant::now();
-    let options = StabilityOptions::default();
-    response.stability =
-        branch_stability(rod, settings, &response, &options).unwrap_or_else(|err| {
-            BranchStability::not_decided(response.points(), Undecided::Failed(err))
-        });
+    let total = response.points();
+    let stability_progress =
+        progress.map(|report| move |done: usize| report(SweepProgress::Stability { done, total }));
+    response.stability = branch_stability(
+        rod,
+        settings,
+        &response,
+        sweep.stability,
+        stability_progress.as_ref().map(|p| p as &dyn Fn(usize)),
+    )
+    .unwrap_or_else(|err| BranchStability::not_decided(total, Undecided::Failed(err)));
     response.stability_seconds = started.elapsed().as_secs_f64();
     Ok(response)
 }

@@ -5,12 +5,12 @@ use std::path::Path;
 
 use super::*;
 
-struct Check<'a> {
+pub(super) struct Check<'a> {
     path: &'a Path,
 }
 
 impl Check<'_> {
-    fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
+    pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
         SceneError::Invalid {
             path: self.path.to_path_buf(),
             key: key.to_string(),
@@ -19,7 +19,7 @@ impl Check<'_> {
         }
     }
 
-    fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+    pub(super) fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
@@ -27,7 +27,7 @@ impl Check<'_> {
         }
     }
 
-    fn non_negative(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+    pub(super) fn non_negative(&self, key: &str, v: f64) -> Result<f64, SceneError> {
         if v.is_finite() && v >= 0.0 {
             Ok(v)
         } else {
@@ -37,7 +37,7 @@ impl Check<'_> {
 
     /// A length or force of the response: `|v| <= MAX_RESPONSE_SCALE`, so that residuals
     /// and their squares (merit functions) stay finite.
-    fn response_scale(&self, key: &str, v: f64) -> Result<f64, SceneError> {
+    pub(super) fn response_scale(&self, key: &str, v: f64) -> Result<f64, SceneError> {
         if v.is_finite() && v.abs() <= MAX_RESPONSE_SCALE {
             Ok(v)
         } else {
@@ -49,7 +49,13 @@ impl Check<'_> {
         }
     }
 
-    fn count(&self, key: &str, v: i64, min: usize, max: usize) -> Result<usize, SceneError> {
+    pub(super) fn count(
+        &self,
+        key: &str,
+        v: i64,
+        min: usize,
+        max: usize,
+    ) -> Result<usize, SceneError> {
         if v >= min as i64 && v <= max as i64 {
             Ok(v as usize)
         } else {
@@ -58,7 +64,7 @@ impl Check<'_> {
     }
 
     /// `count` of `v` when given, else `default`.
-    fn count_or(
+    pub(super) fn count_or(
         &self,
         key: &str,
         v: Option<i64>,
@@ -89,6 +95,14 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             if let Some(c) = raw.contact {
                 rod.contacts = ck.contacts(c, rod.elements)?;
             }
+            if raw.friction.is_some() {
+                return Err(ck.invalid(
+                    "friction.point",
+                    "given in a [rod] scene",
+                    "[[friction.point]] in [model] scenes (`ssn export-model` writes a rod as \
+                     one)",
+                ));
+            }
             let output_dof = raw
                 .output
                 .map(|o| ck.count("output.dof", o.dof, 1, rod.elements))
@@ -97,7 +111,13 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             (rod, None, output_dof)
         }
         (None, Some(m)) => {
-            let model = ck.model(m, raw.damping, &raw.forcing, raw.contact, raw.output)?;
+            let model = ck.model(
+                m,
+                raw.damping,
+                &raw.forcing,
+                (raw.contact, raw.friction),
+                raw.output,
+            )?;
             let output_dof = model.observed_dof;
             (RodSpec::canonical(), Some(model), output_dof)
         }
@@ -122,6 +142,9 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         .as_ref()
         .map_or(rod.contacts.len(), |m| m.contacts.len());
     ck.lcp_size(&solver, contacts, raw.solver.time_samples.is_some())?;
+    if let Some(m) = &model {
+        ck.friction_method(&solver, m)?;
+    }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
@@ -370,7 +393,7 @@ impl Check<'_> {
         m: RawModel,
         damping: Option<RawDamping>,
         f: &RawForcing,
-        contact: Option<RawContact>,
+        (contact, friction): (Option<RawContact>, Option<RawFrictionSection>),
         output: Option<RawOutput>,
     ) -> Result<ModelSpec, SceneError> {
         let dir = self.path.parent().unwrap_or(Path::new(""));
@@ -416,6 +439,10 @@ impl Check<'_> {
             .map(|c| self.dof_contacts(c))
             .transpose()?
             .unwrap_or_default();
+        let friction = friction
+            .map(|f| self.dof_friction(f))
+            .transpose()?
+            .unwrap_or_default();
         let observed_dof = output
             .map(|o| self.count("output.dof", o.dof, 1, usize::MAX >> 1))
             .transpose()?
@@ -430,83 +457,22 @@ impl Check<'_> {
             amplitude,
             frequency,
             contacts,
+            friction,
             observed_dof,
         })
     }
 
-    /// `[[contact.point]]` entries of a `[model]` scene: `dof` (1-based), `gap`, `direction`
-    /// (+1, the default, or -1); one contact per dof and direction.
-    fn dof_contacts(&self, c: RawContact) -> Result<Vec<DofContact>, SceneError> {
-        let allowed = "[[contact.point]] entries with dof, gap and optional direction";
-        let points = match (c.gap, c.node, c.point) {
-            (None, None, Some(points)) if !points.is_empty() => points,
-            (None, None, _) => return Err(self.invalid("contact.point", "an empty list", allowed)),
-            (Some(_), _, _) => {
-                return Err(self.invalid("contact.gap", "given in a [model] scene", allowed))
-            }
-            (None, Some(_), _) => {
-                return Err(self.invalid("contact.node", "given in a [model] scene", allowed))
-            }
-        };
-        let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
-        // The entry (from 1) of each dof and direction seen.
-        let mut seen = std::collections::HashMap::with_capacity(points.len());
-        for (entry, p) in points.into_iter().enumerate() {
-            let entry = entry + 1;
-            if p.node.is_some() {
-                return Err(self.invalid(
-                    "contact.point.node",
-                    "given in a [model] scene",
-                    "`dof` (1-based, as in Matrix Market)",
-                ));
-            }
-            let dof = p.dof.ok_or_else(|| {
-                self.invalid("contact.point.dof", "missing", "a 1-based dof number")
-            })?;
-            let dof = self.count("contact.point.dof", dof, 1, usize::MAX >> 1)? - 1;
-            let direction = match p.direction.unwrap_or(1) {
-                1 => ContactDirection::Positive,
-                -1 => ContactDirection::Negative,
-                d => return Err(self.invalid(
-                    "contact.point.direction",
-                    d,
-                    "1 (obstacle on the positive side: u <= gap) or -1 (negative side: -u <= gap)",
-                )),
-            };
-            if let Some(first) = seen.insert((dof, direction), entry) {
-                return Err(self.invalid(
-                    "contact.point.dof",
-                    format!("{} in entries {first} and {entry}", dof + 1),
-                    "one contact per dof and direction (two contacts on one dof need opposite directions)",
-                ));
-            }
-            let gap = self.response_scale("contact.point.gap", p.gap)?;
-            let opposite = match direction {
-                ContactDirection::Positive => ContactDirection::Negative,
-                ContactDirection::Negative => ContactDirection::Positive,
-            };
-            if let Some(&other) = seen.get(&(dof, opposite)) {
-                let clearance = gap + contacts[other - 1].gap;
-                if clearance.is_nan() || clearance <= 0.0 {
-                    return Err(self.invalid(
-                        "contact.point.gap",
-                        format!(
-                            "{gap} in entry {entry} and {} in entry {other} (both on dof {}, \
-                             opposite directions: clearance {clearance})",
-                            contacts[other - 1].gap,
-                            dof + 1
-                        ),
-                        "two gaps on one dof whose sum is > 0 (room between the two obstacles)",
-                    ));
-                }
-            }
-            contacts.push(DofContact {
-                dof,
-                gap,
-                direction,
-            });
+    /// A scene with friction is solved by the methods that model it: `ssn-hb` and `march`.
+    fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
+        let points = m.friction.len() + m.contacts.iter().filter(|c| c.friction.is_some()).count();
+        if points == 0 || matches!(solver.method, Method::SsnHb | Method::March) {
+            return Ok(());
         }
-        Ok(contacts)
+        Err(self.invalid(
+            "solver.method",
+            format!("\"{}\" with {points} friction points", solver.method.name()),
+            "\"ssn-hb\" or \"march\" (the methods that model Coulomb friction)",
+        ))
     }
 
     /// The periodic LCP's matrix is dense, of order `contacts x time_samples`: that order
@@ -615,6 +581,36 @@ impl Check<'_> {
         if !(0.0..=1.0).contains(&restitution) {
             return Err(self.invalid("solver.restitution", restitution, "a number in [0, 1]"));
         }
+        let accuracy = s
+            .accuracy
+            .map(|a| {
+                if (MIN_ACCURACY..=MAX_ACCURACY).contains(&a) {
+                    Ok(a)
+                } else {
+                    Err(self.invalid(
+                        "solver.accuracy",
+                        a,
+                        &format!("a relative accuracy in [{MIN_ACCURACY:e}, {MAX_ACCURACY}]"),
+                    ))
+                }
+            })
+            .transpose()?;
+        if accuracy.is_some() {
+            // The search chooses the discretisation: one given as well would be ignored.
+            for (key, given) in [
+                ("solver.harmonics", s.harmonics.is_some()),
+                ("solver.time_samples", s.time_samples.is_some()),
+                ("solver.steps_per_period", s.steps_per_period.is_some()),
+            ] {
+                if given {
+                    return Err(self.invalid(
+                        key,
+                        "given with solver.accuracy",
+                        "not both: with an accuracy the method chooses its discretisation",
+                    ));
+                }
+            }
+        }
         Ok(SolverSettings {
             method,
             harmonics,
@@ -630,6 +626,8 @@ impl Check<'_> {
             march_tolerance,
             restitution,
             lcp_scheme: s.lcp_scheme,
+            accuracy,
+            estimate_error: default.estimate_error,
         })
     }
 
@@ -667,6 +665,7 @@ impl Check<'_> {
                 1_000_000,
                 defaults.max_points,
             )?,
+            stability: sw.stability.unwrap_or(defaults.stability),
             ..defaults
         })
     }

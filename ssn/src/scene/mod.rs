@@ -24,12 +24,13 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use semismooth_contact::matrix_market::{ContactDirection, DofContact, ModelSpec};
+use semismooth_contact::matrix_market::{DofContact, DofFriction, ModelSpec};
 use semismooth_contact::rod::{
     DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
 };
 
 mod check;
+mod contacts;
 mod overrides;
 
 pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
@@ -102,6 +103,7 @@ struct RawScene {
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
+    friction: Option<RawFrictionSection>,
     output: Option<RawOutput>,
     #[serde(default)]
     solver: RawSolver,
@@ -191,6 +193,28 @@ struct RawContactPoint {
     dof: Option<i64>,
     gap: f64,
     direction: Option<i64>,
+    dofs: Option<Vec<i64>>,
+    coefficients: Option<Vec<f64>>,
+    friction: Option<f64>,
+    tangent_dofs: Option<Vec<i64>>,
+    tangent_coefficients: Option<Vec<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFrictionSection {
+    point: Option<Vec<RawFrictionPoint>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFrictionPoint {
+    node: Option<i64>,
+    dof: Option<i64>,
+    dofs: Option<Vec<i64>>,
+    coefficients: Option<Vec<f64>>,
+    normal_load: Option<f64>,
+    friction: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Default)]
@@ -214,6 +238,7 @@ struct RawSolver {
     restitution: Option<f64>,
     #[serde(default)]
     lcp_scheme: LcpScheme,
+    accuracy: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -225,12 +250,19 @@ struct RawSweep {
     min_step: Option<f64>,
     max_step: Option<f64>,
     max_points: Option<i64>,
+    stability: Option<bool>,
 }
 
 /// Largest harmonic count accepted.
 pub const MAX_HARMONICS: usize = 2000;
 /// Largest sample / step count accepted.
 pub const MAX_TIME_SAMPLES: usize = 1 << 20;
+/// Smallest `[solver] accuracy` accepted: below it the iterations' own stopping rules limit
+/// the answers (time marching stops at a period-to-period change of 1e-8, an error of
+/// about 1.6e-7 on the paper's rod, module `semismooth_contact::march`).
+pub const MIN_ACCURACY: f64 = 1e-7;
+/// Largest `[solver] accuracy` accepted.
+pub const MAX_ACCURACY: f64 = 0.1;
 /// Largest accepted magnitude of a forcing amplitude or a gap: the response scales with
 /// them, and a residual's square must stay below the largest double (1.8e308).
 pub const MAX_RESPONSE_SCALE: f64 = 1e100;

@@ -10,7 +10,7 @@ use super::super::jacobian::ContactCoupling;
 use super::super::krylov::{CondensedOperator, CondensedPreconditioner};
 use super::super::LinearData;
 use super::{
-    apply_coupling, finite_step, gather_contacts, receptance_columns, FactoredCondensed,
+    apply_coupling, finite_step, gather_contacts, receptance_columns, row_of, FactoredCondensed,
     StructuredHbSolver, KRYLOV_RELATIVE_TOLERANCE,
 };
 
@@ -102,12 +102,7 @@ impl StructuredHbSolver {
         }
         // dU = A^{-1} (r_u + G^T dLambda).
         w.copy_from_slice(&rhs[..nu]);
-        for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-            let s = lin.contact_signs[i];
-            for j in 0..size {
-                w[j * n + dof] += s * self.work_d[j * m + i];
-            }
-        }
+        lin.scatter_rows(&self.work_d, 1.0, &mut w);
         self.apply_dynamic_inverse(&mut w)?;
         rhs[..nu].copy_from_slice(&w);
         rhs[nu..].copy_from_slice(&self.work_d);
@@ -156,6 +151,7 @@ impl StructuredHbSolver {
             dynamic,
             lin,
             q: &self.q,
+            cross: &self.cross,
             c,
             rhs: &mut self.complex_rhs,
             work: &mut self.work_a,
@@ -214,10 +210,9 @@ impl StructuredHbSolver {
         for k in 0..=harmonics {
             let r = &mut self.receptance[k];
             receptance_columns(dynamic, lin, k, &mut self.block_rhs, |first, z| {
-                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                    let s = lin.contact_signs[i];
+                for (i, row) in lin.rows.iter().enumerate() {
                     for j in 0..z.ncols() {
-                        r[(i, first + j)] = z[(dof, j)] * s;
+                        r[(i, first + j)] = lin.measured(i, k, row_of(row, z, j));
                     }
                 }
             })?;

@@ -36,6 +36,7 @@ use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::LinearData;
 use crate::dynamic::DynamicStiffness;
+use crate::model::ContactRow;
 
 mod matrix_free;
 pub use matrix_free::DENSE_PRECONDITIONER_LIMIT;
@@ -101,6 +102,8 @@ pub struct StructuredHbSolver {
     coupling: ContactCoupling,
     /// `Q_i` per contact, copied from the Jacobian.
     q: Vec<Mat<f64>>,
+    /// The friction points' blocks `X` on their contacts' forces, copied from the Jacobian.
+    cross: CrossBlocks,
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -168,6 +171,7 @@ impl StructuredHbSolver {
             receptance: Vec::new(),
             coupling: ContactCoupling::Complementarity { c: 1.0 },
             q: Vec::new(),
+            cross: CrossBlocks::default(),
             schur: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
@@ -288,6 +292,7 @@ impl StructuredHbSolver {
         self.work_rhs = Vec::with_capacity(n * size + nc);
         self.work_res = Vec::with_capacity(n * size + nc);
         self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
+        self.cross = CrossBlocks::new(lin);
         if self.krylov {
             self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
             self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
@@ -343,23 +348,22 @@ impl StructuredHbSolver {
                     for j in 0..z.ncols() {
                         let i = first + j;
                         diagonal[k * lin.contacts() + i] =
-                            z[(lin.contact_dofs[i], j)] * lin.contact_signs[i];
+                            lin.measured(i, k, row_of(&lin.rows[i], z, j));
                     }
                 })?;
                 continue;
             }
             let z = &mut self.response[k];
             z.fill(c64::new(0.0, 0.0));
-            // Columns of G^T: s_i on dof_i (two contacts may share a dof).
-            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                z[(dof, i)] = c64::new(lin.contact_signs[i], 0.0);
+            // Columns of G^T (two rows may share a dof).
+            for (i, row) in lin.rows.iter().enumerate() {
+                set_column(row, z.as_mut(), i);
             }
             dynamic.solve_in_place(k, z.as_mut())?;
             let r = &mut self.receptance[k];
-            for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                let s = lin.contact_signs[i];
+            for (i, row) in lin.rows.iter().enumerate() {
                 for ip in 0..lin.contacts() {
-                    r[(i, ip)] = z[(dof, ip)] * s;
+                    r[(i, ip)] = lin.measured(i, k, row_of(row, z.as_ref(), ip));
                 }
             }
         }
@@ -457,8 +461,7 @@ fn receptance_columns(
         let mut z = block.as_mut().subcols_mut(0, count);
         z.fill(c64::new(0.0, 0.0));
         for j in 0..count {
-            let i = first + j;
-            z[(lin.contact_dofs[i], j)] = c64::new(lin.contact_signs[i], 0.0);
+            set_column(&lin.rows[first + j], z.as_mut(), j);
         }
         dynamic.solve_in_place(k, z.as_mut())?;
         visit(first, z.as_ref());
@@ -466,14 +469,100 @@ fn receptance_columns(
     Ok(())
 }
 
-/// `out = G u`: the contact displacements' coefficients (index `j m + i`) of the full
-/// coefficients `u` (index `j N + dof`).
+/// `out = G u`: the rows' measured coefficients (index `j m + i`; a friction point's
+/// phase velocity, [`LinearData::gather_measured`]) of the full coefficients `u` (index
+/// `j N + dof`).
 fn gather_contacts(lin: &LinearData, u: &[f64], out: &mut [f64]) {
-    let (n, m) = (lin.dofs, lin.contacts());
-    for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-        let s = lin.contact_signs[i];
-        for (j, o) in out[i..].iter_mut().step_by(m).enumerate() {
-            *o = s * u[j * n + dof];
+    lin.gather_measured(u, out);
+}
+
+/// Column `col` of `z` set to the row `g` (a column of `G^T`; the column is zero before).
+fn set_column(row: &ContactRow, mut z: MatMut<'_, c64>, col: usize) {
+    for (dof, a) in row.entries() {
+        z[(dof, col)] = c64::new(a, 0.0);
+    }
+}
+
+/// `g . z[:, col]` (complex).
+pub(crate) fn row_of(row: &ContactRow, z: faer::MatRef<'_, c64>, col: usize) -> c64 {
+    let mut entries = row.entries();
+    let (d, a) = entries.next().expect("a row has at least one dof");
+    entries.fold(z[(d, col)] * a, |s, (d, a)| s + z[(d, col)] * a)
+}
+
+/// The blocks `X_f = dR_t / dLambda_n` of the friction points on contacts (row `t` of the
+/// friction point, row `p` of its contact), as the condensed system uses them.
+#[derive(Debug, Default)]
+pub(crate) struct CrossBlocks {
+    /// `(t, p)` of each friction point on a contact, in the order of the Jacobian's blocks
+    /// (`None` under a prescribed load: no block).
+    rows: Vec<Option<(usize, usize)>>,
+    blocks: Vec<Mat<f64>>,
+}
+
+impl CrossBlocks {
+    /// Empty blocks for the friction points of `lin`.
+    pub(crate) fn new(lin: &LinearData) -> Self {
+        let size = lin.size();
+        let rows: Vec<Option<(usize, usize)>> = lin
+            .friction
+            .iter()
+            .enumerate()
+            .map(|(f, &(_, normal))| match normal {
+                crate::model::NormalForce::Contact(p) => Some((lin.normal_rows() + f, p)),
+                crate::model::NormalForce::Prescribed(_) => None,
+            })
+            .collect();
+        let blocks = rows.iter().map(|_| Mat::zeros(size, size)).collect();
+        Self { rows, blocks }
+    }
+
+    /// Copies the Jacobian's blocks (a non-finite entry is an error).
+    pub(crate) fn copy_from(&mut self, source: &[Mat<f64>]) -> Result<(), LinearSolveError> {
+        for (block, from) in self.blocks.iter_mut().zip(source) {
+            block.copy_from(from);
+            for col in 0..block.ncols() {
+                let column = block.col_as_slice(col);
+                if let Some((row, &value)) = column.iter().enumerate().find(|(_, v)| !v.is_finite())
+                {
+                    return Err(LinearSolveError::NonFiniteEntry { row, col, value });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The `(t, p, X)` of each friction point on a contact.
+    fn each(&self) -> impl Iterator<Item = (usize, usize, &Mat<f64>)> + '_ {
+        self.rows
+            .iter()
+            .zip(&self.blocks)
+            .filter_map(|(rows, x)| rows.map(|(t, p)| (t, p, x)))
+    }
+
+    /// `out[j m + t] += sum_l X[j, l] p[l m + p]` for every block (harmonic-major vectors).
+    pub(crate) fn apply_add(&self, m: usize, x: &[f64], out: &mut [f64]) {
+        for (t, p, block) in self.each() {
+            for l in 0..block.ncols() {
+                let xl = x[l * m + p];
+                if xl == 0.0 {
+                    continue;
+                }
+                for (j, v) in block.col_as_slice(l).iter().enumerate() {
+                    out[j * m + t] += v * xl;
+                }
+            }
+        }
+    }
+
+    /// `S[(j m + t, l m + p)] += X[j, l]` for every block.
+    fn add_to(&self, m: usize, mut out: MatMut<'_, f64>) {
+        for (t, p, block) in self.each() {
+            for l in 0..block.ncols() {
+                for (j, v) in block.col_as_slice(l).iter().enumerate() {
+                    out[(j * m + t, l * m + p)] += v;
+                }
+            }
         }
     }
 }
@@ -522,6 +611,7 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         let (m, size) = (lin.contacts(), lin.size());
         let nc = m * size;
         self.coupling = jac.coupling;
+        self.cross.copy_from(&jac.cross)?;
         for (i, (q, source)) in self.q.iter_mut().zip(&jac.q).enumerate() {
             q.copy_from(source);
             for col in 0..size {
@@ -675,22 +765,14 @@ impl StructuredHbSolver {
                 let (out_u, out_l) = out.split_at_mut(nu);
                 let x_l = &x[nu..];
                 apply_coupling(&self.q, m, x_l, &mut self.work_d);
-                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                    let s = lin.contact_signs[i];
-                    for j in 0..size {
-                        let r = j * m + i;
-                        out_u[j * n + dof] -= s * x_l[r];
-                        out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
-                    }
+                lin.scatter_rows(x_l, -1.0, out_u);
+                for r in 0..m * size {
+                    out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
                 }
+                self.cross.apply_add(m, x_l, out_l);
             }
             ContactCoupling::Penalty { stiffness } => {
-                for (i, &dof) in lin.contact_dofs.iter().enumerate() {
-                    let s = lin.contact_signs[i];
-                    for j in 0..size {
-                        out[j * n + dof] += stiffness * s * self.work_c[j * m + i];
-                    }
-                }
+                lin.scatter_rows(&self.work_c, stiffness, out);
             }
         }
     }
@@ -745,6 +827,7 @@ impl StructuredHbSolver {
         condensed_matrix(
             &self.receptance,
             &self.q,
+            &self.cross,
             self.coupling,
             m,
             self.schur.as_mut(),
@@ -868,12 +951,14 @@ fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> 
     }
 }
 
-/// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R`
-/// (SSN-HB) or `I + k_p R Q` (penalty), using that `R` only couples the two basis
-/// functions of one harmonic (cost `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` of each contact.
+/// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R + X`
+/// (SSN-HB; `X` the friction points' blocks on their contacts' forces) or `I + k_p R Q`
+/// (penalty), using that `R` only couples the two basis functions of one harmonic (cost
+/// `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` of each contact.
 pub(crate) fn condensed_matrix(
     receptance: &[Mat<c64>],
     q: &[Mat<f64>],
+    cross: &CrossBlocks,
     coupling: ContactCoupling,
     m: usize,
     mut out: MatMut<'_, f64>,
@@ -924,4 +1009,5 @@ pub(crate) fn condensed_matrix(
             out[(col, col)] += 1.0;
         }
     }
+    cross.add_to(m, out);
 }

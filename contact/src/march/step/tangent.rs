@@ -90,10 +90,10 @@ impl TimeMarcher<'_> {
     /// saltation.
     pub fn step_tangent(&mut self, active: &[usize]) -> Result<Mat<f64>, MarchError> {
         let model = self.model;
-        if let Some(c) = model.contacts.iter().find(|c| !self.massless[c.dof]) {
+        if let Some(dof) = super::massive_contact_dof(model, &self.massless) {
             return Err(MarchError::MassiveContactDof {
-                dof: c.dof,
-                mass: super::column_max_abs(&model.mass, c.dof),
+                dof,
+                mass: super::column_max_abs(&model.mass, dof),
             });
         }
         let n = self.u.len();
@@ -111,7 +111,8 @@ impl TimeMarcher<'_> {
                 }
             }
         }
-        let contact_dofs: Vec<usize> = active.iter().map(|&k| model.contacts[k].dof).collect();
+        let rows: Vec<&crate::model::ContactRow> =
+            active.iter().map(|&k| &model.contacts[k].row).collect();
         let mut tangent = Mat::<f64>::zeros(2 * n, 2 * n);
         let mut col = vec![0.0; n];
         let mut unit = vec![0.0; n];
@@ -152,7 +153,7 @@ impl TimeMarcher<'_> {
                 })?;
             self.counters.linear_solves += 1;
             if a > 0 {
-                let closed: Vec<f64> = contact_dofs.iter().map(|&d| col[d]).collect();
+                let closed: Vec<f64> = rows.iter().map(|row| row.dot(&col)).collect();
                 for r in 0..n {
                     let mut s = 0.0;
                     for (i, g) in closed.iter().enumerate() {
@@ -168,8 +169,8 @@ impl TimeMarcher<'_> {
                 tangent[(n + r, c)] = 2.0 / h * (col[r] - du) - dv;
             }
             if self.reset_closed_velocity {
-                for &d in &contact_dofs {
-                    tangent[(n + d, c)] = 0.0;
+                for row in &rows {
+                    super::remove_row_component(row, &mut tangent, |t, d| &mut t[(n + d, c)]);
                 }
             }
         }

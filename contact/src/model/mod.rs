@@ -23,58 +23,14 @@ use faer::sparse::{SparseColMat, SparseColMatRef};
 use num_traits::Zero;
 use semismooth::{Factorize, LinearSolve};
 
+mod contact;
+
+pub use contact::{
+    ContactDirection, ContactPoint, ContactRow, FrictionPoint, InvalidRow, NormalForce,
+};
+
 /// Sparse symmetric matrix storage used for `M`, `D` and `K` (column-compressed, faer).
 pub type SparseMatrix = SparseColMat<usize, f64>;
-
-/// One unilateral contact: the obstacle limits degree of freedom `dof` to
-/// `s u[dof] - gap <= 0`, `s = direction.sign()` (+1: obstacle on the positive side, -1: on
-/// the negative side). Row of `G` is `s` times the unit vector on `dof`; the force the
-/// obstacle applies to the dof is `s lambda` (`lambda <= 0`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactPoint {
-    /// Index of the constrained degree of freedom (0-based among the free unknowns).
-    pub dof: usize,
-    /// Initial gap `g` (negative: preloaded against the obstacle at rest).
-    pub gap: f64,
-    /// Side of the obstacle.
-    pub direction: ContactDirection,
-}
-
-impl ContactPoint {
-    /// A contact with the obstacle on the positive side (`u[dof] - gap <= 0`).
-    pub fn new(dof: usize, gap: f64) -> Self {
-        Self {
-            dof,
-            gap,
-            direction: ContactDirection::Positive,
-        }
-    }
-
-    /// The entry `s = +-1` of the contact's row of `G`.
-    pub fn sign(&self) -> f64 {
-        self.direction.sign()
-    }
-}
-
-/// Which side of a contact dof the obstacle is on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum ContactDirection {
-    /// Obstacle on the positive side: `u[dof] - gap <= 0`.
-    #[default]
-    Positive,
-    /// Obstacle on the negative side: `-u[dof] - gap <= 0`.
-    Negative,
-}
-
-impl ContactDirection {
-    /// `+1` or `-1`: the entry of the contact's row of `G`.
-    pub fn sign(self) -> f64 {
-        match self {
-            ContactDirection::Positive => 1.0,
-            ContactDirection::Negative => -1.0,
-        }
-    }
-}
 
 /// The whole semi-discrete model: only the effects it declares are present
 /// (`damping = None` means no damping matrix; empty `contacts` means a linear problem).
@@ -91,6 +47,9 @@ pub struct StructuralModel {
     pub load: Vec<f64>,
     /// Unilateral contacts (rows of `G` and gaps `g`).
     pub contacts: Vec<ContactPoint>,
+    /// Coulomb friction points (tangential rows of `G`, each under a contact's normal
+    /// force or a prescribed normal load); empty: frictionless.
+    pub friction: Vec<FrictionPoint>,
 }
 
 /// A structure ready for every method: the model, its first finite natural frequency
@@ -180,6 +139,56 @@ pub enum InvalidModel {
         /// The sum of the two gaps.
         clearance: f64,
     },
+    /// A friction point's tangential row is on a dof that does not exist.
+    #[error("friction point {point} is on dof {dof}: allowed 0..{dofs}")]
+    FrictionDofOutOfRange {
+        /// Index of the friction point.
+        point: usize,
+        /// The dof.
+        dof: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// A friction coefficient is negative or not finite.
+    #[error("friction point {point} has coefficient {value}: allowed a finite mu >= 0")]
+    FrictionCoefficient {
+        /// Index of the friction point.
+        point: usize,
+        /// The coefficient.
+        value: f64,
+    },
+    /// A prescribed normal load is not a finite positive number.
+    #[error("friction point {point} has normal load {value}: allowed a finite N > 0")]
+    NormalLoad {
+        /// Index of the friction point.
+        point: usize,
+        /// The load.
+        value: f64,
+    },
+    /// A friction point refers to a contact that does not exist.
+    #[error("friction point {point} is on contact {contact}: allowed 0..{contacts}")]
+    FrictionContactOutOfRange {
+        /// Index of the friction point.
+        point: usize,
+        /// The contact it names.
+        contact: usize,
+        /// Number of contacts.
+        contacts: usize,
+    },
+    /// Two friction points on one contact (a two-dimensional tangent plane needs the
+    /// disk-shaped Coulomb cone, not two independent intervals).
+    #[error(
+        "friction points {first} and {second} are both on contact {contact}: allowed one \
+         friction point per contact (one tangential direction)"
+    )]
+    DuplicateFriction {
+        /// The earlier point.
+        first: usize,
+        /// The later point.
+        second: usize,
+        /// The shared contact.
+        contact: usize,
+    },
     /// A matrix entry given in code lies outside the `N x N` matrix.
     #[error("matrix entry ({row}, {col}) is outside the {dofs} x {dofs} matrix")]
     EntryOutOfRange {
@@ -257,37 +266,7 @@ impl StructuralModel {
             });
         }
         first_non_finite("load", &self.load)?;
-        for (contact, c) in self.contacts.iter().enumerate() {
-            if c.dof >= n {
-                return Err(InvalidModel::ContactDofOutOfRange {
-                    contact,
-                    dof: c.dof,
-                    dofs: n,
-                });
-            }
-            first_non_finite("contact gap", &[c.gap])?;
-            for (first, o) in self.contacts[..contact].iter().enumerate() {
-                if o.dof != c.dof {
-                    continue;
-                }
-                if o.direction == c.direction {
-                    return Err(InvalidModel::DuplicateContactDof {
-                        first,
-                        second: contact,
-                        dof: c.dof,
-                    });
-                }
-                let clearance = o.gap + c.gap;
-                if clearance.is_nan() || clearance <= 0.0 {
-                    return Err(InvalidModel::NoClearance {
-                        first,
-                        second: contact,
-                        dof: c.dof,
-                        clearance,
-                    });
-                }
-            }
-        }
+        contact::validate_rows(&self.contacts, &self.friction, n)?;
         Ok(())
     }
 
@@ -301,29 +280,45 @@ impl StructuralModel {
         self.contacts.len()
     }
 
-    /// Stiffness scale seen by the contacts: the mean of `K[dof, dof]` over the contact
-    /// dofs (1 when there is no contact). It converts a length into a force and is the
-    /// default for the complementarity constant `c` and the unit of penalty stiffnesses.
+    /// Number of friction points.
+    pub fn friction_count(&self) -> usize {
+        self.friction.len()
+    }
+
+    /// Every row of `G`: the contacts' normal rows, then the friction points' tangential
+    /// rows (the order of the force unknowns of harmonic balance).
+    pub fn rows(&self) -> impl Iterator<Item = &ContactRow> + '_ {
+        self.contacts
+            .iter()
+            .map(|c| &c.row)
+            .chain(self.friction.iter().map(|f| &f.tangent))
+    }
+
+    /// Stiffness scale seen by the contacts: the mean of `g K g^T` over the rows of `G`
+    /// (`K[dof, dof]` for a one-dof contact; 1 when there is no row). It converts a length
+    /// into a force and is the default for the complementarity constant `c` and the unit
+    /// of penalty stiffnesses.
     pub fn contact_stiffness_scale(&self) -> f64 {
-        if self.contacts.is_empty() {
+        let rows = self.contacts.len() + self.friction.len();
+        if rows == 0 {
             return 1.0;
         }
         let sum: f64 = self
-            .contacts
-            .iter()
-            .map(|c| diagonal_entry(&self.stiffness, c.dof))
+            .rows()
+            .map(|row| row.quadratic_form(&self.stiffness))
             .sum();
-        sum / self.contacts.len() as f64
+        sum / rows as f64
     }
 }
 
 impl StructuralModel {
-    /// Static compliance matrix of the contacts, `C = G K^{-1} G^T` (row-major `m x m`):
-    /// `C_ij` is how far contact `i` moves, along its own normal, under a unit force
-    /// applied at contact `j` along `j`'s normal. `None` without contacts or when `K`
-    /// cannot be factored.
+    /// Static compliance matrix of the rows of `G` ([`StructuralModel::rows`]: contacts,
+    /// then friction points), `C = G K^{-1} G^T` (row-major `m x m`): `C_ij` is how far
+    /// row `i` moves under a unit force applied along row `j`. `None` without rows or when
+    /// `K` cannot be factored.
     pub fn static_contact_compliance(&self) -> Option<Vec<f64>> {
-        let m = self.contacts.len();
+        let rows: Vec<&ContactRow> = self.rows().collect();
+        let m = rows.len();
         if m == 0 {
             return None;
         }
@@ -331,12 +326,12 @@ impl StructuralModel {
         lu.factor(&self.stiffness).ok()?;
         let mut rhs = vec![0.0; self.dofs()];
         let mut compliance = vec![0.0; m * m];
-        for (j, cj) in self.contacts.iter().enumerate() {
+        for (j, gj) in rows.iter().enumerate() {
             rhs.fill(0.0);
-            rhs[cj.dof] = cj.sign();
+            gj.add_transpose_at(1.0, &mut rhs, 0);
             lu.solve_in_place(&mut rhs).ok()?;
-            for (i, ci) in self.contacts.iter().enumerate() {
-                compliance[i * m + j] = ci.sign() * rhs[ci.dof];
+            for (i, gi) in rows.iter().enumerate() {
+                compliance[i * m + j] = gi.dot(&rhs);
             }
         }
         compliance
@@ -350,7 +345,7 @@ impl StructuralModel {
     /// rest of the structure free. Independent of the mesh (for the rod: `EA / x_node`);
     /// `None` without contacts or when `K` cannot be factored.
     pub fn static_contact_stiffness(&self) -> Option<f64> {
-        let m = self.contacts.len();
+        let m = self.contacts.len() + self.friction.len();
         mean_stiffness(diagonal(&self.static_contact_compliance()?, m))
     }
 
@@ -362,7 +357,7 @@ impl StructuralModel {
     /// do not feel each other and for the two sides of a clearance, and `m` for `m` contacts
     /// that move as one; `None` when the static contact stiffness is.
     pub fn shared_contact_stiffness(&self) -> Option<f64> {
-        let m = self.contacts.len();
+        let m = self.contacts.len() + self.friction.len();
         let mut compliance = self.static_contact_compliance()?;
         let stiffness = mean_stiffness(diagonal(&compliance, m))?;
         let largest = diagonal(&compliance, m).fold(0.0, f64::max);
@@ -398,48 +393,25 @@ impl StructuralModel {
     }
 }
 
-impl StructuralModel {
-    /// How much the undamped linear response at `omega` exceeds the static one:
-    /// `max |(K - omega^2 M)^{-1} f| / max |K^{-1} f|`, infinite when `K - omega^2 M` is
-    /// singular (forced at a natural frequency: an undamped structure without contact then
-    /// has no periodic solution); `None` when `K` cannot be factored or the load is zero.
-    /// Ignores damping and contacts.
-    pub fn undamped_amplification(&self, omega: f64) -> Option<f64> {
-        use semismooth::linalg::FaerSparseLu;
-        let n = self.dofs();
-        let response = |matrix: &SparseMatrix| -> Option<f64> {
-            let mut lu = FaerSparseLu::new();
-            if lu.factor(matrix).is_err() {
-                return Some(f64::INFINITY);
-            }
-            let mut u = self.load.clone();
-            lu.solve_in_place(&mut u).ok()?;
-            Some(u.iter().fold(0.0f64, |m, v| m.max(v.abs())))
-        };
-        let static_response = response(&self.stiffness)?;
-        if !(static_response > 0.0 && static_response.is_finite()) {
-            return None;
-        }
-        let dynamic = crate::dynamic::UnionPattern::linear_combination(
-            n,
-            &[&self.stiffness, &self.mass],
-            &[1.0, -omega * omega],
-        );
-        let amplification = response(&dynamic)? / static_response;
-        Some(if amplification.is_nan() {
-            f64::INFINITY
-        } else {
-            amplification
-        })
-    }
-}
-
 /// Ratio of the default complementarity constant `c` to the static contact stiffness.
 pub(crate) const DEFAULT_C_FACTOR: f64 = 10.0;
 
 /// Entry `(i, i)` of a column-compressed matrix (0 when not stored).
 pub fn diagonal_entry(matrix: &SparseMatrix, i: usize) -> f64 {
     semismooth::linalg::diagonal_entry(matrix.as_ref(), i).unwrap_or(0.0)
+}
+
+/// Entry `(i, j)` of a column-compressed matrix (0 when not stored).
+fn diagonal_or_entry(matrix: &SparseMatrix, i: usize, j: usize) -> f64 {
+    if i == j {
+        return diagonal_entry(matrix, i);
+    }
+    let m = matrix.as_ref();
+    m.row_idx_of_col(j)
+        .zip(m.val_of_col(j))
+        .filter(|(r, _)| *r == i)
+        .map(|(_, v)| *v)
+        .sum()
 }
 
 /// `Err(NonFinite)` with the first NaN or infinite entry of `values`.
@@ -550,6 +522,7 @@ mod tests {
             stiffness: matrix(2.0, -1.0),
             load: vec![0.0, 0.0, 1.0],
             contacts: vec![ContactPoint::new(2, 0.1)],
+            friction: Vec::new(),
         }
     }
 
@@ -664,7 +637,7 @@ mod tests {
         }
         let shared = model.shared_contact_stiffness().unwrap();
         assert!((shared - 1.0).abs() < 1e-12, "{shared}");
-        model.contacts[1].direction = ContactDirection::Negative;
+        model.contacts[1] = ContactPoint::on_side(2, 0.1, ContactDirection::Negative);
         let static_stiffness = model.static_contact_stiffness().unwrap();
         assert!((static_stiffness - 4.0 / 3.0).abs() < 1e-14);
         assert_eq!(model.shared_contact_stiffness(), Some(static_stiffness));

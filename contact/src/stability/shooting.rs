@@ -1,6 +1,6 @@
-//! Stability of a periodic harmonic-balance solution: Floquet multipliers of the discrete
-//! monodromy of the modified-mass time-stepping map, linearised along the reconstructed
-//! orbit.
+//! The discrete monodromy of the modified-mass time-stepping map along the map's own
+//! periodic orbit next to a harmonic-balance solution: the confirmation of a multiplier
+//! close to the unit circle ([`super`]), for contacts on massless dofs.
 //!
 //! # Mathematics
 //!
@@ -57,109 +57,20 @@
 //! distance between successive periods with the largest multiplier.
 
 use semismooth::faer::Mat;
-use semismooth::floquet::{FloquetError, Multipliers};
+use semismooth::floquet::Multipliers;
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::Termination;
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
-use crate::march::{
-    resolve_scheme, MarchError, MarchOptions, MarchScheme, MarchState, TimeMarcher,
-};
+use super::{hb_state, StabilityError, StabilityOptions, Undecided, MAX_DOFS};
+use crate::march::{resolve_scheme, MarchOptions, MarchScheme, MarchState, TimeMarcher};
 use crate::model::StructuralModel;
-use crate::settings::Method;
 
-/// Largest number of dofs for which the dense monodromy is formed.
-pub const MAX_DOFS: usize = 400;
-
-/// Default steps per period of the time-stepping map.
-pub const DEFAULT_STEPS_PER_PERIOD: usize = 2000;
-
-/// Options of [`hb_stability`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StabilityOptions {
-    /// Steps per period of the trapezoidal map (`8..=1_000_000`), default
-    /// [`DEFAULT_STEPS_PER_PERIOD`].
-    pub steps_per_period: usize,
-}
-
-impl Default for StabilityOptions {
-    fn default() -> Self {
-        Self {
-            steps_per_period: DEFAULT_STEPS_PER_PERIOD,
-        }
-    }
-}
-
-/// Why the stability could not be computed (bad input or a failed step); a solution whose
-/// stability is not decided by this method is an `Ok` with `stable: None`.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum StabilityError {
-    /// An option or argument is outside its allowed range.
-    #[error("invalid {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// Which option.
-        name: &'static str,
-        /// The value given.
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
-    /// The coefficient vector has the wrong length.
-    #[error("harmonic coefficients: expected length {expected}, found {found}")]
-    Dimension {
-        /// `N (2H + 1)`.
-        expected: usize,
-        /// Length given.
-        found: usize,
-    },
-    /// A step of the time-stepping map failed.
-    #[error(transparent)]
-    March(#[from] MarchError),
-    /// The eigenvalues could not be computed.
-    #[error(transparent)]
-    Floquet(#[from] FloquetError),
-    /// The harmonic-balance problem of a branch could not be rebuilt.
-    #[error(transparent)]
-    Hb(#[from] crate::hb::HbError),
-}
-
-/// Why a periodic solution's stability is not decided.
+/// The stability of one periodic solution from the discrete monodromy of the time-stepping
+/// map along the map's own periodic orbit.
 #[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub enum Undecided {
-    /// A contact dof carries mass: the flow has impacts and its monodromy needs the impact
-    /// law's saltation matrices, which are not implemented (a massless contact dof, e.g.
-    /// the modified mass, is decided).
-    MassCarryingContact,
-    /// The dense monodromy is formed only up to `limit` dofs (it is `2N x 2N`).
-    TooManyDofs {
-        /// The model's dofs.
-        dofs: usize,
-        /// [`MAX_DOFS`].
-        limit: usize,
-    },
-    /// No periodic orbit of the time-stepping map was found near the harmonic-balance
-    /// solution: Newton on the period map stopped.
-    OrbitNotFound {
-        /// Its termination.
-        termination: semismooth::newton::Termination,
-        /// Its iterations.
-        iterations: usize,
-        /// Its last `|F|`.
-        residual_norm: f64,
-    },
-    /// Newton on the period map could not run.
-    ShootingNotRun(semismooth::newton::NewtonError),
-    /// Stability is computed for harmonic-balance solutions only.
-    NotHarmonicBalance(Method),
-    /// The analysis failed.
-    Failed(StabilityError),
-}
-
-/// The stability of one periodic solution.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Stability {
+pub struct MapStability {
     /// `Some(true)`: every multiplier inside the unit circle; `Some(false)`: one outside;
     /// `None`: not decided (see `undecided`).
     pub stable: Option<bool>,
@@ -185,7 +96,7 @@ pub struct Stability {
     pub orbit: Option<MarchState>,
 }
 
-impl Stability {
+impl MapStability {
     /// Not decided, for `reason`.
     pub fn not_decided(reason: Undecided, steps_per_period: usize) -> Self {
         Self {
@@ -207,46 +118,6 @@ impl Stability {
     }
 }
 
-/// The state `(u(t), v(t))` of a harmonic-balance solution: `u` holds the displacement
-/// coefficients harmonic-major (`u[j N + dof]`, `j = 0`: mean, `2k - 1`: `cos(k w t)`,
-/// `2k`: `sin(k w t)`). The contact forces are left at zero (the trapezoidal scheme does
-/// not use them on massless rows).
-pub fn hb_state(
-    model: &StructuralModel,
-    harmonics: usize,
-    omega: f64,
-    u: &[f64],
-    t: f64,
-) -> Result<MarchState, StabilityError> {
-    let n = model.dofs();
-    let expected = n * (2 * harmonics + 1);
-    if u.len() != expected {
-        return Err(StabilityError::Dimension {
-            expected,
-            found: u.len(),
-        });
-    }
-    let mut displacement = u[..n].to_vec();
-    let mut velocity = vec![0.0; n];
-    for k in 1..=harmonics {
-        let kw = k as f64 * omega;
-        let (s, c) = (kw * t).sin_cos();
-        let (a, b) = (
-            &u[(2 * k - 1) * n..2 * k * n],
-            &u[2 * k * n..(2 * k + 1) * n],
-        );
-        for i in 0..n {
-            displacement[i] += a[i] * c + b[i] * s;
-            velocity[i] += kw * (b[i] * c - a[i] * s);
-        }
-    }
-    Ok(MarchState {
-        displacement,
-        velocity,
-        contact_force: vec![0.0; model.contact_count()],
-    })
-}
-
 /// `a^k` by repeated squaring (`k >= 1`).
 fn power(a: &Mat<f64>, mut k: usize) -> Mat<f64> {
     let mut base = a.clone();
@@ -266,15 +137,16 @@ fn power(a: &Mat<f64>, mut k: usize) -> Mat<f64> {
     result.unwrap_or_else(|| Mat::identity(a.nrows(), a.ncols()))
 }
 
-/// Floquet multipliers of the harmonic-balance solution with displacement coefficients `u`
-/// (`H = harmonics`) at angular frequency `omega` (module documentation).
-pub fn hb_stability(
+/// Floquet multipliers of the time-stepping map's periodic orbit next to the
+/// harmonic-balance solution with displacement coefficients `u` (`H = harmonics`) at
+/// angular frequency `omega` (module documentation).
+pub fn map_stability(
     model: &StructuralModel,
     harmonics: usize,
     omega: f64,
     u: &[f64],
     options: &StabilityOptions,
-) -> Result<Stability, StabilityError> {
+) -> Result<MapStability, StabilityError> {
     let spp = options.steps_per_period;
     if !(8..=1_000_000).contains(&spp) {
         return Err(StabilityError::InvalidOption {
@@ -297,11 +169,21 @@ pub fn hb_stability(
             found: u.len(),
         });
     }
+    if !model.friction.is_empty() {
+        let points = model.friction.len();
+        return Ok(MapStability::not_decided(
+            Undecided::Friction { points },
+            spp,
+        ));
+    }
     if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
-        return Ok(Stability::not_decided(Undecided::MassCarryingContact, spp));
+        return Ok(MapStability::not_decided(
+            Undecided::MassCarryingContact,
+            spp,
+        ));
     }
     if n > MAX_DOFS {
-        return Ok(Stability::not_decided(
+        return Ok(MapStability::not_decided(
             Undecided::TooManyDofs {
                 dofs: n,
                 limit: MAX_DOFS,
@@ -323,7 +205,7 @@ pub fn hb_stability(
         // open contacts, whatever the orbit; its monodromy needs no shooting.
         let runs = vec![(Vec::new(), spp)];
         let multipliers = reduced_multipliers(&monodromy(&mut marcher, &runs)?, &keep)?;
-        return Ok(Stability {
+        return Ok(MapStability {
             stable: Some(multipliers.is_stable()),
             floquet_max_abs: Some(multipliers.max_abs()),
             multipliers,
@@ -359,7 +241,12 @@ pub fn hb_stability(
     let report =
         match polyalgorithm::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
             Ok(report) => report,
-            Err(err) => return Ok(Stability::not_decided(Undecided::ShootingNotRun(err), spp)),
+            Err(err) => {
+                return Ok(MapStability::not_decided(
+                    Undecided::ShootingNotRun(err),
+                    spp,
+                ))
+            }
         };
     if !report.converged() {
         // A march that failed inside the solve ended it and comes back in its termination.
@@ -368,7 +255,7 @@ pub fn hb_stability(
                 return Err(err.clone());
             }
         }
-        return Ok(Stability::not_decided(
+        return Ok(MapStability::not_decided(
             Undecided::OrbitNotFound {
                 termination: report.termination.clone(),
                 iterations: report.iterations,
@@ -408,7 +295,7 @@ pub fn hb_stability(
         .filter(|(set, _)| !set.is_empty())
         .map(|(_, c)| c)
         .sum();
-    Ok(Stability {
+    Ok(MapStability {
         stable: Some(multipliers.is_stable()),
         floquet_max_abs: Some(multipliers.max_abs()),
         multipliers,
@@ -439,9 +326,12 @@ fn orbit_stays_open(model: &StructuralModel, harmonics: usize, u: &[f64]) -> boo
     let n = model.dofs();
     model.contacts.iter().all(|c| {
         let amplitude: f64 = (1..=harmonics)
-            .map(|k| u[(2 * k - 1) * n + c.dof].hypot(u[2 * k * n + c.dof]))
+            .map(|k| {
+                let (a, b) = (c.row.dot_at(u, (2 * k - 1) * n), c.row.dot_at(u, 2 * k * n));
+                a.hypot(b)
+            })
             .sum();
-        let highest = c.direction.sign() * u[c.dof] + amplitude;
+        let highest = c.row.dot(u) + amplitude;
         highest <= c.gap - OPEN_MARGIN * (c.gap.abs() + amplitude)
     })
 }
@@ -618,7 +508,7 @@ mod tests {
         let omega = 1.3 * rod.omega_1;
         let harmonics = 2;
         let u = vec![0.0; rod.model.dofs() * (2 * harmonics + 1)];
-        let s = hb_stability(
+        let s = map_stability(
             &rod.model,
             harmonics,
             omega,
@@ -646,7 +536,8 @@ mod tests {
     fn massive_contact_node_is_undecided_with_a_reason() {
         let rod = build_rod(&RodSpec::canonical()).unwrap();
         let u = vec![0.0; rod.model.dofs() * 3];
-        let s = hb_stability(&rod.model, 1, rod.omega_1, &u, &StabilityOptions::default()).unwrap();
+        let s =
+            map_stability(&rod.model, 1, rod.omega_1, &u, &StabilityOptions::default()).unwrap();
         assert_eq!(s.stable, None);
         assert_eq!(s.undecided, Some(Undecided::MassCarryingContact));
     }
@@ -656,7 +547,7 @@ mod tests {
         let rod = build_rod(&RodSpec::canonical()).unwrap();
         let u = vec![0.0; 5];
         assert!(matches!(
-            hb_stability(&rod.model, 1, rod.omega_1, &u, &StabilityOptions::default()),
+            map_stability(&rod.model, 1, rod.omega_1, &u, &StabilityOptions::default()),
             Err(StabilityError::Dimension { .. })
         ));
         let u = vec![0.0; rod.model.dofs() * 3];
@@ -664,14 +555,14 @@ mod tests {
             steps_per_period: 2,
         };
         assert!(matches!(
-            hb_stability(&rod.model, 1, rod.omega_1, &u, &bad),
+            map_stability(&rod.model, 1, rod.omega_1, &u, &bad),
             Err(StabilityError::InvalidOption {
                 name: "steps_per_period",
                 ..
             })
         ));
         assert!(matches!(
-            hb_stability(&rod.model, 1, f64::NAN, &u, &StabilityOptions::default()),
+            map_stability(&rod.model, 1, f64::NAN, &u, &StabilityOptions::default()),
             Err(StabilityError::InvalidOption { name: "omega", .. })
         ));
     }

@@ -1,0 +1,240 @@
+//! The Moreau–Jean step with Coulomb friction: the impact law on the closed contacts and
+//! Coulomb's law on every friction point, at velocity level, as one semismooth equation
+//! solved by the core's Newton.
+//!
+//! With `Y = M_hat^{-1} G^T` over every row of `G` (contacts, then friction points),
+//! `W = G Y` and the impulses `r = (-z, p)` (`z >= 0` the contacts' compressive impulses,
+//! `p` the friction impulses), the rows' velocities after the step are
+//! `s = G v_free + W r`. The unknowns `x = (z, p)` solve
+//!
+//! - closed contact `k`: `z_k - max(0, z_k - c w_k) = 0`, `w_k = -(s_k + e g_k . v_n)`
+//!   (Newton's impact law: `w >= 0`, `z >= 0`, `w z = 0`); open contact: `z_k = 0`;
+//! - friction point `f` on row `i`: `p_f - proj_[-b, b](p_f - c s_i) = 0` with the slip
+//!   limit `b = mu h N` under a prescribed load `N`, or `b = mu max(0, z_p)` on contact
+//!   `p` (Alart–Curnier's projection: stick `s_i = 0` with `|p_f| <= b`, or slip with
+//!   `p_f = -b sign(s_i)`),
+//!
+//! with `c = 1 / mean diag(W)` (an impulse per velocity, so both terms have one scale).
+//! Its generalized Jacobian is that of the max and the clamp; the step is solved from the
+//! previous step's impulses, so a stick or slip phase that goes on costs one iteration.
+
+use faer::Mat;
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::NewtonOptions;
+use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
+
+use crate::model::{NormalForce, StructuralModel};
+
+/// Newton iterations allowed for one step's problem.
+const STEP_MAX_ITERATIONS: usize = 100;
+/// Tolerance on the step residual relative to the impulse scale.
+const STEP_RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// One step's contact and friction problem (module documentation).
+#[derive(Debug)]
+pub(super) struct CoulombStep {
+    /// `W = G M_hat^{-1} G^T` over every row (contacts, then friction points).
+    w: Mat<f64>,
+    contacts: usize,
+    /// `(mu, normal)` of each friction point.
+    friction: Vec<(f64, NormalForce)>,
+    h: f64,
+    c: f64,
+    /// `G v_free` of every row.
+    free: Vec<f64>,
+    /// `e g_k . v_n` of every contact.
+    restitution: Vec<f64>,
+    /// Contacts predicted closed.
+    closed: Vec<bool>,
+    /// Row velocities `s` at the last evaluated `x`.
+    velocity: Vec<f64>,
+    /// The impulses `x = (z, p)` of the last step (the next step's initial guess).
+    pub(super) x: Vec<f64>,
+    lu: FaerDenseLu,
+}
+
+/// Why a step's contact and friction problem was not solved: the Newton residual reached.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct UnsolvedStep {
+    /// `|F|_2` at the end.
+    pub residual: f64,
+    /// The tolerance asked.
+    pub tolerance: f64,
+}
+
+impl CoulombStep {
+    /// The problem for `model` with `W` over its rows and step `h`.
+    pub(super) fn new(model: &StructuralModel, w: Mat<f64>, h: f64) -> Self {
+        let m = w.nrows();
+        let mean_diagonal = (0..m).map(|i| w[(i, i)]).sum::<f64>() / m.max(1) as f64;
+        Self {
+            w,
+            contacts: model.contact_count(),
+            friction: model
+                .friction
+                .iter()
+                .map(|f| (f.coefficient, f.normal))
+                .collect(),
+            h,
+            c: 1.0 / mean_diagonal,
+            free: vec![0.0; m],
+            restitution: vec![0.0; model.contact_count()],
+            closed: vec![false; model.contact_count()],
+            velocity: vec![0.0; m],
+            x: vec![0.0; m],
+            lu: FaerDenseLu::new(),
+        }
+    }
+
+    /// Row velocities `s = free + W r(x)`.
+    fn row_velocities(&mut self, x: &[f64]) {
+        let m = self.free.len();
+        self.velocity.copy_from_slice(&self.free);
+        for (j, xj) in x.iter().enumerate() {
+            let r = if j < self.contacts { -xj } else { *xj };
+            if r != 0.0 {
+                for i in 0..m {
+                    self.velocity[i] += self.w[(i, j)] * r;
+                }
+            }
+        }
+    }
+
+    /// The slip limit `b` of friction point `f` at `x`, and `db / dz_p` with its contact.
+    fn slip_limit(&self, f: usize, x: &[f64]) -> (f64, Option<(usize, f64)>) {
+        let (mu, normal) = self.friction[f];
+        match normal {
+            NormalForce::Prescribed(load) => (mu * self.h * load, None),
+            NormalForce::Contact(p) => {
+                let slope = if x[p] > 0.0 { mu } else { 0.0 };
+                (mu * x[p].max(0.0), Some((p, slope)))
+            }
+        }
+    }
+
+    /// Solves the step from the free velocities `free` (`G v_free`), the restitution terms
+    /// and the closed contacts; the impulses are in [`CoulombStep::x`].
+    pub(super) fn solve(
+        &mut self,
+        free: &[f64],
+        restitution: &[f64],
+        closed: &[bool],
+    ) -> Result<(), UnsolvedStep> {
+        self.free.copy_from_slice(free);
+        self.restitution.copy_from_slice(restitution);
+        self.closed.copy_from_slice(closed);
+        // The impulse scale: the slip limits and what stops the free motion in one step.
+        let stopping = free
+            .iter()
+            .enumerate()
+            .map(|(i, s)| s.abs() / self.w[(i, i)])
+            .fold(0.0, f64::max);
+        let limits = (0..self.friction.len())
+            .map(|f| self.slip_limit(f, &self.x).0)
+            .fold(0.0, f64::max);
+        let tolerance = STEP_RELATIVE_TOLERANCE * stopping.max(limits).max(f64::MIN_POSITIVE);
+        let mut x = std::mem::take(&mut self.x);
+        for (k, xk) in x.iter_mut().enumerate().take(self.contacts) {
+            if !closed[k] {
+                *xk = 0.0;
+            }
+        }
+        let options = NewtonOptions {
+            absolute_tolerance: tolerance,
+            max_iterations: STEP_MAX_ITERATIONS,
+            ..NewtonOptions::default()
+        };
+        let mut lu = std::mem::take(&mut self.lu);
+        let report = semismooth::newton::solve(self, &mut lu, &mut x, &options);
+        self.lu = lu;
+        self.x = x;
+        match report {
+            Ok(report) if report.converged() => Ok(()),
+            Ok(report) => Err(UnsolvedStep {
+                residual: report.residual_norms.last().copied().unwrap_or(f64::NAN),
+                tolerance,
+            }),
+            Err(_) => Err(UnsolvedStep {
+                residual: f64::NAN,
+                tolerance,
+            }),
+        }
+    }
+
+    /// The row impulses `r = (-z, p)` of the solution.
+    pub(super) fn impulses(&self) -> impl Iterator<Item = f64> + '_ {
+        let contacts = self.contacts;
+        self.x
+            .iter()
+            .enumerate()
+            .map(move |(j, x)| if j < contacts { -x } else { *x })
+    }
+}
+
+impl Residual for CoulombStep {
+    fn dim(&self) -> usize {
+        self.free.len()
+    }
+
+    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
+        self.row_velocities(x);
+        for k in 0..self.contacts {
+            out[k] = if self.closed[k] {
+                let w = -(self.velocity[k] + self.restitution[k]);
+                x[k] - (x[k] - self.c * w).max(0.0)
+            } else {
+                x[k]
+            };
+        }
+        for f in 0..self.friction.len() {
+            let i = self.contacts + f;
+            let (b, _) = self.slip_limit(f, x);
+            out[i] = x[i] - (x[i] - self.c * self.velocity[i]).clamp(-b, b);
+        }
+        Ok(())
+    }
+}
+
+impl GeneralizedJacobian for CoulombStep {
+    type Jacobian = Mat<f64>;
+
+    fn new_jacobian(&self) -> Mat<f64> {
+        Mat::zeros(self.dim(), self.dim())
+    }
+
+    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
+        self.row_velocities(x);
+        let m = self.dim();
+        let sign = |j: usize| if j < self.contacts { -1.0 } else { 1.0 };
+        jac.fill(0.0);
+        for k in 0..self.contacts {
+            let w = -(self.velocity[k] + self.restitution[k]);
+            if self.closed[k] && x[k] - self.c * w > 0.0 {
+                // F = c w: dF/dx_j = -c W_kj sign_j.
+                for j in 0..m {
+                    jac[(k, j)] = -self.c * self.w[(k, j)] * sign(j);
+                }
+            } else {
+                jac[(k, k)] = 1.0;
+            }
+        }
+        for f in 0..self.friction.len() {
+            let i = self.contacts + f;
+            let (b, normal) = self.slip_limit(f, x);
+            let y = x[i] - self.c * self.velocity[i];
+            if y.abs() < b {
+                // Stick: F = c s.
+                for j in 0..m {
+                    jac[(i, j)] = self.c * self.w[(i, j)] * sign(j);
+                }
+            } else {
+                // Slip: F = p -+ b.
+                jac[(i, i)] = 1.0;
+                if let Some((p, slope)) = normal {
+                    jac[(i, p)] -= y.signum() * slope;
+                }
+            }
+        }
+        Ok(())
+    }
+}

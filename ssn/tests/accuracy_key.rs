@@ -1,0 +1,97 @@
+//! `[solver] accuracy` and `error_estimate` as users see them in `ssn solve --json`: a
+//! target met with the discretisation the method chose (checked against the method
+//! comparison's time-marching reference), every solve's estimate with what it is based on,
+//! and a target out of range refused as bad input naming the key.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+const SSN: &str = env!("CARGO_BIN_EXE_ssn");
+
+/// The tip minimum of the canonical modified-mass rod by time marching at 4000 steps per
+/// period, converged to 4e-8 (docs/method-comparison.md).
+const REFERENCE_TIP_MIN: f64 = -0.523151;
+
+/// The shipped modified-mass scene with `solver` lines added, written into a fresh file.
+fn scene(tag: &str, solver: &str) -> PathBuf {
+    let base =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/paper_fig1_modified_mass.toml");
+    let text = std::fs::read_to_string(base).unwrap();
+    let text = text.replace("method = \"ssn-hb\"\nharmonics = 20\n", solver);
+    let dir = std::env::temp_dir().join(format!("ssn-accuracy-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn solve_json(path: &Path) -> (Output, Value) {
+    let out = Command::new(SSN)
+        .args(["solve", path.to_str().unwrap(), "--json", "--quiet"])
+        .output()
+        .unwrap();
+    let json = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
+    (out, json)
+}
+
+#[test]
+fn a_scene_with_an_accuracy_meets_it_with_the_discretisation_it_reports() {
+    let path = scene("met", "method = \"lcp-ssn\"\naccuracy = 1e-3\n");
+    let (out, json) = solve_json(&path);
+    assert_eq!(out.status.code(), Some(0), "{json}");
+    let accuracy = &json["accuracy"];
+    assert_eq!(accuracy["met"], true, "{accuracy}");
+    let chosen = accuracy["chosen"]["time_samples"].as_u64().unwrap();
+    assert_eq!(json["time_samples"].as_u64(), Some(chosen));
+    assert!(
+        accuracy["steps"].as_array().unwrap().len() >= 2,
+        "{accuracy}"
+    );
+    let estimate = json["error_estimate"]["relative"].as_f64().unwrap();
+    assert!(estimate <= 1e-3, "{estimate}");
+    // Independent: the tip minimum against the reference (its own error 4e-8).
+    let tip_min = json["tip_min"].as_f64().unwrap();
+    let error = (tip_min - REFERENCE_TIP_MIN).abs() / REFERENCE_TIP_MIN.abs();
+    assert!(error <= 1e-3, "tip min {tip_min}, error {error:.2e}");
+}
+
+#[test]
+fn every_solve_reports_its_error_estimate_and_what_it_is_based_on() {
+    let path = scene("every", "method = \"ssn-hb\"\nharmonics = 20\n");
+    let (out, json) = solve_json(&path);
+    assert_eq!(out.status.code(), Some(0), "{json}");
+    let e = &json["error_estimate"];
+    let relative = e["relative"].as_f64().unwrap();
+    // SSN-HB at H = 20 on this rod: the Galerkin contact's penetration, 3.0e-3 of the
+    // excursion in the tip maximum (docs/accuracy-cost.md), is the largest true error.
+    assert!((1e-3..=3e-2).contains(&relative), "{e}");
+    assert!(e["based_on"].as_str().unwrap().contains("H=40"), "{e}");
+    assert_eq!(json["error_estimate_note"], Value::Null);
+    assert_eq!(json["accuracy"], Value::Null);
+}
+
+#[test]
+fn an_accuracy_out_of_range_is_bad_input_naming_the_key() {
+    let path = scene("bad", "method = \"ssn-hb\"\naccuracy = 0.5\n");
+    let (out, _) = solve_json(&path);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(message.contains("solver.accuracy"), "{message}");
+}
+
+#[test]
+fn an_accuracy_with_a_discretisation_given_too_is_bad_input_naming_both() {
+    let path = scene(
+        "both",
+        "method = \"ssn-hb\"\nharmonics = 20\naccuracy = 1e-3\n",
+    );
+    let (out, _) = solve_json(&path);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        message.contains("solver.harmonics") && message.contains("solver.accuracy"),
+        "{message}"
+    );
+}
