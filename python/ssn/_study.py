@@ -17,6 +17,12 @@ def run_case(scene, index, values, run="solve"):
     return json.loads(_ssn.run_case(scene, index, dict(values), run))
 
 
+def run_cases(scene, numbered, run="solve"):
+    """``run_case`` of each ``(index, values)`` of ``numbered``, in order: one task of a study
+    sent in batches (``study(..., batch=n)``)."""
+    return [run_case(scene, index, values, run) for index, values in numbered]
+
+
 class StudyRecords(list):
     """The records of a study, one per case in case order, with its table."""
 
@@ -50,17 +56,21 @@ class StudyRecords(list):
             f.write(_ssn.study_csv(self.run, self.keys, self._json()))
 
 
-def study(scene, cases, executor=None, run="solve"):
+def study(scene, cases, executor=None, run="solve", batch=1):
     """Runs ``scene`` with each case's values (a list of ``{key: value}`` dicts, the keys of
     ``Scene.with_values``) as ``run`` (``"solve"``, ``"sweep"``, ``"solutions"``).
 
     ``executor``: any ``concurrent.futures.Executor`` (a process pool, Dask's
     ``Client.get_executor()``, dask-jobqueue, mpi4py's ``MPIPoolExecutor``); ``None`` runs
-    the cases here, one after the other. Every case is checked before any runs (a bad one
+    the cases here, one after the other. ``batch``: cases per task sent to the executor
+    (more than 1 spreads an executor's cost per task, which matters for cases of a few
+    milliseconds; see docs/studies.md). Every case is checked before any runs (a bad one
     raises ``SceneError`` naming it). Returns the records in case order
     (``StudyRecords``: a list with ``table()``).
     """
     cases = [dict(c) for c in cases]
+    if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
+        raise _ssn.SceneError(f"invalid batch {batch!r}: allowed an integer >= 1")
     if run not in ("solve", "sweep", "solutions"):
         raise _ssn.SceneError(f'invalid run {run!r}: allowed "solve", "sweep" or "solutions"')
     for index, values in enumerate(cases):
@@ -80,8 +90,12 @@ def study(scene, cases, executor=None, run="solve"):
         finally:
             _ssn.limit_threads(previous)
     else:
-        futures = [executor.submit(run_case, scene, i, v, run) for i, v in enumerate(cases)]
-        records = [f.result() for f in futures]
+        numbered = list(enumerate(cases))
+        futures = [
+            executor.submit(run_cases, scene, numbered[start : start + batch], run)
+            for start in range(0, len(numbered), batch)
+        ]
+        records = [record for f in futures for record in f.result()]
     return StudyRecords(records, run, keys)
 
 

@@ -66,8 +66,13 @@ def test_a_process_pool_gives_the_serial_records():
     serial = ssn.study(scene, few, run="sweep")
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
         pooled = ssn.study(scene, few, executor=pool, run="sweep")
+        batched = ssn.study(scene, few, executor=pool, run="sweep", batch=3)
     strip = lambda r: {**r, "result": {**r["result"], "solve_seconds": 0, "stability_seconds": 0}}
     assert [strip(r) for r in pooled] == [strip(r) for r in serial]
+    # Two tasks, of three cases and of one: the records in case order all the same.
+    assert [strip(r) for r in batched] == [strip(r) for r in serial]
+    with pytest.raises(ssn.SceneError, match="batch"):
+        ssn.study(scene, few, executor=pool, batch=0)
 
 
 def test_the_study_table_of_python_equals_the_command_lines(ssn_bin, tmp_path):

@@ -99,9 +99,16 @@ pub fn prepare(
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
         Some(spec) => {
-            let structure = match matrices {
-                Some(read) => build_imported_with(spec, read),
-                None => build_imported(spec),
+            let structure = match (matrices, &scene.bladed_disk) {
+                (Some(read), _) => build_imported_with(spec, read),
+                (None, Some(mistuning)) => {
+                    let disk = crate::scene::bladed_disk_matrices(mistuning);
+                    build_imported_with(spec, |path: &Path| {
+                        let found = disk.iter().find(|(name, _)| name == path);
+                        Ok(found.expect("the disk's spec names its matrices").1.clone())
+                    })
+                }
+                (None, None) => build_imported(spec),
             }
             .map_err(|e| CliError::BadInput(e.to_string()))?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
@@ -224,7 +231,7 @@ fn check_resonance(scene: &Scene, structure: &Structure, omega: f64) -> Result<(
 /// Claims the files a `[model]` scene names (its matrices and load vector) as inputs of
 /// `set`: no output may replace them.
 pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<(), CliError> {
-    if let Some(spec) = &scene.model {
+    if let (Some(spec), None) = (&scene.model, &scene.bladed_disk) {
         let mut files = vec![
             (&spec.mass, "[model] mass"),
             (&spec.stiffness, "[model] stiffness"),

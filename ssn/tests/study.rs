@@ -3,6 +3,9 @@
 //! gives the bytes of the tables of the whole run; a study killed while it runs and started
 //! again redoes no finished case and ends with the table of an uninterrupted run; bad
 //! studies, cases and directories are refused with exit code 2 and a message naming them.
+//! The `[bladed_disk]` scene of the shipped mistuning study gives the run of the shipped
+//! Matrix Market disk with the same blades, and its study table holds, row by row, what
+//! `ssn solve --set` answers for that row's gap and mistuning pattern.
 
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
@@ -435,4 +438,187 @@ fn the_throughput_page_holds_the_table_of_its_example() {
         assert!(ms > 0.0 && rate > 0.0, "{row}");
     }
     assert!(block.contains("Speed-up of 2 threads over 1"), "{block}");
+}
+
+// The bladed disk of the shipped mistuning study.
+
+fn json(o: &Output) -> Value {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).expect("a JSON document")
+}
+
+/// A TOML list of numbers in shortest round-trip form (read back exactly).
+fn toml_list(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
+    format!("[{}]", items.join(", "))
+}
+
+/// The largest `max |u|` over the contacts of a solve's document (the table's
+/// `contact_amplitude_max`).
+fn contact_amplitude_max(doc: &Value) -> f64 {
+    let contacts = doc["contacts"].as_array().expect("the contacts");
+    contacts
+        .iter()
+        .map(|c| {
+            let lo = c["displacement_min"].as_f64().expect("a minimum");
+            let hi = c["displacement_max"].as_f64().expect("a maximum");
+            lo.abs().max(hi.abs())
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// `|a - b| <= tol max(|a|, |b|, 1)`, refusing NaN.
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs()).max(1.0)
+}
+
+#[test]
+fn the_disk_built_from_its_mistuning_is_the_shipped_matrix_market_disk() {
+    // The shipped files hold the blades 1 + 0.02 sin(2.3 j) (`--example bladed_disk`).
+    let mistuning: Vec<f64> = (0..100)
+        .map(|j| semismooth_contact::structures::SHIPPED_MISTUNING * (2.3 * j as f64).sin())
+        .collect();
+    let set = format!("bladed_disk.mistuning={}", toml_list(&mistuning));
+    let built = json(&ssn(&[
+        "solve",
+        path(&scene("bladed_disk_mistuned.toml")),
+        "--set",
+        &set,
+        "--json",
+    ]));
+    let files = json(&ssn(&[
+        "solve",
+        path(&scene("bladed_disk_casing.toml")),
+        "--json",
+    ]));
+    assert_eq!(built["converged"], Value::Bool(true), "{built}");
+    // The files print every stiffness to 17 digits, so both structures are the same to
+    // round-off; the solves then agree far inside the solver's 1e-10 tolerance scaled by
+    // the conditioning of 100 near-resonant blades (1e-7 relative).
+    for key in ["tip_max", "tip_min", "contact_force_mean", "omega"] {
+        let (a, b) = (built[key].as_f64(), files[key].as_f64());
+        let (a, b) = (a.expect(key), b.expect(key));
+        assert!(close(a, b, 1e-7), "{key}: built {a}, files {b}");
+    }
+    let (a, b) = (contact_amplitude_max(&built), contact_amplitude_max(&files));
+    assert!(
+        close(a, b, 1e-7),
+        "largest pad amplitude: built {a}, files {b}"
+    );
+}
+
+#[test]
+fn a_mistuning_study_table_holds_the_solve_of_each_case() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let small = dir.path().join("disk.toml");
+    let text = std::fs::read_to_string(scene("bladed_disk_mistuned.toml"))
+        .expect("shipped scene")
+        .replace("blades = 100", "blades = 6");
+    std::fs::write(&small, text).expect("write scene");
+    let study = dir.path().join("study.toml");
+    let study_text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/bladed_disk_mistuning.toml"),
+    )
+    .expect("shipped study")
+    .replace("samples = 100", "samples = 3")
+    .replace("size = 100", "size = 6")
+    .replace("[0.5, 1.0, 1.5, 1e3]", "[0.5, 1e3]");
+    std::fs::write(&study, study_text).expect("write study");
+    let out = dir.path().join("out");
+    let run = ssn(&[
+        "study",
+        path(&small),
+        path(&study),
+        "--out",
+        path(&out),
+        "--quiet",
+    ]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let csv = std::fs::read_to_string(out.join("results.csv")).expect("the table");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let at = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6, "two gaps times three patterns");
+    let mut amplitudes = Vec::new();
+    for row in &rows {
+        let gap: f64 = row[at("contact.gap")].parse().expect("a gap");
+        let pattern: Vec<f64> = (0..6)
+            .map(|j| {
+                row[at(&format!("bladed_disk.mistuning[{j}]"))]
+                    .parse()
+                    .expect("a blade's mistuning")
+            })
+            .collect();
+        assert!(pattern.iter().all(|d| d.abs() < 0.2), "{pattern:?}");
+        let alone = json(&ssn(&[
+            "solve",
+            path(&small),
+            "--set",
+            &format!("contact.gap={gap:?}"),
+            "--set",
+            &format!("bladed_disk.mistuning={}", toml_list(&pattern)),
+            "--json",
+        ]));
+        // The same problem solved twice (the study's case single-threaded, the program's
+        // with its default threads): equal to round-off of a 1e-10 solve.
+        for key in ["contact_amplitude_max", "tip_max", "tip_min"] {
+            let table: f64 = row[at(key)].parse().expect("a number");
+            let solve = match key {
+                "contact_amplitude_max" => contact_amplitude_max(&alone),
+                _ => alone[key].as_f64().expect(key),
+            };
+            assert!(
+                close(table, solve, 1e-9),
+                "{key}: table {table}, solve {solve}"
+            );
+        }
+        assert_eq!(row[at("converged")], "true");
+        amplitudes.push((
+            gap,
+            row[at("contact_amplitude_max")].parse::<f64>().unwrap(),
+        ));
+    }
+    // The casing bounds what the linear disk (gap 1e3) exceeds: for every pattern the
+    // largest amplitude with the casing at 0.5 is the smaller.
+    for s in 0..3 {
+        let (near, far) = (amplitudes[s], amplitudes[3 + s]);
+        assert!(near.0 < far.0 && near.1 < far.1, "{near:?} {far:?}");
+    }
+}
+
+#[test]
+fn a_bad_mistuning_is_refused_naming_the_key() {
+    let disk = scene("bladed_disk_mistuned.toml");
+    for (set, key) in [
+        ("bladed_disk.mistuning=[0.1, 0.2]", "bladed_disk.mistuning"),
+        ("bladed_disk.blades=0", "bladed_disk.blades"),
+    ] {
+        let out = ssn(&["solve", path(&disk), "--set", set]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(key), "{set}: {err}");
+    }
+    let mut pattern = vec![0.0; 100];
+    pattern[7] = -1.0;
+    let set = format!("bladed_disk.mistuning={}", toml_list(&pattern));
+    let out = ssn(&["solve", path(&disk), "--set", &set]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("bladed_disk.mistuning[7]"), "{err}");
 }

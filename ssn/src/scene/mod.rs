@@ -31,7 +31,10 @@ use semismooth_contact::rod::{
 
 mod check;
 mod contacts;
+mod disk;
 mod overrides;
+
+pub use disk::{bladed_disk_matrices, MAX_BLADES};
 
 pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
 
@@ -85,6 +88,9 @@ pub struct Scene {
     pub rod: RodSpec,
     /// The imported structure of a `[model]` scene (`None` for a `[rod]` scene).
     pub model: Option<ModelSpec>,
+    /// The blade stiffness deviations of a `[bladed_disk]` scene, one per blade (`None`
+    /// otherwise); its `model` names the disk's matrices ([`bladed_disk_matrices`]).
+    pub bladed_disk: Option<Vec<f64>>,
     /// `[output] dof`, 0-based: the dof that `tip_*` outputs and plots describe (default: the
     /// rod's tip; for a `[model]` scene the first contact dof).
     pub output_dof: Option<usize>,
@@ -100,6 +106,7 @@ struct RawScene {
     title: Option<String>,
     rod: Option<RawRod>,
     model: Option<RawModel>,
+    bladed_disk: Option<disk::RawBladedDisk>,
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
