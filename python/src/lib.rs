@@ -424,12 +424,13 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
             let solution =
                 semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
                     .map_err(|e| bad(e.to_string()))?;
-            let dofs = loaded.structure.model.dofs() * (2 * settings.harmonics + 1);
+            // The whole unknown vector of the method (displacements, and the contact
+            // multipliers of SSN-HB): the contact phases are read from it.
             let stability = semismooth_contact::stability::hb_stability(
                 &loaded.structure.model,
                 settings,
                 loaded.omega,
-                &solution.state[..dofs.min(solution.state.len())],
+                &solution.state,
             )
             .map_err(|e| bad(e.to_string()))?;
             Ok((solution, stability))

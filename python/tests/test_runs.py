@@ -97,7 +97,7 @@ def test_a_model_from_matrices_equals_the_exported_scene(cli, ssn_bin, tmp_path,
     n = k.shape[0]
     # The exported scene: the tip (1-based dof n) against a stop at 0.5, H = 20.
     exported = (out / "scene.toml").read_text()
-    assert f"dof = {n}\ngap = 0.5" in exported and "harmonics = 20" in exported
+    assert f"dof = {n}\ndirection = 1\ngap = 0.5" in exported and "harmonics = 20" in exported
     values = {"solver.harmonics": 20, "output.dof": n}
     scene = ssn.Scene.from_matrices(m, k, f, contacts=[(n - 1, 0.5)], damping=d, values=values)
     python = ssn.solve(scene).to_dict()
