@@ -45,6 +45,9 @@ fn comparable(o: &Output) -> Value {
     for key in ["solve_seconds", "stability_seconds", "scene"] {
         map.remove(key);
     }
+    if let Some(estimate) = map.get_mut("error_estimate").and_then(Value::as_object_mut) {
+        estimate.remove("seconds");
+    }
     doc
 }
 
