@@ -87,9 +87,23 @@ impl BladedDisk {
         3 * j + 1
     }
 
-    /// Stiffness, mass and load shape.
+    /// The deterministic mistuning `delta_j = mistuning sin(2.3 j)`, one per blade.
+    pub fn deterministic_mistuning(&self) -> Vec<f64> {
+        (0..self.blades)
+            .map(|j| self.mistuning * (2.3 * j as f64).sin())
+            .collect()
+    }
+
+    /// Stiffness, mass and load shape with the deterministic mistuning.
     pub fn matrices(&self) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
-        let (blades, n) = (self.blades, self.dofs());
+        Self::mistuned_matrices(&self.deterministic_mistuning())
+    }
+
+    /// Stiffness, mass and load shape of the disk of `mistuning.len()` blades whose blade
+    /// `j` has the stiffness `k_b (1 + mistuning[j])` (the caller keeps each above -1).
+    pub fn mistuned_matrices(mistuning: &[f64]) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
+        let blades = mistuning.len();
+        let n = 3 * blades;
         let (k_g, k_d, k_b, k_c) = (1.0, 1.0, 1.0, 10.0);
         let mut k = Vec::new();
         let mut spring = |i: usize, j: Option<usize>, s: f64| {
@@ -100,13 +114,12 @@ impl BladedDisk {
                 k.push(Triplet::new(j, i, -s));
             }
         };
-        for j in 0..blades {
+        for (j, delta) in mistuning.iter().enumerate() {
             let (d, b, p) = (3 * j, Self::tip(j), Self::pad(j));
             spring(d, None, k_g);
             if blades > 1 {
                 spring(d, Some(3 * ((j + 1) % blades)), k_d);
             }
-            let delta = self.mistuning * (2.3 * j as f64).sin();
             spring(d, Some(b), k_b * (1.0 + delta));
             spring(b, Some(p), k_c);
         }

@@ -9,8 +9,8 @@ use std::path::PathBuf;
 
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 use semismooth_contact::settings::SolverSettings;
+use ssn::accuracy_cost::accuracy_cost;
 use ssn::output::prepare_directory;
-use ssn::study::accuracy_cost;
 
 fn main() -> std::process::ExitCode {
     match run() {

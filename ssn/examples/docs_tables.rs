@@ -23,8 +23,8 @@ use std::path::PathBuf;
 
 use semismooth_contact::from_zero::{hard_cases, public_grid};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+use ssn::accuracy_cost::accuracy_cost;
 use ssn::scene::{GlobalizationChoice, SolverSettings};
-use ssn::study::accuracy_cost;
 use ssn::tables::{self, SECTIONS};
 
 /// The markdown of one section: the command that reproduces it, the machine of its wall

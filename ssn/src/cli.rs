@@ -19,10 +19,10 @@ use crate::output::{
     csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
 };
 use crate::progress::progress_spinner;
-use crate::scene::{Method, Scene};
+use crate::scene::{Method, Override, Scene};
 pub use crate::work::Workload;
-use semismooth_contact::matrix_market::build_imported;
-use semismooth_contact::model::Structure;
+use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
+use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::Solution;
 use semismooth_contact::sweep::fold_accuracy::{refine_folds, MAX_FOLD_HARMONICS};
@@ -56,8 +56,36 @@ pub fn load(path: &Path) -> Result<Loaded, CliError> {
 /// [`load`], with the memory and work estimates of the command's `workload` (a branch
 /// for `sweep` and `solutions`, several runs for `compare`).
 pub fn load_for(path: &Path, workload: Workload) -> Result<Loaded, CliError> {
+    load_with(path, &[], workload)
+}
+
+/// [`load_for`] with `overrides` (`--set key=value`) applied to the scene before it is
+/// validated ([`Scene::from_toml_with`]).
+pub fn load_with(
+    path: &Path,
+    overrides: &[Override],
+    workload: Workload,
+) -> Result<Loaded, CliError> {
+    let scene =
+        Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
+    prepare(scene, workload, None)
+}
+
+/// The matrices of a `[model]` scene held in memory: each path the scene names to its
+/// matrix (the checks of [`build_imported`] apply as to files).
+pub type MatrixSource<'a> = &'a dyn Fn(&Path) -> Result<SparseMatrix, ImportError>;
+
+/// Builds a validated scene's structure as [`load`] does (the memory and work limits of
+/// `workload` checked first), reading the `[model]`'s matrices from `matrices` when given,
+/// else from their files.
+pub fn prepare(
+    scene: Scene,
+    workload: Workload,
+    matrices: Option<MatrixSource>,
+) -> Result<Loaded, CliError> {
+    let path = scene.path.clone();
+    let path = path.as_path();
     let compare = workload == Workload::Compare;
-    let scene = Scene::from_path(path).map_err(|e| CliError::BadInput(e.to_string()))?;
     let limit = crate::limits::memory_limit().map_err(CliError::BadInput)?;
     let work_limit = crate::limits::work_limit().map_err(CliError::BadInput)?;
     // A rod is estimated before it is built; an imported model once its size is read.
@@ -72,7 +100,18 @@ pub fn load_for(path: &Path, workload: Workload) -> Result<Loaded, CliError> {
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
         Some(spec) => {
-            let structure = build_imported(spec).map_err(|e| CliError::BadInput(e.to_string()))?;
+            let structure = match (matrices, &scene.bladed_disk) {
+                (Some(read), _) => build_imported_with(spec, read),
+                (None, Some(mistuning)) => {
+                    let disk = crate::scene::bladed_disk_matrices(mistuning);
+                    build_imported_with(spec, |path: &Path| {
+                        let found = disk.iter().find(|(name, _)| name == path);
+                        Ok(found.expect("the disk's spec names its matrices").1.clone())
+                    })
+                }
+                (None, None) => build_imported(spec),
+            }
+            .map_err(|e| CliError::BadInput(e.to_string()))?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
@@ -193,7 +232,7 @@ fn check_resonance(scene: &Scene, structure: &Structure, omega: f64) -> Result<(
 /// Claims the files a `[model]` scene names (its matrices and load vector) as inputs of
 /// `set`: no output may replace them.
 pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<(), CliError> {
-    if let Some(spec) = &scene.model {
+    if let (Some(spec), None) = (&scene.model, &scene.bladed_disk) {
         let mut files = vec![
             (&spec.mass, "[model] mass"),
             (&spec.stiffness, "[model] stiffness"),
@@ -225,6 +264,16 @@ pub struct RunArgs {
     /// Write a plot of the tip displacement over one period as SVG (`-`: standard output).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Replace a scene key before the scene is checked, e.g. `--set
+    /// forcing.omega_ratio=1.1 --set solver.harmonics=40` (repeatable; the keys, defaults
+    /// and errors of the scene file; `contact.point.0.gap` indexes a list).
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_override)]
+    pub set: Vec<Override>,
+}
+
+/// `--set KEY=VALUE` as an [`Override`].
+fn parse_override(text: &str) -> Result<Override, String> {
+    Override::parse(text).map_err(|e| e.to_string())
 }
 
 /// What `ssn sweep` reads and writes: [`RunArgs`], and whether the points get their
@@ -404,7 +453,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         scene,
         structure: rod,
         omega,
-    } = load(&args.scene)?;
+    } = load_with(&args.scene, &args.set, Workload::Solve)?;
     claim_model_files(&mut outputs, &scene)?;
     let shape = StateShape {
         method: scene.solver.method,
@@ -652,7 +701,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         scene,
         structure: rod,
         ..
-    } = load_for(&args.scene, Workload::Branch)?;
+    } = load_with(&args.scene, &args.set, Workload::Branch)?;
     claim_model_files(&mut outputs, &scene)?;
     let Some(mut settings) = scene.sweep.clone() else {
         return Err(input_error(
@@ -704,17 +753,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
     bar.finish_and_clear();
     let ratio = response.omega_ratio();
     let st = &response.stability;
-    // stable: 1 / 0, NaN when undecided (an empty cell in the CSV).
-    let stable: Vec<f64> = st
-        .stable
-        .iter()
-        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
-        .collect();
-    let floquet: Vec<f64> = st
-        .floquet_max_abs
-        .iter()
-        .map(|a| a.unwrap_or(f64::NAN))
-        .collect();
+    let (stable, floquet) = crate::output::stability_numbers(st);
     let force_mean = response.contact_force_mean();
     let contact_columns = response.contact_columns();
     let mut headers = vec![
@@ -846,7 +885,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
     let mut targets = OutputSet::new();
     targets.input(path, "the scene")?;
     claim_model_files(&mut targets, &scene)?;
-    for name in crate::study::STUDY_FILES {
+    for name in crate::accuracy_cost::STUDY_FILES {
         targets.target(&out.join(name), "ssn compare --out")?;
     }
     let bar = progress_spinner("compare");
@@ -854,7 +893,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
         bar.set_message(line.to_string());
         bar.tick();
     };
-    let study = crate::study::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
+    let study = crate::accuracy_cost::accuracy_cost(&rod, omega, &scene.solver, Some(&say))
         .map_err(|e| input_error(path, e))?;
     say("each method's own search for the accuracy");
     let chosen = (accuracy < 1.0)

@@ -3,6 +3,7 @@
 //! The application of `semismooth-contact`: scenes (TOML problem files), runs, studies,
 //! figures, tables, outputs and the `ssn` program.
 
+pub mod accuracy_cost;
 pub mod accuracy_targets;
 pub mod cli;
 pub mod describe;
@@ -16,6 +17,7 @@ pub mod output;
 pub mod progress;
 pub mod scene;
 pub mod solutions;
+pub mod source;
 pub mod state;
 pub mod study;
 pub mod tables;

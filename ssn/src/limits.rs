@@ -147,7 +147,7 @@ pub fn compare_memory(elements: usize, contacts: usize, base: &SolverSettings) -
         ..base.clone()
     };
     let runs = [
-        hb(Method::SsnHb, crate::study::REFERENCE_HARMONICS),
+        hb(Method::SsnHb, crate::accuracy_cost::REFERENCE_HARMONICS),
         hb(Method::PenaltyHb, 80),
         SolverSettings {
             method: Method::LcpSsn,
@@ -475,7 +475,7 @@ pub(crate) fn compared(settings: &SolverSettings, compare: bool) -> SolverSettin
     let mut settings = settings.clone();
     if compare {
         settings.method = Method::SsnHb;
-        settings.harmonics = crate::study::REFERENCE_HARMONICS;
+        settings.harmonics = crate::accuracy_cost::REFERENCE_HARMONICS;
     }
     settings
 }

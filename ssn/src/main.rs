@@ -122,6 +122,17 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Run a study: a scene and what varies (a grid of scene keys, a list of cases, seeded
+    /// random samples), each case a solve, sweep or solutions run, on every core; one row
+    /// per case in DIR/results.csv (and .parquet), each case's JSON in DIR/cases/.
+    #[command(
+        after_help = "Examples:\n  ssn study scenes/paper_fig2.toml GAPS.toml --out out/gaps\n  \
+        ssn study SCENE.toml STUDY.toml --out DIR --shard 3/8   (one task of a job array)\n  \
+        ssn study merge DIR                                       (when every shard is done)\n\n\
+        A run into a directory that holds records of the same study skips the cases done.\n\
+        Exit code 1 when some case did not converge (the table is written all the same).\n\n"
+    )]
+    Study(ssn::study::command::StudyArgs),
     /// Write a scene's structure as Matrix Market files (M, K, D, f) and a [model] scene
     /// that solves the same problem.
     #[command(
@@ -177,6 +188,7 @@ fn main() -> ExitCode {
         Some(Command::Solve(solve)) => cli::solve(solve),
         Some(Command::Sweep(sweep)) => cli::sweep(sweep),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
+        Some(Command::Study(study)) => ssn::study::command::command(study),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -229,6 +241,7 @@ impl Command {
             Command::ExportModel { .. } => "export-model",
             Command::Compare { .. } => "compare",
             Command::SceneCheck { .. } => "scene-check",
+            Command::Study(_) => "study",
         }
     }
 }

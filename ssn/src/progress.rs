@@ -28,3 +28,17 @@ pub fn progress_bar(len: u64, message: &str) -> indicatif::ProgressBar {
     bar.set_message(message.to_string());
     bar
 }
+
+/// A progress bar on stderr with the count done, the elapsed time and an estimate of the
+/// time left, when stderr is a terminal and the run is not quiet.
+pub fn progress_bar_with_estimate(len: u64, message: &str) -> indicatif::ProgressBar {
+    let bar = progress_bar(len, message);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:30}] {pos}/{len} cases, {elapsed} elapsed, about {eta} left",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar
+}

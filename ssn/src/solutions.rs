@@ -14,7 +14,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         scene,
         structure: rod,
         omega,
-    } = crate::cli::load_for(&args.scene, crate::cli::Workload::Branch)?;
+    } = crate::cli::load_with(&args.scene, &args.set, crate::cli::Workload::Branch)?;
     let mut outputs = args.plan()?;
     crate::cli::claim_model_files(&mut outputs, &scene)?;
     check_window(&scene, omega / rod.omega_1)?;
@@ -136,17 +136,17 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         t
     };
     let complete = incomplete(&set).is_none();
-    args.finish(
-        outputs,
-        || {
-            let mut v = crate::json::solutions_json(&set);
-            v["converged"] = complete.into();
-            v["incomplete"] = incomplete(&set).into();
-            v
-        },
-        text,
-        complete,
-    )
+    args.finish(outputs, || document(&set), text, complete)
+}
+
+/// The JSON document of `ssn solutions --json`: [`crate::json::solutions_json`] with
+/// `converged` (the search finished: [`incomplete`] is `None`, exit code 0) and
+/// `incomplete` (what it missed, in words, or null).
+pub fn document(set: &semismooth_contact::solutions::SolutionSet) -> serde_json::Value {
+    let mut v = crate::json::solutions_json(set);
+    v["converged"] = incomplete(set).is_none().into();
+    v["incomplete"] = incomplete(set).into();
+    v
 }
 
 /// What a search that did not finish missed, in words; `None` when it finished: its

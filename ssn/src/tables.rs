@@ -11,8 +11,8 @@
 
 use std::time::Instant;
 
+use crate::accuracy_cost::{AccuracyCost, Entry};
 use crate::scene::{GlobalizationChoice, Method, SolverSettings, SweepSettings};
-use crate::study::{AccuracyCost, Entry};
 use semismooth_contact::from_zero::GridCase;
 use semismooth_contact::rod::{build_rod, MassModel, ModelError, RodModel, RodSpec};
 use semismooth_contact::solve::{solve, RunError, Solution};

@@ -8,8 +8,8 @@
 
 use semismooth_contact::from_zero::{hard_cases, public_grid};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+use ssn::accuracy_cost::accuracy_cost;
 use ssn::scene::{GlobalizationChoice, SolverSettings};
-use ssn::study::accuracy_cost;
 use ssn::tables::{self, Table};
 
 /// The generated block of `section` in its docs file (the lines between its markers).

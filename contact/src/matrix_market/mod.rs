@@ -307,6 +307,16 @@ fn check_square(
 
 /// Reads and checks the files of `spec` and assembles the structure (module documentation).
 pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
+    build_imported_with(spec, read_matrix)
+}
+
+/// [`build_imported`] with the matrices of `spec`'s file names given by `read` (matrices
+/// held in memory: `read` maps each path of `spec` to its matrix); the checks are the same.
+pub fn build_imported_with(
+    spec: &ModelSpec,
+    read: impl Fn(&Path) -> Result<SparseMatrix, ImportError>,
+) -> Result<Structure, ImportError> {
+    let read_matrix = read;
     let stiffness = read_matrix(&spec.stiffness)?;
     let n = stiffness.nrows();
     if n == 0 || stiffness.ncols() != n {

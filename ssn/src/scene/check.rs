@@ -10,6 +10,11 @@ pub(super) struct Check<'a> {
 }
 
 impl Check<'_> {
+    /// The scene file.
+    pub(super) fn path(&self) -> &Path {
+        self.path
+    }
+
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
         SceneError::Invalid {
             path: self.path.to_path_buf(),
@@ -80,8 +85,28 @@ impl Check<'_> {
 /// the error.
 pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let ck = Check { path };
-    let (rod, model, output_dof) = match (&raw.rod, raw.model) {
-        (Some(raw_rod), None) => {
+    let mut bladed_disk = None;
+    let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
+        (None, None, Some(d)) => {
+            let (model, mistuning) = ck.bladed_disk(
+                d,
+                raw.damping,
+                &raw.forcing,
+                (raw.contact, raw.friction),
+                raw.output,
+            )?;
+            bladed_disk = Some(mistuning);
+            let output_dof = model.observed_dof;
+            (RodSpec::canonical(), Some(model), output_dof)
+        }
+        (_, _, Some(_)) => {
+            return Err(ck.invalid(
+                "bladed_disk",
+                "given together with [rod] or [model]",
+                "one of [rod], [model] or [bladed_disk]",
+            ))
+        }
+        (Some(raw_rod), None, None) => {
             let mut rod = ck.rod(raw_rod)?;
             if raw.forcing.vector.is_some() {
                 return Err(ck.invalid(
@@ -110,7 +135,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
                 .map(|dof| dof - 1);
             (rod, None, output_dof)
         }
-        (None, Some(m)) => {
+        (None, Some(m), None) => {
             let model = ck.model(
                 m,
                 raw.damping,
@@ -121,18 +146,19 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             let output_dof = model.observed_dof;
             (RodSpec::canonical(), Some(model), output_dof)
         }
-        (Some(_), Some(_)) => {
+        (Some(_), Some(_), None) => {
             return Err(ck.invalid(
                 "model",
                 "given together with [rod]",
                 "either [rod] (the built-in rod) or [model] (Matrix Market files)",
             ))
         }
-        (None, None) => {
+        (None, None, None) => {
             return Err(ck.invalid(
                 "rod",
                 "missing",
-                "a [rod] section (the built-in rod) or a [model] section (Matrix Market files)",
+                "a [rod] section (the built-in rod), a [model] section (Matrix Market files) \
+                 or a [bladed_disk] section",
             ))
         }
     };
@@ -151,6 +177,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         title: raw.title,
         rod,
         model,
+        bladed_disk,
         output_dof,
         solver,
         sweep,
@@ -236,7 +263,7 @@ impl Check<'_> {
 
     /// `[damping]`: stiffness-proportional (`zeta`) or Rayleigh (`alpha`, `beta`), chosen by
     /// `model` or by the keys present.
-    fn damping(&self, d: &RawDamping) -> Result<DampingSpec, SceneError> {
+    pub(super) fn damping(&self, d: &RawDamping) -> Result<DampingSpec, SceneError> {
         let model = match (d.model, d.zeta, d.alpha, d.beta) {
             (Some(m), _, _, _) => m,
             (None, Some(_), None, None) => RawDampingModel::StiffnessProportional,
@@ -301,7 +328,10 @@ impl Check<'_> {
     }
 
     /// `[forcing]`: the load, its amplitude and its frequency (`omega_1` by default).
-    fn forcing(&self, f: &RawForcing) -> Result<(LoadKind, f64, FrequencySpec), SceneError> {
+    pub(super) fn forcing(
+        &self,
+        f: &RawForcing,
+    ) -> Result<(LoadKind, f64, FrequencySpec), SceneError> {
         let amplitude = self.response_scale("forcing.amplitude", f.amplitude)?;
         let frequency = match (f.omega_ratio, f.omega) {
             (Some(r), None) => FrequencySpec::Ratio(self.positive("forcing.omega_ratio", r)?),

@@ -31,6 +31,12 @@ use semismooth_contact::rod::{
 
 mod check;
 mod contacts;
+mod disk;
+mod overrides;
+
+pub use disk::{bladed_disk_matrices, MAX_BLADES};
+
+pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
 
 pub use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,
@@ -82,6 +88,9 @@ pub struct Scene {
     pub rod: RodSpec,
     /// The imported structure of a `[model]` scene (`None` for a `[rod]` scene).
     pub model: Option<ModelSpec>,
+    /// The blade stiffness deviations of a `[bladed_disk]` scene, one per blade (`None`
+    /// otherwise); its `model` names the disk's matrices ([`bladed_disk_matrices`]).
+    pub bladed_disk: Option<Vec<f64>>,
     /// `[output] dof`, 0-based: the dof that `tip_*` outputs and plots describe (default: the
     /// rod's tip; for a `[model]` scene the first contact dof).
     pub output_dof: Option<usize>,
@@ -97,6 +106,7 @@ struct RawScene {
     title: Option<String>,
     rod: Option<RawRod>,
     model: Option<RawModel>,
+    bladed_disk: Option<disk::RawBladedDisk>,
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
@@ -300,16 +310,7 @@ impl Scene {
     /// Reads and validates a scene file (a regular file of at most
     /// [`crate::io::SCENE_SIZE_LIMIT`] bytes).
     pub fn from_path(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
-        let path = path.as_ref();
-        // Only a regular file of at most 1 MiB: a FIFO would block, a device never end.
-        let text =
-            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
-                SceneError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
-        Scene::from_toml(&text, path)
+        Scene::from_path_with(path, &[])
     }
 
     /// Parses and validates scene text; `path` is only used in messages.

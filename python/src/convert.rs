@@ -1,0 +1,72 @@
+//! Conversions between Python objects and the scene's TOML values and the JSON documents.
+
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+
+/// A Python value as a TOML value: bool, int, float, str, and lists or tuples (or numpy
+/// arrays, through `tolist()`) of them.
+pub fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if value.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(value.extract()?));
+    }
+    if value.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(value.extract()?));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(value.extract()?));
+    }
+    if value.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(value.extract()?));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items: Vec<Bound<'_, PyAny>> = value.try_iter()?.collect::<PyResult<_>>()?;
+        return items
+            .iter()
+            .map(toml_value)
+            .collect::<PyResult<Vec<_>>>()
+            .map(toml::Value::Array);
+    }
+    // numpy arrays and scalars.
+    if value.hasattr("tolist")? {
+        let plain = value.call_method0("tolist")?;
+        if !plain.is(value) {
+            return toml_value(&plain);
+        }
+    }
+    Err(PyTypeError::new_err(format!(
+        "a scene value must be a bool, int, float, str or a list of them, not {}",
+        value.get_type().name()?
+    )))
+}
+
+/// A TOML value as a Python object.
+pub fn python_value<'py>(py: Python<'py>, value: &toml::Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match value {
+        toml::Value::String(s) => s.into_pyobject(py)?.into_any(),
+        toml::Value::Integer(i) => i.into_pyobject(py)?.into_any(),
+        toml::Value::Float(f) => f.into_pyobject(py)?.into_any(),
+        toml::Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any(),
+        toml::Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any(),
+        toml::Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(python_value(py, item)?)?;
+            }
+            list.into_any()
+        }
+        toml::Value::Table(table) => {
+            let dict = PyDict::new(py);
+            for (k, v) in table {
+                dict.set_item(k, python_value(py, v)?)?;
+            }
+            dict.into_any()
+        }
+    })
+}
+
+/// A JSON document as Python objects (through `json.loads`, so that it is exactly what
+/// `json.loads` of the command line's output gives).
+pub fn python_json<'py>(py: Python<'py>, doc: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (doc.to_string(),))
+}

@@ -1,0 +1,53 @@
+"""Periodic vibrations of structures with unilateral contact, from Python.
+
+The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same scenes
+(keys, defaults and errors), the same runs and the same JSON documents.
+
+>>> import ssn
+>>> scene = ssn.Scene.from_file("scenes/paper_fig1.toml")          # doctest: +SKIP
+>>> solution = ssn.solve(scene.with_values({"contact.gap": 0.3}))   # doctest: +SKIP
+>>> solution.converged, solution.displacement.min()                 # doctest: +SKIP
+
+- ``Scene.from_file``, ``Scene.from_toml``, ``Scene.rod``, ``Scene.from_matrices``;
+  ``scene.with_values({...})`` (the keys of ``ssn solve --set``);
+- ``solve``, ``sweep``, ``solutions``, ``stability``: results with numpy arrays and
+  ``to_dict()`` equal to the JSON of ``ssn solve/sweep/solutions --json``; the GIL is
+  released while they run;
+- ``study(scene, cases, executor=None, run="solve")`` on any
+  ``concurrent.futures.Executor``; ``study_file`` reads the cases of an ``ssn study`` file;
+- ``SceneError`` (a ``ValueError``): a bad scene, value or case, with the command line's
+  message (file, key, value, what is allowed).
+"""
+
+from ._ssn import (
+    FrequencyResponse,
+    Scene,
+    SceneError,
+    Solution,
+    SolutionSet,
+    Stability,
+    limit_threads,
+    solutions,
+    solve,
+    stability,
+    sweep,
+)
+from ._study import StudyRecords, run_case, study, study_file
+
+__all__ = [
+    "FrequencyResponse",
+    "Scene",
+    "SceneError",
+    "Solution",
+    "SolutionSet",
+    "Stability",
+    "StudyRecords",
+    "limit_threads",
+    "run_case",
+    "solutions",
+    "solve",
+    "stability",
+    "study",
+    "study_file",
+    "sweep",
+]

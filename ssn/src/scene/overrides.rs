@@ -1,0 +1,181 @@
+//! Scene overrides: `--set key=value` on the command line, `Scene.with_values({...})` in
+//! Python and the varied values of a study. An override replaces one key of the parsed TOML
+//! document before the scene is validated, so every key, default and error is the scene's
+//! own: an unknown key, a wrong type or a value out of range is refused exactly as it would
+//! be in the file, with the override named in the message.
+//!
+//! Keys are dotted paths as in the README's scene table (`forcing.omega_ratio`,
+//! `solver.harmonics`); an array of tables is indexed by a number
+//! (`contact.point.0.gap`, 0-based). Values are TOML values (`1.1`, `40`, `"ssn-hb"`,
+//! `[0.01, -0.02]`); a bare word that is not one (`ssn-hb`) is read as a string.
+
+use std::fmt;
+use std::path::Path;
+
+use super::{RawScene, Scene, SceneError};
+
+/// One override: a dotted scene key and the TOML value it takes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Override {
+    /// The dotted key, as `section.key` (`contact.point.0.gap` into an array of tables).
+    pub key: String,
+    /// The value.
+    pub value: toml::Value,
+}
+
+impl fmt::Display for Override {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}={}", self.key, self.value)
+    }
+}
+
+/// Why an override could not be read (before the scene checks its value).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("invalid override `{text}`: {reason}")]
+pub struct OverrideError {
+    /// The override as given.
+    pub text: String,
+    /// What is wrong and what is allowed.
+    pub reason: String,
+}
+
+impl Override {
+    /// An override of `key` by `value`; the key must be a non-empty dotted path.
+    pub fn new(key: &str, value: toml::Value) -> Result<Override, OverrideError> {
+        let key = key.trim();
+        if key.is_empty() || key.split('.').any(|part| part.trim().is_empty()) {
+            return Err(OverrideError {
+                text: format!("{key}={value}"),
+                reason: "allowed a dotted scene key such as forcing.omega_ratio or \
+                         contact.point.0.gap"
+                    .into(),
+            });
+        }
+        Ok(Override {
+            key: key.to_string(),
+            value,
+        })
+    }
+
+    /// Reads `key=value` (the form of `--set`): the value as a TOML value, or as a string
+    /// when it is a bare word that TOML does not read.
+    pub fn parse(text: &str) -> Result<Override, OverrideError> {
+        let Some((key, value)) = text.split_once('=') else {
+            return Err(OverrideError {
+                text: text.to_string(),
+                reason: "allowed key=value, e.g. forcing.omega_ratio=1.1".into(),
+            });
+        };
+        Override::new(key, parse_value(value.trim()))
+    }
+}
+
+/// A TOML value from its text; text that is not one is a string.
+pub fn parse_value(text: &str) -> toml::Value {
+    toml::from_str::<toml::Table>(&format!("value = {text}"))
+        .ok()
+        .filter(|table| table.len() == 1)
+        .and_then(|mut table| table.remove("value"))
+        .unwrap_or_else(|| toml::Value::String(text.to_string()))
+}
+
+impl Scene {
+    /// [`Scene::from_toml`] with `overrides` applied to the document before it is
+    /// validated (module documentation). Without overrides this is `from_toml` itself.
+    pub fn from_toml_with(
+        text: &str,
+        path: impl AsRef<Path>,
+        overrides: &[Override],
+    ) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        if overrides.is_empty() {
+            return Scene::from_toml(text, path);
+        }
+        let mut document: toml::Table = toml::from_str(text).map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        for o in overrides {
+            apply(&mut document, o).map_err(|reason| SceneError::Parse {
+                path: path.to_path_buf(),
+                message: format!("--set {o}: {reason}"),
+            })?;
+        }
+        let named = overrides
+            .iter()
+            .map(|o| format!("--set {o}"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let raw: RawScene = document.try_into().map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            message: format!("with {named}: {}", e.to_string().trim_end()),
+        })?;
+        super::check::resolve(raw, path)
+    }
+
+    /// Reads a scene file and applies `overrides` ([`Scene::from_toml_with`]).
+    pub fn from_path_with(
+        path: impl AsRef<Path>,
+        overrides: &[Override],
+    ) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = read_scene_text(path)?;
+        Scene::from_toml_with(&text, path, overrides)
+    }
+}
+
+/// The text of a scene file (a regular file of at most [`crate::io::SCENE_SIZE_LIMIT`]
+/// bytes).
+pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
+        SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Sets `o.key` in `document`, creating the tables on its path; an index into an array of
+/// tables must exist. The scene's own checks then judge the key and the value.
+fn apply(document: &mut toml::Table, o: &Override) -> Result<(), String> {
+    let parts: Vec<&str> = o.key.split('.').map(str::trim).collect();
+    let (last, path) = parts.split_last().expect("a non-empty key");
+    let mut table = document;
+    let mut i = 0;
+    while i < path.len() {
+        let part = path[i];
+        let entry = table
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = match entry {
+            toml::Value::Table(t) => t,
+            toml::Value::Array(items) => {
+                let Some(index) = path.get(i + 1).and_then(|s| s.parse::<usize>().ok()) else {
+                    return Err(format!(
+                        "`{part}` is a list: allowed {part}.INDEX.KEY with INDEX in 0..{}",
+                        items.len()
+                    ));
+                };
+                let count = items.len();
+                i += 1;
+                match items.get_mut(index) {
+                    Some(toml::Value::Table(t)) => t,
+                    _ => {
+                        return Err(format!(
+                            "no entry {index} in `{part}`: allowed an index in 0..{count}"
+                        ))
+                    }
+                }
+            }
+            other => {
+                return Err(format!(
+                    "`{part}` is a {}, not a section: allowed keys inside sections",
+                    other.type_str()
+                ))
+            }
+        };
+        i += 1;
+    }
+    table.insert((*last).to_string(), o.value.clone());
+    Ok(())
+}

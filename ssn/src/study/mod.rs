@@ -1,0 +1,467 @@
+//! Studies: one scene and what varies, each case a solve, a sweep or a solutions run.
+//!
+//! A study file (TOML) names what varies by scene keys (the keys of `--set`):
+//!
+//! ```toml
+//! run = "solve"                      # or "sweep", "solutions"
+//! [grid]                             # every combination (keys in alphabetical order, the first slowest)
+//! "contact.gap" = [0.5, 1.0]
+//! [[case]]                           # a list of cases (each combined with every grid point)
+//! "forcing.amplitude" = 0.02
+//! [random]                           # seeded samples (each combined with every case above)
+//! samples = 200
+//! seed = 2026
+//! [random.keys."damping.zeta"]
+//! distribution = "normal"            # or "uniform" (low, high)
+//! mean = 0.01
+//! std = 0.002
+//! # size = 100                       # a list of 100 values per sample, for a key that takes a
+//! #                                  # list (absent: one number)
+//! ```
+//!
+//! Cases are numbered from 0: the grid point outermost, then the listed case, then the
+//! random sample. Sample `s` draws from the ChaCha12 stream `s` of the seed, so every grid
+//! point and listed case sees the same random values (common random numbers: a difference
+//! between two gaps is not blurred by different samples), and a case's values depend only
+//! on the study file and its number, never on the shard or thread that runs it.
+
+pub mod command;
+pub mod run;
+pub mod table;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use rand::SeedableRng;
+use rand_distr::Distribution;
+use serde::Deserialize;
+
+use crate::scene::Override;
+use crate::source::SceneSource;
+
+/// What each case of a study runs (`run = "..."`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunKind {
+    /// `ssn solve`: one periodic response at the scene's frequency.
+    #[default]
+    Solve,
+    /// `ssn sweep`: the frequency response over the scene's `[sweep]`.
+    Sweep,
+    /// `ssn solutions`: every periodic solution at the scene's frequency.
+    Solutions,
+}
+
+impl RunKind {
+    /// The study file's spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunKind::Solve => "solve",
+            RunKind::Sweep => "sweep",
+            RunKind::Solutions => "solutions",
+        }
+    }
+
+    /// The kind named `name` (`solve`, `sweep`, `solutions`).
+    pub fn from_name(name: &str) -> Option<RunKind> {
+        [RunKind::Solve, RunKind::Sweep, RunKind::Solutions]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+/// One case: its number and the scene keys it sets, in study order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Case {
+    /// Number of the case (from 0, study order).
+    pub index: usize,
+    /// The scene keys it sets and their values.
+    pub values: Vec<Override>,
+}
+
+impl Case {
+    /// The values as a JSON object (key to value).
+    pub fn values_json(&self) -> serde_json::Value {
+        serde_json::Value::Object(
+            self.values
+                .iter()
+                .map(|o| (o.key.clone(), toml_to_json(&o.value)))
+                .collect(),
+        )
+    }
+}
+
+/// A TOML value as JSON (datetimes as their text).
+pub fn toml_to_json(v: &toml::Value) -> serde_json::Value {
+    match v {
+        toml::Value::String(s) => s.clone().into(),
+        toml::Value::Integer(i) => (*i).into(),
+        toml::Value::Float(f) => crate::json::finite_or_null(*f),
+        toml::Value::Boolean(b) => (*b).into(),
+        toml::Value::Datetime(d) => d.to_string().into(),
+        toml::Value::Array(a) => a.iter().map(toml_to_json).collect(),
+        toml::Value::Table(t) => serde_json::Value::Object(
+            t.iter()
+                .map(|(k, v)| (k.clone(), toml_to_json(v)))
+                .collect(),
+        ),
+    }
+}
+
+/// A validated study: what each case runs and the cases.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Study {
+    /// The study file (`<built-in>` for studies built in code).
+    pub path: PathBuf,
+    /// What each case runs.
+    pub run: RunKind,
+    /// The cases in study order.
+    pub cases: Vec<Case>,
+    /// The varied keys in table order (grid, listed cases, random), each once.
+    pub keys: Vec<String>,
+}
+
+/// Why a study file could not be used: the file, the key, the value, what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// The file could not be read.
+    #[error("{path}: cannot read study: {source}")]
+    Io {
+        /// The study file.
+        path: PathBuf,
+        /// The system error.
+        source: std::io::Error,
+    },
+    /// Malformed TOML, an unknown key, a wrong type or a missing required key.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The study file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value of the right type outside its allowed range.
+    #[error("{path}: invalid `{key}` = {value}: allowed {allowed}")]
+    Invalid {
+        /// The study file.
+        path: PathBuf,
+        /// The offending key.
+        key: String,
+        /// The value found.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// A case makes the scene invalid (the scene's own message).
+    #[error("{path}: case {case} ({values}) makes the scene invalid: {message}")]
+    Case {
+        /// The study file.
+        path: PathBuf,
+        /// The case number.
+        case: usize,
+        /// Its values, as `key=value` words.
+        values: String,
+        /// The scene's message.
+        message: String,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStudy {
+    #[serde(default)]
+    run: RunKind,
+    grid: Option<toml::Table>,
+    case: Option<Vec<toml::Table>>,
+    random: Option<RawRandom>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRandom {
+    samples: i64,
+    seed: i64,
+    keys: BTreeMap<String, RawDistribution>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, tag = "distribution", rename_all = "lowercase")]
+enum RawDistribution {
+    Normal {
+        mean: Option<f64>,
+        std: f64,
+        size: Option<i64>,
+    },
+    Uniform {
+        low: f64,
+        high: f64,
+        size: Option<i64>,
+    },
+}
+
+/// Largest number of cases in one study.
+pub const MAX_CASES: usize = 10_000_000;
+/// Largest number of random values per key and sample.
+pub const MAX_SAMPLE_SIZE: usize = 100_000;
+
+/// A distribution checked: draws one number.
+enum Draw {
+    Normal(rand_distr::Normal<f64>),
+    Uniform(rand_distr::Uniform<f64>),
+}
+
+impl Study {
+    /// Reads and validates a study file; every case is checked against `scene` (its scene
+    /// is validated, nothing is solved), so a bad case is refused before any case runs.
+    pub fn from_path(path: &Path, scene: &SceneSource) -> Result<Study, StudyError> {
+        let text =
+            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
+                StudyError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
+        Study::from_toml(&text, path, scene)
+    }
+
+    /// Parses and validates study text (`path` only names it in messages).
+    pub fn from_toml(text: &str, path: &Path, scene: &SceneSource) -> Result<Study, StudyError> {
+        let raw: RawStudy = toml::from_str(text).map_err(|e| StudyError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        let invalid = |key: &str, value: String, allowed: &str| StudyError::Invalid {
+            path: path.to_path_buf(),
+            key: key.to_string(),
+            value,
+            allowed: allowed.to_string(),
+        };
+        let mut keys: Vec<String> = Vec::new();
+        let mut note_key = |k: &str| {
+            if !keys.iter().any(|x| x == k) {
+                keys.push(k.to_string());
+            }
+        };
+        // The grid: a list of values per key.
+        let mut grid: Vec<(String, Vec<toml::Value>)> = Vec::new();
+        for (key, values) in raw.grid.unwrap_or_default() {
+            let key_name = format!("grid.\"{key}\"");
+            let toml::Value::Array(values) = values else {
+                return Err(invalid(
+                    &key_name,
+                    values.to_string(),
+                    "a non-empty list of values, e.g. [0.5, 1.0]",
+                ));
+            };
+            if values.is_empty() {
+                return Err(invalid(
+                    &key_name,
+                    "[]".into(),
+                    "a non-empty list of values",
+                ));
+            }
+            note_key(&key);
+            grid.push((key, values));
+        }
+        let listed: Vec<Vec<(String, toml::Value)>> = match raw.case {
+            Some(cases) if cases.is_empty() => {
+                return Err(invalid(
+                    "case",
+                    "an empty list".into(),
+                    "[[case]] tables of scene keys",
+                ))
+            }
+            Some(cases) => cases
+                .into_iter()
+                .map(|t| {
+                    t.into_iter()
+                        .inspect(|(k, _)| note_key(k))
+                        .collect::<Vec<_>>()
+                })
+                .collect(),
+            None => vec![Vec::new()],
+        };
+        let random = match raw.random {
+            Some(r) => {
+                let samples = usize::try_from(r.samples)
+                    .ok()
+                    .filter(|s| (1..=MAX_CASES).contains(s))
+                    .ok_or_else(|| {
+                        invalid(
+                            "random.samples",
+                            r.samples.to_string(),
+                            &format!("an integer in 1..={MAX_CASES}"),
+                        )
+                    })?;
+                if r.keys.is_empty() {
+                    return Err(invalid(
+                        "random.keys",
+                        "an empty table".into(),
+                        "[random.keys.\"KEY\"] tables with a distribution",
+                    ));
+                }
+                let mut draws = Vec::new();
+                for (key, d) in r.keys {
+                    let name = |field: &str| format!("random.keys.\"{key}\".{field}");
+                    let (draw, size) = match d {
+                        RawDistribution::Normal { mean, std, size } => {
+                            let mean = mean.unwrap_or(0.0);
+                            if !mean.is_finite() {
+                                return Err(invalid(
+                                    &name("mean"),
+                                    mean.to_string(),
+                                    "a finite number",
+                                ));
+                            }
+                            let normal = rand_distr::Normal::new(mean, std)
+                                .ok()
+                                .filter(|_| std.is_finite() && std >= 0.0)
+                                .ok_or_else(|| {
+                                    invalid(&name("std"), std.to_string(), "a finite number >= 0")
+                                })?;
+                            (Draw::Normal(normal), size)
+                        }
+                        RawDistribution::Uniform { low, high, size } => {
+                            let uniform = rand_distr::Uniform::new(low, high)
+                                .ok()
+                                .filter(|_| low.is_finite() && high.is_finite())
+                                .ok_or_else(|| {
+                                    invalid(
+                                        &name("high"),
+                                        high.to_string(),
+                                        &format!("a finite number > low ({low})"),
+                                    )
+                                })?;
+                            (Draw::Uniform(uniform), size)
+                        }
+                    };
+                    let size = size
+                        .map(|s| {
+                            usize::try_from(s)
+                                .ok()
+                                .filter(|s| (1..=MAX_SAMPLE_SIZE).contains(s))
+                                .ok_or_else(|| {
+                                    invalid(
+                                        &name("size"),
+                                        s.to_string(),
+                                        &format!(
+                                            "an integer in 1..={MAX_SAMPLE_SIZE} (absent: one number)"
+                                        ),
+                                    )
+                                })
+                        })
+                        .transpose()?;
+                    note_key(&key);
+                    draws.push((key, draw, size));
+                }
+                Some((samples, r.seed as u64, draws))
+            }
+            None => None,
+        };
+        let grid_points: usize = grid.iter().map(|(_, v)| v.len()).product();
+        let samples = random.as_ref().map_or(1, |r| r.0);
+        let total = grid_points
+            .checked_mul(listed.len())
+            .and_then(|n| n.checked_mul(samples))
+            .filter(|&n| n <= MAX_CASES)
+            .ok_or_else(|| {
+                invalid(
+                    "grid",
+                    format!(
+                        "{grid_points} grid points x {} cases x {samples} samples",
+                        listed.len()
+                    ),
+                    &format!("at most {MAX_CASES} cases in all"),
+                )
+            })?;
+        // The random values of each sample, drawn once.
+        let sampled: Vec<Vec<(String, toml::Value)>> = match &random {
+            Some((samples, seed, draws)) => (0..*samples)
+                .map(|s| {
+                    let mut rng = rand_chacha::ChaCha12Rng::seed_from_u64(*seed);
+                    rng.set_stream(s as u64);
+                    draws
+                        .iter()
+                        .map(|(key, draw, size)| {
+                            let mut one = || match draw {
+                                Draw::Normal(d) => d.sample(&mut rng),
+                                Draw::Uniform(d) => d.sample(&mut rng),
+                            };
+                            let value = match size {
+                                Some(n) => toml::Value::Array(
+                                    (0..*n).map(|_| toml::Value::Float(one())).collect(),
+                                ),
+                                None => toml::Value::Float(one()),
+                            };
+                            (key.clone(), value)
+                        })
+                        .collect()
+                })
+                .collect(),
+            None => vec![Vec::new()],
+        };
+        let mut cases = Vec::with_capacity(total);
+        for point in 0..grid_points {
+            // Mixed radix, the first key slowest.
+            let mut rest = point;
+            let mut grid_values = vec![None; grid.len()];
+            for (slot, (_, values)) in grid_values.iter_mut().zip(&grid).rev() {
+                *slot = Some(values[rest % values.len()].clone());
+                rest /= values.len();
+            }
+            for listed_case in &listed {
+                for sample in &sampled {
+                    let mut values: Vec<Override> = Vec::new();
+                    let pairs = grid
+                        .iter()
+                        .map(|(k, _)| k.clone())
+                        .zip(grid_values.iter().map(|v| v.clone().expect("set above")))
+                        .chain(listed_case.iter().cloned())
+                        .chain(sample.iter().cloned());
+                    for (key, value) in pairs {
+                        let o = Override::new(&key, value)
+                            .map_err(|e| invalid(&key, e.text.clone(), &e.reason))?;
+                        values.retain(|x| x.key != o.key);
+                        values.push(o);
+                    }
+                    cases.push(Case {
+                        index: cases.len(),
+                        values,
+                    });
+                }
+            }
+        }
+        for case in &cases {
+            scene
+                .with(&case.values)
+                .scene()
+                .map_err(|e| StudyError::Case {
+                    path: path.to_path_buf(),
+                    case: case.index,
+                    values: words(&case.values),
+                    message: e.to_string(),
+                })?;
+        }
+        Ok(Study {
+            path: path.to_path_buf(),
+            run: raw.run,
+            cases,
+            keys,
+        })
+    }
+}
+
+/// Overrides as `key=value` words (long lists shortened).
+pub fn words(values: &[Override]) -> String {
+    values
+        .iter()
+        .map(|o| match &o.value {
+            toml::Value::Array(a) if a.len() > 4 => format!("{}=[{} values]", o.key, a.len()),
+            _ => o.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests;
