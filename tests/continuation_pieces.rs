@@ -380,6 +380,7 @@ fn fold_detector_confirms_reversals_and_ignores_unconfirmed_tangent_flips() {
         let s = 0.3 * k as f64;
         events.extend(detector.push(s.sin(), s.cos(), 0.3));
     }
+    events.extend(detector.finish());
     assert_eq!(events.len(), 1, "{events:?}");
     let ContinuationEvent::Fold { index, parameter } = events[0] else {
         unreachable!()
@@ -392,7 +393,7 @@ fn fold_detector_confirms_reversals_and_ignores_unconfirmed_tangent_flips() {
     let mut detector = FoldDetector::new(true);
     let pushed: Vec<_> = [(0.0, 1.0), (0.1, -1.0), (0.2, 1.0), (0.3, 1.0), (0.25, 1.0)]
         .iter()
-        .filter_map(|&(p, t)| detector.push(p, t, 0.1))
+        .flat_map(|&(p, t)| detector.push(p, t, 0.1))
         .collect();
     assert_eq!(
         pushed,

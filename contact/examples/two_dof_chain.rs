@@ -1,51 +1,20 @@
 //! Scratch: two-dof chain with a stop on a mass-carrying dof, swept at H = 10, 20, 40.
-use faer::sparse::Triplet;
-use semismooth_contact::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
+#[path = "../tests/common/chain.rs"]
+mod chain;
+
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::sweep::frequency_response;
 
-fn matrix(entries: &[(usize, usize, f64)]) -> SparseMatrix {
-    let t: Vec<_> = entries
-        .iter()
-        .map(|&(i, j, v)| Triplet::new(i, j, v))
-        .collect();
-    SparseMatrix::try_new_from_triplets(2, 2, &t).unwrap()
-}
-
 fn main() {
-    let k = matrix(&[(0, 0, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)]);
-    let m = matrix(&[(0, 0, 1.0), (1, 1, 1.0)]);
-    let omega_1 = ((3.0 - 5f64.sqrt()) / 2.0).sqrt();
     let arg = |i: usize, d: f64| {
         std::env::args()
             .nth(i)
             .map(|s| s.parse().unwrap())
             .unwrap_or(d)
     };
-    let zeta = arg(2, 0.02);
-    let d = matrix(&[
-        (0, 0, 2.0 * 2.0 * zeta / omega_1),
-        (0, 1, -2.0 * zeta / omega_1),
-        (1, 0, -2.0 * zeta / omega_1),
-        (1, 1, 2.0 * zeta / omega_1),
-    ]);
-    let gap: f64 = std::env::args()
-        .nth(1)
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(0.5);
-    let model = StructuralModel {
-        mass: m,
-        damping: Some(d),
-        stiffness: k,
-        load: vec![arg(3, 0.0), arg(4, 0.1)],
-        contacts: vec![ContactPoint::new(1, gap)],
-        friction: Vec::new(),
-    };
-    let structure = Structure {
-        model,
-        omega_1,
-        observed_dof: 1,
-    };
+    // Arguments: gap, damping ratio, force on mass 0, force on mass 1.
+    let structure = chain::chain(arg(1, 0.5), arg(2, 0.02), [arg(3, 0.0), arg(4, 0.1)]);
+    let omega_1 = structure.omega_1;
     let hs: Vec<usize> = std::env::var("HS")
         .map(|v| v.split(',').map(|x| x.parse().unwrap()).collect())
         .unwrap_or(vec![10, 20, 40]);

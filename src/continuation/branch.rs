@@ -42,6 +42,16 @@ pub enum ContinuationEvent {
         /// [`ContinuationOptions::refine_folds`](super::ContinuationOptions::refine_folds) is set).
         parameter: f64,
     },
+    /// The parameter turned back by less than
+    /// [`ContinuationOptions::fold_excursion`](super::ContinuationOptions::fold_excursion)
+    /// and forward again (see [`FoldDetector`](super::FoldDetector)): a corner of a
+    /// piecewise-smooth branch, not a fold. One event per reversal of the increments.
+    Zigzag {
+        /// Index of the point where the increments reverse.
+        index: usize,
+        /// Its parameter.
+        parameter: f64,
+    },
     /// A corner of a piecewise-affine branch, crossed exactly
     /// ([`Continuation::with_affine_pieces`](super::Continuation::with_affine_pieces)).
     Corner {
@@ -306,7 +316,7 @@ impl std::ops::AddAssign for ContinuationCounters {
 pub struct Branch {
     /// Accepted points in branch order, the corrected starting point first.
     pub points: Vec<BranchPoint>,
-    /// Events (folds) in branch order.
+    /// Events (folds, zigzags, corners) in the order they were decided.
     pub events: Vec<ContinuationEvent>,
     /// Why the run stopped.
     pub termination: ContinuationTermination,
@@ -325,6 +335,11 @@ impl Branch {
         self.event_parameters(|e| matches!(e, ContinuationEvent::Fold { .. }))
     }
 
+    /// Parameters of the zigzags (reversals within the fold excursion), in branch order.
+    pub fn zigzag_parameters(&self) -> Vec<f64> {
+        self.event_parameters(|e| matches!(e, ContinuationEvent::Zigzag { .. }))
+    }
+
     /// Parameters of the corners crossed exactly, in branch order.
     pub fn corner_parameters(&self) -> Vec<f64> {
         self.event_parameters(|e| matches!(e, ContinuationEvent::Corner { .. }))
@@ -336,6 +351,7 @@ impl Branch {
             .filter(|e| kind(e))
             .map(|e| match e {
                 ContinuationEvent::Fold { parameter, .. }
+                | ContinuationEvent::Zigzag { parameter, .. }
                 | ContinuationEvent::Corner { parameter, .. } => *parameter,
             })
             .collect()

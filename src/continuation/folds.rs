@@ -1,4 +1,5 @@
-//! Folds: reversals of the parameter along a branch, located by Hermite interpolation.
+//! Folds: reversals of the parameter along a branch, told apart from the zigzags of a
+//! piecewise-smooth branch by their excursion, and located by Hermite interpolation.
 
 use super::ContinuationEvent;
 
@@ -45,120 +46,231 @@ struct FoldSample {
 
 /// Fold detection along a sequence of accepted points.
 ///
-/// A fold is a local extremum of the parameter along the branch: the increments
-/// `p_k - p_{k-1}` change sign at the extreme point `k`. On a smooth branch the tangent's
-/// parameter component `t_p` changes sign between `k - 1` and `k` or between `k` and `k + 1`;
-/// the fold is then located by cubic Hermite interpolation of `p(s)` on that interval (when
-/// refinement is asked for and the interpolated extremum lies beyond `p_k`, within the
-/// reach of the neighbouring steps), otherwise reported at the extreme point `p_k`. A reversal without such a sign change (a fold at a corner of a
-/// piecewise-smooth branch) is reported at `p_k`. A sign change of `t_p` without a reversal
-/// of the increments (a generalized Jacobian taken on the other side of a corner, where
-/// the tangent of the neighbouring piece points backwards) is no fold.
+/// A fold is a local extremum of the parameter along the branch that the branch leaves by
+/// more than a minimal excursion `δ` ([`FoldDetector::with_min_excursion`], `0` by
+/// default) before passing it again: a detector with hysteresis. On a piecewise-smooth
+/// branch the parameter can turn back by a tiny amount at a corner and forward again at
+/// the next one (a discretisation's active set changing sample by sample where the branch
+/// is nearly vertical); such a turn, back and forth within `δ`, is a zigzag
+/// ([`ContinuationEvent::Zigzag`], one event per reversal of the increments), not a fold.
 ///
-/// A fold is confirmed by the first point after the extremum, so it is reported one point
-/// late; a fold at the last point of a branch is not reported.
+/// A confirmed fold is located at the extreme point `p_k`, or, when refinement is asked
+/// for and the tangent's parameter component `t_p` changes sign on `[k - 1, k]` or
+/// `[k, k + 1]`, by cubic Hermite interpolation of `p(s)` on that interval (kept when the
+/// interpolated extremum lies beyond `p_k`, within the reach of the neighbouring steps).
+/// A sign change of `t_p` without a reversal of the increments (a generalized Jacobian
+/// taken on the other side of a corner) is no fold.
+///
+/// A fold is confirmed by the first point more than `δ` back from the extremum, so it is
+/// reported late; a fold the branch does not leave by `δ` before it ends is not reported,
+/// and [`FoldDetector::finish`] reports the reversals still undecided as zigzags.
 #[derive(Clone, Debug)]
 pub struct FoldDetector {
     refine: bool,
-    /// The last three points (oldest first).
-    recent: Vec<FoldSample>,
-    /// Index of the newest point in `recent`.
-    newest: usize,
-    /// Sign of the last non-zero parameter increment.
+    /// Smallest excursion `δ >= 0` of the parameter that confirms a fold.
+    min_excursion: f64,
+    /// Every point pushed.
+    samples: Vec<FoldSample>,
+    /// Direction of travel of the parameter since the last fold (`0` before the first
+    /// non-zero increment).
+    travel: f64,
+    /// Index of the farthest point along `travel` since the last fold (the candidate).
+    extreme: usize,
+    /// Index of the farthest point against `travel` after the candidate.
+    counter: usize,
+    /// Sign of the last non-zero increment.
     increment_sign: f64,
+    /// Reversals of the increments (index of the extreme point) not yet decided.
+    undecided: Vec<usize>,
 }
 
 impl FoldDetector {
-    /// A detector; `refine` locates folds by Hermite interpolation.
+    /// A detector that confirms every reversal (`δ = 0`); `refine` locates folds by
+    /// Hermite interpolation.
     pub fn new(refine: bool) -> Self {
         Self {
             refine,
-            recent: Vec::with_capacity(3),
-            newest: 0,
+            min_excursion: 0.0,
+            samples: Vec::new(),
+            travel: 0.0,
+            extreme: 0,
+            counter: 0,
             increment_sign: 0.0,
+            undecided: Vec::new(),
         }
+    }
+
+    /// The same detector with the minimal excursion `δ` (in parameter units, `>= 0`) that
+    /// tells a fold from a zigzag.
+    pub fn with_min_excursion(mut self, min_excursion: f64) -> Self {
+        self.min_excursion = min_excursion.max(0.0);
+        self
     }
 
     /// Adds the next accepted point: its parameter, the parameter component of its unit
     /// tangent oriented along the branch, and the θ-length of the chord from the previous
-    /// point (ignored for the first). Returns the fold this point confirms, if any; its
-    /// `index` counts the points pushed (from 0).
+    /// point (ignored for the first). Returns the events this point decides (a fold it
+    /// confirms, zigzags it rules out), in branch order; their `index` counts the points
+    /// pushed (from 0).
     pub fn push(
         &mut self,
         parameter: f64,
         tangent_parameter: f64,
         chord: f64,
-    ) -> Option<ContinuationEvent> {
-        let sample = FoldSample {
+    ) -> Vec<ContinuationEvent> {
+        let k = self.samples.len();
+        self.samples.push(FoldSample {
             parameter,
             tangent_parameter,
             chord,
-        };
-        if self.recent.is_empty() {
-            self.recent.push(sample);
-            self.newest = 0;
-            return None;
-        }
-        self.newest += 1;
-        if self.recent.len() == 3 {
-            self.recent.remove(0);
-        }
-        self.recent.push(sample);
-        let m = self.recent.len();
-        let increment = parameter - self.recent[m - 2].parameter;
-        if increment == 0.0 {
-            return None;
-        }
-        let sign = increment.signum();
-        let previous = std::mem::replace(&mut self.increment_sign, sign);
-        if previous == 0.0 || previous == sign {
-            return None;
-        }
-        // The extreme point is the one before this increment.
-        let extreme = self.recent[m - 2];
-        let extreme_index = self.newest - 1;
-        // Intervals [k-1, k] and [k, k+1] around the extreme k, as (left, right, index of
-        // right); a sign change of t_p from `previous` to `sign` brackets a smooth fold.
-        let mut brackets = Vec::with_capacity(2);
-        if m == 3 {
-            brackets.push((self.recent[0], self.recent[1], extreme_index));
-        }
-        brackets.push((self.recent[m - 2], self.recent[m - 1], self.newest));
-        let bracket = brackets.into_iter().find(|(a, b, _)| {
-            a.tangent_parameter.signum() == previous && b.tangent_parameter.signum() == sign
         });
-        let reach = if m == 3 {
-            (extreme.parameter - self.recent[0].parameter)
-                .abs()
-                .max(increment.abs())
-        } else {
-            increment.abs()
-        };
+        let mut events = Vec::new();
+        if k == 0 {
+            return events;
+        }
+        let increment = parameter - self.samples[k - 1].parameter;
+        if increment != 0.0 {
+            let sign = increment.signum();
+            let previous = std::mem::replace(&mut self.increment_sign, sign);
+            if previous != 0.0 && previous != sign {
+                self.undecided.push(k - 1);
+            }
+        }
+        if self.travel == 0.0 {
+            if increment != 0.0 {
+                self.travel = increment.signum();
+                self.extreme = k;
+                self.counter = k;
+            }
+            return events;
+        }
+        let extreme = self.samples[self.extreme].parameter;
+        if (parameter - extreme) * self.travel > 0.0 {
+            // Beyond the candidate: every reversal since it was a zigzag.
+            let undecided = std::mem::take(&mut self.undecided);
+            events.extend(undecided.into_iter().map(|i| self.zigzag(i)));
+            self.extreme = k;
+            self.counter = k;
+            return events;
+        }
+        if (parameter - self.samples[self.counter].parameter) * self.travel <= 0.0 {
+            self.counter = k;
+        }
+        if (extreme - parameter) * self.travel > self.min_excursion {
+            let fold = self.extreme;
+            let before: Vec<usize> = self
+                .undecided
+                .iter()
+                .copied()
+                .filter(|&i| i < fold)
+                .collect();
+            self.undecided.retain(|&i| i > fold);
+            events.extend(before.into_iter().map(|i| self.zigzag(i)));
+            events.push(self.fold(fold));
+            self.travel = -self.travel;
+            self.extreme = self.counter;
+            // The farthest point against the new travel after the new candidate.
+            let travel = self.travel;
+            self.counter = (self.extreme..=k)
+                .min_by(|&a, &b| {
+                    (self.samples[a].parameter * travel)
+                        .total_cmp(&(self.samples[b].parameter * travel))
+                })
+                .unwrap_or(k);
+        }
+        events
+    }
+
+    /// Ends the sequence: the reversals still undecided (the branch ended within `δ` of
+    /// them) are reported as zigzags.
+    pub fn finish(&mut self) -> Vec<ContinuationEvent> {
+        let undecided = std::mem::take(&mut self.undecided);
+        undecided.into_iter().map(|i| self.zigzag(i)).collect()
+    }
+
+    fn zigzag(&self, index: usize) -> ContinuationEvent {
+        ContinuationEvent::Zigzag {
+            index,
+            parameter: self.samples[index].parameter,
+        }
+    }
+
+    /// The fold at the extreme point `k` (`0 < k < len - 1`), refined on a bracketing
+    /// interval where `t_p` changes sign from the travel before to the travel after.
+    fn fold(&self, k: usize) -> ContinuationEvent {
+        let s = &self.samples;
+        let extreme = s[k];
+        let (before, after) = (self.travel, -self.travel);
+        let brackets = [(k - 1, k), (k, k + 1)];
+        let bracket = brackets.into_iter().find(|&(a, b)| {
+            s[a].tangent_parameter.signum() == before && s[b].tangent_parameter.signum() == after
+        });
+        let reach = (extreme.parameter - s[k - 1].parameter)
+            .abs()
+            .max((s[k + 1].parameter - extreme.parameter).abs());
         let (index, parameter) = match bracket {
-            Some((a, b, index)) if self.refine && b.chord > 0.0 => {
+            Some((a, b)) if self.refine && s[b].chord > 0.0 => {
                 let p = hermite_fold(
-                    a.parameter,
-                    a.tangent_parameter,
-                    b.parameter,
-                    b.tangent_parameter,
-                    b.chord,
+                    s[a].parameter,
+                    s[a].tangent_parameter,
+                    s[b].parameter,
+                    s[b].tangent_parameter,
+                    s[b].chord,
                 );
-                let beyond = (p - extreme.parameter) * previous;
-                if beyond >= 0.0 && beyond <= reach {
-                    (index, p)
+                let beyond = (p - extreme.parameter) * before;
+                if (0.0..=reach).contains(&beyond) {
+                    (b, p)
                 } else {
-                    (index, extreme.parameter)
+                    (b, extreme.parameter)
                 }
             }
-            _ => (extreme_index, extreme.parameter),
+            _ => (k, extreme.parameter),
         };
-        Some(ContinuationEvent::Fold { index, parameter })
+        ContinuationEvent::Fold { index, parameter }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::hermite_fold;
+    use super::{hermite_fold, FoldDetector};
+    use crate::continuation::ContinuationEvent;
+
+    #[test]
+    fn turns_back_and_forth_within_the_excursion_are_zigzags_around_the_folds() {
+        // Up to 1.0277 with two small zigzags, back to 1.0178 with one, then on to 2; the
+        // excursion 2e-3 separates the two turning points (0.0099 and 0.98 beyond them)
+        // from the turns of at most 5e-4.
+        let p = [
+            0.5, 1.0, 1.0272, 1.0271, 1.0276, 1.0275, 1.0277, 1.0263, 1.0264, 1.0178, 1.5, 2.0,
+        ];
+        let mut detector = FoldDetector::new(false).with_min_excursion(2e-3);
+        let mut events: Vec<_> = p.iter().flat_map(|&p| detector.push(p, 0.0, 0.1)).collect();
+        events.extend(detector.finish());
+        let fold = |index, parameter| ContinuationEvent::Fold { index, parameter };
+        let zigzag = |index, parameter| ContinuationEvent::Zigzag { index, parameter };
+        assert_eq!(
+            events,
+            [
+                zigzag(2, 1.0272),
+                zigzag(3, 1.0271),
+                zigzag(4, 1.0276),
+                zigzag(5, 1.0275),
+                fold(6, 1.0277),
+                zigzag(7, 1.0263),
+                zigzag(8, 1.0264),
+                fold(9, 1.0178),
+            ]
+        );
+        // A monotone branch with one small turn back and forth has no fold, and a turn the
+        // branch ends on is a zigzag.
+        let mut detector = FoldDetector::new(false).with_min_excursion(2e-3);
+        let mut events: Vec<_> = [0.5, 1.0, 0.9999, 1.5, 1.4995]
+            .iter()
+            .flat_map(|&p| detector.push(p, 0.0, 0.1))
+            .collect();
+        events.extend(detector.finish());
+        assert_eq!(events, [zigzag(1, 1.0), zigzag(2, 0.9999), zigzag(3, 1.5)]);
+    }
 
     #[test]
     fn hermite_fold_is_exact_for_a_quadratic_turn() {

@@ -54,12 +54,17 @@
 //! `[parameter_min, parameter_max]` (the last point is then re-solved at the bound), or after
 //! `max_points` points.
 //!
-//! Folds are detected as sign changes of the parameter component of the tangent, oriented
-//! along the step just taken, confirmed by a reversal of the parameter's increments between
-//! accepted points, and located by cubic Hermite interpolation of `p(s)` (values and slopes
-//! `dp/ds = t_p` at both points); a reversal at a corner of a piecewise-smooth branch (no
-//! sign change of `t_p`) is a fold at the extreme point ([`FoldDetector`], also usable on
-//! branches stitched together from several runs).
+//! Folds are extrema of the parameter along the branch that the branch leaves by more than
+//! [`ContinuationOptions::fold_excursion`] (a θ-length, default the default `min_step`),
+//! located by cubic Hermite interpolation of `p(s)` (values and slopes `dp/ds = t_p`, the
+//! tangent oriented along the step just taken) where `t_p` changes sign next to the
+//! extreme point, else at the extreme point (a fold at a corner of a piecewise-smooth
+//! branch). A branch that turns back by less and forward again zigzags: on a sampled
+//! nonsmooth problem the active set changes sample by sample and, where the branch is
+//! nearly vertical, each change can tip the parameter back and forth by a sample-scale
+//! amount. Those reversals are [`ContinuationEvent::Zigzag`]s, not folds ([`FoldDetector`],
+//! a detector with hysteresis, also usable on branches stitched together from several
+//! runs).
 //!
 //! # Corners
 //!

@@ -105,6 +105,13 @@ pub struct ContinuationOptions {
     /// bracket the sign change (otherwise the fold is reported at the extreme point of the
     /// accepted points). Default `true`.
     pub refine_folds: bool,
+    /// Smallest excursion of the parameter, as a θ-length (`sqrt(1 - θ) |Δp| / s_p`), by
+    /// which the branch must leave an extremum of `p` for it to be a fold; a smaller turn
+    /// back and forth is a zigzag of a piecewise-smooth branch
+    /// ([`ContinuationEvent::Zigzag`](super::ContinuationEvent::Zigzag)). `0` makes every
+    /// reversal a fold. Default `0.002` (the default `min_step`: a turn the steps cannot
+    /// resolve is no fold).
+    pub fold_excursion: f64,
     /// When the step has been halved to its end (the run would stop), try once to pass a
     /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
     /// before giving up. Default `true`.
@@ -176,6 +183,7 @@ impl Default for ContinuationOptions {
             predictor: Predictor::Secant,
             corrector_line_search: None,
             refine_folds: true,
+            fold_excursion: 0.002,
             pass_corners: true,
             trust_factor: None,
             restarts: None,
@@ -184,6 +192,11 @@ impl Default for ContinuationOptions {
 }
 
 impl ContinuationOptions {
+    /// [`ContinuationOptions::fold_excursion`] in parameter units: `δ s_p / sqrt(1 - θ)`.
+    pub fn fold_parameter_excursion(&self) -> f64 {
+        self.fold_excursion * self.parameter_scale / (1.0 - self.theta).sqrt()
+    }
+
     /// NLvib-like step settings around `ds`: `initial_step = ds`, `min_step = ds / 5`,
     /// `max_step = 5 ds`, other fields at their defaults.
     pub fn with_step(ds: f64) -> Self {
@@ -239,6 +252,13 @@ impl ContinuationOptions {
             }
         }
         positive_finite("corrector_tolerance", self.corrector_tolerance)?;
+        if !(self.fold_excursion.is_finite() && self.fold_excursion >= 0.0) {
+            return Err(invalid(
+                "fold_excursion",
+                self.fold_excursion,
+                "finite and >= 0",
+            ));
+        }
         if !(self.step_tolerance.is_finite() && self.step_tolerance >= 0.0) {
             return Err(invalid(
                 "step_tolerance",

@@ -81,7 +81,7 @@ enum Command {
         floquet_max_abs, contact_force_mean (sum over the contacts), max_penetration,\n  \
         contacts (per point, the list of ssn solve) (arrays in branch order),\n  \
         stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
-        branch turns), corner_folds (reversals of less than 2e-3 omega_1: corners),\n  \
+        branch turns), corner_folds (reversals of less than 5e-3 omega_1: corners),\n  \
         converged, termination, solve_seconds, counters\n\n\
         CSV: one row per point; contact k (from 0) adds contact{k}_force_mean,\n  \
         contact{k}_max_penetration, contact{k}_contact_fraction, contact{k}_displacement_min,\n  \

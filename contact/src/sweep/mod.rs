@@ -73,12 +73,13 @@
 //!
 //! # Folds and corners
 //!
-//! The continuation reports every reversal of the frequency. On piecewise-smooth branches
+//! The continuation reports the reversals of the frequency. On piecewise-smooth branches
 //! most of them are corners, not turning points: fine steps resolve micro-zigzags of about
 //! 1e-4 `ω_1` where AFT samples enter contact, and a penalty branch turns back a little at
-//! many of its corners. [`separate_turning_points`] keeps as `folds` the reversals whose
-//! frequency excursion is at least [`TURNING_POINT_EXCURSION`] `ω_1` and lists the others
-//! as `corner_folds`.
+//! many of its corners. The sweep sets the core's
+//! [`ContinuationOptions::fold_excursion`] to [`TURNING_POINT_EXCURSION`] (in `ω_1`, the
+//! θ-length of a frequency step here): a reversal the branch leaves by at least that much
+//! is a fold (`folds`), the others are zigzags (`corner_folds`).
 //!
 //! Measured branch sizes, timings and limits are in `docs/sweeps.md` and
 //! `examples/lcp_sweep.rs`.
@@ -100,9 +101,7 @@ use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
-pub use response::{
-    separate_turning_points, FrequencyResponse, SweepTermination, TURNING_POINT_EXCURSION,
-};
+pub use response::{FrequencyResponse, SweepTermination, TURNING_POINT_EXCURSION};
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
@@ -320,6 +319,8 @@ fn continuation_options(
         },
         predictor: Predictor::Secant,
         refine_folds: true,
+        // With the scaling above a θ-length in the parameter is |Δω| / ω_1.
+        fold_excursion: TURNING_POINT_EXCURSION,
         trust_factor: Some(TRUST_FACTOR),
         restarts: Some(RestartPolicy::default()),
         ..ContinuationOptions::default()
@@ -464,19 +465,25 @@ where
         }
     }
     let c = continuation.counters();
-    let reversals: Vec<(f64, usize)> = continuation
+    // The core tells folds from zigzags by their excursion (`fold_excursion`).
+    let mut events: Vec<(usize, f64, bool)> = continuation
         .events()
         .iter()
         .filter_map(|event| match event {
-            ContinuationEvent::Fold { index, parameter } => Some((*parameter, *index)),
+            ContinuationEvent::Fold { index, parameter } => Some((*index, *parameter, true)),
+            ContinuationEvent::Zigzag { index, parameter } => Some((*index, *parameter, false)),
             _ => None,
         })
         .collect();
-    if let (Some(&first), Some(&last)) = (response.omega.first(), response.omega.last()) {
-        let (folds, corners) =
-            separate_turning_points(first, last, &reversals, TURNING_POINT_EXCURSION * omega_1);
-        (response.folds, response.fold_indices) = folds.into_iter().unzip();
-        (response.corner_folds, response.corner_fold_indices) = corners.into_iter().unzip();
+    events.sort_by_key(|e| e.0);
+    for (index, omega, fold) in events {
+        if fold {
+            response.folds.push(omega);
+            response.fold_indices.push(index);
+        } else {
+            response.corner_folds.push(omega);
+            response.corner_fold_indices.push(index);
+        }
     }
     let termination = continuation.termination().cloned();
     drop(continuation);

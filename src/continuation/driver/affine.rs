@@ -130,7 +130,8 @@ where
             current: None,
             travel: self.options.direction.sign(),
         });
-        self.folds = FoldDetector::new(false);
+        self.folds =
+            FoldDetector::new(false).with_min_excursion(self.options.fold_parameter_excursion());
         self
     }
 }

@@ -173,7 +173,8 @@ where
         );
         let bordered = Bordered::new(n, problem.new_jacobian());
         let problem_start = problem.problem_counters();
-        let folds = FoldDetector::new(options.refine_folds);
+        let folds = FoldDetector::new(options.refine_folds)
+            .with_min_excursion(options.fold_parameter_excursion());
         let window = options.restarts.map_or(0, |r| r.retrace_window);
         Ok(Self {
             problem,
@@ -413,21 +414,18 @@ where
         }
         let index = self.points;
         if point.corner {
-            if let Some(event) = self.folds.push(point.parameter, 0.0, 0.0) {
-                self.events.push(event);
-            }
+            let events = self.folds.push(point.parameter, 0.0, 0.0);
+            self.events.extend(events);
             self.events.push(ContinuationEvent::Corner {
                 index,
                 parameter: point.parameter,
             });
             self.counters.corners += 1;
         } else {
-            if let Some(event) = self
+            let events = self
                 .folds
-                .push(point.parameter, point.tangent_parameter, chord)
-            {
-                self.events.push(event);
-            }
+                .push(point.parameter, point.tangent_parameter, chord);
+            self.events.extend(events);
             self.last_tangent_parameter = point.tangent_parameter;
             self.set_trust(&point.state, point.parameter, point.step);
         }
@@ -716,6 +714,9 @@ where
             match std::mem::replace(&mut self.phase, Phase::Running) {
                 Phase::Finished => {
                     self.phase = Phase::Finished;
+                    // The reversals the branch ended on are zigzags (idempotent).
+                    let undecided = self.folds.finish();
+                    self.events.extend(undecided);
                     return None;
                 }
                 Phase::NotStarted { x0, p0 } => self.start(x0, p0),

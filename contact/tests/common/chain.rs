@@ -1,0 +1,39 @@
+//! The two-dof chain with a stop on its free mass (a contact on a dof that carries mass),
+//! shared by a test and an example.
+
+use faer::sparse::Triplet;
+use semismooth_contact::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
+
+fn matrix(entries: &[(usize, usize, f64)]) -> SparseMatrix {
+    let t: Vec<_> = entries
+        .iter()
+        .map(|&(i, j, v)| Triplet::new(i, j, v))
+        .collect();
+    SparseMatrix::try_new_from_triplets(2, 2, &t).unwrap()
+}
+
+/// Unit masses and springs (ground - 0 - 1), stiffness-proportional damping of ratio
+/// `zeta` at the first mode, the forces `load` on the masses and a stop at `gap` from the
+/// free mass 1 (observed).
+pub fn chain(gap: f64, zeta: f64, load: [f64; 2]) -> Structure {
+    let omega_1 = ((3.0 - 5f64.sqrt()) / 2.0).sqrt();
+    let c = 2.0 * zeta / omega_1;
+    let model = StructuralModel {
+        mass: matrix(&[(0, 0, 1.0), (1, 1, 1.0)]),
+        damping: Some(matrix(&[
+            (0, 0, 2.0 * c),
+            (0, 1, -c),
+            (1, 0, -c),
+            (1, 1, c),
+        ])),
+        stiffness: matrix(&[(0, 0, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)]),
+        load: load.to_vec(),
+        contacts: vec![ContactPoint::new(1, gap)],
+        friction: Vec::new(),
+    };
+    Structure {
+        model,
+        omega_1,
+        observed_dof: 1,
+    }
+}
