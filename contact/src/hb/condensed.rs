@@ -24,7 +24,7 @@ use crate::model::{mean_stiffness, NormalForce, StructuralModel};
 /// `Lambda + P max(0, c (E (y_lin + R Lambda) - g) - E Lambda)` and its generalized Jacobian
 /// the dense `I - Q + c Q R` (`Q = P diag(h) E` per contact): solve it with a dense LU
 /// (`semismooth::linalg::FaerDenseLu`). A friction point's row measures its slip `y_t`
-/// (the phase velocity of its row, [`super::friction`]) in `y_lin + R Lambda`, and its
+/// (the phase velocity of its row, module `hb::friction`) in `y_lin + R Lambda`, and its
 /// equation `Lambda_t - P proj(Lambda_t - c y_t)` has the same Jacobian form with
 /// `Q_t = P diag(stick) E`, plus its block `X` on its contact's force. The full solution `[U; Lambda]` of [`SsnHb`] is
 /// recovered by [`CondensedSsnHb::expand`], and is a root of the full residual.

@@ -84,7 +84,7 @@ impl SequencedSolution {
 /// Semismooth Newton on `min(z, q + A z) = 0` of `finest` by mesh sequencing (method
 /// `"lcp-ssn"` at large `Nt`): the LCP of `model` forced at `omega` is solved at `Nt / 2^j`
 /// (halving while
-/// even and not below [`SEQUENCING_COARSEST_TIME_SAMPLES`]) from `z = 0` (offering the
+/// even and not below `SEQUENCING_COARSEST_TIME_SAMPLES`) from `z = 0` (offering the
 /// polyalgorithm the min-map's smoothing, [`super::MinMapLcp`]'s `Smoothing`), then each finer
 /// level starts from the previous solution interpolated in time
 /// ([`PeriodicLcp::interpolate_forces`]); the last level is `finest` itself (built by the

@@ -9,7 +9,7 @@
 //! refined between the `Nt` AFT samples on the truncated series
 //! ([`SsnHb::closed_intervals`], [`PenaltyHb::closed_intervals`]). Between two switching
 //! instants the set of closed contacts is fixed and a small perturbation of the orbit
-//! obeys a linear system with constant coefficients (module [`phases`]: the held dofs of
+//! obeys a linear system with constant coefficients (module `phases`: the held dofs of
 //! the closed contacts are removed, massless dofs follow statically or by first-order
 //! dynamics); at the closing of a contact the perturbation jumps by a saltation matrix
 //! that depends on the model only. The monodromy is the product, over one period, of the

@@ -3,7 +3,7 @@
 //!
 //! [`frequency_response`] solves at `omega_from = omega_ratio_from * omega_1` by globalized
 //! Newton from zero, then follows the branch with the core's
-//! [`Continuation`](semismooth::continuation::Continuation) until the frequency leaves
+//! [`Continuation`] until the frequency leaves
 //! `[omega_from, omega_to]` (through folds, where the frequency turns back). Each point is
 //! reduced to the tip over one period: `tip_max`, `tip_min` and the amplitude
 //! `max_t |u_tip(t)|` (with contact the maximum sits at the gap along the contact branch, so
@@ -34,7 +34,7 @@
 //! nodes changes along them), with corners and folds at corners. The sweep turns on the
 //! core continuation's measures for such branches:
 //!
-//! - a trust ball of [`TRUST_FACTOR`] times the largest next step around the last point
+//! - a trust ball of `TRUST_FACTOR` (3) times the largest next step around the last point
 //!   ([`ContinuationOptions::trust_factor`]): without it Newton sometimes converged on the
 //!   far side of an overhang and skipped both folds;
 //! - the corner passes ([`ContinuationOptions::pass_corners`]) and restarts with a
@@ -44,7 +44,7 @@
 //!   switching functions are the gaps at the AFT samples): its corners are crossed exactly
 //!   ([`Continuation::with_affine_pieces`]), and its folds are corners.
 //!
-//! The corrector tolerance is [`CORRECTOR_TOLERANCE_FACTOR`] times the scene's Newton
+//! The corrector tolerance is `CORRECTOR_TOLERANCE_FACTOR` (0.1) times the scene's Newton
 //! tolerance for SSN-HB and lcp-ssn (for SSN-HB at least the round-off floor of its
 //! residual, which large models reach), so each point is a fixed point of a Newton solve at
 //! that tolerance. For penalty HB it is the scene's tolerance or the rounding floor of

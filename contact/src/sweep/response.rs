@@ -32,7 +32,7 @@ pub struct FrequencyResponse {
     pub iterations: Vec<usize>,
     /// Frequencies `ω` (absolute) where the branch turns back, in branch order: the turning
     /// points whose frequency excursion to the next one is at least
-    /// [`TURNING_POINT_EXCURSION`] `ω_1` ([`separate_turning_points`]).
+    /// [`TURNING_POINT_EXCURSION`] `ω_1` (the core continuation's `fold_excursion`).
     pub folds: Vec<f64>,
     /// Index of the extreme point at each fold (same order as `folds`).
     pub fold_indices: Vec<usize>,
