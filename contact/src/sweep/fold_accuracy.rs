@@ -8,8 +8,8 @@
 //! ([`APPROACH`] `ω_1` in frequency, or the first point), carries its coefficients to `2H`
 //! harmonics and `2Nt` AFT samples ([`resize_harmonics`]), and follows the branch at `2H`
 //! from there with the core's continuation, with steps of at most [`SEGMENT_MAX_STEP`],
-//! until it turns back at the fold (a reversal followed by a retreat of at least
-//! [`TURNING_POINT_EXCURSION`] `ω_1`, so that a corner's zigzag is not taken for it).
+//! until it turns back at the fold (the core confirms a fold by a retreat of
+//! [`TURNING_POINT_EXCURSION`](super::TURNING_POINT_EXCURSION) `ω_1`, so that a corner's zigzag is not taken for it).
 //!
 //! The change `d` of the fold frequency between `H` and `2H` gives the coarser fold's error
 //! by Richardson with the order [`HB_ORDER`] of the harmonic-balance estimate,
@@ -30,7 +30,7 @@ use semismooth::continuation::{
 };
 use semismooth::{Factorize, GeneralizedJacobian, ParameterDependent};
 
-use super::response::{FrequencyResponse, TURNING_POINT_EXCURSION};
+use super::response::FrequencyResponse;
 use super::{
     continuation_error, continuation_options, hb_solver, penalty_continuation, ssn_continuation,
     MethodContinuation,
@@ -228,7 +228,8 @@ pub fn refine_folds(
                 seconds,
             });
             uncertainty = Some(previous.map_or(error, |p| p.max(error)));
-            if previous.is_some() && error.max(previous.unwrap_or(0.0)) <= target * omega.abs() {
+            // One pair can be small by chance: met only on two pairs.
+            if previous.is_some() && uncertainty.is_some_and(|u| u <= target * omega.abs()) {
                 break FoldStop::Met;
             }
         };
@@ -299,7 +300,7 @@ impl Segment<'_> {
     }
 
     /// Follows the branch of `problem` from `x` at the segment's start until it has turned
-    /// back and retreated [`TURNING_POINT_EXCURSION`] `ω_1` (module documentation).
+    /// back at a fold the core confirms (module documentation).
     fn follow<P, S>(
         &self,
         (problem, solver): (&mut P, &mut S),
@@ -337,23 +338,17 @@ impl Segment<'_> {
         let mut continuation = configure(
             Continuation::new(problem, solver, x, omega, options).map_err(continuation_error)?,
         );
-        let excursion = TURNING_POINT_EXCURSION * omega_1;
-        let direction = self.heading.signum();
-        let mut candidate: Option<f64> = None;
-        let mut seen = 0;
+        // The sweep's options confirm a fold by its excursion (`fold_excursion`), so the
+        // first fold event is the fold and not a corner's zigzag.
         let mut points = 0;
-        while let Some(point) = continuation.next() {
+        while continuation.next().is_some() {
             points += 1;
-            for event in &continuation.events()[seen..] {
-                if let ContinuationEvent::Fold { parameter, .. } = event {
-                    candidate = Some(*parameter);
-                }
-            }
-            seen = continuation.events().len();
-            if let Some(c) = candidate {
-                if direction * (c - point.parameter) >= excursion {
-                    return Ok((Found::Fold(c), points));
-                }
+            let fold = continuation.events().iter().find_map(|event| match event {
+                ContinuationEvent::Fold { parameter, .. } => Some(*parameter),
+                _ => None,
+            });
+            if let Some(fold) = fold {
+                return Ok((Found::Fold(fold), points));
             }
         }
         let found = match continuation.termination() {
