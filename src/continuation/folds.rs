@@ -107,6 +107,15 @@ impl FoldDetector {
         self
     }
 
+    /// Replaces the tangent's parameter component of the last point pushed (the same point
+    /// corrected again on another discretisation, [`Continuation::resume`](super::Continuation::resume)):
+    /// its parameter, and so every decision taken, stay.
+    pub fn retangent_last(&mut self, tangent_parameter: f64) {
+        if let Some(last) = self.samples.last_mut() {
+            last.tangent_parameter = tangent_parameter;
+        }
+    }
+
     /// Adds the next accepted point: its parameter, the parameter component of its unit
     /// tangent oriented along the branch, and the θ-length of the chord from the previous
     /// point (ignored for the first). Returns the events this point decides (a fold it

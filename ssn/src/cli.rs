@@ -783,11 +783,19 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         columns.push(values);
     }
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
-        let label = format!(
-            "{} H = {}",
-            scene.solver.method.name(),
-            scene.solver.harmonics
-        );
+        let label = match (
+            response.harmonics.iter().min(),
+            response.harmonics.iter().max(),
+        ) {
+            (Some(lo), Some(hi)) if lo != hi => {
+                format!("{} H = {lo} to {hi}", scene.solver.method.name())
+            }
+            _ => format!(
+                "{} H = {}",
+                scene.solver.method.name(),
+                scene.solver.harmonics
+            ),
+        };
         let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
         series.extend(stability_key(&st.stable));
         Plot {
@@ -809,6 +817,9 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
                 "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
                 ratio[i]
             );
+        }
+        if let Some(a) = &response.accuracy {
+            t += &crate::words::branch_accuracy(a, &response.harmonics);
         }
         t += &format!(
             "folds             {}\n",

@@ -25,35 +25,45 @@ pub(super) fn branch_contacts(
     let model = &rod.model;
     let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
     let points = response.output_points;
-    let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<ContactReport>>, RunError> {
-        response
-            .states
-            .iter()
-            .map(|x| {
-                let forces = (0..contacts.len())
-                    .map(|i| problem.contact_force(x, i, points))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let displacements = (0..contacts.len())
-                    .map(|i| problem.row_displacement(x, i, points))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let closed = (0..contacts.len())
-                    .map(|i| problem.closed_intervals(x, i))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let mut reports = contact_reports(&contacts, &forces, &displacements);
-                set_closed_fractions(&mut reports, &closed);
-                Ok(reports)
-            })
-            .collect()
+    let report = |problem: &dyn HbReconstruction, x: &[f64]| -> Result<_, RunError> {
+        let forces = (0..contacts.len())
+            .map(|i| problem.contact_force(x, i, points))
+            .collect::<Result<Vec<_>, _>>()?;
+        let displacements = (0..contacts.len())
+            .map(|i| problem.row_displacement(x, i, points))
+            .collect::<Result<Vec<_>, _>>()?;
+        let closed = (0..contacts.len())
+            .map(|i| problem.closed_intervals(x, i))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut reports = contact_reports(&contacts, &forces, &displacements);
+        set_closed_fractions(&mut reports, &closed);
+        Ok(reports)
     };
-    // The reconstructions over one period do not depend on the frequency: any valid one.
+    // The reconstructions over one period do not depend on the frequency: any valid one,
+    // with the point's harmonics (built again where they change along the branch).
     let omega = rod.omega_1;
+    let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
+        Ok(match s.method {
+            Method::SsnHb => Box::new(SsnHb::new(model, omega, &hb_options(s))?),
+            _ => Box::new(PenaltyHb::new(model, omega, &penalty_options(s, model))?),
+        })
+    };
+    let hb = || -> Result<Vec<Vec<ContactReport>>, RunError> {
+        let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
+        let mut out = Vec::with_capacity(response.points());
+        for (i, x) in response.states.iter().enumerate() {
+            let at = response.point_settings(settings, i);
+            let key = (at.harmonics, at.time_samples);
+            if current.as_ref().is_none_or(|(k, _)| *k != key) {
+                current = Some((key, build(&at)?));
+            }
+            let (_, problem) = current.as_ref().expect("built above");
+            out.push(report(problem.as_ref(), x)?);
+        }
+        Ok(out)
+    };
     match settings.method {
-        Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
-        Method::PenaltyHb => hb(&PenaltyHb::new(
-            model,
-            omega,
-            &penalty_options(settings, model),
-        )?),
+        Method::SsnHb | Method::PenaltyHb => hb(),
         Method::LcpSsn => {
             let m = contacts.len();
             Ok(response

@@ -166,9 +166,10 @@ pub fn refine_folds(
             .find(|&j| (response.omega[j] - fold).abs() >= APPROACH * omega_1)
             .unwrap_or(0);
         let heading = fold - response.omega[start];
+        let at_fold = response.point_settings(settings, index);
         let mut rungs = vec![FoldRung {
-            harmonics: settings.harmonics,
-            time_samples: settings.time_samples,
+            harmonics: at_fold.harmonics,
+            time_samples: at_fold.time_samples,
             omega: fold,
             points: 0,
             seconds: 0.0,
@@ -195,7 +196,7 @@ pub fn refine_folds(
                 from: (
                     response.omega[start],
                     &response.states[start],
-                    settings.harmonics,
+                    response.point_settings(settings, start).harmonics,
                 ),
                 heading,
                 near: fold,
