@@ -312,11 +312,8 @@ where
     fn start(&mut self, x0: Vec<f64>, p0: f64, carried: Option<&[f64]>) {
         let mut x = x0;
         let mut p = p0;
-        let corrected = match carried {
-            None => self.correct_start(&mut x, &mut p, self.options.direction),
-            Some(carried) => self.correct_along(&mut x, &mut p, carried),
-        };
-        let corrected = match corrected {
+        let orientation = (carried, self.options.direction);
+        let corrected = match self.correct_start(&mut x, &mut p, orientation) {
             Ok(c) => c,
             Err(failure) => {
                 self.problem.set_parameter(p0);
@@ -364,7 +361,7 @@ where
         if self.stop_if_budget_spent(parameter) {
             return;
         }
-        let corrected = match self.correct_start(&mut x, &mut p, direction) {
+        let corrected = match self.correct_start(&mut x, &mut p, (None, direction)) {
             Ok(c) => c,
             Err(failure) => {
                 let parameter = self.last.as_ref().map_or(p, |l| l.parameter);

@@ -1,9 +1,8 @@
 //! Taking a branch up again on another problem: the same branch in another discretisation
 //! (more or fewer unknowns), from where a run stood.
 
-use super::super::corrector::{Constraint, Corrected};
 use super::{Continuation, Phase};
-use crate::continuation::{ContinuationError, ContinuationOptions, CorrectorFailure, FoldDetector};
+use crate::continuation::{ContinuationError, ContinuationOptions, FoldDetector};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 /// Where a run stood after its last accepted point ([`Continuation::resumption`]): enough
@@ -99,24 +98,5 @@ where
             carried: direction,
         };
         Ok(run)
-    }
-
-    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented along
-    /// `carried` (a resumed run's start).
-    pub(super) fn correct_along(
-        &mut self,
-        x: &mut [f64],
-        p: &mut f64,
-        carried: &[f64],
-    ) -> Result<Corrected, CorrectorFailure> {
-        let constraint = Constraint {
-            arclength: false,
-            w_p: 1.0,
-            target: *p,
-        };
-        let corrected = self.correct_at(x, p, constraint).0?;
-        self.take_tangent(Some(carried), 0.0);
-        self.direction.copy_from_slice(&self.tangent);
-        Ok(corrected)
     }
 }

@@ -112,13 +112,14 @@ where
         outcome
     }
 
-    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented so that `p`
-    /// moves as `direction` says.
+    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented along
+    /// `carried` when given (a resumed run's start), else so that `p` moves as
+    /// `direction` says.
     pub(super) fn correct_start(
         &mut self,
         x: &mut [f64],
         p: &mut f64,
-        direction: Direction,
+        (carried, direction): (Option<&[f64]>, Direction),
     ) -> Result<Corrected, CorrectorFailure> {
         let constraint = Constraint {
             arclength: false,
@@ -126,7 +127,7 @@ where
             target: *p,
         };
         let corrected = self.correct_at(x, p, constraint).0?;
-        self.take_tangent(None, direction.sign());
+        self.take_tangent(carried, direction.sign());
         self.direction.copy_from_slice(&self.tangent);
         Ok(corrected)
     }
