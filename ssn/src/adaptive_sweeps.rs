@@ -19,6 +19,9 @@ use semismooth_contact::solve::{solve, RunError};
 use semismooth_contact::sweep::adaptive::HARMONICS_LADDER;
 use semismooth_contact::sweep::frequency_response;
 
+/// A point's reference: its state and the observed dof's extremes.
+type Reference = (Vec<f64>, (f64, f64));
+
 /// Harmonics of the reference solves.
 pub const REFERENCE_HARMONICS: usize = 320;
 
@@ -166,7 +169,7 @@ pub fn compare_adaptive(
     let reference_settings = fixed_at(REFERENCE_HARMONICS);
     say("references");
     // Each point's reference state and extremes.
-    let mut references: Vec<Option<(Vec<f64>, (f64, f64))>> = Vec::with_capacity(adaptive.points());
+    let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points());
     let mut errors = Vec::with_capacity(adaptive.points());
     for i in 0..adaptive.points() {
         let h = adaptive.harmonics[i];
