@@ -14,7 +14,6 @@ use std::time::Instant;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::Residual;
 use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
-use semismooth_contact::model::{ContactRow, FrictionPoint};
 use semismooth_contact::structures::{BladedDisk, DiskLoading, SHIPPED_MISTUNING};
 
 fn main() {
@@ -38,15 +37,9 @@ fn main() {
     );
     println!("|---:|---:|---:|---:|---:|---:|");
     for normal_load in [1e-4, 1e-2, 1.0] {
-        let mut structure = disk.structure(&loading).expect("a valid disk");
-        for j in 0..disk.blades {
-            let platform = ContactRow::unit(BladedDisk::pad(j), 1.0);
-            structure
-                .model
-                .friction
-                .push(FrictionPoint::prescribed(platform, 0.3, normal_load));
-        }
-        let omega = loading.omega(structure.omega_1);
+        let (structure, omega) = disk
+            .with_platform_friction(&loading, 0.3, normal_load)
+            .expect("a valid disk");
         let options = HbOptions {
             harmonics,
             ..HbOptions::default()

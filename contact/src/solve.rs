@@ -24,8 +24,8 @@ use semismooth::newton::{
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
 
-use crate::contacts::{contact_reports, ContactReport};
-use crate::contacts::{period_statistics, PeriodStatistics};
+use crate::contacts::{contact_reports, ContactReport, FrictionReport};
+use crate::contacts::{march_friction_report, period_statistics, PeriodStatistics};
 use crate::hb::{
     CondensedSolve, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
@@ -36,7 +36,7 @@ use crate::lcp::{
 };
 use crate::march::{march_from_state, MarchError, MarchOptions, MarchScheme, MarchState};
 use crate::model::Structure;
-use crate::model::DEFAULT_C_FACTOR;
+use crate::model::{NormalForce, DEFAULT_C_FACTOR};
 use crate::rod::ModelError;
 use crate::settings::{GlobalizationChoice, Method, SolverSettings};
 use accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
@@ -269,6 +269,9 @@ pub struct Solution {
     pub stats: PeriodStatistics,
     /// Every contact point over the period.
     pub contacts: Vec<ContactReport>,
+    /// Every friction point over the period, at [`Solution::times`] (harmonic balance and
+    /// time marching; empty for the LCP, which has no friction).
+    pub friction: Vec<FrictionReport>,
     /// Work counters.
     pub counters: RunCounters,
     /// The method's unknowns, for warm starts: HB coefficients, the LCP's `z`, the state
@@ -324,6 +327,18 @@ pub(crate) fn penalty_options(
             .penalty_stiffness
             .unwrap_or_else(|| PenaltyHbOptions::default_penalty_stiffness(model)),
     }
+}
+
+/// The scene's penalty-HB problem at `omega`: [`penalty_options`] and the friction
+/// regularisation of `settings`.
+pub(crate) fn penalty_problem(
+    model: &crate::model::StructuralModel,
+    omega: f64,
+    settings: &SolverSettings,
+) -> Result<PenaltyHb, HbError> {
+    let mut problem = PenaltyHb::new(model, omega, &penalty_options(settings, model))?;
+    problem.set_friction_regularisation(settings.friction_regularisation)?;
+    Ok(problem)
 }
 
 /// The periodic LCP's options of a scene and the index of the tip's contact: the tip is
@@ -465,6 +480,7 @@ struct Period {
     tip: Vec<f64>,
     contact_forces: Vec<Vec<f64>>,
     contact_displacements: Vec<Vec<f64>>,
+    friction: Vec<FrictionReport>,
 }
 
 /// The solution record of a run of the scene's method at `omega`.
@@ -497,6 +513,7 @@ fn solution(
     Solution {
         method,
         contacts,
+        friction: period.friction,
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
@@ -551,11 +568,15 @@ fn hb_outputs(
     let closed = (0..contacts)
         .map(|i| problem.closed_intervals(&x, i))
         .collect::<Result<Vec<_>, _>>()?;
+    let friction = (0..rod.model.friction.len())
+        .map(|f| problem.friction(&x, f, points))
+        .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
         times,
         tip,
         contact_forces,
         contact_displacements,
+        friction,
     };
     let mut solution = solution(
         rod,
@@ -661,7 +682,7 @@ pub(crate) fn solve_as_given(
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
             let target = options.penalty_stiffness;
-            let mut problem = PenaltyHb::new(model, omega, &options)?;
+            let mut problem = penalty_problem(model, omega, settings)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
             // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
@@ -672,7 +693,26 @@ pub(crate) fn solve_as_given(
             // last converged stiffness with the square root of the factor.
             let mut counters = WorkCounters::default();
             let mut homotopy_iterations = 0;
-            if warm_start.is_none() {
+            // Regularisation homotopy: a narrow tanh law is a near-discontinuity Newton
+            // cannot cross from zero, so without a warm start its width is narrowed in log
+            // from the static slip itself (a soft, nearly viscous law) by factors of 10.
+            let width = settings.friction_regularisation;
+            if warm_start.is_none() && !model.friction.is_empty() && width < 1.0 {
+                let stages = homotopy(
+                    0.0,
+                    -width.ln(),
+                    &HomotopySchedule::default(),
+                    &mut x,
+                    |narrowing, x| {
+                        problem.set_friction_regularisation((-narrowing).exp())?;
+                        newton_hb(&mut problem, x, settings, model, (target, None))
+                    },
+                )?;
+                counters += stages.counters;
+                homotopy_iterations += stages.iterations;
+                problem.set_friction_regularisation(width)?;
+            }
+            if warm_start.is_none() && !model.contacts.is_empty() {
                 let k0 = model
                     .static_contact_stiffness()
                     .map(|s| DEFAULT_C_FACTOR * s)
@@ -689,7 +729,7 @@ pub(crate) fn solve_as_given(
                     },
                 )?;
                 counters += stages.counters;
-                homotopy_iterations = stages.iterations;
+                homotopy_iterations += stages.iterations;
                 problem.set_penalty_stiffness(target)?;
             }
             let mut report = newton_hb(&mut problem, &mut x, settings, model, (target, None))?;
@@ -835,6 +875,7 @@ fn solve_lcp(
         tip: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
+        friction: Vec::new(),
     };
     let mut sol = solution(
         rod,
@@ -874,6 +915,40 @@ fn march_state(model: &crate::model::StructuralModel, state: &[f64]) -> Option<M
         velocity: state[n..2 * n].to_vec(),
         contact_force: state[2 * n..].to_vec(),
     })
+}
+
+/// The slip limit `mu N` of each friction point at the steps of a marched period, from the
+/// contacts' forces there.
+fn march_slip_limits(model: &crate::model::StructuralModel, forces: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let steps = forces.first().map_or(0, Vec::len);
+    model
+        .friction
+        .iter()
+        .map(|point| match point.normal {
+            NormalForce::Contact(p) => forces[p].iter().map(|l| point.slip_limit(*l)).collect(),
+            NormalForce::Prescribed(_) => vec![point.slip_limit(0.0); steps.max(1)],
+        })
+        .collect()
+}
+
+/// The largest static deflection under the load, `max |K^{-1} f|` (0 when `K` cannot be
+/// factored): a displacement scale that does not vanish when nothing moves.
+fn static_deflection(model: &crate::model::StructuralModel) -> f64 {
+    use semismooth::{Factorize, LinearSolve};
+    let mut lu = semismooth::linalg::FaerSparseLu::new();
+    let mut u = model.load.clone();
+    match lu
+        .factor(&model.stiffness)
+        .and_then(|_| lu.solve_in_place(&mut u))
+    {
+        Ok(()) if u.iter().all(|v| v.is_finite()) => max_abs(&u),
+        _ => 0.0,
+    }
+}
+
+/// Largest magnitude of a series (0 for an empty one).
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
 }
 
 /// Time marching from rest (or from `warm_start`, the [`Solution::state`] of a march of
@@ -959,12 +1034,25 @@ fn solve_march(
         solve_seconds: seconds,
         newton: None,
     };
+    let slip_limits = march_slip_limits(model, &forces);
+    let velocity_scale = omega * max_abs(&tip_series).max(static_deflection(model));
+    let friction = period
+        .friction_forces
+        .iter()
+        .zip(&period.slip_velocities)
+        .zip(slip_limits)
+        .enumerate()
+        .map(|(f, ((force, velocity), limit))| {
+            march_friction_report(f, cut(force), cut(velocity), &limit, velocity_scale)
+        })
+        .collect();
     let final_state = period.final_state;
     let period = Period {
         times,
         tip: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
+        friction,
     };
     let state = [
         final_state.displacement,

@@ -176,6 +176,13 @@ result_methods!(Solution, "Solution", {
         self.stored.field(py, "contacts")
     }
 
+    /// Per-friction-point quantities (the JSON's `friction`: stick fraction, force
+    /// amplitude, and the tangential force and slip velocity over the period).
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.stored.field(py, "friction")
+    }
+
     /// Why the solver stopped (`converged`, `max-iterations`, ...).
     #[getter]
     fn termination(&self) -> String {

@@ -14,7 +14,8 @@
 //! for 1e-3, 1e-4 and 1e-5 against the reference, about 10 minutes, most of it Lemke and
 //! harmonic balance at their finest), `sweeps` (about 10 s), `from-zero` (the public grid with `auto` and
 //! `hybrid`, about 6 s), `performance` (what the examples time, about 2 s), `hard` (the
-//! hard cases from zero, about 2 minutes, most of it the 100-contact rod). Wall times vary
+//! hard cases from zero, about 2 minutes, most of it the 100-contact rod), `friction` (Den
+//! Hartog's oscillator by H and the friction-damper curve, about 5 s). Wall times vary
 //! with the machine and its load (each block names the machine it was measured on); every
 //! other cell is deterministic, and `tests/docs_tables.rs` checks those of the cheap
 //! tables against the docs files.
@@ -79,6 +80,11 @@ fn compute(section: &str) -> Result<String, Box<dyn std::error::Error>> {
                 .map(|(name, cases)| tables::solve_group(name, cases, GlobalizationChoice::Auto))
                 .collect();
             out.push_str(&tables::from_zero_hard(&groups).markdown());
+        }
+        "friction" => {
+            out.push_str(&ssn::friction_tables::den_hartog_convergence()?.markdown());
+            out.push('\n');
+            out.push_str(&ssn::friction_tables::damper_curve()?.markdown());
         }
         other => return Err(format!("unknown section {other:?}").into()),
     }

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod describe;
 pub mod exit;
 pub mod figures;
+pub mod friction_tables;
 pub mod import;
 pub mod io;
 pub mod json;

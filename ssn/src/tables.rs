@@ -31,8 +31,8 @@ pub struct Section {
 /// Every section, in the order the example computes them: the method comparison, the
 /// cheapest setting per accuracy, the discretisation chosen for an accuracy target, the
 /// frequency sweeps, the public grid from zero, what the
-/// examples time, and the hard cases from zero (minutes).
-pub const SECTIONS: [Section; 7] = [
+/// examples time, the hard cases from zero (minutes), and the friction tables.
+pub const SECTIONS: [Section; 8] = [
     Section {
         name: "methods",
         file: "docs/method-comparison.md",
@@ -60,6 +60,10 @@ pub const SECTIONS: [Section; 7] = [
     Section {
         name: "hard",
         file: "docs/solving-from-zero.md",
+    },
+    Section {
+        name: "friction",
+        file: "docs/friction.md",
     },
 ];
 
@@ -126,7 +130,7 @@ pub struct Table {
 }
 
 impl Table {
-    fn new(header: &[&str], timing: &[usize]) -> Self {
+    pub(crate) fn new(header: &[&str], timing: &[usize]) -> Self {
         Self {
             header: header.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),

@@ -179,7 +179,9 @@ use crate::model::{
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
-pub use penalty::{PenaltyHb, PenaltyHbOptions, DEFAULT_RELATIVE_PENALTY};
+pub use penalty::{
+    PenaltyHb, PenaltyHbOptions, DEFAULT_FRICTION_REGULARISATION, DEFAULT_RELATIVE_PENALTY,
+};
 pub(crate) use ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use ssn::{HbOptions, SsnHb};
 pub use structured::{

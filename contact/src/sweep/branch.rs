@@ -19,7 +19,7 @@ use crate::contacts::ContactSummary;
 use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, RunError};
+use crate::solve::{hb_options, penalty_problem, RunError};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::FrequencyResponse;
 
@@ -89,11 +89,7 @@ impl Reconstruction {
     ) -> Result<Self, RunError> {
         Ok(match settings.method {
             Method::SsnHb => Self::Ssn(SsnHb::new(model, omega, &hb_options(settings))?),
-            Method::PenaltyHb => Self::Penalty(PenaltyHb::new(
-                model,
-                omega,
-                &penalty_options(settings, model),
-            )?),
+            Method::PenaltyHb => Self::Penalty(penalty_problem(model, omega, settings)?),
             other => {
                 return Err(RunError::Unsupported {
                     method: other.name(),

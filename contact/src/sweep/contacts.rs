@@ -7,11 +7,11 @@
 //! branch (`lcp-ssn`) has them at its `Nt` time nodes: the state is `(w, z)`, time-major,
 //! so contact `c` has displacement `u = g - w[n m + c]` and force `-z[n m + c]` at node `n`.
 
-use crate::contacts::{contact_reports, ContactReport};
-use crate::hb::{PenaltyHb, SsnHb};
+use crate::contacts::{contact_reports, ContactReport, FrictionSummary};
+use crate::hb::SsnHb;
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, set_closed_fractions, HbReconstruction, RunError};
+use crate::solve::{hb_options, penalty_problem, set_closed_fractions, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
@@ -49,11 +49,7 @@ pub(super) fn branch_contacts(
     let omega = rod.omega_1;
     match settings.method {
         Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
-        Method::PenaltyHb => hb(&PenaltyHb::new(
-            model,
-            omega,
-            &penalty_options(settings, model),
-        )?),
+        Method::PenaltyHb => hb(&penalty_problem(model, omega, settings)?),
         Method::LcpSsn => {
             let m = contacts.len();
             Ok(response
@@ -63,6 +59,39 @@ pub(super) fn branch_contacts(
                 .collect())
         }
         Method::LcpLemke | Method::March => Ok(Vec::new()),
+    }
+}
+
+/// The friction summaries of each point of a harmonic-balance `response` (one list per
+/// point, the friction points in the model's order), reconstructed on its output points;
+/// no lists for methods without friction.
+pub(super) fn branch_friction(
+    rod: &Structure,
+    settings: &SolverSettings,
+    response: &FrequencyResponse,
+) -> Result<Vec<Vec<FrictionSummary>>, RunError> {
+    let model = &rod.model;
+    let (count, points) = (model.friction.len(), response.output_points);
+    let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<FrictionSummary>>, RunError> {
+        response
+            .states
+            .iter()
+            .map(|x| {
+                (0..count)
+                    .map(|f| Ok(problem.friction(x, f, points)?.summary))
+                    .collect()
+            })
+            .collect()
+    };
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    // The reconstructions over one period do not depend on the frequency: any valid one.
+    let omega = rod.omega_1;
+    match settings.method {
+        Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
+        Method::PenaltyHb => hb(&penalty_problem(model, omega, settings)?),
+        _ => Ok(Vec::new()),
     }
 }
 

@@ -35,7 +35,7 @@ use super::{
     continuation_error, continuation_options, hb_solver, penalty_continuation, ssn_continuation,
     MethodContinuation,
 };
-use crate::hb::{resize_harmonics, PenaltyHb, SsnHb};
+use crate::hb::{resize_harmonics, SsnHb};
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::accuracy::{search::MAX_SEARCH_UNKNOWNS, HB_ORDER};
@@ -288,11 +288,16 @@ impl Segment<'_> {
             }
             _ => {
                 let options = penalty_options(self.settings, model);
-                let mut problem = PenaltyHb::new(model, omega, &options)?;
+                let mut problem = crate::solve::penalty_problem(model, omega, self.settings)?;
                 let x = resize_harmonics(state, from_h, h, dofs, 0);
                 let method = penalty_continuation(model, &problem, &options, self.u_ref);
+                let affine = method.affine_pieces;
                 self.follow((&mut problem, &mut *solver), &x, method, |c| {
-                    c.with_affine_pieces()
+                    if affine {
+                        c.with_affine_pieces()
+                    } else {
+                        c
+                    }
                 })?
             }
         };

@@ -153,6 +153,7 @@ fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
 fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
+    model.friction.clear();
     let dofs = model.dofs().max(1);
     let options = PenaltyHbOptions {
         harmonics: 1,
@@ -254,7 +255,7 @@ fn penalty_continuation(
     MethodContinuation {
         units: vec![1.0; problem.dim()],
         residual_floor: f64::EPSILON * options.penalty_stiffness * largest_gap(model, u_ref),
-        affine_pieces: true,
+        affine_pieces: model.friction.is_empty(),
     }
 }
 
@@ -442,6 +443,7 @@ where
         stability: BranchStability::default(),
         stability_seconds: 0.0,
         contacts: Vec::new(),
+        friction: Vec::new(),
     };
     if !report.converged() {
         response.termination = SweepTermination::StartNotConverged {
@@ -561,6 +563,7 @@ pub fn frequency_response(
         branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64)),
     )?;
     response.contacts = contacts::branch_contacts(rod, settings, &response)?;
+    response.friction = contacts::branch_friction(rod, settings, &response)?;
     let started = Instant::now();
     let total = response.points();
     let stability_progress =
@@ -622,7 +625,7 @@ pub(crate) fn follow_branch(
         }
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
-            let mut problem = PenaltyHb::new(model, omega_from, &options)?;
+            let mut problem = crate::solve::penalty_problem(model, omega_from, settings)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
             let method = penalty_continuation(model, &problem, &options, u_ref);
@@ -631,7 +634,14 @@ pub(crate) fn follow_branch(
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
-                |c| c.with_affine_pieces(),
+                // With friction (regularised, smooth) the branch is not piecewise affine.
+                |c| {
+                    if model.friction.is_empty() {
+                        c.with_affine_pieces()
+                    } else {
+                        c
+                    }
+                },
                 progress,
             )
         }

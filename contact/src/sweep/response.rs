@@ -3,7 +3,7 @@
 use semismooth::continuation::{ContinuationCounters, ContinuationTermination, CorrectorFailure};
 use semismooth::harmonic::{Aft, FourierBasis};
 
-use crate::contacts::ContactReport;
+use crate::contacts::{ContactReport, FrictionSummary};
 use crate::hb::HbError;
 use crate::settings::Method;
 use crate::solve::{RunCounters, RunError};
@@ -75,6 +75,9 @@ pub struct FrequencyResponse {
     pub stability_seconds: f64,
     /// Every contact of each point, in the scene's order (as `ssn solve` reports them).
     pub contacts: Vec<Vec<ContactReport>>,
+    /// Every friction point of each point, in the model's order (stick fraction, force
+    /// and slip velocity amplitudes, as `ssn solve` reports them).
+    pub friction: Vec<Vec<FrictionSummary>>,
 }
 
 /// Why a sweep stopped.

@@ -225,3 +225,17 @@ pub fn sweep_fig2_interval(
 ) -> Result<FrequencyResponse, RunError> {
     frequency_response(rod, settings, &SweepSettings::new(0.5, 2.0), None)
 }
+
+/// The amplitude `sqrt(a_1^2 + b_1^2)` of the first harmonic of `N` equally spaced
+/// samples of one period (the trapezoidal rule, exact for a trigonometric polynomial of
+/// degree `< N - 1`).
+pub fn first_harmonic(u: &[f64]) -> f64 {
+    let n = u.len() as f64;
+    let (mut a, mut b) = (0.0, 0.0);
+    for (j, v) in u.iter().enumerate() {
+        let phase = 2.0 * std::f64::consts::PI * j as f64 / n;
+        a += v * phase.cos();
+        b += v * phase.sin();
+    }
+    2.0 * a.hypot(b) / n
+}

@@ -233,6 +233,7 @@ struct RawSolver {
     time_samples: Option<i64>,
     c: Option<f64>,
     penalty_stiffness: Option<f64>,
+    friction_regularisation: Option<f64>,
     #[serde(default)]
     linear_solver: LinearSolverChoice,
     max_iterations: Option<i64>,
