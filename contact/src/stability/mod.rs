@@ -32,15 +32,16 @@
 //! periods of the highest harmonic whatever happens physically. What the orbit does at the
 //! end of the interval tells which law it follows, and the monodromy uses that law:
 //!
-//! - The orbit stays on the obstacle and leaves it slowly (a release speed at most
-//!   [`REBOUND`] times the approach speed; the rod with consistent mass, whose tip the rod
-//!   behind it keeps pressed): a perfectly inelastic impact (restitution 0) that keeps the
+//! - The orbit stays on the obstacle and leaves it slower than it came (a release speed
+//!   at most [`REBOUND`] times the approach speed; the rod with consistent mass, whose tip
+//!   the rod behind it keeps pressed): a perfectly inelastic impact (restitution 0) that keeps the
 //!   dof on the obstacle until the contact force returns to zero. Its saltation at the
 //!   closing depends on the model only (module `phases`), and the interval is a phase with
 //!   the dof held. Moreau–Jean marching with restitution 0 marches the same law
 //!   (`contact/tests/stability_impacts.rs`).
 //! - The orbit rebounds (a release speed above [`REBOUND`] times the approach speed; the
-//!   two-dof chain with a stop on its mass, 0.97 to 1.0 at `H = 40`): an impact with the orbit's restitution
+//!   two-dof chain with a stop on its mass, 0.97 to 1.0 at `H = 40`; an orbit grazing the
+//!   stop): an impact with the orbit's restitution
 //!   `e = min(1, release / approach)` at the interval's midpoint, followed by free flight.
 //!   Its saltation `S = DR + (f+ - DR f-) n^T / (n^T f-)` (Müller 1995) carries the term
 //!   `(1 + e) w a_c / v_c` (free acceleration over approach speed of the contact dof), which
@@ -102,9 +103,11 @@ pub const MARGINAL: f64 = 1e-9;
 /// A closed interval of a contact on a dof with mass is an impact with rebound when the
 /// orbit leaves the obstacle at more than this fraction of its approach speed (module
 /// documentation). Measured: 0.97 to 1.0 on the two-dof chain with a stop on its mass
-/// (`H = 40`), -0.07 to 0.33 on the rod with consistent mass (`H = 20`), whose tip the rod
-/// behind it keeps pressed; any value between separates the two.
-pub const REBOUND: f64 = 0.5;
+/// (`H = 40`); on the rod with consistent mass, whose tip the rod behind it keeps pressed,
+/// -0.07 to 0.33 at `H = 20` and 0.55 to 0.87 at `H = 5` except within 5e-3 `omega_1` of
+/// its first contact (0.93 to 1.0: the orbit grazes the stop and leaves it at once, as
+/// Moreau–Jean marching with restitution 0 does there, and is unstable).
+pub const REBOUND: f64 = 0.9;
 
 /// Options of [`map_stability`].
 #[derive(Debug, Clone, Copy, PartialEq)]
