@@ -9,6 +9,8 @@
 //! what happened.
 
 pub mod accuracy;
+mod raised_c;
+pub use raised_c::RAISED_C_FACTOR;
 mod reconstruction;
 
 pub(crate) use reconstruction::HbReconstruction;
@@ -283,6 +285,16 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// `settings` with the complementarity constant this solution solved with (SSN-HB
+    /// raises the default when Newton cannot leave the start with it): the settings that
+    /// pose its equation again, for a second solve or its stability.
+    pub fn solved_settings(&self, settings: &SolverSettings) -> SolverSettings {
+        SolverSettings {
+            c: self.c.or(settings.c),
+            ..settings.clone()
+        }
+    }
+
     /// Whether the run converged ([`Termination::converged`]).
     pub fn converged(&self) -> bool {
         self.termination.converged()
@@ -629,7 +641,9 @@ pub fn solve(
     }
     let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
     if settings.estimate_error {
-        solution.error_estimate = accuracy::estimate(rod, omega, settings, &solution);
+        // The second solve poses the equation the first one solved (its `c` may be raised).
+        let solved = solution.solved_settings(settings);
+        solution.error_estimate = accuracy::estimate(rod, omega, &solved, &solution);
     }
     Ok(solution)
 }
@@ -649,8 +663,7 @@ pub(crate) fn solve_as_given(
             let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
-            let smoothing = Some(SmoothingOf::new());
-            let report = newton_hb(&mut problem, &mut x, settings, model, (0.0, smoothing))?;
+            let report = raised_c::ssn_hb_newton(&mut problem, &mut x, settings, model, omega)?;
             let seconds = start.elapsed().as_secs_f64();
             let points = HB_OUTPUT_POINTS.max(settings.time_samples);
             let outcome = Outcome::of_newton(&report, seconds);

@@ -428,7 +428,7 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
             // multipliers of SSN-HB): the contact phases are read from it.
             let stability = semismooth_contact::stability::hb_stability(
                 &loaded.structure.model,
-                settings,
+                &solution.solved_settings(settings),
                 loaded.omega,
                 &solution.state,
             )
