@@ -400,7 +400,7 @@ pub struct Fig2 {
 /// resonance ([`resonance_window`]), where the folds and the unstable parts lie.
 ///
 /// With the consistent mass the contact node has mass: the verdict is that of the
-/// harmonic-balance orbit under a perfectly inelastic impact (module
+/// harmonic-balance orbit under the impact law it follows (module
 /// `semismooth_contact::stability`).
 pub fn figure_2(out: &Path, harmonics: usize, mass: MassModel) -> Result<Vec<Fig2Curve>, CliError> {
     let fig = figure_2_curves(harmonics, mass)?;
@@ -627,9 +627,10 @@ pub fn default_run(out: &Path) -> Result<(), CliError> {
          the branches fold over (the jump frequencies are the folds) and are unstable between \
          their folds. Stability: solid stable, dashed unstable, dotted undecided. With the \
          consistent mass (the paper's rod, fig2_H5.svg) the contact node has mass: the \
-         verdict is that of the harmonic-balance orbit under a perfectly inelastic impact \
-         (restitution 0), the law under which a closed interval follows an arrival with \
-         speed. At H = 5 the branches turn several times near their peaks: the contact \
+         verdict is that of the harmonic-balance orbit under the impact law it follows: a \
+         perfectly inelastic impact (restitution 0) where it stays on the stop, its own \
+         restitution where it rebounds or grazes the stop (just above the first contact, \
+         where the impacting orbits are unstable). At H = 5 the branches turn several times near their peaks: the contact \
          holds only in the Galerkin sense (ssn/examples/strange_loops.rs)."
     )?;
     crate::outln!(

@@ -209,17 +209,12 @@ pub fn branch_stability(
             report(i + 1);
         }
     }
-    let reversals: Vec<usize> = {
-        let mut r: Vec<usize> = response
-            .fold_indices
-            .iter()
-            .chain(&response.corner_fold_indices)
-            .copied()
-            .collect();
-        r.sort_unstable();
-        r
-    };
-    let outside = fold_consistent_counts(&analyses, &reversals);
+    // The folds only: a zigzag of the truncated balance (`corner_folds`) turns back and
+    // forth within the fold excursion, and counting its two reversals would flip the
+    // verdict of the points between them.
+    // They come in branch order, with their frequencies in `folds`.
+    let reversals = &response.fold_indices;
+    let outside = fold_consistent_counts(&analyses, reversals);
     for (s, counts) in analyses.iter().zip(&outside) {
         if s.stable.is_none() && out.undecided.is_none() {
             out.undecided.clone_from(&s.undecided);
@@ -238,9 +233,9 @@ pub fn branch_stability(
             let (before, _) = outside[j].expect("decided");
             if let Some(kind) = crossing_of(before, after) {
                 let (w0, w1) = (response.omega[j], response.omega[i]);
-                let omega = match reversals.iter().find(|&&r| j <= r && r <= i) {
+                let omega = match reversals.iter().position(|&r| j <= r && r <= i) {
                     // A fold of the branch between the two: the crossing is the fold.
-                    Some(&r) if kind == BifurcationKind::Fold => response.omega[r],
+                    Some(k) if kind == BifurcationKind::Fold => response.folds[k],
                     _ => {
                         let a0 = analyses[j].floquet_max_abs.unwrap_or(1.0);
                         let a1 = analyses[i].floquet_max_abs.unwrap_or(1.0);
