@@ -25,13 +25,7 @@ fn main() {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: Vec::new(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped(Vec::new());
     println!(
         "| normal load N | H | unknowns | Newton iterations | solve time | blade 0 peak tip |"
     );

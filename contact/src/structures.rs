@@ -66,6 +66,19 @@ pub struct DiskLoading {
 }
 
 impl DiskLoading {
+    /// The loading of the shipped disk scenes (`scenes/bladed_disk_casing.toml`): casing
+    /// clearance 1 on the pads of `stops`, load amplitude 0.02, 1 % damping, forced at the
+    /// tuned resonance.
+    pub fn shipped(stops: Vec<usize>) -> Self {
+        Self {
+            stops,
+            gap: 1.0,
+            amplitude: 0.02,
+            zeta: 0.01,
+            omega_ratio: 1.0,
+        }
+    }
+
     /// The forcing frequency for a disk whose first natural frequency is `omega_1`
     /// ([`Structure::omega_1`] of [`BladedDisk::structure`]).
     pub fn omega(&self, omega_1: f64) -> f64 {

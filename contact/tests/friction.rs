@@ -417,13 +417,7 @@ fn disk_with_friction(blades: usize, normal_load: f64) -> (StructuralModel, f64)
         blades,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: Vec::new(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped(Vec::new());
     let (structure, omega) = disk
         .with_platform_friction(&loading, 0.3, normal_load)
         .unwrap();

@@ -61,13 +61,7 @@ fn friction(c: &mut Criterion) {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: Vec::new(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped(Vec::new());
     let (structure, omega) = disk
         .with_platform_friction(&loading, 0.3, 1e-2)
         .expect("a valid disk");

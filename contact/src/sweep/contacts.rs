@@ -15,35 +15,47 @@ use crate::solve::{hb_options, penalty_problem, set_closed_fractions, HbReconstr
 
 use super::FrequencyResponse;
 
-/// The per-contact reports of each point of `response` (one list per point, the contacts
-/// in the scene's order). Methods that do not sweep give no points and no lists.
-pub(super) fn branch_contacts(
+/// Per-contact reports and friction summaries of every point of a branch, one list per
+/// point in the model's order of contacts and friction points.
+pub(super) type BranchReports = (Vec<Vec<ContactReport>>, Vec<Vec<FrictionSummary>>);
+
+/// The per-contact reports of each point of `response` and, for harmonic balance, the
+/// friction summaries (one list per point; none without friction points). Methods that do
+/// not sweep give no points and no lists.
+pub(super) fn branch_reports(
     rod: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
-) -> Result<Vec<Vec<ContactReport>>, RunError> {
+) -> Result<BranchReports, RunError> {
     let model = &rod.model;
     let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
+    let friction_points = model.friction.len();
     let points = response.output_points;
-    let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<ContactReport>>, RunError> {
-        response
-            .states
-            .iter()
-            .map(|x| {
-                let forces = (0..contacts.len())
-                    .map(|i| problem.contact_force(x, i, points))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let displacements = (0..contacts.len())
-                    .map(|i| problem.row_displacement(x, i, points))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let closed = (0..contacts.len())
-                    .map(|i| problem.closed_intervals(x, i))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let mut reports = contact_reports(&contacts, &forces, &displacements);
-                set_closed_fractions(&mut reports, &closed);
-                Ok(reports)
-            })
-            .collect()
+    let hb = |problem: &dyn HbReconstruction| -> Result<BranchReports, RunError> {
+        let mut reports = Vec::with_capacity(response.states.len());
+        let mut friction = Vec::new();
+        for x in &response.states {
+            let forces = (0..contacts.len())
+                .map(|i| problem.contact_force(x, i, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let displacements = (0..contacts.len())
+                .map(|i| problem.row_displacement(x, i, points))
+                .collect::<Result<Vec<_>, _>>()?;
+            let closed = (0..contacts.len())
+                .map(|i| problem.closed_intervals(x, i))
+                .collect::<Result<Vec<_>, _>>()?;
+            let mut point = contact_reports(&contacts, &forces, &displacements);
+            set_closed_fractions(&mut point, &closed);
+            reports.push(point);
+            if friction_points > 0 {
+                friction.push(
+                    (0..friction_points)
+                        .map(|f| Ok(problem.friction(x, f, points)?.summary))
+                        .collect::<Result<Vec<_>, RunError>>()?,
+                );
+            }
+        }
+        Ok((reports, friction))
     };
     // The reconstructions over one period do not depend on the frequency: any valid one.
     let omega = rod.omega_1;
@@ -52,46 +64,14 @@ pub(super) fn branch_contacts(
         Method::PenaltyHb => hb(&penalty_problem(model, omega, settings)?),
         Method::LcpSsn => {
             let m = contacts.len();
-            Ok(response
+            let reports = response
                 .states
                 .iter()
                 .map(|y| lcp_point_contacts(&contacts, y, m))
-                .collect())
+                .collect();
+            Ok((reports, Vec::new()))
         }
-        Method::LcpLemke | Method::March => Ok(Vec::new()),
-    }
-}
-
-/// The friction summaries of each point of a harmonic-balance `response` (one list per
-/// point, the friction points in the model's order), reconstructed on its output points;
-/// no lists for methods without friction.
-pub(super) fn branch_friction(
-    rod: &Structure,
-    settings: &SolverSettings,
-    response: &FrequencyResponse,
-) -> Result<Vec<Vec<FrictionSummary>>, RunError> {
-    let model = &rod.model;
-    let (count, points) = (model.friction.len(), response.output_points);
-    let hb = |problem: &dyn HbReconstruction| -> Result<Vec<Vec<FrictionSummary>>, RunError> {
-        response
-            .states
-            .iter()
-            .map(|x| {
-                (0..count)
-                    .map(|f| Ok(problem.friction(x, f, points)?.summary))
-                    .collect()
-            })
-            .collect()
-    };
-    if count == 0 {
-        return Ok(Vec::new());
-    }
-    // The reconstructions over one period do not depend on the frequency: any valid one.
-    let omega = rod.omega_1;
-    match settings.method {
-        Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
-        Method::PenaltyHb => hb(&penalty_problem(model, omega, settings)?),
-        _ => Ok(Vec::new()),
+        Method::LcpLemke | Method::March => Ok((Vec::new(), Vec::new())),
     }
 }
 

@@ -562,8 +562,7 @@ pub fn frequency_response(
         sweep,
         branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64)),
     )?;
-    response.contacts = contacts::branch_contacts(rod, settings, &response)?;
-    response.friction = contacts::branch_friction(rod, settings, &response)?;
+    (response.contacts, response.friction) = contacts::branch_reports(rod, settings, &response)?;
     let started = Instant::now();
     let total = response.points();
     let stability_progress =
