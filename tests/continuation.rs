@@ -11,7 +11,7 @@ use semismooth::continuation::{
     ContinuationTermination, CorrectorFailure, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver, Tolerances};
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::ParameterDependent;
 
@@ -665,7 +665,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
     // driver and a tolerance 100x tighter than the continuation's, so that a Newton step is
     // taken: the correction is about |J^{-1}| |F| <= 1e-10 / σ_min(J).
     let strict = PolyalgorithmOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         ..Default::default()
     };
     let mut solver = FaerDenseLu::new();

@@ -9,18 +9,18 @@
 //! `cargo run --release -p semismooth-contact --example bladed_disk_friction -- [H]`
 //! (default `H = 10`).
 
+mod args;
+
 use std::time::Instant;
 
+use args::positional;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::Residual;
 use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_contact::structures::{BladedDisk, DiskLoading, SHIPPED_MISTUNING};
 
 fn main() {
-    let harmonics: usize = std::env::args()
-        .nth(1)
-        .map(|a| a.parse().expect("H: a positive integer"))
-        .unwrap_or(10);
+    let harmonics: usize = positional(1, 10, "H: a positive integer");
     let disk = BladedDisk {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,

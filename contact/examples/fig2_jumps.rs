@@ -11,23 +11,20 @@
 //!
 //! `STEP` is the frequency step in `omega_1` (default 0.002), `STEPS_PER_PERIOD` the
 //! march's (default 500).
+mod args;
 #[path = "../tests/common/stepped_march.rs"]
 mod stepped_march;
 
 use std::time::Instant;
 
+use args::positional;
 use semismooth_contact::march::{MarchOptions, MarchScheme};
 use semismooth_contact::rod::{build_rod, RodSpec};
 use stepped_march::{branch_folds, jump, stepped_amplitudes};
 
 fn main() {
-    let arg = |i: usize, d: f64| {
-        std::env::args()
-            .nth(i)
-            .map(|s| s.parse().expect("a number"))
-            .unwrap_or(d)
-    };
-    let (step, steps_per_period) = (arg(1, 0.002), arg(2, 500.0) as usize);
+    let step = positional(1, 0.002, "STEP: a number");
+    let steps_per_period = positional(2, 500, "STEPS_PER_PERIOD: an integer");
     let rod = build_rod(&RodSpec::canonical().with_tip_gap(Some(0.5))).expect("the rod");
     let w1 = rod.omega_1;
     let (folds_5, folds_20) = (branch_folds(&rod, 5), branch_folds(&rod, 20));

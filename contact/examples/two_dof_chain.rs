@@ -13,19 +13,16 @@
 //! masses 0 and 1 (default `0.5 0.02 0 0.1`). `HS=10,20,40` chooses the harmonic counts;
 //! `DUMP=1` prints every point (frequency, tip extremes, Newton iterations, verdict,
 //! largest multiplier modulus).
+mod args;
 #[path = "../tests/common/chain.rs"]
 mod chain;
 
+use args::positional;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::sweep::frequency_response;
 
 fn main() {
-    let arg = |i: usize, d: f64| {
-        std::env::args()
-            .nth(i)
-            .map(|s| s.parse().expect("a number"))
-            .unwrap_or(d)
-    };
+    let arg = |i: usize, d: f64| positional(i, d, "a number");
     let structure = chain::chain(arg(1, 0.5), arg(2, 0.02), [arg(3, 0.0), arg(4, 0.1)]);
     let omega_1 = structure.omega_1;
     let hs: Vec<usize> = std::env::var("HS")

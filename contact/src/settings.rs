@@ -146,7 +146,7 @@ impl Default for SolverSettings {
             linear_solver: LinearSolverChoice::default(),
             max_iterations: newton.max_iterations,
             globalization: GlobalizationChoice::default(),
-            tolerance: newton.absolute_tolerance,
+            tolerance: newton.tolerances.absolute_tolerance,
             steps_per_period: march.steps_per_period,
             max_periods: march.max_periods,
             march_tolerance: march.tolerance,

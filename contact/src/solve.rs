@@ -24,7 +24,7 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonOptions, NewtonReport, Strategy, WorkCounters,
+    self, Globalization, NewtonOptions, NewtonReport, Strategy, Tolerances, WorkCounters,
 };
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
@@ -381,10 +381,9 @@ pub(crate) fn lcp_options(
 pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
     let plain = |globalization| {
         SolveOptions::Newton(NewtonOptions {
-            absolute_tolerance: settings.tolerance,
+            tolerances: Tolerances::absolute(settings.tolerance),
             max_iterations: settings.max_iterations,
             globalization,
-            ..NewtonOptions::default()
         })
     };
     match settings.globalization {
@@ -393,7 +392,7 @@ pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
         GlobalizationChoice::Nonmonotone => plain(Globalization::non_monotone()),
         GlobalizationChoice::Hybrid => plain(Globalization::hybrid()),
         GlobalizationChoice::Auto => SolveOptions::Polyalgorithm(PolyalgorithmOptions {
-            absolute_tolerance: settings.tolerance,
+            tolerances: Tolerances::absolute(settings.tolerance),
             max_iterations: settings.max_iterations,
             ..PolyalgorithmOptions::default()
         }),

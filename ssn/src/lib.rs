@@ -11,6 +11,7 @@ pub mod exit;
 pub mod figures;
 pub mod friction_tables;
 pub mod import;
+pub mod input_file;
 pub mod io;
 pub mod json;
 pub mod limits;

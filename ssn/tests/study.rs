@@ -281,11 +281,7 @@ fn a_killed_study_started_again_redoes_no_finished_case() {
         "{} records when killed: the study must be stopped part way",
         before.len()
     );
-    let o = Command::new(SSN)
-        .args(["study", path(&scene), path(&study), "--out", path(&out)])
-        .args(finer)
-        .output()
-        .expect("the ssn binary runs");
+    let o = run_study(&scene, &study, &out, &finer);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let done = before.len();
     assert!(
@@ -306,11 +302,7 @@ fn a_killed_study_started_again_redoes_no_finished_case() {
     }
     // And the table is that of a run that was never interrupted.
     let whole = dir.path().join("whole");
-    let o = Command::new(SSN)
-        .args(["study", path(&scene), path(&study), "--out", path(&whole)])
-        .args(finer)
-        .output()
-        .expect("the ssn binary runs");
+    let o = run_study(&scene, &study, &whole, &finer);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     assert_eq!(
         read(out.join("results.csv")),

@@ -467,38 +467,28 @@ impl LinearData {
         }
     }
 
+    /// `Err` unless `dof` is a dof of the model.
     pub(crate) fn check_dof(&self, dof: usize) -> Result<(), HbError> {
-        if dof >= self.dofs {
-            return Err(HbError::IndexOutOfRange {
-                what: "dof",
-                index: dof,
-                count: self.dofs,
-            });
-        }
-        Ok(())
+        check_index("dof", dof, self.dofs)
     }
 
     /// `Err` unless `contact` is a contact's normal row (not a friction point's).
     pub(crate) fn check_normal_row(&self, contact: usize) -> Result<(), HbError> {
-        if contact >= self.normal_rows() {
-            return Err(HbError::IndexOutOfRange {
-                what: "contact",
-                index: contact,
-                count: self.normal_rows(),
-            });
-        }
-        Ok(())
+        check_index("contact", contact, self.normal_rows())
     }
 
+    /// `Err` unless `contact` is a contact row (a normal row or a friction point's).
     pub(crate) fn check_contact(&self, contact: usize) -> Result<(), HbError> {
-        if contact >= self.contacts() {
-            return Err(HbError::IndexOutOfRange {
-                what: "contact",
-                index: contact,
-                count: self.contacts(),
-            });
-        }
+        check_index("contact", contact, self.contacts())
+    }
+}
+
+/// `Err(IndexOutOfRange { what, index, count })` unless `index < count`.
+fn check_index(what: &'static str, index: usize, count: usize) -> Result<(), HbError> {
+    if index < count {
         Ok(())
+    } else {
+        Err(HbError::IndexOutOfRange { what, index, count })
     }
 }
 

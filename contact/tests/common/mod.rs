@@ -9,7 +9,7 @@
 pub mod periodic;
 
 use nalgebra::{Complex, DMatrix, DVector};
-use semismooth::newton::{Globalization, NewtonOptions, NewtonReport};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonReport, Tolerances};
 use semismooth::polyalgorithm::{SmoothingOf, SolveOptions};
 use semismooth::{Factorize, GeneralizedJacobian};
 use semismooth_contact::hb::{HbOptions, SsnHb};
@@ -210,10 +210,9 @@ pub fn ssn_hb(model: &StructuralModel, omega: f64, harmonics: usize) -> SsnHb {
 /// point already on a branch must converge at once and not move it.
 pub fn plain_newton() -> SolveOptions {
     SolveOptions::Newton(NewtonOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         max_iterations: 20,
         globalization: Globalization::None,
-        ..NewtonOptions::default()
     })
 }
 

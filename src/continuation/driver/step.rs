@@ -7,6 +7,7 @@ use crate::continuation::{
     BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
 use crate::iteration::kernel::{KernelRules, StepRule};
+use crate::newton::Tolerances;
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 /// The squared θ-norm of the state (parameter) part of a unit direction below which a
@@ -75,10 +76,12 @@ where
                 .trust_factor
                 .map(|_| (&self.trust, &self.main_metric)),
             rules: KernelRules {
-                absolute_tolerance: tolerance,
-                relative_tolerance: 0.0,
-                residual_floor: 0.0,
-                step_tolerance: self.options.step_tolerance,
+                tolerances: Tolerances {
+                    absolute_tolerance: tolerance,
+                    relative_tolerance: 0.0,
+                    residual_floor: 0.0,
+                    step_tolerance: self.options.step_tolerance,
+                },
                 max_iterations,
                 min_iterations: 1,
                 step: match self.options.corrector_line_search {

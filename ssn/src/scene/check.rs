@@ -16,12 +16,7 @@ impl Check<'_> {
     }
 
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
-        SceneError::Invalid {
-            path: self.path.to_path_buf(),
-            key: key.to_string(),
-            value: value.to_string(),
-            allowed: allowed.to_string(),
-        }
+        SceneError::invalid(self.path, key, value, allowed)
     }
 
     pub(super) fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
