@@ -577,12 +577,17 @@ pub(crate) fn fine_samples(
     dof: usize,
     points: usize,
 ) -> Result<Vec<f64>, HbError> {
-    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
-    let mut aft = Aft::new(basis);
     let mut coeffs = vec![0.0; lin.size()];
     lin.gather(u, dof, &mut coeffs);
+    samples_of(lin, &coeffs, points)
+}
+
+/// Samples of the signal with coefficients `coeffs` (`2H + 1`) at `points` equally spaced
+/// times over one period.
+fn samples_of(lin: &LinearData, coeffs: &[f64], points: usize) -> Result<Vec<f64>, HbError> {
+    let mut aft = Aft::new(FourierBasis::new(lin.basis.harmonics(), points)?);
     let mut samples = vec![0.0; points];
-    aft.to_time(&coeffs, &mut samples)?;
+    aft.to_time(coeffs, &mut samples)?;
     Ok(samples)
 }
 
@@ -608,14 +613,10 @@ pub(crate) fn row_samples(
     points: usize,
 ) -> Result<Vec<f64>, HbError> {
     lin.check_contact(row)?;
-    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
-    let mut aft = Aft::new(basis);
     let coeffs: Vec<f64> = (0..lin.size())
         .map(|j| lin.rows[row].dot_at(u, j * lin.dofs))
         .collect();
-    let mut samples = vec![0.0; points];
-    aft.to_time(&coeffs, &mut samples)?;
-    Ok(samples)
+    samples_of(lin, &coeffs, points)
 }
 
 /// Displacement extremes, RMS and penetration from the displacement coefficients `u`.
