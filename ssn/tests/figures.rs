@@ -33,6 +33,47 @@ fn paper_fig2_is_drawn_finely_with_equal_csv_columns() {
     assert!(fig.curves.iter().all(|c| c.converged && c.undecided == 0));
 }
 
+/// Every contact branch of the paper's Fig. 2 (consistent mass, H = 5): unstable at every
+/// point strictly between its two folds (the middle branch of the overhang, however the
+/// harmonic balance zigzags near its peak), stable at every point after the lower fold,
+/// and before the upper fold stable but within 0.02 omega_1 above the first contact (the
+/// grazing band of the test below): the stability boundaries are the folds.
+#[test]
+fn paper_fig2_branches_change_stability_at_their_folds() {
+    for gap in [0.25, 0.5, 0.75] {
+        let (rod, r) = figure_2_branch(Some(gap), 5, MassModel::Consistent).unwrap();
+        assert!(r.converged());
+        let w1 = rod.omega_1;
+        let stable = &r.stability.stable;
+        assert_eq!(r.fold_indices.len(), 2, "gap {gap}: {:?}", r.folds);
+        let (upper, lower) = (r.fold_indices[0], r.fold_indices[1]);
+        let contact = (0..r.points())
+            .find(|&i| r.tip_max[i] > gap)
+            .expect("a contact");
+        let unstable_between = (upper + 1..lower)
+            .filter(|&i| stable[i] == Some(false))
+            .count();
+        println!(
+            "gap {gap}: folds {:?}, {unstable_between} of {} points between them unstable",
+            r.folds.iter().map(|w| w / w1).collect::<Vec<_>>(),
+            lower - upper - 1
+        );
+        assert_eq!(unstable_between, lower - upper - 1, "gap {gap}");
+        assert!(
+            (lower + 1..r.points()).all(|i| stable[i] == Some(true)),
+            "gap {gap}"
+        );
+        for (i, (verdict, omega)) in stable.iter().zip(&r.omega).take(upper).enumerate() {
+            let grazing = i >= contact && *omega < r.omega[contact] + 0.02 * w1;
+            assert!(
+                *verdict == Some(true) || grazing,
+                "gap {gap}: unstable at {:.4} before the upper fold",
+                omega / w1
+            );
+        }
+    }
+}
+
 /// The paper's Fig. 2 branch with gap 0.5 (consistent mass, H = 5): unstable between its
 /// first and last reversal of the frequency, and just above its first contact, where its
 /// orbit grazes the stop and rebounds (at 0.6 to 1.0 times its approach speed at H = 5)

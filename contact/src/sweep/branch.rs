@@ -153,9 +153,9 @@ impl Reconstruction {
     }
 }
 
-/// Real multipliers within this distance of `+1` may be placed on the side of `+1` that
-/// the branch's fold count requires (module documentation); farther ones are left as
-/// computed. Near a fold the multiplier moves like the square root of the distance to it,
+/// Outside the folds of an overhang, a real multiplier above `+1` and within this distance
+/// of it is counted below `+1` where the branch's fold count requires; a farther one is
+/// left as computed (`fold_consistent_counts`). Near a fold the multiplier moves like the square root of the distance to it,
 /// so the harmonic-balance error of the switching instants moves it far: on the strongly
 /// forced modified-mass rod at `H = 20` the point `1.3e-3 omega_1` past the upper fold has
 /// its real multiplier at 0.88 (measured, `ssn/tests/stability.rs`).
@@ -259,11 +259,16 @@ pub fn branch_stability(
     Ok(out)
 }
 
-/// The counts of multipliers outside the unit circle of each decided point, with the real
-/// multiplier nearest `+1` placed on the side that the parity of the number of reversals
-/// of the branch before the point requires when it is within [`FOLD_BAND`] of `+1` (the
-/// flag says where that changed the count). The parity of the first segment is the one
-/// most points agree with. Points at a reversal keep their own counts.
+/// The counts of multipliers outside the unit circle of each decided point, with the
+/// parity of the real multipliers above `+1` that the number of folds of the branch
+/// before the point requires (the flag says where that changed the count): a point that
+/// needs one more (the middle branch of an overhang, a saddle between its folds, whatever
+/// the impact model's own multipliers say far from the fold) gets its real multiplier
+/// nearest `+1` counted above it, or one more when it has none; a point that needs one
+/// fewer gets its real multiplier nearest `+1` counted below it only within [`FOLD_BAND`]
+/// of `+1` (a multiplier far above `+1`, e.g. where the orbit grazes the stop, is an
+/// instability of its own). The parity of the first segment is the one most points agree
+/// with. Points at a reversal keep their own counts.
 fn fold_consistent_counts(
     analyses: &[Stability],
     reversals: &[usize],
@@ -288,13 +293,14 @@ fn fold_consistent_counts(
             if at_reversal(i) || counts.real_above_one % 2 == wanted {
                 return Some((counts, false));
             }
+            if counts.real_above_one % 2 != wanted && wanted == (offset + 1) % 2 {
+                // Between the folds of an overhang: one more above +1.
+                counts.real_above_one += 1;
+                return Some((counts, true));
+            }
             match s.multipliers.nearest_real_to_one() {
-                Some(mu) if (mu - 1.0).abs() <= FOLD_BAND => {
-                    if mu > 1.0 {
-                        counts.real_above_one -= 1;
-                    } else {
-                        counts.real_above_one += 1;
-                    }
+                Some(mu) if mu > 1.0 && mu - 1.0 <= FOLD_BAND => {
+                    counts.real_above_one -= 1;
                     Some((counts, true))
                 }
                 _ => Some((counts, false)),
