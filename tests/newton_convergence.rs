@@ -453,6 +453,7 @@ fn counters_are_exact_on_a_linear_problem_and_jacobian_is_reused() {
         factorizations: 1,
         linear_solves: 1,
         line_search_backtracks: 0,
+        krylov_iterations: 0,
         problem: ProblemCounters::new().with("transforms", 4),
     };
     let mut total = WorkCounters::default();

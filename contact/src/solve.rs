@@ -112,6 +112,8 @@ pub struct RunCounters {
     pub lemke_pivots: u64,
     /// Time steps (time marching).
     pub time_steps: u64,
+    /// GMRES iterations of the matrix-free condensed solve (0 on the direct paths).
+    pub krylov_iterations: u64,
 }
 
 impl std::ops::Add for RunCounters {
@@ -128,6 +130,7 @@ impl std::ops::Add for RunCounters {
             ffts: self.ffts + other.ffts,
             lemke_pivots: self.lemke_pivots + other.lemke_pivots,
             time_steps: self.time_steps + other.time_steps,
+            krylov_iterations: self.krylov_iterations + other.krylov_iterations,
         }
     }
 }
@@ -141,6 +144,7 @@ impl From<WorkCounters> for RunCounters {
             linear_solves: c.linear_solves,
             line_search_backtracks: c.line_search_backtracks,
             ffts: c.problem.get("ffts"),
+            krylov_iterations: c.krylov_iterations,
             ..RunCounters::default()
         }
     }

@@ -160,6 +160,9 @@ pub struct WorkCounters {
     pub linear_solves: u64,
     /// Rejected line-search trials.
     pub line_search_backtracks: u64,
+    /// Krylov iterations of the linear solver over the run
+    /// ([`crate::LinearSolve::krylov_iterations`]; 0 for direct solvers).
+    pub krylov_iterations: u64,
     /// The problem's own counters over the solve ([`crate::Residual::problem_counters`]).
     pub problem: ProblemCounters,
 }
@@ -171,6 +174,7 @@ impl AddAssign for WorkCounters {
         self.factorizations += rhs.factorizations;
         self.linear_solves += rhs.linear_solves;
         self.line_search_backtracks += rhs.line_search_backtracks;
+        self.krylov_iterations += rhs.krylov_iterations;
         self.problem += rhs.problem;
     }
 }

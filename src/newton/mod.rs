@@ -482,6 +482,7 @@ impl<J> NewtonSolver<J> {
         S: Factorize<J> + ?Sized,
     {
         let start = self.work.begin(problem, x)?;
+        let krylov_start = linear.krylov_iterations();
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
         let backtracking = |memory, line_search| StepRule::Backtracking {
@@ -520,6 +521,7 @@ impl<J> NewtonSolver<J> {
             _ => Strategy::LineSearch,
         };
         counters.problem = problem.problem_counters().since(&start);
+        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
         let outcome = Outcome {
             attempts: vec![Attempt::new(strategy, run.iterations, &termination)],
             termination,

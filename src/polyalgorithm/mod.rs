@@ -310,10 +310,12 @@ impl<J> Polyalgorithm<J> {
         S: Factorize<J> + ?Sized,
     {
         let start = self.work.begin(problem, x)?;
+        let krylov_start = linear.krylov_iterations();
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
         let outcome = self.run(problem, linear, x, smoothing, (&mut counters, &mut log));
         counters.problem = problem.problem_counters().since(&start);
+        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
         Ok(NewtonReport::new(outcome, log, counters))
     }
 }

@@ -55,7 +55,7 @@ pub fn friction_json(f: &FrictionReport) -> Value {
 
 /// The JSON fields of the Newton-style counters: `residual_evaluations`,
 /// `jacobian_evaluations`, `factorizations`, `linear_solves`, `line_search_backtracks`,
-/// `ffts`.
+/// `ffts`, `krylov_iterations`.
 pub fn newton_counters(c: &RunCounters) -> serde_json::Map<String, Value> {
     let mut map = serde_json::Map::new();
     for (name, value) in [
@@ -65,6 +65,7 @@ pub fn newton_counters(c: &RunCounters) -> serde_json::Map<String, Value> {
         ("linear_solves", c.linear_solves),
         ("line_search_backtracks", c.line_search_backtracks),
         ("ffts", c.ffts),
+        ("krylov_iterations", c.krylov_iterations),
     ] {
         map.insert(name.to_string(), value.into());
     }

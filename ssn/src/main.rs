@@ -67,7 +67,8 @@ enum Command {
         displacement_max}], friction [{point, stick_fraction, force_amplitude,\n  \
         slip_velocity_amplitude, slip_limit_max, force, slip_velocity}], c (SSN-HB),\n  \
         counters {residual_evaluations,\n  \
-        jacobian_evaluations, factorizations, linear_solves, ffts, ...}, started_from\n  \
+        jacobian_evaluations, factorizations, linear_solves, ffts, krylov_iterations,\n  \
+        ...}, started_from\n  \
         {file, entry, omega_ratio, note} (with --start)\n\n\
         State file (--state): format, version, method, harmonics, dofs, contacts, omega,\n  \
         omega_ratio, layout, displacement [(2H+1) dofs], contact_force [(2H+1) contacts]\n  \

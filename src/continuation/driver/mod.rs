@@ -112,6 +112,8 @@ where
     termination: Option<ContinuationTermination>,
     counters: ContinuationCounters,
     problem_start: ProblemCounters,
+    /// The solver's Krylov iterations when the run started.
+    krylov_start: u64,
     trust: TrustBall,
     segment: Segment,
     segment_direction: Direction,
@@ -173,6 +175,7 @@ where
         );
         let bordered = Bordered::new(n, problem.new_jacobian());
         let problem_start = problem.problem_counters();
+        let krylov_start = solver.krylov_iterations();
         let folds = FoldDetector::new(options.refine_folds)
             .with_min_excursion(options.fold_parameter_excursion());
         let window = options.restarts.map_or(0, |r| r.retrace_window);
@@ -202,6 +205,7 @@ where
             termination: None,
             counters: ContinuationCounters::default(),
             problem_start,
+            krylov_start,
             trust: TrustBall::default(),
             segment: Segment::Main,
             segment_points: 0,
@@ -228,6 +232,7 @@ where
         let mut c = self.counters;
         c.work = self.work;
         c.work.problem = self.problem.problem_counters().since(&self.problem_start);
+        c.work.krylov_iterations = self.solver.krylov_iterations() - self.krylov_start;
         c.parameter_derivative_evaluations = self.corrector_counts.parameter_derivatives;
         c.dense_bordered_factorizations = self.corrector_counts.dense_factorizations;
         c.corrector_iterations = self.corrector_counts.iterations;
