@@ -199,17 +199,33 @@ fn period_figures(
 ) -> Result<(), CliError> {
     let mut forces = Vec::new();
     let mut orbits = Vec::new();
+    // A time-marching contact force is an impulse divided by one step at an impact, far
+    // beyond the harmonic-balance force it is drawn with: it is clipped at twice the
+    // largest harmonic-balance compression, and its label says so.
+    let hb_compression = solutions
+        .iter()
+        .filter(|(s, _)| s.method.is_harmonic_balance())
+        .flat_map(|(s, _)| s.contact_forces.iter().flatten())
+        .fold(0.0f64, |a, f| a.max(-f));
+    let floor = -2.0 * hb_compression;
     for (color, (s, label)) in solutions.iter().enumerate() {
         let period = 2.0 * std::f64::consts::PI / s.omega;
         let phase: Vec<f64> = s.times.iter().map(|t| t / period).collect();
         for (k, f) in s.contact_forces.iter().enumerate() {
-            let curve = if s.contact_forces.len() > 1 {
+            let mut curve = if s.contact_forces.len() > 1 {
                 format!("{label}, contact {k}")
             } else {
                 label.to_string()
             };
+            let deepest = f.iter().fold(0.0f64, |a, &v| a.min(v));
+            let values = if hb_compression > 0.0 && deepest < 2.0 * floor {
+                curve = format!("{curve} (impacts clipped at {floor:.2}; deepest {deepest:.2})");
+                f.iter().map(|&v| v.max(floor)).collect()
+            } else {
+                f.clone()
+            };
             forces.push(styled(
-                Series::new(curve, phase.clone(), f.clone()),
+                Series::new(curve, phase.clone(), values),
                 color + k,
                 color,
             ));
