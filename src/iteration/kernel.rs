@@ -14,10 +14,9 @@
 //! [`Kernel::finish`]; [`Kernel::run`] is the common case of one rule throughout.
 
 use crate::linesearch::{backtrack, Backtrack, LineSearchOptions, NonMonotoneHistory};
-use crate::newton::Tolerances;
 use crate::EvaluationError;
 
-use super::WorkCounters;
+use super::{Tolerances, WorkCounters};
 
 /// A system `G(y) = 0` on `R^N` with a way to compute Newton directions.
 pub(crate) trait NewtonSystem {

@@ -200,8 +200,9 @@ fn period_figures(
     let mut forces = Vec::new();
     let mut orbits = Vec::new();
     // A time-marching contact force is an impulse divided by one step at an impact, far
-    // beyond the harmonic-balance force it is drawn with: it is clipped at twice the
-    // largest harmonic-balance compression, and its label says so.
+    // beyond the harmonic-balance force it is drawn with: where it reaches four times the
+    // largest harmonic-balance compression it is clipped at twice that, and its label says
+    // so.
     let hb_compression = solutions
         .iter()
         .filter(|(s, _)| s.method.is_harmonic_balance())
