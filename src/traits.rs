@@ -414,6 +414,13 @@ const PARAMETER_STEP: f64 = 1e-7;
 pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
+
+    /// Krylov iterations (operator products) of the solves so far, over the solver's
+    /// life; 0 for a direct solver. Drivers report the difference over a run in
+    /// [`WorkCounters::krylov_iterations`](crate::newton::WorkCounters::krylov_iterations).
+    fn krylov_iterations(&self) -> u64 {
+        0
+    }
 }
 
 /// The factorization half of a linear solver for Jacobians of type `J` (an example with

@@ -11,7 +11,7 @@ use semismooth::continuation::{
     ContinuationTermination, CorrectorFailure, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::{FaerDenseLu, LinearSolveError};
-use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonSolver, Tolerances};
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::ParameterDependent;
 
@@ -80,17 +80,12 @@ fn s_curve_branch_passes_both_folds_located_within_the_interpolation_error() {
 
 #[test]
 fn s_curve_followed_downwards_ends_at_the_lower_root() {
-    let mut problem = s_curve();
-    let mut solver = FaerDenseLu::new();
     let options = ContinuationOptions {
-        parameter_min: -1.0,
-        parameter_max: 1.0,
         direction: Direction::Decreasing,
-        ..Default::default()
+        ..between(-1.0, 1.0)
     };
-    let branch = Continuation::new(&mut problem, &mut solver, &[1.3], 1.0, options)
-        .unwrap()
-        .run();
+    let mut problem = s_curve();
+    let branch = follow(&mut problem, &[1.3], 1.0, options);
     let folds = branch.fold_parameters();
     assert_eq!(folds.len(), 2);
     // Same interpolation bound as upwards.
@@ -104,15 +99,12 @@ fn s_curve_followed_downwards_ends_at_the_lower_root() {
     assert_eq!(problem.parameter(), -1.0);
 
     // Started on the lower bound heading down: the start is the whole branch.
-    let mut problem = s_curve();
     let options = ContinuationOptions {
         parameter_min: -1.0,
         direction: Direction::Decreasing,
         ..Default::default()
     };
-    let branch = Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
-        .unwrap()
-        .run();
+    let branch = follow(&mut s_curve(), &[-1.3], -1.0, options);
     assert_eq!(branch.points.len(), 1);
     assert_eq!(
         branch.termination,
@@ -218,29 +210,11 @@ fn duffing_folds_by_discriminant() -> Vec<f64> {
 }
 
 fn s_curve_branch() -> Branch {
-    let mut problem = s_curve();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: -1.0,
-        parameter_max: 1.0,
-        ..Default::default()
-    };
-    Continuation::new(&mut problem, &mut solver, &[-1.3], -1.0, options)
-        .unwrap()
-        .run()
+    follow(&mut s_curve(), &[-1.3], -1.0, between(-1.0, 1.0))
 }
 
 fn duffing_branch() -> Branch {
-    let mut problem = duffing();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: 0.5,
-        parameter_max: 2.0,
-        ..Default::default()
-    };
-    Continuation::new(&mut problem, &mut solver, &[0.13, 0.0], 0.5, options)
-        .unwrap()
-        .run()
+    follow(&mut duffing(), &[0.13, 0.0], 0.5, between(0.5, 2.0))
 }
 
 #[test]
@@ -307,16 +281,7 @@ fn duffing_frequency_response_satisfies_the_implicit_amplitude_equation_through_
 
 #[test]
 fn kinked_piecewise_linear_branch_is_followed_through_the_kink() {
-    let mut problem = kink();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: 0.0,
-        parameter_max: 3.0,
-        ..Default::default()
-    };
-    let branch = Continuation::new(&mut problem, &mut solver, &[0.2], 0.2, options)
-        .unwrap()
-        .run();
+    let branch = follow(&mut kink(), &[0.2], 0.2, between(0.0, 3.0));
     // Piecewise linear: Newton with the generalized Jacobian is exact on each piece, so
     // every point matches the closed form to rounding (1e-12 on O(1) values).
     for q in &branch.points {
@@ -665,7 +630,7 @@ fn every_continuation_point_resolved_by_plain_newton_stays_put() {
     // driver and a tolerance 100x tighter than the continuation's, so that a Newton step is
     // taken: the correction is about |J^{-1}| |F| <= 1e-10 / σ_min(J).
     let strict = PolyalgorithmOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         ..Default::default()
     };
     let mut solver = FaerDenseLu::new();

@@ -264,16 +264,8 @@ fn steep_corner() -> Closure {
 
 #[test]
 fn corner_fold_of_a_piecewise_linear_branch_is_reported_within_one_step_of_the_corner() {
-    let mut problem = roof();
-    let mut solver = FaerDenseLu::new();
-    let options = ContinuationOptions {
-        parameter_min: -1.0,
-        parameter_max: 1.0,
-        ..Default::default()
-    };
-    let branch = Continuation::new(&mut problem, &mut solver, &[-1.0], -1.0, options.clone())
-        .unwrap()
-        .run();
+    let options = between(-1.0, 1.0);
+    let branch = follow(&mut roof(), &[-1.0], -1.0, options.clone());
     // Up the left side, over the corner, down the right side to the bound p = -1 at x = 1.
     let last = branch.points.last().unwrap();
     assert_eq!(

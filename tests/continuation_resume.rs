@@ -14,11 +14,17 @@ use semismooth::linalg::FaerDenseLu;
 
 /// The S-curve in `n` unknowns: `x0^3 - x0 - p = 0`, `x_i - x0 / (i + 1)^2 = 0`.
 fn slaved_s_curve(n: usize) -> Closure {
+    shifted_s_curve(n, 0.0)
+}
+
+/// The S-curve moved by `shift` in the parameter: `x0^3 - x0 - p - shift = 0` (folds at
+/// `p = ±2/(3√3) - shift`), the other unknowns slaved as in [`slaved_s_curve`].
+fn shifted_s_curve(n: usize, shift: f64) -> Closure {
     Closure {
         n,
         p: 0.0,
-        f: Box::new(|x, p, out| {
-            out[0] = x[0].powi(3) - x[0] - p;
+        f: Box::new(move |x, p, out| {
+            out[0] = x[0].powi(3) - x[0] - p - shift;
             for i in 1..x.len() {
                 out[i] = x[i] - x[0] / ((i + 1) * (i + 1)) as f64;
             }
@@ -126,8 +132,12 @@ fn a_branch_switched_between_discretisations_finds_both_folds_at_their_closed_fo
     )
     .unwrap();
     let first = run.next().expect("the resumed point");
-    // The resumed point replaces the last one: same parameter, the padding corrected.
-    assert_eq!(first.parameter, *parameters.last().unwrap());
+    // The resumed point replaces the last one: the same point of the curve (the slaved
+    // unknowns weigh nothing in the metric, so the hyperplane only fixes x0 and p, which
+    // already solve the cubic to the corrector's tolerance 1e-10: p moves by less), the
+    // padding corrected.
+    let moved = (first.parameter - parameters.last().unwrap()).abs();
+    assert!(moved < 1e-10, "moved by {moved:e}");
     assert!((first.state[1] - first.state[0] / 4.0).abs() < 1e-9);
     assert!((first.state[2] - first.state[0] / 9.0).abs() < 1e-9);
     let mut resumption = None;
@@ -181,4 +191,64 @@ fn a_branch_switched_between_discretisations_finds_both_folds_at_their_closed_fo
             "fold {parameter} (exact {exact}): error {error:e}, uninterrupted {reference_error:e}"
         );
     }
+}
+
+#[test]
+fn a_branch_resumed_past_the_new_discretisations_fold_is_taken_up_on_the_same_branch() {
+    // The branch with one unknown, in steps of at most 0.01, up to p > 0.36 on the lower
+    // sheet (x0 < -1/√3), just before its fold 2/(3√3) = 0.3849.
+    let fine = |n| ContinuationOptions {
+        max_step: 0.01,
+        ..options(n)
+    };
+    let mut solver = FaerDenseLu::new();
+    let mut one = slaved_s_curve(1);
+    let mut run = Continuation::new(&mut one, &mut solver, &[-1.3], -0.897, fine(1)).unwrap();
+    let mut resumption = None;
+    for point in run.by_ref() {
+        if point.parameter > 0.36 && point.state[0] < -1.0 / 3f64.sqrt() {
+            resumption = run.resumption();
+            break;
+        }
+    }
+    drop(run);
+    let resumption = resumption.expect("a point past p = 0.36 on the lower sheet");
+    let (x_old, p_old) = (resumption.state[0], resumption.parameter);
+    assert!(x_old < -1.0 / 3f64.sqrt() && p_old < FOLD_S);
+
+    // Three unknowns whose curve is moved by 0.03: its lower sheet ends at the fold
+    // FOLD_S - 0.03 < p_old, so no solution of the new problem is near the point at its
+    // parameter (the nearest at p_old is on the upper sheet, x0 > 1). On the hyperplane
+    // normal to the carried direction the point is taken up on the lower sheet, near the
+    // new fold, and the run turns there.
+    let shift = 0.03;
+    let mut three = shifted_s_curve(3, shift);
+    let mut run =
+        Continuation::resume(&mut three, &mut solver, carried(resumption, 1, 3), fine(3)).unwrap();
+    let first = run.next().expect("the resumed point");
+    let x0 = first.state[0];
+    let residual = x0.powi(3) - x0 - first.parameter - shift;
+    assert!(residual.abs() < 1e-9, "residual {residual:e}");
+    // On the same (lower) sheet, moved by less than the shift.
+    assert!(x0 < 0.0 && (x0 - x_old).abs() < 0.2, "x0 {x0} from {x_old}");
+    assert!(first.parameter < FOLD_S - shift, "p {} ", first.parameter);
+    assert!((first.parameter - p_old).abs() < 2.0 * shift);
+    let mut parameters = vec![first.parameter];
+    for point in run.by_ref() {
+        parameters.push(point.parameter);
+        if parameters.len() > 10 {
+            break;
+        }
+    }
+    let found = folds(run.events());
+    assert!(!found.is_empty(), "{:?} {parameters:?}", run.events());
+    let error = (found[0].1 - (FOLD_S - shift)).abs();
+    // Hermite location on steps of at most 0.01: at least as accurate as the uninterrupted
+    // run's on steps of 0.1 (3.5e-4).
+    assert!(
+        error < 3.5e-4,
+        "fold {} (exact {}): {error:e}",
+        found[0].1,
+        FOLD_S - shift
+    );
 }

@@ -14,6 +14,7 @@ use semismooth::lemke::{
     LemkeTermination,
 };
 use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::Tolerances;
 use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
@@ -600,7 +601,7 @@ impl GeneralizedJacobian for MinMap<'_> {
 #[test]
 fn lemke_agrees_with_semismooth_newton_on_the_min_map() {
     let options = PolyalgorithmOptions {
-        absolute_tolerance: 1e-13,
+        tolerances: Tolerances::absolute(1e-13),
         ..PolyalgorithmOptions::default()
     };
     let mut lemke = Lemke::new(8);

@@ -13,7 +13,8 @@ use rand_chacha::ChaCha8Rng;
 use semismooth::complementarity::{fischer_burmeister, max_form, min_function, PhiValue};
 use semismooth::linalg::{FaerDenseLu, FaerSparseLu, NalgebraLu};
 use semismooth::newton::{
-    solve, Globalization, NewtonError, NewtonOptions, NewtonReport, NewtonSolver, EXACT_RESIDUAL,
+    solve, Globalization, NewtonError, NewtonOptions, NewtonReport, NewtonSolver, Tolerances,
+    EXACT_RESIDUAL,
 };
 use semismooth::polyalgorithm::{self, Polyalgorithm, PolyalgorithmOptions};
 use semismooth::{EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual};
@@ -173,7 +174,7 @@ fn nonsmooth_lcp_terminates_finitely_with_min_and_max_form_and_quadratically_wit
         }
         let mut z = vec![1.0; 8];
         let opts = NewtonOptions {
-            absolute_tolerance: 1e-10,
+            tolerances: Tolerances::absolute(1e-10),
             globalization: Globalization::non_monotone(),
             ..Default::default()
         };
@@ -325,7 +326,7 @@ fn sparse_obstacle_problem_matches_dense_solve_and_satisfies_complementarity() {
     let mut sparse: Obstacle<SparseColMat<usize, f64>> = make(n);
     let mut dense: Obstacle<Mat<f64>> = make(n);
     let opts = PolyalgorithmOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         ..Default::default()
     };
     let mut us = vec![0.0; n];

@@ -1,13 +1,17 @@
 //! The semismooth Newton driver on problems with known answers: convergence order on
 //! smooth and nonsmooth problems, globalization, exact work counters, every termination.
 
+mod common;
+
 use std::cell::Cell;
+
+use common::branches::Closure;
 
 use faer::Mat;
 use semismooth::linalg::{FaerDenseLu, LinearSolveError, NalgebraLu};
 use semismooth::newton::{
     solve, Globalization, LineSearchOptions, NewtonError, NewtonOptions, NewtonReport,
-    NewtonSolver, Termination, WorkCounters,
+    NewtonSolver, Termination, Tolerances, WorkCounters,
 };
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
@@ -103,80 +107,58 @@ fn newton_on_cube(opts: &NewtonOptions) -> (semismooth::newton::NewtonReport, [f
 
 /// Gradient of Rosenbrock's function f = (1 - x)^2 + 100 (y - x^2)^2; its only root is
 /// the minimizer (1, 1), where the Hessian [[802, -400], [-400, 200]] is regular.
-struct RosenbrockGradient;
-impl Residual for RosenbrockGradient {
-    fn dim(&self) -> usize {
-        2
-    }
-    fn residual(&mut self, v: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        let (x, y) = (v[0], v[1]);
-        out[0] = -2.0 * (1.0 - x) - 400.0 * x * (y - x * x);
-        out[1] = 200.0 * (y - x * x);
-        Ok(())
-    }
-}
-impl GeneralizedJacobian for RosenbrockGradient {
-    type Jacobian = Mat<f64>;
-    fn new_jacobian(&self) -> Mat<f64> {
-        Mat::zeros(2, 2)
-    }
-    fn jacobian(&mut self, v: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-        let (x, y) = (v[0], v[1]);
-        jac[(0, 0)] = 2.0 - 400.0 * (y - 3.0 * x * x);
-        jac[(0, 1)] = -400.0 * x;
-        jac[(1, 0)] = -400.0 * x;
-        jac[(1, 1)] = 200.0;
-        Ok(())
+fn rosenbrock_gradient() -> Closure {
+    Closure {
+        n: 2,
+        p: 0.0,
+        f: Box::new(|v, _, out| {
+            let (x, y) = (v[0], v[1]);
+            out[0] = -2.0 * (1.0 - x) - 400.0 * x * (y - x * x);
+            out[1] = 200.0 * (y - x * x);
+        }),
+        j: Box::new(|v, _, jac| {
+            let (x, y) = (v[0], v[1]);
+            jac[(0, 0)] = 2.0 - 400.0 * (y - 3.0 * x * x);
+            jac[(0, 1)] = -400.0 * x;
+            jac[(1, 0)] = -400.0 * x;
+            jac[(1, 1)] = 200.0;
+        }),
+        fp: None,
     }
 }
 
 /// Coupled squares F(x) = B (x o x) - B (s o s) with B well conditioned: the root x = s
-/// (all s_i > 0) is regular (J = 2 B diag(x)).
-struct CoupledSquares {
-    b: Mat<f64>,
-    target: Vec<f64>,
-}
-impl CoupledSquares {
-    fn new(n: usize) -> Self {
-        let b = Mat::from_fn(n, n, |i, j| {
-            if i == j {
-                4.0
-            } else {
-                1.0 / (1.0 + (i + j) as f64)
-            }
-        });
-        let target = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
-        Self { b, target }
-    }
-}
-impl Residual for CoupledSquares {
-    fn dim(&self) -> usize {
-        self.target.len()
-    }
-    fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        let n = self.dim();
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = (0..n)
-                .map(|j| self.b[(i, j)] * (x[j] * x[j] - self.target[j] * self.target[j]))
-                .sum();
+/// (all s_i > 0) is regular (J = 2 B diag(x)). The problem and its root `s`.
+fn coupled_squares(n: usize) -> (Closure, Vec<f64>) {
+    let b = Mat::from_fn(n, n, |i, j| {
+        if i == j {
+            4.0
+        } else {
+            1.0 / (1.0 + (i + j) as f64)
         }
-        Ok(())
-    }
-}
-impl GeneralizedJacobian for CoupledSquares {
-    type Jacobian = Mat<f64>;
-    fn new_jacobian(&self) -> Mat<f64> {
-        Mat::zeros(self.dim(), self.dim())
-    }
-    fn jacobian(&mut self, x: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-        let n = self.dim();
-        for i in 0..n {
-            for j in 0..n {
-                jac[(i, j)] = 2.0 * self.b[(i, j)] * x[j];
+    });
+    let target: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
+    let (b_jac, s) = (b.clone(), target.clone());
+    let problem = Closure {
+        n,
+        p: 0.0,
+        f: Box::new(move |x, _, out| {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = (0..n)
+                    .map(|j| b[(i, j)] * (x[j] * x[j] - s[j] * s[j]))
+                    .sum();
             }
-        }
-        Ok(())
-    }
+        }),
+        j: Box::new(move |x, _, jac| {
+            for i in 0..n {
+                for j in 0..n {
+                    jac[(i, j)] = 2.0 * b_jac[(i, j)] * x[j];
+                }
+            }
+        }),
+        fp: None,
+    };
+    (problem, target)
 }
 
 /// On smooth systems with a regular root, the observed order over the last three
@@ -186,17 +168,17 @@ impl GeneralizedJacobian for CoupledSquares {
 #[test]
 fn smooth_regular_root_converges_with_order_at_least_1_8() {
     let opts = NewtonOptions {
-        absolute_tolerance: 1e-9,
+        tolerances: Tolerances::absolute(1e-9),
         ..options(Globalization::None)
     };
-    let mut problem = CoupledSquares::new(6);
-    let mut x: Vec<f64> = problem.target.iter().map(|s| s * 1.3).collect();
+    let (mut problem, target) = coupled_squares(6);
+    let mut x: Vec<f64> = target.iter().map(|s| s * 1.3).collect();
     let report = solve(&mut problem, &mut FaerDenseLu::new(), &mut x, &opts).unwrap();
     println!("coupled squares: {:?}", report.residual_norms);
     assert!(report.converged());
     let q = report.observed_order.unwrap();
     assert!(q >= 1.8, "order {q}");
-    for (xi, si) in x.iter().zip(&problem.target) {
+    for (xi, si) in x.iter().zip(&target) {
         assert!((xi - si).abs() < 1e-10);
     }
 
@@ -204,12 +186,12 @@ fn smooth_regular_root_converges_with_order_at_least_1_8() {
     // |grad f|^2 has a curved valley where Armijo takes tiny steps; Newton's iteration
     // itself reaches the quadratic region within a few steps from here).
     let opts = NewtonOptions {
-        absolute_tolerance: 1e-11,
+        tolerances: Tolerances::absolute(1e-11),
         ..options(Globalization::None)
     };
     let mut x = [-1.2, 1.0];
     let report = solve(
-        &mut RosenbrockGradient,
+        &mut rosenbrock_gradient(),
         &mut FaerDenseLu::new(),
         &mut x,
         &opts,
@@ -243,7 +225,7 @@ fn smooth_regular_root_converges_with_order_at_least_1_8() {
 #[test]
 fn singular_root_is_reported_with_order_one() {
     let (report, _) = newton_on_cube(&NewtonOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         ..options(Globalization::None)
     });
     assert!(report.converged());
@@ -471,6 +453,7 @@ fn counters_are_exact_on_a_linear_problem_and_jacobian_is_reused() {
         factorizations: 1,
         linear_solves: 1,
         line_search_backtracks: 0,
+        krylov_iterations: 0,
         problem: ProblemCounters::new().with("transforms", 4),
     };
     let mut total = WorkCounters::default();
@@ -614,8 +597,11 @@ fn non_finite_residual_is_reported_and_x_kept() {
 #[test]
 fn small_steps_without_convergence_are_reported_as_stalled() {
     let (report, x) = newton_on_cube(&NewtonOptions {
-        absolute_tolerance: UNREACHABLE_TOLERANCE,
-        step_tolerance: 0.01,
+        tolerances: Tolerances {
+            absolute_tolerance: UNREACHABLE_TOLERANCE,
+            step_tolerance: 0.01,
+            ..Default::default()
+        },
         ..options(Globalization::None)
     });
     assert_eq!(report.termination, Termination::Stalled);
@@ -647,7 +633,10 @@ fn bad_options_and_dimensions_are_errors_before_any_evaluation() {
     let mut p = scalar(|x| x, |_| 1.0);
     let mut x = [1.0];
     let opts = NewtonOptions {
-        step_tolerance: -1.0,
+        tolerances: Tolerances {
+            step_tolerance: -1.0,
+            ..Default::default()
+        },
         ..Default::default()
     };
     assert_eq!(
@@ -678,8 +667,11 @@ fn bad_options_and_dimensions_are_errors_before_any_evaluation() {
 #[test]
 fn relative_tolerance_is_relative_to_initial_residual() {
     let (report, _) = newton_on_cube(&NewtonOptions {
-        absolute_tolerance: 0.0,
-        relative_tolerance: 1e-3,
+        tolerances: Tolerances {
+            absolute_tolerance: 0.0,
+            relative_tolerance: 1e-3,
+            ..Default::default()
+        },
         ..options(Globalization::None)
     });
     assert!(report.converged());

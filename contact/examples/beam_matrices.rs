@@ -12,19 +12,18 @@
 //! `cargo run --release --example beam_matrices -- [ELEMENTS] [DIR]` (defaults 20 and
 //! `scenes/beam`).
 
+mod args;
+
 use std::path::PathBuf;
 
+use args::positional;
 use semismooth_contact::matrix_market::model_matrix_files;
 use semismooth_contact::structures::cantilever_with_tip_pad;
 
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let elements: usize = args
-        .next()
-        .map(|a| a.parse().expect("ELEMENTS: a positive integer"))
-        .unwrap_or(20);
+    let elements: usize = positional(1, 20, "ELEMENTS: a positive integer");
     assert!(elements >= 1, "ELEMENTS: a positive integer");
-    let dir = PathBuf::from(args.next().unwrap_or_else(|| "scenes/beam".into()));
+    let dir: PathBuf = positional(2, "scenes/beam".into(), "DIR: a directory");
     std::fs::create_dir_all(&dir).expect("output directory");
     let (k, m, f) = cantilever_with_tip_pad(elements);
     for (name, text) in model_matrix_files(&k, &m, &f) {

@@ -17,19 +17,18 @@
 //! `cargo run --release --example bladed_disk -- [BLADES] [DIR]` (defaults 100 and
 //! `scenes/blades`); the scene's contact list is printed.
 
+mod args;
+
 use std::path::PathBuf;
 
+use args::positional;
 use semismooth_contact::matrix_market::model_matrix_files;
 use semismooth_contact::structures::{BladedDisk, SHIPPED_MISTUNING};
 
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let blades: usize = args
-        .next()
-        .map(|a| a.parse().expect("BLADES: a positive integer"))
-        .unwrap_or(100);
+    let blades: usize = positional(1, 100, "BLADES: a positive integer");
     assert!(blades >= 1, "BLADES: a positive integer");
-    let dir = PathBuf::from(args.next().unwrap_or_else(|| "scenes/blades".into()));
+    let dir: PathBuf = positional(2, "scenes/blades".into(), "DIR: a directory");
     std::fs::create_dir_all(&dir).expect("output directory");
     let (k, m, f) = BladedDisk {
         blades,

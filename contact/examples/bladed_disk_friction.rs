@@ -9,44 +9,31 @@
 //! `cargo run --release -p semismooth-contact --example bladed_disk_friction -- [H]`
 //! (default `H = 10`).
 
+mod args;
+
 use std::time::Instant;
 
+use args::positional;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::Residual;
 use semismooth_contact::hb::{HbOptions, SsnHb, StructuredHbSolver};
-use semismooth_contact::model::{ContactRow, FrictionPoint};
 use semismooth_contact::structures::{BladedDisk, DiskLoading, SHIPPED_MISTUNING};
 
 fn main() {
-    let harmonics: usize = std::env::args()
-        .nth(1)
-        .map(|a| a.parse().expect("H: a positive integer"))
-        .unwrap_or(10);
+    let harmonics: usize = positional(1, 10, "H: a positive integer");
     let disk = BladedDisk {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: Vec::new(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped(Vec::new());
     println!(
         "| normal load N | H | unknowns | Newton iterations | solve time | blade 0 peak tip |"
     );
     println!("|---:|---:|---:|---:|---:|---:|");
     for normal_load in [1e-4, 1e-2, 1.0] {
-        let mut structure = disk.structure(&loading).expect("a valid disk");
-        for j in 0..disk.blades {
-            let platform = ContactRow::unit(BladedDisk::pad(j), 1.0);
-            structure
-                .model
-                .friction
-                .push(FrictionPoint::prescribed(platform, 0.3, normal_load));
-        }
-        let omega = loading.omega(structure.omega_1);
+        let (structure, omega) = disk
+            .with_platform_friction(&loading, 0.3, normal_load)
+            .expect("a valid disk");
         let options = HbOptions {
             harmonics,
             ..HbOptions::default()

@@ -75,13 +75,7 @@ fn run_one(args: &Args, count: usize) {
         mistuning: SHIPPED_MISTUNING,
     };
     let stops = (0..count).map(|i| i * args.blades / count).collect();
-    let loading = DiskLoading {
-        stops,
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped(stops);
     let structure = disk.structure(&loading).expect("valid disk");
     let omega = loading.omega(structure.omega_1);
     let settings = SolverSettings {

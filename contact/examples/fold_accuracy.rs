@@ -12,6 +12,9 @@
 //! Times are CPU seconds of this process (`/proc/self/stat`, 10 ms ticks), which the load
 //! of a shared machine does not inflate as it does wall time.
 
+mod args;
+
+use args::positional;
 use semismooth_contact::rod::{build_rod, MassModel, RodModel, RodSpec};
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::sweep::fold_accuracy::{refine_folds, MAX_FOLD_HARMONICS};
@@ -47,11 +50,7 @@ fn sweep_at(rod: &RodModel, harmonics: usize, sweep: &SweepSettings) -> (Frequen
 }
 
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let target: f64 = args
-        .next()
-        .map(|a| a.parse().expect("TARGET is a number"))
-        .unwrap_or(1e-4);
+    let target: f64 = positional(1, 1e-4, "TARGET: a number");
     let reference = std::env::args().any(|a| a == "--reference");
     let rod = build_rod(&RodSpec {
         mass: MassModel::Modified,

@@ -1,46 +1,78 @@
-//! Scratch: two-dof chain with a stop on a mass-carrying dof, swept at H = 10, 20, 40.
+//! The frequency response of a two-dof chain with a stop on its free mass (a contact on a
+//! dof that carries mass), swept over `[0.5, 3] omega_1` at several harmonic counts: the
+//! folds of the branch, the zigzags of the truncated balance told apart from them, and
+//! the stability along the branch with its bifurcations (the harmonic-balance orbit
+//! rebounds off the stop, so the verdict is that of an impact with the orbit's own
+//! restitution, close to 1; module `stability`).
+//!
+//! ```text
+//! cargo run --release -p semismooth-contact --example two_dof_chain [gap zeta f0 f1]
+//! ```
+//!
+//! Arguments (optional): the gap, the damping ratio at the first mode and the forces on
+//! masses 0 and 1 (default `0.5 0.02 0 0.1`). `HS=10,20,40` chooses the harmonic counts;
+//! `DUMP=1` prints every point (frequency, tip extremes, Newton iterations, verdict,
+//! largest multiplier modulus).
+mod args;
 #[path = "../tests/common/chain.rs"]
 mod chain;
 
+use args::positional;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::sweep::frequency_response;
 
 fn main() {
-    let arg = |i: usize, d: f64| {
-        std::env::args()
-            .nth(i)
-            .map(|s| s.parse().unwrap())
-            .unwrap_or(d)
-    };
-    // Arguments: gap, damping ratio, force on mass 0, force on mass 1.
+    let arg = |i: usize, d: f64| positional(i, d, "a number");
     let structure = chain::chain(arg(1, 0.5), arg(2, 0.02), [arg(3, 0.0), arg(4, 0.1)]);
     let omega_1 = structure.omega_1;
     let hs: Vec<usize> = std::env::var("HS")
-        .map(|v| v.split(',').map(|x| x.parse().unwrap()).collect())
+        .map(|v| {
+            v.split(',')
+                .map(|x| x.parse().expect("an integer"))
+                .collect()
+        })
         .unwrap_or(vec![10, 20, 40]);
+    println!("   H  points  converged  folds (omega_1)         zigzags  stable  unstable  undecided  solve s  stability s");
     for h in hs {
         let settings = SolverSettings::with_harmonics(h);
-        let t = std::time::Instant::now();
-        let r =
-            frequency_response(&structure, &settings, &SweepSettings::new(0.5, 3.0), None).unwrap();
-        println!("H = {h}: points {} converged {} {:?} folds {:?} corners {} restarts {} last {:.4} stable {} unstable {} undecided {} {:.2}s stab {:.2}s",
-            r.points(), r.converged(), r.termination, r.folds.iter().map(|w| w / omega_1).collect::<Vec<_>>(), r.corner_folds.len(), r.restarts,
-            r.omega.last().unwrap() / omega_1,
-            r.stability.stable.iter().filter(|s| **s == Some(true)).count(),
-            r.stability.stable.iter().filter(|s| **s == Some(false)).count(),
-            r.stability.stable.iter().filter(|s| s.is_none()).count(),
-            t.elapsed().as_secs_f64(), r.stability_seconds);
+        let r = frequency_response(&structure, &settings, &SweepSettings::new(0.5, 3.0), None)
+            .expect("valid settings");
+        let count = |v: Option<bool>| r.stability.stable.iter().filter(|s| **s == v).count();
+        let folds: Vec<String> = r
+            .folds
+            .iter()
+            .map(|w| format!("{:.4}", w / omega_1))
+            .collect();
+        println!(
+            "{h:>4}  {:>6}  {:>9}  {:<22}  {:>7}  {:>6}  {:>8}  {:>9}  {:>7.2}  {:>11.2}",
+            r.points(),
+            r.converged(),
+            folds.join(", "),
+            r.corner_folds.len(),
+            count(Some(true)),
+            count(Some(false)),
+            count(None),
+            r.solve_seconds,
+            r.stability_seconds
+        );
+        for e in &r.stability.events {
+            println!(
+                "      {} at {:.4} omega_1 (point {})",
+                e.kind.name(),
+                e.omega / omega_1,
+                e.index
+            );
+        }
         if std::env::var("DUMP").is_ok() {
             for i in 0..r.points() {
                 println!(
-                    "{i} {:.6} {:.6} {:.6} it {} stable {:?} mu {:?} placed {}",
+                    "{i} {:.6} {:.6} {:.6} it {} stable {:?} mu {:?}",
                     r.omega[i] / omega_1,
                     r.tip_max[i],
                     r.tip_min[i],
                     r.iterations[i],
                     r.stability.stable[i],
                     r.stability.floquet_max_abs[i],
-                    r.stability.placed_by_fold[i]
                 );
             }
         }

@@ -28,6 +28,90 @@ pub struct ContactReport {
     pub displacement_max: f64,
 }
 
+/// One friction point over one period: its tangential force and slip velocity at the
+/// run's output times, with the numbers a sweep keeps per point ([`FrictionSummary`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrictionReport {
+    /// Index of the friction point (the model's order).
+    pub point: usize,
+    /// Tangential force `lambda_t` at the run's times (for harmonic balance the law's force
+    /// `proj_[-b, b](lambda_t - c y_t)` of the truncated series, inside the slip limit by
+    /// construction; the series of `lambda_t` itself rings past it like a square wave's).
+    pub force: Vec<f64>,
+    /// Slip velocity `v_t = d (g_t . u) / dt` at the same times.
+    pub slip_velocity: Vec<f64>,
+    /// Stick fraction, force and velocity amplitudes.
+    pub summary: FrictionSummary,
+}
+
+/// The per-point numbers of a friction point over one period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionSummary {
+    /// Fraction of the period the point sticks: for harmonic balance the samples where the
+    /// law's argument is strictly inside the slip limit (`|lambda_t - c y_t| < b`), for
+    /// regularised friction where `|v_t| < eps`, for time marching the steps with a slip
+    /// velocity below `1e-8` of its largest magnitude.
+    pub stick_fraction: f64,
+    /// Largest tangential force magnitude `max |lambda_t|` over the period.
+    pub force_amplitude: f64,
+    /// Largest slip velocity magnitude `max |v_t|` over the period.
+    pub slip_velocity_amplitude: f64,
+    /// Largest slip limit `max mu N` over the period.
+    pub slip_limit_max: f64,
+}
+
+impl FrictionReport {
+    /// The report of friction point `point` from its force, slip velocity and slip limit
+    /// samples and the samples where it sticks (all at the same equally spaced times).
+    pub fn from_samples(
+        point: usize,
+        force: Vec<f64>,
+        slip_velocity: Vec<f64>,
+        slip_limit: &[f64],
+        stuck: impl Iterator<Item = bool>,
+    ) -> Self {
+        let samples = force.len().max(1) as f64;
+        let largest = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let summary = FrictionSummary {
+            stick_fraction: stuck.filter(|s| *s).count() as f64 / samples,
+            force_amplitude: largest(&force),
+            slip_velocity_amplitude: largest(&slip_velocity),
+            slip_limit_max: largest(slip_limit),
+        };
+        Self {
+            point,
+            force,
+            slip_velocity,
+            summary,
+        }
+    }
+}
+
+/// Slip velocity, relative to the run's velocity scale, below which a time-marching step
+/// counts as stuck: the step's friction problem is solved to `1e-12` of its impulse scale,
+/// so a stuck point's velocity is round-off far below it.
+pub const MARCH_STICK_VELOCITY: f64 = 1e-8;
+
+/// The report of a time-marched friction point from its force and slip velocity at the
+/// steps of one period and its slip limits there; a step sticks where `|v_t|` is below
+/// [`MARCH_STICK_VELOCITY`] times the largest of `velocity_scale` and `max |v_t|`.
+pub fn march_friction_report(
+    point: usize,
+    force: Vec<f64>,
+    slip_velocity: Vec<f64>,
+    slip_limit: &[f64],
+    velocity_scale: f64,
+) -> FrictionReport {
+    let scale = slip_velocity
+        .iter()
+        .fold(velocity_scale, |a, v| a.max(v.abs()));
+    let stuck: Vec<bool> = slip_velocity
+        .iter()
+        .map(|v| v.abs() <= MARCH_STICK_VELOCITY * scale)
+        .collect();
+    FrictionReport::from_samples(point, force, slip_velocity, slip_limit, stuck.into_iter())
+}
+
 /// One contact's diagnostics over a period.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactSummary {

@@ -11,6 +11,7 @@
 pub mod builder;
 pub mod contacts;
 mod dynamic;
+pub mod exact;
 pub mod from_zero;
 pub mod hb;
 pub mod lcp;

@@ -91,6 +91,9 @@ pub struct SolverSettings {
     pub c: Option<f64>,
     /// Penalty stiffness `k_p` (absolute); `None`: 1e5 times the contact stiffness scale.
     pub penalty_stiffness: Option<f64>,
+    /// Width of penalty HB's regularised friction law `-mu N tanh(v_t / eps)`, relative
+    /// to each point's static slip ([`crate::hb::PenaltyHb::set_friction_regularisation`]).
+    pub friction_regularisation: f64,
     /// Linear solver for HB Newton systems.
     pub linear_solver: LinearSolverChoice,
     /// Newton iteration limit.
@@ -139,10 +142,11 @@ impl Default for SolverSettings {
                 .unwrap_or_else(|| default_hb_time_samples(hb.harmonics)),
             c: hb.c,
             penalty_stiffness: None,
+            friction_regularisation: crate::hb::DEFAULT_FRICTION_REGULARISATION,
             linear_solver: LinearSolverChoice::default(),
             max_iterations: newton.max_iterations,
             globalization: GlobalizationChoice::default(),
-            tolerance: newton.absolute_tolerance,
+            tolerance: newton.tolerances.absolute_tolerance,
             steps_per_period: march.steps_per_period,
             max_periods: march.max_periods,
             march_tolerance: march.tolerance,

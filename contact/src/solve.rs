@@ -9,10 +9,13 @@
 //! what happened.
 
 pub mod accuracy;
+mod march;
 mod raised_c;
 pub use raised_c::RAISED_C_FACTOR;
 mod reconstruction;
 
+pub(crate) use march::march_scheme;
+use march::solve_march;
 pub(crate) use reconstruction::HbReconstruction;
 
 use std::time::Instant;
@@ -21,12 +24,12 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonOptions, NewtonReport, Strategy, WorkCounters,
+    self, Globalization, NewtonOptions, NewtonReport, Strategy, Tolerances, WorkCounters,
 };
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
 
-use crate::contacts::{contact_reports, ContactReport};
+use crate::contacts::{contact_reports, ContactReport, FrictionReport};
 use crate::contacts::{period_statistics, PeriodStatistics};
 use crate::hb::{
     CondensedSolve, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
@@ -36,7 +39,7 @@ use crate::lcp::{
     ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
     DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use crate::march::{march_from_state, MarchError, MarchOptions, MarchScheme, MarchState};
+use crate::march::MarchError;
 use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
 use crate::rod::ModelError;
@@ -109,6 +112,8 @@ pub struct RunCounters {
     pub lemke_pivots: u64,
     /// Time steps (time marching).
     pub time_steps: u64,
+    /// GMRES iterations of the matrix-free condensed solve (0 on the direct paths).
+    pub krylov_iterations: u64,
 }
 
 impl std::ops::Add for RunCounters {
@@ -125,6 +130,7 @@ impl std::ops::Add for RunCounters {
             ffts: self.ffts + other.ffts,
             lemke_pivots: self.lemke_pivots + other.lemke_pivots,
             time_steps: self.time_steps + other.time_steps,
+            krylov_iterations: self.krylov_iterations + other.krylov_iterations,
         }
     }
 }
@@ -138,6 +144,7 @@ impl From<WorkCounters> for RunCounters {
             linear_solves: c.linear_solves,
             line_search_backtracks: c.line_search_backtracks,
             ffts: c.problem.get("ffts"),
+            krylov_iterations: c.krylov_iterations,
             ..RunCounters::default()
         }
     }
@@ -271,6 +278,9 @@ pub struct Solution {
     pub stats: PeriodStatistics,
     /// Every contact point over the period.
     pub contacts: Vec<ContactReport>,
+    /// Every friction point over the period, at [`Solution::times`] (harmonic balance and
+    /// time marching; empty for the LCP, which has no friction).
+    pub friction: Vec<FrictionReport>,
     /// Work counters.
     pub counters: RunCounters,
     /// The method's unknowns, for warm starts: HB coefficients, the LCP's `z`, the state
@@ -338,6 +348,18 @@ pub(crate) fn penalty_options(
     }
 }
 
+/// The scene's penalty-HB problem at `omega`: [`penalty_options`] and the friction
+/// regularisation of `settings`.
+pub(crate) fn penalty_problem(
+    model: &crate::model::StructuralModel,
+    omega: f64,
+    settings: &SolverSettings,
+) -> Result<PenaltyHb, HbError> {
+    let mut problem = PenaltyHb::new(model, omega, &penalty_options(settings, model))?;
+    problem.set_friction_regularisation(settings.friction_regularisation)?;
+    Ok(problem)
+}
+
 /// The periodic LCP's options of a scene and the index of the tip's contact: the tip is
 /// observed (its history kept) when it is not a contact.
 pub(crate) fn lcp_options(
@@ -363,10 +385,9 @@ pub(crate) fn lcp_options(
 pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
     let plain = |globalization| {
         SolveOptions::Newton(NewtonOptions {
-            absolute_tolerance: settings.tolerance,
+            tolerances: Tolerances::absolute(settings.tolerance),
             max_iterations: settings.max_iterations,
             globalization,
-            ..NewtonOptions::default()
         })
     };
     match settings.globalization {
@@ -375,7 +396,7 @@ pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
         GlobalizationChoice::Nonmonotone => plain(Globalization::non_monotone()),
         GlobalizationChoice::Hybrid => plain(Globalization::hybrid()),
         GlobalizationChoice::Auto => SolveOptions::Polyalgorithm(PolyalgorithmOptions {
-            absolute_tolerance: settings.tolerance,
+            tolerances: Tolerances::absolute(settings.tolerance),
             max_iterations: settings.max_iterations,
             ..PolyalgorithmOptions::default()
         }),
@@ -477,6 +498,7 @@ struct Period {
     tip: Vec<f64>,
     contact_forces: Vec<Vec<f64>>,
     contact_displacements: Vec<Vec<f64>>,
+    friction: Vec<FrictionReport>,
 }
 
 /// The solution record of a run of the scene's method at `omega`.
@@ -509,6 +531,7 @@ fn solution(
     Solution {
         method,
         contacts,
+        friction: period.friction,
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
@@ -563,11 +586,15 @@ fn hb_outputs(
     let closed = (0..contacts)
         .map(|i| problem.closed_intervals(&x, i))
         .collect::<Result<Vec<_>, _>>()?;
+    let friction = (0..rod.model.friction.len())
+        .map(|f| problem.friction(&x, f, points))
+        .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
         times,
         tip,
         contact_forces,
         contact_displacements,
+        friction,
     };
     let mut solution = solution(
         rod,
@@ -674,7 +701,7 @@ pub(crate) fn solve_as_given(
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
             let target = options.penalty_stiffness;
-            let mut problem = PenaltyHb::new(model, omega, &options)?;
+            let mut problem = penalty_problem(model, omega, settings)?;
             let mut x = initial_state(problem.dim(), warm_start);
             let start = Instant::now();
             // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
@@ -685,7 +712,26 @@ pub(crate) fn solve_as_given(
             // last converged stiffness with the square root of the factor.
             let mut counters = WorkCounters::default();
             let mut homotopy_iterations = 0;
-            if warm_start.is_none() {
+            // Regularisation homotopy: a narrow tanh law is a near-discontinuity Newton
+            // cannot cross from zero, so without a warm start its width is narrowed in log
+            // from the static slip itself (a soft, nearly viscous law) by factors of 10.
+            let width = settings.friction_regularisation;
+            if warm_start.is_none() && !model.friction.is_empty() && width < 1.0 {
+                let stages = homotopy(
+                    0.0,
+                    -width.ln(),
+                    &HomotopySchedule::default(),
+                    &mut x,
+                    |narrowing, x| {
+                        problem.set_friction_regularisation((-narrowing).exp())?;
+                        newton_hb(&mut problem, x, settings, model, (target, None))
+                    },
+                )?;
+                counters += stages.counters;
+                homotopy_iterations += stages.iterations;
+                problem.set_friction_regularisation(width)?;
+            }
+            if warm_start.is_none() && !model.contacts.is_empty() {
                 let k0 = model
                     .static_contact_stiffness()
                     .map(|s| DEFAULT_C_FACTOR * s)
@@ -702,7 +748,7 @@ pub(crate) fn solve_as_given(
                     },
                 )?;
                 counters += stages.counters;
-                homotopy_iterations = stages.iterations;
+                homotopy_iterations += stages.iterations;
                 problem.set_penalty_stiffness(target)?;
             }
             let mut report = newton_hb(&mut problem, &mut x, settings, model, (target, None))?;
@@ -848,6 +894,7 @@ fn solve_lcp(
         tip: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
+        friction: Vec::new(),
     };
     let mut sol = solution(
         rod,
@@ -863,135 +910,4 @@ fn solve_lcp(
         sol.diagnosis = Some(Diagnosis::AlternatingNullVector);
     }
     Ok(sol)
-}
-
-/// The time-marching scheme of `settings`: Moreau–Jean with the restitution when it is
-/// positive, else the model's choice ([`MarchScheme::Auto`]).
-pub(crate) fn march_scheme(settings: &SolverSettings) -> MarchScheme {
-    if settings.restitution > 0.0 {
-        MarchScheme::MoreauJean {
-            theta: 0.5,
-            restitution: settings.restitution,
-        }
-    } else {
-        MarchScheme::Auto
-    }
-}
-
-/// The march state `(u, v, lambda)` of [`Solution::state`] (`None` when `state` is not of
-/// the model's size).
-fn march_state(model: &crate::model::StructuralModel, state: &[f64]) -> Option<MarchState> {
-    let (n, m) = (model.dofs(), model.contact_count());
-    (state.len() == 2 * n + m).then(|| MarchState {
-        displacement: state[..n].to_vec(),
-        velocity: state[n..2 * n].to_vec(),
-        contact_force: state[2 * n..].to_vec(),
-    })
-}
-
-/// Time marching from rest (or from `warm_start`, the [`Solution::state`] of a march of
-/// the same model) to the steady state.
-fn solve_march(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
-    let model = &rod.model;
-    let tip = rod.observed_dof;
-    let options = MarchOptions {
-        steps_per_period: settings.steps_per_period,
-        max_periods: settings.max_periods,
-        tolerance: settings.march_tolerance,
-        scheme: march_scheme(settings),
-    };
-    // The tip, then every dof of the contacts' rows (their gap closures `g . u` are
-    // combined from these series).
-    let mut observed = vec![tip];
-    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
-        if !observed[1..].contains(dof) {
-            observed.push(*dof);
-        }
-    }
-    let initial = warm_start
-        .and_then(|w| march_state(model, w))
-        .unwrap_or_else(|| MarchState::rest(model));
-    let start = Instant::now();
-    // A march that does not settle is a run that did not converge: its last period is
-    // reported with the last period-to-period change.
-    let (period, steady) = match march_from_state(model, omega, &options, &observed, &initial) {
-        Ok(period) => (period, true),
-        Err(MarchError::NotSteady { last_period, .. }) => (*last_period, false),
-        Err(e) => return Err(e.into()),
-    };
-    let seconds = start.elapsed().as_secs_f64();
-    // Drop the closing sample (t = T repeats t = 0).
-    let keep = period.times.len().saturating_sub(1).max(1);
-    let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
-    let tip_series = cut(&period.displacements[0]);
-    let series = |dof: usize| {
-        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
-        cut(&period.displacements[k])
-    };
-    let contact_u: Vec<Vec<f64>> = model
-        .contacts
-        .iter()
-        .map(|c| {
-            let mut entries = c.row.entries();
-            let (d, a) = entries.next().expect("a row has at least one dof");
-            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
-            for (d, a) in entries {
-                for (ui, v) in u.iter_mut().zip(series(d)) {
-                    *ui += a * v;
-                }
-            }
-            u
-        })
-        .collect();
-    let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
-    let start_time = period.times[0];
-    let times = period.times[..keep]
-        .iter()
-        .map(|t| t - start_time)
-        .collect();
-    let outcome = Outcome {
-        termination: Termination::March {
-            steady,
-            period_change: period.period_change,
-            tolerance: settings.march_tolerance,
-            periods: period.periods,
-        },
-        iterations: period.periods,
-        residual_norm: period.period_change,
-        effective_tolerance: Some(settings.march_tolerance),
-        counters: RunCounters {
-            time_steps: period.counters.steps,
-            factorizations: period.counters.factorizations,
-            ..RunCounters::default()
-        },
-        solve_seconds: seconds,
-        newton: None,
-    };
-    let final_state = period.final_state;
-    let period = Period {
-        times,
-        tip: tip_series,
-        contact_forces: forces,
-        contact_displacements: contact_u,
-    };
-    let state = [
-        final_state.displacement,
-        final_state.velocity,
-        final_state.contact_force,
-    ]
-    .concat();
-    Ok(solution(
-        rod,
-        omega,
-        settings,
-        settings.steps_per_period,
-        outcome,
-        period,
-        state,
-    ))
 }

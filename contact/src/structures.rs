@@ -33,7 +33,9 @@
 use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
-use crate::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
+use crate::model::{
+    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
+};
 use crate::rod::{natural_frequencies, ModelError};
 
 /// Mistuning amplitude of the shipped disk (`scenes/bladed_disk_casing.toml`).
@@ -64,6 +66,19 @@ pub struct DiskLoading {
 }
 
 impl DiskLoading {
+    /// The loading of the shipped disk scenes (`scenes/bladed_disk_casing.toml`): casing
+    /// clearance 1 on the pads of `stops`, load amplitude 0.02, 1 % damping, forced at the
+    /// tuned resonance.
+    pub fn shipped(stops: Vec<usize>) -> Self {
+        Self {
+            stops,
+            gap: 1.0,
+            amplitude: 0.02,
+            zeta: 0.01,
+            omega_ratio: 1.0,
+        }
+    }
+
     /// The forcing frequency for a disk whose first natural frequency is `omega_1`
     /// ([`Structure::omega_1`] of [`BladedDisk::structure`]).
     pub fn omega(&self, omega_1: f64) -> f64 {
@@ -131,6 +146,27 @@ impl BladedDisk {
         let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("entries within 3B x 3B");
         let f = (0..n).map(|i| if i % 3 == 1 { 1.0 } else { 0.0 }).collect();
         (k, m, f)
+    }
+
+    /// The disk under `loading` with a Coulomb friction point on every blade's platform
+    /// (its pad rubbing a fixed part, coefficient `mu`, constant `normal_load`), and its
+    /// forcing frequency [`DiskLoading::omega`].
+    pub fn with_platform_friction(
+        &self,
+        loading: &DiskLoading,
+        mu: f64,
+        normal_load: f64,
+    ) -> Result<(Structure, f64), ModelError> {
+        let mut structure = self.structure(loading)?;
+        for j in 0..self.blades {
+            let platform = ContactRow::unit(Self::pad(j), 1.0);
+            structure
+                .model
+                .friction
+                .push(FrictionPoint::prescribed(platform, mu, normal_load));
+        }
+        let omega = loading.omega(structure.omega_1);
+        Ok((structure, omega))
     }
 
     /// The disk as a structure: `omega_1` its lowest natural frequency, the observed dof the

@@ -4,6 +4,7 @@
 
 use semismooth::continuation::{Continuation, ContinuationOptions};
 use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::NewtonReport;
 use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
 use semismooth::{ParameterDependent, Residual};
 use semismooth_contact::hb::{CondensedSsnHb, HbOptions, SsnHb};
@@ -29,10 +30,10 @@ fn options(h: usize) -> HbOptions {
 /// smooth in `w` at fixed active set, so the difference is exact to `O(h^2)` (h = 1e-6 w,
 /// the resonance scale zeta w = 1.6e-2: truncation ~ 1e-8 relative) plus rounding
 /// `eps |R| / h ~ 1e-10`.
-#[test]
-fn condensed_frequency_derivative_matches_central_differences() {
-    let rod = rod();
-    let mut problem = CondensedSsnHb::new(&rod.model, rod.omega(), &options(10)).unwrap();
+/// The condensed SSN-HB problem of `rod` at `h` harmonics solved from zero by the
+/// polyalgorithm (converged): the problem, the force coefficients and the report.
+fn solved_from_zero(rod: &RodModel, h: usize) -> (CondensedSsnHb, Vec<f64>, NewtonReport) {
+    let mut problem = CondensedSsnHb::new(&rod.model, rod.omega(), &options(h)).unwrap();
     let mut lambda = vec![0.0; problem.dim()];
     let report = solve(
         &mut problem,
@@ -42,6 +43,13 @@ fn condensed_frequency_derivative_matches_central_differences() {
     )
     .unwrap();
     assert!(report.converged(), "{:?}", report.termination);
+    (problem, lambda, report)
+}
+
+#[test]
+fn condensed_frequency_derivative_matches_central_differences() {
+    let rod = rod();
+    let (mut problem, lambda, report) = solved_from_zero(&rod, 10);
     assert!(report.iterations > 1, "contact: more than one Newton step");
     let omega = problem.parameter();
     let mut analytic = vec![0.0; problem.dim()];
@@ -109,16 +117,7 @@ fn condensed_branch_points_are_full_solutions_and_end_at_the_direct_solution() {
     }
     assert!(worst < 1e-8, "full residual at condensed points {worst:e}");
 
-    let mut direct = CondensedSsnHb::new(&rod.model, rod.omega(), &options(h)).unwrap();
-    let mut lambda = vec![0.0; direct.dim()];
-    let report = solve(
-        &mut direct,
-        &mut FaerDenseLu::new(),
-        &mut lambda,
-        &PolyalgorithmOptions::default(),
-    )
-    .unwrap();
-    assert!(report.converged(), "{:?}", report.termination);
+    let (_, lambda, _) = solved_from_zero(&rod, h);
     let scale = lambda.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     for (a, b) in last.state.iter().zip(&lambda) {
         assert!((a - b).abs() <= 1e-8 * scale, "{a} vs {b}");

@@ -45,6 +45,15 @@ fn refined(rod: &RodModel, harmonics: usize, target: (f64, usize)) -> Vec<FoldAc
     refine_folds(rod, &settings, &range(), &coarse, target).unwrap()
 }
 
+/// The distance from `omega` to the nearest fold of `response` (infinite without folds).
+fn distance_to_folds(response: &FrequencyResponse, omega: f64) -> f64 {
+    response
+        .folds
+        .iter()
+        .map(|w| (w - omega).abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
 #[test]
 fn folds_refined_around_themselves_equal_the_folds_of_a_whole_sweep_at_those_harmonics() {
     let rod = strong_rod();
@@ -62,11 +71,7 @@ fn folds_refined_around_themselves_equal_the_folds_of_a_whole_sweep_at_those_har
             ..range()
         };
         let whole = sweep_with(&rod, fold.harmonics(), &fine_steps);
-        let nearest = whole
-            .folds
-            .iter()
-            .map(|w| (w - fold.omega).abs())
-            .fold(f64::INFINITY, f64::min);
+        let nearest = distance_to_folds(&whole, fold.omega);
         assert!(
             nearest <= 5e-6 * fold.omega,
             "H = {}: segment {} against whole sweep {:?}",
@@ -89,11 +94,7 @@ fn the_uncertainty_of_a_refined_fold_bounds_its_distance_to_the_folds_at_eight_t
         assert!(fold.met(), "{fold:?}");
         let uncertainty = fold.uncertainty.unwrap();
         assert!(uncertainty <= 1e-3 * fold.omega);
-        let distance = fine
-            .folds
-            .iter()
-            .map(|w| (w - fold.omega).abs())
-            .fold(f64::INFINITY, f64::min);
+        let distance = distance_to_folds(&fine, fold.omega);
         assert!(
             distance <= uncertainty,
             "fold {} +- {uncertainty:e} at H = {}, H = 160 folds {:?}",

@@ -7,9 +7,12 @@
 //! matching conditions at the reversals; its amplitude is checked against Den Hartog's own
 //! formula for the undamped case, and harmonic balance converges to it as `H` grows.
 
+mod common;
+
 use semismooth::linalg::FaerDenseLu;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::{ParameterDependent, Residual};
+use semismooth_contact::exact;
 use semismooth_contact::hb::{
     CondensedSolve, CondensedSsnHb, HbOptions, SsnHb, StructuredHbSolver,
 };
@@ -42,39 +45,10 @@ fn oscillator(m: f64, c: f64, k: f64, f0: f64, friction: f64) -> StructuralModel
     }
 }
 
-/// The exact amplitude `X` of Den Hartog's continuous-sliding solution of
-/// `m x'' + c x' + k x + F sign(x') = F0 cos(w t)` (`c` below critical).
-///
-/// Over the half period `(0, T/2)` after a velocity reversal at `x(0) = -X`, `x' > 0` and
-/// `x = x_p + x_h`: the particular solution `x_p = A cos(w t + phi) + B sin(w t + phi) - F/k`
-/// of the linear response `(A, B)` to `F0`, and the free damped motion `x_h` from
-/// `x_h(0) = -X - x_p(0)`, `x_h'(0) = -x_p'(0)`. The half-period symmetry asks
-/// `x(T/2) = X`, `x'(T/2) = 0`. With `p = A cos(phi) + B sin(phi)`,
-/// `q = B cos(phi) - A sin(phi)` (so `p^2 + q^2 = A^2 + B^2`) and `Phi` the free motion's
-/// transition matrix over `T/2`, both conditions are linear in `Y = X + p` and `q`; then
-/// `X = Y - p` with `p = -sqrt(A^2 + B^2 - q^2)` (the root with `X > 0`).
+/// Den Hartog's amplitude ([`exact::den_hartog`]), asserted to exist (continuous sliding).
 fn den_hartog(m: f64, c: f64, k: f64, f0: f64, friction: f64, w: f64) -> f64 {
-    let wn = (k / m).sqrt();
-    let zeta = c / (2.0 * (k * m).sqrt());
-    let wd = wn * (1.0 - zeta * zeta).sqrt();
-    let d = (k - m * w * w).powi(2) + (c * w).powi(2);
-    let (a, b) = (f0 * (k - m * w * w) / d, f0 * c * w / d);
-    let tau = std::f64::consts::PI / w;
-    let s = friction / k;
-    let (e, cs, sn) = ((-zeta * wn * tau).exp(), (wd * tau).cos(), (wd * tau).sin());
-    let p11 = e * (cs + zeta * wn / wd * sn);
-    let p12 = e * sn / wd;
-    let p21 = -e * wn * wn / wd * sn;
-    let p22 = e * (cs - zeta * wn / wd * sn);
-    // -(P11 + 1) Y - P12 w q = -(P11 - 1) s;  -P21 Y - (P22 + 1) w q = -P21 s.
-    let (a11, a12, b1) = (-(p11 + 1.0), -p12 * w, -(p11 - 1.0) * s);
-    let (a21, a22, b2) = (-p21, -(p22 + 1.0) * w, -p21 * s);
-    let det = a11 * a22 - a12 * a21;
-    let y = (b1 * a22 - a12 * b2) / det;
-    let q = (a11 * b2 - a21 * b1) / det;
-    let r2 = a * a + b * b;
-    assert!(r2 > q * q, "no continuous sliding at w = {w}");
-    y + (r2 - q * q).sqrt()
+    exact::den_hartog(m, c, k, f0, friction, w)
+        .unwrap_or_else(|| panic!("no continuous sliding at w = {w}"))
 }
 
 /// Den Hartog's closed form of the undamped case:
@@ -102,24 +76,10 @@ fn hb_solve(model: &StructuralModel, w: f64, h: usize) -> (SsnHb, Vec<f64>) {
     (hb, x)
 }
 
-/// The amplitude `sqrt(a_1^2 + b_1^2)` of the first harmonic of `N` equally spaced
-/// samples of one period (the trapezoidal rule, exact for a trigonometric polynomial of
-/// degree `< N - 1`).
-fn first_harmonic(u: &[f64]) -> f64 {
-    let n = u.len() as f64;
-    let (mut a, mut b) = (0.0, 0.0);
-    for (j, v) in u.iter().enumerate() {
-        let phase = 2.0 * std::f64::consts::PI * j as f64 / n;
-        a += v * phase.cos();
-        b += v * phase.sin();
-    }
-    2.0 * a.hypot(b) / n
-}
-
 /// The first-harmonic amplitude of `u[dof]` of the SSN-HB solution with `h` harmonics.
 fn hb_first_harmonic(model: &StructuralModel, w: f64, h: usize, dof: usize) -> f64 {
     let (hb, x) = hb_solve(model, w, h);
-    first_harmonic(&hb.displacement_samples(&x, dof, 4096).unwrap())
+    common::first_harmonic(&hb.displacement_samples(&x, dof, 4096).unwrap())
 }
 
 /// The first-harmonic amplitude of `u[dof]` over the steady period of the Moreau–Jean
@@ -150,7 +110,7 @@ fn march_first_harmonic(
         .count();
     // The series holds both ends of the period: the last sample repeats the first.
     (
-        first_harmonic(&u[..u.len() - 1]),
+        common::first_harmonic(&u[..u.len() - 1]),
         still as f64 / (u.len() - 1) as f64,
     )
 }
@@ -457,22 +417,11 @@ fn disk_with_friction(blades: usize, normal_load: f64) -> (StructuralModel, f64)
         blades,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: Vec::new(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
-    let mut structure = disk.structure(&loading).unwrap();
-    for j in 0..blades {
-        let pad = ContactRow::unit(BladedDisk::pad(j), 1.0);
-        structure
-            .model
-            .friction
-            .push(FrictionPoint::prescribed(pad, 0.3, normal_load));
-    }
-    (structure.model, loading.omega(structure.omega_1))
+    let loading = DiskLoading::shipped(Vec::new());
+    let (structure, omega) = disk
+        .with_platform_friction(&loading, 0.3, normal_load)
+        .unwrap();
+    (structure.model, omega)
 }
 
 #[test]

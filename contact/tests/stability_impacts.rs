@@ -4,6 +4,10 @@
 //! plus a small perturbation, the march's period-to-period change decays or grows at the
 //! rate of the largest multiplier.
 
+#[path = "common/orbit_march.rs"]
+mod orbit_march;
+
+use orbit_march::{distance, snapshot};
 use semismooth_contact::march::{MarchOptions, MarchScheme, TimeMarcher};
 use semismooth_contact::rod::{build_rod, RodModel, RodSpec};
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
@@ -62,23 +66,6 @@ fn marcher_from_orbit<'a>(
         ..MarchOptions::default()
     };
     TimeMarcher::new(&rod.model, omega, &options, &start).unwrap()
-}
-
-/// The state `(u, v / omega)` of a march.
-fn snapshot(m: &TimeMarcher, omega: f64) -> Vec<f64> {
-    m.displacement()
-        .iter()
-        .copied()
-        .chain(m.velocity().iter().map(|v| v / omega))
-        .collect()
-}
-
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).powi(2))
-        .sum::<f64>()
-        .sqrt()
 }
 
 /// The period-to-period changes `|x_{k+1} - x_k|` of `periods` more periods of `marcher`.

@@ -339,20 +339,12 @@ impl Scene {
 /// while it runs. Not converging is not an error: see `Solution.converged`.
 #[pyfunction]
 fn solve(py: Python<'_>, scene: &Scene) -> PyResult<Solution> {
-    let source = scene.source.clone();
-    let (solution, structure) = py
-        .detach(move || -> Result<_, CliError> {
-            let loaded = source.load(Workload::Solve)?;
-            let solution = semismooth_contact::solve(
-                &loaded.structure,
-                loaded.omega,
-                &loaded.scene.solver,
-                None,
-            )
-            .map_err(|e| CliError::BadInput(format!("{}: {e}", source.path.display())))?;
-            Ok((solution, loaded.structure))
-        })
-        .map_err(run_error)?;
+    let (solution, structure) = detached(py, scene, Workload::Solve, |loaded| {
+        let settings = &loaded.scene.solver;
+        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
+            .map_err(|e| e.to_string())?;
+        Ok((solution, loaded.structure))
+    })?;
     Ok(Solution::new(&scene.source.path, &solution, &structure))
 }
 
@@ -360,26 +352,18 @@ fn solve(py: Python<'_>, scene: &Scene) -> PyResult<Solution> {
 /// every point; the GIL is released while it runs.
 #[pyfunction]
 fn sweep(py: Python<'_>, scene: &Scene) -> PyResult<FrequencyResponse> {
-    let source = scene.source.clone();
-    let response = py
-        .detach(move || -> Result<_, CliError> {
-            let loaded = source.load(Workload::Branch)?;
-            let Some(settings) = loaded.scene.sweep.as_ref() else {
-                return Err(CliError::BadInput(format!(
-                    "{}: no [sweep] section: add omega_ratio_from and omega_ratio_to (units of \
-                     omega_1)",
-                    source.path.display()
-                )));
-            };
-            semismooth_contact::sweep::frequency_response(
-                &loaded.structure,
-                &loaded.scene.solver,
-                settings,
-                None,
-            )
-            .map_err(|e| CliError::BadInput(format!("{}: {e}", source.path.display())))
-        })
-        .map_err(run_error)?;
+    let response = detached(py, scene, Workload::Branch, |loaded| {
+        let settings = loaded.scene.sweep.as_ref().ok_or(
+            "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
+        )?;
+        semismooth_contact::sweep::frequency_response(
+            &loaded.structure,
+            &loaded.scene.solver,
+            settings,
+            None,
+        )
+        .map_err(|e| e.to_string())
+    })?;
     Ok(FrequencyResponse::new(&response))
 }
 
@@ -387,19 +371,15 @@ fn sweep(py: Python<'_>, scene: &Scene) -> PyResult<FrequencyResponse> {
 /// the GIL is released while it runs.
 #[pyfunction]
 fn solutions(py: Python<'_>, scene: &Scene) -> PyResult<SolutionSet> {
-    let source = scene.source.clone();
-    let set = py
-        .detach(move || -> Result<_, CliError> {
-            let loaded = source.load(Workload::Branch)?;
-            semismooth_contact::solutions::find_solutions(
-                &loaded.structure,
-                loaded.omega,
-                &loaded.scene.solver,
-                loaded.scene.sweep.as_ref(),
-            )
-            .map_err(|e| CliError::BadInput(format!("{}: {e}", source.path.display())))
-        })
-        .map_err(run_error)?;
+    let set = detached(py, scene, Workload::Branch, |loaded| {
+        semismooth_contact::solutions::find_solutions(
+            &loaded.structure,
+            loaded.omega,
+            &loaded.scene.solver,
+            loaded.scene.sweep.as_ref(),
+        )
+        .map_err(|e| e.to_string())
+    })?;
     Ok(SolutionSet::new(&set))
 }
 
@@ -408,35 +388,45 @@ fn solutions(py: Python<'_>, scene: &Scene) -> PyResult<SolutionSet> {
 /// `SceneError`); the GIL is released while it runs.
 #[pyfunction]
 fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
-    let source = scene.source.clone();
-    let (solution, stability) = py
-        .detach(move || -> Result<_, CliError> {
-            let loaded = source.load(Workload::Solve)?;
-            let settings = &loaded.scene.solver;
-            let bad = |e: String| CliError::BadInput(format!("{}: {e}", source.path.display()));
-            if !settings.method.is_harmonic_balance() {
-                return Err(bad(format!(
-                    "stability needs a harmonic-balance method: allowed solver.method = \
-                     \"ssn-hb\" or \"penalty-hb\", not \"{}\"",
-                    settings.method.name()
-                )));
-            }
-            let solution =
-                semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
-                    .map_err(|e| bad(e.to_string()))?;
-            // The whole unknown vector of the method (displacements, and the contact
-            // multipliers of SSN-HB): the contact phases are read from it.
-            let stability = semismooth_contact::stability::hb_stability(
-                &loaded.structure.model,
-                &solution.solved_settings(settings),
-                loaded.omega,
-                &solution.state,
-            )
-            .map_err(|e| bad(e.to_string()))?;
-            Ok((solution, stability))
-        })
-        .map_err(run_error)?;
+    let (solution, stability) = detached(py, scene, Workload::Solve, |loaded| {
+        let settings = &loaded.scene.solver;
+        if !settings.method.is_harmonic_balance() {
+            return Err(format!(
+                "stability needs a harmonic-balance method: allowed solver.method = \
+                 \"ssn-hb\" or \"penalty-hb\", not \"{}\"",
+                settings.method.name()
+            ));
+        }
+        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
+            .map_err(|e| e.to_string())?;
+        // The whole unknown vector of the method (displacements, and the contact
+        // multipliers of SSN-HB): the contact phases are read from it.
+        let stability = semismooth_contact::stability::hb_stability(
+            &loaded.structure.model,
+            &solution.solved_settings(settings),
+            loaded.omega,
+            &solution.state,
+        )
+        .map_err(|e| e.to_string())?;
+        Ok((solution, stability))
+    })?;
     Ok(Stability::new(&solution, &stability))
+}
+
+/// Loads `scene` for `workload` and runs `run` on it with the GIL released; a message of
+/// `run` is bad input naming the scene file (as the command line's).
+fn detached<T: Send>(
+    py: Python<'_>,
+    scene: &Scene,
+    workload: Workload,
+    run: impl FnOnce(ssn::cli::Loaded) -> Result<T, String> + Send,
+) -> PyResult<T> {
+    let source = scene.source.clone();
+    py.detach(move || -> Result<T, CliError> {
+        let loaded = source.load(workload)?;
+        run(loaded).map_err(|e| CliError::BadInput(format!("{}: {e}", source.path.display())))
+    })
+    .map_err(run_error)
 }
 
 /// Runs case `index` of a study (`values`: the scene keys it sets, in order) as `run`

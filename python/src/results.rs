@@ -178,6 +178,13 @@ result_methods!(Solution, "Solution", {
         self.stored.field(py, "contacts")
     }
 
+    /// Per-friction-point quantities (the JSON's `friction`: stick fraction, force
+    /// amplitude, and the tangential force and slip velocity over the period).
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.stored.field(py, "friction")
+    }
+
     /// Why the solver stopped (`converged`, `max-iterations`, ...).
     #[getter]
     fn termination(&self) -> String {
@@ -455,45 +462,30 @@ pub fn _restore_result(
 ) -> PyResult<Py<PyAny>> {
     let doc: Value = serde_json::from_str(doc)
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    let flag = |key: &str| doc[key].as_bool().unwrap_or(false);
+    let (converged, solution_converged) = (flag("converged"), flag("solution_converged"));
     let stored = Stored { doc, arrays };
-    let converged = |s: &Stored, key: &str| s.doc[key].as_bool().unwrap_or(false);
-    Ok(match kind {
-        "Solution" => Py::new(
-            py,
-            Solution {
-                converged: converged(&stored, "converged"),
-                stored,
-            },
-        )?
-        .into_any(),
-        "FrequencyResponse" => Py::new(
-            py,
-            FrequencyResponse {
-                converged: converged(&stored, "converged"),
-                stored,
-            },
-        )?
-        .into_any(),
-        "SolutionSet" => Py::new(
-            py,
-            SolutionSet {
-                converged: converged(&stored, "converged"),
-                stored,
-            },
-        )?
-        .into_any(),
-        "Stability" => Py::new(
+    match kind {
+        "Solution" => into_py(py, Solution { stored, converged }),
+        "FrequencyResponse" => into_py(py, FrequencyResponse { stored, converged }),
+        "SolutionSet" => into_py(py, SolutionSet { stored, converged }),
+        "Stability" => into_py(
             py,
             Stability {
-                converged: converged(&stored, "solution_converged"),
                 stored,
+                converged: solution_converged,
             },
-        )?
-        .into_any(),
-        other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                "unknown result kind {other:?}"
-            )))
-        }
-    })
+        ),
+        other => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "unknown result kind {other:?}"
+        ))),
+    }
+}
+
+/// A result class's value as a Python object.
+fn into_py<T>(py: Python<'_>, value: T) -> PyResult<Py<PyAny>>
+where
+    T: pyo3::PyClass + Into<pyo3::PyClassInitializer<T>>,
+{
+    Ok(Py::new(py, value)?.into_any())
 }

@@ -77,6 +77,7 @@ class Solution:
     contact_forces: npt.NDArray[np.float64]
     state: npt.NDArray[np.float64]
     contacts: list[dict[str, Any]]
+    friction: list[dict[str, Any]]
     def to_dict(self) -> dict[str, Any]: ...
 
 class FrequencyResponse:

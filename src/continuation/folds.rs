@@ -107,11 +107,13 @@ impl FoldDetector {
         self
     }
 
-    /// Replaces the tangent's parameter component of the last point pushed (the same point
-    /// corrected again on another discretisation, [`Continuation::resume`](super::Continuation::resume)):
-    /// its parameter, and so every decision taken, stay.
-    pub fn retangent_last(&mut self, tangent_parameter: f64) {
+    /// Replaces the parameter and the tangent's parameter component of the last point
+    /// pushed (the same point corrected again on another discretisation, across the
+    /// branch, [`Continuation::resume`](super::Continuation::resume)): the decisions taken
+    /// on it stay, later points are compared with, and folds located from, its new values.
+    pub fn replace_last(&mut self, parameter: f64, tangent_parameter: f64) {
         if let Some(last) = self.samples.last_mut() {
+            last.parameter = parameter;
             last.tangent_parameter = tangent_parameter;
         }
     }

@@ -16,7 +16,7 @@
 use crate::linesearch::{backtrack, Backtrack, LineSearchOptions, NonMonotoneHistory};
 use crate::EvaluationError;
 
-use super::WorkCounters;
+use super::{Tolerances, WorkCounters};
 
 /// A system `G(y) = 0` on `R^N` with a way to compute Newton directions.
 pub(crate) trait NewtonSystem {
@@ -74,12 +74,9 @@ impl StepRule {
 /// The rules of one run (validated by the callers' options).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct KernelRules {
-    pub absolute_tolerance: f64,
-    pub relative_tolerance: f64,
-    /// `|G|` that round-off alone produces near a solution: the tolerance is at least this,
-    /// and a run that stalls within [`FLOOR_STALL_FACTOR`] of it has converged.
-    pub residual_floor: f64,
-    pub step_tolerance: f64,
+    /// When the run has converged or stalled; a run that stalls within
+    /// [`FLOOR_STALL_FACTOR`] of the residual floor has converged.
+    pub tolerances: Tolerances,
     pub max_iterations: usize,
     /// Steps taken before convergence may be declared (the continuation corrector takes
     /// at least one, for its tangent).
@@ -90,6 +87,21 @@ pub(crate) struct KernelRules {
     pub restore_best: bool,
     /// Stop a run that stopped making progress ([`Stagnation`]); `None`: never.
     pub stagnation: Option<Stagnation>,
+}
+
+impl KernelRules {
+    /// The rules of a driver's run: `tolerances`, at most `max_iterations` steps of the
+    /// rule `step`, the best iterate returned, no stagnation test.
+    pub fn new(tolerances: Tolerances, max_iterations: usize, step: StepRule) -> Self {
+        Self {
+            tolerances,
+            max_iterations,
+            min_iterations: 0,
+            step,
+            restore_best: true,
+            stagnation: None,
+        }
+    }
 }
 
 /// A run stagnates when, after at least `after` iterations, the smallest `|G|` of the last
@@ -295,17 +307,14 @@ impl Kernel {
             best_norm: f64::INFINITY,
             smallest: f64::INFINITY,
             iterations: 0,
-            tolerance: rules.absolute_tolerance,
+            tolerance: rules.tolerances.absolute_tolerance,
         };
         let norm = match Self::evaluate(system, y, &mut self.g, counters) {
             Ok(norm) => norm,
             Err(e) => return Some(Stop::Evaluation(e)),
         };
         self.residual_norms.push(norm);
-        let tolerance = rules
-            .absolute_tolerance
-            .max(rules.relative_tolerance * norm)
-            .max(rules.residual_floor);
+        let tolerance = rules.tolerances.threshold(norm);
         self.reset_history(rules.step.memory()).push(merit_of(norm));
         self.best.copy_from_slice(y);
         self.best_g.copy_from_slice(&self.g);
@@ -463,12 +472,14 @@ impl Kernel {
             {
                 return Some(Stop::Stagnated);
             }
-            if step_norm <= rules.step_tolerance * (1.0 + system.step_norm(y)) {
-                return Some(if norm <= FLOOR_STALL_FACTOR * rules.residual_floor {
-                    Stop::ConvergedAtFloor
-                } else {
-                    Stop::Stalled { step_norm }
-                });
+            if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
+                return Some(
+                    if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
+                        Stop::ConvergedAtFloor
+                    } else {
+                        Stop::Stalled { step_norm }
+                    },
+                );
             }
         }
         None

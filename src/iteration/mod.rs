@@ -160,6 +160,9 @@ pub struct WorkCounters {
     pub linear_solves: u64,
     /// Rejected line-search trials.
     pub line_search_backtracks: u64,
+    /// Krylov iterations of the linear solver over the run
+    /// ([`crate::LinearSolve::krylov_iterations`]; 0 for direct solvers).
+    pub krylov_iterations: u64,
     /// The problem's own counters over the solve ([`crate::Residual::problem_counters`]).
     pub problem: ProblemCounters,
 }
@@ -171,6 +174,7 @@ impl AddAssign for WorkCounters {
         self.factorizations += rhs.factorizations;
         self.linear_solves += rhs.linear_solves;
         self.line_search_backtracks += rhs.line_search_backtracks;
+        self.krylov_iterations += rhs.krylov_iterations;
         self.problem += rhs.problem;
     }
 }
@@ -318,6 +322,81 @@ impl NewtonReport {
             step_norms: log.step_norms,
             counters,
         }
+    }
+}
+
+/// Absolute tolerance on `|F|_2` of the drivers' defaults.
+pub(crate) const DEFAULT_ABSOLUTE_TOLERANCE: f64 = 1e-10;
+/// Stall threshold on the accepted step of the drivers' defaults.
+pub(crate) const DEFAULT_STEP_TOLERANCE: f64 = 1e-15;
+/// When a run of a driver ([`NewtonOptions`](crate::newton::NewtonOptions), the polyalgorithm's options) has converged,
+/// `|F|_2 <= max(absolute, relative |F(x_0)|_2, residual_floor)`, or stalled,
+/// `alpha |d| <= step_tolerance (1 + |x|)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerances {
+    /// Absolute tolerance on `|F|_2`, `>= 0`.
+    pub absolute_tolerance: f64,
+    /// Relative tolerance on `|F|_2 / |F(x_0)|_2`, in `[0, 1)` (0 = off).
+    pub relative_tolerance: f64,
+    /// `|F|_2` that round-off alone produces near a solution, `>= 0` (0 = off): the
+    /// tolerance is at least this, and a stall with `|F| <= 100 residual_floor` is
+    /// convergence ([`Termination::ConvergedAtRoundoff`]).
+    pub residual_floor: f64,
+    /// Stall threshold on the accepted step, `>= 0`.
+    pub step_tolerance: f64,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Self {
+            absolute_tolerance: DEFAULT_ABSOLUTE_TOLERANCE,
+            relative_tolerance: 0.0,
+            residual_floor: 0.0,
+            step_tolerance: DEFAULT_STEP_TOLERANCE,
+        }
+    }
+}
+
+impl Tolerances {
+    /// The default tolerances with the absolute tolerance `absolute`.
+    pub fn absolute(absolute: f64) -> Self {
+        Self {
+            absolute_tolerance: absolute,
+            ..Self::default()
+        }
+    }
+
+    /// The `|F|_2` below which a run from `|F(x_0)|_2 = initial_norm` has converged.
+    pub(crate) fn threshold(&self, initial_norm: f64) -> f64 {
+        self.absolute_tolerance
+            .max(self.relative_tolerance * initial_norm)
+            .max(self.residual_floor)
+    }
+
+    /// Checks every field; the error names the field, the value and the allowed range.
+    pub fn validate(&self) -> Result<(), NewtonError> {
+        for (name, t) in [
+            ("absolute_tolerance", self.absolute_tolerance),
+            ("residual_floor", self.residual_floor),
+            ("step_tolerance", self.step_tolerance),
+        ] {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(NewtonError::InvalidOption {
+                    name,
+                    value: t,
+                    allowed: "finite and >= 0",
+                });
+            }
+        }
+        let t = self.relative_tolerance;
+        if !(t.is_finite() && (0.0..1.0).contains(&t)) {
+            return Err(NewtonError::InvalidOption {
+                name: "relative_tolerance",
+                value: t,
+                allowed: "[0, 1)",
+            });
+        }
+        Ok(())
     }
 }
 

@@ -33,10 +33,10 @@
 //!
 //! | field | default | meaning |
 //! |---|---|---|
-//! | `absolute_tolerance` | `1e-10` | converged when `\|F\|_2 <= max(abs, rel \|F(x_0)\|_2, floor)` |
-//! | `relative_tolerance` | `0` (off) | see above; in `[0, 1)` |
-//! | `residual_floor` | `0` (off) | `\|F\|` round-off alone produces near a solution: the tolerance is at least this, and a run that stalls with `\|F\| <= 100 floor` has converged ([`Termination::ConvergedAtRoundoff`]) |
-//! | `step_tolerance` | `1e-15` | stalled when `alpha \|d\| <= step_tol (1 + \|x\|)` |
+//! | `tolerances.absolute_tolerance` | `1e-10` | converged when `\|F\|_2 <= max(abs, rel \|F(x_0)\|_2, floor)` |
+//! | `tolerances.relative_tolerance` | `0` (off) | see above; in `[0, 1)` |
+//! | `tolerances.residual_floor` | `0` (off) | `\|F\|` round-off alone produces near a solution: the tolerance is at least this, and a run that stalls with `\|F\| <= 100 floor` has converged ([`Termination::ConvergedAtRoundoff`]) |
+//! | `tolerances.step_tolerance` | `1e-15` | stalled when `alpha \|d\| <= step_tol (1 + \|x\|)` |
 //! | `max_iterations` | `200` | Newton iterations (not counting line-search trials) |
 //! | `globalization` | [`Globalization::hybrid`] | [`None`](Globalization::None), [`Armijo`](Globalization::Armijo), [`NonMonotone`](Globalization::NonMonotone) (memory 10) or [`Hybrid`](Globalization::Hybrid) (30 full steps, then non-monotone with memory 10); line searches with [`LineSearchOptions::default`] (`sigma = 1e-4`, `shrink = 0.5`, `min_step = 1e-10`) |
 //!
@@ -88,7 +88,8 @@ use crate::iteration::kernel::{
     Kernel, KernelRules, NewtonSystem, Run, StepRule, Stop, FLOOR_STALL_FACTOR,
 };
 pub use crate::iteration::{
-    Attempt, NewtonError, NewtonReport, Strategy, Termination, WorkCounters, EXACT_RESIDUAL,
+    Attempt, NewtonError, NewtonReport, Strategy, Termination, Tolerances, WorkCounters,
+    EXACT_RESIDUAL,
 };
 use crate::iteration::{Log, Outcome};
 use crate::linalg::LinearSolveError;
@@ -161,64 +162,25 @@ impl Default for Globalization {
 /// Options of the Newton driver (defaults in the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonOptions {
-    /// Absolute tolerance on `|F|_2`, `>= 0`.
-    pub absolute_tolerance: f64,
-    /// Relative tolerance on `|F|_2 / |F(x_0)|_2`, in `[0, 1)` (0 = off).
-    pub relative_tolerance: f64,
-    /// `|F|_2` that round-off alone produces near a solution, `>= 0` (0 = off): the
-    /// tolerance is at least this, and a stall with `|F| <= 100 residual_floor` is
-    /// convergence ([`Termination::ConvergedAtRoundoff`]).
-    pub residual_floor: f64,
-    /// Stall threshold on the accepted step, `>= 0`.
-    pub step_tolerance: f64,
+    /// When a run has converged or stalled.
+    pub tolerances: Tolerances,
     /// Maximum number of Newton iterations.
     pub max_iterations: usize,
     /// Step-length rule.
     pub globalization: Globalization,
 }
 
-/// Absolute tolerance on `|F|_2` of the drivers' defaults.
-pub(crate) const DEFAULT_ABSOLUTE_TOLERANCE: f64 = 1e-10;
-/// Stall threshold on the accepted step of the drivers' defaults.
-pub(crate) const DEFAULT_STEP_TOLERANCE: f64 = 1e-15;
 /// Newton iterations of the drivers' defaults.
 pub(crate) const DEFAULT_MAX_ITERATIONS: usize = 200;
 
 impl Default for NewtonOptions {
     fn default() -> Self {
         Self {
-            absolute_tolerance: DEFAULT_ABSOLUTE_TOLERANCE,
-            relative_tolerance: 0.0,
-            residual_floor: 0.0,
-            step_tolerance: DEFAULT_STEP_TOLERANCE,
+            tolerances: Tolerances::default(),
             max_iterations: DEFAULT_MAX_ITERATIONS,
             globalization: Globalization::default(),
         }
     }
-}
-
-/// Checks the stopping rules shared by the drivers' options; the error names the field,
-/// the value and the allowed range.
-pub(crate) fn validate_stopping(
-    absolute_tolerance: f64,
-    relative_tolerance: f64,
-    residual_floor: f64,
-    step_tolerance: f64,
-) -> Result<(), NewtonError> {
-    for (name, t) in [
-        ("absolute_tolerance", absolute_tolerance),
-        ("residual_floor", residual_floor),
-        ("step_tolerance", step_tolerance),
-    ] {
-        if !(t.is_finite() && t >= 0.0) {
-            return Err(invalid_option(name, t, "finite and >= 0"));
-        }
-    }
-    let t = relative_tolerance;
-    if !(t.is_finite() && (0.0..1.0).contains(&t)) {
-        return Err(invalid_option("relative_tolerance", t, "[0, 1)"));
-    }
-    Ok(())
 }
 
 /// Checks a line search with its memory (`memory_name` names the memory's field).
@@ -246,12 +208,7 @@ fn invalid_option(name: &'static str, value: f64, allowed: &'static str) -> Newt
 impl NewtonOptions {
     /// Checks every field; the error names the field, the value and the allowed range.
     pub fn validate(&self) -> Result<(), NewtonError> {
-        validate_stopping(
-            self.absolute_tolerance,
-            self.relative_tolerance,
-            self.residual_floor,
-            self.step_tolerance,
-        )?;
+        self.tolerances.validate()?;
         match self.globalization {
             Globalization::None => Ok(()),
             Globalization::Armijo(ls) => validate_line_search("globalization.memory", 1, &ls),
@@ -269,17 +226,7 @@ impl NewtonOptions {
 
     /// The kernel's rules of a run with the step rule `step`.
     fn rules(&self, step: StepRule) -> KernelRules {
-        KernelRules {
-            absolute_tolerance: self.absolute_tolerance,
-            relative_tolerance: self.relative_tolerance,
-            residual_floor: self.residual_floor,
-            step_tolerance: self.step_tolerance,
-            max_iterations: self.max_iterations,
-            min_iterations: 0,
-            step,
-            restore_best: true,
-            stagnation: None,
-        }
+        KernelRules::new(self.tolerances, self.max_iterations, step)
     }
 }
 
@@ -425,7 +372,7 @@ impl<J> Workspace<J> {
         };
         let run = drive(&mut self.kernel, &mut system, x, rules, counters);
         log.extend(&self.kernel);
-        let termination = termination_of(&run.stop, rules.residual_floor);
+        let termination = termination_of(&run.stop, rules.tolerances.residual_floor);
         (termination, run)
     }
 }
@@ -469,6 +416,7 @@ impl<J> NewtonSolver<J> {
         S: Factorize<J> + ?Sized,
     {
         let start = self.work.begin(problem, x)?;
+        let krylov_start = linear.krylov_iterations();
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
         let backtracking = |memory, line_search| StepRule::Backtracking {
@@ -507,6 +455,7 @@ impl<J> NewtonSolver<J> {
             _ => Strategy::LineSearch,
         };
         counters.problem = problem.problem_counters().since(&start);
+        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
         let outcome = Outcome {
             attempts: vec![Attempt::new(strategy, run.iterations, &termination)],
             termination,
@@ -609,7 +558,10 @@ mod tests {
     #[test]
     fn validation_names_field_value_and_range() {
         let o = NewtonOptions {
-            relative_tolerance: 1.0,
+            tolerances: Tolerances {
+                relative_tolerance: 1.0,
+                ..Default::default()
+            },
             ..Default::default()
         };
         assert_eq!(
@@ -645,7 +597,7 @@ mod tests {
             matches!(o.validate(), Err(NewtonError::InvalidOption { name: "line_search.shrink", value, .. }) if value == 0.0)
         );
         let o = NewtonOptions {
-            absolute_tolerance: f64::NAN,
+            tolerances: Tolerances::absolute(f64::NAN),
             ..Default::default()
         };
         assert!(matches!(

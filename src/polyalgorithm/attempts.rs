@@ -6,7 +6,7 @@ use crate::continuation::Predictor;
 use crate::iteration::kernel::{norm2, KernelRules, Stagnation, StepRule};
 use crate::iteration::{Attempt, Log, Outcome};
 use crate::linesearch::LineSearchOptions;
-use crate::newton::{Strategy, Termination, WorkCounters};
+use crate::newton::{Strategy, Termination, Tolerances, WorkCounters};
 use crate::{Factorize, GeneralizedJacobian, Residual};
 
 use super::path::{self, PathShape};
@@ -296,8 +296,11 @@ impl<J> Polyalgorithm<J> {
         let accuracy = tolerance.max(SMOOTHING_ACCURACY * norm2(&f));
         let mut smoothed = smoothed.with_tolerance_decay(tolerance_rate, tolerance / accuracy);
         let rules = KernelRules {
-            absolute_tolerance: accuracy,
-            relative_tolerance: 0.0,
+            tolerances: Tolerances {
+                absolute_tolerance: accuracy,
+                relative_tolerance: 0.0,
+                ..self.options.tolerances
+            },
             max_iterations: budget.min(SMOOTHING_START_ITERATIONS),
             ..self.options.rules(StepRule::Backtracking {
                 memory: 1,

@@ -50,7 +50,7 @@
 //!
 //! | field | default | meaning |
 //! |---|---|---|
-//! | `absolute_tolerance`, `relative_tolerance`, `residual_floor`, `step_tolerance` | `1e-10`, `0`, `0`, `1e-15` | as for [`NewtonOptions`] |
+//! | `tolerances` | [`Tolerances::default`]: `1e-10`, `0`, `0`, `1e-15` | as for [`NewtonOptions`] |
 //! | `max_iterations` | `200` | the budget of every attempt together (Newton and corrector iterations) |
 //! | `full_steps` | `30` | iterations of the first attempt (and of each finish on `F` after a path) |
 //! | `memory` | `10` | memory of the non-monotone line search (attempt 3) |
@@ -130,24 +130,16 @@ use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::iteration::Log;
 use crate::linesearch::LineSearchOptions;
 use crate::newton::{
-    self, validate_line_search, validate_stopping, NewtonError, NewtonOptions, NewtonReport,
-    Termination, WorkCounters, Workspace, DEFAULT_ABSOLUTE_TOLERANCE, DEFAULT_FULL_STEPS,
-    DEFAULT_MAX_ITERATIONS, DEFAULT_MEMORY, DEFAULT_STEP_TOLERANCE,
+    self, validate_line_search, NewtonError, NewtonOptions, NewtonReport, Termination, Tolerances,
+    WorkCounters, Workspace, DEFAULT_FULL_STEPS, DEFAULT_MAX_ITERATIONS, DEFAULT_MEMORY,
 };
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, Smoothing};
 
 /// Options of the polyalgorithm (defaults in the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PolyalgorithmOptions {
-    /// Absolute tolerance on `|F|_2`, `>= 0`.
-    pub absolute_tolerance: f64,
-    /// Relative tolerance on `|F|_2 / |F(x_0)|_2`, in `[0, 1)` (0 = off).
-    pub relative_tolerance: f64,
-    /// `|F|_2` that round-off alone produces near a solution, `>= 0` (0 = off), as
-    /// [`NewtonOptions::residual_floor`].
-    pub residual_floor: f64,
-    /// Stall threshold on the accepted step, `>= 0`.
-    pub step_tolerance: f64,
+    /// When an attempt has converged or stalled (as for [`NewtonOptions`]).
+    pub tolerances: Tolerances,
     /// Iterations of every attempt together (Newton iterations, corrector iterations of
     /// the paths).
     pub max_iterations: usize,
@@ -162,10 +154,7 @@ pub struct PolyalgorithmOptions {
 impl Default for PolyalgorithmOptions {
     fn default() -> Self {
         Self {
-            absolute_tolerance: DEFAULT_ABSOLUTE_TOLERANCE,
-            relative_tolerance: 0.0,
-            residual_floor: 0.0,
-            step_tolerance: DEFAULT_STEP_TOLERANCE,
+            tolerances: Tolerances::default(),
             max_iterations: DEFAULT_MAX_ITERATIONS,
             full_steps: DEFAULT_FULL_STEPS,
             memory: DEFAULT_MEMORY,
@@ -177,28 +166,13 @@ impl Default for PolyalgorithmOptions {
 impl PolyalgorithmOptions {
     /// Checks every field; the error names the field, the value and the allowed range.
     pub fn validate(&self) -> Result<(), NewtonError> {
-        validate_stopping(
-            self.absolute_tolerance,
-            self.relative_tolerance,
-            self.residual_floor,
-            self.step_tolerance,
-        )?;
+        self.tolerances.validate()?;
         validate_line_search("memory", self.memory, &self.line_search)
     }
 
     /// The kernel's rules of an attempt with the step rule `step`.
     fn rules(&self, step: StepRule) -> KernelRules {
-        KernelRules {
-            absolute_tolerance: self.absolute_tolerance,
-            relative_tolerance: self.relative_tolerance,
-            residual_floor: self.residual_floor,
-            step_tolerance: self.step_tolerance,
-            max_iterations: self.max_iterations,
-            min_iterations: 0,
-            step,
-            restore_best: true,
-            stagnation: None,
-        }
+        KernelRules::new(self.tolerances, self.max_iterations, step)
     }
 }
 
@@ -336,10 +310,12 @@ impl<J> Polyalgorithm<J> {
         S: Factorize<J> + ?Sized,
     {
         let start = self.work.begin(problem, x)?;
+        let krylov_start = linear.krylov_iterations();
         let mut counters = WorkCounters::default();
         let mut log = Log::default();
         let outcome = self.run(problem, linear, x, smoothing, (&mut counters, &mut log));
         counters.problem = problem.problem_counters().since(&start);
+        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
         Ok(NewtonReport::new(outcome, log, counters))
     }
 }
@@ -386,7 +362,7 @@ where
 /// });
 /// assert!(plain.validate().is_ok());
 /// let floor = SolveOptions::default().with_residual_floor(1e-9);
-/// assert!(matches!(floor, SolveOptions::Polyalgorithm(o) if o.residual_floor == 1e-9));
+/// assert!(matches!(floor, SolveOptions::Polyalgorithm(o) if o.tolerances.residual_floor == 1e-9));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -416,8 +392,8 @@ impl SolveOptions {
     /// solution) set to `floor`.
     pub fn with_residual_floor(mut self, floor: f64) -> Self {
         match &mut self {
-            Self::Newton(options) => options.residual_floor = floor,
-            Self::Polyalgorithm(options) => options.residual_floor = floor,
+            Self::Newton(options) => options.tolerances.residual_floor = floor,
+            Self::Polyalgorithm(options) => options.tolerances.residual_floor = floor,
         }
         self
     }

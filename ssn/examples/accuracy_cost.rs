@@ -5,6 +5,8 @@
 //!
 //! `cargo run --release --example accuracy_cost [SCENE.toml]`
 
+mod common;
+
 use std::path::PathBuf;
 
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
@@ -13,13 +15,7 @@ use ssn::accuracy_cost::accuracy_cost;
 use ssn::output::prepare_directory;
 
 fn main() -> std::process::ExitCode {
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    common::exit_code(run())
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {

@@ -6,18 +6,20 @@
 //! ```sh
 //! cargo run --release -p ssn --example adaptive_sweep                  # the docs' table
 //! cargo run --release -p ssn --example adaptive_sweep -- 1e-4 --points # one target, per point
+//! cargo run --release -p ssn --example adaptive_sweep -- 1e-3 --strong  # p0 = 0.2
 //! ```
 //!
 //! The docs' block (docs/sweeps.md) is written by
 //! `cargo run --release -p ssn --example docs_tables -- --write adaptive-sweeps`.
 
-use ssn::adaptive_sweeps::{compare_adaptive, paper_rod, study};
+use ssn::adaptive_sweeps::{compare_adaptive, paper_rod, strongly_forced_rod, study};
 use ssn::tables;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     faer::set_global_parallelism(faer::Par::Seq);
     let say = |line: &str| eprintln!("  {line}");
     let points = std::env::args().any(|a| a == "--points");
+    let strong = std::env::args().any(|a| a == "--strong");
     let target: Option<f64> = std::env::args()
         .skip(1)
         .find(|a| !a.starts_with("--"))
@@ -25,9 +27,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .transpose()?;
     let rows = match target {
         Some(target) => {
-            let rod = paper_rod()?;
+            let (label, rod) = if strong {
+                ("strongly forced rod", strongly_forced_rod()?)
+            } else {
+                ("paper's rod", paper_rod()?)
+            };
             vec![(
-                "paper's rod".to_string(),
+                label.to_string(),
                 compare_adaptive(&rod, target, Some(&say))?,
             )]
         }

@@ -15,7 +15,8 @@
 //! harmonic balance at their finest), `sweeps` (about 10 s), `adaptive-sweeps` (harmonics per point against fixed
 //! harmonics, minutes: most of it the references at H = 320), `from-zero` (the public grid with `auto` and
 //! `hybrid`, about 6 s), `performance` (what the examples time, about 2 s), `hard` (the
-//! hard cases from zero, about 2 minutes, most of it the 100-contact rod). Wall times vary
+//! hard cases from zero, about 2 minutes, most of it the 100-contact rod), `friction` (Den
+//! Hartog's oscillator by H and the friction-damper curve, about 5 s). Wall times vary
 //! with the machine and its load (each block names the machine it was measured on); every
 //! other cell is deterministic, and `tests/docs_tables.rs` checks those of the cheap
 //! tables against the docs files.
@@ -84,6 +85,11 @@ fn compute(section: &str) -> Result<String, Box<dyn std::error::Error>> {
                 .map(|(name, cases)| tables::solve_group(name, cases, GlobalizationChoice::Auto))
                 .collect();
             out.push_str(&tables::from_zero_hard(&groups).markdown());
+        }
+        "friction" => {
+            out.push_str(&ssn::friction_tables::den_hartog_convergence()?.markdown());
+            out.push('\n');
+            out.push_str(&ssn::friction_tables::damper_curve()?.markdown());
         }
         other => return Err(format!("unknown section {other:?}").into()),
     }

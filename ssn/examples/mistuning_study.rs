@@ -11,6 +11,8 @@
 //! puts the figure into `docs/` and the quantile table into `docs/studies.md` (its generated
 //! block).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -187,12 +189,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&figure, svg)?;
     eprintln!("wrote {}", figure.display());
     if write {
-        let docs = root.join("docs/studies.md");
-        let text = std::fs::read_to_string(&docs)?;
-        let text = ssn::tables::replace_block(&text, QUANTILE_BLOCK, &page)
-            .ok_or("docs/studies.md has no mistuning-study block")?;
-        std::fs::write(&docs, text)?;
-        eprintln!("wrote {}", docs.display());
+        common::write_studies_block(QUANTILE_BLOCK, &page)?;
     }
     Ok(())
 }

@@ -10,6 +10,8 @@
 //! 1000 cases); `--write` puts the table into `docs/studies.md` (its generated block,
 //! checked by `tests/study.rs`).
 
+mod common;
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -31,13 +33,7 @@ fn median(values: &[f64]) -> f64 {
 }
 
 fn main() -> std::process::ExitCode {
-    match run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    common::exit_code(run())
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
@@ -167,12 +163,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     );
     print!("{page}");
     if write {
-        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/studies.md");
-        let text = std::fs::read_to_string(&docs)?;
-        let text = ssn::tables::replace_block(&text, THROUGHPUT_BLOCK, &page)
-            .ok_or("docs/studies.md has no study-throughput block")?;
-        std::fs::write(&docs, text)?;
-        eprintln!("wrote {}", docs.display());
+        common::write_studies_block(THROUGHPUT_BLOCK, &page)?;
     }
     Ok(())
 }

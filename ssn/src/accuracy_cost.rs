@@ -16,6 +16,9 @@
 //! at [`REFERENCE_HARMONICS`] harmonics; both numbers are reported with the reference. An
 //! accuracy below the reference uncertainty cannot be resolved by the study.
 //!
+//! With friction points under prescribed normal loads, penalty HB's regularised friction
+//! (`tanh(v_t / eps)`) is swept over its width at two `H` beside SSN-HB's exact law.
+//!
 //! Wall times are medians of [`REPEATS`] runs when a run takes less than 50 ms, else one
 //! run; they include what the runner times (the solve, not the set-up of the rod).
 
@@ -24,7 +27,7 @@ use std::path::Path;
 
 use crate::output::{write_atomically, write_line_plot, OutputError, PlotSpec, Series};
 use crate::scene::{default_hb_time_samples, Method, SolverSettings};
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{NormalForce, Structure};
 use semismooth_contact::solve::{solve, RunError, Solution};
 
 /// Steps per period of the time-marching reference.
@@ -384,6 +387,22 @@ fn sweep_settings(
             hb(Method::SsnHb, 20, nt),
         ));
     }
+    // Regularised (tanh) friction: penalty HB under prescribed normal loads, narrowing.
+    let prescribed = rod
+        .model
+        .friction
+        .iter()
+        .all(|f| matches!(f.normal, NormalForce::Prescribed(_)));
+    if !rod.model.friction.is_empty() && prescribed {
+        for h in [10, 40] {
+            for width in [1e-1, 1e-2, 1e-3] {
+                let nt = default_hb_time_samples(h);
+                let mut s = hb(Method::PenaltyHb, h, nt);
+                s.friction_regularisation = width;
+                out.push((Method::PenaltyHb, format!("H={h} eps={width:.0e}"), s));
+            }
+        }
+    }
     if contact {
         for h in [20, 80] {
             for relative in [1e1, 1e2, 1e3, 1e4] {
@@ -683,7 +702,7 @@ mod tests {
         );
         let last = csv.lines().last().unwrap();
         assert!(
-            last.starts_with("lcp-lemke,,,,,,1,false,")
+            last.starts_with("lcp-lemke,,,,,,,1,false,")
                 && last.ends_with("\"could not run: invalid time_samples, \"\"x\"\"\""),
             "{last}"
         );

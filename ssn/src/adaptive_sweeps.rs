@@ -3,27 +3,42 @@
 //! `examples/adaptive_sweep.rs`.
 //!
 //! For a rod and a target, the SSN-HB sweep over `[0.5, 2] ω_1` with `[solver] accuracy`
-//! (stability off) is compared point by point with a reference: SSN-HB at
-//! [`REFERENCE_HARMONICS`] solved at the point's frequency from the point lifted (so on
-//! the same branch inside an overhang). A point's error is the largest change of the
-//! observed dof's extremes relative to the reference's largest excursion, as its estimate
-//! is. The fixed harmonics reaching the adaptive sweep's worst error are found on the
-//! same points: for each rung of the ladder in turn, every point is solved at that rung
-//! from its reference truncated, and the first rung whose worst error is at most the
-//! adaptive sweep's is swept whole, in the same run, for its cost.
+//! (stability off) is compared point by point with a reference that follows the same
+//! solution: the point taken up by SSN-HB at [`REFERENCE_RATIO`] times the sweep's largest
+//! harmonics (at least [`REFERENCE_HARMONICS`]) on the hyperplane
+//! through it normal to the sweep's secant there ([`take_up`]; at its frequency where that
+//! fails), so that near a fold, where the two discretisations' branches turn at different
+//! frequencies, the point is compared with the nearest point of the reference's branch, not
+//! with whatever solution the reference has at its frequency. A point's error is the
+//! distance [`point_distance`] from its reference, as its estimate is. The fixed harmonics
+//! reaching the adaptive sweep's worst error are found on the same points: for each rung
+//! of the ladder in turn, every reference is taken up at that rung the same way, and the
+//! first rung whose worst error is at most the adaptive sweep's is swept whole, in the same
+//! run, for its cost.
 
 use semismooth_contact::hb::resize_harmonics;
 use semismooth_contact::model::Structure;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::solve::{solve, RunError};
-use semismooth_contact::sweep::adaptive::HARMONICS_LADDER;
+use semismooth_contact::sweep::adaptive::{point_distance, secant, take_up, HARMONICS_LADDER};
 use semismooth_contact::sweep::frequency_response;
 
-/// A point's reference: its state and the observed dof's extremes.
-type Reference = (Vec<f64>, (f64, f64));
+/// A point's reference: its state, frequency, the observed dof's extremes and the
+/// secant it was taken up across (at the reference's harmonics).
+struct Reference {
+    state: Vec<f64>,
+    omega: f64,
+    extremes: (f64, f64),
+    secant: Vec<f64>,
+}
 
-/// Harmonics of the reference solves.
+/// Fewest harmonics of the reference solves.
 pub const REFERENCE_HARMONICS: usize = 320;
+
+/// The reference has at least this many times the adaptive sweep's largest harmonics, so
+/// that its own error (order 0.75 in `H`: at most `4^-0.75`, 35 %, of a point's) does
+/// not hide the points' errors.
+pub const REFERENCE_RATIO: usize = 4;
 
 /// One adaptive sweep against its references and against the fixed harmonics.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,6 +61,8 @@ pub struct AdaptiveComparison {
     pub harmonics: (usize, usize),
     /// Mean harmonics over the points.
     pub mean_harmonics: f64,
+    /// Harmonics of the references.
+    pub reference_harmonics: usize,
     /// Error of each point against its reference (NaN where the reference did not
     /// converge).
     pub errors: Vec<f64>,
@@ -55,7 +72,7 @@ pub struct AdaptiveComparison {
     pub seconds: f64,
     /// The fixed harmonics reaching the adaptive sweep's worst error on its points, their
     /// worst error there, and their whole sweep's points, folds (`ω / ω_1`) and wall time;
-    /// `None` when no rung up to the reference's half reaches it.
+    /// `None` when no rung up to a [`REFERENCE_RATIO`]th of the reference's reaches it.
     pub fixed: Option<FixedSweep>,
 }
 
@@ -110,23 +127,49 @@ impl AdaptiveComparison {
             .fold(0.0, f64::max)
     }
 
+    /// The largest ratio of a point's estimate to its error (above 1: the estimate was
+    /// high), over the same points as [`Self::worst_underestimate`].
+    pub fn worst_overestimate(&self) -> f64 {
+        self.errors
+            .iter()
+            .zip(&self.estimates)
+            .filter(|(e, s)| e.is_finite() && s.is_finite() && **e > 0.01 * self.target)
+            .map(|(e, s)| s / e)
+            .fold(0.0, f64::max)
+    }
+
     /// Wall time of the adaptive sweep over that of the fixed one.
     pub fn cost_ratio(&self) -> Option<f64> {
         self.fixed.as_ref().map(|f| self.seconds / f.seconds)
     }
 }
 
-/// The relative error of extremes `(max, min)` against the reference's.
-fn displacement_error((max, min): (f64, f64), (ref_max, ref_min): (f64, f64)) -> f64 {
-    let excursion = ref_max.abs().max(ref_min.abs());
-    let change = (max - ref_max).abs().max((min - ref_min).abs());
-    if change == 0.0 {
-        0.0
-    } else if excursion > 0.0 {
-        change / excursion
-    } else {
-        f64::INFINITY
-    }
+/// A solution taken up across a branch: its state and `(max, min, ω)` (the observed
+/// dof's extremes and the frequency).
+type TakenUp = (Vec<f64>, (f64, f64, f64));
+
+/// The solution at `h` harmonics of the SSN-HB branch of `rod` through `(x, ω)` at `from`
+/// harmonics across `secant` ([`take_up`]): its extremes and frequency, `None` when
+/// neither way converged.
+fn taken_up(
+    rod: &Structure,
+    sweep: &SweepSettings,
+    (x, omega, from): (&[f64], f64, usize),
+    secant: &[f64],
+    h: usize,
+) -> Result<Option<TakenUp>, RunError> {
+    let settings = SolverSettings {
+        estimate_error: false,
+        ..SolverSettings::with_harmonics(h)
+    };
+    let Some((state, at)) = take_up(rod, &settings, sweep, (x, omega, from), secant, h)? else {
+        return Ok(None);
+    };
+    // The extremes as `ssn solve` reports them: a solve from the point, at its frequency,
+    // converging at once.
+    let solved = solve(rod, at, &settings, Some(&state))?;
+    let extremes = (solved.stats.max, solved.stats.min, at);
+    Ok(solved.converged().then_some((solved.state, extremes)))
 }
 
 /// The comparison of the module documentation for `rod` and `target`; `say` hears of each
@@ -161,30 +204,34 @@ pub fn compare_adaptive(
     ));
     let model = &rod.model;
     let (dofs, contacts) = (model.dofs(), model.contact_count());
-    // The references and the fixed-harmonics solves estimate no error of their own.
-    let fixed_at = |h: usize| SolverSettings {
-        estimate_error: false,
-        ..SolverSettings::with_harmonics(h)
-    };
-    let reference_settings = fixed_at(REFERENCE_HARMONICS);
-    say("references");
-    // Each point's reference state and extremes.
+    let reference_harmonics = REFERENCE_HARMONICS
+        .max(REFERENCE_RATIO * adaptive.harmonics.iter().copied().max().unwrap_or(0));
+    say(&format!("references at {reference_harmonics} harmonics"));
     let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points());
     let mut errors = Vec::with_capacity(adaptive.points());
     for i in 0..adaptive.points() {
         let h = adaptive.harmonics[i];
-        let start = resize_harmonics(&adaptive.states[i], h, REFERENCE_HARMONICS, dofs, contacts);
-        let reference = solve(rod, adaptive.omega[i], &reference_settings, Some(&start))?;
-        if reference.converged() {
-            let extremes = (reference.stats.max, reference.stats.min);
-            errors.push(displacement_error(
-                (adaptive.tip_max[i], adaptive.tip_min[i]),
-                extremes,
-            ));
-            references.push(Some((reference.state, extremes)));
-        } else {
-            errors.push(f64::NAN);
-            references.push(None);
+        let secant = secant(&adaptive, i, dofs, contacts);
+        let point = (adaptive.states[i].as_slice(), adaptive.omega[i], h);
+        match taken_up(rod, &sweep, point, &secant, reference_harmonics)? {
+            Some((state, (max, min, omega))) => {
+                let here = (adaptive.tip_max[i], adaptive.tip_min[i], adaptive.omega[i]);
+                errors.push(point_distance(here, (max, min, omega)));
+                let n = secant.len() - 1;
+                let mut lifted =
+                    resize_harmonics(&secant[..n], h, reference_harmonics, dofs, contacts);
+                lifted.push(secant[n]);
+                references.push(Some(Reference {
+                    state,
+                    omega,
+                    extremes: (max, min),
+                    secant: lifted,
+                }));
+            }
+            None => {
+                errors.push(f64::NAN);
+                references.push(None);
+            }
         }
     }
     let estimates: Vec<f64> = adaptive
@@ -208,6 +255,7 @@ pub fn compare_adaptive(
         folds: adaptive.folds.iter().map(|w| w / w1).collect(),
         harmonics,
         mean_harmonics,
+        reference_harmonics,
         errors,
         estimates,
         seconds: adaptive.solve_seconds,
@@ -216,21 +264,20 @@ pub fn compare_adaptive(
     let worst = comparison.worst_error();
     for &h in HARMONICS_LADDER
         .iter()
-        .filter(|&&h| 2 * h <= REFERENCE_HARMONICS)
+        .filter(|&&h| REFERENCE_RATIO * h <= reference_harmonics)
     {
         say(&format!("fixed H = {h} on the adaptive points"));
-        let fixed_settings = fixed_at(h);
         let mut fixed_worst = 0.0f64;
-        for (i, reference) in references.iter().enumerate() {
-            let Some((reference, extremes)) = reference else {
-                continue;
-            };
-            let start = resize_harmonics(reference, REFERENCE_HARMONICS, h, dofs, contacts);
-            let at = solve(rod, adaptive.omega[i], &fixed_settings, Some(&start))?;
-            let error = if at.converged() {
-                displacement_error((at.stats.max, at.stats.min), *extremes)
-            } else {
-                f64::INFINITY
+        for reference in references.iter().flatten() {
+            let point = (
+                reference.state.as_slice(),
+                reference.omega,
+                reference_harmonics,
+            );
+            let (max, min) = reference.extremes;
+            let error = match taken_up(rod, &sweep, point, &reference.secant, h)? {
+                Some((_, at)) => point_distance(at, (max, min, reference.omega)),
+                None => f64::INFINITY,
             };
             fixed_worst = fixed_worst.max(error);
             if fixed_worst > worst {
@@ -239,6 +286,10 @@ pub fn compare_adaptive(
         }
         if fixed_worst <= worst {
             say(&format!("fixed H = {h} sweep"));
+            let fixed_settings = SolverSettings {
+                estimate_error: false,
+                ..SolverSettings::with_harmonics(h)
+            };
             let fixed = frequency_response(rod, &fixed_settings, &sweep, None)?;
             comparison.fixed = Some(FixedSweep {
                 harmonics: h,
@@ -260,6 +311,17 @@ pub fn paper_rod() -> Result<semismooth_contact::rod::RodModel, RunError> {
     use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
     Ok(build_rod(&RodSpec {
         mass: MassModel::Modified,
+        ..RodSpec::canonical()
+    })?)
+}
+
+/// [`paper_rod`] forced five times as hard (`p0 = 0.2`): contact strong over the whole
+/// resonance, a wide overhang.
+pub fn strongly_forced_rod() -> Result<semismooth_contact::rod::RodModel, RunError> {
+    use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+    Ok(build_rod(&RodSpec {
+        mass: MassModel::Modified,
+        amplitude: 0.2,
         ..RodSpec::canonical()
     })?)
 }

@@ -3,6 +3,7 @@
 use semismooth_contact::matrix_market::{matrix_market_text, vector_market_text};
 use semismooth_contact::model::{ContactRow, NormalForce, Structure};
 use semismooth_contact::rod::FrequencySpec;
+use semismooth_contact::settings::SolverSettings;
 
 /// Name of the scene file [`export_files`] writes.
 pub const EXPORTED_SCENE: &str = "scene.toml";
@@ -80,6 +81,13 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     }
     if let Some(k) = v.penalty_stiffness {
         let _ = writeln!(t, "penalty_stiffness = {k:?}");
+    }
+    if v.friction_regularisation != SolverSettings::default().friction_regularisation {
+        let _ = writeln!(
+            t,
+            "friction_regularisation = {:?}",
+            v.friction_regularisation
+        );
     }
     let lower = |d: String| d.to_lowercase();
     let _ = writeln!(

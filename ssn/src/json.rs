@@ -7,7 +7,7 @@ use std::path::Path;
 use serde_json::{json, Value};
 
 use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
-use semismooth_contact::contacts::ContactReport;
+use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummary};
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
@@ -30,9 +30,32 @@ pub fn contact_json(c: &ContactReport) -> Value {
     })
 }
 
+/// The JSON object of one friction point's numbers over a period: `point`,
+/// `stick_fraction`, `force_amplitude`, `slip_velocity_amplitude`, `slip_limit_max`.
+pub fn friction_summary_json(point: usize, f: &FrictionSummary) -> Value {
+    json!({
+        "point": point,
+        "stick_fraction": finite_or_null(f.stick_fraction),
+        "force_amplitude": finite_or_null(f.force_amplitude),
+        "slip_velocity_amplitude": finite_or_null(f.slip_velocity_amplitude),
+        "slip_limit_max": finite_or_null(f.slip_limit_max),
+    })
+}
+
+/// The JSON object of one friction point of a solution: its numbers
+/// ([`friction_summary_json`]) and its `force` and `slip_velocity` over the period (at the
+/// times of the solution's CSV).
+pub fn friction_json(f: &FrictionReport) -> Value {
+    let mut v = friction_summary_json(f.point, &f.summary);
+    let series = |s: &[f64]| s.iter().map(|x| finite_or_null(*x)).collect::<Vec<_>>();
+    v["force"] = json!(series(&f.force));
+    v["slip_velocity"] = json!(series(&f.slip_velocity));
+    v
+}
+
 /// The JSON fields of the Newton-style counters: `residual_evaluations`,
 /// `jacobian_evaluations`, `factorizations`, `linear_solves`, `line_search_backtracks`,
-/// `ffts`.
+/// `ffts`, `krylov_iterations`.
 pub fn newton_counters(c: &RunCounters) -> serde_json::Map<String, Value> {
     let mut map = serde_json::Map::new();
     for (name, value) in [
@@ -42,6 +65,7 @@ pub fn newton_counters(c: &RunCounters) -> serde_json::Map<String, Value> {
         ("linear_solves", c.linear_solves),
         ("line_search_backtracks", c.line_search_backtracks),
         ("ffts", c.ffts),
+        ("krylov_iterations", c.krylov_iterations),
     ] {
         map.insert(name.to_string(), value.into());
     }
@@ -76,6 +100,7 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "max_penetration": finite_or_null(s.stats.max_penetration),
         "contact_force_mean": finite_or_null(s.stats.mean_contact_force),
         "contacts": s.contacts.iter().map(contact_json).collect::<Vec<_>>(),
+        "friction": s.friction.iter().map(friction_json).collect::<Vec<_>>(),
         "counters": counters_json(&s.counters),
     });
     if let Some(h) = s.harmonics {
@@ -172,6 +197,17 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
             .iter()
             .map(|point| point.iter().map(contact_json).collect::<Vec<_>>())
             .collect::<Vec<_>>(),
+        "friction": r
+            .friction
+            .iter()
+            .map(|point| {
+                point
+                    .iter()
+                    .enumerate()
+                    .map(|(f, s)| friction_summary_json(f, s))
+                    .collect::<Vec<_>>()
+            })
+            .collect::<Vec<_>>(),
         "stability_note": st.undecided.as_ref().map(crate::words::undecided),
         "stability_seconds": r.stability_seconds,
         "events": events,
@@ -236,6 +272,12 @@ pub fn solutions_json(set: &SolutionSet) -> Value {
                 "contact_force_mean": s.solution.stats.mean_contact_force,
                 "max_penetration": s.solution.stats.max_penetration,
                 "contacts": contacts,
+                "friction": s
+                    .solution
+                    .friction
+                    .iter()
+                    .map(|f| friction_summary_json(f.point, &f.summary))
+                    .collect::<Vec<_>>(),
                 "stable": s.stability.stable,
                 "floquet_max_abs": s.stability.floquet_max_abs,
                 "stability_note": s.stability.undecided.as_ref().map(crate::words::undecided),

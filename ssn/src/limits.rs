@@ -335,6 +335,129 @@ pub const PENALTY_JACOBIAN_FLOPS: f64 = 0.09;
 /// scenes take 7 to 14 Newton iterations, one factorization each).
 const NEWTON_FACTORIZATIONS: f64 = 10.0;
 
+/// Newton iterations counted for a solve on the matrix-free path (many contacts): from
+/// zero, the rod of 1,000 elements with 50 and 200 evenly spaced stops (gap 0.5, H = 20)
+/// took 49 and 38.
+pub const MATRIX_FREE_NEWTON_ITERATIONS: f64 = 50.0;
+
+/// GMRES iterations per Newton iteration and contact on the matrix-free path, between
+/// [`KRYLOV_ITERATIONS_PER_NEWTON_MIN`] and [`KRYLOV_ITERATIONS_PER_NEWTON_MAX`] (the contact
+/// blocks leave out the coupling between contacts, so the iterations grow with their
+/// number). Measured with the `krylov_iterations` counter on rods with evenly spaced stops
+/// (gap 0.5, H = 20), per Newton iteration: 48 with 10 stops on 100 elements
+/// (`condensed-krylov`), 48 with 50 on 100, 200 and 1,000 elements, 244 with 200 and 295
+/// with 1,000 on 1,000 elements.
+pub const KRYLOV_ITERATIONS_PER_CONTACT: f64 = 1.25;
+
+/// GMRES iterations of one Newton iteration with two contacts or more, at least (48
+/// measured with 10 stops); one contact's block is the whole system and its solves take
+/// one iteration each (two solves a Newton iteration are counted).
+pub const KRYLOV_ITERATIONS_PER_NEWTON_MIN: f64 = 50.0;
+
+/// GMRES iterations of one Newton iteration with many contacts (295 measured with 1,000
+/// stops: restarted cycles of 200 converge in about one and a half).
+pub const KRYLOV_ITERATIONS_PER_NEWTON_MAX: f64 = 300.0;
+
+/// Operations of one GMRES iteration of the matrix-free path per unit of
+/// `N (H + 1) + m S^2 + m S b` (the `H + 1` sparse solves of a product, `Q` and the contact
+/// blocks, the Gram-Schmidt on the `2b` Krylov vectors of the current cycle). On the rod
+/// above (CPU time, a load of 5 on 2 cores, at 2.3e10 operations per second): 200 stops
+/// (no dense preconditioner: `m S > 6000`) took 30.2 s for 9,264 GMRES iterations, 63 per
+/// unit; 1,000 stops 194 s for 10,617, 72 per unit.
+pub const KRYLOV_PRODUCT_FLOPS: f64 = 70.0;
+
+/// Dense factorizations of the condensed system per Newton iteration counted where the
+/// matrix-free path may fall back on the dense preconditioner (two or more contacts, at
+/// most `DENSE_PRECONDITIONER_LIMIT` condensed unknowns): it is refactored when GMRES
+/// needs more than 30 iterations with an earlier one, and how often varies. 50 stops (2,050
+/// condensed unknowns, 5.7e9 operations a factorization, 49 or 50 Newton iterations) took
+/// 13.3 s of CPU on 1,000 elements with gap 0.5 (3 counted: 2.8 times that), 102 s with
+/// gap 0.1 and 92 s on 100 elements (2.7 and 2.4 times the count).
+pub const DENSE_PRECONDITIONER_FACTORIZATIONS_PER_ITERATION: f64 = 3.0;
+
+/// The work of one Newton iteration of the matrix-free path, and its parts.
+struct MatrixFreeIteration {
+    /// All of it.
+    flops: f64,
+    /// GMRES iterations.
+    krylov: f64,
+    /// Operations of one GMRES iteration.
+    product: f64,
+    /// Operations of the dense preconditioner's factorizations.
+    dense: f64,
+}
+
+/// One Newton iteration of the matrix-free path on `n` dofs, `m` contacts and `harmonics`
+/// harmonics (`S = 2H + 1`): `k` GMRES (2 for one contact, else
+/// [`KRYLOV_ITERATIONS_PER_CONTACT`] `m` within its bounds)
+/// iterations of [`KRYLOV_PRODUCT_FLOPS`] `(N (H + 1) + m S^2 + m S min(k, 200) / 2)`,
+/// the contact blocks' LU `(2/3) m S^3`, and
+/// [`DENSE_PRECONDITIONER_FACTORIZATIONS_PER_ITERATION`] dense LUs `(2/3) (m S)^3` where
+/// GMRES may fall back on them.
+fn matrix_free_iteration(n: f64, m: f64, harmonics: usize) -> MatrixFreeIteration {
+    let h = harmonics as f64;
+    let s = 2.0 * h + 1.0;
+    let krylov = if m < 2.0 {
+        2.0
+    } else {
+        (KRYLOV_ITERATIONS_PER_CONTACT * m).clamp(
+            KRYLOV_ITERATIONS_PER_NEWTON_MIN,
+            KRYLOV_ITERATIONS_PER_NEWTON_MAX,
+        )
+    };
+    let basis = krylov.min(200.0) / 2.0;
+    let product = KRYLOV_PRODUCT_FLOPS * (n * (h + 1.0) + m * s * s + m * s * basis);
+    let unknowns = m * s;
+    let dense = if m >= 2.0 && unknowns <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64
+    {
+        DENSE_PRECONDITIONER_FACTORIZATIONS_PER_ITERATION * 2.0 / 3.0 * unknowns.powi(3)
+    } else {
+        0.0
+    };
+    let blocks = 2.0 / 3.0 * m * s.powi(3);
+    MatrixFreeIteration {
+        flops: krylov * product + blocks + dense,
+        krylov,
+        product,
+        dense,
+    }
+}
+
+/// Whether the SSN-HB condensed system of `contacts` contacts is solved matrix-free with
+/// `settings` (more than `KRYLOV_THRESHOLD` condensed unknowns, or on request).
+fn matrix_free(contacts: usize, settings: &SolverSettings) -> bool {
+    settings.method == Method::SsnHb
+        && settings
+            .linear_solver
+            .condensed()
+            .is_some_and(|c| c.uses_krylov(contacts, settings.harmonics, true))
+}
+
+/// GMRES iterations [`run_work`] counts for one SSN-HB solve of `dofs` dofs and `contacts`
+/// contacts with `settings` (0 off the matrix-free path).
+pub fn estimated_krylov_iterations(dofs: usize, contacts: usize, settings: &SolverSettings) -> f64 {
+    if matrix_free(contacts, settings) {
+        MATRIX_FREE_NEWTON_ITERATIONS
+            * matrix_free_iteration(dofs as f64, contacts as f64, settings.harmonics).krylov
+    } else {
+        0.0
+    }
+}
+
+/// Newton iterations [`size_work`] counts for one solve with `settings` (the divisor that
+/// gives the work of one iteration).
+pub(crate) fn counted_newton_iterations(contacts: usize, settings: &SolverSettings) -> f64 {
+    match settings.method {
+        Method::PenaltyHb
+            if settings.linear_solver != LinearSolverChoice::Dense && contacts > 0 =>
+        {
+            settings.max_iterations as f64
+        }
+        _ if matrix_free(contacts, settings) => MATRIX_FREE_NEWTON_ITERATIONS,
+        _ => NEWTON_FACTORIZATIONS,
+    }
+}
+
 /// Default limit of [`work_limit`]: 1e14 operations, about 70 minutes at the 2.3e10
 /// operations per second that faer's dense LU reached on a 2-core machine (a factorization
 /// of 8241 unknowns, 3.7e11 operations, in 16 s).
@@ -382,30 +505,26 @@ pub(crate) fn size_work(
                 keys: dense_keys,
             }
         }
-        // Above the threshold the automatic choice solves the condensed system matrix-free.
-        (Method::SsnHb, LinearSolverChoice::Structured)
-            if contacts * (2 * settings.harmonics + 1)
-                > semismooth_contact::hb::KRYLOV_THRESHOLD =>
-        {
-            // At most one dense factorization per iteration where GMRES may fall back on
-            // the dense preconditioner; none above its limit.
-            let unknowns = m * s;
-            if unknowns <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64 {
-                WorkEstimate {
-                    flops: lu(unknowns),
-                    what: format!(
-                        "{NEWTON_FACTORIZATIONS} LU factorizations at most of the condensed \
-                         contact system on {unknowns:.0} unknowns (the matrix-free solve's \
-                         dense preconditioner)"
-                    ),
-                    keys: "solver.harmonics and the number of contacts",
-                }
-            } else {
-                WorkEstimate {
-                    flops: 0.0,
-                    what: "no dense factorization (matrix-free condensed solve)".into(),
-                    keys: "",
-                }
+        // Above the threshold (or on request) the condensed system is solved matrix-free.
+        (Method::SsnHb, _) if matrix_free(contacts, settings) => {
+            let iteration = matrix_free_iteration(n, m, settings.harmonics);
+            WorkEstimate {
+                flops: MATRIX_FREE_NEWTON_ITERATIONS * iteration.flops,
+                what: format!(
+                    "{MATRIX_FREE_NEWTON_ITERATIONS} Newton iterations of a matrix-free solve of \
+                     the condensed contact system on {:.0} unknowns, each {:.1e} operations: \
+                     {:.0} GMRES iterations of {:.1e}, the contact blocks' factorizations{}",
+                    m * s,
+                    iteration.flops,
+                    iteration.krylov,
+                    iteration.product,
+                    if iteration.dense > 0.0 {
+                        " and the dense preconditioner's"
+                    } else {
+                        ""
+                    }
+                ),
+                keys: "solver.harmonics and the number of contacts",
             }
         }
         (Method::PenaltyHb, _) if contacts > 0 => {
@@ -426,17 +545,20 @@ pub(crate) fn size_work(
                 keys: "solver.harmonics, solver.max_iterations and the structure's size",
             }
         }
-        (Method::SsnHb, LinearSolverChoice::Structured | LinearSolverChoice::CondensedDense) => {
-            WorkEstimate {
-                flops: lu(m * s),
-                what: format!(
-                    "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
+        (
+            Method::SsnHb,
+            LinearSolverChoice::Structured
+            | LinearSolverChoice::CondensedDense
+            | LinearSolverChoice::CondensedKrylov,
+        ) => WorkEstimate {
+            flops: lu(m * s),
+            what: format!(
+                "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
                  on {:.0} unknowns",
-                    m * s
-                ),
-                keys: "solver.harmonics and the number of contacts",
-            }
-        }
+                m * s
+            ),
+            keys: "solver.harmonics and the number of contacts",
+        },
         _ => WorkEstimate {
             flops: 0.0,
             what: "no dense factorization".into(),
@@ -596,7 +718,7 @@ mod tests {
     }
 
     #[test]
-    fn imported_models_are_estimated_by_their_size_and_the_matrix_free_path_by_none() {
+    fn imported_models_are_estimated_by_their_size_and_the_matrix_free_path_by_its_gmres() {
         // A model of 32,481 dofs with the dense solver at H = 1: (32481 + 1) x 3 unknowns,
         // 10 x (2/3) n^3 = 6.2e14 operations, refused, naming the model's size.
         let dense = size_work(
@@ -607,13 +729,47 @@ mod tests {
         );
         let e = check_work(&dense, DEFAULT_WORK_LIMIT).unwrap_err();
         assert!(e.contains("the model's size"), "{e}");
-        // 1,000 contacts at H = 20: 41,000 condensed unknowns, solved matrix-free (a dense
-        // estimate would be 4.6e14 and refuse a run that takes seconds).
+        // 1,000 contacts at H = 20 on the 10,002-dof disk of examples/contact_scaling.rs:
+        // 41,000 condensed unknowns, solved matrix-free (a dense estimate would be 4.6e14
+        // and refuse a run that takes seconds); the GMRES iterations of the rod's stops,
+        // which couple far more, are counted, and the run is allowed.
         let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "");
-        assert_eq!(many.flops, 0.0, "{many:?}");
+        assert!((1e12..1e14).contains(&many.flops), "{many:?}");
+        assert!(many.what.contains("GMRES iterations"), "{many:?}");
         // At the threshold the condensed system is still factored dense.
         let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "");
         let n: f64 = 40.0 * 41.0;
         assert!((dense_condensed.flops - 10.0 * 2.0 / 3.0 * n.powi(3)).abs() <= 1e-9 * n.powi(3));
+    }
+
+    #[test]
+    fn the_matrix_free_path_is_estimated_within_a_factor_three_of_its_measured_runs() {
+        // The rod of 1,000 elements with m evenly spaced stops (gap 0.5, H = 20), from
+        // zero: GMRES iterations (the `krylov_iterations` counter) and CPU seconds
+        // (a load of 5 on 2 cores) measured, converted at 2.3e10 operations per second.
+        for (m, krylov, seconds) in [
+            (50, 2370.0, 13.3),
+            (200, 9264.0, 30.2),
+            (1000, 10617.0, 194.0),
+        ] {
+            let settings = settings(Method::SsnHb, 20, false);
+            let counted = estimated_krylov_iterations(1001, m, &settings);
+            assert!(
+                (krylov / 3.0..3.0 * krylov).contains(&counted),
+                "{m} contacts: {counted} GMRES iterations counted, {krylov} measured"
+            );
+            let work = run_work(1000, m, &settings).flops;
+            let measured = seconds * 2.3e10;
+            assert!(
+                (measured / 3.0..3.0 * measured).contains(&work),
+                "{m} contacts: {work:e} against {measured:e}"
+            );
+            assert!(check_work(&run_work(1000, m, &settings), DEFAULT_WORK_LIMIT).is_ok());
+        }
+        // Below the threshold nothing is counted for GMRES; `condensed-krylov` asks for it.
+        let mut small = settings(Method::SsnHb, 20, false);
+        assert_eq!(estimated_krylov_iterations(1001, 20, &small), 0.0);
+        small.linear_solver = LinearSolverChoice::CondensedKrylov;
+        assert!(estimated_krylov_iterations(1001, 20, &small) > 0.0);
     }
 }

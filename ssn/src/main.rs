@@ -64,8 +64,11 @@ enum Command {
         methods), solve_seconds, tip_max, tip_min,\n  \
         max_penetration, contact_force_mean (sum over the contacts), contacts [{node, dof,\n  \
         gap, force_mean, max_penetration, contact_fraction, displacement_min,\n  \
-        displacement_max}], c (SSN-HB), counters {residual_evaluations,\n  \
-        jacobian_evaluations, factorizations, linear_solves, ffts, ...}, started_from\n  \
+        displacement_max}], friction [{point, stick_fraction, force_amplitude,\n  \
+        slip_velocity_amplitude, slip_limit_max, force, slip_velocity}], c (SSN-HB),\n  \
+        counters {residual_evaluations,\n  \
+        jacobian_evaluations, factorizations, linear_solves, ffts, krylov_iterations,\n  \
+        ...}, started_from\n  \
         {file, entry, omega_ratio, note} (with --start)\n\n\
         State file (--state): format, version, method, harmonics, dofs, contacts, omega,\n  \
         omega_ratio, layout, displacement [(2H+1) dofs], contact_force [(2H+1) contacts]\n  \
@@ -79,7 +82,9 @@ enum Command {
         ssn sweep scenes/paper_fig2.toml --json --csv fig2.csv --svg fig2.svg\n\n\
         JSON fields: points, omega, omega_ratio, tip_max, tip_min, amplitude, stable,\n  \
         floquet_max_abs, contact_force_mean (sum over the contacts), max_penetration,\n  \
-        contacts (per point, the list of ssn solve) (arrays in branch order),\n  \
+        contacts (per point, the list of ssn solve), friction (per point: point,\n  \
+        stick_fraction, force_amplitude, slip_velocity_amplitude, slip_limit_max) (arrays\n  \
+        in branch order),\n  \
         stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
         branch turns), corner_folds (reversals of less than 5e-3 omega_1: corners),\n  \
         converged, termination, solve_seconds, counters\n\n\
@@ -98,7 +103,8 @@ enum Command {
         after_help = "Example:\n  ssn solutions SCENE.toml --json --csv solutions.csv --svg solutions.svg\n\n\
         JSON fields: omega, omega_ratio, window, branch_points, branch_converged, crossings,\n  \
         failed_corrections, seconds, solutions [{tip_min, tip_max, contact_force_mean,\n  \
-        max_penetration, contacts, stable, floquet_max_abs, stability_note, iterations,\n  \
+        max_penetration, contacts, friction, stable, floquet_max_abs, stability_note,\n  \
+        iterations,\n  \
         residual_norm, state}]; start a solve from solution K with\n  \
         ssn solve SCENE.toml --start solutions.json --entry K\n\n",
         mut_arg("json", |a| a.help("Print the solutions as JSON on stdout")),

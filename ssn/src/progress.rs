@@ -2,13 +2,21 @@
 //! run is not quiet ([`crate::io::quiet`]).
 
 use std::io::IsTerminal;
+use std::sync::OnceLock;
+
+/// The process's bars, drawn together so that bars of work running side by side do not
+/// overwrite each other's line.
+fn bars() -> &'static indicatif::MultiProgress {
+    static BARS: OnceLock<indicatif::MultiProgress> = OnceLock::new();
+    BARS.get_or_init(indicatif::MultiProgress::new)
+}
 
 /// A spinner on stderr when it is a terminal and the run is not quiet.
 pub fn progress_spinner(message: &str) -> indicatif::ProgressBar {
     if crate::io::quiet() || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
     }
-    let bar = indicatif::ProgressBar::new_spinner();
+    let bar = bars().add(indicatif::ProgressBar::new_spinner());
     bar.set_message(message.to_string());
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     bar
@@ -19,7 +27,7 @@ pub fn progress_bar(len: u64, message: &str) -> indicatif::ProgressBar {
     if crate::io::quiet() || !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
     }
-    let bar = indicatif::ProgressBar::new(len);
+    let bar = bars().add(indicatif::ProgressBar::new(len));
     bar.set_style(
         indicatif::ProgressStyle::with_template("{msg:32} [{bar:30}] {pos}/{len} {elapsed}")
             .expect("valid template")

@@ -8,7 +8,7 @@
 //! second on 2 cores ([`crate::limits::DEFAULT_WORK_LIMIT`]); the per-unit costs below are
 //! measured and converted at that rate.
 
-use crate::limits::{compared, size_work, WorkEstimate};
+use crate::limits::{compared, counted_newton_iterations, size_work, WorkEstimate};
 use crate::scene::{Method, Scene, SolverSettings};
 
 /// Operations of one time step of one dof of time marching: 1e8 dof-steps (a 10,000-element
@@ -23,6 +23,17 @@ pub const BRANCH_FLOPS_PER_DOF_FUNCTION: f64 = 5e5;
 
 /// Corrector iterations counted per branch point (the step control aims at 4).
 pub const CORRECTOR_ITERATIONS_PER_POINT: f64 = 4.0;
+
+/// Operations of one corrector iteration of a harmonic-balance branch per contact and
+/// `S^2 log2 S` (`S = 2H + 1`): the dense `S x S` contact block of the Jacobian, formed a
+/// column at a time by FFTs, and the products with it, which outgrow the per-harmonic
+/// terms at high `H` (a point's work grows like `S^2.2`). Measured with `ssn solutions` on
+/// `scenes/paper_fig1.toml` (20 dofs, one contact; CPU time at a load of 5 to 6 on 2
+/// cores): 4.1 s at H = 200 (63 points), 172 s at H = 1000 (68 points, 4.0e12 operations
+/// at 2.3e10 per second), more than 1,058 s at H = 2000. 900 puts the estimate at 1.5
+/// times the measured work at H = 1000, 1.2e3 s (2.7e13) at H = 2000 and 2.9 times the
+/// measured work at H = 200, where the per-dof term dominates.
+pub const BRANCH_FLOPS_PER_CONTACT_JACOBIAN: f64 = 900.0;
 
 /// What a command runs on a scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -104,7 +115,9 @@ fn march_work(dofs: usize, settings: &SolverSettings, size_key: &'static str) ->
 
 /// A branch over the `[sweep]` window (for `ssn solutions` without one: half to twice the
 /// scene's frequency): at least `range / max_step` points, each
-/// [`CORRECTOR_ITERATIONS_PER_POINT`] factorizations of one solve's system and
+/// [`CORRECTOR_ITERATIONS_PER_POINT`] iterations of one solve's linear algebra (a
+/// factorization, or the matrix-free path's GMRES) and contact blocks
+/// ([`BRANCH_FLOPS_PER_CONTACT_JACOBIAN`] `m S^2 log2 S`), and
 /// [`BRANCH_FLOPS_PER_DOF_FUNCTION`] per dof and harmonic function.
 fn branch_work(
     scene: &Scene,
@@ -130,17 +143,22 @@ fn branch_work(
     };
     let points = (range / max_step).ceil().clamp(1.0, max_points as f64);
     let one = size_work(dofs, contacts, settings, "");
-    let factorization = if settings.method == Method::PenaltyHb {
-        one.flops / settings.max_iterations as f64
-    } else {
-        one.flops / 10.0
-    };
+    let factorization = one.flops / counted_newton_iterations(contacts, settings);
     let functions = if settings.method.is_harmonic_balance() {
         2.0 * settings.harmonics as f64 + 1.0
     } else {
         settings.time_samples as f64
     };
-    let per_point = CORRECTOR_ITERATIONS_PER_POINT * factorization
+    let contact_jacobian = if settings.method.is_harmonic_balance() {
+        BRANCH_FLOPS_PER_CONTACT_JACOBIAN
+            * contacts as f64
+            * functions
+            * functions
+            * functions.log2()
+    } else {
+        0.0
+    };
+    let per_point = CORRECTOR_ITERATIONS_PER_POINT * (factorization + contact_jacobian)
         + BRANCH_FLOPS_PER_DOF_FUNCTION * dofs as f64 * functions;
     WorkEstimate {
         flops: points * per_point,
@@ -149,5 +167,39 @@ fn branch_work(
              {per_point:.1e} operations"
         ),
         keys: "sweep.max_step, sweep.omega_ratio_from/to, solver.harmonics, the structure's size",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `scenes/paper_fig1.toml` (20 elements, one contact at the tip) at `harmonics`.
+    fn paper_fig1(harmonics: usize) -> Scene {
+        let mut scene = Scene::from_toml(
+            include_str!("../../scenes/paper_fig1.toml"),
+            "paper_fig1.toml",
+        )
+        .unwrap();
+        scene.solver.harmonics = harmonics;
+        scene
+    }
+
+    #[test]
+    fn branches_at_high_h_are_estimated_within_a_factor_three_of_their_measured_work() {
+        // `ssn solutions` measured in CPU seconds (module constants), at 2.3e10 operations
+        // per second.
+        for (harmonics, seconds) in [(200, 4.08), (1000, 172.4)] {
+            let e = scene_work(&paper_fig1(harmonics), 20, 1, Workload::Branch);
+            let measured = seconds * 2.3e10;
+            assert!(
+                (measured / 3.0..3.0 * measured).contains(&e.flops),
+                "H = {harmonics}: {e:?} against {measured:e}"
+            );
+        }
+        // H = 2000 ran more than 1,058 s: the estimate is at least that.
+        let e = scene_work(&paper_fig1(2000), 20, 1, Workload::Branch);
+        assert!(e.flops >= 1058.0 * 2.3e10, "{e:?}");
+        assert!(e.what.contains("points"), "{e:?}");
     }
 }

@@ -194,3 +194,19 @@ fn accuracy_target_rows_for_1e_3_on_the_paper_rod_are_the_codes_and_meet_it() {
     }
     assert_in_docs("accuracy-targets", &target_table(case.name, &rows), false);
 }
+
+#[test]
+fn friction_tables_are_the_codes() {
+    // Den Hartog's oscillator by H (SSN-HB against the closed form) and the damper curve
+    // (the resonance peak of two blades against the damper's normal load): about 5 s.
+    assert_in_docs(
+        "friction",
+        &ssn::friction_tables::den_hartog_convergence().unwrap(),
+        true,
+    );
+    assert_in_docs(
+        "friction",
+        &ssn::friction_tables::damper_curve().unwrap(),
+        true,
+    );
+}

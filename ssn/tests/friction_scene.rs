@@ -82,8 +82,8 @@ fn friction_keys_a_user_gets_wrong_are_named_with_what_is_allowed() {
         ),
         (
             "method = \"ssn-hb\"",
-            "method = \"penalty-hb\"",
-            &["solver.method", "penalty-hb", "ssn-hb"],
+            "method = \"lcp-ssn\"",
+            &["solver.method", "lcp-ssn", "ssn-hb", "penalty-hb"],
         ),
     ];
     for (from, to, words) in cases {

@@ -19,13 +19,7 @@ fn disk_with_stops(count: usize) -> (Structure, f64) {
         blades: 100,
         mistuning: SHIPPED_MISTUNING,
     };
-    let loading = DiskLoading {
-        stops: (0..count).map(|i| i * 100 / count).collect(),
-        gap: 1.0,
-        amplitude: 0.02,
-        zeta: 0.01,
-        omega_ratio: 1.0,
-    };
+    let loading = DiskLoading::shipped((0..count).map(|i| i * 100 / count).collect());
     let structure = disk.structure(&loading).unwrap();
     let omega = loading.omega(structure.omega_1);
     (structure, omega)

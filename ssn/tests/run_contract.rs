@@ -365,3 +365,96 @@ fn scene_check_counts_the_natural_frequencies_in_its_work_estimate() {
     let o = ssn_env(&["scene-check", &small], "SSN_WORK_LIMIT", "1e11");
     assert_exit(&o, 0, "1e4 elements");
 }
+
+/// A rod of `elements` elements with `stops` evenly spaced stops of gap 0.5 at H = 20, and
+/// `solver` appended to its `[solver]`.
+fn stops_scene(dir: &Path, name: &str, elements: usize, stops: usize, solver: &str) -> String {
+    let points: String = (1..=stops)
+        .map(|k| {
+            format!(
+                "[[contact.point]]\nnode = {}\ngap = 0.5\n",
+                k * elements / stops
+            )
+        })
+        .collect();
+    rod_scene(
+        dir,
+        name,
+        &format!("elements = {elements}\nmass = \"modified\""),
+        &format!("[damping]\nzeta = 0.01\n{points}[solver]\nharmonics = 20\n{solver}"),
+    )
+}
+
+/// The GMRES iterations of a short matrix-free run (10 stops on 100 elements, the
+/// condensed system solved by GMRES on request) are within a factor 3 of those the work
+/// estimate counts, and its answer is the dense condensed solve's.
+#[test]
+fn a_matrix_free_run_takes_the_gmres_iterations_its_estimate_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |solver: &str| {
+        let scene = stops_scene(dir.path(), "stops.toml", 100, 10, solver);
+        let o = ssn(&["solve", &scene, "--json"]);
+        assert_exit(&o, 0, solver);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (scene, v)
+    };
+    let (scene, krylov) = run("linear_solver = \"condensed-krylov\"");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let settings = ssn::scene::Scene::from_toml(&text, &scene).unwrap().solver;
+    let counted = ssn::limits::estimated_krylov_iterations(100, 10, &settings);
+    let measured = krylov["counters"]["krylov_iterations"].as_f64().unwrap();
+    assert!(
+        (measured / 3.0..3.0 * measured).contains(&counted),
+        "{counted} GMRES iterations counted, {measured} taken"
+    );
+    // GMRES stops at 1e-10 of the step's right-hand side: the tips agree to 1e-8.
+    let (_, dense) = run("linear_solver = \"condensed-dense\"");
+    assert_eq!(dense["counters"]["krylov_iterations"], 0);
+    for key in ["tip_max", "tip_min"] {
+        let (a, b) = (krylov[key].as_f64().unwrap(), dense[key].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-8 * b.abs().max(1.0), "{key}: {a} {b}");
+    }
+}
+
+/// The matrix-free path is estimated by its GMRES iterations: 1,000 stops on 1,000
+/// elements (measured 194 s of CPU, estimated 6e12 operations) are refused up front under
+/// a limit of 1e12, naming the keys and the estimate, where a count of its dense
+/// factorizations alone (none) let it run.
+#[test]
+fn many_stops_are_refused_beyond_the_work_limit_naming_gmres_and_the_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = stops_scene(dir.path(), "stops.toml", 1000, 1000, "");
+    let o = ssn_env(&["solve", &scene], "SSN_WORK_LIMIT", "1e12");
+    assert_exit(&o, 2, "1,000 stops under a limit of 1e12");
+    assert_mentions(
+        &o,
+        &[
+            "stops.toml",
+            "GMRES iterations",
+            "41000 unknowns",
+            "solver.harmonics and the number of contacts",
+            "6.1e12",
+        ],
+    );
+}
+
+/// `ssn solutions` on the paper's rod at H = 2000 (measured more than 1,058 s of CPU, 2.4e13
+/// operations) is estimated above it and refused under a limit of 1e13.
+#[test]
+fn solutions_at_h_2000_are_estimated_by_their_measured_growth() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/paper_fig1.toml");
+    let o = ssn_env(
+        &["solutions", s(&scene), "--set", "solver.harmonics=2000"],
+        "SSN_WORK_LIMIT",
+        "1e13",
+    );
+    assert_exit(&o, 2, "solutions at H = 2000");
+    assert_mentions(&o, &["points", "solver.harmonics", "SSN_WORK_LIMIT"]);
+    let estimate: f64 = err(&o)
+        .split("need about ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .expect("the estimate in the message");
+    assert!(estimate >= 1058.0 * 2.3e10, "{}", err(&o));
+}

@@ -194,6 +194,20 @@ fn pad_between_stops(dir: &std::path::Path, harmonics: usize) -> std::path::Path
     scene
 }
 
+/// Time marching of a loaded pad chain (an independent formulation in time), converged.
+fn marched(loaded: &ssn::cli::Loaded) -> Solution {
+    let mut settings = loaded.scene.solver.clone();
+    settings.method = Method::March;
+    let sol = semismooth_contact::solve(&loaded.structure, loaded.omega, &settings, None).unwrap();
+    assert!(sol.converged(), "march: {}", sol.termination);
+    sol
+}
+
+/// The mean force of the pad's two stops.
+fn pad_force(s: &Solution) -> f64 {
+    s.contacts[0].force_mean + s.contacts[1].force_mean
+}
+
 /// Stops that share a load path but close one after the other keep the default `c` of one
 /// contact (10 x the static contact stiffness, 1.11 here): counted as sharing it was halved
 /// to 0.56, where the solve from zero stagnated (measured: c from 0.05 to 0.8 failed in 4 of
@@ -224,16 +238,8 @@ fn stops_on_one_load_path_that_close_one_after_the_other_converge_from_zero_with
             hb.termination,
             hb.iterations
         );
-        let march = march.get_or_insert_with(|| {
-            let mut settings = loaded.scene.solver.clone();
-            settings.method = Method::March;
-            let sol = semismooth_contact::solve(&loaded.structure, loaded.omega, &settings, None)
-                .unwrap();
-            assert!(sol.converged(), "march: {}", sol.termination);
-            sol
-        });
-        let pad = |s: &Solution| s.contacts[0].force_mean + s.contacts[1].force_mean;
-        let (a, b) = (pad(&hb), pad(march));
+        let march = march.get_or_insert_with(|| marched(&loaded));
+        let (a, b) = (pad_force(&hb), pad_force(march));
         assert!(
             a < 0.0 && common::relative(a, b) < 0.01,
             "H = {harmonics}: pad force {a} vs march {b}"
@@ -260,7 +266,7 @@ fn the_default_c_on_the_pad_chain_converges_at_h_30_and_60_through_a_raised_c_st
         let loaded = ssn::cli::load(&path).unwrap();
         let structure = &loaded.structure;
         let default_c = structure.model.default_complementarity_constant();
-        let mut settings = loaded.scene.solver.clone();
+        let settings = loaded.scene.solver.clone();
         let hb = semismooth_contact::solve(structure, loaded.omega, &settings, None).unwrap();
         assert!(
             hb.converged(),
@@ -279,14 +285,8 @@ fn the_default_c_on_the_pad_chain_converges_at_h_30_and_60_through_a_raised_c_st
              longer needs the raised start",
             hb.iterations
         );
-        let march = march.get_or_insert_with(|| {
-            settings.method = Method::March;
-            let sol = semismooth_contact::solve(structure, loaded.omega, &settings, None).unwrap();
-            assert!(sol.converged(), "march: {}", sol.termination);
-            sol
-        });
-        let pad = |s: &Solution| s.contacts[0].force_mean + s.contacts[1].force_mean;
-        let (a, b) = (pad(&hb), pad(march));
+        let march = march.get_or_insert_with(|| marched(&loaded));
+        let (a, b) = (pad_force(&hb), pad_force(march));
         assert!(
             a < 0.0 && common::relative(a, b) < 0.01,
             "H = {harmonics}: {a} vs {b}"

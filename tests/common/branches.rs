@@ -4,7 +4,8 @@
 //! identity every block-eliminated branch satisfies.
 
 use faer::Mat;
-use semismooth::continuation::{Branch, ContinuationEvent};
+use semismooth::continuation::{Branch, Continuation, ContinuationEvent, ContinuationOptions};
+use semismooth::linalg::FaerDenseLu;
 use semismooth::{EvaluationError, GeneralizedJacobian, ParameterDependent, Residual};
 
 pub type ResidualFn = Box<dyn Fn(&[f64], f64, &mut [f64])>;
@@ -67,6 +68,22 @@ impl ParameterDependent for Closure {
             }
         }
         Ok(())
+    }
+}
+
+/// The branch of `problem` from `(x0, p0)` with `options`, followed with the dense LU.
+pub fn follow(problem: &mut Closure, x0: &[f64], p0: f64, options: ContinuationOptions) -> Branch {
+    Continuation::new(problem, &mut FaerDenseLu::new(), x0, p0, options)
+        .unwrap()
+        .run()
+}
+
+/// The default continuation options over the parameter range `[min, max]`.
+pub fn between(min: f64, max: f64) -> ContinuationOptions {
+    ContinuationOptions {
+        parameter_min: min,
+        parameter_max: max,
+        ..Default::default()
     }
 }
 

@@ -36,10 +36,11 @@
 //! F. Thouverez, L. Jézéquel, J. Sound Vib. 265 (2003) 201–219; J. P. Den Hartog, Trans.
 //! ASME 53 (1931) 107–115 (the exact single-dof solution in continuous sliding).
 
-use semismooth::harmonic::Aft;
+use semismooth::harmonic::{Aft, FourierBasis};
 
 use super::ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope, SsnHb};
-use super::LinearData;
+use super::{HbError, LinearData};
+use crate::contacts::FrictionReport;
 use crate::model::NormalForce;
 
 /// `proj_[-b, b](z)` as `z - phi_mu(z - b) + phi_mu(-z - b)` (exact clamp at `mu = 0`).
@@ -284,6 +285,117 @@ impl SsnHb {
                 NormalForce::Contact(_) => 0.0,
             })
             .fold(0.0, f64::max)
+    }
+}
+
+/// The samples of friction point `f` on `points` equally spaced times from its
+/// coefficients: the law's argument `z = lambda_t - c y_t`, the slip velocity
+/// `v_t = w d (g_t . u) / d(w t)` (no mean-slip anchor) and the slip limit `b`.
+pub(crate) struct FrictionPeriod {
+    pub(crate) argument: Vec<f64>,
+    pub(crate) slip_velocity: Vec<f64>,
+    pub(crate) slip_limit: Vec<f64>,
+}
+
+impl FrictionPeriod {
+    /// From friction point `f`'s force coefficients `force(j)` (`None`: the argument is
+    /// the slip velocity alone), the displacement coefficients `u`, its contact's normal
+    /// force coefficients `normal(j, p)` (used on a contact), `c` and `omega`.
+    pub(crate) fn reconstruct(
+        lin: &LinearData,
+        (u, omega, c): (&[f64], f64, f64),
+        f: usize,
+        force: Option<&dyn Fn(usize) -> f64>,
+        normal: &dyn Fn(usize, usize) -> f64,
+        points: usize,
+    ) -> Result<Self, HbError> {
+        if f >= lin.friction.len() {
+            return Err(HbError::IndexOutOfRange {
+                what: "friction point",
+                index: f,
+                count: lin.friction.len(),
+            });
+        }
+        let i = lin.normal_rows() + f;
+        let mut aft = Aft::new(FourierBasis::new(lin.basis.harmonics(), points)?);
+        let size = lin.size();
+        let mut sample = |coefficient: &dyn Fn(usize) -> f64| -> Result<Vec<f64>, HbError> {
+            let coeffs: Vec<f64> = (0..size).map(coefficient).collect();
+            let mut out = vec![0.0; points];
+            aft.to_time(&coeffs, &mut out)?;
+            Ok(out)
+        };
+        // The phase velocity y without the anchor on its constant.
+        let phase_velocity = |j: usize| {
+            if j == 0 {
+                0.0
+            } else {
+                lin.measured_coefficient(i, u, j)
+            }
+        };
+        let slip_velocity = sample(&|j| omega * phase_velocity(j))?;
+        let argument = match force {
+            Some(force) => sample(&|j| force(j) - c * lin.measured_coefficient(i, u, j))?,
+            None => slip_velocity.clone(),
+        };
+        let (mu, normal_force) = lin.friction[f];
+        let slip_limit = match normal_force {
+            NormalForce::Prescribed(load) => vec![mu * load; points],
+            NormalForce::Contact(p) => sample(&|j| normal(j, p))?
+                .into_iter()
+                .map(|l| mu * (-l).max(0.0))
+                .collect(),
+        };
+        Ok(Self {
+            argument,
+            slip_velocity,
+            slip_limit,
+        })
+    }
+}
+
+impl SsnHb {
+    /// Friction point `f` over one period on `points` equally spaced times (`points > 2H`):
+    /// the law's force `proj_[-b, b](lambda_t - c y_t)` of the truncated series (its
+    /// Galerkin projection is `Lambda_t`; the series itself overshoots `b` like a square
+    /// wave), the slip velocity, and sticking where `|lambda_t - c y_t| < b`.
+    pub fn friction_report(
+        &self,
+        x: &[f64],
+        f: usize,
+        points: usize,
+    ) -> Result<FrictionReport, HbError> {
+        let u = self.displacement_coefficients(x)?;
+        let lambda = self.force_coefficients(x)?;
+        let lin = &self.state.linear;
+        let m = lin.contacts();
+        let i = lin.normal_rows() + f;
+        let period = FrictionPeriod::reconstruct(
+            lin,
+            (u, self.state.omega, self.c()),
+            f,
+            Some(&|j| lambda[j * m + i]),
+            &|j, p| lambda[j * m + p],
+            points,
+        )?;
+        let force = period
+            .argument
+            .iter()
+            .zip(&period.slip_limit)
+            .map(|(z, b)| z.clamp(-b, *b))
+            .collect();
+        let stuck = period
+            .argument
+            .iter()
+            .zip(&period.slip_limit)
+            .map(|(z, b)| z.abs() < *b);
+        Ok(FrictionReport::from_samples(
+            f,
+            force,
+            period.slip_velocity,
+            &period.slip_limit,
+            stuck,
+        ))
     }
 }
 

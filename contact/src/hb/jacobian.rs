@@ -182,12 +182,13 @@ impl DenseAssemble for HbJacobian {
                     }
                 }
                 ContactCoupling::Penalty { stiffness } => {
-                    // k_p G^T Q G (penalty HB has no friction row).
+                    // k_p G^T Q G (Q D G on a friction point's row).
                     for (r, a) in row.entries() {
                         for (col, b) in row.entries() {
                             for j in 0..size {
                                 for l in 0..size {
-                                    out[(j * n + r, l * n + col)] += stiffness * a * b * q[(j, l)];
+                                    out[(j * n + r, l * n + col)] +=
+                                        stiffness * a * b * coupling(j, l);
                                 }
                             }
                         }

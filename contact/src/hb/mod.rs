@@ -179,7 +179,9 @@ use crate::model::{
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
-pub use penalty::{PenaltyHb, PenaltyHbOptions, DEFAULT_RELATIVE_PENALTY};
+pub use penalty::{
+    PenaltyHb, PenaltyHbOptions, DEFAULT_FRICTION_REGULARISATION, DEFAULT_RELATIVE_PENALTY,
+};
 pub(crate) use ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use ssn::{HbOptions, SsnHb};
 pub use structured::{
@@ -465,38 +467,28 @@ impl LinearData {
         }
     }
 
+    /// `Err` unless `dof` is a dof of the model.
     pub(crate) fn check_dof(&self, dof: usize) -> Result<(), HbError> {
-        if dof >= self.dofs {
-            return Err(HbError::IndexOutOfRange {
-                what: "dof",
-                index: dof,
-                count: self.dofs,
-            });
-        }
-        Ok(())
+        check_index("dof", dof, self.dofs)
     }
 
     /// `Err` unless `contact` is a contact's normal row (not a friction point's).
     pub(crate) fn check_normal_row(&self, contact: usize) -> Result<(), HbError> {
-        if contact >= self.normal_rows() {
-            return Err(HbError::IndexOutOfRange {
-                what: "contact",
-                index: contact,
-                count: self.normal_rows(),
-            });
-        }
-        Ok(())
+        check_index("contact", contact, self.normal_rows())
     }
 
+    /// `Err` unless `contact` is a contact row (a normal row or a friction point's).
     pub(crate) fn check_contact(&self, contact: usize) -> Result<(), HbError> {
-        if contact >= self.contacts() {
-            return Err(HbError::IndexOutOfRange {
-                what: "contact",
-                index: contact,
-                count: self.contacts(),
-            });
-        }
+        check_index("contact", contact, self.contacts())
+    }
+}
+
+/// `Err(IndexOutOfRange { what, index, count })` unless `index < count`.
+fn check_index(what: &'static str, index: usize, count: usize) -> Result<(), HbError> {
+    if index < count {
         Ok(())
+    } else {
+        Err(HbError::IndexOutOfRange { what, index, count })
     }
 }
 
@@ -585,12 +577,17 @@ pub(crate) fn fine_samples(
     dof: usize,
     points: usize,
 ) -> Result<Vec<f64>, HbError> {
-    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
-    let mut aft = Aft::new(basis);
     let mut coeffs = vec![0.0; lin.size()];
     lin.gather(u, dof, &mut coeffs);
+    samples_of(lin, &coeffs, points)
+}
+
+/// Samples of the signal with coefficients `coeffs` (`2H + 1`) at `points` equally spaced
+/// times over one period.
+fn samples_of(lin: &LinearData, coeffs: &[f64], points: usize) -> Result<Vec<f64>, HbError> {
+    let mut aft = Aft::new(FourierBasis::new(lin.basis.harmonics(), points)?);
     let mut samples = vec![0.0; points];
-    aft.to_time(&coeffs, &mut samples)?;
+    aft.to_time(coeffs, &mut samples)?;
     Ok(samples)
 }
 
@@ -616,14 +613,10 @@ pub(crate) fn row_samples(
     points: usize,
 ) -> Result<Vec<f64>, HbError> {
     lin.check_contact(row)?;
-    let basis = FourierBasis::new(lin.basis.harmonics(), points)?;
-    let mut aft = Aft::new(basis);
     let coeffs: Vec<f64> = (0..lin.size())
         .map(|j| lin.rows[row].dot_at(u, j * lin.dofs))
         .collect();
-    let mut samples = vec![0.0; points];
-    aft.to_time(&coeffs, &mut samples)?;
-    Ok(samples)
+    samples_of(lin, &coeffs, points)
 }
 
 /// Displacement extremes, RMS and penetration from the displacement coefficients `u`.

@@ -1,18 +1,63 @@
-//! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`.
+//! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`,
+//! and a friction point's force the regularised (tanh) Coulomb law of NLvib,
+//! `lambda_t = -mu N tanh(v_t / eps)` under its prescribed normal load `N`.
+//!
+//! The regularisation is written on the phase velocity `y = v_t / w` of the point's row,
+//! `lambda_t = -b tanh(y / eta)` (`b = mu N`, so `eps = w eta`): the residual depends on
+//! `w` only through the dynamic blocks, as SSN-HB's. `eta`, a slip length, is
+//! [`DEFAULT_FRICTION_REGULARISATION`] (or [`PenaltyHb::set_friction_regularisation`])
+//! times `b C_tt`, the slip a force `b` makes statically (`C_tt` the row's static
+//! compliance): the relative width of the law's stick band. As `eta -> 0` the regularised
+//! force tends to Coulomb's in slip, and the stick phases are replaced by slow creep.
 
 use semismooth::continuation::PiecewiseAffine;
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
 
+use super::friction::FrictionPeriod;
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::{
     check_len, check_positive, displacement_summary, row_samples, validate_basis, HbError, HbState,
     LinearData, ResponseSummary,
 };
-use crate::model::StructuralModel;
+use crate::contacts::FrictionReport;
+use crate::model::{NormalForce, StructuralModel};
+
+/// The static slip `b C_tt` of each friction point of `model` (`C_tt` the static compliance
+/// of its row; `1 / (g_t K g_t^T)` when `K` cannot be factored).
+fn static_slips(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
+    let m = lin.contacts();
+    let compliance = model.static_contact_compliance();
+    lin.friction
+        .iter()
+        .enumerate()
+        .map(|(f, &(mu, normal))| {
+            let i = lin.normal_rows() + f;
+            let c = compliance
+                .as_ref()
+                .map(|c| c[i * m + i])
+                .filter(|c| c.is_finite() && *c > 0.0)
+                .unwrap_or_else(|| 1.0 / lin.rows[i].quadratic_form(&model.stiffness));
+            let b = match normal {
+                NormalForce::Prescribed(load) => mu * load,
+                NormalForce::Contact(_) => 0.0,
+            };
+            // (A point without friction, b = 0, carries no force whatever its width.)
+            if b > 0.0 {
+                b * c
+            } else {
+                c
+            }
+        })
+        .collect()
+}
 
 /// Default penalty stiffness, relative to the contact stiffness scale
 /// ([`StructuralModel::contact_stiffness_scale`]).
 pub const DEFAULT_RELATIVE_PENALTY: f64 = 1e5;
+
+/// Default width of the regularised friction law, relative to the static slip `b C_tt` of
+/// each friction point (module documentation).
+pub const DEFAULT_FRICTION_REGULARISATION: f64 = 1e-3;
 
 /// Options of [`PenaltyHb`].
 ///
@@ -85,6 +130,11 @@ pub struct PenaltyHb {
     frozen: Vec<bool>,
     /// Whether `frozen` is held (its storage is kept either way).
     holding: bool,
+    /// The static slip `b C_tt` of each friction point (the unit of its `eta`).
+    static_slip: Vec<f64>,
+    /// The regularisation width `eta` of each friction point (a phase-velocity, i.e.
+    /// slip-length, scale).
+    eta: Vec<f64>,
 }
 
 impl PenaltyHb {
@@ -118,19 +168,97 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
-        if !model.friction.is_empty() {
+        if model
+            .friction
+            .iter()
+            .any(|f| matches!(f.normal, NormalForce::Contact(_)))
+        {
             return Err(HbError::Unsupported {
                 formulation: "penalty harmonic balance",
-                what: "friction points (use ssn-hb)",
+                what: "friction on a contact's normal force (its regularised friction takes a \
+                       prescribed normal load; use ssn-hb)",
             });
         }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
-        Ok(Self {
+        let static_slip = static_slips(model, &linear);
+        let mut problem = Self {
             state: HbState::new(linear, omega),
             stiffness: kp,
             frozen: Vec::new(),
             holding: false,
-        })
+            eta: Vec::new(),
+            static_slip,
+        };
+        problem.set_friction_regularisation(DEFAULT_FRICTION_REGULARISATION)?;
+        Ok(problem)
+    }
+
+    /// Sets the width of the regularised friction law relative to each point's static slip
+    /// `b C_tt` (finite, `> 0`; module documentation).
+    pub fn set_friction_regularisation(&mut self, relative: f64) -> Result<(), HbError> {
+        check_positive(
+            "friction_regularisation",
+            relative,
+            "a finite width > 0 relative to the static slip mu N C_tt",
+        )?;
+        self.eta = self.static_slip.iter().map(|s| relative * s).collect();
+        Ok(())
+    }
+
+    /// The regularisation width `eps = w eta` of each friction point, a slip velocity:
+    /// `lambda_t = -mu N tanh(v_t / eps)`.
+    pub fn friction_velocity_widths(&self) -> Vec<f64> {
+        self.eta.iter().map(|e| self.state.omega * e).collect()
+    }
+
+    /// Friction point `f` over one period on `points` equally spaced times (`points > 2H`):
+    /// the regularised force `-b tanh(v_t / eps)`, the slip velocity, and sticking where
+    /// `|v_t| < eps` (the law's stick band).
+    pub fn friction_report(
+        &self,
+        u: &[f64],
+        f: usize,
+        points: usize,
+    ) -> Result<FrictionReport, HbError> {
+        check_len("HB unknowns", self.dim(), u.len())?;
+        let lin = &self.state.linear;
+        let omega = self.state.omega;
+        let period =
+            FrictionPeriod::reconstruct(lin, (u, omega, 0.0), f, None, &|_, _| 0.0, points)?;
+        let eps = omega * self.eta[f];
+        let force = period
+            .slip_velocity
+            .iter()
+            .zip(&period.slip_limit)
+            .map(|(v, b)| -b * (v / eps).tanh())
+            .collect();
+        let stuck: Vec<bool> = period.slip_velocity.iter().map(|v| v.abs() < eps).collect();
+        Ok(FrictionReport::from_samples(
+            f,
+            force,
+            period.slip_velocity,
+            &period.slip_limit,
+            stuck.into_iter(),
+        ))
+    }
+
+    /// Samples of friction point `f`'s phase velocity `y_n / eta` (no mean-slip anchor)
+    /// into the AFT's samples; returns its slip limit `b`.
+    fn friction_samples(&mut self, u: &[f64], f: usize) -> f64 {
+        let lin = &self.state.linear;
+        let i = lin.normal_rows() + f;
+        let eta = self.eta[f];
+        let coeffs = self.state.aft.coefficients_mut();
+        coeffs[0] = 0.0;
+        for (j, coeff) in coeffs.iter_mut().enumerate().skip(1) {
+            *coeff = lin.measured_coefficient(i, u, j) / eta;
+        }
+        self.state.aft.coefficients_to_samples();
+        let (mu, normal) = lin.friction[f];
+        match normal {
+            NormalForce::Prescribed(load) => mu * load,
+            NormalForce::Contact(_) => 0.0,
+        }
     }
 
     /// The penalty stiffness `k_p` in use.
@@ -171,7 +299,7 @@ impl PenaltyHb {
     ) -> Result<Vec<f64>, HbError> {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
-        lin.check_contact(contact)?;
+        lin.check_normal_row(contact)?;
         let gap = lin.gaps[contact];
         let samples = row_samples(lin, u, contact, points)?;
         Ok(samples
@@ -193,7 +321,7 @@ impl PenaltyHb {
     ) -> Result<ResponseSummary, HbError> {
         check_len("HB unknowns", self.dim(), u.len())?;
         let nt = self.state.linear.basis.time_samples();
-        let means = (0..self.contacts())
+        let means = (0..self.state.linear.normal_rows())
             .map(|i| {
                 self.contact_force_samples(u, i, nt)
                     .map(|f| f.iter().sum::<f64>() / nt as f64)
@@ -249,7 +377,19 @@ impl Residual for PenaltyHb {
         let lin = self.state.linear.clone();
         let n = lin.dofs;
         lin.dynamic_residual(self.state.omega, u, out);
-        for i in 0..lin.contacts() {
+        for f in 0..lin.friction.len() {
+            // - G_t^T P lambda_t = + G_t^T P b tanh(y / eta).
+            let b = self.friction_samples(u, f);
+            for s in self.state.aft.samples_mut() {
+                *s = b * s.tanh();
+            }
+            self.state.aft.samples_to_coefficients();
+            let row = &lin.rows[lin.normal_rows() + f];
+            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
+                row.add_transpose_at(*c, out, j * n);
+            }
+        }
+        for i in 0..lin.normal_rows() {
             self.gap_samples(u, i);
             self.penetrations(i);
             for s in self.state.aft.samples_mut() {
@@ -281,7 +421,20 @@ impl GeneralizedJacobian for PenaltyHb {
     fn jacobian(&mut self, u: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
         self.state.prepare_jacobian(jac, self.coupling());
         let nt = self.time_samples();
-        for i in 0..self.contacts() {
+        let lin = self.state.linear.clone();
+        for f in 0..lin.friction.len() {
+            // dR/dU = G_t^T P diag(b sech^2(y / eta) / eta) E D G_t, written as
+            // k_p G_t^T Q D G_t (the coupling's stiffness divided out).
+            let b = self.friction_samples(u, f);
+            let scale = b / (self.eta[f] * self.stiffness);
+            for s in self.state.aft.samples_mut() {
+                let sech = 1.0 / s.cosh();
+                *s = scale * sech * sech;
+            }
+            let i = lin.normal_rows() + f;
+            self.state.write_weighted_contact_block(jac, i);
+        }
+        for i in 0..lin.normal_rows() {
             self.gap_samples(u, i);
             if let Some(h) = self.holding.then_some(&self.frozen) {
                 // The indicator is the sign of the sample: impose the frozen one.
@@ -300,12 +453,12 @@ impl GeneralizedJacobian for PenaltyHb {
 /// contact-major (`i Nt + n`): a sample carries penalty force where its gap is positive.
 impl PiecewiseAffine for PenaltyHb {
     fn switching_count(&self) -> usize {
-        self.contacts() * self.time_samples()
+        self.state.linear.normal_rows() * self.time_samples()
     }
 
     fn switching(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let nt = self.time_samples();
-        for i in 0..self.contacts() {
+        for i in 0..self.state.linear.normal_rows() {
             self.gap_samples(u, i);
             out[i * nt..(i + 1) * nt].copy_from_slice(self.state.aft.samples());
         }

@@ -20,7 +20,7 @@
 
 use faer::Mat;
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::NewtonOptions;
+use semismooth::newton::{NewtonOptions, Tolerances};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use crate::model::{NormalForce, StructuralModel};
@@ -140,7 +140,7 @@ impl CoulombStep {
             }
         }
         let options = NewtonOptions {
-            absolute_tolerance: tolerance,
+            tolerances: Tolerances::absolute(tolerance),
             max_iterations: STEP_MAX_ITERATIONS,
             ..NewtonOptions::default()
         };

@@ -131,7 +131,9 @@ use crate::model::{InvalidModel, SparseMatrix, StructuralModel};
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum MarchScheme {
     /// [`MarchScheme::MasslessContactTrapezoidal`] when every contact dof has a zero mass
-    /// row (or there is no contact), otherwise `MoreauJean { theta: 0.5, restitution: 0.0 }`.
+    /// row (or there is no contact) and there is no friction point, otherwise
+    /// `MoreauJean { theta: 0.5, restitution: 0.0 }` (`theta = 1` with friction and a contact
+    /// row with a massless dof: [`resolve_scheme`]).
     #[default]
     Auto,
     /// Moreau–Jean theta-scheme with impulses and Newton's impact law (first order in time
@@ -310,6 +312,12 @@ pub struct SteadyPeriod {
     /// One series per contact, at [`SteadyPeriod::times`]: the force `lambda <= 0` of the
     /// step (impulse / h for Moreau–Jean).
     pub contact_forces: Vec<Vec<f64>>,
+    /// One series per friction point, at [`SteadyPeriod::times`]: its tangential force
+    /// (impulse / h).
+    pub friction_forces: Vec<Vec<f64>>,
+    /// One series per friction point, at [`SteadyPeriod::times`]: its slip velocity
+    /// `g_t . v` at the end of the step.
+    pub slip_velocities: Vec<Vec<f64>>,
     /// Periods marched, the reported one included.
     pub periods: usize,
     /// Relative period-to-period change of the last period (below the tolerance).
@@ -432,15 +440,32 @@ pub(crate) fn column_max_abs(m: &SparseMatrix, j: usize) -> f64 {
         .fold(0.0_f64, |a, v| a.max(v.abs()))
 }
 
-/// The scheme `Auto` resolves to for this model.
+/// The scheme `Auto` resolves to for this model: with friction points Moreau–Jean (the
+/// trapezoidal scheme imposes positions, Coulomb's law acts on velocities), with
+/// `theta = 1` when a contact's row has a massless dof (which then follows its
+/// quasi-static equilibrium at each step; `theta = 1/2` alternates about it), else
+/// `theta = 1/2` (no numerical damping: `theta = 1` damps a resonance by about `pi /
+/// steps` of critical).
 pub fn resolve_scheme(model: &StructuralModel, scheme: MarchScheme) -> MarchScheme {
+    let massless = |dof: &usize| column_max_abs(&model.mass, *dof) == 0.0;
     match scheme {
-        MarchScheme::Auto => {
+        MarchScheme::Auto if !model.friction.is_empty() => {
             if model
-                .rows()
-                .flat_map(|row| row.dofs())
-                .all(|&dof| column_max_abs(&model.mass, dof) == 0.0)
+                .contacts
+                .iter()
+                .flat_map(|c| c.row.dofs())
+                .any(massless)
             {
+                MarchScheme::MoreauJean {
+                    theta: 1.0,
+                    restitution: 0.0,
+                }
+            } else {
+                MarchScheme::MOREAU_JEAN_DEFAULT
+            }
+        }
+        MarchScheme::Auto => {
+            if model.rows().flat_map(|row| row.dofs()).all(massless) {
                 MarchScheme::MasslessContactTrapezoidal
             } else {
                 MarchScheme::MOREAU_JEAN_DEFAULT
@@ -509,50 +534,81 @@ pub fn march_from_state(
     let mut series = vec![0.0; nobs * samples];
     let mut previous_series = vec![0.0; nobs * samples];
     let mut forces = vec![0.0; m * samples];
+    // Friction forces and slip velocities `g_t . v` of the current period.
+    let nf = model.friction_count();
+    let mut friction = vec![0.0; 2 * nf * samples];
     let mut start = vec![0.0; 2 * n];
     let mut previous_start = vec![0.0; 2 * n];
-    let record = |marcher: &TimeMarcher, s: usize, series: &mut [f64], forces: &mut [f64]| {
+    let record = |marcher: &TimeMarcher,
+                  s: usize,
+                  series: &mut [f64],
+                  (forces, friction): (&mut [f64], &mut [f64])| {
         for (o, &dof) in observed_dofs.iter().enumerate() {
             series[s * nobs + o] = marcher.displacement()[dof];
         }
         forces[s * m..(s + 1) * m].copy_from_slice(marcher.contact_force());
+        let (force, velocity) = friction[2 * nf * s..2 * nf * (s + 1)].split_at_mut(nf);
+        force.copy_from_slice(marcher.friction_force());
+        for (v, point) in velocity.iter_mut().zip(&model.friction) {
+            *v = point.tangent.dot(marcher.velocity());
+        }
     };
     let mut change = f64::INFINITY;
     let h = marcher.step_size();
-    let build =
-        |marcher: &TimeMarcher, series: &[f64], forces: &[f64], periods: usize, change: f64| {
-            SteadyPeriod {
-                scheme: marcher.scheme(),
-                omega,
-                times: (0..samples).map(|s| s as f64 * h).collect(),
-                observed_dofs: observed_dofs.to_vec(),
-                displacements: (0..nobs)
-                    .map(|o| (0..samples).map(|s| series[s * nobs + o]).collect())
-                    .collect(),
-                contact_forces: (0..m)
-                    .map(|k| (0..samples).map(|s| forces[s * m + k]).collect())
-                    .collect(),
-                periods,
-                period_change: change,
-                counters: marcher.counters(),
-                final_state: marcher.state(),
-            }
+    let build = |marcher: &TimeMarcher,
+                 series: &[f64],
+                 (forces, friction): (&[f64], &[f64]),
+                 periods: usize,
+                 change: f64| {
+        let friction_series = |offset: usize| -> Vec<Vec<f64>> {
+            (0..nf)
+                .map(|f| {
+                    (0..samples)
+                        .map(|s| friction[2 * nf * s + offset + f])
+                        .collect()
+                })
+                .collect()
         };
+        SteadyPeriod {
+            scheme: marcher.scheme(),
+            omega,
+            times: (0..samples).map(|s| s as f64 * h).collect(),
+            observed_dofs: observed_dofs.to_vec(),
+            displacements: (0..nobs)
+                .map(|o| (0..samples).map(|s| series[s * nobs + o]).collect())
+                .collect(),
+            contact_forces: (0..m)
+                .map(|k| (0..samples).map(|s| forces[s * m + k]).collect())
+                .collect(),
+            friction_forces: friction_series(0),
+            slip_velocities: friction_series(nf),
+            periods,
+            period_change: change,
+            counters: marcher.counters(),
+            final_state: marcher.state(),
+        }
+    };
     for period in 1..=options.max_periods {
         for i in 0..n {
             start[i] = marcher.displacement()[i];
             start[n + i] = marcher.velocity()[i] / omega;
         }
-        record(&marcher, 0, &mut series, &mut forces);
+        record(&marcher, 0, &mut series, (&mut forces, &mut friction));
         for s in 1..=spp {
             marcher.step()?;
-            record(&marcher, s, &mut series, &mut forces);
+            record(&marcher, s, &mut series, (&mut forces, &mut friction));
         }
         if period > 1 {
             change = relative_change(&start, &previous_start)
                 .max(relative_change(&series, &previous_series));
             if change < options.tolerance {
-                return Ok(build(&marcher, &series, &forces, period, change));
+                return Ok(build(
+                    &marcher,
+                    &series,
+                    (&forces, &friction),
+                    period,
+                    change,
+                ));
             }
         }
         if period == options.max_periods {
@@ -567,7 +623,7 @@ pub fn march_from_state(
         last_period: Box::new(build(
             &marcher,
             &series,
-            &forces,
+            (&forces, &friction),
             options.max_periods,
             change,
         )),

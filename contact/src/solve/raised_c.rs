@@ -37,12 +37,15 @@ pub(super) fn ssn_hb_newton(
     model: &StructuralModel,
     omega: f64,
 ) -> Result<NewtonReport, RunError> {
-    let start = x.to_vec();
+    let may_raise = settings.c.is_none()
+        && problem.contacts() > 0
+        && settings.globalization == GlobalizationChoice::Auto;
+    // The start is kept only when a second run may need it (most solves converge).
+    let start = may_raise.then(|| x.to_vec());
     let first = newton_hb(problem, x, settings, model, (0.0, Some(SmoothingOf::new())))?;
-    let default_c = settings.c.is_none() && problem.contacts() > 0;
-    if first.converged() || !default_c || settings.globalization != GlobalizationChoice::Auto {
+    let Some(start) = start.filter(|_| !first.converged()) else {
         return Ok(first);
-    }
+    };
     let options = HbOptions {
         c: Some(RAISED_C_FACTOR * problem.c()),
         ..hb_options(settings)

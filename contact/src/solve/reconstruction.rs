@@ -1,6 +1,7 @@
 //! What the outputs reconstruct from a harmonic-balance solution, offered alike by both
 //! harmonic-balance problems.
 
+use crate::contacts::FrictionReport;
 use crate::hb::{HbError, PenaltyHb, SsnHb};
 
 /// Reconstruction a harmonic-balance problem offers for the outputs.
@@ -11,6 +12,8 @@ pub(crate) trait HbReconstruction {
     fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError>;
     /// `g_i . u` of row `i` of `G`.
     fn row_displacement(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// Friction point `f` over one period on `points` times.
+    fn friction(&self, x: &[f64], f: usize, points: usize) -> Result<FrictionReport, HbError>;
 }
 
 /// Both harmonic-balance problems reconstruct through the same inherent methods.
@@ -38,6 +41,14 @@ macro_rules! hb_reconstruction {
                 points: usize,
             ) -> Result<Vec<f64>, HbError> {
                 self.row_displacement_samples(x, i, points)
+            }
+            fn friction(
+                &self,
+                x: &[f64],
+                f: usize,
+                points: usize,
+            ) -> Result<FrictionReport, HbError> {
+                self.friction_report(x, f, points)
             }
         }
     )*};

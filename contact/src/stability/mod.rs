@@ -27,16 +27,31 @@
 //!
 //! # What the verdict means with a contact dof that carries mass
 //!
-//! Harmonic balance imposes no impact law: its contact holds in the Galerkin sense, and a
-//! closed interval of positive length after an arrival with nonzero speed is what a
-//! perfectly inelastic impact (restitution 0) produces. The verdict is the stability of
-//! the harmonic-balance orbit under that law: the saltation at each closing is that of an
-//! impact with restitution 0 that keeps the dof on the obstacle until the contact force
-//! returns to zero. Time marching with the Moreau–Jean scheme and restitution 0 marches
-//! the same law; from the orbit plus a small perturbation its period-to-period change
-//! decays or grows at the rate of the largest multiplier (`ssn/tests/stability.rs`).
-//! With a restitution above 0 time marching bounces where harmonic balance rests, and the
-//! two describe different dynamics.
+//! Harmonic balance imposes no impact law: its contact holds in the Galerkin sense, and
+//! the orbit's closed interval after an arrival with nonzero speed spans a couple of
+//! periods of the highest harmonic whatever happens physically. What the orbit does at the
+//! end of the interval tells which law it follows, and the monodromy uses that law:
+//!
+//! - The orbit stays on the obstacle and leaves it slower than it came (a release speed
+//!   at most [`REBOUND`] times the approach speed; the rod with consistent mass, whose tip
+//!   the rod behind it keeps pressed): a perfectly inelastic impact (restitution 0) that keeps the
+//!   dof on the obstacle until the contact force returns to zero. Its saltation at the
+//!   closing depends on the model only (module `phases`), and the interval is a phase with
+//!   the dof held. Moreau–Jean marching with restitution 0 marches the same law
+//!   (`contact/tests/stability_impacts.rs`).
+//! - The orbit rebounds (a release speed above [`REBOUND`] times the approach speed; the
+//!   two-dof chain with a stop on its mass, 0.97 to 1.0 at `H = 40`; an orbit grazing the
+//!   stop): an impact with the orbit's restitution
+//!   `e = min(1, release / approach)` at the interval's midpoint, followed by free flight.
+//!   Its saltation `S = DR + (f+ - DR f-) n^T / (n^T f-)` (Müller 1995) carries the term
+//!   `(1 + e) w a_c / v_c` (free acceleration over approach speed of the contact dof), which
+//!   grows without bound towards grazing: the impacting orbits near a grazing contact are
+//!   unstable, as the fixed-point index requires between a fold and a grazing point.
+//!   Moreau–Jean marching with restitution 1 confirms the verdicts
+//!   (`contact/tests/chain_stability.rs`).
+//!
+//! With a restitution between 0 and 1 time marching bounces where the orbit rests, or rests
+//! where it bounces, and the two describe different dynamics.
 //!
 //! With every contact on a massless dof (modified mass) no impact law is needed: the
 //! verdict is that of the semi-discrete model, and
@@ -49,10 +64,11 @@
 //! The switching instants are those of the truncated series, so the multipliers carry the
 //! harmonic-balance error; a multiplier through `+1` therefore crosses within that error of
 //! the branch's fold, not exactly at it. Along a branch ([`crate::sweep::branch`]) the
-//! number of real multipliers above `+1` changes parity at each reversal of the frequency
-//! (the sign of the determinant of the harmonic-balance Jacobian, which the continuation's
-//! orientation follows, is that of `prod (1 - mu)` over the real multipliers), and the
-//! branch analysis uses this to place the crossing at the fold.
+//! number of real multipliers above `+1` changes parity at each fold (the sign of the
+//! determinant of the harmonic-balance Jacobian, which the continuation's orientation
+//! follows, is that of `prod (1 - mu)` over the real multipliers), and the branch analysis
+//! uses this to place the crossing at the fold. The zigzags of a truncated balance
+//! (reversals within the fold excursion) are not counted.
 
 mod phases;
 mod shooting;
@@ -83,6 +99,15 @@ pub const MAX_WORK: f64 = 4e9;
 
 /// A multiplier whose modulus is within this of 1 decides nothing (an undamped model).
 pub const MARGINAL: f64 = 1e-9;
+
+/// A closed interval of a contact on a dof with mass is an impact with rebound when the
+/// orbit leaves the obstacle at more than this fraction of its approach speed (module
+/// documentation). Measured: 0.97 to 1.0 on the two-dof chain with a stop on its mass
+/// (`H = 40`); on the rod with consistent mass, whose tip the rod behind it keeps pressed,
+/// -0.07 to 0.33 at `H = 20` and 0.55 to 0.87 at `H = 5` except within 5e-3 `omega_1` of
+/// its first contact (0.93 to 1.0: the orbit grazes the stop and leaves it at once, as
+/// Moreau–Jean marching with restitution 0 does there, and is unstable).
+pub const REBOUND: f64 = 0.9;
 
 /// Options of [`map_stability`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -297,6 +322,9 @@ enum Formulation {
 /// along a branch (the phases met are decomposed once).
 pub struct HbStability {
     formulation: Formulation,
+    /// The model (the orbit's state at the impacts).
+    model: StructuralModel,
+    harmonics: usize,
     phases: Option<PhaseModel>,
     /// Why nothing is decided (too many dofs).
     refused: Option<Undecided>,
@@ -352,6 +380,8 @@ impl HbStability {
         };
         Ok(Self {
             formulation,
+            model: model.clone(),
+            harmonics: settings.harmonics,
             phases,
             refused,
         })
@@ -382,13 +412,73 @@ impl HbStability {
                 allowed: "a finite angular frequency > 0",
             });
         }
-        let intervals = self.closed_intervals(x)?;
+        let mut intervals = self.closed_intervals(x)?;
         if let Some(reason) = &self.refused {
             return Ok(Stability::not_decided(reason.clone()));
         }
+        let rebounds = match self.formulation {
+            Formulation::Ssn(_) => self.rebounds(omega, x, &mut intervals)?,
+            Formulation::Penalty(_) => Vec::new(),
+        };
         let phases = self.phases.as_mut().expect("built when not refused");
         let period = 2.0 * std::f64::consts::PI / omega;
-        switched_stability(phases, period, &intervals)
+        switched_stability(phases, period, &intervals, &rebounds)
+    }
+
+    /// The closed intervals of contacts on dofs with mass that the orbit `x` leaves at
+    /// more than [`REBOUND`] times its approach speed, removed from `intervals` and
+    /// returned as impacts with the orbit's restitution at their midpoints.
+    fn rebounds(
+        &self,
+        omega: f64,
+        x: &[f64],
+        intervals: &mut [Vec<(f64, f64)>],
+    ) -> Result<Vec<Rebound>, StabilityError> {
+        let Some(phases) = self.phases.as_ref() else {
+            return Ok(Vec::new());
+        };
+        if phases.first_order_massless() {
+            return Ok(Vec::new());
+        }
+        let (model, h) = (&self.model, self.harmonics);
+        let u = &x[..model.dofs() * (2 * h + 1)];
+        let period = 2.0 * std::f64::consts::PI / omega;
+        let mut rebounds = Vec::new();
+        for (contact, closed) in intervals.iter_mut().enumerate() {
+            if !phases.impacts(contact) {
+                continue;
+            }
+            let point = &model.contacts[contact];
+            let (dof, sign) = (point.dof(), point.row.coefficients()[0]);
+            let mut kept = Vec::with_capacity(closed.len());
+            for &(a, b) in closed.iter() {
+                if b - a >= 1.0 {
+                    kept.push((a, b));
+                    continue;
+                }
+                let arrival = hb_state(model, h, omega, u, a * period)?;
+                let departure = hb_state(model, h, omega, u, b * period)?;
+                let approach = sign * arrival.velocity[dof];
+                let leave = -sign * departure.velocity[dof];
+                if !(approach > 0.0 && leave > REBOUND * approach) {
+                    kept.push((a, b));
+                    continue;
+                }
+                let time = (0.5 * (a + b)).rem_euclid(1.0);
+                let mut at = hb_state(model, h, omega, u, time * period)?;
+                at.displacement[dof] = sign * point.gap;
+                rebounds.push(Rebound {
+                    time,
+                    contact,
+                    restitution: (leave / approach).min(1.0),
+                    displacement: at.displacement,
+                    velocity: arrival.velocity,
+                    load_phase: (2.0 * std::f64::consts::PI * time).cos(),
+                });
+            }
+            *closed = kept;
+        }
+        Ok(rebounds)
     }
 }
 
@@ -401,6 +491,19 @@ pub fn hb_stability(
     x: &[f64],
 ) -> Result<Stability, StabilityError> {
     HbStability::new(model, settings)?.of(omega, x)
+}
+
+/// An impact with rebound of a contact on a dof with mass: the orbit's closed interval
+/// collapsed to its midpoint `time` (fraction of the period), with the orbit's restitution
+/// and its state just before.
+struct Rebound {
+    time: f64,
+    contact: usize,
+    restitution: f64,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+    /// `cos(omega t)` at the impact.
+    load_phase: f64,
 }
 
 /// Whether contact phase intervals `intervals` hold the fraction `t` of the period.
@@ -423,6 +526,7 @@ fn switched_stability(
     phases: &mut PhaseModel,
     period: f64,
     intervals: &[Vec<(f64, f64)>],
+    rebounds: &[Rebound],
 ) -> Result<Stability, StabilityError> {
     let mut times: Vec<f64> = intervals
         .iter()
@@ -431,6 +535,7 @@ fn switched_stability(
                 .filter(|(a, b)| b - a < 1.0)
                 .flat_map(|&(a, b)| [a.rem_euclid(1.0), b.rem_euclid(1.0)])
         })
+        .chain(rebounds.iter().map(|r| r.time))
         .collect();
     times.sort_by(f64::total_cmp);
     times.dedup();
@@ -477,7 +582,7 @@ fn switched_stability(
             work,
         }));
     }
-    match monodromy_of_phases(phases, period, &times, &sets) {
+    match monodromy_of_phases(phases, period, &times, &sets, rebounds) {
         Ok((monodromy, closings)) => {
             let multipliers = Multipliers::of(monodromy.as_ref())?;
             Ok(Stability::of(multipliers, k, closings))
@@ -486,14 +591,15 @@ fn switched_stability(
     }
 }
 
-/// The product of the phase propagators and the closing saltations over one period,
-/// starting after the switch at `times[0]`, on the coordinates of phase `sets[0]`; and the
-/// number of closings.
+/// The product of the phase propagators and the closing and rebound saltations over one
+/// period, starting after the switch at `times[0]`, on the coordinates of phase `sets[0]`;
+/// and the number of closings and rebounds.
 fn monodromy_of_phases(
     phases: &mut PhaseModel,
     period: f64,
     times: &[f64],
     sets: &[Vec<usize>],
+    rebounds: &[Rebound],
 ) -> Result<(semismooth::faer::Mat<f64>, usize), PhaseError> {
     let k = times.len();
     let d0 = phases.phase(&sets[0])?.dim();
@@ -507,6 +613,16 @@ fn monodromy_of_phases(
         };
         let tau = (end - times[j]) * period;
         y = &phases.phase(&sets[j])?.propagator(tau) * &y;
+        let switch = times[(j + 1) % k];
+        for r in rebounds.iter().filter(|r| r.time == switch) {
+            let state = (r.displacement.as_slice(), r.velocity.as_slice());
+            if let Some(s) =
+                phases.rebound(&sets[j], r.contact, r.restitution, state, r.load_phase)?
+            {
+                y = &s * &y;
+                closings += 1;
+            }
+        }
         let next = &sets[(j + 1) % k];
         let mut pre = sets[j].clone();
         for &c in next.iter().filter(|c| !sets[j].contains(c)) {

@@ -41,6 +41,11 @@
 //! - Massless dof following statically: nothing jumps (the vector field of the others is
 //!   continuous); the held dof is simply not a state of the next phase.
 //!
+//! An orbit that rebounds ([`PhaseModel::rebound`]): an impact with restitution `e`
+//! followed by free flight, `v+ = P_e v-`, `P_e = I - (1 + e) w e_c^T`; the vector field
+//! after it is the free one, so the saltation keeps the term `(1 + e) w a_c / v_c` of the
+//! contact dof's free acceleration `a_c` over its approach speed `v_c`.
+//!
 //! At an opening the force returns to zero continuously: nothing jumps, the released dof
 //! enters the next phase with `dq = dv = 0`. A penalty law has a continuous vector field:
 //! no saltation at all.
@@ -104,6 +109,8 @@ pub(crate) struct PhaseModel {
     /// massless row) rather than statically.
     first_order_massless: bool,
     contact_dofs: Vec<usize>,
+    /// The load's spatial shape (`f(t) = load cos(omega t)`).
+    load: Vec<f64>,
     closed: ClosedContact,
     phases: HashMap<Vec<usize>, Phase>,
 }
@@ -199,6 +206,7 @@ impl PhaseModel {
             massless,
             first_order_massless,
             contact_dofs: model.contacts.iter().map(|c| c.dof()).collect(),
+            load: model.load.clone(),
             closed,
             phases: HashMap::new(),
         }
@@ -228,6 +236,70 @@ impl PhaseModel {
     /// Whether the phase with the contacts `closed` closed is built.
     pub(crate) fn has_phase(&self, closed: &[usize]) -> bool {
         self.phases.contains_key(closed)
+    }
+
+    /// Whether contact `contact` holds a dof with mass (the closings of such a contact are
+    /// impacts).
+    pub(crate) fn impacts(&self, contact: usize) -> bool {
+        self.closed == ClosedContact::Held && !self.massless[self.contact_dofs[contact]]
+    }
+
+    /// The saltation (on the coordinates of the phase `pre`) of an impact of contact
+    /// `contact` with restitution `e` followed by free flight, at the orbit's state
+    /// `(q, v)` just before it with the load's phase `cos(omega t) = load_phase`:
+    /// `dq+ = dq - (1 + e) w dq_c`, `dv+ = P_e dv + (1 + e) (M^{-1} D_eff w + w a_c / v_c) dq_c`,
+    /// `P_e = I - (1 + e) w e_c^T` (module documentation). `None` when the dof is not a
+    /// massive dof of `pre` or `pre` has first-order massless dofs.
+    pub(crate) fn rebound(
+        &mut self,
+        pre: &[usize],
+        contact: usize,
+        restitution: f64,
+        (q, v): (&[f64], &[f64]),
+        load_phase: f64,
+    ) -> Result<Option<Mat<f64>>, PhaseError> {
+        let dof = self.contact_dofs[contact];
+        let n = self.n;
+        // Free acceleration of the massive dofs: M_aa a = f_a - (K q)_a - (D v)_a.
+        let force: Vec<f64> = (0..n)
+            .map(|i| {
+                let mut f = self.load[i] * load_phase;
+                for j in 0..n {
+                    f -= self.stiffness[(i, j)] * q[j];
+                    if let Some(d) = &self.damping {
+                        f -= d[(i, j)] * v[j];
+                    }
+                }
+                f
+            })
+            .collect();
+        let zero = Mat::zeros(0, 0);
+        let damping = self.damping.clone().unwrap_or(zero);
+        let phase = self.phase(pre)?;
+        let Some(ic) = phase.massive.iter().position(|&j| j == dof) else {
+            return Ok(None);
+        };
+        let (na, nb) = (phase.massive.len(), phase.first_order.len());
+        if nb > 0 || v[dof] == 0.0 {
+            return Ok(None);
+        }
+        let rhs = Mat::from_fn(na, 1, |i, _| force[phase.massive[i]]);
+        let acceleration = solve(&phase.mass_aa, &rhs, "mass")?;
+        let ratio = acceleration[(ic, 0)] / v[dof];
+        let ImpulseResponse { w, v_kick, .. } = impulse_response(phase, &damping, ic)?;
+        let gain = 1.0 + restitution;
+        let mut s = Mat::<f64>::identity(2 * na, 2 * na);
+        for i in 0..na {
+            s[(i, ic)] -= gain * w[(i, 0)];
+            s[(na + i, na + ic)] -= gain * w[(i, 0)];
+            s[(na + i, ic)] += gain * (v_kick[(i, 0)] + w[(i, 0)] * ratio);
+        }
+        Ok(Some(s))
+    }
+
+    /// Whether the massless dofs follow by first-order dynamics.
+    pub(crate) fn first_order_massless(&self) -> bool {
+        self.first_order_massless
     }
 
     /// Number of dofs.
@@ -387,25 +459,7 @@ impl PhaseModel {
         };
         if closed == ClosedContact::Held {
             if let Some(ic) = phase.massive.iter().position(|&j| j == dof) {
-                let a = phase.massive.clone();
-                let b = phase.first_order.clone();
-                let unit = Mat::from_fn(na, 1, |i, _| if i == ic { 1.0 } else { 0.0 });
-                let z = solve(&phase.mass_aa, &unit, "mass")?;
-                let w = Mat::from_fn(na, 1, |i, _| z[(i, 0)] / z[(ic, 0)]);
-                // D_eff w, with D_eff = D_aa - D_ab D_bb^{-1} D_ba (first-order massless
-                // dofs) or D_aa + D_au Q (static ones, q_u = Q q_a).
-                let mut d_eff_w = &damp(&a, &a) * &w;
-                let mut qb_jump = Mat::zeros(nb, 1);
-                if nb == 0 && !phase.statics_dofs.is_empty() {
-                    let u = phase.statics_dofs.clone();
-                    d_eff_w += &damp(&a, &u) * (&phase.statics * &w);
-                }
-                if nb > 0 {
-                    let d_ba_w = &damp(&b, &a) * &w;
-                    qb_jump = solve(&damp(&b, &b), &d_ba_w, "damping (massless dofs)")?;
-                    d_eff_w -= &damp(&a, &b) * &qb_jump;
-                }
-                let v_kick = solve(&phase.mass_aa, &d_eff_w, "mass")?;
+                let ImpulseResponse { w, v_kick, qb_jump } = impulse_response(phase, damping, ic)?;
                 // dq_a -= w dq_c.
                 for i in 0..na {
                     s[(i, ic)] -= w[(i, 0)];
@@ -455,6 +509,51 @@ impl PhaseModel {
         phase.closings.insert(contact, s.clone());
         Ok(s)
     }
+}
+
+/// What an impulse on the massive dof `massive[ic]` of a phase changes (columns).
+struct ImpulseResponse {
+    /// `w = M_aa^{-1} e_c / (M_aa^{-1})_cc`: the velocity change per unit change of the
+    /// contact dof's velocity.
+    w: Mat<f64>,
+    /// `M_aa^{-1} D_eff w`: the acceleration change per unit velocity change along `w`.
+    v_kick: Mat<f64>,
+    /// `D_bb^{-1} D_ba w`: the jump of the first-order massless dofs.
+    qb_jump: Mat<f64>,
+}
+
+/// The [`ImpulseResponse`] of the massive dof `massive[ic]` of `phase`.
+fn impulse_response(
+    phase: &Phase,
+    damping: &Mat<f64>,
+    ic: usize,
+) -> Result<ImpulseResponse, PhaseError> {
+    let (na, nb) = (phase.massive.len(), phase.first_order.len());
+    let damp = |rows: &[usize], cols: &[usize]| {
+        if damping.nrows() == 0 {
+            Mat::zeros(rows.len(), cols.len())
+        } else {
+            block(damping, rows, cols)
+        }
+    };
+    let (a, b) = (&phase.massive, &phase.first_order);
+    let unit = Mat::from_fn(na, 1, |i, _| if i == ic { 1.0 } else { 0.0 });
+    let z = solve(&phase.mass_aa, &unit, "mass")?;
+    let w = Mat::from_fn(na, 1, |i, _| z[(i, 0)] / z[(ic, 0)]);
+    // D_eff w, with D_eff = D_aa - D_ab D_bb^{-1} D_ba (first-order massless dofs) or
+    // D_aa + D_au Q (static ones, q_u = Q q_a).
+    let mut d_eff_w = &damp(a, a) * &w;
+    let mut qb_jump = Mat::zeros(nb, 1);
+    if nb == 0 && !phase.statics_dofs.is_empty() {
+        d_eff_w += &damp(a, &phase.statics_dofs) * (&phase.statics * &w);
+    }
+    if nb > 0 {
+        let d_ba_w = &damp(b, a) * &w;
+        qb_jump = solve(&damp(b, b), &d_ba_w, "damping (massless dofs)")?;
+        d_eff_w -= &damp(a, b) * &qb_jump;
+    }
+    let v_kick = solve(&phase.mass_aa, &d_eff_w, "mass")?;
+    Ok(ImpulseResponse { w, v_kick, qb_jump })
 }
 
 impl Exponential {

@@ -234,7 +234,7 @@ pub fn map_stability(
     };
     let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
     let options = PolyalgorithmOptions {
-        absolute_tolerance: SHOOTING_TOLERANCE * scale,
+        tolerances: semismooth::newton::Tolerances::absolute(SHOOTING_TOLERANCE * scale),
         max_iterations: 50,
         ..PolyalgorithmOptions::default()
     };

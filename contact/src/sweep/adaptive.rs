@@ -3,13 +3,18 @@
 //!
 //! # The estimate of a point
 //!
-//! Each point of the branch, solved with `H` harmonics, is solved again at `H/2` (Newton
-//! from its truncated coefficients, a few iterations of a problem half the size), and the
-//! change `d` of the observed dof's extremes, relative to the point's largest excursion
-//! `max(|u_max|, |u_min|)`, gives Richardson's estimate of the error at `H`,
-//! `e = d / (2^p - 1)` with the harmonic-balance order `p` = [`HB_ORDER`] (module
-//! [`crate::solve::accuracy`]; `e = 1.47 d`). Validated against solves at `H = 320` at
-//! every point of the paper's rod (`ssn/examples/adaptive_sweep.rs`, docs/sweeps.md).
+//! Each point of the branch, solved with `H` harmonics, is taken up at `H/2` (its
+//! truncated coefficients corrected on the hyperplane through the point normal to the
+//! branch's direction there, [`Continuation::resume`]; at the point's frequency by
+//! globalized Newton when that fails), and the distance `d` between the two
+//! ([`point_distance`]: the change of the observed dof's extremes relative to its largest
+//! excursion, or of the frequency, whichever is larger) gives Richardson's estimate of the
+//! error at `H`, `e = d / (2^p - 1)` with the harmonic-balance order `p` = [`HB_ORDER`]
+//! (module [`crate::solve::accuracy`]; `e = 1.47 d`). Across the branch rather than at a
+//! fixed frequency, the distance stays defined near a fold, where the two
+//! discretisations' branches turn at different frequencies. Validated against the branch
+//! at `H = 320` taken up the same way at every point of the paper's rod
+//! (`ssn/examples/adaptive_sweep.rs`, docs/sweeps.md).
 //!
 //! # The harmonics of the next points
 //!
@@ -31,10 +36,12 @@
 //! run's [`Resumption`] (last point, predictor direction, step, fold detector), lifts or
 //! truncates the state and the direction's state part to the new harmonics
 //! ([`resize_harmonics`]; the step scaling of the sweep makes the θ-norm independent of
-//! `H`), and [`Continuation::resume`]s with the problem at the new harmonics. Folds and
-//! zigzags are thus detected across the changes. A resumed start that cannot be
-//! corrected (the new harmonics' branch is not near the lifted point) falls back to the
-//! old harmonics at that point.
+//! `H`), and [`Continuation::resume`]s with the problem at the new harmonics, which
+//! corrects the point across the branch (so a point near a fold is not carried to
+//! another solution at its frequency). Folds and zigzags are thus detected across the
+//! changes. A resumed start that the corrector's full steps cannot take up is solved
+//! once by globalized Newton at its frequency and taken up from there; failing that,
+//! the branch goes on at the old harmonics from that point.
 //!
 //! The branch starts at [`HARMONICS_LADDER`]`[0]` harmonics (the scene's `harmonics` is
 //! ignored with a target), each point's harmonics and estimate are in
@@ -42,7 +49,9 @@
 
 use std::time::Instant;
 
-use semismooth::continuation::{Continuation, ContinuationCounters, ContinuationEvent, Resumption};
+use semismooth::continuation::{
+    Continuation, ContinuationCounters, ContinuationEvent, FoldDetector, Resumption,
+};
 use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, ParameterDependent, Residual};
 
@@ -149,20 +158,43 @@ type HalfProblem = (usize, SsnHb, HbTip, Box<dyn Factorize<HbJacobian>>);
 struct Estimator<'a> {
     rod: &'a Structure,
     settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    u_ref: f64,
     problems: Vec<HalfProblem>,
     seconds: f64,
     counters: RunCounters,
 }
 
+/// The relative distance of a branch point `(max, min, ω)` (the observed dof's extremes
+/// and the frequency) from another solution of the same branch `reference`: the larger of
+/// the extremes' change over the reference's largest excursion and the frequency's change
+/// over its frequency. Measured between points of one hyperplane across the branch, it is
+/// the distance between two discretisations' branches, defined at a fold as elsewhere.
+pub fn point_distance((max, min, omega): (f64, f64, f64), reference: (f64, f64, f64)) -> f64 {
+    let (ref_max, ref_min, ref_omega) = reference;
+    let excursion = ref_max.abs().max(ref_min.abs());
+    let change = (max - ref_max).abs().max((min - ref_min).abs());
+    let displacement = if change == 0.0 {
+        0.0
+    } else if excursion > 0.0 {
+        change / excursion
+    } else {
+        f64::INFINITY
+    };
+    displacement.max((omega - ref_omega).abs() / ref_omega.abs())
+}
+
 impl Estimator<'_> {
     /// The estimated relative error of the point `x` at `h` harmonics and `omega`, whose
-    /// observed dof has the extremes `(max, min)` (module documentation).
+    /// observed dof has the extremes `(max, min)` and whose branch goes on along
+    /// `direction` (module documentation).
     fn estimate(
         &mut self,
         omega: f64,
         h: usize,
         x: &[f64],
         (max, min): (f64, f64),
+        direction: Option<&[f64]>,
     ) -> Result<Option<f64>, RunError> {
         let half = h / 2;
         if half == 0 {
@@ -170,37 +202,133 @@ impl Estimator<'_> {
         }
         let started = Instant::now();
         let model = &self.rod.model;
+        let dofs = model.dofs();
         let settings = at_harmonics(self.settings, half);
         let slot = match self.problems.iter().position(|(k, ..)| *k == half) {
             Some(slot) => slot,
             None => {
                 let problem = SsnHb::new(model, omega, &hb_options(&settings))?;
-                let tip = HbTip::new(half, output_points(h), model.dofs(), self.rod.observed_dof)?;
+                let tip = HbTip::new(half, output_points(h), dofs, self.rod.observed_dof)?;
                 let solver = hb_solver(settings.linear_solver);
                 self.problems.push((half, problem, tip, solver));
                 self.problems.len() - 1
             }
         };
         let (_, problem, tip, solver) = &mut self.problems[slot];
-        problem.set_parameter(omega);
-        let mut y = resize_harmonics(x, h, half, model.dofs(), problem.contacts());
-        let report = newton_at(&settings, model, problem, &mut **solver, &mut y)?;
-        self.counters = self.counters + RunCounters::from(report.counters);
+        let (found, work) = take_up_with(
+            (self.rod, &settings, self.sweep, self.u_ref),
+            problem,
+            &mut **solver,
+            (x, omega, h),
+            direction,
+        )?;
+        self.counters = self.counters + work;
         self.seconds += started.elapsed().as_secs_f64();
-        if !report.converged() {
+        let Some((y, coarse_omega)) = found else {
             return Ok(None);
-        }
+        };
         let (coarse_max, coarse_min) = tip.extremes(&y)?;
-        let excursion = max.abs().max(min.abs());
-        let change = (max - coarse_max).abs().max((min - coarse_min).abs());
-        if change == 0.0 {
-            return Ok(Some(0.0));
-        }
-        if excursion == 0.0 {
-            return Ok(Some(f64::INFINITY));
-        }
-        Ok(Some(change / excursion / (2f64.powf(HB_ORDER) - 1.0)))
+        let distance = point_distance((coarse_max, coarse_min, coarse_omega), (max, min, omega));
+        Ok(Some(distance / (2f64.powf(HB_ORDER) - 1.0)))
     }
+}
+
+/// A branch point taken up on other harmonics: its state and frequency.
+pub type BranchPointAt = (Vec<f64>, f64);
+
+/// The point `x` (at `h` harmonics) and `omega` of an SSN-HB branch taken up on
+/// `problem` (the same model at other harmonics, `settings`): corrected on the hyperplane
+/// through the point normal to `direction` (its state part at `h` harmonics, then the
+/// frequency component), else at `omega` by globalized Newton. The state on `problem`'s
+/// harmonics and its frequency (`None` when neither converged), and the work.
+fn take_up_with(
+    (rod, settings, sweep, u_ref): (&Structure, &SolverSettings, &SweepSettings, f64),
+    problem: &mut SsnHb,
+    solver: &mut dyn Factorize<HbJacobian>,
+    (x, omega, h): (&[f64], f64, usize),
+    direction: Option<&[f64]>,
+) -> Result<(Option<BranchPointAt>, RunCounters), RunError> {
+    let model = &rod.model;
+    let (dofs, contacts) = (model.dofs(), model.contact_count());
+    let to = settings.harmonics;
+    let mut y = resize_harmonics(x, h, to, dofs, contacts);
+    let mut counters = RunCounters::default();
+    if let Some(direction) = direction {
+        let n = x.len();
+        let mut carried = resize_harmonics(&direction[..n], h, to, dofs, contacts);
+        carried.push(direction[n]);
+        let method = ssn_continuation(model, problem, u_ref);
+        let options = continuation_options(settings, sweep, rod.omega_1, dofs, u_ref, &method)?;
+        let resumption = Resumption {
+            state: y.clone(),
+            parameter: omega,
+            direction: carried,
+            step: options.initial_step,
+            folds: FoldDetector::new(false),
+            points: 0,
+        };
+        let mut run = Continuation::resume(problem, solver, resumption, options)
+            .map_err(continuation_error)?;
+        let first = run.next();
+        let run_counters = run.counters();
+        drop(run);
+        let mut work = run_counters.work;
+        work.factorizations += run_counters.dense_bordered_factorizations;
+        counters = counters + RunCounters::from(work);
+        if let Some(point) = first {
+            return Ok((Some((point.state, point.parameter)), counters));
+        }
+    }
+    problem.set_parameter(omega);
+    let report = newton_at(settings, model, problem, solver, &mut y)?;
+    counters = counters + RunCounters::from(report.counters);
+    Ok((report.converged().then_some((y, omega)), counters))
+}
+
+/// The point `x` (at `h` harmonics) and `omega` of the SSN-HB branch of `rod` swept with
+/// `settings` over `sweep`, taken up at `to` harmonics across the branch (normal to
+/// `direction`, a tangent or secant at the point: state part at `h` harmonics, then the
+/// frequency component) or, failing that, at its frequency: the state at `to` harmonics
+/// and its frequency, `None` when neither converged. The reference of a point's error
+/// that follows the same solution through a fold.
+pub fn take_up(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    (x, omega, h): (&[f64], f64, usize),
+    direction: &[f64],
+    to: usize,
+) -> Result<Option<BranchPointAt>, RunError> {
+    let at = at_harmonics(settings, to);
+    let mut problem = SsnHb::new(&rod.model, omega, &hb_options(&at))?;
+    let mut solver = hb_solver(at.linear_solver);
+    let u_ref = reference_amplitude(rod);
+    let (found, _) = take_up_with(
+        (rod, &at, sweep, u_ref),
+        &mut problem,
+        &mut *solver,
+        (x, omega, h),
+        Some(direction),
+    )?;
+    Ok(found)
+}
+
+/// The secant of `response` at its point `i` (from the point before to the point after,
+/// one side at the ends), both carried to point `i`'s harmonics when they differ: the
+/// state part, then the frequency component. Panics if `i` is not a point of `response`.
+pub fn secant(response: &FrequencyResponse, i: usize, dofs: usize, contacts: usize) -> Vec<f64> {
+    let last = response.points() - 1;
+    let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
+    let at = |j: usize| match (response.harmonics.get(j), response.harmonics.get(i)) {
+        (Some(&from), Some(&to)) if from != to => {
+            resize_harmonics(&response.states[j], from, to, dofs, contacts)
+        }
+        _ => response.states[j].clone(),
+    };
+    let (xa, xb) = (at(a), at(b));
+    let mut d: Vec<f64> = xb.iter().zip(&xa).map(|(u, v)| u - v).collect();
+    d.push(response.omega[b] - response.omega[a]);
+    d
 }
 
 /// Globalized Newton on `problem` from `x` with the scene's options, the tolerance raised
@@ -331,6 +459,8 @@ pub(crate) fn adaptive_branch(
     let mut estimator = Estimator {
         rod,
         settings,
+        sweep,
+        u_ref,
         problems: Vec::new(),
         seconds: 0.0,
         counters: RunCounters::default(),
@@ -343,6 +473,9 @@ pub(crate) fn adaptive_branch(
     // and the index of the point that may not be raised again.
     let mut fallback: Option<(usize, Resumption)> = None;
     let mut no_raise_at: Option<usize> = None;
+    // The start carried to new harmonics, until taken up there (a globalized solve at
+    // its frequency is tried once when the continuation's start fails).
+    let mut unsolved: Option<Resumption> = None;
     // Work of the solves at new harmonics.
     let mut switch_work = RunCounters::default();
     let termination = loop {
@@ -377,7 +510,9 @@ pub(crate) fn adaptive_branch(
             let omega = point.parameter;
             let (max, min) = tip.extremes(&point.state)?;
             let index = response.points();
-            let estimate = estimator.estimate(omega, h, &point.state, (max, min))?;
+            let here = run.resumption();
+            let direction = here.as_ref().map(|r| r.direction.as_slice());
+            let estimate = estimator.estimate(omega, h, &point.state, (max, min), direction)?;
             let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
             let raise =
                 estimate.is_some_and(|e| e > target) && h < limit && no_raise_at != Some(index);
@@ -424,6 +559,26 @@ pub(crate) fn adaptive_branch(
         events.extend(run.events().iter().cloned());
         let ended = run.termination().cloned();
         drop(run);
+        if let (None, true, 0) = (&switch, resumed, items) {
+            if let Some(mut retry) = unsolved.take() {
+                // Not taken up by the corrector's full steps (on the hyperplane across the
+                // branch, then at the point's frequency): the point at the new harmonics
+                // by globalized Newton at its frequency, then taken up from there.
+                problem.set_parameter(retry.parameter);
+                let report = newton_at(
+                    settings,
+                    model,
+                    &mut problem,
+                    &mut *solver,
+                    &mut retry.state,
+                )?;
+                switch_work = switch_work + RunCounters::from(report.counters);
+                if report.converged() {
+                    resumption = Some(retry);
+                    continue;
+                }
+            }
+        }
         let switch = match switch {
             Some(switch) => switch,
             None if resumed && items == 0 && first == First::Raised => {
@@ -465,39 +620,16 @@ pub(crate) fn adaptive_branch(
         let to = switch.to;
         let resumed_at = switch.resumption.parameter;
         let carried = carried(switch.resumption, switch.from, to, dofs, contacts);
-        let from = switch.from;
         h = to;
         problem = SsnHb::new(model, resumed_at, &hb_options(&at_harmonics(settings, h)))?;
-        let mut carried = carried;
         first = match switch.first {
             // The fallback's first item is the point itself at the old harmonics.
-            First::New => First::Raised,
+            First::New => {
+                unsolved = None;
+                First::Raised
+            }
             other => {
-                // The point at the new harmonics by globalized Newton from the carried one
-                // (the continuation's corrector takes full steps only).
-                let report = newton_at(
-                    settings,
-                    model,
-                    &mut problem,
-                    &mut *solver,
-                    &mut carried.state,
-                )?;
-                switch_work = switch_work + RunCounters::from(report.counters);
-                if !report.converged() {
-                    // Not found at the new harmonics: the branch goes on at the old ones.
-                    if other == First::Raised {
-                        accuracy.failed_raises += 1;
-                        no_raise_at = Some(response.points());
-                    }
-                    let back = fallback.take().map(|(_, r)| r);
-                    let Some(back) = back else {
-                        break ended;
-                    };
-                    h = from;
-                    problem =
-                        SsnHb::new(model, resumed_at, &hb_options(&at_harmonics(settings, h)))?;
-                    carried = back;
-                }
+                unsolved = Some(carried.clone());
                 other
             }
         };

@@ -19,7 +19,7 @@ use crate::contacts::ContactSummary;
 use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, RunError};
+use crate::solve::{hb_options, penalty_problem, RunError};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::FrequencyResponse;
 
@@ -89,11 +89,7 @@ impl Reconstruction {
     ) -> Result<Self, RunError> {
         Ok(match settings.method {
             Method::SsnHb => Self::Ssn(SsnHb::new(model, omega, &hb_options(settings))?),
-            Method::PenaltyHb => Self::Penalty(PenaltyHb::new(
-                model,
-                omega,
-                &penalty_options(settings, model),
-            )?),
+            Method::PenaltyHb => Self::Penalty(penalty_problem(model, omega, settings)?),
             other => {
                 return Err(RunError::Unsupported {
                     method: other.name(),
@@ -157,9 +153,9 @@ impl Reconstruction {
     }
 }
 
-/// Real multipliers within this distance of `+1` may be placed on the side of `+1` that
-/// the branch's fold count requires (module documentation); farther ones are left as
-/// computed. Near a fold the multiplier moves like the square root of the distance to it,
+/// Outside the folds of an overhang, a real multiplier above `+1` and within this distance
+/// of it is counted below `+1` where the branch's fold count requires; a farther one is
+/// left as computed (`fold_consistent_counts`). Near a fold the multiplier moves like the square root of the distance to it,
 /// so the harmonic-balance error of the switching instants moves it far: on the strongly
 /// forced modified-mass rod at `H = 20` the point `1.3e-3 omega_1` past the upper fold has
 /// its real multiplier at 0.88 (measured, `ssn/tests/stability.rs`).
@@ -223,17 +219,12 @@ pub fn branch_stability(
             report(i + 1);
         }
     }
-    let reversals: Vec<usize> = {
-        let mut r: Vec<usize> = response
-            .fold_indices
-            .iter()
-            .chain(&response.corner_fold_indices)
-            .copied()
-            .collect();
-        r.sort_unstable();
-        r
-    };
-    let outside = fold_consistent_counts(&analyses, &reversals);
+    // The folds only: a zigzag of the truncated balance (`corner_folds`) turns back and
+    // forth within the fold excursion, and counting its two reversals would flip the
+    // verdict of the points between them.
+    // They come in branch order, with their frequencies in `folds`.
+    let reversals = &response.fold_indices;
+    let outside = fold_consistent_counts(&analyses, reversals);
     for (s, counts) in analyses.iter().zip(&outside) {
         if s.stable.is_none() && out.undecided.is_none() {
             out.undecided.clone_from(&s.undecided);
@@ -252,9 +243,9 @@ pub fn branch_stability(
             let (before, _) = outside[j].expect("decided");
             if let Some(kind) = crossing_of(before, after) {
                 let (w0, w1) = (response.omega[j], response.omega[i]);
-                let omega = match reversals.iter().find(|&&r| j <= r && r <= i) {
+                let omega = match reversals.iter().position(|&r| j <= r && r <= i) {
                     // A fold of the branch between the two: the crossing is the fold.
-                    Some(&r) if kind == BifurcationKind::Fold => response.omega[r],
+                    Some(k) if kind == BifurcationKind::Fold => response.folds[k],
                     _ => {
                         let a0 = analyses[j].floquet_max_abs.unwrap_or(1.0);
                         let a1 = analyses[i].floquet_max_abs.unwrap_or(1.0);
@@ -278,11 +269,16 @@ pub fn branch_stability(
     Ok(out)
 }
 
-/// The counts of multipliers outside the unit circle of each decided point, with the real
-/// multiplier nearest `+1` placed on the side that the parity of the number of reversals
-/// of the branch before the point requires when it is within [`FOLD_BAND`] of `+1` (the
-/// flag says where that changed the count). The parity of the first segment is the one
-/// most points agree with. Points at a reversal keep their own counts.
+/// The counts of multipliers outside the unit circle of each decided point, with the
+/// parity of the real multipliers above `+1` that the number of folds of the branch
+/// before the point requires (the flag says where that changed the count): a point that
+/// needs one more (the middle branch of an overhang, a saddle between its folds, whatever
+/// the impact model's own multipliers say far from the fold) gets its real multiplier
+/// nearest `+1` counted above it, or one more when it has none; a point that needs one
+/// fewer gets its real multiplier nearest `+1` counted below it only within [`FOLD_BAND`]
+/// of `+1` (a multiplier far above `+1`, e.g. where the orbit grazes the stop, is an
+/// instability of its own). The parity of the first segment is the one most points agree
+/// with. Points at a reversal keep their own counts.
 fn fold_consistent_counts(
     analyses: &[Stability],
     reversals: &[usize],
@@ -307,13 +303,14 @@ fn fold_consistent_counts(
             if at_reversal(i) || counts.real_above_one % 2 == wanted {
                 return Some((counts, false));
             }
+            if counts.real_above_one % 2 != wanted && wanted == (offset + 1) % 2 {
+                // Between the folds of an overhang: one more above +1.
+                counts.real_above_one += 1;
+                return Some((counts, true));
+            }
             match s.multipliers.nearest_real_to_one() {
-                Some(mu) if (mu - 1.0).abs() <= FOLD_BAND => {
-                    if mu > 1.0 {
-                        counts.real_above_one -= 1;
-                    } else {
-                        counts.real_above_one += 1;
-                    }
+                Some(mu) if mu > 1.0 && mu - 1.0 <= FOLD_BAND => {
+                    counts.real_above_one -= 1;
                     Some((counts, true))
                 }
                 _ => Some((counts, false)),

@@ -7,23 +7,29 @@
 //! branch (`lcp-ssn`) has them at its `Nt` time nodes: the state is `(w, z)`, time-major,
 //! so contact `c` has displacement `u = g - w[n m + c]` and force `-z[n m + c]` at node `n`.
 
-use crate::contacts::{contact_reports, ContactReport};
-use crate::hb::{PenaltyHb, SsnHb};
+use crate::contacts::{contact_reports, ContactReport, FrictionSummary};
+use crate::hb::SsnHb;
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options, set_closed_fractions, HbReconstruction, RunError};
+use crate::solve::{hb_options, penalty_problem, set_closed_fractions, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
-/// The per-contact reports of each point of `response` (one list per point, the contacts
-/// in the scene's order). Methods that do not sweep give no points and no lists.
-pub(super) fn branch_contacts(
+/// Per-contact reports and friction summaries of every point of a branch, one list per
+/// point in the model's order of contacts and friction points.
+pub(super) type BranchReports = (Vec<Vec<ContactReport>>, Vec<Vec<FrictionSummary>>);
+
+/// The per-contact reports of each point of `response` and, for harmonic balance, the
+/// friction summaries (one list per point; none without friction points). Methods that do
+/// not sweep give no points and no lists.
+pub(super) fn branch_reports(
     rod: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
-) -> Result<Vec<Vec<ContactReport>>, RunError> {
+) -> Result<BranchReports, RunError> {
     let model = &rod.model;
     let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
+    let friction_points = model.friction.len();
     let points = response.output_points;
     let report = |problem: &dyn HbReconstruction, x: &[f64]| -> Result<_, RunError> {
         let forces = (0..contacts.len())
@@ -37,7 +43,10 @@ pub(super) fn branch_contacts(
             .collect::<Result<Vec<_>, _>>()?;
         let mut reports = contact_reports(&contacts, &forces, &displacements);
         set_closed_fractions(&mut reports, &closed);
-        Ok(reports)
+        let friction = (0..friction_points)
+            .map(|f| Ok(problem.friction(x, f, points)?.summary))
+            .collect::<Result<Vec<_>, RunError>>()?;
+        Ok((reports, friction))
     };
     // The reconstructions over one period do not depend on the frequency: any valid one,
     // with the point's harmonics (built again where they change along the branch).
@@ -45,12 +54,13 @@ pub(super) fn branch_contacts(
     let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
         Ok(match s.method {
             Method::SsnHb => Box::new(SsnHb::new(model, omega, &hb_options(s))?),
-            _ => Box::new(PenaltyHb::new(model, omega, &penalty_options(s, model))?),
+            _ => Box::new(penalty_problem(model, omega, s)?),
         })
     };
-    let hb = || -> Result<Vec<Vec<ContactReport>>, RunError> {
+    let hb = || -> Result<BranchReports, RunError> {
         let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
-        let mut out = Vec::with_capacity(response.points());
+        let mut reports = Vec::with_capacity(response.points());
+        let mut friction = Vec::new();
         for (i, x) in response.states.iter().enumerate() {
             let at = response.point_settings(settings, i);
             let key = (at.harmonics, at.time_samples);
@@ -58,21 +68,26 @@ pub(super) fn branch_contacts(
                 current = Some((key, build(&at)?));
             }
             let (_, problem) = current.as_ref().expect("built above");
-            out.push(report(problem.as_ref(), x)?);
+            let (point, point_friction) = report(problem.as_ref(), x)?;
+            reports.push(point);
+            if friction_points > 0 {
+                friction.push(point_friction);
+            }
         }
-        Ok(out)
+        Ok((reports, friction))
     };
     match settings.method {
         Method::SsnHb | Method::PenaltyHb => hb(),
         Method::LcpSsn => {
             let m = contacts.len();
-            Ok(response
+            let reports = response
                 .states
                 .iter()
                 .map(|y| lcp_point_contacts(&contacts, y, m))
-                .collect())
+                .collect();
+            Ok((reports, Vec::new()))
         }
-        Method::LcpLemke | Method::March => Ok(Vec::new()),
+        Method::LcpLemke | Method::March => Ok((Vec::new(), Vec::new())),
     }
 }
 

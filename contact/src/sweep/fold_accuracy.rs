@@ -7,7 +7,9 @@
 //! each fold of a branch, [`refine_folds`] takes the branch point some way before it
 //! ([`APPROACH`] `ω_1` in frequency, or the first point), carries its coefficients to `2H`
 //! harmonics and `2Nt` AFT samples ([`resize_harmonics`]), and follows the branch at `2H`
-//! from there with the core's continuation, with steps of at most [`SEGMENT_MAX_STEP`],
+//! from there (each further rung starts from the previous rung's corrected start, carried
+//! to its harmonics: the sweep's point lifted to many more harmonics is too far from the
+//! fine branch for the corrector) with the core's continuation, with steps of at most [`SEGMENT_MAX_STEP`],
 //! until it turns back at the fold (the core confirms a fold by a retreat of
 //! [`TURNING_POINT_EXCURSION`](super::TURNING_POINT_EXCURSION) `ω_1`, so that a corner's zigzag is not taken for it).
 //!
@@ -35,7 +37,7 @@ use super::{
     continuation_error, continuation_options, hb_solver, penalty_continuation, ssn_continuation,
     MethodContinuation,
 };
-use crate::hb::{resize_harmonics, PenaltyHb, SsnHb};
+use crate::hb::{resize_harmonics, SsnHb};
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::accuracy::{search::MAX_SEARCH_UNKNOWNS, HB_ORDER};
@@ -175,6 +177,11 @@ pub fn refine_folds(
             seconds: 0.0,
         }];
         let mut uncertainty = None;
+        // The start of the next rung: the branch point, then each rung's corrected start.
+        let mut from = (
+            response.states[start].clone(),
+            response.point_settings(settings, start).harmonics,
+        );
         let stop = loop {
             let last = rungs.last().expect("one rung at least");
             let (h, nt) = (2 * last.harmonics, 2 * last.time_samples);
@@ -193,16 +200,20 @@ pub fn refine_folds(
                 rod,
                 settings: &rung_settings,
                 sweep,
-                from: (
-                    response.omega[start],
-                    &response.states[start],
-                    response.point_settings(settings, start).harmonics,
-                ),
+                from: (response.omega[start], &from.0, from.1),
                 heading,
                 near: fold,
                 u_ref: response.reference_amplitude,
             };
-            let (found, points, seconds) = segment.fold()?;
+            let SegmentRun {
+                found,
+                points,
+                seconds,
+                corrected_start,
+            } = segment.fold()?;
+            if let Some(state) = corrected_start {
+                from = (state, h);
+            }
             let omega = match found {
                 Found::Fold(omega) => omega,
                 Found::StartFailed(termination) => {
@@ -255,6 +266,14 @@ enum Found {
     Nothing,
 }
 
+/// What a segment met, its points, its wall time and its start as corrected.
+struct SegmentRun {
+    found: Found,
+    points: usize,
+    seconds: f64,
+    corrected_start: Option<Vec<f64>>,
+}
+
 /// One refinement segment: from a branch point carried to the rung's harmonics, towards
 /// the fold near `near`.
 struct Segment<'a> {
@@ -272,8 +291,8 @@ struct Segment<'a> {
 }
 
 impl Segment<'_> {
-    /// What this segment meets, its points and its wall time.
-    fn fold(&self) -> Result<(Found, usize, f64), RunError> {
+    /// What this segment meets.
+    fn fold(&self) -> Result<SegmentRun, RunError> {
         let started = Instant::now();
         let model = &self.rod.model;
         let (omega, state, from_h) = self.from;
@@ -289,26 +308,38 @@ impl Segment<'_> {
             }
             _ => {
                 let options = penalty_options(self.settings, model);
-                let mut problem = PenaltyHb::new(model, omega, &options)?;
+                let mut problem = crate::solve::penalty_problem(model, omega, self.settings)?;
                 let x = resize_harmonics(state, from_h, h, dofs, 0);
                 let method = penalty_continuation(model, &problem, &options, self.u_ref);
+                let affine = method.affine_pieces;
                 self.follow((&mut problem, &mut *solver), &x, method, |c| {
-                    c.with_affine_pieces()
+                    if affine {
+                        c.with_affine_pieces()
+                    } else {
+                        c
+                    }
                 })?
             }
         };
-        Ok((found.0, found.1, started.elapsed().as_secs_f64()))
+        let (found, points, corrected_start) = found;
+        Ok(SegmentRun {
+            found,
+            points,
+            seconds: started.elapsed().as_secs_f64(),
+            corrected_start,
+        })
     }
 
     /// Follows the branch of `problem` from `x` at the segment's start until it has turned
-    /// back at a fold the core confirms (module documentation).
+    /// back at a fold the core confirms (module documentation); with the start as
+    /// corrected.
     fn follow<P, S>(
         &self,
         (problem, solver): (&mut P, &mut S),
         x: &[f64],
         method: MethodContinuation,
         configure: impl FnOnce(Continuation<'_, P, S>) -> Continuation<'_, P, S>,
-    ) -> Result<(Found, usize), RunError>
+    ) -> Result<(Found, usize, Option<Vec<f64>>), RunError>
     where
         P: GeneralizedJacobian + ParameterDependent + ?Sized,
         S: Factorize<P::Jacobian> + ?Sized,
@@ -342,20 +373,24 @@ impl Segment<'_> {
         // The sweep's options confirm a fold by its excursion (`fold_excursion`), so the
         // first fold event is the fold and not a corner's zigzag.
         let mut points = 0;
-        while continuation.next().is_some() {
+        let mut corrected_start = None;
+        while let Some(point) = continuation.next() {
+            if points == 0 {
+                corrected_start = Some(point.state);
+            }
             points += 1;
             let fold = continuation.events().iter().find_map(|event| match event {
                 ContinuationEvent::Fold { parameter, .. } => Some(*parameter),
                 _ => None,
             });
             if let Some(fold) = fold {
-                return Ok((Found::Fold(fold), points));
+                return Ok((Found::Fold(fold), points, corrected_start));
             }
         }
         let found = match continuation.termination() {
             Some(t) if points == 0 => Found::StartFailed(t.clone()),
             _ => Found::Nothing,
         };
-        Ok((found, points))
+        Ok((found, points, corrected_start))
     }
 }

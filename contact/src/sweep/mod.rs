@@ -154,6 +154,7 @@ fn hb_solver(choice: LinearSolverChoice) -> Box<dyn Factorize<HbJacobian>> {
 fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
+    model.friction.clear();
     let dofs = model.dofs().max(1);
     let options = PenaltyHbOptions {
         harmonics: 1,
@@ -255,7 +256,7 @@ fn penalty_continuation(
     MethodContinuation {
         units: vec![1.0; problem.dim()],
         residual_floor: f64::EPSILON * options.penalty_stiffness * largest_gap(model, u_ref),
-        affine_pieces: true,
+        affine_pieces: model.friction.is_empty(),
     }
 }
 
@@ -554,7 +555,7 @@ pub fn frequency_response(
         }
         _ => follow_branch(rod, settings, sweep, branch_progress)?,
     };
-    response.contacts = contacts::branch_contacts(rod, settings, &response)?;
+    (response.contacts, response.friction) = contacts::branch_reports(rod, settings, &response)?;
     let started = Instant::now();
     let total = response.points();
     let stability_progress =
@@ -616,7 +617,7 @@ pub(crate) fn follow_branch(
         }
         Method::PenaltyHb => {
             let options = penalty_options(settings, model);
-            let mut problem = PenaltyHb::new(model, omega_from, &options)?;
+            let mut problem = crate::solve::penalty_problem(model, omega_from, settings)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
             let method = penalty_continuation(model, &problem, &options, u_ref);
@@ -625,7 +626,14 @@ pub(crate) fn follow_branch(
                 &mut *hb_solver(settings.linear_solver),
                 setup(method, output_points),
                 &mut measure,
-                |c| c.with_affine_pieces(),
+                // With friction (regularised, smooth) the branch is not piecewise affine.
+                |c| {
+                    if model.friction.is_empty() {
+                        c.with_affine_pieces()
+                    } else {
+                        c
+                    }
+                },
                 progress,
             )
         }

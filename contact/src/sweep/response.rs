@@ -3,7 +3,7 @@
 use semismooth::continuation::{ContinuationCounters, ContinuationTermination, CorrectorFailure};
 use semismooth::harmonic::{Aft, FourierBasis};
 
-use crate::contacts::ContactReport;
+use crate::contacts::{ContactReport, FrictionSummary};
 use crate::hb::HbError;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::{RunCounters, RunError};
@@ -83,6 +83,9 @@ pub struct FrequencyResponse {
     /// With an accuracy target ([`SolverSettings::accuracy`], SSN-HB): the harmonics chosen
     /// point by point and each point's error estimate ([`super::adaptive`]).
     pub accuracy: Option<BranchAccuracy>,
+    /// Every friction point of each point, in the model's order (stick fraction, force
+    /// and slip velocity amplitudes, as `ssn solve` reports them).
+    pub friction: Vec<Vec<FrictionSummary>>,
 }
 
 /// Why a sweep stopped.
@@ -158,6 +161,7 @@ impl FrequencyResponse {
             harmonics: Vec::new(),
             time_samples: Vec::new(),
             accuracy: None,
+            friction: Vec::new(),
         }
     }
 

@@ -9,7 +9,7 @@
 pub mod periodic;
 
 use nalgebra::{Complex, DMatrix, DVector};
-use semismooth::newton::{Globalization, NewtonOptions, NewtonReport};
+use semismooth::newton::{Globalization, NewtonOptions, NewtonReport, Tolerances};
 use semismooth::polyalgorithm::{SmoothingOf, SolveOptions};
 use semismooth::{Factorize, GeneralizedJacobian};
 use semismooth_contact::hb::{HbOptions, SsnHb};
@@ -210,10 +210,9 @@ pub fn ssn_hb(model: &StructuralModel, omega: f64, harmonics: usize) -> SsnHb {
 /// point already on a branch must converge at once and not move it.
 pub fn plain_newton() -> SolveOptions {
     SolveOptions::Newton(NewtonOptions {
-        absolute_tolerance: 1e-12,
+        tolerances: Tolerances::absolute(1e-12),
         max_iterations: 20,
         globalization: Globalization::None,
-        ..NewtonOptions::default()
     })
 }
 
@@ -224,4 +223,18 @@ pub fn sweep_fig2_interval(
     settings: &SolverSettings,
 ) -> Result<FrequencyResponse, RunError> {
     frequency_response(rod, settings, &SweepSettings::new(0.5, 2.0), None)
+}
+
+/// The amplitude `sqrt(a_1^2 + b_1^2)` of the first harmonic of `N` equally spaced
+/// samples of one period (the trapezoidal rule, exact for a trigonometric polynomial of
+/// degree `< N - 1`).
+pub fn first_harmonic(u: &[f64]) -> f64 {
+    let n = u.len() as f64;
+    let (mut a, mut b) = (0.0, 0.0);
+    for (j, v) in u.iter().enumerate() {
+        let phase = 2.0 * std::f64::consts::PI * j as f64 / n;
+        a += v * phase.cos();
+        b += v * phase.sin();
+    }
+    2.0 * a.hypot(b) / n
 }

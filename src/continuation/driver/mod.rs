@@ -26,8 +26,9 @@ enum Phase {
         x0: Vec<f64>,
         p0: f64,
     },
-    /// Taken up from another run ([`Continuation::resume`]): the start is corrected at
-    /// fixed `p0` and its tangent oriented along `carried`.
+    /// Taken up from another run ([`Continuation::resume`]): the start is corrected on
+    /// the hyperplane through `(x0, p0)` normal to `carried` (else at fixed `p0`) and its
+    /// tangent oriented along `carried`.
     Resuming {
         x0: Vec<f64>,
         p0: f64,
@@ -125,6 +126,8 @@ where
     termination: Option<ContinuationTermination>,
     counters: ContinuationCounters,
     problem_start: ProblemCounters,
+    /// The solver's Krylov iterations when the run started.
+    krylov_start: u64,
     trust: TrustBall,
     segment: Segment,
     segment_direction: Direction,
@@ -189,6 +192,7 @@ where
         );
         let bordered = Bordered::new(n, problem.new_jacobian());
         let problem_start = problem.problem_counters();
+        let krylov_start = solver.krylov_iterations();
         let folds = FoldDetector::new(options.refine_folds)
             .with_min_excursion(options.fold_parameter_excursion());
         let window = options.restarts.map_or(0, |r| r.retrace_window);
@@ -218,6 +222,7 @@ where
             termination: None,
             counters: ContinuationCounters::default(),
             problem_start,
+            krylov_start,
             trust: TrustBall::default(),
             segment: Segment::Main,
             segment_points: 0,
@@ -245,6 +250,7 @@ where
         let mut c = self.counters;
         c.work = self.work;
         c.work.problem = self.problem.problem_counters().since(&self.problem_start);
+        c.work.krylov_iterations = self.solver.krylov_iterations() - self.krylov_start;
         c.parameter_derivative_evaluations = self.corrector_counts.parameter_derivatives;
         c.dense_bordered_factorizations = self.corrector_counts.dense_factorizations;
         c.corrector_iterations = self.corrector_counts.iterations;
@@ -308,7 +314,7 @@ where
     }
 
     /// The run's first point: `(x0, p0)` corrected at fixed `p0`, the tangent oriented by
-    /// the options' direction, or along `carried` for a resumed run.
+    /// the options' direction, or for a resumed run corrected and oriented along `carried`.
     fn start(&mut self, x0: Vec<f64>, p0: f64, carried: Option<&[f64]>) {
         let mut x = x0;
         let mut p = p0;
@@ -443,7 +449,8 @@ where
             self.counters.corners += 1;
         } else {
             if std::mem::take(&mut self.replacing) {
-                self.folds.retangent_last(point.tangent_parameter);
+                self.folds
+                    .replace_last(point.parameter, point.tangent_parameter);
             } else {
                 let events = self
                     .folds

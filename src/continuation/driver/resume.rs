@@ -52,8 +52,9 @@ where
 
     /// Takes a branch up from `resumption` with `problem` (its state and direction carried
     /// over to this problem's unknowns by the caller). The first item is the
-    /// resumption's point corrected at its fixed parameter on this problem, with the
-    /// tangent oriented along the carried direction: it replaces the last point of the run
+    /// resumption's point corrected on this problem on the hyperplane through it normal to
+    /// the carried direction (regular at a fold; at the fixed parameter when that fails),
+    /// with the tangent oriented along the carried direction: it replaces the last point of the run
     /// taken up (same index; the fold detector takes its new tangent). Then the run goes on with the carried
     /// step, its events and point count continuing the earlier run's.
     ///

@@ -16,12 +16,7 @@ impl Check<'_> {
     }
 
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
-        SceneError::Invalid {
-            path: self.path.to_path_buf(),
-            key: key.to_string(),
-            value: value.to_string(),
-            allowed: allowed.to_string(),
-        }
+        SceneError::invalid(self.path, key, value, allowed)
     }
 
     pub(super) fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
@@ -492,17 +487,31 @@ impl Check<'_> {
         })
     }
 
-    /// A scene with friction is solved by the methods that model it: `ssn-hb` and `march`.
+    /// A scene with friction is solved by the methods that model it: `ssn-hb` and `march`
+    /// (exact Coulomb friction), and `penalty-hb` (regularised friction) when every
+    /// friction point has a prescribed normal load.
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
-        let points = m.friction.len() + m.contacts.iter().filter(|c| c.friction.is_some()).count();
-        if points == 0 || matches!(solver.method, Method::SsnHb | Method::March) {
-            return Ok(());
-        }
-        Err(self.invalid(
-            "solver.method",
-            format!("\"{}\" with {points} friction points", solver.method.name()),
-            "\"ssn-hb\" or \"march\" (the methods that model Coulomb friction)",
-        ))
+        let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
+        let points = m.friction.len() + on_contacts;
+        let allowed = match solver.method {
+            _ if points == 0 => return Ok(()),
+            Method::SsnHb | Method::March => return Ok(()),
+            Method::PenaltyHb if on_contacts == 0 => return Ok(()),
+            Method::PenaltyHb => {
+                "\"ssn-hb\" or \"march\" (penalty-hb regularises friction only under a \
+                 prescribed normal load, [[friction.point]])"
+            }
+            _ => {
+                "\"ssn-hb\" or \"march\" (exact Coulomb friction), or \"penalty-hb\" \
+                 (regularised friction under prescribed normal loads)"
+            }
+        };
+        let what = if solver.method == Method::PenaltyHb {
+            format!("\"penalty-hb\" with {on_contacts} friction points on contacts")
+        } else {
+            format!("\"{}\" with {points} friction points", solver.method.name())
+        };
+        Err(self.invalid("solver.method", what, allowed))
     }
 
     /// The periodic LCP's matrix is dense, of order `contacts x time_samples`: that order
@@ -580,6 +589,11 @@ impl Check<'_> {
             .penalty_stiffness
             .map(|k| self.positive("solver.penalty_stiffness", k))
             .transpose()?;
+        let friction_regularisation = self.positive(
+            "solver.friction_regularisation",
+            s.friction_regularisation
+                .unwrap_or(default.friction_regularisation),
+        )?;
         let max_iterations = self.count_or(
             "solver.max_iterations",
             s.max_iterations,
@@ -647,6 +661,7 @@ impl Check<'_> {
             time_samples,
             c,
             penalty_stiffness,
+            friction_regularisation,
             linear_solver: s.linear_solver,
             max_iterations,
             globalization: s.globalization,

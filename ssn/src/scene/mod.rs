@@ -43,39 +43,9 @@ pub use semismooth_contact::settings::{
     SolverSettings, SweepSettings, DEFAULT_RELATIVE_PENALTY,
 };
 
-/// Why a scene could not be used. Every variant names the file; `Invalid` also names the
-/// key, the value found and what is allowed.
-#[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    /// The file could not be read.
-    #[error("{path}: cannot read scene: {source}")]
-    Io {
-        /// The scene file.
-        path: PathBuf,
-        /// The system error.
-        source: std::io::Error,
-    },
-    /// Malformed TOML, an unknown key, a wrong type or a missing required key.
-    #[error("{path}: {message}")]
-    Parse {
-        /// The scene file.
-        path: PathBuf,
-        /// The parser's message (with line and column, key and expected type).
-        message: String,
-    },
-    /// A value of the right type outside its allowed range, or conflicting keys.
-    #[error("{path}: invalid `{key}` = {value}: allowed {allowed}")]
-    Invalid {
-        /// The scene file.
-        path: PathBuf,
-        /// The offending key, as `section.key`.
-        key: String,
-        /// The value found.
-        value: String,
-        /// What is allowed.
-        allowed: String,
-    },
-}
+/// Why a scene could not be used: the input-file errors (the file; for a bad value also
+/// the key, the value found and what is allowed).
+pub type SceneError = crate::input_file::InputFileError;
 
 /// A validated scene.
 #[derive(Debug, Clone, PartialEq)]
@@ -233,6 +203,7 @@ struct RawSolver {
     time_samples: Option<i64>,
     c: Option<f64>,
     penalty_stiffness: Option<f64>,
+    friction_regularisation: Option<f64>,
     #[serde(default)]
     linear_solver: LinearSolverChoice,
     max_iterations: Option<i64>,
@@ -337,10 +308,7 @@ impl Scene {
                 }
                 message
             })
-            .map_err(|message| SceneError::Parse {
-                path: path.to_path_buf(),
-                message,
-            })?;
+            .map_err(|message| SceneError::parse(path, message))?;
         check::resolve(raw, path)
     }
 

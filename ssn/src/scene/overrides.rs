@@ -13,6 +13,7 @@ use std::fmt;
 use std::path::Path;
 
 use super::{RawScene, Scene, SceneError};
+use crate::input_file::{read_input_file, FileKind};
 
 /// One override: a dotted scene key and the TOML value it takes.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,24 +92,19 @@ impl Scene {
         if overrides.is_empty() {
             return Scene::from_toml(text, path);
         }
-        let mut document: toml::Table = toml::from_str(text).map_err(|e| SceneError::Parse {
-            path: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
+        let mut document: toml::Table =
+            toml::from_str(text).map_err(|e| SceneError::parse(path, e.to_string().trim_end()))?;
         for o in overrides {
-            apply(&mut document, o).map_err(|reason| SceneError::Parse {
-                path: path.to_path_buf(),
-                message: format!("--set {o}: {reason}"),
-            })?;
+            apply(&mut document, o)
+                .map_err(|reason| SceneError::parse(path, format!("--set {o}: {reason}")))?;
         }
         let named = overrides
             .iter()
             .map(|o| format!("--set {o}"))
             .collect::<Vec<_>>()
             .join(" ");
-        let raw: RawScene = document.try_into().map_err(|e| SceneError::Parse {
-            path: path.to_path_buf(),
-            message: format!("with {named}: {}", e.to_string().trim_end()),
+        let raw: RawScene = document.try_into().map_err(|e| {
+            SceneError::parse(path, format!("with {named}: {}", e.to_string().trim_end()))
         })?;
         super::check::resolve(raw, path)
     }
@@ -127,12 +123,7 @@ impl Scene {
 /// The text of a scene file (a regular file of at most [`crate::io::SCENE_SIZE_LIMIT`]
 /// bytes).
 pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
-    crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
-        SceneError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
+    read_input_file(path, FileKind::Scene)
 }
 
 /// Sets `o.key` in `document`, creating the tables on its path; an index into an array of

@@ -36,6 +36,7 @@ use rand::SeedableRng;
 use rand_distr::Distribution;
 use serde::Deserialize;
 
+use crate::input_file::{read_input_file, FileKind, InputFileError};
 use crate::scene::Override;
 use crate::source::SceneSource;
 
@@ -124,34 +125,9 @@ pub struct Study {
 /// Why a study file could not be used: the file, the key, the value, what is allowed.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
-    /// The file could not be read.
-    #[error("{path}: cannot read study: {source}")]
-    Io {
-        /// The study file.
-        path: PathBuf,
-        /// The system error.
-        source: std::io::Error,
-    },
-    /// Malformed TOML, an unknown key, a wrong type or a missing required key.
-    #[error("{path}: {message}")]
-    Parse {
-        /// The study file.
-        path: PathBuf,
-        /// The parser's message.
-        message: String,
-    },
-    /// A value of the right type outside its allowed range.
-    #[error("{path}: invalid `{key}` = {value}: allowed {allowed}")]
-    Invalid {
-        /// The study file.
-        path: PathBuf,
-        /// The offending key.
-        key: String,
-        /// The value found.
-        value: String,
-        /// What is allowed.
-        allowed: String,
-    },
+    /// The file could not be read, is not TOML of the study's keys, or has a bad value.
+    #[error(transparent)]
+    File(#[from] InputFileError),
     /// A case makes the scene invalid (the scene's own message).
     #[error("{path}: case {case} ({values}) makes the scene invalid: {message}")]
     Case {
@@ -214,27 +190,16 @@ impl Study {
     /// Reads and validates a study file; every case is checked against `scene` (its scene
     /// is validated, nothing is solved), so a bad case is refused before any case runs.
     pub fn from_path(path: &Path, scene: &SceneSource) -> Result<Study, StudyError> {
-        let text =
-            crate::io::read_regular_file(path, crate::io::SCENE_SIZE_LIMIT).map_err(|source| {
-                StudyError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                }
-            })?;
+        let text = read_input_file(path, FileKind::Study)?;
         Study::from_toml(&text, path, scene)
     }
 
     /// Parses and validates study text (`path` only names it in messages).
     pub fn from_toml(text: &str, path: &Path, scene: &SceneSource) -> Result<Study, StudyError> {
-        let raw: RawStudy = toml::from_str(text).map_err(|e| StudyError::Parse {
-            path: path.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
-        })?;
-        let invalid = |key: &str, value: String, allowed: &str| StudyError::Invalid {
-            path: path.to_path_buf(),
-            key: key.to_string(),
-            value,
-            allowed: allowed.to_string(),
+        let raw: RawStudy = toml::from_str(text)
+            .map_err(|e| InputFileError::parse(path, e.to_string().trim_end()))?;
+        let invalid = |key: &str, value: String, allowed: &str| {
+            StudyError::from(InputFileError::invalid(path, key, value, allowed))
         };
         let mut keys: Vec<String> = Vec::new();
         let mut note_key = |k: &str| {

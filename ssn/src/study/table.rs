@@ -94,7 +94,14 @@ impl Column {
     /// The cell of `row` as text: shortest round-trip numbers, `true`/`false`, empty for
     /// null.
     fn text(&self, row: usize) -> String {
-        match &self.cells[row] {
+        self.cells[row].text()
+    }
+}
+
+impl Cell {
+    /// The cell as text: shortest round-trip numbers, `true`/`false`, empty for null.
+    fn text(&self) -> String {
+        match self {
             Cell::Null => String::new(),
             Cell::Int(i) => i.to_string(),
             Cell::Float(f) => format!("{f:?}"),
@@ -385,61 +392,25 @@ impl Table {
             let Some(mut column) = group.next_column()? else {
                 break;
             };
-            let defined: Vec<i16> = c
-                .cells
-                .iter()
-                .map(|cell| i16::from(*cell != Cell::Null))
-                .collect();
             match c.column_type() {
-                ColumnType::Int => {
-                    let v: Vec<i64> = c
-                        .cells
-                        .iter()
-                        .filter_map(|cell| match cell {
-                            Cell::Int(i) => Some(*i),
-                            _ => None,
-                        })
-                        .collect();
-                    column
-                        .typed::<Int64Type>()
-                        .write_batch(&v, Some(&defined), None)?;
-                }
+                ColumnType::Int => write_column::<Int64Type>(&mut column, c, |cell| match cell {
+                    Cell::Int(i) => Some(*i),
+                    _ => None,
+                })?,
                 ColumnType::Float => {
-                    let v: Vec<f64> = c
-                        .cells
-                        .iter()
-                        .filter_map(|cell| match cell {
-                            Cell::Int(i) => Some(*i as f64),
-                            Cell::Float(f) => Some(*f),
-                            _ => None,
-                        })
-                        .collect();
-                    column
-                        .typed::<DoubleType>()
-                        .write_batch(&v, Some(&defined), None)?;
+                    write_column::<DoubleType>(&mut column, c, |cell| match cell {
+                        Cell::Int(i) => Some(*i as f64),
+                        Cell::Float(f) => Some(*f),
+                        _ => None,
+                    })?
                 }
-                ColumnType::Bool => {
-                    let v: Vec<bool> = c
-                        .cells
-                        .iter()
-                        .filter_map(|cell| match cell {
-                            Cell::Bool(b) => Some(*b),
-                            _ => None,
-                        })
-                        .collect();
-                    column
-                        .typed::<BoolType>()
-                        .write_batch(&v, Some(&defined), None)?;
-                }
-                ColumnType::Text => {
-                    let v: Vec<ByteArray> = (0..c.cells.len())
-                        .filter(|&r| c.cells[r] != Cell::Null)
-                        .map(|r| ByteArray::from(c.text(r).as_str()))
-                        .collect();
-                    column
-                        .typed::<ByteArrayType>()
-                        .write_batch(&v, Some(&defined), None)?;
-                }
+                ColumnType::Bool => write_column::<BoolType>(&mut column, c, |cell| match cell {
+                    Cell::Bool(b) => Some(*b),
+                    _ => None,
+                })?,
+                ColumnType::Text => write_column::<ByteArrayType>(&mut column, c, |cell| {
+                    (*cell != Cell::Null).then(|| ByteArray::from(cell.text().as_str()))
+                })?,
             }
             column.close()?;
         }
@@ -447,4 +418,24 @@ impl Table {
         writer.close()?;
         Ok(bytes)
     }
+}
+
+/// Writes the cells of `c` to `column` as the Parquet type `T`: the values `value` finds
+/// in the cells, and a definition level per row (0 for a null cell).
+#[cfg(feature = "parquet")]
+fn write_column<T: parquet::data_type::DataType>(
+    column: &mut parquet::file::writer::SerializedColumnWriter<'_>,
+    c: &Column,
+    value: impl Fn(&Cell) -> Option<T::T>,
+) -> Result<(), parquet::errors::ParquetError> {
+    let defined: Vec<i16> = c
+        .cells
+        .iter()
+        .map(|cell| i16::from(*cell != Cell::Null))
+        .collect();
+    let values: Vec<T::T> = c.cells.iter().filter_map(value).collect();
+    column
+        .typed::<T>()
+        .write_batch(&values, Some(&defined), None)?;
+    Ok(())
 }

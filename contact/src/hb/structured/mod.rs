@@ -571,6 +571,10 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
 }
 
 impl LinearSolve for StructuredHbSolver {
+    fn krylov_iterations(&self) -> u64 {
+        self.krylov_iterations
+    }
+
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
         self.work_rhs.clear();
         self.work_rhs.extend_from_slice(rhs);

@@ -1,0 +1,22 @@
+//! Time marching from a periodic orbit: the march's state and distances between states,
+//! shared by the stability tests.
+
+use semismooth_contact::march::TimeMarcher;
+
+/// The state `(u, v / omega)` of a march.
+pub fn snapshot(m: &TimeMarcher, omega: f64) -> Vec<f64> {
+    m.displacement()
+        .iter()
+        .copied()
+        .chain(m.velocity().iter().map(|v| v / omega))
+        .collect()
+}
+
+/// Euclidean distance of two states.
+pub fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
