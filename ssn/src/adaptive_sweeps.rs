@@ -91,23 +91,24 @@ pub struct FixedSweep {
     pub seconds: f64,
 }
 
+/// The largest finite value of `values` (0 when none).
+fn largest_finite(values: &[f64]) -> f64 {
+    values
+        .iter()
+        .copied()
+        .filter(|e| e.is_finite())
+        .fold(0.0, f64::max)
+}
+
 impl AdaptiveComparison {
     /// The largest error over the points with a reference.
     pub fn worst_error(&self) -> f64 {
-        self.errors
-            .iter()
-            .copied()
-            .filter(|e| e.is_finite())
-            .fold(0.0, f64::max)
+        largest_finite(&self.errors)
     }
 
     /// The largest estimate.
     pub fn worst_estimate(&self) -> f64 {
-        self.estimates
-            .iter()
-            .copied()
-            .filter(|e| e.is_finite())
-            .fold(0.0, f64::max)
+        largest_finite(&self.estimates)
     }
 
     /// Points whose error meets the target.
