@@ -501,3 +501,39 @@ fn a_beam_sweep_at_high_h_takes_the_points_and_iterations_its_estimate_counts() 
         );
     }
 }
+
+/// The text summaries of `sweep` and `solutions` count the GMRES iterations of a
+/// matrix-free run (4 stops on 40 elements, `condensed-krylov`, H = 5), as the sweep's JSON
+/// does.
+#[test]
+fn sweep_and_solutions_summaries_count_the_gmres_iterations() {
+    let dir = tempfile::tempdir().unwrap();
+    let points: String = (1..=4)
+        .map(|k| format!("[[contact.point]]\nnode = {}\ngap = 0.5\n", 10 * k))
+        .collect();
+    let scene = rod_scene(
+        dir.path(),
+        "krylov.toml",
+        "elements = 40\nmass = \"modified\"",
+        &format!(
+            "[damping]\nzeta = 0.01\n{points}[solver]\nharmonics = 5\n\
+             linear_solver = \"condensed-krylov\"\n[sweep]\nomega_ratio_from = 0.9\n\
+             omega_ratio_to = 1.1"
+        ),
+    );
+    let json = ssn(&["sweep", &scene, "--json"]);
+    assert_exit(&json, 0, "sweep --json");
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let krylov = v["counters"]["krylov_iterations"].as_u64().unwrap();
+    assert!(krylov > 0);
+    let text = ssn(&["sweep", &scene]);
+    assert_exit(&text, 0, "sweep");
+    let words = format!("{krylov} GMRES iterations");
+    assert!(
+        String::from_utf8_lossy(&text.stdout).contains(&words),
+        "{words}"
+    );
+    let text = ssn(&["solutions", &scene]);
+    assert_exit(&text, 0, "solutions");
+    assert!(String::from_utf8_lossy(&text.stdout).contains("GMRES iterations"));
+}
