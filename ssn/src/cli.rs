@@ -681,15 +681,24 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
         }
         writeln!(
             t,
-            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",
+            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs{}",
             c.residual_evaluations,
             c.jacobian_evaluations,
             c.factorizations,
             c.linear_solves,
-            c.ffts
+            c.ffts,
+            gmres_words(c)
         )
     })();
     t
+}
+
+/// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.
+fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String {
+    match c.krylov_iterations {
+        0 => String::new(),
+        k => format!(", {k} GMRES iterations"),
+    }
 }
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
@@ -853,6 +862,12 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         for fold in fold_accuracy.iter().flatten() {
             t += &crate::words::fold_accuracy(fold, rod.omega_1);
         }
+        t += &format!(
+            "work              {} corrector iterations, {} factorizations{}\n",
+            response.continuation.corrector_iterations,
+            response.counters.factorizations,
+            gmres_words(&response.counters)
+        );
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
             response.converged(),
