@@ -167,9 +167,34 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
         changes[19]
     );
     assert!(changes[19] > 2.0 * changes[0], "point {flip}: {changes:?}");
-    assert!(r
+    let doubling = r
         .stability
         .events
         .iter()
-        .any(|e| e.kind == BifurcationKind::PeriodDoubling && e.index <= flip));
+        .find(|e| e.kind == BifurcationKind::PeriodDoubling && e.index <= flip)
+        .expect("a period doubling before the flip point");
+    // Its uncertainty covers the two points it was interpolated between: the point after
+    // the change and the decided point before it, one of them at its edge, of different
+    // stability on either side.
+    let u = doubling.uncertainty.expect("an interpolated change");
+    let i = doubling.index;
+    let before = (0..i)
+        .rev()
+        .find(|&j| r.stability.floquet_max_abs[j].is_some())
+        .expect("a decided point before");
+    let distance = |j: usize| (r.omega[j] - doubling.omega).abs();
+    let round_off = 1e-12 * w1;
+    assert!(distance(i) <= u + round_off && distance(before) <= u + round_off);
+    assert!(
+        (distance(i).max(distance(before)) - u).abs() <= round_off,
+        "{doubling:?}"
+    );
+    let modulus = |j: usize| r.stability.floquet_max_abs[j].unwrap();
+    assert!(
+        (modulus(before) - 1.0) * (modulus(i) - 1.0) <= 0.0
+            || r.stability.stable[before] != r.stability.stable[i],
+        "{doubling:?}: {} and {}",
+        modulus(before),
+        modulus(i)
+    );
 }

@@ -177,6 +177,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
                 "omega": e.omega,
                 "omega_ratio": e.omega / r.omega_1,
                 "index": e.index,
+                "uncertainty_ratio": e.uncertainty.map(|u| u / r.omega_1),
             })
         })
         .collect();

@@ -35,6 +35,11 @@ pub struct BifurcationEvent {
     pub omega: f64,
     /// Index of the point after the change.
     pub index: usize,
+    /// A stability change interpolated between two points (not a fold of the branch): the
+    /// larger distance from `omega` to their frequencies, so that the crossing, which lies
+    /// between them, is within it (the points' own discretisation error aside). `None` for a fold of the branch, located instead by the
+    /// continuation (and to an accuracy by [`super::fold_accuracy`]).
+    pub uncertainty: Option<f64>,
 }
 
 /// Per-point stability and contact diagnostics of a branch.
@@ -243,9 +248,9 @@ pub fn branch_stability(
             let (before, _) = outside[j].expect("decided");
             if let Some(kind) = crossing_of(before, after) {
                 let (w0, w1) = (response.omega[j], response.omega[i]);
-                let omega = match reversals.iter().position(|&r| j <= r && r <= i) {
+                let (omega, uncertainty) = match reversals.iter().position(|&r| j <= r && r <= i) {
                     // A fold of the branch between the two: the crossing is the fold.
-                    Some(k) if kind == BifurcationKind::Fold => response.folds[k],
+                    Some(k) if kind == BifurcationKind::Fold => (response.folds[k], None),
                     _ => {
                         let a0 = analyses[j].floquet_max_abs.unwrap_or(1.0);
                         let a1 = analyses[i].floquet_max_abs.unwrap_or(1.0);
@@ -254,13 +259,15 @@ pub fn branch_stability(
                         } else {
                             0.5
                         };
-                        w0 + t * (w1 - w0)
+                        let omega = w0 + t * (w1 - w0);
+                        (omega, Some((omega - w0).abs().max((w1 - omega).abs())))
                     }
                 };
                 out.events.push(BifurcationEvent {
                     kind,
                     omega,
                     index: i,
+                    uncertainty,
                 });
             }
         }
