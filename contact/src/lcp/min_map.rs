@@ -25,6 +25,7 @@ use semismooth::linalg::{
     check_finite_dense, check_pivots, DenseAssemble, FaerDenseLu, LinearSolveError,
     DEFAULT_PIVOT_THRESHOLD,
 };
+use semismooth::InvalidOption;
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual, Smoothing,
 };
@@ -358,11 +359,11 @@ impl ActiveSetSolver {
     /// reporting it.
     pub fn with_regularization(mut self, shift: f64) -> Result<Self, LcpError> {
         if !(shift.is_finite() && shift > 0.0) {
-            return Err(LcpError::InvalidOption {
-                name: "regularization",
-                value: shift,
-                allowed: "a finite relative diagonal shift > 0",
-            });
+            return Err(LcpError::InvalidOption(InvalidOption::new(
+                "regularization",
+                shift,
+                "a finite relative diagonal shift > 0",
+            )));
         }
         self.regularization = Some(shift);
         Ok(self)
