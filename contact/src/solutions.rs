@@ -20,7 +20,7 @@ use crate::contacts::ContactSummary;
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::StateShape;
-use crate::solve::{solve, RunError, Solution, Termination};
+use crate::solve::{solve, RunCounters, RunError, Solution, Termination};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::Reconstruction;
 use crate::sweep::{follow_branch, SweepTermination};
@@ -75,6 +75,8 @@ pub struct SolutionSet {
     pub crossings: usize,
     /// Crossings whose correction did not converge.
     pub failed_corrections: Vec<FailedCorrection>,
+    /// Work of the branch and of the corrections at `w*`.
+    pub counters: RunCounters,
     /// Wall time.
     pub seconds: f64,
 }
@@ -145,6 +147,7 @@ pub fn find_solutions(
         branch_termination: branch.termination.clone(),
         crossings: 0,
         failed_corrections: Vec::new(),
+        counters: branch.counters,
         seconds: 0.0,
     };
     for i in 1..branch.points() {
@@ -166,6 +169,7 @@ pub fn find_solutions(
             .map(|(a, b)| a + t * (b - a))
             .collect();
         let solution = solve(rod, omega, settings, Some(&start))?;
+        set.counters = set.counters + solution.counters;
         if !solution.converged() {
             set.failed_corrections.push(FailedCorrection {
                 branch_index: i,

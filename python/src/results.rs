@@ -56,9 +56,11 @@ impl Stored {
     }
 }
 
-/// Rows of equal length as a row-major array `(rows, columns)`.
+/// Rows as a row-major array `(rows, columns)`.
 fn matrix(name: &str, rows: &[Vec<f64>]) -> (String, Vec<usize>, Vec<f64>) {
-    let columns = rows.first().map_or(0, Vec::len);
+    // Rows of different lengths (a branch whose harmonics change from point to point)
+    // are padded with NaN to the longest.
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(0);
     let values: Vec<f64> = rows
         .iter()
         .flat_map(|r| {
@@ -295,7 +297,8 @@ result_methods!(FrequencyResponse, "FrequencyResponse", {
         self.stored.array(py, "floquet_max_abs")
     }
 
-    /// The unknowns at each point, one row per point.
+    /// The unknowns at each point, one row per point (where the harmonics change from point
+    /// to point, `to_dict()["harmonics"]`, each row is padded with NaN to the longest).
     #[getter]
     fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.stored.array(py, "states")

@@ -107,6 +107,17 @@ impl FoldDetector {
         self
     }
 
+    /// Replaces the parameter and the tangent's parameter component of the last point
+    /// pushed (the same point corrected again on another discretisation, across the
+    /// branch, [`Continuation::resume`](super::Continuation::resume)): the decisions taken
+    /// on it stay, later points are compared with, and folds located from, its new values.
+    pub fn replace_last(&mut self, parameter: f64, tangent_parameter: f64) {
+        if let Some(last) = self.samples.last_mut() {
+            last.parameter = parameter;
+            last.tangent_parameter = tangent_parameter;
+        }
+    }
+
     /// Adds the next accepted point: its parameter, the parameter component of its unit
     /// tangent oriented along the branch, and the θ-length of the chord from the previous
     /// point (ignored for the first). Returns the events this point decides (a fold it

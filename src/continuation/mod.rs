@@ -99,6 +99,16 @@
 //! A restarted segment that comes back near the points before the restart is going back
 //! along the branch: the run then ends ([`ContinuationTermination::Retraced`]).
 //!
+//! # Another discretisation on the way
+//!
+//! A branch can be taken up on another problem (the same equations discretised with more or
+//! fewer unknowns) from where a run stands: [`Continuation::resumption`] gives the last
+//! point, the next predictor direction and step, and the fold detector; the caller carries
+//! the state and direction over to the other unknowns and [`Continuation::resume`]s with the
+//! other problem. The resumed run corrects that point at its fixed parameter, orients its
+//! tangent along the carried direction and goes on with the carried step; its first item
+//! replaces the last point of the earlier run, and fold events continue across the change.
+//!
 //! # Piecewise-affine branches
 //!
 //! When the residual is affine in `x` on each piece of a sign pattern
@@ -185,7 +195,7 @@ pub use branch::{
     Branch, BranchPoint, ContinuationCounters, ContinuationError, ContinuationEvent,
     ContinuationTermination, CorrectorFailure,
 };
-pub use driver::Continuation;
+pub use driver::{Continuation, Resumption};
 pub use folds::FoldDetector;
 pub use homotopy::{homotopy, HomotopyReport, HomotopySchedule};
 pub use natural::{natural_sweep, NaturalSweep, SweepFailure, SweepPoint};

@@ -12,7 +12,8 @@
 //! comparison, both mass models, about 3 s), `accuracy` (cheapest setting per method,
 //! about 5 s), `accuracy-targets` (the discretisation search
 //! for 1e-3, 1e-4 and 1e-5 against the reference, about 10 minutes, most of it Lemke and
-//! harmonic balance at their finest), `sweeps` (about 10 s), `from-zero` (the public grid with `auto` and
+//! harmonic balance at their finest), `sweeps` (about 10 s), `adaptive-sweeps` (harmonics per point against fixed
+//! harmonics, minutes: most of it the references at H = 320), `from-zero` (the public grid with `auto` and
 //! `hybrid`, about 6 s), `performance` (what the examples time, about 2 s), `hard` (the
 //! hard cases from zero, about 2 minutes, most of it the 100-contact rod), `friction` (Den
 //! Hartog's oscillator by H and the friction-damper curve, about 5 s). Wall times vary
@@ -59,6 +60,10 @@ fn compute(section: &str) -> Result<String, Box<dyn std::error::Error>> {
             out.push_str(&table.markdown());
         }
         "sweeps" => out.push_str(&tables::sweeps(&tables::sweep_cases())?.markdown()),
+        "adaptive-sweeps" => {
+            let rows = ssn::adaptive_sweeps::study(None)?;
+            out.push_str(&tables::adaptive_sweeps(&rows).markdown());
+        }
         "from-zero" => {
             let groups = public_grid(&[0.1, 0.2, 0.4])?;
             let run = |g: GlobalizationChoice| -> Vec<tables::GroupSummary> {

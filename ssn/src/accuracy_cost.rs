@@ -72,6 +72,10 @@ pub struct Entry {
     pub setting: String,
     /// Relative error of the tip minimum.
     pub tip_min_error: f64,
+    /// The solve's own estimate of the tip minimum's relative error (its error estimate's
+    /// `displacement_min` part, module `accuracy` of the library), beside the measured one;
+    /// NaN where the method gives none.
+    pub tip_min_estimate: f64,
     /// Relative error of the tip RMS.
     pub tip_rms_error: f64,
     /// Relative error of the mean contact force (`None` without contact).
@@ -144,7 +148,7 @@ impl AccuracyCost {
             r.description, r.tip_min, r.tip_rms, r.mean_force, r.uncertainty
         );
         s.push_str(
-            "method,setting,tip_min_error,tip_rms_error,mean_force_error,seconds,iterations,converged,failure\n",
+            "method,setting,tip_min_error,tip_min_estimate,tip_rms_error,mean_force_error,seconds,iterations,converged,failure\n",
         );
         for e in &self.entries {
             s.push_str(&e.cells(Cells::Csv).join(","));
@@ -175,7 +179,8 @@ impl AccuracyCost {
                 .unwrap_or_else(|| "n/a".into())
         );
         let header = [
-            "method", "setting", "err(min)", "err(rms)", "err(F)", "time [s]", "iter", "conv",
+            "method", "setting", "err(min)", "est(min)", "err(rms)", "err(F)", "time [s]", "iter",
+            "conv",
         ];
         table_line(&mut s, header.map(String::from));
         for e in &self.entries {
@@ -235,27 +240,41 @@ impl AccuracyCost {
     }
 
     /// Log-log plot of the tip-minimum error against wall time, one curve per method
-    /// (converged entries only).
+    /// (converged entries only), and dashed beside it the method's own estimate of that
+    /// error.
     pub fn write_svg(&self, path: &Path) -> Result<(), OutputError> {
         let series: Vec<Series> = METHODS
             .iter()
             .enumerate()
             .filter_map(|(color, &m)| {
-                let mut points: Vec<(f64, f64)> = self
+                let mut points: Vec<(f64, f64, f64)> = self
                     .entries
                     .iter()
                     .filter(|e| e.method == m && e.converged)
-                    .map(|e| (e.seconds, e.tip_min_error.max(1e-16)))
+                    .map(|e| (e.seconds, e.tip_min_error.max(1e-16), e.tip_min_estimate))
                     .collect();
                 if points.is_empty() {
                     return None;
                 }
                 points.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let (x, y): (Vec<f64>, Vec<f64>) = points.into_iter().unzip();
-                Some([
+                let x: Vec<f64> = points.iter().map(|p| p.0).collect();
+                let y: Vec<f64> = points.iter().map(|p| p.1).collect();
+                // The method's own estimates, dashed, where it gives them.
+                let (ex, ey): (Vec<f64>, Vec<f64>) = points
+                    .iter()
+                    .filter(|p| p.2.is_finite())
+                    .map(|p| (p.0, p.2.max(1e-16)))
+                    .unzip();
+                let mut curves = vec![
                     Series::new(m.name(), x.clone(), y.clone()).with_color(color),
                     Series::markers("", x, y).with_color(color),
-                ])
+                ];
+                if !ex.is_empty() {
+                    curves.push(
+                        Series::dashed(format!("{} estimate", m.name()), ex, ey).with_color(color),
+                    );
+                }
+                Some(curves)
             })
             .flatten()
             .collect();
@@ -277,9 +296,10 @@ enum Cells {
 }
 
 impl Entry {
-    /// The entry's columns: method, setting, the relative errors of the tip minimum, tip RMS
-    /// and mean force, seconds, iterations, converged.
-    fn cells(&self, style: Cells) -> [String; 8] {
+    /// The entry's columns: method, setting, the relative error of the tip minimum and its
+    /// estimate, the relative errors of the tip RMS and mean force, seconds, iterations,
+    /// converged.
+    fn cells(&self, style: Cells) -> [String; 9] {
         let csv = style == Cells::Csv;
         let missing = if csv { "" } else { "-" };
         let number = |v: f64, digits: usize| {
@@ -300,6 +320,7 @@ impl Entry {
             self.method.name().into(),
             self.setting.clone(),
             number(self.tip_min_error, 2),
+            number(self.tip_min_estimate, 2),
             number(self.tip_rms_error, 2),
             self.mean_force_error
                 .map_or_else(|| missing.into(), |v| number(v, 2)),
@@ -311,11 +332,11 @@ impl Entry {
 }
 
 /// One line of the printed table (header or entry).
-fn table_line(s: &mut String, c: [String; 8]) {
+fn table_line(s: &mut String, c: [String; 9]) {
     let _ = writeln!(
         s,
-        "{:<11} {:<22} {:>10} {:>10} {:>10} {:>11} {:>6} {:>5}",
-        c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]
+        "{:<11} {:<22} {:>10} {:>10} {:>10} {:>10} {:>11} {:>6} {:>5}",
+        c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8]
     );
 }
 
@@ -570,6 +591,11 @@ pub fn accuracy_cost(
                 method,
                 setting,
                 tip_min_error: relative(sol.stats.min, reference.tip_min),
+                // Estimated after the timing, which it does not enter.
+                tip_min_estimate: semismooth_contact::accuracy::estimate(
+                    rod, omega, &settings, &sol,
+                )
+                .map_or(f64::NAN, |e| e.parts.displacement_min),
                 tip_rms_error: relative(rms(&sol.tip), reference.tip_rms),
                 // Only with a nonzero reference force (a relative error of 0 is meaningless).
                 mean_force_error: (contact && reference.mean_force != 0.0)
@@ -583,6 +609,7 @@ pub fn accuracy_cost(
                 method,
                 setting,
                 tip_min_error: f64::NAN,
+                tip_min_estimate: f64::NAN,
                 tip_rms_error: f64::NAN,
                 mean_force_error: None,
                 seconds: f64::NAN,
@@ -605,6 +632,7 @@ mod tests {
             method,
             setting: String::new(),
             tip_min_error: err,
+            tip_min_estimate: f64::NAN,
             tip_rms_error: err,
             mean_force_error: None,
             seconds,
@@ -674,7 +702,7 @@ mod tests {
         );
         let last = csv.lines().last().unwrap();
         assert!(
-            last.starts_with("lcp-lemke,,,,,,1,false,")
+            last.starts_with("lcp-lemke,,,,,,,1,false,")
                 && last.ends_with("\"could not run: invalid time_samples, \"\"x\"\"\""),
             "{last}"
         );

@@ -681,15 +681,24 @@ fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> Strin
         }
         writeln!(
             t,
-            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs",
+            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs{}",
             c.residual_evaluations,
             c.jacobian_evaluations,
             c.factorizations,
             c.linear_solves,
-            c.ffts
+            c.ffts,
+            gmres_words(c)
         )
     })();
     t
+}
+
+/// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.
+fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String {
+    match c.krylov_iterations {
+        0 => String::new(),
+        k => format!(", {k} GMRES iterations"),
+    }
 }
 
 /// `ssn sweep SCENE`: the frequency response over the scene's `[sweep]` range by
@@ -783,11 +792,19 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         columns.push(values);
     }
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
-        let label = format!(
-            "{} H = {}",
-            scene.solver.method.name(),
-            scene.solver.harmonics
-        );
+        let label = match (
+            response.harmonics.iter().min(),
+            response.harmonics.iter().max(),
+        ) {
+            (Some(lo), Some(hi)) if lo != hi => {
+                format!("{} H = {lo} to {hi}", scene.solver.method.name())
+            }
+            _ => format!(
+                "{} H = {}",
+                scene.solver.method.name(),
+                scene.solver.harmonics
+            ),
+        };
         let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
         series.extend(stability_key(&st.stable));
         Plot {
@@ -809,6 +826,9 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
                 "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
                 ratio[i]
             );
+        }
+        if let Some(a) = &response.accuracy {
+            t += &crate::words::branch_accuracy(a, &response.harmonics);
         }
         t += &format!(
             "folds             {}\n",
@@ -842,6 +862,12 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         for fold in fold_accuracy.iter().flatten() {
             t += &crate::words::fold_accuracy(fold, rod.omega_1);
         }
+        t += &format!(
+            "work              {} corrector iterations, {} factorizations{}\n",
+            response.continuation.corrector_iterations,
+            response.counters.factorizations,
+            gmres_words(&response.counters)
+        );
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
             response.converged(),

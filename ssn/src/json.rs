@@ -150,7 +150,11 @@ pub fn finite_or_null(v: f64) -> Value {
 /// `contact_force_mean` (the sum over the contacts), `max_penetration`, `contacts` (per
 /// point, the list of [`ContactReport`]s), then `stability_note` (why points are
 /// undecided), `stability_seconds`, `events` ({`kind`, `omega`, `omega_ratio`,
-/// `index`}), `folds`, `corner_folds`, `converged`, `solve_seconds`, `termination`, `counters`.
+/// `index`}), `folds`, `corner_folds`, `converged`, `solve_seconds`, `termination`, `counters`;
+/// harmonic balance: per point `harmonics` and `time_samples`; with an accuracy target
+/// (SSN-HB, harmonics chosen per point): per point `error_estimate` and the summary
+/// `accuracy` {`target`, `basis`, `order`, `points_met`, `worst_estimate`, `raises`,
+/// `lowers`, `failed_raises`, `max_harmonics`, `estimate_seconds`, `estimate_counters`}.
 /// Non-finite numbers become `null`.
 pub fn response_json(r: &FrequencyResponse) -> Value {
     let mut counters = newton_counters(&r.counters);
@@ -176,7 +180,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
             })
         })
         .collect();
-    json!({
+    let mut doc = json!({
         "points": r.points(),
         "omega": r.omega,
         "omega_ratio": r.omega_ratio(),
@@ -213,7 +217,29 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "solve_seconds": r.solve_seconds,
         "termination": crate::words::sweep_termination(r),
         "counters": counters,
-    })
+    });
+    if !r.harmonics.is_empty() {
+        doc["harmonics"] = json!(r.harmonics);
+        doc["time_samples"] = json!(r.time_samples);
+    }
+    if let Some(a) = &r.accuracy {
+        doc["error_estimate"] = json!(a.estimates);
+        doc["accuracy"] = json!({
+            "target": a.target,
+            "basis": "the change of the observed extremes against H/2 solved from the truncated \
+                      point, times 1/(2^p - 1) with p = HB_ORDER",
+            "order": semismooth_contact::solve::accuracy::HB_ORDER,
+            "points_met": a.met(),
+            "worst_estimate": a.worst(),
+            "raises": a.raises,
+            "lowers": a.lowers,
+            "failed_raises": a.failed_raises,
+            "max_harmonics": a.max_harmonics,
+            "estimate_seconds": a.estimate_seconds,
+            "estimate_counters": newton_counters(&a.estimate_counters),
+        });
+    }
+    doc
 }
 
 /// The JSON of `ssn solutions --json`: `omega`, `omega_ratio`, `window`,

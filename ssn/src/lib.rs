@@ -5,6 +5,7 @@
 
 pub mod accuracy_cost;
 pub mod accuracy_targets;
+pub mod adaptive_sweeps;
 pub mod cli;
 pub mod describe;
 pub mod exit;

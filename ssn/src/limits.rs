@@ -22,7 +22,8 @@
 //! none is known nothing is refused.
 //!
 //! A run that fits in memory can still take hours: [`run_work`] estimates the operations of
-//! its dense factorizations, refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
+//! one solve (its factorizations, the matrix-free path's GMRES, the error estimate's second
+//! solve), refused above `SSN_WORK_LIMIT` (default [`DEFAULT_WORK_LIMIT`]).
 
 use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
 use semismooth_contact::model::Structure;
@@ -331,14 +332,28 @@ pub struct WorkEstimate {
 /// growth of more than 10 for 2 in H; `S^3` alone gives 8), on 2 loaded cores (load 11-13).
 pub const PENALTY_JACOBIAN_FLOPS: f64 = 0.09;
 
-/// Factorizations counted for a Newton solve (an estimate: the solves from zero of the shipped
-/// scenes take 7 to 14 Newton iterations, one factorization each).
+/// Newton iterations counted for a solve from zero with one contact (an estimate: the shipped
+/// scenes take 7 to 13, one factorization each).
 const NEWTON_FACTORIZATIONS: f64 = 10.0;
 
-/// Newton iterations counted for a solve on the matrix-free path (many contacts): from
-/// zero, the rod of 1,000 elements with 50 and 200 evenly spaced stops (gap 0.5, H = 20)
-/// took 49 and 38.
-pub const MATRIX_FREE_NEWTON_ITERATIONS: f64 = 50.0;
+/// Newton iterations counted for a solve from zero with two contacts or more, and on the
+/// matrix-free path: `scenes/two_contacts.toml` took 43, the rod of 1,000 elements with 5,
+/// 10, 20 and 40 evenly spaced stops (gap 0.5, H = 20) 48, 48, 47 and 52 (Newton stalls and
+/// the smoothing strategy takes over), with 50 and 200 stops (matrix-free) 49 and 38.
+pub const SEVERAL_CONTACTS_NEWTON_ITERATIONS: f64 = 50.0;
+
+/// Newton iterations counted for the error estimate's second solve, started from the first
+/// solve's state at the comparison's discretisation: measured 1 to 9 on the shipped scenes
+/// and the rod with 5 to 50 stops (102 with 40 stops, an outlier the count leaves out).
+pub const ERROR_ESTIMATE_NEWTON_ITERATIONS: f64 = 10.0;
+
+/// Operations of one iteration of the structured solver beyond the condensed LU, per unit
+/// of `N (H + 1) (m + 4)`: the receptance's `m` columns in each harmonic and about four
+/// sweeps of the per-harmonic solves (residual, step, outputs). Measured on the rod of
+/// 1,000 elements at H = 20 (CPU time, a load of 6 on 2 cores, 2.3e10 operations per
+/// second): 5, 10 and 20 stops took 2.1e8, 3.2e8 and 8.1e8 operations an iteration, of
+/// which the condensed LU 5.7e6, 4.6e7 and 3.7e8: 900 per unit fits all three within 25 %.
+pub const STRUCTURED_ITERATION_FLOPS: f64 = 900.0;
 
 /// GMRES iterations per Newton iteration and contact on the matrix-free path, between
 /// [`KRYLOV_ITERATIONS_PER_NEWTON_MIN`] and [`KRYLOV_ITERATIONS_PER_NEWTON_MAX`] (the contact
@@ -393,8 +408,13 @@ struct MatrixFreeIteration {
 /// iterations of [`KRYLOV_PRODUCT_FLOPS`] `(N (H + 1) + m S^2 + m S min(k, 200) / 2)`,
 /// the contact blocks' LU `(2/3) m S^3`, and
 /// [`DENSE_PRECONDITIONER_FACTORIZATIONS_PER_ITERATION`] dense LUs `(2/3) (m S)^3` where
-/// GMRES may fall back on them.
-fn matrix_free_iteration(n: f64, m: f64, harmonics: usize) -> MatrixFreeIteration {
+/// GMRES may fall back on them (when `preconditioner_factorizations`).
+fn matrix_free_iteration(
+    n: f64,
+    m: f64,
+    harmonics: usize,
+    preconditioner_factorizations: bool,
+) -> MatrixFreeIteration {
     let h = harmonics as f64;
     let s = 2.0 * h + 1.0;
     let krylov = if m < 2.0 {
@@ -408,7 +428,9 @@ fn matrix_free_iteration(n: f64, m: f64, harmonics: usize) -> MatrixFreeIteratio
     let basis = krylov.min(200.0) / 2.0;
     let product = KRYLOV_PRODUCT_FLOPS * (n * (h + 1.0) + m * s * s + m * s * basis);
     let unknowns = m * s;
-    let dense = if m >= 2.0 && unknowns <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64
+    let dense = if preconditioner_factorizations
+        && m >= 2.0
+        && unknowns <= semismooth_contact::hb::DENSE_PRECONDITIONER_LIMIT as f64
     {
         DENSE_PRECONDITIONER_FACTORIZATIONS_PER_ITERATION * 2.0 / 3.0 * unknowns.powi(3)
     } else {
@@ -437,8 +459,8 @@ fn matrix_free(contacts: usize, settings: &SolverSettings) -> bool {
 /// contacts with `settings` (0 off the matrix-free path).
 pub fn estimated_krylov_iterations(dofs: usize, contacts: usize, settings: &SolverSettings) -> f64 {
     if matrix_free(contacts, settings) {
-        MATRIX_FREE_NEWTON_ITERATIONS
-            * matrix_free_iteration(dofs as f64, contacts as f64, settings.harmonics).krylov
+        SEVERAL_CONTACTS_NEWTON_ITERATIONS
+            * matrix_free_iteration(dofs as f64, contacts as f64, settings.harmonics, true).krylov
     } else {
         0.0
     }
@@ -453,28 +475,108 @@ pub(crate) fn counted_newton_iterations(contacts: usize, settings: &SolverSettin
         {
             settings.max_iterations as f64
         }
-        _ if matrix_free(contacts, settings) => MATRIX_FREE_NEWTON_ITERATIONS,
+        _ if matrix_free(contacts, settings) => SEVERAL_CONTACTS_NEWTON_ITERATIONS,
+        Method::SsnHb => newton_iterations(contacts),
         _ => NEWTON_FACTORIZATIONS,
     }
 }
 
-/// Default limit of [`work_limit`]: 1e14 operations, about 70 minutes at the 2.3e10
-/// operations per second that faer's dense LU reached on a 2-core machine (a factorization
-/// of 8241 unknowns, 3.7e11 operations, in 16 s).
-pub const DEFAULT_WORK_LIMIT: f64 = 1e14;
+/// Newton iterations counted for an SSN-HB solve from zero off the matrix-free path:
+/// [`NEWTON_FACTORIZATIONS`] with one contact, [`SEVERAL_CONTACTS_NEWTON_ITERATIONS`] with
+/// more.
+fn newton_iterations(contacts: usize) -> f64 {
+    if contacts >= 2 {
+        SEVERAL_CONTACTS_NEWTON_ITERATIONS
+    } else {
+        NEWTON_FACTORIZATIONS
+    }
+}
 
-/// Estimated work of one run: `NEWTON_FACTORIZATIONS` dense LU factorizations of
-/// `(2/3) n^3` operations each, `n` the unknowns of the dense Jacobian (the dense solver:
-/// `(N + m) S` for SSN-HB, `N S` for penalty HB) or of the condensed contact system (the
-/// structured solver: `m S`), `S = 2H + 1`. The sparse per-harmonic factorizations, the
-/// FFTs, the LCP and time marching are not the danger here and count as 0.
+/// One iteration of the structured solver with the condensed system factored dense on `n`
+/// dofs and `m` contacts: its LU `(2/3) (m S)^3` and [`STRUCTURED_ITERATION_FLOPS`]
+/// `N (H + 1) (m + 4)`.
+fn dense_condensed_iteration(n: f64, m: f64, harmonics: usize) -> f64 {
+    let h = harmonics as f64;
+    2.0 / 3.0 * (m * (2.0 * h + 1.0)).powi(3)
+        + STRUCTURED_ITERATION_FLOPS * n * (h + 1.0) * (m + 4.0)
+}
+
+/// Operations per second the estimates are counted in: faer's dense LU on a 2-core machine
+/// (a factorization of 8241 unknowns, 3.7e11 operations, in 16 s).
+pub const OPERATIONS_PER_SECOND: f64 = 2.3e10;
+
+/// Default limit of [`work_limit`]: 1e12 operations, about 43 s at
+/// [`OPERATIONS_PER_SECOND`]. The lowest round value that leaves a factor 3 for the
+/// estimates' error above every shipped scene's `solve`, `sweep`, `solutions`, `compare`
+/// and `scene-check` (2.5e11 at most: `compare` on the beams), the documentation's runs and
+/// the tests', and refuses the natural frequencies of a rod of 1e6 elements (2.6e12,
+/// measured 88 s) and the branches that take a quarter of an hour or more.
+pub const DEFAULT_WORK_LIMIT: f64 = 1e12;
+
+/// Estimated work of one run ([`solve_work`] on a rod of `elements` elements).
 pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
-    size_work(
+    solve_work(
         elements,
         contacts,
         settings,
         "solver.linear_solver, solver.harmonics, rod.elements",
     )
+}
+
+/// Estimated work of one solve with its error estimate: [`size_work`] and
+/// [`error_estimate_work`].
+pub(crate) fn solve_work(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+    dense_keys: &'static str,
+) -> WorkEstimate {
+    let mut work = size_work(dofs, contacts, settings, dense_keys);
+    if let Some((harmonics, flops)) = error_estimate_work(dofs, contacts, settings) {
+        work.flops += flops;
+        work.what += &format!(", and the error estimate's solve at H = {harmonics} ({flops:.1e})");
+    }
+    work
+}
+
+/// The error estimate's second solve of an SSN-HB run on the structured solver: at `2H`
+/// (at `H / 2` beyond the search's `MAX_SEARCH_UNKNOWNS` unknowns, none below `H = 2`),
+/// [`ERROR_ESTIMATE_NEWTON_ITERATIONS`] iterations of its path (the matrix-free path
+/// without the dense preconditioner's factorizations: the first solve's state leaves GMRES
+/// few iterations). Its harmonics and operations; `None` where no such solve runs.
+fn error_estimate_work(
+    dofs: usize,
+    contacts: usize,
+    settings: &SolverSettings,
+) -> Option<(usize, f64)> {
+    let runs = settings.method == Method::SsnHb
+        && settings.linear_solver != LinearSolverChoice::Dense
+        && settings.estimate_error
+        && settings.accuracy.is_none()
+        && contacts > 0;
+    if !runs {
+        return None;
+    }
+    let h = settings.harmonics;
+    let width = dofs.saturating_add(contacts);
+    let finer = width.saturating_mul(4 * h + 1)
+        <= semismooth_contact::accuracy::search::MAX_SEARCH_UNKNOWNS;
+    let harmonics = match (finer, h) {
+        (true, _) => 2 * h,
+        (false, h) if h >= 2 => h / 2,
+        _ => return None,
+    };
+    let other = SolverSettings {
+        harmonics,
+        ..settings.clone()
+    };
+    let (n, m) = (dofs as f64, contacts as f64);
+    let iteration = if matrix_free(contacts, &other) {
+        matrix_free_iteration(n, m, harmonics, false).flops
+    } else {
+        dense_condensed_iteration(n, m, harmonics)
+    };
+    Some((harmonics, ERROR_ESTIMATE_NEWTON_ITERATIONS * iteration))
 }
 
 /// [`run_work`] for a model of `dofs` dofs and `contacts` contacts; `dense_keys`: the keys a
@@ -487,7 +589,6 @@ pub(crate) fn size_work(
 ) -> WorkEstimate {
     let (n, m) = (dofs as f64, contacts as f64);
     let s = 2.0 * settings.harmonics as f64 + 1.0;
-    let lu = |unknowns: f64| NEWTON_FACTORIZATIONS * 2.0 / 3.0 * unknowns.powi(3);
     match (settings.method, settings.linear_solver) {
         (Method::SsnHb | Method::PenaltyHb, LinearSolverChoice::Dense) => {
             let unknowns = if settings.method == Method::SsnHb {
@@ -495,10 +596,14 @@ pub(crate) fn size_work(
             } else {
                 n * s
             };
+            let count = match settings.method {
+                Method::SsnHb => newton_iterations(contacts),
+                _ => NEWTON_FACTORIZATIONS,
+            };
             WorkEstimate {
-                flops: lu(unknowns),
+                flops: count * 2.0 / 3.0 * unknowns.powi(3),
                 what: format!(
-                    "{NEWTON_FACTORIZATIONS} LU factorizations of a dense Jacobian on \
+                    "{count} LU factorizations of a dense Jacobian on \
                      {unknowns:.0} unknowns (solver.linear_solver = \"dense\"; \"structured\" \
                      factors per harmonic)"
                 ),
@@ -507,11 +612,11 @@ pub(crate) fn size_work(
         }
         // Above the threshold (or on request) the condensed system is solved matrix-free.
         (Method::SsnHb, _) if matrix_free(contacts, settings) => {
-            let iteration = matrix_free_iteration(n, m, settings.harmonics);
+            let iteration = matrix_free_iteration(n, m, settings.harmonics, true);
             WorkEstimate {
-                flops: MATRIX_FREE_NEWTON_ITERATIONS * iteration.flops,
+                flops: SEVERAL_CONTACTS_NEWTON_ITERATIONS * iteration.flops,
                 what: format!(
-                    "{MATRIX_FREE_NEWTON_ITERATIONS} Newton iterations of a matrix-free solve of \
+                    "{SEVERAL_CONTACTS_NEWTON_ITERATIONS} Newton iterations of a matrix-free solve of \
                      the condensed contact system on {:.0} unknowns, each {:.1e} operations: \
                      {:.0} GMRES iterations of {:.1e}, the contact blocks' factorizations{}",
                     m * s,
@@ -550,15 +655,18 @@ pub(crate) fn size_work(
             LinearSolverChoice::Structured
             | LinearSolverChoice::CondensedDense
             | LinearSolverChoice::CondensedKrylov,
-        ) => WorkEstimate {
-            flops: lu(m * s),
-            what: format!(
-                "{NEWTON_FACTORIZATIONS} LU factorizations of the condensed contact system \
-                 on {:.0} unknowns",
-                m * s
-            ),
-            keys: "solver.harmonics and the number of contacts",
-        },
+        ) => {
+            let iterations = newton_iterations(contacts);
+            WorkEstimate {
+                flops: iterations * dense_condensed_iteration(n, m, settings.harmonics),
+                what: format!(
+                    "{iterations} Newton iterations, each an LU factorization of the condensed \
+                     contact system on {:.0} unknowns and the per-harmonic solves of {dofs} dofs",
+                    m * s
+                ),
+                keys: "solver.harmonics and the number of contacts",
+            }
+        }
         _ => WorkEstimate {
             flops: 0.0,
             what: "no dense factorization".into(),
@@ -581,15 +689,52 @@ pub fn work_limit() -> Result<f64, String> {
 pub fn check_work(need: &WorkEstimate, limit: f64) -> Result<(), String> {
     if need.flops.is_nan() || need.flops > limit {
         Err(format!(
-            "these settings need about {:.1e} floating-point operations ({}), more than the \
-             limit of {limit:.1e} (SSN_WORK_LIMIT, default {DEFAULT_WORK_LIMIT:.0e}: about 70 \
-             minutes on 2 cores): allowed are settings whose estimate is within the limit; \
-             reduce {}, or raise SSN_WORK_LIMIT",
-            need.flops, need.what, need.keys
+            "these settings need about {:.1e} floating-point operations ({}; {} on a 2-core \
+             machine at {OPERATIONS_PER_SECOND:.1e} operations per second), more than the \
+             limit of {limit:.1e} (SSN_WORK_LIMIT, default {DEFAULT_WORK_LIMIT:.0e}: {}): \
+             allowed are settings whose estimate is within the limit; reduce {}{}",
+            need.flops,
+            need.what,
+            duration_words(need.flops / OPERATIONS_PER_SECOND),
+            duration_words(DEFAULT_WORK_LIMIT / OPERATIONS_PER_SECOND),
+            need.keys,
+            match round_up(need.flops) {
+                Some(limit) =>
+                    format!(", or raise the limit for this run: SSN_WORK_LIMIT={limit} ssn ..."),
+                None => String::new(),
+            },
         ))
     } else {
         Ok(())
     }
+}
+
+/// A duration in seconds in words: `about 45 s`, `about 13 minutes`, `about 2.5 hours`,
+/// `about 3 days`; `longer than can be counted` beyond any of them.
+fn duration_words(seconds: f64) -> String {
+    match seconds {
+        s if !s.is_finite() || s > 1e6 * 86400.0 => "longer than can be counted".into(),
+        s if s < 1.0 => "under a second".into(),
+        s if s < 120.0 => format!("about {s:.0} s"),
+        s if s < 7200.0 => format!("about {:.0} minutes", s / 60.0),
+        s if s < 2.0 * 86400.0 => format!("about {:.1} hours", s / 3600.0),
+        s => format!("about {:.0} days", s / 86400.0),
+    }
+}
+
+/// `x > 0` rounded up to one significant digit, as `2e13` (a limit that lets `x` run);
+/// `None` for a need no limit lets run (not finite, or beyond the largest float).
+fn round_up(x: f64) -> Option<String> {
+    let exponent = x.log10().floor();
+    let digit = (x / 10f64.powf(exponent)).ceil();
+    let (digit, exponent) = if digit >= 10.0 {
+        (1.0, exponent + 1.0)
+    } else {
+        (digit, exponent)
+    };
+    (digit * 10f64.powf(exponent))
+        .is_finite()
+        .then(|| format!("{digit}e{exponent}"))
 }
 
 /// `settings`, or those of the comparison's SSN-HB reference run when `compare`.
@@ -682,17 +827,22 @@ mod tests {
         for word in [
             "solver.linear_solver",
             "2.3e14",
-            "1.0e14",
-            "SSN_WORK_LIMIT",
+            "1.0e12",
+            "SSN_WORK_LIMIT=3e14",
+            "about 2.8 hours",
             "32481",
         ] {
             assert!(e.contains(word), "{word}: {e}");
         }
-        // What the tests and examples run stays allowed: the dense solver at 200 elements,
-        // H = 20 (3.7e12), the structured one at 10,000 elements with 100 contacts.
-        assert!(check_work(&run_work(200, 1, &settings(Method::SsnHb, 20, true)), 1e14).is_ok());
-        let many = run_work(10_000, 100, &settings(Method::SsnHb, 20, false));
-        assert!(check_work(&many, DEFAULT_WORK_LIMIT).is_ok(), "{many:?}");
+        // The dense solver at 100 elements, H = 20 (4.7e11) stays allowed, as does the
+        // structured one at 10,000 elements with one contact.
+        assert!(check_work(
+            &run_work(100, 1, &settings(Method::SsnHb, 20, true)),
+            DEFAULT_WORK_LIMIT
+        )
+        .is_ok());
+        let long = run_work(10_000, 1, &settings(Method::SsnHb, 20, false));
+        assert!(check_work(&long, DEFAULT_WORK_LIMIT).is_ok(), "{long:?}");
         assert!(
             check_work(&dense, 1e15).is_ok(),
             "a raised limit lets it run"
@@ -707,7 +857,7 @@ mod tests {
         let near = run_work(1000, 1, &settings(Method::PenaltyHb, 200, false));
         let measured = 37.8 * 2.3e10;
         assert!((measured..3.0 * measured).contains(&near.flops), "{near:?}");
-        assert!(check_work(&near, DEFAULT_WORK_LIMIT).is_ok());
+        assert!(check_work(&near, 3.0 * measured).is_ok());
         // H = 2000: about 1000 times H = 200 (more than 10 times from 200 to 400 measured).
         let big = run_work(1000, 1, &settings(Method::PenaltyHb, 2000, false));
         let e = check_work(&big, DEFAULT_WORK_LIMIT).unwrap_err();
@@ -736,19 +886,52 @@ mod tests {
         let many = size_work(10_002, 1000, &settings(Method::SsnHb, 20, false), "");
         assert!((1e12..1e14).contains(&many.flops), "{many:?}");
         assert!(many.what.contains("GMRES iterations"), "{many:?}");
-        // At the threshold the condensed system is still factored dense.
+        // At the threshold the condensed system is still factored dense, at every one of
+        // the 50 Newton iterations counted with several contacts.
         let dense_condensed = size_work(10_002, 40, &settings(Method::SsnHb, 20, false), "");
         let n: f64 = 40.0 * 41.0;
-        assert!((dense_condensed.flops - 10.0 * 2.0 / 3.0 * n.powi(3)).abs() <= 1e-9 * n.powi(3));
+        assert!(dense_condensed.flops >= 50.0 * 2.0 / 3.0 * n.powi(3));
+        assert!(
+            dense_condensed.what.contains("on 1640 unknowns"),
+            "{dense_condensed:?}"
+        );
+    }
+
+    #[test]
+    fn the_dense_condensed_path_is_estimated_within_a_factor_three_of_its_measured_runs() {
+        // The rod of 1,000 elements with m evenly spaced stops (gap 0.5, H = 20), from zero,
+        // with its error estimate: CPU seconds of `ssn solve` (a load of 6 on 2 cores) at
+        // 2.3e10 operations per second. The solves took 48, 48 and 47 Newton iterations (50
+        // counted), their error estimates' solves at H = 40 4, 3 and 9 (10 counted).
+        for (m, seconds) in [(5, 0.52), (10, 0.81), (20, 3.04), (20, 1.58)] {
+            let settings = settings(Method::SsnHb, 20, false);
+            let work = run_work(1000, m, &settings);
+            let measured = seconds * 2.3e10;
+            assert!(
+                (measured / 3.0..3.0 * measured).contains(&work.flops),
+                "{m} contacts: {work:?} against {measured:e}"
+            );
+            assert!(
+                work.what.contains("error estimate's solve at H = 40"),
+                "{work:?}"
+            );
+        }
+        // Without an error estimate only the solve is counted.
+        let mut alone = settings(Method::SsnHb, 20, false);
+        alone.estimate_error = false;
+        let with = run_work(1000, 20, &settings(Method::SsnHb, 20, false)).flops;
+        let without = run_work(1000, 20, &alone).flops;
+        assert!(without < 0.6 * with, "{without:e} {with:e}");
     }
 
     #[test]
     fn the_matrix_free_path_is_estimated_within_a_factor_three_of_its_measured_runs() {
         // The rod of 1,000 elements with m evenly spaced stops (gap 0.5, H = 20), from
         // zero: GMRES iterations (the `krylov_iterations` counter) and CPU seconds
-        // (a load of 5 on 2 cores) measured, converted at 2.3e10 operations per second.
+        // (a load of 5 on 2 cores) measured, converted at 2.3e10 operations per second. 50
+        // stops took 13.3 s and 19.5 s (a load of 6) in two runs: their mean.
         for (m, krylov, seconds) in [
-            (50, 2370.0, 13.3),
+            (50, 2370.0, 16.4),
             (200, 9264.0, 30.2),
             (1000, 10617.0, 194.0),
         ] {
@@ -764,8 +947,16 @@ mod tests {
                 (measured / 3.0..3.0 * measured).contains(&work),
                 "{m} contacts: {work:e} against {measured:e}"
             );
-            assert!(check_work(&run_work(1000, m, &settings), DEFAULT_WORK_LIMIT).is_ok());
         }
+        // The default limit lets 50 stops run (13 to 20 s) and refuses 200 (30 s, estimated
+        // 1.6e12) and 1,000 (194 s).
+        let default = |m| {
+            check_work(
+                &run_work(1000, m, &settings(Method::SsnHb, 20, false)),
+                DEFAULT_WORK_LIMIT,
+            )
+        };
+        assert!(default(50).is_ok() && default(200).is_err() && default(1000).is_err());
         // Below the threshold nothing is counted for GMRES; `condensed-krylov` asks for it.
         let mut small = settings(Method::SsnHb, 20, false);
         assert_eq!(estimated_krylov_iterations(1001, 20, &small), 0.0);

@@ -22,7 +22,12 @@ Exit codes:
   0  converged (or, for scene-check, a valid scene)
   1  the solver ran but did not converge (its JSON is still printed, with converged = false)
   2  bad input (scene file, option): the message names the file, the key and what is allowed
-  3  an output file or directory could not be written (nothing half-written is left)";
+  3  an output file or directory could not be written (nothing half-written is left)
+
+Limits (a run beyond either is refused up front with exit code 2, naming the keys to reduce):
+  SSN_WORK_LIMIT    operations a run may take, default 1e12 (about 43 s on a 2-core machine
+                    at 2.3e10 per second); SSN_WORK_LIMIT=1 shows any run's estimate unrun
+  SSN_MEMORY_LIMIT  bytes a run may use, default the memory available (MemAvailable)";
 
 #[derive(Parser, Debug)]
 #[command(

@@ -129,6 +129,12 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
         if let Some(missed) = incomplete(&set) {
             t += &format!("  incomplete search: {missed}\n");
         }
+        if set.counters.krylov_iterations > 0 {
+            t += &format!(
+                "  work: {} GMRES iterations (matrix-free condensed solves)\n",
+                set.counters.krylov_iterations
+            );
+        }
         if !set.solutions.is_empty() {
             t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
                   starts from solution K)\n";

@@ -32,7 +32,7 @@ pub struct Section {
 /// cheapest setting per accuracy, the discretisation chosen for an accuracy target, the
 /// frequency sweeps, the public grid from zero, what the
 /// examples time, the hard cases from zero (minutes), and the friction tables.
-pub const SECTIONS: [Section; 8] = [
+pub const SECTIONS: [Section; 9] = [
     Section {
         name: "methods",
         file: "docs/method-comparison.md",
@@ -47,6 +47,10 @@ pub const SECTIONS: [Section; 8] = [
     },
     Section {
         name: "sweeps",
+        file: "docs/sweeps.md",
+    },
+    Section {
+        name: "adaptive-sweeps",
         file: "docs/sweeps.md",
     },
     Section {
@@ -723,6 +727,71 @@ pub fn performance() -> Result<Table, TableError> {
         format!("{:.3}", lemke.solve_seconds),
     ]);
     Ok(table)
+}
+
+/// The table of adaptive sweeps against the fixed harmonics reaching the same worst error
+/// ([`crate::adaptive_sweeps`]), one row per `(label, comparison)`: points, harmonics used
+/// (range and mean), the worst error against the references and the worst estimate, the
+/// points meeting the target, the references' harmonics, the largest ratios of error to
+/// estimate and of estimate to error, the fixed
+/// harmonics, their worst error and points; the wall times and their ratio are the timing
+/// columns.
+pub fn adaptive_sweeps(rows: &[(String, crate::adaptive_sweeps::AdaptiveComparison)]) -> Table {
+    let mut table = Table::new(
+        &[
+            "rod, target",
+            "points",
+            "H per point (mean)",
+            "worst error",
+            "worst estimate",
+            "points meeting",
+            "reference H",
+            "error / estimate at most",
+            "estimate / error at most",
+            "folds",
+            "fixed H",
+            "its worst error",
+            "its points",
+            "its folds",
+            "seconds adaptive",
+            "seconds fixed",
+            "cost ratio",
+        ],
+        &[14, 15, 16],
+    );
+    let folds = |f: &[f64]| {
+        f.iter()
+            .map(|w| format!("{w:.5}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for (label, c) in rows {
+        let fixed = c.fixed.as_ref();
+        table.rows.push(vec![
+            format!("{label}, {:.0e}", c.target),
+            c.points.to_string(),
+            format!(
+                "{} to {} ({:.1})",
+                c.harmonics.0, c.harmonics.1, c.mean_harmonics
+            ),
+            format!("{:.1e}", c.worst_error()),
+            format!("{:.1e}", c.worst_estimate()),
+            format!("{} of {}", c.met(), c.points),
+            c.reference_harmonics.to_string(),
+            format!("{:.2}", c.worst_underestimate()),
+            format!("{:.1}", c.worst_overestimate()),
+            folds(&c.folds),
+            fixed.map_or("none".to_string(), |f| f.harmonics.to_string()),
+            fixed.map_or("-".to_string(), |f| format!("{:.1e}", f.worst_error)),
+            fixed.map_or("-".to_string(), |f| f.points.to_string()),
+            fixed.map_or("-".to_string(), |f| folds(&f.folds)),
+            format!("{:.2}", c.seconds),
+            fixed.map_or("-".to_string(), |f| format!("{:.2}", f.seconds)),
+            c.cost_ratio()
+                .map_or("-".to_string(), |r| format!("{r:.2}")),
+        ]);
+    }
+    table
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
 use semismooth_contact::solve::{Diagnosis, Solution, Termination};
 use semismooth_contact::stability::Undecided;
+use semismooth_contact::sweep::adaptive::BranchAccuracy;
 use semismooth_contact::sweep::fold_accuracy::{FoldAccuracy, FoldStop};
 use semismooth_contact::sweep::{FrequencyResponse, SweepTermination};
 
@@ -351,5 +352,26 @@ pub fn fold_accuracy(fold: &FoldAccuracy, omega_1: f64) -> String {
         fold.harmonics(),
         fold.rungs.first().map_or(0, |r| r.harmonics),
         fold.sweep_omega / omega_1,
+    )
+}
+
+/// The lines of `ssn sweep` on a branch whose harmonics were chosen point by point: the
+/// range of harmonics, how many points meet the target and the largest estimate.
+pub fn branch_accuracy(accuracy: &BranchAccuracy, harmonics: &[usize]) -> String {
+    let lo = harmonics.iter().min().copied().unwrap_or(0);
+    let hi = harmonics.iter().max().copied().unwrap_or(0);
+    format!(
+        "harmonics         {lo} to {hi} chosen per point for the accuracy {:e} \
+         ({} raised, {} lowered; in --json as harmonics)\n\
+         error estimate    {} of {} points meet it, the largest {} (against H/2; in --json \
+         as error_estimate)\n",
+        accuracy.target,
+        accuracy.raises,
+        accuracy.lowers,
+        accuracy.met(),
+        accuracy.estimates.len(),
+        accuracy
+            .worst()
+            .map_or("not estimated".to_string(), |w| format!("{w:.2e}")),
     )
 }

@@ -98,7 +98,9 @@ fn an_accuracy_with_a_discretisation_given_too_is_bad_input_naming_both() {
 
 #[test]
 fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics() {
-    let path = scene("sweep", "method = \"ssn-hb\"\naccuracy = 1e-3\n");
+    // 1e-2: the harmonics chosen per point stay below 100 (1e-3 takes about 250 over the
+    // resonance of this rod).
+    let path = scene("sweep", "method = \"ssn-hb\"\naccuracy = 1e-2\n");
     let text = std::fs::read_to_string(&path)
         .unwrap()
         .replace("amplitude = 0.04", "amplitude = 0.2")
@@ -110,6 +112,20 @@ fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics
         .unwrap();
     let json: Value = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
     assert_eq!(out.status.code(), Some(0), "{json}");
+    // The harmonics chosen point by point, each point with its estimate within the target
+    // (the estimates are checked against refined solves in contact/tests/adaptive_sweep.rs).
+    let points = json["points"].as_u64().unwrap() as usize;
+    let harmonics = json["harmonics"].as_array().expect("harmonics per point");
+    let estimates = json["error_estimate"].as_array().expect("error_estimate");
+    assert_eq!((harmonics.len(), estimates.len()), (points, points));
+    // (null where the solve at H/2 did not converge).
+    assert!(
+        estimates
+            .iter()
+            .all(|e| e.as_f64().is_none_or(|e| e <= 1e-2)),
+        "{json}"
+    );
+    assert!(json["accuracy"]["points_met"].as_u64().unwrap() as usize + 2 >= points);
     let folds = json["fold_accuracy"].as_array().expect("fold_accuracy");
     let swept = json["folds"].as_array().unwrap();
     assert_eq!(folds.len(), swept.len());
@@ -118,7 +134,7 @@ fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics
         assert_eq!(fold["met"], true, "{fold}");
         let omega = fold["omega_ratio"].as_f64().unwrap();
         let uncertainty = fold["uncertainty_ratio"].as_f64().unwrap();
-        assert!(uncertainty <= 1e-3 * omega, "{fold}");
+        assert!(uncertainty <= 1e-2 * omega, "{fold}");
         let rungs = fold["rungs"].as_array().unwrap();
         assert!(rungs.len() >= 2, "{fold}");
         assert_eq!(
@@ -126,7 +142,7 @@ fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics
             rungs.last().unwrap()["harmonics"],
             "{fold}"
         );
-        // The refinement starts from the sweep's own fold at the scene's harmonics.
+        // The refinement starts from the sweep's own fold at its point's harmonics.
         assert_eq!(rungs[0]["omega_ratio"], fold["sweep_omega_ratio"], "{fold}");
     }
 }

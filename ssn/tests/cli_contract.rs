@@ -683,7 +683,7 @@ fn a_run_that_cannot_finish_in_time_is_refused_with_its_work_estimate() {
         path,
         "solver.linear_solver",
         "2.3e14",
-        "1.0e14",
+        "1.0e12",
         "SSN_WORK_LIMIT",
     ] {
         assert!(err(&o).contains(word), "{word}: {}", err(&o));

@@ -181,19 +181,29 @@ pub fn branch_stability(
             Undecided::NotHarmonicBalance(settings.method),
         ));
     }
-    // The reconstructions over one period do not depend on the frequency: any valid one.
-    let reconstruction =
-        Reconstruction::new(model, rod.omega_1, settings).map_err(|e| match e {
-            RunError::HarmonicBalance(e) => StabilityError::Hb(e),
-            _ => StabilityError::InvalidOption {
-                name: "method",
-                value: f64::NAN,
-                allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
-            },
-        })?;
-    let mut analysis = HbStability::new(model, settings)?;
+    // The reconstructions over one period do not depend on the frequency: any valid one,
+    // with the point's harmonics (built again where they change along the branch).
+    let analysers = |settings: &SolverSettings| -> Result<_, StabilityError> {
+        let reconstruction =
+            Reconstruction::new(model, rod.omega_1, settings).map_err(|e| match e {
+                RunError::HarmonicBalance(e) => StabilityError::Hb(e),
+                _ => StabilityError::InvalidOption {
+                    name: "method",
+                    value: f64::NAN,
+                    allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
+                },
+            })?;
+        Ok((reconstruction, HbStability::new(model, settings)?))
+    };
+    let mut current = response.point_settings(settings, 0);
+    let (mut reconstruction, mut analysis) = analysers(&current)?;
     let mut analyses: Vec<Stability> = Vec::with_capacity(points);
     for (i, x) in response.states.iter().enumerate() {
+        let at = response.point_settings(settings, i);
+        if (at.harmonics, at.time_samples) != (current.harmonics, current.time_samples) {
+            (reconstruction, analysis) = analysers(&at)?;
+            current = at;
+        }
         let s = if multipliers {
             analysis.of(response.omega[i], x)?
         } else {

@@ -31,37 +31,53 @@ pub(super) fn branch_reports(
     let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
     let friction_points = model.friction.len();
     let points = response.output_points;
-    let hb = |problem: &dyn HbReconstruction| -> Result<BranchReports, RunError> {
-        let mut reports = Vec::with_capacity(response.states.len());
+    let report = |problem: &dyn HbReconstruction, x: &[f64]| -> Result<_, RunError> {
+        let forces = (0..contacts.len())
+            .map(|i| problem.contact_force(x, i, points))
+            .collect::<Result<Vec<_>, _>>()?;
+        let displacements = (0..contacts.len())
+            .map(|i| problem.row_displacement(x, i, points))
+            .collect::<Result<Vec<_>, _>>()?;
+        let closed = (0..contacts.len())
+            .map(|i| problem.closed_intervals(x, i))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut reports = contact_reports(&contacts, &forces, &displacements);
+        set_closed_fractions(&mut reports, &closed);
+        let friction = (0..friction_points)
+            .map(|f| Ok(problem.friction(x, f, points)?.summary))
+            .collect::<Result<Vec<_>, RunError>>()?;
+        Ok((reports, friction))
+    };
+    // The reconstructions over one period do not depend on the frequency: any valid one,
+    // with the point's harmonics (built again where they change along the branch).
+    let omega = rod.omega_1;
+    let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
+        Ok(match s.method {
+            Method::SsnHb => Box::new(SsnHb::new(model, omega, &hb_options(s))?),
+            _ => Box::new(penalty_problem(model, omega, s)?),
+        })
+    };
+    let hb = || -> Result<BranchReports, RunError> {
+        let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
+        let mut reports = Vec::with_capacity(response.points());
         let mut friction = Vec::new();
-        for x in &response.states {
-            let forces = (0..contacts.len())
-                .map(|i| problem.contact_force(x, i, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let displacements = (0..contacts.len())
-                .map(|i| problem.row_displacement(x, i, points))
-                .collect::<Result<Vec<_>, _>>()?;
-            let closed = (0..contacts.len())
-                .map(|i| problem.closed_intervals(x, i))
-                .collect::<Result<Vec<_>, _>>()?;
-            let mut point = contact_reports(&contacts, &forces, &displacements);
-            set_closed_fractions(&mut point, &closed);
+        for (i, x) in response.states.iter().enumerate() {
+            let at = response.point_settings(settings, i);
+            let key = (at.harmonics, at.time_samples);
+            if current.as_ref().is_none_or(|(k, _)| *k != key) {
+                current = Some((key, build(&at)?));
+            }
+            let (_, problem) = current.as_ref().expect("built above");
+            let (point, point_friction) = report(problem.as_ref(), x)?;
             reports.push(point);
             if friction_points > 0 {
-                friction.push(
-                    (0..friction_points)
-                        .map(|f| Ok(problem.friction(x, f, points)?.summary))
-                        .collect::<Result<Vec<_>, RunError>>()?,
-                );
+                friction.push(point_friction);
             }
         }
         Ok((reports, friction))
     };
-    // The reconstructions over one period do not depend on the frequency: any valid one.
-    let omega = rod.omega_1;
     match settings.method {
-        Method::SsnHb => hb(&SsnHb::new(model, omega, &hb_options(settings))?),
-        Method::PenaltyHb => hb(&penalty_problem(model, omega, settings)?),
+        Method::SsnHb | Method::PenaltyHb => hb(),
         Method::LcpSsn => {
             let m = contacts.len();
             let reports = response

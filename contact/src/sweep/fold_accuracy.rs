@@ -168,16 +168,20 @@ pub fn refine_folds(
             .find(|&j| (response.omega[j] - fold).abs() >= APPROACH * omega_1)
             .unwrap_or(0);
         let heading = fold - response.omega[start];
+        let at_fold = response.point_settings(settings, index);
         let mut rungs = vec![FoldRung {
-            harmonics: settings.harmonics,
-            time_samples: settings.time_samples,
+            harmonics: at_fold.harmonics,
+            time_samples: at_fold.time_samples,
             omega: fold,
             points: 0,
             seconds: 0.0,
         }];
         let mut uncertainty = None;
         // The start of the next rung: the branch point, then each rung's corrected start.
-        let mut from = (response.states[start].clone(), settings.harmonics);
+        let mut from = (
+            response.states[start].clone(),
+            response.point_settings(settings, start).harmonics,
+        );
         let stop = loop {
             let last = rungs.last().expect("one rung at least");
             let (h, nt) = (2 * last.harmonics, 2 * last.time_samples);

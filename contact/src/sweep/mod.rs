@@ -84,6 +84,7 @@
 //! Measured branch sizes, timings and limits are in `docs/sweeps.md` and
 //! `examples/lcp_sweep.rs`.
 
+pub mod adaptive;
 pub mod branch;
 mod contacts;
 pub mod fold_accuracy;
@@ -416,35 +417,10 @@ where
         .unwrap_or_else(|| (vec![0.0; n], WorkCounters::default()));
     let report = newton_options(settings).solve(problem, solver, &mut x, smoothing)?;
     work += report.counters;
-    let mut response = FrequencyResponse {
-        method: settings.method,
-        omega_1,
-        omega: Vec::new(),
-        tip_max: Vec::new(),
-        tip_min: Vec::new(),
-        amplitude: Vec::new(),
-        iterations: Vec::new(),
-        folds: Vec::new(),
-        fold_indices: Vec::new(),
-        corner_folds: Vec::new(),
-        corner_fold_indices: Vec::new(),
-        omega_from,
-        omega_to: sweep.omega_ratio_to * omega_1,
-        termination: SweepTermination::Unexplained,
-        solve_seconds: 0.0,
-        counters: RunCounters::from(work),
-        continuation: Default::default(),
-        initial_iterations: report.iterations,
-        restarts: 0,
-        corners: 0,
-        reference_amplitude: setup.u_ref,
-        output_points: setup.output_points,
-        states: Vec::new(),
-        stability: BranchStability::default(),
-        stability_seconds: 0.0,
-        contacts: Vec::new(),
-        friction: Vec::new(),
-    };
+    let mut response = FrequencyResponse::empty(settings.method, omega_1, sweep, setup.u_ref);
+    response.counters = RunCounters::from(work);
+    response.initial_iterations = report.iterations;
+    response.output_points = setup.output_points;
     if !report.converged() {
         response.termination = SweepTermination::StartNotConverged {
             termination: report.termination.clone(),
@@ -462,31 +438,16 @@ where
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
         response.push(omega, max, min, point.iterations, point.state);
+        if settings.method.is_harmonic_balance() {
+            response.harmonics.push(settings.harmonics);
+            response.time_samples.push(settings.time_samples);
+        }
         if let Some(report) = progress {
             report(response.points() - 1, omega / omega_1);
         }
     }
     let c = continuation.counters();
-    // The core tells folds from zigzags by their excursion (`fold_excursion`).
-    let mut events: Vec<(usize, f64, bool)> = continuation
-        .events()
-        .iter()
-        .filter_map(|event| match event {
-            ContinuationEvent::Fold { index, parameter } => Some((*index, *parameter, true)),
-            ContinuationEvent::Zigzag { index, parameter } => Some((*index, *parameter, false)),
-            _ => None,
-        })
-        .collect();
-    events.sort_by_key(|e| e.0);
-    for (index, omega, fold) in events {
-        if fold {
-            response.folds.push(omega);
-            response.fold_indices.push(index);
-        } else {
-            response.corner_folds.push(omega);
-            response.corner_fold_indices.push(index);
-        }
-    }
+    set_events(&mut response, continuation.events());
     let termination = continuation.termination().cloned();
     drop(continuation);
     let mut total = work;
@@ -496,16 +457,44 @@ where
     response.restarts = c.restarts as usize;
     response.corners = c.corners as usize;
     response.continuation = c;
-    response.termination = match termination {
+    response.termination = sweep_termination(termination);
+    response.solve_seconds = setup.started.elapsed().as_secs_f64();
+    Ok(response)
+}
+
+/// The folds (`fold_excursion` confirmed) and zigzags of a branch's `events`, in branch
+/// order, into `response`.
+fn set_events(response: &mut FrequencyResponse, events: &[ContinuationEvent]) {
+    let mut reversals: Vec<(usize, f64, bool)> = events
+        .iter()
+        .filter_map(|event| match event {
+            ContinuationEvent::Fold { index, parameter } => Some((*index, *parameter, true)),
+            ContinuationEvent::Zigzag { index, parameter } => Some((*index, *parameter, false)),
+            _ => None,
+        })
+        .collect();
+    reversals.sort_by_key(|e| e.0);
+    for (index, omega, fold) in reversals {
+        if fold {
+            response.folds.push(omega);
+            response.fold_indices.push(index);
+        } else {
+            response.corner_folds.push(omega);
+            response.corner_fold_indices.push(index);
+        }
+    }
+}
+
+/// A sweep's termination from its continuation's.
+fn sweep_termination(termination: Option<ContinuationTermination>) -> SweepTermination {
+    match termination {
         Some(
             ContinuationTermination::StartFailed { failure, .. }
             | ContinuationTermination::SegmentStartFailed { failure, .. },
         ) => SweepTermination::StartNotCorrected(failure),
         Some(t) => SweepTermination::Branch(t),
         None => SweepTermination::Unexplained,
-    };
-    response.solve_seconds = setup.started.elapsed().as_secs_f64();
-    Ok(response)
+    }
 }
 
 /// What a sweep reports while it runs ([`frequency_response`]'s `progress`).
@@ -537,6 +526,9 @@ pub enum SweepProgress {
 /// method cannot build); a branch that stopped early is an `Ok` curve with
 /// `converged = false` and the reason in `termination`.
 ///
+/// With [`SolverSettings::accuracy`] an SSN-HB branch chooses its harmonics point by point
+/// to meet it ([`adaptive`]; the scene's `harmonics` is then ignored).
+///
 /// Each point then gets its stability and contact diagnostics
 /// ([`crate::sweep::branch::branch_stability`], in [`FrequencyResponse::stability`]) unless
 /// [`SweepSettings::stability`] is off (the points are then undecided with
@@ -556,12 +548,13 @@ pub fn frequency_response(
             })
         }
     });
-    let mut response = follow_branch(
-        rod,
-        settings,
-        sweep,
-        branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64)),
-    )?;
+    let branch_progress = branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64));
+    let mut response = match settings.accuracy {
+        Some(target) if settings.method == Method::SsnHb => {
+            adaptive::adaptive_branch(rod, settings, sweep, target, branch_progress)?
+        }
+        _ => follow_branch(rod, settings, sweep, branch_progress)?,
+    };
     (response.contacts, response.friction) = contacts::branch_reports(rod, settings, &response)?;
     let started = Instant::now();
     let total = response.points();

@@ -5,8 +5,9 @@ use semismooth::harmonic::{Aft, FourierBasis};
 
 use crate::contacts::{ContactReport, FrictionSummary};
 use crate::hb::HbError;
-use crate::settings::Method;
+use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::{RunCounters, RunError};
+use crate::sweep::adaptive::BranchAccuracy;
 use crate::sweep::branch::BranchStability;
 
 /// One number of a [`ContactReport`].
@@ -75,6 +76,13 @@ pub struct FrequencyResponse {
     pub stability_seconds: f64,
     /// Every contact of each point, in the scene's order (as `ssn solve` reports them).
     pub contacts: Vec<Vec<ContactReport>>,
+    /// Harmonic balance: the harmonics of each point's state (empty for the LCP).
+    pub harmonics: Vec<usize>,
+    /// Harmonic balance: the AFT samples of each point (empty for the LCP).
+    pub time_samples: Vec<usize>,
+    /// With an accuracy target ([`SolverSettings::accuracy`], SSN-HB): the harmonics chosen
+    /// point by point and each point's error estimate ([`super::adaptive`]).
+    pub accuracy: Option<BranchAccuracy>,
     /// Every friction point of each point, in the model's order (stick fraction, force
     /// and slip velocity amplitudes, as `ssn solve` reports them).
     pub friction: Vec<Vec<FrictionSummary>>,
@@ -121,6 +129,54 @@ impl std::fmt::Display for SweepTermination {
 }
 
 impl FrequencyResponse {
+    /// A curve of `method` over `sweep` without points yet.
+    pub(super) fn empty(method: Method, omega_1: f64, sweep: &SweepSettings, u_ref: f64) -> Self {
+        Self {
+            method,
+            omega_1,
+            omega: Vec::new(),
+            tip_max: Vec::new(),
+            tip_min: Vec::new(),
+            amplitude: Vec::new(),
+            iterations: Vec::new(),
+            folds: Vec::new(),
+            fold_indices: Vec::new(),
+            corner_folds: Vec::new(),
+            corner_fold_indices: Vec::new(),
+            omega_from: sweep.omega_ratio_from * omega_1,
+            omega_to: sweep.omega_ratio_to * omega_1,
+            termination: SweepTermination::Unexplained,
+            solve_seconds: 0.0,
+            counters: RunCounters::default(),
+            continuation: Default::default(),
+            initial_iterations: 0,
+            restarts: 0,
+            corners: 0,
+            reference_amplitude: u_ref,
+            output_points: 0,
+            states: Vec::new(),
+            stability: BranchStability::default(),
+            stability_seconds: 0.0,
+            contacts: Vec::new(),
+            harmonics: Vec::new(),
+            time_samples: Vec::new(),
+            accuracy: None,
+            friction: Vec::new(),
+        }
+    }
+
+    /// `settings` with the harmonics and AFT samples of point `i` (as given for the LCP or
+    /// a point out of range).
+    pub fn point_settings(&self, settings: &SolverSettings, i: usize) -> SolverSettings {
+        let mut s = settings.clone();
+        if let (Some(&h), Some(&nt)) = (self.harmonics.get(i), self.time_samples.get(i)) {
+            s.harmonics = h;
+            s.time_samples = nt;
+        }
+        s.accuracy = None;
+        s
+    }
+
     /// Whether the branch reached the end of the sweep (`omega_to`).
     pub fn converged(&self) -> bool {
         matches!(

@@ -2,7 +2,10 @@
 //! corner passes, bound landing, the trust ball, restarts and piecewise-affine corners.
 
 mod affine;
+mod resume;
 mod step;
+
+pub use resume::Resumption;
 
 use std::collections::VecDeque;
 
@@ -19,7 +22,18 @@ use crate::newton::WorkCounters;
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters};
 
 enum Phase {
-    NotStarted { x0: Vec<f64>, p0: f64 },
+    NotStarted {
+        x0: Vec<f64>,
+        p0: f64,
+    },
+    /// Taken up from another run ([`Continuation::resume`]): the start is corrected on
+    /// the hyperplane through `(x0, p0)` normal to `carried` (else at fixed `p0`) and its
+    /// tangent oriented along `carried`.
+    Resuming {
+        x0: Vec<f64>,
+        p0: f64,
+        carried: Vec<f64>,
+    },
     Running,
     Finished,
 }
@@ -126,6 +140,9 @@ where
     last_tangent_parameter: f64,
     pending: VecDeque<BranchPoint>,
     pieces: Option<Pieces<P>>,
+    /// The next emitted point replaces the last point of the run taken up (it is already
+    /// in the fold detector).
+    replacing: bool,
 }
 
 impl<'a, P, S> Continuation<'a, P, S>
@@ -214,6 +231,7 @@ where
             last_tangent_parameter: 0.0,
             pending: VecDeque::new(),
             pieces: None,
+            replacing: false,
         })
     }
 
@@ -295,10 +313,13 @@ where
         }
     }
 
-    fn start(&mut self, x0: Vec<f64>, p0: f64) {
+    /// The run's first point: `(x0, p0)` corrected at fixed `p0`, the tangent oriented by
+    /// the options' direction, or for a resumed run corrected and oriented along `carried`.
+    fn start(&mut self, x0: Vec<f64>, p0: f64, carried: Option<&[f64]>) {
         let mut x = x0;
         let mut p = p0;
-        let corrected = match self.correct_start(&mut x, &mut p, self.options.direction) {
+        let orientation = (carried, self.options.direction);
+        let corrected = match self.correct_start(&mut x, &mut p, orientation) {
             Ok(c) => c,
             Err(failure) => {
                 self.problem.set_parameter(p0);
@@ -346,7 +367,7 @@ where
         if self.stop_if_budget_spent(parameter) {
             return;
         }
-        let corrected = match self.correct_start(&mut x, &mut p, direction) {
+        let corrected = match self.correct_start(&mut x, &mut p, (None, direction)) {
             Ok(c) => c,
             Err(failure) => {
                 let parameter = self.last.as_ref().map_or(p, |l| l.parameter);
@@ -427,10 +448,15 @@ where
             });
             self.counters.corners += 1;
         } else {
-            let events = self
-                .folds
-                .push(point.parameter, point.tangent_parameter, chord);
-            self.events.extend(events);
+            if std::mem::take(&mut self.replacing) {
+                self.folds
+                    .replace_last(point.parameter, point.tangent_parameter);
+            } else {
+                let events = self
+                    .folds
+                    .push(point.parameter, point.tangent_parameter, chord);
+                self.events.extend(events);
+            }
             self.last_tangent_parameter = point.tangent_parameter;
             self.set_trust(&point.state, point.parameter, point.step);
         }
@@ -724,7 +750,8 @@ where
                     self.events.extend(undecided);
                     return None;
                 }
-                Phase::NotStarted { x0, p0 } => self.start(x0, p0),
+                Phase::NotStarted { x0, p0 } => self.start(x0, p0, None),
+                Phase::Resuming { x0, p0, carried } => self.start(x0, p0, Some(&carried)),
                 Phase::Running => self.advance(),
             }
         }

@@ -115,21 +115,59 @@ where
         outcome
     }
 
-    /// Corrects `(x, p)` at fixed `p` and takes the tangent there, oriented so that `p`
-    /// moves as `direction` says.
+    /// Corrects `(x, p)` and takes the tangent there. A resumed run's start (`carried`
+    /// given) is corrected first on the hyperplane through `(x, p)` normal to `carried`
+    /// (regular at a fold, where the new problem's branch may not reach `p`), then, if
+    /// that fails, at fixed `p`; its tangent is oriented along `carried`. Any other start
+    /// is corrected at fixed `p`, its tangent oriented so that `p` moves as `direction`
+    /// says.
     pub(super) fn correct_start(
         &mut self,
         x: &mut [f64],
         p: &mut f64,
-        direction: Direction,
+        (carried, direction): (Option<&[f64]>, Direction),
     ) -> Result<Corrected, CorrectorFailure> {
+        if let Some(carried) = carried {
+            let n = self.metric.n;
+            let (x0, p0) = (x.to_vec(), *p);
+            self.metric
+                .state_normal(&carried[..n], &mut self.bordered.w);
+            let w_p = self.metric.parameter_dot(carried[n], 1.0);
+            let target = self
+                .bordered
+                .w
+                .iter()
+                .zip(&x0)
+                .map(|(w, v)| w * v)
+                .sum::<f64>()
+                + w_p * p0;
+            let normal = Constraint {
+                arclength: true,
+                w_p,
+                target,
+            };
+            if let Ok(corrected) = self.correct_at(x, p, normal).0 {
+                self.take_tangent(Some(carried), 0.0);
+                self.direction.copy_from_slice(&self.tangent);
+                return Ok(corrected);
+            }
+            if self.finished() {
+                return Err(CorrectorFailure::MaxIterations {
+                    iterations: 0,
+                    residual_norm: f64::INFINITY,
+                });
+            }
+            x.copy_from_slice(&x0);
+            *p = p0;
+            self.problem.set_parameter(p0);
+        }
         let constraint = Constraint {
             arclength: false,
             w_p: 1.0,
             target: *p,
         };
         let corrected = self.correct_at(x, p, constraint).0?;
-        self.take_tangent(None, direction.sign());
+        self.take_tangent(carried, direction.sign());
         self.direction.copy_from_slice(&self.tangent);
         Ok(corrected)
     }

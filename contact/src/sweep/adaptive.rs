@@ -1,0 +1,658 @@
+//! Harmonics chosen point by point along an SSN-HB branch to meet an accuracy target
+//! ([`SolverSettings::accuracy`]): more where contact is strong, fewer in the linear tails.
+//!
+//! # The estimate of a point
+//!
+//! Each point of the branch, solved with `H` harmonics, is taken up at `H/2` (its
+//! truncated coefficients corrected on the hyperplane through the point normal to the
+//! branch's direction there, [`Continuation::resume`]; at the point's frequency by
+//! globalized Newton when that fails), and the distance `d` between the two
+//! ([`point_distance`]: the change of the observed dof's extremes relative to its largest
+//! excursion, or of the frequency, whichever is larger) gives Richardson's estimate of the
+//! error at `H`, `e = d / (2^p - 1)` with the harmonic-balance order `p` = [`HB_ORDER`]
+//! (module [`crate::solve::accuracy`]; `e = 1.47 d`). Across the branch rather than at a
+//! fixed frequency, the distance stays defined near a fold, where the two
+//! discretisations' branches turn at different frequencies. Validated against the branch
+//! at `H = 320` taken up the same way at every point of the paper's rod
+//! (`ssn/examples/adaptive_sweep.rs`, docs/sweeps.md).
+//!
+//! # The harmonics of the next points
+//!
+//! The harmonics are taken from [`HARMONICS_LADDER`] (8 to 1024, ratios 1.5 and 4/3, so that a
+//! change is worth a new problem). With the error model `e(H) ~ H^-p` the harmonics that
+//! meet the target are `H* = H (e SAFETY / target)^(1/p)` ([`SAFETY`]):
+//!
+//! - `e > target`: the point is solved again at the first rung at or above `H*` (the
+//!   branch taken up there from the point, see below) and estimated again; it is reported
+//!   only once its estimate meets the target or the ladder's top is reached;
+//! - `e <= LOWER_BELOW target` ([`LOWER_BELOW`]): the point is kept and the branch goes
+//!   on at the first rung at or above `H*`, the hysteresis between both rules keeping
+//!   the harmonics from flickering;
+//! - otherwise the branch goes on at `H`.
+//!
+//! # Changing the harmonics on the way
+//!
+//! The core continuation knows nothing of harmonics: at a change, the sweep takes the
+//! run's [`Resumption`] (last point, predictor direction, step, fold detector), lifts or
+//! truncates the state and the direction's state part to the new harmonics
+//! ([`resize_harmonics`]; the step scaling of the sweep makes the θ-norm independent of
+//! `H`), and [`Continuation::resume`]s with the problem at the new harmonics, which
+//! corrects the point across the branch (so a point near a fold is not carried to
+//! another solution at its frequency). Folds and zigzags are thus detected across the
+//! changes. A resumed start that the corrector's full steps cannot take up is solved
+//! once by globalized Newton at its frequency and taken up from there; failing that,
+//! the branch goes on at the old harmonics from that point.
+//!
+//! The branch starts at [`HARMONICS_LADDER`]`[0]` harmonics (the scene's `harmonics` is
+//! ignored with a target), each point's harmonics and estimate are in
+//! [`FrequencyResponse::harmonics`] and [`BranchAccuracy::estimates`].
+
+use std::time::Instant;
+
+use semismooth::continuation::{
+    Continuation, ContinuationCounters, ContinuationEvent, FoldDetector, Resumption,
+};
+use semismooth::polyalgorithm::SmoothingOf;
+use semismooth::{Factorize, ParameterDependent, Residual};
+
+use super::response::HbTip;
+use super::{
+    check_sweep, continuation_error, continuation_options, hb_solver, reference_amplitude,
+    set_events, ssn_continuation, sweep_termination, FrequencyResponse, SweepTermination,
+};
+use crate::hb::{resize_harmonics, HbJacobian, SsnHb};
+use crate::model::{StructuralModel, Structure};
+use crate::settings::{default_hb_time_samples, Method, SolverSettings, SweepSettings};
+use crate::solve::accuracy::search::{
+    MAX_RATIO, MAX_SEARCH_HARMONICS, MAX_SEARCH_UNKNOWNS, SAFETY,
+};
+use crate::solve::accuracy::HB_ORDER;
+use crate::solve::{
+    hb_options, newton_options, roundoff_floor, RunCounters, RunError, HB_OUTPUT_POINTS,
+};
+
+/// The harmonics a branch may use, in increasing order. It starts at 8: at 4 the pair
+/// with 2 harmonics is no Richardson pair (on the paper's rod inside the overhang a point
+/// at 4 harmonics estimated at 2.6e-3 was 5.8e-2 off).
+pub const HARMONICS_LADDER: [usize; 15] = [
+    8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256, 384, 512, 768, 1024,
+];
+
+/// A point whose estimate is at most this fraction of the target lets the branch go on
+/// with fewer harmonics (module documentation).
+pub const LOWER_BELOW: f64 = 0.25;
+
+/// What the harmonics chosen point by point achieved along a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchAccuracy {
+    /// The relative accuracy asked of each point's observed displacement.
+    pub target: f64,
+    /// The estimated relative error of each point (module documentation; `None` where the
+    /// solve at `H/2` did not converge).
+    pub estimates: Vec<Option<f64>>,
+    /// Points solved again with more harmonics.
+    pub raises: usize,
+    /// Changes to fewer harmonics.
+    pub lowers: usize,
+    /// Resumed starts that could not be corrected (the point kept its harmonics).
+    pub failed_raises: usize,
+    /// The largest harmonics the ladder allows for this model.
+    pub max_harmonics: usize,
+    /// Wall time of the estimates (the solves at `H/2`).
+    pub estimate_seconds: f64,
+    /// Work of the estimates.
+    pub estimate_counters: RunCounters,
+}
+
+impl BranchAccuracy {
+    /// Points whose estimate meets the target.
+    pub fn met(&self) -> usize {
+        self.estimates
+            .iter()
+            .filter(|e| e.is_some_and(|e| e <= self.target))
+            .count()
+    }
+
+    /// The largest estimate over the points (`None` if none was estimated).
+    pub fn worst(&self) -> Option<f64> {
+        self.estimates.iter().flatten().copied().reduce(f64::max)
+    }
+}
+
+/// `settings` with `h` harmonics and their default AFT samples.
+pub fn at_harmonics(settings: &SolverSettings, h: usize) -> SolverSettings {
+    SolverSettings {
+        harmonics: h,
+        time_samples: default_hb_time_samples(h),
+        accuracy: None,
+        estimate_error: false,
+        ..settings.clone()
+    }
+}
+
+/// Reconstruction points of the observed dof at `h` harmonics.
+fn output_points(h: usize) -> usize {
+    HB_OUTPUT_POINTS.max(default_hb_time_samples(h))
+}
+
+/// The first rung at or above `wanted`, at most `limit`.
+fn rung(wanted: f64, limit: usize) -> usize {
+    HARMONICS_LADDER
+        .iter()
+        .copied()
+        .filter(|&h| h <= limit)
+        .find(|&h| h as f64 >= wanted)
+        .unwrap_or(limit)
+}
+
+/// `H* = h (e SAFETY / target)^(1/p)`.
+fn wanted_harmonics(h: usize, estimate: f64, target: f64) -> f64 {
+    h as f64 * (estimate * SAFETY / target).powf(1.0 / HB_ORDER)
+}
+
+/// A problem of the estimates: its harmonics, the problem, the observed dof's
+/// reconstruction and the linear solver.
+type HalfProblem = (usize, SsnHb, HbTip, Box<dyn Factorize<HbJacobian>>);
+
+/// The solves at `H/2` that estimate the points' errors, with one problem per harmonics.
+struct Estimator<'a> {
+    rod: &'a Structure,
+    settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    u_ref: f64,
+    problems: Vec<HalfProblem>,
+    seconds: f64,
+    counters: RunCounters,
+}
+
+/// The relative distance of a branch point `(max, min, ω)` (the observed dof's extremes
+/// and the frequency) from another solution of the same branch `reference`: the larger of
+/// the extremes' change over the reference's largest excursion and the frequency's change
+/// over its frequency. Measured between points of one hyperplane across the branch, it is
+/// the distance between two discretisations' branches, defined at a fold as elsewhere.
+pub fn point_distance((max, min, omega): (f64, f64, f64), reference: (f64, f64, f64)) -> f64 {
+    let (ref_max, ref_min, ref_omega) = reference;
+    let excursion = ref_max.abs().max(ref_min.abs());
+    let change = (max - ref_max).abs().max((min - ref_min).abs());
+    let displacement = if change == 0.0 {
+        0.0
+    } else if excursion > 0.0 {
+        change / excursion
+    } else {
+        f64::INFINITY
+    };
+    displacement.max((omega - ref_omega).abs() / ref_omega.abs())
+}
+
+impl Estimator<'_> {
+    /// The estimated relative error of the point `x` at `h` harmonics and `omega`, whose
+    /// observed dof has the extremes `(max, min)` and whose branch goes on along
+    /// `direction` (module documentation).
+    fn estimate(
+        &mut self,
+        omega: f64,
+        h: usize,
+        x: &[f64],
+        (max, min): (f64, f64),
+        direction: Option<&[f64]>,
+    ) -> Result<Option<f64>, RunError> {
+        let half = h / 2;
+        if half == 0 {
+            return Ok(None);
+        }
+        let started = Instant::now();
+        let model = &self.rod.model;
+        let dofs = model.dofs();
+        let settings = at_harmonics(self.settings, half);
+        let slot = match self.problems.iter().position(|(k, ..)| *k == half) {
+            Some(slot) => slot,
+            None => {
+                let problem = SsnHb::new(model, omega, &hb_options(&settings))?;
+                let tip = HbTip::new(half, output_points(h), dofs, self.rod.observed_dof)?;
+                let solver = hb_solver(settings.linear_solver);
+                self.problems.push((half, problem, tip, solver));
+                self.problems.len() - 1
+            }
+        };
+        let (_, problem, tip, solver) = &mut self.problems[slot];
+        let (found, work) = take_up_with(
+            (self.rod, &settings, self.sweep, self.u_ref),
+            problem,
+            &mut **solver,
+            (x, omega, h),
+            direction,
+        )?;
+        self.counters = self.counters + work;
+        self.seconds += started.elapsed().as_secs_f64();
+        let Some((y, coarse_omega)) = found else {
+            return Ok(None);
+        };
+        let (coarse_max, coarse_min) = tip.extremes(&y)?;
+        let distance = point_distance((coarse_max, coarse_min, coarse_omega), (max, min, omega));
+        Ok(Some(distance / (2f64.powf(HB_ORDER) - 1.0)))
+    }
+}
+
+/// A branch point taken up on other harmonics: its state and frequency.
+pub type BranchPointAt = (Vec<f64>, f64);
+
+/// The point `x` (at `h` harmonics) and `omega` of an SSN-HB branch taken up on
+/// `problem` (the same model at other harmonics, `settings`): corrected on the hyperplane
+/// through the point normal to `direction` (its state part at `h` harmonics, then the
+/// frequency component), else at `omega` by globalized Newton. The state on `problem`'s
+/// harmonics and its frequency (`None` when neither converged), and the work.
+fn take_up_with(
+    (rod, settings, sweep, u_ref): (&Structure, &SolverSettings, &SweepSettings, f64),
+    problem: &mut SsnHb,
+    solver: &mut dyn Factorize<HbJacobian>,
+    (x, omega, h): (&[f64], f64, usize),
+    direction: Option<&[f64]>,
+) -> Result<(Option<BranchPointAt>, RunCounters), RunError> {
+    let model = &rod.model;
+    let (dofs, contacts) = (model.dofs(), model.contact_count());
+    let to = settings.harmonics;
+    let mut y = resize_harmonics(x, h, to, dofs, contacts);
+    let mut counters = RunCounters::default();
+    if let Some(direction) = direction {
+        let n = x.len();
+        let mut carried = resize_harmonics(&direction[..n], h, to, dofs, contacts);
+        carried.push(direction[n]);
+        let method = ssn_continuation(model, problem, u_ref);
+        let options = continuation_options(settings, sweep, rod.omega_1, dofs, u_ref, &method)?;
+        let resumption = Resumption {
+            state: y.clone(),
+            parameter: omega,
+            direction: carried,
+            step: options.initial_step,
+            folds: FoldDetector::new(false),
+            points: 0,
+        };
+        let mut run = Continuation::resume(problem, solver, resumption, options)
+            .map_err(continuation_error)?;
+        let first = run.next();
+        let run_counters = run.counters();
+        drop(run);
+        let mut work = run_counters.work;
+        work.factorizations += run_counters.dense_bordered_factorizations;
+        counters = counters + RunCounters::from(work);
+        if let Some(point) = first {
+            return Ok((Some((point.state, point.parameter)), counters));
+        }
+    }
+    problem.set_parameter(omega);
+    let report = newton_at(settings, model, problem, solver, &mut y)?;
+    counters = counters + RunCounters::from(report.counters);
+    Ok((report.converged().then_some((y, omega)), counters))
+}
+
+/// The point `x` (at `h` harmonics) and `omega` of the SSN-HB branch of `rod` swept with
+/// `settings` over `sweep`, taken up at `to` harmonics across the branch (normal to
+/// `direction`, a tangent or secant at the point: state part at `h` harmonics, then the
+/// frequency component) or, failing that, at its frequency: the state at `to` harmonics
+/// and its frequency, `None` when neither converged. The reference of a point's error
+/// that follows the same solution through a fold.
+pub fn take_up(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    (x, omega, h): (&[f64], f64, usize),
+    direction: &[f64],
+    to: usize,
+) -> Result<Option<BranchPointAt>, RunError> {
+    let at = at_harmonics(settings, to);
+    let mut problem = SsnHb::new(&rod.model, omega, &hb_options(&at))?;
+    let mut solver = hb_solver(at.linear_solver);
+    let u_ref = reference_amplitude(rod);
+    let (found, _) = take_up_with(
+        (rod, &at, sweep, u_ref),
+        &mut problem,
+        &mut *solver,
+        (x, omega, h),
+        Some(direction),
+    )?;
+    Ok(found)
+}
+
+/// The secant of `response` at its point `i` (from the point before to the point after,
+/// one side at the ends), both carried to point `i`'s harmonics when they differ: the
+/// state part, then the frequency component. Panics if `i` is not a point of `response`.
+pub fn secant(response: &FrequencyResponse, i: usize, dofs: usize, contacts: usize) -> Vec<f64> {
+    let last = response.points() - 1;
+    let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
+    let at = |j: usize| match (response.harmonics.get(j), response.harmonics.get(i)) {
+        (Some(&from), Some(&to)) if from != to => {
+            resize_harmonics(&response.states[j], from, to, dofs, contacts)
+        }
+        _ => response.states[j].clone(),
+    };
+    let (xa, xb) = (at(a), at(b));
+    let mut d: Vec<f64> = xb.iter().zip(&xa).map(|(u, v)| u - v).collect();
+    d.push(response.omega[b] - response.omega[a]);
+    d
+}
+
+/// Globalized Newton on `problem` from `x` with the scene's options, the tolerance raised
+/// to the round-off level of the residual (as `ssn solve` judges a solve).
+fn newton_at(
+    settings: &SolverSettings,
+    model: &StructuralModel,
+    problem: &mut SsnHb,
+    solver: &mut dyn Factorize<HbJacobian>,
+    x: &mut [f64],
+) -> Result<semismooth::newton::NewtonReport, RunError> {
+    let gap = model
+        .contacts
+        .iter()
+        .fold(0.0f64, |a, c| a.max(c.gap.abs()));
+    let floor = roundoff_floor(model, problem.dim(), gap.max(f64::MIN_POSITIVE), 0.0);
+    Ok(newton_options(settings).with_residual_floor(floor).solve(
+        problem,
+        solver,
+        x,
+        Some(SmoothingOf::new()),
+    )?)
+}
+
+/// The resumption `r` of a run at `from` harmonics carried to `to` harmonics.
+fn carried(r: Resumption, from: usize, to: usize, dofs: usize, contacts: usize) -> Resumption {
+    let n = r.state.len();
+    let state = resize_harmonics(&r.state, from, to, dofs, contacts);
+    let mut direction = resize_harmonics(&r.direction[..n], from, to, dofs, contacts);
+    direction.push(r.direction[n]);
+    Resumption {
+        state,
+        direction,
+        ..r
+    }
+}
+
+/// What the first item of a resumed run is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum First {
+    /// A fresh run: its first point is a new point.
+    New,
+    /// The point just estimated, solved again with more harmonics: reported if it meets.
+    Raised,
+    /// The point just reported, at the new (fewer) harmonics: not reported again.
+    Lowered,
+}
+
+/// A change of harmonics decided at a point: to `to` harmonics from `resumption`, taken at
+/// `from` harmonics.
+struct Switch {
+    from: usize,
+    to: usize,
+    resumption: Resumption,
+    first: First,
+}
+
+/// The SSN-HB branch of [`super::frequency_response`] with the harmonics chosen point by
+/// point for the relative accuracy `target` (module documentation), without its
+/// stability and contacts.
+pub(crate) fn adaptive_branch(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    target: f64,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    if !(target.is_finite() && target > 0.0 && target < 1.0) {
+        return Err(RunError::InvalidSetting {
+            name: "solver.accuracy",
+            value: target,
+            allowed: "a relative accuracy in (0, 1)",
+        });
+    }
+    if settings.method != Method::SsnHb {
+        return Err(RunError::Unsupported {
+            method: settings.method.name(),
+            what: "harmonics chosen point by point (ssn-hb)",
+        });
+    }
+    check_sweep(sweep)?;
+    let started = Instant::now();
+    let model = &rod.model;
+    let (dofs, contacts, tip_dof) = (model.dofs(), model.contact_count(), rod.observed_dof);
+    let omega_1 = rod.omega_1;
+    let u_ref = reference_amplitude(rod);
+    let width = dofs + contacts;
+    let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
+    let limit = rung(
+        MAX_SEARCH_HARMONICS.min(by_size) as f64,
+        MAX_SEARCH_HARMONICS.min(by_size),
+    )
+    .max(HARMONICS_LADDER[0]);
+    let omega_from = sweep.omega_ratio_from * omega_1;
+    let mut h = HARMONICS_LADDER[0];
+    let mut problem = SsnHb::new(model, omega_from, &hb_options(&at_harmonics(settings, h)))?;
+    let mut solver = hb_solver(settings.linear_solver);
+    let mut x = vec![0.0; problem.dim()];
+    let report = newton_options(settings).solve(
+        &mut problem,
+        &mut *solver,
+        &mut x,
+        Some(SmoothingOf::new()),
+    )?;
+    let mut response = FrequencyResponse::empty(settings.method, omega_1, sweep, u_ref);
+    response.counters = RunCounters::from(report.counters);
+    response.initial_iterations = report.iterations;
+    let mut accuracy = BranchAccuracy {
+        target,
+        estimates: Vec::new(),
+        raises: 0,
+        lowers: 0,
+        failed_raises: 0,
+        max_harmonics: limit,
+        estimate_seconds: 0.0,
+        estimate_counters: RunCounters::default(),
+    };
+    if !report.converged() {
+        response.termination = SweepTermination::StartNotConverged {
+            termination: report.termination.clone(),
+            iterations: report.iterations,
+            residual_norm: report.residual_norm(),
+        };
+        response.accuracy = Some(accuracy);
+        response.solve_seconds = started.elapsed().as_secs_f64();
+        return Ok(response);
+    }
+    let mut estimator = Estimator {
+        rod,
+        settings,
+        sweep,
+        u_ref,
+        problems: Vec::new(),
+        seconds: 0.0,
+        counters: RunCounters::default(),
+    };
+    let mut events: Vec<ContinuationEvent> = Vec::new();
+    let mut counters = ContinuationCounters::default();
+    let mut resumption: Option<Resumption> = None;
+    let mut first = First::New;
+    // After a resumed start failed: the old harmonics and the resumption to go back to,
+    // and the index of the point that may not be raised again.
+    let mut fallback: Option<(usize, Resumption)> = None;
+    let mut no_raise_at: Option<usize> = None;
+    // The start carried to new harmonics, until taken up there (a globalized solve at
+    // its frequency is tried once when the continuation's start fails).
+    let mut unsolved: Option<Resumption> = None;
+    // Work of the solves at new harmonics.
+    let mut switch_work = RunCounters::default();
+    let termination = loop {
+        let method = ssn_continuation(model, &problem, u_ref);
+        let options = continuation_options(
+            &at_harmonics(settings, h),
+            sweep,
+            omega_1,
+            dofs,
+            u_ref,
+            &method,
+        )?;
+        let resumed = resumption.is_some();
+        let mut run = match resumption.take() {
+            None => Continuation::new(&mut problem, &mut *solver, &x, omega_from, options),
+            Some(r) => Continuation::resume(&mut problem, &mut *solver, r, options),
+        }
+        .map_err(continuation_error)?;
+        let mut tip = HbTip::new(h, output_points(h), dofs, tip_dof)?;
+        let mut switch: Option<Switch> = None;
+        let mut items = 0;
+        while let Some(point) = run.next() {
+            items += 1;
+            let kind = if items == 1 && resumed {
+                first
+            } else {
+                First::New
+            };
+            if kind == First::Lowered {
+                continue;
+            }
+            let omega = point.parameter;
+            let (max, min) = tip.extremes(&point.state)?;
+            let index = response.points();
+            let here = run.resumption();
+            let direction = here.as_ref().map(|r| r.direction.as_slice());
+            let estimate = estimator.estimate(omega, h, &point.state, (max, min), direction)?;
+            let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
+            let raise =
+                estimate.is_some_and(|e| e > target) && h < limit && no_raise_at != Some(index);
+            if raise {
+                if let Some(r) = run.resumption() {
+                    let wanted = wanted
+                        .unwrap_or(f64::INFINITY)
+                        .clamp(h as f64 + 1.0, (MAX_RATIO * h as f64).max(h as f64 + 1.0));
+                    switch = Some(Switch {
+                        from: h,
+                        to: rung(wanted, limit),
+                        resumption: r,
+                        first: First::Raised,
+                    });
+                    break;
+                }
+            }
+            let nt = default_hb_time_samples(h);
+            response.push(omega, max, min, point.iterations, point.state);
+            response.harmonics.push(h);
+            response.time_samples.push(nt);
+            accuracy.estimates.push(estimate);
+            if let Some(report) = progress {
+                report(index, omega / omega_1);
+            }
+            let lower =
+                estimate.is_some_and(|e| e <= LOWER_BELOW * target) && run.termination().is_none();
+            if let (true, Some(w)) = (lower, wanted) {
+                let to = rung(w.max(h as f64 / MAX_RATIO), limit);
+                if to < h {
+                    if let Some(r) = run.resumption() {
+                        switch = Some(Switch {
+                            from: h,
+                            to,
+                            resumption: r,
+                            first: First::Lowered,
+                        });
+                        break;
+                    }
+                }
+            }
+        }
+        counters += run.counters();
+        events.extend(run.events().iter().cloned());
+        let ended = run.termination().cloned();
+        drop(run);
+        if let (None, true, 0) = (&switch, resumed, items) {
+            if let Some(mut retry) = unsolved.take() {
+                // Not taken up by the corrector's full steps (on the hyperplane across the
+                // branch, then at the point's frequency): the point at the new harmonics
+                // by globalized Newton at its frequency, then taken up from there.
+                problem.set_parameter(retry.parameter);
+                let report = newton_at(
+                    settings,
+                    model,
+                    &mut problem,
+                    &mut *solver,
+                    &mut retry.state,
+                )?;
+                switch_work = switch_work + RunCounters::from(report.counters);
+                if report.converged() {
+                    resumption = Some(retry);
+                    continue;
+                }
+            }
+        }
+        let switch = match switch {
+            Some(switch) => switch,
+            None if resumed && items == 0 && first == First::Raised => {
+                // The raised start could not be corrected: back to the old harmonics.
+                let Some((old, back)) = fallback.take() else {
+                    break ended;
+                };
+                accuracy.failed_raises += 1;
+                no_raise_at = Some(response.points());
+                Switch {
+                    from: old,
+                    to: old,
+                    resumption: back,
+                    first: First::New,
+                }
+            }
+            None if resumed && items == 0 && first == First::Lowered => {
+                // The lowered start could not be corrected: on with the old harmonics.
+                let Some((old, back)) = fallback.take() else {
+                    break ended;
+                };
+                Switch {
+                    from: old,
+                    to: old,
+                    resumption: back,
+                    first: First::Lowered,
+                }
+            }
+            None => break ended,
+        };
+        match switch.first {
+            First::Raised => accuracy.raises += 1,
+            First::Lowered => accuracy.lowers += 1,
+            First::New => {}
+        }
+        // A change (not a return to the old harmonics) can be undone once.
+        fallback = (switch.first != First::New && switch.from != switch.to)
+            .then(|| (switch.from, switch.resumption.clone()));
+        let to = switch.to;
+        let resumed_at = switch.resumption.parameter;
+        let carried = carried(switch.resumption, switch.from, to, dofs, contacts);
+        h = to;
+        problem = SsnHb::new(model, resumed_at, &hb_options(&at_harmonics(settings, h)))?;
+        first = match switch.first {
+            // The fallback's first item is the point itself at the old harmonics.
+            First::New => {
+                unsolved = None;
+                First::Raised
+            }
+            other => {
+                unsolved = Some(carried.clone());
+                other
+            }
+        };
+        resumption = Some(carried);
+    };
+    set_events(&mut response, &events);
+    let mut total = counters.work;
+    total.factorizations += counters.dense_bordered_factorizations;
+    response.counters =
+        response.counters + RunCounters::from(total) + estimator.counters + switch_work;
+    response.restarts = counters.restarts as usize;
+    response.corners = counters.corners as usize;
+    response.continuation = counters;
+    response.termination = sweep_termination(termination);
+    response.output_points = response
+        .harmonics
+        .iter()
+        .map(|&h| output_points(h))
+        .max()
+        .unwrap_or(HB_OUTPUT_POINTS);
+    accuracy.estimate_seconds = estimator.seconds;
+    accuracy.estimate_counters = estimator.counters;
+    response.accuracy = Some(accuracy);
+    response.solve_seconds = started.elapsed().as_secs_f64();
+    Ok(response)
+}
