@@ -58,6 +58,7 @@
 use faer::MatRef;
 
 use crate::linalg::{check_finite_dense, LinearSolveError};
+use crate::InvalidOption;
 
 /// Marker for "not in the basis" in the row-of-variable map.
 const NONBASIC: usize = usize::MAX;
@@ -106,11 +107,11 @@ impl LemkeOptions {
     /// covering entries finite and `> 0`.
     pub fn validate(&self) -> Result<(), LemkeError> {
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(LemkeError::InvalidOption {
-                name: "tolerance",
-                value: self.tolerance,
-                allowed: "finite, in (0, 1)",
-            });
+            return Err(LemkeError::InvalidOption(InvalidOption::new(
+                "tolerance",
+                self.tolerance,
+                "finite, in (0, 1)",
+            )));
         }
         if let Some(d) = &self.covering {
             if let Some((index, &value)) = d
@@ -255,15 +256,8 @@ pub enum LemkeError {
         value: f64,
     },
     /// A scalar option is out of range.
-    #[error("invalid option {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// Name of the option.
-        name: &'static str,
-        /// The value given.
-        value: f64,
-        /// The allowed range.
-        allowed: &'static str,
-    },
+    #[error("invalid option {0}")]
+    InvalidOption(#[from] InvalidOption),
     /// An entry of the covering vector is not finite and positive.
     #[error("covering vector entry d[{index}] = {value}: must be finite and > 0")]
     InvalidCovering {

@@ -75,6 +75,7 @@ pub mod complementarity;
 pub mod continuation;
 pub mod floquet;
 pub mod harmonic;
+mod invalid_option;
 mod iteration;
 pub mod lemke;
 pub mod linalg;
@@ -84,6 +85,7 @@ pub mod polyalgorithm;
 mod traits;
 pub mod trigonometric;
 
+pub use invalid_option::InvalidOption;
 pub use traits::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,
     ProblemCounters, Residual, Smoothing, MAX_PROBLEM_COUNTERS,

@@ -18,6 +18,8 @@
 //! other insufficient decrease, so a far step into an overflow region is shortened
 //! rather than accepted.
 
+use crate::InvalidOption;
+
 /// Options of the backtracking line search (all validated by
 /// [`LineSearchOptions::validate`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,34 +42,21 @@ impl Default for LineSearchOptions {
     }
 }
 
-/// A line-search option outside its allowed range.
-#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
-#[error("line-search option {name} = {value} is not allowed: must be in {allowed}")]
-pub struct InvalidLineSearchOption {
-    /// Field name.
-    pub name: &'static str,
-    /// Rejected value.
-    pub value: f64,
-    /// Allowed range.
-    pub allowed: &'static str,
-}
-
-impl InvalidLineSearchOption {
-    /// The field's name inside the options field `within` (`"line_search"` gives
-    /// `"line_search.shrink"`); the bare name for other prefixes.
-    pub(crate) fn qualified_name(&self, within: &'static str) -> &'static str {
-        match (within, self.name) {
-            ("line_search", "sufficient_decrease") => "line_search.sufficient_decrease",
-            ("line_search", "shrink") => "line_search.shrink",
-            ("line_search", "min_step") => "line_search.min_step",
-            ("corrector_line_search", "sufficient_decrease") => {
-                "corrector_line_search.sufficient_decrease"
-            }
-            ("corrector_line_search", "shrink") => "corrector_line_search.shrink",
-            ("corrector_line_search", "min_step") => "corrector_line_search.min_step",
-            _ => self.name,
+/// `error` of a line-search field, named inside the options field `within`
+/// (`"line_search"` gives `"line_search.shrink"`; the bare name for other prefixes).
+pub(crate) fn within(within: &'static str, error: InvalidOption) -> InvalidOption {
+    let name = match (within, error.name) {
+        ("line_search", "sufficient_decrease") => "line_search.sufficient_decrease",
+        ("line_search", "shrink") => "line_search.shrink",
+        ("line_search", "min_step") => "line_search.min_step",
+        ("corrector_line_search", "sufficient_decrease") => {
+            "corrector_line_search.sufficient_decrease"
         }
-    }
+        ("corrector_line_search", "shrink") => "corrector_line_search.shrink",
+        ("corrector_line_search", "min_step") => "corrector_line_search.min_step",
+        _ => error.name,
+    };
+    InvalidOption { name, ..error }
 }
 
 /// Checks `lo < value < hi` (open) or `lo < value <= hi` (`closed_hi`).
@@ -76,22 +65,14 @@ fn check_range(
     value: f64,
     closed_hi: bool,
     allowed: &'static str,
-) -> Result<(), InvalidLineSearchOption> {
+) -> Result<(), InvalidOption> {
     let ok = value > 0.0 && (value < 1.0 || (closed_hi && value == 1.0));
-    if ok {
-        Ok(())
-    } else {
-        Err(InvalidLineSearchOption {
-            name,
-            value,
-            allowed,
-        })
-    }
+    InvalidOption::check(ok, name, value, allowed)
 }
 
 impl LineSearchOptions {
     /// Checks every field against its range (NaN is rejected).
-    pub fn validate(&self) -> Result<(), InvalidLineSearchOption> {
+    pub fn validate(&self) -> Result<(), InvalidOption> {
         check_range(
             "sufficient_decrease",
             self.sufficient_decrease,
@@ -340,7 +321,7 @@ mod tests {
         };
         assert_eq!(
             bad.validate(),
-            Err(InvalidLineSearchOption {
+            Err(InvalidOption {
                 name: "shrink",
                 value: 1.5,
                 allowed: "(0, 1)"

@@ -16,6 +16,7 @@ use semismooth::lemke::{
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::Tolerances;
 use semismooth::polyalgorithm::{solve, PolyalgorithmOptions};
+use semismooth::InvalidOption;
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 #[global_allocator]
@@ -497,10 +498,10 @@ fn bad_inputs_give_typed_errors() {
         };
         assert!(matches!(
             lemke.solve(m.as_ref(), &[-1.0, 2.0, 3.0], &o),
-            Err(LemkeError::InvalidOption {
+            Err(LemkeError::InvalidOption(InvalidOption {
                 name: "tolerance",
                 ..
-            })
+            }))
         ));
     }
     let o = LemkeOptions {

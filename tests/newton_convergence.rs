@@ -14,6 +14,7 @@ use semismooth::newton::{
     NewtonSolver, Termination, Tolerances, WorkCounters,
 };
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
+use semismooth::InvalidOption;
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual};
 
 fn options(globalization: Globalization) -> NewtonOptions {
@@ -641,11 +642,11 @@ fn bad_options_and_dimensions_are_errors_before_any_evaluation() {
     };
     assert_eq!(
         solve(&mut p, &mut FaerDenseLu::new(), &mut x, &opts),
-        Err(NewtonError::InvalidOption {
-            name: "step_tolerance",
-            value: -1.0,
-            allowed: "finite and >= 0"
-        })
+        Err(NewtonError::InvalidOption(InvalidOption::new(
+            "step_tolerance",
+            -1.0,
+            "finite and >= 0"
+        )))
     );
     let mut x2 = [1.0, 2.0];
     assert_eq!(

@@ -15,6 +15,7 @@ use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::linalg::{DenseAssemble, FaerDenseLu};
 use semismooth::newton::NewtonReport;
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
+use semismooth::InvalidOption;
 use semismooth::{
     Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual, Smoothing,
 };
@@ -467,7 +468,9 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         ..HbOptions::default()
     };
     let err = SsnHb::new(&model, omega, &negative_c).unwrap_err();
-    assert!(matches!(err, HbError::InvalidOption { name: "c", value, .. } if value == -1.0));
+    assert!(
+        matches!(err, HbError::InvalidOption(InvalidOption { name: "c", value, .. }) if value == -1.0)
+    );
     let nan_penalty = PenaltyHbOptions {
         penalty_stiffness: f64::NAN,
         ..PenaltyHbOptions::for_model(&model)
@@ -483,7 +486,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
         ),
     ] {
         assert!(
-            matches!(err, HbError::InvalidOption { name, .. } if name == option),
+            matches!(err, HbError::InvalidOption(InvalidOption { name, .. }) if name == option),
             "{option}: {err:?}"
         );
     }
@@ -500,7 +503,7 @@ fn bad_options_are_typed_errors_with_the_numbers() {
     let (model, _) = chain(3, None, 1.0, vec![]);
     assert!(matches!(
         SsnHb::new(&model, 0.0, &HbOptions::default()).unwrap_err(),
-        HbError::InvalidOption { name: "omega", value, .. } if value == 0.0
+        HbError::InvalidOption(InvalidOption { name: "omega", value, .. }) if value == 0.0
     ));
 }
 

@@ -10,6 +10,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::newton::{self, NewtonOptions, Strategy};
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions, SolveOptions};
+use semismooth::InvalidOption;
 use semismooth_contact::lcp::{
     solve_min_map_sequenced, ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
     DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -334,7 +335,7 @@ fn bad_options_and_models_are_typed_errors() {
     let (model, omega) = rod(MassModel::Modified, true);
     for nt in [0usize, 1, 7, 8193] {
         match PeriodicLcp::new(&model, omega, options(nt, vec![])) {
-            Err(LcpError::InvalidOption { name, value, .. }) => {
+            Err(LcpError::InvalidOption(InvalidOption { name, value, .. })) => {
                 assert_eq!(name, "time_samples");
                 assert_eq!(value, nt as f64);
             }
@@ -354,7 +355,7 @@ fn bad_options_and_models_are_typed_errors() {
     );
     assert!(matches!(
         PeriodicLcp::new(&model, f64::NAN, options(16, vec![])),
-        Err(LcpError::InvalidOption { name: "omega", value, .. }) if value.is_nan()
+        Err(LcpError::InvalidOption(InvalidOption { name: "omega", value, .. })) if value.is_nan()
     ));
     let lcp = PeriodicLcp::new(&model, omega, options(16, vec![])).unwrap();
     assert_eq!(

@@ -10,6 +10,7 @@ use common::periodic::{
 };
 use common::{allocations, dense};
 use nalgebra::DVector;
+use semismooth::InvalidOption;
 use semismooth_contact::march::{
     march_from_state, march_to_steady_state, MarchError, MarchOptions, MarchScheme, MarchState,
     SteadyPeriod, TimeMarcher,
@@ -446,7 +447,7 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
         spoil(&mut options);
         let err = march_to_steady_state(model, rod.omega(), &options, &[19]).unwrap_err();
         assert!(
-            matches!(err, MarchError::InvalidOption { name, .. } if name == field),
+            matches!(err, MarchError::InvalidOption(InvalidOption { name, .. }) if name == field),
             "{err}"
         );
         assert!(err.to_string().contains(field), "{err}");
@@ -454,7 +455,7 @@ fn bad_options_and_inputs_are_rejected_with_the_field_name() {
     // The frequency is the march's argument, checked like an option.
     let err = march_to_steady_state(model, -1.0, &MarchOptions::default(), &[19]).unwrap_err();
     assert!(
-        matches!(err, MarchError::InvalidOption { name: "omega", value, .. } if value == -1.0),
+        matches!(err, MarchError::InvalidOption(InvalidOption { name: "omega", value, .. }) if value == -1.0),
         "{err}"
     );
     let err =

@@ -312,11 +312,8 @@ impl ContinuationOptions {
         }
         if let Some(ls) = &self.corrector_line_search {
             ls.validate().map_err(|e| {
-                invalid(
-                    e.qualified_name("corrector_line_search"),
-                    e.value,
-                    e.allowed,
-                )
+                let e = crate::linesearch::within("corrector_line_search", e);
+                invalid(e.name, e.value, e.allowed)
             })?;
         }
         Ok(())

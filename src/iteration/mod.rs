@@ -11,6 +11,7 @@ use std::iter::Sum;
 use std::ops::AddAssign;
 
 use crate::linalg::LinearSolveError;
+use crate::InvalidOption;
 use crate::{EvaluationError, ProblemCounters};
 
 /// `|F|` below which a run has ended on an exact root (the active set was found and the
@@ -244,15 +245,8 @@ impl NewtonReport {
 #[non_exhaustive]
 pub enum NewtonError {
     /// An option is outside its allowed range.
-    #[error("invalid Newton option {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// Field name (dotted for nested fields).
-        name: &'static str,
-        /// Rejected value.
-        value: f64,
-        /// Allowed range.
-        allowed: &'static str,
-    },
+    #[error("invalid Newton option {0}")]
+    InvalidOption(#[from] InvalidOption),
     /// `x` does not have the problem's dimension.
     #[error("initial guess has length {found}, the problem has dimension {expected}")]
     DimensionMismatch {
@@ -381,20 +375,20 @@ impl Tolerances {
             ("step_tolerance", self.step_tolerance),
         ] {
             if !(t.is_finite() && t >= 0.0) {
-                return Err(NewtonError::InvalidOption {
+                return Err(NewtonError::InvalidOption(InvalidOption::new(
                     name,
-                    value: t,
-                    allowed: "finite and >= 0",
-                });
+                    t,
+                    "finite and >= 0",
+                )));
             }
         }
         let t = self.relative_tolerance;
         if !(t.is_finite() && (0.0..1.0).contains(&t)) {
-            return Err(NewtonError::InvalidOption {
-                name: "relative_tolerance",
-                value: t,
-                allowed: "[0, 1)",
-            });
+            return Err(NewtonError::InvalidOption(InvalidOption::new(
+                "relative_tolerance",
+                t,
+                "[0, 1)",
+            )));
         }
         Ok(())
     }

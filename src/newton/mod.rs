@@ -93,7 +93,8 @@ pub use crate::iteration::{
 };
 use crate::iteration::{Log, Outcome};
 use crate::linalg::LinearSolveError;
-pub use crate::linesearch::{InvalidLineSearchOption, LineSearchOptions};
+pub use crate::linesearch::LineSearchOptions;
+use crate::InvalidOption;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters};
 
 /// How the step length is chosen.
@@ -189,20 +190,11 @@ pub(crate) fn validate_line_search(
     memory: usize,
     line_search: &LineSearchOptions,
 ) -> Result<(), NewtonError> {
-    if memory == 0 {
-        return Err(invalid_option(memory_name, 0.0, ">= 1"));
-    }
+    InvalidOption::check(memory >= 1, memory_name, memory as f64, ">= 1")?;
     line_search
         .validate()
-        .map_err(|e| invalid_option(e.qualified_name("line_search"), e.value, e.allowed))
-}
-
-fn invalid_option(name: &'static str, value: f64, allowed: &'static str) -> NewtonError {
-    NewtonError::InvalidOption {
-        name,
-        value,
-        allowed,
-    }
+        .map_err(|e| crate::linesearch::within("line_search", e))?;
+    Ok(())
 }
 
 impl NewtonOptions {
@@ -566,11 +558,11 @@ mod tests {
         };
         assert_eq!(
             o.validate(),
-            Err(NewtonError::InvalidOption {
-                name: "relative_tolerance",
-                value: 1.0,
-                allowed: "[0, 1)"
-            })
+            Err(NewtonError::InvalidOption(InvalidOption::new(
+                "relative_tolerance",
+                1.0,
+                "[0, 1)"
+            )))
         );
         let o = NewtonOptions {
             globalization: Globalization::NonMonotone {
@@ -581,10 +573,10 @@ mod tests {
         };
         assert!(matches!(
             o.validate(),
-            Err(NewtonError::InvalidOption {
+            Err(NewtonError::InvalidOption(InvalidOption {
                 name: "globalization.memory",
                 ..
-            })
+            }))
         ));
         let o = NewtonOptions {
             globalization: Globalization::Armijo(LineSearchOptions {
@@ -594,7 +586,7 @@ mod tests {
             ..Default::default()
         };
         assert!(
-            matches!(o.validate(), Err(NewtonError::InvalidOption { name: "line_search.shrink", value, .. }) if value == 0.0)
+            matches!(o.validate(), Err(NewtonError::InvalidOption(InvalidOption { name: "line_search.shrink", value, .. })) if value == 0.0)
         );
         let o = NewtonOptions {
             tolerances: Tolerances::absolute(f64::NAN),
@@ -602,10 +594,10 @@ mod tests {
         };
         assert!(matches!(
             o.validate(),
-            Err(NewtonError::InvalidOption {
+            Err(NewtonError::InvalidOption(InvalidOption {
                 name: "absolute_tolerance",
                 ..
-            })
+            }))
         ));
         assert!(NewtonOptions::default().validate().is_ok());
     }

@@ -21,7 +21,7 @@ fn scene_header(path: &std::path::Path, title: Option<&str>) -> String {
 
 /// The resolved model of a scene forced at `omega`, in words (`ssn scene-check`).
 pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> String {
-    use semismooth_contact::rod::{DampingSpec, FrequencySpec, LoadKind};
+    use semismooth_contact::rod::{FrequencySpec, LoadKind};
     if let Some(spec) = &scene.model {
         return describe_imported(scene, spec, rod, omega, modes);
     }
@@ -41,16 +41,7 @@ pub fn describe(scene: &Scene, rod: &Structure, omega: f64, modes: &[f64]) -> St
     ));
     let freqs: Vec<String> = modes.iter().map(|w| format!("{w:.6}")).collect();
     line(format!("natural freqs     {}", freqs.join(", ")));
-    line(match s.damping {
-        None => "damping           none (no damping matrix)".into(),
-        Some(DampingSpec::StiffnessProportional { zeta }) => format!(
-            "damping           D = beta K, beta = 2 zeta / omega_1 = {:.6e} (zeta = {zeta})",
-            2.0 * zeta / rod.omega_1
-        ),
-        Some(DampingSpec::Rayleigh { alpha, beta }) => {
-            format!("damping           D = {alpha} M + {beta} K")
-        }
-    });
+    line(damping_line(s.damping.as_ref(), rod.omega_1));
     let ratio = match s.frequency {
         FrequencySpec::Ratio(r) => r,
         FrequencySpec::Absolute(w) => w / rod.omega_1,
@@ -199,14 +190,7 @@ pub fn describe_imported(
     line(format!("natural freqs     {}", freqs.join(", ")));
     line(match spec.damping {
         None if spec.damping_matrix.is_some() => "damping           from the damping file".into(),
-        None => "damping           none (no damping matrix)".into(),
-        Some(DampingSpec::StiffnessProportional { zeta }) => format!(
-            "damping           D = beta K, beta = 2 zeta / omega_1 = {:.6e} (zeta = {zeta})",
-            2.0 * zeta / structure.omega_1
-        ),
-        Some(DampingSpec::Rayleigh { alpha, beta }) => {
-            format!("damping           D = {alpha} M + {beta} K")
-        }
+        _ => damping_line(spec.damping.as_ref(), structure.omega_1),
     });
     line(format!(
         "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
@@ -257,4 +241,19 @@ fn row_words(row: &semismooth_contact::model::ContactRow) -> String {
         .map(|(dof, a)| format!("{a} u[{}]", dof + 1))
         .collect();
     terms.join(" + ").replace("+ -", "- ")
+}
+
+/// The `damping` line of a description: the damping a `[damping]` section builds
+/// (`omega_1` converts a modal damping ratio to the stiffness factor).
+fn damping_line(damping: Option<&DampingSpec>, omega_1: f64) -> String {
+    match damping {
+        None => "damping           none (no damping matrix)".into(),
+        Some(DampingSpec::StiffnessProportional { zeta }) => format!(
+            "damping           D = beta K, beta = 2 zeta / omega_1 = {:.6e} (zeta = {zeta})",
+            2.0 * zeta / omega_1
+        ),
+        Some(DampingSpec::Rayleigh { alpha, beta }) => {
+            format!("damping           D = {alpha} M + {beta} K")
+        }
+    }
 }

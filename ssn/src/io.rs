@@ -231,16 +231,7 @@ impl OutputSet {
     /// Claims an input (the scene, a file it names, a start state): no output may replace
     /// it; `Err` when an output claimed before names it.
     pub fn input(&mut self, path: &Path, what: &str) -> Result<(), TargetError> {
-        let id = identity(path);
-        if let Some((_, first, _)) = self.claimed.iter().find(|(i, _, out)| *out && *i == id) {
-            return Err(TargetError::Clash {
-                path: path.to_path_buf(),
-                first: first.clone(),
-                second: what.to_string(),
-            });
-        }
-        self.claimed.push((id, what.to_string(), false));
-        Ok(())
+        self.claim(path, what, false)
     }
 
     /// Claims standard output for `what` (e.g. `--json`).
@@ -261,15 +252,22 @@ impl OutputSet {
                 }
             }
         }
+        self.claim(path, what, true)
+    }
+
+    /// Claims `path` for `what`, an output or an input: `Err` when a claim before names the
+    /// same file and one of the two is an output (two inputs may share a file).
+    fn claim(&mut self, path: &Path, what: &str, output: bool) -> Result<(), TargetError> {
         let id = identity(path);
-        if let Some((_, first, _)) = self.claimed.iter().find(|(i, _, _)| *i == id) {
+        let clash = |(i, _, out): &&(Identity, String, bool)| *i == id && (output || *out);
+        if let Some((_, first, _)) = self.claimed.iter().find(clash) {
             return Err(TargetError::Clash {
                 path: path.to_path_buf(),
                 first: first.clone(),
                 second: what.to_string(),
             });
         }
-        self.claimed.push((id, what.to_string(), true));
+        self.claimed.push((id, what.to_string(), output));
         Ok(())
     }
 

@@ -4,14 +4,19 @@
 //! with `converged = false`, exit code 1) and `ssn scene-check`.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
+#[path = "common/exit_status.rs"]
+mod exit_status;
 #[path = "common/json_fields.rs"]
 mod json_fields;
+#[path = "common/process.rs"]
+mod process;
 
-const SSN: &str = env!("CARGO_BIN_EXE_ssn");
+use exit_status::err as stderr;
+use process::{out as stdout, ssn};
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
@@ -26,21 +31,6 @@ fn shipped_scenes() -> Vec<PathBuf> {
     scenes.sort();
     assert!(scenes.len() >= 6, "expected the shipped scenes: {scenes:?}");
     scenes
-}
-
-fn ssn(args: &[&str]) -> Output {
-    Command::new(SSN)
-        .args(args)
-        .output()
-        .expect("the ssn binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// A fresh directory under the system temporary directory, removed on drop.

@@ -8,6 +8,14 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[path = "common/exit_status.rs"]
+mod exit_status;
+#[path = "common/process.rs"]
+mod process;
+
+use exit_status::{assert_exit, err};
+use process::{out, ssn};
+
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
 
 fn scene(name: &str) -> String {
@@ -23,10 +31,6 @@ fn fig1() -> String {
     scene("paper_fig1_modified_mass.toml")
 }
 
-fn ssn(args: &[&str]) -> Output {
-    Command::new(SSN).args(args).output().expect("ssn runs")
-}
-
 fn ssn_with_stdout(args: &[&str], stdout: Stdio) -> Output {
     Command::new(SSN)
         .args(args)
@@ -34,19 +38,6 @@ fn ssn_with_stdout(args: &[&str], stdout: Stdio) -> Output {
         .stderr(Stdio::piped())
         .output()
         .expect("ssn runs")
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn out(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn assert_exit(o: &Output, code: i32, what: &str) {
-    assert_eq!(o.status.code(), Some(code), "{what}: stderr {}", err(o));
-    assert!(!err(o).contains("panicked"), "{what}: {}", err(o));
 }
 
 /// Every subcommand that prints something, as `ssn` arguments.

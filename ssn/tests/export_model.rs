@@ -6,17 +6,15 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
+#[path = "common/process.rs"]
+mod process;
+
+use process::ssn;
+
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
-}
-
-fn ssn(args: &[&str]) -> Output {
-    Command::new(SSN)
-        .args(args)
-        .output()
-        .expect("the ssn binary runs")
 }
 
 fn json(o: &Output) -> Value {

@@ -2,7 +2,6 @@
 //! (300 dofs, a stop on each of 100 blade tip pads), and its tuned twin, whose cyclic
 //! symmetry makes every blade answer exactly as one sector with one contact.
 
-use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{ContactPoint, StructuralModel, Structure};
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::solve::solve;
@@ -12,11 +11,7 @@ use ssn::scene::Scene;
 mod common;
 
 fn shipped(edit: impl Fn(String) -> String) -> (Scene, Structure) {
-    let path = common::scenes_dir().join("bladed_disk_casing.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let scene = Scene::from_toml(&edit(text), &path).unwrap();
-    let s = build_imported(scene.model.as_ref().unwrap()).unwrap();
-    (scene, s)
+    common::shipped_model("bladed_disk_casing.toml", edit)
 }
 
 #[test]

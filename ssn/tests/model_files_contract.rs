@@ -9,14 +9,13 @@ mod exit_status;
 
 use std::process::{Command, Output, Stdio};
 
+#[path = "common/process.rs"]
+mod process;
 use exit_status::{assert_exit, assert_mentions, err};
+use process::ssn;
 use std::time::{Duration, Instant};
 
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
-
-fn ssn(args: &[&str]) -> Output {
-    Command::new(SSN).args(args).output().expect("ssn runs")
-}
 
 /// A three-dof chain `[model]` scene (K, M, f and `model.toml`) in a new directory.
 fn chain(extra: &str) -> (tempfile::TempDir, PathBuf) {

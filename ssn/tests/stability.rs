@@ -16,6 +16,9 @@ use semismooth_contact::stability::{
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 use ssn::scene::Scene;
 
+#[path = "common/process.rs"]
+mod process;
+
 /// The strongly forced rod: 20 elements, modified mass, p0 = 0.2, gap 0.5, H = 20.
 const STRONG: &str = r#"
 [rod]
@@ -352,22 +355,13 @@ fn sweep_json_and_csv_carry_the_stability_of_every_point() {
     let scene = dir.join("strong.toml");
     std::fs::write(&scene, STRONG).unwrap();
     let csv = dir.join("strong.csv");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ssn"))
-        .args([
-            "sweep",
-            scene.to_str().unwrap(),
-            "--json",
-            "--csv",
-            csv.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let json = process::json_success(&process::ssn(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]));
     let points = json["points"].as_u64().unwrap() as usize;
     for key in [
         "omega_ratio",

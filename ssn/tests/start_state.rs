@@ -5,9 +5,13 @@
 //! the field named (exit code 2); a state of other harmonics is lifted or truncated.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
+
+#[path = "common/process.rs"]
+mod process;
+
+use process::{json_success, ssn};
 
 /// The strongly forced rod inside its overhang: 20 elements, modified mass, p0 = 0.2,
 /// gap 0.5, H = 20, at 1.14 omega_1 (folds at 1.098 and 1.185).
@@ -42,23 +46,6 @@ impl Drop for Dir {
     }
 }
 
-fn ssn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ssn"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn json_of(o: &Output) -> Value {
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
-
 fn read_json(path: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(Path::new(path)).unwrap()).unwrap()
 }
@@ -86,7 +73,7 @@ fn a_solve_started_from_its_own_state_converges_at_once_to_the_same_answer() {
     let dir = Dir::new("own");
     let scene = dir.write("strong.toml", STRONG);
     let state = dir.path("state.json");
-    let first = json_of(&ssn(&["solve", &scene, "--json", "--state", &state]));
+    let first = json_success(&ssn(&["solve", &scene, "--json", "--state", &state]));
     let doc = read_json(&state);
     assert_eq!(doc["method"], "ssn-hb");
     assert_eq!(doc["harmonics"], 20);
@@ -94,7 +81,7 @@ fn a_solve_started_from_its_own_state_converges_at_once_to_the_same_answer() {
     assert_eq!(doc["contacts"], 1);
     assert_eq!(numbers(&doc["displacement"]).len(), 41 * 20);
     assert_eq!(numbers(&doc["contact_force"]).len(), 41);
-    let second = json_of(&ssn(&["solve", &scene, "--json", "--start", &state]));
+    let second = json_success(&ssn(&["solve", &scene, "--json", "--start", &state]));
     // The state is a solution to the Newton tolerance: at most one more step, and the same
     // tip extremes to round-off (1e-12 of the amplitude).
     assert!(second["iterations"].as_u64().unwrap() <= 1, "{second}");
@@ -110,7 +97,7 @@ fn inside_the_overhang_each_listed_solution_is_a_start_that_returns_it() {
     let dir = Dir::new("entries");
     let scene = dir.write("strong.toml", STRONG);
     let solutions_out = ssn(&["solutions", &scene, "--json"]);
-    let solutions = json_of(&solutions_out);
+    let solutions = json_success(&solutions_out);
     let list = solutions["solutions"].as_array().unwrap();
     let stable: Vec<&Value> = list.iter().map(|s| &s["stable"]).collect();
     assert_eq!(
@@ -122,12 +109,12 @@ fn inside_the_overhang_each_listed_solution_is_a_start_that_returns_it() {
         "solutions.json",
         &String::from_utf8(solutions_out.stdout).unwrap(),
     );
-    let zero = json_of(&ssn(&["solve", &scene, "--json"]));
+    let zero = json_success(&ssn(&["solve", &scene, "--json"]));
     let zero_tip = zero["tip_min"].as_f64().unwrap();
     let mut different_from_zero = 0;
     for (k, entry) in list.iter().enumerate() {
         let k1 = (k + 1).to_string();
-        let solved = json_of(&ssn(&[
+        let solved = json_success(&ssn(&[
             "solve", &scene, "--json", "--start", &file, "--entry", &k1,
         ]));
         // The entry is a Newton solution at this very frequency and settings: the solve
@@ -152,7 +139,7 @@ fn inside_the_overhang_each_listed_solution_is_a_start_that_returns_it() {
     // The state of an entry is the entry's coefficients: its tip minimum is reproduced by
     // `--state` of the solve started from it.
     let state = dir.path("state.json");
-    json_of(&ssn(&[
+    json_success(&ssn(&[
         "solve", &scene, "--json", "--start", &file, "--entry", "1", "--state", &state,
     ]));
     let written = numbers(&read_json(&state)["displacement"]);
@@ -166,7 +153,7 @@ fn a_state_of_other_harmonics_is_lifted_or_truncated_and_mismatches_name_the_fie
     let scene = dir.write("strong.toml", STRONG);
     let state = dir.path("state.json");
     let solutions = dir.path("solutions.json");
-    json_of(&ssn(&["solve", &scene, "--json", "--state", &state]));
+    json_success(&ssn(&["solve", &scene, "--json", "--state", &state]));
     let out = ssn(&["solutions", &scene, "--json"]);
     std::fs::write(&solutions, &out.stdout).unwrap();
     // The contact solution (entry 1) at H = 20 started at H = 40 and H = 10: Newton stays
@@ -177,7 +164,7 @@ fn a_state_of_other_harmonics_is_lifted_or_truncated_and_mismatches_name_the_fie
             &format!("h{harmonics}.toml"),
             &STRONG.replace("harmonics = 20", &format!("harmonics = {harmonics}")),
         );
-        let solved = json_of(&ssn(&[
+        let solved = json_success(&ssn(&[
             "solve", &other, "--json", "--start", &solutions, "--entry", "1",
         ]));
         let tip = solved["tip_min"].as_f64().unwrap();

@@ -14,19 +14,17 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+#[path = "common/process.rs"]
+mod process;
+
+use process::{json_success, ssn};
+
 const SSN: &str = env!("CARGO_BIN_EXE_ssn");
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenes")
         .join(name)
-}
-
-fn ssn(args: &[&str]) -> Output {
-    Command::new(SSN)
-        .args(args)
-        .output()
-        .expect("the ssn binary runs")
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -414,16 +412,6 @@ fn the_throughput_page_holds_the_table_of_its_example() {
 
 // The bladed disk of the shipped mistuning study.
 
-fn json(o: &Output) -> Value {
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).expect("a JSON document")
-}
-
 /// A TOML list of numbers in shortest round-trip form (read back exactly).
 fn toml_list(v: &[f64]) -> String {
     let items: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
@@ -456,14 +444,14 @@ fn the_disk_built_from_its_mistuning_is_the_shipped_matrix_market_disk() {
         .map(|j| semismooth_contact::structures::SHIPPED_MISTUNING * (2.3 * j as f64).sin())
         .collect();
     let set = format!("bladed_disk.mistuning={}", toml_list(&mistuning));
-    let built = json(&ssn(&[
+    let built = json_success(&ssn(&[
         "solve",
         path(&scene("bladed_disk_mistuned.toml")),
         "--set",
         &set,
         "--json",
     ]));
-    let files = json(&ssn(&[
+    let files = json_success(&ssn(&[
         "solve",
         path(&scene("bladed_disk_casing.toml")),
         "--json",
@@ -531,7 +519,7 @@ fn a_mistuning_study_table_holds_the_solve_of_each_case() {
             })
             .collect();
         assert!(pattern.iter().all(|d| d.abs() < 0.2), "{pattern:?}");
-        let alone = json(&ssn(&[
+        let alone = json_success(&ssn(&[
             "solve",
             path(&small),
             "--set",
@@ -630,7 +618,7 @@ fn the_mistuning_page_holds_ordered_quantiles_over_the_tuned_disks_solves() {
         // 1e-4 at most for amplitudes above 0.5).
         assert!((number(8) - quantiles[3] / tuned).abs() <= 1e-3, "{row:?}");
         let set = format!("contact.gap={gap:?}");
-        let solved = json(&ssn(&[
+        let solved = json_success(&ssn(&[
             "solve",
             path(&scene("bladed_disk_mistuned.toml")),
             "--set",

@@ -2,7 +2,6 @@
 //! cantilever of `scenes/beam_two_sided.toml` rattling between two stops, solved
 //! by SSN-HB and time marching; the sign of a contact's row of `G` checked by mirror images.
 
-use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{ContactDirection, InvalidModel, Structure};
 use semismooth_contact::solve::Solution;
 use ssn::scene::{default_hb_time_samples, Method, Scene};
@@ -11,11 +10,7 @@ mod common;
 
 /// The shipped two-sided scene, with `edit` applied to its text.
 fn beam(edit: impl Fn(String) -> String) -> (Scene, Structure) {
-    let path = common::scenes_dir().join("beam_two_sided.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let scene = Scene::from_toml(&edit(text), &path).unwrap();
-    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
-    (scene, structure)
+    common::shipped_model("beam_two_sided.toml", edit)
 }
 
 /// The scene's text with its contacts replaced by one stop on the pad (`direction`) and

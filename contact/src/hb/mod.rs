@@ -171,6 +171,7 @@ use std::sync::Arc;
 
 use faer::c64;
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
+use semismooth::InvalidOption;
 
 use crate::model::{
     sparse_mul_add, ContactRow, InvalidModel, NormalForce, SparseMatrix, StructuralModel,
@@ -194,15 +195,8 @@ omega_parameter!(SsnHb, PenaltyHb);
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HbError {
     /// An option or parameter is outside its allowed range.
-    #[error("invalid {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// Which option (field name).
-        name: &'static str,
-        /// The value received.
-        value: f64,
-        /// The allowed range, in words.
-        allowed: &'static str,
-    },
+    #[error("invalid {0}")]
+    InvalidOption(#[from] InvalidOption),
     /// The model is not usable (sizes, non-finite data, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),
@@ -505,11 +499,11 @@ pub(crate) const MEAN_SLIP_ANCHOR: f64 = 1e-6;
 /// `harmonics >= 1` (the forcing is harmonic 1) and `time_samples > 2H` when given.
 pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> Result<(), HbError> {
     if harmonics == 0 {
-        return Err(HbError::InvalidOption {
-            name: "harmonics",
-            value: 0.0,
-            allowed: "an integer >= 1 (the forcing is harmonic 1)",
-        });
+        return Err(HbError::InvalidOption(InvalidOption::new(
+            "harmonics",
+            0.0,
+            "an integer >= 1 (the forcing is harmonic 1)",
+        )));
     }
     if let Some(nt) = time_samples {
         FourierBasis::new(harmonics, nt)?;
@@ -517,26 +511,15 @@ pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> R
     Ok(())
 }
 
+pub(crate) use crate::model::check_omega;
+
 /// `Err(InvalidOption { name, value, allowed })` unless `value` is finite and `> 0`.
 pub(crate) fn check_positive(
     name: &'static str,
     value: f64,
     allowed: &'static str,
-) -> Result<(), HbError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(HbError::InvalidOption {
-            name,
-            value,
-            allowed,
-        })
-    }
-}
-
-/// `Err(InvalidOption { name: "omega" })` unless the forcing frequency is finite and `> 0`.
-pub(crate) fn check_omega(omega: f64) -> Result<(), HbError> {
-    check_positive("omega", omega, "a finite angular frequency > 0")
+) -> Result<(), InvalidOption> {
+    InvalidOption::check(value.is_finite() && value > 0.0, name, value, allowed)
 }
 
 /// Harmonic-balance unknowns of `from` harmonics carried to `to` harmonics: the

@@ -104,11 +104,11 @@ impl PenaltyHbOptions {
 }
 
 fn check_penalty_stiffness(kp: f64) -> Result<(), HbError> {
-    check_positive(
+    Ok(check_positive(
         "penalty_stiffness",
         kp,
         "a finite penalty stiffness > 0 (absolute, force per length)",
-    )
+    )?)
 }
 
 /// Penalty HB on a [`StructuralModel`]: unknowns `U` (length `N (2H + 1)`, harmonic-major),

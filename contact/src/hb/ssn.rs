@@ -49,11 +49,11 @@ impl HbOptions {
 }
 
 fn check_c(c: f64) -> Result<(), HbError> {
-    check_positive(
+    Ok(check_positive(
         "c",
         c,
         "a finite complementarity constant > 0 (force per length)",
-    )
+    )?)
 }
 
 /// SSN-HB on a [`StructuralModel`] with `m >= 0` contacts.

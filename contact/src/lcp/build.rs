@@ -9,7 +9,7 @@ use semismooth::{Factorize, LinearSolve};
 
 use super::{FftPlans, FrequencyDerivative, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions};
 use crate::dynamic::DynamicStiffness;
-use crate::model::{ContactDirection, SparseMatrix, StructuralModel};
+use crate::model::{check_omega, ContactDirection, SparseMatrix, StructuralModel};
 
 /// `true` when column `j` of `m` has no non-zero entry.
 fn column_is_zero(m: &SparseMatrix, j: usize) -> bool {
@@ -62,13 +62,7 @@ impl PeriodicLcp {
         with_derivative: bool,
     ) -> Result<Self, LcpError> {
         model.validate()?;
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(LcpError::InvalidOption {
-                name: "omega",
-                value: omega,
-                allowed: "a finite angular frequency > 0",
-            });
-        }
+        check_omega(omega)?;
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);
         }

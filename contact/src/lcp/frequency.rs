@@ -29,6 +29,7 @@ use std::rc::Rc;
 use faer::MatMut;
 use semismooth::complementarity::min_function;
 use semismooth::linalg::{DenseAssemble, LinearSolveError};
+use semismooth::InvalidOption;
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual,
 };
@@ -66,11 +67,11 @@ impl FrequencyLcp {
         kappa: f64,
     ) -> Result<Self, LcpError> {
         if !(kappa.is_finite() && kappa > 0.0) {
-            return Err(LcpError::InvalidOption {
-                name: "kappa",
-                value: kappa,
-                allowed: "a finite number > 0",
-            });
+            return Err(LcpError::InvalidOption(InvalidOption::new(
+                "kappa",
+                kappa,
+                "a finite number > 0",
+            )));
         }
         let lcp = PeriodicLcp::with_frequency_derivative(model, omega, options.clone())?;
         let n = lcp.dim();

@@ -25,6 +25,7 @@ use semismooth::linalg::{
     check_finite_dense, check_pivots, DenseAssemble, FaerDenseLu, LinearSolveError,
     DEFAULT_PIVOT_THRESHOLD,
 };
+use semismooth::InvalidOption;
 use semismooth::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, Residual, Smoothing,
 };
@@ -358,11 +359,11 @@ impl ActiveSetSolver {
     /// reporting it.
     pub fn with_regularization(mut self, shift: f64) -> Result<Self, LcpError> {
         if !(shift.is_finite() && shift > 0.0) {
-            return Err(LcpError::InvalidOption {
-                name: "regularization",
-                value: shift,
-                allowed: "a finite relative diagonal shift > 0",
-            });
+            return Err(LcpError::InvalidOption(InvalidOption::new(
+                "regularization",
+                shift,
+                "a finite relative diagonal shift > 0",
+            )));
         }
         self.regularization = Some(shift);
         Ok(self)
@@ -575,6 +576,14 @@ mod tests {
         })
     }
 
+    /// `(A, q)` of 12 unknowns (a diagonally dominant `A`) and a point `z > 0`.
+    fn twelve_unknowns() -> (Mat<f64>, Vec<f64>, Vec<f64>) {
+        let n = 12;
+        let q = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
+        let z = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
+        (matrix(n), q, z)
+    }
+
     #[test]
     fn active_set_solver_matches_dense_lu_on_the_assembled_jacobian() {
         for n in [1usize, 2, 3, 17, 64] {
@@ -646,10 +655,8 @@ mod tests {
 
     #[test]
     fn smoothing_at_mu_zero_is_bitwise_the_min_map_and_its_derivatives_match_differences() {
-        let n = 12;
-        let a = matrix(n);
-        let q: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
-        let z: Vec<f64> = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
+        let (a, q, z) = twelve_unknowns();
+        let n = q.len();
         let mut plain = MinMapLcp::new(a.as_ref(), &q).unwrap();
         let mut smooth = MinMapLcp::new(a.as_ref(), &q).unwrap();
         smooth.set_smoothing(0.0);
@@ -713,10 +720,8 @@ mod tests {
 
     #[test]
     fn jacobian_rows_match_finite_differences_away_from_kinks() {
-        let n = 12;
-        let a = matrix(n);
-        let q: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
-        let z: Vec<f64> = (0..n).map(|i| 0.5 + 0.4 * (i as f64 * 0.9).sin()).collect();
+        let (a, q, z) = twelve_unknowns();
+        let n = q.len();
         let mut f = MinMapLcp::new(a.as_ref(), &q).unwrap();
         let mut jac = f.new_jacobian();
         f.jacobian(&z, &mut jac).unwrap();

@@ -151,6 +151,7 @@ use rustfft::{Fft, FftPlanner};
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeReport, LemkeTermination};
 use semismooth::linalg::LinearSolveError;
 use semismooth::newton::NewtonError;
+use semismooth::InvalidOption;
 
 use crate::model::InvalidModel;
 
@@ -219,12 +220,12 @@ impl PeriodicLcpOptions {
     pub fn validate(&self, contacts: usize, dofs: usize) -> Result<(), LcpError> {
         let nt = self.time_samples;
         if nt < MIN_LCP_TIME_SAMPLES || contacts.saturating_mul(nt) > MAX_LCP_SIZE {
-            return Err(LcpError::InvalidOption {
-                name: "time_samples",
-                value: nt as f64,
-                allowed: "an integer >= 8 with (number of contacts) * time_samples <= 8192 (a \
+            return Err(LcpError::InvalidOption(InvalidOption::new(
+                "time_samples",
+                nt as f64,
+                "an integer >= 8 with (number of contacts) * time_samples <= 8192 (a \
                           scene's solver.time_samples; the LCP matrix is dense)",
-            });
+            )));
         }
         Ok(crate::model::check_observed(&self.observed_dofs, dofs)?)
     }
@@ -234,15 +235,8 @@ impl PeriodicLcpOptions {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LcpError {
     /// An option is out of range.
-    #[error("invalid option {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// Which option.
-        name: &'static str,
-        /// The value received.
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
+    #[error("invalid option {0}")]
+    InvalidOption(#[from] InvalidOption),
     /// The model has no contact: there is no complementarity problem.
     #[error("the model has no contact: the periodic LCP needs at least one")]
     NoContacts,

@@ -124,6 +124,7 @@ pub use step::TimeMarcher;
 
 use semismooth::lemke::LemkeError;
 use semismooth::linalg::LinearSolveError;
+use semismooth::InvalidOption;
 
 use crate::model::{InvalidModel, SparseMatrix, StructuralModel};
 
@@ -188,40 +189,40 @@ impl MarchOptions {
     /// Checks every field; the error names the field, the value and what is allowed.
     pub fn validate(&self) -> Result<(), MarchError> {
         if !(4..=MAX_STEPS_PER_PERIOD).contains(&self.steps_per_period) {
-            return Err(MarchError::InvalidOption {
+            return Err(MarchError::InvalidOption(InvalidOption {
                 name: "steps_per_period",
                 value: self.steps_per_period as f64,
                 allowed: "an integer in 4..=100000000",
-            });
+            }));
         }
         if self.max_periods == 0 {
-            return Err(MarchError::InvalidOption {
-                name: "max_periods",
-                value: 0.0,
-                allowed: "an integer >= 1",
-            });
+            return Err(MarchError::InvalidOption(InvalidOption::new(
+                "max_periods",
+                0.0,
+                "an integer >= 1",
+            )));
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(MarchError::InvalidOption {
-                name: "tolerance",
-                value: self.tolerance,
-                allowed: "a number in (0, 1)",
-            });
+            return Err(MarchError::InvalidOption(InvalidOption::new(
+                "tolerance",
+                self.tolerance,
+                "a number in (0, 1)",
+            )));
         }
         if let MarchScheme::MoreauJean { theta, restitution } = self.scheme {
             if !(0.5..=1.0).contains(&theta) {
-                return Err(MarchError::InvalidOption {
-                    name: "theta",
-                    value: theta,
-                    allowed: "a number in [0.5, 1]",
-                });
+                return Err(MarchError::InvalidOption(InvalidOption::new(
+                    "theta",
+                    theta,
+                    "a number in [0.5, 1]",
+                )));
             }
             if !(0.0..=1.0).contains(&restitution) {
-                return Err(MarchError::InvalidOption {
-                    name: "restitution",
-                    value: restitution,
-                    allowed: "a number in [0, 1]",
-                });
+                return Err(MarchError::InvalidOption(InvalidOption::new(
+                    "restitution",
+                    restitution,
+                    "a number in [0, 1]",
+                )));
             }
         }
         Ok(())
@@ -333,15 +334,8 @@ pub struct SteadyPeriod {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MarchError {
     /// An option is outside its allowed range.
-    #[error("invalid option {name} = {value}: allowed {allowed}")]
-    InvalidOption {
-        /// The option's name.
-        name: &'static str,
-        /// The value given.
-        value: f64,
-        /// What is allowed.
-        allowed: &'static str,
-    },
+    #[error("invalid option {0}")]
+    InvalidOption(#[from] InvalidOption),
     /// The model is not usable (sizes, non-finite data, frequency, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),

@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 use faer::Mat;
 use semismooth::lemke::{Lemke, LemkeError, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerSparseLu;
+use semismooth::InvalidOption;
 use semismooth::{Factorize, LinearSolve};
 
 use super::friction::CoulombStep;
@@ -16,7 +17,7 @@ use super::{
     MarchState,
 };
 use crate::dynamic::UnionPattern;
-use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
+use crate::model::{check_omega, sparse_mul_add, SparseMatrix, StructuralModel};
 
 /// A dof of a contact row (or of a friction point's tangential row) that carries mass, if
 /// any.
@@ -189,24 +190,18 @@ impl<'a> TimeMarcher<'a> {
     ) -> Result<Self, MarchError> {
         options.validate()?;
         model.validate()?;
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(MarchError::InvalidOption {
-                name: "omega",
-                value: omega,
-                allowed: "a finite angular frequency > 0",
-            });
-        }
+        check_omega(omega)?;
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
         let scheme = Scheme::resolve(model, options.scheme);
         if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
-            return Err(MarchError::InvalidOption {
-                name: "friction points marched by the trapezoidal scheme (every row dof massless)",
-                value: model.friction.len() as f64,
-                allowed: "none: Coulomb's law acts on velocities, the trapezoidal scheme imposes \
+            return Err(MarchError::InvalidOption(InvalidOption::new(
+                "friction points marched by the trapezoidal scheme (every row dof massless)",
+                model.friction.len() as f64,
+                "none: Coulomb's law acts on velocities, the trapezoidal scheme imposes \
                           positions; march with MoreauJean",
-            });
+            )));
         }
         let rows = m + model.friction_count();
         let massless: Vec<bool> = (0..n)

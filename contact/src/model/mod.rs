@@ -21,7 +21,7 @@ use std::ops::{AddAssign, Mul};
 
 use faer::sparse::{SparseColMat, SparseColMatRef};
 use num_traits::Zero;
-use semismooth::{Factorize, LinearSolve};
+use semismooth::{Factorize, InvalidOption, LinearSolve};
 
 mod contact;
 
@@ -232,6 +232,12 @@ pub(crate) fn check_observed(observed: &[usize], dofs: usize) -> Result<(), Inva
         Some(&dof) => Err(InvalidModel::ObservedDofOutOfRange { dof, dofs }),
         None => Ok(()),
     }
+}
+
+/// `Err` naming `omega` unless the forcing's angular frequency is finite and `> 0`.
+pub(crate) fn check_omega(omega: f64) -> Result<(), InvalidOption> {
+    let valid = omega.is_finite() && omega > 0.0;
+    InvalidOption::check(valid, "omega", omega, "a finite angular frequency > 0")
 }
 
 impl StructuralModel {

@@ -74,10 +74,11 @@ mod phases;
 mod shooting;
 
 use semismooth::floquet::{FloquetError, Multipliers};
+use semismooth::InvalidOption;
 
 use crate::hb::{HbError, PenaltyHb, SsnHb};
 use crate::march::{MarchError, MarchState};
-use crate::model::StructuralModel;
+use crate::model::{check_omega, StructuralModel};
 use crate::settings::{Method, SolverSettings};
 use crate::solve::{hb_options, penalty_options};
 
@@ -157,6 +158,16 @@ pub enum StabilityError {
     /// The harmonic-balance problem of a branch could not be rebuilt.
     #[error(transparent)]
     Hb(#[from] HbError),
+}
+
+impl From<InvalidOption> for StabilityError {
+    fn from(e: InvalidOption) -> Self {
+        Self::InvalidOption {
+            name: e.name,
+            value: e.value,
+            allowed: e.allowed,
+        }
+    }
 }
 
 /// Why a periodic solution's stability is not decided.
@@ -405,13 +416,7 @@ impl HbStability {
     /// The stability of the solution `x` (the method's unknowns) at angular frequency
     /// `omega` (module documentation).
     pub fn of(&mut self, omega: f64, x: &[f64]) -> Result<Stability, StabilityError> {
-        if !(omega.is_finite() && omega > 0.0) {
-            return Err(StabilityError::InvalidOption {
-                name: "omega",
-                value: omega,
-                allowed: "a finite angular frequency > 0",
-            });
-        }
+        check_omega(omega)?;
         let mut intervals = self.closed_intervals(x)?;
         if let Some(reason) = &self.refused {
             return Ok(Stability::not_decided(reason.clone()));

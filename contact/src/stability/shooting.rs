@@ -65,7 +65,7 @@ use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
 use super::{hb_state, StabilityError, StabilityOptions, Undecided, MAX_DOFS};
 use crate::march::{resolve_scheme, MarchOptions, MarchScheme, MarchState, TimeMarcher};
-use crate::model::StructuralModel;
+use crate::model::{check_omega, StructuralModel};
 
 /// The stability of one periodic solution from the discrete monodromy of the time-stepping
 /// map along the map's own periodic orbit.
@@ -155,13 +155,7 @@ pub fn map_stability(
             allowed: "an integer in 8..=1000000",
         });
     }
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(StabilityError::InvalidOption {
-            name: "omega",
-            value: omega,
-            allowed: "a finite angular frequency > 0",
-        });
-    }
+    check_omega(omega)?;
     let n = model.dofs();
     if u.len() != n * (2 * harmonics + 1) {
         return Err(StabilityError::Dimension {

@@ -19,6 +19,19 @@ impl Check<'_> {
         SceneError::invalid(self.path, key, value, allowed)
     }
 
+    /// Refuses the first of `keys` that is given (`value` says why it may not be).
+    fn refuse_given(
+        &self,
+        keys: &[(&str, bool)],
+        value: &str,
+        allowed: &str,
+    ) -> Result<(), SceneError> {
+        match keys.iter().find(|(_, given)| *given) {
+            Some((key, _)) => Err(self.invalid(key, value, allowed)),
+            None => Ok(()),
+        }
+    }
+
     pub(super) fn positive(&self, key: &str, v: f64) -> Result<f64, SceneError> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
@@ -365,18 +378,14 @@ impl Check<'_> {
                 }
                 let mut contacts: Vec<RodContact> = Vec::with_capacity(points.len());
                 for p in points {
-                    for (key, given) in [
-                        ("contact.point.dof", p.dof.is_some()),
-                        ("contact.point.direction", p.direction.is_some()),
-                    ] {
-                        if given {
-                            return Err(self.invalid(
-                                key,
-                                "given in a [rod] scene",
-                                "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
-                            ));
-                        }
-                    }
+                    self.refuse_given(
+                        &[
+                            ("contact.point.dof", p.dof.is_some()),
+                            ("contact.point.direction", p.direction.is_some()),
+                        ],
+                        "given in a [rod] scene",
+                        "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                    )?;
                     let node = p.node.ok_or_else(|| {
                         self.invalid("contact.point.node", "missing", "an integer node number")
                     })?;
@@ -641,19 +650,15 @@ impl Check<'_> {
             .transpose()?;
         if accuracy.is_some() {
             // The search chooses the discretisation: one given as well would be ignored.
-            for (key, given) in [
-                ("solver.harmonics", s.harmonics.is_some()),
-                ("solver.time_samples", s.time_samples.is_some()),
-                ("solver.steps_per_period", s.steps_per_period.is_some()),
-            ] {
-                if given {
-                    return Err(self.invalid(
-                        key,
-                        "given with solver.accuracy",
-                        "not both: with an accuracy the method chooses its discretisation",
-                    ));
-                }
-            }
+            self.refuse_given(
+                &[
+                    ("solver.harmonics", s.harmonics.is_some()),
+                    ("solver.time_samples", s.time_samples.is_some()),
+                    ("solver.steps_per_period", s.steps_per_period.is_some()),
+                ],
+                "given with solver.accuracy",
+                "not both: with an accuracy the method chooses its discretisation",
+            )?;
         }
         Ok(SolverSettings {
             method,

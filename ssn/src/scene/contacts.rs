@@ -14,6 +14,8 @@ use super::*;
 struct RawRow<'a> {
     /// The section's key prefix, `contact.point` or `friction.point`.
     section: &'static str,
+    /// A rod node, refused: a `[model]` scene names dofs.
+    node: Option<i64>,
     dof: Option<i64>,
     direction: Option<i64>,
     dofs: Option<&'a [i64]>,
@@ -39,15 +41,9 @@ impl Check<'_> {
         let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
         for (index, p) in points.into_iter().enumerate() {
             let entry = index + 1;
-            if p.node.is_some() {
-                return Err(self.invalid(
-                    "contact.point.node",
-                    "given in a [model] scene",
-                    "`dof` (1-based, as in Matrix Market) or `dofs` with `coefficients`",
-                ));
-            }
             let row = self.row(RawRow {
                 section: "contact.point",
+                node: p.node,
                 dof: p.dof,
                 direction: p.direction,
                 dofs: p.dofs.as_deref(),
@@ -154,15 +150,9 @@ impl Check<'_> {
         points
             .into_iter()
             .map(|p| {
-                if p.node.is_some() {
-                    return Err(self.invalid(
-                        "friction.point.node",
-                        "given in a [model] scene",
-                        "`dof` (1-based, as in Matrix Market) or `dofs` with `coefficients`",
-                    ));
-                }
                 let tangent = self.row(RawRow {
                     section: "friction.point",
+                    node: p.node,
                     dof: p.dof,
                     direction: None,
                     dofs: p.dofs.as_deref(),
@@ -211,6 +201,13 @@ impl Check<'_> {
     /// `coefficients`, never both.
     fn row(&self, r: RawRow<'_>) -> Result<ContactRow, SceneError> {
         let key = |name: &str| format!("{}.{name}", r.section);
+        if r.node.is_some() {
+            return Err(self.invalid(
+                &key("node"),
+                "given in a [model] scene",
+                "`dof` (1-based, as in Matrix Market) or `dofs` with `coefficients`",
+            ));
+        }
         match (r.dof, r.dofs) {
             (Some(dof), None) => {
                 if r.coefficients.is_some() {

@@ -149,11 +149,7 @@ pub fn quantities(kind: RunKind, doc: &Value) -> Vec<(&'static str, Cell)> {
                         .collect()
                 })
                 .unwrap_or_default();
-            let argmax = excursions
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.is_finite())
-                .max_by(|a, b| a.1.total_cmp(b.1));
+            let argmax = finite_argmax(&excursions);
             vec![
                 ("omega_ratio", num(&doc["omega_ratio"])),
                 ("iterations", int(&doc["iterations"])),
@@ -174,11 +170,7 @@ pub fn quantities(kind: RunKind, doc: &Value) -> Vec<(&'static str, Cell)> {
                 .as_array()
                 .map(|a| a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect())
                 .unwrap_or_default();
-            let peak = amplitude
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.is_finite())
-                .max_by(|a, b| a.1.total_cmp(b.1));
+            let peak = finite_argmax(&amplitude);
             let stable = doc["stable"].as_array().cloned().unwrap_or_default();
             let count = |want: &Value| {
                 if absent {
@@ -438,4 +430,13 @@ fn write_column<T: parquet::data_type::DataType>(
         .typed::<T>()
         .write_batch(&values, Some(&defined), None)?;
     Ok(())
+}
+
+/// The index and value of the largest finite entry of `values` (`None` without one).
+fn finite_argmax(values: &[f64]) -> Option<(usize, &f64)> {
+    values
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))
 }

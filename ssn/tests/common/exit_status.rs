@@ -1,6 +1,8 @@
 //! What a finished `ssn` process said: its standard error, its exit code, the words a
 //! refusal must name.
 
+#![allow(dead_code)]
+
 use std::process::Output;
 
 /// The process's standard error as text.

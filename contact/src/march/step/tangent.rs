@@ -35,6 +35,7 @@
 
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::Mat;
+use semismooth::InvalidOption;
 use semismooth::LinearSolve;
 
 use super::{MarchError, MarchState, Scheme, TimeMarcher};
@@ -47,11 +48,11 @@ impl TimeMarcher<'_> {
         let (n, m) = (self.u.len(), self.lambda.len());
         state.check(n, m)?;
         if phase >= self.steps_per_period {
-            return Err(MarchError::InvalidOption {
-                name: "phase",
-                value: phase as f64,
-                allowed: "a step index below steps_per_period",
-            });
+            return Err(MarchError::InvalidOption(InvalidOption::new(
+                "phase",
+                phase as f64,
+                "a step index below steps_per_period",
+            )));
         }
         self.u.copy_from_slice(&state.displacement);
         self.v.copy_from_slice(&state.velocity);
