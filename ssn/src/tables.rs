@@ -776,7 +776,10 @@ pub fn adaptive_sweeps(rows: &[(String, crate::adaptive_sweeps::AdaptiveComparis
             ),
             format!("{:.1e}", c.worst_error()),
             format!("{:.1e}", c.worst_estimate()),
-            format!("{} of {}", c.met(), c.points),
+            match c.errors.iter().filter(|e| e.is_nan()).count() {
+                0 => format!("{} of {}", c.met(), c.points),
+                n => format!("{} of {} ({n} without a reference)", c.met(), c.points),
+            },
             c.reference_harmonics.to_string(),
             format!("{:.2}", c.worst_underestimate()),
             format!("{:.1}", c.worst_overestimate()),
