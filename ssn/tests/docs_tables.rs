@@ -210,3 +210,17 @@ fn friction_tables_are_the_codes() {
         true,
     );
 }
+
+#[test]
+fn adaptive_sweep_row_for_1e_2_on_the_paper_rod_is_the_codes_and_meets_it() {
+    use ssn::adaptive_sweeps::{compare_adaptive, paper_rod};
+    let rod = paper_rod().unwrap();
+    let comparison = compare_adaptive(&rod, 1e-2, None).unwrap();
+    // Every point within the target against the branch at the reference's harmonics taken
+    // up across it, and the estimate neither below a third nor above ten times the error.
+    assert_eq!(comparison.met(), comparison.points, "{comparison:?}");
+    assert!(comparison.worst_underestimate() <= 3.0, "{comparison:?}");
+    assert!(comparison.worst_overestimate() <= 10.0, "{comparison:?}");
+    let rows = vec![("paper's rod".to_string(), comparison)];
+    assert_in_docs("adaptive-sweeps", &tables::adaptive_sweeps(&rows), false);
+}
