@@ -24,7 +24,6 @@ pub use crate::work::Workload;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
 use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
-use semismooth_contact::solve::Solution;
 use semismooth_contact::sweep::fold_accuracy::{refine_folds, MAX_FOLD_HARMONICS};
 use semismooth_contact::sweep::SweepProgress;
 
@@ -408,34 +407,6 @@ impl RunArgs {
     }
 }
 
-/// Largest number of folds listed one by one in the human-readable sweep summary.
-const LISTED_FOLDS: usize = 8;
-
-/// The folds of a sweep in words (units of omega_1): all of them when there are few; else
-/// their count, range, first and last (LCP and stiff-penalty branches have tens to
-/// hundreds of small folds where the contact moves from node to node; `--json` and
-/// `--csv` keep every one).
-fn folds_summary(folds: &[f64], omega_1: f64) -> String {
-    let ratio: Vec<f64> = folds.iter().map(|w| w / omega_1).collect();
-    match ratio.len() {
-        0 => "none".into(),
-        n if n <= LISTED_FOLDS => ratio
-            .iter()
-            .map(|r| format!("{r:.4}"))
-            .collect::<Vec<_>>()
-            .join(", "),
-        n => {
-            let lo = ratio.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = ratio.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            format!(
-                "{n} between {lo:.4} and {hi:.4} (first {:.4}, last {:.4}; all in --json)",
-                ratio[0],
-                ratio[n - 1]
-            )
-        }
-    }
-}
-
 /// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
 /// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
 pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
@@ -517,7 +488,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         let period = 2.0 * std::f64::consts::PI / solution.omega;
         let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
         let mut series = vec![Series::new(
-            describe_method(&solution),
+            crate::words::describe_method(&solution),
             t.clone(),
             solution.tip.clone(),
         )];
@@ -554,7 +525,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
             v
         },
         || {
-            let mut t = solution_text(&solution, &scene.solver);
+            let mut t = crate::words::solution_text(&solution, &scene.solver);
             if let Some(s) = &start {
                 t += &format!("started from      {}\n", s.describe());
             }
@@ -597,107 +568,6 @@ impl StartedFrom {
                 .map(|n| format!("; {n}"))
                 .unwrap_or_default()
         )
-    }
-}
-
-fn describe_method(s: &Solution) -> String {
-    match (s.harmonics, s.lcp_scheme) {
-        (Some(h), _) => format!("{} H={h} Nt={}", s.method.name(), s.time_samples),
-        (None, Some(scheme)) if scheme != semismooth_contact::lcp::LcpScheme::Trapezoidal => {
-            format!(
-                "{} Nt={} {}",
-                s.method.name(),
-                s.time_samples,
-                scheme.name()
-            )
-        }
-        (None, _) => format!("{} Nt={}", s.method.name(), s.time_samples),
-    }
-}
-
-/// The text of `ssn solve`; `settings` gives the tolerance the scene asked for, which the
-/// text compares with the effective one.
-fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
-    use std::fmt::Write;
-    let mut t = String::new();
-    let c = &s.counters;
-    // Writing into a String cannot fail.
-    let _ = (|| -> std::fmt::Result {
-        writeln!(t, "method            {}", describe_method(s))?;
-        writeln!(
-            t,
-            "omega             {:.6} ({:.4} omega_1)",
-            s.omega,
-            s.omega / s.omega_1
-        )?;
-        writeln!(
-            t,
-            "converged         {} ({}), {} iterations, residual {:.3e}",
-            s.converged(),
-            crate::words::termination(&s.termination),
-            s.iterations,
-            s.residual_norm
-        )?;
-        if let Some(diagnosis) = s.diagnosis {
-            writeln!(
-                t,
-                "diagnosis         {}",
-                crate::words::diagnosis(diagnosis)
-            )?;
-        }
-        let asked = if s.method == Method::March {
-            settings.march_tolerance
-        } else {
-            settings.tolerance
-        };
-        if let Some(effective) = s.effective_tolerance.filter(|&e| e > asked) {
-            writeln!(
-                t,
-                "tolerance         {effective:.3e} effective: the scene's {asked:e} is below the \
-                 round-off floor of this formulation"
-            )?;
-        }
-        writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
-        writeln!(
-            t,
-            "tip max / min     {:.6} / {:.6}",
-            s.stats.max, s.stats.min
-        )?;
-        writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
-        writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
-        t += &crate::words::estimate_lines(s);
-        if s.contacts.len() > 1 {
-            for c in &s.contacts {
-                writeln!(
-                    t,
-                    "  contact node {:<4} mean force {:.6e}, in contact {:.1} % of the period, \
-                     max penetration {:.3e}",
-                    c.node,
-                    c.force_mean,
-                    100.0 * c.contact_fraction,
-                    c.max_penetration
-                )?;
-            }
-        }
-        writeln!(
-            t,
-            "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs{}",
-            c.residual_evaluations,
-            c.jacobian_evaluations,
-            c.factorizations,
-            c.linear_solves,
-            c.ffts,
-            gmres_words(c)
-        )
-    })();
-    t
-}
-
-/// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.
-fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String {
-    match c.krylov_iterations {
-        0 => String::new(),
-        k => format!(", {k} GMRES iterations"),
     }
 }
 
@@ -832,7 +702,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         }
         t += &format!(
             "folds             {}\n",
-            folds_summary(&response.folds, rod.omega_1)
+            crate::words::folds_summary(&response.folds, rod.omega_1)
         );
         if !response.corner_folds.is_empty() {
             t += &format!(
@@ -866,7 +736,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
             "work              {} corrector iterations, {} factorizations{}\n",
             response.continuation.corrector_iterations,
             response.counters.factorizations,
-            gmres_words(&response.counters)
+            crate::words::gmres_words(&response.counters)
         );
         t += &format!(
             "converged         {} ({}), {:.3} s\n",
@@ -993,7 +863,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
 
 #[cfg(test)]
 mod tests {
-    use super::folds_summary;
+    use crate::words::folds_summary;
 
     #[test]
     fn few_folds_are_listed_and_many_are_summarised_by_count_and_range() {
