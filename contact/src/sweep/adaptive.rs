@@ -510,14 +510,16 @@ pub(crate) fn adaptive_branch(
             let omega = point.parameter;
             let (max, min) = tip.extremes(&point.state)?;
             let index = response.points();
-            let here = run.resumption();
+            // Where the run stands at this point: the direction of its estimate, and the start
+            // of a change of harmonics decided here (taken once, not cloned again).
+            let mut here = run.resumption();
             let direction = here.as_ref().map(|r| r.direction.as_slice());
             let estimate = estimator.estimate(omega, h, &point.state, (max, min), direction)?;
             let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
             let raise =
                 estimate.is_some_and(|e| e > target) && h < limit && no_raise_at != Some(index);
             if raise {
-                if let Some(r) = run.resumption() {
+                if let Some(r) = here.take() {
                     let wanted = wanted
                         .unwrap_or(f64::INFINITY)
                         .clamp(h as f64 + 1.0, (MAX_RATIO * h as f64).max(h as f64 + 1.0));
@@ -543,7 +545,7 @@ pub(crate) fn adaptive_branch(
             if let (true, Some(w)) = (lower, wanted) {
                 let to = rung(w.max(h as f64 / MAX_RATIO), limit);
                 if to < h {
-                    if let Some(r) = run.resumption() {
+                    if let Some(r) = here.take() {
                         switch = Some(Switch {
                             from: h,
                             to,
