@@ -11,6 +11,7 @@
 pub mod builder;
 pub mod contacts;
 mod dynamic;
+mod error;
 pub mod exact;
 pub mod from_zero;
 pub mod hb;
@@ -26,5 +27,6 @@ pub mod stability;
 pub mod structures;
 pub mod sweep;
 
+pub use error::Error;
 pub use solve::accuracy;
 pub use solve::solve;
