@@ -111,3 +111,109 @@ through_core!(
     semismooth::EvaluationError,
     semismooth::InvalidOption
 );
+
+/// What kind of failure an [`Error`] is, for callers that react by kind (the program's exit
+/// codes, the Python package's exception classes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// The input (a model, an option, a setting) is not usable: change it.
+    InvalidInput,
+    /// A matrix of the problem is singular, e.g. the dynamic stiffness of an undamped model
+    /// forced at one of its natural frequencies ([`Error::linear_solve`] holds the pivot).
+    SingularMatrix,
+    /// The computation could not be carried out for another reason.
+    Failed,
+}
+
+impl Error {
+    /// The kind of this error ([`ErrorKind`]).
+    pub fn kind(&self) -> ErrorKind {
+        use semismooth::Error as Core;
+        if matches!(
+            self.linear_solve(),
+            Some(semismooth::linalg::LinearSolveError::Singular { .. })
+        ) {
+            return ErrorKind::SingularMatrix;
+        }
+        match self {
+            Error::InvalidSetting { .. }
+            | Error::Unsupported { .. }
+            | Error::InvalidModel(_)
+            | Error::InvalidRow(_)
+            | Error::Import(_)
+            | Error::Structure(StructureError::Invalid(_))
+            | Error::Core(Core::InvalidOption(_) | Core::ComplementarityConstant(_))
+            | Error::HarmonicBalance(
+                HbError::InvalidOption(_)
+                | HbError::Model(_)
+                | HbError::Unsupported { .. }
+                | HbError::IndexOutOfRange { .. }
+                | HbError::DimensionMismatch { .. }
+                | HbError::Harmonic(_),
+            )
+            | Error::Lcp(LcpError::InvalidOption(_))
+            | Error::March(MarchError::InvalidOption(_))
+            | Error::Stability(StabilityError::InvalidOption { .. })
+            | Error::Newton(_) => ErrorKind::InvalidInput,
+            _ => ErrorKind::Failed,
+        }
+    }
+
+    /// The failed factorization or solve behind this error, if there is one.
+    pub fn linear_solve(&self) -> Option<&semismooth::linalg::LinearSolveError> {
+        use semismooth::linalg::LinearSolveError;
+        if let Error::Core(semismooth::Error::LinearSolve(e)) = self {
+            return Some(e);
+        }
+        // Transparent variants hand on their inner error's source: the chain below `self`.
+        let mut source = std::error::Error::source(self);
+        while let Some(e) = source {
+            if let Some(linear) = e.downcast_ref::<LinearSolveError>() {
+                return Some(linear);
+            }
+            source = e.source();
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use semismooth::linalg::LinearSolveError;
+
+    const SINGULAR: LinearSolveError = LinearSolveError::Singular {
+        index: 3,
+        pivot: 0.0,
+        max_pivot: 2.0,
+    };
+
+    #[test]
+    fn a_singular_pivot_is_found_through_every_layer_that_wraps_it() {
+        for error in [
+            Error::from(SINGULAR),
+            Error::from(HbError::Linear(SINGULAR)),
+            Error::from(StabilityError::Hb(HbError::Linear(SINGULAR))),
+        ] {
+            assert_eq!(error.linear_solve(), Some(&SINGULAR), "{error:?}");
+            assert_eq!(error.kind(), ErrorKind::SingularMatrix, "{error:?}");
+        }
+    }
+
+    #[test]
+    fn options_and_settings_out_of_range_are_invalid_input_and_other_failures_are_not() {
+        let option = semismooth::InvalidOption::new("c", -1.0, "c > 0");
+        assert_eq!(Error::from(option).kind(), ErrorKind::InvalidInput);
+        assert_eq!(
+            Error::from(HbError::InvalidOption(option)).kind(),
+            ErrorKind::InvalidInput
+        );
+        let not_factored = Error::from(HbError::Linear(LinearSolveError::NotFactored));
+        assert_eq!(not_factored.kind(), ErrorKind::Failed);
+        assert_eq!(
+            not_factored.linear_solve(),
+            Some(&LinearSolveError::NotFactored)
+        );
+    }
+}

@@ -27,6 +27,6 @@ pub mod stability;
 pub mod structures;
 pub mod sweep;
 
-pub use error::Error;
+pub use error::{Error, ErrorKind};
 pub use solve::accuracy;
 pub use solve::solve;
