@@ -441,46 +441,61 @@ impl Kernel {
                 }
             }
 
-            // Accept: y <- trial, G <- G(trial).
-            y.copy_from_slice(&self.trial);
-            std::mem::swap(&mut self.g, &mut self.g_trial);
-            let norm = norm2(&self.g);
-            let progress = &mut self.progress;
-            progress.norm = norm;
-            progress.iterations += 1;
-            let step_norm = alpha * system.step_norm(&self.d);
-            self.residual_norms.push(norm);
-            self.step_lengths.push(alpha);
-            self.step_norms.push(step_norm);
-            if let Some(history) = self.history.as_mut() {
-                history.push(merit_of(norm));
+            if let Some(stop) = self.accept(system, y, rules, alpha) {
+                return Some(stop);
             }
-            progress.smallest = progress.smallest.min(norm);
-            if norm < progress.best_norm {
-                progress.best_norm = norm;
-                if rules.restore_best {
-                    self.best.copy_from_slice(y);
-                    self.best_g.copy_from_slice(&self.g);
-                }
+        }
+        None
+    }
+
+    /// Takes the step of length `alpha` along the direction (`y` and `G` become the trial
+    /// point's), records it and applies the stopping rules: `Some(stop)` when the run ends.
+    fn accept<S: NewtonSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        y: &mut [f64],
+        rules: &KernelRules,
+        alpha: f64,
+    ) -> Option<Stop<S::Failure>> {
+        // Accept: y <- trial, G <- G(trial).
+        y.copy_from_slice(&self.trial);
+        std::mem::swap(&mut self.g, &mut self.g_trial);
+        let norm = norm2(&self.g);
+        let progress = &mut self.progress;
+        progress.norm = norm;
+        progress.iterations += 1;
+        let step_norm = alpha * system.step_norm(&self.d);
+        self.residual_norms.push(norm);
+        self.step_lengths.push(alpha);
+        self.step_norms.push(step_norm);
+        if let Some(history) = self.history.as_mut() {
+            history.push(merit_of(norm));
+        }
+        progress.smallest = progress.smallest.min(norm);
+        if norm < progress.best_norm {
+            progress.best_norm = norm;
+            if rules.restore_best {
+                self.best.copy_from_slice(y);
+                self.best_g.copy_from_slice(&self.g);
             }
-            if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
-                return Some(Stop::Converged);
-            }
-            if rules
-                .stagnation
-                .is_some_and(|rule| rule.holds(&self.residual_norms))
-            {
-                return Some(Stop::Stagnated);
-            }
-            if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
-                return Some(
-                    if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
-                        Stop::ConvergedAtFloor
-                    } else {
-                        Stop::Stalled { step_norm }
-                    },
-                );
-            }
+        }
+        if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
+            return Some(Stop::Converged);
+        }
+        if rules
+            .stagnation
+            .is_some_and(|rule| rule.holds(&self.residual_norms))
+        {
+            return Some(Stop::Stagnated);
+        }
+        if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
+            return Some(
+                if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
+                    Stop::ConvergedAtFloor
+                } else {
+                    Stop::Stalled { step_norm }
+                },
+            );
         }
         None
     }
