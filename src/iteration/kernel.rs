@@ -13,7 +13,9 @@
 //! step rule, possibly after [`Kernel::restart`] from the initial guess), then
 //! [`Kernel::finish`]; [`Kernel::run`] is the common case of one rule throughout.
 
-use crate::linesearch::{backtrack, Backtrack, LineSearchOptions, NonMonotoneHistory};
+use crate::linesearch::{
+    backtrack, AcceptedStep, Backtrack, LineSearchOptions, NonMonotoneHistory,
+};
 use crate::EvaluationError;
 
 use super::{Tolerances, WorkCounters};
@@ -223,6 +225,30 @@ pub(crate) fn norm2(v: &[f64]) -> f64 {
     scale * v.iter().map(|x| (x / scale).powi(2)).sum::<f64>().sqrt()
 }
 
+/// The step a backtracking search accepted, its backtracks counted; `Err` with the stop
+/// when it failed or the merit could not be evaluated.
+fn backtracked<E>(
+    searched: Result<AcceptedStep, Backtrack<EvaluationError>>,
+    counters: &mut WorkCounters,
+) -> Result<f64, Stop<E>> {
+    match searched {
+        Ok(accepted) => {
+            counters.line_search_backtracks += accepted.backtracks;
+            Ok(accepted.step)
+        }
+        Err(Backtrack::Failed(failure)) => {
+            counters.line_search_backtracks += failure.backtracks;
+            Err(Stop::LineSearchFailed {
+                last_step: failure.last_step,
+            })
+        }
+        Err(Backtrack::Aborted { error, backtracks }) => {
+            counters.line_search_backtracks += backtracks;
+            Err(Stop::Evaluation(error))
+        }
+    }
+}
+
 fn merit_of(norm: f64) -> f64 {
     if norm.is_finite() {
         0.5 * norm * norm
@@ -423,21 +449,10 @@ impl Kernel {
             let mut alpha = 1.0;
             if let Some(ls) = line_search {
                 let history = self.history.as_ref().expect("reset by start");
-                match backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit) {
-                    Ok(accepted) => {
-                        counters.line_search_backtracks += accepted.backtracks;
-                        alpha = accepted.step;
-                    }
-                    Err(Backtrack::Failed(failure)) => {
-                        counters.line_search_backtracks += failure.backtracks;
-                        return Some(Stop::LineSearchFailed {
-                            last_step: failure.last_step,
-                        });
-                    }
-                    Err(Backtrack::Aborted { error, backtracks }) => {
-                        counters.line_search_backtracks += backtracks;
-                        return Some(Stop::Evaluation(error));
-                    }
+                let searched = backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit);
+                match backtracked(searched, counters) {
+                    Ok(step) => alpha = step,
+                    Err(stop) => return Some(stop),
                 }
             }
 
