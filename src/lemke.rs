@@ -323,6 +323,48 @@ pub struct Lemke {
     ties: Vec<usize>,
 }
 
+/// `Err` when Lemke's method cannot run on `M`, `q` with `options` ([`Lemke::solve`]).
+fn check_input(m: MatRef<'_, f64>, q: &[f64], options: &LemkeOptions) -> Result<(), LemkeError> {
+    options.validate()?;
+    let n = m.nrows();
+    if m.ncols() != n {
+        return Err(LemkeError::DimensionMismatch {
+            what: "columns of M",
+            expected: n,
+            found: m.ncols(),
+        });
+    }
+    if q.len() != n {
+        return Err(LemkeError::DimensionMismatch {
+            what: "q",
+            expected: n,
+            found: q.len(),
+        });
+    }
+    if let Some(d) = &options.covering {
+        if d.len() != n {
+            return Err(LemkeError::DimensionMismatch {
+                what: "covering",
+                expected: n,
+                found: d.len(),
+            });
+        }
+    }
+    if let Some((index, &value)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(LemkeError::NonFiniteVectorEntry {
+            name: "q",
+            index,
+            value,
+        });
+    }
+    if let Err(LinearSolveError::NonFiniteEntry { row, col, value }) =
+        check_finite_dense(n, n, |i, j| m[(i, j)])
+    {
+        return Err(LemkeError::NonFiniteMatrixEntry { row, col, value });
+    }
+    Ok(())
+}
+
 impl Lemke {
     /// A workspace for LCPs of size `n` (about `n^2` doubles).
     pub fn new(n: usize) -> Self {
@@ -377,66 +419,15 @@ impl Lemke {
         q: &[f64],
         options: &LemkeOptions,
     ) -> Result<LemkeReport, LemkeError> {
-        options.validate()?;
+        check_input(m, q, options)?;
         let n = m.nrows();
-        if m.ncols() != n {
-            return Err(LemkeError::DimensionMismatch {
-                what: "columns of M",
-                expected: n,
-                found: m.ncols(),
-            });
-        }
-        if q.len() != n {
-            return Err(LemkeError::DimensionMismatch {
-                what: "q",
-                expected: n,
-                found: q.len(),
-            });
-        }
-        if let Some(d) = &options.covering {
-            if d.len() != n {
-                return Err(LemkeError::DimensionMismatch {
-                    what: "covering",
-                    expected: n,
-                    found: d.len(),
-                });
-            }
-        }
-        if let Some((index, &value)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(LemkeError::NonFiniteVectorEntry {
-                name: "q",
-                index,
-                value,
-            });
-        }
-        if let Err(LinearSolveError::NonFiniteEntry { row, col, value }) =
-            check_finite_dense(n, n, |i, j| m[(i, j)])
-        {
-            return Err(LemkeError::NonFiniteMatrixEntry { row, col, value });
-        }
         if n != self.n {
             self.resize(n);
         }
         let limit = options.pivot_limit(n);
         let tol = options.tolerance;
 
-        // Start: basis = all w, B^{-1} = I, x = q.
-        self.binv.fill(0.0);
-        for i in 0..n {
-            self.binv[i * n + i] = 1.0;
-            self.basis[i] = i;
-        }
-        self.x.copy_from_slice(q);
-        self.row_of.fill(NONBASIC);
-        for i in 0..n {
-            self.row_of[i] = i;
-        }
-        self.nonbasic_w.clear();
-        self.nonbasic_slot.fill(NONBASIC);
-        match &options.covering {
-            Some(d) => self.d.copy_from_slice(d),
-            None => self.d.fill(1.0),
-        }
+        self.start_basis(q, options);
 
         if q.iter().all(|&v| v >= 0.0) {
             return Ok(self.finish(m, q, LemkeTermination::Solved, 0, None));
@@ -492,6 +483,28 @@ impl Lemke {
                 self.refine(m, q);
                 return Ok(self.finish(m, q, LemkeTermination::Solved, pivots, None));
             }
+        }
+    }
+
+    /// The start of a solve: the basis of all `w`, `B^{-1} = I`, `x = q` and the covering
+    /// vector of `options` (ones by default).
+    fn start_basis(&mut self, q: &[f64], options: &LemkeOptions) {
+        let n = self.n;
+        self.binv.fill(0.0);
+        for i in 0..n {
+            self.binv[i * n + i] = 1.0;
+            self.basis[i] = i;
+        }
+        self.x.copy_from_slice(q);
+        self.row_of.fill(NONBASIC);
+        for i in 0..n {
+            self.row_of[i] = i;
+        }
+        self.nonbasic_w.clear();
+        self.nonbasic_slot.fill(NONBASIC);
+        match &options.covering {
+            Some(d) => self.d.copy_from_slice(d),
+            None => self.d.fill(1.0),
         }
     }
 

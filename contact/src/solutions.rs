@@ -23,7 +23,7 @@ use crate::solve::StateShape;
 use crate::solve::{solve, RunCounters, RunError, Solution, Termination};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::Reconstruction;
-use crate::sweep::{follow_branch, SweepTermination};
+use crate::sweep::{follow_branch, FrequencyResponse, SweepTermination};
 
 /// Relative distance of the unknowns below which two corrected solutions are the same.
 pub const SAME_SOLUTION: f64 = 1e-6;
@@ -93,6 +93,80 @@ pub fn find_solutions(
     sweep: Option<&SweepSettings>,
 ) -> Result<SolutionSet, RunError> {
     let started = Instant::now();
+    let window = search_window(rod, omega, settings, sweep)?;
+    let branch = follow_branch(rod, settings, &window, None)?;
+    let reconstruction = Reconstruction::new(&rod.model, omega, settings)?;
+    // The method is a harmonic-balance one (checked by `search_window`): only the model
+    // can fail here.
+    let mut analysis = HbStability::new(&rod.model, settings).map_err(|e| match e {
+        StabilityError::Hb(e) => RunError::HarmonicBalance(e),
+        _ => RunError::Unsupported {
+            method: settings.method.name(),
+            what: "a harmonic-balance method (ssn-hb or penalty-hb)",
+        },
+    })?;
+    let mut set = SolutionSet {
+        omega,
+        omega_1: rod.omega_1,
+        shape: StateShape {
+            method: settings.method,
+            harmonics: settings.harmonics,
+            dofs: rod.model.dofs(),
+            contacts: rod.model.contacts.len(),
+        },
+        solutions: Vec::new(),
+        window: (window.omega_ratio_from, window.omega_ratio_to),
+        branch_points: branch.points(),
+        branch_converged: branch.converged(),
+        branch_termination: branch.termination.clone(),
+        crossings: 0,
+        failed_corrections: Vec::new(),
+        counters: branch.counters,
+        seconds: 0.0,
+    };
+    for i in 1..branch.points() {
+        let Some(start) = crossing_start(&branch, i, omega) else {
+            continue;
+        };
+        set.crossings += 1;
+        let solution = solve(rod, omega, settings, Some(&start))?;
+        set.counters = set.counters + solution.counters;
+        if !solution.converged() {
+            set.failed_corrections.push(FailedCorrection {
+                branch_index: i,
+                termination: solution.termination,
+                residual_norm: solution.residual_norm,
+            });
+            continue;
+        }
+        let x = &solution.state;
+        if is_known(&set.solutions, x) {
+            continue;
+        }
+        let stability = analysis
+            .of(omega, x)
+            .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
+        let contacts = reconstruction.contacts(&rod.model, x)?;
+        set.solutions.push(PeriodicSolution {
+            solution,
+            contacts,
+            stability,
+            branch_index: i,
+        });
+    }
+    set.seconds = started.elapsed().as_secs_f64();
+    Ok(set)
+}
+
+/// The window searched for the solutions at `omega` (`sweep`, else `[0.5, 2] omega /
+/// omega_1`): `Err` unless the method is a harmonic-balance one, `omega` a finite
+/// frequency > 0 and inside the window.
+fn search_window(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    sweep: Option<&SweepSettings>,
+) -> Result<SweepSettings, RunError> {
     if !matches!(settings.method, Method::SsnHb | Method::PenaltyHb) {
         return Err(RunError::Unsupported {
             method: settings.method.name(),
@@ -123,95 +197,49 @@ pub fn find_solutions(
             allowed: "a frequency inside the [sweep] range searched for solutions",
         });
     }
-    let branch = follow_branch(rod, settings, &window, None)?;
-    let reconstruction = Reconstruction::new(&rod.model, omega, settings)?;
-    // The method is a harmonic-balance one (checked above): only the model can fail here.
-    let mut analysis = HbStability::new(&rod.model, settings).map_err(|e| match e {
-        StabilityError::Hb(e) => RunError::HarmonicBalance(e),
-        _ => RunError::Unsupported {
-            method: settings.method.name(),
-            what: "a harmonic-balance method (ssn-hb or penalty-hb)",
-        },
-    })?;
-    let mut set = SolutionSet {
-        omega,
-        omega_1: rod.omega_1,
-        shape: StateShape {
-            method: settings.method,
-            harmonics: settings.harmonics,
-            dofs: rod.model.dofs(),
-            contacts: rod.model.contacts.len(),
-        },
-        solutions: Vec::new(),
-        window: (window.omega_ratio_from, window.omega_ratio_to),
-        branch_points: branch.points(),
-        branch_converged: branch.converged(),
-        branch_termination: branch.termination.clone(),
-        crossings: 0,
-        failed_corrections: Vec::new(),
-        counters: branch.counters,
-        seconds: 0.0,
+    Ok(window)
+}
+
+/// The start of the correction at `omega` when the branch crosses it between its points
+/// `i - 1` and `i` (interpolated linearly in the frequency); `None` when it does not.
+fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<Vec<f64>> {
+    let (w0, w1) = (branch.omega[i - 1], branch.omega[i]);
+    // Each crossing once: the left point strictly on one side (or exactly at w*).
+    let crosses = (w0 - omega) * (w1 - omega) < 0.0 || w1 == omega;
+    if !crosses {
+        return None;
+    }
+    let t = if w1 != w0 {
+        (omega - w0) / (w1 - w0)
+    } else {
+        1.0
     };
-    for i in 1..branch.points() {
-        let (w0, w1) = (branch.omega[i - 1], branch.omega[i]);
-        // Each crossing once: the left point strictly on one side (or exactly at w*).
-        let crosses = (w0 - omega) * (w1 - omega) < 0.0 || w1 == omega;
-        if !crosses {
-            continue;
-        }
-        set.crossings += 1;
-        let t = if w1 != w0 {
-            (omega - w0) / (w1 - w0)
-        } else {
-            1.0
-        };
-        let start: Vec<f64> = branch.states[i - 1]
+    Some(
+        branch.states[i - 1]
             .iter()
             .zip(&branch.states[i])
             .map(|(a, b)| a + t * (b - a))
-            .collect();
-        let solution = solve(rod, omega, settings, Some(&start))?;
-        set.counters = set.counters + solution.counters;
-        if !solution.converged() {
-            set.failed_corrections.push(FailedCorrection {
-                branch_index: i,
-                termination: solution.termination,
-                residual_norm: solution.residual_norm,
-            });
-            continue;
-        }
-        let x = &solution.state;
-        let scale = x
+            .collect(),
+    )
+}
+
+/// Whether the state `x` is one of `solutions` (within [`SAME_SOLUTION`] of its norm).
+fn is_known(solutions: &[PeriodicSolution], x: &[f64]) -> bool {
+    let scale = x
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
+    solutions.iter().any(|s| {
+        let d = s
+            .solution
+            .state
             .iter()
-            .map(|v| v * v)
+            .zip(x)
+            .map(|(a, b)| (a - b).powi(2))
             .sum::<f64>()
-            .sqrt()
-            .max(f64::MIN_POSITIVE);
-        let duplicate = set.solutions.iter().any(|s| {
-            let d = s
-                .solution
-                .state
-                .iter()
-                .zip(x)
-                .map(|(a, b)| (a - b).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            d <= SAME_SOLUTION * scale
-        });
-        if duplicate {
-            continue;
-        }
-        let stability = analysis
-            .of(omega, x)
-            .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
-        let contacts = reconstruction.contacts(&rod.model, x)?;
-        set.solutions.push(PeriodicSolution {
-            solution,
-            contacts,
-            stability,
-            branch_index: i,
-        });
-    }
-    set.seconds = started.elapsed().as_secs_f64();
-    Ok(set)
+            .sqrt();
+        d <= SAME_SOLUTION * scale
+    })
 }

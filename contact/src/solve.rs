@@ -38,8 +38,8 @@ use crate::hb::{
 use crate::lcp::{
     ActiveSetSolver, LcpScheme, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
+use crate::model::{StructuralModel, Structure};
 use crate::settings::{GlobalizationChoice, Method, SolverSettings};
 use accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
 
@@ -741,6 +741,8 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
     }
 }
 
+/// The periodic LCP of `rod` at `omega` solved by the scene's LCP method (Lemke or
+/// semismooth Newton), from `warm_start` (contact forces) when it fits.
 fn solve_lcp(
     rod: &Structure,
     omega: f64,
@@ -758,77 +760,17 @@ fn solve_lcp(
     let (options, tip_contact) = lcp_options(rod, settings);
     let start = Instant::now();
     let lcp = PeriodicLcp::new(model, omega, options)?;
-    let (z, termination, iterations, residual, counters, effective_tolerance, finest) = match method
-    {
-        Method::LcpLemke => {
-            let mut lemke = Lemke::new(lcp.dim());
-            let lemke_options = LemkeOptions::default();
-            let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
-            let termination = Termination::Lemke {
-                outcome: report.termination,
-                pivots: report.pivots,
-                pivot_limit: lemke_options.pivot_limit(lcp.dim()),
-                order: lcp.dim(),
-                smallest_symmetric_eigenvalue: (report.termination == LemkeTermination::Ray)
-                    .then(|| lcp.symmetric_part_spectrum().0),
-            };
-            let counters = RunCounters {
-                lemke_pivots: report.pivots as u64,
-                ..RunCounters::default()
-            };
-            (
-                report.z.clone(),
-                termination,
-                report.pivots,
-                report.complementarity_error,
-                counters,
-                None,
-                None,
-            )
-        }
-        _ => {
-            // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
-            // one) unless a warm start is given: from z = 0 the active set of a fine LCP
-            // creeps one time node per iteration. Residual floor: the min-map residual
-            // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
-            // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
-            let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let options = newton_options(settings)
-                .with_residual_floor(f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale);
-            let (z, report_list) = match warm_start {
-                Some(w) if w.len() == lcp.dim() => {
-                    let mut problem = lcp.min_map();
-                    let mut z = w.to_vec();
-                    let mut solver = ActiveSetSolver::new()
-                        .with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
-                    let report = options.solve(&mut problem, &mut solver, &mut z, None)?;
-                    (z, vec![report])
-                }
-                _ => {
-                    let sequenced =
-                        crate::lcp::solve_min_map_sequenced(model, omega, &lcp, &options)?;
-                    let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
-                    (sequenced.z, reports)
-                }
-            };
-            let last = report_list.last().expect("at least one level");
-            let counters = report_list
-                .iter()
-                .map(|r| r.counters)
-                .sum::<WorkCounters>()
-                .into();
-            (
-                z,
-                Termination::Newton(last.termination.clone()),
-                report_list.iter().map(|r| r.iterations).sum(),
-                last.residual_norm(),
-                counters,
-                Some(last.effective_tolerance),
-                // The finest level's run: its strategy, attempts and residual history
-                // are the answer's (the iterations and counters are the levels' sums).
-                report_list.last().cloned(),
-            )
-        }
+    let LcpRun {
+        z,
+        termination,
+        iterations,
+        residual,
+        counters,
+        effective_tolerance,
+        finest,
+    } = match method {
+        Method::LcpLemke => lcp_by_lemke(&lcp)?,
+        _ => lcp_by_min_map(model, omega, settings, &lcp, warm_start)?,
     };
     let seconds = start.elapsed().as_secs_f64();
     let contact_u = lcp.contact_displacements(&z)?;
@@ -867,4 +809,95 @@ fn solve_lcp(
         sol.diagnosis = Some(Diagnosis::AlternatingNullVector);
     }
     Ok(sol)
+}
+
+/// The contact forces `z` of a periodic LCP solve and how it ended (`finest`: the Newton
+/// report of the finest level of a min-map solve).
+struct LcpRun {
+    z: Vec<f64>,
+    termination: Termination,
+    iterations: usize,
+    residual: f64,
+    counters: RunCounters,
+    effective_tolerance: Option<f64>,
+    finest: Option<NewtonReport>,
+}
+
+/// The periodic LCP `lcp` solved by Lemke's pivoting.
+fn lcp_by_lemke(lcp: &PeriodicLcp) -> Result<LcpRun, RunError> {
+    let mut lemke = Lemke::new(lcp.dim());
+    let lemke_options = LemkeOptions::default();
+    let report = lemke.solve(lcp.matrix(), lcp.q(), &lemke_options)?;
+    let termination = Termination::Lemke {
+        outcome: report.termination,
+        pivots: report.pivots,
+        pivot_limit: lemke_options.pivot_limit(lcp.dim()),
+        order: lcp.dim(),
+        smallest_symmetric_eigenvalue: (report.termination == LemkeTermination::Ray)
+            .then(|| lcp.symmetric_part_spectrum().0),
+    };
+    let counters = RunCounters {
+        lemke_pivots: report.pivots as u64,
+        ..RunCounters::default()
+    };
+    Ok(LcpRun {
+        z: report.z.clone(),
+        termination,
+        iterations: report.pivots,
+        residual: report.complementarity_error,
+        counters,
+        effective_tolerance: None,
+        finest: None,
+    })
+}
+
+/// The periodic LCP `lcp` of `model` at `omega` solved by semismooth Newton on its
+/// min-map, from `warm_start` when it fits, else by mesh sequencing.
+fn lcp_by_min_map(
+    model: &StructuralModel,
+    omega: f64,
+    settings: &SolverSettings,
+    lcp: &PeriodicLcp,
+    warm_start: Option<&[f64]>,
+) -> Result<LcpRun, RunError> {
+    // Mesh sequencing (Nt/2^j from 128 up, each level warm-started by the coarser
+    // one) unless a warm start is given: from z = 0 the active set of a fine LCP
+    // creeps one time node per iteration. Residual floor: the min-map residual
+    // min(z, q + A z) is a length; one ulp of its largest term is eps max|q|, summed
+    // over sqrt(n) entries (a tolerance below it is raised to it, as for HB).
+    let q_scale = lcp.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let options = newton_options(settings)
+        .with_residual_floor(f64::EPSILON * (lcp.dim() as f64).sqrt() * q_scale);
+    let (z, report_list) = match warm_start {
+        Some(w) if w.len() == lcp.dim() => {
+            let mut problem = lcp.min_map();
+            let mut z = w.to_vec();
+            let mut solver =
+                ActiveSetSolver::new().with_regularization(DEFAULT_ACTIVE_SET_REGULARIZATION)?;
+            let report = options.solve(&mut problem, &mut solver, &mut z, None)?;
+            (z, vec![report])
+        }
+        _ => {
+            let sequenced = crate::lcp::solve_min_map_sequenced(model, omega, lcp, &options)?;
+            let reports = sequenced.levels.into_iter().map(|l| l.report).collect();
+            (sequenced.z, reports)
+        }
+    };
+    let last = report_list.last().expect("at least one level");
+    let counters = report_list
+        .iter()
+        .map(|r| r.counters)
+        .sum::<WorkCounters>()
+        .into();
+    Ok(LcpRun {
+        z,
+        termination: Termination::Newton(last.termination.clone()),
+        iterations: report_list.iter().map(|r| r.iterations).sum(),
+        residual: last.residual_norm(),
+        counters,
+        effective_tolerance: Some(last.effective_tolerance),
+        // The finest level's run: its strategy, attempts and residual history
+        // are the answer's (the iterations and counters are the levels' sums).
+        finest: report_list.last().cloned(),
+    })
 }

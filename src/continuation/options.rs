@@ -210,20 +210,42 @@ impl ContinuationOptions {
 
     /// Checks every field; the error names the field, its value and what is allowed.
     pub fn validate(&self) -> Result<(), ContinuationError> {
-        fn invalid(name: &'static str, value: f64, allowed: &'static str) -> ContinuationError {
-            ContinuationError::InvalidOption {
-                name,
-                value,
-                allowed,
-            }
-        }
-        let positive_finite = |name, v: f64| {
-            if v.is_finite() && v > 0.0 {
+        self.validate_steps()?;
+        self.validate_range()?;
+        let open_unit = |name, v: f64| {
+            if v > 0.0 && v < 1.0 {
                 Ok(())
             } else {
-                Err(invalid(name, v, "finite and > 0"))
+                Err(invalid(name, v, "in the open interval (0, 1)"))
             }
         };
+        open_unit("theta", self.theta)?;
+        positive_finite("parameter_scale", self.parameter_scale)?;
+        if let Some(factor) = self.trust_factor {
+            positive_finite("trust_factor", factor)?;
+        }
+        if let Some(policy) = &self.restarts {
+            open_unit("restarts.theta", policy.theta)?;
+            if policy.points == 0 {
+                return Err(invalid("restarts.points", 0.0, ">= 1"));
+            }
+        }
+        if let Some(scale) = &self.state_scale {
+            if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+                return Err(invalid("state_scale", bad, "finite and > 0 entries"));
+            }
+        }
+        if let Some(ls) = &self.corrector_line_search {
+            ls.validate().map_err(|e| {
+                let e = crate::linesearch::within("corrector_line_search", e);
+                invalid(e.name, e.value, e.allowed)
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Checks the steps, the iteration and point counts and the corrector's tolerance.
+    fn validate_steps(&self) -> Result<(), ContinuationError> {
         positive_finite("min_step", self.min_step)?;
         positive_finite("max_step", self.max_step)?;
         positive_finite("initial_step", self.initial_step)?;
@@ -251,7 +273,11 @@ impl ContinuationOptions {
                 return Err(invalid(name, 0.0, ">= 1"));
             }
         }
-        positive_finite("corrector_tolerance", self.corrector_tolerance)?;
+        positive_finite("corrector_tolerance", self.corrector_tolerance)
+    }
+
+    /// Checks the fold excursion, the step tolerance and the parameter's range.
+    fn validate_range(&self) -> Result<(), ContinuationError> {
         if !(self.fold_excursion.is_finite() && self.fold_excursion >= 0.0) {
             return Err(invalid(
                 "fold_excursion",
@@ -287,35 +313,24 @@ impl ContinuationOptions {
                 "> parameter_min",
             ));
         }
-        let open_unit = |name, v: f64| {
-            if v > 0.0 && v < 1.0 {
-                Ok(())
-            } else {
-                Err(invalid(name, v, "in the open interval (0, 1)"))
-            }
-        };
-        open_unit("theta", self.theta)?;
-        positive_finite("parameter_scale", self.parameter_scale)?;
-        if let Some(factor) = self.trust_factor {
-            positive_finite("trust_factor", factor)?;
-        }
-        if let Some(policy) = &self.restarts {
-            open_unit("restarts.theta", policy.theta)?;
-            if policy.points == 0 {
-                return Err(invalid("restarts.points", 0.0, ">= 1"));
-            }
-        }
-        if let Some(scale) = &self.state_scale {
-            if let Some(&bad) = scale.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
-                return Err(invalid("state_scale", bad, "finite and > 0 entries"));
-            }
-        }
-        if let Some(ls) = &self.corrector_line_search {
-            ls.validate().map_err(|e| {
-                let e = crate::linesearch::within("corrector_line_search", e);
-                invalid(e.name, e.value, e.allowed)
-            })?;
-        }
         Ok(())
+    }
+}
+
+/// The error of the option `name` whose `value` is not `allowed`.
+fn invalid(name: &'static str, value: f64, allowed: &'static str) -> ContinuationError {
+    ContinuationError::InvalidOption {
+        name,
+        value,
+        allowed,
+    }
+}
+
+/// `Err` naming `name` unless `v` is finite and > 0.
+fn positive_finite(name: &'static str, v: f64) -> Result<(), ContinuationError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(name, v, "finite and > 0"))
     }
 }

@@ -13,7 +13,9 @@
 //! step rule, possibly after [`Kernel::restart`] from the initial guess), then
 //! [`Kernel::finish`]; [`Kernel::run`] is the common case of one rule throughout.
 
-use crate::linesearch::{backtrack, Backtrack, LineSearchOptions, NonMonotoneHistory};
+use crate::linesearch::{
+    backtrack, AcceptedStep, Backtrack, LineSearchOptions, NonMonotoneHistory,
+};
 use crate::EvaluationError;
 
 use super::{Tolerances, WorkCounters};
@@ -223,6 +225,30 @@ pub(crate) fn norm2(v: &[f64]) -> f64 {
     scale * v.iter().map(|x| (x / scale).powi(2)).sum::<f64>().sqrt()
 }
 
+/// The step a backtracking search accepted, its backtracks counted; `Err` with the stop
+/// when it failed or the merit could not be evaluated.
+fn backtracked<E>(
+    searched: Result<AcceptedStep, Backtrack<EvaluationError>>,
+    counters: &mut WorkCounters,
+) -> Result<f64, Stop<E>> {
+    match searched {
+        Ok(accepted) => {
+            counters.line_search_backtracks += accepted.backtracks;
+            Ok(accepted.step)
+        }
+        Err(Backtrack::Failed(failure)) => {
+            counters.line_search_backtracks += failure.backtracks;
+            Err(Stop::LineSearchFailed {
+                last_step: failure.last_step,
+            })
+        }
+        Err(Backtrack::Aborted { error, backtracks }) => {
+            counters.line_search_backtracks += backtracks;
+            Err(Stop::Evaluation(error))
+        }
+    }
+}
+
 fn merit_of(norm: f64) -> f64 {
     if norm.is_finite() {
         0.5 * norm * norm
@@ -423,64 +449,68 @@ impl Kernel {
             let mut alpha = 1.0;
             if let Some(ls) = line_search {
                 let history = self.history.as_ref().expect("reset by start");
-                match backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit) {
-                    Ok(accepted) => {
-                        counters.line_search_backtracks += accepted.backtracks;
-                        alpha = accepted.step;
-                    }
-                    Err(Backtrack::Failed(failure)) => {
-                        counters.line_search_backtracks += failure.backtracks;
-                        return Some(Stop::LineSearchFailed {
-                            last_step: failure.last_step,
-                        });
-                    }
-                    Err(Backtrack::Aborted { error, backtracks }) => {
-                        counters.line_search_backtracks += backtracks;
-                        return Some(Stop::Evaluation(error));
-                    }
+                let searched = backtrack(history.reference(), -2.0 * merit0, &ls, &mut merit);
+                match backtracked(searched, counters) {
+                    Ok(step) => alpha = step,
+                    Err(stop) => return Some(stop),
                 }
             }
 
-            // Accept: y <- trial, G <- G(trial).
-            y.copy_from_slice(&self.trial);
-            std::mem::swap(&mut self.g, &mut self.g_trial);
-            let norm = norm2(&self.g);
-            let progress = &mut self.progress;
-            progress.norm = norm;
-            progress.iterations += 1;
-            let step_norm = alpha * system.step_norm(&self.d);
-            self.residual_norms.push(norm);
-            self.step_lengths.push(alpha);
-            self.step_norms.push(step_norm);
-            if let Some(history) = self.history.as_mut() {
-                history.push(merit_of(norm));
+            if let Some(stop) = self.accept(system, y, rules, alpha) {
+                return Some(stop);
             }
-            progress.smallest = progress.smallest.min(norm);
-            if norm < progress.best_norm {
-                progress.best_norm = norm;
-                if rules.restore_best {
-                    self.best.copy_from_slice(y);
-                    self.best_g.copy_from_slice(&self.g);
-                }
+        }
+        None
+    }
+
+    /// Takes the step of length `alpha` along the direction (`y` and `G` become the trial
+    /// point's), records it and applies the stopping rules: `Some(stop)` when the run ends.
+    fn accept<S: NewtonSystem + ?Sized>(
+        &mut self,
+        system: &S,
+        y: &mut [f64],
+        rules: &KernelRules,
+        alpha: f64,
+    ) -> Option<Stop<S::Failure>> {
+        // Accept: y <- trial, G <- G(trial).
+        y.copy_from_slice(&self.trial);
+        std::mem::swap(&mut self.g, &mut self.g_trial);
+        let norm = norm2(&self.g);
+        let progress = &mut self.progress;
+        progress.norm = norm;
+        progress.iterations += 1;
+        let step_norm = alpha * system.step_norm(&self.d);
+        self.residual_norms.push(norm);
+        self.step_lengths.push(alpha);
+        self.step_norms.push(step_norm);
+        if let Some(history) = self.history.as_mut() {
+            history.push(merit_of(norm));
+        }
+        progress.smallest = progress.smallest.min(norm);
+        if norm < progress.best_norm {
+            progress.best_norm = norm;
+            if rules.restore_best {
+                self.best.copy_from_slice(y);
+                self.best_g.copy_from_slice(&self.g);
             }
-            if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
-                return Some(Stop::Converged);
-            }
-            if rules
-                .stagnation
-                .is_some_and(|rule| rule.holds(&self.residual_norms))
-            {
-                return Some(Stop::Stagnated);
-            }
-            if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
-                return Some(
-                    if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
-                        Stop::ConvergedAtFloor
-                    } else {
-                        Stop::Stalled { step_norm }
-                    },
-                );
-            }
+        }
+        if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
+            return Some(Stop::Converged);
+        }
+        if rules
+            .stagnation
+            .is_some_and(|rule| rule.holds(&self.residual_norms))
+        {
+            return Some(Stop::Stagnated);
+        }
+        if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
+            return Some(
+                if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
+                    Stop::ConvergedAtFloor
+                } else {
+                    Stop::Stalled { step_norm }
+                },
+            );
         }
         None
     }

@@ -198,78 +198,102 @@ impl Gmres {
             let mut steps = 0;
             while steps < restart && iterations < options.max_iterations {
                 let j = steps;
-                if self.basis.len() < (j + 2) * n {
-                    self.basis.resize((j + 2) * n, 0.0);
-                }
-                if self.preconditioned.len() < (j + 1) * n {
-                    self.preconditioned.resize((j + 1) * n, 0.0);
-                }
-                let (done, next) = self.basis.split_at_mut((j + 1) * n);
-                let vj = &done[j * n..];
-                let zj = &mut self.preconditioned[j * n..(j + 1) * n];
-                a.precondition(vj, zj)?;
-                let w = &mut next[..n];
-                a.apply(zj, w)?;
+                let h_next = self.arnoldi(a, j, (n, restart))?;
                 iterations += 1;
-                let column = &mut self.hessenberg[j * (restart + 1)..(j + 1) * (restart + 1)];
-                for (i, h) in column.iter_mut().enumerate().take(j + 1) {
-                    let vi = &done[i * n..(i + 1) * n];
-                    *h = dot(w, vi);
-                    for (wk, vk) in w.iter_mut().zip(vi) {
-                        *wk -= *h * vk;
-                    }
-                }
-                let h_next = norm(w);
-                if !h_next.is_finite() {
-                    return Err(LinearSolveError::NonFiniteEntry {
-                        row: 0,
-                        col: j,
-                        value: h_next,
-                    });
-                }
-                column[j + 1] = h_next;
-                if h_next > 0.0 {
-                    w.iter_mut().for_each(|v| *v /= h_next);
-                }
-                // Previous rotations, then a new one zeroing column[j + 1].
-                for (i, &(c, s)) in self.rotations.iter().enumerate().take(j) {
-                    let (hi, hk) = (column[i], column[i + 1]);
-                    column[i] = c * hi + s * hk;
-                    column[i + 1] = -s * hi + c * hk;
-                }
-                let r = column[j].hypot(column[j + 1]);
-                let (c, s) = if r == 0.0 {
-                    (1.0, 0.0)
-                } else {
-                    (column[j] / r, column[j + 1] / r)
-                };
-                self.rotations[j] = (c, s);
-                column[j] = r;
-                column[j + 1] = 0.0;
-                let gj = self.g[j];
-                self.g[j] = c * gj;
-                self.g[j + 1] = -s * gj;
+                self.rotate(j, restart);
                 steps += 1;
                 // Lucky breakdown: the Krylov space is invariant, the solution is in it.
                 if self.g[j + 1].abs() <= tolerance || h_next == 0.0 {
                     break;
                 }
             }
-            // y = H^{-1} g (upper triangular), x += Z y.
-            for i in (0..steps).rev() {
-                let mut v = self.g[i];
-                for k in i + 1..steps {
-                    v -= self.hessenberg[k * (restart + 1) + i] * self.work[k];
-                }
-                let diag = self.hessenberg[i * (restart + 1) + i];
-                self.work[i] = if diag == 0.0 { 0.0 } else { v / diag };
+            self.correct(x, steps, (n, restart));
+        }
+    }
+
+    /// Arnoldi step `j`: `w = A M^-1 v_j` (`M^-1 v_j` kept for the correction)
+    /// orthogonalised against `v_0..v_j` into `v_{j+1}`, its coefficients into column `j`
+    /// of the Hessenberg matrix; `|w|` before the normalisation.
+    fn arnoldi<A: KrylovOperator + ?Sized>(
+        &mut self,
+        a: &mut A,
+        j: usize,
+        (n, restart): (usize, usize),
+    ) -> Result<f64, LinearSolveError> {
+        if self.basis.len() < (j + 2) * n {
+            self.basis.resize((j + 2) * n, 0.0);
+        }
+        if self.preconditioned.len() < (j + 1) * n {
+            self.preconditioned.resize((j + 1) * n, 0.0);
+        }
+        let (done, next) = self.basis.split_at_mut((j + 1) * n);
+        let vj = &done[j * n..];
+        let zj = &mut self.preconditioned[j * n..(j + 1) * n];
+        a.precondition(vj, zj)?;
+        let w = &mut next[..n];
+        a.apply(zj, w)?;
+        let column = &mut self.hessenberg[j * (restart + 1)..(j + 1) * (restart + 1)];
+        for (i, h) in column.iter_mut().enumerate().take(j + 1) {
+            let vi = &done[i * n..(i + 1) * n];
+            *h = dot(w, vi);
+            for (wk, vk) in w.iter_mut().zip(vi) {
+                *wk -= *h * vk;
             }
-            for k in 0..steps {
-                let yk = self.work[k];
-                let zk = &self.preconditioned[k * n..(k + 1) * n];
-                for (xi, z) in x.iter_mut().zip(zk) {
-                    *xi += yk * z;
-                }
+        }
+        let h_next = norm(w);
+        if !h_next.is_finite() {
+            return Err(LinearSolveError::NonFiniteEntry {
+                row: 0,
+                col: j,
+                value: h_next,
+            });
+        }
+        column[j + 1] = h_next;
+        if h_next > 0.0 {
+            w.iter_mut().for_each(|v| *v /= h_next);
+        }
+        Ok(h_next)
+    }
+
+    /// The previous Givens rotations on column `j` of the Hessenberg matrix, then a new one
+    /// zeroing `column[j + 1]`, applied to `g` too.
+    fn rotate(&mut self, j: usize, restart: usize) {
+        let column = &mut self.hessenberg[j * (restart + 1)..(j + 1) * (restart + 1)];
+        for (i, &(c, s)) in self.rotations.iter().enumerate().take(j) {
+            let (hi, hk) = (column[i], column[i + 1]);
+            column[i] = c * hi + s * hk;
+            column[i + 1] = -s * hi + c * hk;
+        }
+        let r = column[j].hypot(column[j + 1]);
+        let (c, s) = if r == 0.0 {
+            (1.0, 0.0)
+        } else {
+            (column[j] / r, column[j + 1] / r)
+        };
+        self.rotations[j] = (c, s);
+        column[j] = r;
+        column[j + 1] = 0.0;
+        let gj = self.g[j];
+        self.g[j] = c * gj;
+        self.g[j + 1] = -s * gj;
+    }
+
+    /// The correction of a cycle of `steps` steps: `y = H^-1 g` (upper triangular), then
+    /// `x += Z y`.
+    fn correct(&mut self, x: &mut [f64], steps: usize, (n, restart): (usize, usize)) {
+        for i in (0..steps).rev() {
+            let mut v = self.g[i];
+            for k in i + 1..steps {
+                v -= self.hessenberg[k * (restart + 1) + i] * self.work[k];
+            }
+            let diag = self.hessenberg[i * (restart + 1) + i];
+            self.work[i] = if diag == 0.0 { 0.0 } else { v / diag };
+        }
+        for k in 0..steps {
+            let yk = self.work[k];
+            let zk = &self.preconditioned[k * n..(k + 1) * n];
+            for (xi, z) in x.iter_mut().zip(zk) {
+                *xi += yk * z;
             }
         }
     }

@@ -3,10 +3,10 @@
 //! initial guess, within one iteration budget.
 
 use crate::continuation::Predictor;
-use crate::iteration::kernel::{norm2, KernelRules, Stagnation, StepRule};
+use crate::iteration::kernel::{norm2, KernelRules, Run, Stagnation, StepRule};
 use crate::iteration::{Attempt, Log, Outcome};
 use crate::linesearch::LineSearchOptions;
-use crate::newton::{Strategy, Termination, Tolerances, WorkCounters};
+use crate::newton::{PlainFailure, Strategy, Termination, Tolerances, WorkCounters};
 use crate::{Factorize, GeneralizedJacobian, Residual};
 
 use super::path::{self, PathShape};
@@ -51,14 +51,8 @@ impl<J> Polyalgorithm<J> {
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
-        let (full_steps, memory, line_search) = (
-            self.options.full_steps,
-            self.options.memory,
-            self.options.line_search,
-        );
-        let max_iterations = self.options.max_iterations;
         let base = KernelRules {
-            max_iterations: full_steps.min(max_iterations),
+            max_iterations: self.options.full_steps.min(self.options.max_iterations),
             ..self.options.rules(StepRule::Full)
         };
         // With a smoothing to fall back on, the full steps stop as soon as they stagnate.
@@ -66,22 +60,14 @@ impl<J> Polyalgorithm<J> {
             stagnation: smoothing.is_some().then_some(FULL_STEP_STAGNATION),
             ..base
         };
-        let mut attempts = Vec::new();
-        let mut used = 0;
 
         // 1. Full steps.
         let (termination, run) = self.work.phase(problem, linear, x, &first, counters, log);
         let tolerance = run.tolerance;
-        attempts.push(Attempt::new(
-            Strategy::FullSteps,
-            run.iterations,
-            &termination,
-        ));
-        used += run.iterations;
+        let attempt = Attempt::new(Strategy::FullSteps, run.iterations, &termination);
         if termination.converged() || ends_run(&termination) {
-            return ended(termination, Strategy::FullSteps, attempts, tolerance);
+            return ended(termination, Strategy::FullSteps, vec![attempt], tolerance);
         }
-        let mut best = Best::new(x, self.work.kernel.residual(), run.smallest);
         let first_step = self
             .work
             .kernel
@@ -90,175 +76,35 @@ impl<J> Polyalgorithm<J> {
             .copied()
             .unwrap_or(f64::NAN);
         let scale = path::state_scale(first_step, x.len());
-        let mut last = termination;
-        let mut strategy = Strategy::FullSteps;
-
-        // Full steps on F from the end of a path (it is near a root: usually a few steps,
-        // sometimes a slow creep that still converges). From a path that stopped short they
-        // stop when they stagnate, as the first ones do, leaving the budget to the next
-        // attempt.
-        let finish = |solver: &mut Self,
-                      problem: &mut P,
-                      linear: &mut S,
-                      x: &mut [f64],
-                      (used, reached): (usize, bool),
-                      counters: &mut WorkCounters,
-                      log: &mut Log| {
-            let rules = KernelRules {
-                // What is left of the budget (none left: the end of the path is only
-                // checked against the tolerance).
-                max_iterations: max_iterations.saturating_sub(used).min(full_steps.max(1)),
-                stagnation: (!reached && first.stagnation.is_some()).then_some(FINISH_STAGNATION),
-                ..base
-            };
-            solver.work.phase(problem, linear, x, &rules, counters, log)
+        let best = Best::new(x, self.work.kernel.residual(), run.smallest);
+        let mut attempts = Attempts {
+            solver: self,
+            problem,
+            linear,
+            x,
+            start,
+            counters,
+            log,
+            base,
+            stagnates: first.stagnation.is_some(),
+            tolerance,
+            scale,
+            attempts: vec![attempt],
+            used: run.iterations,
+            best,
+            last: termination,
+            strategy: Strategy::FullSteps,
         };
-
-        // 2. The smoothing path, when the problem offers a smoothing; a path that stops
-        // after `SMOOTHING_PARTIAL` decades still hands its last point to Newton on `F`.
-        // When it fails, it is followed once more with the points' tolerance shrinking with
-        // `mu` (`SmoothingPath::with_tolerance_decay`).
-        if let Some((ops, mu0)) = smoothing
-            .map(|ops| (ops, SMOOTHING_START * (ops.scale)(problem)))
-            .filter(|(_, mu)| mu.is_finite() && *mu > 0.0)
-        {
-            for tolerance_rate in [0.0, TIGHTENED_TOLERANCE_RATE] {
-                let budget = max_iterations.saturating_sub(used);
-                if budget == 0 {
-                    break;
-                }
-                x.copy_from_slice(start);
-                let setup = SmoothingSetup {
-                    ops,
-                    mu0,
-                    state_scale: scale,
-                    tolerance,
-                    budget,
-                    line_search,
-                    tolerance_rate,
-                };
-                let outcome = self.smoothing_path(problem, linear, x, &setup, counters);
-                used += outcome.iterations;
-                strategy = Strategy::Smoothing;
-                if outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL {
-                    let (termination, run) = finish(
-                        self,
-                        problem,
-                        linear,
-                        x,
-                        (used, outcome.reached),
-                        counters,
-                        log,
-                    );
-                    used += run.iterations;
-                    attempts.push(Attempt::new(
-                        Strategy::Smoothing,
-                        outcome.iterations + run.iterations,
-                        &termination,
-                    ));
-                    if termination.converged() || ends_run(&termination) {
-                        return ended(termination, Strategy::Smoothing, attempts, tolerance);
-                    }
-                    best.update(x, self.work.kernel.residual(), run.smallest);
-                    last = termination;
-                } else {
-                    attempts.push(failed_path(Strategy::Smoothing, &outcome));
-                    if let Some(error) = outcome.error {
-                        return ended(
-                            Termination::Evaluation(error),
-                            Strategy::Smoothing,
-                            attempts,
-                            tolerance,
-                        );
-                    }
-                }
-            }
+        if let Some(outcome) = attempts.smoothing(smoothing) {
+            return outcome;
         }
-
-        // 3. The non-monotone line search from the initial guess, on at most half of what is
-        // left (it ends early when backtracking fails at a kink of the merit).
-        let budget = max_iterations.saturating_sub(used) / 2;
-        if budget > 0 {
-            x.copy_from_slice(start);
-            let rules = KernelRules {
-                step: StepRule::Backtracking {
-                    memory,
-                    line_search,
-                },
-                max_iterations: budget,
-                ..base
-            };
-            let (termination, run) = self.work.phase(problem, linear, x, &rules, counters, log);
-            used += run.iterations;
-            attempts.push(Attempt::new(
-                Strategy::LineSearch,
-                run.iterations,
-                &termination,
-            ));
-            if termination.converged() || ends_run(&termination) {
-                return ended(termination, Strategy::LineSearch, attempts, tolerance);
-            }
-            best.update(x, self.work.kernel.residual(), run.smallest);
-            last = termination;
-            strategy = Strategy::LineSearch;
+        if let Some(outcome) = attempts.line_search() {
+            return outcome;
         }
-
-        // 4. The Newton homotopy from the initial guess to t = 1.
-        let budget = max_iterations.saturating_sub(used);
-        if budget > 0 {
-            let mut f0 = vec![0.0; start.len()];
-            counters.residual_evaluations += 1;
-            let evaluated = problem.residual(start, &mut f0);
-            if let Err(error) = evaluated.as_ref() {
-                if error.ends_run() {
-                    let termination = Termination::Evaluation(error.clone());
-                    return ended(termination, strategy, attempts, tolerance);
-                }
-            }
-            if evaluated.is_ok() && f0.iter().all(|v| v.is_finite()) {
-                x.copy_from_slice(start);
-                let plan = path::PathPlan {
-                    shape: NEWTON_HOMOTOPY,
-                    state_scale: scale,
-                    accuracy: tolerance.max(path::PATH_ACCURACY * norm2(&f0)),
-                    budget,
-                };
-                let mut homotopy = path::NewtonHomotopy::new(&mut *problem, &f0);
-                let outcome = path::follow(&mut homotopy, &mut *linear, x, &plan);
-                *counters += outcome.counters;
-                used += outcome.iterations;
-                strategy = Strategy::Homotopy;
-                if outcome.reached {
-                    let (termination, run) =
-                        finish(self, problem, linear, x, (used, true), counters, log);
-                    attempts.push(Attempt::new(
-                        Strategy::Homotopy,
-                        outcome.iterations + run.iterations,
-                        &termination,
-                    ));
-                    if termination.converged() || ends_run(&termination) {
-                        return ended(termination, Strategy::Homotopy, attempts, tolerance);
-                    }
-                    best.update(x, self.work.kernel.residual(), run.smallest);
-                    last = termination;
-                } else {
-                    attempts.push(failed_path(Strategy::Homotopy, &outcome));
-                    if let Some(error) = outcome.error {
-                        return ended(
-                            Termination::Evaluation(error),
-                            Strategy::Homotopy,
-                            attempts,
-                            tolerance,
-                        );
-                    }
-                }
-            }
+        if let Some(outcome) = attempts.homotopy() {
+            return outcome;
         }
-
-        if best.restore(x) {
-            self.work.kernel.set_residual(&best.f);
-        }
-        ended(last, strategy, attempts, tolerance)
+        attempts.best_outcome()
     }
 
     /// The smoothing path from `x`: `F_mu0(x) = 0` solved by Newton with an Armijo search
@@ -330,6 +176,230 @@ impl<J> Polyalgorithm<J> {
         *counters += outcome.counters;
         outcome.iterations += run.iterations;
         outcome
+    }
+}
+
+/// The attempts after the full steps: the polyalgorithm, the problem, its linear solver,
+/// the iterate and the initial guess, the run's counters and histories, the rules of the
+/// full steps (whether they stop when they stagnate), the run's tolerance and state scale,
+/// and the attempts so far with the iterations they used, the best iterate and the last
+/// termination and strategy.
+struct Attempts<'a, J, P: ?Sized, S: ?Sized> {
+    solver: &'a mut Polyalgorithm<J>,
+    problem: &'a mut P,
+    linear: &'a mut S,
+    x: &'a mut [f64],
+    start: &'a [f64],
+    counters: &'a mut WorkCounters,
+    log: &'a mut Log,
+    base: KernelRules,
+    stagnates: bool,
+    tolerance: f64,
+    scale: f64,
+    attempts: Vec<Attempt>,
+    used: usize,
+    best: Best,
+    last: Termination,
+    strategy: Strategy,
+}
+
+impl<J, P, S> Attempts<'_, J, P, S>
+where
+    P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+    S: Factorize<J> + ?Sized,
+{
+    /// The iterations left of the run's budget.
+    fn left(&self) -> usize {
+        self.solver.options.max_iterations.saturating_sub(self.used)
+    }
+
+    /// Full steps on F from the end of a path (`reached` when it reached its end) within
+    /// what is left of the budget.
+    ///
+    /// The end of a path is near a root: usually a few steps, sometimes a slow creep that
+    /// still converges. From a path that stopped short they stop when they stagnate, as the
+    /// first ones do, leaving the budget to the next attempt.
+    fn finish_path(&mut self, reached: bool) -> (Termination, Run<PlainFailure>) {
+        let rules = KernelRules {
+            // What is left of the budget (none left: the end of the path is only
+            // checked against the tolerance).
+            max_iterations: self.left().min(self.solver.options.full_steps.max(1)),
+            stagnation: (!reached && self.stagnates).then_some(FINISH_STAGNATION),
+            ..self.base
+        };
+        self.phase(&rules)
+    }
+
+    /// A phase of the kernel from the iterate with `rules`.
+    fn phase(&mut self, rules: &KernelRules) -> (Termination, Run<PlainFailure>) {
+        let (problem, linear, x) = (&mut *self.problem, &mut *self.linear, &mut *self.x);
+        self.solver
+            .work
+            .phase(problem, linear, x, rules, self.counters, self.log)
+    }
+
+    /// Attempt 2, the smoothing path, when the problem offers a smoothing; a path that
+    /// stops after `SMOOTHING_PARTIAL` decades still hands its last point to Newton on `F`.
+    /// When it fails, it is followed once more with the points' tolerance shrinking with
+    /// `mu` (`SmoothingPath::with_tolerance_decay`). The outcome when it ends the run.
+    fn smoothing(&mut self, smoothing: Option<SmoothingOf<P>>) -> Option<Outcome> {
+        let (ops, mu0) = smoothing
+            .map(|ops| (ops, SMOOTHING_START * (ops.scale)(self.problem)))
+            .filter(|(_, mu)| mu.is_finite() && *mu > 0.0)?;
+        for tolerance_rate in [0.0, TIGHTENED_TOLERANCE_RATE] {
+            let budget = self.left();
+            if budget == 0 {
+                break;
+            }
+            self.x.copy_from_slice(self.start);
+            let setup = SmoothingSetup {
+                ops,
+                mu0,
+                state_scale: self.scale,
+                tolerance: self.tolerance,
+                budget,
+                line_search: self.solver.options.line_search,
+                tolerance_rate,
+            };
+            let outcome = self.solver.smoothing_path(
+                self.problem,
+                self.linear,
+                self.x,
+                &setup,
+                self.counters,
+            );
+            self.used += outcome.iterations;
+            self.strategy = Strategy::Smoothing;
+            if outcome.reached || outcome.furthest >= SMOOTHING_PARTIAL {
+                let (termination, run) = self.finish_path(outcome.reached);
+                self.used += run.iterations;
+                let iterations = outcome.iterations + run.iterations;
+                let settled =
+                    self.settle(Strategy::Smoothing, iterations, termination, run.smallest);
+                if settled.is_some() {
+                    return settled;
+                }
+            } else if let Some(ended) = self.failed(Strategy::Smoothing, outcome) {
+                return Some(ended);
+            }
+        }
+        None
+    }
+
+    /// Attempt 3, the non-monotone line search from the initial guess, on at most half of
+    /// what is left (it ends early when backtracking fails at a kink of the merit). The
+    /// outcome when it ends the run.
+    fn line_search(&mut self) -> Option<Outcome> {
+        let budget = self.left() / 2;
+        if budget == 0 {
+            return None;
+        }
+        self.x.copy_from_slice(self.start);
+        let options = &self.solver.options;
+        let rules = KernelRules {
+            step: StepRule::Backtracking {
+                memory: options.memory,
+                line_search: options.line_search,
+            },
+            max_iterations: budget,
+            ..self.base
+        };
+        let (termination, run) = self.phase(&rules);
+        self.used += run.iterations;
+        let settled = self.settle(
+            Strategy::LineSearch,
+            run.iterations,
+            termination,
+            run.smallest,
+        );
+        if settled.is_none() {
+            self.strategy = Strategy::LineSearch;
+        }
+        settled
+    }
+
+    /// Attempt 4, the Newton homotopy from the initial guess to t = 1. The outcome when it
+    /// ends the run.
+    fn homotopy(&mut self) -> Option<Outcome> {
+        let budget = self.left();
+        if budget == 0 {
+            return None;
+        }
+        let start = self.start;
+        let mut f0 = vec![0.0; start.len()];
+        self.counters.residual_evaluations += 1;
+        let evaluated = self.problem.residual(start, &mut f0);
+        if let Err(error) = evaluated.as_ref() {
+            if error.ends_run() {
+                let termination = Termination::Evaluation(error.clone());
+                return Some(self.end(termination, self.strategy));
+            }
+        }
+        if evaluated.is_err() || !f0.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        self.x.copy_from_slice(start);
+        let plan = path::PathPlan {
+            shape: NEWTON_HOMOTOPY,
+            state_scale: self.scale,
+            accuracy: self.tolerance.max(path::PATH_ACCURACY * norm2(&f0)),
+            budget,
+        };
+        let mut homotopy = path::NewtonHomotopy::new(&mut *self.problem, &f0);
+        let outcome = path::follow(&mut homotopy, &mut *self.linear, self.x, &plan);
+        *self.counters += outcome.counters;
+        self.used += outcome.iterations;
+        self.strategy = Strategy::Homotopy;
+        if !outcome.reached {
+            return self.failed(Strategy::Homotopy, outcome);
+        }
+        let (termination, run) = self.finish_path(true);
+        let iterations = outcome.iterations + run.iterations;
+        self.settle(Strategy::Homotopy, iterations, termination, run.smallest)
+    }
+
+    /// The outcome of the attempts so far ended by `termination` of `strategy`.
+    fn end(&mut self, termination: Termination, strategy: Strategy) -> Outcome {
+        let attempts = std::mem::take(&mut self.attempts);
+        ended(termination, strategy, attempts, self.tolerance)
+    }
+
+    /// Records the attempt `strategy` of `iterations` that ended in `termination` at the
+    /// iterate (smallest residual norm `smallest`): the outcome when it ends the run, else
+    /// `None` with the best iterate updated.
+    fn settle(
+        &mut self,
+        strategy: Strategy,
+        iterations: usize,
+        termination: Termination,
+        smallest: f64,
+    ) -> Option<Outcome> {
+        self.attempts
+            .push(Attempt::new(strategy, iterations, &termination));
+        if termination.converged() || ends_run(&termination) {
+            return Some(self.end(termination, strategy));
+        }
+        self.best
+            .update(self.x, self.solver.work.kernel.residual(), smallest);
+        self.last = termination;
+        None
+    }
+
+    /// Records the path of `strategy` that stopped short: the outcome when the problem's
+    /// own error ended it.
+    fn failed(&mut self, strategy: Strategy, outcome: path::PathOutcome) -> Option<Outcome> {
+        self.attempts.push(failed_path(strategy, &outcome));
+        let error = outcome.error?;
+        Some(self.end(Termination::Evaluation(error), strategy))
+    }
+
+    /// The outcome when no attempt converged: the best iterate of all, with the last
+    /// attempt's termination.
+    fn best_outcome(self) -> Outcome {
+        if self.best.restore(self.x) {
+            self.solver.work.kernel.set_residual(&self.best.f);
+        }
+        ended(self.last, self.strategy, self.attempts, self.tolerance)
     }
 }
 

@@ -19,13 +19,15 @@ use crate::output::{
     csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
 };
 use crate::progress::progress_spinner;
-use crate::scene::{Method, Override, Scene};
+use crate::scene::{Method, Override, Scene, SweepSettings};
+use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
 use semismooth_contact::model::{SparseMatrix, Structure};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
-use semismooth_contact::sweep::fold_accuracy::{refine_folds, MAX_FOLD_HARMONICS};
-use semismooth_contact::sweep::SweepProgress;
+use semismooth_contact::solve::{RunError, Solution};
+use semismooth_contact::sweep::fold_accuracy::{refine_folds, FoldAccuracy, MAX_FOLD_HARMONICS};
+use semismooth_contact::sweep::{FrequencyResponse, SweepProgress};
 
 /// Bad input found in the scene file `path`: the message starts with the file.
 fn input_error(path: &Path, e: impl Display) -> CliError {
@@ -416,7 +418,6 @@ impl RunArgs {
 /// `ssn solve SCENE`: one periodic response; text or JSON on stdout, optional CSV/SVG, and
 /// the harmonic-balance state with `--state`; Newton starts from `--start` when given.
 pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
-    use crate::state::{read_state, HbState, StateShape};
     let args = &solve_args.run;
     let mut outputs = args.plan()?;
     // The start is an input: no output may replace it.
@@ -438,37 +439,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         dofs: rod.model.dofs(),
         contacts: rod.model.contacts.len(),
     };
-    for (given, option) in [
-        (solve_args.state.is_some(), "--state"),
-        (solve_args.start.is_some(), "--start"),
-    ] {
-        if given {
-            crate::state::check_method(shape.method, option)
-                .map_err(|e| input_error(&args.scene, e))?;
-        }
-    }
-    if solve_args.start.is_some() && scene.solver.accuracy.is_some() {
-        return Err(input_error(
-            &args.scene,
-            "--start with solver.accuracy: the search chooses the harmonics and solves from zero (remove one of the two)",
-        ));
-    }
-    let start = match &solve_args.start {
-        Some(path) => {
-            let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
-            let (x, note) = state.unknowns_for(shape).map_err(|e| {
-                CliError::BadInput(format!("{}: {e}", printable(&path.display().to_string())))
-            })?;
-            Some(StartedFrom {
-                file: printable(&path.display().to_string()),
-                entry: solve_args.entry,
-                omega_ratio: state.omega / state.omega_1,
-                note,
-                unknowns: x,
-            })
-        }
-        None => None,
-    };
+    let start = read_start(solve_args, &scene, shape)?;
     // Time marching to a steady state is the long one: a spinner while it runs.
     let bar = if scene.solver.method == Method::March {
         progress_spinner("time marching to a steady state")
@@ -491,35 +462,10 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     }
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
-        let period = 2.0 * std::f64::consts::PI / solution.omega;
-        let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
-        let mut series = vec![Series::new(
-            crate::words::describe_method(&solution),
-            t.clone(),
-            solution.tip.clone(),
-        )];
-        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
-        Plot {
-            untitled: "tip displacement",
-            x_label: "time t / T (T: forcing period)",
-            y_label: "tip displacement u_tip",
-            series,
-        }
+        solve_plot(&solution, &rod)
     })?;
     if let Some(path) = &solve_args.state {
-        // With an accuracy target the harmonics are the search's.
-        let shape = StateShape {
-            harmonics: solution.harmonics.unwrap_or(shape.harmonics),
-            ..shape
-        };
-        let mut doc =
-            HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state)
-                .to_json();
-        doc["converged"] = json!(solution.converged());
-        doc["residual_norm"] = crate::json::finite_or_null(solution.residual_norm);
-        let text = serde_json::to_string_pretty(&doc)
-            .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
-        outputs.add(path, format!("{text}\n").into_bytes());
+        outputs.add(path, state_document(&solution, shape)?.into_bytes());
     }
     args.finish(
         outputs,
@@ -540,6 +486,78 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         // An accuracy target not met is a run that did not converge (exit code 1).
         solution.converged() && solution.search.as_ref().is_none_or(|s| s.met()),
     )
+}
+
+/// The SVG of a solve: the tip over one period, with the obstacles of `rod`.
+fn solve_plot(solution: &Solution, rod: &Structure) -> Plot {
+    let period = 2.0 * std::f64::consts::PI / solution.omega;
+    let t: Vec<f64> = solution.times.iter().map(|t| t / period).collect();
+    let mut series = vec![Series::new(
+        crate::words::describe_method(solution),
+        t.clone(),
+        solution.tip.clone(),
+    )];
+    series.extend(crate::figures::obstacle_lines(rod, 0.0, 1.0));
+    Plot {
+        untitled: "tip displacement",
+        x_label: "time t / T (T: forcing period)",
+        y_label: "tip displacement u_tip",
+        series,
+    }
+}
+
+/// The state `--start` names, read for the unknowns of `shape` (`None` without it), after
+/// checking that `--state` and `--start` fit the scene's method and its accuracy target.
+fn read_start(
+    solve_args: &SolveArgs,
+    scene: &Scene,
+    shape: StateShape,
+) -> Result<Option<StartedFrom>, CliError> {
+    let path = &solve_args.run.scene;
+    for (given, option) in [
+        (solve_args.state.is_some(), "--state"),
+        (solve_args.start.is_some(), "--start"),
+    ] {
+        if given {
+            crate::state::check_method(shape.method, option).map_err(|e| input_error(path, e))?;
+        }
+    }
+    if solve_args.start.is_some() && scene.solver.accuracy.is_some() {
+        return Err(input_error(
+            path,
+            "--start with solver.accuracy: the search chooses the harmonics and solves from zero (remove one of the two)",
+        ));
+    }
+    let Some(path) = &solve_args.start else {
+        return Ok(None);
+    };
+    let state = read_state(path, solve_args.entry).map_err(CliError::BadInput)?;
+    let (x, note) = state.unknowns_for(shape).map_err(|e| {
+        CliError::BadInput(format!("{}: {e}", printable(&path.display().to_string())))
+    })?;
+    Ok(Some(StartedFrom {
+        file: printable(&path.display().to_string()),
+        entry: solve_args.entry,
+        omega_ratio: state.omega / state.omega_1,
+        note,
+        unknowns: x,
+    }))
+}
+
+/// The `--state` file of `solution` (unknowns of `shape`, with an accuracy target at the
+/// search's harmonics): the state, whether it converged and its residual norm.
+fn state_document(solution: &Solution, shape: StateShape) -> Result<String, CliError> {
+    let shape = StateShape {
+        harmonics: solution.harmonics.unwrap_or(shape.harmonics),
+        ..shape
+    };
+    let mut doc =
+        HbState::from_unknowns(shape, solution.omega, solution.omega_1, &solution.state).to_json();
+    doc["converged"] = json!(solution.converged());
+    doc["residual_norm"] = crate::json::finite_or_null(solution.residual_norm);
+    let text = serde_json::to_string_pretty(&doc)
+        .map_err(|e| CliError::Output(format!("cannot format the state: {e}")))?;
+    Ok(format!("{text}\n"))
 }
 
 /// The state `ssn solve --start` began from.
@@ -595,47 +613,8 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         ));
     };
     settings.stability &= !sweep_args.no_stability;
-    let bar = progress_spinner("sweep");
-    let progress = |p: SweepProgress| {
-        match p {
-            SweepProgress::Branch {
-                points,
-                omega_ratio,
-            } => bar.set_message(format!(
-                "sweep: {points} points, omega/omega_1 = {omega_ratio:.4}"
-            )),
-            SweepProgress::Stability { done, total } => {
-                bar.set_message(format!("stability: {done} of {total} points"))
-            }
-            _ => {}
-        }
-        bar.tick();
-    };
-    let response = semismooth_contact::sweep::frequency_response(
-        &rod,
-        &scene.solver,
-        &settings,
-        Some(&progress),
-    )
-    .map_err(|e| input_error(&args.scene, e))?;
-    // With an accuracy target the folds are located again with the harmonics it needs.
-    let fold_accuracy = match scene.solver.accuracy {
-        Some(target) if response.converged() => {
-            bar.set_message("folds to the accuracy target");
-            Some(
-                refine_folds(
-                    &rod,
-                    &scene.solver,
-                    &settings,
-                    &response,
-                    (target, MAX_FOLD_HARMONICS),
-                )
-                .map_err(|e| input_error(&args.scene, e))?,
-            )
-        }
-        _ => None,
-    };
-    bar.finish_and_clear();
+    let (response, fold_accuracy) =
+        run_sweep(&rod, &scene, &settings).map_err(|e| input_error(&args.scene, e))?;
     let ratio = response.omega_ratio();
     let st = &response.stability;
     let (stable, floquet) = crate::output::stability_numbers(st);
@@ -668,90 +647,8 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         columns.push(values);
     }
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
-        let label = match (
-            response.harmonics.iter().min(),
-            response.harmonics.iter().max(),
-        ) {
-            (Some(lo), Some(hi)) if lo != hi => {
-                format!("{} H = {lo} to {hi}", scene.solver.method.name())
-            }
-            _ => format!(
-                "{} H = {}",
-                scene.solver.method.name(),
-                scene.solver.harmonics
-            ),
-        };
-        let mut series = stability_series(&label, 0, &ratio, &response.amplitude, &st.stable);
-        series.extend(stability_key(&st.stable));
-        Plot {
-            untitled: "frequency response",
-            x_label: "forcing frequency omega / omega_1",
-            y_label: "tip amplitude max_t |u_tip(t)|",
-            series,
-        }
+        sweep_plot(&scene, &response, &ratio)
     })?;
-    let text = || {
-        let mut t = format!(
-            "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",
-            response.points(),
-            ratio.first().copied().unwrap_or(f64::NAN),
-            ratio.last().copied().unwrap_or(f64::NAN)
-        );
-        if let Some((i, a)) = response.peak() {
-            t += &format!(
-                "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
-                ratio[i]
-            );
-        }
-        if let Some(a) = &response.accuracy {
-            t += &crate::words::branch_accuracy(a, &response.harmonics);
-        }
-        t += &format!(
-            "folds             {}\n",
-            crate::words::folds_summary(&response.folds, rod.omega_1)
-        );
-        if !response.corner_folds.is_empty() {
-            t += &format!(
-                "corner reversals  {} (the frequency goes back by less than {} omega_1; in \
-                 --json as corner_folds)\n",
-                response.corner_folds.len(),
-                semismooth_contact::sweep::TURNING_POINT_EXCURSION
-            );
-        }
-        let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
-        let undecided = st.stable.iter().filter(|s| s.is_none()).count();
-        t += &format!(
-            "stability         {} stable, {unstable} unstable, {undecided} undecided{}\n",
-            st.stable.len() - unstable - undecided,
-            st.undecided
-                .as_ref()
-                .map(|u| format!(" ({})", crate::words::undecided(u)))
-                .unwrap_or_default()
-        );
-        for e in &st.events {
-            t += &format!(
-                "  {:<15} at omega/omega_1 = {:.4}\n",
-                e.kind.name(),
-                e.omega / rod.omega_1
-            );
-        }
-        for fold in fold_accuracy.iter().flatten() {
-            t += &crate::words::fold_accuracy(fold, rod.omega_1);
-        }
-        t += &format!(
-            "work              {} corrector iterations, {} factorizations{}\n",
-            response.continuation.corrector_iterations,
-            response.counters.factorizations,
-            crate::words::gmres_words(&response.counters)
-        );
-        t += &format!(
-            "converged         {} ({}), {:.3} s\n",
-            response.converged(),
-            crate::words::sweep_termination(&response),
-            response.solve_seconds
-        );
-        t
-    };
     let folds_met = fold_accuracy.iter().flatten().all(|f| f.met());
     args.finish(
         outputs,
@@ -762,9 +659,81 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
             }
             json
         },
-        text,
+        || crate::words::sweep_text(&response, fold_accuracy.as_deref(), rod.omega_1),
         response.converged() && folds_met,
     )
+}
+
+/// The frequency response of `rod` over `settings` with a spinner telling the progress,
+/// and with an accuracy target its folds located again with the harmonics it needs.
+fn run_sweep(
+    rod: &Structure,
+    scene: &Scene,
+    settings: &SweepSettings,
+) -> Result<(FrequencyResponse, Option<Vec<FoldAccuracy>>), RunError> {
+    let bar = progress_spinner("sweep");
+    let progress = |p: SweepProgress| {
+        match p {
+            SweepProgress::Branch {
+                points,
+                omega_ratio,
+            } => bar.set_message(format!(
+                "sweep: {points} points, omega/omega_1 = {omega_ratio:.4}"
+            )),
+            SweepProgress::Stability { done, total } => {
+                bar.set_message(format!("stability: {done} of {total} points"))
+            }
+            _ => {}
+        }
+        bar.tick();
+    };
+    let response = semismooth_contact::sweep::frequency_response(
+        rod,
+        &scene.solver,
+        settings,
+        Some(&progress),
+    )?;
+    let fold_accuracy = match scene.solver.accuracy {
+        Some(target) if response.converged() => {
+            bar.set_message("folds to the accuracy target");
+            Some(refine_folds(
+                rod,
+                &scene.solver,
+                settings,
+                &response,
+                (target, MAX_FOLD_HARMONICS),
+            )?)
+        }
+        _ => None,
+    };
+    bar.finish_and_clear();
+    Ok((response, fold_accuracy))
+}
+
+/// The SVG of a sweep: the amplitude against the frequency ratio `ratio`, by stability.
+fn sweep_plot(scene: &Scene, response: &FrequencyResponse, ratio: &[f64]) -> Plot {
+    let label = match (
+        response.harmonics.iter().min(),
+        response.harmonics.iter().max(),
+    ) {
+        (Some(lo), Some(hi)) if lo != hi => {
+            format!("{} H = {lo} to {hi}", scene.solver.method.name())
+        }
+        _ => format!(
+            "{} H = {}",
+            scene.solver.method.name(),
+            scene.solver.harmonics
+        ),
+    };
+    let stable = &response.stability.stable;
+    let mut series = stability_series(&label, 0, ratio, &response.amplitude, stable);
+    series.extend(stability_key(stable));
+    Plot {
+        untitled: "frequency response",
+        x_label: "forcing frequency omega / omega_1",
+        y_label: "tip amplitude max_t |u_tip(t)|",
+        series,
+    }
 }
 
 /// `ssn compare SCENE`: accuracy against cost of every applicable method on the scene's rod

@@ -1,15 +1,17 @@
 //! `ssn solutions SCENE`: every periodic response at the scene's frequency with its
 //! stability ([`semismooth_contact::solutions::find_solutions`]).
 
-use semismooth_contact::solutions::{find_solutions, PeriodicSolution};
+use semismooth_contact::model::Structure;
+use semismooth_contact::solutions::{find_solutions, PeriodicSolution, SolutionSet};
 use semismooth_contact::solve::RunError;
+
+use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
 
 /// `ssn solutions SCENE`: every periodic solution at the scene's frequency (module
 /// documentation); text or JSON on stdout, a CSV row per solution, an SVG of the tip over
 /// one period (stable solid, unstable dashed, undecided dotted).
 pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> {
     use crate::exit::CliError;
-    use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
     let crate::cli::Loaded {
         scene,
         structure: rod,
@@ -20,129 +22,143 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
     check_window(&scene, omega / rod.omega_1)?;
     let bad = |e: RunError| CliError::BadInput(format!("{}: {e}", args.scene.display()));
     let set = find_solutions(&rod, omega, &scene.solver, scene.sweep.as_ref()).map_err(bad)?;
+    if let Some(csv) = &args.csv {
+        outputs.add(csv, csv_text(&set).into_bytes());
+    }
+    if let Some(svg) = &args.svg {
+        outputs.add(svg, svg_text(&set, &rod)?.into_bytes());
+    }
+    let complete = incomplete(&set).is_none();
+    args.finish(outputs, || document(&set), || summary(&set), complete)
+}
+
+/// The CSV of `ssn solutions`: a row per solution.
+fn csv_text(set: &SolutionSet) -> String {
     let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
         set.solutions.iter().map(f).collect()
     };
-    if let Some(csv) = &args.csv {
-        let columns = [
-            column(&|s| s.solution.stats.min),
-            column(&|s| s.solution.stats.max),
-            column(&|s| s.solution.stats.mean_contact_force),
-            column(&|s| s.solution.stats.max_penetration),
-            column(&|s| {
-                s.stability
-                    .stable
-                    .map_or(f64::NAN, |b| f64::from(u8::from(b)))
-            }),
-            column(&|s| s.stability.floquet_max_abs.unwrap_or(f64::NAN)),
-        ];
-        let refs: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect();
-        let headers = [
-            "tip_min",
-            "tip_max",
-            "contact_force_mean",
-            "max_penetration",
-            "stable",
-            "floquet_max_abs",
-        ];
-        outputs.add(csv, csv_table(&headers, &refs).into_bytes());
-    }
-    if let Some(svg) = &args.svg {
-        let mut series: Vec<Series> = set
-            .solutions
-            .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                let t: Vec<f64> = s
-                    .solution
-                    .times
-                    .iter()
-                    .map(|t| t * set.omega / (2.0 * std::f64::consts::PI))
-                    .collect();
-                let label = match s.stability.stable {
-                    Some(true) => format!("solution {} (stable)", k + 1),
-                    Some(false) => format!("solution {} (unstable)", k + 1),
-                    None => format!("solution {} (stability undecided)", k + 1),
-                };
-                // The stability styles of the sweeps: solid, dashed, dotted.
-                let style = match s.stability.stable {
-                    Some(true) => LineStyle::Solid,
-                    Some(false) => LineStyle::Dashed,
-                    None => LineStyle::Dotted,
-                };
-                Series {
-                    style,
-                    ..Series::new(label, t, s.solution.tip.clone())
-                }
-            })
-            .collect();
-        series.extend(crate::figures::obstacle_lines(&rod, 0.0, 1.0));
-        let spec = PlotSpec {
-            title: format!(
-                "periodic solutions at omega/omega_1 = {:.4}",
-                set.omega / set.omega_1
-            ),
-            x_label: "time t / T (T: forcing period)".into(),
-            y_label: "tip displacement u_tip".into(),
-            log_log: false,
-        };
-        outputs.add(svg, line_plot_svg(&spec, &series)?.into_bytes());
-    }
-    let text = || {
-        let mut t = format!(
-            "omega/omega_1     {:.6}: {} solution(s) from {} crossing(s) of a {}-point branch \
-             over [{}, {}]\n",
-            set.omega / set.omega_1,
-            set.solutions.len(),
-            set.crossings,
-            set.branch_points,
-            set.window.0,
-            set.window.1
-        );
-        for (k, s) in set.solutions.iter().enumerate() {
-            t += &format!(
-                "  {}: tip min {:.6} max {:.6}, mean contact force {:.4e}, {} (max |mu| {})\n",
-                k + 1,
-                s.solution.stats.min,
-                s.solution.stats.max,
-                s.solution.stats.mean_contact_force,
-                match s.stability.stable {
-                    Some(true) => "stable".to_string(),
-                    Some(false) => "unstable".to_string(),
-                    None => format!(
-                        "undecided: {}",
-                        s.stability
-                            .undecided
-                            .as_ref()
-                            .map(crate::words::undecided)
-                            .unwrap_or_default()
-                    ),
-                },
-                s.stability
-                    .floquet_max_abs
-                    .map_or("-".to_string(), |m| format!("{m:.4}"))
-            );
-        }
-        for f in &set.failed_corrections {
-            t += &format!("  not corrected: {}\n", crate::words::failed_correction(f));
-        }
-        if let Some(missed) = incomplete(&set) {
-            t += &format!("  incomplete search: {missed}\n");
-        }
-        if set.counters.krylov_iterations > 0 {
-            t += &format!(
-                "  work: {} GMRES iterations (matrix-free condensed solves)\n",
-                set.counters.krylov_iterations
-            );
-        }
-        if !set.solutions.is_empty() {
-            t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
-                  starts from solution K)\n";
-        }
-        t
+    let columns = [
+        column(&|s| s.solution.stats.min),
+        column(&|s| s.solution.stats.max),
+        column(&|s| s.solution.stats.mean_contact_force),
+        column(&|s| s.solution.stats.max_penetration),
+        column(&|s| {
+            s.stability
+                .stable
+                .map_or(f64::NAN, |b| f64::from(u8::from(b)))
+        }),
+        column(&|s| s.stability.floquet_max_abs.unwrap_or(f64::NAN)),
+    ];
+    let refs: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect();
+    let headers = [
+        "tip_min",
+        "tip_max",
+        "contact_force_mean",
+        "max_penetration",
+        "stable",
+        "floquet_max_abs",
+    ];
+    csv_table(&headers, &refs)
+}
+
+/// The SVG of `ssn solutions`: the tip of each solution over one period, styled by its
+/// stability, with the obstacles of `rod`.
+fn svg_text(set: &SolutionSet, rod: &Structure) -> Result<String, crate::exit::CliError> {
+    let mut series: Vec<Series> = set
+        .solutions
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let t: Vec<f64> = s
+                .solution
+                .times
+                .iter()
+                .map(|t| t * set.omega / (2.0 * std::f64::consts::PI))
+                .collect();
+            let label = match s.stability.stable {
+                Some(true) => format!("solution {} (stable)", k + 1),
+                Some(false) => format!("solution {} (unstable)", k + 1),
+                None => format!("solution {} (stability undecided)", k + 1),
+            };
+            // The stability styles of the sweeps: solid, dashed, dotted.
+            let style = match s.stability.stable {
+                Some(true) => LineStyle::Solid,
+                Some(false) => LineStyle::Dashed,
+                None => LineStyle::Dotted,
+            };
+            Series {
+                style,
+                ..Series::new(label, t, s.solution.tip.clone())
+            }
+        })
+        .collect();
+    series.extend(crate::figures::obstacle_lines(rod, 0.0, 1.0));
+    let spec = PlotSpec {
+        title: format!(
+            "periodic solutions at omega/omega_1 = {:.4}",
+            set.omega / set.omega_1
+        ),
+        x_label: "time t / T (T: forcing period)".into(),
+        y_label: "tip displacement u_tip".into(),
+        log_log: false,
     };
-    let complete = incomplete(&set).is_none();
-    args.finish(outputs, || document(&set), text, complete)
+    Ok(line_plot_svg(&spec, &series)?)
+}
+
+/// The text summary of `ssn solutions`: the search, each solution with its stability,
+/// what was not corrected or missed, and the work.
+fn summary(set: &SolutionSet) -> String {
+    let mut t = format!(
+        "omega/omega_1     {:.6}: {} solution(s) from {} crossing(s) of a {}-point branch \
+         over [{}, {}]\n",
+        set.omega / set.omega_1,
+        set.solutions.len(),
+        set.crossings,
+        set.branch_points,
+        set.window.0,
+        set.window.1
+    );
+    for (k, s) in set.solutions.iter().enumerate() {
+        t += &format!(
+            "  {}: tip min {:.6} max {:.6}, mean contact force {:.4e}, {} (max |mu| {})\n",
+            k + 1,
+            s.solution.stats.min,
+            s.solution.stats.max,
+            s.solution.stats.mean_contact_force,
+            match s.stability.stable {
+                Some(true) => "stable".to_string(),
+                Some(false) => "unstable".to_string(),
+                None => format!(
+                    "undecided: {}",
+                    s.stability
+                        .undecided
+                        .as_ref()
+                        .map(crate::words::undecided)
+                        .unwrap_or_default()
+                ),
+            },
+            s.stability
+                .floquet_max_abs
+                .map_or("-".to_string(), |m| format!("{m:.4}"))
+        );
+    }
+    for f in &set.failed_corrections {
+        t += &format!("  not corrected: {}\n", crate::words::failed_correction(f));
+    }
+    if let Some(missed) = incomplete(set) {
+        t += &format!("  incomplete search: {missed}\n");
+    }
+    if set.counters.krylov_iterations > 0 {
+        t += &format!(
+            "  work: {} GMRES iterations (matrix-free condensed solves)\n",
+            set.counters.krylov_iterations
+        );
+    }
+    if !set.solutions.is_empty() {
+        t += "  (--json carries each solution's state: ssn solve SCENE --start FILE --entry K \
+              starts from solution K)\n";
+    }
+    t
 }
 
 /// The JSON document of `ssn solutions --json`: [`crate::json::solutions_json`] with

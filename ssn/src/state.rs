@@ -147,13 +147,7 @@ impl HbState {
                 format!("expected \"{STATE_FORMAT}\" (written by ssn solve --state or ssn solutions --json)"),
             ));
         }
-        let count = |name: &str| -> Result<usize, StateError> {
-            v.get(name)
-                .and_then(Value::as_u64)
-                .and_then(|n| usize::try_from(n).ok())
-                .ok_or_else(|| field_error(name, "missing or not a non-negative integer"))
-        };
-        if count("version")? as u64 != STATE_VERSION {
+        if count_field(v, "version")? as u64 != STATE_VERSION {
             return Err(field_error("version", format!("allowed {STATE_VERSION}")));
         }
         let method = match v.get("method").and_then(Value::as_str) {
@@ -166,7 +160,11 @@ impl HbState {
                 ))
             }
         };
-        let (harmonics, dofs, contacts) = (count("harmonics")?, count("dofs")?, count("contacts")?);
+        let (harmonics, dofs, contacts) = (
+            count_field(v, "harmonics")?,
+            count_field(v, "dofs")?,
+            count_field(v, "contacts")?,
+        );
         if harmonics > crate::scene::MAX_HARMONICS {
             return Err(field_error(
                 "harmonics",
@@ -176,14 +174,8 @@ impl HbState {
                 ),
             ));
         }
-        let number = |name: &str| -> Result<f64, StateError> {
-            v.get(name)
-                .and_then(Value::as_f64)
-                .filter(|x| x.is_finite() && *x > 0.0)
-                .ok_or_else(|| field_error(name, "missing or not a finite number > 0"))
-        };
-        let omega = number("omega")?;
-        let ratio = number("omega_ratio")?;
+        let omega = positive_field(v, "omega")?;
+        let ratio = positive_field(v, "omega_ratio")?;
         let omega_1 = omega / ratio;
         if !(omega_1.is_finite() && omega_1 > 0.0) {
             return Err(field_error(
@@ -194,43 +186,6 @@ impl HbState {
             ));
         }
         let functions = 2 * harmonics + 1;
-        let list = |name: &str, len: usize| -> Result<Vec<f64>, StateError> {
-            let items = v
-                .get(name)
-                .and_then(Value::as_array)
-                .ok_or_else(|| field_error(name, "missing or not a list of numbers"))?;
-            if items.len() != len {
-                return Err(field_error(
-                    name,
-                    format!(
-                        "{} numbers, but (2 harmonics + 1) x {} = {len} expected",
-                        items.len(),
-                        if name == "displacement" {
-                            "dofs"
-                        } else {
-                            "contacts"
-                        }
-                    ),
-                ));
-            }
-            items
-                .iter()
-                .enumerate()
-                .map(|(i, x)| {
-                    x.as_f64()
-                        .filter(|x| x.abs() <= MAX_COEFFICIENT)
-                        .ok_or_else(|| {
-                            field_error(
-                                format!("{name}[{i}]"),
-                                format!(
-                                    "{x}: allowed finite numbers of magnitude at most \
-                                     {MAX_COEFFICIENT:e}"
-                                ),
-                            )
-                        })
-                })
-                .collect()
-        };
         let length = |name: &str, width: usize| {
             functions.checked_mul(width).ok_or_else(|| {
                 field_error(
@@ -239,9 +194,13 @@ impl HbState {
                 )
             })
         };
-        let displacement = list("displacement", length("dofs", dofs)?)?;
+        let displacement = coefficients_field(v, "displacement", length("dofs", dofs)?)?;
         let contact_force = match method {
-            Method::SsnHb => Some(list("contact_force", length("contacts", contacts)?)?),
+            Method::SsnHb => Some(coefficients_field(
+                v,
+                "contact_force",
+                length("contacts", contacts)?,
+            )?),
             _ => None,
         };
         Ok(Self {
@@ -313,6 +272,62 @@ impl HbState {
         });
         Ok((x, note))
     }
+}
+
+/// The field `name` of the state document `v`: a non-negative integer.
+fn count_field(v: &Value, name: &str) -> Result<usize, StateError> {
+    v.get(name)
+        .and_then(Value::as_u64)
+        .and_then(|n| usize::try_from(n).ok())
+        .ok_or_else(|| field_error(name, "missing or not a non-negative integer"))
+}
+
+/// The field `name` of the state document `v`: a finite number > 0.
+fn positive_field(v: &Value, name: &str) -> Result<f64, StateError> {
+    v.get(name)
+        .and_then(Value::as_f64)
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .ok_or_else(|| field_error(name, "missing or not a finite number > 0"))
+}
+
+/// The field `name` of the state document `v`: a list of `len` coefficients, each finite
+/// and of magnitude at most [`MAX_COEFFICIENT`].
+fn coefficients_field(v: &Value, name: &str, len: usize) -> Result<Vec<f64>, StateError> {
+    let items = v
+        .get(name)
+        .and_then(Value::as_array)
+        .ok_or_else(|| field_error(name, "missing or not a list of numbers"))?;
+    if items.len() != len {
+        return Err(field_error(
+            name,
+            format!(
+                "{} numbers, but (2 harmonics + 1) x {} = {len} expected",
+                items.len(),
+                if name == "displacement" {
+                    "dofs"
+                } else {
+                    "contacts"
+                }
+            ),
+        ));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            x.as_f64()
+                .filter(|x| x.abs() <= MAX_COEFFICIENT)
+                .ok_or_else(|| {
+                    field_error(
+                        format!("{name}[{i}]"),
+                        format!(
+                            "{x}: allowed finite numbers of magnitude at most \
+                             {MAX_COEFFICIENT:e}"
+                        ),
+                    )
+                })
+        })
+        .collect()
 }
 
 /// Picks the state in a document: the document itself, or entry `entry` (from 1) of the

@@ -404,6 +404,77 @@ pub(crate) fn folds_summary(folds: &[f64], omega_1: f64) -> String {
     }
 }
 
+/// The text summary of `ssn sweep`: the branch, its accuracy, folds, stability, the folds
+/// located to an accuracy target (`folds`), the work and how it ended.
+pub(crate) fn sweep_text(
+    response: &FrequencyResponse,
+    folds: Option<&[FoldAccuracy]>,
+    omega_1: f64,
+) -> String {
+    let ratio = response.omega_ratio();
+    let st = &response.stability;
+    let mut t = format!(
+        "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",
+        response.points(),
+        ratio.first().copied().unwrap_or(f64::NAN),
+        ratio.last().copied().unwrap_or(f64::NAN)
+    );
+    if let Some((i, a)) = response.peak() {
+        t += &format!(
+            "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
+            ratio[i]
+        );
+    }
+    if let Some(a) = &response.accuracy {
+        t += &branch_accuracy(a, &response.harmonics);
+    }
+    t += &format!(
+        "folds             {}\n",
+        folds_summary(&response.folds, omega_1)
+    );
+    if !response.corner_folds.is_empty() {
+        t += &format!(
+            "corner reversals  {} (the frequency goes back by less than {} omega_1; in \
+             --json as corner_folds)\n",
+            response.corner_folds.len(),
+            semismooth_contact::sweep::TURNING_POINT_EXCURSION
+        );
+    }
+    let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
+    let undecided_count = st.stable.iter().filter(|s| s.is_none()).count();
+    t += &format!(
+        "stability         {} stable, {unstable} unstable, {undecided_count} undecided{}\n",
+        st.stable.len() - unstable - undecided_count,
+        st.undecided
+            .as_ref()
+            .map(|u| format!(" ({})", undecided(u)))
+            .unwrap_or_default()
+    );
+    for e in &st.events {
+        t += &format!(
+            "  {:<15} at omega/omega_1 = {:.4}\n",
+            e.kind.name(),
+            e.omega / omega_1
+        );
+    }
+    for fold in folds.unwrap_or_default() {
+        t += &fold_accuracy(fold, omega_1);
+    }
+    t += &format!(
+        "work              {} corrector iterations, {} factorizations{}\n",
+        response.continuation.corrector_iterations,
+        response.counters.factorizations,
+        gmres_words(&response.counters)
+    );
+    t += &format!(
+        "converged         {} ({}), {:.3} s\n",
+        response.converged(),
+        sweep_termination(response),
+        response.solve_seconds
+    );
+    t
+}
+
 /// The method and its discretisation, as the first line of `ssn solve` names them.
 pub(crate) fn describe_method(s: &Solution) -> String {
     match (s.harmonics, s.lcp_scheme) {

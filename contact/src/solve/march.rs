@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use super::{solution, Outcome, Period, RunCounters, RunError, Solution, Termination};
 use crate::contacts::march_friction_report;
-use crate::march::{march_from_state, MarchError, MarchOptions, MarchScheme, MarchState};
+use crate::march::{
+    march_from_state, MarchError, MarchOptions, MarchScheme, MarchState, SteadyPeriod,
+};
 use crate::model::{NormalForce, StructuralModel, Structure};
 use crate::settings::SolverSettings;
 
@@ -84,14 +86,7 @@ pub(super) fn solve_march(
         tolerance: settings.march_tolerance,
         scheme: march_scheme(settings),
     };
-    // The tip, then every dof of the contacts' rows (their gap closures `g . u` are
-    // combined from these series).
-    let mut observed = vec![tip];
-    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
-        if !observed[1..].contains(dof) {
-            observed.push(*dof);
-        }
-    }
+    let observed = observed_dofs(model, tip);
     let initial = warm_start
         .and_then(|w| march_state(model, w))
         .unwrap_or_else(|| MarchState::rest(model));
@@ -108,49 +103,14 @@ pub(super) fn solve_march(
     let keep = period.times.len().saturating_sub(1).max(1);
     let cut = |v: &Vec<f64>| v[..keep.min(v.len())].to_vec();
     let tip_series = cut(&period.displacements[0]);
-    let series = |dof: usize| {
-        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
-        cut(&period.displacements[k])
-    };
-    let contact_u: Vec<Vec<f64>> = model
-        .contacts
-        .iter()
-        .map(|c| {
-            let mut entries = c.row.entries();
-            let (d, a) = entries.next().expect("a row has at least one dof");
-            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
-            for (d, a) in entries {
-                for (ui, v) in u.iter_mut().zip(series(d)) {
-                    *ui += a * v;
-                }
-            }
-            u
-        })
-        .collect();
+    let contact_u = contact_closures(model, &observed, &period.displacements, cut);
     let forces: Vec<Vec<f64>> = period.contact_forces.iter().map(cut).collect();
     let start_time = period.times[0];
     let times = period.times[..keep]
         .iter()
         .map(|t| t - start_time)
         .collect();
-    let outcome = Outcome {
-        termination: Termination::March {
-            steady,
-            period_change: period.period_change,
-            tolerance: settings.march_tolerance,
-            periods: period.periods,
-        },
-        iterations: period.periods,
-        residual_norm: period.period_change,
-        effective_tolerance: Some(settings.march_tolerance),
-        counters: RunCounters {
-            time_steps: period.counters.steps,
-            factorizations: period.counters.factorizations,
-            ..RunCounters::default()
-        },
-        solve_seconds: seconds,
-        newton: None,
-    };
+    let outcome = march_outcome(&period, steady, settings, seconds);
     let slip_limits = march_slip_limits(model, &forces);
     let velocity_scale = omega * max_abs(&tip_series).max(static_deflection(model));
     let friction = period
@@ -186,4 +146,72 @@ pub(super) fn solve_march(
         period,
         state,
     ))
+}
+
+/// The observed dofs of a march: the tip, then every dof of the contacts' rows (their gap
+/// closures `g . u` are combined from these series).
+fn observed_dofs(model: &StructuralModel, tip: usize) -> Vec<usize> {
+    let mut observed = vec![tip];
+    for dof in model.contacts.iter().flat_map(|c| c.row.dofs()) {
+        if !observed[1..].contains(dof) {
+            observed.push(*dof);
+        }
+    }
+    observed
+}
+
+/// Each contact's gap closure `g . u` over the period, combined from the series of the
+/// `observed` dofs (`displacements`, each shortened by `cut`).
+fn contact_closures(
+    model: &StructuralModel,
+    observed: &[usize],
+    displacements: &[Vec<f64>],
+    cut: impl Fn(&Vec<f64>) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let series = |dof: usize| {
+        let k = 1 + observed[1..].iter().position(|d| *d == dof).unwrap_or(0);
+        cut(&displacements[k])
+    };
+    model
+        .contacts
+        .iter()
+        .map(|c| {
+            let mut entries = c.row.entries();
+            let (d, a) = entries.next().expect("a row has at least one dof");
+            let mut u: Vec<f64> = series(d).iter().map(|v| a * v).collect();
+            for (d, a) in entries {
+                for (ui, v) in u.iter_mut().zip(series(d)) {
+                    *ui += a * v;
+                }
+            }
+            u
+        })
+        .collect()
+}
+
+/// How the march of `period` ended (`steady`: it settled), its work and wall time.
+fn march_outcome(
+    period: &SteadyPeriod,
+    steady: bool,
+    settings: &SolverSettings,
+    seconds: f64,
+) -> Outcome<'static> {
+    Outcome {
+        termination: Termination::March {
+            steady,
+            period_change: period.period_change,
+            tolerance: settings.march_tolerance,
+            periods: period.periods,
+        },
+        iterations: period.periods,
+        residual_norm: period.period_change,
+        effective_tolerance: Some(settings.march_tolerance),
+        counters: RunCounters {
+            time_steps: period.counters.steps,
+            factorizations: period.counters.factorizations,
+            ..RunCounters::default()
+        },
+        solve_seconds: seconds,
+        newton: None,
+    }
 }

@@ -59,7 +59,7 @@
 use semismooth::faer::Mat;
 use semismooth::floquet::Multipliers;
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::Termination;
+use semismooth::newton::{NewtonReport, Termination};
 use semismooth::polyalgorithm::{self, PolyalgorithmOptions};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
@@ -149,42 +149,8 @@ pub fn map_stability(
     options: &StabilityOptions,
 ) -> Result<MapStability, StabilityError> {
     let spp = options.steps_per_period;
-    if !(8..=1_000_000).contains(&spp) {
-        return Err(StabilityError::InvalidOption {
-            name: "steps_per_period",
-            value: spp as f64,
-            allowed: "an integer in 8..=1000000",
-        });
-    }
-    check_omega(omega)?;
-    let n = model.dofs();
-    if u.len() != n * (2 * harmonics + 1) {
-        return Err(StabilityError::Dimension {
-            expected: n * (2 * harmonics + 1),
-            found: u.len(),
-        });
-    }
-    if !model.friction.is_empty() {
-        let points = model.friction.len();
-        return Ok(MapStability::not_decided(
-            Undecided::Friction { points },
-            spp,
-        ));
-    }
-    if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
-        return Ok(MapStability::not_decided(
-            Undecided::MassCarryingContact,
-            spp,
-        ));
-    }
-    if n > MAX_DOFS {
-        return Ok(MapStability::not_decided(
-            Undecided::TooManyDofs {
-                dofs: n,
-                limit: MAX_DOFS,
-            },
-            spp,
-        ));
+    if let Some(undecided) = map_undecided(model, harmonics, omega, u, spp)? {
+        return Ok(undecided);
     }
     let march = MarchOptions {
         steps_per_period: spp,
@@ -227,63 +193,15 @@ pub fn map_stability(
         runs: Vec::new(),
         evaluated: None,
     };
-    let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
-    let options = PolyalgorithmOptions {
-        tolerances: semismooth::newton::Tolerances::absolute(SHOOTING_TOLERANCE * scale),
-        max_iterations: 50,
-        ..PolyalgorithmOptions::default()
+    let report = match shooting.orbit(&mut x, spp)? {
+        Ok(report) => report,
+        Err(undecided) => return Ok(undecided),
     };
-    let report =
-        match polyalgorithm::solve(&mut shooting, &mut FaerDenseLu::new(), &mut x, &options) {
-            Ok(report) => report,
-            Err(err) => {
-                return Ok(MapStability::not_decided(
-                    Undecided::ShootingNotRun(err),
-                    spp,
-                ))
-            }
-        };
-    if !report.converged() {
-        // A march that failed inside the solve ended it and comes back in its termination.
-        if let Termination::Evaluation(e) = &report.termination {
-            if let Some(err) = e.downcast_ref::<StabilityError>() {
-                return Err(err.clone());
-            }
-        }
-        return Ok(MapStability::not_decided(
-            Undecided::OrbitNotFound {
-                termination: report.termination.clone(),
-                iterations: report.iterations,
-                residual_norm: report.residual_norms.last().copied().unwrap_or(f64::NAN),
-            },
-            spp,
-        ));
-    }
     shooting.period(&x)?;
     let keep = &shooting.keep;
     let multipliers =
         reduced_multipliers(&monodromy(&mut shooting.marcher, &shooting.runs)?, keep)?;
-    let n = model.dofs();
-    let displacements = |x: &[f64]| -> Vec<f64> {
-        keep.iter()
-            .zip(x)
-            .filter(|(i, _)| **i < n)
-            .map(|(_, v)| *v)
-            .collect()
-    };
-    let (u_orbit, u_hb) = (displacements(&x), displacements(&x_hb));
-    let distance = u_orbit
-        .iter()
-        .zip(&u_hb)
-        .map(|(a, b)| (a - b).powi(2))
-        .sum::<f64>()
-        .sqrt()
-        / u_hb
-            .iter()
-            .map(|a| a * a)
-            .sum::<f64>()
-            .sqrt()
-            .max(f64::MIN_POSITIVE);
+    let distance = orbit_distance(keep, model.dofs(), &x, &x_hb);
     let contact_steps = shooting
         .runs
         .iter()
@@ -301,6 +219,72 @@ pub fn map_stability(
         shooting_iterations: report.iterations,
         orbit: Some(shooting.state(&x, model.contact_count())),
     })
+}
+
+/// `Err` for a bad step count, frequency or size of `u`; the answer without a monodromy
+/// (with friction, a contact on a dof with mass, more than [`MAX_DOFS`] dofs), `None`
+/// when the map's monodromy decides.
+fn map_undecided(
+    model: &StructuralModel,
+    harmonics: usize,
+    omega: f64,
+    u: &[f64],
+    spp: usize,
+) -> Result<Option<MapStability>, StabilityError> {
+    if !(8..=1_000_000).contains(&spp) {
+        return Err(StabilityError::InvalidOption {
+            name: "steps_per_period",
+            value: spp as f64,
+            allowed: "an integer in 8..=1000000",
+        });
+    }
+    check_omega(omega)?;
+    let n = model.dofs();
+    if u.len() != n * (2 * harmonics + 1) {
+        return Err(StabilityError::Dimension {
+            expected: n * (2 * harmonics + 1),
+            found: u.len(),
+        });
+    }
+    let reason = if !model.friction.is_empty() {
+        let points = model.friction.len();
+        Undecided::Friction { points }
+    } else if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
+        Undecided::MassCarryingContact
+    } else if n > MAX_DOFS {
+        Undecided::TooManyDofs {
+            dofs: n,
+            limit: MAX_DOFS,
+        }
+    } else {
+        return Ok(None);
+    };
+    Ok(Some(MapStability::not_decided(reason, spp)))
+}
+
+/// `|u* - u_HB| / |u_HB|` between the displacements (the components of `keep` below
+/// `dofs`) of the orbit's state `x` and the harmonic-balance state `x_hb`.
+fn orbit_distance(keep: &[usize], dofs: usize, x: &[f64], x_hb: &[f64]) -> f64 {
+    let displacements = |x: &[f64]| -> Vec<f64> {
+        keep.iter()
+            .zip(x)
+            .filter(|(i, _)| **i < dofs)
+            .map(|(_, v)| *v)
+            .collect()
+    };
+    let (u_orbit, u_hb) = (displacements(x), displacements(x_hb));
+    u_orbit
+        .iter()
+        .zip(&u_hb)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt()
+        / u_hb
+            .iter()
+            .map(|a| a * a)
+            .sum::<f64>()
+            .sqrt()
+            .max(f64::MIN_POSITIVE)
 }
 
 /// The multipliers of `monodromy` restricted to the influential components `keep`.
@@ -395,6 +379,48 @@ struct Shooting<'a> {
 }
 
 impl Shooting<'_> {
+    /// The periodic orbit of the map by semismooth Newton on the period map from `x`
+    /// (the orbit on return): Newton's report, or the undecided answer (`spp` steps per
+    /// period) when it could not run or did not converge; `Err` when a march failed.
+    fn orbit(
+        &mut self,
+        x: &mut [f64],
+        spp: usize,
+    ) -> Result<Result<NewtonReport, MapStability>, StabilityError> {
+        let scale = x.iter().fold(1.0f64, |a, v| a.max(v.abs()));
+        let options = PolyalgorithmOptions {
+            tolerances: semismooth::newton::Tolerances::absolute(SHOOTING_TOLERANCE * scale),
+            max_iterations: 50,
+            ..PolyalgorithmOptions::default()
+        };
+        let report = match polyalgorithm::solve(self, &mut FaerDenseLu::new(), x, &options) {
+            Ok(report) => report,
+            Err(err) => {
+                return Ok(Err(MapStability::not_decided(
+                    Undecided::ShootingNotRun(err),
+                    spp,
+                )))
+            }
+        };
+        if report.converged() {
+            return Ok(Ok(report));
+        }
+        // A march that failed inside the solve ended it and comes back in its termination.
+        if let Termination::Evaluation(e) = &report.termination {
+            if let Some(err) = e.downcast_ref::<StabilityError>() {
+                return Err(err.clone());
+            }
+        }
+        Ok(Err(MapStability::not_decided(
+            Undecided::OrbitNotFound {
+                termination: report.termination.clone(),
+                iterations: report.iterations,
+                residual_norm: report.residual_norms.last().copied().unwrap_or(f64::NAN),
+            },
+            spp,
+        )))
+    }
+
     fn state(&self, x: &[f64], contacts: usize) -> MarchState {
         let n = self.full.len() / 2;
         let mut full = self.full.clone();

@@ -50,7 +50,8 @@
 use std::time::Instant;
 
 use semismooth::continuation::{
-    Continuation, ContinuationCounters, ContinuationEvent, FoldDetector, Resumption,
+    BranchPoint, Continuation, ContinuationCounters, ContinuationEvent, ContinuationTermination,
+    FoldDetector, Resumption,
 };
 use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, ParameterDependent, Residual};
@@ -64,7 +65,7 @@ use crate::hb::{resize_harmonics, HbJacobian, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{default_hb_time_samples, Method, SolverSettings, SweepSettings};
 use crate::solve::accuracy::search::{
-    MAX_RATIO, MAX_SEARCH_HARMONICS, MAX_SEARCH_UNKNOWNS, SAFETY,
+    check_target, MAX_RATIO, MAX_SEARCH_HARMONICS, MAX_SEARCH_UNKNOWNS, SAFETY,
 };
 use crate::solve::accuracy::HB_ORDER;
 use crate::solve::{
@@ -112,6 +113,20 @@ impl BranchAccuracy {
             .iter()
             .filter(|e| e.is_some_and(|e| e <= self.target))
             .count()
+    }
+
+    /// Nothing achieved yet towards `target` with at most `max_harmonics` harmonics.
+    fn none_yet(target: f64, max_harmonics: usize) -> Self {
+        Self {
+            target,
+            estimates: Vec::new(),
+            raises: 0,
+            lowers: 0,
+            failed_raises: 0,
+            max_harmonics,
+            estimate_seconds: 0.0,
+            estimate_counters: RunCounters::default(),
+        }
     }
 
     /// The largest estimate over the points (`None` if none was estimated).
@@ -185,7 +200,26 @@ pub fn point_distance((max, min, omega): (f64, f64, f64), reference: (f64, f64, 
     displacement.max((omega - ref_omega).abs() / ref_omega.abs())
 }
 
-impl Estimator<'_> {
+impl<'a> Estimator<'a> {
+    /// No estimate made yet for the branch of `rod` swept with `settings` over `sweep`
+    /// (reference amplitude `u_ref`).
+    fn new(
+        rod: &'a Structure,
+        settings: &'a SolverSettings,
+        sweep: &'a SweepSettings,
+        u_ref: f64,
+    ) -> Self {
+        Self {
+            rod,
+            settings,
+            sweep,
+            u_ref,
+            problems: Vec::new(),
+            seconds: 0.0,
+            counters: RunCounters::default(),
+        }
+    }
+
     /// The estimated relative error of the point `x` at `h` harmonics and `omega`, whose
     /// observed dof has the extremes `(max, min)` and whose branch goes on along
     /// `direction` (module documentation).
@@ -387,6 +421,70 @@ struct Switch {
     first: First,
 }
 
+/// How one run of the continuation at fixed harmonics ended: the change of harmonics
+/// decided at one of its points, its termination, whether it was resumed and how many
+/// items it gave.
+struct Segment {
+    switch: Option<Switch>,
+    ended: Option<ContinuationTermination>,
+    resumed: bool,
+    items: usize,
+}
+
+/// The state an adaptive branch carries from one run of the continuation to the next.
+struct Adaptive<'a> {
+    rod: &'a Structure,
+    settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    progress: Option<&'a dyn Fn(usize, f64)>,
+    u_ref: f64,
+    limit: usize,
+    h: usize,
+    response: FrequencyResponse,
+    accuracy: BranchAccuracy,
+    estimator: Estimator<'a>,
+    events: Vec<ContinuationEvent>,
+    counters: ContinuationCounters,
+    resumption: Option<Resumption>,
+    first: First,
+    // After a resumed start failed: the old harmonics and the resumption to go back to,
+    // and the index of the point that may not be raised again.
+    fallback: Option<(usize, Resumption)>,
+    no_raise_at: Option<usize>,
+    // The start carried to new harmonics, until taken up there (a globalized solve at
+    // its frequency is tried once when the continuation's start fails).
+    unsolved: Option<Resumption>,
+    // Work of the solves at new harmonics.
+    switch_work: RunCounters,
+}
+
+/// `Err` unless `target` is a relative accuracy, the method SSN-HB and the sweep valid.
+fn check_adaptive(
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    target: f64,
+) -> Result<(), RunError> {
+    check_target(target)?;
+    if settings.method != Method::SsnHb {
+        return Err(RunError::Unsupported {
+            method: settings.method.name(),
+            what: "harmonics chosen point by point (ssn-hb)",
+        });
+    }
+    check_sweep(sweep)
+}
+
+/// The largest rung of the ladder for a model of `width` unknowns per harmonic (at least
+/// the ladder's first).
+fn harmonics_limit(width: usize) -> usize {
+    let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
+    rung(
+        MAX_SEARCH_HARMONICS.min(by_size) as f64,
+        MAX_SEARCH_HARMONICS.min(by_size),
+    )
+    .max(HARMONICS_LADDER[0])
+}
+
 /// The SSN-HB branch of [`super::frequency_response`] with the harmonics chosen point by
 /// point for the relative accuracy `target` (module documentation), without its
 /// stability and contacts.
@@ -397,34 +495,13 @@ pub(crate) fn adaptive_branch(
     target: f64,
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError> {
-    if !(target.is_finite() && target > 0.0 && target < 1.0) {
-        return Err(RunError::InvalidSetting {
-            name: "solver.accuracy",
-            value: target,
-            allowed: "a relative accuracy in (0, 1)",
-        });
-    }
-    if settings.method != Method::SsnHb {
-        return Err(RunError::Unsupported {
-            method: settings.method.name(),
-            what: "harmonics chosen point by point (ssn-hb)",
-        });
-    }
-    check_sweep(sweep)?;
+    check_adaptive(settings, sweep, target)?;
     let started = Instant::now();
     let model = &rod.model;
-    let (dofs, contacts, tip_dof) = (model.dofs(), model.contact_count(), rod.observed_dof);
-    let omega_1 = rod.omega_1;
     let u_ref = reference_amplitude(rod);
-    let width = dofs + contacts;
-    let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
-    let limit = rung(
-        MAX_SEARCH_HARMONICS.min(by_size) as f64,
-        MAX_SEARCH_HARMONICS.min(by_size),
-    )
-    .max(HARMONICS_LADDER[0]);
-    let omega_from = sweep.omega_ratio_from * omega_1;
-    let mut h = HARMONICS_LADDER[0];
+    let limit = harmonics_limit(model.dofs() + model.contact_count());
+    let omega_from = sweep.omega_ratio_from * rod.omega_1;
+    let h = HARMONICS_LADDER[0];
     let mut problem = SsnHb::new(model, omega_from, &hb_options(&at_harmonics(settings, h)))?;
     let mut solver = hb_solver(settings.linear_solver);
     let mut x = vec![0.0; problem.dim()];
@@ -434,19 +511,10 @@ pub(crate) fn adaptive_branch(
         &mut x,
         Some(SmoothingOf::new()),
     )?;
-    let mut response = FrequencyResponse::empty(settings.method, omega_1, sweep, u_ref);
+    let mut response = FrequencyResponse::empty(settings.method, rod.omega_1, sweep, u_ref);
     response.counters = RunCounters::from(report.counters);
     response.initial_iterations = report.iterations;
-    let mut accuracy = BranchAccuracy {
-        target,
-        estimates: Vec::new(),
-        raises: 0,
-        lowers: 0,
-        failed_raises: 0,
-        max_harmonics: limit,
-        estimate_seconds: 0.0,
-        estimate_counters: RunCounters::default(),
-    };
+    let accuracy = BranchAccuracy::none_yet(target, limit);
     if !report.converged() {
         response.termination = SweepTermination::StartNotConverged {
             termination: report.termination.clone(),
@@ -457,205 +525,296 @@ pub(crate) fn adaptive_branch(
         response.solve_seconds = started.elapsed().as_secs_f64();
         return Ok(response);
     }
-    let mut estimator = Estimator {
+    let mut adaptive = Adaptive {
         rod,
         settings,
         sweep,
+        progress,
         u_ref,
-        problems: Vec::new(),
-        seconds: 0.0,
-        counters: RunCounters::default(),
+        limit,
+        h,
+        response,
+        accuracy,
+        estimator: Estimator::new(rod, settings, sweep, u_ref),
+        events: Vec::new(),
+        counters: ContinuationCounters::default(),
+        resumption: None,
+        first: First::New,
+        fallback: None,
+        no_raise_at: None,
+        unsolved: None,
+        switch_work: RunCounters::default(),
     };
-    let mut events: Vec<ContinuationEvent> = Vec::new();
-    let mut counters = ContinuationCounters::default();
-    let mut resumption: Option<Resumption> = None;
-    let mut first = First::New;
-    // After a resumed start failed: the old harmonics and the resumption to go back to,
-    // and the index of the point that may not be raised again.
-    let mut fallback: Option<(usize, Resumption)> = None;
-    let mut no_raise_at: Option<usize> = None;
-    // The start carried to new harmonics, until taken up there (a globalized solve at
-    // its frequency is tried once when the continuation's start fails).
-    let mut unsolved: Option<Resumption> = None;
-    // Work of the solves at new harmonics.
-    let mut switch_work = RunCounters::default();
     let termination = loop {
-        let method = ssn_continuation(model, &problem, u_ref);
+        let segment = adaptive.segment(&mut problem, &mut *solver, (&x, omega_from))?;
+        if adaptive.retry_unsolved(&segment, &mut problem, &mut *solver)? {
+            continue;
+        }
+        let Some(switch) = adaptive.next_switch(segment.switch, segment.resumed, segment.items)
+        else {
+            break segment.ended;
+        };
+        problem = adaptive.apply(switch)?;
+    };
+    Ok(adaptive.finish(termination, started))
+}
+
+impl Adaptive<'_> {
+    /// One run of the continuation at the current harmonics, from the pending resumption
+    /// or else from `x` at `omega_from`, until it ends or a point decides a change of
+    /// harmonics.
+    fn segment(
+        &mut self,
+        problem: &mut SsnHb,
+        solver: &mut dyn Factorize<HbJacobian>,
+        (x, omega_from): (&[f64], f64),
+    ) -> Result<Segment, RunError> {
+        let (model, h) = (&self.rod.model, self.h);
+        let method = ssn_continuation(model, problem, self.u_ref);
         let options = continuation_options(
-            &at_harmonics(settings, h),
-            sweep,
-            omega_1,
-            dofs,
-            u_ref,
+            &at_harmonics(self.settings, h),
+            self.sweep,
+            self.rod.omega_1,
+            model.dofs(),
+            self.u_ref,
             &method,
         )?;
-        let resumed = resumption.is_some();
-        let mut run = match resumption.take() {
-            None => Continuation::new(&mut problem, &mut *solver, &x, omega_from, options),
-            Some(r) => Continuation::resume(&mut problem, &mut *solver, r, options),
+        let resumed = self.resumption.is_some();
+        let mut run = match self.resumption.take() {
+            None => Continuation::new(problem, solver, x, omega_from, options),
+            Some(r) => Continuation::resume(problem, solver, r, options),
         }
         .map_err(continuation_error)?;
-        let mut tip = HbTip::new(h, output_points(h), dofs, tip_dof)?;
+        let mut tip = HbTip::new(h, output_points(h), model.dofs(), self.rod.observed_dof)?;
         let mut switch: Option<Switch> = None;
         let mut items = 0;
         while let Some(point) = run.next() {
             items += 1;
-            let kind = if items == 1 && resumed {
-                first
-            } else {
-                First::New
-            };
-            if kind == First::Lowered {
+            if items == 1 && resumed && self.first == First::Lowered {
                 continue;
             }
-            let omega = point.parameter;
-            let (max, min) = tip.extremes(&point.state)?;
-            let index = response.points();
-            // Where the run stands at this point: the direction of its estimate, and the start
-            // of a change of harmonics decided here (taken once, not cloned again).
-            let mut here = run.resumption();
-            let direction = here.as_ref().map(|r| r.direction.as_slice());
-            let estimate = estimator.estimate(omega, h, &point.state, (max, min), direction)?;
-            let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
-            let raise =
-                estimate.is_some_and(|e| e > target) && h < limit && no_raise_at != Some(index);
-            if raise {
-                if let Some(r) = here.take() {
-                    let wanted = wanted
-                        .unwrap_or(f64::INFINITY)
-                        .clamp(h as f64 + 1.0, (MAX_RATIO * h as f64).max(h as f64 + 1.0));
-                    switch = Some(Switch {
-                        from: h,
-                        to: rung(wanted, limit),
-                        resumption: r,
-                        first: First::Raised,
-                    });
-                    break;
-                }
-            }
-            let nt = default_hb_time_samples(h);
-            response.push(omega, max, min, point.iterations, point.state);
-            response.harmonics.push(h);
-            response.time_samples.push(nt);
-            accuracy.estimates.push(estimate);
-            if let Some(report) = progress {
-                report(index, omega / omega_1);
-            }
-            let lower =
-                estimate.is_some_and(|e| e <= LOWER_BELOW * target) && run.termination().is_none();
-            if let (true, Some(w)) = (lower, wanted) {
-                let to = rung(w.max(h as f64 / MAX_RATIO), limit);
-                if to < h {
-                    if let Some(r) = here.take() {
-                        switch = Some(Switch {
-                            from: h,
-                            to,
-                            resumption: r,
-                            first: First::Lowered,
-                        });
-                        break;
-                    }
-                }
+            // Where the run stands at this point: the direction of its estimate, and the
+            // start of a change of harmonics decided here (taken once, not cloned again).
+            let here = run.resumption();
+            let running = run.termination().is_none();
+            switch = self.point(&mut tip, point, here, running)?;
+            if switch.is_some() {
+                break;
             }
         }
-        counters += run.counters();
-        events.extend(run.events().iter().cloned());
+        self.counters += run.counters();
+        self.events.extend(run.events().iter().cloned());
         let ended = run.termination().cloned();
-        drop(run);
-        if let (None, true, 0) = (&switch, resumed, items) {
-            if let Some(mut retry) = unsolved.take() {
-                // Not taken up by the corrector's full steps (on the hyperplane across the
-                // branch, then at the point's frequency): the point at the new harmonics
-                // by globalized Newton at its frequency, then taken up from there.
-                problem.set_parameter(retry.parameter);
-                let report = newton_at(
-                    settings,
-                    model,
-                    &mut problem,
-                    &mut *solver,
-                    &mut retry.state,
-                )?;
-                switch_work = switch_work + RunCounters::from(report.counters);
-                if report.converged() {
-                    resumption = Some(retry);
-                    continue;
+        Ok(Segment {
+            switch,
+            ended,
+            resumed,
+            items,
+        })
+    }
+
+    /// Estimates the branch point `point` and reports it, unless the estimate asks for
+    /// more harmonics; the change of harmonics decided there, if any (module
+    /// documentation). `here` is the run's resumption at the point, `running` whether the
+    /// run goes on after it.
+    fn point(
+        &mut self,
+        tip: &mut HbTip,
+        point: BranchPoint,
+        mut here: Option<Resumption>,
+        running: bool,
+    ) -> Result<Option<Switch>, RunError> {
+        let (h, target, limit) = (self.h, self.accuracy.target, self.limit);
+        let omega = point.parameter;
+        let (max, min) = tip.extremes(&point.state)?;
+        let index = self.response.points();
+        let direction = here.as_ref().map(|r| r.direction.as_slice());
+        let estimate = self
+            .estimator
+            .estimate(omega, h, &point.state, (max, min), direction)?;
+        let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
+        let raise =
+            estimate.is_some_and(|e| e > target) && h < limit && self.no_raise_at != Some(index);
+        if raise {
+            if let Some(r) = here.take() {
+                let wanted = wanted
+                    .unwrap_or(f64::INFINITY)
+                    .clamp(h as f64 + 1.0, (MAX_RATIO * h as f64).max(h as f64 + 1.0));
+                return Ok(Some(Switch {
+                    from: h,
+                    to: rung(wanted, limit),
+                    resumption: r,
+                    first: First::Raised,
+                }));
+            }
+        }
+        let nt = default_hb_time_samples(h);
+        self.response
+            .push(omega, max, min, point.iterations, point.state);
+        self.response.harmonics.push(h);
+        self.response.time_samples.push(nt);
+        self.accuracy.estimates.push(estimate);
+        if let Some(report) = self.progress {
+            report(index, omega / self.rod.omega_1);
+        }
+        let lower = estimate.is_some_and(|e| e <= LOWER_BELOW * target) && running;
+        if let (true, Some(w)) = (lower, wanted) {
+            let to = rung(w.max(h as f64 / MAX_RATIO), limit);
+            if to < h {
+                if let Some(r) = here.take() {
+                    return Ok(Some(Switch {
+                        from: h,
+                        to,
+                        resumption: r,
+                        first: First::Lowered,
+                    }));
                 }
             }
         }
-        let switch = match switch {
-            Some(switch) => switch,
-            None if resumed && items == 0 && first == First::Raised => {
+        Ok(None)
+    }
+
+    /// After a resumed start at new harmonics that gave nothing: the point there by
+    /// globalized Newton at its frequency, once; `true` when it converged and the
+    /// continuation is to be resumed from it.
+    fn retry_unsolved(
+        &mut self,
+        segment: &Segment,
+        problem: &mut SsnHb,
+        solver: &mut dyn Factorize<HbJacobian>,
+    ) -> Result<bool, RunError> {
+        if segment.switch.is_some() || !segment.resumed || segment.items != 0 {
+            return Ok(false);
+        }
+        let Some(mut retry) = self.unsolved.take() else {
+            return Ok(false);
+        };
+        // Not taken up by the corrector's full steps (on the hyperplane across the
+        // branch, then at the point's frequency): the point at the new harmonics
+        // by globalized Newton at its frequency, then taken up from there.
+        problem.set_parameter(retry.parameter);
+        let report = newton_at(
+            self.settings,
+            &self.rod.model,
+            problem,
+            solver,
+            &mut retry.state,
+        )?;
+        self.switch_work = self.switch_work + RunCounters::from(report.counters);
+        if report.converged() {
+            self.resumption = Some(retry);
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// The change of harmonics after a run: the one decided at a point, else the way
+    /// back to the old harmonics when a resumed start gave nothing; `None` ends the branch.
+    fn next_switch(
+        &mut self,
+        switch: Option<Switch>,
+        resumed: bool,
+        items: usize,
+    ) -> Option<Switch> {
+        match switch {
+            Some(switch) => Some(switch),
+            None if resumed && items == 0 && self.first == First::Raised => {
                 // The raised start could not be corrected: back to the old harmonics.
-                let Some((old, back)) = fallback.take() else {
-                    break ended;
-                };
-                accuracy.failed_raises += 1;
-                no_raise_at = Some(response.points());
-                Switch {
+                let (old, back) = self.fallback.take()?;
+                self.accuracy.failed_raises += 1;
+                self.no_raise_at = Some(self.response.points());
+                Some(Switch {
                     from: old,
                     to: old,
                     resumption: back,
                     first: First::New,
-                }
+                })
             }
-            None if resumed && items == 0 && first == First::Lowered => {
+            None if resumed && items == 0 && self.first == First::Lowered => {
                 // The lowered start could not be corrected: on with the old harmonics.
-                let Some((old, back)) = fallback.take() else {
-                    break ended;
-                };
-                Switch {
+                let (old, back) = self.fallback.take()?;
+                Some(Switch {
                     from: old,
                     to: old,
                     resumption: back,
                     first: First::Lowered,
-                }
+                })
             }
-            None => break ended,
-        };
+            None => None,
+        }
+    }
+
+    /// Counts `switch`, carries its resumption to its harmonics and makes it the next
+    /// start; the problem at the new harmonics.
+    fn apply(&mut self, switch: Switch) -> Result<SsnHb, RunError> {
         match switch.first {
-            First::Raised => accuracy.raises += 1,
-            First::Lowered => accuracy.lowers += 1,
+            First::Raised => self.accuracy.raises += 1,
+            First::Lowered => self.accuracy.lowers += 1,
             First::New => {}
         }
         // A change (not a return to the old harmonics) can be undone once.
-        fallback = (switch.first != First::New && switch.from != switch.to)
+        self.fallback = (switch.first != First::New && switch.from != switch.to)
             .then(|| (switch.from, switch.resumption.clone()));
+        let model = &self.rod.model;
+        let (dofs, contacts) = (model.dofs(), model.contact_count());
         let to = switch.to;
         let resumed_at = switch.resumption.parameter;
         let carried = carried(switch.resumption, switch.from, to, dofs, contacts);
-        h = to;
-        problem = SsnHb::new(model, resumed_at, &hb_options(&at_harmonics(settings, h)))?;
-        first = match switch.first {
+        self.h = to;
+        let problem = SsnHb::new(
+            model,
+            resumed_at,
+            &hb_options(&at_harmonics(self.settings, to)),
+        )?;
+        self.first = match switch.first {
             // The fallback's first item is the point itself at the old harmonics.
             First::New => {
-                unsolved = None;
+                self.unsolved = None;
                 First::Raised
             }
             other => {
-                unsolved = Some(carried.clone());
+                self.unsolved = Some(carried.clone());
                 other
             }
         };
-        resumption = Some(carried);
-    };
-    set_events(&mut response, &events);
-    let mut total = counters.work;
-    total.factorizations += counters.dense_bordered_factorizations;
-    response.counters =
-        response.counters + RunCounters::from(total) + estimator.counters + switch_work;
-    response.restarts = counters.restarts as usize;
-    response.corners = counters.corners as usize;
-    response.continuation = counters;
-    response.termination = sweep_termination(termination);
-    response.output_points = response
-        .harmonics
-        .iter()
-        .map(|&h| output_points(h))
-        .max()
-        .unwrap_or(HB_OUTPUT_POINTS);
-    accuracy.estimate_seconds = estimator.seconds;
-    accuracy.estimate_counters = estimator.counters;
-    response.accuracy = Some(accuracy);
-    response.solve_seconds = started.elapsed().as_secs_f64();
-    Ok(response)
+        self.resumption = Some(carried);
+        Ok(problem)
+    }
+
+    /// The response with the branch's events, work, termination and accuracy.
+    fn finish(
+        self,
+        termination: Option<ContinuationTermination>,
+        started: Instant,
+    ) -> FrequencyResponse {
+        let Adaptive {
+            mut response,
+            mut accuracy,
+            estimator,
+            events,
+            counters,
+            switch_work,
+            ..
+        } = self;
+        set_events(&mut response, &events);
+        let mut total = counters.work;
+        total.factorizations += counters.dense_bordered_factorizations;
+        response.counters =
+            response.counters + RunCounters::from(total) + estimator.counters + switch_work;
+        response.restarts = counters.restarts as usize;
+        response.corners = counters.corners as usize;
+        response.continuation = counters;
+        response.termination = sweep_termination(termination);
+        response.output_points = response
+            .harmonics
+            .iter()
+            .map(|&h| output_points(h))
+            .max()
+            .unwrap_or(HB_OUTPUT_POINTS);
+        accuracy.estimate_seconds = estimator.seconds;
+        accuracy.estimate_counters = estimator.counters;
+        response.accuracy = Some(accuracy);
+        response.solve_seconds = started.elapsed().as_secs_f64();
+        response
+    }
 }

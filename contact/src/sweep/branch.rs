@@ -181,34 +181,69 @@ pub fn branch_stability(
 ) -> Result<BranchStability, StabilityError> {
     let points = response.points();
     let mut out = BranchStability::default();
-    let model = &rod.model;
     if !settings.method.is_harmonic_balance() {
         return Ok(BranchStability::not_decided(
             points,
             Undecided::NotHarmonicBalance(settings.method),
         ));
     }
+    let analyses = point_analyses(rod, settings, response, multipliers, progress, &mut out)?;
+    // The folds only: a zigzag of the truncated balance (`corner_folds`) turns back and
+    // forth within the fold excursion, and counting its two reversals would flip the
+    // verdict of the points between them.
+    // They come in branch order, with their frequencies in `folds`.
+    let reversals = &response.fold_indices;
+    let outside = fold_consistent_counts(&analyses, reversals);
+    for (s, counts) in analyses.iter().zip(&outside) {
+        if s.stable.is_none() && out.undecided.is_none() {
+            out.undecided.clone_from(&s.undecided);
+        }
+        out.stable.push(counts.map(|(c, _)| c.is_stable()));
+        out.floquet_max_abs.push(s.floquet_max_abs);
+        out.placed_by_fold
+            .push(counts.is_some_and(|(_, placed)| placed));
+    }
+    out.events = bifurcation_events(response, &analyses, &outside);
+    Ok(out)
+}
+
+/// The reconstruction and the stability analysis of `rod` with `settings`.
+fn analysers(
+    rod: &Structure,
+    settings: &SolverSettings,
+) -> Result<(Reconstruction, HbStability), StabilityError> {
+    let model = &rod.model;
+    let reconstruction =
+        Reconstruction::new(model, rod.omega_1, settings).map_err(|e| match e {
+            RunError::HarmonicBalance(e) => StabilityError::Hb(e),
+            _ => StabilityError::InvalidOption {
+                name: "method",
+                value: f64::NAN,
+                allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
+            },
+        })?;
+    Ok((reconstruction, HbStability::new(model, settings)?))
+}
+
+/// The stability of each point of `response` (undecided without `multipliers`), its
+/// contact diagnostics pushed onto `out`; `progress(points)` after each point.
+fn point_analyses(
+    rod: &Structure,
+    settings: &SolverSettings,
+    response: &FrequencyResponse,
+    multipliers: bool,
+    progress: Option<&dyn Fn(usize)>,
+    out: &mut BranchStability,
+) -> Result<Vec<Stability>, StabilityError> {
     // The reconstructions over one period do not depend on the frequency: any valid one,
     // with the point's harmonics (built again where they change along the branch).
-    let analysers = |settings: &SolverSettings| -> Result<_, StabilityError> {
-        let reconstruction =
-            Reconstruction::new(model, rod.omega_1, settings).map_err(|e| match e {
-                RunError::HarmonicBalance(e) => StabilityError::Hb(e),
-                _ => StabilityError::InvalidOption {
-                    name: "method",
-                    value: f64::NAN,
-                    allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
-                },
-            })?;
-        Ok((reconstruction, HbStability::new(model, settings)?))
-    };
     let mut current = response.point_settings(settings, 0);
-    let (mut reconstruction, mut analysis) = analysers(&current)?;
-    let mut analyses: Vec<Stability> = Vec::with_capacity(points);
+    let (mut reconstruction, mut analysis) = analysers(rod, &current)?;
+    let mut analyses: Vec<Stability> = Vec::with_capacity(response.points());
     for (i, x) in response.states.iter().enumerate() {
         let at = response.point_settings(settings, i);
         if (at.harmonics, at.time_samples) != (current.harmonics, current.time_samples) {
-            (reconstruction, analysis) = analysers(&at)?;
+            (reconstruction, analysis) = analysers(rod, &at)?;
             current = at;
         }
         let s = if multipliers {
@@ -226,23 +261,21 @@ pub fn branch_stability(
             report(i + 1);
         }
     }
-    // The folds only: a zigzag of the truncated balance (`corner_folds`) turns back and
-    // forth within the fold excursion, and counting its two reversals would flip the
-    // verdict of the points between them.
-    // They come in branch order, with their frequencies in `folds`.
+    Ok(analyses)
+}
+
+/// The stability changes between neighbouring decided points (counts `outside`), in
+/// branch order: at the branch's fold between them for a fold, else interpolated where
+/// the largest multiplier modulus crosses 1.
+fn bifurcation_events(
+    response: &FrequencyResponse,
+    analyses: &[Stability],
+    outside: &[Option<(Outside, bool)>],
+) -> Vec<BifurcationEvent> {
     let reversals = &response.fold_indices;
-    let outside = fold_consistent_counts(&analyses, reversals);
-    for (s, counts) in analyses.iter().zip(&outside) {
-        if s.stable.is_none() && out.undecided.is_none() {
-            out.undecided.clone_from(&s.undecided);
-        }
-        out.stable.push(counts.map(|(c, _)| c.is_stable()));
-        out.floquet_max_abs.push(s.floquet_max_abs);
-        out.placed_by_fold
-            .push(counts.is_some_and(|(_, placed)| placed));
-    }
+    let mut events = Vec::new();
     let mut last: Option<usize> = None;
-    for i in 0..points {
+    for i in 0..response.points() {
         let Some((after, _)) = outside[i] else {
             continue;
         };
@@ -265,7 +298,7 @@ pub fn branch_stability(
                         (omega, Some((omega - w0).abs().max((w1 - omega).abs())))
                     }
                 };
-                out.events.push(BifurcationEvent {
+                events.push(BifurcationEvent {
                     kind,
                     omega,
                     index: i,
@@ -275,7 +308,7 @@ pub fn branch_stability(
         }
         last = Some(i);
     }
-    Ok(out)
+    events
 }
 
 /// The counts of multipliers outside the unit circle of each decided point, with the

@@ -40,7 +40,8 @@ use super::{
 use crate::hb::{resize_harmonics, SsnHb};
 use crate::model::Structure;
 use crate::settings::{Method, SolverSettings, SweepSettings};
-use crate::solve::accuracy::{search::MAX_SEARCH_UNKNOWNS, HB_ORDER};
+use crate::solve::accuracy::search::{check_target, MAX_SEARCH_UNKNOWNS};
+use crate::solve::accuracy::HB_ORDER;
 use crate::solve::{hb_options, penalty_options, RunError};
 
 /// Frequency distance, in units of `ω_1`, before a fold where its refinement starts.
@@ -147,13 +148,7 @@ pub fn refine_folds(
     response: &FrequencyResponse,
     (target, max_harmonics): (f64, usize),
 ) -> Result<Vec<FoldAccuracy>, RunError> {
-    if !(target.is_finite() && target > 0.0 && target < 1.0) {
-        return Err(RunError::InvalidSetting {
-            name: "solver.accuracy",
-            value: target,
-            allowed: "a relative accuracy in (0, 1)",
-        });
-    }
+    check_target(target)?;
     if !matches!(settings.method, Method::SsnHb | Method::PenaltyHb) {
         return Err(RunError::Unsupported {
             method: settings.method.name(),
@@ -168,93 +163,142 @@ pub fn refine_folds(
             .rev()
             .find(|&j| (response.omega[j] - fold).abs() >= APPROACH * omega_1)
             .unwrap_or(0);
-        let heading = fold - response.omega[start];
+        let ladder = Ladder {
+            rod,
+            settings,
+            sweep,
+            start_omega: response.omega[start],
+            heading: fold - response.omega[start],
+            fold,
+            u_ref: response.reference_amplitude,
+            max_harmonics,
+        };
         let at_fold = response.point_settings(settings, index);
-        let mut rungs = vec![FoldRung {
+        let first = FoldRung {
             harmonics: at_fold.harmonics,
             time_samples: at_fold.time_samples,
             omega: fold,
             points: 0,
             seconds: 0.0,
-        }];
-        let mut uncertainty = None;
+        };
         // The start of the next rung: the branch point, then each rung's corrected start.
-        let mut from = (
+        let from = (
             response.states[start].clone(),
             response.point_settings(settings, start).harmonics,
         );
+        out.push(ladder.climb(first, from, target)?);
+    }
+    Ok(out)
+}
+
+/// The ladder of one fold: the sweep of `rod` with `settings` over `sweep`, the branch
+/// point's frequency the segments start from, the heading from it towards the fold, the
+/// fold as the sweep found it, the branch's reference amplitude and the harmonics allowed.
+struct Ladder<'a> {
+    rod: &'a Structure,
+    settings: &'a SolverSettings,
+    sweep: &'a SweepSettings,
+    start_omega: f64,
+    heading: f64,
+    fold: f64,
+    u_ref: f64,
+    max_harmonics: usize,
+}
+
+impl Ladder<'_> {
+    /// The fold to the relative accuracy `target`: rungs doubling the harmonics from
+    /// `first` (the sweep's own fold), each segment starting from `from` (a state and its
+    /// harmonics, the last corrected start), until two pairs meet the target or it stops.
+    fn climb(
+        &self,
+        first: FoldRung,
+        mut from: (Vec<f64>, usize),
+        target: f64,
+    ) -> Result<FoldAccuracy, RunError> {
+        let mut rungs = vec![first];
+        let mut uncertainty = None;
         let stop = loop {
             let last = rungs.last().expect("one rung at least");
-            let (h, nt) = (2 * last.harmonics, 2 * last.time_samples);
-            let width = rod.model.dofs() + rod.model.contact_count();
-            if h > max_harmonics || width.saturating_mul(2 * h + 1) > MAX_SEARCH_UNKNOWNS {
-                break FoldStop::Limit { harmonics: h };
-            }
-            let rung_settings = SolverSettings {
-                harmonics: h,
-                time_samples: nt,
-                estimate_error: false,
-                accuracy: None,
-                ..settings.clone()
+            let rung = match self.rung(last, &mut from)? {
+                Ok(rung) => rung,
+                Err(stop) => break stop,
             };
-            let segment = Segment {
-                rod,
-                settings: &rung_settings,
-                sweep,
-                from: (response.omega[start], &from.0, from.1),
-                heading,
-                near: fold,
-                u_ref: response.reference_amplitude,
-            };
-            let SegmentRun {
-                found,
-                points,
-                seconds,
-                corrected_start,
-            } = segment.fold()?;
-            if let Some(state) = corrected_start {
-                from = (state, h);
-            }
-            let omega = match found {
-                Found::Fold(omega) => omega,
-                Found::StartFailed(termination) => {
-                    break FoldStop::StartFailed {
-                        harmonics: h,
-                        termination,
-                    }
-                }
-                Found::Nothing => {
-                    break FoldStop::NotFound {
-                        harmonics: h,
-                        points,
-                    }
-                }
-            };
+            let omega = rung.omega;
             let error = coarse_error(last.omega, omega);
             let previous =
                 (rungs.len() >= 2).then(|| coarse_error(rungs[rungs.len() - 2].omega, last.omega));
-            rungs.push(FoldRung {
-                harmonics: h,
-                time_samples: nt,
-                omega,
-                points,
-                seconds,
-            });
+            rungs.push(rung);
             uncertainty = Some(previous.map_or(error, |p| p.max(error)));
             // One pair can be small by chance: met only on two pairs.
             if previous.is_some() && uncertainty.is_some_and(|u| u <= target * omega.abs()) {
                 break FoldStop::Met;
             }
         };
-        out.push(FoldAccuracy {
-            sweep_omega: fold,
+        Ok(FoldAccuracy {
+            sweep_omega: self.fold,
             omega: rungs.last().expect("one rung at least").omega,
             uncertainty,
             rungs,
             stop,
-        });
+        })
     }
-    Ok(out)
+
+    /// The fold at twice the harmonics of `last`, the segment starting from `from` (set to
+    /// its corrected start when there is one); `Err` inside: why the ladder stops there.
+    fn rung(
+        &self,
+        last: &FoldRung,
+        from: &mut (Vec<f64>, usize),
+    ) -> Result<Result<FoldRung, FoldStop>, RunError> {
+        let rod = self.rod;
+        let (h, nt) = (2 * last.harmonics, 2 * last.time_samples);
+        let width = rod.model.dofs() + rod.model.contact_count();
+        if h > self.max_harmonics || width.saturating_mul(2 * h + 1) > MAX_SEARCH_UNKNOWNS {
+            return Ok(Err(FoldStop::Limit { harmonics: h }));
+        }
+        let rung_settings = SolverSettings {
+            harmonics: h,
+            time_samples: nt,
+            estimate_error: false,
+            accuracy: None,
+            ..self.settings.clone()
+        };
+        let segment = Segment {
+            rod,
+            settings: &rung_settings,
+            sweep: self.sweep,
+            from: (self.start_omega, &from.0, from.1),
+            heading: self.heading,
+            near: self.fold,
+            u_ref: self.u_ref,
+        };
+        let SegmentRun {
+            found,
+            points,
+            seconds,
+            corrected_start,
+        } = segment.fold()?;
+        if let Some(state) = corrected_start {
+            *from = (state, h);
+        }
+        Ok(match found {
+            Found::Fold(omega) => Ok(FoldRung {
+                harmonics: h,
+                time_samples: nt,
+                omega,
+                points,
+                seconds,
+            }),
+            Found::StartFailed(termination) => Err(FoldStop::StartFailed {
+                harmonics: h,
+                termination,
+            }),
+            Found::Nothing => Err(FoldStop::NotFound {
+                harmonics: h,
+                points,
+            }),
+        })
+    }
 }
 
 /// What a segment met.

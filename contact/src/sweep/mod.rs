@@ -637,66 +637,7 @@ pub(crate) fn follow_branch(
                 progress,
             )
         }
-        Method::LcpSsn => {
-            if model.contacts.is_empty() {
-                return Err(RunError::Unsupported {
-                    method: "lcp-ssn",
-                    what: "a [contact] section (the periodic LCP is posed on the contact \
-                           forces; sweep a linear scene with ssn-hb or penalty-hb)",
-                });
-            }
-            let kappa = settings.c.unwrap_or(model.contact_stiffness_scale());
-            // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip is
-            // observed by the LCPs the problem builds.
-            let contacts = model.contact_count();
-            let (lcp_options, tip_contact) = lcp_options(rod, settings);
-            // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
-            let mut problem = FrequencyLcp::new(model, omega_from, lcp_options, kappa)?;
-            let finest = problem.current()?;
-            let sequenced =
-                solve_min_map_sequenced(model, omega_from, &finest, &newton_options(settings))?;
-            let start_counters = sequenced.levels.iter().map(|l| l.report.counters).sum();
-            let y0 = problem.state_from_forces(&sequenced.z)?;
-            let half = problem.half();
-            let units = (0..problem.dim())
-                .map(|i| if i < half { 1.0 } else { kappa })
-                .collect();
-            let gap = tip_contact.map_or(0.0, |c| model.contacts[c].gap);
-            let time_samples = settings.time_samples;
-            let mut measure =
-                |p: &FrequencyLcp, y: &[f64], omega: f64| -> Result<(f64, f64), RunError> {
-                    match tip_contact {
-                        Some(c) => {
-                            let tip: Vec<f64> = (0..time_samples)
-                                .map(|n| gap - y[n * contacts + c])
-                                .collect();
-                            Ok(extremes(&tip))
-                        }
-                        None => {
-                            let lcp = p.lcp_at(omega)?;
-                            let u = lcp.displacements(&y[half..])?;
-                            Ok(extremes(&u[0]))
-                        }
-                    }
-                };
-            let method = MethodContinuation {
-                units,
-                residual_floor: 0.0,
-                affine_pieces: false,
-            };
-            let setup = Setup {
-                start: Some((y0, start_counters)),
-                ..setup(method, settings.time_samples)
-            };
-            follow(
-                (&mut problem, None),
-                &mut FrequencyLcpSolver::new(),
-                setup,
-                &mut measure,
-                |c| c,
-                progress,
-            )
-        }
+        Method::LcpSsn => follow_lcp(rod, settings, omega_from, setup, progress),
         Method::LcpLemke => Err(RunError::Unsupported {
             method: "lcp-lemke",
             what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
@@ -710,4 +651,73 @@ pub(crate) fn follow_branch(
                    with `ssn solve`",
         }),
     }
+}
+
+/// The branch of the periodic LCP solved by SSN (`lcp-ssn`), from the sequenced min-map
+/// solve at `omega_from`; `setup` completes [`follow`]'s setup with the continuation's
+/// method and the output points.
+fn follow_lcp<'a>(
+    rod: &Structure,
+    settings: &SolverSettings,
+    omega_from: f64,
+    setup: impl FnOnce(MethodContinuation, usize) -> Setup<'a>,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
+    let model = &rod.model;
+    if model.contacts.is_empty() {
+        return Err(RunError::Unsupported {
+            method: "lcp-ssn",
+            what: "a [contact] section (the periodic LCP is posed on the contact \
+                   forces; sweep a linear scene with ssn-hb or penalty-hb)",
+        });
+    }
+    let kappa = settings.c.unwrap_or(model.contact_stiffness_scale());
+    // u_tip = g - w on the nodes when the tip is a contact dof; otherwise the tip is
+    // observed by the LCPs the problem builds.
+    let contacts = model.contact_count();
+    let (lcp_options, tip_contact) = lcp_options(rod, settings);
+    // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
+    let mut problem = FrequencyLcp::new(model, omega_from, lcp_options, kappa)?;
+    let finest = problem.current()?;
+    let sequenced = solve_min_map_sequenced(model, omega_from, &finest, &newton_options(settings))?;
+    let start_counters = sequenced.levels.iter().map(|l| l.report.counters).sum();
+    let y0 = problem.state_from_forces(&sequenced.z)?;
+    let half = problem.half();
+    let units = (0..problem.dim())
+        .map(|i| if i < half { 1.0 } else { kappa })
+        .collect();
+    let gap = tip_contact.map_or(0.0, |c| model.contacts[c].gap);
+    let time_samples = settings.time_samples;
+    let mut measure = |p: &FrequencyLcp, y: &[f64], omega: f64| -> Result<(f64, f64), RunError> {
+        match tip_contact {
+            Some(c) => {
+                let tip: Vec<f64> = (0..time_samples)
+                    .map(|n| gap - y[n * contacts + c])
+                    .collect();
+                Ok(extremes(&tip))
+            }
+            None => {
+                let lcp = p.lcp_at(omega)?;
+                let u = lcp.displacements(&y[half..])?;
+                Ok(extremes(&u[0]))
+            }
+        }
+    };
+    let method = MethodContinuation {
+        units,
+        residual_floor: 0.0,
+        affine_pieces: false,
+    };
+    let setup = Setup {
+        start: Some((y0, start_counters)),
+        ..setup(method, settings.time_samples)
+    };
+    follow(
+        (&mut problem, None),
+        &mut FrequencyLcpSolver::new(),
+        setup,
+        &mut measure,
+        |c| c,
+        progress,
+    )
 }

@@ -284,34 +284,12 @@ where
             return None;
         }
         if let Some(pb) = bound {
-            let lambda = (pb - last.parameter) / (p - last.parameter);
-            let mut xb: Vec<f64> = last
-                .state
-                .iter()
-                .zip(&x)
-                .map(|(a, b)| a + lambda * (b - a))
-                .collect();
-            let mut pbv = pb;
-            let constraint = Constraint {
-                arclength: false,
-                w_p: 1.0,
-                target: pb,
-            };
-            let saved_tangent = self.tangent.clone();
-            match self.correct_at(&mut xb, &mut pbv, constraint).0 {
-                Ok(c) => {
-                    self.take_tangent(Some(&direction), 0.0);
-                    x = xb;
-                    p = pbv;
-                    iterations += c.iterations;
-                    residual_norm = c.residual_norm;
-                    step = lambda * ds;
-                }
-                Err(_) => {
-                    self.tangent = saved_tangent;
-                    // Keep the point outside the bound; the problem follows it.
-                    self.problem.set_parameter(p);
-                }
+            if let Some((xb, pbv, c, lambda)) = self.land_on_bound(last, (&x, p), pb, &direction) {
+                x = xb;
+                p = pbv;
+                iterations += c.iterations;
+                residual_norm = c.residual_norm;
+                step = lambda * ds;
             }
         }
 
@@ -319,36 +297,7 @@ where
         let dx: Vec<f64> = x.iter().zip(&last.state).map(|(a, b)| a - b).collect();
         let dpar = p - last.parameter;
         let chord = self.metric.norm(&dx, dpar);
-        // Orient the tangent along the step just taken: where the branch turns sharply the
-        // predictor's direction can make an obtuse angle with the new tangent, and orienting
-        // by it would reverse the tangent (a spurious fold, and a tangent predictor heading
-        // back along the branch). The secant always has a positive component along the
-        // predictor (the arclength constraint), so it is the forward direction here.
-        let forward = match along {
-            Some(a) => self
-                .metric
-                .dot(&self.tangent[..n], self.tangent[n], &a[..n], a[n]),
-            None if chord > 0.0 => self
-                .metric
-                .dot(&self.tangent[..n], self.tangent[n], &dx, dpar),
-            None => 0.0,
-        };
-        if forward < 0.0 {
-            for v in &mut self.tangent {
-                *v = -*v;
-            }
-        }
-
-        match self.options.predictor {
-            // After a corner the chord cuts across it: the new piece's tangent is the way on.
-            Predictor::Secant if chord > 0.0 && along.is_none() => {
-                for (d, v) in self.direction.iter_mut().zip(&dx) {
-                    *d = v / chord;
-                }
-                self.direction[n] = dpar / chord;
-            }
-            _ => self.direction.copy_from_slice(&self.tangent),
-        }
+        self.turn_along((&dx, dpar, chord), along);
 
         let factor = (self.options.target_iterations as f64 / iterations.max(1) as f64)
             .sqrt()
@@ -371,5 +320,80 @@ where
             });
         }
         Some((point, chord))
+    }
+
+    /// The point `(x, p)` past the bound `pb` taken back to it: the corrector at the bound
+    /// from the point interpolated between `last` and `(x, p)`. The point, the correction
+    /// and the fraction of the chord, with the tangent oriented along `direction`; `None`
+    /// when it failed (the tangent kept, the problem at `p`).
+    fn land_on_bound(
+        &mut self,
+        last: &BranchPoint,
+        (x, p): (&[f64], f64),
+        pb: f64,
+        direction: &[f64],
+    ) -> Option<(Vec<f64>, f64, Corrected, f64)> {
+        let lambda = (pb - last.parameter) / (p - last.parameter);
+        let mut xb: Vec<f64> = last
+            .state
+            .iter()
+            .zip(x)
+            .map(|(a, b)| a + lambda * (b - a))
+            .collect();
+        let mut pbv = pb;
+        let constraint = Constraint {
+            arclength: false,
+            w_p: 1.0,
+            target: pb,
+        };
+        let saved_tangent = self.tangent.clone();
+        match self.correct_at(&mut xb, &mut pbv, constraint).0 {
+            Ok(c) => {
+                self.take_tangent(Some(direction), 0.0);
+                Some((xb, pbv, c, lambda))
+            }
+            Err(_) => {
+                self.tangent = saved_tangent;
+                // Keep the point outside the bound; the problem follows it.
+                self.problem.set_parameter(p);
+                None
+            }
+        }
+    }
+
+    /// Orients the tangent along the step just taken (the chord `(dx, dpar)` of θ-length
+    /// `chord`, or `along` after a corner pass) and sets the next predictor's direction.
+    fn turn_along(&mut self, (dx, dpar, chord): (&[f64], f64, f64), along: Option<&[f64]>) {
+        let n = self.metric.n;
+        // Orient the tangent along the step just taken: where the branch turns sharply the
+        // predictor's direction can make an obtuse angle with the new tangent, and orienting
+        // by it would reverse the tangent (a spurious fold, and a tangent predictor heading
+        // back along the branch). The secant always has a positive component along the
+        // predictor (the arclength constraint), so it is the forward direction here.
+        let forward = match along {
+            Some(a) => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], &a[..n], a[n]),
+            None if chord > 0.0 => self
+                .metric
+                .dot(&self.tangent[..n], self.tangent[n], dx, dpar),
+            None => 0.0,
+        };
+        if forward < 0.0 {
+            for v in &mut self.tangent {
+                *v = -*v;
+            }
+        }
+
+        match self.options.predictor {
+            // After a corner the chord cuts across it: the new piece's tangent is the way on.
+            Predictor::Secant if chord > 0.0 && along.is_none() => {
+                for (d, v) in self.direction.iter_mut().zip(dx) {
+                    *d = v / chord;
+                }
+                self.direction[n] = dpar / chord;
+            }
+            _ => self.direction.copy_from_slice(&self.tangent),
+        }
     }
 }

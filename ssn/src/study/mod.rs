@@ -198,139 +198,27 @@ impl Study {
     pub fn from_toml(text: &str, path: &Path, scene: &SceneSource) -> Result<Study, StudyError> {
         let raw: RawStudy = toml::from_str(text)
             .map_err(|e| InputFileError::parse(path, e.to_string().trim_end()))?;
-        let invalid = |key: &str, value: String, allowed: &str| {
-            StudyError::from(InputFileError::invalid(path, key, value, allowed))
-        };
+        let grid = parse_grid(path, raw.grid.unwrap_or_default())?;
+        let listed = parse_listed(path, raw.case)?;
+        let random = raw.random.map(|r| parse_random(path, r)).transpose()?;
         let mut keys: Vec<String> = Vec::new();
-        let mut note_key = |k: &str| {
-            if !keys.iter().any(|x| x == k) {
-                keys.push(k.to_string());
+        let named = (grid.iter().map(|(k, _)| k))
+            .chain(listed.iter().flatten().map(|(k, _)| k))
+            .chain(random.iter().flat_map(|r| r.draws.iter().map(|(k, ..)| k)));
+        for k in named {
+            if !keys.contains(k) {
+                keys.push(k.clone());
             }
-        };
-        // The grid: a list of values per key.
-        let mut grid: Vec<(String, Vec<toml::Value>)> = Vec::new();
-        for (key, values) in raw.grid.unwrap_or_default() {
-            let key_name = format!("grid.\"{key}\"");
-            let toml::Value::Array(values) = values else {
-                return Err(invalid(
-                    &key_name,
-                    values.to_string(),
-                    "a non-empty list of values, e.g. [0.5, 1.0]",
-                ));
-            };
-            if values.is_empty() {
-                return Err(invalid(
-                    &key_name,
-                    "[]".into(),
-                    "a non-empty list of values",
-                ));
-            }
-            note_key(&key);
-            grid.push((key, values));
         }
-        let listed: Vec<Vec<(String, toml::Value)>> = match raw.case {
-            Some(cases) if cases.is_empty() => {
-                return Err(invalid(
-                    "case",
-                    "an empty list".into(),
-                    "[[case]] tables of scene keys",
-                ))
-            }
-            Some(cases) => cases
-                .into_iter()
-                .map(|t| {
-                    t.into_iter()
-                        .inspect(|(k, _)| note_key(k))
-                        .collect::<Vec<_>>()
-                })
-                .collect(),
-            None => vec![Vec::new()],
-        };
-        let random = match raw.random {
-            Some(r) => {
-                let samples = usize::try_from(r.samples)
-                    .ok()
-                    .filter(|s| (1..=MAX_CASES).contains(s))
-                    .ok_or_else(|| {
-                        invalid(
-                            "random.samples",
-                            r.samples.to_string(),
-                            &format!("an integer in 1..={MAX_CASES}"),
-                        )
-                    })?;
-                if r.keys.is_empty() {
-                    return Err(invalid(
-                        "random.keys",
-                        "an empty table".into(),
-                        "[random.keys.\"KEY\"] tables with a distribution",
-                    ));
-                }
-                let mut draws = Vec::new();
-                for (key, d) in r.keys {
-                    let name = |field: &str| format!("random.keys.\"{key}\".{field}");
-                    let (draw, size) = match d {
-                        RawDistribution::Normal { mean, std, size } => {
-                            let mean = mean.unwrap_or(0.0);
-                            if !mean.is_finite() {
-                                return Err(invalid(
-                                    &name("mean"),
-                                    mean.to_string(),
-                                    "a finite number",
-                                ));
-                            }
-                            let normal = rand_distr::Normal::new(mean, std)
-                                .ok()
-                                .filter(|_| std.is_finite() && std >= 0.0)
-                                .ok_or_else(|| {
-                                    invalid(&name("std"), std.to_string(), "a finite number >= 0")
-                                })?;
-                            (Draw::Normal(normal), size)
-                        }
-                        RawDistribution::Uniform { low, high, size } => {
-                            let uniform = rand_distr::Uniform::new(low, high)
-                                .ok()
-                                .filter(|_| low.is_finite() && high.is_finite())
-                                .ok_or_else(|| {
-                                    invalid(
-                                        &name("high"),
-                                        high.to_string(),
-                                        &format!("a finite number > low ({low})"),
-                                    )
-                                })?;
-                            (Draw::Uniform(uniform), size)
-                        }
-                    };
-                    let size = size
-                        .map(|s| {
-                            usize::try_from(s)
-                                .ok()
-                                .filter(|s| (1..=MAX_SAMPLE_SIZE).contains(s))
-                                .ok_or_else(|| {
-                                    invalid(
-                                        &name("size"),
-                                        s.to_string(),
-                                        &format!(
-                                            "an integer in 1..={MAX_SAMPLE_SIZE} (absent: one number)"
-                                        ),
-                                    )
-                                })
-                        })
-                        .transpose()?;
-                    note_key(&key);
-                    draws.push((key, draw, size));
-                }
-                Some((samples, r.seed as u64, draws))
-            }
-            None => None,
-        };
         let grid_points: usize = grid.iter().map(|(_, v)| v.len()).product();
-        let samples = random.as_ref().map_or(1, |r| r.0);
+        let samples = random.as_ref().map_or(1, |r| r.samples);
         let total = grid_points
             .checked_mul(listed.len())
             .and_then(|n| n.checked_mul(samples))
             .filter(|&n| n <= MAX_CASES)
             .ok_or_else(|| {
                 invalid(
+                    path,
                     "grid",
                     format!(
                         "{grid_points} grid points x {} cases x {samples} samples",
@@ -340,62 +228,10 @@ impl Study {
                 )
             })?;
         // The random values of each sample, drawn once.
-        let sampled: Vec<Vec<(String, toml::Value)>> = match &random {
-            Some((samples, seed, draws)) => (0..*samples)
-                .map(|s| {
-                    let mut rng = rand_chacha::ChaCha12Rng::seed_from_u64(*seed);
-                    rng.set_stream(s as u64);
-                    draws
-                        .iter()
-                        .map(|(key, draw, size)| {
-                            let mut one = || match draw {
-                                Draw::Normal(d) => d.sample(&mut rng),
-                                Draw::Uniform(d) => d.sample(&mut rng),
-                            };
-                            let value = match size {
-                                Some(n) => toml::Value::Array(
-                                    (0..*n).map(|_| toml::Value::Float(one())).collect(),
-                                ),
-                                None => toml::Value::Float(one()),
-                            };
-                            (key.clone(), value)
-                        })
-                        .collect()
-                })
-                .collect(),
-            None => vec![Vec::new()],
-        };
-        let mut cases = Vec::with_capacity(total);
-        for point in 0..grid_points {
-            // Mixed radix, the first key slowest.
-            let mut rest = point;
-            let mut grid_values = vec![None; grid.len()];
-            for (slot, (_, values)) in grid_values.iter_mut().zip(&grid).rev() {
-                *slot = Some(values[rest % values.len()].clone());
-                rest /= values.len();
-            }
-            for listed_case in &listed {
-                for sample in &sampled {
-                    let mut values: Vec<Override> = Vec::new();
-                    let pairs = grid
-                        .iter()
-                        .map(|(k, _)| k.clone())
-                        .zip(grid_values.iter().map(|v| v.clone().expect("set above")))
-                        .chain(listed_case.iter().cloned())
-                        .chain(sample.iter().cloned());
-                    for (key, value) in pairs {
-                        let o = Override::new(&key, value)
-                            .map_err(|e| invalid(&key, e.text.clone(), &e.reason))?;
-                        values.retain(|x| x.key != o.key);
-                        values.push(o);
-                    }
-                    cases.push(Case {
-                        index: cases.len(),
-                        values,
-                    });
-                }
-            }
-        }
+        let sampled = random
+            .as_ref()
+            .map_or_else(|| vec![Vec::new()], Random::values);
+        let cases = combine(path, &grid, &listed, &sampled, total)?;
         for case in &cases {
             scene
                 .with(&case.values)
@@ -414,6 +250,229 @@ impl Study {
             keys,
         })
     }
+}
+
+/// The error of the study file `path` whose `key` has `value`, with what is `allowed`.
+fn invalid(path: &Path, key: &str, value: String, allowed: &str) -> StudyError {
+    StudyError::from(InputFileError::invalid(path, key, value, allowed))
+}
+
+/// Scene keys and their values, in study order.
+type Pairs = Vec<(String, toml::Value)>;
+
+/// The study's `[grid]`: a non-empty list of values per key, in key order.
+fn parse_grid(
+    path: &Path,
+    grid: toml::Table,
+) -> Result<Vec<(String, Vec<toml::Value>)>, StudyError> {
+    let mut parsed = Vec::new();
+    for (key, values) in grid {
+        let key_name = format!("grid.\"{key}\"");
+        let toml::Value::Array(values) = values else {
+            return Err(invalid(
+                path,
+                &key_name,
+                values.to_string(),
+                "a non-empty list of values, e.g. [0.5, 1.0]",
+            ));
+        };
+        if values.is_empty() {
+            return Err(invalid(
+                path,
+                &key_name,
+                "[]".into(),
+                "a non-empty list of values",
+            ));
+        }
+        parsed.push((key, values));
+    }
+    Ok(parsed)
+}
+
+/// The study's `[[case]]` tables (one case without values when there are none).
+fn parse_listed(path: &Path, cases: Option<Vec<toml::Table>>) -> Result<Vec<Pairs>, StudyError> {
+    match cases {
+        Some(cases) if cases.is_empty() => Err(invalid(
+            path,
+            "case",
+            "an empty list".into(),
+            "[[case]] tables of scene keys",
+        )),
+        Some(cases) => Ok(cases.into_iter().map(|t| t.into_iter().collect()).collect()),
+        None => Ok(vec![Vec::new()]),
+    }
+}
+
+/// The study's `[random]` checked: the samples, the seed and each key's distribution and
+/// size (`None`: one number), in key order.
+struct Random {
+    samples: usize,
+    seed: u64,
+    draws: Vec<(String, Draw, Option<usize>)>,
+}
+
+impl Random {
+    /// The random values of each sample: sample `s` draws from stream `s` of the seed.
+    fn values(&self) -> Vec<Pairs> {
+        (0..self.samples)
+            .map(|s| {
+                let mut rng = rand_chacha::ChaCha12Rng::seed_from_u64(self.seed);
+                rng.set_stream(s as u64);
+                self.draws
+                    .iter()
+                    .map(|(key, draw, size)| {
+                        let mut one = || match draw {
+                            Draw::Normal(d) => d.sample(&mut rng),
+                            Draw::Uniform(d) => d.sample(&mut rng),
+                        };
+                        let value = match size {
+                            Some(n) => toml::Value::Array(
+                                (0..*n).map(|_| toml::Value::Float(one())).collect(),
+                            ),
+                            None => toml::Value::Float(one()),
+                        };
+                        (key.clone(), value)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// The study's `[random]` checked.
+fn parse_random(path: &Path, r: RawRandom) -> Result<Random, StudyError> {
+    let samples = usize::try_from(r.samples)
+        .ok()
+        .filter(|s| (1..=MAX_CASES).contains(s))
+        .ok_or_else(|| {
+            invalid(
+                path,
+                "random.samples",
+                r.samples.to_string(),
+                &format!("an integer in 1..={MAX_CASES}"),
+            )
+        })?;
+    if r.keys.is_empty() {
+        return Err(invalid(
+            path,
+            "random.keys",
+            "an empty table".into(),
+            "[random.keys.\"KEY\"] tables with a distribution",
+        ));
+    }
+    let mut draws = Vec::new();
+    for (key, d) in r.keys {
+        let (draw, size) = parse_draw(path, &key, d)?;
+        draws.push((key, draw, size));
+    }
+    Ok(Random {
+        samples,
+        seed: r.seed as u64,
+        draws,
+    })
+}
+
+/// The distribution of the random key `key` checked, and its size (`None`: one number).
+fn parse_draw(
+    path: &Path,
+    key: &str,
+    d: RawDistribution,
+) -> Result<(Draw, Option<usize>), StudyError> {
+    let name = |field: &str| format!("random.keys.\"{key}\".{field}");
+    let (draw, size) = match d {
+        RawDistribution::Normal { mean, std, size } => {
+            let mean = mean.unwrap_or(0.0);
+            if !mean.is_finite() {
+                return Err(invalid(
+                    path,
+                    &name("mean"),
+                    mean.to_string(),
+                    "a finite number",
+                ));
+            }
+            let normal = rand_distr::Normal::new(mean, std)
+                .ok()
+                .filter(|_| std.is_finite() && std >= 0.0)
+                .ok_or_else(|| {
+                    invalid(path, &name("std"), std.to_string(), "a finite number >= 0")
+                })?;
+            (Draw::Normal(normal), size)
+        }
+        RawDistribution::Uniform { low, high, size } => {
+            let uniform = rand_distr::Uniform::new(low, high)
+                .ok()
+                .filter(|_| low.is_finite() && high.is_finite())
+                .ok_or_else(|| {
+                    invalid(
+                        path,
+                        &name("high"),
+                        high.to_string(),
+                        &format!("a finite number > low ({low})"),
+                    )
+                })?;
+            (Draw::Uniform(uniform), size)
+        }
+    };
+    let size = size
+        .map(|s| {
+            usize::try_from(s)
+                .ok()
+                .filter(|s| (1..=MAX_SAMPLE_SIZE).contains(s))
+                .ok_or_else(|| {
+                    invalid(
+                        path,
+                        &name("size"),
+                        s.to_string(),
+                        &format!("an integer in 1..={MAX_SAMPLE_SIZE} (absent: one number)"),
+                    )
+                })
+        })
+        .transpose()?;
+    Ok((draw, size))
+}
+
+/// The cases in study order: each grid point (mixed radix, the first key slowest) with
+/// each listed case and each sample, later values of a key replacing earlier ones.
+fn combine(
+    path: &Path,
+    grid: &[(String, Vec<toml::Value>)],
+    listed: &[Pairs],
+    sampled: &[Pairs],
+    total: usize,
+) -> Result<Vec<Case>, StudyError> {
+    let grid_points: usize = grid.iter().map(|(_, v)| v.len()).product();
+    let mut cases = Vec::with_capacity(total);
+    for point in 0..grid_points {
+        // Mixed radix, the first key slowest.
+        let mut rest = point;
+        let mut grid_values = vec![None; grid.len()];
+        for (slot, (_, values)) in grid_values.iter_mut().zip(grid).rev() {
+            *slot = Some(values[rest % values.len()].clone());
+            rest /= values.len();
+        }
+        for listed_case in listed {
+            for sample in sampled {
+                let mut values: Vec<Override> = Vec::new();
+                let pairs = grid
+                    .iter()
+                    .map(|(k, _)| k.clone())
+                    .zip(grid_values.iter().map(|v| v.clone().expect("set above")))
+                    .chain(listed_case.iter().cloned())
+                    .chain(sample.iter().cloned());
+                for (key, value) in pairs {
+                    let o = Override::new(&key, value)
+                        .map_err(|e| invalid(path, &key, e.text.clone(), &e.reason))?;
+                    values.retain(|x| x.key != o.key);
+                    values.push(o);
+                }
+                cases.push(Case {
+                    index: cases.len(),
+                    values,
+                });
+            }
+        }
+    }
+    Ok(cases)
 }
 
 /// Overrides as `key=value` words (long lists shortened).

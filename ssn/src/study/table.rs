@@ -132,111 +132,129 @@ pub struct Table {
 ///   `amplitude_max` and `amplitude_min` (over the solutions, of `max(|tip_min|,
 ///   |tip_max|)`).
 pub fn quantities(kind: RunKind, doc: &Value) -> Vec<(&'static str, Cell)> {
-    let num = |v: &Value| Cell::float(v.as_f64());
-    let int = |v: &Value| v.as_i64().map_or(Cell::Null, Cell::Int);
-    let absent = doc.is_null();
     match kind {
-        RunKind::Solve => {
-            let excursions: Vec<f64> = doc["contacts"]
-                .as_array()
-                .map(|cs| {
-                    cs.iter()
-                        .map(|c| {
-                            let lo = c["displacement_min"].as_f64().unwrap_or(f64::NAN);
-                            let hi = c["displacement_max"].as_f64().unwrap_or(f64::NAN);
-                            lo.abs().max(hi.abs())
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
-            let argmax = finite_argmax(&excursions);
-            vec![
-                ("omega_ratio", num(&doc["omega_ratio"])),
-                ("iterations", int(&doc["iterations"])),
-                ("residual_norm", num(&doc["residual_norm"])),
-                ("tip_min", num(&doc["tip_min"])),
-                ("tip_max", num(&doc["tip_max"])),
-                ("max_penetration", num(&doc["max_penetration"])),
-                ("contact_force_mean", num(&doc["contact_force_mean"])),
-                ("contact_amplitude_max", Cell::float(argmax.map(|a| *a.1))),
-                (
-                    "contact_amplitude_argmax",
-                    argmax.map_or(Cell::Null, |a| Cell::Int(a.0 as i64)),
-                ),
-            ]
-        }
-        RunKind::Sweep => {
-            let amplitude: Vec<f64> = doc["amplitude"]
-                .as_array()
-                .map(|a| a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect())
-                .unwrap_or_default();
-            let peak = finite_argmax(&amplitude);
-            let stable = doc["stable"].as_array().cloned().unwrap_or_default();
-            let count = |want: &Value| {
-                if absent {
-                    Cell::Null
-                } else {
-                    Cell::Int(stable.iter().filter(|s| *s == want).count() as i64)
-                }
-            };
-            vec![
-                ("points", int(&doc["points"])),
-                ("peak_amplitude", Cell::float(peak.map(|p| *p.1))),
-                (
-                    "peak_omega_ratio",
-                    Cell::float(peak.and_then(|p| doc["omega_ratio"][p.0].as_f64())),
-                ),
-                (
-                    "folds",
-                    doc["folds"]
-                        .as_array()
-                        .map_or(Cell::Null, |f| Cell::Int(f.len() as i64)),
-                ),
-                ("stable_points", count(&Value::Bool(true))),
-                ("unstable_points", count(&Value::Bool(false))),
-                ("undecided_points", count(&Value::Null)),
-            ]
-        }
-        RunKind::Solutions => {
-            let solutions = doc["solutions"].as_array().cloned().unwrap_or_default();
-            let amplitudes: Vec<f64> = solutions
-                .iter()
-                .map(|s| {
-                    let lo = s["tip_min"].as_f64().unwrap_or(f64::NAN);
-                    let hi = s["tip_max"].as_f64().unwrap_or(f64::NAN);
+        RunKind::Solve => solve_quantities(doc),
+        RunKind::Sweep => sweep_quantities(doc),
+        RunKind::Solutions => solutions_quantities(doc),
+    }
+}
+
+/// A number of the JSON document as a cell.
+fn num(v: &Value) -> Cell {
+    Cell::float(v.as_f64())
+}
+
+/// An integer of the JSON document as a cell.
+fn int(v: &Value) -> Cell {
+    v.as_i64().map_or(Cell::Null, Cell::Int)
+}
+
+/// The quantities of a `solve` case ([`quantities`]).
+fn solve_quantities(doc: &Value) -> Vec<(&'static str, Cell)> {
+    let excursions: Vec<f64> = doc["contacts"]
+        .as_array()
+        .map(|cs| {
+            cs.iter()
+                .map(|c| {
+                    let lo = c["displacement_min"].as_f64().unwrap_or(f64::NAN);
+                    let hi = c["displacement_max"].as_f64().unwrap_or(f64::NAN);
                     lo.abs().max(hi.abs())
                 })
-                .filter(|a| a.is_finite())
-                .collect();
-            let count = |want: &Value| {
-                if absent {
-                    Cell::Null
-                } else {
-                    Cell::Int(solutions.iter().filter(|s| &s["stable"] == want).count() as i64)
-                }
-            };
-            vec![
-                (
-                    "solutions",
-                    if absent {
-                        Cell::Null
-                    } else {
-                        Cell::Int(solutions.len() as i64)
-                    },
-                ),
-                ("stable_solutions", count(&Value::Bool(true))),
-                ("unstable_solutions", count(&Value::Bool(false))),
-                (
-                    "amplitude_max",
-                    Cell::float(amplitudes.iter().copied().reduce(f64::max)),
-                ),
-                (
-                    "amplitude_min",
-                    Cell::float(amplitudes.iter().copied().reduce(f64::min)),
-                ),
-            ]
+                .collect()
+        })
+        .unwrap_or_default();
+    let argmax = finite_argmax(&excursions);
+    vec![
+        ("omega_ratio", num(&doc["omega_ratio"])),
+        ("iterations", int(&doc["iterations"])),
+        ("residual_norm", num(&doc["residual_norm"])),
+        ("tip_min", num(&doc["tip_min"])),
+        ("tip_max", num(&doc["tip_max"])),
+        ("max_penetration", num(&doc["max_penetration"])),
+        ("contact_force_mean", num(&doc["contact_force_mean"])),
+        ("contact_amplitude_max", Cell::float(argmax.map(|a| *a.1))),
+        (
+            "contact_amplitude_argmax",
+            argmax.map_or(Cell::Null, |a| Cell::Int(a.0 as i64)),
+        ),
+    ]
+}
+
+/// The quantities of a `sweep` case ([`quantities`]).
+fn sweep_quantities(doc: &Value) -> Vec<(&'static str, Cell)> {
+    let absent = doc.is_null();
+    let amplitude: Vec<f64> = doc["amplitude"]
+        .as_array()
+        .map(|a| a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect())
+        .unwrap_or_default();
+    let peak = finite_argmax(&amplitude);
+    let stable = doc["stable"].as_array().cloned().unwrap_or_default();
+    let count = |want: &Value| {
+        if absent {
+            Cell::Null
+        } else {
+            Cell::Int(stable.iter().filter(|s| *s == want).count() as i64)
         }
-    }
+    };
+    vec![
+        ("points", int(&doc["points"])),
+        ("peak_amplitude", Cell::float(peak.map(|p| *p.1))),
+        (
+            "peak_omega_ratio",
+            Cell::float(peak.and_then(|p| doc["omega_ratio"][p.0].as_f64())),
+        ),
+        (
+            "folds",
+            doc["folds"]
+                .as_array()
+                .map_or(Cell::Null, |f| Cell::Int(f.len() as i64)),
+        ),
+        ("stable_points", count(&Value::Bool(true))),
+        ("unstable_points", count(&Value::Bool(false))),
+        ("undecided_points", count(&Value::Null)),
+    ]
+}
+
+/// The quantities of a `solutions` case ([`quantities`]).
+fn solutions_quantities(doc: &Value) -> Vec<(&'static str, Cell)> {
+    let absent = doc.is_null();
+    let solutions = doc["solutions"].as_array().cloned().unwrap_or_default();
+    let amplitudes: Vec<f64> = solutions
+        .iter()
+        .map(|s| {
+            let lo = s["tip_min"].as_f64().unwrap_or(f64::NAN);
+            let hi = s["tip_max"].as_f64().unwrap_or(f64::NAN);
+            lo.abs().max(hi.abs())
+        })
+        .filter(|a| a.is_finite())
+        .collect();
+    let count = |want: &Value| {
+        if absent {
+            Cell::Null
+        } else {
+            Cell::Int(solutions.iter().filter(|s| &s["stable"] == want).count() as i64)
+        }
+    };
+    vec![
+        (
+            "solutions",
+            if absent {
+                Cell::Null
+            } else {
+                Cell::Int(solutions.len() as i64)
+            },
+        ),
+        ("stable_solutions", count(&Value::Bool(true))),
+        ("unstable_solutions", count(&Value::Bool(false))),
+        (
+            "amplitude_max",
+            Cell::float(amplitudes.iter().copied().reduce(f64::max)),
+        ),
+        (
+            "amplitude_min",
+            Cell::float(amplitudes.iter().copied().reduce(f64::min)),
+        ),
+    ]
 }
 
 impl Table {

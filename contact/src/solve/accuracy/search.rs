@@ -278,6 +278,42 @@ impl Record {
         });
         solution
     }
+    /// `solution`, which did not converge, as the last step of the finished search.
+    fn unconverged(mut self, solution: Solution) -> Solution {
+        let step = self.push(&solution, None);
+        let at = self.steps[step].discretisation;
+        self.finish(solution, step, SearchStop::NotConverged { at }, None)
+    }
+
+    /// The basis of an estimate against the rung `against` with the order `order`.
+    fn basis(&self, against: &Rung, order: f64) -> EstimateBasis {
+        EstimateBasis {
+            against: self.steps[against.step].discretisation,
+            order,
+            softer_penalty: None,
+            time_samples_check: None,
+        }
+    }
+
+    /// Richardson's estimates of the pair `(coarse, fine)` from the `change` between them
+    /// with the convergence order `order`, recorded on their steps (the fine one's only
+    /// without a finer partner): the coarse and the fine error.
+    fn estimate_pair(
+        &mut self,
+        (coarse, fine): (&Rung, &Rung),
+        change: &RelativeErrors,
+        order: f64,
+        finer_partner: bool,
+    ) -> (RelativeErrors, RelativeErrors) {
+        let rp = (fine.level as f64 / coarse.level as f64).powf(order);
+        let fine_error = change.scaled(1.0 / (rp - 1.0));
+        let coarse_error = change.scaled(rp / (rp - 1.0));
+        self.steps[coarse.step].estimate = Some(coarse_error.largest());
+        if !finer_partner {
+            self.steps[fine.step].estimate = Some(fine_error.largest());
+        }
+        (coarse_error, fine_error)
+    }
 }
 
 /// A converged solve of the ladder and its index in the record.
@@ -285,6 +321,18 @@ struct Rung {
     level: usize,
     solution: Solution,
     step: usize,
+}
+
+/// `Err` unless `target` is a relative accuracy in (0, 1) (the scene's `solver.accuracy`).
+pub(crate) fn check_target(target: f64) -> Result<(), RunError> {
+    if !(target.is_finite() && target > 0.0 && target < 1.0) {
+        return Err(RunError::InvalidSetting {
+            name: "solver.accuracy",
+            value: target,
+            allowed: "a relative accuracy in (0, 1)",
+        });
+    }
+    Ok(())
 }
 
 /// Solves `rod` at `omega` with the cheapest discretisation of `settings.method` whose
@@ -298,13 +346,7 @@ pub fn solve_to_accuracy(
     target: f64,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
-    if !(target.is_finite() && target > 0.0 && target < 1.0) {
-        return Err(RunError::InvalidSetting {
-            name: "solver.accuracy",
-            value: target,
-            allowed: "a relative accuracy in (0, 1)",
-        });
-    }
+    check_target(target)?;
     let mut ladder = Ladder::new(rod, settings);
     let mut record = Record::new(target);
     let first = solve_as_given(
@@ -313,11 +355,10 @@ pub fn solve_to_accuracy(
         &ladder.settings(settings, ladder.start),
         warm_start,
     )?;
-    let step = record.push(&first, None);
     if !first.converged() {
-        let at = record.steps[step].discretisation;
-        return Ok(record.finish(first, step, SearchStop::NotConverged { at }, None));
+        return Ok(record.unconverged(first));
     }
+    let step = record.push(&first, None);
     let mut current = Rung {
         level: ladder.start,
         solution: first,
@@ -350,19 +391,9 @@ pub fn solve_to_accuracy(
             Ok(pair) => pair,
             Err(unconverged) => return Ok(unconverged),
         };
-        let rp = (level as f64 / current.level as f64).powf(ladder.order);
-        let fine_error = change.scaled(1.0 / (rp - 1.0));
-        let coarse_error = change.scaled(rp / (rp - 1.0));
-        record.steps[current.step].estimate = Some(coarse_error.largest());
-        if !finer_partner {
-            record.steps[fine.step].estimate = Some(fine_error.largest());
-        }
-        let basis = |against: &Rung| EstimateBasis {
-            against: record.steps[against.step].discretisation,
-            order: ladder.order,
-            softer_penalty: None,
-            time_samples_check: None,
-        };
+        let (coarse_error, fine_error) =
+            record.estimate_pair((&current, &fine), &change, ladder.order, finer_partner);
+        let basis = |against: &Rung| record.basis(against, ladder.order);
         let (chosen, error, basis) = if coarse_error.largest() <= target {
             let b = basis(&fine);
             let chosen = (current, coarse_error, b);
@@ -419,15 +450,8 @@ fn pair(
         record.push(failed, None);
     })?;
     if !fine.converged() {
-        let step = record.push(&fine, None);
-        let at = record.steps[step].discretisation;
         let record = std::mem::replace(record, Record::new(record.target));
-        return Ok(Err(record.finish(
-            fine,
-            step,
-            SearchStop::NotConverged { at },
-            None,
-        )));
+        return Ok(Err(record.unconverged(fine)));
     }
     let change = RelativeErrors::between(
         &ReportedQuantities::of(&current.solution),
