@@ -69,7 +69,7 @@
 //! stopped.
 //!
 //! Nothing in this crate knows about rods, contact or any particular model: those live
-//! in the `semismooth-problems` crate, which uses only this crate's public API.
+//! in the `semismooth-contact` crate, which uses only this crate's public API.
 
 pub mod complementarity;
 pub mod continuation;
