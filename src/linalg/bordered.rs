@@ -67,10 +67,12 @@ pub struct BorderedCounters {
 ///
 /// With one factorization of `J` and `k + 1` solves: `J X = B` (once per border),
 /// the Schur complement `S = D - C^T X` factored by a dense LU with partial pivoting, then
-/// per right-hand side `J y = f`, `p = S^{-1} (g - C^T y)`, `x = y - X p`. The bordered
-/// matrix may be regular where `J` is nearly singular only as far as the inner solves stay
-/// accurate (Govaerts, *Numerical methods for bifurcations of dynamical equilibria*, 2000,
-/// ch. 3); a pivot `|u_ii| <= threshold * max_ij (|D_ij| + |C_i| |X_j|)` of `S` is
+/// per right-hand side `J y = f`, `p = S^{-1} (g - C^T y)`, `x = y - X p`. It needs `J`
+/// regular: where `J` is singular or nearly so (a fold) and the bordered matrix is not,
+/// its accuracy is that of the inner solves (Govaerts, *Numerical methods for bifurcations
+/// of dynamical equilibria*, 2000, ch. 3), and a caller may fall back to a dense LU of the
+/// assembled matrix, as the continuation does. A pivot
+/// `|u_ii| <= threshold * max_ij (|D_ij| + |C_i| |X_j|)` of the LU of `S` is
 /// [`BorderedError::SingularBorder`]. `B`, `C` and the right-hand sides are stored column
 /// by column (column-major), `D` column-major too; all storage is allocated by
 /// [`BorderedSolver::new`] and reused.
