@@ -415,11 +415,46 @@ pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
 
+    /// Solves `J X = R` in place for `ncols` right-hand sides stored one after the other
+    /// (column-major, `columns.len() = n * ncols`) with the last factorization. The default
+    /// solves them column by column; direct solvers override it with one blocked solve.
+    /// A length that `ncols` does not divide is [`LinearSolveError::DimensionMismatch`].
+    fn solve_columns_in_place(
+        &mut self,
+        columns: &mut [f64],
+        ncols: usize,
+    ) -> Result<(), LinearSolveError> {
+        let n = column_length(columns.len(), ncols)?;
+        if n > 0 {
+            for column in columns.chunks_exact_mut(n) {
+                self.solve_in_place(column)?;
+            }
+        }
+        Ok(())
+    }
+
     /// Krylov iterations (operator products) of the solves so far, over the solver's
     /// life; 0 for a direct solver. Drivers report the difference over a run in
     /// [`WorkCounters::krylov_iterations`](crate::newton::WorkCounters::krylov_iterations).
     fn krylov_iterations(&self) -> u64 {
         0
+    }
+}
+
+/// The length `n` of each of `ncols` columns stored in `len` numbers
+/// ([`LinearSolveError::DimensionMismatch`] when `ncols` does not divide `len`).
+pub(crate) fn column_length(len: usize, ncols: usize) -> Result<usize, LinearSolveError> {
+    match ncols {
+        0 if len == 0 => Ok(0),
+        0 => Err(LinearSolveError::DimensionMismatch {
+            expected: 0,
+            found: len,
+        }),
+        _ if len % ncols != 0 => Err(LinearSolveError::DimensionMismatch {
+            expected: len / ncols * ncols,
+            found: len,
+        }),
+        _ => Ok(len / ncols),
     }
 }
 

@@ -657,9 +657,14 @@ fn custom_problem_newton_agrees_with_lemke_in_every_contact_state() {
         assert!(diff <= 1e-9, "load {load}: difference {diff:e}");
         let mut f = vec![0.0; y.len()];
         chain.residual(&y, &mut f).unwrap();
-        // Forces of order 1, stiffness 100: rounding leaves residuals ~1e-14.
+        println!(
+            "load {load}: difference {diff:e}, residual {:e}",
+            max_abs(&f)
+        );
+        // Forces of order 1, stiffness 100: rounding leaves residuals ~1e-14 (measured
+        // 8.3e-16, 1.5e-15, 1.6e-14 at the three loads); allowed 3 times the largest.
         assert!(
-            max_abs(&f) <= 1e-10,
+            max_abs(&f) <= 5e-14,
             "load {load}: residual {:e}",
             max_abs(&f)
         );

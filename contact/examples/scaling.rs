@@ -5,7 +5,7 @@
 //! least squares on log-log axes.
 //!
 //! The complementarity constant is the rod's static tip stiffness `c = EA / L` (mesh
-//! independent). The runner's default, `K[tip, tip] = 2 n EA / L`, grows with the element
+//! independent). The local stiffness `K[tip, tip] = 2 n EA / L` grows with the element
 //! count, and from zero Newton then cycles between active sets (no convergence in 200
 //! iterations from 100 elements up, measured).
 //!

@@ -59,7 +59,7 @@ pub enum GlobalizationChoice {
     /// Full steps for 30 iterations (active-set behaviour), then the non-monotone line
     /// search from the initial guess.
     Hybrid,
-    /// The polyalgorithm (`semismooth::newton::Globalization::Polyalgorithm`): up to 30 full
+    /// The polyalgorithm (`semismooth::polyalgorithm::SolveOptions::Polyalgorithm`): up to 30 full
     /// steps (stopped early when they stagnate and the problem offers a smoothing); then,
     /// each from the initial guess, the smoothing path where the problem offers one (SSN-HB
     /// and the LCP's min map; penalty HB does not), the non-monotone line search on at most

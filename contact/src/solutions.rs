@@ -6,8 +6,8 @@
 //! are connected to the linear response: [`find_solutions`] follows it in frequency with
 //! the core's continuation over a window around `w*` (the scene's `[sweep]` range, or
 //! `[0.5, 2] w*` without one), takes every pair of neighbouring branch points on either
-//! side of `w*`, corrects the interpolated state by Newton at exactly `w*` (the runner's
-//! solve with that warm start), merges corrections that land on the same solution
+//! side of `w*`, corrects the interpolated state by Newton at exactly `w*` (the one-call
+//! [`crate::solve()`] with that warm start), merges corrections that land on the same solution
 //! (relative distance of the unknowns below [`SAME_SOLUTION`]) and computes the stability
 //! of each ([`crate::stability::hb_stability`]).
 //!

@@ -321,7 +321,9 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
                 fnorm <= tolerance,
                 "w = {w}: |F| = {fnorm:e} > {tolerance:e}"
             );
-            assert!(step <= 1e-6, "w = {w}: Newton step {step:e}");
+            // Relative Newton step left at a converged point: measured at most 2.9e-8
+            // over the four sweeps; allowed 1e-7 (3.4 times that).
+            assert!(step <= 1e-7, "w = {w}: Newton step {step:e}");
             worst_f = worst_f.max(fnorm);
             worst_step = worst_step.max(step);
         }

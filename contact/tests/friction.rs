@@ -278,7 +278,9 @@ fn harmonic_balance_converges_to_the_exact_march_through_liftoff() {
 fn the_march_with_exact_friction_reproduces_den_hartog() {
     // zeta = 0.01, F = 0.3 F0 at w = 0.7: continuous sliding. The peak of the sampled
     // period against Den Hartog's X. Measured 9.6e-4 at 1000 steps and 4.7e-5 at 4000:
-    // second order (theta = 1/2; no stick, so no switch of the law inside a step matters).
+    // second order (theta = 1/2; no stick, so no switch of the law inside a step matters),
+    // a ratio of 20.6 for 4 times the steps (order 2.2). Allowed: a ratio above 8 (order
+    // 1.5, 2.6 times below the measured ratio) and 1e-4 at 4000 steps (2.1 times).
     let model = oscillator(1.0, 0.02, 1.0, 1.0, 0.3);
     let exact = den_hartog(1.0, 0.02, 1.0, 1.0, 0.3, 0.7);
     let errors: Vec<f64> = [1000, 4000]
@@ -301,7 +303,7 @@ fn the_march_with_exact_friction_reproduces_den_hartog() {
         "march against Den Hartog X = {exact}: relative errors at 1000, 4000 steps: {errors:?}"
     );
     assert!(
-        errors[1] < errors[0] / 3.0 && errors[1] < 1e-4,
+        errors[1] < errors[0] / 8.0 && errors[1] < 1e-4,
         "{errors:?}"
     );
 }

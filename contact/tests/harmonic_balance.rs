@@ -790,15 +790,17 @@ fn canonical_modified_rod_ssn_hb_converges_from_zero() {
 
 /// Penalty HB with k_p stepped up by decades (each solve warm-started from the previous,
 /// as a stiff penalty does not converge from zero): the penetration at the samples shrinks
-/// like 1/k_p over four decades and the solutions settle. Their limit is *not* SSN-HB at the
-/// same H: the penalty limit enforces `u <= g` at every AFT sample, SSN-HB enforces
-/// complementarity only in the Galerkin sense; the two differ at the truncation level
-/// (below 1e-2 relative at H = 20, less at H = 40).
+/// by a factor 4.7 to 7.0 per decade of k_p (measured; a little slower than 1/k_p) over four
+/// decades and the solutions settle. Their limit is *not* SSN-HB at the same H: the penalty
+/// limit enforces `u <= g` at every AFT sample, SSN-HB enforces complementarity only in the
+/// Galerkin sense; the two differ at the truncation level (measured 7.9e-3 relative at
+/// H = 20, 1.6e-4 at H = 40).
 #[test]
 fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
     let (model, omega) = canonical_modified_rod();
     let scale = model.contact_stiffness_scale();
-    for (h, limit) in [(20, 1e-2), (40, 2e-3)] {
+    // Allowed: 1.3 and 3.2 times the measured distances.
+    for (h, limit) in [(20, 1e-2), (40, 5e-4)] {
         let nt = 1024;
         let (_, x, _) = solve_ssn(&model, omega, &hb_options(h, Some(nt), None));
         let reference = x[..model.dofs() * (2 * h + 1)].to_vec();
@@ -829,10 +831,12 @@ fn penalty_hb_converges_like_one_over_kp_to_within_truncation_of_ssn_hb() {
             );
             penetrations.push(s.max_penetration);
         }
+        // Ratios per decade measured 4.7 to 7.0; allowed 1.5 times beyond either end (3.1 to
+        // 10.5: never faster than 1/k_p).
         for w in penetrations.windows(2) {
             let ratio = w[0] / w[1];
             assert!(
-                (3.0..30.0).contains(&ratio),
+                (3.1..10.5).contains(&ratio),
                 "penetration ratio per decade {ratio}"
             );
         }

@@ -86,10 +86,11 @@ fn all_methods_agree_on_the_tip_minimum_at_their_finest_settings() {
             assert!(d < tolerance(*ma) + tolerance(*mb), "{a} vs {b}: {d:e}");
         }
     }
-    // Lemke and Newton solve the same LCP: same answer to round-off (measured 8.5e-16).
+    // Lemke and Newton solve the same LCP: same answer to round-off (measured 8.5e-16, a
+    // few ulps of the tip); allowed 3e-15 (3.5 times that).
     let same = relative(finest[2].2.stats.min, finest[3].2.stats.min);
     println!("lcp-lemke vs lcp-ssn at Nt = 1024: {same:e}");
-    assert!(same < 1e-13, "{same:e}");
+    assert!(same < 3e-15, "{same:e}");
 }
 
 #[test]

@@ -5,10 +5,12 @@
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Mat, MatMut};
 
-use super::options::BORDER_PIVOT_THRESHOLD;
 use super::CorrectorFailure;
 use crate::iteration::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
-use crate::linalg::{check_finite_dense, check_pivots, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use crate::linalg::{
+    check_finite_dense, check_pivots, BorderedError, BorderedSolver, LinearSolveError,
+    DEFAULT_PIVOT_THRESHOLD,
+};
 use crate::newton::WorkCounters;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent};
 
@@ -131,9 +133,12 @@ pub(super) struct Bordered<J> {
     fp: Vec<f64>,
     /// Workspace of `F_p` (the default central difference's second residual).
     fp_scratch: Vec<f64>,
-    a: Vec<f64>,
+    /// The block elimination of `[[J, F_p], [w_x^T, w_p]]` (k = 1).
+    border: BorderedSolver,
     /// θ-weighted constraint row `w_x`.
     pub w: Vec<f64>,
+    /// The constraint row of the fixed-parameter correction (`w_x = 0`).
+    zeros: Vec<f64>,
     /// Raw (unnormalised) tangent from the last iteration, length `n + 1`, with positive
     /// inner product with the constraint row.
     pub tangent: Vec<f64>,
@@ -148,8 +153,9 @@ impl<J> Bordered<J> {
             jac,
             fp: vec![0.0; n],
             fp_scratch: vec![0.0; n],
-            a: vec![0.0; n],
+            border: BorderedSolver::new(n, 1),
             w: vec![0.0; n],
+            zeros: vec![0.0; n],
             tangent: vec![0.0; n + 1],
             dense: None,
             kernel: Kernel::default(),
@@ -238,10 +244,7 @@ where
         self.counts.iterations += 1;
         counters.factorizations += 1;
         let n_value = g[n];
-        let block = match self.solver.factor(&self.ws.jac) {
-            Ok(()) => self.block_elimination(&g[..n], n_value, d, counters),
-            Err(error) => Err(BorderedFailure::Linear(error)),
-        };
+        let block = self.block_elimination(&g[..n], n_value, d, counters);
         match (block, self.fallback) {
             (Ok(()), _) => {}
             (Err(BorderedFailure::Linear(_) | BorderedFailure::SingularBorder(_)), Some(a)) => {
@@ -281,9 +284,9 @@ where
         w_x_dot_x + c.w_p * p - c.target
     }
 
-    /// Block elimination with the current factorization: `J a = F_p`, `J b = F`,
-    /// `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`, raw tangent
-    /// `sign(pivot) (-a, 1)`.
+    /// Block elimination by the core's [`BorderedSolver`]: one factorization of `J`, the
+    /// solves `J a = F_p` and `J b = F`, `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`
+    /// (the bordered solve of `[F; N]`, negated), raw tangent `sign(pivot) (-a, 1)`.
     fn block_elimination(
         &mut self,
         f: &[f64],
@@ -293,40 +296,31 @@ where
     ) -> Result<(), BorderedFailure> {
         let n = self.metric.n;
         let ws = &mut *self.ws;
-        ws.a.copy_from_slice(&ws.fp);
-        let b = &mut d[..n];
-        b.copy_from_slice(f);
-        counters.linear_solves += 2;
-        self.solver
-            .solve_in_place(&mut ws.a)
-            .map_err(BorderedFailure::Linear)?;
-        self.solver
-            .solve_in_place(b)
-            .map_err(BorderedFailure::Linear)?;
-        if !all_finite(&ws.a) || !all_finite(b) {
-            return Err(BorderedFailure::NonFinite);
-        }
-        let constraint = self.constraint;
-        let (w_a, w_b, w_norm) = if constraint.arclength {
-            let wa: f64 = ws.w.iter().zip(&ws.a).map(|(u, v)| u * v).sum();
-            let wb: f64 = ws.w.iter().zip(b.iter()).map(|(u, v)| u * v).sum();
-            (wa, wb, norm2(&ws.w))
+        let w = if self.constraint.arclength {
+            &ws.w
         } else {
-            (0.0, 0.0, 0.0)
+            &ws.zeros
         };
-        let pivot = constraint.w_p - w_a;
-        let scale = constraint.w_p.abs() + w_norm * norm2(&ws.a);
-        if !pivot.is_finite() || pivot.abs() <= BORDER_PIVOT_THRESHOLD * scale {
-            return Err(BorderedFailure::SingularBorder(pivot));
+        let border = [self.constraint.w_p];
+        let factored = ws.border.factor(self.solver, &ws.jac, &ws.fp, w, &border);
+        if !matches!(factored, Err(BorderedError::Factorization(_))) {
+            counters.linear_solves += 2;
         }
-        let dp = (w_b - n_value) / pivot;
-        let sign = pivot.signum();
-        for ((t, bi), ai) in ws.tangent.iter_mut().zip(b.iter_mut()).zip(&ws.a) {
+        factored.map_err(border_failure)?;
+        let (dx, dp) = d.split_at_mut(n);
+        dx.copy_from_slice(f);
+        dp[0] = n_value;
+        ws.border
+            .solve(self.solver, dx, dp)
+            .map_err(border_failure)?;
+        for v in d.iter_mut() {
+            *v = -*v;
+        }
+        let sign = ws.border.schur_complement()[0].signum();
+        for (t, ai) in ws.tangent.iter_mut().zip(ws.border.inner_solution()) {
             *t = -sign * ai;
-            *bi = -*bi - ai * dp;
         }
         ws.tangent[n] = sign;
-        d[n] = dp;
         Ok(())
     }
 
@@ -371,6 +365,18 @@ where
         })();
         ws.dense = Some(m);
         result
+    }
+}
+
+/// The corrector's failure for an error of the bordered solver.
+fn border_failure(error: BorderedError) -> BorderedFailure {
+    match error {
+        BorderedError::Factorization(e) | BorderedError::Solve(e) => BorderedFailure::Linear(e),
+        BorderedError::SingularBorder { pivot, .. } => BorderedFailure::SingularBorder(pivot),
+        BorderedError::NonFinite => BorderedFailure::NonFinite,
+        BorderedError::DimensionMismatch {
+            expected, found, ..
+        } => BorderedFailure::Linear(LinearSolveError::DimensionMismatch { expected, found }),
     }
 }
 

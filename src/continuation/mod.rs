@@ -21,7 +21,8 @@
 //! [[J, F_p], [w_x^T, w_p]] [dx; dp] = -[F; N],    w_x = (θ/n) t_x / s^2,  w_p = (1-θ) t_p / s_p^2,
 //! ```
 //!
-//! solved by block elimination with ONE factorization of `J` per corrector iteration and two
+//! solved by block elimination ([`BorderedSolver`](crate::linalg::BorderedSolver) with one
+//! border row and column) with ONE factorization of `J` per corrector iteration and two
 //! solves, `J a = F_p` and `J b = F`: `dp = (w_x·b - N) / (w_p - w_x·a)`, `dx = -b - a dp`.
 //! The bordered matrix is never assembled, so structured Jacobians (sparse, condensed)
 //! keep their structure. The tangent at the converged point comes for free from the last

@@ -3,10 +3,6 @@
 use super::ContinuationError;
 use crate::linesearch::LineSearchOptions;
 
-/// Relative size below which the block-elimination pivot `w_p - w_x·a` is treated as zero:
-/// `|w_p - w_x·a| <= BORDER_PIVOT_THRESHOLD (|w_p| + |w_x| |a|)`.
-pub(crate) const BORDER_PIVOT_THRESHOLD: f64 = 1e-12;
-
 /// In which direction of the parameter the branch is followed from the starting point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Direction {

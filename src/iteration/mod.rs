@@ -24,8 +24,7 @@ pub const EXACT_RESIDUAL: f64 = 1e-300;
 pub enum Termination {
     /// `|F| <= max(absolute, relative |F(x_0)|, residual_floor)`.
     Converged,
-    /// The step stalled with `|F|` within 100 times the residual floor of
-    /// [`NewtonOptions::residual_floor`](crate::newton::NewtonOptions::residual_floor):
+    /// The step stalled with `|F|` within 100 times [`Tolerances::residual_floor`]:
     /// converged as far as floating point allows.
     ConvergedAtRoundoff {
         /// `100 residual_floor`.

@@ -20,17 +20,26 @@
 //! with `A` and a preconditioner ([`KrylovOperator`]); a problem's structured solver can
 //! use it inside its own [`LinearSolve`](crate::LinearSolve).
 //!
+//! A matrix bordered by a few rows and columns, `[[J, B], [C^T, D]]`, is solved by
+//! [`BorderedSolver`] with one factorization of `J` by any of these solvers (block
+//! elimination through the Schur complement `D - C^T J^{-1} B`): a problem with a few extra
+//! scalar unknowns (a frequency, an amplitude, a phase) keeps its Jacobian's structure.
+//!
 //! Every solver implements [`Factorize<J>`](crate::Factorize) for the Jacobian types it
 //! can factor (the dense ones for every [`DenseAssemble`] type) and the single
 //! [`LinearSolve`](crate::LinearSolve) (the solves with the last factorization), so
 //! `lu.factor(&a)` and `lu.solve_in_place(&mut x)` need no annotation of the Jacobian type.
 
+mod bordered;
 mod dense;
 mod krylov;
 mod nalgebra_lu;
 mod scratch;
 mod sparse;
 
+pub use bordered::{
+    BorderedCounters, BorderedError, BorderedSolver, DEFAULT_BORDER_PIVOT_THRESHOLD,
+};
 pub use dense::{check_finite_dense, DenseAssemble, FaerDenseLu};
 pub use krylov::{Gmres, GmresOptions, GmresReport, KrylovOperator};
 pub use nalgebra_lu::NalgebraLu;

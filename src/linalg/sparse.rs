@@ -510,6 +510,16 @@ impl Factorize<SparseColMat<usize, f64>> for SparseLu<f64> {
 impl LinearSolve for SparseLu<f64> {
     /// Overwrites `rhs` with `A^{-1} rhs` using the factorization in slot 0.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
+        self.solve_columns_in_place(rhs, 1)
+    }
+
+    /// Overwrites the `ncols` columns of `columns` with `A^{-1} columns` using the
+    /// factorization in slot 0, in blocks of columns ([`SparseLu::solve_slot_in_place`]).
+    fn solve_columns_in_place(
+        &mut self,
+        columns: &mut [f64],
+        ncols: usize,
+    ) -> Result<(), LinearSolveError> {
         let factored = matches!(
             self.slots.first(),
             Some(Slot {
@@ -517,8 +527,11 @@ impl LinearSolve for SparseLu<f64> {
                 ..
             })
         );
-        check_solve(factored, self.dim, rhs.len())?;
         let n = self.dim;
-        self.solve_slot_in_place(0, MatMut::from_column_major_slice_mut(rhs, n, 1))
+        check_solve(factored, n * ncols, columns.len())?;
+        if ncols == 0 {
+            return Ok(());
+        }
+        self.solve_slot_in_place(0, MatMut::from_column_major_slice_mut(columns, n, ncols))
     }
 }

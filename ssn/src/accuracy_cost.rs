@@ -20,7 +20,8 @@
 //! (`tanh(v_t / eps)`) is swept over its width at two `H` beside SSN-HB's exact law.
 //!
 //! Wall times are medians of [`REPEATS`] runs when a run takes less than 50 ms, else one
-//! run; they include what the runner times (the solve, not the set-up of the rod).
+//! run; they include what the one-call solve times (`semismooth_contact::solve`: the solve,
+//! not the set-up of the rod).
 
 use std::fmt::Write as _;
 use std::path::Path;

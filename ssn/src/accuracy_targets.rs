@@ -152,8 +152,8 @@ pub fn ladder(method: Method) -> Vec<usize> {
     }
 }
 
-/// Wall time of one cold solve with `settings` (the median of [`REPEATS`] below
-/// [`REPEAT_BELOW_SECONDS`]) and the solution.
+/// Wall time of one cold solve with `settings` (the median of `REPEATS` below
+/// `REPEAT_BELOW_SECONDS`) and the solution.
 pub fn cold_solve(
     rod: &RodModel,
     settings: &SolverSettings,

@@ -513,7 +513,7 @@ pub const OPERATIONS_PER_SECOND: f64 = 2.3e10;
 /// measured 88 s) and the branches that take a quarter of an hour or more.
 pub const DEFAULT_WORK_LIMIT: f64 = 1e12;
 
-/// Estimated work of one run ([`solve_work`] on a rod of `elements` elements).
+/// Estimated work of one run (`solve_work` on a rod of `elements` elements).
 pub fn run_work(elements: usize, contacts: usize, settings: &SolverSettings) -> WorkEstimate {
     solve_work(
         elements,

@@ -162,7 +162,7 @@ fn summary(set: &SolutionSet) -> String {
 }
 
 /// The JSON document of `ssn solutions --json`: [`crate::json::solutions_json`] with
-/// `converged` (the search finished: [`incomplete`] is `None`, exit code 0) and
+/// `converged` (the search finished: `incomplete` is `None`, exit code 0) and
 /// `incomplete` (what it missed, in words, or null).
 pub fn document(set: &semismooth_contact::solutions::SolutionSet) -> serde_json::Value {
     let mut v = crate::json::solutions_json(set);

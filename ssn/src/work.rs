@@ -33,7 +33,7 @@ pub const CORRECTOR_ITERATIONS_PER_POINT: f64 = 4.0;
 pub const BRANCH_POINTS_PER_HARMONIC: f64 = 0.3;
 
 /// Operations of one corrector iteration of a harmonic-balance branch per contact and
-/// `S^2 log2 S` (`S = 2H + 1`), beyond the solve's own iteration ([`size_work`]: the
+/// `S^2 log2 S` (`S = 2H + 1`), beyond the solve's own iteration (`size_work`: the
 /// condensed LU `(2/3) (m S)^3` and the per-harmonic solves): the dense `S x S` contact
 /// block of the Jacobian, formed a column at a time by FFTs, and the products with it.
 /// Fitted on `ssn sweep scenes/beam_tip_stop.toml` (41 dofs, one contact; CPU time at a
@@ -59,7 +59,7 @@ pub enum Workload {
 
 /// The work of the command `workload` on `scene`'s structure of `dofs` dofs and
 /// `contacts` contacts: the largest of the dense factorizations of one solve
-/// ([`size_work`], with the error estimate's solve for `solve`: [`solve_work`]), time
+/// (`size_work`, with the error estimate's solve for `solve`: `solve_work`), time
 /// marching and, for a branch, its points.
 pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workload) -> WorkEstimate {
     let settings = compared(&scene.solver, workload == Workload::Compare);

@@ -402,7 +402,7 @@ fn a_writable_output_is_complete_csv() {
     let header = lines.next().unwrap();
     assert!(header.starts_with("t,u_tip"), "{header}");
     let rows: Vec<&str> = lines.filter(|l| !l.is_empty()).collect();
-    // 1024 reconstruction points for HB (runner::HB_OUTPUT_POINTS).
+    // 1024 reconstruction points for HB (semismooth_contact::solve::HB_OUTPUT_POINTS).
     assert_eq!(rows.len(), 1024);
     for r in rows {
         assert!(

@@ -143,6 +143,11 @@ fn marches_and_branches_that_would_take_hours_are_refused_naming_the_keys() {
 }
 
 /// Starts `ssn args`, waits until `ready` holds, sends SIGINT and returns the output.
+///
+/// No delay is needed after `ready`: the program installs its interrupt handler before it
+/// reads its arguments, and registers an output directory for removal before it creates
+/// it, so once the directory exists an interrupt finds both in place (and the run, which
+/// takes seconds, is still going).
 fn interrupt(args: &[&str], ready: impl Fn() -> bool) -> Output {
     let child = Command::new(SSN)
         .args(args)
@@ -155,8 +160,6 @@ fn interrupt(args: &[&str], ready: impl Fn() -> bool) -> Output {
         assert!(start.elapsed() < Duration::from_secs(60), "never ready");
         std::thread::sleep(Duration::from_millis(20));
     }
-    // Let the run get going inside the directory.
-    std::thread::sleep(Duration::from_millis(500));
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()

@@ -59,7 +59,7 @@
 //!   `y = (w, z)` at the `Nt` time nodes, `w - q(ω) - A(ω) z = 0`, `min(z, κ w) = 0`
 //!   (`κ` = the scene's `c`, default the contact stiffness scale; the force unit of the
 //!   arclength), with the active-block solver [`FrequencyLcpSolver`] and the analytic
-//!   `dF/dω`. It starts from the runner's mesh-sequenced min-map solve at `omega_from`.
+//!   `dF/dω`. It starts from the one-call solve's mesh-sequenced min-map solve at `omega_from`.
 //!   The tip extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a
 //!   contact, else from the LCP of the point's frequency with the tip observed). The
 //!   discrete LCP branch has a small fold at many changes of the active set (a node
@@ -676,7 +676,7 @@ fn follow_lcp<'a>(
     // observed by the LCPs the problem builds.
     let contacts = model.contact_count();
     let (lcp_options, tip_contact) = lcp_options(rod, settings);
-    // Start: the runner's sequenced min-map solve at omega_from, y0 = (q + A z, z).
+    // Start: the one-call solve's sequenced min-map solve at omega_from, y0 = (q + A z, z).
     let mut problem = FrequencyLcp::new(model, omega_from, lcp_options, kappa)?;
     let finest = problem.current()?;
     let sequenced = solve_min_map_sequenced(model, omega_from, &finest, &newton_options(settings))?;
