@@ -229,4 +229,12 @@ fn loads_beyond_the_harmonics_and_non_cosine_loads_of_the_lcp_are_refused() {
         lcp,
         Err(semismooth_contact::lcp::LcpError::Unsupported { .. })
     ));
+    use semismooth_contact::march::{MarchError, MarchOptions, MarchState, TimeMarcher};
+    let march = TimeMarcher::new(
+        &model,
+        OMEGA,
+        &MarchOptions::default(),
+        &MarchState::rest(&model),
+    );
+    assert!(matches!(march, Err(MarchError::Unsupported { .. })));
 }
