@@ -14,6 +14,7 @@ use semismooth_contact::hb::{
     CondensedSsnHb, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
 use semismooth_contact::model::{ContactPoint, HarmonicLoad, StructuralModel};
+use semismooth_contact::operator::OperatorParameter;
 
 const N: usize = 4;
 const H: usize = 3;
@@ -185,6 +186,39 @@ fn modal_damping_enters_as_minus_xi_m_in_the_damping() {
 }
 
 #[test]
+fn residual_operator_derivatives_are_the_central_differences_of_the_residual() {
+    let model = chain(general_load());
+    let mut hb = SsnHb::new(&model, OMEGA, &options()).unwrap();
+    hb.set_modal_damping(0.04).unwrap();
+    let x: Vec<f64> = (0..hb.dim())
+        .map(|i| ((i * 5) % 7) as f64 / 7.0 - 0.4)
+        .collect();
+    let step = 1e-4;
+    for parameter in [OperatorParameter::Omega, OperatorParameter::ModalDamping] {
+        let mut residual_at = |delta: f64| {
+            match parameter {
+                OperatorParameter::ModalDamping => hb.set_modal_damping(0.04 + delta).unwrap(),
+                _ => hb.set_omega(OMEGA + delta).unwrap(),
+            }
+            let mut r = vec![0.0; hb.dim()];
+            hb.residual(&x, &mut r).unwrap();
+            r
+        };
+        let (plus, minus) = (residual_at(step), residual_at(-step));
+        residual_at(0.0);
+        let mut derivative = vec![0.0; hb.dim()];
+        hb.residual_operator_derivative(parameter, &x, &mut derivative)
+            .unwrap();
+        // The residual is quadratic in w and linear in xi (the contact law does not depend
+        // on them): the central difference is exact but for rounding, eps |R| / step.
+        for (i, d) in derivative.iter().enumerate() {
+            let fd = (plus[i] - minus[i]) / (2.0 * step);
+            assert!((fd - d).abs() < 1e-9, "{parameter:?} {i}: {fd} vs {d}");
+        }
+    }
+}
+
+#[test]
 fn changing_the_modal_damping_at_fixed_frequency_refactors_and_nothing_else_does() {
     let model = chain(general_load());
     let mut hb = SsnHb::new(&model, OMEGA, &options()).unwrap();
@@ -214,7 +248,7 @@ fn changing_the_modal_damping_at_fixed_frequency_refactors_and_nothing_else_does
 }
 
 #[test]
-fn loads_beyond_the_harmonics_and_non_cosine_loads_of_the_lcp_are_refused() {
+fn loads_beyond_the_harmonics_and_non_cosine_loads_of_the_lcp_and_the_march_are_refused() {
     let mut load = HarmonicLoad::cosine(vec![0.1; N]);
     load.add_harmonic(H + 1, &[0.0; N], &[1.0; N]).unwrap();
     let model = chain(load);
