@@ -20,7 +20,8 @@ use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, FrictionPoint, InvalidModel, SparseMatrix, StructuralModel, Structure,
+    ContactPoint, FrictionPoint, HarmonicLoad, InvalidModel, SparseMatrix, StructuralModel,
+    Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -62,10 +63,15 @@ impl StructuralModel {
             mass,
             damping: None,
             stiffness,
-            load,
+            load: HarmonicLoad::cosine(load),
             contacts: Vec::new(),
             friction: Vec::new(),
         }
+    }
+
+    /// The model with the external force `load` in place of its own.
+    pub fn with_load(self, load: HarmonicLoad) -> Self {
+        Self { load, ..self }
     }
 
     /// The model with the damping matrix `D`.

@@ -29,7 +29,7 @@ use faer::{c64, MatMut};
 use num_traits::Zero;
 use semismooth::linalg::{LinearSolveError, PivotRule, SparseLu};
 
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::SparseMatrix;
 
 /// The union sparsity pattern of `N x N` source matrices and the diagonal, with the
 /// position in it of every stored entry of every source.
@@ -219,43 +219,6 @@ impl DynamicStiffness {
         self.pattern
             .combine(self.sources.iter().zip(coefficients), values);
         crate::model::sparse_mul_add(self.pattern.matrix(values), c64::new(1.0, 0.0), x, y);
-    }
-}
-
-impl StructuralModel {
-    /// How much the undamped linear response at `omega` exceeds the static one:
-    /// `max |(K - omega^2 M)^{-1} f| / max |K^{-1} f|`, infinite when `K - omega^2 M` is
-    /// singular (forced at a natural frequency: an undamped structure without contact then
-    /// has no periodic solution); `None` when `K` cannot be factored or the load is zero.
-    /// Ignores damping and contacts.
-    pub fn undamped_amplification(&self, omega: f64) -> Option<f64> {
-        use semismooth::linalg::FaerSparseLu;
-        use semismooth::{Factorize, LinearSolve};
-        let n = self.dofs();
-        let response = |matrix: &SparseMatrix| -> Option<f64> {
-            let mut lu = FaerSparseLu::new();
-            if lu.factor(matrix).is_err() {
-                return Some(f64::INFINITY);
-            }
-            let mut u = self.load.clone();
-            lu.solve_in_place(&mut u).ok()?;
-            Some(u.iter().fold(0.0f64, |m, v| m.max(v.abs())))
-        };
-        let static_response = response(&self.stiffness)?;
-        if !(static_response > 0.0 && static_response.is_finite()) {
-            return None;
-        }
-        let dynamic = UnionPattern::linear_combination(
-            n,
-            &[&self.stiffness, &self.mass],
-            &[1.0, -omega * omega],
-        );
-        let amplification = response(&dynamic)? / static_response;
-        Some(if amplification.is_nan() {
-            f64::INFINITY
-        } else {
-            amplification
-        })
     }
 }
 

@@ -19,6 +19,7 @@ pub mod lcp;
 pub mod march;
 pub mod matrix_market;
 pub mod model;
+pub mod operator;
 pub mod rod;
 pub mod settings;
 pub mod solutions;

@@ -19,7 +19,9 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::{Factorize, LinearSolve};
 
 use crate::dynamic::UnionPattern;
-use crate::model::{sparse_mul_add, ContactPoint, SparseMatrix, StructuralModel, Structure};
+use crate::model::{
+    sparse_mul_add, ContactPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
+};
 
 /// How the rod's mass is discretised.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -388,7 +390,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         mass,
         damping: None,
         stiffness,
-        load,
+        load: HarmonicLoad::cosine(load),
         contacts,
         friction: Vec::new(),
     };
@@ -690,7 +692,7 @@ mod tests {
     #[test]
     fn distributed_load_is_consistent_and_sums_to_the_resultant() {
         let rod = build_rod(&RodSpec::canonical()).unwrap();
-        let f = &rod.model.load;
+        let f = &rod.model.load.forcing_cosine();
         // Resultant of p0 over (0, L] minus the clamped node's half element.
         let total: f64 = f.iter().sum();
         assert!((total - 0.04 * (1.0 - 0.5 / 20.0)).abs() < 1e-15);

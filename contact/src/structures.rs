@@ -34,7 +34,7 @@ use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
+    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -194,7 +194,7 @@ impl BladedDisk {
             mass,
             damping: None,
             stiffness,
-            load: shape.iter().map(|f| loading.amplitude * f).collect(),
+            load: HarmonicLoad::cosine(shape.iter().map(|f| loading.amplitude * f).collect()),
             contacts: loading
                 .stops
                 .iter()

@@ -18,7 +18,7 @@ use semismooth_contact::hb::{
 };
 use semismooth_contact::march::{march_to_steady_state, MarchOptions, MarchScheme};
 use semismooth_contact::model::{
-    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel,
+    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel,
 };
 use semismooth_contact::settings::SolverSettings;
 use semismooth_contact::stability::{hb_stability, Undecided};
@@ -34,7 +34,7 @@ fn oscillator(m: f64, c: f64, k: f64, f0: f64, friction: f64) -> StructuralModel
         mass: one(m),
         damping: (c > 0.0).then(|| one(c)),
         stiffness: one(k),
-        load: vec![f0],
+        load: HarmonicLoad::cosine(vec![f0]),
         contacts: Vec::new(),
         // mu = 0.5 under N = 2 friction: the slip limit `friction`.
         friction: vec![FrictionPoint::prescribed(

@@ -23,7 +23,7 @@ use semismooth_contact::hb::{
     CondensedSsnHb, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
     StructuredHbSolver,
 };
-use semismooth_contact::model::{ContactPoint, InvalidModel, StructuralModel};
+use semismooth_contact::model::{ContactPoint, HarmonicLoad, InvalidModel, StructuralModel};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 
 /// A fixed-free chain of `n` masses and springs (stiffness `k`, masses `mass`), damping
@@ -61,7 +61,7 @@ fn chain(
         mass,
         damping,
         stiffness,
-        load: (0..n).map(|i| 0.3 + 0.1 * i as f64).collect(),
+        load: HarmonicLoad::cosine((0..n).map(|i| 0.3 + 0.1 * i as f64).collect()),
         contacts,
         friction: Vec::new(),
     };
@@ -153,7 +153,7 @@ fn dynamic_blocks_match_time_domain_equation_of_motion() {
     // R = A(w) U - F with F = 0 and no contact, against M u'' + D u' + K u evaluated at
     // the samples (derivatives from the coefficient-space operator) and projected by P.
     let (mut model, omega) = chain(3, Some(0.05), 1.3, vec![]);
-    model.load = vec![0.0; 3];
+    model.load = HarmonicLoad::cosine(vec![0.0; 3]);
     let mut hb = SsnHb::new(&model, omega, &hb_options(4, Some(32), None)).unwrap();
     let basis = FourierBasis::new(4, 32).unwrap();
     let size = basis.basis_size();
@@ -374,7 +374,7 @@ fn without_contact_hb_equals_exact_linear_response_and_needs_no_fft() {
             }
         }
         hb.residual(&x, &mut r).unwrap();
-        assert!(norm(&r) < 1e-12 * norm(&model.load));
+        assert!(norm(&r) < 1e-12 * norm(&model.load.forcing_cosine()));
         assert_eq!(hb.problem_counters().get("ffts"), 0, "no contact: no FFT");
     }
 }

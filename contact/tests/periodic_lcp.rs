@@ -176,6 +176,7 @@ fn trapezoidal_contact_displacement(
     let mut a = DMatrix::<f64>::zeros(size, size);
     let mut b = DVector::<f64>::zeros(size);
     let tip = model.contacts[0].dof();
+    let load = model.load.forcing_cosine();
     for step in 0..nt {
         let row0 = step * 2 * n;
         for i in 0..n {
@@ -194,7 +195,7 @@ fn trapezoidal_contact_displacement(
             let t0 = step as f64 * dt;
             let t1 = t0 + dt;
             let w = omega;
-            let mut rhs = model.load[i] * ((w * t0).cos() + (w * t1).cos());
+            let mut rhs = load[i] * ((w * t0).cos() + (w * t1).cos());
             if i == tip {
                 rhs += lambda[step] + lambda[(step + 1) % nt];
             }

@@ -65,7 +65,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let model = &structure.model;
         let dir = Path::new("scenes/friction_damper");
         std::fs::create_dir_all(dir)?;
-        for (name, text) in model_matrix_files(&model.stiffness, &model.mass, &model.load) {
+        for (name, text) in
+            model_matrix_files(&model.stiffness, &model.mass, &model.load.forcing_cosine())
+        {
             std::fs::write(dir.join(name), text)?;
         }
         println!(

@@ -119,6 +119,10 @@ pub fn prepare(
                 (None, None) => build_imported(spec),
             }
             .map_err(|e| CliError::BadInput(e.to_string()))?;
+            let mut structure = structure;
+            let parts = &scene.load_parts;
+            crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
+                .map_err(CliError::BadInput)?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
             crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());

@@ -22,7 +22,10 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     if let Some(d) = &model.damping {
         files.push(("D.mtx".to_string(), matrix_market_text(d)));
     }
-    files.push(("f.mtx".to_string(), vector_market_text(&model.load)));
+    files.push((
+        "f.mtx".to_string(),
+        vector_market_text(&model.load.forcing_cosine()),
+    ));
     let frequency = scene.frequency();
     let mut t = String::new();
     let title = scene.title.as_deref().unwrap_or("untitled");

@@ -2,7 +2,7 @@
 //! (300 dofs, a stop on each of 100 blade tip pads), and its tuned twin, whose cyclic
 //! symmetry makes every blade answer exactly as one sector with one contact.
 
-use semismooth_contact::model::{ContactPoint, StructuralModel, Structure};
+use semismooth_contact::model::{ContactPoint, HarmonicLoad, StructuralModel, Structure};
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::solve::solve;
 use semismooth_contact::structures::BladedDisk;
@@ -64,7 +64,7 @@ fn tuned(blades: usize, gap: f64) -> StructuralModel {
         mass,
         damping: Some(stiffness.clone()),
         stiffness,
-        load: shape.iter().map(|f| 0.02 * f).collect(),
+        load: HarmonicLoad::cosine(shape.iter().map(|f| 0.02 * f).collect()),
         contacts: (0..blades)
             .map(|j| ContactPoint::new(BladedDisk::pad(j), gap))
             .collect(),

@@ -13,6 +13,7 @@ use super::ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope, H
 use super::structured::{condensed_matrix, CondensedSolve, CrossBlocks, StructuredHbSolver};
 use super::{check_len, indicator, HbError, ResponseSummary};
 use crate::model::{mean_stiffness, NormalForce, StructuralModel};
+use crate::operator::OperatorParameter;
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
 /// index `j m + row`, the contacts' rows then the friction points' tangential rows).
@@ -92,14 +93,13 @@ impl CondensedSsnHb {
         Ok(this)
     }
 
-    /// Factors `A(w)` at the current `w`, then `A^{-1} F`, `G A^{-1} F` and `R`.
+    /// Factors `A(w, p)` at the current parameters, then `A^{-1} F`, `G A^{-1} F` and `R`.
     fn refactor(&mut self) -> Result<(), HbError> {
-        self.dynamic.omega = self.full.omega();
+        self.dynamic.parameters = self.full.state.parameters();
         self.solver.factor(&self.dynamic)?;
         let lin = self.full.state.linear.clone();
-        let (n, m, h) = (lin.dofs, lin.contacts(), lin.basis.harmonics());
-        self.linear_response.fill(0.0);
-        self.linear_response[n..2 * n].copy_from_slice(&lin.load);
+        let (m, h) = (lin.contacts(), lin.basis.harmonics());
+        lin.operator.load_coefficients(&mut self.linear_response);
         self.solver
             .apply_dynamic_inverse(&mut self.linear_response)?;
         lin.gather_measured(&self.linear_response, &mut self.contact_linear);
@@ -163,6 +163,23 @@ impl CondensedSsnHb {
     pub fn set_omega(&mut self, omega: f64) -> Result<(), HbError> {
         self.full.set_omega(omega)?;
         self.refactor()
+    }
+
+    /// The modal damping `xi` of the operator (`D - xi M`; 0 by default).
+    pub fn modal_damping(&self) -> f64 {
+        self.full.modal_damping()
+    }
+
+    /// Sets the modal damping `xi` (finite) at fixed `w` and refactors the dynamic blocks
+    /// when it changed.
+    pub fn set_modal_damping(&mut self, xi: f64) -> Result<(), HbError> {
+        self.full.set_modal_damping(xi)?;
+        self.refactor()
+    }
+
+    /// Number of times the dynamic blocks were factored (once per change of `w` or `xi`).
+    pub fn dynamic_factorizations(&self) -> u64 {
+        self.solver.dynamic_factorizations()
     }
 
     /// The full unknowns `[U; Lambda]` of [`SsnHb`] from `Lambda` at the current `w`:
@@ -364,7 +381,9 @@ impl ParameterDependent for CondensedSsnHb {
         // U = A^{-1} F + A^{-1} G^T Lambda.
         self.full_u.copy_from_slice(&self.linear_response);
         self.solver.add_response(lambda, 1.0, &mut self.full_u);
-        lin.dynamic_omega_derivative(self.full.omega(), &self.full_u, &mut self.full_w);
+        let parameters = self.full.state.parameters();
+        let omega = OperatorParameter::Omega;
+        (lin.operator).apply_derivative(&parameters, omega, &self.full_u, &mut self.full_w);
         self.solver
             .apply_dynamic_inverse(&mut self.full_w)
             .map_err(|_| EvaluationError::OutsideDomain {

@@ -8,6 +8,7 @@ use semismooth::linalg::DenseAssemble;
 
 use super::LinearData;
 use crate::model::NormalForce;
+use crate::operator::HarmonicParameters;
 
 /// How the contact unknowns enter the Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,14 +36,15 @@ pub enum ContactCoupling {
 /// `dR_i/dU = c Q_i D G_i`, `dR_i/dLambda_i = I - Q_i` with `Q_i = P diag(stick) E`, and
 /// on its contact's force `dR_i/dLambda_n = X_i`.
 ///
-/// The dynamic part `A(w)` is represented by the model matrices (shared with the problem
-/// through an `Arc`, never copied per iteration) and `w`; a solver can tell that it has not
+/// The dynamic part `A(w, p)` is represented by the harmonic operator (shared with the
+/// problem through an `Arc`, never copied per iteration) and its parameters; a solver can tell that it has not
 /// changed since its last factorization ([`HbJacobian::same_dynamic_part`]). The contact
 /// part is the `(2H + 1) x (2H + 1)` matrix `Q_i = P diag(h_i) E` per contact.
 #[derive(Debug, Clone)]
 pub struct HbJacobian {
     pub(crate) linear: Arc<LinearData>,
-    pub(crate) omega: f64,
+    /// `w` and the other parameters of the dynamic part.
+    pub(crate) parameters: HarmonicParameters,
     pub(crate) coupling: ContactCoupling,
     /// `Q_i` of each row (`(2H + 1)` square): contacts, then friction points.
     pub(crate) q: Vec<Mat<f64>>,
@@ -54,7 +56,11 @@ pub struct HbJacobian {
 }
 
 impl HbJacobian {
-    pub(crate) fn new(linear: Arc<LinearData>, omega: f64, coupling: ContactCoupling) -> Self {
+    pub(crate) fn new(
+        linear: Arc<LinearData>,
+        parameters: HarmonicParameters,
+        coupling: ContactCoupling,
+    ) -> Self {
         let size = linear.size();
         let m = linear.contacts();
         Self {
@@ -64,14 +70,19 @@ impl HbJacobian {
                 .collect(),
             active: vec![0; m],
             linear,
-            omega,
+            parameters,
             coupling,
         }
     }
 
     /// Angular frequency `w` of the dynamic blocks.
     pub fn omega(&self) -> f64 {
-        self.omega
+        self.parameters.omega
+    }
+
+    /// The parameters of the dynamic blocks (`w`, the modal damping).
+    pub fn parameters(&self) -> HarmonicParameters {
+        self.parameters
     }
 
     /// Number of harmonics `H`.
@@ -94,40 +105,10 @@ impl HbJacobian {
         self.coupling
     }
 
-    /// True when `other` has the same dynamic part `A(w)` (same model data and same `w`),
-    /// so a factorization of it can be reused.
+    /// True when `other` has the same dynamic part `A(w, p)` (same model data and the same
+    /// bits of every parameter), so a factorization of it can be reused.
     pub fn same_dynamic_part(&self, other: &HbJacobian) -> bool {
-        Arc::ptr_eq(&self.linear, &other.linear) && self.omega.to_bits() == other.omega.to_bits()
-    }
-
-    /// Writes `A(w)` into the leading `N (2H + 1)` square of `out` (which must be zeroed).
-    fn assemble_dynamic(&self, out: &mut MatMut<'_, f64>) {
-        let lin = &self.linear;
-        let n = lin.dofs;
-        let mut add = |m: &crate::model::SparseMatrix, r0: usize, c0: usize, alpha: f64| {
-            let m = m.as_ref();
-            let symbolic = m.symbolic();
-            let rows = symbolic.row_idx();
-            let values = m.val();
-            for j in 0..n {
-                for p in symbolic.col_range(j) {
-                    out[(r0 + rows[p], c0 + j)] += alpha * values[p];
-                }
-            }
-        };
-        add(&lin.stiffness, 0, 0, 1.0);
-        for k in 1..=lin.basis.harmonics() {
-            let kw = k as f64 * self.omega;
-            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
-            for (r0, c0) in [(c, c), (s, s)] {
-                add(&lin.stiffness, r0, c0, 1.0);
-                add(&lin.mass, r0, c0, -kw * kw);
-            }
-            if let Some(d) = &lin.damping {
-                add(d, c, s, kw);
-                add(d, s, c, -kw);
-            }
-        }
+        Arc::ptr_eq(&self.linear, &other.linear) && self.parameters.same_as(&other.parameters)
     }
 }
 
@@ -142,7 +123,7 @@ impl DenseAssemble for HbJacobian {
 
     fn assemble_dense(&self, mut out: MatMut<'_, f64>) {
         out.fill(0.0);
-        self.assemble_dynamic(&mut out);
+        self.linear.operator.add_dense(&self.parameters, &mut out);
         let lin = &self.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;

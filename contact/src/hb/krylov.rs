@@ -45,7 +45,7 @@ use semismooth::linalg::{check_pivots, KrylovOperator, LinearSolveError, DEFAULT
 
 use super::structured::{apply_coupling, CrossBlocks, FactoredCondensed};
 use super::LinearData;
-use crate::dynamic::DynamicStiffness;
+use crate::operator::HarmonicFactors;
 
 /// Above this many condensed unknowns `m (2H + 1)` the default structured solver applies
 /// the condensed SSN-HB system matrix-free inside GMRES instead of forming and factoring it.
@@ -57,7 +57,7 @@ pub const KRYLOV_THRESHOLD: usize = 2000;
 /// The condensed operator `S` and its preconditioner at one Newton iterate (module
 /// documentation).
 pub(crate) struct CondensedOperator<'a> {
-    pub(crate) dynamic: &'a mut DynamicStiffness,
+    pub(crate) dynamic: &'a mut HarmonicFactors,
     pub(crate) lin: &'a LinearData,
     pub(crate) q: &'a [Mat<f64>],
     /// The friction points' blocks on their contacts' forces.

@@ -1,17 +1,17 @@
 //! Harmonic balance for periodic contact problems: the semismooth formulation of Shi &
 //! Legrand (SSN-HB, their equations (5)-(6)) and penalty harmonic balance.
 //!
-//! Both are built for a model and a forcing frequency `w` (`f(t) = load cos(w t)`; a new
-//! frequency is [`SsnHb::set_omega`] or the continuation parameter, not a new problem).
-//! Both expand the displacements of the [`StructuralModel`] with `H` harmonics in the real
-//! basis of [`semismooth::harmonic`] (`u(t) = u_0 + sum_k u_ck cos(k w t) + u_sk sin(k w t)`),
+//! Both are built for a model and a forcing frequency `w` (the model's
+//! [`HarmonicLoad`](crate::model::HarmonicLoad) on harmonics of `w`; a new frequency is
+//! [`SsnHb::set_omega`] or the continuation parameter, not a new problem). Both expand the
+//! displacements of the [`StructuralModel`] with `H` harmonics in the real basis of
+//! [`semismooth::harmonic`] (`u(t) = u_0 + sum_k u_ck cos(k w t) + u_sk sin(k w t)`),
 //! harmonic-major: unknown `j * N + dof` is coefficient `j` of `dof`. The linear dynamics
-//! `M u'' + D u' + K u` become the block-diagonal `A(w) U` with, for harmonic `k` on
-//! `(u_ck, u_sk)`,
-//!
-//! `[[K - (k w)^2 M,  k w D], [-k w D,  K - (k w)^2 M]]`
-//!
-//! (from `d/dt (a cos + b sin) = k w (b cos - a sin)`), and `K` alone on `u_0`.
+//! `M u'' + D u' + K u` become the block-diagonal `A(w, p) U` of the harmonic operator
+//! ([`crate::operator`]: for harmonic `k` on `(u_ck, u_sk)` and the default modal damping
+//! `xi = 0`, `[[K - (k w)^2 M, k w D], [-k w D, K - (k w)^2 M]]`; `K` alone on `u_0`), and
+//! the load its coefficients `F`. The modal damping `xi` (`D - xi M`) is set at fixed `w` by
+//! `set_modal_damping`.
 //!
 //! - [`SsnHb`]: unknowns `X = [U; Lambda]`, `Lambda` the contact-force coefficients (index
 //!   `j * m + contact`), residual `R_u = A(w) U - F - G^T Lambda`,
@@ -95,6 +95,34 @@ macro_rules! shared_accessors {
             Ok(())
         }
 
+        /// The modal damping `xi` of the operator (`D - xi M` as the damping; 0 by default).
+        pub fn modal_damping(&self) -> f64 {
+            self.state.modal_damping
+        }
+
+        /// Sets the modal damping `xi` (finite; any sign) at fixed `w`.
+        pub fn set_modal_damping(&mut self, xi: f64) -> Result<(), $crate::hb::HbError> {
+            $crate::hb::check_modal_damping(xi)?;
+            self.state.modal_damping = xi;
+            Ok(())
+        }
+
+        /// `dR/d parameter` at `x` (length [`Residual::dim`](semismooth::Residual::dim)):
+        /// `dA/d parameter U` on the displacement equations, zero elsewhere (only the
+        /// operator depends on its parameters).
+        pub fn residual_operator_derivative(
+            &self,
+            parameter: $crate::operator::OperatorParameter,
+            x: &[f64],
+            out: &mut [f64],
+        ) -> Result<(), $crate::hb::HbError> {
+            let len = self.displacement_len();
+            $crate::hb::check_len("HB unknowns", semismooth::Residual::dim(self), x.len())?;
+            $crate::hb::check_len("derivative", x.len(), out.len())?;
+            self.state.parameter_derivative(parameter, x, len, out);
+            Ok(())
+        }
+
         /// `u_dof(t_n)` at `points` equally spaced times over one period (`points > 2H`).
         pub fn displacement_samples(
             &self,
@@ -152,7 +180,12 @@ macro_rules! omega_parameter {
                 out: &mut [f64],
                 _scratch: &mut [f64],
             ) -> Result<(), semismooth::EvaluationError> {
-                self.state.omega_derivative(x, self.displacement_len(), out);
+                self.state.parameter_derivative(
+                    $crate::operator::OperatorParameter::Omega,
+                    x,
+                    self.displacement_len(),
+                    out,
+                );
                 Ok(())
             }
         }
@@ -173,9 +206,8 @@ use faer::c64;
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::InvalidOption;
 
-use crate::model::{
-    sparse_mul_add, ContactRow, InvalidModel, NormalForce, SparseMatrix, StructuralModel,
-};
+use crate::model::{ContactRow, InvalidModel, NormalForce, StructuralModel};
+use crate::operator::{HarmonicOperator, HarmonicParameters, OperatorParameter};
 
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
@@ -259,15 +291,13 @@ pub struct ResponseSummary {
 }
 
 /// The linear data shared by the formulations and their Jacobians (immutable, behind an
-/// `Arc`): matrices, load, contact rows and the Fourier basis.
+/// `Arc`): the harmonic operator (matrices and load), contact rows and the Fourier basis.
 #[derive(Debug)]
 pub(crate) struct LinearData {
     pub(crate) dofs: usize,
     pub(crate) basis: FourierBasis,
-    pub(crate) mass: SparseMatrix,
-    pub(crate) damping: Option<SparseMatrix>,
-    pub(crate) stiffness: SparseMatrix,
-    pub(crate) load: Vec<f64>,
+    /// The linear dynamics `A(w, p)` and the load `F`.
+    pub(crate) operator: HarmonicOperator,
     /// The rows of `G`: the contacts' normal rows (the first `gaps.len()`), then the
     /// friction points' tangential rows.
     pub(crate) rows: Vec<ContactRow>,
@@ -287,6 +317,7 @@ impl LinearData {
     ) -> Result<Self, HbError> {
         model.validate()?;
         validate_basis(harmonics, time_samples)?;
+        model.load.check_harmonics(harmonics)?;
         let basis = match time_samples {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
             None => FourierBasis::with_default_samples(harmonics),
@@ -294,10 +325,7 @@ impl LinearData {
         Ok(Self {
             dofs: model.dofs(),
             basis,
-            mass: model.mass.clone(),
-            damping: model.damping.clone(),
-            stiffness: model.stiffness.clone(),
-            load: model.load.clone(),
+            operator: HarmonicOperator::new(model, harmonics),
             rows: model.rows().cloned().collect(),
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
             friction: model
@@ -406,53 +434,14 @@ impl LinearData {
         self.basis.basis_size()
     }
 
-    /// `out = A(w) U - F`.
-    pub(crate) fn dynamic_residual(&self, omega: f64, u: &[f64], out: &mut [f64]) {
-        self.apply_dynamic(omega, u, out);
-        let n = self.dofs;
-        for (o, f) in out[n..2 * n].iter_mut().zip(&self.load) {
-            *o -= f;
-        }
+    /// `out = A(w, p) U - F` ([`HarmonicOperator::residual`]).
+    pub(crate) fn dynamic_residual(&self, p: &HarmonicParameters, u: &[f64], out: &mut [f64]) {
+        self.operator.residual(p, u, out);
     }
 
-    /// `out = A(w) U`.
-    pub(crate) fn apply_dynamic(&self, omega: f64, u: &[f64], out: &mut [f64]) {
-        let n = self.dofs;
-        out.fill(0.0);
-        sparse_mul_add(self.stiffness.as_ref(), 1.0, &u[..n], &mut out[..n]);
-        for k in 1..=self.basis.harmonics() {
-            let kw = k as f64 * omega;
-            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
-            let (a, b) = (&u[c..c + n], &u[s..s + n]);
-            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
-            sparse_mul_add(self.stiffness.as_ref(), 1.0, a, out_c);
-            sparse_mul_add(self.mass.as_ref(), -kw * kw, a, out_c);
-            sparse_mul_add(self.stiffness.as_ref(), 1.0, b, out_s);
-            sparse_mul_add(self.mass.as_ref(), -kw * kw, b, out_s);
-            if let Some(d) = &self.damping {
-                sparse_mul_add(d.as_ref(), kw, b, out_c);
-                sparse_mul_add(d.as_ref(), -kw, a, out_s);
-            }
-        }
-    }
-
-    /// `out = dA/dw (w) U`: for harmonic `k`, `-2 k^2 w M` on the diagonal blocks and
-    /// `+-k D` off the diagonal.
-    pub(crate) fn dynamic_omega_derivative(&self, omega: f64, u: &[f64], out: &mut [f64]) {
-        let n = self.dofs;
-        out.fill(0.0);
-        for k in 1..=self.basis.harmonics() {
-            let kf = k as f64;
-            let (c, s) = ((2 * k - 1) * n, 2 * k * n);
-            let (a, b) = (&u[c..c + n], &u[s..s + n]);
-            let (out_c, out_s) = out[c..s + n].split_at_mut(n);
-            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, a, out_c);
-            sparse_mul_add(self.mass.as_ref(), -2.0 * kf * kf * omega, b, out_s);
-            if let Some(d) = &self.damping {
-                sparse_mul_add(d.as_ref(), kf, b, out_c);
-                sparse_mul_add(d.as_ref(), -kf, a, out_s);
-            }
-        }
+    /// `out = A(w, p) U` ([`HarmonicOperator::apply`]).
+    pub(crate) fn apply_dynamic(&self, p: &HarmonicParameters, u: &[f64], out: &mut [f64]) {
+        self.operator.apply(p, u, out);
     }
 
     /// Coefficients (length `2H + 1`) of `dof` from a harmonic-major vector.
@@ -514,6 +503,11 @@ pub(crate) fn validate_basis(harmonics: usize, time_samples: Option<usize>) -> R
 }
 
 pub(crate) use crate::model::check_omega;
+
+/// `Err(InvalidOption)` unless the modal damping `xi` is finite.
+pub(crate) fn check_modal_damping(xi: f64) -> Result<(), InvalidOption> {
+    InvalidOption::check(xi.is_finite(), "modal damping", xi, "a finite number")
+}
 
 /// `Err(InvalidOption { name, value, allowed })` unless `value` is finite and `> 0`.
 pub(crate) fn check_positive(
@@ -657,6 +651,8 @@ pub(crate) fn displacement_at(
 pub(crate) struct HbState {
     pub(crate) linear: Arc<LinearData>,
     pub(crate) omega: f64,
+    /// The modal damping `xi` of the operator (`D - xi M`; 0 by default).
+    pub(crate) modal_damping: f64,
     pub(crate) aft: Aft,
 }
 
@@ -681,9 +677,17 @@ impl HbState {
         self.aft.samples_multiplication_matrix(&mut jac.q[i]);
     }
 
-    /// A Jacobian of this state's model at its frequency with `coupling`.
+    /// The operator's parameters: `w` and the modal damping.
+    pub(crate) fn parameters(&self) -> HarmonicParameters {
+        HarmonicParameters {
+            omega: self.omega,
+            modal_damping: self.modal_damping,
+        }
+    }
+
+    /// A Jacobian of this state's model at its parameters with `coupling`.
     pub(crate) fn new_jacobian(&self, coupling: ContactCoupling) -> HbJacobian {
-        HbJacobian::new(self.linear.clone(), self.omega, coupling)
+        HbJacobian::new(self.linear.clone(), self.parameters(), coupling)
     }
 
     /// Makes `jac` a Jacobian of this state's model at its frequency with `coupling` (its
@@ -692,16 +696,23 @@ impl HbState {
         if !Arc::ptr_eq(&jac.linear, &self.linear) {
             *jac = self.new_jacobian(coupling);
         }
-        jac.omega = self.omega;
+        jac.parameters = self.parameters();
         jac.coupling = coupling;
     }
 
-    /// `dR/dw` of the displacement equations, `dA/dw U`, into `out` (first `len` entries,
-    /// `U = x[..len]`); the rest of `out` (force equations) is zero.
-    pub(crate) fn omega_derivative(&self, x: &[f64], len: usize, out: &mut [f64]) {
+    /// `dR/d parameter` of the displacement equations, `dA/d parameter U`, into `out`
+    /// (first `len` entries, `U = x[..len]`); the rest of `out` (force equations) is zero.
+    pub(crate) fn parameter_derivative(
+        &self,
+        parameter: OperatorParameter,
+        x: &[f64],
+        len: usize,
+        out: &mut [f64],
+    ) {
         let (out_u, rest) = out.split_at_mut(len);
         self.linear
-            .dynamic_omega_derivative(self.omega, &x[..len], out_u);
+            .operator
+            .apply_derivative(&self.parameters(), parameter, &x[..len], out_u);
         rest.fill(0.0);
     }
 
@@ -710,6 +721,7 @@ impl HbState {
         Self {
             linear: Arc::new(linear),
             omega,
+            modal_damping: 0.0,
             aft,
         }
     }

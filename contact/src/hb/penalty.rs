@@ -376,7 +376,7 @@ impl Residual for PenaltyHb {
     fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
         let n = lin.dofs;
-        lin.dynamic_residual(self.state.omega, u, out);
+        lin.dynamic_residual(&self.state.parameters(), u, out);
         for f in 0..lin.friction.len() {
             // - G_t^T P lambda_t = + G_t^T P b tanh(y / eta).
             let b = self.friction_samples(u, f);

@@ -248,7 +248,7 @@ impl Residual for SsnHb {
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
         let (out_u, out_l) = out.split_at_mut(offset);
-        lin.dynamic_residual(self.state.omega, &x[..offset], out_u);
+        lin.dynamic_residual(&self.state.parameters(), &x[..offset], out_u);
         lin.scatter_rows(&x[offset..], -1.0, out_u);
         for i in 0..lin.normal_rows() {
             self.switching_samples(x, i);

@@ -170,6 +170,7 @@ fn bin_transfers(
     with_derivative: bool,
 ) -> Result<Bins, LcpError> {
     let (n, m, nr) = (model.dofs(), model.contact_count(), rows.len());
+    let load = lcp_load(model)?;
     let dt = 2.0 * std::f64::consts::PI / omega / nt as f64;
     let bins = nt / 2 + 1;
     let zero = c64::new(0.0, 0.0);
@@ -224,7 +225,7 @@ fn bin_transfers(
             x[(dof, c)] = c64::new(1.0, 0.0);
         }
         if with_forcing {
-            for (i, a) in model.load.iter().enumerate() {
+            for (i, a) in load.iter().enumerate() {
                 x[(i, m)] = c64::new(*a, 0.0);
             }
         }
@@ -332,6 +333,15 @@ pub(super) fn bin_symbol(scheme: LcpScheme, nt: usize, dt: f64, k: usize) -> Opt
             Some((c64::new(3.0, 0.0) - back * 4.0 + back * back) / (2.0 * dt))
         }
     }
+}
+
+/// The amplitude `f` of the model's load `f cos(w t)`; any other load is
+/// [`LcpError::Unsupported`] (the LCP's forcing is bin 1 only).
+fn lcp_load(model: &StructuralModel) -> Result<Vec<f64>, LcpError> {
+    model.load.as_cosine().ok_or(LcpError::Unsupported {
+        formulation: "the periodic LCP",
+        what: "a load other than f cos(w t) (a sine part, a constant or another harmonic)",
+    })
 }
 
 /// Fills a length-`Nt` spectrum from bins `0..=Nt/2` by conjugate symmetry.

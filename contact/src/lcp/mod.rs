@@ -241,6 +241,14 @@ pub enum LcpError {
     /// The model has no contact: there is no complementarity problem.
     #[error("the model has no contact: the periodic LCP needs at least one")]
     NoContacts,
+    /// The formulation does not model something the model declares.
+    #[error("{formulation} does not model {what}")]
+    Unsupported {
+        /// The formulation.
+        formulation: &'static str,
+        /// What it does not model.
+        what: &'static str,
+    },
     /// A contact has its obstacle on the negative side (not formulated here).
     #[error(
         "contact {contact} (dof {}, 1-based) has its obstacle on the negative side: the \

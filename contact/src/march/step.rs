@@ -144,6 +144,8 @@ pub struct TimeMarcher<'a> {
     h: f64,
     /// `cos(2 pi j / steps_per_period)`, `j = 0..=steps_per_period`.
     cosines: Vec<f64>,
+    /// The load's amplitude `f` of `f cos(w t)` (the only load marched).
+    load: Vec<f64>,
     /// Step index within the current period (0 at a period start).
     phase: usize,
     /// Periods completed.
@@ -255,6 +257,7 @@ impl<'a> TimeMarcher<'a> {
             steps_per_period: spp,
             h,
             cosines,
+            load: marched_load(model)?,
             phase: 0,
             completed_periods: 0,
             lu,
@@ -293,7 +296,7 @@ impl<'a> TimeMarcher<'a> {
     fn equilibrium_inertia(&mut self, j: usize) {
         let model = self.model;
         let c = self.cosines[j];
-        for (ri, ai) in self.r.iter_mut().zip(&model.load) {
+        for (ri, ai) in self.r.iter_mut().zip(&self.load) {
             *ri = c * ai;
         }
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
@@ -447,7 +450,7 @@ impl<'a> TimeMarcher<'a> {
         let c = self.cosines[j + 1];
         // rhs = f_{n+1} + r_n + M (4/h^2 u + 4/h v) + D (2/h u + v)
         for i in 0..n {
-            self.rhs[i] = c * model.load[i] + self.r[i];
+            self.rhs[i] = c * self.load[i] + self.r[i];
             self.tmp[i] = 4.0 / (h * h) * self.u[i] + 4.0 / h * self.v[i];
         }
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.tmp, &mut self.rhs);
@@ -494,7 +497,7 @@ impl<'a> TimeMarcher<'a> {
         let f_theta = theta * self.cosines[j + 1] + (1.0 - theta) * self.cosines[j];
         // rhs = M v - h D (1 - theta) v - h K (u + h theta (1 - theta) v) + h f_theta
         for i in 0..n {
-            self.rhs[i] = h * f_theta * model.load[i];
+            self.rhs[i] = h * f_theta * self.load[i];
         }
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.v, &mut self.rhs);
         if let Some(d) = &model.damping {
@@ -578,6 +581,15 @@ impl<'a> TimeMarcher<'a> {
         }
         Ok(())
     }
+}
+
+/// The amplitude `f` of the model's load `f cos(w t)`; any other load is
+/// [`MarchError::Unsupported`] (the march samples only that forcing).
+fn marched_load(model: &StructuralModel) -> Result<Vec<f64>, MarchError> {
+    model.load.as_cosine().ok_or(MarchError::Unsupported {
+        formulation: "time marching",
+        what: "a load other than f cos(w t) (a sine part, a constant or another harmonic)",
+    })
 }
 
 #[cfg(test)]

@@ -437,7 +437,7 @@ pub fn build_imported_with(
         mass,
         damping,
         stiffness,
-        load,
+        load: crate::model::HarmonicLoad::cosine(load),
         contacts,
         friction,
     };

@@ -4,10 +4,11 @@
 //! `G u - g <= 0, lambda <= 0, (G u - g) . lambda = 0` (lambda is the force the obstacle
 //! applies, non-positive: it pushes the structure back).
 //!
-//! The external force is `f(t) = load cos(omega t)`: the model holds the spatial shape
-//! `load`, and every formulation takes the angular frequency `omega` as an argument where it
-//! is built (and checks it: finite and `> 0`), so that one model serves every frequency of a
-//! sweep without being copied.
+//! The external force `f(t)` is a [`HarmonicLoad`] on harmonics of the forcing frequency
+//! `omega` (classically `load cos(omega t)`, [`HarmonicLoad::cosine`]): the model holds its
+//! spatial parts, and every formulation takes the angular frequency `omega` as an argument
+//! where it is built (and checks it: finite and `> 0`), so that one model serves every
+//! frequency of a sweep without being copied.
 //!
 //! [`StructuralModel::validate`] is the one check every formulation makes before using a
 //! model: square matrices of one size `N >= 1`, a load of length `N`, finite entries, and
@@ -24,10 +25,12 @@ use num_traits::Zero;
 use semismooth::{Factorize, InvalidOption, LinearSolve};
 
 mod contact;
+mod load;
 
 pub use contact::{
     ContactDirection, ContactPoint, ContactRow, FrictionPoint, InvalidRow, NormalForce,
 };
+pub use load::{HarmonicLoad, LoadHarmonic};
 
 /// Sparse symmetric matrix storage used for `M`, `D` and `K` (column-compressed, faer).
 pub type SparseMatrix = SparseColMat<usize, f64>;
@@ -42,9 +45,10 @@ pub struct StructuralModel {
     pub damping: Option<SparseMatrix>,
     /// Stiffness matrix `K` (N x N, symmetric positive definite).
     pub stiffness: SparseMatrix,
-    /// Nodal amplitudes of the external force `f(t) = load cos(omega t)` (length `N`); the
-    /// angular frequency `omega` is an argument of each formulation.
-    pub load: Vec<f64>,
+    /// The external force `f(t)` on harmonics of the forcing frequency `omega` (today's
+    /// `load cos(omega t)` is [`HarmonicLoad::cosine`]); `omega` is an argument of each
+    /// formulation.
+    pub load: HarmonicLoad,
     /// Unilateral contacts (rows of `G` and gaps `g`).
     pub contacts: Vec<ContactPoint>,
     /// Coulomb friction points (tangential rows of `G`, each under a contact's normal
@@ -92,6 +96,24 @@ pub enum InvalidModel {
         found: usize,
         /// `N`.
         dofs: usize,
+    },
+    /// The load is on a harmonic the formulation's basis does not hold.
+    #[error("model load is on harmonic {harmonic}: allowed harmonics 0..={harmonics}")]
+    LoadHarmonic {
+        /// The highest harmonic of the load.
+        harmonic: usize,
+        /// The number of harmonics `H` of the basis.
+        harmonics: usize,
+    },
+    /// A constant load (harmonic 0) was given a sine part.
+    #[error(
+        "constant load has sine part {value} on dof {dof}: allowed 0 (harmonic 0 has no sine)"
+    )]
+    ConstantLoadSine {
+        /// The dof.
+        dof: usize,
+        /// The value found.
+        value: f64,
     },
     /// A matrix entry, a load entry or a gap is NaN or infinite.
     #[error("model {part} holds a non-finite value {value}: allowed finite numbers")]
@@ -266,13 +288,7 @@ impl StructuralModel {
             }
             first_non_finite(part, matrix.val())?;
         }
-        if self.load.len() != n {
-            return Err(InvalidModel::LoadLength {
-                found: self.load.len(),
-                dofs: n,
-            });
-        }
-        first_non_finite("load", &self.load)?;
+        self.load.validate(n)?;
         contact::validate_rows(&self.contacts, &self.friction, n)?;
         Ok(())
     }
@@ -338,7 +354,7 @@ impl StructuralModel {
         }
         let mut lu = semismooth::linalg::FaerSparseLu::new();
         lu.factor(&self.stiffness).ok()?;
-        let mut rhs = self.load.clone();
+        let mut rhs = self.load.forcing_cosine();
         lu.solve_in_place(&mut rhs).ok()?;
         let load_motion: Vec<f64> = rows.iter().map(|g| g.dot(&rhs)).collect();
         let mut compliance = vec![0.0; m * m];
@@ -579,7 +595,7 @@ mod tests {
             mass: matrix(2.0, 0.5),
             damping: Some(matrix(0.2, -0.1)),
             stiffness: matrix(2.0, -1.0),
-            load: vec![0.0, 0.0, 1.0],
+            load: HarmonicLoad::cosine(vec![0.0, 0.0, 1.0]),
             contacts: vec![ContactPoint::new(2, 0.1)],
             friction: Vec::new(),
         }
@@ -600,13 +616,13 @@ mod tests {
             })
         );
         let mut m = chain();
-        m.load.push(0.0);
+        m.load = HarmonicLoad::cosine(vec![0.0; 4]);
         assert_eq!(
             m.validate(),
             Err(InvalidModel::LoadLength { found: 4, dofs: 3 })
         );
         let mut m = chain();
-        m.load[1] = f64::INFINITY;
+        m.load = HarmonicLoad::cosine(vec![0.0, f64::INFINITY, 1.0]);
         assert_eq!(
             m.validate(),
             Err(InvalidModel::NonFinite {
@@ -704,7 +720,7 @@ mod tests {
         let shared = model.shared_contact_stiffness().unwrap();
         assert!((shared - 1.0).abs() < 1e-12, "{shared}");
         model.contacts[0].gap = 0.1;
-        model.load = vec![1.0, 0.0, 1.0];
+        model.load = HarmonicLoad::cosine(vec![1.0, 0.0, 1.0]);
         let shared = model.shared_contact_stiffness().unwrap();
         assert!((shared - 1.0).abs() < 1e-12, "{shared}");
         model.contacts[1] = ContactPoint::on_side(2, 0.1, ContactDirection::Negative);

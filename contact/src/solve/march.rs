@@ -55,7 +55,7 @@ fn march_slip_limits(model: &StructuralModel, forces: &[Vec<f64>]) -> Vec<Vec<f6
 fn static_deflection(model: &StructuralModel) -> f64 {
     use semismooth::{Factorize, LinearSolve};
     let mut lu = semismooth::linalg::FaerSparseLu::new();
-    let mut u = model.load.clone();
+    let mut u = model.load.forcing_cosine();
     match lu
         .factor(&model.stiffness)
         .and_then(|_| lu.solve_in_place(&mut u))

@@ -480,7 +480,7 @@ impl HbStability {
                     restitution: (leave / approach).min(1.0),
                     displacement: at.displacement,
                     velocity: arrival.velocity,
-                    load_phase: (2.0 * std::f64::consts::PI * time).cos(),
+                    load_phase: 2.0 * std::f64::consts::PI * time,
                 });
             }
             *closed = kept;
@@ -509,7 +509,7 @@ struct Rebound {
     restitution: f64,
     displacement: Vec<f64>,
     velocity: Vec<f64>,
-    /// `cos(omega t)` at the impact.
+    /// The load's phase `omega t` at the impact.
     load_phase: f64,
 }
 

@@ -55,7 +55,7 @@ use std::collections::HashMap;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{c64, Mat};
 
-use crate::model::{SparseMatrix, StructuralModel};
+use crate::model::{HarmonicLoad, SparseMatrix, StructuralModel};
 
 /// Relative pivot below which a block that must be inverted is singular.
 const SINGULAR_PIVOT: f64 = 1e-12;
@@ -111,7 +111,7 @@ pub(crate) struct PhaseModel {
     first_order_massless: bool,
     contact_dofs: Vec<usize>,
     /// The load's spatial shape (`f(t) = load cos(omega t)`).
-    load: Vec<f64>,
+    load: HarmonicLoad,
     closed: ClosedContact,
     phases: HashMap<Vec<usize>, Phase>,
 }
@@ -247,7 +247,7 @@ impl PhaseModel {
 
     /// The saltation (on the coordinates of the phase `pre`) of an impact of contact
     /// `contact` with restitution `e` followed by free flight, at the orbit's state
-    /// `(q, v)` just before it with the load's phase `cos(omega t) = load_phase`:
+    /// `(q, v)` just before it with the load's phase `omega t = load_phase`:
     /// `dq+ = dq - (1 + e) w dq_c`, `dv+ = P_e dv + (1 + e) (M^{-1} D_eff w + w a_c / v_c) dq_c`,
     /// `P_e = I - (1 + e) w e_c^T` (module documentation). `None` when the dof is not a
     /// massive dof of `pre` or `pre` has first-order massless dofs.
@@ -262,9 +262,11 @@ impl PhaseModel {
         let dof = self.contact_dofs[contact];
         let n = self.n;
         // Free acceleration of the massive dofs: M_aa a = f_a - (K q)_a - (D v)_a.
+        let mut load = vec![0.0; n];
+        self.load.at_phase(load_phase, &mut load);
         let force: Vec<f64> = (0..n)
             .map(|i| {
-                let mut f = self.load[i] * load_phase;
+                let mut f = load[i];
                 for j in 0..n {
                     f -= self.stiffness[(i, j)] * q[j];
                     if let Some(d) = &self.damping {

@@ -2,7 +2,9 @@
 //! shared by a test and an example.
 
 use faer::sparse::Triplet;
-use semismooth_contact::model::{ContactPoint, SparseMatrix, StructuralModel, Structure};
+use semismooth_contact::model::{
+    ContactPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
+};
 
 fn matrix(entries: &[(usize, usize, f64)]) -> SparseMatrix {
     let t: Vec<_> = entries
@@ -27,7 +29,7 @@ pub fn chain(gap: f64, zeta: f64, load: [f64; 2]) -> Structure {
             (1, 1, c),
         ])),
         stiffness: matrix(&[(0, 0, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)]),
-        load: load.to_vec(),
+        load: HarmonicLoad::cosine(load.to_vec()),
         contacts: vec![ContactPoint::new(1, gap)],
         friction: Vec::new(),
     };

@@ -145,7 +145,8 @@ pub fn exact_linear(model: &StructuralModel, w: f64) -> DVector<Complex<f64>> {
     let a = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
         Complex::new(k[(i, j)] - w * w * m[(i, j)], w * d[(i, j)])
     });
-    let f = DVector::from_fn(k.nrows(), |i, _| Complex::new(model.load[i], 0.0));
+    let load = model.load.forcing_cosine();
+    let f = DVector::from_fn(k.nrows(), |i, _| Complex::new(load[i], 0.0));
     a.lu().solve(&f).expect("regular dynamic stiffness")
 }
 

@@ -10,7 +10,8 @@ fn response_at_symbol(model: &StructuralModel, s: Complex<f64>) -> DVector<Compl
     let z = DMatrix::from_fn(k.nrows(), k.ncols(), |i, j| {
         s * s * m[(i, j)] + s * d[(i, j)] + k[(i, j)]
     });
-    let f = DVector::from_fn(k.nrows(), |i, _| Complex::new(model.load[i], 0.0));
+    let load = model.load.forcing_cosine();
+    let f = DVector::from_fn(k.nrows(), |i, _| Complex::new(load[i], 0.0));
     z.lu().solve(&f).unwrap()
 }
 

@@ -116,13 +116,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         }
         (Some(raw_rod), None, None) => {
             let mut rod = ck.rod(raw_rod)?;
-            if raw.forcing.vector.is_some() {
-                return Err(ck.invalid(
-                    "forcing.vector",
-                    "given in a [rod] scene",
-                    "`load` (\"distributed\" or \"tip\"); `vector` belongs to [model] scenes",
-                ));
-            }
+            ck.load_parts(&raw.forcing, false, 0)?;
             rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
             (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
             if let Some(c) = raw.contact {
@@ -180,6 +174,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         ck.friction_method(&solver, m)?;
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
+    let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
     Ok(Scene {
         path: path.to_path_buf(),
         title: raw.title,
@@ -187,6 +182,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         model,
         bladed_disk,
         output_dof,
+        load_parts,
         solver,
         sweep,
     })

@@ -32,9 +32,11 @@ use semismooth_contact::rod::{
 mod check;
 mod contacts;
 mod disk;
+mod load_parts;
 mod overrides;
 
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
+pub use load_parts::{add_load_parts, LoadPart};
 
 pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
 
@@ -64,6 +66,9 @@ pub struct Scene {
     /// `[output] dof`, 0-based: the dof that `tip_*` outputs and plots describe (default: the
     /// rod's tip; for a `[model]` scene the first contact dof).
     pub output_dof: Option<usize>,
+    /// The load parts of a `[model]` scene beyond its cosine `vector` (`[forcing]
+    /// vector_sin`, `static`, `[[forcing.harmonic]]`), added when its structure is built.
+    pub load_parts: Vec<LoadPart>,
     /// Solver settings.
     pub solver: SolverSettings,
     /// Frequency sweep, if declared.
@@ -150,6 +155,10 @@ enum RawLoad {
 struct RawForcing {
     load: Option<RawLoad>,
     vector: Option<String>,
+    vector_sin: Option<String>,
+    #[serde(rename = "static")]
+    constant: Option<String>,
+    harmonic: Option<Vec<load_parts::RawForcingHarmonic>>,
     amplitude: f64,
     omega_ratio: Option<f64>,
     omega: Option<f64>,

@@ -87,8 +87,7 @@ impl StructuredHbSolver {
                 // The preconditioner no longer captures the coupling at this iterate:
                 // factor the dense condensed matrix here and go on from GMRES's last
                 // iterate with it.
-                let omega = self.factored_for.as_ref().map_or(0.0, |(_, w)| *w);
-                if let Err(e) = self.factor_dense_preconditioner(omega) {
+                if let Err(e) = self.factor_dense_preconditioner() {
                     self.work_u = w;
                     return Err(e);
                 }
@@ -169,13 +168,10 @@ impl StructuredHbSolver {
     }
 
     /// Matrix-free path: forms the dense condensed matrix at the current `Q` (the full
-    /// receptance at `omega` first, when not yet computed there), factors it and makes it
+    /// receptance at the factored parameters first, when not yet computed there), factors it and makes it
     /// GMRES's preconditioner until it needs more than [`DENSE_REFRESH_ITERATIONS`].
-    pub(super) fn factor_dense_preconditioner(
-        &mut self,
-        omega: f64,
-    ) -> Result<(), LinearSolveError> {
-        let Some((lin, _)) = self.factored_for.clone() else {
+    pub(super) fn factor_dense_preconditioner(&mut self) -> Result<(), LinearSolveError> {
+        let Some((lin, parameters)) = self.factored_for.clone() else {
             return Err(LinearSolveError::NotFactored);
         };
         let (m, size) = (lin.contacts(), lin.size());
@@ -183,9 +179,12 @@ impl StructuredHbSolver {
         if self.schur.nrows() != nc {
             self.allocate_condensed_lu(nc, "allocating the dense condensed preconditioner")?;
         }
-        if self.receptance_omega != Some(omega.to_bits()) {
+        if !self
+            .receptance_parameters
+            .is_some_and(|p| p.same_as(&parameters))
+        {
             self.full_receptance(&lin)?;
-            self.receptance_omega = Some(omega.to_bits());
+            self.receptance_parameters = Some(parameters);
         }
         self.factor_condensed_equilibrated_if_needed(lin.dofs * size, m)?;
         self.dense_preconditioner = true;

@@ -2,11 +2,11 @@
 //! condensation onto the `m (2H + 1)` contact unknowns (receptance / Schur complement).
 //!
 //! For harmonic `k >= 1` the real `2N x 2N` block on `(u_ck, u_sk)` is equivalent to the
-//! complex `N x N` matrix `Z_k = K - (k w)^2 M + i k w D` acting on `z = u_c - i u_s`
-//! (`k = 0`: `K` on `u_0`). Each `Z_k` is factored once per frequency by the crate's
-//! dynamic stiffness (sparse LU; column ordering once per model, numeric factorization per
-//! frequency into reused storage, rejected only on a zero pivot), so the cost is linear in
-//! `N` for banded models. The receptance `R_k = G Z_k^{-1} G^T` (`m x m` complex) maps contact-force
+//! complex `N x N` block `Z_k(w, p)` of the harmonic operator ([`crate::operator`]) acting
+//! on `z = u_c - i u_s` (`k = 0`: `K` on `u_0`). Each `Z_k` is factored once per change of
+//! the operator's parameters by its factors (sparse LU; column ordering once per model,
+//! numeric factorization into reused storage, rejected only on a zero pivot), so the cost
+//! is linear in `N` for banded models. The receptance `R_k = G Z_k^{-1} G^T` (`m x m` complex) maps contact-force
 //! coefficients to contact-displacement coefficients.
 //!
 //! SSN-HB, `J = [[A, -G^T], [c Q G, I - Q]]`: with `w = A^{-1} r_u` and `y = G w`,
@@ -35,8 +35,8 @@ use semismooth::{Factorize, LinearSolve};
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::LinearData;
-use crate::dynamic::DynamicStiffness;
 use crate::model::ContactRow;
+use crate::operator::{HarmonicFactors, HarmonicParameters};
 
 mod cross_blocks;
 mod matrix_free;
@@ -95,10 +95,10 @@ impl CondensedSolve {
 pub struct StructuredHbSolver {
     /// The model the workspaces are sized for, and its dynamic stiffness with one
     /// factorization slot per harmonic `k = 0..=H`.
-    dynamic: Option<(Arc<LinearData>, DynamicStiffness)>,
-    /// Jacobian whose dynamic part is currently factored (only its `linear` and `omega`
-    /// matter).
-    factored_for: Option<(Arc<LinearData>, f64)>,
+    dynamic: Option<(Arc<LinearData>, HarmonicFactors)>,
+    /// Jacobian whose dynamic part is currently factored (only its `linear` and
+    /// `parameters` matter).
+    factored_for: Option<(Arc<LinearData>, HarmonicParameters)>,
     /// `Z_k^{-1} G^T` (N x m) per harmonic `k = 0..=H`.
     response: Vec<Mat<c64>>,
     /// `R_k = G Z_k^{-1} G^T` (m x m) per harmonic.
@@ -145,8 +145,8 @@ pub struct StructuredHbSolver {
     /// The dense preconditioner is refactored at the next iterate (it needed more than
     /// [`DENSE_REFRESH_ITERATIONS`] GMRES iterations).
     refresh_dense: bool,
-    /// Frequency (bits of `w`) of the full receptance `receptance` on the matrix-free path.
-    receptance_omega: Option<u64>,
+    /// Parameters of the full receptance `receptance` on the matrix-free path.
+    receptance_parameters: Option<HarmonicParameters>,
     dense_preconditioner_factorizations: u64,
 }
 
@@ -205,7 +205,7 @@ impl StructuredHbSolver {
             block_rhs: Mat::zeros(0, 0),
             dense_preconditioner: false,
             refresh_dense: false,
-            receptance_omega: None,
+            receptance_parameters: None,
             dense_preconditioner_factorizations: 0,
         }
     }
@@ -252,8 +252,8 @@ impl StructuredHbSolver {
         self.schur_factorizations
     }
 
-    /// Receptance `R_k = G (K - (k w)^2 M + i k w D)^{-1} G^T` of harmonic `k` (m x m,
-    /// complex) at the last factored frequency.
+    /// Receptance `R_k = G Z_k(w, p)^{-1} G^T` of harmonic `k` (m x m, complex; `Z_k` the
+    /// harmonic operator's block) at the last factored parameters.
     pub fn receptance(&self, k: usize) -> Option<&Mat<c64>> {
         self.receptance.get(k)
     }
@@ -281,13 +281,7 @@ impl StructuredHbSolver {
         } else {
             m.max(1)
         };
-        let dynamic = DynamicStiffness::new(
-            &lin.stiffness,
-            &lin.mass,
-            lin.damping.as_ref(),
-            h + 1,
-            columns,
-        )?;
+        let dynamic = lin.operator.factors(columns)?;
         self.complex_rhs = Mat::zeros(n, 1);
         self.work_u = vec![0.0; n * size];
         self.work_a = vec![0.0; nc];
@@ -305,7 +299,7 @@ impl StructuredHbSolver {
             self.schur = Mat::zeros(0, 0);
             self.dense_preconditioner = false;
             self.refresh_dense = false;
-            self.receptance_omega = None;
+            self.receptance_parameters = None;
         } else {
             self.allocate_condensed_lu(nc, "allocating the condensed LU workspace")?;
             self.response = (0..=h).map(|_| Mat::zeros(n, m)).collect();
@@ -315,7 +309,7 @@ impl StructuredHbSolver {
         Ok(())
     }
 
-    /// Factors `Z_k = K - (k w)^2 M + i k w D` for every harmonic and forms the responses
+    /// Factors every harmonic's `Z_k(w, p)` (unless factored there) and forms the responses
     /// `Z_k^{-1} G^T` and receptances `G Z_k^{-1} G^T` (no allocation once prepared).
     fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
         let lin = jac.linear.clone();
@@ -323,28 +317,8 @@ impl StructuredHbSolver {
         let Some((_, dynamic)) = &mut self.dynamic else {
             return Err(LinearSolveError::NotFactored);
         };
-        let n = lin.dofs;
+        dynamic.factor(&jac.parameters)?;
         for k in 0..=lin.basis.harmonics() {
-            let kw = k as f64 * jac.omega;
-            dynamic
-                .factor(k, c64::new(-kw * kw, 0.0), c64::new(0.0, kw))
-                .map_err(|e| match e {
-                    // The pivot's dof, as an unknown of the cosine block of harmonic k.
-                    LinearSolveError::Singular {
-                        index,
-                        pivot,
-                        max_pivot,
-                    } => LinearSolveError::Singular {
-                        index: if k == 0 {
-                            index
-                        } else {
-                            (2 * k - 1) * n + index
-                        },
-                        pivot,
-                        max_pivot,
-                    },
-                    other => other,
-                })?;
             if self.krylov {
                 // R_k,ii only.
                 let diagonal = &mut self.receptance_diagonal;
@@ -371,46 +345,17 @@ impl StructuredHbSolver {
                 }
             }
         }
-        self.factored_for = Some((lin, jac.omega));
+        self.factored_for = Some((lin, jac.parameters));
         self.dynamic_factorizations += 1;
         Ok(())
     }
 
-    /// `u <- A(w)^{-1} u` harmonic by harmonic (complex form).
+    /// `u <- A(w, p)^{-1} u` harmonic by harmonic (complex form).
     pub(crate) fn apply_dynamic_inverse(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
-        let (Some((_, dynamic)), Some((lin, _))) = (&mut self.dynamic, &self.factored_for) else {
+        let (Some((_, dynamic)), Some(_)) = (&mut self.dynamic, &self.factored_for) else {
             return Err(LinearSolveError::NotFactored);
         };
-        let n = lin.dofs;
-        // Harmonic k of `u` as one complex vector: `u_0` (k = 0), `u_ck - i u_sk` (k >= 1).
-        let (constant, harmonics) = u.split_at_mut(n);
-        for (z, &a) in first_column(&mut self.complex_rhs)
-            .iter_mut()
-            .zip(&*constant)
-        {
-            *z = c64::new(a, 0.0);
-        }
-        dynamic.solve_in_place(0, self.complex_rhs.as_mut())?;
-        for (a, z) in constant
-            .iter_mut()
-            .zip(first_column(&mut self.complex_rhs).iter())
-        {
-            *a = z.re;
-        }
-        for (k, pair) in harmonics.chunks_exact_mut(2 * n).enumerate() {
-            let (cosine, sine) = pair.split_at_mut(n);
-            let rhs = first_column(&mut self.complex_rhs);
-            for ((z, &a), &b) in rhs.iter_mut().zip(&*cosine).zip(&*sine) {
-                *z = c64::new(a, -b);
-            }
-            dynamic.solve_in_place(k + 1, self.complex_rhs.as_mut())?;
-            let rhs = first_column(&mut self.complex_rhs);
-            for ((z, a), b) in rhs.iter().zip(cosine.iter_mut()).zip(sine.iter_mut()) {
-                *a = z.re;
-                *b = -z.im;
-            }
-        }
-        Ok(())
+        dynamic.solve_real(u)
     }
 
     /// `u += alpha A^{-1} G^T p` for contact coefficients `p` (index `j m + i`).
@@ -442,18 +387,10 @@ impl StructuredHbSolver {
     }
 }
 
-/// The first column of `rhs` as a slice (an owned matrix's columns are contiguous).
-fn first_column(rhs: &mut Mat<c64>) -> &mut [c64] {
-    rhs.col_mut(0)
-        .try_as_col_major_mut()
-        .expect("a column of an owned matrix is contiguous")
-        .as_slice_mut()
-}
-
 /// `Z_k^{-1} G^T`, a block of contacts' columns at a time (as many as `block` has): calls
 /// `visit(first, z)` with the columns of contacts `first..first + z.ncols()`.
 fn receptance_columns(
-    dynamic: &mut DynamicStiffness,
+    dynamic: &mut HarmonicFactors,
     lin: &LinearData,
     k: usize,
     block: &mut Mat<c64>,
@@ -529,7 +466,7 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
     fn factor(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
         self.schur_ready = false;
         let reuse = matches!(&self.factored_for,
-            Some((lin, omega)) if Arc::ptr_eq(lin, &jac.linear) && omega.to_bits() == jac.omega.to_bits());
+            Some((lin, p)) if Arc::ptr_eq(lin, &jac.linear) && p.same_as(&jac.parameters));
         if !reuse {
             self.factored_for = None;
             self.factor_dynamic(jac)?;
@@ -557,7 +494,7 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
                 return Ok(());
             }
             if self.dense_preconditioner {
-                return self.factor_dense_preconditioner(jac.omega);
+                return self.factor_dense_preconditioner();
             }
             return self.factor_preconditioner();
         }
@@ -683,12 +620,12 @@ impl StructuredHbSolver {
 impl StructuredHbSolver {
     /// `out = J x` with the Jacobian last factored (structured product, no assembly).
     fn apply_jacobian(&mut self, x: &[f64], out: &mut [f64]) {
-        let Some((lin, omega)) = self.factored_for.clone() else {
+        let Some((lin, parameters)) = self.factored_for.clone() else {
             return;
         };
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let nu = n * size;
-        lin.apply_dynamic(omega, &x[..nu], &mut out[..nu]);
+        lin.apply_dynamic(&parameters, &x[..nu], &mut out[..nu]);
         gather_contacts(&lin, &x[..n * size], &mut self.work_a);
         apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
         match self.coupling {
