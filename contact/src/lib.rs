@@ -14,6 +14,7 @@ mod dynamic;
 pub mod exact;
 pub mod from_zero;
 pub mod hb;
+pub mod import;
 pub mod lcp;
 pub mod march;
 pub mod matrix_market;

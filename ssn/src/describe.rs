@@ -179,8 +179,17 @@ pub fn describe_imported(
         printable(&spec.stiffness.display().to_string()),
         spec.damping_matrix.as_ref().map_or(String::new(), |d| {
             format!(", D = {}", printable(&d.display().to_string()))
-        })
+        }),
     ));
+    if let Some(m) = &spec.dof_map {
+        let nodes = m.map.node_range().unwrap_or((0, 0));
+        line(format!(
+            "dof map           {}: nodes {}..={}",
+            printable(&m.path.display().to_string()),
+            nodes.0,
+            nodes.1
+        ));
+    }
     line(format!(
         "unknowns          {} dofs ({massless} with a zero mass diagonal), {} stored entries in K",
         model.dofs(),
