@@ -143,7 +143,7 @@ fn a_malformed_or_short_dof_map_is_refused_with_its_file_and_line() {
         ),
         (
             map.lines().take(11).map(|l| format!("{l}\n")).collect(),
-            &["nodes.dof", "dof map is 11 x 1", "12 rows"],
+            &["nodes.dof", "the dof map has 11 rows", "allowed 12"],
         ),
     ];
     for (text, words) in cases {

@@ -106,12 +106,13 @@ const ALLOWED_LINE: &str = "`node.component` (as CalculiX's .dof files, e.g. `12
                             `node component`, node >= 1, component 1..=6 (1, 2, 3: x, y, z)";
 
 impl DofMap {
-    /// The map whose row `k` is `rows[k]`; `Err(k)` when `rows[k]` repeats an earlier row.
-    pub fn new(rows: Vec<NodeComponent>) -> Result<Self, usize> {
+    /// The map whose row `k` is `rows[k]`; `Err((first, k))` when `rows[k]` repeats
+    /// `rows[first]`.
+    pub fn new(rows: Vec<NodeComponent>) -> Result<Self, (usize, usize)> {
         let mut index = HashMap::with_capacity(rows.len());
         for (k, r) in rows.iter().enumerate() {
-            if index.insert(*r, k).is_some() {
-                return Err(k);
+            if let Some(first) = index.insert(*r, k) {
+                return Err((first, k));
             }
         }
         Ok(Self { rows, index })
@@ -157,29 +158,36 @@ impl DofMap {
 
     /// Parses dof map text (`path` for messages only).
     pub fn parse(text: &str, path: &Path) -> Result<Self, DofMapError> {
+        let data = || {
+            text.lines().enumerate().filter(|(_, line)| {
+                let t = line.trim();
+                !(t.is_empty() || t.starts_with('#'))
+            })
+        };
         let mut rows = Vec::new();
-        let mut lines = Vec::new();
-        for (k, line) in text.lines().enumerate() {
+        for (k, line) in data() {
             let t = line.trim();
-            if t.is_empty() || t.starts_with('#') {
-                continue;
-            }
             rows.push(node_component(t).map_err(|m| line_error(path, k + 1, t, &m))?);
-            lines.push(k + 1);
         }
         if rows.is_empty() {
             return Err(DofMapError::Empty {
                 path: path.to_path_buf(),
             });
         }
-        Self::new(rows.clone()).map_err(|k| {
-            let first = rows.iter().position(|r| *r == rows[k]).unwrap_or(k);
+        Self::new(rows).map_err(|(first, k)| {
+            // The lines of the two rows (data lines are counted again: a rare path).
+            let line = |row: usize| data().nth(row).map_or(0, |(l, _)| l + 1);
+            let again = data().nth(k).map(|(_, l)| l.trim()).unwrap_or("");
+            let r = node_component(again).unwrap_or(NodeComponent {
+                node: 0,
+                component: 0,
+            });
             DofMapError::Duplicate {
                 path: path.to_path_buf(),
-                line: lines[k],
-                first_line: lines[first],
-                node: rows[k].node,
-                component: rows[k].component,
+                line: line(k),
+                first_line: line(first),
+                node: r.node,
+                component: r.component,
             }
         })
     }

@@ -27,6 +27,8 @@
 //! Damping `StiffnessProportional { zeta }` gives `D = (2 zeta / omega_1) K`, `Rayleigh`
 //! gives `D = alpha M + beta K`, exactly as for the rod.
 
+use std::sync::Arc;
+
 use faer::sparse::Triplet;
 use semismooth::linalg::FaerSparseLu;
 use semismooth::Factorize;
@@ -60,8 +62,9 @@ pub struct ModelParts {
     pub damping: Option<SparseMatrix>,
     /// The load shape `f`, `N x 1` (applied as `amplitude * f * cos(omega t)`).
     pub load: SparseMatrix,
-    /// The node and component of each row, when the format gives them.
-    pub dof_map: Option<DofMap>,
+    /// The node and component of each row, when the format gives them (shared: a map of
+    /// every row of a large model is not copied).
+    pub dof_map: Option<Arc<DofMap>>,
 }
 
 /// A contact of an imported model: its row of `G` on 0-based dofs, its gap and its friction.
@@ -222,6 +225,14 @@ pub enum ModelError {
         /// The storage's message.
         message: String,
     },
+    /// The dof map does not have one row per matrix row.
+    #[error("the dof map has {rows} rows: allowed {dofs} (one per matrix row)")]
+    DofMapRows {
+        /// Rows of the map.
+        rows: usize,
+        /// `N`.
+        dofs: usize,
+    },
     /// An entry of `amplitude x load` is too large.
     #[error(
         "the load amplitude x load vector entry {row} = {value:e}: allowed magnitudes of at \
@@ -308,11 +319,9 @@ pub fn assemble(parts: ModelParts, attach: &Attachments) -> Result<Structure, Mo
     let load = scaled_load(&load, n, attach.amplitude)?;
     if let Some(map) = &dof_map {
         if map.len() != n {
-            return Err(ModelError::Size {
-                part: Part::DofMap,
+            return Err(ModelError::DofMapRows {
                 rows: map.len(),
-                cols: 1,
-                expected: format!("{n} rows (one per matrix row)"),
+                dofs: n,
             });
         }
     }

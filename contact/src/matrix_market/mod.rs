@@ -19,6 +19,7 @@
 //! error (of the scene).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::import::{assemble, Attachments, DofMap, DofUse, ModelError, ModelParts, Part};
 use crate::model::{SparseMatrix, Structure};
@@ -39,8 +40,8 @@ pub use crate::model::ContactDirection;
 pub struct DofMapFile {
     /// The file (for messages).
     pub path: PathBuf,
-    /// Its rows.
-    pub map: DofMap,
+    /// Its rows (shared by the scene's copies).
+    pub map: Arc<DofMap>,
 }
 
 /// Everything a `[model]` scene declares (paths resolved against the scene's directory).
@@ -240,6 +241,14 @@ pub enum ImportError {
         /// `N`.
         dofs: usize,
     },
+    /// A defect of a part as [`crate::import::assemble`] names it, with the part's file.
+    #[error("{path}: {source}")]
+    Part {
+        /// The part's file.
+        path: PathBuf,
+        /// The defect.
+        source: ModelError,
+    },
     /// Any other defect of the assembled model or of the forcing frequency.
     #[error("{scene}: {reason}")]
     Model {
@@ -350,6 +359,10 @@ impl ImportError {
             | ModelError::FrequencyOutOfRange { .. }) => ImportError::Stiffness {
                 path: spec.stiffness.clone(),
                 reason: e.to_string(),
+            },
+            e @ ModelError::DofMapRows { .. } => ImportError::Part {
+                path: file(Part::DofMap),
+                source: e,
             },
             ModelError::Invalid(reason) => ImportError::Model {
                 scene: spec.scene.clone(),

@@ -497,6 +497,7 @@ impl Check<'_> {
                 let path = file("model.dof_map", &name)?;
                 let map = DofMap::read(&path)
                     .map_err(|e| SceneError::parse(self.path, format!("`model.dof_map`: {e}")))?;
+                let map = std::sync::Arc::new(map);
                 Ok(DofMapFile { path, map })
             })
             .transpose()?;
