@@ -162,3 +162,22 @@ fn a_malformed_or_short_dof_map_is_refused_with_its_file_and_line() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn scene_check_names_the_rows_of_a_node_scene_with_their_node_and_component() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ssn"))
+        .arg("scene-check")
+        .arg(fixture().join("by_node.toml"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    // Rows 7 and 1 are the lines `9.1` and `30.2` of nodes.dof.
+    for w in [
+        "nodes.dof: nodes 4..=30",
+        "dof 7 (node 9, component 1), gap 0.01",
+        "observed dof      1 (node 30, component 2)",
+    ] {
+        assert!(text.contains(w), "`{w}` not in:\n{text}");
+    }
+}
