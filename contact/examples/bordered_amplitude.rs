@@ -22,7 +22,8 @@ fn main() {
     let rod = build_rod(&RodSpec::canonical().with_tip_gap(None)).expect("the canonical rod");
     let (s, w) = (&rod.structure, rod.omega());
     let (model, o) = (&s.model, s.observed_dof);
-    let (n, target) = (model.load.len(), 0.5); // the canonical stop's gap
+    let load = model.load.forcing_cosine();
+    let (n, target) = (load.len(), 0.5); // the canonical stop's gap
     let (k, m) = (&model.stiffness, &model.mass);
     let d = model.damping.as_ref().expect("a damped rod");
     // J = [[K - w^2 M, w D], [-w D, K - w^2 M]] on (u_c, u_s).
@@ -40,7 +41,7 @@ fn main() {
     }
     let jac = SparseColMat::try_new_from_triplets(2 * n, 2 * n, &t).expect("the HB block");
     let mut b = vec![0.0; 2 * n]; // B = -(f, 0)
-    (0..n).for_each(|i| b[i] = -model.load[i]);
+    (0..n).for_each(|i| b[i] = -load[i]);
     // Newton on (U, a) from a guess with the phase of resonance: the tip's sine part at
     // the target (the root a > 0; -a gives the same amplitude).
     let (mut u, mut a) = (vec![0.0; 2 * n], 1.0);
@@ -80,7 +81,7 @@ fn main() {
             z[(e.row, e.col)] += scale * *e.val;
         }
     }
-    let mut x = Mat::<c64>::from_fn(n, 1, |i, _| c64::new(model.load[i], 0.0));
+    let mut x = Mat::<c64>::from_fn(n, 1, |i, _| c64::new(load[i], 0.0));
     PartialPivLu::new(z.as_ref()).solve_in_place(x.as_mut());
     let closed_form = target / x[(o, 0)].norm();
     let counters = bordered.counters();

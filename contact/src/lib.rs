@@ -15,6 +15,7 @@ mod error;
 pub mod exact;
 pub mod from_zero;
 pub mod hb;
+pub mod import;
 pub mod lcp;
 pub mod march;
 pub mod matrix_market;

@@ -179,8 +179,17 @@ pub fn describe_imported(
         printable(&spec.stiffness.display().to_string()),
         spec.damping_matrix.as_ref().map_or(String::new(), |d| {
             format!(", D = {}", printable(&d.display().to_string()))
-        })
+        }),
     ));
+    if let Some(m) = &spec.dof_map {
+        let nodes = m.map.node_range().unwrap_or((0, 0));
+        line(format!(
+            "dof map           {}: nodes {}..={}",
+            printable(&m.path.display().to_string()),
+            nodes.0,
+            nodes.1
+        ));
+    }
     line(format!(
         "unknowns          {} dofs ({massless} with a zero mass diagonal), {} stored entries in K",
         model.dofs(),
@@ -206,7 +215,7 @@ pub fn describe_imported(
         let row = match c.row.single() {
             Some((dof, a)) if a.abs() == 1.0 => format!(
                 "dof {}, gap {}, obstacle on the {} side",
-                dof + 1,
+                dof_words(spec, dof),
                 c.gap,
                 if a > 0.0 { "positive" } else { "negative" }
             ),
@@ -229,9 +238,24 @@ pub fn describe_imported(
             row_words(&f.tangent)
         ));
     }
-    line(format!("observed dof      {}", structure.observed_dof + 1));
+    line(format!(
+        "observed dof      {}",
+        dof_words(spec, structure.observed_dof)
+    ));
     out.push_str(&describe_run(scene, structure));
     out
+}
+
+/// The 0-based `dof` as a scene names it: `7`, or `7 (node 9, component 1)` with a dof map.
+fn dof_words(spec: &ModelSpec, dof: usize) -> String {
+    let node = spec
+        .dof_map
+        .as_ref()
+        .and_then(|m| m.map.node_component(dof));
+    match node {
+        Some(r) => format!("{} (node {}, component {})", dof + 1, r.node, r.component),
+        None => (dof + 1).to_string(),
+    }
 }
 
 /// A row of `G` in words: `1 u[41] - 1 u[83]` (1-based dofs).

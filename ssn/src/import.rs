@@ -1,7 +1,7 @@
 //! Any scene's structure exported as a `[model]` scene (`ssn export-model`).
 
 use semismooth_contact::matrix_market::{matrix_market_text, vector_market_text};
-use semismooth_contact::model::{ContactRow, NormalForce, Structure};
+use semismooth_contact::model::{ContactRow, NormalForce, StructuralModel, Structure};
 use semismooth_contact::rod::FrequencySpec;
 use semismooth_contact::settings::SolverSettings;
 
@@ -26,7 +26,6 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
         "f.mtx".to_string(),
         vector_market_text(&model.load.forcing_cosine()),
     ));
-    let frequency = scene.frequency();
     let mut t = String::new();
     let title = scene.title.as_deref().unwrap_or("untitled");
     // A TOML string (TOML's escapes, not Rust's `{:?}` ones, which TOML cannot read).
@@ -37,10 +36,29 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
         let _ = writeln!(t, "damping = \"D.mtx\"");
     }
     let _ = writeln!(t, "\n[forcing]\nvector = \"f.mtx\"\namplitude = 1.0");
-    let _ = match frequency {
+    let _ = match scene.frequency() {
         FrequencySpec::Ratio(r) => writeln!(t, "omega_ratio = {r:?}"),
         FrequencySpec::Absolute(w) => writeln!(t, "omega = {w:?}"),
     };
+    t.push_str(&contact_sections(model));
+    let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);
+    t.push_str(&solver_section(&scene.solver));
+    if let Some(sw) = &scene.sweep {
+        let _ = writeln!(
+            t,
+            "\n[sweep]\nomega_ratio_from = {:?}\nomega_ratio_to = {:?}\nstep = {:?}\nmin_step = {:?}\nmax_step = {:?}\nmax_points = {}",
+            sw.omega_ratio_from, sw.omega_ratio_to, sw.step, sw.min_step, sw.max_step, sw.max_points
+        );
+    }
+    files.push((EXPORTED_SCENE.to_string(), t));
+    files
+}
+
+/// The `[[contact.point]]` (with their friction) and `[[friction.point]]` sections of
+/// `model`.
+fn contact_sections(model: &StructuralModel) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
     for (i, c) in model.contacts.iter().enumerate() {
         let _ = writeln!(
             t,
@@ -71,8 +89,14 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
             );
         }
     }
-    let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);
-    let v = &scene.solver;
+    t
+}
+
+/// The `[solver]` section of the settings `v` (the keys that differ from the defaults where
+/// a default is implicit).
+fn solver_section(v: &SolverSettings) -> String {
+    use std::fmt::Write;
+    let mut t = String::new();
     let _ = writeln!(t, "\n[solver]\nmethod = \"{}\"", v.method.name());
     let _ = writeln!(
         t,
@@ -110,15 +134,7 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
         v.restitution,
         v.lcp_scheme.name()
     );
-    if let Some(sw) = &scene.sweep {
-        let _ = writeln!(
-            t,
-            "\n[sweep]\nomega_ratio_from = {:?}\nomega_ratio_to = {:?}\nstep = {:?}\nmin_step = {:?}\nmax_step = {:?}\nmax_points = {}",
-            sw.omega_ratio_from, sw.omega_ratio_to, sw.step, sw.min_step, sw.max_step, sw.max_points
-        );
-    }
-    files.push((EXPORTED_SCENE.to_string(), t));
-    files
+    t
 }
 
 /// The scene keys of a row, one per line: `dof` (with `direction` when `with_direction`:

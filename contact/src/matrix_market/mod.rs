@@ -1,54 +1,29 @@
-//! Imported structures: a `[model]` scene's Matrix Market files resolved into the
-//! [`Structure`] every method runs on, and the inverse, a rod written as such files.
+//! Matrix Market files of an imported structure: the reader of the format-neutral
+//! [`ModelParts`] for a `[model]` scene ([`ModelSpec`]: the files and what the scene
+//! attaches to them), and the inverse, a structure written as such files.
 //!
-//! The files hold the matrices of `M u'' + D u' + K u = f(t) + G^T lambda(t)` on the free
-//! dofs (the finite-element code has already removed the constrained ones): `M`, `K` and an
-//! optional `D`, `N x N`, and the load shape `f`, `N x 1`, applied as
-//! `amplitude * f * cos(omega t)`. Matrix Market coordinate (real or integer; general,
-//! symmetric or skew-symmetric, the lower triangle then mirrored) and array formats are
-//! read by [`read_matrix`] as the file goes, from regular files only, with the declared size
-//! checked before it is allocated and every defect named with its line (nalgebra-sparse's
-//! reader reads any file whole, allocates what the header declares and reports neither the
-//! line nor the value); duplicate coordinate entries are summed (assembly).
+//! The files hold `M`, `K` and an optional `D`, `N x N`, and the load shape `f`, `N x 1`
+//! (module [`crate::import`] for what they mean and how they are checked). Matrix Market
+//! coordinate (real or integer; general, symmetric or skew-symmetric, the lower triangle
+//! then mirrored) and array formats are read by [`read_matrix`] as the file goes, from
+//! regular files only, with the declared size checked before it is allocated and every
+//! defect named with its line (nalgebra-sparse's reader reads any file whole, allocates what
+//! the header declares and reports neither the line nor the value); duplicate coordinate
+//! entries are summed (assembly).
 //!
-//! Contract of [`build_imported`] (each violation is an [`ImportError`] naming the file, and
-//! the entry or the key with its value):
-//!
-//! - every matrix is square of the stiffness' size `N >= 1`, the load vector is `N x 1`,
-//!   every entry finite;
-//! - `K` and `M` are symmetric to round-off, `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`
-//!   (files written with ten significant digits pass), and are then replaced by
-//!   `(A + A^T) / 2`; `D` may be any matrix (e.g. gyroscopic terms);
-//! - `M` has no negative diagonal entry; zero rows are massless dofs (allowed, as the rod's
-//!   modified mass: their frequencies are infinite and are not counted);
-//! - `K` is nonsingular on the free dofs (its sparse LU has no zero pivot) and the pencil
-//!   `(K, M)` has a lowest finite natural frequency `omega_1` (Rayleigh–Ritz / subspace
-//!   iteration of [`natural_frequencies`]);
-//! - contact and observed dofs exist (`1..=N` in the scene, 1-based as in Matrix Market);
-//! - the forcing frequency ([`ModelSpec::omega`]) is finite and `> 0`.
-//!
-//! `[damping] zeta` gives `D = (2 zeta / omega_1) K`, `alpha`/`beta` give
-//! `D = alpha M + beta K`, exactly as for the rod; a `damping` file and a `[damping]`
-//! section together are an error (of the scene).
+//! [`build_imported`] reads the files of a [`ModelSpec`], checks them with
+//! [`crate::import::assemble`] and names each violation as the scene gives it (an
+//! [`ImportError`] with the file, or the scene and its key, and the value); it also checks
+//! that the forcing frequency ([`ModelSpec::omega`]) is finite and `> 0`. A `dof_map`
+//! ([`DofMap`]) has `N` rows. A `damping` file and a `[damping]` section together are an
+//! error (of the scene).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use faer::sparse::Triplet;
-use semismooth::linalg::FaerSparseLu;
-use semismooth::Factorize;
-
-use crate::dynamic::UnionPattern;
-use crate::model::{
-    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
-};
-use crate::rod::{natural_frequencies, DampingSpec, FrequencySpec};
-
-/// Smallest first natural frequency of an imported model (its inverse the largest): the
-/// rod's scale rule.
-pub const MIN_OMEGA_1: f64 = 1e-100;
-
-/// Relative tolerance of the symmetry check of `K` and `M`.
-pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
+use crate::import::{assemble, Attachments, DofMap, DofUse, ModelError, ModelParts, Part};
+use crate::model::{SparseMatrix, Structure};
+use crate::rod::{DampingSpec, FrequencySpec};
 
 mod read;
 
@@ -57,29 +32,16 @@ pub use read::{
     MAX_LINE_BYTES, MAX_MATRIX_DIMENSION, MAX_MATRIX_FILE_BYTES,
 };
 
+pub use crate::import::{DofContact, DofFriction, MIN_OMEGA_1, SYMMETRY_TOLERANCE};
 pub use crate::model::ContactDirection;
 
-/// A contact of an imported model: its row of `G` on 0-based dofs (the scene's `dof` or
-/// `dofs` minus one, with `direction` or `coefficients`), its gap and its friction.
+/// A dof map file and the map read from it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct DofContact {
-    /// The row of `G`.
-    pub row: ContactRow,
-    /// Gap (negative: preloaded).
-    pub gap: f64,
-    /// Coulomb friction on the contact: the coefficient `mu` and the tangential row.
-    pub friction: Option<(f64, ContactRow)>,
-}
-
-/// A friction point of an imported model under a prescribed normal load.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DofFriction {
-    /// The tangential row on 0-based dofs.
-    pub tangent: ContactRow,
-    /// The coefficient `mu`.
-    pub coefficient: f64,
-    /// The normal load `N > 0`.
-    pub normal_load: f64,
+pub struct DofMapFile {
+    /// The file (for messages).
+    pub path: PathBuf,
+    /// Its rows (shared by the scene's copies).
+    pub map: Arc<DofMap>,
 }
 
 /// Everything a `[model]` scene declares (paths resolved against the scene's directory).
@@ -108,6 +70,9 @@ pub struct ModelSpec {
     /// Observed dof (0-based); `None`: the first contact dof, else the first friction
     /// point's, else the largest load entry.
     pub observed_dof: Option<usize>,
+    /// The node and component of each row (`[model] dof_map`), read when the scene was;
+    /// the scene's node-addressed dofs are already resolved through it.
+    pub dof_map: Option<DofMapFile>,
 }
 
 impl ModelSpec {
@@ -115,6 +80,46 @@ impl ModelSpec {
     /// `omega_1` ([`Structure::omega_1`] of [`build_imported`], which checks it).
     pub fn omega(&self, omega_1: f64) -> f64 {
         self.frequency.omega(omega_1)
+    }
+
+    /// What the scene attaches to the matrices.
+    fn attachments(&self) -> Attachments {
+        Attachments {
+            contacts: self.contacts.clone(),
+            friction: self.friction.clone(),
+            observed_dof: self.observed_dof,
+            damping: self.damping,
+            amplitude: self.amplitude,
+        }
+    }
+
+    /// The file of `part`.
+    fn path_of(&self, part: Part) -> PathBuf {
+        let none = PathBuf::new;
+        match part {
+            Part::Mass => self.mass.clone(),
+            Part::Stiffness => self.stiffness.clone(),
+            Part::Damping => self.damping_matrix.clone().unwrap_or_else(none),
+            Part::Load => self.forcing_vector.clone(),
+            Part::DofMap => self.dof_map.as_ref().map_or_else(none, |m| m.path.clone()),
+        }
+    }
+
+    /// The scene key that names the dof of `used_by`.
+    fn key_of(&self, used_by: DofUse) -> &'static str {
+        let single = |row: &crate::model::ContactRow| row.single().is_some();
+        match used_by {
+            DofUse::ContactRow { contact } => match self.contacts.get(contact) {
+                Some(c) if !single(&c.row) => "contact.point.dofs",
+                _ => "contact.point.dof",
+            },
+            DofUse::ContactTangent { .. } => "contact.point.tangent_dofs",
+            DofUse::FrictionRow { point } => match self.friction.get(point) {
+                Some(f) if !single(&f.tangent) => "friction.point.dofs",
+                _ => "friction.point.dof",
+            },
+            DofUse::Observed => "output.dof",
+        }
     }
 }
 
@@ -237,6 +242,14 @@ pub enum ImportError {
         /// `N`.
         dofs: usize,
     },
+    /// A defect of a part as [`crate::import::assemble`] names it, with the part's file.
+    #[error("{path}: {source}")]
+    Part {
+        /// The part's file.
+        path: PathBuf,
+        /// The defect.
+        source: ModelError,
+    },
     /// Any other defect of the assembled model or of the forcing frequency.
     #[error("{scene}: {reason}")]
     Model {
@@ -245,65 +258,6 @@ pub enum ImportError {
         /// What is wrong.
         reason: String,
     },
-}
-
-/// `(A + A^T) / 2` after checking `|a_ij - a_ji| <= SYMMETRY_TOLERANCE max |a|`.
-fn symmetrized(
-    a: &SparseMatrix,
-    path: &Path,
-    what: &'static str,
-) -> Result<SparseMatrix, ImportError> {
-    let n = a.nrows();
-    let r = a.as_ref();
-    let max = a.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tolerance = SYMMETRY_TOLERANCE * max;
-    let entry = |i: usize, j: usize| -> f64 {
-        r.row_idx_of_col(j)
-            .zip(r.val_of_col(j))
-            .find(|(row, _)| *row == i)
-            .map_or(0.0, |(_, v)| *v)
-    };
-    let mut triplets = Vec::with_capacity(2 * a.val().len());
-    for j in 0..n {
-        for (i, &v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-            let t = entry(j, i);
-            if (v - t).abs() > tolerance {
-                return Err(ImportError::NotSymmetric {
-                    path: path.to_path_buf(),
-                    what,
-                    row: i + 1,
-                    col: j + 1,
-                    value: v,
-                    transposed: t,
-                    tolerance,
-                });
-            }
-            triplets.push(Triplet::new(i, j, 0.5 * v));
-            triplets.push(Triplet::new(j, i, 0.5 * v));
-        }
-    }
-    SparseMatrix::try_new_from_triplets(n, n, &triplets).map_err(|e| ImportError::MatrixMarket {
-        path: path.to_path_buf(),
-        message: format!("{e:?}"),
-    })
-}
-
-fn check_square(
-    a: &SparseMatrix,
-    n: usize,
-    path: &Path,
-    what: &'static str,
-) -> Result<(), ImportError> {
-    if a.nrows() == n && a.ncols() == n {
-        return Ok(());
-    }
-    Err(ImportError::Size {
-        path: path.to_path_buf(),
-        what,
-        rows: a.nrows(),
-        cols: a.ncols(),
-        expected: format!("{n} x {n} (the stiffness matrix' size)"),
-    })
 }
 
 /// Reads and checks the files of `spec` and assembles the structure (module documentation).
@@ -317,178 +271,106 @@ pub fn build_imported_with(
     spec: &ModelSpec,
     read: impl Fn(&Path) -> Result<SparseMatrix, ImportError>,
 ) -> Result<Structure, ImportError> {
-    let read_matrix = read;
-    let stiffness = read_matrix(&spec.stiffness)?;
-    let n = stiffness.nrows();
-    if n == 0 || stiffness.ncols() != n {
-        return Err(ImportError::Size {
-            path: spec.stiffness.clone(),
-            what: "stiffness matrix",
-            rows: n,
-            cols: stiffness.ncols(),
-            expected: "N x N with N >= 1".into(),
-        });
-    }
-    let stiffness = symmetrized(&stiffness, &spec.stiffness, "stiffness matrix")?;
-    let mass = read_matrix(&spec.mass)?;
-    check_square(&mass, n, &spec.mass, "mass matrix")?;
-    let mass = symmetrized(&mass, &spec.mass, "mass matrix")?;
-    for dof in 0..n {
-        let m = crate::model::diagonal_entry(&mass, dof);
-        if m < 0.0 {
-            return Err(ImportError::NegativeMass {
-                path: spec.mass.clone(),
-                dof: dof + 1,
-                value: m,
-            });
-        }
-    }
-    let damping = match &spec.damping_matrix {
-        Some(path) => {
-            let d = read_matrix(path)?;
-            check_square(&d, n, path, "damping matrix")?;
-            Some(d)
-        }
-        None => None,
-    };
-    let load = read_matrix(&spec.forcing_vector)?;
-    if load.nrows() != n || load.ncols() != 1 {
-        return Err(ImportError::Size {
-            path: spec.forcing_vector.clone(),
-            what: "load vector",
-            rows: load.nrows(),
-            cols: load.ncols(),
-            expected: format!("{n} x 1 (one entry per dof)"),
-        });
-    }
-    let shape = load;
-    let mut load = vec![0.0; n];
-    for (i, v) in shape.row_idx_of_col(0).zip(shape.val_of_col(0)) {
-        load[i] += spec.amplitude * v;
-        if !load[i].is_finite() || load[i].abs() > MAX_ENTRY_MAGNITUDE {
-            return Err(ImportError::Model {
-                scene: spec.scene.clone(),
-                reason: format!(
-                    "the load amplitude x {} entry {} = {:e}: allowed magnitudes of at most \
-                     {MAX_ENTRY_MAGNITUDE:e} (as the rod's amplitude)",
-                    spec.forcing_vector.display(),
-                    i + 1,
-                    load[i]
-                ),
-            });
-        }
-    }
-    let dof_in_range = |key: &'static str, dof: usize| {
-        if dof < n {
-            Ok(dof)
-        } else {
-            Err(ImportError::DofOutOfRange {
-                scene: spec.scene.clone(),
-                key,
-                value: dof + 1,
-                dofs: n,
-            })
-        }
-    };
-    let row_in_range = |one: &'static str, many: &'static str, row: &ContactRow| {
-        let key = if row.single().is_some() { one } else { many };
-        row.dofs()
-            .iter()
-            .try_for_each(|&d| dof_in_range(key, d).map(|_| ()))
-    };
-    let mut contacts = Vec::with_capacity(spec.contacts.len());
-    let mut friction = Vec::new();
-    for (i, c) in spec.contacts.iter().enumerate() {
-        row_in_range("contact.point.dof", "contact.point.dofs", &c.row)?;
-        contacts.push(ContactPoint::on_row(c.row.clone(), c.gap));
-        if let Some((mu, tangent)) = &c.friction {
-            let key = "contact.point.tangent_dofs";
-            row_in_range(key, key, tangent)?;
-            friction.push(FrictionPoint::on_contact(tangent.clone(), *mu, i));
-        }
-    }
-    for f in &spec.friction {
-        row_in_range("friction.point.dof", "friction.point.dofs", &f.tangent)?;
-        friction.push(FrictionPoint::prescribed(
-            f.tangent.clone(),
-            f.coefficient,
-            f.normal_load,
-        ));
-    }
-    let observed_dof = match spec.observed_dof {
-        Some(dof) => dof_in_range("output.dof", dof)?,
-        None => match (contacts.first(), friction.first()) {
-            (Some(c), _) => c.dof(),
-            (None, Some(f)) => f.tangent.first_dof(),
-            (None, None) => largest_entry(&load),
-        },
-    };
-    let stiffness_error = |reason: String| ImportError::Stiffness {
-        path: spec.stiffness.clone(),
-        reason,
-    };
-    FaerSparseLu::new().factor(&stiffness).map_err(|e| {
-        stiffness_error(format!(
-            "the stiffness matrix is singular on the free dofs ({e}): remove the rigid-body \
-             motions (constrain dofs) before exporting"
-        ))
-    })?;
-    let mut model = StructuralModel {
+    let stiffness = read(&spec.stiffness)?;
+    let mass = read(&spec.mass)?;
+    let damping = spec.damping_matrix.as_deref().map(&read).transpose()?;
+    let load = read(&spec.forcing_vector)?;
+    let parts = ModelParts {
         mass,
-        damping,
         stiffness,
-        load: crate::model::HarmonicLoad::cosine(load),
-        contacts,
-        friction,
+        damping,
+        load,
+        dof_map: spec.dof_map.as_ref().map(|m| m.map.clone()),
     };
-    let omega_1 = natural_frequencies(&model, 1)
-        .map_err(|e| stiffness_error(format!("no lowest natural frequency of (K, M): {e}")))?[0];
-    if !(MIN_OMEGA_1..=1.0 / MIN_OMEGA_1).contains(&omega_1) {
-        return Err(stiffness_error(format!(
-            "the first natural frequency of (K, M) is {omega_1:e}: allowed in [{MIN_OMEGA_1:e}, \
-             {:e}] (as the rod's; rescale the units of the model)",
-            1.0 / MIN_OMEGA_1
-        )));
-    }
-    if let Some(d) = spec.damping {
-        model.damping = Some(match d {
-            DampingSpec::StiffnessProportional { zeta } => {
-                UnionPattern::linear_combination(n, &[&model.stiffness], &[2.0 * zeta / omega_1])
-            }
-            DampingSpec::Rayleigh { alpha, beta } => UnionPattern::linear_combination(
-                n,
-                &[&model.stiffness, &model.mass],
-                &[beta, alpha],
-            ),
-        });
-    }
-    model.validate().map_err(|e| ImportError::Model {
-        scene: spec.scene.clone(),
-        reason: e.to_string(),
-    })?;
-    let omega = spec.omega(omega_1);
+    let structure =
+        assemble(parts, &spec.attachments()).map_err(|e| ImportError::of_model(spec, e))?;
+    let omega = spec.omega(structure.omega_1);
     if !(omega.is_finite() && omega > 0.0) {
         return Err(ImportError::Model {
             scene: spec.scene.clone(),
             reason: format!("forcing omega = {omega}: allowed a finite angular frequency > 0"),
         });
     }
-    Ok(Structure {
-        model,
-        omega_1,
-        observed_dof,
-    })
+    Ok(structure)
 }
 
-/// Index of the entry of largest magnitude (0 for an all-zero vector).
-fn largest_entry(v: &[f64]) -> usize {
-    let mut best = 0;
-    for (i, x) in v.iter().enumerate() {
-        if x.abs() > v[best].abs() {
-            best = i;
+impl ImportError {
+    /// `e` as the scene of `spec` gives it: a part's defect names its file, a dof's the
+    /// scene and the key that names it.
+    pub fn of_model(spec: &ModelSpec, e: ModelError) -> Self {
+        let file = |part: Part| spec.path_of(part);
+        match e {
+            ModelError::Size {
+                part,
+                rows,
+                cols,
+                expected,
+            } => ImportError::Size {
+                path: file(part),
+                what: part.name(),
+                rows,
+                cols,
+                expected,
+            },
+            ModelError::NotSymmetric {
+                part,
+                row,
+                col,
+                value,
+                transposed,
+                tolerance,
+            } => ImportError::NotSymmetric {
+                path: file(part),
+                what: part.name(),
+                row,
+                col,
+                value,
+                transposed,
+                tolerance,
+            },
+            ModelError::NegativeMass { dof, value } => ImportError::NegativeMass {
+                path: spec.mass.clone(),
+                dof,
+                value,
+            },
+            ModelError::Storage { part, message } => ImportError::MatrixMarket {
+                path: file(part),
+                message,
+            },
+            ModelError::LoadTooLarge { row, value } => ImportError::Model {
+                scene: spec.scene.clone(),
+                reason: format!(
+                    "the load amplitude x {} entry {row} = {value:e}: allowed magnitudes of at \
+                     most {MAX_ENTRY_MAGNITUDE:e} (as the rod's amplitude)",
+                    spec.forcing_vector.display(),
+                ),
+            },
+            ModelError::DofOutOfRange {
+                used_by,
+                value,
+                dofs,
+            } => ImportError::DofOutOfRange {
+                scene: spec.scene.clone(),
+                key: spec.key_of(used_by),
+                value,
+                dofs,
+            },
+            e @ (ModelError::SingularStiffness { .. }
+            | ModelError::NoFrequency { .. }
+            | ModelError::FrequencyOutOfRange { .. }) => ImportError::Stiffness {
+                path: spec.stiffness.clone(),
+                reason: e.to_string(),
+            },
+            e @ ModelError::DofMapRows { .. } => ImportError::Part {
+                path: file(Part::DofMap),
+                source: e,
+            },
+            ModelError::Invalid(reason) => ImportError::Model {
+                scene: spec.scene.clone(),
+                reason,
+            },
         }
     }
-    best
 }
 
 /// The Matrix Market files of a structure built in code for a `[model]` scene: `K.mtx`,

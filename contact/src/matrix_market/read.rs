@@ -246,6 +246,19 @@ fn push(
     Ok(())
 }
 
+/// The declared shape of a file: what the banner says and the size line gives.
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    format: Format,
+    field: Field,
+    symmetry: Symmetry,
+    rows: usize,
+    cols: usize,
+    /// Values the file declares (coordinate) or holds (array).
+    declared: usize,
+}
+
+/// Parses a file: its banner, its size line and its entries.
 fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, ImportError> {
     let first = lines.next(path)?.ok_or_else(|| ImportError::MatrixMarket {
         path: path.to_path_buf(),
@@ -253,6 +266,26 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
             .into(),
     })?;
     let (format, field, symmetry) = header(&first).map_err(|m| lines.error(path, m))?;
+    let shape = size_line(lines, path, format, field, symmetry)?;
+    let triplets = entries(lines, path, &shape)?;
+    let (rows, cols) = (shape.rows, shape.cols);
+    SparseMatrix::try_new_from_triplets(rows, cols, &triplets).map_err(|e| {
+        ImportError::MatrixMarket {
+            path: path.to_path_buf(),
+            message: format!("cannot store the {rows} x {cols} matrix: {e:?}"),
+        }
+    })
+}
+
+/// The size line after the banner: `rows columns entries` (coordinate) or `rows columns`
+/// (array), checked against the limits before anything is allocated.
+fn size_line<R: BufRead>(
+    lines: &mut Lines<R>,
+    path: &Path,
+    format: Format,
+    field: Field,
+    symmetry: Symmetry,
+) -> Result<Shape, ImportError> {
     let size_line = lines.next_data(path)?.ok_or_else(|| {
         lines.error(
             path,
@@ -322,6 +355,24 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
             capacity as usize
         }
     };
+    Ok(Shape {
+        format,
+        field,
+        symmetry,
+        rows,
+        cols,
+        declared,
+    })
+}
+
+/// The entries after the size line as triplets: exactly `shape.declared` values, a
+/// symmetric file's lower triangle mirrored, an array's zeros dropped.
+fn entries<R: BufRead>(
+    lines: &mut Lines<R>,
+    path: &Path,
+    shape: &Shape,
+) -> Result<Vec<Triplet<usize, usize, f64>>, ImportError> {
+    let (declared, symmetry, format) = (shape.declared, shape.symmetry, shape.format);
     let mut triplets = Vec::new();
     triplets
         .try_reserve(declared.min(1 << 20))
@@ -337,71 +388,7 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
                 ),
             ));
         }
-        let words: Vec<&str> = line.split_whitespace().collect();
-        let (i, j, v) = match format {
-            Format::Coordinate => {
-                if words.len() != 3 {
-                    return Err(lines.error(
-                        path,
-                        format!(
-                            "{} is not an entry of this header's format: allowed `row column \
-                             value`",
-                            quoted(&line)
-                        ),
-                    ));
-                }
-                let index = |word: &str, what: &str, n: usize| -> Result<usize, String> {
-                    match word.parse::<usize>() {
-                        Ok(k) if (1..=n).contains(&k) => Ok(k - 1),
-                        _ => Err(format!(
-                            "{}: {what} index `{word}`: allowed 1..={n} (1-based)",
-                            quoted(&line)
-                        )),
-                    }
-                };
-                let i = index(words[0], "row", rows).map_err(|m| lines.error(path, m))?;
-                let j = index(words[1], "column", cols).map_err(|m| lines.error(path, m))?;
-                let v = value(words[2], field)
-                    .map_err(|m| lines.error(path, format!("entry ({}, {}): {m}", i + 1, j + 1)))?;
-                (i, j, v)
-            }
-            Format::Array => {
-                if words.len() != 1 {
-                    return Err(lines.error(
-                        path,
-                        format!(
-                            "{} is not an entry of this header's format: allowed one value per \
-                             line",
-                            quoted(&line)
-                        ),
-                    ));
-                }
-                let (i, j) = array_position(stored, rows, symmetry);
-                let v = value(words[0], field)
-                    .map_err(|m| lines.error(path, format!("entry ({}, {}): {m}", i + 1, j + 1)))?;
-                (i, j, v)
-            }
-        };
-        if symmetry != Symmetry::General && i < j {
-            return Err(lines.error(
-                path,
-                format!(
-                    "entry ({}, {}) above the diagonal: a symmetric file stores the lower \
-                     triangle (row >= column)",
-                    i + 1,
-                    j + 1
-                ),
-            ));
-        }
-        if symmetry == Symmetry::SkewSymmetric && i == j && v != 0.0 {
-            return Err(lines.error(
-                path,
-                format!(
-                    "diagonal entry ({0}, {0}) = {v:e} of a skew-symmetric matrix: allowed 0",
-                    i + 1
-                ),
-            ));
-        }
+        let (i, j, v) = entry(&line, shape, stored).map_err(|m| lines.error(path, m))?;
         stored += 1;
         // A dense array's zeros are not entries; a coordinate file's stored zeros are kept
         // (its pattern reads back as written).
@@ -409,15 +396,14 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
             continue;
         }
         push(&mut triplets, Triplet::new(i, j, v)).map_err(|m| lines.error(path, m))?;
-        if i != j {
-            let mirrored = match symmetry {
-                Symmetry::General => None,
-                Symmetry::Symmetric => Some(v),
-                Symmetry::SkewSymmetric => Some(-v),
-            };
-            if let Some(w) = mirrored {
-                push(&mut triplets, Triplet::new(j, i, w)).map_err(|m| lines.error(path, m))?;
-            }
+        let mirrored = match symmetry {
+            _ if i == j => None,
+            Symmetry::General => None,
+            Symmetry::Symmetric => Some(v),
+            Symmetry::SkewSymmetric => Some(-v),
+        };
+        if let Some(w) = mirrored {
+            push(&mut triplets, Triplet::new(j, i, w)).map_err(|m| lines.error(path, m))?;
         }
     }
     if stored < declared {
@@ -426,12 +412,63 @@ fn parse<R: BufRead>(lines: &mut Lines<R>, path: &Path) -> Result<SparseMatrix, 
             format!("the file ends after {stored} of the {declared} entries it declares"),
         ));
     }
-    SparseMatrix::try_new_from_triplets(rows, cols, &triplets).map_err(|e| {
-        ImportError::MatrixMarket {
-            path: path.to_path_buf(),
-            message: format!("cannot store the {rows} x {cols} matrix: {e:?}"),
+    Ok(triplets)
+}
+
+/// The `stored`-th entry of the file, on the data line `line`: its 0-based row, column and
+/// value, checked against the shape (in range, in the stored triangle, a skew diagonal 0).
+fn entry(line: &str, shape: &Shape, stored: usize) -> Result<(usize, usize, f64), String> {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = |i: usize, j: usize, m: String| format!("entry ({}, {}): {m}", i + 1, j + 1);
+    let (i, j, v) = match shape.format {
+        Format::Coordinate => {
+            if words.len() != 3 {
+                return Err(format!(
+                    "{} is not an entry of this header's format: allowed `row column value`",
+                    quoted(line)
+                ));
+            }
+            let index = |word: &str, what: &str, n: usize| -> Result<usize, String> {
+                match word.parse::<usize>() {
+                    Ok(k) if (1..=n).contains(&k) => Ok(k - 1),
+                    _ => Err(format!(
+                        "{}: {what} index `{word}`: allowed 1..={n} (1-based)",
+                        quoted(line)
+                    )),
+                }
+            };
+            let i = index(words[0], "row", shape.rows)?;
+            let j = index(words[1], "column", shape.cols)?;
+            let v = value(words[2], shape.field).map_err(|m| at(i, j, m))?;
+            (i, j, v)
         }
-    })
+        Format::Array => {
+            if words.len() != 1 {
+                return Err(format!(
+                    "{} is not an entry of this header's format: allowed one value per line",
+                    quoted(line)
+                ));
+            }
+            let (i, j) = array_position(stored, shape.rows, shape.symmetry);
+            let v = value(words[0], shape.field).map_err(|m| at(i, j, m))?;
+            (i, j, v)
+        }
+    };
+    if shape.symmetry != Symmetry::General && i < j {
+        return Err(format!(
+            "entry ({}, {}) above the diagonal: a symmetric file stores the lower triangle (row \
+             >= column)",
+            i + 1,
+            j + 1
+        ));
+    }
+    if shape.symmetry == Symmetry::SkewSymmetric && i == j && v != 0.0 {
+        return Err(format!(
+            "diagonal entry ({0}, {0}) = {v:e} of a skew-symmetric matrix: allowed 0",
+            i + 1
+        ));
+    }
+    Ok((i, j, v))
 }
 
 /// Row and column (0-based) of the `k`-th value of an array file: column-major, the lower

@@ -7,12 +7,27 @@ use super::*;
 
 pub(super) struct Check<'a> {
     path: &'a Path,
+    /// The `[model]`'s dof map, once read.
+    dof_map: Option<&'a DofMapFile>,
 }
 
-impl Check<'_> {
+impl<'a> Check<'a> {
+    /// The checks of the scene file `path` (no dof map yet).
+    fn new(path: &'a Path) -> Self {
+        Check {
+            path,
+            dof_map: None,
+        }
+    }
+
     /// The scene file.
     pub(super) fn path(&self) -> &Path {
         self.path
+    }
+
+    /// The `[model]`'s dof map (`None`: none, or not read yet).
+    pub(super) fn dof_map(&self) -> Option<&DofMapFile> {
+        self.dof_map
     }
 
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
@@ -92,7 +107,7 @@ impl Check<'_> {
 /// Validates a parsed scene section by section, in file order; the first invalid value is
 /// the error.
 pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
-    let ck = Check { path };
+    let ck = Check::new(path);
     let mut bladed_disk = None;
     let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
         (None, None, Some(d)) => {
@@ -132,9 +147,8 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             }
             let output_dof = raw
                 .output
-                .map(|o| ck.count("output.dof", o.dof, 1, rod.elements))
-                .transpose()?
-                .map(|dof| dof - 1);
+                .map(|o| ck.output_dof(o, rod.elements))
+                .transpose()?;
             (rod, None, output_dof)
         }
         (None, Some(m), None) => {
@@ -378,6 +392,14 @@ impl Check<'_> {
                         &[
                             ("contact.point.dof", p.dof.is_some()),
                             ("contact.point.direction", p.direction.is_some()),
+                            ("contact.point.component", p.component.is_some()),
+                            ("contact.point.nodes", p.nodes.is_some()),
+                            ("contact.point.components", p.components.is_some()),
+                            ("contact.point.tangent_nodes", p.tangent_nodes.is_some()),
+                            (
+                                "contact.point.tangent_components",
+                                p.tangent_components.is_some(),
+                            ),
                         ],
                         "given in a [rod] scene",
                         "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
@@ -465,18 +487,29 @@ impl Check<'_> {
         })?;
         let forcing_vector = file("forcing.vector", vector)?;
         let (_, amplitude, frequency) = self.forcing(f)?;
+        let dof_map = m
+            .dof_map
+            .map(|name| -> Result<DofMapFile, SceneError> {
+                let path = file("model.dof_map", &name)?;
+                let map = DofMap::read(&path)
+                    .map_err(|e| SceneError::parse(self.path, format!("`model.dof_map`: {e}")))?;
+                let map = std::sync::Arc::new(map);
+                Ok(DofMapFile { path, map })
+            })
+            .transpose()?;
+        let ck = Check {
+            path: self.path,
+            dof_map: dof_map.as_ref(),
+        };
         let contacts = contact
-            .map(|c| self.dof_contacts(c))
+            .map(|c| ck.dof_contacts(c))
             .transpose()?
             .unwrap_or_default();
         let friction = friction
-            .map(|f| self.dof_friction(f))
+            .map(|f| ck.dof_friction(f))
             .transpose()?
             .unwrap_or_default();
-        let observed_dof = output
-            .map(|o| self.count("output.dof", o.dof, 1, usize::MAX >> 1))
-            .transpose()?
-            .map(|dof| dof - 1);
+        let observed_dof = output.map(|o| ck.model_output(o)).transpose()?;
         Ok(ModelSpec {
             scene: self.path.to_path_buf(),
             mass,
@@ -489,6 +522,7 @@ impl Check<'_> {
             contacts,
             friction,
             observed_dof,
+            dof_map,
         })
     }
 

@@ -2,7 +2,9 @@
 //! (`dof`, `direction`) or on a combination of dofs (`dofs`, `coefficients`), with optional
 //! Coulomb friction (`friction`, `tangent_dofs`, `tangent_coefficients`), and
 //! `[[friction.point]]` under a prescribed `normal_load`. Dofs are 1-based as in Matrix
-//! Market; their upper bound is checked when the files are read.
+//! Market; their upper bound is checked when the files are read. With a `[model] dof_map`,
+//! `node` and `component` (lists `nodes` and `components`) name a dof instead (module
+//! `nodes`).
 
 use semismooth_contact::model::ContactRow;
 
@@ -14,11 +16,14 @@ use super::*;
 struct RawRow<'a> {
     /// The section's key prefix, `contact.point` or `friction.point`.
     section: &'static str,
-    /// A rod node, refused: a `[model]` scene names dofs.
+    /// A node of the dof map, with `component`.
     node: Option<i64>,
+    component: Option<i64>,
     dof: Option<i64>,
     direction: Option<i64>,
     dofs: Option<&'a [i64]>,
+    nodes: Option<&'a [i64]>,
+    components: Option<&'a [i64]>,
     coefficients: Option<&'a [f64]>,
 }
 
@@ -44,9 +49,12 @@ impl Check<'_> {
             let row = self.row(RawRow {
                 section: "contact.point",
                 node: p.node,
+                component: p.component,
                 dof: p.dof,
                 direction: p.direction,
                 dofs: p.dofs.as_deref(),
+                nodes: p.nodes.as_deref(),
+                components: p.components.as_deref(),
                 coefficients: p.coefficients.as_deref(),
             })?;
             let gap = self.response_scale("contact.point.gap", p.gap)?;
@@ -85,17 +93,25 @@ impl Check<'_> {
         Ok(contacts)
     }
 
-    /// A contact's `friction`, `tangent_dofs` and `tangent_coefficients`: all three or none.
+    /// A contact's `friction`, `tangent_dofs` (or `tangent_nodes` with `tangent_components`)
+    /// and `tangent_coefficients`: all three or none.
     fn contact_friction(
         &self,
         p: &RawContactPoint,
     ) -> Result<Option<(f64, ContactRow)>, SceneError> {
+        let keys = ["tangent_dofs", "tangent_nodes", "tangent_components"]
+            .map(|k| format!("contact.point.{k}"));
+        let tangent = self.addresses(
+            keys,
+            p.tangent_dofs.as_deref(),
+            p.tangent_nodes.as_deref(),
+            p.tangent_components.as_deref(),
+        )?;
         let Some(mu) = p.friction else {
-            if p.tangent_dofs.is_some() || p.tangent_coefficients.is_some() {
-                let key = if p.tangent_dofs.is_some() {
-                    "contact.point.tangent_dofs"
-                } else {
-                    "contact.point.tangent_coefficients"
+            if tangent.is_some() || p.tangent_coefficients.is_some() {
+                let key = match &tangent {
+                    Some((_, key)) => key.as_str(),
+                    None => "contact.point.tangent_coefficients",
                 };
                 return Err(self.invalid(
                     key,
@@ -106,12 +122,12 @@ impl Check<'_> {
             return Ok(None);
         };
         let mu = self.friction_coefficient("contact.point.friction", mu)?;
-        let dofs = p.tangent_dofs.as_deref().ok_or_else(|| {
+        let (dofs, dofs_key) = tangent.ok_or_else(|| {
             self.invalid(
                 "contact.point.tangent_dofs",
                 "missing",
                 "the 1-based dofs of the tangential row (with `tangent_coefficients`) when \
-                 `friction` is given",
+                 `friction` is given, or `tangent_nodes` with `tangent_components`",
             )
         })?;
         let coefficients = p.tangent_coefficients.as_deref().ok_or_else(|| {
@@ -122,9 +138,9 @@ impl Check<'_> {
             )
         })?;
         let tangent = self.combination(
-            "contact.point.tangent_dofs",
+            &dofs_key,
             "contact.point.tangent_coefficients",
-            dofs,
+            &dofs,
             coefficients,
         )?;
         Ok(Some((mu, tangent)))
@@ -153,9 +169,12 @@ impl Check<'_> {
                 let tangent = self.row(RawRow {
                     section: "friction.point",
                     node: p.node,
+                    component: p.component,
                     dof: p.dof,
                     direction: None,
                     dofs: p.dofs.as_deref(),
+                    nodes: p.nodes.as_deref(),
+                    components: p.components.as_deref(),
                     coefficients: p.coefficients.as_deref(),
                 })?;
                 let normal_load = p.normal_load.ok_or_else(|| {
@@ -201,14 +220,10 @@ impl Check<'_> {
     /// `coefficients`, never both.
     fn row(&self, r: RawRow<'_>) -> Result<ContactRow, SceneError> {
         let key = |name: &str| format!("{}.{name}", r.section);
-        if r.node.is_some() {
-            return Err(self.invalid(
-                &key("node"),
-                "given in a [model] scene",
-                "`dof` (1-based, as in Matrix Market) or `dofs` with `coefficients`",
-            ));
-        }
-        match (r.dof, r.dofs) {
+        let dof = self.address(r.section, r.dof, r.node, r.component)?;
+        let keys = ["dofs", "nodes", "components"].map(key);
+        let dofs = self.addresses(keys, r.dofs, r.nodes, r.components)?;
+        match (dof, dofs) {
             (Some(dof), None) => {
                 if r.coefficients.is_some() {
                     return Err(self.invalid(
@@ -233,7 +248,7 @@ impl Check<'_> {
                 };
                 Ok(ContactRow::unit(dof, sign))
             }
-            (None, Some(dofs)) => {
+            (None, Some((dofs, dofs_key))) => {
                 if r.direction.is_some() {
                     return Err(self.invalid(
                         &key("direction"),
@@ -250,7 +265,7 @@ impl Check<'_> {
                          displacement of two dofs)",
                     )
                 })?;
-                self.combination(&key("dofs"), &key("coefficients"), dofs, coefficients)
+                self.combination(&dofs_key, &key("coefficients"), &dofs, coefficients)
             }
             (Some(_), Some(_)) => Err(self.invalid(
                 &key("dofs"),
@@ -260,7 +275,8 @@ impl Check<'_> {
             (None, None) => Err(self.invalid(
                 &key("dof"),
                 "missing",
-                "a 1-based dof number, or `dofs` with `coefficients`",
+                "a 1-based dof number, or `dofs` with `coefficients` (or, with a [model] \
+                 dof_map, `node` with `component`)",
             )),
         }
     }

@@ -132,10 +132,7 @@ impl Check<'_> {
                 })
                 .collect()
         });
-        let observed_dof = output
-            .map(|o| self.count("output.dof", o.dof, 1, 3 * blades))
-            .transpose()?
-            .map(|dof| dof - 1);
+        let observed_dof = output.map(|o| self.output_dof(o, 3 * blades)).transpose()?;
         let spec = ModelSpec {
             scene: self.path().to_path_buf(),
             mass: PathBuf::from(MASS),
@@ -148,6 +145,7 @@ impl Check<'_> {
             contacts,
             friction: Vec::new(),
             observed_dof: observed_dof.or(Some(BladedDisk::tip(0))),
+            dof_map: None,
         };
         Ok((spec, mistuning))
     }

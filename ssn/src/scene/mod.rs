@@ -24,7 +24,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use semismooth_contact::matrix_market::{DofContact, DofFriction, ModelSpec};
+use semismooth_contact::import::DofMap;
+use semismooth_contact::matrix_market::{DofContact, DofFriction, DofMapFile, ModelSpec};
 use semismooth_contact::rod::{
     DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
 };
@@ -33,6 +34,7 @@ mod check;
 mod contacts;
 mod disk;
 mod load_parts;
+mod nodes;
 mod overrides;
 
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
@@ -109,12 +111,15 @@ struct RawModel {
     mass: String,
     stiffness: String,
     damping: Option<String>,
+    dof_map: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawOutput {
-    dof: i64,
+    dof: Option<i64>,
+    node: Option<i64>,
+    component: Option<i64>,
 }
 
 #[derive(Debug, Deserialize, Default, Clone, Copy)]
@@ -176,13 +181,18 @@ struct RawContact {
 #[serde(deny_unknown_fields)]
 struct RawContactPoint {
     node: Option<i64>,
+    component: Option<i64>,
     dof: Option<i64>,
     gap: f64,
     direction: Option<i64>,
     dofs: Option<Vec<i64>>,
+    nodes: Option<Vec<i64>>,
+    components: Option<Vec<i64>>,
     coefficients: Option<Vec<f64>>,
     friction: Option<f64>,
     tangent_dofs: Option<Vec<i64>>,
+    tangent_nodes: Option<Vec<i64>>,
+    tangent_components: Option<Vec<i64>>,
     tangent_coefficients: Option<Vec<f64>>,
 }
 
@@ -196,8 +206,11 @@ struct RawFrictionSection {
 #[serde(deny_unknown_fields)]
 struct RawFrictionPoint {
     node: Option<i64>,
+    component: Option<i64>,
     dof: Option<i64>,
     dofs: Option<Vec<i64>>,
+    nodes: Option<Vec<i64>>,
+    components: Option<Vec<i64>>,
     coefficients: Option<Vec<f64>>,
     normal_load: Option<f64>,
     friction: Option<f64>,
