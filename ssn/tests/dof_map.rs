@@ -1,7 +1,7 @@
 //! Dofs named by node and component through a `[model] dof_map`: the fixture
 //! `fixtures/node_lattice` is a 12-dof spring lattice whose rows are in a shuffled node and
-//! component order (`nodes.dof`); `by_node.toml` names its contacts, friction point and
-//! observed dof by node and component, `by_dof.toml` the same by matrix row, written by hand
+//! component order (`nodes.dof`); `by_node.toml` names its contacts (one with friction on a
+//! tangent row), friction point and observed dof by node and component, `by_dof.toml` the same by matrix row, written by hand
 //! from the map's lines. A wrong map (or a wrong resolution) gives other rows, hence other
 //! answers.
 

@@ -511,3 +511,79 @@ fn largest_entry(v: &[f64]) -> usize {
     }
     best
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2-dof spring chain `K = [[2, -1], [-1, 1]]`, `M = I`, a unit load on dof 2.
+    fn chain() -> ModelParts {
+        let sparse = |n: usize, m: usize, t: &[(usize, usize, f64)]| {
+            let t: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+            SparseMatrix::try_new_from_triplets(n, m, &t).unwrap()
+        };
+        ModelParts {
+            mass: sparse(2, 2, &[(0, 0, 1.0), (1, 1, 1.0)]),
+            stiffness: sparse(
+                2,
+                2,
+                &[(0, 0, 2.0), (1, 0, -1.0), (0, 1, -1.0), (1, 1, 1.0)],
+            ),
+            damping: None,
+            load: sparse(2, 1, &[(1, 0, 1.0)]),
+            dof_map: None,
+        }
+    }
+
+    fn attachments(contact_dof: usize) -> Attachments {
+        Attachments {
+            contacts: vec![DofContact {
+                row: ContactRow::unit(contact_dof, 1.0),
+                gap: 0.1,
+                friction: None,
+            }],
+            friction: Vec::new(),
+            observed_dof: None,
+            damping: None,
+            amplitude: 2.0,
+        }
+    }
+
+    #[test]
+    fn errors_name_the_part_and_the_use_of_a_dof_not_a_scene_key() {
+        let e = assemble(chain(), &attachments(4)).unwrap_err();
+        assert_eq!(
+            e,
+            ModelError::DofOutOfRange {
+                used_by: DofUse::ContactRow { contact: 0 },
+                value: 5,
+                dofs: 2
+            }
+        );
+        let message = e.to_string();
+        assert!(
+            message.contains("contact 1") && message.contains("1..=2"),
+            "{message}"
+        );
+        assert!(!message.contains("contact.point"), "{message}");
+        let mut short_map = chain();
+        let rows = vec![NodeComponent {
+            node: 3,
+            component: 1,
+        }];
+        short_map.dof_map = Some(Arc::new(DofMap::new(rows).unwrap()));
+        assert_eq!(
+            assemble(short_map, &attachments(1)).unwrap_err(),
+            ModelError::DofMapRows { rows: 1, dofs: 2 }
+        );
+    }
+
+    #[test]
+    fn the_load_is_scaled_by_the_amplitude_and_the_contact_dof_observed_by_default() {
+        let s = assemble(chain(), &attachments(1)).unwrap();
+        // 2 x 1.0 is exact; the frequency of this chain is checked against its closed form
+        // in ssn's imported_model tests.
+        assert_eq!(s.model.load, vec![0.0, 2.0]);
+        assert_eq!(s.observed_dof, 1);
+    }
+}
