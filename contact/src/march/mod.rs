@@ -118,6 +118,7 @@
 //! ```
 
 mod friction;
+mod load;
 mod step;
 
 pub use step::TimeMarcher;
@@ -340,14 +341,6 @@ pub enum MarchError {
     /// The model is not usable (sizes, non-finite data, frequency, contacts).
     #[error(transparent)]
     Model(#[from] InvalidModel),
-    /// The formulation does not model something the model declares.
-    #[error("{formulation} does not model {what}")]
-    Unsupported {
-        /// The formulation.
-        formulation: &'static str,
-        /// What it does not model.
-        what: &'static str,
-    },
     /// A vector of the initial state has the wrong length.
     #[error("initial state {what} has length {found}, expected {expected}")]
     StateDimension {

@@ -12,6 +12,7 @@ use semismooth::InvalidOption;
 use semismooth::{Factorize, LinearSolve};
 
 use super::friction::CoulombStep;
+use super::load::SampledLoad;
 use super::{
     column_max_abs, resolve_scheme, MarchCounters, MarchError, MarchOptions, MarchScheme,
     MarchState,
@@ -143,9 +144,8 @@ pub struct TimeMarcher<'a> {
     steps_per_period: usize,
     h: f64,
     /// `cos(2 pi j / steps_per_period)`, `j = 0..=steps_per_period`.
-    cosines: Vec<f64>,
-    /// The load's amplitude `f` of `f cos(w t)` (the only load marched).
-    load: Vec<f64>,
+    /// The load at the step times.
+    load: SampledLoad,
     /// Step index within the current period (0 at a period start).
     phase: usize,
     /// Periods completed.
@@ -248,16 +248,12 @@ impl<'a> TimeMarcher<'a> {
         }
         let coulomb =
             (!model.friction.is_empty()).then(|| Box::new(CoulombStep::new(model, w.clone(), h)));
-        let cosines = (0..=spp)
-            .map(|j| (2.0 * PI * j as f64 / spp as f64).cos())
-            .collect();
         let mut marcher = Self {
             model,
             scheme,
             steps_per_period: spp,
             h,
-            cosines,
-            load: marched_load(model)?,
+            load: SampledLoad::new(&model.load, spp),
             phase: 0,
             completed_periods: 0,
             lu,
@@ -295,10 +291,7 @@ impl<'a> TimeMarcher<'a> {
     /// `r = f(t_j) + G^T lambda - D v - K u`, zero on massless rows.
     fn equilibrium_inertia(&mut self, j: usize) {
         let model = self.model;
-        let c = self.cosines[j];
-        for (ri, ai) in self.r.iter_mut().zip(&self.load) {
-            *ri = c * ai;
-        }
+        self.load.write(j, (1.0, 0.0), 1.0, &mut self.r);
         for (ct, l) in model.contacts.iter().zip(&self.lambda) {
             ct.row.add_transpose_at(*l, &mut self.r, 0);
         }
@@ -447,10 +440,10 @@ impl<'a> TimeMarcher<'a> {
         let model = self.model;
         let n = self.u.len();
         let h = self.h;
-        let c = self.cosines[j + 1];
         // rhs = f_{n+1} + r_n + M (4/h^2 u + 4/h v) + D (2/h u + v)
+        self.load.write(j, (0.0, 1.0), 1.0, &mut self.rhs);
         for i in 0..n {
-            self.rhs[i] = c * self.load[i] + self.r[i];
+            self.rhs[i] += self.r[i];
             self.tmp[i] = 4.0 / (h * h) * self.u[i] + 4.0 / h * self.v[i];
         }
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.tmp, &mut self.rhs);
@@ -494,11 +487,8 @@ impl<'a> TimeMarcher<'a> {
         let model = self.model;
         let n = self.u.len();
         let h = self.h;
-        let f_theta = theta * self.cosines[j + 1] + (1.0 - theta) * self.cosines[j];
         // rhs = M v - h D (1 - theta) v - h K (u + h theta (1 - theta) v) + h f_theta
-        for i in 0..n {
-            self.rhs[i] = h * f_theta * self.load[i];
-        }
+        self.load.write(j, (1.0 - theta, theta), h, &mut self.rhs);
         sparse_mul_add(model.mass.as_ref(), 1.0, &self.v, &mut self.rhs);
         if let Some(d) = &model.damping {
             sparse_mul_add(d.as_ref(), -h * (1.0 - theta), &self.v, &mut self.rhs);
@@ -581,15 +571,6 @@ impl<'a> TimeMarcher<'a> {
         }
         Ok(())
     }
-}
-
-/// The amplitude `f` of the model's load `f cos(w t)`; any other load is
-/// [`MarchError::Unsupported`] (the march samples only that forcing).
-fn marched_load(model: &StructuralModel) -> Result<Vec<f64>, MarchError> {
-    model.load.as_cosine().ok_or(MarchError::Unsupported {
-        formulation: "time marching",
-        what: "a load other than f cos(w t) (a sine part, a constant or another harmonic)",
-    })
 }
 
 #[cfg(test)]
