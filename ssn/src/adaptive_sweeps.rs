@@ -21,7 +21,7 @@ use semismooth_contact::model::Structure;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::solve::{solve, RunError};
 use semismooth_contact::sweep::adaptive::{point_distance, secant, take_up, HARMONICS_LADDER};
-use semismooth_contact::sweep::frequency_response;
+use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
 /// A point's reference: its state, frequency, the observed dof's extremes and the
 /// secant it was taken up across (at the reference's harmonics).
@@ -203,38 +203,10 @@ pub fn compare_adaptive(
         adaptive.solve_seconds,
         crate::words::sweep_termination(&adaptive)
     ));
-    let model = &rod.model;
-    let (dofs, contacts) = (model.dofs(), model.contact_count());
     let reference_harmonics = REFERENCE_HARMONICS
         .max(REFERENCE_RATIO * adaptive.harmonics.iter().copied().max().unwrap_or(0));
     say(&format!("references at {reference_harmonics} harmonics"));
-    let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points());
-    let mut errors = Vec::with_capacity(adaptive.points());
-    for i in 0..adaptive.points() {
-        let h = adaptive.harmonics[i];
-        let secant = secant(&adaptive, i, dofs, contacts);
-        let point = (adaptive.states[i].as_slice(), adaptive.omega[i], h);
-        match taken_up(rod, &sweep, point, &secant, reference_harmonics)? {
-            Some((state, (max, min, omega))) => {
-                let here = (adaptive.tip_max[i], adaptive.tip_min[i], adaptive.omega[i]);
-                errors.push(point_distance(here, (max, min, omega)));
-                let n = secant.len() - 1;
-                let mut lifted =
-                    resize_harmonics(&secant[..n], h, reference_harmonics, dofs, contacts);
-                lifted.push(secant[n]);
-                references.push(Some(Reference {
-                    state,
-                    omega,
-                    extremes: (max, min),
-                    secant: lifted,
-                }));
-            }
-            None => {
-                errors.push(f64::NAN);
-                references.push(None);
-            }
-        }
-    }
+    let (references, errors) = reference_points(rod, &sweep, &adaptive, reference_harmonics)?;
     let estimates: Vec<f64> = adaptive
         .accuracy
         .as_ref()
@@ -263,6 +235,59 @@ pub fn compare_adaptive(
         fixed: None,
     };
     let worst = comparison.worst_error();
+    comparison.fixed = fixed_sweep(rod, &sweep, (&references, reference_harmonics), worst, &say)?;
+    Ok(comparison)
+}
+
+/// Each point of `adaptive` taken up across the branch at `reference_harmonics` (`None`
+/// where neither way converged), and its error against it (NaN there).
+fn reference_points(
+    rod: &Structure,
+    sweep: &SweepSettings,
+    adaptive: &FrequencyResponse,
+    reference_harmonics: usize,
+) -> Result<(Vec<Option<Reference>>, Vec<f64>), RunError> {
+    let (dofs, contacts) = (rod.model.dofs(), rod.model.contact_count());
+    let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points());
+    let mut errors = Vec::with_capacity(adaptive.points());
+    for i in 0..adaptive.points() {
+        let h = adaptive.harmonics[i];
+        let secant = secant(adaptive, i, dofs, contacts);
+        let point = (adaptive.states[i].as_slice(), adaptive.omega[i], h);
+        match taken_up(rod, sweep, point, &secant, reference_harmonics)? {
+            Some((state, (max, min, omega))) => {
+                let here = (adaptive.tip_max[i], adaptive.tip_min[i], adaptive.omega[i]);
+                errors.push(point_distance(here, (max, min, omega)));
+                let n = secant.len() - 1;
+                let mut lifted =
+                    resize_harmonics(&secant[..n], h, reference_harmonics, dofs, contacts);
+                lifted.push(secant[n]);
+                references.push(Some(Reference {
+                    state,
+                    omega,
+                    extremes: (max, min),
+                    secant: lifted,
+                }));
+            }
+            None => {
+                errors.push(f64::NAN);
+                references.push(None);
+            }
+        }
+    }
+    Ok((references, errors))
+}
+
+/// The first fixed harmonics of the ladder (below the references') whose worst error on
+/// the `references` (at `reference_harmonics`) is at most `worst`, swept over `sweep`;
+/// `None` when none is.
+fn fixed_sweep(
+    rod: &Structure,
+    sweep: &SweepSettings,
+    (references, reference_harmonics): (&[Option<Reference>], usize),
+    worst: f64,
+    say: &dyn Fn(&str),
+) -> Result<Option<FixedSweep>, RunError> {
     for &h in HARMONICS_LADDER
         .iter()
         .filter(|&&h| REFERENCE_RATIO * h <= reference_harmonics)
@@ -276,7 +301,7 @@ pub fn compare_adaptive(
                 reference_harmonics,
             );
             let (max, min) = reference.extremes;
-            let error = match taken_up(rod, &sweep, point, &reference.secant, h)? {
+            let error = match taken_up(rod, sweep, point, &reference.secant, h)? {
                 Some((_, at)) => point_distance(at, (max, min, reference.omega)),
                 None => f64::INFINITY,
             };
@@ -291,18 +316,17 @@ pub fn compare_adaptive(
                 estimate_error: false,
                 ..SolverSettings::with_harmonics(h)
             };
-            let fixed = frequency_response(rod, &fixed_settings, &sweep, None)?;
-            comparison.fixed = Some(FixedSweep {
+            let fixed = frequency_response(rod, &fixed_settings, sweep, None)?;
+            return Ok(Some(FixedSweep {
                 harmonics: h,
                 worst_error: fixed_worst,
                 points: fixed.points(),
-                folds: fixed.folds.iter().map(|w| w / w1).collect(),
+                folds: fixed.folds.iter().map(|w| w / rod.omega_1).collect(),
                 seconds: fixed.solve_seconds,
-            });
-            break;
+            }));
         }
     }
-    Ok(comparison)
+    Ok(None)
 }
 
 /// The paper's rod with the massless contact node (Fig. 1 and 2's forcing `p0 = 0.04`, gap
