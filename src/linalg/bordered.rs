@@ -1,8 +1,8 @@
 //! A matrix bordered by a few rows and columns, solved by block elimination with one
 //! factorization of its inner block.
 
+use super::norm2;
 use super::LinearSolveError;
-use crate::iteration::kernel::norm2;
 use crate::{Factorize, LinearSolve};
 
 /// Default relative size below which a pivot of the Schur complement is treated as zero

@@ -178,3 +178,24 @@ pub fn check_pivots(
     }
     Ok(())
 }
+
+/// `|v|_2`, infinite for any non-finite component; scaled against overflow and underflow.
+pub(crate) fn norm2(v: &[f64]) -> f64 {
+    // One pass in the common case; the scaled pass only when the squares overflow or
+    // underflow (or a component is not finite).
+    let squares: f64 = v.iter().map(|x| x * x).sum();
+    if squares.is_finite() && squares > f64::MIN_POSITIVE / f64::EPSILON {
+        return squares.sqrt();
+    }
+    let mut scale = 0.0_f64;
+    for x in v {
+        if !x.is_finite() {
+            return f64::INFINITY;
+        }
+        scale = scale.max(x.abs());
+    }
+    if scale == 0.0 {
+        return 0.0;
+    }
+    scale * v.iter().map(|x| (x / scale).powi(2)).sum::<f64>().sqrt()
+}

@@ -22,8 +22,8 @@ use crate::progress::progress_spinner;
 use crate::scene::{Method, Override, Scene, SweepSettings};
 use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
-use semismooth_contact::matrix_market::{build_imported, build_imported_with, ImportError};
-use semismooth_contact::model::{SparseMatrix, Structure};
+use semismooth_contact::matrix_market::{build_imported, build_imported_with};
+use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::{RunError, Solution};
 use semismooth_contact::sweep::fold_accuracy::{refine_folds, FoldAccuracy, MAX_FOLD_HARMONICS};
@@ -78,9 +78,7 @@ pub fn load_with(
     prepare(scene, workload, None)
 }
 
-/// The matrices of a `[model]` scene held in memory: each path the scene names to its
-/// matrix (the checks of [`build_imported`] apply as to files).
-pub type MatrixSource<'a> = &'a dyn Fn(&Path) -> Result<SparseMatrix, ImportError>;
+pub use crate::scene::MatrixSource;
 
 /// Builds a validated scene's structure as [`load`] does (the memory and work limits of
 /// `workload` checked first), reading the `[model]`'s matrices from `matrices` when given,

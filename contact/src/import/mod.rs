@@ -34,11 +34,14 @@ use semismooth::linalg::FaerSparseLu;
 use semismooth::Factorize;
 
 use crate::dynamic::UnionPattern;
-use crate::matrix_market::MAX_ENTRY_MAGNITUDE;
 use crate::model::{
     ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, DampingSpec};
+
+/// Largest magnitude of an entry of a model (the scale rule of the rod's data and load
+/// amplitude).
+pub const MAX_ENTRY_MAGNITUDE: f64 = 1e100;
 
 mod dof_map;
 

@@ -28,8 +28,7 @@ pub const MAX_LINE_BYTES: u64 = 1 << 16;
 /// Largest number of rows or columns declared (the largest built-in rod has as many dofs).
 pub const MAX_MATRIX_DIMENSION: usize = 10_000_000;
 
-/// Largest magnitude of an entry (the scale rule of the rod's data and load amplitude).
-pub const MAX_ENTRY_MAGNITUDE: f64 = 1e100;
+pub use crate::import::MAX_ENTRY_MAGNITUDE;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Format {

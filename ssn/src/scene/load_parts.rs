@@ -7,11 +7,15 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use semismooth_contact::matrix_market::read_matrix;
-use semismooth_contact::model::StructuralModel;
+use semismooth_contact::matrix_market::{read_matrix, ImportError};
+use semismooth_contact::model::{SparseMatrix, StructuralModel};
 
 use super::check::Check;
 use super::{RawForcing, SceneError};
+
+/// The matrices of a `[model]` scene held in memory: each path the scene names to its
+/// matrix (the checks of the files' import apply as to files).
+pub type MatrixSource<'a> = &'a dyn Fn(&Path) -> Result<SparseMatrix, ImportError>;
 
 /// One `[[forcing.harmonic]]` entry as written.
 #[derive(Debug, Deserialize)]
@@ -147,7 +151,7 @@ pub fn add_load_parts(
     parts: &[LoadPart],
     amplitude: f64,
     model: &mut StructuralModel,
-    read: Option<crate::cli::MatrixSource>,
+    read: Option<MatrixSource>,
 ) -> Result<(), String> {
     let n = model.dofs();
     let vector = |part: &Option<(PathBuf, &'static str)>, scale: f64| match part {

@@ -38,7 +38,7 @@ mod nodes;
 mod overrides;
 
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
-pub use load_parts::{add_load_parts, LoadPart};
+pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
 
 pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
 
