@@ -67,6 +67,7 @@ pub struct Multipliers {
 
 /// How a multiplier left (or entered) the unit circle between two orbits of a branch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum BifurcationKind {
     /// A real multiplier through `+1` (turning point of the branch).
     Fold,

@@ -69,10 +69,11 @@
 //! stopped.
 //!
 //! Nothing in this crate knows about rods, contact or any particular model: those live
-//! in the `semismooth-problems` crate, which uses only this crate's public API.
+//! in the `semismooth-contact` crate, which uses only this crate's public API.
 
 pub mod complementarity;
 pub mod continuation;
+mod error;
 pub mod floquet;
 pub mod harmonic;
 mod invalid_option;
@@ -85,6 +86,7 @@ pub mod polyalgorithm;
 mod traits;
 pub mod trigonometric;
 
+pub use error::Error;
 pub use invalid_option::InvalidOption;
 pub use traits::{
     EvaluationError, Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent,

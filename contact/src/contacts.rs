@@ -4,6 +4,7 @@
 
 /// One contact point over one period.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ContactReport {
     /// Node of the rod (node 0 is clamped).
     pub node: usize,
@@ -31,6 +32,7 @@ pub struct ContactReport {
 /// One friction point over one period: its tangential force and slip velocity at the
 /// run's output times, with the numbers a sweep keeps per point ([`FrictionSummary`]).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FrictionReport {
     /// Index of the friction point (the model's order).
     pub point: usize,
@@ -114,6 +116,7 @@ pub fn march_friction_report(
 
 /// One contact's diagnostics over a period.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ContactSummary {
     /// The contact dof.
     pub dof: usize,

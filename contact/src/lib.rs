@@ -11,6 +11,7 @@
 pub mod builder;
 pub mod contacts;
 mod dynamic;
+mod error;
 pub mod exact;
 pub mod from_zero;
 pub mod hb;
@@ -27,5 +28,6 @@ pub mod stability;
 pub mod structures;
 pub mod sweep;
 
+pub use error::{Error, ErrorKind};
 pub use solve::accuracy;
 pub use solve::solve;

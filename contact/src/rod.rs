@@ -195,6 +195,7 @@ impl std::ops::DerefMut for RodModel {
 
 /// Why a model could not be built or analysed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum ModelError {
     /// A scalar parameter is outside its allowed range.
     #[error("invalid {name} = {value}: allowed {allowed}")]

@@ -30,6 +30,7 @@ pub const SAME_SOLUTION: f64 = 1e-6;
 
 /// One periodic solution at the frequency.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct PeriodicSolution {
     /// The corrected solve at exactly the frequency (tip series, statistics, unknowns).
     pub solution: Solution,
@@ -54,6 +55,7 @@ pub struct FailedCorrection {
 
 /// The answer of [`find_solutions`].
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct SolutionSet {
     /// The forcing frequency `w*`.
     pub omega: f64,

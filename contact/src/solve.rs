@@ -36,62 +36,18 @@ use crate::hb::{
     StructuredHbSolver,
 };
 use crate::lcp::{
-    ActiveSetSolver, LcpError, LcpScheme, PeriodicLcp, PeriodicLcpOptions,
-    DEFAULT_ACTIVE_SET_REGULARIZATION,
+    ActiveSetSolver, LcpScheme, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
 };
-use crate::march::MarchError;
 use crate::model::Structure;
 use crate::model::DEFAULT_C_FACTOR;
-use crate::rod::ModelError;
 use crate::settings::{GlobalizationChoice, Method, SolverSettings};
 use accuracy::{DiscretisationSearch, ErrorEstimate, NoEstimate};
 
 /// Number of reconstruction points per period for harmonic-balance outputs.
 pub const HB_OUTPUT_POINTS: usize = 1024;
 
-/// Why a run could not be carried out.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The rod could not be built.
-    #[error(transparent)]
-    Model(#[from] ModelError),
-    /// The harmonic-balance problem could not be built.
-    #[error(transparent)]
-    HarmonicBalance(#[from] HbError),
-    /// The periodic LCP could not be built.
-    #[error(transparent)]
-    Lcp(#[from] LcpError),
-    /// Lemke's algorithm could not run.
-    #[error(transparent)]
-    Lemke(#[from] semismooth::lemke::LemkeError),
-    /// Newton's method could not run.
-    #[error(transparent)]
-    Newton(#[from] newton::NewtonError),
-    /// The continuation could not run (an error the sweep settings do not name).
-    #[error(transparent)]
-    Continuation(semismooth::continuation::ContinuationError),
-    /// Time marching could not run (or did not reach a steady state).
-    #[error(transparent)]
-    March(#[from] MarchError),
-    /// A run setting (e.g. a `sweep.*` field) is outside its allowed range.
-    #[error("invalid {name} = {value}: allowed {allowed}")]
-    InvalidSetting {
-        /// Which setting (the scene's field name).
-        name: &'static str,
-        /// The value received.
-        value: f64,
-        /// The allowed range, in words.
-        allowed: &'static str,
-    },
-    /// The method needs something the scene does not declare.
-    #[error("method {method} needs {what}")]
-    Unsupported {
-        /// The method.
-        method: &'static str,
-        /// What is missing.
-        what: &'static str,
-    },
-}
+/// Why a run could not be carried out: the crate's one error type, [`crate::Error`].
+pub type RunError = crate::Error;
 
 /// Work done by a run (the JSON `counters` object).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -228,6 +184,7 @@ pub enum Diagnosis {
 
 /// The answer of one run, reduced to one period of the observed dof.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Solution {
     /// Method used.
     pub method: Method,

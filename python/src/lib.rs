@@ -8,48 +8,26 @@
 //! `ssn::json`'s, a study case is `ssn::study::run::run_case`.
 
 mod convert;
+mod errors;
 mod results;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
 use semismooth_contact::matrix_market::{matrix_market_text, parse_matrix};
 use semismooth_contact::model::SparseMatrix;
-use ssn::cli::Workload;
-use ssn::exit::CliError;
 use ssn::scene::Override;
 use ssn::source::SceneSource;
 use ssn::study::{Case, RunKind};
+use ssn::work::Workload;
 
 use convert::{python_json, python_value, toml_value};
+use errors::{bad_input, run_failure, RunFailure};
 use results::{FrequencyResponse, Solution, SolutionSet, Stability};
-
-pyo3::create_exception!(
-    ssn,
-    SceneError,
-    PyValueError,
-    "A scene, a value or a study that cannot be used: the message names the file, the key, \
-     the value and what is allowed (the command line's exit code 2)."
-);
-
-/// A bad input as [`SceneError`] with the command line's message.
-fn bad_input(e: impl std::fmt::Display) -> PyErr {
-    SceneError::new_err(e.to_string())
-}
-
-/// A failed run as a Python exception: bad input is [`SceneError`]; an output error cannot
-/// happen here (nothing is written).
-fn run_error(e: CliError) -> PyErr {
-    match e {
-        CliError::BadInput(m) | CliError::Output(m) => SceneError::new_err(m),
-        CliError::NotConverged => SceneError::new_err("the solver did not converge"),
-    }
-}
 
 /// The path of a scene built in Python from matrices (its `[model]` file names are keys of
 /// the matrices held in memory).
@@ -223,7 +201,8 @@ impl Scene {
         source.matrices = Some(Arc::new(matrices));
         let scene = Scene::checked(source.with(&Scene::overrides(values)?))?;
         // The matrices are checked when the structure is built: build it once now.
-        scene.source.load(Workload::Solve).map_err(run_error)?;
+        (scene.source.load(Workload::Solve))
+            .map_err(|e| run_failure(&scene.source.path, RunFailure::Load(e)))?;
         Ok(scene)
     }
 
@@ -341,8 +320,7 @@ impl Scene {
 fn solve(py: Python<'_>, scene: &Scene) -> PyResult<Solution> {
     let (solution, structure) = detached(py, scene, Workload::Solve, |loaded| {
         let settings = &loaded.scene.solver;
-        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
-            .map_err(|e| e.to_string())?;
+        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)?;
         Ok((solution, loaded.structure))
     })?;
     Ok(Solution::new(&scene.source.path, &solution, &structure))
@@ -356,13 +334,12 @@ fn sweep(py: Python<'_>, scene: &Scene) -> PyResult<FrequencyResponse> {
         let settings = loaded.scene.sweep.as_ref().ok_or(
             "no [sweep] section: add omega_ratio_from and omega_ratio_to (units of omega_1)",
         )?;
-        semismooth_contact::sweep::frequency_response(
+        Ok(semismooth_contact::sweep::frequency_response(
             &loaded.structure,
             &loaded.scene.solver,
             settings,
             None,
-        )
-        .map_err(|e| e.to_string())
+        )?)
     })?;
     Ok(FrequencyResponse::new(&response))
 }
@@ -372,33 +349,39 @@ fn sweep(py: Python<'_>, scene: &Scene) -> PyResult<FrequencyResponse> {
 #[pyfunction]
 fn solutions(py: Python<'_>, scene: &Scene) -> PyResult<SolutionSet> {
     let set = detached(py, scene, Workload::Branch, |loaded| {
-        semismooth_contact::solutions::find_solutions(
+        Ok(semismooth_contact::solutions::find_solutions(
             &loaded.structure,
             loaded.omega,
             &loaded.scene.solver,
             loaded.scene.sweep.as_ref(),
-        )
-        .map_err(|e| e.to_string())
+        )?)
     })?;
     Ok(SolutionSet::new(&set))
 }
 
 /// The Floquet stability of the harmonic-balance solution at the scene's frequency (the
 /// solve of `solve`, then its monodromy; a method other than SSN-HB or penalty HB is a
-/// `SceneError`); the GIL is released while it runs.
+/// `SceneError`, a solve that did not converge a `NotConvergedError`); the GIL is released
+/// while it runs.
 #[pyfunction]
 fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
     let (solution, stability) = detached(py, scene, Workload::Solve, |loaded| {
         let settings = &loaded.scene.solver;
         if !settings.method.is_harmonic_balance() {
-            return Err(format!(
+            return Err(RunFailure::Input(format!(
                 "stability needs a harmonic-balance method: allowed solver.method = \
                  \"ssn-hb\" or \"penalty-hb\", not \"{}\"",
                 settings.method.name()
-            ));
+            )));
         }
-        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)
-            .map_err(|e| e.to_string())?;
+        let solution = semismooth_contact::solve(&loaded.structure, loaded.omega, settings, None)?;
+        if !solution.converged() {
+            return Err(RunFailure::NotConverged {
+                termination: solution.termination.to_string(),
+                iterations: solution.iterations,
+                residual_norm: solution.residual_norm,
+            });
+        }
         // The whole unknown vector of the method (displacements, and the contact
         // multipliers of SSN-HB): the contact phases are read from it.
         let stability = semismooth_contact::stability::hb_stability(
@@ -407,26 +390,27 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
             loaded.omega,
             &solution.state,
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(semismooth_contact::Error::from)?;
         Ok((solution, stability))
     })?;
     Ok(Stability::new(&solution, &stability))
 }
 
-/// Loads `scene` for `workload` and runs `run` on it with the GIL released; a message of
-/// `run` is bad input naming the scene file (as the command line's).
+/// Loads `scene` for `workload` and runs `run` on it with the GIL released; a failure is
+/// raised as the exception of its kind, its message naming the scene file (as the command
+/// line's).
 fn detached<T: Send>(
     py: Python<'_>,
     scene: &Scene,
     workload: Workload,
-    run: impl FnOnce(ssn::cli::Loaded) -> Result<T, String> + Send,
+    run: impl FnOnce(ssn::cli::Loaded) -> Result<T, RunFailure> + Send,
 ) -> PyResult<T> {
     let source = scene.source.clone();
-    py.detach(move || -> Result<T, CliError> {
-        let loaded = source.load(workload)?;
-        run(loaded).map_err(|e| CliError::BadInput(format!("{}: {e}", source.path.display())))
+    py.detach(move || -> Result<T, RunFailure> {
+        let loaded = source.load(workload).map_err(RunFailure::Load)?;
+        run(loaded)
     })
-    .map_err(run_error)
+    .map_err(|failure| run_failure(&scene.source.path, failure))
 }
 
 /// Runs case `index` of a study (`values`: the scene keys it sets, in order) as `run`
@@ -546,7 +530,6 @@ fn _ssn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<FrequencyResponse>()?;
     m.add_class::<SolutionSet>()?;
     m.add_class::<Stability>()?;
-    m.add("SceneError", m.py().get_type::<SceneError>())?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(solutions, m)?)?;

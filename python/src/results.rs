@@ -194,6 +194,15 @@ result_methods!(Solution, "Solution", {
             .to_string()
     }
 
+    /// Why the solver stopped, as an `ssn.Termination` member (the first word of
+    /// `termination`).
+    #[getter]
+    fn termination_kind<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("ssn._termination")?
+            .getattr("Termination")?
+            .call_method1("of", (self.termination(),))
+    }
+
     /// Newton iterations (or Lemke pivots, periods marched).
     #[getter]
     fn iterations(&self) -> u64 {

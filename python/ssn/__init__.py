@@ -15,14 +15,17 @@ The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same s
   released while they run;
 - ``study(scene, cases, executor=None, run="solve")`` on any
   ``concurrent.futures.Executor``; ``study_file`` reads the cases of an ``ssn study`` file;
-- ``SceneError`` (a ``ValueError``): a bad scene, value or case, with the command line's
-  message (file, key, value, what is allowed).
+- ``Solution.termination_kind``: why the solve stopped, a ``Termination`` member;
+- exceptions by kind, all ``SsnError``: ``SceneError`` (a ``ValueError``): a bad scene,
+  value or case, with the command line's message (file, key, value, what is allowed);
+  ``TooLargeError`` (a ``SceneError``): a run refused up front by its memory or work
+  estimate; ``SolveError`` (a ``RuntimeError``): the computation could not be carried out,
+  ``NotConvergedError`` (``termination``, ``iterations``, ``residual_norm``) among them.
 """
 
 from ._ssn import (
     FrequencyResponse,
     Scene,
-    SceneError,
     Solution,
     SolutionSet,
     Stability,
@@ -32,16 +35,29 @@ from ._ssn import (
     stability,
     sweep,
 )
+from ._errors import (
+    NotConvergedError,
+    SceneError,
+    SolveError,
+    SsnError,
+    TooLargeError,
+)
+from ._termination import Termination
 from ._study import StudyRecords, run_case, study, study_file
 
 __all__ = [
     "FrequencyResponse",
+    "NotConvergedError",
     "Scene",
     "SceneError",
     "Solution",
     "SolutionSet",
+    "SolveError",
+    "SsnError",
     "Stability",
     "StudyRecords",
+    "Termination",
+    "TooLargeError",
     "limit_threads",
     "run_case",
     "solutions",

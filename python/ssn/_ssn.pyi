@@ -6,12 +6,10 @@ from typing import Any, Mapping, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._termination import Termination
+
 Value = Union[bool, int, float, str, Sequence["Value"]]
 Path = Union[str, PathLike[str]]
-
-class SceneError(ValueError):
-    """A scene, a value or a study that cannot be used: the file, the key, the value and
-    what is allowed (the command line's exit code 2)."""
 
 class Scene:
     """A scene: what ``ssn`` reads from a scene file, with the values set by
@@ -68,6 +66,7 @@ class Solution:
 
     converged: bool
     termination: str
+    termination_kind: Termination
     iterations: int
     residual_norm: Optional[float]
     omega: float

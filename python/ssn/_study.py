@@ -3,6 +3,7 @@
 import json
 
 from . import _ssn
+from ._errors import SceneError
 
 
 def run_case(scene, index, values, run="solve"):
@@ -70,14 +71,14 @@ def study(scene, cases, executor=None, run="solve", batch=1):
     """
     cases = [dict(c) for c in cases]
     if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
-        raise _ssn.SceneError(f"invalid batch {batch!r}: allowed an integer >= 1")
+        raise SceneError(f"invalid batch {batch!r}: allowed an integer >= 1")
     if run not in ("solve", "sweep", "solutions"):
-        raise _ssn.SceneError(f'invalid run {run!r}: allowed "solve", "sweep" or "solutions"')
+        raise SceneError(f'invalid run {run!r}: allowed "solve", "sweep" or "solutions"')
     for index, values in enumerate(cases):
         try:
             scene.with_values(values)
-        except _ssn.SceneError as e:
-            raise _ssn.SceneError(f"case {index} ({values}): {e}") from None
+        except SceneError as e:
+            raise SceneError(f"case {index} ({values}): {e}") from None
     keys = []
     for values in cases:
         keys.extend(k for k in values if k not in keys)

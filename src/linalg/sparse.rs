@@ -71,6 +71,7 @@ impl LuScalar for c64 {
 
 /// When [`SparseLu`] reports a factorization as singular ([`LinearSolveError::Singular`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum PivotRule {
     /// The rule of the other solvers of this module: the entries of the matrix are checked
     /// first ([`LinearSolveError::NonFiniteEntry`]), then a pivot with

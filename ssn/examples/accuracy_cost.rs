@@ -28,10 +28,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 scene,
                 structure,
                 omega,
-            } = load(path.as_ref()).map_err(|e| match e {
-                CliError::BadInput(m) | CliError::Output(m) => m,
-                CliError::NotConverged => "not converged".to_string(),
-            })?;
+            } = load(path.as_ref()).map_err(|e: CliError| e.to_string())?;
             (structure, omega, scene.solver)
         }
         None => {

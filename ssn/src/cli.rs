@@ -32,6 +32,12 @@ fn input_error(path: &Path, e: impl Display) -> CliError {
     CliError::BadInput(format!("{}: {e}", path.display()))
 }
 
+/// A run of the scene `path` refused up front: its memory or work estimate is above the
+/// limit (the message says by how much and how to lift it).
+fn too_large(path: &Path, e: impl Display) -> CliError {
+    CliError::TooLarge(format!("{}: {e}", path.display()))
+}
+
 /// A scene ready to run: the scene, its structure and its `[forcing]` frequency resolved
 /// once against the structure's `omega_1` ([`Scene::omega`]).
 #[derive(Debug, Clone)]
@@ -89,12 +95,12 @@ pub fn prepare(
     let work_limit = crate::limits::work_limit().map_err(CliError::BadInput)?;
     // A rod is estimated before it is built; an imported model once its size is read.
     if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
-        crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+        crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
     }
     if scene.model.is_none() {
         let (n, m) = (scene.rod.elements, scene.rod.contacts.len());
         let work = crate::work::scene_work(&scene, n, m, workload);
-        crate::limits::check_work(&work, work_limit).map_err(|e| input_error(path, e))?;
+        crate::limits::check_work(&work, work_limit).map_err(|e| too_large(path, e))?;
     }
     let structure = match &scene.model {
         // Import errors name the scene or the matrix file themselves.
@@ -116,10 +122,10 @@ pub fn prepare(
             crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
                 .map_err(CliError::BadInput)?;
             let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
-            crate::limits::check(&need, limit).map_err(|e| input_error(path, e))?;
+            crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
             let work = crate::work::scene_work(&scene, n, m, workload);
-            crate::limits::check_work(&work, work_limit).map_err(|e| input_error(path, e))?;
+            crate::limits::check_work(&work, work_limit).map_err(|e| too_large(path, e))?;
             structure
         }
         None => {

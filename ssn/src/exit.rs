@@ -1,5 +1,5 @@
-//! How a command failed, as the documented exit codes: 1 not converged, 2 bad input, 3 an
-//! output not written.
+//! How a command failed, as the documented exit codes: 1 not converged, 2 bad input (or a
+//! run refused up front as too large), 3 an output not written.
 
 use crate::io::{OutputError, TargetError};
 
@@ -12,6 +12,10 @@ pub enum CliError {
     /// Bad input: scene, option (exit code 2).
     #[error("{0}")]
     BadInput(String),
+    /// A run refused before it starts: its memory or work estimate is above the limit
+    /// (exit code 2, as bad input: smaller settings or a raised limit let it run).
+    #[error("{0}")]
+    TooLarge(String),
     /// An output could not be written (exit code 3).
     #[error("{0}")]
     Output(String),

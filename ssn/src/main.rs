@@ -204,7 +204,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(CliError::NotConverged) => ExitCode::from(1),
-        Err(CliError::BadInput(m)) => {
+        Err(CliError::BadInput(m) | CliError::TooLarge(m)) => {
             io::write_stderr(&format!("error: {}\n", io::printable_message(&m)));
             ExitCode::from(2)
         }

@@ -659,7 +659,9 @@ pub fn performance() -> Result<Table, TableError> {
     let mut table = Table::new(&["what", "counts", "seconds"], &[2]);
     let figure = |e: crate::exit::CliError| {
         TableError::Figure(match e {
-            crate::exit::CliError::BadInput(m) | crate::exit::CliError::Output(m) => m,
+            crate::exit::CliError::BadInput(m)
+            | crate::exit::CliError::TooLarge(m)
+            | crate::exit::CliError::Output(m) => m,
             crate::exit::CliError::NotConverged => "not converged".into(),
         })
     };

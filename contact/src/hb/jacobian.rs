@@ -12,6 +12,7 @@ use crate::operator::HarmonicParameters;
 
 /// How the contact unknowns enter the Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum ContactCoupling {
     /// SSN-HB: unknowns `[U; Lambda]`,
     /// `J = [[A(w), -G^T], [c Q G, I - Q]]` with `Q = P diag(h) E` per contact,

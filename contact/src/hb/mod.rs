@@ -225,6 +225,7 @@ omega_parameter!(SsnHb, PenaltyHb);
 
 /// Why a harmonic-balance problem could not be built or a reconstruction not made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum HbError {
     /// An option or parameter is outside its allowed range.
     #[error("invalid {0}")]
@@ -271,6 +272,7 @@ pub enum HbError {
 /// Extremes and contact diagnostics of a harmonic-balance solution over one period,
 /// reconstructed on `points` equally spaced times.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ResponseSummary {
     /// Degree of freedom whose extremes are reported.
     pub dof: usize,

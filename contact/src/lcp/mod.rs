@@ -233,6 +233,7 @@ impl PeriodicLcpOptions {
 
 /// Why a periodic LCP could not be built, or a result could not be produced.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum LcpError {
     /// An option is out of range.
     #[error("invalid option {0}")]

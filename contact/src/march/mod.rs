@@ -333,6 +333,7 @@ pub struct SteadyPeriod {
 
 /// Why a march could not be carried out or did not become periodic.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum MarchError {
     /// An option is outside its allowed range.
     #[error("invalid option {0}")]

@@ -120,6 +120,7 @@ impl ModelSpec {
 
 /// Why an imported model could not be built.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ImportError {
     /// A file could not be read or written.
     #[error("{path}: {source}")]

@@ -26,6 +26,7 @@ pub struct ContactRow {
 
 /// Why a [`ContactRow`] cannot be built.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum InvalidRow {
     /// No dof.
     #[error("a contact row needs at least one dof")]

@@ -72,6 +72,7 @@ pub struct Structure {
 
 /// Why a [`StructuralModel`] cannot be used: the part, the value found and what is allowed.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum InvalidModel {
     /// The stiffness matrix has no row: there is no degree of freedom.
     #[error("the model has no degree of freedom: allowed N >= 1")]

@@ -234,6 +234,7 @@ pub enum Undecided {
 
 /// The stability of one periodic solution ([`hb_stability`]).
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Stability {
     /// `Some(true)`: every multiplier inside the unit circle; `Some(false)`: one outside;
     /// `None`: not decided (see `undecided`).
@@ -331,6 +332,7 @@ enum Formulation {
 
 /// The stability analysis of harmonic-balance solutions of one model and method, reused
 /// along a branch (the phases met are decomposed once).
+#[non_exhaustive]
 pub struct HbStability {
     formulation: Formulation,
     /// The model (the orbit's state at the impacts).

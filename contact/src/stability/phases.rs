@@ -66,6 +66,7 @@ const EIGEN_RECONSTRUCTION: f64 = 1e-9;
 
 /// How a closed contact acts on the perturbation.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum ClosedContact {
     /// The contact's dof is held (Signorini law, SSN-HB).
     Held,

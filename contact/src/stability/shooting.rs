@@ -70,6 +70,7 @@ use crate::model::{check_omega, StructuralModel};
 /// The stability of one periodic solution from the discrete monodromy of the time-stepping
 /// map along the map's own periodic orbit.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct MapStability {
     /// `Some(true)`: every multiplier inside the unit circle; `Some(false)`: one outside;
     /// `None`: not decided (see `undecided`).

@@ -84,6 +84,7 @@ pub const LOWER_BELOW: f64 = 0.25;
 
 /// What the harmonics chosen point by point achieved along a branch.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct BranchAccuracy {
     /// The relative accuracy asked of each point's observed displacement.
     pub target: f64,

@@ -28,6 +28,7 @@ const DIAGNOSTIC_POINTS: usize = 1024;
 
 /// A change of stability between two neighbouring points of a branch.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct BifurcationEvent {
     /// Fold, period doubling or Neimark–Sacker.
     pub kind: BifurcationKind,
@@ -44,6 +45,7 @@ pub struct BifurcationEvent {
 
 /// Per-point stability and contact diagnostics of a branch.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct BranchStability {
     /// Stable / unstable / undecided, one per point.
     pub stable: Vec<Option<bool>>,

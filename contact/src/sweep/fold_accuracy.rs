@@ -102,6 +102,7 @@ pub enum FoldStop {
 
 /// A fold frequency with its uncertainty.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FoldAccuracy {
     /// The fold as the sweep found it (`ω`, absolute).
     pub sweep_omega: f64,

@@ -16,6 +16,7 @@ type ContactField = fn(&ContactReport) -> f64;
 /// A frequency-response curve: one entry per branch point, in branch order (the frequency
 /// is not monotone across folds).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FrequencyResponse {
     /// Method used.
     pub method: Method,

@@ -54,6 +54,7 @@ pub const KRYLOV_RELATIVE_TOLERANCE: f64 = 1e-10;
 
 /// How [`StructuredHbSolver`] solves the condensed SSN-HB system on the contact unknowns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum CondensedSolve {
     /// Dense LU up to [`KRYLOV_THRESHOLD`] condensed unknowns, GMRES above.
     #[default]

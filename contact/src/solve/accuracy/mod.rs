@@ -209,6 +209,7 @@ pub struct EstimateBasis {
 /// An estimate of the relative error of a solution's reported quantities (module
 /// documentation).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ErrorEstimate {
     /// The estimated relative error: the largest of `parts`.
     pub relative: f64,
