@@ -152,7 +152,7 @@ impl Error {
                 | HbError::DimensionMismatch { .. }
                 | HbError::Harmonic(_),
             )
-            | Error::Lcp(LcpError::InvalidOption(_))
+            | Error::Lcp(LcpError::InvalidOption(_) | LcpError::Unsupported { .. })
             | Error::March(MarchError::InvalidOption(_))
             | Error::Stability(StabilityError::InvalidOption { .. })
             | Error::Newton(_) => ErrorKind::InvalidInput,

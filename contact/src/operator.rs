@@ -142,8 +142,13 @@ impl HarmonicOperator {
     fn apply_with(&self, coefficients: impl Fn(usize) -> Coefficients, u: &[f64], out: &mut [f64]) {
         let n = self.dofs;
         out.fill(0.0);
-        for (a, c) in self.terms(coefficients(0)) {
-            if c.re != 0.0 {
+        let sources = [
+            Some(&self.stiffness),
+            Some(&self.mass),
+            self.damping.as_ref(),
+        ];
+        for (a, c) in sources.iter().zip(coefficients(0)) {
+            if let (Some(a), true) = (a, c.re != 0.0) {
                 sparse_mul_add(a.as_ref(), c.re, &u[..n], &mut out[..n]);
             }
         }
@@ -151,8 +156,10 @@ impl HarmonicOperator {
             let (cos, sin) = ((2 * k - 1) * n, 2 * k * n);
             let (a, b) = (&u[cos..cos + n], &u[sin..sin + n]);
             let (out_c, out_s) = out[cos..sin + n].split_at_mut(n);
-            for (matrix, c) in self.terms(coefficients(k)) {
-                let matrix = matrix.as_ref();
+            for (matrix, c) in sources.iter().zip(coefficients(k)) {
+                let Some(matrix) = matrix.map(|m| m.as_ref()) else {
+                    continue;
+                };
                 // z = a - i b: Z z = (Re Z a + Im Z b) - i (Re Z b - Im Z a).
                 if c.re != 0.0 {
                     sparse_mul_add(matrix, c.re, a, out_c);
