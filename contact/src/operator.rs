@@ -14,9 +14,9 @@
 //!
 //! - [`HarmonicParameters`]: `w` and every other parameter of the coefficients;
 //!   [`OperatorParameter`] names one of them for derivatives.
-//! - [`HarmonicOperator`]: the sources and the [`HarmonicLoad`]; the coefficients and their
+//! - `HarmonicOperator`: the sources and the [`HarmonicLoad`]; the coefficients and their
 //!   derivatives, the real form's product, residual and dense assembly (no allocation).
-//! - [`HarmonicFactors`]: the sparse complex LU of every `Z_k` (one union pattern, one
+//! - `HarmonicFactors`: the sparse complex LU of every `Z_k` (one union pattern, one
 //!   reusable slot per harmonic), refactored only when a parameter changed (the cache key
 //!   is the bits of all of them), counted.
 
