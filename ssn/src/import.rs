@@ -1,7 +1,9 @@
 //! Any scene's structure exported as a `[model]` scene (`ssn export-model`).
 
 use semismooth_contact::matrix_market::{matrix_market_text, vector_market_text};
-use semismooth_contact::model::{ContactRow, NormalForce, StructuralModel, Structure};
+use semismooth_contact::model::{
+    ContactRow, HarmonicLoad, NormalForce, StructuralModel, Structure,
+};
 use semismooth_contact::rod::FrequencySpec;
 use semismooth_contact::settings::SolverSettings;
 
@@ -9,9 +11,10 @@ use semismooth_contact::settings::SolverSettings;
 pub const EXPORTED_SCENE: &str = "scene.toml";
 
 /// The files of a scene's structure as a `[model]` scene: `M.mtx`, `K.mtx`, `D.mtx` (when
-/// damped), `f.mtx` (the load vector at unit amplitude) and [`EXPORTED_SCENE`], whose
+/// damped), `f.mtx` (the load's cosine part on the forcing frequency at unit amplitude, and
+/// one file for each of its other parts: [`load_files`]) and [`EXPORTED_SCENE`], whose
 /// forcing, contacts, observed dof, solver and sweep are the scene's. Reading them back
-/// gives the same matrices bit for bit, hence the same answers.
+/// gives the same matrices and load bit for bit, hence the same answers.
 pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(String, String)> {
     use std::fmt::Write;
     let model = &structure.model;
@@ -22,10 +25,8 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     if let Some(d) = &model.damping {
         files.push(("D.mtx".to_string(), matrix_market_text(d)));
     }
-    files.push((
-        "f.mtx".to_string(),
-        vector_market_text(&model.load.forcing_cosine()),
-    ));
+    let (load_files, load_keys) = load_files(&model.load);
+    files.extend(load_files);
     let mut t = String::new();
     let title = scene.title.as_deref().unwrap_or("untitled");
     // A TOML string (TOML's escapes, not Rust's `{:?}` ones, which TOML cannot read).
@@ -40,6 +41,7 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
         FrequencySpec::Ratio(r) => writeln!(t, "omega_ratio = {r:?}"),
         FrequencySpec::Absolute(w) => writeln!(t, "omega = {w:?}"),
     };
+    t.push_str(&load_keys);
     t.push_str(&contact_sections(model));
     let _ = writeln!(t, "\n[output]\ndof = {}", structure.observed_dof + 1);
     t.push_str(&solver_section(&scene.solver));
@@ -52,6 +54,52 @@ pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(
     }
     files.push((EXPORTED_SCENE.to_string(), t));
     files
+}
+
+/// The files of `load` beyond `f.mtx` (its cosine part on harmonic 1), with the `[forcing]`
+/// keys that name them: `vector_sin` (`f_sin.mtx`), `static` (`f_static.mtx`) and a
+/// `[[forcing.harmonic]]` per higher harmonic (`f_cos_K.mtx`, `f_sin_K.mtx`); parts that are
+/// zero are not written. The keys come last in the `[forcing]` section.
+fn load_files(load: &HarmonicLoad) -> (Vec<(String, String)>, String) {
+    use std::fmt::Write;
+    let mut files = vec![(
+        "f.mtx".to_string(),
+        vector_market_text(&load.forcing_cosine()),
+    )];
+    let (mut keys, mut tables) = (String::new(), String::new());
+    let nonzero = |v: &[f64]| v.iter().any(|x| *x != 0.0);
+    for h in load.harmonics() {
+        let mut file = |name: String, v: &[f64]| {
+            files.push((name.clone(), vector_market_text(v)));
+            name
+        };
+        match h.harmonic {
+            0 if nonzero(&h.cosine) => {
+                let _ = writeln!(
+                    keys,
+                    "static = \"{}\"",
+                    file("f_static.mtx".into(), &h.cosine)
+                );
+            }
+            1 if nonzero(&h.sine) => {
+                let _ = writeln!(
+                    keys,
+                    "vector_sin = \"{}\"",
+                    file("f_sin.mtx".into(), &h.sine)
+                );
+            }
+            k if k >= 2 && (nonzero(&h.cosine) || nonzero(&h.sine)) => {
+                let cos = file(format!("f_cos_{k}.mtx"), &h.cosine);
+                let sin = file(format!("f_sin_{k}.mtx"), &h.sine);
+                let _ = writeln!(
+                    tables,
+                    "\n[[forcing.harmonic]]\norder = {k}\ncos = \"{cos}\"\nsin = \"{sin}\""
+                );
+            }
+            _ => {}
+        }
+    }
+    (files, keys + &tables)
 }
 
 /// The `[[contact.point]]` (with their friction) and `[[friction.point]]` sections of
