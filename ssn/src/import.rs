@@ -12,7 +12,7 @@ pub const EXPORTED_SCENE: &str = "scene.toml";
 
 /// The files of a scene's structure as a `[model]` scene: `M.mtx`, `K.mtx`, `D.mtx` (when
 /// damped), `f.mtx` (the load's cosine part on the forcing frequency at unit amplitude, and
-/// one file for each of its other parts: [`load_files`]) and [`EXPORTED_SCENE`], whose
+/// one file for each of its other parts) and [`EXPORTED_SCENE`], whose
 /// forcing, contacts, observed dof, solver and sweep are the scene's. Reading them back
 /// gives the same matrices and load bit for bit, hence the same answers.
 pub fn export_files(scene: &crate::scene::Scene, structure: &Structure) -> Vec<(String, String)> {
