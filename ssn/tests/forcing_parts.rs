@@ -58,14 +58,14 @@ fn scene(dir: &Path, forcing: &str) -> PathBuf {
     path
 }
 
+/// A sine part, a static load and harmonic 2's cosine and sine parts.
+const EVERY_PART: &str = "vector_sin = \"fs.mtx\"\nstatic = \"f0.mtx\"\n\
+     [[forcing.harmonic]]\norder = 2\ncos = \"c2.mtx\"\nsin = \"s2.mtx\"";
+
 #[test]
 fn sine_static_and_harmonic_loads_reach_the_model_scaled_by_the_amplitude_but_static() {
     let dir = temp_dir("parts");
-    let path = scene(
-        &dir,
-        "vector_sin = \"fs.mtx\"\nstatic = \"f0.mtx\"\n\
-         [[forcing.harmonic]]\norder = 2\ncos = \"c2.mtx\"\nsin = \"s2.mtx\"",
-    );
+    let path = scene(&dir, EVERY_PART);
     let loaded = load(&path).unwrap();
     let f = &loaded.structure.model.load;
     // Exact: each part is its file times 0.5 (or 1 for `static`), a single product.
@@ -129,11 +129,7 @@ fn bad_load_parts_are_refused_with_the_key_the_value_and_what_is_allowed() {
 #[test]
 fn an_exported_scene_keeps_every_load_part_bit_for_bit() {
     let dir = temp_dir("export");
-    let path = scene(
-        &dir,
-        "vector_sin = \"fs.mtx\"\nstatic = \"f0.mtx\"\n\
-         [[forcing.harmonic]]\norder = 2\ncos = \"c2.mtx\"\nsin = \"s2.mtx\"",
-    );
+    let path = scene(&dir, EVERY_PART);
     let loaded = load(&path).unwrap();
     let out = dir.join("exported");
     std::fs::create_dir_all(&out).unwrap();
