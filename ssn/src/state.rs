@@ -181,7 +181,8 @@ impl HbState {
             return Err(field_error(
                 "omega_ratio",
                 format!(
-                    "{ratio:e}: omega / omega_ratio = {omega_1:e} is no natural frequency                      (allowed a ratio that leaves it finite and > 0)"
+                    "{ratio:e}: omega / omega_ratio = {omega_1:e} is no natural frequency (allowed a \
+                     ratio that leaves it finite and > 0)"
                 ),
             ));
         }
@@ -410,6 +411,20 @@ mod tests {
         // H = 0: the constants only.
         let (cut, _) = back.unknowns_for(shape(0)).unwrap();
         assert_eq!(cut, [1., 2., 7.]);
+    }
+
+    #[test]
+    fn a_ratio_that_leaves_no_natural_frequency_is_named_in_one_sentence() {
+        let mut doc = HbState::from_unknowns(shape(1), 2.0, 1.0, &[0.0; 9]).to_json();
+        (doc["omega"], doc["omega_ratio"]) = (json!(1e300), json!(1e-300));
+        let error = HbState::from_json(&doc).unwrap_err();
+        assert_eq!(error.field, "omega_ratio");
+        let message = error.to_string();
+        assert!(
+            message.contains("is no natural frequency (allowed a ratio"),
+            "{message}"
+        );
+        assert!(!message.contains("  "), "{message}");
     }
 
     #[test]
