@@ -62,12 +62,6 @@ impl From<LibraryError> for RunFailure {
     }
 }
 
-impl From<String> for RunFailure {
-    fn from(message: String) -> Self {
-        RunFailure::Input(message)
-    }
-}
-
 impl From<&str> for RunFailure {
     fn from(message: &str) -> Self {
         RunFailure::Input(message.to_string())
