@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-signals, memory and work limits, studies, `--set` and friction keys, as an adversary and a careless user would try them.
-signals, memory and work limits, as an adversary and a careless user would try them.
+"""Adversarial probe of the program's contract: imported files, solutions, states, exports,
+signals, memory and work limits, studies, `--set` and friction keys, as an adversary and a
+careless user would try them.
 
 usage: contract_probe.py SSN_BINARY SCENES_DIR
 PROBE_FAST=1 leaves out the cases that are heavy by design (they check that a work estimate
