@@ -723,6 +723,7 @@ mod tests {
                 entry(Method::SsnHb, 1e-6, 0.010, true),
                 entry(Method::March, 1e-2, 0.1, true),
             ],
+            skipped: Vec::new(),
         };
         let best = study.cheapest(1e-3);
         assert_eq!(best.len(), 2);
@@ -750,6 +751,7 @@ mod tests {
                 march_tolerance: None,
             },
             entries: vec![entry(Method::SsnHb, 1e-4, 0.003, true), failed],
+            skipped: Vec::new(),
         };
         let (table, csv) = (study.table(), study.to_csv());
         for text in [&table, &csv] {
