@@ -647,7 +647,7 @@ fn does_not_apply(e: &RunError) -> bool {
         )
 }
 
-/// The methods of the study (those [`sweep_settings`] runs on `rod`) that do not apply to
+/// The methods of the study (the methods it runs on `rod`) that do not apply to
 /// it, with the reason: a formulation that does not model something the structure declares
 /// (the periodic LCP and a two-sided stop) refuses its smallest run (one harmonic, 16 time
 /// samples or steps, two periods, one iteration) before computing anything, so the study
