@@ -1,12 +1,27 @@
 //! Conversions between Python objects and the scene's TOML values and the JSON documents.
 
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
+/// Deepest nesting of lists in a scene value (a scene key takes a number, a list of them,
+/// or a list of such lists): deeper is refused before it can exhaust the stack, which a
+/// list that contains itself would otherwise do.
+pub const MAX_VALUE_DEPTH: usize = 8;
+
 /// A Python value as a TOML value: bool, int, float, str, and lists or tuples (or numpy
-/// arrays, through `tolist()`) of them.
+/// arrays, through `tolist()`) of them, nested at most [`MAX_VALUE_DEPTH`] deep.
 pub fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    nested_toml_value(value, 0)
+}
+
+fn nested_toml_value(value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Value> {
+    if depth > MAX_VALUE_DEPTH {
+        return Err(PyValueError::new_err(format!(
+            "lists nested more than {MAX_VALUE_DEPTH} deep (or a list that contains itself): \
+             allowed a number, a string, a bool or a list of them"
+        )));
+    }
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.extract()?));
     }
@@ -23,7 +38,7 @@ pub fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         let items: Vec<Bound<'_, PyAny>> = value.try_iter()?.collect::<PyResult<_>>()?;
         return items
             .iter()
-            .map(toml_value)
+            .map(|item| nested_toml_value(item, depth + 1))
             .collect::<PyResult<Vec<_>>>()
             .map(toml::Value::Array);
     }
@@ -31,7 +46,7 @@ pub fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     if value.hasattr("tolist")? {
         let plain = value.call_method0("tolist")?;
         if !plain.is(value) {
-            return toml_value(&plain);
+            return nested_toml_value(&plain, depth + 1);
         }
     }
     Err(PyTypeError::new_err(format!(

@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
@@ -59,8 +60,22 @@ impl Scene {
         values
             .iter()
             .map(|(k, v)| {
-                let key: String = k.extract()?;
-                Override::new(&key, toml_value(&v)?).map_err(bad_input)
+                let py = k.py();
+                let key: String = k.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "scene key {}: allowed a str such as \"forcing.amplitude\"",
+                        k.repr().map_or_else(|_| "?".into(), |r| r.to_string())
+                    ))
+                })?;
+                let value = toml_value(&v).map_err(|e| {
+                    let message = format!("`{key}`: {}", e.value(py));
+                    if e.is_instance_of::<PyTypeError>(py) {
+                        PyTypeError::new_err(message)
+                    } else {
+                        PyValueError::new_err(message)
+                    }
+                })?;
+                Override::new(&key, value).map_err(bad_input)
             })
             .collect()
     }
@@ -126,10 +141,12 @@ impl Scene {
     }
 
     /// A structure of your own: mass `mass`, stiffness `stiffness` (numpy arrays or
-    /// scipy.sparse matrices, N x N, symmetric), load shape `load` (length N), contacts
-    /// as `(dof, gap)` or `(dof, gap, direction)` with a 0-based `dof` and direction +1
-    /// (`u[dof] <= gap`) or -1 (`-u[dof] <= gap`), or `{"row": G_row, "gap": g}` with a
-    /// signed unit row; optional damping matrix `damping`; any other scene key in `values`
+    /// scipy.sparse matrices, N x N, symmetric, real and finite), load shape `load` (length
+    /// N), contacts as `(dof, gap)` or `(dof, gap, direction)` with a 0-based `dof` and
+    /// direction +1 (`u[dof] <= gap`) or -1 (`-u[dof] <= gap`), or
+    /// `{"row": G_row, "gap": g}` with a row of G over one or several dofs (`"dof"` instead
+    /// of `"row"`; `"friction": mu` with `"tangent": T_row` adds Coulomb friction; any
+    /// other key is refused); optional damping matrix `damping`; any other scene key in `values`
     /// (`damping.zeta`, `forcing.amplitude` (default 1), `forcing.omega_ratio`,
     /// `solver.harmonics`, `output.dof` (1-based, as in scene files), ...). The checks of
     /// an imported model apply (symmetry, sizes, a nonsingular stiffness).
@@ -146,29 +163,30 @@ impl Scene {
     ) -> PyResult<Scene> {
         let helpers = py.import("ssn._convert")?;
         let mut matrices = BTreeMap::new();
-        let mut read = |name: &str, what: &Bound<'_, PyAny>, vector: bool| -> PyResult<()> {
-            let coo = helpers.call_method1("coo", (what, vector))?;
-            let (rows, cols, i, j, v): (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>) =
-                coo.extract()?;
-            let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
-                .iter()
-                .zip(&j)
-                .zip(&v)
-                .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
-                .collect();
-            let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
-                .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
-            matrices.insert(PathBuf::from(name), matrix);
-            Ok(())
-        };
-        read("M.mtx", mass, false)?;
-        read("K.mtx", stiffness, false)?;
-        read("f.mtx", load, true)?;
+        let mut read =
+            |name: &str, argument: &str, what: &Bound<'_, PyAny>, vector: bool| -> PyResult<()> {
+                let coo = helpers.call_method1("coo", (what, vector, argument))?;
+                let (rows, cols, i, j, v): (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>) =
+                    coo.extract()?;
+                let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
+                    .iter()
+                    .zip(&j)
+                    .zip(&v)
+                    .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
+                    .collect();
+                let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
+                    .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
+                matrices.insert(PathBuf::from(name), matrix);
+                Ok(())
+            };
+        read("M.mtx", "mass", mass, false)?;
+        read("K.mtx", "stiffness", stiffness, false)?;
+        read("f.mtx", "load", load, true)?;
         let mut model = toml::Table::new();
         model.insert("mass".into(), "M.mtx".into());
         model.insert("stiffness".into(), "K.mtx".into());
         if let Some(d) = damping {
-            read("D.mtx", d, false)?;
+            read("D.mtx", "damping", d, false)?;
             model.insert("damping".into(), "D.mtx".into());
         }
         let mut table = toml::Table::new();
@@ -178,19 +196,19 @@ impl Scene {
         forcing.insert("amplitude".into(), 1.0.into());
         table.insert("forcing".into(), toml::Value::Table(forcing));
         if let Some(contacts) = contacts {
-            let list: Vec<(usize, f64, i64)> =
+            let list: Vec<Bound<'_, PyDict>> =
                 helpers.call_method1("contacts", (contacts,))?.extract()?;
             if !list.is_empty() {
                 let points: Vec<toml::Value> = list
-                    .into_iter()
-                    .map(|(dof, gap, direction)| {
+                    .iter()
+                    .map(|point| {
                         let mut p = toml::Table::new();
-                        p.insert("dof".into(), ((dof + 1) as i64).into());
-                        p.insert("gap".into(), gap.into());
-                        p.insert("direction".into(), direction.into());
-                        toml::Value::Table(p)
+                        for (k, v) in point.iter() {
+                            p.insert(k.extract()?, toml_value(&v)?);
+                        }
+                        Ok(toml::Value::Table(p))
                     })
-                    .collect();
+                    .collect::<PyResult<_>>()?;
                 let mut contact = toml::Table::new();
                 contact.insert("point".into(), toml::Value::Array(points));
                 table.insert("contact".into(), toml::Value::Table(contact));

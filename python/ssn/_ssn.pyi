@@ -42,10 +42,13 @@ class Scene:
         damping: Any = None,
         values: Optional[Mapping[str, Value]] = None,
     ) -> Scene:
-        """A structure of your own from numpy arrays or scipy.sparse matrices; contacts as
-        ``(dof, gap[, direction])`` with a 0-based dof, or ``{"row": G_row, "gap": g}``;
-        other scene keys (``damping.zeta``, ``forcing.amplitude``, ``solver.harmonics``,
-        ``output.dof`` (1-based), ...) in ``values``."""
+        """A structure of your own from numpy arrays or scipy.sparse matrices (real and
+        finite; ``load`` a vector of length N); contacts as ``(dof, gap[, direction])`` with
+        a 0-based integer dof, or ``{"row": G_row, "gap": g}`` with a row of G over one or
+        several dofs (``"dof"`` instead of ``"row"``; ``"friction": mu`` with
+        ``"tangent": T_row`` adds Coulomb friction; other keys are refused); other scene
+        keys (``damping.zeta``, ``forcing.amplitude``, ``solver.harmonics``, ``output.dof``
+        (1-based), ...) in ``values``."""
     def with_values(self, values: Mapping[str, Value]) -> Scene:
         """A copy with scene keys set (the keys of ``ssn solve --set``)."""
     @property

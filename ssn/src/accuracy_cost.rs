@@ -100,6 +100,9 @@ pub struct AccuracyCost {
     pub reference: Reference,
     /// Every run, grouped by method in the order they ran.
     pub entries: Vec<Entry>,
+    /// The methods left out because they do not apply to the structure, with the reason
+    /// ([`inapplicable_methods`]).
+    pub skipped: Vec<(Method, String)>,
 }
 
 fn rms(v: &[f64]) -> f64 {
@@ -580,12 +583,17 @@ pub fn accuracy_cost(
         ..base.clone()
     };
     let contact = !rod.model.contacts.is_empty();
+    let skipped = inapplicable_methods(rod, omega, base);
     let reference = reference(rod, omega, base, &say)?;
     let mut entries = Vec::new();
     let march_tolerance = reference
         .march_tolerance
         .map_or(base.march_tolerance, |t| t.max(base.march_tolerance));
-    for (method, setting, settings) in sweep_settings(rod, base, march_tolerance) {
+    let settings_list = sweep_settings(rod, base, march_tolerance);
+    let applicable = settings_list
+        .into_iter()
+        .filter(|(m, ..)| skipped.iter().all(|(s, _)| s != m));
+    for (method, setting, settings) in applicable {
         say(&format!("{} {setting}", method.name()));
         let entry = match timed(rod, omega, &settings) {
             Ok(sol) => Entry {
@@ -621,7 +629,59 @@ pub fn accuracy_cost(
         };
         entries.push(entry);
     }
-    Ok(AccuracyCost { reference, entries })
+    Ok(AccuracyCost {
+        reference,
+        entries,
+        skipped,
+    })
+}
+
+/// Whether a run's error says its method does not apply to the structure (an input the
+/// method refuses, or a stop on the negative side, which the periodic LCP does not pose).
+fn does_not_apply(e: &RunError) -> bool {
+    use semismooth_contact::lcp::LcpError;
+    e.kind() == semismooth_contact::ErrorKind::InvalidInput
+        || matches!(
+            e,
+            semismooth_contact::Error::Lcp(LcpError::NegativeDirection { .. })
+        )
+}
+
+/// The methods of the study (the methods it runs on `rod`) that do not apply to
+/// it, with the reason: a formulation that does not model something the structure declares
+/// (the periodic LCP and a two-sided stop) refuses its smallest run (one harmonic, 16 time
+/// samples or steps, two periods, one iteration) before computing anything, so the study
+/// decides applicability up front instead of failing after its other runs.
+pub fn inapplicable_methods(
+    rod: &Structure,
+    omega: f64,
+    base: &SolverSettings,
+) -> Vec<(Method, String)> {
+    let mut methods: Vec<Method> = sweep_settings(rod, base, base.march_tolerance)
+        .into_iter()
+        .map(|(m, ..)| m)
+        .collect();
+    methods.dedup();
+    methods
+        .into_iter()
+        .filter_map(|method| {
+            let smallest = SolverSettings {
+                method,
+                harmonics: 1,
+                time_samples: 16,
+                steps_per_period: 16,
+                max_periods: 2,
+                max_iterations: 1,
+                estimate_error: false,
+                accuracy: None,
+                ..base.clone()
+            };
+            match solve(rod, omega, &smallest, None) {
+                Err(e) if does_not_apply(&e) => Some((method, e.to_string())),
+                _ => None,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -663,6 +723,7 @@ mod tests {
                 entry(Method::SsnHb, 1e-6, 0.010, true),
                 entry(Method::March, 1e-2, 0.1, true),
             ],
+            skipped: Vec::new(),
         };
         let best = study.cheapest(1e-3);
         assert_eq!(best.len(), 2);
@@ -690,6 +751,7 @@ mod tests {
                 march_tolerance: None,
             },
             entries: vec![entry(Method::SsnHb, 1e-4, 0.003, true), failed],
+            skipped: Vec::new(),
         };
         let (table, csv) = (study.table(), study.to_csv());
         for text in [&table, &csv] {

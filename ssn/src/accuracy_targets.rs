@@ -409,11 +409,16 @@ pub fn self_chosen_lines(
     base: &SolverSettings,
     target: f64,
     reference_tip_min: f64,
+    skipped: &[(Method, String)],
 ) -> Result<String, semismooth_contact::solve::RunError> {
     let contact = !structure.model.contacts.is_empty();
     let mut out = String::new();
     for method in METHODS {
         if !contact && !matches!(method, Method::SsnHb | Method::March) {
+            continue;
+        }
+        if skipped.iter().any(|(m, _)| *m == method) {
+            out += &format!("  {:<11} skipped: does not apply\n", method.name());
             continue;
         }
         let settings = SolverSettings {

@@ -91,10 +91,17 @@ pub fn prepare(
     let path = scene.path.clone();
     let path = path.as_path();
     let compare = workload == Workload::Compare;
+    let solves = !matches!(workload, Workload::Check | Workload::Export);
     let limit = crate::limits::memory_limit().map_err(CliError::BadInput)?;
     let work_limit = crate::limits::work_limit().map_err(CliError::BadInput)?;
     // A rod is estimated before it is built; an imported model once its size is read.
-    if let Some(need) = crate::limits::rod_scene_memory(&scene, compare) {
+    let rod_need = match solves {
+        true => crate::limits::rod_scene_memory(&scene, compare),
+        false => {
+            (scene.model.is_none()).then(|| crate::limits::model_only_memory(scene.rod.elements))
+        }
+    };
+    if let Some(need) = rod_need {
         crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
     }
     if scene.model.is_none() {
@@ -121,8 +128,10 @@ pub fn prepare(
             let parts = &scene.load_parts;
             crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
                 .map_err(CliError::BadInput)?;
-            let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
-            crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
+            if solves {
+                let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
+                crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
+            }
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
             let work = crate::work::scene_work(&scene, n, m, workload);
             crate::limits::check_work(&work, work_limit).map_err(|e| too_large(path, e))?;
@@ -777,6 +786,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
                 &scene.solver,
                 accuracy,
                 study.reference.tip_min,
+                &study.skipped,
             )
         })
         .transpose()
@@ -784,8 +794,11 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
         .unwrap_or_default();
     bar.finish_and_clear();
     study.write_files(out)?;
+    let skipped: String = (study.skipped.iter())
+        .map(|(method, why)| format!("{} skipped: does not apply ({why})\n", method.name()))
+        .collect();
     write_text(&format!(
-        "{}\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip \
+        "{skipped}{}\nCheapest setting of each method for a relative accuracy of {accuracy:e} on the tip \
          minimum:\n{}\nThe setting each method chooses itself for {accuracy:e} (its estimate, on \
          the tip extremes and mean contact forces, without the reference):\n{chosen}\nWrote \
          {}/accuracy_cost.csv and accuracy_cost.svg\n",
@@ -801,7 +814,7 @@ pub fn compare(path: &Path, out: &Path, accuracy: f64) -> Result<(), CliError> {
 pub fn export_model(path: &Path, dir: &Path) -> Result<(), CliError> {
     let Loaded {
         scene, structure, ..
-    } = load(path)?;
+    } = load_for(path, Workload::Export)?;
     prepare_directory(dir)?;
     // All files or none: every target is claimed before anything is written.
     let mut set = OutputSet::new();

@@ -409,6 +409,18 @@ pub fn unregister_cleanup(path: &Path) {
     }
 }
 
+/// What an interrupted run keeps, in words (`None`: nothing, the run's outputs are
+/// written at its end).
+static KEPT_ON_INTERRUPT: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Says what an interrupted run keeps (a study keeps the records of the cases done), in
+/// the message of [`remove_on_interrupt`].
+pub fn keep_on_interrupt(kept: String) {
+    if let Ok(mut k) = KEPT_ON_INTERRUPT.lock() {
+        *k = Some(kept);
+    }
+}
+
 /// Exit code of a run ended by a signal (128 + SIGINT, as a shell reports it).
 pub const INTERRUPTED_EXIT_CODE: i32 = 130;
 
@@ -436,8 +448,10 @@ pub fn remove_on_interrupt() {
                         std::fs::remove_file(path)
                     };
                 }
+                let kept = KEPT_ON_INTERRUPT.lock().ok().and_then(|k| k.clone());
                 write_stderr(&format!(
-                    "interrupted (signal {signal}): no output written\n"
+                    "interrupted (signal {signal}): {}\n",
+                    kept.unwrap_or_else(|| "no output written".into())
                 ));
                 std::process::exit(INTERRUPTED_EXIT_CODE);
             }

@@ -271,6 +271,20 @@ pub fn rod_scene_memory(scene: &Scene, compare: bool) -> Option<MemoryEstimate> 
     Some(size_memory(n, m, &scene.solver, compare))
 }
 
+/// Bytes per dof of a command that solves nothing (`scene-check`, `export-model`): the
+/// model ([`ROD_BYTES_PER_ELEMENT`]) and the 18 vectors of the natural frequencies'
+/// subspace iteration with their sparse solves.
+const MODEL_ONLY_BYTES_PER_DOF: f64 = ROD_BYTES_PER_ELEMENT + 8.0 * 18.0 * 4.0;
+
+/// The estimate of a command that builds the structure of `dofs` dofs and solves nothing.
+pub fn model_only_memory(dofs: usize) -> MemoryEstimate {
+    MemoryEstimate {
+        bytes: MODEL_ONLY_BYTES_PER_DOF * dofs as f64,
+        what: format!("the model of {dofs} dofs"),
+        keys: "rod.elements",
+    }
+}
+
 /// The estimate of the command run with `settings` on a built structure (its dofs and
 /// contacts; `compare` runs several settings).
 pub fn structure_memory(

@@ -195,7 +195,9 @@ fn main() -> ExitCode {
             command.name()
         ))),
         Some(Command::SceneCheck { scene }) => cli::scene_check(scene),
-        Some(Command::ExportModel { scene, dir }) => cli::export_model(scene, dir),
+        Some(Command::ExportModel { scene, dir }) => {
+            in_new_directory(dir, || cli::export_model(scene, dir))
+        }
         Some(Command::Solve(solve)) => cli::solve(solve),
         Some(Command::Sweep(sweep)) => cli::sweep(sweep),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),

@@ -49,8 +49,10 @@ pub const BRANCH_FLOPS_PER_CONTACT_JACOBIAN: f64 = 200.0;
 pub enum Workload {
     /// One solve (`solve`, `export-model`).
     Solve,
-    /// `scene-check`: one solve's estimates and the natural frequencies it prints.
+    /// `scene-check`: the natural frequencies it prints (it solves nothing).
     Check,
+    /// `export-model`: the structure only (it solves and factors nothing).
+    Export,
     /// A branch over a frequency window (`sweep`, `solutions`).
     Branch,
     /// `compare`'s runs.
@@ -60,7 +62,8 @@ pub enum Workload {
 /// The work of the command `workload` on `scene`'s structure of `dofs` dofs and
 /// `contacts` contacts: the largest of the dense factorizations of one solve
 /// (`size_work`, with the error estimate's solve for `solve`: `solve_work`), time
-/// marching and, for a branch, its points.
+/// marching and, for a branch, its points; for `scene-check` only its natural frequencies
+/// and for `export-model` nothing (they solve nothing).
 pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workload) -> WorkEstimate {
     let settings = compared(&scene.solver, workload == Workload::Compare);
     let size_key = if scene.model.is_some() {
@@ -68,6 +71,17 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
     } else {
         "rod.elements"
     };
+    match workload {
+        Workload::Check => return eigen_work(dofs, size_key),
+        Workload::Export => {
+            return WorkEstimate {
+                flops: 0.0,
+                what: "no solve".into(),
+                keys: "",
+            }
+        }
+        Workload::Solve | Workload::Branch | Workload::Compare => {}
+    }
     let dense_keys = if scene.model.is_some() {
         "solver.linear_solver, solver.harmonics, the model's size"
     } else {
@@ -83,9 +97,6 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
     }
     if workload == Workload::Branch {
         estimates.push(branch_work(scene, dofs, contacts, &settings));
-    }
-    if workload == Workload::Check {
-        estimates.push(eigen_work(dofs, size_key));
     }
     estimates
         .into_iter()

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Adversarial probe of the program's contract: imported files, solutions, states, exports,
-signals, memory and work limits, as an adversary and a careless user would try them.
+signals, memory and work limits, studies, `--set` and friction keys, as an adversary and a
+careless user would try them.
 
 usage: contract_probe.py SSN_BINARY SCENES_DIR
 PROBE_FAST=1 leaves out the cases that are heavy by design (they check that a work estimate
@@ -403,6 +404,118 @@ def _(d):
         "amplitude = 1.0\nomega_ratio = 1.0\n[[contact.point]]\ndof = 10\ngap = 0.01\n[[contact.point]]\ndof = 10\n"
         "gap = 0.01\ndirection = -1\n[[contact.point]]\ndof = 9\ngap = 0.02\n[solver]\nharmonics = 20\n")
     return ["solve", "p.toml", "--json"], {}, None
+
+
+# ---- studies, --set and friction keys ---------------------------------------------------
+def study(d, text, scene_rest="[damping]\nzeta = 0.01\n[contact]\ngap = 0.5\n[solver]\nharmonics = 5"):
+    open(os.path.join(d, "study.toml"), "w").write(text)
+    return [rod(d, n=10, rest=scene_rest), "study.toml"]
+
+
+DEEP_KEY = ".".join(["a"] * 60000)
+
+
+@case("--set key 60,000 levels deep", 2)
+def _(d):
+    return ["solve", rod(d), "--set", DEEP_KEY + "=1"], {}, mentions("--set")
+
+
+@case("study grid key 60,000 levels deep", 2)
+def _(d):
+    return ["study", *study(d, f'[grid]\n"{DEEP_KEY}" = [1]\n'), "--out", "o"], {}, mentions("[grid]", "8 parts")
+
+
+for keys, values, count in [(64, "[1, 2]", "18446744073709551616"), (41, "[1, 2, 3]", "36472996377170786403")]:
+    @case(f"study grid of {keys} keys x {values}", 2)
+    def _(d, keys=keys, values=values, count=count):
+        grid = "".join(f'"forcing.k{k}" = {values}\n' for k in range(keys))
+        return ["study", *study(d, "[grid]\n" + grid), "--out", "o"], {}, mentions(count + " cases")
+
+
+for samples, size, named in [("10000000", "", "random.samples"), ("1000000", "size = 100\n", "values")]:
+    @case(f"study of {samples} random samples {size.strip()}", 2)
+    def _(d, samples=samples, size=size, named=named):
+        text = (f"[random]\nsamples = {samples}\nseed = 1\n[random.keys.\"forcing.amplitude\"]\n"
+                f"distribution = \"uniform\"\nlow = 0.01\nhigh = 0.02\n{size}")
+        return ["study", *study(d, text), "--out", "o"], {}, mentions(named)
+
+
+for label, text, named in [
+    ("grid key repeated in [[case]]", '[grid]\n"forcing.amplitude" = [0.01]\n[[case]]\n"forcing.amplitude" = 0.02\n', "also in [grid]"),
+    ("grid key with a leading space", '[grid]\n" forcing.amplitude" = [0.01]\n[[case]]\n"forcing.amplitude" = 0.02\n', "also in [grid]"),
+    ('run = "sweep" without [sweep]', 'run = "sweep"\n[grid]\n"forcing.amplitude" = [0.01]\n', "[sweep]"),
+]:
+    @case(f"study {label}", 2)
+    def _(d, text=text, named=named):
+        return ["study", *study(d, text), "--out", "o"], {}, mentions(named)
+
+
+for jobs in ["65535", "-1"]:
+    @case(f"study --jobs {jobs}", 2)
+    def _(d, jobs=jobs):
+        return ["study", *study(d, '[grid]\n"forcing.amplitude" = [0.01]\n'), "--out", "o", "--jobs", jobs], {}, mentions("--jobs")
+
+
+for var, value in [("SSN_WORK_LIMIT", "x"), ("SSN_MEMORY_LIMIT", "-5")]:
+    @case(f"study with {var}={value}", 2)
+    def _(d, var=var, value=value):
+        return ["study", *study(d, '[grid]\n"forcing.amplitude" = [0.01]\n'), "--out", "o"], {var: value}, \
+            ("mentions", (var,))
+
+
+for cases in ["18446744073709551615", "200000000", "0"]:
+    @case(f"study merge with cases = {cases}", 2)
+    def _(d, cases=cases):
+        run(d, ["study", *study(d, '[grid]\n"forcing.amplitude" = [0.01, 0.02]\n'), "--out", "o"], 30)
+        path = os.path.join(d, "o", "study.json")
+        text = open(path).read().replace('"cases": 2,', f'"cases": {cases},')
+        open(path, "w").write(text)
+        return ["study", "merge", "o"], {}, mentions("`cases`")
+
+
+for label, record in [("of another study", None), ("holding only the case", '{"case": 1}')]:
+    @case(f"study merge with a record {label}", 2)
+    def _(d, record=record):
+        run(d, ["study", *study(d, '[grid]\n"forcing.amplitude" = [0.01, 0.02]\n'), "--out", "o"], 30)
+        path = os.path.join(d, "o", "cases", "case-000001.json")
+        if record is None:
+            doc = json.load(open(path))
+            doc["study"] = "0123456789abcdef"
+            record = json.dumps(doc)
+        open(path, "w").write(record)
+        return ["study", "merge", "o"], {}, mentions("case-000001.json")
+
+
+for line, key in [("friction = 0.3", "friction"), ("tangent_dofs = [1]", "tangent_dofs"),
+                  ("dofs = [1, 2]", "dofs"), ("coefficients = [1.0]", "coefficients")]:
+    @case(f"rod contact with {key}", 2)
+    def _(d, line=line, key=key):
+        s = rod(d, rest=f"[[contact.point]]\nnode = 20\ngap = 0.5\n{line}")
+        return ["solve", s], {}, mentions(f"contact.point.{key}")
+
+
+for label, normal, tangent in [("equal", "[1.0, -1.0]", "[1.0, -1.0]"), ("parallel", "[1.0, -1.0]", "[-2.0, 2.0]")]:
+    @case(f"tangent row {label} to the normal row", 2)
+    def _(d, normal=normal, tangent=tangent):
+        s = chain(d, tail=f"[[contact.point]]\ndofs = [1, 2]\ncoefficients = {normal}\ngap = 0.1\n"
+                          f"friction = 0.3\ntangent_dofs = [1, 2]\ntangent_coefficients = {tangent}\n")
+        return ["solve", s], {}, mentions("contact.point.tangent_coefficients", "parallel")
+
+
+@case("contact coefficients of 1e-300", 2)
+def _(d):
+    s = chain(d, tail="[[contact.point]]\ndofs = [1, 2]\ncoefficients = [1e-300, -1e-300]\ngap = 0.1\n")
+    return ["solve", s], {}, mentions("contact.point.coefficients")
+
+
+@case("scene-check of 2,000 elements with a stop on every node", 0, timeout=30)
+def _(d):
+    return ["scene-check", rod(d, n=2000, rest="[damping]\nzeta = 0.01\n" + pts(range(1, 2001)))], {}, None
+
+
+@case("export-model of 2,000 elements with a stop on every node", 0, timeout=30)
+def _(d):
+    return ["export-model", rod(d, n=2000, rest="[damping]\nzeta = 0.01\n" + pts(range(1, 2001))), "out"], {}, None
 
 
 NUMERIC = ("residual", "tip", "amplitude", "force", "omega", "penetration", "displacement")

@@ -395,14 +395,24 @@ impl Check<'_> {
                             ("contact.point.component", p.component.is_some()),
                             ("contact.point.nodes", p.nodes.is_some()),
                             ("contact.point.components", p.components.is_some()),
+                            ("contact.point.dofs", p.dofs.is_some()),
+                            ("contact.point.coefficients", p.coefficients.is_some()),
+                            ("contact.point.friction", p.friction.is_some()),
+                            ("contact.point.tangent_dofs", p.tangent_dofs.is_some()),
                             ("contact.point.tangent_nodes", p.tangent_nodes.is_some()),
                             (
                                 "contact.point.tangent_components",
                                 p.tangent_components.is_some(),
                             ),
+                            (
+                                "contact.point.tangent_coefficients",
+                                p.tangent_coefficients.is_some(),
+                            ),
                         ],
                         "given in a [rod] scene",
-                        "`node` and `gap` (`dof` and `direction` belong to [model] scenes)",
+                        "`node` and `gap` (a rod's contact is a stop on its axial \
+                         displacement, without friction; `dof`, `direction`, `dofs`, \
+                         `coefficients`, `friction` and `tangent_*` belong to [model] scenes)",
                     )?;
                     let node = p.node.ok_or_else(|| {
                         self.invalid("contact.point.node", "missing", "an integer node number")

@@ -27,6 +27,39 @@ struct RawRow<'a> {
     coefficients: Option<&'a [f64]>,
 }
 
+/// Largest departure of `|cos|` from 1 at which a tangential row counts as parallel to
+/// its normal row (round-off of rows given to 16 digits).
+const PARALLEL_TOLERANCE: f64 = 1e-9;
+
+/// The Euclidean norm of `values`, scaled by the largest magnitude so that squares of
+/// tiny or huge entries neither underflow nor overflow.
+fn scaled_norm(values: &[f64]) -> f64 {
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 {
+        return 0.0;
+    }
+    largest
+        * values
+            .iter()
+            .map(|v| (v / largest).powi(2))
+            .sum::<f64>()
+            .sqrt()
+}
+
+/// The cosine of the angle between two rows of `G` (as vectors over the dofs).
+fn row_cosine(a: &ContactRow, b: &ContactRow) -> f64 {
+    let dot: f64 = a
+        .entries()
+        .map(|(dof, x)| {
+            b.entries()
+                .filter(|(d, _)| *d == dof)
+                .map(|(_, y)| x * y)
+                .sum::<f64>()
+        })
+        .sum();
+    dot / (scaled_norm(a.coefficients()) * scaled_norm(b.coefficients()))
+}
+
 impl Check<'_> {
     /// `[[contact.point]]` entries of a `[model]` scene (module documentation); one
     /// contact per dof and direction.
@@ -87,17 +120,19 @@ impl Check<'_> {
                     }
                 }
             }
-            let friction = self.contact_friction(&p)?;
+            let friction = self.contact_friction(&p, &row)?;
             contacts.push(DofContact { row, gap, friction });
         }
         Ok(contacts)
     }
 
     /// A contact's `friction`, `tangent_dofs` (or `tangent_nodes` with `tangent_components`)
-    /// and `tangent_coefficients`: all three or none.
+    /// and `tangent_coefficients`: all three or none; the tangential row is not parallel to
+    /// the contact's `normal` row (a slip along the normal is no slip).
     fn contact_friction(
         &self,
         p: &RawContactPoint,
+        normal: &ContactRow,
     ) -> Result<Option<(f64, ContactRow)>, SceneError> {
         let keys = ["tangent_dofs", "tangent_nodes", "tangent_components"]
             .map(|k| format!("contact.point.{k}"));
@@ -143,6 +178,15 @@ impl Check<'_> {
             &dofs,
             coefficients,
         )?;
+        let cosine = row_cosine(normal, &tangent);
+        if cosine.abs() >= 1.0 - PARALLEL_TOLERANCE {
+            return Err(self.invalid(
+                "contact.point.tangent_coefficients",
+                format!("a row parallel to the contact's normal row (cosine {cosine:.6})"),
+                "a tangential row independent of the normal row (the slip direction, \
+                 e.g. orthogonal to it)",
+            ));
+        }
         Ok(Some((mu, tangent)))
     }
 
@@ -316,6 +360,16 @@ impl Check<'_> {
                 coefficients_key,
                 "all zero",
                 "at least one non-zero coefficient",
+            ));
+        }
+        let norm = scaled_norm(coefficients);
+        if norm < 1.0 / MAX_RESPONSE_SCALE {
+            return Err(self.invalid(
+                coefficients_key,
+                format!("a row of Euclidean norm {norm:e}"),
+                "coefficients of norm >= 1e-100: the contact's stiffness 1 / (G K^-1 G^T), \
+                 and the complementarity constant c made from it, would not be a number \
+                 (scale the row and its gap together)",
             ));
         }
         ContactRow::new(zero_based, coefficients.to_vec())

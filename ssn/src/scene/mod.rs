@@ -40,7 +40,9 @@ mod overrides;
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
 
-pub use overrides::{parse_value, read_scene_text, Override, OverrideError};
+pub use overrides::{
+    normal_key, parse_value, read_scene_text, Override, OverrideError, MAX_KEY_PARTS,
+};
 
 pub use semismooth_contact::settings::{
     default_hb_time_samples, GlobalizationChoice, LcpScheme, LinearSolverChoice, Method,

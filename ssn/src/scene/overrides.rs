@@ -40,22 +40,44 @@ pub struct OverrideError {
     pub reason: String,
 }
 
+/// Most parts of an override's dotted key (the deepest scene key, `friction.point.0.dofs`,
+/// has four): a deeper key names nothing and would nest that many tables.
+pub const MAX_KEY_PARTS: usize = 8;
+
 impl Override {
-    /// An override of `key` by `value`; the key must be a non-empty dotted path.
+    /// An override of `key` by `value`; the key must be a non-empty dotted path of at most
+    /// [`MAX_KEY_PARTS`] parts, each trimmed of surrounding spaces.
     pub fn new(key: &str, value: toml::Value) -> Result<Override, OverrideError> {
-        let key = key.trim();
-        if key.is_empty() || key.split('.').any(|part| part.trim().is_empty()) {
+        let parts = key.split('.').count();
+        let shown = |key: &str| {
+            if key.chars().count() > 80 {
+                format!(
+                    "{}... ({parts} parts)",
+                    key.chars().take(60).collect::<String>()
+                )
+            } else {
+                key.to_string()
+            }
+        };
+        if parts > MAX_KEY_PARTS {
             return Err(OverrideError {
-                text: format!("{key}={value}"),
+                text: shown(key),
+                reason: format!(
+                    "allowed a dotted scene key of at most {MAX_KEY_PARTS} parts (this one \
+                     has {parts}) such as forcing.omega_ratio or contact.point.0.gap"
+                ),
+            });
+        }
+        let key = normal_key(key);
+        if key.split('.').any(str::is_empty) {
+            return Err(OverrideError {
+                text: format!("{}={value}", shown(&key)),
                 reason: "allowed a dotted scene key such as forcing.omega_ratio or \
                          contact.point.0.gap"
                     .into(),
             });
         }
-        Ok(Override {
-            key: key.to_string(),
-            value,
-        })
+        Ok(Override { key, value })
     }
 
     /// Reads `key=value` (the form of `--set`): the value as a TOML value, or as a string
@@ -69,6 +91,12 @@ impl Override {
         };
         Override::new(key, parse_value(value.trim()))
     }
+}
+
+/// A dotted key with the spaces around each part removed (` contact . gap` is
+/// `contact.gap`): two spellings of one scene key compare equal.
+pub fn normal_key(key: &str) -> String {
+    key.split('.').map(str::trim).collect::<Vec<_>>().join(".")
 }
 
 /// A TOML value from its text; text that is not one is a string.

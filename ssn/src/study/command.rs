@@ -30,13 +30,17 @@ pub struct StudyArgs {
     /// job array; then `ssn study merge DIR`.
     #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
     pub shard: Option<Shard>,
-    /// Worker threads [default: every core].
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    /// Worker threads, 1 to 1024 [default: every core].
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u16).range(1..=MAX_JOBS))]
     pub jobs: Option<u16>,
     /// Replace a scene key for every case (as in `ssn solve --set`).
     #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_override)]
     pub set: Vec<Override>,
 }
+
+/// Most worker threads of `--jobs` (more only costs the time to create them: each case runs
+/// on one thread, and a machine has far fewer cores).
+pub const MAX_JOBS: i64 = 1024;
 
 /// `ssn study merge DIR`.
 #[derive(Debug, Clone, clap::Subcommand)]
@@ -82,6 +86,9 @@ pub fn command(args: &StudyArgs) -> Result<(), CliError> {
             "ssn study needs SCENE STUDY.toml --out DIR (or `ssn study merge DIR`)".into(),
         ));
     };
+    // The limits every case would apply, refused once here rather than in every case.
+    crate::limits::work_limit().map_err(CliError::BadInput)?;
+    crate::limits::memory_limit().map_err(CliError::BadInput)?;
     let scene = SceneSource::from_path(scene_path)
         .map_err(|e| CliError::BadInput(e.to_string()))?
         .with(&args.set);

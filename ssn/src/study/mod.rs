@@ -37,7 +37,7 @@ use rand_distr::Distribution;
 use serde::Deserialize;
 
 use crate::input_file::{read_input_file, FileKind, InputFileError};
-use crate::scene::Override;
+use crate::scene::{normal_key, Override};
 use crate::source::SceneSource;
 
 /// What each case of a study runs (`run = "..."`).
@@ -175,8 +175,12 @@ enum RawDistribution {
     },
 }
 
-/// Largest number of cases in one study.
-pub const MAX_CASES: usize = 10_000_000;
+/// Largest number of cases in one study (each is validated before any runs, and leaves a
+/// record file).
+pub const MAX_CASES: usize = 1_000_000;
+/// Largest number of values in all the cases of a study (cases times the values each
+/// sets, a list of `size` counting `size`): the cases are held in memory.
+pub const MAX_VALUES: usize = 10_000_000;
 /// Largest number of random values per key and sample.
 pub const MAX_SAMPLE_SIZE: usize = 100_000;
 
@@ -201,47 +205,35 @@ impl Study {
         let grid = parse_grid(path, raw.grid.unwrap_or_default())?;
         let listed = parse_listed(path, raw.case)?;
         let random = raw.random.map(|r| parse_random(path, r)).transpose()?;
-        let mut keys: Vec<String> = Vec::new();
-        let named = (grid.iter().map(|(k, _)| k))
-            .chain(listed.iter().flatten().map(|(k, _)| k))
-            .chain(random.iter().flat_map(|r| r.draws.iter().map(|(k, ..)| k)));
-        for k in named {
-            if !keys.contains(k) {
-                keys.push(k.clone());
-            }
-        }
-        let grid_points: usize = grid.iter().map(|(_, v)| v.len()).product();
+        let keys = distinct_keys(path, &grid, &listed, random.as_ref())?;
         let samples = random.as_ref().map_or(1, |r| r.samples);
-        let total = grid_points
-            .checked_mul(listed.len())
-            .and_then(|n| n.checked_mul(samples))
-            .filter(|&n| n <= MAX_CASES)
-            .ok_or_else(|| {
-                invalid(
-                    path,
-                    "grid",
-                    format!(
-                        "{grid_points} grid points x {} cases x {samples} samples",
-                        listed.len()
-                    ),
-                    &format!("at most {MAX_CASES} cases in all"),
-                )
-            })?;
+        let total = case_count(path, &grid, listed.len(), samples)?;
+        let per_case = grid.len()
+            + listed.iter().map(Vec::len).max().unwrap_or(0)
+            + random.as_ref().map_or(0, |r| {
+                r.draws.iter().map(|(.., size)| size.unwrap_or(1)).sum()
+            });
+        if total.saturating_mul(per_case) > MAX_VALUES {
+            return Err(invalid(
+                path,
+                "random",
+                format!(
+                    "{total} cases x {per_case} values = {} values",
+                    total as u128 * per_case as u128
+                ),
+                &format!(
+                    "at most {MAX_VALUES} values in all (fewer samples or cases, a smaller \
+                     size, or the study split into several files)"
+                ),
+            ));
+        }
         // The random values of each sample, drawn once.
         let sampled = random
             .as_ref()
             .map_or_else(|| vec![Vec::new()], Random::values);
         let cases = combine(path, &grid, &listed, &sampled, total)?;
         for case in &cases {
-            scene
-                .with(&case.values)
-                .scene()
-                .map_err(|e| StudyError::Case {
-                    path: path.to_path_buf(),
-                    case: case.index,
-                    values: words(&case.values),
-                    message: e.to_string(),
-                })?;
+            check_case(path, scene, case, raw.run)?;
         }
         Ok(Study {
             path: path.to_path_buf(),
@@ -250,6 +242,141 @@ impl Study {
             keys,
         })
     }
+}
+
+/// Checks that `case` makes a valid scene for `run` (validated, nothing solved): a sweep
+/// needs the scene's `[sweep]`.
+fn check_case(
+    path: &Path,
+    scene: &SceneSource,
+    case: &Case,
+    run: RunKind,
+) -> Result<(), StudyError> {
+    let refused = |message: String| StudyError::Case {
+        path: path.to_path_buf(),
+        case: case.index,
+        values: words(&case.values),
+        message,
+    };
+    let resolved = scene
+        .with(&case.values)
+        .scene()
+        .map_err(|e| refused(e.to_string()))?;
+    if run == RunKind::Sweep && resolved.sweep.is_none() {
+        return Err(refused(format!(
+            "run = \"sweep\" needs the scene's [sweep] section: add omega_ratio_from and \
+             omega_ratio_to (units of omega_1) to {}, or vary sweep.omega_ratio_from and \
+             sweep.omega_ratio_to",
+            scene.path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The varied keys in table order (grid, listed cases, random), each once and with the
+/// spaces around its parts removed; a key named in two places (the grid and a listed case,
+/// twice in one table under two spellings, ...) is refused, since one would silently
+/// replace the other's values.
+fn distinct_keys(
+    path: &Path,
+    grid: &[(String, Vec<toml::Value>)],
+    listed: &[Pairs],
+    random: Option<&Random>,
+) -> Result<Vec<String>, StudyError> {
+    let mut places: Vec<(String, String)> = Vec::new();
+    let mut claim = |key: &str, place: String, shared: bool| -> Result<(), StudyError> {
+        let normal = Override::new(key, toml::Value::Boolean(true))
+            .map_err(|e| {
+                let allowed = e.reason.trim_start_matches("allowed ");
+                invalid(path, &place, e.text, allowed)
+            })?
+            .key;
+        if let Some((_, first)) = places.iter().find(|(k, _)| *k == normal) {
+            if !(shared && *first == place) {
+                return Err(invalid(
+                    path,
+                    &format!("{place} \"{key}\""),
+                    format!("the scene key {normal}, also in {first}"),
+                    "each scene key in one place: [grid], [[case]] tables or [random.keys]",
+                ));
+            }
+            return Ok(());
+        }
+        places.push((normal, place));
+        Ok(())
+    };
+    for (key, _) in grid {
+        claim(key, "[grid]".into(), false)?;
+    }
+    for table in listed {
+        let mut in_table: Vec<String> = Vec::new();
+        for (key, _) in table {
+            let normal = normal_key(key);
+            if in_table.contains(&normal) {
+                return Err(invalid(
+                    path,
+                    &format!("[[case]] \"{key}\""),
+                    format!("the scene key {normal} twice in one table"),
+                    "each scene key once per [[case]] table",
+                ));
+            }
+            in_table.push(normal);
+            claim(key, "[[case]]".into(), true)?;
+        }
+    }
+    for (key, ..) in random.map_or(&[][..], |r| &r.draws[..]) {
+        claim(key, "[random.keys]".into(), false)?;
+    }
+    Ok(places.into_iter().map(|(k, _)| k).collect())
+}
+
+/// The number of cases, `grid points x listed cases x samples`, refused above
+/// [`MAX_CASES`] with the exact count (a grid's size can exceed any integer type).
+fn case_count(
+    path: &Path,
+    grid: &[(String, Vec<toml::Value>)],
+    listed: usize,
+    samples: usize,
+) -> Result<usize, StudyError> {
+    let factors = || grid.iter().map(|(_, v)| v.len()).chain([listed, samples]);
+    factors()
+        .try_fold(1usize, usize::checked_mul)
+        .filter(|&n| n <= MAX_CASES)
+        .ok_or_else(|| {
+            let points = exact_product(grid.iter().map(|(_, v)| v.len()));
+            invalid(
+                path,
+                "grid",
+                format!(
+                    "{points} grid points x {listed} cases x {samples} samples = {} cases",
+                    exact_product(factors())
+                ),
+                &format!("at most {MAX_CASES} cases in all"),
+            )
+        })
+}
+
+/// The exact decimal product of `factors`, in base-10^9 limbs (least significant first).
+fn exact_product(factors: impl IntoIterator<Item = usize>) -> String {
+    const BASE: u128 = 1_000_000_000;
+    let mut limbs: Vec<u128> = vec![1];
+    for f in factors {
+        let mut carry = 0u128;
+        for limb in &mut limbs {
+            let v = *limb * f as u128 + carry;
+            *limb = v % BASE;
+            carry = v / BASE;
+        }
+        while carry > 0 {
+            limbs.push(carry % BASE);
+            carry /= BASE;
+        }
+    }
+    let mut text = limbs.last().copied().unwrap_or(0).to_string();
+    for limb in limbs.iter().rev().skip(1) {
+        text += &format!("{limb:09}");
+    }
+    text
 }
 
 /// The error of the study file `path` whose `key` has `value`, with what is `allowed`.
@@ -432,7 +559,7 @@ fn parse_draw(
 }
 
 /// The cases in study order: each grid point (mixed radix, the first key slowest) with
-/// each listed case and each sample, later values of a key replacing earlier ones.
+/// each listed case and each sample (each key in one place: [`distinct_keys`]).
 fn combine(
     path: &Path,
     grid: &[(String, Vec<toml::Value>)],
@@ -462,7 +589,6 @@ fn combine(
                 for (key, value) in pairs {
                     let o = Override::new(&key, value)
                         .map_err(|e| invalid(path, &key, e.text.clone(), &e.reason))?;
-                    values.retain(|x| x.key != o.key);
                     values.push(o);
                 }
                 cases.push(Case {

@@ -6,8 +6,11 @@
 //! `N`) runs beside the others on a shared directory, and [`merge`] makes the table from
 //! the records alone.
 //!
-//! `DIR/study.json` records the scene and the study texts; a run or a merge into a
-//! directory that holds another study is refused, so records of two studies never mix.
+//! `DIR/study.json` records the scene and the study texts; it is created exclusively, so of
+//! two studies started together on one new directory the second finds the first's manifest,
+//! and a run into a directory that holds another study is refused. Every record carries the
+//! study's identity ([`study_id`]): a run or a merge takes no record of another study, so
+//! records of two studies never mix.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -164,12 +167,46 @@ fn write_record(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The record of `case` in `dir` when it is there and is the record of these values.
-fn finished_record(dir: &Path, case: &Case) -> Option<Value> {
+/// The record of `case` in `dir` when it is there and is this study's record of these
+/// values.
+fn finished_record(dir: &Path, case: &Case, id: &str) -> Option<Value> {
     let text = std::fs::read_to_string(case_file(dir, case.index)).ok()?;
     let record: Value = serde_json::from_str(&text).ok()?;
-    (record["case"] == json!(case.index) && record["values"] == case.values_json())
-        .then_some(record)
+    (record["case"] == json!(case.index)
+        && record["values"] == case.values_json()
+        && record_error(&record, id).is_none())
+    .then_some(record)
+}
+
+/// What is wrong with `record` as a record of the study `id` (`None`: nothing): it must
+/// carry the study's identity, its values, whether it converged, and its result or error.
+fn record_error(record: &Value, id: &str) -> Option<&'static str> {
+    if record["study"] != json!(id) {
+        Some("a record of another study (its `study` differs from the manifest's)")
+    } else if !record["values"].is_object() || !record["converged"].is_boolean() {
+        Some("not a whole record (`values` and `converged` missing)")
+    } else if record["result"].is_null() == record["error"].is_null() {
+        Some("not a whole record (one of `result` and `error` expected)")
+    } else {
+        None
+    }
+}
+
+/// The identity of the study of `manifest`: FNV-1a (64 bits, as 16 hex digits) of its
+/// scene text, overrides, study text and case count.
+pub fn study_id(manifest: &Value) -> String {
+    let identity = json!([
+        manifest["format"],
+        manifest["scene_text"],
+        manifest["scene_overrides"],
+        manifest["study_text"],
+        manifest["cases"]
+    ])
+    .to_string();
+    let hash = identity.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{hash:016x}")
 }
 
 /// What a study run did.
@@ -205,11 +242,13 @@ fn manifest(scene: &SceneSource, study: &Study, study_text: &str) -> Value {
     })
 }
 
-/// Claims `dir` for this study: writes its manifest, or checks that the one there is this
+/// Claims `dir` for this study: creates its manifest (exclusively: of two studies started
+/// together, one creates it and the other reads it), or checks that the one there is this
 /// study's (the scene and study texts and the case count; the paths may differ).
 fn claim_directory(dir: &Path, manifest: &Value) -> Result<(), CliError> {
     prepare_directory(&dir.join("cases"))?;
     let path = dir.join("study.json");
+    create_manifest(&path, manifest)?;
     match std::fs::read_to_string(&path) {
         Ok(text) => {
             let found: Value = serde_json::from_str(&text).map_err(|e| {
@@ -235,16 +274,37 @@ fn claim_directory(dir: &Path, manifest: &Value) -> Result<(), CliError> {
             }
             Ok(())
         }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            let text = serde_json::to_string_pretty(manifest)
-                .map_err(|e| CliError::Output(format!("cannot format the manifest: {e}")))?;
-            write_atomically(&path, format!("{text}\n").as_bytes())?;
-            Ok(())
-        }
         Err(e) => Err(CliError::Output(format!(
             "{}: {e}",
             printable(&path.display().to_string())
         ))),
+    }
+}
+
+/// Writes `manifest` to `path` unless a file is there already: staged beside it and linked
+/// into place without replacing anything, so the manifest is whole when it appears.
+fn create_manifest(path: &Path, manifest: &Value) -> Result<(), CliError> {
+    use std::io::Write;
+    if path.exists() {
+        return Ok(());
+    }
+    let io = |e: std::io::Error| {
+        CliError::Output(format!("{}: {e}", printable(&path.display().to_string())))
+    };
+    let text = serde_json::to_string_pretty(manifest)
+        .map_err(|e| CliError::Output(format!("cannot format the manifest: {e}")))?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".study.")
+        .suffix(".tmp")
+        .tempfile_in(path.parent().unwrap_or(Path::new(".")))
+        .map_err(io)?;
+    tmp.write_all(format!("{text}\n").as_bytes())
+        .and_then(|()| tmp.as_file().sync_all())
+        .map_err(io)?;
+    match tmp.persist_noclobber(path) {
+        Ok(_) => Ok(()),
+        Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => Err(io(e.error)),
     }
 }
 
@@ -268,7 +328,14 @@ pub fn run_study(
     dir: &Path,
     options: RunOptions,
 ) -> Result<StudyOutcome, CliError> {
-    claim_directory(dir, &manifest(scene, study, study_text))?;
+    let manifest = manifest(scene, study, study_text);
+    claim_directory(dir, &manifest)?;
+    let id = study_id(&manifest);
+    crate::io::keep_on_interrupt(format!(
+        "the records of the cases done are kept in {}/cases (run the study again to \
+         continue: it skips them)",
+        printable(&dir.display().to_string())
+    ));
     let mine: Vec<&Case> = study
         .cases
         .iter()
@@ -277,7 +344,7 @@ pub fn run_study(
     let pending: Vec<&Case> = mine
         .iter()
         .copied()
-        .filter(|c| finished_record(dir, c).is_none())
+        .filter(|c| finished_record(dir, c, &id).is_none())
         .collect();
     let skipped = mine.len() - pending.len();
     let bar = crate::progress::progress_bar_with_estimate(
@@ -292,7 +359,8 @@ pub fn run_study(
     let ran = AtomicUsize::new(0);
     let written: Result<(), CliError> = pool.install(|| {
         pending.par_iter().try_for_each(|case| {
-            let record = run_case(scene, case, study.run);
+            let mut record = run_case(scene, case, study.run);
+            record["study"] = id.clone().into();
             let text = serde_json::to_string_pretty(&record)
                 .map_err(|e| CliError::Output(format!("cannot format a record: {e}")))?;
             write_record(&case_file(dir, case.index), format!("{text}\n").as_bytes())?;
@@ -305,7 +373,7 @@ pub fn run_study(
     written?;
     let records: Vec<Value> = mine
         .iter()
-        .filter_map(|c| finished_record(dir, c))
+        .filter_map(|c| finished_record(dir, c, &id))
         .collect();
     let not_converged = records
         .iter()
@@ -360,29 +428,49 @@ pub fn merge(dir: &Path) -> Result<Table, CliError> {
             printable(&path.display().to_string())
         ))
     })?;
+    let shown = printable(&path.display().to_string());
     let (Some(cases), Some(kind), Some(keys)) = (
         manifest["cases"].as_u64(),
         manifest["run"].as_str().and_then(RunKind::from_name),
         manifest["keys"].as_array(),
     ) else {
         return Err(CliError::BadInput(format!(
-            "{}: not a study manifest (cases, run, keys)",
-            printable(&path.display().to_string())
+            "{shown}: not a study manifest (cases, run, keys)"
         )));
     };
+    let cases = usize::try_from(cases)
+        .ok()
+        .filter(|n| (1..=super::MAX_CASES).contains(n))
+        .ok_or_else(|| {
+            CliError::BadInput(format!(
+                "{shown}: `cases` is {cases}: allowed 1..={} (the manifest `ssn study` wrote)",
+                super::MAX_CASES
+            ))
+        })?;
     let keys: Vec<String> = keys
         .iter()
         .filter_map(|k| k.as_str().map(str::to_string))
         .collect();
-    let mut records = Vec::with_capacity(cases as usize);
+    let id = study_id(&manifest);
+    let mut records = Vec::new();
     let mut missing = Vec::new();
-    for case in 0..cases as usize {
-        let record = std::fs::read_to_string(case_file(dir, case))
+    for case in 0..cases {
+        let file = case_file(dir, case);
+        let record = std::fs::read_to_string(&file)
             .ok()
             .and_then(|t| serde_json::from_str::<Value>(&t).ok())
             .filter(|r| r["case"] == json!(case));
         match record {
-            Some(r) => records.push(r),
+            Some(r) => {
+                if let Some(wrong) = record_error(&r, &id) {
+                    return Err(CliError::BadInput(format!(
+                        "{}: {wrong}: allowed the records `ssn study` wrote for the study of \
+                         {shown} (run it again to replace the record)",
+                        printable(&file.display().to_string())
+                    )));
+                }
+                records.push(r)
+            }
             None => missing.push(case),
         }
     }
