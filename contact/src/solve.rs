@@ -15,8 +15,8 @@ pub use raised_c::RAISED_C_FACTOR;
 pub(crate) mod formulation;
 mod reconstruction;
 
-pub use formulation::DiscretisationKind;
 pub(crate) use formulation::HarmonicProblem;
+pub use formulation::{DiscretisationKind, FrictionSupport};
 pub(crate) use march::march_scheme;
 pub(crate) use reconstruction::HbReconstruction;
 
@@ -251,6 +251,11 @@ pub struct Solution {
     /// With an accuracy target ([`SolverSettings::accuracy`]): the discretisations tried,
     /// what was chosen and what the search cost.
     pub search: Option<DiscretisationSearch>,
+    /// The settings that pose its equation again: the method and discretisation it was
+    /// solved with and the complementarity constant it solved with
+    /// ([`Solution::solved_settings`]); what its stability
+    /// ([`crate::stability::solution_stability`]) or a second solve needs.
+    pub settings: SolverSettings,
 }
 
 impl Solution {
@@ -517,6 +522,7 @@ fn solution(
         state,
         error_estimate: Err(NoEstimate::Off),
         search: None,
+        settings: settings.clone(),
     }
 }
 
@@ -628,7 +634,7 @@ pub fn solve(
     let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
     if settings.estimate_error {
         // The second solve poses the equation the first one solved (its `c` may be raised).
-        let solved = solution.solved_settings(settings);
+        let solved = solution.settings.clone();
         solution.error_estimate = accuracy::estimate(rod, omega, &solved, &solution);
     }
     Ok(solution)
@@ -641,7 +647,9 @@ pub(crate) fn solve_as_given(
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
-    formulation::of(settings.method).solve(rod, omega, settings, warm_start)
+    let mut solution = formulation::of(settings.method).solve(rod, omega, settings, warm_start)?;
+    solution.settings = solution.solved_settings(settings);
+    Ok(solution)
 }
 
 /// The SSN-HB solve of `rod` at `omega` (module documentation of [`solve`]).

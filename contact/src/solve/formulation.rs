@@ -12,9 +12,9 @@ use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
 use crate::model::{StructuralModel, Structure};
 use crate::settings::{default_hb_time_samples, Method, SolverSettings};
 
-/// The parameter a formulation's discretisation is refined in.
+/// The parameter a formulation's discretisation is refined in (exhaustive: a formulation
+/// with a new kind of discretisation is to be met by every match on the kind).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
 pub enum DiscretisationKind {
     /// Harmonics `H`, with the default AFT samples for them (harmonic balance).
     Harmonics,
@@ -73,6 +73,34 @@ impl Method {
     pub fn adapts_harmonics(self) -> bool {
         of(self).adapts_harmonics()
     }
+
+    /// Whether the method's unknowns hold the contact forces beside the displacements
+    /// (the multipliers of SSN-HB).
+    pub fn carries_contact_forces(self) -> bool {
+        of(self).carries_contact_forces()
+    }
+
+    /// Whether contact is a penalty law (the solve raises its stiffness from a soft one;
+    /// the error estimate adds the change against a softer penalty).
+    pub fn penalises_contact(self) -> bool {
+        of(self).penalises_contact()
+    }
+
+    /// How the method models friction.
+    pub fn friction(self) -> FrictionSupport {
+        of(self).friction()
+    }
+}
+
+/// How a formulation models friction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionSupport {
+    /// Exact Coulomb friction, under any normal load.
+    Exact,
+    /// A regularised law, only under a prescribed normal load.
+    RegularisedUnderPrescribedLoad,
+    /// None.
+    Unsupported,
 }
 
 impl SolverSettings {
@@ -227,9 +255,19 @@ pub(crate) trait Formulation: Sync {
         false
     }
 
-    /// Whether its error estimate adds the change against a softer penalty.
-    fn has_penalty_error(&self) -> bool {
+    /// Whether contact is a penalty law ([`Method::penalises_contact`]).
+    fn penalises_contact(&self) -> bool {
         false
+    }
+
+    /// Whether its unknowns hold the contact forces ([`Method::carries_contact_forces`]).
+    fn carries_contact_forces(&self) -> bool {
+        false
+    }
+
+    /// How it models friction.
+    fn friction(&self) -> FrictionSupport {
+        FrictionSupport::Unsupported
     }
 
     /// Whether it marches to a steady state, so that a comparison that did not settle from
@@ -333,6 +371,12 @@ impl Formulation for SsnHbFormulation {
     fn adapts_harmonics(&self) -> bool {
         true
     }
+    fn carries_contact_forces(&self) -> bool {
+        true
+    }
+    fn friction(&self) -> FrictionSupport {
+        FrictionSupport::Exact
+    }
 }
 
 /// Harmonic balance with a penalty contact law (`penalty-hb`).
@@ -376,8 +420,11 @@ impl Formulation for PenaltyHbFormulation {
     ) -> Option<Result<HarmonicProblem, HbError>> {
         Some(penalty_problem(model, omega, settings).map(HarmonicProblem::Penalty))
     }
-    fn has_penalty_error(&self) -> bool {
+    fn penalises_contact(&self) -> bool {
         true
+    }
+    fn friction(&self) -> FrictionSupport {
+        FrictionSupport::RegularisedUnderPrescribedLoad
     }
 }
 
@@ -496,5 +543,8 @@ impl Formulation for MarchFormulation {
     }
     fn marches(&self) -> bool {
         true
+    }
+    fn friction(&self) -> FrictionSupport {
+        FrictionSupport::Exact
     }
 }

@@ -80,7 +80,7 @@ use crate::hb::HbError;
 use crate::march::{MarchError, MarchState};
 use crate::model::{check_omega, StructuralModel};
 use crate::settings::{Method, SolverSettings};
-use crate::solve::HarmonicProblem;
+use crate::solve::{HarmonicProblem, Solution};
 
 use phases::PhaseModel;
 pub use phases::{ClosedContact, PhaseError};
@@ -477,6 +477,15 @@ pub fn hb_stability(
     x: &[f64],
 ) -> Result<Stability, StabilityError> {
     HbStability::new(model, settings)?.of(omega, x)
+}
+
+/// The stability of `solution`, a harmonic-balance solve on `model`, from what it carries
+/// (its settings, frequency and state; [`hb_stability`]).
+pub fn solution_stability(
+    model: &StructuralModel,
+    solution: &Solution,
+) -> Result<Stability, StabilityError> {
+    hb_stability(model, &solution.settings, solution.omega, &solution.state)
 }
 
 /// An impact with rebound of a contact on a dof with mass: the orbit's closed interval

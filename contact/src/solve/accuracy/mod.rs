@@ -439,7 +439,7 @@ pub fn estimate(
         softer_penalty: None,
         time_samples_check: None,
     };
-    if formulation.has_penalty_error() {
+    if formulation.penalises_contact() {
         let (penalty, penalty_parts, s, c) = penalty_part(rod, omega, settings, solution)?;
         parts = parts.plus(&penalty_parts);
         seconds += s;

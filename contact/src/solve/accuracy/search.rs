@@ -547,7 +547,7 @@ fn finish_met(
     chosen: Rung,
     (error, basis): (RelativeErrors, EstimateBasis),
 ) -> Result<Solution, RunError> {
-    if !crate::solve::formulation::of(settings.method).has_penalty_error() {
+    if !crate::solve::formulation::of(settings.method).penalises_contact() {
         return Ok(record.finish(
             chosen.solution,
             chosen.step,
