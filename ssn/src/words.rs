@@ -7,7 +7,7 @@ use semismooth::lemke::{LemkeOptions, LemkeTermination};
 use semismooth_contact::accuracy::{Discretisation, EstimateBasis, NoEstimate, SearchStop};
 use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
-use semismooth_contact::solve::{Diagnosis, Solution, Termination};
+use semismooth_contact::solve::{Diagnosis, DiscretisationKind, Solution, Termination};
 use semismooth_contact::stability::Undecided;
 use semismooth_contact::sweep::adaptive::BranchAccuracy;
 use semismooth_contact::sweep::fold_accuracy::{FoldAccuracy, FoldStop};
@@ -216,9 +216,9 @@ pub fn failed_correction(f: &FailedCorrection) -> String {
 /// A discretisation of `method` as the tables print it: `H=20 Nt=256` (harmonic balance),
 /// `Nt=512` (the periodic LCP), `steps=2000` (time marching).
 pub fn discretisation(method: Method, d: &Discretisation) -> String {
-    match (d.harmonics, method) {
+    match (d.harmonics, method.discretisation()) {
         (Some(h), _) => format!("H={h} Nt={}", d.time_samples),
-        (None, Method::March) => format!("steps={}", d.time_samples),
+        (None, DiscretisationKind::StepsPerPeriod) => format!("steps={}", d.time_samples),
         (None, _) => format!("Nt={}", d.time_samples),
     }
 }

@@ -139,6 +139,22 @@ pub(crate) enum HarmonicProblem {
 }
 
 impl HarmonicProblem {
+    /// The harmonic-balance problem of `settings`' method at `omega` (`Unsupported` for a
+    /// method that is not harmonic balance).
+    pub(crate) fn of(
+        model: &StructuralModel,
+        omega: f64,
+        settings: &SolverSettings,
+    ) -> Result<Self, RunError> {
+        let problem = of(settings.method)
+            .harmonic_problem(model, omega, settings)
+            .ok_or(RunError::Unsupported {
+                method: settings.method.name(),
+                what: "a harmonic-balance method (ssn-hb or penalty-hb)",
+            })??;
+        Ok(problem)
+    }
+
     /// The closed intervals of every contact of `x`, as fractions of the period (the
     /// friction rows of SSN-HB follow the contacts' and have no closed phase).
     pub(crate) fn closed_intervals(&self, x: &[f64]) -> Result<Vec<Vec<(f64, f64)>>, HbError> {
@@ -216,24 +232,79 @@ pub(crate) trait Formulation: Sync {
     ) -> Result<Solution, RunError>;
 
     /// The accuracy search's ladder: the order in the discretisation, the first level and
-    /// the finest.
-    fn search_ladder(&self, rod: &Structure, settings: &SolverSettings) -> (f64, usize, usize);
+    /// the finest (by default those of its kind of discretisation).
+    fn search_ladder(&self, rod: &Structure, settings: &SolverSettings) -> (f64, usize, usize) {
+        match self.discretisation() {
+            DiscretisationKind::Harmonics => {
+                let width = rod.model.dofs() + rod.model.contact_count();
+                let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
+                (
+                    accuracy::HB_ORDER,
+                    5,
+                    MAX_SEARCH_HARMONICS.min(by_size).max(10),
+                )
+            }
+            DiscretisationKind::TimeSamples => {
+                let m = rod.model.contact_count().max(1);
+                let limit = MAX_SEARCH_LCP_STEPS.min(crate::lcp::MAX_LCP_SIZE / m);
+                (
+                    2.0,
+                    64.min(limit / 2).max(crate::lcp::MIN_LCP_TIME_SAMPLES),
+                    limit,
+                )
+            }
+            DiscretisationKind::StepsPerPeriod => (
+                accuracy::march_order(rod, settings),
+                64,
+                MAX_SEARCH_MARCH_STEPS,
+            ),
+        }
+    }
 
-    /// The discretisation a solve with `settings` is compared with for its error estimate.
+    /// The discretisation a solve with `settings` is compared with for its error estimate
+    /// (by default that of its kind of discretisation).
     fn comparison(
         &self,
         rod: &Structure,
         settings: &SolverSettings,
-    ) -> Result<Comparison, NoEstimate>;
+    ) -> Result<Comparison, NoEstimate> {
+        match self.discretisation() {
+            DiscretisationKind::Harmonics => accuracy::harmonic_comparison(settings, rod),
+            DiscretisationKind::TimeSamples => accuracy::lcp_comparison(settings),
+            DiscretisationKind::StepsPerPeriod => accuracy::march_comparison(settings, rod),
+        }
+    }
 
     /// The start of a solve with the discretisation of `to` from `solution` (`None`: the
-    /// formulation's own start).
+    /// formulation's own start); by default that of its kind of discretisation: harmonic
+    /// coefficients truncated or lifted, time-step values interpolated periodically, the
+    /// march's final state.
     fn carried_start(
         &self,
         rod: &Structure,
         solution: &Solution,
         to: &SolverSettings,
-    ) -> Option<Vec<f64>>;
+    ) -> Option<Vec<f64>> {
+        let state = &solution.state;
+        match self.discretisation() {
+            DiscretisationKind::Harmonics => Some(crate::hb::resize_harmonics(
+                state,
+                solution.harmonics?,
+                to.harmonics,
+                rod.model.dofs(),
+                if self.carries_contact_forces() {
+                    rod.model.contact_count()
+                } else {
+                    0
+                },
+            )),
+            DiscretisationKind::TimeSamples => {
+                let m = rod.model.contact_count().max(1);
+                Some(crate::lcp::interpolate_periodic(state, m, to.time_samples))
+            }
+            DiscretisationKind::StepsPerPeriod => Some(state.clone()),
+        }
+    }
 
     /// Its harmonic-balance problem at `omega` (`None`: not harmonic balance).
     fn harmonic_problem(
@@ -288,45 +359,6 @@ pub(crate) fn of(method: Method) -> &'static dyn Formulation {
     }
 }
 
-/// The harmonic-balance ladder: from 5 harmonics up to the search's size.
-fn harmonic_ladder(rod: &Structure) -> (f64, usize, usize) {
-    let width = rod.model.dofs() + rod.model.contact_count();
-    let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
-    (
-        accuracy::HB_ORDER,
-        5,
-        MAX_SEARCH_HARMONICS.min(by_size).max(10),
-    )
-}
-
-/// The periodic LCP's ladder: time steps up to the size of a dense LCP matrix.
-fn lcp_ladder(rod: &Structure) -> (f64, usize, usize) {
-    let m = rod.model.contact_count().max(1);
-    let limit = MAX_SEARCH_LCP_STEPS.min(crate::lcp::MAX_LCP_SIZE / m);
-    (
-        2.0,
-        64.min(limit / 2).max(crate::lcp::MIN_LCP_TIME_SAMPLES),
-        limit,
-    )
-}
-
-/// Harmonic-balance coefficients of `solution` truncated or lifted to the harmonics of
-/// `to` (`contacts` multiplier rows beside the displacements).
-fn resized_harmonics(
-    rod: &Structure,
-    solution: &Solution,
-    to: &SolverSettings,
-    contacts: usize,
-) -> Option<Vec<f64>> {
-    Some(crate::hb::resize_harmonics(
-        &solution.state,
-        solution.harmonics?,
-        to.harmonics,
-        rod.model.dofs(),
-        contacts,
-    ))
-}
-
 /// Harmonic balance with exact contact, semismooth Newton (`ssn-hb`).
 struct SsnHbFormulation;
 
@@ -345,20 +377,6 @@ impl Formulation for SsnHbFormulation {
         warm_start: Option<&[f64]>,
     ) -> Result<Solution, RunError> {
         super::solve_ssn_hb(rod, omega, settings, warm_start)
-    }
-    fn search_ladder(&self, rod: &Structure, _: &SolverSettings) -> (f64, usize, usize) {
-        harmonic_ladder(rod)
-    }
-    fn comparison(&self, rod: &Structure, s: &SolverSettings) -> Result<Comparison, NoEstimate> {
-        accuracy::harmonic_comparison(s, rod)
-    }
-    fn carried_start(
-        &self,
-        rod: &Structure,
-        sol: &Solution,
-        to: &SolverSettings,
-    ) -> Option<Vec<f64>> {
-        resized_harmonics(rod, sol, to, rod.model.contact_count())
     }
     fn harmonic_problem(
         &self,
@@ -398,20 +416,6 @@ impl Formulation for PenaltyHbFormulation {
     ) -> Result<Solution, RunError> {
         super::solve_penalty_hb(rod, omega, settings, warm_start)
     }
-    fn search_ladder(&self, rod: &Structure, _: &SolverSettings) -> (f64, usize, usize) {
-        harmonic_ladder(rod)
-    }
-    fn comparison(&self, rod: &Structure, s: &SolverSettings) -> Result<Comparison, NoEstimate> {
-        accuracy::harmonic_comparison(s, rod)
-    }
-    fn carried_start(
-        &self,
-        rod: &Structure,
-        sol: &Solution,
-        to: &SolverSettings,
-    ) -> Option<Vec<f64>> {
-        resized_harmonics(rod, sol, to, 0)
-    }
     fn harmonic_problem(
         &self,
         model: &StructuralModel,
@@ -447,12 +451,6 @@ impl Formulation for LcpLemkeFormulation {
     ) -> Result<Solution, RunError> {
         super::solve_lcp_by_lemke(rod, omega, settings)
     }
-    fn search_ladder(&self, rod: &Structure, _: &SolverSettings) -> (f64, usize, usize) {
-        lcp_ladder(rod)
-    }
-    fn comparison(&self, _: &Structure, s: &SolverSettings) -> Result<Comparison, NoEstimate> {
-        accuracy::lcp_comparison(s)
-    }
     fn carried_start(&self, _: &Structure, _: &Solution, _: &SolverSettings) -> Option<Vec<f64>> {
         // Lemke starts from its own basis.
         None
@@ -485,25 +483,6 @@ impl Formulation for LcpSsnFormulation {
     ) -> Result<Solution, RunError> {
         super::solve_lcp_by_min_map(rod, omega, settings, warm_start)
     }
-    fn search_ladder(&self, rod: &Structure, _: &SolverSettings) -> (f64, usize, usize) {
-        lcp_ladder(rod)
-    }
-    fn comparison(&self, _: &Structure, s: &SolverSettings) -> Result<Comparison, NoEstimate> {
-        accuracy::lcp_comparison(s)
-    }
-    fn carried_start(
-        &self,
-        rod: &Structure,
-        sol: &Solution,
-        to: &SolverSettings,
-    ) -> Option<Vec<f64>> {
-        let m = rod.model.contact_count().max(1);
-        Some(crate::lcp::interpolate_periodic(
-            &sol.state,
-            m,
-            to.time_samples,
-        ))
-    }
 }
 
 /// Time marching to the steady state (`march`).
@@ -524,15 +503,6 @@ impl Formulation for MarchFormulation {
         warm_start: Option<&[f64]>,
     ) -> Result<Solution, RunError> {
         super::march::solve_march(rod, omega, settings, warm_start)
-    }
-    fn search_ladder(&self, rod: &Structure, s: &SolverSettings) -> (f64, usize, usize) {
-        (accuracy::march_order(rod, s), 64, MAX_SEARCH_MARCH_STEPS)
-    }
-    fn comparison(&self, rod: &Structure, s: &SolverSettings) -> Result<Comparison, NoEstimate> {
-        accuracy::march_comparison(s, rod)
-    }
-    fn carried_start(&self, _: &Structure, sol: &Solution, _: &SolverSettings) -> Option<Vec<f64>> {
-        Some(sol.state.clone())
     }
     fn continuation_refusal(&self) -> Option<&'static str> {
         Some(

@@ -91,12 +91,7 @@ impl Reconstruction {
         omega: f64,
         settings: &SolverSettings,
     ) -> Result<Self, RunError> {
-        let problem = crate::solve::formulation::of(settings.method)
-            .harmonic_problem(model, omega, settings)
-            .ok_or(RunError::Unsupported {
-                method: settings.method.name(),
-                what: "a harmonic-balance method (ssn-hb or penalty-hb)",
-            })??;
+        let problem = HarmonicProblem::of(model, omega, settings)?;
         Ok(Self(problem))
     }
 

@@ -10,7 +10,7 @@
 use crate::contacts::{contact_reports, ContactReport, FrictionSummary};
 use crate::model::Structure;
 use crate::settings::SolverSettings;
-use crate::solve::{set_closed_fractions, HbReconstruction, RunError};
+use crate::solve::{set_closed_fractions, HarmonicProblem, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
@@ -51,12 +51,7 @@ pub(super) fn branch_reports(
     // with the point's harmonics (built again where they change along the branch).
     let omega = rod.omega_1;
     let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
-        let problem = crate::solve::formulation::of(s.method)
-            .harmonic_problem(model, omega, s)
-            .ok_or(RunError::Unsupported {
-                method: s.method.name(),
-                what: "a harmonic-balance method (ssn-hb or penalty-hb)",
-            })??;
+        let problem = HarmonicProblem::of(model, omega, s)?;
         Ok(problem.into_reconstruction())
     };
     let hb = || -> Result<BranchReports, RunError> {

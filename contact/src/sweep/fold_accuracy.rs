@@ -344,12 +344,7 @@ impl Segment<'_> {
         let h = self.settings.harmonics;
         let dofs = model.dofs();
         let mut solver = hb_solver(self.settings.linear_solver);
-        let problem = crate::solve::formulation::of(self.settings.method)
-            .harmonic_problem(model, omega, self.settings)
-            .ok_or(RunError::Unsupported {
-                method: self.settings.method.name(),
-                what: "a harmonic-balance method (ssn-hb or penalty-hb)",
-            })??;
+        let problem = HarmonicProblem::of(model, omega, self.settings)?;
         let found = match problem {
             HarmonicProblem::Ssn(mut problem) => {
                 let x = resize_harmonics(state, from_h, h, dofs, problem.contacts());
