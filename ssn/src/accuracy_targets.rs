@@ -257,12 +257,12 @@ pub fn target_row(
     let chosen = search.steps[search.chosen].discretisation;
     let chosen_settings = SolverSettings {
         harmonics: chosen.harmonics.unwrap_or(settings.harmonics),
-        time_samples: if method == Method::March {
+        time_samples: if method.marches() {
             settings.time_samples
         } else {
             chosen.time_samples
         },
-        steps_per_period: if method == Method::March {
+        steps_per_period: if method.marches() {
             chosen.time_samples
         } else {
             settings.steps_per_period

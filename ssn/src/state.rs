@@ -115,7 +115,10 @@ impl HbState {
             omega,
             omega_1,
             displacement: u.to_vec(),
-            contact_force: (shape.method == Method::SsnHb).then(|| lambda.to_vec()),
+            contact_force: shape
+                .method
+                .carries_contact_forces()
+                .then(|| lambda.to_vec()),
         }
     }
 

@@ -265,12 +265,10 @@ pub fn search_stop(method: Method, s: &SearchStop) -> String {
         SearchStop::Limit { limit } => format!(
             "not met: the finest discretisation the search allows ({} = {limit}) was reached \
              with a larger estimate",
-            if method.is_harmonic_balance() {
-                "harmonics"
-            } else if method == Method::March {
-                "steps_per_period"
-            } else {
-                "time_samples"
+            match method.discretisation() {
+                DiscretisationKind::Harmonics => "harmonics",
+                DiscretisationKind::StepsPerPeriod => "steps_per_period",
+                DiscretisationKind::TimeSamples => "time_samples",
             }
         ),
         SearchStop::NotConverged { at } => format!(
@@ -517,7 +515,7 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
         if let Some(d) = s.diagnosis {
             writeln!(t, "diagnosis         {}", diagnosis(d))?;
         }
-        let asked = if s.method == Method::March {
+        let asked = if s.method.marches() {
             settings.march_tolerance
         } else {
             settings.tolerance

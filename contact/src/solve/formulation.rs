@@ -90,6 +90,12 @@ impl Method {
     pub fn friction(self) -> FrictionSupport {
         of(self).friction()
     }
+
+    /// Whether the method marches in time to a steady state (its tolerance is
+    /// `march_tolerance`, its run the long one).
+    pub fn marches(self) -> bool {
+        of(self).marches()
+    }
 }
 
 /// How a formulation models friction.
