@@ -22,29 +22,6 @@ pub enum Method {
     March,
 }
 
-impl Method {
-    /// The scene spelling of the method.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::SsnHb => "ssn-hb",
-            Method::PenaltyHb => "penalty-hb",
-            Method::LcpLemke => "lcp-lemke",
-            Method::LcpSsn => "lcp-ssn",
-            Method::March => "march",
-        }
-    }
-
-    /// Whether the method represents the response by harmonics.
-    pub fn is_harmonic_balance(self) -> bool {
-        matches!(self, Method::SsnHb | Method::PenaltyHb)
-    }
-
-    /// Whether the method solves the periodic LCP.
-    pub fn is_lcp(self) -> bool {
-        matches!(self, Method::LcpLemke | Method::LcpSsn)
-    }
-}
-
 /// Globalization of the Newton iterations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -159,19 +136,6 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
-    /// The defaults for `method`, with its own time discretisation: the AFT samples of
-    /// harmonic balance, the time steps per period of the periodic LCP.
-    pub fn for_method(method: Method) -> Self {
-        let mut settings = Self {
-            method,
-            ..Self::default()
-        };
-        if method.is_lcp() {
-            settings.time_samples = crate::lcp::PeriodicLcpOptions::default().time_samples;
-        }
-        settings
-    }
-
     /// The defaults ([`SolverSettings::default`]) with `harmonics` harmonics and the default
     /// AFT sample count for them.
     pub fn with_harmonics(harmonics: usize) -> Self {

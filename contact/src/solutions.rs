@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use crate::contacts::ContactSummary;
 use crate::model::Structure;
-use crate::settings::{Method, SolverSettings, SweepSettings};
+use crate::settings::{SolverSettings, SweepSettings};
 use crate::solve::StateShape;
 use crate::solve::{solve, RunCounters, RunError, Solution, Termination};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
@@ -167,7 +167,7 @@ fn search_window(
     settings: &SolverSettings,
     sweep: Option<&SweepSettings>,
 ) -> Result<SweepSettings, RunError> {
-    if !matches!(settings.method, Method::SsnHb | Method::PenaltyHb) {
+    if !settings.method.is_harmonic_balance() {
         return Err(RunError::Unsupported {
             method: settings.method.name(),
             what: "a harmonic-balance method (ssn-hb or penalty-hb) to follow the branch \

@@ -12,10 +12,12 @@ pub mod accuracy;
 mod march;
 mod raised_c;
 pub use raised_c::RAISED_C_FACTOR;
+pub(crate) mod formulation;
 mod reconstruction;
 
+pub(crate) use formulation::HarmonicProblem;
+pub use formulation::{DiscretisationKind, FrictionSupport};
 pub(crate) use march::march_scheme;
-use march::solve_march;
 pub(crate) use reconstruction::HbReconstruction;
 
 use std::time::Instant;
@@ -249,6 +251,11 @@ pub struct Solution {
     /// With an accuracy target ([`SolverSettings::accuracy`]): the discretisations tried,
     /// what was chosen and what the search cost.
     pub search: Option<DiscretisationSearch>,
+    /// The settings that pose its equation again: the method and discretisation it was
+    /// solved with and the complementarity constant it solved with
+    /// ([`Solution::solved_settings`]); what its stability
+    /// ([`crate::stability::solution_stability`]) or a second solve needs.
+    pub settings: SolverSettings,
 }
 
 impl Solution {
@@ -515,6 +522,7 @@ fn solution(
         state,
         error_estimate: Err(NoEstimate::Off),
         search: None,
+        settings: settings.clone(),
     }
 }
 
@@ -626,7 +634,7 @@ pub fn solve(
     let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
     if settings.estimate_error {
         // The second solve poses the equation the first one solved (its `c` may be raised).
-        let solved = solution.solved_settings(settings);
+        let solved = solution.settings.clone();
         solution.error_estimate = accuracy::estimate(rod, omega, &solved, &solution);
     }
     Ok(solution)
@@ -639,99 +647,114 @@ pub(crate) fn solve_as_given(
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
+    let mut solution = formulation::of(settings.method).solve(rod, omega, settings, warm_start)?;
+    solution.settings = solution.solved_settings(settings);
+    Ok(solution)
+}
+
+/// The SSN-HB solve of `rod` at `omega` (module documentation of [`solve`]).
+pub(super) fn solve_ssn_hb(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
+    let model = &rod.model;
+    let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
+    let mut x = initial_state(problem.dim(), warm_start);
+    let start = Instant::now();
+    let report = raised_c::ssn_hb_newton(&mut problem, &mut x, settings, model, omega)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+    let outcome = Outcome::of_newton(&report, seconds);
+    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    sol.c = (problem.contacts() > 0).then(|| problem.c());
+    Ok(sol)
+}
+
+/// The penalty-HB solve of `rod` at `omega`, through the penalty and regularisation
+/// homotopies from a cold start.
+pub(super) fn solve_penalty_hb(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError> {
     let model = &rod.model;
     let tip = rod.observed_dof;
     let scale = model.contact_stiffness_scale();
-    match settings.method {
-        Method::SsnHb => {
-            let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
-            let mut x = initial_state(problem.dim(), warm_start);
-            let start = Instant::now();
-            let report = raised_c::ssn_hb_newton(&mut problem, &mut x, settings, model, omega)?;
-            let seconds = start.elapsed().as_secs_f64();
-            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let outcome = Outcome::of_newton(&report, seconds);
-            let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
-            sol.c = (problem.contacts() > 0).then(|| problem.c());
-            Ok(sol)
-        }
-        Method::PenaltyHb => {
-            let options = penalty_options(settings, model);
-            let target = options.penalty_stiffness;
-            let mut problem = penalty_problem(model, omega, settings)?;
-            let mut x = initial_state(problem.dim(), warm_start);
-            let start = Instant::now();
-            // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
-            // is the linear response, deep in the obstacle), so without a warm start the
-            // stiffness is raised in log k_p from 10 x the static contact stiffness
-            // (mesh-independent; the local one grows with the mesh and is already too stiff
-            // a start on fine meshes) by factors of 10, a failed stage going back to the
-            // last converged stiffness with the square root of the factor.
-            let mut counters = WorkCounters::default();
-            let mut homotopy_iterations = 0;
-            // Regularisation homotopy: a narrow tanh law is a near-discontinuity Newton
-            // cannot cross from zero, so without a warm start its width is narrowed in log
-            // from the static slip itself (a soft, nearly viscous law) by factors of 10.
-            let width = settings.friction_regularisation;
-            if warm_start.is_none() && !model.friction.is_empty() && width < 1.0 {
-                let stages = homotopy(
-                    0.0,
-                    -width.ln(),
-                    &HomotopySchedule::default(),
-                    &mut x,
-                    |narrowing, x| {
-                        problem.set_friction_regularisation((-narrowing).exp())?;
-                        newton_hb(&mut problem, x, settings, model, (target, None))
-                    },
-                )?;
-                counters += stages.counters;
-                homotopy_iterations += stages.iterations;
-                problem.set_friction_regularisation(width)?;
-            }
-            if warm_start.is_none() && !model.contacts.is_empty() {
-                let k0 = model
-                    .static_contact_stiffness()
-                    .map(|s| DEFAULT_C_FACTOR * s)
-                    .unwrap_or(scale);
-                let stages = homotopy(
-                    k0.ln(),
-                    target.ln(),
-                    &HomotopySchedule::default(),
-                    &mut x,
-                    |log_k, x| {
-                        let k = log_k.exp();
-                        problem.set_penalty_stiffness(k)?;
-                        newton_hb(&mut problem, x, settings, model, (k, None))
-                    },
-                )?;
-                counters += stages.counters;
-                homotopy_iterations += stages.iterations;
-                problem.set_penalty_stiffness(target)?;
-            }
-            let mut report = newton_hb(&mut problem, &mut x, settings, model, (target, None))?;
-            counters += report.counters;
-            report.counters = counters;
-            // Iterations of the whole homotopy, so that costs compare across methods.
-            report.iterations += homotopy_iterations;
-            let seconds = start.elapsed().as_secs_f64();
-            let points = HB_OUTPUT_POINTS.max(settings.time_samples);
-            let outcome = Outcome::of_newton(&report, seconds);
-            let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
-            // The mean penalty force as the equations see it: over the Nt AFT samples (a
-            // finer grid resolves narrow force peaks the quadrature does not).
-            if problem.contacts() > 0 {
-                let summary = problem.summary(&sol.state, tip, points)?;
-                for (c, mean) in sol.contacts.iter_mut().zip(&summary.contact_force_mean) {
-                    // (+0 for a contact that never closes, not -0.)
-                    c.force_mean = if *mean == 0.0 { 0.0 } else { *mean };
-                }
-                sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
-            }
-            Ok(sol)
-        }
-        Method::LcpLemke | Method::LcpSsn => solve_lcp(rod, omega, settings, warm_start),
-        Method::March => solve_march(rod, omega, settings, warm_start),
+    let options = penalty_options(settings, model);
+    let target = options.penalty_stiffness;
+    let mut problem = penalty_problem(model, omega, settings)?;
+    let mut x = initial_state(problem.dim(), warm_start);
+    let start = Instant::now();
+    // Penalty homotopy: a stiff penalty from zero is hard for Newton (the first step
+    // is the linear response, deep in the obstacle), so without a warm start the
+    // stiffness is raised in log k_p from 10 x the static contact stiffness
+    // (mesh-independent; the local one grows with the mesh and is already too stiff
+    // a start on fine meshes) by factors of 10, a failed stage going back to the
+    // last converged stiffness with the square root of the factor.
+    let mut counters = WorkCounters::default();
+    let mut homotopy_iterations = 0;
+    // Regularisation homotopy: a narrow tanh law is a near-discontinuity Newton
+    // cannot cross from zero, so without a warm start its width is narrowed in log
+    // from the static slip itself (a soft, nearly viscous law) by factors of 10.
+    let width = settings.friction_regularisation;
+    if warm_start.is_none() && !model.friction.is_empty() && width < 1.0 {
+        let stages = homotopy(
+            0.0,
+            -width.ln(),
+            &HomotopySchedule::default(),
+            &mut x,
+            |narrowing, x| {
+                problem.set_friction_regularisation((-narrowing).exp())?;
+                newton_hb(&mut problem, x, settings, model, (target, None))
+            },
+        )?;
+        counters += stages.counters;
+        homotopy_iterations += stages.iterations;
+        problem.set_friction_regularisation(width)?;
     }
+    if warm_start.is_none() && !model.contacts.is_empty() {
+        let k0 = model
+            .static_contact_stiffness()
+            .map(|s| DEFAULT_C_FACTOR * s)
+            .unwrap_or(scale);
+        let stages = homotopy(
+            k0.ln(),
+            target.ln(),
+            &HomotopySchedule::default(),
+            &mut x,
+            |log_k, x| {
+                let k = log_k.exp();
+                problem.set_penalty_stiffness(k)?;
+                newton_hb(&mut problem, x, settings, model, (k, None))
+            },
+        )?;
+        counters += stages.counters;
+        homotopy_iterations += stages.iterations;
+        problem.set_penalty_stiffness(target)?;
+    }
+    let mut report = newton_hb(&mut problem, &mut x, settings, model, (target, None))?;
+    counters += report.counters;
+    report.counters = counters;
+    // Iterations of the whole homotopy, so that costs compare across methods.
+    report.iterations += homotopy_iterations;
+    let seconds = start.elapsed().as_secs_f64();
+    let points = HB_OUTPUT_POINTS.max(settings.time_samples);
+    let outcome = Outcome::of_newton(&report, seconds);
+    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    // The mean penalty force as the equations see it: over the Nt AFT samples (a
+    // finer grid resolves narrow force peaks the quadrature does not).
+    if problem.contacts() > 0 {
+        let summary = problem.summary(&sol.state, tip, points)?;
+        for (c, mean) in sol.contacts.iter_mut().zip(&summary.contact_force_mean) {
+            // (+0 for a contact that never closes, not -0.)
+            c.force_mean = if *mean == 0.0 { 0.0 } else { *mean };
+        }
+        sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
+    }
+    Ok(sol)
 }
 
 fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
@@ -741,19 +764,39 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
     }
 }
 
-/// The periodic LCP of `rod` at `omega` solved by the scene's LCP method (Lemke or
-/// semismooth Newton), from `warm_start` (contact forces) when it fits.
-fn solve_lcp(
+/// The periodic LCP of `rod` at `omega` solved by Lemke's pivoting.
+pub(super) fn solve_lcp_by_lemke(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+) -> Result<Solution, RunError> {
+    solve_lcp(rod, omega, settings, &lcp_by_lemke)
+}
+
+/// The periodic LCP of `rod` at `omega` solved by semismooth Newton on its min map, from
+/// `warm_start` (contact forces) when it fits.
+pub(super) fn solve_lcp_by_min_map(
     rod: &Structure,
     omega: f64,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
+    solve_lcp(rod, omega, settings, &|lcp| {
+        lcp_by_min_map(&rod.model, omega, settings, lcp, warm_start)
+    })
+}
+
+/// The periodic LCP of `rod` at `omega` solved by `solve_lcp` and reduced to a [`Solution`].
+fn solve_lcp(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    solve_lcp: &dyn Fn(&PeriodicLcp) -> Result<LcpRun, RunError>,
+) -> Result<Solution, RunError> {
     let model = &rod.model;
-    let method = settings.method;
     if model.contacts.is_empty() {
         return Err(RunError::Unsupported {
-            method: method.name(),
+            method: settings.method.name(),
             what: "a [contact] section (the periodic LCP is posed on the contact forces)",
         });
     }
@@ -768,10 +811,7 @@ fn solve_lcp(
         counters,
         effective_tolerance,
         finest,
-    } = match method {
-        Method::LcpLemke => lcp_by_lemke(&lcp)?,
-        _ => lcp_by_min_map(model, omega, settings, &lcp, warm_start)?,
-    };
+    } = solve_lcp(&lcp)?;
     let seconds = start.elapsed().as_secs_f64();
     let contact_u = lcp.contact_displacements(&z)?;
     let forces = lcp.contact_forces(&z)?;

@@ -402,13 +402,9 @@ fn stability(py: Python<'_>, scene: &Scene) -> PyResult<Stability> {
         }
         // The whole unknown vector of the method (displacements, and the contact
         // multipliers of SSN-HB): the contact phases are read from it.
-        let stability = semismooth_contact::stability::hb_stability(
-            &loaded.structure.model,
-            &solution.solved_settings(settings),
-            loaded.omega,
-            &solution.state,
-        )
-        .map_err(semismooth_contact::Error::from)?;
+        let stability =
+            semismooth_contact::stability::solution_stability(&loaded.structure.model, &solution)
+                .map_err(semismooth_contact::Error::from)?;
         Ok((solution, stability))
     })?;
     Ok(Stability::new(&solution, &stability))

@@ -15,9 +15,9 @@
 
 use semismooth_contact::accuracy::{Discretisation, RelativeErrors, ReportedQuantities};
 use semismooth_contact::rod::{build_rod, MassModel, RodModel, RodSpec};
-use semismooth_contact::solve::{solve, Solution};
+use semismooth_contact::solve::{solve, DiscretisationKind, Solution};
 
-use crate::scene::{default_hb_time_samples, Method, SolverSettings};
+use crate::scene::{Method, SolverSettings};
 use crate::tables::{Table, TableError};
 use crate::words::discretisation;
 
@@ -76,9 +76,10 @@ pub const METHODS: [Method; 5] = [
 /// at the default penalty stiffness stops falling near 3e-5 on the paper's rod (H = 452
 /// and 640), not 1e-5.
 pub fn targets_of(method: Method) -> &'static [f64] {
-    match method {
-        Method::PenaltyHb => &TARGETS[..2],
-        _ => &TARGETS,
+    if method.penalises_contact() {
+        &TARGETS[..2]
+    } else {
+        &TARGETS
     }
 }
 
@@ -120,33 +121,29 @@ pub fn reference(rod: &RodModel) -> Result<TargetReference, TableError> {
 /// The settings of `method` at `level` on its ladder: harmonics with the default AFT
 /// samples (harmonic balance), time steps per period (the LCP, time marching); no estimate.
 pub fn at_level(method: Method, level: usize) -> SolverSettings {
-    let mut s = SolverSettings::for_method(method);
-    s.estimate_error = false;
-    match method {
-        Method::SsnHb | Method::PenaltyHb => {
-            s.harmonics = level;
-            s.time_samples = default_hb_time_samples(level);
-        }
-        Method::March => s.steps_per_period = level,
-        _ => s.time_samples = level,
-    }
-    s
+    SolverSettings::for_method(method).at_level(level)
 }
 
 /// The discretisations of `method` the cheapest setting is looked for in, by increasing
-/// cost (ratio about `sqrt 2`).
+/// cost (ratio about `sqrt 2`); penalty HB stops at 320 harmonics, where its error stops
+/// falling ([`targets_of`]).
 pub fn ladder(method: Method) -> Vec<usize> {
-    match method {
-        Method::SsnHb => vec![
-            5, 7, 10, 14, 20, 28, 40, 56, 80, 113, 160, 226, 320, 452, 640,
-        ],
-        Method::PenaltyHb => vec![5, 7, 10, 14, 20, 28, 40, 56, 80, 113, 160, 226, 320],
-        Method::LcpLemke | Method::LcpSsn => {
+    match method.discretisation() {
+        DiscretisationKind::Harmonics => {
+            let top = if method.penalises_contact() { 320 } else { 640 };
+            [
+                5, 7, 10, 14, 20, 28, 40, 56, 80, 113, 160, 226, 320, 452, 640,
+            ]
+            .into_iter()
+            .filter(|&h| h <= top)
+            .collect()
+        }
+        DiscretisationKind::TimeSamples => {
             vec![
                 32, 48, 64, 96, 128, 192, 256, 384, 512, 768, 1024, 1536, 2048,
             ]
         }
-        _ => vec![
+        DiscretisationKind::StepsPerPeriod => vec![
             64, 96, 128, 192, 256, 384, 512, 768, 1024, 1536, 2048, 3072, 4096, 6144, 8192,
         ],
     }
@@ -260,12 +257,12 @@ pub fn target_row(
     let chosen = search.steps[search.chosen].discretisation;
     let chosen_settings = SolverSettings {
         harmonics: chosen.harmonics.unwrap_or(settings.harmonics),
-        time_samples: if method == Method::March {
+        time_samples: if method.marches() {
             settings.time_samples
         } else {
             chosen.time_samples
         },
-        steps_per_period: if method == Method::March {
+        steps_per_period: if method.marches() {
             chosen.time_samples
         } else {
             settings.steps_per_period
@@ -320,14 +317,7 @@ pub fn target_table(case: &str, rows: &[TargetRow]) -> Table {
     };
     for r in rows {
         let cheapest = r.cheapest.map(|c| {
-            let d = Discretisation {
-                harmonics: r.method.is_harmonic_balance().then_some(c.level),
-                time_samples: if r.method.is_harmonic_balance() {
-                    default_hb_time_samples(c.level)
-                } else {
-                    c.level
-                },
-            };
+            let d = Discretisation::of(&at_level(r.method, c.level));
             (discretisation(r.method, &d), c.seconds)
         });
         table.rows.push(vec![

@@ -19,7 +19,7 @@ use crate::output::{
     csv_table, line_plot_svg, prepare_directory, stability_key, stability_series, PlotSpec, Series,
 };
 use crate::progress::progress_spinner;
-use crate::scene::{Method, Override, Scene, SweepSettings};
+use crate::scene::{Override, Scene, SweepSettings};
 use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with};
@@ -452,7 +452,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     };
     let start = read_start(solve_args, &scene, shape)?;
     // Time marching to a steady state is the long one: a spinner while it runs.
-    let bar = if scene.solver.method == Method::March {
+    let bar = if scene.solver.method.marches() {
         progress_spinner("time marching to a steady state")
     } else {
         indicatif::ProgressBar::hidden()

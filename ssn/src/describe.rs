@@ -5,7 +5,8 @@ use semismooth_contact::model::Structure;
 use semismooth_contact::rod::DampingSpec;
 
 use crate::io::printable;
-use crate::scene::{Method, Scene};
+use crate::scene::Scene;
+use semismooth_contact::solve::DiscretisationKind;
 
 /// The first lines of a description: the scene's file and its title.
 fn scene_header(path: &std::path::Path, title: Option<&str>) -> String {
@@ -88,22 +89,24 @@ pub fn describe_run(scene: &Scene, rod: &Structure) -> String {
         out.push('\n');
     };
     let v = &scene.solver;
-    line(match v.method {
-        m if m.is_harmonic_balance() => format!(
+    line(match v.method.discretisation() {
+        DiscretisationKind::Harmonics => format!(
             "solver            {} H = {}, Nt = {}, {:?} linear solver, {:?} globalization",
-            m.name(),
+            v.method.name(),
             v.harmonics,
             v.time_samples,
             v.linear_solver,
             v.globalization
         ),
-        Method::March => format!(
-            "solver            march, {} steps per period, tolerance {:e}",
-            v.steps_per_period, v.march_tolerance
+        DiscretisationKind::StepsPerPeriod => format!(
+            "solver            {}, {} steps per period, tolerance {:e}",
+            v.method.name(),
+            v.steps_per_period,
+            v.march_tolerance
         ),
-        m => format!(
+        DiscretisationKind::TimeSamples => format!(
             "solver            {}, Nt = {} steps per period",
-            m.name(),
+            v.method.name(),
             v.time_samples
         ),
     });

@@ -27,6 +27,7 @@
 
 use crate::scene::{default_hb_time_samples, LinearSolverChoice, Method, Scene, SolverSettings};
 use semismooth_contact::model::Structure;
+use semismooth_contact::solve::DiscretisationKind;
 
 /// The dense condensed matrix (and full receptance) the matrix-free path may factor as
 /// GMRES's preconditioner: `8 (m S)^2 + 16 (H + 1) m^2` bytes up to
@@ -60,8 +61,8 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
     let n = elements as f64;
     let m = contacts as f64;
     let rod = ROD_BYTES_PER_ELEMENT * n;
-    match settings.method {
-        Method::SsnHb | Method::PenaltyHb => {
+    match settings.method.discretisation() {
+        DiscretisationKind::Harmonics => {
             let h = settings.harmonics as f64;
             let s = 2.0 * h + 1.0;
             let nt = settings.time_samples as f64;
@@ -72,7 +73,7 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                 c.uses_krylov(
                     contacts,
                     settings.harmonics,
-                    settings.method == Method::SsnHb,
+                    settings.method.carries_contact_forces(),
                 )
             });
             match settings.linear_solver {
@@ -103,9 +104,10 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                     keys: "rod.elements, solver.harmonics (and the number of contacts)",
                 },
                 LinearSolverChoice::Dense => {
-                    let unknowns = match settings.method {
-                        Method::SsnHb => (n + m) * s,
-                        _ => n * s,
+                    let unknowns = if settings.method.carries_contact_forces() {
+                        (n + m) * s
+                    } else {
+                        n * s
                     };
                     MemoryEstimate {
                         bytes: rod + structured + 10.0 * unknowns * unknowns,
@@ -119,7 +121,7 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                 }
             }
         }
-        Method::LcpLemke | Method::LcpSsn => {
+        DiscretisationKind::TimeSamples => {
             let dim = m * settings.time_samples as f64;
             MemoryEstimate {
                 bytes: rod + 24.0 * dim * dim + 1000.0 * n,
@@ -129,7 +131,7 @@ pub fn run_memory(elements: usize, contacts: usize, settings: &SolverSettings) -
                 keys: "solver.time_samples (and the number of contacts)",
             }
         }
-        Method::March => MemoryEstimate {
+        DiscretisationKind::StepsPerPeriod => MemoryEstimate {
             bytes: rod + 1000.0 * n,
             what: format!("time-stepping matrices of {elements} dofs"),
             keys: "rod.elements",
@@ -462,7 +464,7 @@ fn matrix_free_iteration(
 /// Whether the SSN-HB condensed system of `contacts` contacts is solved matrix-free with
 /// `settings` (more than `KRYLOV_THRESHOLD` condensed unknowns, or on request).
 fn matrix_free(contacts: usize, settings: &SolverSettings) -> bool {
-    settings.method == Method::SsnHb
+    settings.method.carries_contact_forces()
         && settings
             .linear_solver
             .condensed()
@@ -483,15 +485,18 @@ pub fn estimated_krylov_iterations(dofs: usize, contacts: usize, settings: &Solv
 /// Newton iterations [`size_work`] counts for one solve with `settings` (the divisor that
 /// gives the work of one iteration).
 pub(crate) fn counted_newton_iterations(contacts: usize, settings: &SolverSettings) -> f64 {
-    match settings.method {
-        Method::PenaltyHb
-            if settings.linear_solver != LinearSolverChoice::Dense && contacts > 0 =>
-        {
-            settings.max_iterations as f64
-        }
-        _ if matrix_free(contacts, settings) => SEVERAL_CONTACTS_NEWTON_ITERATIONS,
-        Method::SsnHb => newton_iterations(contacts),
-        _ => NEWTON_FACTORIZATIONS,
+    let method = settings.method;
+    if method.penalises_contact()
+        && settings.linear_solver != LinearSolverChoice::Dense
+        && contacts > 0
+    {
+        settings.max_iterations as f64
+    } else if matrix_free(contacts, settings) {
+        SEVERAL_CONTACTS_NEWTON_ITERATIONS
+    } else if method.carries_contact_forces() {
+        newton_iterations(contacts)
+    } else {
+        NEWTON_FACTORIZATIONS
     }
 }
 
@@ -563,7 +568,7 @@ fn error_estimate_work(
     contacts: usize,
     settings: &SolverSettings,
 ) -> Option<(usize, f64)> {
-    let runs = settings.method == Method::SsnHb
+    let runs = settings.method.carries_contact_forces()
         && settings.linear_solver != LinearSolverChoice::Dense
         && settings.estimate_error
         && settings.accuracy.is_none()
@@ -603,16 +608,13 @@ pub(crate) fn size_work(
 ) -> WorkEstimate {
     let (n, m) = (dofs as f64, contacts as f64);
     let s = 2.0 * settings.harmonics as f64 + 1.0;
-    match (settings.method, settings.linear_solver) {
-        (Method::SsnHb | Method::PenaltyHb, LinearSolverChoice::Dense) => {
-            let unknowns = if settings.method == Method::SsnHb {
-                (n + m) * s
+    let method = settings.method;
+    match settings.linear_solver {
+        LinearSolverChoice::Dense if method.is_harmonic_balance() => {
+            let (unknowns, count) = if method.carries_contact_forces() {
+                ((n + m) * s, newton_iterations(contacts))
             } else {
-                n * s
-            };
-            let count = match settings.method {
-                Method::SsnHb => newton_iterations(contacts),
-                _ => NEWTON_FACTORIZATIONS,
+                (n * s, NEWTON_FACTORIZATIONS)
             };
             WorkEstimate {
                 flops: count * 2.0 / 3.0 * unknowns.powi(3),
@@ -625,7 +627,7 @@ pub(crate) fn size_work(
             }
         }
         // Above the threshold (or on request) the condensed system is solved matrix-free.
-        (Method::SsnHb, _) if matrix_free(contacts, settings) => {
+        _ if matrix_free(contacts, settings) => {
             let iteration = matrix_free_iteration(n, m, settings.harmonics, true);
             WorkEstimate {
                 flops: SEVERAL_CONTACTS_NEWTON_ITERATIONS * iteration.flops,
@@ -646,7 +648,7 @@ pub(crate) fn size_work(
                 keys: "solver.harmonics and the number of contacts",
             }
         }
-        (Method::PenaltyHb, _) if contacts > 0 => {
+        _ if method.penalises_contact() && contacts > 0 => {
             // Penalty HB factors the condensed system at every iteration and stiff
             // penalties take hundreds of them: counted at solver.max_iterations.
             let unknowns = m * s;
@@ -664,12 +666,11 @@ pub(crate) fn size_work(
                 keys: "solver.harmonics, solver.max_iterations and the structure's size",
             }
         }
-        (
-            Method::SsnHb,
-            LinearSolverChoice::Structured
-            | LinearSolverChoice::CondensedDense
-            | LinearSolverChoice::CondensedKrylov,
-        ) => {
+        LinearSolverChoice::Structured
+        | LinearSolverChoice::CondensedDense
+        | LinearSolverChoice::CondensedKrylov
+            if method.carries_contact_forces() =>
+        {
             let iterations = newton_iterations(contacts);
             WorkEstimate {
                 flops: iterations * dense_condensed_iteration(n, m, settings.harmonics),

@@ -115,7 +115,10 @@ impl HbState {
             omega,
             omega_1,
             displacement: u.to_vec(),
-            contact_force: (shape.method == Method::SsnHb).then(|| lambda.to_vec()),
+            contact_force: shape
+                .method
+                .carries_contact_forces()
+                .then(|| lambda.to_vec()),
         }
     }
 
@@ -150,16 +153,16 @@ impl HbState {
         if count_field(v, "version")? as u64 != STATE_VERSION {
             return Err(field_error("version", format!("allowed {STATE_VERSION}")));
         }
-        let method = match v.get("method").and_then(Value::as_str) {
-            Some("ssn-hb") => Method::SsnHb,
-            Some("penalty-hb") => Method::PenaltyHb,
-            other => {
-                return Err(field_error(
+        let named = v.get("method").and_then(Value::as_str);
+        let method = named
+            .and_then(|name| serde_json::from_value::<Method>(Value::from(name)).ok())
+            .filter(|m| m.is_harmonic_balance())
+            .ok_or_else(|| {
+                field_error(
                     "method",
-                    format!("{other:?}: allowed \"ssn-hb\" or \"penalty-hb\""),
-                ))
-            }
-        };
+                    format!("{named:?}: allowed \"ssn-hb\" or \"penalty-hb\""),
+                )
+            })?;
         let (harmonics, dofs, contacts) = (
             count_field(v, "harmonics")?,
             count_field(v, "dofs")?,
@@ -196,13 +199,14 @@ impl HbState {
             })
         };
         let displacement = coefficients_field(v, "displacement", length("dofs", dofs)?)?;
-        let contact_force = match method {
-            Method::SsnHb => Some(coefficients_field(
+        let contact_force = if method.carries_contact_forces() {
+            Some(coefficients_field(
                 v,
                 "contact_force",
                 length("contacts", contacts)?,
-            )?),
-            _ => None,
+            )?)
+        } else {
+            None
         };
         Ok(Self {
             method,

@@ -7,7 +7,7 @@ use semismooth::lemke::{LemkeOptions, LemkeTermination};
 use semismooth_contact::accuracy::{Discretisation, EstimateBasis, NoEstimate, SearchStop};
 use semismooth_contact::settings::{LcpScheme, Method};
 use semismooth_contact::solutions::FailedCorrection;
-use semismooth_contact::solve::{Diagnosis, Solution, Termination};
+use semismooth_contact::solve::{Diagnosis, DiscretisationKind, Solution, Termination};
 use semismooth_contact::stability::Undecided;
 use semismooth_contact::sweep::adaptive::BranchAccuracy;
 use semismooth_contact::sweep::fold_accuracy::{FoldAccuracy, FoldStop};
@@ -216,9 +216,9 @@ pub fn failed_correction(f: &FailedCorrection) -> String {
 /// A discretisation of `method` as the tables print it: `H=20 Nt=256` (harmonic balance),
 /// `Nt=512` (the periodic LCP), `steps=2000` (time marching).
 pub fn discretisation(method: Method, d: &Discretisation) -> String {
-    match (d.harmonics, method) {
+    match (d.harmonics, method.discretisation()) {
         (Some(h), _) => format!("H={h} Nt={}", d.time_samples),
-        (None, Method::March) => format!("steps={}", d.time_samples),
+        (None, DiscretisationKind::StepsPerPeriod) => format!("steps={}", d.time_samples),
         (None, _) => format!("Nt={}", d.time_samples),
     }
 }
@@ -265,12 +265,10 @@ pub fn search_stop(method: Method, s: &SearchStop) -> String {
         SearchStop::Limit { limit } => format!(
             "not met: the finest discretisation the search allows ({} = {limit}) was reached \
              with a larger estimate",
-            if method.is_harmonic_balance() {
-                "harmonics"
-            } else if method == Method::March {
-                "steps_per_period"
-            } else {
-                "time_samples"
+            match method.discretisation() {
+                DiscretisationKind::Harmonics => "harmonics",
+                DiscretisationKind::StepsPerPeriod => "steps_per_period",
+                DiscretisationKind::TimeSamples => "time_samples",
             }
         ),
         SearchStop::NotConverged { at } => format!(
@@ -517,7 +515,7 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
         if let Some(d) = s.diagnosis {
             writeln!(t, "diagnosis         {}", diagnosis(d))?;
         }
-        let asked = if s.method == Method::March {
+        let asked = if s.method.marches() {
             settings.march_tolerance
         } else {
             settings.tolerance

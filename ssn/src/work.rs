@@ -9,7 +9,7 @@
 //! are measured and converted at that rate.
 
 use crate::limits::{compared, counted_newton_iterations, size_work, solve_work, WorkEstimate};
-use crate::scene::{Method, Scene, SolverSettings};
+use crate::scene::{Scene, SolverSettings};
 
 /// Operations of one time step of one dof of time marching: 1e8 dof-steps (a 10,000-element
 /// rod, 2,000 steps for 5 periods) took 6.5 s on 2 loaded cores, 1,500 operations at
@@ -92,7 +92,7 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
         _ => size_work(dofs, contacts, &settings, dense_keys),
     };
     let mut estimates = vec![one];
-    if settings.method == Method::March || workload == Workload::Compare {
+    if settings.method.marches() || workload == Workload::Compare {
         estimates.push(march_work(dofs, &settings, size_key));
     }
     if workload == Workload::Branch {

@@ -7,7 +7,7 @@
 //! switching function is positive (SSN-HB: `c (G u - g) - lambda > 0`, the samples the
 //! generalized Jacobian treats as active; penalty HB: `G u - g > 0`), the interval ends
 //! refined between the `Nt` AFT samples on the truncated series
-//! ([`SsnHb::closed_intervals`], [`PenaltyHb::closed_intervals`]). Between two switching
+//! ([`crate::hb::SsnHb::closed_intervals`], [`crate::hb::PenaltyHb::closed_intervals`]). Between two switching
 //! instants the set of closed contacts is fixed and a small perturbation of the orbit
 //! obeys a linear system with constant coefficients (module `phases`: the held dofs of
 //! the closed contacts are removed, massless dofs follow statically or by first-order
@@ -76,11 +76,11 @@ mod shooting;
 use semismooth::floquet::{FloquetError, Multipliers};
 use semismooth::InvalidOption;
 
-use crate::hb::{HbError, PenaltyHb, SsnHb};
+use crate::hb::HbError;
 use crate::march::{MarchError, MarchState};
 use crate::model::{check_omega, StructuralModel};
 use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_options};
+use crate::solve::{HarmonicProblem, Solution};
 
 use phases::PhaseModel;
 pub use phases::{ClosedContact, PhaseError};
@@ -324,17 +324,11 @@ pub fn hb_state(
     })
 }
 
-/// The harmonic-balance formulation whose contact phases a solution has.
-enum Formulation {
-    Ssn(SsnHb),
-    Penalty(PenaltyHb),
-}
-
 /// The stability analysis of harmonic-balance solutions of one model and method, reused
 /// along a branch (the phases met are decomposed once).
 #[non_exhaustive]
 pub struct HbStability {
-    formulation: Formulation,
+    formulation: HarmonicProblem,
     /// The model (the orbit's state at the impacts).
     model: StructuralModel,
     harmonics: usize,
@@ -349,26 +343,16 @@ impl HbStability {
     pub fn new(model: &StructuralModel, settings: &SolverSettings) -> Result<Self, StabilityError> {
         // The contact phases are fractions of the period: any valid frequency builds them.
         let omega = 1.0;
-        let (formulation, closed) = match settings.method {
-            Method::SsnHb => (
-                Formulation::Ssn(SsnHb::new(model, omega, &hb_options(settings))?),
-                ClosedContact::Held,
-            ),
-            Method::PenaltyHb => {
-                let options = penalty_options(settings, model);
-                let k = options.penalty_stiffness;
-                (
-                    Formulation::Penalty(PenaltyHb::new(model, omega, &options)?),
-                    ClosedContact::Spring(k),
-                )
-            }
-            _ => {
-                return Err(StabilityError::InvalidOption {
-                    name: "method",
-                    value: f64::NAN,
-                    allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
-                })
-            }
+        let formulation = crate::solve::formulation::of(settings.method)
+            .harmonic_problem(model, omega, settings)
+            .ok_or(StabilityError::InvalidOption {
+                name: "method",
+                value: f64::NAN,
+                allowed: "a harmonic-balance method (ssn-hb or penalty-hb)",
+            })??;
+        let closed = match formulation.closed_contact_stiffness() {
+            None => ClosedContact::Held,
+            Some(k) => ClosedContact::Spring(k),
         };
         let n = model.dofs();
         let (phases, refused) = if !model.friction.is_empty() {
@@ -401,18 +385,11 @@ impl HbStability {
     }
 
     /// The closed intervals of every contact of the solution `x`, as fractions of the
-    /// period ([`SsnHb::closed_intervals`], [`PenaltyHb::closed_intervals`]).
+    /// period ([`crate::hb::SsnHb::closed_intervals`], [`crate::hb::PenaltyHb::closed_intervals`]).
     pub fn closed_intervals(&self, x: &[f64]) -> Result<Vec<Vec<(f64, f64)>>, StabilityError> {
-        match &self.formulation {
-            // The friction points' rows follow the contacts' and have no closed phase.
-            Formulation::Ssn(p) => (0..p.contacts() - p.friction_points())
-                .map(|i| p.closed_intervals(x, i))
-                .collect::<Result<Vec<_>, _>>(),
-            Formulation::Penalty(p) => (0..p.contacts())
-                .map(|i| p.closed_intervals(x, i))
-                .collect::<Result<Vec<_>, _>>(),
-        }
-        .map_err(StabilityError::from)
+        self.formulation
+            .closed_intervals(x)
+            .map_err(StabilityError::from)
     }
 
     /// The stability of the solution `x` (the method's unknowns) at angular frequency
@@ -423,9 +400,11 @@ impl HbStability {
         if let Some(reason) = &self.refused {
             return Ok(Stability::not_decided(reason.clone()));
         }
-        let rebounds = match self.formulation {
-            Formulation::Ssn(_) => self.rebounds(omega, x, &mut intervals)?,
-            Formulation::Penalty(_) => Vec::new(),
+        // A contact held exactly rebounds at its impacts; a penalty spring does not.
+        let rebounds = if self.formulation.closed_contact_stiffness().is_none() {
+            self.rebounds(omega, x, &mut intervals)?
+        } else {
+            Vec::new()
         };
         let phases = self.phases.as_mut().expect("built when not refused");
         let period = 2.0 * std::f64::consts::PI / omega;
@@ -498,6 +477,15 @@ pub fn hb_stability(
     x: &[f64],
 ) -> Result<Stability, StabilityError> {
     HbStability::new(model, settings)?.of(omega, x)
+}
+
+/// The stability of `solution`, a harmonic-balance solve on `model`, from what it carries
+/// (its settings, frequency and state; [`hb_stability`]).
+pub fn solution_stability(
+    model: &StructuralModel,
+    solution: &Solution,
+) -> Result<Stability, StabilityError> {
+    hb_stability(model, &solution.settings, solution.omega, &solution.state)
 }
 
 /// An impact with rebound of a contact on a dof with mass: the orbit's closed interval

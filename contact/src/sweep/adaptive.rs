@@ -63,7 +63,7 @@ use super::{
 };
 use crate::hb::{resize_harmonics, HbJacobian, SsnHb};
 use crate::model::{StructuralModel, Structure};
-use crate::settings::{default_hb_time_samples, Method, SolverSettings, SweepSettings};
+use crate::settings::{default_hb_time_samples, SolverSettings, SweepSettings};
 use crate::solve::accuracy::search::{
     check_target, MAX_RATIO, MAX_SEARCH_HARMONICS, MAX_SEARCH_UNKNOWNS, SAFETY,
 };
@@ -465,7 +465,7 @@ fn check_adaptive(
     target: f64,
 ) -> Result<(), RunError> {
     check_target(target)?;
-    if settings.method != Method::SsnHb {
+    if !settings.method.adapts_harmonics() {
         return Err(RunError::Unsupported {
             method: settings.method.name(),
             what: "harmonics chosen point by point (ssn-hb)",

@@ -16,10 +16,10 @@
 use semismooth::floquet::{crossing_of, BifurcationKind, Outside};
 
 use crate::contacts::ContactSummary;
-use crate::hb::{HbError, PenaltyHb, ResponseSummary, SsnHb};
+use crate::hb::HbError;
 use crate::model::{StructuralModel, Structure};
-use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_problem, RunError};
+use crate::settings::SolverSettings;
+use crate::solve::{HarmonicProblem, RunError};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
 use crate::sweep::FrequencyResponse;
 
@@ -81,10 +81,7 @@ impl BranchStability {
 }
 
 /// The harmonic-balance problem whose reconstructions a branch's states belong to.
-pub(crate) enum Reconstruction {
-    Ssn(SsnHb),
-    Penalty(PenaltyHb),
-}
+pub(crate) struct Reconstruction(HarmonicProblem);
 
 impl Reconstruction {
     /// The scene's harmonic-balance problem at `omega` (`Unsupported` for other methods);
@@ -94,16 +91,8 @@ impl Reconstruction {
         omega: f64,
         settings: &SolverSettings,
     ) -> Result<Self, RunError> {
-        Ok(match settings.method {
-            Method::SsnHb => Self::Ssn(SsnHb::new(model, omega, &hb_options(settings))?),
-            Method::PenaltyHb => Self::Penalty(penalty_problem(model, omega, settings)?),
-            other => {
-                return Err(RunError::Unsupported {
-                    method: other.name(),
-                    what: "a harmonic-balance method (ssn-hb or penalty-hb)",
-                })
-            }
-        })
+        let problem = HarmonicProblem::of(model, omega, settings)?;
+        Ok(Self(problem))
     }
 
     /// Mean force and largest penetration of each contact.
@@ -113,22 +102,10 @@ impl Reconstruction {
         x: &[f64],
     ) -> Result<Vec<ContactSummary>, HbError> {
         let first = model.contacts.first().map_or(0, |c| c.dof());
-        // Both formulations offer the same summary and reconstruction.
-        let gather = |summary: Result<ResponseSummary, HbError>,
-                      samples: &dyn Fn(usize) -> Result<Vec<f64>, HbError>| {
-            let samples = (0..model.contacts.len())
-                .map(samples)
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok::<_, HbError>((summary?, samples))
-        };
-        let (summary, samples) = match self {
-            Self::Ssn(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
-                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
-            })?,
-            Self::Penalty(p) => gather(p.summary(x, first, DIAGNOSTIC_POINTS), &|i| {
-                p.row_displacement_samples(x, i, DIAGNOSTIC_POINTS)
-            })?,
-        };
+        let summary = self.0.summary(x, first, DIAGNOSTIC_POINTS)?;
+        let samples = (0..model.contacts.len())
+            .map(|i| self.0.row_displacement_samples(x, i, DIAGNOSTIC_POINTS))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(model
             .contacts
             .iter()
@@ -144,10 +121,7 @@ impl Reconstruction {
     }
 
     fn summary(&self, x: &[f64], dof: usize) -> Result<(f64, f64), HbError> {
-        let s = match self {
-            Self::Ssn(p) => p.summary(x, dof, DIAGNOSTIC_POINTS)?,
-            Self::Penalty(p) => p.summary(x, dof, DIAGNOSTIC_POINTS)?,
-        };
+        let s = self.0.summary(x, dof, DIAGNOSTIC_POINTS)?;
         let mean = s.contact_force_mean.first().copied().unwrap_or(0.0);
         Ok((
             if mean.abs() < f64::MIN_POSITIVE {

@@ -8,10 +8,9 @@
 //! so contact `c` has displacement `u = g - w[n m + c]` and force `-z[n m + c]` at node `n`.
 
 use crate::contacts::{contact_reports, ContactReport, FrictionSummary};
-use crate::hb::SsnHb;
 use crate::model::Structure;
-use crate::settings::{Method, SolverSettings};
-use crate::solve::{hb_options, penalty_problem, set_closed_fractions, HbReconstruction, RunError};
+use crate::settings::SolverSettings;
+use crate::solve::{set_closed_fractions, HarmonicProblem, HbReconstruction, RunError};
 
 use super::FrequencyResponse;
 
@@ -52,10 +51,8 @@ pub(super) fn branch_reports(
     // with the point's harmonics (built again where they change along the branch).
     let omega = rod.omega_1;
     let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
-        Ok(match s.method {
-            Method::SsnHb => Box::new(SsnHb::new(model, omega, &hb_options(s))?),
-            _ => Box::new(penalty_problem(model, omega, s)?),
-        })
+        let problem = HarmonicProblem::of(model, omega, s)?;
+        Ok(problem.into_reconstruction())
     };
     let hb = || -> Result<BranchReports, RunError> {
         let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
@@ -76,19 +73,22 @@ pub(super) fn branch_reports(
         }
         Ok((reports, friction))
     };
-    match settings.method {
-        Method::SsnHb | Method::PenaltyHb => hb(),
-        Method::LcpSsn => {
-            let m = contacts.len();
-            let reports = response
-                .states
-                .iter()
-                .map(|y| lcp_point_contacts(&contacts, y, m))
-                .collect();
-            Ok((reports, Vec::new()))
-        }
-        Method::LcpLemke | Method::March => Ok((Vec::new(), Vec::new())),
+    if settings.method.is_harmonic_balance() {
+        return hb();
     }
+    // The periodic LCP's states are its contact forces (a branch of lcp-ssn; the other
+    // time-domain methods have no branch).
+    let m = contacts.len();
+    let reports = if settings.method.is_lcp() {
+        response
+            .states
+            .iter()
+            .map(|y| lcp_point_contacts(&contacts, y, m))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    Ok((reports, Vec::new()))
 }
 
 /// The reports of an LCP state `y = (w, z)` with `m` contacts (module documentation).

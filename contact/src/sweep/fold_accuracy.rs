@@ -37,12 +37,12 @@ use super::{
     continuation_error, continuation_options, hb_solver, penalty_continuation, ssn_continuation,
     MethodContinuation,
 };
-use crate::hb::{resize_harmonics, SsnHb};
+use crate::hb::resize_harmonics;
 use crate::model::Structure;
-use crate::settings::{Method, SolverSettings, SweepSettings};
+use crate::settings::{SolverSettings, SweepSettings};
 use crate::solve::accuracy::search::{check_target, MAX_SEARCH_UNKNOWNS};
 use crate::solve::accuracy::HB_ORDER;
-use crate::solve::{hb_options, penalty_options, RunError};
+use crate::solve::{penalty_options, HarmonicProblem, RunError};
 
 /// Frequency distance, in units of `ω_1`, before a fold where its refinement starts.
 pub const APPROACH: f64 = 0.02;
@@ -149,7 +149,7 @@ pub fn refine_folds(
     (target, max_harmonics): (f64, usize),
 ) -> Result<Vec<FoldAccuracy>, RunError> {
     check_target(target)?;
-    if !matches!(settings.method, Method::SsnHb | Method::PenaltyHb) {
+    if !settings.method.is_harmonic_balance() {
         return Err(RunError::Unsupported {
             method: settings.method.name(),
             what: "fold frequencies to an accuracy (harmonic balance only: ssn-hb, penalty-hb)",
@@ -344,16 +344,15 @@ impl Segment<'_> {
         let h = self.settings.harmonics;
         let dofs = model.dofs();
         let mut solver = hb_solver(self.settings.linear_solver);
-        let found = match self.settings.method {
-            Method::SsnHb => {
-                let mut problem = SsnHb::new(model, omega, &hb_options(self.settings))?;
+        let problem = HarmonicProblem::of(model, omega, self.settings)?;
+        let found = match problem {
+            HarmonicProblem::Ssn(mut problem) => {
                 let x = resize_harmonics(state, from_h, h, dofs, problem.contacts());
                 let method = ssn_continuation(model, &problem, self.u_ref);
                 self.follow((&mut problem, &mut *solver), &x, method, |c| c)?
             }
-            _ => {
+            HarmonicProblem::Penalty(mut problem) => {
                 let options = penalty_options(self.settings, model);
-                let mut problem = crate::solve::penalty_problem(model, omega, self.settings)?;
                 let x = resize_harmonics(state, from_h, h, dofs, 0);
                 let method = penalty_continuation(model, &problem, &options, self.u_ref);
                 let affine = method.affine_pieces;

@@ -107,9 +107,9 @@ pub use response::{FrequencyResponse, SweepTermination, TURNING_POINT_EXCURSION}
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
 use crate::model::{StructuralModel, Structure};
-use crate::settings::{LinearSolverChoice, Method, SolverSettings, SweepSettings};
+use crate::settings::{LinearSolverChoice, SolverSettings, SweepSettings};
 use crate::solve::{
-    hb_options, lcp_options, newton_options, penalty_options, RunCounters, RunError,
+    lcp_options, newton_options, penalty_options, HarmonicProblem, RunCounters, RunError,
     HB_OUTPUT_POINTS,
 };
 use crate::stability::Undecided;
@@ -550,7 +550,7 @@ pub fn frequency_response(
     });
     let branch_progress = branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64));
     let mut response = match settings.accuracy {
-        Some(target) if settings.method == Method::SsnHb => {
+        Some(target) if settings.method.adapts_harmonics() => {
             adaptive::adaptive_branch(rod, settings, sweep, target, branch_progress)?
         }
         _ => follow_branch(rod, settings, sweep, branch_progress)?,
@@ -600,9 +600,18 @@ pub(crate) fn follow_branch(
         started,
         start: None,
     };
-    match settings.method {
-        Method::SsnHb => {
-            let mut problem = SsnHb::new(model, omega_from, &hb_options(settings))?;
+    let formulation = crate::solve::formulation::of(settings.method);
+    if let Some(what) = formulation.continuation_refusal() {
+        return Err(RunError::Unsupported {
+            method: formulation.name(),
+            what,
+        });
+    }
+    match formulation
+        .harmonic_problem(model, omega_from, settings)
+        .transpose()?
+    {
+        Some(HarmonicProblem::Ssn(mut problem)) => {
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64], _: f64| tip_rec.extremes(x);
             let method = ssn_continuation(model, &problem, u_ref);
@@ -615,9 +624,8 @@ pub(crate) fn follow_branch(
                 progress,
             )
         }
-        Method::PenaltyHb => {
+        Some(HarmonicProblem::Penalty(mut problem)) => {
             let options = penalty_options(settings, model);
-            let mut problem = crate::solve::penalty_problem(model, omega_from, settings)?;
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &PenaltyHb, x: &[f64], _: f64| tip_rec.extremes(x);
             let method = penalty_continuation(model, &problem, &options, u_ref);
@@ -637,19 +645,8 @@ pub(crate) fn follow_branch(
                 progress,
             )
         }
-        Method::LcpSsn => follow_lcp(rod, settings, omega_from, setup, progress),
-        Method::LcpLemke => Err(RunError::Unsupported {
-            method: "lcp-lemke",
-            what: "a method continuable in omega (Lemke's pivoting is not a smooth equation): \
-                   sweep with ssn-hb or penalty-hb, or solve frequency by frequency \
-                   with `ssn solve`",
-        }),
-        Method::March => Err(RunError::Unsupported {
-            method: "march",
-            what: "a method continuable in omega (time marching has no equation to continue): \
-                   sweep with ssn-hb or penalty-hb, or march frequency by frequency \
-                   with `ssn solve`",
-        }),
+        // The periodic LCP by its min map, the one continuable time-domain formulation.
+        None => follow_lcp(rod, settings, omega_from, setup, progress),
     }
 }
 

@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use super::*;
+use semismooth_contact::solve::FrictionSupport;
 
 pub(super) struct Check<'a> {
     path: &'a Path,
@@ -542,11 +543,11 @@ impl Check<'_> {
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
-        let allowed = match solver.method {
+        let allowed = match solver.method.friction() {
             _ if points == 0 => return Ok(()),
-            Method::SsnHb | Method::March => return Ok(()),
-            Method::PenaltyHb if on_contacts == 0 => return Ok(()),
-            Method::PenaltyHb => {
+            FrictionSupport::Exact => return Ok(()),
+            FrictionSupport::RegularisedUnderPrescribedLoad if on_contacts == 0 => return Ok(()),
+            FrictionSupport::RegularisedUnderPrescribedLoad => {
                 "\"ssn-hb\" or \"march\" (penalty-hb regularises friction only under a \
                  prescribed normal load, [[friction.point]])"
             }
@@ -555,8 +556,11 @@ impl Check<'_> {
                  (regularised friction under prescribed normal loads)"
             }
         };
-        let what = if solver.method == Method::PenaltyHb {
-            format!("\"penalty-hb\" with {on_contacts} friction points on contacts")
+        let what = if solver.method.friction() == FrictionSupport::RegularisedUnderPrescribedLoad {
+            format!(
+                "\"{}\" with {on_contacts} friction points on contacts",
+                solver.method.name()
+            )
         } else {
             format!("\"{}\" with {points} friction points", solver.method.name())
         };
@@ -573,7 +577,7 @@ impl Check<'_> {
         given: bool,
     ) -> Result<(), SceneError> {
         let nt = solver.time_samples;
-        if !matches!(solver.method, Method::LcpLemke | Method::LcpSsn)
+        if !solver.method.is_lcp()
             || contacts.saturating_mul(nt) <= semismooth_contact::lcp::MAX_LCP_SIZE
         {
             return Ok(());

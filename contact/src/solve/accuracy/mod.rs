@@ -50,7 +50,8 @@
 pub mod search;
 
 use crate::model::Structure;
-use crate::settings::{Method, SolverSettings};
+use crate::settings::SolverSettings;
+use crate::solve::DiscretisationKind;
 use crate::solve::{RunCounters, RunError, Solution, Termination};
 
 pub use search::{DiscretisationSearch, SearchStep, SearchStop};
@@ -175,13 +176,14 @@ pub struct Discretisation {
 impl Discretisation {
     /// The discretisation `settings` give `method` (`settings.method`).
     pub fn of(settings: &SolverSettings) -> Self {
-        let method = settings.method;
+        let kind = settings.method.discretisation();
+        let by_harmonics = kind == DiscretisationKind::Harmonics;
         Self {
-            harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
-            time_samples: if method == Method::March {
-                settings.steps_per_period
-            } else {
+            harmonics: by_harmonics.then_some(settings.harmonics),
+            time_samples: if by_harmonics {
                 settings.time_samples
+            } else {
+                kind.level(settings)
             },
         }
     }
@@ -248,7 +250,7 @@ pub enum NoEstimate {
 pub const MIN_COMPARISON_PERIODS: usize = 20;
 
 /// The coarser settings a solve is compared with, and the scaling of the change.
-struct Comparison {
+pub(crate) struct Comparison {
     settings: SolverSettings,
     /// The change times this is the error.
     factor: f64,
@@ -259,63 +261,84 @@ struct Comparison {
 /// The discretisation `settings` are compared with (module documentation), or why there is
 /// none.
 fn comparison(settings: &SolverSettings, rod: &Structure) -> Result<Comparison, NoEstimate> {
+    crate::solve::formulation::of(settings.method).comparison(rod, settings)
+}
+
+/// `settings` without an estimate or a target: the start of a comparison's settings.
+fn compared(settings: &SolverSettings) -> SolverSettings {
     let mut other = settings.clone();
     other.estimate_error = false;
     other.accuracy = None;
-    match settings.method {
-        Method::SsnHb | Method::PenaltyHb => {
-            let h = settings.harmonics;
-            let width = rod.model.dofs() + rod.model.contact_count();
-            if width.saturating_mul(4 * h + 1) <= search::MAX_SEARCH_UNKNOWNS {
-                // The finer partner: the coarser side of Richardson's pair, r = 2, p = 1.
-                other.harmonics = 2 * h;
-                other.time_samples = 2 * settings.time_samples;
-                let rp = HB_RATIO.powf(HB_ORDER);
-                return Ok(Comparison {
-                    settings: other,
-                    factor: rp / (rp - 1.0),
-                    order: HB_ORDER,
-                });
-            }
-            if h < 2 {
-                return Err(NoEstimate::Coarsest { minimum: 1 });
-            }
-            other.harmonics = h / 2;
-            other.time_samples = (settings.time_samples / 2).max(2 * other.harmonics + 1);
-            Ok(Comparison {
-                settings: other,
-                factor: 1.0 / (HB_RATIO.powf(HB_ORDER) - 1.0),
-                order: HB_ORDER,
-            })
-        }
-        Method::LcpLemke | Method::LcpSsn => {
-            let minimum = crate::lcp::MIN_LCP_TIME_SAMPLES;
-            if settings.time_samples < 2 * minimum {
-                return Err(NoEstimate::Coarsest { minimum });
-            }
-            other.time_samples = settings.time_samples / 2;
-            let r = settings.time_samples as f64 / other.time_samples as f64;
-            Ok(Comparison {
-                settings: other,
-                factor: 1.0 / (r * r - 1.0),
-                order: 2.0,
-            })
-        }
-        Method::March => {
-            let minimum = COARSEST_STEPS_PER_PERIOD;
-            if settings.steps_per_period < 2 * minimum {
-                return Err(NoEstimate::Coarsest { minimum });
-            }
-            other.steps_per_period = settings.steps_per_period / 2;
-            let r = settings.steps_per_period as f64 / other.steps_per_period as f64;
-            let order = march_order(rod, settings);
-            Ok(Comparison {
-                settings: other,
-                factor: 1.0 / (r.powf(order) - 1.0),
-                order,
-            })
-        }
+    other
+}
+
+/// The comparison of a harmonic-balance solve: twice the harmonics while the problem stays
+/// within the search's size, else half of them.
+pub(crate) fn harmonic_comparison(
+    settings: &SolverSettings,
+    rod: &Structure,
+) -> Result<Comparison, NoEstimate> {
+    let mut other = compared(settings);
+    let h = settings.harmonics;
+    let width = rod.model.dofs() + rod.model.contact_count();
+    if width.saturating_mul(4 * h + 1) <= search::MAX_SEARCH_UNKNOWNS {
+        // The finer partner: the coarser side of Richardson's pair, r = 2, p = 1.
+        other.harmonics = 2 * h;
+        other.time_samples = 2 * settings.time_samples;
+        let rp = HB_RATIO.powf(HB_ORDER);
+        return Ok(Comparison {
+            settings: other,
+            factor: rp / (rp - 1.0),
+            order: HB_ORDER,
+        });
     }
+    if h < 2 {
+        return Err(NoEstimate::Coarsest { minimum: 1 });
+    }
+    other.harmonics = h / 2;
+    other.time_samples = (settings.time_samples / 2).max(2 * other.harmonics + 1);
+    Ok(Comparison {
+        settings: other,
+        factor: 1.0 / (HB_RATIO.powf(HB_ORDER) - 1.0),
+        order: HB_ORDER,
+    })
+}
+
+/// The comparison of a periodic-LCP solve: half the time steps (second order).
+pub(crate) fn lcp_comparison(settings: &SolverSettings) -> Result<Comparison, NoEstimate> {
+    let mut other = compared(settings);
+    let minimum = crate::lcp::MIN_LCP_TIME_SAMPLES;
+    if settings.time_samples < 2 * minimum {
+        return Err(NoEstimate::Coarsest { minimum });
+    }
+    other.time_samples = settings.time_samples / 2;
+    let r = settings.time_samples as f64 / other.time_samples as f64;
+    Ok(Comparison {
+        settings: other,
+        factor: 1.0 / (r * r - 1.0),
+        order: 2.0,
+    })
+}
+
+/// The comparison of a time-marching solve: half the steps per period, at the order of
+/// its scheme ([`march_order`]).
+pub(crate) fn march_comparison(
+    settings: &SolverSettings,
+    rod: &Structure,
+) -> Result<Comparison, NoEstimate> {
+    let mut other = compared(settings);
+    let minimum = COARSEST_STEPS_PER_PERIOD;
+    if settings.steps_per_period < 2 * minimum {
+        return Err(NoEstimate::Coarsest { minimum });
+    }
+    other.steps_per_period = settings.steps_per_period / 2;
+    let r = settings.steps_per_period as f64 / other.steps_per_period as f64;
+    let order = march_order(rod, settings);
+    Ok(Comparison {
+        settings: other,
+        factor: 1.0 / (r.powf(order) - 1.0),
+        order,
+    })
 }
 
 /// Order in the step of the time-marching scheme `settings` selects for `rod`: 2 for the
@@ -338,29 +361,7 @@ pub(crate) fn carried_start(
     solution: &Solution,
     to: &SolverSettings,
 ) -> Option<Vec<f64>> {
-    let state = &solution.state;
-    match solution.method {
-        Method::SsnHb | Method::PenaltyHb => {
-            let contacts = if solution.method == Method::SsnHb {
-                rod.model.contact_count()
-            } else {
-                0
-            };
-            Some(crate::hb::resize_harmonics(
-                state,
-                solution.harmonics?,
-                to.harmonics,
-                rod.model.dofs(),
-                contacts,
-            ))
-        }
-        Method::LcpSsn => {
-            let m = rod.model.contact_count().max(1);
-            Some(crate::lcp::interpolate_periodic(state, m, to.time_samples))
-        }
-        Method::LcpLemke => None,
-        Method::March => Some(state.clone()),
-    }
+    crate::solve::formulation::of(solution.method).carried_start(rod, solution, to)
 }
 
 /// Solves with `settings` from `start`, the answer of another discretisation carried
@@ -393,7 +394,7 @@ fn change_against(
 ) -> Result<(RelativeErrors, f64, RunCounters), NoEstimate> {
     // A march from the solve's own orbit that did not settle will not settle from rest in
     // the same budget: no second march.
-    let other = if coarse.method == Method::March {
+    let other = if crate::solve::formulation::of(coarse.method).marches() {
         crate::solve::solve_as_given(rod, omega, coarse, start)
     } else {
         solve_carried(rod, omega, coarse, start, |_| {})
@@ -421,7 +422,8 @@ pub fn estimate(
         return Err(NoEstimate::NotConverged);
     }
     let mut comparison = comparison(settings, rod)?;
-    if settings.method == Method::March {
+    let formulation = crate::solve::formulation::of(settings.method);
+    if formulation.marches() {
         comparison.settings.max_periods = comparison
             .settings
             .max_periods
@@ -437,7 +439,7 @@ pub fn estimate(
         softer_penalty: None,
         time_samples_check: None,
     };
-    if settings.method == Method::PenaltyHb {
+    if formulation.penalises_contact() {
         let (penalty, penalty_parts, s, c) = penalty_part(rod, omega, settings, solution)?;
         parts = parts.plus(&penalty_parts);
         seconds += s;

@@ -26,11 +26,12 @@
 use std::time::Instant;
 
 use super::{
-    carried_start, march_order, penalty_part, Discretisation, ErrorEstimate, EstimateBasis,
-    NoEstimate, RelativeErrors, ReportedQuantities,
+    carried_start, penalty_part, Discretisation, ErrorEstimate, EstimateBasis, NoEstimate,
+    RelativeErrors, ReportedQuantities,
 };
 use crate::model::Structure;
-use crate::settings::{default_hb_time_samples, Method, SolverSettings};
+use crate::settings::SolverSettings;
+use crate::solve::DiscretisationKind;
 use crate::solve::{solve_as_given, RunCounters, RunError, Solution};
 
 /// The predicted discretisation is multiplied by this (the error model's constant and
@@ -129,7 +130,7 @@ impl DiscretisationSearch {
 
 /// The discretisations a method's search walks through.
 struct Ladder {
-    method: Method,
+    kind: DiscretisationKind,
     /// The method's order in its discretisation.
     order: f64,
     /// First level.
@@ -142,30 +143,10 @@ struct Ladder {
 
 impl Ladder {
     fn new(rod: &Structure, settings: &SolverSettings) -> Self {
-        let method = settings.method;
-        let (order, start, limit) = match method {
-            Method::SsnHb | Method::PenaltyHb => {
-                let width = rod.model.dofs() + rod.model.contact_count();
-                let by_size = (MAX_SEARCH_UNKNOWNS / width.max(1)).saturating_sub(1) / 2;
-                (
-                    super::HB_ORDER,
-                    5,
-                    MAX_SEARCH_HARMONICS.min(by_size).max(10),
-                )
-            }
-            Method::LcpLemke | Method::LcpSsn => {
-                let m = rod.model.contact_count().max(1);
-                let limit = MAX_SEARCH_LCP_STEPS.min(crate::lcp::MAX_LCP_SIZE / m);
-                (
-                    2.0,
-                    64.min(limit / 2).max(crate::lcp::MIN_LCP_TIME_SAMPLES),
-                    limit,
-                )
-            }
-            Method::March => (march_order(rod, settings), 64, MAX_SEARCH_MARCH_STEPS),
-        };
+        let formulation = crate::solve::formulation::of(settings.method);
+        let (order, start, limit) = formulation.search_ladder(rod, settings);
         Self {
-            method,
+            kind: formulation.discretisation(),
             order,
             start,
             limit,
@@ -178,14 +159,7 @@ impl Ladder {
         let mut s = base.clone();
         s.accuracy = None;
         s.estimate_error = false;
-        match self.method {
-            Method::SsnHb | Method::PenaltyHb => {
-                s.harmonics = level;
-                s.time_samples = self.sample_factor * default_hb_time_samples(level);
-            }
-            Method::LcpLemke | Method::LcpSsn => s.time_samples = level,
-            Method::March => s.steps_per_period = level,
-        }
+        self.kind.set_level(&mut s, level, self.sample_factor);
         s
     }
 
@@ -198,7 +172,7 @@ impl Ladder {
         };
         let ratio = (wanted / level as f64).clamp(MIN_RATIO, MAX_RATIO);
         let mut next = (ratio * level as f64).ceil() as usize;
-        if !self.method.is_harmonic_balance() {
+        if self.kind != DiscretisationKind::Harmonics {
             // Time steps in multiples of 8.
             next = next.div_ceil(8) * 8;
         }
@@ -368,7 +342,7 @@ pub fn solve_to_accuracy(
     // the level and estimate of the last rung that did not meet the target.
     let mut last: Option<(RelativeErrors, EstimateBasis)> = None;
     let mut failed: Option<(usize, f64)> = None;
-    let finer_partner = ladder.method.is_harmonic_balance();
+    let finer_partner = ladder.kind == DiscretisationKind::Harmonics;
     loop {
         if current.level >= ladder.limit {
             let stop = SearchStop::Limit {
@@ -573,7 +547,7 @@ fn finish_met(
     chosen: Rung,
     (error, basis): (RelativeErrors, EstimateBasis),
 ) -> Result<Solution, RunError> {
-    if settings.method != Method::PenaltyHb {
+    if !crate::solve::formulation::of(settings.method).penalises_contact() {
         return Ok(record.finish(
             chosen.solution,
             chosen.step,
