@@ -98,6 +98,16 @@ pub trait ContactLaw: std::fmt::Debug + Send + Sync {
     fn force_scale(&self) -> f64 {
         0.0
     }
+
+    /// The regularised form penalty formulations use: the force as a function of the
+    /// measured samples alone, `force(y)` with `at.z` holding `(y - o) / w` in the units of
+    /// the formulation's width `w` (the force is then per unit of its stiffness for a
+    /// gap, absolute for a slip), and its slope `d force / d at.z`. False when the law has
+    /// none (the default).
+    fn regularised(&self, at: &LawSamples<'_>, force: &mut [f64], slope: &mut [f64]) -> bool {
+        let _ = (at, force, slope);
+        false
+    }
 }
 
 /// A group of rows of `G` added to a model with its law: the rows (each over any dofs),
@@ -174,6 +184,15 @@ impl ContactLaw for Unilateral {
         for (o, z) in out.iter_mut().zip(at.z) {
             *o = -smoothed_max_mu_derivative(-z, mu);
         }
+    }
+
+    /// The penalty spring: `force = -max(0, y)`, slope `-[y > 0]`.
+    fn regularised(&self, at: &LawSamples<'_>, force: &mut [f64], slope: &mut [f64]) -> bool {
+        for ((f, d), y) in force.iter_mut().zip(slope.iter_mut()).zip(at.z) {
+            *f = -y.max(0.0);
+            *d = if *y > 0.0 { -1.0 } else { 0.0 };
+        }
+        true
     }
 }
 
@@ -260,6 +279,21 @@ impl ContactLaw for Coulomb {
             NormalForce::Prescribed(load) => self.coefficient * load,
             NormalForce::Contact(_) => 0.0,
         }
+    }
+
+    /// NLvib's regularised Coulomb law under a prescribed load: `force = -b tanh(y)`,
+    /// slope `-b sech^2(y)` (none on a contact's normal force).
+    fn regularised(&self, at: &LawSamples<'_>, force: &mut [f64], slope: &mut [f64]) -> bool {
+        let NormalForce::Prescribed(_) = self.normal else {
+            return false;
+        };
+        let b = self.force_scale();
+        for ((f, d), y) in force.iter_mut().zip(slope.iter_mut()).zip(at.z) {
+            let sech = 1.0 / y.cosh();
+            *f = -(b * y.tanh());
+            *d = -(b * sech * sech);
+        }
+        true
     }
 }
 

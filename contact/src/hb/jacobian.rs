@@ -38,7 +38,9 @@ pub enum ContactCoupling {
 /// The dynamic part `A(w, p)` is represented by the harmonic operator (shared with the
 /// problem through an `Arc`, never copied per iteration) and its parameters; a solver can tell that it has not
 /// changed since its last factorization ([`HbJacobian::same_dynamic_part`]). The contact
-/// part is the `(2H + 1) x (2H + 1)` matrix `Q_i = P diag(h_i) E` per contact.
+/// part is block diagonal by row group ([`crate::law`]): the `(2H + 1) x (2H + 1)` matrices
+/// `Q_ab = P diag(d proj_a / d z_b) E` between the rows `a`, `b` of one group (one block
+/// `Q_i = P diag(h_i) E` for a contact), plus the blocks on the rows a group reads.
 #[derive(Debug, Clone)]
 pub struct HbJacobian {
     pub(crate) linear: Arc<LinearData>,

@@ -20,7 +20,8 @@
 //!   residual `R = A(w) U - F - G^T P lambda(E U)`.
 //!
 //! Both write their generalized Jacobian into an [`HbJacobian`] (dynamic blocks shared, not
-//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact). It can be
+//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact, block
+//! diagonal by row group when a law couples several rows, [`crate::law`]). It can be
 //! assembled densely ([`semismooth::linalg::DenseAssemble`], for the dense LU solvers) or
 //! solved by [`StructuredHbSolver`], which factors each harmonic's dynamic block once per
 //! frequency (sparse complex LU) and solves the Newton system on the `m (2H + 1)` contact
