@@ -16,6 +16,7 @@ pub mod exact;
 pub mod from_zero;
 pub mod hb;
 pub mod import;
+pub mod law;
 pub mod lcp;
 pub mod march;
 pub mod matrix_market;

@@ -7,12 +7,12 @@ use semismooth::{
     Smoothing,
 };
 
-use super::friction::{self, FrictionSamples};
 use super::jacobian::{ContactCoupling, HbJacobian};
-use super::ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope, HbOptions, SsnHb};
-use super::structured::{condensed_matrix, CondensedSolve, CrossBlocks, StructuredHbSolver};
-use super::{check_len, indicator, HbError, ResponseSummary};
-use crate::model::{mean_stiffness, NormalForce, StructuralModel};
+use super::laws::LawSampler;
+use super::ssn::{HbOptions, SsnHb};
+use super::structured::{condensed_matrix, CondensedSolve, StructuredHbSolver};
+use super::{check_len, HbError, ResponseSummary};
+use crate::model::{mean_stiffness, StructuralModel};
 use crate::operator::OperatorParameter;
 
 /// SSN-HB with the displacements eliminated: unknowns `Lambda` only (length `m (2H + 1)`,
@@ -42,7 +42,7 @@ pub struct CondensedSsnHb {
     linear_response: Vec<f64>,
     contact_linear: Vec<f64>,
     y: Vec<f64>,
-    /// `Q_i = P diag(h_i) E` per contact.
+    /// The blocks `Q_ab` of the row groups (block diagonal by group).
     q: Vec<Mat<f64>>,
     aft: Aft,
     /// The dynamic part `A(w)` handed to the structured solver.
@@ -50,15 +50,14 @@ pub struct CondensedSsnHb {
     /// Full-size workspace for `U` and `(dA/dw) U`.
     full_u: Vec<f64>,
     full_w: Vec<f64>,
-    /// Indicator `h_n` of the active samples, or a friction point's stick weights (for
-    /// `dR/dw`).
-    mask: Vec<f64>,
-    /// Sample buffers of the friction law.
-    friction: FrictionSamples,
+    /// Sample buffers of the contact laws.
+    laws: LawSampler,
+    /// The active sample count of each row (the Jacobian's, unused here).
+    active: Vec<usize>,
     /// Smoothing parameter `mu >= 0` of the laws' `max` terms (0: the formulation itself).
     smoothing: f64,
-    /// The friction points' blocks `X` on their contacts' forces.
-    cross: CrossBlocks,
+    /// The row groups' blocks `X` on the rows they read.
+    cross: Vec<Mat<f64>>,
     /// `w` of the last factorization differs from the problem's.
     stale: bool,
 }
@@ -70,6 +69,7 @@ impl CondensedSsnHb {
         let full = SsnHb::new(model, omega, options)?;
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
+        let (q, cross) = full.state.linear.laws.zero_blocks(size);
         let mut this = Self {
             receptance: Vec::new(),
             // The receptance blocks are read here: the dense condensed path keeps them.
@@ -77,15 +77,15 @@ impl CondensedSsnHb {
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],
-            q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
+            q,
             aft: Aft::new(basis),
             dynamic: full.new_jacobian(),
             full_u: vec![0.0; full.displacement_len()],
             full_w: vec![0.0; full.displacement_len()],
-            mask: vec![0.0; basis.time_samples()],
-            friction: FrictionSamples::new(basis.time_samples()),
+            laws: LawSampler::new(&full.state.linear),
+            active: vec![0; m],
             smoothing: 0.0,
-            cross: CrossBlocks::new(&full.state.linear),
+            cross,
             stale: false,
             full,
         };
@@ -227,59 +227,14 @@ impl CondensedSsnHb {
         }
     }
 
-    /// Samples of `s = c (G u - g) - lambda` of contact `i` into the AFT's samples.
-    fn switching_samples(&mut self, lambda: &[f64], i: usize) {
+    /// Samples group `g`'s arguments `z = lambda - c (y - o)` and the forces it reads
+    /// from `y = y_lin + R Lambda`.
+    fn sample_group(&mut self, lambda: &[f64], g: usize) {
         let lin = &self.full.state.linear;
-        let m = lin.contacts();
-        let c = self.full.c();
-        let coeffs = self.aft.coefficients_mut();
-        for (j, coeff) in coeffs.iter_mut().enumerate() {
-            *coeff = c * self.y[j * m + i] - lambda[j * m + i];
-        }
-        coeffs[0] -= c * lin.gaps[i];
-        self.aft.coefficients_to_samples();
-    }
-
-    /// [`friction::point_samples`] of friction point `f` from `y = y_lin + R Lambda`.
-    fn friction_samples(&mut self, lambda: &[f64], f: usize) {
-        let lin = &self.full.state.linear;
-        let i = lin.normal_rows() + f;
         let (m, y) = (lin.contacts(), &self.y);
+        let measured = |row: usize, j: usize| y[j * m + row];
         let c = self.full.c();
-        friction::point_samples(
-            &mut self.aft,
-            lin,
-            f,
-            c,
-            lambda,
-            |j| y[j * m + i],
-            &mut self.friction,
-        );
-    }
-
-    /// The weights of row `i`'s block `Q_i = P diag(w) E` into the AFT's samples: the
-    /// indicator `h` of a contact's switching function (its smoothed slope when
-    /// smoothing), a friction point's stick weights (its block `X`'s weights then in
-    /// `self.friction`).
-    fn activity_weights(&mut self, lambda: &[f64], i: usize) {
-        let lin = self.full.state.linear.clone();
-        let mu = self.smoothing;
-        match i.checked_sub(lin.normal_rows()) {
-            None if mu > 0.0 => {
-                self.switching_samples(lambda, i);
-                for s in self.aft.samples_mut() {
-                    *s = smoothed_max_slope(*s, mu);
-                }
-            }
-            None => {
-                self.switching_samples(lambda, i);
-                indicator(self.aft.samples_mut());
-            }
-            Some(f) => {
-                self.friction_samples(lambda, f);
-                friction::point_jacobian_weights(&mut self.aft, &lin, f, &mut self.friction, mu);
-            }
-        }
+        (self.laws).sample(&mut self.aft, lin, (g, c), lambda, measured);
     }
 }
 
@@ -291,23 +246,11 @@ impl Residual for CondensedSsnHb {
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();
-        let m = lin.contacts();
         self.contact_displacements(lambda);
-        for i in 0..lin.normal_rows() {
-            self.switching_samples(lambda, i);
-            let mu = self.smoothing;
-            for s in self.aft.samples_mut() {
-                *s = smoothed_max(*s, mu);
-            }
-            self.aft.samples_to_coefficients();
-            for (j, c) in self.aft.coefficients().iter().enumerate() {
-                out[j * m + i] = lambda[j * m + i] + c;
-            }
-        }
-        for f in 0..lin.friction.len() {
-            self.friction_samples(lambda, f);
-            let mu = self.smoothing;
-            friction::point_residual(&mut self.aft, &lin, f, lambda, &self.friction, mu, out);
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(lambda, g);
+            let at = (g, self.smoothing);
+            (self.laws).residual(&mut self.aft, &lin, at, lambda, out);
         }
         Ok(())
     }
@@ -331,22 +274,15 @@ impl GeneralizedJacobian for CondensedSsnHb {
         let lin = self.full.state.linear.clone();
         let m = lin.contacts();
         self.contact_displacements(lambda);
-        for i in 0..m {
-            self.activity_weights(lambda, i);
-            self.aft.samples_multiplication_matrix(&mut self.q[i]);
-            if let Some(f) = i.checked_sub(lin.normal_rows()) {
-                if matches!(lin.friction[f].1, NormalForce::Contact(_)) {
-                    let weights = self.friction.cross_weights();
-                    self.aft.samples_mut().copy_from_slice(weights);
-                    self.aft
-                        .samples_multiplication_matrix(self.cross.block_mut(f));
-                }
-            }
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(lambda, g);
+            let blocks = (self.q.as_mut_slice(), self.cross.as_mut_slice());
+            let at = (g, self.smoothing);
+            (self.laws).jacobian(&mut self.aft, &lin, at, blocks, &mut self.active);
         }
         condensed_matrix(
             &self.receptance,
-            &self.q,
-            &self.cross,
+            (&lin.laws, &self.q, &self.cross),
             ContactCoupling::Complementarity { c: self.full.c() },
             m,
             jac.as_mut(),
@@ -368,7 +304,7 @@ impl ParameterDependent for CondensedSsnHb {
         }
     }
 
-    /// `dR/dw = c P diag(h) E dy/dw`, `dy/dw = -G A^{-1} (dA/dw) U` (type documentation).
+    /// `dR/dw = c P diag(d proj / dz) E dy/dw` per group, `dy/dw = -G A^{-1} (dA/dw) U` (type documentation).
     fn residual_parameter_derivative(
         &mut self,
         lambda: &[f64],
@@ -377,7 +313,6 @@ impl ParameterDependent for CondensedSsnHb {
     ) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();
-        let m = lin.contacts();
         // U = A^{-1} F + A^{-1} G^T Lambda.
         self.full_u.copy_from_slice(&self.linear_response);
         self.solver.add_response(lambda, 1.0, &mut self.full_u);
@@ -392,21 +327,15 @@ impl ParameterDependent for CondensedSsnHb {
             })?;
         self.contact_displacements(lambda);
         let c = self.full.c();
-        for i in 0..m {
-            self.activity_weights(lambda, i);
-            self.mask.copy_from_slice(self.aft.samples());
-            for (j, coeff) in self.aft.coefficients_mut().iter_mut().enumerate() {
-                *coeff = -c * lin.measured_coefficient(i, &self.full_w, j);
-            }
-            self.aft.coefficients_to_samples();
-            for (s, h) in self.aft.samples_mut().iter_mut().zip(&self.mask) {
-                *s *= h;
-            }
-            self.aft.samples_to_coefficients();
-            for (j, coeff) in self.aft.coefficients().iter().enumerate() {
-                out[j * m + i] = *coeff;
-            }
+        // dy/dw = -G A^{-1} (dA/dw) U.
+        let moved = std::mem::take(&mut self.full_w);
+        let dy = |row: usize, j: usize| -lin.measured_coefficient(row, &moved, j);
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(lambda, g);
+            let at = (g, c, self.smoothing);
+            (self.laws).measured_response(&mut self.aft, &lin, at, dy, out);
         }
+        self.full_w = moved;
         Ok(())
     }
 }
@@ -422,8 +351,7 @@ impl Smoothing for CondensedSsnHb {
         self.smoothing = mu.max(0.0);
     }
 
-    /// `dR/dmu`: `P phi_mu'` of the switching samples for a contact, `-P d proj / d mu` of
-    /// a friction point's.
+    /// `dR/dmu = -P d proj / d mu` of each group's law.
     fn residual_smoothing_derivative(
         &mut self,
         lambda: &[f64],
@@ -431,28 +359,11 @@ impl Smoothing for CondensedSsnHb {
     ) -> Result<(), EvaluationError> {
         self.ensure_factored()?;
         let lin = self.full.state.linear.clone();
-        let (m, mu) = (lin.contacts(), self.smoothing);
         self.contact_displacements(lambda);
-        for i in 0..m {
-            match i.checked_sub(lin.normal_rows()) {
-                None => {
-                    self.switching_samples(lambda, i);
-                    for s in self.aft.samples_mut() {
-                        *s = smoothed_max_mu_derivative(*s, mu);
-                    }
-                }
-                Some(f) => {
-                    self.friction_samples(lambda, f);
-                    let bounds = self.friction.bounds();
-                    for (z, b) in self.aft.samples_mut().iter_mut().zip(bounds) {
-                        *z = -friction::projection_mu_derivative(*z, *b, mu);
-                    }
-                }
-            }
-            self.aft.samples_to_coefficients();
-            for (j, c) in self.aft.coefficients().iter().enumerate() {
-                out[j * m + i] = *c;
-            }
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(lambda, g);
+            let at = (g, self.smoothing);
+            (self.laws).smoothing_derivative(&mut self.aft, &lin, at, out);
         }
         Ok(())
     }

@@ -7,7 +7,6 @@ use faer::{Mat, MatMut};
 use semismooth::linalg::DenseAssemble;
 
 use super::LinearData;
-use crate::model::NormalForce;
 use crate::operator::HarmonicParameters;
 
 /// How the contact unknowns enter the Jacobian.
@@ -39,18 +38,21 @@ pub enum ContactCoupling {
 /// The dynamic part `A(w, p)` is represented by the harmonic operator (shared with the
 /// problem through an `Arc`, never copied per iteration) and its parameters; a solver can tell that it has not
 /// changed since its last factorization ([`HbJacobian::same_dynamic_part`]). The contact
-/// part is the `(2H + 1) x (2H + 1)` matrix `Q_i = P diag(h_i) E` per contact.
+/// part is block diagonal by row group ([`crate::law`]): the `(2H + 1) x (2H + 1)` matrices
+/// `Q_ab = P diag(d proj_a / d z_b) E` between the rows `a`, `b` of one group (one block
+/// `Q_i = P diag(h_i) E` for a contact), plus the blocks on the rows a group reads.
 #[derive(Debug, Clone)]
 pub struct HbJacobian {
     pub(crate) linear: Arc<LinearData>,
     /// `w` and the other parameters of the dynamic part.
     pub(crate) parameters: HarmonicParameters,
     pub(crate) coupling: ContactCoupling,
-    /// `Q_i` of each row (`(2H + 1)` square): contacts, then friction points.
+    /// The blocks `Q_ab = P diag(d proj_a / d z_b) E` of each row group (`(2H + 1)`
+    /// square, in the order of the layout's `q_pairs`): `Q` is block diagonal by group.
     pub(crate) q: Vec<Mat<f64>>,
-    /// `X_f = dR_t / dLambda_n` of each friction point on a contact (`(2H + 1)` square; zero
-    /// under a prescribed normal load): how its slip limit `mu max(0, -lambda_n)` moves with
-    /// the normal force.
+    /// The blocks `X_as = dR_a / dLambda_s` of each group on the rows it reads (the
+    /// layout's `x_pairs`): how a friction point's slip limit `mu max(0, -lambda_n)` moves
+    /// with its contact's normal force.
     pub(crate) cross: Vec<Mat<f64>>,
     pub(crate) active: Vec<usize>,
 }
@@ -61,14 +63,11 @@ impl HbJacobian {
         parameters: HarmonicParameters,
         coupling: ContactCoupling,
     ) -> Self {
-        let size = linear.size();
-        let m = linear.contacts();
+        let (q, cross) = linear.laws.zero_blocks(linear.size());
         Self {
-            q: (0..m).map(|_| Mat::zeros(size, size)).collect(),
-            cross: (0..linear.friction.len())
-                .map(|_| Mat::zeros(size, size))
-                .collect(),
-            active: vec![0; m],
+            q,
+            cross,
+            active: vec![0; linear.contacts()],
             linear,
             parameters,
             coupling,
@@ -127,50 +126,43 @@ impl DenseAssemble for HbJacobian {
         let lin = &self.linear;
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
-        for (i, row) in lin.rows.iter().enumerate() {
-            let q = &self.q[i];
-            // Q D for a friction point's row (its measured quantity is D G u).
-            let velocity = lin.is_velocity_row(i);
-            let coupling = |j: usize, l: usize| {
-                if !velocity {
-                    q[(j, l)]
-                } else if l == 0 {
-                    super::MEAN_SLIP_ANCHOR * q[(j, 0)]
-                } else {
-                    let k = l.div_ceil(2) as f64;
-                    if l % 2 == 1 {
-                        -k * q[(j, l + 1)]
-                    } else {
-                        k * q[(j, l - 1)]
+        if let ContactCoupling::Complementarity { .. } = self.coupling {
+            for (i, row) in lin.rows.iter().enumerate() {
+                for j in 0..size {
+                    for (dof, a) in row.entries() {
+                        // dR_u / dLambda = -G^T.
+                        out[(j * n + dof, offset + j * m + i)] -= a;
                     }
+                    out[(offset + j * m + i, offset + j * m + i)] += 1.0;
                 }
-            };
+            }
+        }
+        for (q, &(a, b)) in self.q.iter().zip(&lin.laws.q_pairs) {
+            // Q_ab M_b: the measure of row b (a slip row's is the phase derivative D).
+            let measured = measured_block(q, lin.is_velocity_row(b));
             match self.coupling {
                 ContactCoupling::Complementarity { c } => {
                     for j in 0..size {
-                        for (dof, a) in row.entries() {
-                            // dR_u / dLambda = -G^T.
-                            out[(j * n + dof, offset + j * m + i)] -= a;
+                        for (dof, g) in lin.rows[b].entries() {
                             for l in 0..size {
-                                // dR_lambda / dU = c Q G.
-                                out[(offset + j * m + i, l * n + dof)] += c * a * coupling(j, l);
+                                // dR_a / dU = c Q_ab M_b G_b.
+                                out[(offset + j * m + a, l * n + dof)] += c * g * measured(j, l);
                             }
                         }
                         for l in 0..size {
-                            // dR_lambda / dLambda = I - Q.
-                            out[(offset + j * m + i, offset + l * m + i)] -= q[(j, l)];
+                            // dR_a / dLambda_b = [a = b] I - Q_ab.
+                            out[(offset + j * m + a, offset + l * m + b)] -= q[(j, l)];
                         }
-                        out[(offset + j * m + i, offset + j * m + i)] += 1.0;
                     }
                 }
                 ContactCoupling::Penalty { stiffness } => {
-                    // k_p G^T Q G (Q D G on a friction point's row).
-                    for (r, a) in row.entries() {
-                        for (col, b) in row.entries() {
+                    // k_p G_a^T Q_ab M_b G_b.
+                    for (r, ga) in lin.rows[a].entries() {
+                        for (col, gb) in lin.rows[b].entries() {
                             for j in 0..size {
                                 for l in 0..size {
                                     out[(j * n + r, l * n + col)] +=
-                                        stiffness * a * b * coupling(j, l);
+                                        stiffness * ga * gb * measured(j, l);
                                 }
                             }
                         }
@@ -178,17 +170,29 @@ impl DenseAssemble for HbJacobian {
                 }
             }
         }
-        // dR_t / dLambda_n = X of each friction point on a contact.
-        for (f, &(_, normal)) in lin.friction.iter().enumerate() {
-            let NormalForce::Contact(p) = normal else {
-                continue;
-            };
-            let t = lin.normal_rows() + f;
-            let x = &self.cross[f];
-            for j in 0..size {
-                for l in 0..size {
-                    out[(offset + j * m + t, offset + l * m + p)] += x[(j, l)];
-                }
+        if let ContactCoupling::Complementarity { .. } = self.coupling {
+            // dR_a / dLambda_s = X_as of each group on the rows it reads.
+            let lambda_block = out.submatrix_mut(offset, offset, m * size, m * size);
+            lin.laws.add_x_dense(&self.cross, m, lambda_block);
+        }
+    }
+}
+
+/// Entry `(j, l)` of `Q M`, `M` the measure of `Q`'s column row: the identity, or for a
+/// slip row the phase derivative (harmonic `k` of `(a, b)` is `(k b, -k a)`) with the
+/// mean-slip anchor on the constant.
+fn measured_block(q: &Mat<f64>, velocity: bool) -> impl Fn(usize, usize) -> f64 + '_ {
+    move |j: usize, l: usize| {
+        if !velocity {
+            q[(j, l)]
+        } else if l == 0 {
+            super::MEAN_SLIP_ANCHOR * q[(j, 0)]
+        } else {
+            let k = l.div_ceil(2) as f64;
+            if l % 2 == 1 {
+                -k * q[(j, l + 1)]
+            } else {
+                k * q[(j, l - 1)]
             }
         }
     }

@@ -43,7 +43,7 @@ use faer::perm::PermRef;
 use faer::{c64, Conj, Mat, Par};
 use semismooth::linalg::{check_pivots, KrylovOperator, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 
-use super::structured::{apply_coupling, CrossBlocks, FactoredCondensed};
+use super::structured::FactoredCondensed;
 use super::LinearData;
 use crate::operator::HarmonicFactors;
 
@@ -59,9 +59,10 @@ pub const KRYLOV_THRESHOLD: usize = 2000;
 pub(crate) struct CondensedOperator<'a> {
     pub(crate) dynamic: &'a mut HarmonicFactors,
     pub(crate) lin: &'a LinearData,
+    /// The row groups' blocks `Q_ab` (the layout is `lin.laws`).
     pub(crate) q: &'a [Mat<f64>],
-    /// The friction points' blocks on their contacts' forces.
-    pub(crate) cross: &'a CrossBlocks,
+    /// The row groups' blocks `X` on the rows they read.
+    pub(crate) cross: &'a [Mat<f64>],
     pub(crate) c: f64,
     /// `N x 1` complex scratch.
     pub(crate) rhs: &'a mut Mat<c64>,
@@ -114,11 +115,11 @@ impl KrylovOperator for CondensedOperator<'_> {
         for (ti, pi) in t.iter_mut().zip(p) {
             *ti = self.c * *ti - pi;
         }
-        apply_coupling(self.q, m, t, out);
+        lin.laws.apply_q(self.q, m, t, out);
         for (o, pi) in out.iter_mut().zip(p) {
             *o += pi;
         }
-        self.cross.apply_add(m, p, out);
+        lin.laws.apply_x_add(self.cross, m, p, out);
         Ok(())
     }
 
@@ -164,16 +165,17 @@ impl Default for ContactBlocks {
 }
 
 impl ContactBlocks {
-    /// Factors `S_i` for the contacts' `Q_i`, the receptance diagonal `r[k m + i] = R_k,ii`
-    /// and `c`.
-    pub(crate) fn factor(
+    /// Factors `S_i` for the rows' diagonal blocks `Q_ii` (a row group's blocks between
+    /// its rows are dropped with the receptance between rows), the receptance diagonal
+    /// `r[k m + i] = R_k,ii` and `c`.
+    pub(crate) fn factor<'q>(
         &mut self,
-        q: &[Mat<f64>],
+        q: impl ExactSizeIterator<Item = &'q Mat<f64>> + Clone,
         r: &[c64],
         c: f64,
     ) -> Result<(), LinearSolveError> {
         let m = q.len();
-        let size = q.first().map_or(0, |qi| qi.nrows());
+        let size = q.clone().next().map_or(0, |qi| qi.nrows());
         if self.blocks.len() != m || self.rhs.nrows() != size {
             self.blocks = (0..m).map(|_| Mat::zeros(size, size)).collect();
             self.fwd = vec![vec![0; size]; m];
@@ -199,7 +201,7 @@ impl ContactBlocks {
         let Some(mem) = self.mem.as_mut() else {
             return Err(LinearSolveError::NotFactored);
         };
-        for (i, qi) in q.iter().enumerate() {
+        for (i, qi) in q.enumerate() {
             self.identity[i] = (0..size).all(|l| qi.col_as_slice(l).iter().all(|v| *v == 0.0));
             if self.identity[i] {
                 continue;

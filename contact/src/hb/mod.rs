@@ -20,7 +20,8 @@
 //!   residual `R = A(w) U - F - G^T P lambda(E U)`.
 //!
 //! Both write their generalized Jacobian into an [`HbJacobian`] (dynamic blocks shared, not
-//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact). It can be
+//! rebuilt while `w` is fixed, plus the contact coupling `P diag(h) E` per contact, block
+//! diagonal by row group when a law couples several rows, [`crate::law`]). It can be
 //! assembled densely ([`semismooth::linalg::DenseAssemble`], for the dense LU solvers) or
 //! solved by [`StructuredHbSolver`], which factors each harmonic's dynamic block once per
 //! frequency (sparse complex LU) and solves the Newton system on the `m (2H + 1)` contact
@@ -196,6 +197,7 @@ mod condensed;
 mod friction;
 mod jacobian;
 mod krylov;
+mod laws;
 mod penalty;
 mod ssn;
 mod structured;
@@ -206,16 +208,18 @@ use faer::c64;
 use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::InvalidOption;
 
+use crate::law::LawGroup;
 use crate::model::{ContactRow, InvalidModel, NormalForce, StructuralModel};
 use crate::operator::{HarmonicOperator, HarmonicParameters, OperatorParameter};
 
+pub(crate) use crate::law::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use condensed::CondensedSsnHb;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
+pub(crate) use laws::LawLayout;
 pub use penalty::{
     PenaltyHb, PenaltyHbOptions, DEFAULT_FRICTION_REGULARISATION, DEFAULT_RELATIVE_PENALTY,
 };
-pub(crate) use ssn::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use ssn::{HbOptions, SsnHb};
 pub use structured::{
     CondensedSolve, StructuredHbSolver, DENSE_PRECONDITIONER_LIMIT, KRYLOV_RELATIVE_TOLERANCE,
@@ -291,7 +295,8 @@ pub struct ResponseSummary {
 }
 
 /// The linear data shared by the formulations and their Jacobians (immutable, behind an
-/// `Arc`): the harmonic operator (matrices and load), contact rows and the Fourier basis.
+/// `Arc`): the harmonic operator (matrices and load), contact rows, their laws and the
+/// Fourier basis.
 #[derive(Debug)]
 pub(crate) struct LinearData {
     pub(crate) dofs: usize,
@@ -299,13 +304,15 @@ pub(crate) struct LinearData {
     /// The linear dynamics `A(w, p)` and the load `F`.
     pub(crate) operator: HarmonicOperator,
     /// The rows of `G`: the contacts' normal rows (the first `gaps.len()`), then the
-    /// friction points' tangential rows.
+    /// friction points' tangential rows, then the rows of added law groups.
     pub(crate) rows: Vec<ContactRow>,
     /// The gap of each contact (normal row).
     pub(crate) gaps: Vec<f64>,
     /// The Coulomb coefficient and the normal force of each friction point (tangential
     /// row `gaps.len() + f`).
     pub(crate) friction: Vec<(f64, NormalForce)>,
+    /// The row groups with their laws and the pattern of their Jacobian blocks.
+    pub(crate) laws: LawLayout,
 }
 
 impl LinearData {
@@ -315,6 +322,16 @@ impl LinearData {
         harmonics: usize,
         time_samples: Option<usize>,
     ) -> Result<Self, HbError> {
+        Self::with_laws(model, harmonics, time_samples, &[])
+    }
+
+    /// [`LinearData::new`] with the rows and laws of `groups` after the model's rows.
+    pub(crate) fn with_laws(
+        model: &StructuralModel,
+        harmonics: usize,
+        time_samples: Option<usize>,
+        groups: &[LawGroup],
+    ) -> Result<Self, HbError> {
         model.validate()?;
         validate_basis(harmonics, time_samples)?;
         model.load.check_harmonics(harmonics)?;
@@ -322,17 +339,21 @@ impl LinearData {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
             None => FourierBasis::with_default_samples(harmonics),
         };
+        let mut rows: Vec<ContactRow> = model.rows().cloned().collect();
+        let laws = LawLayout::new(model, groups, model.dofs())?;
+        rows.extend(groups.iter().flat_map(|g| g.rows.iter().cloned()));
         Ok(Self {
             dofs: model.dofs(),
             basis,
             operator: HarmonicOperator::new(model, harmonics),
-            rows: model.rows().cloned().collect(),
+            rows,
             gaps: model.contacts.iter().map(|c| c.gap).collect(),
             friction: model
                 .friction
                 .iter()
                 .map(|f| (f.coefficient, f.normal))
                 .collect(),
+            laws,
         })
     }
 
@@ -350,7 +371,7 @@ impl LinearData {
     /// Whether row `i` is a friction point's tangential row: its measured quantity is the
     /// slip velocity `d (g_i . u) / d(w t)`, not the displacement `g_i . u`.
     pub(crate) fn is_velocity_row(&self, i: usize) -> bool {
-        i >= self.gaps.len()
+        self.laws.velocity[i]
     }
 
     /// `out[j m + i] = g_i . U_j`: the rows of `G` applied to the harmonic-major
@@ -374,17 +395,18 @@ impl LinearData {
     /// [`MEAN_SLIP_ANCHOR`]` (g_i . U_0)`.
     pub(crate) fn gather_measured(&self, u: &[f64], out: &mut [f64]) {
         self.gather_rows(u, out);
-        let (m, first) = (self.contacts(), self.normal_rows());
-        if first == m {
+        let m = self.contacts();
+        let velocity = &self.laws.velocity_rows;
+        if velocity.is_empty() {
             return;
         }
-        for o in &mut out[first..m] {
-            *o *= MEAN_SLIP_ANCHOR;
+        for &i in velocity {
+            out[i] *= MEAN_SLIP_ANCHOR;
         }
         for k in 1..=self.basis.harmonics() {
             let (c, s) = ((2 * k - 1) * m, 2 * k * m);
             let kf = k as f64;
-            for i in first..m {
+            for &i in velocity {
                 let (a, b) = (out[c + i], out[s + i]);
                 out[c + i] = kf * b;
                 out[s + i] = -kf * a;
@@ -469,7 +491,7 @@ impl LinearData {
 }
 
 /// `Err(IndexOutOfRange { what, index, count })` unless `index < count`.
-fn check_index(what: &'static str, index: usize, count: usize) -> Result<(), HbError> {
+pub(crate) fn check_index(what: &'static str, index: usize, count: usize) -> Result<(), HbError> {
     if index < count {
         Ok(())
     } else {
@@ -662,7 +684,8 @@ impl HbState {
     /// active count.
     pub(crate) fn write_contact_block(&mut self, jac: &mut jacobian::HbJacobian, i: usize) {
         jac.active[i] = indicator(self.aft.samples_mut());
-        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+        let block = self.linear.laws.diagonal[i];
+        self.aft.samples_multiplication_matrix(&mut jac.q[block]);
     }
 
     /// Writes the block `P diag(w) E` of contact `i` with the weights `w_n` in the AFT's
@@ -674,7 +697,8 @@ impl HbState {
         i: usize,
     ) {
         jac.active[i] = self.aft.samples_mut().iter().filter(|w| **w > 0.5).count();
-        self.aft.samples_multiplication_matrix(&mut jac.q[i]);
+        let block = self.linear.laws.diagonal[i];
+        self.aft.samples_multiplication_matrix(&mut jac.q[block]);
     }
 
     /// The operator's parameters: `w` and the modal damping.

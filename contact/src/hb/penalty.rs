@@ -1,6 +1,7 @@
 //! Penalty harmonic balance: the contact force is `lambda(t) = -k_p max(0, G u(t) - g)`,
 //! and a friction point's force the regularised (tanh) Coulomb law of NLvib,
-//! `lambda_t = -mu N tanh(v_t / eps)` under its prescribed normal load `N`.
+//! `lambda_t = -mu N tanh(v_t / eps)` under its prescribed normal load `N`: the regularised
+//! forms of the laws [`crate::law::Unilateral`] and [`crate::law::Coulomb`].
 //!
 //! The regularisation is written on the phase velocity `y = v_t / w` of the point's row,
 //! `lambda_t = -b tanh(y / eta)` (`b = mu N`, so `eps = w eta`): the residual depends on
@@ -20,6 +21,7 @@ use super::{
     LinearData, ResponseSummary,
 };
 use crate::contacts::FrictionReport;
+use crate::law::LawSamples;
 use crate::model::{NormalForce, StructuralModel};
 
 /// The static slip `b C_tt` of each friction point of `model` (`C_tt` the static compliance
@@ -135,6 +137,9 @@ pub struct PenaltyHb {
     /// The regularisation width `eta` of each friction point (a phase-velocity, i.e.
     /// slip-length, scale).
     eta: Vec<f64>,
+    /// The regularised laws' force and slope samples (`Nt` each).
+    force: Vec<f64>,
+    slope: Vec<f64>,
 }
 
 impl PenaltyHb {
@@ -181,6 +186,7 @@ impl PenaltyHb {
         }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let static_slip = static_slips(model, &linear);
+        let nt = linear.basis.time_samples();
         let mut problem = Self {
             state: HbState::new(linear, omega),
             stiffness: kp,
@@ -188,6 +194,8 @@ impl PenaltyHb {
             holding: false,
             eta: Vec::new(),
             static_slip,
+            force: vec![0.0; nt],
+            slope: vec![0.0; nt],
         };
         problem.set_friction_regularisation(DEFAULT_FRICTION_REGULARISATION)?;
         Ok(problem)
@@ -243,8 +251,8 @@ impl PenaltyHb {
     }
 
     /// Samples of friction point `f`'s phase velocity `y_n / eta` (no mean-slip anchor)
-    /// into the AFT's samples; returns its slip limit `b`.
-    fn friction_samples(&mut self, u: &[f64], f: usize) -> f64 {
+    /// into the AFT's samples.
+    fn friction_samples(&mut self, u: &[f64], f: usize) {
         let lin = &self.state.linear;
         let i = lin.normal_rows() + f;
         let eta = self.eta[f];
@@ -254,11 +262,22 @@ impl PenaltyHb {
             *coeff = lin.measured_coefficient(i, u, j) / eta;
         }
         self.state.aft.coefficients_to_samples();
-        let (mu, normal) = lin.friction[f];
-        match normal {
-            NormalForce::Prescribed(load) => mu * load,
-            NormalForce::Contact(_) => 0.0,
-        }
+    }
+
+    /// Row `i`'s regularised law ([`crate::law::ContactLaw::regularised`]) at the AFT's
+    /// samples into `force` and `slope`.
+    fn regularise(&mut self, i: usize) {
+        let lin = &self.state.linear;
+        let law = &lin.laws.groups[i].law;
+        let at = LawSamples {
+            z: self.state.aft.samples(),
+            read: &[],
+            samples: lin.basis.time_samples(),
+            smoothing: 0.0,
+        };
+        // (Every law of a model penalty HB accepts has its regularised form.)
+        let regularised = law.regularised(&at, &mut self.force, &mut self.slope);
+        debug_assert!(regularised, "row {i} has no regularised law");
     }
 
     /// The penalty stiffness `k_p` in use.
@@ -348,8 +367,9 @@ impl PenaltyHb {
                 }
             }
             None => {
-                for s in samples {
-                    *s = s.max(0.0);
+                self.regularise(i);
+                for (s, f) in self.state.aft.samples_mut().iter_mut().zip(&self.force) {
+                    *s = -f;
                 }
             }
         }
@@ -379,9 +399,10 @@ impl Residual for PenaltyHb {
         lin.dynamic_residual(&self.state.parameters(), u, out);
         for f in 0..lin.friction.len() {
             // - G_t^T P lambda_t = + G_t^T P b tanh(y / eta).
-            let b = self.friction_samples(u, f);
-            for s in self.state.aft.samples_mut() {
-                *s = b * s.tanh();
+            self.friction_samples(u, f);
+            self.regularise(lin.normal_rows() + f);
+            for (s, force) in self.state.aft.samples_mut().iter_mut().zip(&self.force) {
+                *s = -force;
             }
             self.state.aft.samples_to_coefficients();
             let row = &lin.rows[lin.normal_rows() + f];
@@ -425,13 +446,13 @@ impl GeneralizedJacobian for PenaltyHb {
         for f in 0..lin.friction.len() {
             // dR/dU = G_t^T P diag(b sech^2(y / eta) / eta) E D G_t, written as
             // k_p G_t^T Q D G_t (the coupling's stiffness divided out).
-            let b = self.friction_samples(u, f);
-            let scale = b / (self.eta[f] * self.stiffness);
-            for s in self.state.aft.samples_mut() {
-                let sech = 1.0 / s.cosh();
-                *s = scale * sech * sech;
-            }
+            self.friction_samples(u, f);
             let i = lin.normal_rows() + f;
+            self.regularise(i);
+            let scale = -1.0 / (self.eta[f] * self.stiffness);
+            for (s, d) in self.state.aft.samples_mut().iter_mut().zip(&self.slope) {
+                *s = scale * d;
+            }
             self.state.write_weighted_contact_block(jac, i);
         }
         for i in 0..lin.normal_rows() {
@@ -442,8 +463,15 @@ impl GeneralizedJacobian for PenaltyHb {
                 for (s, &on) in samples.iter_mut().zip(&h[i * nt..(i + 1) * nt]) {
                     *s = if on { 1.0 } else { 0.0 };
                 }
+                self.state.write_contact_block(jac, i);
+            } else {
+                // The law's slope per unit stiffness, -[G u - g > 0].
+                self.regularise(i);
+                for (s, d) in self.state.aft.samples_mut().iter_mut().zip(&self.slope) {
+                    *s = -d;
+                }
+                self.state.write_weighted_contact_block(jac, i);
             }
-            self.state.write_contact_block(jac, i);
         }
         Ok(())
     }

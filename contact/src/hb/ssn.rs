@@ -4,12 +4,13 @@
 use semismooth::harmonic::FourierBasis;
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual, Smoothing};
 
-use super::friction::FrictionSamples;
 use super::jacobian::{ContactCoupling, HbJacobian};
+use super::laws::LawSampler;
 use super::{
     check_len, check_omega, check_positive, displacement_summary, validate_basis, HbError, HbState,
     LinearData, ResponseSummary,
 };
+use crate::law::LawGroup;
 use crate::model::StructuralModel;
 
 /// Options of [`SsnHb`].
@@ -75,8 +76,8 @@ pub struct SsnHb {
     c: f64,
     /// Smoothing parameter `mu >= 0` of `max(0, s)` (0: the formulation itself).
     smoothing: f64,
-    /// Sample buffers of the friction law.
-    pub(super) friction: FrictionSamples,
+    /// Sample buffers of the contact laws.
+    laws: LawSampler,
 }
 
 impl SsnHb {
@@ -90,20 +91,34 @@ impl SsnHb {
     /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
     /// model, the frequency and the options.
     pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
+        Self::with_laws(model, omega, options, &[])
+    }
+
+    /// [`SsnHb::new`] with the row groups `laws` added after the model's contacts and
+    /// friction points (their rows and force unknowns follow the model's, in order): each
+    /// group's law is sampled like the built-in ones ([`crate::law`]). Refuses a group
+    /// whose rows, offsets or reads do not fit ([`HbError::DimensionMismatch`],
+    /// [`HbError::IndexOutOfRange`], [`HbError::InvalidOption`]).
+    pub fn with_laws(
+        model: &StructuralModel,
+        omega: f64,
+        options: &HbOptions,
+        laws: &[LawGroup],
+    ) -> Result<Self, HbError> {
         options.validate()?;
         check_omega(omega)?;
-        let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
+        let linear = LinearData::with_laws(model, options.harmonics, options.time_samples, laws)?;
         let c = match options.c {
             Some(c) => c,
             None => model.default_complementarity_constant(),
         };
         check_c(c)?;
-        let friction = FrictionSamples::new(linear.basis.time_samples());
+        let laws = LawSampler::new(&linear);
         Ok(Self {
             state: HbState::new(linear, omega),
             c,
             smoothing: 0.0,
-            friction,
+            laws,
         })
     }
 
@@ -117,11 +132,6 @@ impl SsnHb {
         check_c(c)?;
         self.c = c;
         Ok(())
-    }
-
-    /// The smoothing parameter in use (0: the formulation itself).
-    pub(super) fn smoothing(&self) -> f64 {
-        self.smoothing
     }
 
     /// Number of friction points (their rows follow the contacts').
@@ -222,18 +232,13 @@ impl SsnHb {
             .collect()
     }
 
-    /// Samples `s_n = c (G u_n - g) - lambda_n` of contact `i` into the AFT's samples.
-    fn switching_samples(&mut self, x: &[f64], i: usize) {
-        let lin = &self.state.linear;
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
-        let offset = n * size;
-        let (row, c) = (&lin.rows[i], self.c);
-        let coeffs = self.state.aft.coefficients_mut();
-        for (j, coeff) in coeffs.iter_mut().enumerate() {
-            *coeff = c * row.dot_at(x, j * n) - x[offset + j * m + i];
-        }
-        coeffs[0] -= self.c * lin.gaps[i];
-        self.state.aft.coefficients_to_samples();
+    /// Samples group `g`'s arguments `z = lambda - c (y - o)` and the forces it reads
+    /// from the full unknowns `x = [U; Lambda]`.
+    fn sample_group(&mut self, x: &[f64], g: usize) {
+        let lin = self.state.linear.clone();
+        let (u, forces) = x.split_at(lin.dofs * lin.size());
+        let measured = |row: usize, j: usize| lin.measured_coefficient(row, u, j);
+        (self.laws).sample(&mut self.state.aft, &lin, (g, self.c), forces, measured);
     }
 }
 
@@ -245,23 +250,17 @@ impl Residual for SsnHb {
 
     fn residual(&mut self, x: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
-        let offset = n * size;
+        let offset = lin.dofs * lin.size();
         let (out_u, out_l) = out.split_at_mut(offset);
         lin.dynamic_residual(&self.state.parameters(), &x[..offset], out_u);
         lin.scatter_rows(&x[offset..], -1.0, out_u);
-        for i in 0..lin.normal_rows() {
-            self.switching_samples(x, i);
-            let mu = self.smoothing;
-            for s in self.state.aft.samples_mut() {
-                *s = smoothed_max(*s, mu);
-            }
-            self.state.aft.samples_to_coefficients();
-            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                out_l[j * m + i] = x[offset + j * m + i] + c;
-            }
+        let forces = &x[offset..];
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(x, g);
+            let at = (g, self.smoothing);
+            self.laws
+                .residual(&mut self.state.aft, &lin, at, forces, out_l);
         }
-        self.friction_residual(x, out_l);
         Ok(())
     }
 
@@ -282,53 +281,24 @@ impl GeneralizedJacobian for SsnHb {
     fn jacobian(&mut self, x: &[f64], jac: &mut HbJacobian) -> Result<(), EvaluationError> {
         self.state
             .prepare_jacobian(jac, ContactCoupling::Complementarity { c: self.c });
-        for i in 0..self.state.linear.normal_rows() {
-            self.switching_samples(x, i);
-            if self.smoothing > 0.0 {
-                let mu = self.smoothing;
-                for s in self.state.aft.samples_mut() {
-                    *s = smoothed_max_slope(*s, mu);
-                }
-                self.state.write_weighted_contact_block(jac, i);
-            } else {
-                self.state.write_contact_block(jac, i);
-            }
+        let lin = self.state.linear.clone();
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(x, g);
+            let blocks = (jac.q.as_mut_slice(), jac.cross.as_mut_slice());
+            let at = (g, self.smoothing);
+            (self.laws).jacobian(&mut self.state.aft, &lin, at, blocks, &mut jac.active);
         }
-        self.friction_jacobian(x, jac);
         Ok(())
     }
 }
 
-/// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2`, the Chen–Harker–Kanzow–Smale smoothing of
-/// `max(0, s)` (`phi_0 = max(0, .)`, `0 < phi_mu(s) - max(0, s) <= mu`).
-pub(crate) fn smoothed_max(s: f64, mu: f64) -> f64 {
-    if mu == 0.0 {
-        s.max(0.0)
-    } else {
-        0.5 * (s + s.hypot(2.0 * mu))
-    }
-}
-
-/// `phi_mu'(s) = (1 + s / sqrt(s^2 + 4 mu^2)) / 2`, in `(0, 1)` for `mu > 0`.
-pub(crate) fn smoothed_max_slope(s: f64, mu: f64) -> f64 {
-    0.5 * (1.0 + s / s.hypot(2.0 * mu))
-}
-
-/// `d phi_mu(s) / d mu = 2 mu / sqrt(s^2 + 4 mu^2)`.
-pub(crate) fn smoothed_max_mu_derivative(s: f64, mu: f64) -> f64 {
-    2.0 * mu / s.hypot(2.0 * mu)
-}
-
 impl Smoothing for SsnHb {
     fn smoothing_scale(&self) -> f64 {
-        let g = self
-            .state
-            .linear
-            .gaps
-            .iter()
-            .fold(0.0f64, |a, g| a.max(g.abs()));
+        let laws = &self.state.linear.laws;
+        let g = laws.offsets.iter().fold(0.0f64, |a, g| a.max(g.abs()));
         // A friction point under a prescribed load switches at its slip limit.
-        (self.c * g.max(f64::MIN_POSITIVE)).max(self.largest_prescribed_slip_limit())
+        let force = (laws.groups.iter()).fold(0.0, |a, group| group.law.force_scale().max(a));
+        (self.c * g.max(f64::MIN_POSITIVE)).max(force)
     }
 
     fn set_smoothing(&mut self, mu: f64) {
@@ -340,22 +310,14 @@ impl Smoothing for SsnHb {
         x: &[f64],
         out: &mut [f64],
     ) -> Result<(), EvaluationError> {
-        let lin = &self.state.linear;
-        let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
-        let offset = n * size;
+        let lin = self.state.linear.clone();
+        let offset = lin.dofs * lin.size();
         out[..offset].fill(0.0);
-        let mu = self.smoothing;
-        for i in 0..lin.normal_rows() {
-            self.switching_samples(x, i);
-            for s in self.state.aft.samples_mut() {
-                *s = smoothed_max_mu_derivative(*s, mu);
-            }
-            self.state.aft.samples_to_coefficients();
-            for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                out[offset + j * m + i] = *c;
-            }
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(x, g);
+            let at = (g, self.smoothing);
+            (self.laws).smoothing_derivative(&mut self.state.aft, &lin, at, &mut out[offset..]);
         }
-        self.friction_smoothing_derivative(x, &mut out[offset..]);
         Ok(())
     }
 }

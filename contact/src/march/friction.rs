@@ -15,7 +15,8 @@
 //!   `p_f = -b sign(s_i)`),
 //!
 //! with `c = 1 / mean diag(W)` (an impulse per velocity, so both terms have one scale).
-//! Its generalized Jacobian is that of the max and the clamp; the step is solved from the
+//! The clamp is Coulomb's projection of [`crate::law`] (the same law harmonic balance
+//! samples); the generalized Jacobian is that of the max and the clamp; the step is solved from the
 //! previous step's impulses, so a stick or slip phase that goes on costs one iteration.
 
 use faer::Mat;
@@ -23,6 +24,7 @@ use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{NewtonOptions, Tolerances};
 use semismooth::{EvaluationError, GeneralizedJacobian, Residual};
 
+use crate::law::{coulomb_projection, coulomb_slopes};
 use crate::model::{NormalForce, StructuralModel};
 
 /// Newton iterations allowed for one step's problem.
@@ -189,7 +191,7 @@ impl Residual for CoulombStep {
         for f in 0..self.friction.len() {
             let i = self.contacts + f;
             let (b, _) = self.slip_limit(f, x);
-            out[i] = x[i] - (x[i] - self.c * self.velocity[i]).clamp(-b, b);
+            out[i] = x[i] - coulomb_projection(x[i] - self.c * self.velocity[i], b, 0.0);
         }
         Ok(())
     }
@@ -222,7 +224,8 @@ impl GeneralizedJacobian for CoulombStep {
             let i = self.contacts + f;
             let (b, normal) = self.slip_limit(f, x);
             let y = x[i] - self.c * self.velocity[i];
-            if y.abs() < b {
+            let (plus, minus) = coulomb_slopes(y, b, 0.0);
+            if plus + minus == 0.0 {
                 // Stick: F = c s.
                 for j in 0..m {
                     jac[(i, j)] = self.c * self.w[(i, j)] * sign(j);
@@ -231,7 +234,8 @@ impl GeneralizedJacobian for CoulombStep {
                 // Slip: F = p -+ b.
                 jac[(i, i)] = 1.0;
                 if let Some((p, slope)) = normal {
-                    jac[(i, p)] -= y.signum() * slope;
+                    // d proj / db = w+ - w- (the side of the interval reached).
+                    jac[(i, p)] -= (plus - minus) * slope;
                 }
             }
         }

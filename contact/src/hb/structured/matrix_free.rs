@@ -10,7 +10,7 @@ use super::super::jacobian::ContactCoupling;
 use super::super::krylov::{CondensedOperator, CondensedPreconditioner};
 use super::super::LinearData;
 use super::{
-    apply_coupling, finite_step, gather_contacts, receptance_columns, row_of, FactoredCondensed,
+    finite_step, gather_contacts, receptance_columns, row_of, FactoredCondensed,
     StructuredHbSolver, KRYLOV_RELATIVE_TOLERANCE,
 };
 
@@ -45,8 +45,12 @@ impl StructuredHbSolver {
         let ContactCoupling::Complementarity { c } = self.coupling else {
             return Err(LinearSolveError::NotFactored);
         };
+        let Some((lin, _)) = &self.factored_for else {
+            return Err(LinearSolveError::NotFactored);
+        };
+        let diagonal = lin.laws.diagonal.iter().map(|&block| &self.q[block]);
         self.contact_blocks
-            .factor(&self.q, &self.receptance_diagonal, c)?;
+            .factor(diagonal, &self.receptance_diagonal, c)?;
         self.schur_factorizations += 1;
         self.schur_ready = true;
         Ok(())
@@ -70,7 +74,7 @@ impl StructuredHbSolver {
         w.copy_from_slice(&rhs[..nu]);
         self.apply_dynamic_inverse(&mut w)?;
         gather_contacts(lin, &w[..n * size], &mut self.work_a);
-        apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
         for (r, b) in self.work_c.iter_mut().enumerate() {
             *b = rhs[nu + r] - c * *b;
         }

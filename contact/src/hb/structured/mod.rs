@@ -34,14 +34,13 @@ use semismooth::{Factorize, LinearSolve};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
+use super::laws::{copy_blocks, LawLayout};
 use super::LinearData;
 use crate::model::ContactRow;
 use crate::operator::{HarmonicFactors, HarmonicParameters};
 
-mod cross_blocks;
 mod matrix_free;
 
-pub(crate) use cross_blocks::CrossBlocks;
 pub use matrix_free::DENSE_PRECONDITIONER_LIMIT;
 
 /// Relative residual `|J x - b| / |b|` below which iterative refinement stops.
@@ -104,10 +103,10 @@ pub struct StructuredHbSolver {
     /// `R_k = G Z_k^{-1} G^T` (m x m) per harmonic.
     receptance: Vec<Mat<c64>>,
     coupling: ContactCoupling,
-    /// `Q_i` per contact, copied from the Jacobian.
+    /// The row groups' blocks `Q_ab`, copied from the Jacobian.
     q: Vec<Mat<f64>>,
-    /// The friction points' blocks `X` on their contacts' forces, copied from the Jacobian.
-    cross: CrossBlocks,
+    /// The row groups' blocks `X` on the rows they read, copied from the Jacobian.
+    cross: Vec<Mat<f64>>,
     schur: Mat<f64>,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
@@ -175,7 +174,7 @@ impl StructuredHbSolver {
             receptance: Vec::new(),
             coupling: ContactCoupling::Complementarity { c: 1.0 },
             q: Vec::new(),
-            cross: CrossBlocks::default(),
+            cross: Vec::new(),
             schur: Mat::zeros(0, 0),
             perm: Vec::new(),
             perm_inv: Vec::new(),
@@ -289,8 +288,7 @@ impl StructuredHbSolver {
         self.work_d = vec![0.0; nc];
         self.work_rhs = Vec::with_capacity(n * size + nc);
         self.work_res = Vec::with_capacity(n * size + nc);
-        self.q = (0..m).map(|_| Mat::zeros(size, size)).collect();
-        self.cross = CrossBlocks::new(lin);
+        (self.q, self.cross) = lin.laws.zero_blocks(size);
         if self.krylov {
             self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
             self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
@@ -443,25 +441,6 @@ fn finite_step(step: &[f64]) -> Result<(), LinearSolveError> {
     }
 }
 
-/// `out = Q p` with `Q` block diagonal over contacts (`Q_i` on indices `j m + i`).
-pub(crate) fn apply_coupling(q: &[Mat<f64>], m: usize, p: &[f64], out: &mut [f64]) {
-    for (i, qi) in q.iter().enumerate() {
-        // Column by column (contiguous), each sum still accumulated in the order of l.
-        for o in out[i..].iter_mut().step_by(m) {
-            *o = 0.0;
-        }
-        for l in 0..qi.ncols() {
-            let pl = p[l * m + i];
-            if pl == 0.0 {
-                continue;
-            }
-            for (o, v) in out[i..].iter_mut().step_by(m).zip(qi.col_as_slice(l)) {
-                *o += v * pl;
-            }
-        }
-    }
-}
-
 impl Factorize<HbJacobian> for StructuredHbSolver {
     fn factor(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
         self.schur_ready = false;
@@ -475,18 +454,8 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
         let (m, size) = (lin.contacts(), lin.size());
         let nc = m * size;
         self.coupling = jac.coupling;
-        self.cross.copy_from(&jac.cross)?;
-        for (i, (q, source)) in self.q.iter_mut().zip(&jac.q).enumerate() {
-            q.copy_from(source);
-            for col in 0..size {
-                let column = q.col_as_slice(col);
-                if let Some((row, &value)) = column.iter().enumerate().find(|(_, v)| !v.is_finite())
-                {
-                    let col = i * size + col;
-                    return Err(LinearSolveError::NonFiniteEntry { row, col, value });
-                }
-            }
-        }
+        copy_blocks(&mut self.cross, &jac.cross)?;
+        copy_blocks(&mut self.q, &jac.q)?;
         if self.krylov {
             if self.dense_preconditioner && !self.refresh_dense {
                 // The dense factorization of a recent iterate stays the preconditioner.
@@ -585,7 +554,7 @@ impl StructuredHbSolver {
         match self.coupling {
             ContactCoupling::Complementarity { c } => {
                 // b = r_lambda - c Q y.
-                apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
                 for r in 0..nc {
                     self.work_b[(r, 0)] = rhs[nu + r] - c * self.work_c[r];
                 }
@@ -607,7 +576,7 @@ impl StructuredHbSolver {
                     self.work_a[r] = self.work_b[(r, 0)];
                 }
                 // dU = w - k_p A^{-1} G^T Q y.
-                apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+                lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
                 self.add_response(&self.work_c, -stiffness, &mut w);
                 rhs.copy_from_slice(&w);
             }
@@ -627,17 +596,17 @@ impl StructuredHbSolver {
         let nu = n * size;
         lin.apply_dynamic(&parameters, &x[..nu], &mut out[..nu]);
         gather_contacts(&lin, &x[..n * size], &mut self.work_a);
-        apply_coupling(&self.q, m, &self.work_a, &mut self.work_c);
+        lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
         match self.coupling {
             ContactCoupling::Complementarity { c } => {
                 let (out_u, out_l) = out.split_at_mut(nu);
                 let x_l = &x[nu..];
-                apply_coupling(&self.q, m, x_l, &mut self.work_d);
+                lin.laws.apply_q(&self.q, m, x_l, &mut self.work_d);
                 lin.scatter_rows(x_l, -1.0, out_u);
                 for r in 0..m * size {
                     out_l[r] = c * self.work_c[r] + x_l[r] - self.work_d[r];
                 }
-                self.cross.apply_add(m, x_l, out_l);
+                lin.laws.apply_x_add(&self.cross, m, x_l, out_l);
             }
             ContactCoupling::Penalty { stiffness } => {
                 lin.scatter_rows(&self.work_c, stiffness, out);
@@ -692,10 +661,12 @@ impl StructuredHbSolver {
         m: usize,
         equilibrate: bool,
     ) -> Result<(), LinearSolveError> {
+        let Some((lin, _)) = &self.factored_for else {
+            return Err(LinearSolveError::NotFactored);
+        };
         condensed_matrix(
             &self.receptance,
-            &self.q,
-            &self.cross,
+            (&lin.laws, &self.q, &self.cross),
             self.coupling,
             m,
             self.schur.as_mut(),
@@ -820,62 +791,81 @@ fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> 
 }
 
 /// Writes the condensed matrix on the `m (2H + 1)` contact unknowns: `I - Q + c Q R + X`
-/// (SSN-HB; `X` the friction points' blocks on their contacts' forces) or `I + k_p R Q`
-/// (penalty), using that `R` only couples the two basis functions of one harmonic (cost
-/// `O(m^2 (2H + 1)^2)`). `q` holds `Q_i` of each contact.
+/// (SSN-HB; `X` the row groups' blocks on the rows they read) or `I + k_p R Q` (penalty),
+/// using that `R` only couples the two basis functions of one harmonic (cost
+/// `O(m^2 (2H + 1)^2)` for groups of one row). `blocks` holds the layout of the groups and
+/// their blocks `Q_ab` and `X_as`.
 pub(crate) fn condensed_matrix(
     receptance: &[Mat<c64>],
-    q: &[Mat<f64>],
-    cross: &CrossBlocks,
+    (layout, q, cross): (&LawLayout, &[Mat<f64>], &[Mat<f64>]),
     coupling: ContactCoupling,
     m: usize,
     mut out: MatMut<'_, f64>,
 ) {
     let size = (2 * receptance.len()).saturating_sub(1);
     out.fill(0.0);
-    for l in 0..size {
-        let k = l.div_ceil(2);
-        // Basis functions of harmonic k: (first, count).
-        let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
-        for ip in 0..m {
-            let col = l * m + ip;
-            match coupling {
-                ContactCoupling::Complementarity { c } => {
-                    for (i, qi) in q.iter().enumerate() {
-                        let (rho0, rho1) = receptance_column(receptance, l, i, ip);
-                        let (q0, ql) = (qi.col_as_slice(first), qi.col_as_slice(l));
-                        let q1 = qi.col_as_slice(first + count - 1);
-                        let rho1 = if count == 2 { rho1 } else { 0.0 };
-                        for (j, ((a, b), d)) in q0.iter().zip(q1).zip(ql).enumerate() {
-                            let mut value = c * rho0 * a;
-                            if count == 2 {
-                                value += c * rho1 * b;
-                            }
-                            if i == ip {
-                                value -= d;
-                            }
-                            out[(j * m + i, col)] = value;
-                        }
-                    }
-                }
-                ContactCoupling::Penalty { stiffness } => {
-                    // v = Q_{ip}[:, l] on contact ip; S e = e + k_p R v.
-                    let qp = &q[ip];
+    for (qab, &(a, b)) in q.iter().zip(&layout.q_pairs) {
+        match coupling {
+            ContactCoupling::Complementarity { c } => {
+                complementarity_columns(receptance, qab, (a, b), (c, m), out.as_mut());
+            }
+            ContactCoupling::Penalty { stiffness } => {
+                // Column (l, b) of Q is Q_ab[:, l] on row a: S e += k_p R_{:, a} Q_ab[:, l].
+                for l in 0..size {
+                    let col = l * m + b;
                     for i in 0..m {
-                        let r0 = receptance[0][(i, ip)].re;
-                        out[(i, col)] = stiffness * r0 * qp[(0, l)];
+                        let r0 = receptance[0][(i, a)].re;
+                        out[(i, col)] += stiffness * r0 * qab[(0, l)];
                         for (kk, rk) in receptance.iter().enumerate().skip(1) {
                             let (jc, js) = (2 * kk - 1, 2 * kk);
-                            let r = rk[(i, ip)];
-                            let (pc, ps) = (qp[(jc, l)], qp[(js, l)]);
-                            out[(jc * m + i, col)] = stiffness * (r.re * pc + r.im * ps);
-                            out[(js * m + i, col)] = stiffness * (-r.im * pc + r.re * ps);
+                            let r = rk[(i, a)];
+                            let (pc, ps) = (qab[(jc, l)], qab[(js, l)]);
+                            out[(jc * m + i, col)] += stiffness * (r.re * pc + r.im * ps);
+                            out[(js * m + i, col)] += stiffness * (-r.im * pc + r.re * ps);
                         }
                     }
                 }
             }
-            out[(col, col)] += 1.0;
         }
     }
-    cross.add_to(m, out);
+    for col in 0..m * size {
+        out[(col, col)] += 1.0;
+    }
+    if let ContactCoupling::Complementarity { .. } = coupling {
+        layout.add_x_dense(cross, m, out);
+    }
+}
+
+/// Adds the rows `j m + a` of `c Q_ab R_b - Q_ab` (the block `(a, b)` of `Q` times the
+/// receptance rows of `b`, and minus itself on the columns of `b`) to `out`.
+fn complementarity_columns(
+    receptance: &[Mat<c64>],
+    qab: &Mat<f64>,
+    (a, b): (usize, usize),
+    (c, m): (f64, usize),
+    mut out: MatMut<'_, f64>,
+) {
+    let size = qab.ncols();
+    for l in 0..size {
+        let k = l.div_ceil(2);
+        // Basis functions of harmonic k: (first, count).
+        let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
+        let (q0, ql) = (qab.col_as_slice(first), qab.col_as_slice(l));
+        let q1 = qab.col_as_slice(first + count - 1);
+        for ip in 0..m {
+            let col = l * m + ip;
+            let (rho0, rho1) = receptance_column(receptance, l, b, ip);
+            let rho1 = if count == 2 { rho1 } else { 0.0 };
+            for (j, ((x, y), d)) in q0.iter().zip(q1).zip(ql).enumerate() {
+                let mut value = c * rho0 * x;
+                if count == 2 {
+                    value += c * rho1 * y;
+                }
+                if b == ip {
+                    value -= d;
+                }
+                out[(j * m + a, col)] += value;
+            }
+        }
+    }
 }
