@@ -44,6 +44,7 @@ pub struct PeriodicSolution {
 
 /// A crossing of the frequency whose correction did not converge.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FailedCorrection {
     /// Index of the branch point after the crossing.
     pub branch_index: usize,

@@ -211,7 +211,7 @@ pub fn compare_adaptive(
     let estimates: Vec<f64> = adaptive
         .accuracy
         .as_ref()
-        .map(|a| a.estimates.iter().map(|e| e.unwrap_or(f64::NAN)).collect())
+        .map(|_| adaptive.column(|p| p.error_estimate.unwrap_or(f64::NAN)))
         .unwrap_or_default();
     let harmonics = (
         point_harmonics.iter().copied().min().unwrap_or(0),

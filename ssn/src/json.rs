@@ -223,14 +223,14 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         doc["time_samples"] = json!(r.time_samples());
     }
     if let Some(a) = &r.accuracy {
-        doc["error_estimate"] = json!(a.estimates);
+        doc["error_estimate"] = json!(column(|p| json!(p.error_estimate)));
         doc["accuracy"] = json!({
             "target": a.target,
             "basis": "the change of the observed extremes against H/2 solved from the truncated \
                       point, times 1/(2^p - 1) with p = HB_ORDER",
             "order": semismooth_contact::solve::accuracy::HB_ORDER,
-            "points_met": a.met(),
-            "worst_estimate": a.worst(),
+            "points_met": a.met(points),
+            "worst_estimate": r.worst_estimate(),
             "raises": a.raises,
             "lowers": a.lowers,
             "failed_raises": a.failed_raises,

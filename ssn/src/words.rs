@@ -357,7 +357,8 @@ pub fn fold_accuracy(fold: &FoldAccuracy, omega_1: f64) -> String {
 
 /// The lines of `ssn sweep` on a branch whose harmonics were chosen point by point: the
 /// range of harmonics, how many points meet the target and the largest estimate.
-pub fn branch_accuracy(accuracy: &BranchAccuracy, harmonics: &[usize]) -> String {
+pub fn branch_accuracy(accuracy: &BranchAccuracy, response: &FrequencyResponse) -> String {
+    let harmonics = response.harmonics();
     let lo = harmonics.iter().min().copied().unwrap_or(0);
     let hi = harmonics.iter().max().copied().unwrap_or(0);
     format!(
@@ -368,10 +369,10 @@ pub fn branch_accuracy(accuracy: &BranchAccuracy, harmonics: &[usize]) -> String
         accuracy.target,
         accuracy.raises,
         accuracy.lowers,
-        accuracy.met(),
-        accuracy.estimates.len(),
-        accuracy
-            .worst()
+        accuracy.met(&response.points),
+        response.points.len(),
+        response
+            .worst_estimate()
             .map_or("not estimated".to_string(), |w| format!("{w:.2e}")),
     )
 }
@@ -425,7 +426,7 @@ pub(crate) fn sweep_text(
         );
     }
     if let Some(a) = &response.accuracy {
-        t += &branch_accuracy(a, &response.harmonics());
+        t += &branch_accuracy(a, response);
     }
     t += &format!(
         "folds             {}\n",

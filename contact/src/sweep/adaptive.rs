@@ -45,7 +45,7 @@
 //!
 //! The branch starts at [`HARMONICS_LADDER`]`[0]` harmonics (the scene's `harmonics` is
 //! ignored with a target), each point's harmonics and estimate are in
-//! [`ResponsePoint::harmonics`] and [`BranchAccuracy::estimates`].
+//! [`ResponsePoint::harmonics`] and [`ResponsePoint::error_estimate`].
 
 use std::time::Instant;
 
@@ -90,9 +90,6 @@ pub const LOWER_BELOW: f64 = 0.25;
 pub struct BranchAccuracy {
     /// The relative accuracy asked of each point's observed displacement.
     pub target: f64,
-    /// The estimated relative error of each point (module documentation; `None` where the
-    /// solve at `H/2` did not converge).
-    pub estimates: Vec<Option<f64>>,
     /// Points solved again with more harmonics.
     pub raises: usize,
     /// Changes to fewer harmonics.
@@ -108,11 +105,11 @@ pub struct BranchAccuracy {
 }
 
 impl BranchAccuracy {
-    /// Points whose estimate meets the target.
-    pub fn met(&self) -> usize {
-        self.estimates
+    /// The points of `points` whose estimate meets the target.
+    pub fn met(&self, points: &[ResponsePoint]) -> usize {
+        points
             .iter()
-            .filter(|e| e.is_some_and(|e| e <= self.target))
+            .filter(|p| p.error_estimate.is_some_and(|e| e <= self.target))
             .count()
     }
 
@@ -120,7 +117,6 @@ impl BranchAccuracy {
     fn none_yet(target: f64, max_harmonics: usize) -> Self {
         Self {
             target,
-            estimates: Vec::new(),
             raises: 0,
             lowers: 0,
             failed_raises: 0,
@@ -128,11 +124,6 @@ impl BranchAccuracy {
             estimate_seconds: 0.0,
             estimate_counters: RunCounters::default(),
         }
-    }
-
-    /// The largest estimate over the points (`None` if none was estimated).
-    pub fn worst(&self) -> Option<f64> {
-        self.estimates.iter().flatten().copied().reduce(f64::max)
     }
 }
 
@@ -654,8 +645,8 @@ impl Adaptive<'_> {
         let mut record = ResponsePoint::new(omega, (max, min), point.iterations, point.state);
         record.harmonics = Some(h);
         record.time_samples = Some(nt);
+        record.error_estimate = estimate;
         self.response.points.push(record);
-        self.accuracy.estimates.push(estimate);
         if let Some(report) = self.progress {
             report(index, omega / self.rod.omega_1);
         }

@@ -60,6 +60,7 @@ pub const MAX_SEGMENT_POINTS: usize = 400;
 
 /// One rung of a fold's ladder.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FoldRung {
     /// Harmonics.
     pub harmonics: usize,

@@ -69,7 +69,8 @@ pub struct FrequencyResponse {
     /// Wall time of the stability analysis (not in `solve_seconds`).
     pub stability_seconds: f64,
     /// With an accuracy target ([`SolverSettings::accuracy`], SSN-HB): the harmonics chosen
-    /// point by point and each point's error estimate ([`super::adaptive`]).
+    /// point by point, what they achieved ([`super::adaptive`]; each point's estimate is its
+    /// [`ResponsePoint::error_estimate`]).
     pub accuracy: Option<BranchAccuracy>,
 }
 
@@ -95,6 +96,10 @@ pub struct ResponsePoint {
     pub harmonics: Option<usize>,
     /// Harmonic balance: the AFT samples of the state (`None` for the LCP).
     pub time_samples: Option<usize>,
+    /// With an accuracy target (SSN-HB, harmonics chosen point by point): the estimated
+    /// relative error of the observed extremes ([`super::adaptive`]; `None` without a
+    /// target or where the solve at `H/2` did not converge).
+    pub error_estimate: Option<f64>,
     /// Stability and contact diagnostics (undecided until the branch's stability is
     /// computed).
     pub stability: PointStability,
@@ -123,6 +128,7 @@ impl ResponsePoint {
             state,
             harmonics: None,
             time_samples: None,
+            error_estimate: None,
             stability: PointStability::default(),
             contacts: Vec::new(),
             friction: Vec::new(),
@@ -248,6 +254,15 @@ impl FrequencyResponse {
     /// Harmonic balance: the harmonics of each point (empty for the LCP).
     pub fn harmonics(&self) -> Vec<usize> {
         self.points.iter().filter_map(|p| p.harmonics).collect()
+    }
+
+    /// With an accuracy target: the largest error estimate over the points (`None` if none
+    /// was estimated).
+    pub fn worst_estimate(&self) -> Option<f64> {
+        self.points
+            .iter()
+            .filter_map(|p| p.error_estimate)
+            .reduce(f64::max)
     }
 
     /// Harmonic balance: the AFT samples of each point (empty for the LCP).
