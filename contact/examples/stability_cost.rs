@@ -67,7 +67,7 @@ fn main() {
                 format!("{mass:?}").to_lowercase(),
                 harmonics,
                 gap,
-                response.points(),
+                response.points.len(),
                 1e3 * without,
                 1e3 * with,
                 with / without
@@ -82,18 +82,18 @@ fn main() {
         let (mut agree, mut differ, mut undecided) = (0, Vec::new(), 0);
         let t = cpu_seconds();
         let n = rod.model.dofs() * (2 * settings.harmonics + 1);
-        for i in 0..r.points() {
+        for i in 0..r.points.len() {
             let map = map_stability(
                 &rod.model,
                 settings.harmonics,
-                r.omega[i],
-                &r.states[i][..n],
+                r.points[i].omega,
+                &r.points[i].state[..n],
                 &StabilityOptions::default(),
             )
             .expect("the shooting runs");
-            match (map.stable, r.stability.stable[i]) {
+            match (map.stable, r.points[i].stability.stable) {
                 (Some(a), Some(b)) if a == b => agree += 1,
-                (Some(_), Some(_)) => differ.push(r.omega[i] / rod.omega_1),
+                (Some(_), Some(_)) => differ.push(r.points[i].omega / rod.omega_1),
                 _ => undecided += 1,
             }
         }
@@ -101,20 +101,20 @@ fn main() {
         let t = cpu_seconds();
         let mut analysis =
             HbStability::new(&rod.model, &settings).expect("a harmonic-balance method");
-        for i in 0..r.points() {
+        for i in 0..r.points.len() {
             analysis
-                .of(r.omega[i], &r.states[i])
+                .of(r.points[i].omega, &r.points[i].state)
                 .expect("the phases run");
         }
         let phases = cpu_seconds() - t;
         println!(
             "gap {gap}: {} points, {agree} agree, {} differ at omega/omega_1 {:.4?}, {undecided} \
              undecided by one of them; shooting {:.2} ms per point, contact phases {:.3} ms",
-            r.points(),
+            r.points.len(),
             differ.len(),
             differ,
-            1e3 * shooting / r.points() as f64,
-            1e3 * phases / r.points() as f64
+            1e3 * shooting / r.points.len() as f64,
+            1e3 * phases / r.points.len() as f64
         );
     }
 }

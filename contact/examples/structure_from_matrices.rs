@@ -38,14 +38,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let branch = frequency_response(&structure, &settings, &SweepSettings::new(0.6, 1.6), None)?;
     let (peak, amplitude) = branch.peak().ok_or("an empty branch")?;
     let stable = branch
-        .stability
-        .stable
+        .points
         .iter()
-        .flatten()
-        .filter(|s| **s)
+        .filter(|p| p.stability.stable == Some(true))
         .count();
     let folds = branch.folds.iter().map(|w| format!("{:.4}", w / w1));
-    let (points, complete, at) = (branch.points(), branch.converged(), branch.omega[peak] / w1);
+    let (points, complete, at) = (
+        branch.points.len(),
+        branch.converged(),
+        branch.points[peak].omega / w1,
+    );
     println!("sweep over [0.6, 1.6] omega_1: {points} points, complete {complete}");
     println!("  {stable} stable, peak {amplitude:.4} at {at:.4} omega_1");
     println!(

@@ -37,7 +37,7 @@ fn main() {
         let settings = SolverSettings::with_harmonics(h);
         let r = frequency_response(&structure, &settings, &SweepSettings::new(0.5, 3.0), None)
             .expect("valid settings");
-        let count = |v: Option<bool>| r.stability.stable.iter().filter(|s| **s == v).count();
+        let count = |v: Option<bool>| r.stable().iter().filter(|s| **s == v).count();
         let folds: Vec<String> = r
             .folds
             .iter()
@@ -45,7 +45,7 @@ fn main() {
             .collect();
         println!(
             "{h:>4}  {:>6}  {:>9}  {:<22}  {:>7}  {:>6}  {:>8}  {:>9}  {:>7.2}  {:>11.2}",
-            r.points(),
+            r.points.len(),
             r.converged(),
             folds.join(", "),
             r.corner_folds.len(),
@@ -55,7 +55,7 @@ fn main() {
             r.solve_seconds,
             r.stability_seconds
         );
-        for e in &r.stability.events {
+        for e in &r.events {
             println!(
                 "      {} at {:.4} omega_1 (point {})",
                 e.kind.name(),
@@ -64,15 +64,15 @@ fn main() {
             );
         }
         if std::env::var("DUMP").is_ok() {
-            for i in 0..r.points() {
+            for i in 0..r.points.len() {
                 println!(
                     "{i} {:.6} {:.6} {:.6} it {} stable {:?} mu {:?}",
-                    r.omega[i] / omega_1,
-                    r.tip_max[i],
-                    r.tip_min[i],
-                    r.iterations[i],
-                    r.stability.stable[i],
-                    r.stability.floquet_max_abs[i],
+                    r.points[i].omega / omega_1,
+                    r.points[i].observed_max,
+                    r.points[i].observed_min,
+                    r.points[i].iterations,
+                    r.points[i].stability.stable,
+                    r.points[i].stability.floquet_max_abs,
                 );
             }
         }

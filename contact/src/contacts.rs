@@ -48,6 +48,7 @@ pub struct FrictionReport {
 
 /// The per-point numbers of a friction point over one period.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct FrictionSummary {
     /// Fraction of the period the point sticks: for harmonic balance the samples where the
     /// law's argument is strictly inside the slip limit (`|lambda_t - c y_t| < b`), for
@@ -172,6 +173,7 @@ pub fn contact_reports(
 
 /// Summary of one period of a contact response, from samples at equal time steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct PeriodStatistics {
     /// Largest displacement of the observed dof.
     pub max: f64,

@@ -44,6 +44,7 @@ pub struct PeriodicSolution {
 
 /// A crossing of the frequency whose correction did not converge.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FailedCorrection {
     /// Index of the branch point after the crossing.
     pub branch_index: usize,
@@ -83,22 +84,22 @@ pub struct SolutionSet {
     pub seconds: f64,
 }
 
-/// All periodic solutions of `rod` at the forcing frequency `omega` (module
+/// All periodic solutions of `structure` at the forcing frequency `omega` (module
 /// documentation). `sweep`: the window and continuation settings (`None`:
 /// `[0.5, 2] w* / omega_1` with the scene defaults).
 pub fn find_solutions(
-    rod: &Structure,
+    structure: &Structure,
     omega: f64,
     settings: &SolverSettings,
     sweep: Option<&SweepSettings>,
 ) -> Result<SolutionSet, RunError> {
     let started = Instant::now();
-    let window = search_window(rod, omega, settings, sweep)?;
-    let branch = follow_branch(rod, settings, &window, None)?;
-    let reconstruction = Reconstruction::new(&rod.model, omega, settings)?;
+    let window = search_window(structure, omega, settings, sweep)?;
+    let branch = follow_branch(structure, settings, &window, None)?;
+    let reconstruction = Reconstruction::new(&structure.model, omega, settings)?;
     // The method is a harmonic-balance one (checked by `search_window`): only the model
     // can fail here.
-    let mut analysis = HbStability::new(&rod.model, settings).map_err(|e| match e {
+    let mut analysis = HbStability::new(&structure.model, settings).map_err(|e| match e {
         StabilityError::Hb(e) => RunError::HarmonicBalance(e),
         _ => RunError::Unsupported {
             method: settings.method.name(),
@@ -107,16 +108,16 @@ pub fn find_solutions(
     })?;
     let mut set = SolutionSet {
         omega,
-        omega_1: rod.omega_1,
+        omega_1: structure.omega_1,
         shape: StateShape {
             method: settings.method,
             harmonics: settings.harmonics,
-            dofs: rod.model.dofs(),
-            contacts: rod.model.contacts.len(),
+            dofs: structure.model.dofs(),
+            contacts: structure.model.contacts.len(),
         },
         solutions: Vec::new(),
         window: (window.omega_ratio_from, window.omega_ratio_to),
-        branch_points: branch.points(),
+        branch_points: branch.points.len(),
         branch_converged: branch.converged(),
         branch_termination: branch.termination.clone(),
         crossings: 0,
@@ -124,12 +125,12 @@ pub fn find_solutions(
         counters: branch.counters,
         seconds: 0.0,
     };
-    for i in 1..branch.points() {
+    for i in 1..branch.points.len() {
         let Some(start) = crossing_start(&branch, i, omega) else {
             continue;
         };
         set.crossings += 1;
-        let solution = solve(rod, omega, settings, Some(&start))?;
+        let solution = solve(structure, omega, settings, Some(&start))?;
         set.counters = set.counters + solution.counters;
         if !solution.converged() {
             set.failed_corrections.push(FailedCorrection {
@@ -146,7 +147,7 @@ pub fn find_solutions(
         let stability = analysis
             .of(omega, x)
             .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
-        let contacts = reconstruction.contacts(&rod.model, x)?;
+        let contacts = reconstruction.contacts(&structure.model, x)?;
         set.solutions.push(PeriodicSolution {
             solution,
             contacts,
@@ -203,7 +204,7 @@ fn search_window(
 /// The start of the correction at `omega` when the branch crosses it between its points
 /// `i - 1` and `i` (interpolated linearly in the frequency); `None` when it does not.
 fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<Vec<f64>> {
-    let (w0, w1) = (branch.omega[i - 1], branch.omega[i]);
+    let (w0, w1) = (branch.points[i - 1].omega, branch.points[i].omega);
     // Each crossing once: the left point strictly on one side (or exactly at w*).
     let crosses = (w0 - omega) * (w1 - omega) < 0.0 || w1 == omega;
     if !crosses {
@@ -215,9 +216,10 @@ fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<Ve
         1.0
     };
     Some(
-        branch.states[i - 1]
+        branch.points[i - 1]
+            .state
             .iter()
-            .zip(&branch.states[i])
+            .zip(&branch.points[i].state)
             .map(|(a, b)| a + t * (b - a))
             .collect(),
     )

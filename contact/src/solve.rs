@@ -203,7 +203,7 @@ pub struct Solution {
     pub c: Option<f64>,
     /// Forcing frequency.
     pub omega: f64,
-    /// First natural frequency of the rod.
+    /// First natural frequency of the structure.
     pub omega_1: f64,
     /// How the run ended ([`Solution::converged`]).
     pub termination: Termination,
@@ -224,16 +224,16 @@ pub struct Solution {
     pub observed_order: Option<f64>,
     /// Residual norm of every Newton iterate, the initial guess first (Newton methods).
     pub residual_history: Vec<f64>,
-    /// Wall time of the solve (not the set-up of the rod).
+    /// Wall time of the solve (not the set-up of the structure).
     pub solve_seconds: f64,
     /// Times over one period, `[0, T)` (the forcing is `cos(omega t)`).
     pub times: Vec<f64>,
-    /// Tip displacement at `times`.
-    pub tip: Vec<f64>,
+    /// Displacement of the observed dof ([`Structure::observed_dof`]) at `times`.
+    pub observed: Vec<f64>,
     /// Contact forces at `times`, one series per contact.
     pub contact_forces: Vec<Vec<f64>>,
-    /// Tip statistics (penetration over all contacts; the mean contact force is the sum of
-    /// the contacts' mean forces).
+    /// Statistics of the observed dof (penetration over all contacts; the mean contact
+    /// force is the sum of the contacts' mean forces).
     pub stats: PeriodStatistics,
     /// Every contact point over the period.
     pub contacts: Vec<ContactReport>,
@@ -459,7 +459,7 @@ impl<'a> Outcome<'a> {
 /// One period of a run's answer.
 struct Period {
     times: Vec<f64>,
-    tip: Vec<f64>,
+    observed: Vec<f64>,
     contact_forces: Vec<Vec<f64>>,
     contact_displacements: Vec<Vec<f64>>,
     friction: Vec<FrictionReport>,
@@ -487,7 +487,7 @@ fn solution(
     );
     let mut stats = statistics(
         rod,
-        &period.tip,
+        &period.observed,
         &period.contact_forces,
         &period.contact_displacements,
     );
@@ -516,7 +516,7 @@ fn solution(
         solve_seconds: outcome.solve_seconds,
         stats,
         times: period.times,
-        tip: period.tip,
+        observed: period.observed,
         contact_forces: period.contact_forces,
         counters: outcome.counters,
         state,
@@ -556,7 +556,7 @@ fn hb_outputs(
         .collect::<Result<Vec<_>, _>>()?;
     let period = Period {
         times,
-        tip,
+        observed: tip,
         contact_forces,
         contact_displacements,
         friction,
@@ -616,26 +616,26 @@ fn statistics(
     stats
 }
 
-/// Solves the rod forced at the angular frequency `omega` with the scene's method, from a
+/// Solves the structure forced at the angular frequency `omega` with the scene's method, from a
 /// zero initial guess (or `warm_start`, [`Solution::state`] of a solve with the same
 /// discretisation), with the error estimate of [`crate::accuracy::estimate`] when
 /// [`SolverSettings::estimate_error`] is on. With [`SolverSettings::accuracy`] the method
 /// chooses its discretisation ([`crate::accuracy::search`]). An `omega` that is not finite
 /// and `> 0` is the formulation's typed error.
 pub fn solve(
-    rod: &Structure,
+    structure: &Structure,
     omega: f64,
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
     if let Some(target) = settings.accuracy {
-        return accuracy::search::solve_to_accuracy(rod, omega, settings, target, warm_start);
+        return accuracy::search::solve_to_accuracy(structure, omega, settings, target, warm_start);
     }
-    let mut solution = solve_as_given(rod, omega, settings, warm_start)?;
+    let mut solution = solve_as_given(structure, omega, settings, warm_start)?;
     if settings.estimate_error {
         // The second solve poses the equation the first one solved (its `c` may be raised).
         let solved = solution.settings.clone();
-        solution.error_estimate = accuracy::estimate(rod, omega, &solved, &solution);
+        solution.error_estimate = accuracy::estimate(structure, omega, &solved, &solution);
     }
     Ok(solution)
 }
@@ -830,7 +830,7 @@ fn solve_lcp(
     };
     let period = Period {
         times: lcp.times(),
-        tip: tip_series,
+        observed: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
         friction: Vec::new(),

@@ -35,23 +35,26 @@ fn every_point_of_an_adaptive_sweep_meets_its_target_against_the_refined_branch(
     };
     let r = frequency_response(&rod, &settings, &sweep, None)?;
     assert!(r.converged(), "{}", r.termination);
-    assert_eq!(r.harmonics.len(), r.points());
+    assert!(r.points.iter().all(|p| p.harmonics.is_some()));
     let accuracy = r.accuracy.as_ref().expect("an adaptive sweep");
     // Every point is estimated and its estimate meets the target.
     assert!(
-        accuracy.estimates.iter().flatten().all(|e| *e <= target),
+        r.points
+            .iter()
+            .flat_map(|p| p.error_estimate)
+            .all(|e| e <= target),
         "{accuracy:?}"
     );
-    assert_eq!(accuracy.met(), r.points(), "{accuracy:?}");
+    assert_eq!(accuracy.met(&r.points), r.points.len(), "{accuracy:?}");
 
     // The linear tail needs few harmonics, the contact many.
-    let first = r.harmonics[0];
-    let most = *r.harmonics.iter().max().unwrap();
+    let first = r.harmonics()[0];
+    let most = *r.harmonics().iter().max().unwrap();
     assert!(
-        r.contacts[0][0].force_mean == 0.0,
+        r.points[0].contacts[0].force_mean == 0.0,
         "no contact at 0.8 omega_1"
     );
-    assert!(most >= 4 * first, "harmonics {:?}", r.harmonics);
+    assert!(most >= 4 * first, "harmonics {:?}", r.harmonics());
 
     // Each point against SSN-HB at H = 160 taken up across the branch there (normal to
     // the sweep's secant): its distance (extremes relative to the reference's largest
@@ -64,9 +67,10 @@ fn every_point_of_an_adaptive_sweep_meets_its_target_against_the_refined_branch(
     };
     let mut worst = 0.0f64;
     let mut unreferenced = Vec::new();
-    for i in 0..r.points() {
+    for (i, p) in r.points.iter().enumerate() {
         let direction = secant(&r, i, dofs, contacts);
-        let point = (r.states[i].as_slice(), r.omega[i], r.harmonics[i]);
+        let h = p.harmonics.expect("a harmonic-balance point");
+        let point = (p.state.as_slice(), p.omega, h);
         let Some((state, omega)) = take_up(&rod, &refined, &sweep, point, &direction, REFINED)?
         else {
             unreferenced.push(i);
@@ -78,14 +82,14 @@ fn every_point_of_an_adaptive_sweep_meets_its_target_against_the_refined_branch(
             "point {i}: the reference solves again"
         );
         let (max, min) = (reference.stats.max, reference.stats.min);
-        let error = point_distance((r.tip_max[i], r.tip_min[i], r.omega[i]), (max, min, omega));
+        let error = point_distance((p.observed_max, p.observed_min, p.omega), (max, min, omega));
         worst = worst.max(error);
-        let estimate = accuracy.estimates[i];
+        let estimate = p.error_estimate;
         assert!(
             error <= target,
             "point {i} at {} omega_1, H = {}: error {error:e}, estimate {estimate:?}",
-            r.omega[i] / rod.omega_1,
-            r.harmonics[i],
+            p.omega / rod.omega_1,
+            h,
         );
         // Below a hundredth of the target both numbers are round-off and the extremes'
         // sampling on two time grids (about 1e-6).
@@ -104,7 +108,7 @@ fn every_point_of_an_adaptive_sweep_meets_its_target_against_the_refined_branch(
     println!(
         "worst error {worst:e} over {} points (no reference at {unreferenced:?}), harmonics \
          {first} to {most}",
-        r.points()
+        r.points.len()
     );
     Ok(())
 }

@@ -28,7 +28,7 @@ fn chain_with_a_stop_on_its_mass_has_the_two_folds_of_the_resolved_response_at_e
     let resolved = folds(&reference);
     println!(
         "H = 40: {} points, folds {resolved:?}, {} corner reversals",
-        reference.points(),
+        reference.points.len(),
         reference.corner_folds.len()
     );
     assert!(reference.converged(), "{:?}", reference.termination);
@@ -40,12 +40,12 @@ fn chain_with_a_stop_on_its_mass_has_the_two_folds_of_the_resolved_response_at_e
         let f = folds(&r);
         println!(
             "H = {h}: {} points, folds {f:?}, {} corner reversals",
-            r.points(),
+            r.points.len(),
             r.corner_folds.len()
         );
         // The whole range, passing every corner.
         assert!(r.converged(), "H = {h}: {:?}", r.termination);
-        let last = r.omega.last().unwrap() / w1;
+        let last = r.points.last().unwrap().omega / w1;
         assert!((last - 3.0).abs() < 1e-12, "H = {h} ends at {last}");
         // The branch turns back by 2e-3 to 3.4e-3 omega_1 several times below the
         // resonance at H = 10 and 20 (zigzags of the truncated balance, gone at H = 40):

@@ -78,21 +78,27 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
     let w1 = structure.omega_1;
     assert_eq!(r.fold_indices.len(), 2, "folds {:?}", r.folds);
     let (upper, lower) = (r.fold_indices[0], r.fold_indices[1]);
+    // The multipliers of point i, computed again from its state.
+    let multipliers_at = |i: usize| {
+        let p = &r.points[i];
+        hb_stability(&structure.model, &settings, p.omega, &p.state).unwrap()
+    };
     // Every point between the folds is unstable in the sweep, and its own multipliers have
     // a real one above 1 wherever the branch is 5e-3 omega_1 (the fold excursion) below the
     // upper fold: nearer, the multiplier crosses 1 within the truncation error of the fold
     // (measured at 1.2648 against the fold at 1.2667) and the sweep places it by the fold.
     for i in upper + 1..lower {
-        assert_eq!(r.stability.stable[i], Some(false), "point {i} in the sweep");
-        if r.omega[i] > r.folds[0] - 5e-3 * w1 {
+        let stable = r.points[i].stability.stable;
+        assert_eq!(stable, Some(false), "point {i} in the sweep");
+        if r.points[i].omega > r.folds[0] - 5e-3 * w1 {
             continue;
         }
-        let s = hb_stability(&structure.model, &settings, r.omega[i], &r.states[i]).unwrap();
+        let s = multipliers_at(i);
         let (re, im) = s.dominant().unwrap();
         assert!(
             s.stable == Some(false) && re > 1.0 && im == 0.0,
             "point {i} at {}: {:?}",
-            r.omega[i] / w1,
+            r.points[i].omega / w1,
             s.multipliers
         );
     }
@@ -103,10 +109,10 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
     // truncated one, and its first impacts are first order in the step; 15 % bounds both).
     for k in [2, 3, 4] {
         let i = upper + k * (lower - upper) / 6;
-        let omega = r.omega[i];
-        let s = hb_stability(&structure.model, &settings, omega, &r.states[i]).unwrap();
+        let omega = r.points[i].omega;
+        let s = multipliers_at(i);
         let mu = s.floquet_max_abs.unwrap();
-        let (changes, excursions) = march_from_orbit(&structure, h, omega, &r.states[i], 30);
+        let (changes, excursions) = march_from_orbit(&structure, h, omega, &r.points[i].state, 30);
         let growth = (changes[2] / changes[0]).sqrt();
         println!(
             "unstable point {i} at {:.4}: mu {mu:.3}, growth {growth:.3}, excursion {:.3}",
@@ -120,18 +126,18 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
     }
     // Stable points of the upper branch below its fold: the march settles near the orbit.
     let stable: Vec<usize> = (upper - 45..upper - 3)
-        .filter(|&i| r.stability.stable[i] == Some(true))
+        .filter(|&i| r.points[i].stability.stable == Some(true))
         .step_by(6)
         .collect();
     assert!(stable.len() >= 3, "{stable:?}");
     for i in stable {
-        let omega = r.omega[i];
-        let (changes, excursions) = march_from_orbit(&structure, h, omega, &r.states[i], 30);
+        let omega = r.points[i].omega;
+        let (changes, excursions) = march_from_orbit(&structure, h, omega, &r.points[i].state, 30);
         let farthest = excursions.iter().fold(0.0f64, |a, e| a.max(*e));
         println!(
             "stable point {i} at {:.4}: mu {:.3}, changes {:.1e} -> {:.1e}, farthest {farthest:.3}",
             omega / w1,
-            r.stability.floquet_max_abs[i].unwrap(),
+            r.points[i].stability.floquet_max_abs.unwrap(),
             changes[0],
             changes[29],
         );
@@ -144,31 +150,25 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
     // sweep's events): the march from the orbit alternates and its change grows (measured
     // 5.5e-2 to 2.2e-1 in 20 periods at the most negative multiplier, -1.25).
     let flip = (0..upper)
-        .filter(|&i| r.stability.stable[i] == Some(false) && r.omega[i] > 1.1 * w1)
+        .filter(|&i| r.points[i].stability.stable == Some(false) && r.points[i].omega > 1.1 * w1)
         .min_by(|&a, &b| {
-            let re = |i: usize| {
-                hb_stability(&structure.model, &settings, r.omega[i], &r.states[i])
-                    .unwrap()
-                    .dominant()
-                    .unwrap()
-                    .0
-            };
+            let re = |i: usize| multipliers_at(i).dominant().unwrap().0;
             re(a).total_cmp(&re(b))
         })
         .unwrap();
-    let s = hb_stability(&structure.model, &settings, r.omega[flip], &r.states[flip]).unwrap();
+    let s = multipliers_at(flip);
     let (re, im) = s.dominant().unwrap();
     assert!(re < -1.1 && im == 0.0, "point {flip}: {:?}", s.multipliers);
-    let (changes, _) = march_from_orbit(&structure, h, r.omega[flip], &r.states[flip], 20);
+    let at_flip = &r.points[flip];
+    let (changes, _) = march_from_orbit(&structure, h, at_flip.omega, &at_flip.state, 20);
     println!(
         "period-doubling point {flip} at {:.4}: multiplier {re:.3}, changes {:.1e} -> {:.1e}",
-        r.omega[flip] / w1,
+        r.points[flip].omega / w1,
         changes[0],
         changes[19]
     );
     assert!(changes[19] > 2.0 * changes[0], "point {flip}: {changes:?}");
     let doubling = r
-        .stability
         .events
         .iter()
         .find(|e| e.kind == BifurcationKind::PeriodDoubling && e.index <= flip)
@@ -180,19 +180,19 @@ fn branch_between_the_folds_is_unstable_and_the_march_leaves_it_at_the_multiplie
     let i = doubling.index;
     let before = (0..i)
         .rev()
-        .find(|&j| r.stability.floquet_max_abs[j].is_some())
+        .find(|&j| r.points[j].stability.floquet_max_abs.is_some())
         .expect("a decided point before");
-    let distance = |j: usize| (r.omega[j] - doubling.omega).abs();
+    let distance = |j: usize| (r.points[j].omega - doubling.omega).abs();
     let round_off = 1e-12 * w1;
     assert!(distance(i) <= u + round_off && distance(before) <= u + round_off);
     assert!(
         (distance(i).max(distance(before)) - u).abs() <= round_off,
         "{doubling:?}"
     );
-    let modulus = |j: usize| r.stability.floquet_max_abs[j].unwrap();
+    let modulus = |j: usize| r.points[j].stability.floquet_max_abs.unwrap();
     assert!(
         (modulus(before) - 1.0) * (modulus(i) - 1.0) <= 0.0
-            || r.stability.stable[before] != r.stability.stable[i],
+            || r.points[before].stability.stable != r.points[i].stability.stable,
         "{doubling:?}: {} and {}",
         modulus(before),
         modulus(i)

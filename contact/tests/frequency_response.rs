@@ -46,7 +46,7 @@ fn linear_curve_equals_the_exact_frequency_response_at_every_branch_point() {
     assert!(r.converged(), "{}", r.termination);
     let n = rod.model.dofs();
     let tip = rod.tip_dof();
-    assert!(r.points() > 20);
+    assert!(r.points.len() > 20);
     assert!(
         r.folds.is_empty(),
         "a linear response has no fold: {:?}",
@@ -54,8 +54,8 @@ fn linear_curve_equals_the_exact_frequency_response_at_every_branch_point() {
     );
     // Reconstruction on `points` samples sees the peak of a sinusoid up to 1 - cos(pi/points).
     let sampling = 1.0 - (std::f64::consts::PI / r.output_points as f64).cos();
-    for (i, x) in r.states.iter().enumerate() {
-        let w = r.omega[i];
+    for (i, x) in r.points.iter().map(|p| &p.state).enumerate() {
+        let w = r.points[i].omega;
         let z = exact_linear(&rod.model, w);
         let scale = z.iter().map(|c| c.norm()).fold(0.0, f64::max);
         let mut err: f64 = 0.0;
@@ -72,19 +72,22 @@ fn linear_curve_equals_the_exact_frequency_response_at_every_branch_point() {
         assert!(err <= 1e-9 * scale, "w = {w}: error {err:e} vs {scale:e}");
         let exact = z[tip].norm();
         assert!(
-            (r.amplitude[i] - exact).abs() <= (sampling + 1e-9) * exact,
+            (r.points[i].amplitude - exact).abs() <= (sampling + 1e-9) * exact,
             "w = {w}: amplitude {} vs {exact}",
-            r.amplitude[i]
+            r.points[i].amplitude
         );
-        assert!((r.tip_max[i] + r.tip_min[i]).abs() <= (sampling + 1e-9) * exact);
+        assert!(
+            (r.points[i].observed_max + r.points[i].observed_min).abs()
+                <= (sampling + 1e-9) * exact
+        );
     }
     // The peak sits at the first resonance (zeta = 0.01: within 1e-3 of omega_1 with the
     // curve's resolution there).
     let (ip, _) = r.peak().unwrap();
     assert!(
-        (r.omega[ip] / rod.omega_1 - 1.0).abs() < 2e-3,
+        (r.points[ip].omega / rod.omega_1 - 1.0).abs() < 2e-3,
         "{}",
-        r.omega[ip] / rod.omega_1
+        r.points[ip].omega / rod.omega_1
     );
 }
 
@@ -98,7 +101,7 @@ fn contact_stiffens_the_resonance_bounds_the_peak_and_passes_folds() {
         let contact = curve(&rod, Method::SsnHb, h, 0.5, 2.0);
         let (il, linear_peak) = linear.peak().unwrap();
         let (ic, contact_peak) = contact.peak().unwrap();
-        let (wl, wc) = (linear.omega[il], contact.omega[ic]);
+        let (wl, wc) = (linear.points[il].omega, contact.points[ic].omega);
         println!(
             "{mass:?}: linear peak {linear_peak} at {}, contact peak {contact_peak} at {}, folds {:?}",
             wl / rod.omega_1,
@@ -112,19 +115,19 @@ fn contact_stiffens_the_resonance_bounds_the_peak_and_passes_folds() {
         assert!(!contact.folds.is_empty(), "{mass:?}");
         assert_eq!(contact.folds.len() % 2, 0, "{mass:?}");
         let fold_index = contact.fold_indices[0];
-        let before = contact.omega[fold_index] - contact.omega[fold_index - 1];
-        let after = contact.omega[fold_index + 1] - contact.omega[fold_index];
+        let before = contact.points[fold_index].omega - contact.points[fold_index - 1].omega;
+        let after = contact.points[fold_index + 1].omega - contact.points[fold_index].omega;
         assert!(
             before > 0.0 && after < 0.0,
             "{mass:?}: omega reverses at the first fold"
         );
-        assert!((contact.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
+        assert!((contact.points.last().unwrap().omega / rod.omega_1 - 2.0).abs() < 1e-12);
         // The tip stays behind the gap up to the resolution of the discretised contact law:
         // SSN-HB imposes it on the Galerkin projection onto 2H+1 harmonics (not sample by
         // sample), so the excess is a truncation effect that must shrink as H grows, and at
         // H = 5 stays a small fraction of the gap (5 % with the default c = 10 x static).
         let excess = |r: &FrequencyResponse| {
-            r.tip_max
+            r.column(|p| p.observed_max)
                 .iter()
                 .map(|m| m - gap)
                 .fold(f64::NEG_INFINITY, f64::max)
@@ -153,19 +156,19 @@ fn every_branch_point_is_a_fixed_point_of_plain_newton() {
         let mut solver = StructuredHbSolver::new();
         let newton = common::plain_newton();
         let mut worst: f64 = 0.0;
-        for (i, x0) in r.states.iter().enumerate() {
-            problem.set_parameter(r.omega[i]);
+        for (i, x0) in r.points.iter().map(|p| &p.state).enumerate() {
+            problem.set_parameter(r.points[i].omega);
             let mut x = x0.clone();
-            let what = format!("w = {}", r.omega[i]);
+            let what = format!("w = {}", r.points[i].omega);
             common::newton_converged(&what, &mut problem, &mut solver, &mut x, (&newton, None));
             let dx: Vec<f64> = x.iter().zip(x0).map(|(a, b)| a - b).collect();
             let moved = norm(&dx) / norm(x0);
             worst = worst.max(moved);
-            assert!(moved <= 1e-8, "w = {}: moved {moved:e}", r.omega[i]);
+            assert!(moved <= 1e-8, "w = {}: moved {moved:e}", r.points[i].omega);
         }
         println!(
             "gap {gap}, p0 {amplitude}, {mass:?}: {} points, {} folds, largest relative move {worst:e}",
-            r.points(),
+            r.points.len(),
             r.folds.len()
         );
     }
@@ -191,7 +194,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
         .map(|i| (w0 + dw * i as f64) * rod.omega_1)
         .collect();
     // Globalized Newton from the previous point, as a user stepping in omega would.
-    let sweep = natural_sweep(&mut problem, &arc.states[0], &omegas, |p, x| {
+    let sweep = natural_sweep(&mut problem, &arc.points[0].state, &omegas, |p, x| {
         newton.solve_smoothing(p, &mut solver, x)
     })
     .unwrap();
@@ -206,7 +209,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
         .map(|(i, p)| (i, (p[1] - p[0]).abs()))
         .fold((0, 0.0), |b, (i, d)| if d > b.1 { (i, d) } else { b });
     // Largest change between consecutive arclength points: the branch has no jump.
-    let arc_first: Vec<f64> = arc.states.iter().map(|x| amplitude(x)).collect();
+    let arc_first: Vec<f64> = arc.points.iter().map(|p| amplitude(&p.state)).collect();
     let arc_variation = arc_first
         .windows(2)
         .map(|p| (p[1] - p[0]).abs())
@@ -250,7 +253,7 @@ fn natural_sweep_jumps_at_the_fold_that_arclength_follows() {
             );
         }
     }
-    assert!((arc.omega.last().unwrap() / rod.omega_1 - 1.2).abs() < 1e-12);
+    assert!((arc.points.last().unwrap().omega / rod.omega_1 - 1.2).abs() < 1e-12);
 }
 
 /// The frequency where the branch turns back last (the jump-down frequency of an upward
@@ -273,12 +276,12 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
         let s = settings(Method::PenaltyHb, h);
         let r = frequency_response(&rod, &s, &sweep(0.5, 2.0), None).unwrap();
         assert!(r.converged(), "gap {gap}, H = {h}: {}", r.termination);
-        assert!((r.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
+        assert!((r.points.last().unwrap().omega / rod.omega_1 - 2.0).abs() < 1e-12);
         let (fold, peak) = jump_down_and_peak(&r);
         println!(
             "gap {gap}, H = {h}: {} points, {} corners, {} folds, {} corner reversals, jump-down \
              {fold}, peak {peak}, {} factorizations, {:.3} s",
-            r.points(),
+            r.points.len(),
             r.corners,
             r.folds.len(),
             r.corner_folds.len(),
@@ -309,7 +312,7 @@ fn penalty_sweep_at_the_default_penalty_crosses_its_corner_folds_to_the_end() {
             .tolerance
             .max(f64::EPSILON * kp * gap.max(r.reference_amplitude));
         let (mut worst_f, mut worst_step): (f64, f64) = (0.0, 0.0);
-        for (x, &w) in r.states.iter().zip(&r.omega) {
+        for (x, w) in r.points.iter().map(|p| (&p.state, p.omega)) {
             problem.set_parameter(w);
             problem.residual(x, &mut f).unwrap();
             let fnorm = norm(&f);
@@ -348,7 +351,7 @@ fn penalty_folds_do_not_depend_on_the_continuation_step() {
     let fine = frequency_response(&rod, &s, &fine_steps, None).unwrap();
     assert!(coarse.converged(), "{}", coarse.termination);
     assert!(fine.converged(), "{}", fine.termination);
-    assert!(fine.points() > 10 * coarse.points());
+    assert!(fine.points.len() > 10 * coarse.points.len());
     assert_eq!(coarse.folds.len(), fine.folds.len());
     let worst = coarse
         .folds
@@ -359,8 +362,8 @@ fn penalty_folds_do_not_depend_on_the_continuation_step() {
     println!(
         "{} folds, {} and {} points: largest difference {worst:e} omega_1",
         coarse.folds.len(),
-        coarse.points(),
-        fine.points()
+        coarse.points.len(),
+        fine.points.len()
     );
     // Corners are located to 1e-10 omega (or the rounding of a slowly crossing gap).
     assert!(worst < 1e-8, "{worst:e}");

@@ -137,7 +137,7 @@ fn regularised_friction_approaches_the_exact_law_as_its_width_shrinks() {
         ("gross slip", oscillator(0.02, 0.3), 0.7, 40),
     ] {
         let exact = solve(&structure, w, hb(Method::SsnHb, h));
-        let reference = common::first_harmonic(&exact.tip);
+        let reference = common::first_harmonic(&exact.observed);
         let errors: Vec<f64> = widths
             .iter()
             .map(|&width| {
@@ -149,7 +149,7 @@ fn regularised_friction_approaches_the_exact_law_as_its_width_shrinks() {
                 // The regularised force never exceeds mu N (tanh < 1).
                 let f = &s.friction[0].summary;
                 assert!(f.force_amplitude <= f.slip_limit_max, "{f:?}");
-                (common::first_harmonic(&s.tip) - reference).abs() / reference
+                (common::first_harmonic(&s.observed) - reference).abs() / reference
             })
             .collect();
         let rates: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log10()).collect();

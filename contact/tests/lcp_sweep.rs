@@ -63,7 +63,7 @@ fn lcp_ssn_branch_passes_the_overhang_and_converges_to_the_ssn_hb_branch_at_seco
     let fine = lcp_branch(256);
     for (nt, r) in [(128, coarse), (256, fine)] {
         assert!(r.converged(), "Nt = {nt}: {}", r.termination);
-        assert!((r.omega.last().unwrap() / rod.omega_1 - 2.0).abs() < 1e-12);
+        assert!((r.points.last().unwrap().omega / rod.omega_1 - 2.0).abs() < 1e-12);
         // The branch turns back at least once and ends going up: an even number of folds.
         assert!(r.folds.len() >= 2, "Nt = {nt}: {:?}", r.folds);
         assert_eq!(r.folds.len() % 2, 0, "Nt = {nt}");
@@ -71,8 +71,9 @@ fn lcp_ssn_branch_passes_the_overhang_and_converges_to_the_ssn_hb_branch_at_seco
         // the LCP's tip never passes the gap (w >= 0 node by node).
         let gap = 0.5;
         let excess = r
-            .tip_max
+            .points
             .iter()
+            .map(|p| p.observed_max)
             .fold(f64::NEG_INFINITY, |m, t| m.max(t - gap));
         assert!(
             excess <= 1e-9,
@@ -139,12 +140,12 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
     let newton = common::plain_newton();
     let mut worst: f64 = 0.0;
     let mut worst_gap: f64 = 0.0;
-    for (i, y) in r.states.iter().enumerate() {
+    for (i, y) in r.points.iter().map(|p| &p.state).enumerate() {
         let options = PeriodicLcpOptions {
             time_samples: 128,
             ..Default::default()
         };
-        let lcp = PeriodicLcp::new(&rod.model, r.omega[i], options).unwrap();
+        let lcp = PeriodicLcp::new(&rod.model, r.points[i].omega, options).unwrap();
         let n = lcp.dim();
         assert_eq!(y.len(), 2 * n);
         let (w, z0) = y.split_at(n);
@@ -157,11 +158,15 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         worst_gap = worst_gap.max(dw / scale);
         // Corrector tolerance 1e-11 on |F|, entries of A of order 1: 1e-10 relative.
-        assert!(dw <= 1e-10 * scale, "w = {}: gap off by {dw:e}", r.omega[i]);
+        assert!(
+            dw <= 1e-10 * scale,
+            "w = {}: gap off by {dw:e}",
+            r.points[i].omega
+        );
         let mut z = z0.to_vec();
         let mut problem = lcp.min_map();
         let mut solver = ActiveSetSolver::new().without_regularization();
-        let what = format!("w = {}", r.omega[i]);
+        let what = format!("w = {}", r.points[i].omega);
         common::newton_converged(&what, &mut problem, &mut solver, &mut z, (&newton, None));
         let moved: f64 = z
             .iter()
@@ -177,13 +182,13 @@ fn every_lcp_ssn_branch_point_is_a_fixed_point_of_min_map_newton() {
         assert!(
             moved <= 1e-8 * size || moved <= 1e-14,
             "w = {}: moved {moved:e} (|z| = {size:e})",
-            r.omega[i]
+            r.points[i].omega
         );
     }
     println!(
         "{} points: largest relative move of z {worst:e}, largest relative gap mismatch \
          {worst_gap:e}",
-        r.points()
+        r.points.len()
     );
 }
 
@@ -211,7 +216,7 @@ fn lcp_ssn_sweep_that_cannot_turn_a_corner_stops_with_a_reason_instead_of_going_
     let r = sweep_fig2_interval(&rod, &settings(Method::LcpSsn, 5, 128)).unwrap();
     println!(
         "{} points, last ratio {:.6}: {}",
-        r.points(),
+        r.points.len(),
         r.omega_ratio().last().copied().unwrap_or(f64::NAN),
         r.termination
     );
@@ -237,6 +242,6 @@ fn lcp_ssn_sweep_that_cannot_turn_a_corner_stops_with_a_reason_instead_of_going_
     // The contact is active there (the stall is at a corner of the contact branch, past
     // the onset): the tip's maximum over the nodes is the gap (`u_tip = g - w`, `w = 0` at
     // a node in contact), to the corrector's tolerance.
-    let tip_max = *r.tip_max.last().unwrap();
+    let tip_max = r.points.last().unwrap().observed_max;
     assert!((tip_max - 0.5).abs() < 1e-9, "{tip_max}");
 }

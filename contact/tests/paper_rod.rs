@@ -58,7 +58,7 @@ fn without_contact_the_hb_answer_is_the_exact_linear_response_after_one_newton_s
         let exact = exact_linear_tip(&spec, &s.times);
         let scale = exact.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let error = s
-            .tip
+            .observed
             .iter()
             .zip(&exact)
             .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
@@ -133,7 +133,7 @@ fn modified_mass_hb_converges_to_the_time_marching_reference() {
     for h in [10, 20, 40] {
         let s = solve_converged(&rod, &SolverSettings::with_harmonics(h));
         let e_min = relative(s.stats.min, fine.stats.min);
-        let e_rms = relative(rms(&s.tip), rms(&fine.tip));
+        let e_rms = relative(rms(&s.observed), rms(&fine.observed));
         let e_force = relative(s.stats.mean_contact_force, fine.stats.mean_contact_force);
         // The fraction of the period in contact: SSN-HB's is the measure of its contact
         // law's active set, the march's that of its compressive samples.

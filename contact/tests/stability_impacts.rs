@@ -118,12 +118,12 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
     };
     let mut checked = 0;
     for i in (upper_fold / 2..upper_fold).step_by(16) {
-        let omega = r.omega[i];
-        let s = hb_stability(&rod.model, &settings, omega, &r.states[i]).unwrap();
+        let omega = r.points[i].omega;
+        let s = hb_stability(&rod.model, &settings, omega, &r.points[i].state).unwrap();
         assert!(s.closings > 0, "point {i} at {}: no contact", omega / w1);
         assert_eq!(s.stable, Some(true), "point {i} at {}", omega / w1);
         let mu = s.floquet_max_abs.unwrap();
-        let mut marcher = marcher_from_orbit(&rod, h, omega, &r.states[i], 0.0, STEPS);
+        let mut marcher = marcher_from_orbit(&rod, h, omega, &r.points[i].state, 0.0, STEPS);
         let settle = changes(&mut marcher, omega, STEPS, 200);
         let mut start = marcher.state();
         let settled = settle[199] < 1e-9;
@@ -160,11 +160,11 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
     // multiplier (the orbits differ by about 1e-2, so the growth is fitted from the start;
     // measured 1.0265 against |mu| 1.0859).
     let i = (upper_fold + lower_fold) / 2;
-    let omega = r.omega[i];
-    let s = hb_stability(&rod.model, &settings, omega, &r.states[i]).unwrap();
+    let omega = r.points[i].omega;
+    let s = hb_stability(&rod.model, &settings, omega, &r.points[i].state).unwrap();
     assert_eq!(s.stable, Some(false), "point {i} at {}", omega / w1);
     let mu = s.floquet_max_abs.unwrap();
-    let mut marcher = marcher_from_orbit(&rod, h, omega, &r.states[i], 1e-8, STEPS);
+    let mut marcher = marcher_from_orbit(&rod, h, omega, &r.points[i].state, 1e-8, STEPS);
     let growth = changes(&mut marcher, omega, STEPS, 12);
     let rate = fitted_rate(&growth, 1, 12);
     println!(

@@ -57,14 +57,15 @@ impl Stored {
 }
 
 /// Rows as a row-major array `(rows, columns)`.
-fn matrix(name: &str, rows: &[Vec<f64>]) -> (String, Vec<usize>, Vec<f64>) {
+fn matrix<R: AsRef<[f64]>>(name: &str, rows: &[R]) -> (String, Vec<usize>, Vec<f64>) {
     // Rows of different lengths (a branch whose harmonics change from point to point)
     // are padded with NaN to the longest.
-    let columns = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let columns = rows.iter().map(|r| r.as_ref().len()).max().unwrap_or(0);
     let values: Vec<f64> = rows
         .iter()
         .flat_map(|r| {
-            r.iter()
+            r.as_ref()
+                .iter()
                 .copied()
                 .chain(std::iter::repeat(f64::NAN))
                 .take(columns)
@@ -125,7 +126,7 @@ impl Solution {
             stored: Stored {
                 arrays: vec![
                     vector("times", &s.times),
-                    vector("displacement", &s.tip),
+                    vector("displacement", &s.observed),
                     matrix("contact_forces", &s.contact_forces),
                     vector("state", &s.state),
                     vector("observed_dof", &[structure.observed_dof as f64]),
@@ -243,20 +244,23 @@ pub struct FrequencyResponse {
 
 impl FrequencyResponse {
     pub fn new(r: &LibResponse) -> FrequencyResponse {
-        let (stable, floquet) = ssn::output::stability_numbers(&r.stability);
+        let (stable, floquet) = ssn::output::stability_numbers(r);
         FrequencyResponse {
             converged: r.converged(),
             stored: Stored {
                 doc: ssn::json::response_json(r),
                 arrays: vec![
-                    vector("omega", &r.omega),
+                    vector("omega", &r.omegas()),
                     vector("omega_ratio", &r.omega_ratio()),
-                    vector("tip_max", &r.tip_max),
-                    vector("tip_min", &r.tip_min),
-                    vector("amplitude", &r.amplitude),
+                    vector("tip_max", &r.column(|p| p.observed_max)),
+                    vector("tip_min", &r.column(|p| p.observed_min)),
+                    vector("amplitude", &r.amplitudes()),
                     vector("stable", &stable),
                     vector("floquet_max_abs", &floquet),
-                    matrix("states", &r.states),
+                    matrix(
+                        "states",
+                        &r.points.iter().map(|p| &p.state).collect::<Vec<_>>(),
+                    ),
                 ],
             },
         }
@@ -351,7 +355,7 @@ impl SolutionSet {
         let tips: Vec<Vec<f64>> = set
             .solutions
             .iter()
-            .map(|s| s.solution.tip.clone())
+            .map(|s| s.solution.observed.clone())
             .collect();
         let doc = ssn::solutions::document(set);
         SolutionSet {

@@ -65,9 +65,9 @@ fn compare(mass: MassModel, out: &std::path::Path) -> Result<(), Box<dyn std::er
                 let period = 2.0 * std::f64::consts::PI / s.omega;
                 let phase = s.times.iter().map(|t| t / period).collect();
                 let item = if row.label.starts_with("march") {
-                    Series::dashed(row.label.clone(), phase, s.tip.clone())
+                    Series::dashed(row.label.clone(), phase, s.observed.clone())
                 } else {
-                    Series::new(row.label.clone(), phase, s.tip.clone())
+                    Series::new(row.label.clone(), phase, s.observed.clone())
                 };
                 series.push(item);
             }

@@ -52,12 +52,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         println!(
             "{label:<16} {:>7} {:>9} {:>6} {:>9.3} {:>12.7} {:>10.6}  {:?}",
-            r.points(),
+            r.points.len(),
             r.converged(),
             r.restarts,
             r.solve_seconds,
             peak,
-            r.omega[ip] / rod.omega_1,
+            r.points[ip].omega / rod.omega_1,
             (
                 r.folds.len(),
                 r.folds.iter().copied().fold(f64::INFINITY, f64::min) / rod.omega_1,

@@ -85,10 +85,12 @@ fn print_row(c: &Curve) {
         "{:<12} {:>3} {:>6} {:>6} {:>9.5} {:>9.4} {:>8.4} {:>6} {:>7} {:>6}  [{}] {}",
         c.name,
         c.harmonics,
-        r.points(),
+        r.points.len(),
         r.folds.len(),
         peak,
-        r.omega.get(peak_i).map_or(f64::NAN, |w| w / r.omega_1),
+        r.points
+            .get(peak_i)
+            .map_or(f64::NAN, |p| p.omega / r.omega_1),
         c.seconds,
         r.continuation.corrector_iterations,
         r.continuation.rejected_steps,
@@ -146,15 +148,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut csv = String::from("curve,harmonics,omega_ratio,tip_max,tip_min,amplitude\n");
     for c in &curves {
         let r = &c.response;
-        for i in 0..r.points() {
+        for i in 0..r.points.len() {
             csv.push_str(&format!(
                 "{},{},{:e},{:e},{:e},{:e}\n",
                 c.name,
                 c.harmonics,
-                r.omega[i] / r.omega_1,
-                r.tip_max[i],
-                r.tip_min[i],
-                r.amplitude[i]
+                r.points[i].omega / r.omega_1,
+                r.points[i].observed_max,
+                r.points[i].observed_min,
+                r.points[i].amplitude
             ));
         }
     }
@@ -166,12 +168,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             series.push(Series::new(
                 format!("{}: max u_tip", c.name),
                 r.omega_ratio(),
-                r.tip_max.clone(),
+                r.column(|p| p.observed_max),
             ));
             series.push(Series::dashed(
                 format!("{}: max |u_tip|", c.name),
                 r.omega_ratio(),
-                r.amplitude.clone(),
+                r.column(|p| p.amplitude),
             ));
         }
         let spec = PlotSpec {

@@ -33,6 +33,15 @@ const HARMONICS: [usize; 2] = [5, 20];
 /// LCP time nodes per period.
 const LCP_NODES: usize = 512;
 
+/// The largest finite value of `values`, at least 0 (undecided points carry NaN).
+fn largest_finite(values: &[f64]) -> f64 {
+    values
+        .iter()
+        .copied()
+        .filter(|p| p.is_finite())
+        .fold(0.0f64, f64::max)
+}
+
 fn main() {
     println!(
         "Strange loops: SSN-HB frequency responses of the rod (modified mass, p0 = 0.04) at \
@@ -54,16 +63,12 @@ fn main() {
             let r = frequency_response(&rod, &settings, &SweepSettings::new(0.5, 2.0), None)
                 .expect("sweep");
             let w1 = rod.omega_1;
-            let penetration = &r.stability.max_penetration;
-            let max_pen = penetration
-                .iter()
-                .copied()
-                .filter(|p| p.is_finite())
-                .fold(0.0f64, f64::max);
+            let penetration = r.column(|p| p.stability.max_penetration);
+            let max_pen = largest_finite(&penetration);
             let folds: Vec<String> = r.folds.iter().map(|w| format!("{:.4}", w / w1)).collect();
             println!(
                 "{h:>3} {gap:>6} {:>6} {:>7} {max_pen:>9.2e} {:>10.3}  {}{}",
-                r.points(),
+                r.points.len(),
                 r.corner_folds.len(),
                 max_pen / gap,
                 if folds.is_empty() {
@@ -81,23 +86,21 @@ fn main() {
                 let (a, b) = (r.fold_indices[k - 1], r.fold_indices[k]);
                 let target = 0.5 * (r.folds[k - 1] + r.folds[k]);
                 // HB amplitudes where the branch crosses w* (linear interpolation).
-                let crossings: Vec<f64> = (1..r.points())
-                    .filter(|&i| (r.omega[i - 1] - target) * (r.omega[i] - target) <= 0.0)
-                    .map(|i| {
-                        let (w0, w1p) = (r.omega[i - 1], r.omega[i]);
+                let crossings: Vec<f64> = r
+                    .points
+                    .windows(2)
+                    .filter(|p| (p[0].omega - target) * (p[1].omega - target) <= 0.0)
+                    .map(|p| {
+                        let (w0, w1p) = (p[0].omega, p[1].omega);
                         let t = if w1p != w0 {
                             (target - w0) / (w1p - w0)
                         } else {
                             0.0
                         };
-                        r.amplitude[i - 1] + t * (r.amplitude[i] - r.amplitude[i - 1])
+                        p[0].amplitude + t * (p[1].amplitude - p[0].amplitude)
                     })
                     .collect();
-                let between = penetration[a.min(b)..=a.max(b)]
-                    .iter()
-                    .copied()
-                    .filter(|p| p.is_finite())
-                    .fold(0.0f64, f64::max);
+                let between = largest_finite(&penetration[a.min(b)..=a.max(b)]);
                 intervals.push((h, gap, target / w1, crossings, between, rod.clone()));
             }
         }

@@ -510,7 +510,7 @@ fn reference(
                 "time marching, {REFERENCE_STEPS} steps per period, period-to-period tolerance {tolerance:e}"
             ),
             tip_min,
-            tip_rms: rms(&fine.tip),
+            tip_rms: rms(&fine.observed),
             mean_force: fine.stats.mean_contact_force,
             uncertainty: relative(half.stats.min, tip_min),
             cross_check: hb.as_ref().map(|s| relative(s.stats.min, tip_min)),
@@ -545,7 +545,7 @@ fn reference(
             "SSN-HB, {h_fine} harmonics (time marching reached no steady state; uncertainty against H = {h_half})"
         ),
         tip_min,
-        tip_rms: rms(&fine.tip),
+        tip_rms: rms(&fine.observed),
         mean_force: fine.stats.mean_contact_force,
         uncertainty: relative(half.stats.min, tip_min),
         cross_check: None,
@@ -605,7 +605,7 @@ pub fn accuracy_cost(
                     rod, omega, &settings, &sol,
                 )
                 .map_or(f64::NAN, |e| e.parts.displacement_min),
-                tip_rms_error: relative(rms(&sol.tip), reference.tip_rms),
+                tip_rms_error: relative(rms(&sol.observed), reference.tip_rms),
                 // Only with a nonzero reference force (a relative error of 0 is meaningless).
                 mean_force_error: (contact && reference.mean_force != 0.0)
                     .then(|| relative(sol.stats.mean_contact_force, reference.mean_force)),

@@ -196,35 +196,36 @@ pub fn compare_adaptive(
     say("adaptive sweep");
     let adaptive = frequency_response(rod, &settings, &sweep, None)?;
     let w1 = rod.omega_1;
+    let point_harmonics = adaptive.harmonics();
     say(&format!(
         "adaptive sweep: {} points, harmonics {:?}, {:.2} s, {}",
-        adaptive.points(),
-        adaptive.harmonics,
+        adaptive.points.len(),
+        point_harmonics,
         adaptive.solve_seconds,
         crate::words::sweep_termination(&adaptive)
     ));
     let reference_harmonics = REFERENCE_HARMONICS
-        .max(REFERENCE_RATIO * adaptive.harmonics.iter().copied().max().unwrap_or(0));
+        .max(REFERENCE_RATIO * point_harmonics.iter().copied().max().unwrap_or(0));
     say(&format!("references at {reference_harmonics} harmonics"));
     let (references, errors) = reference_points(rod, &sweep, &adaptive, reference_harmonics)?;
     let estimates: Vec<f64> = adaptive
         .accuracy
         .as_ref()
-        .map(|a| a.estimates.iter().map(|e| e.unwrap_or(f64::NAN)).collect())
+        .map(|_| adaptive.column(|p| p.error_estimate.unwrap_or(f64::NAN)))
         .unwrap_or_default();
     let harmonics = (
-        adaptive.harmonics.iter().copied().min().unwrap_or(0),
-        adaptive.harmonics.iter().copied().max().unwrap_or(0),
+        point_harmonics.iter().copied().min().unwrap_or(0),
+        point_harmonics.iter().copied().max().unwrap_or(0),
     );
     let mean_harmonics =
-        adaptive.harmonics.iter().sum::<usize>() as f64 / adaptive.points().max(1) as f64;
+        point_harmonics.iter().sum::<usize>() as f64 / adaptive.points.len().max(1) as f64;
     let mut comparison = AdaptiveComparison {
         target,
-        points: adaptive.points(),
+        points: adaptive.points.len(),
         converged: adaptive.converged(),
         termination: crate::words::sweep_termination(&adaptive),
         omega_ratio: adaptive.omega_ratio(),
-        point_harmonics: adaptive.harmonics.clone(),
+        point_harmonics,
         folds: adaptive.folds.iter().map(|w| w / w1).collect(),
         harmonics,
         mean_harmonics,
@@ -248,15 +249,15 @@ fn reference_points(
     reference_harmonics: usize,
 ) -> Result<(Vec<Option<Reference>>, Vec<f64>), RunError> {
     let (dofs, contacts) = (rod.model.dofs(), rod.model.contact_count());
-    let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points());
-    let mut errors = Vec::with_capacity(adaptive.points());
-    for i in 0..adaptive.points() {
-        let h = adaptive.harmonics[i];
+    let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points.len());
+    let mut errors = Vec::with_capacity(adaptive.points.len());
+    for (i, p) in adaptive.points.iter().enumerate() {
+        let h = p.harmonics.unwrap_or(0);
         let secant = secant(adaptive, i, dofs, contacts);
-        let point = (adaptive.states[i].as_slice(), adaptive.omega[i], h);
+        let point = (p.state.as_slice(), p.omega, h);
         match taken_up(rod, sweep, point, &secant, reference_harmonics)? {
             Some((state, (max, min, omega))) => {
-                let here = (adaptive.tip_max[i], adaptive.tip_min[i], adaptive.omega[i]);
+                let here = (p.observed_max, p.observed_min, p.omega);
                 errors.push(point_distance(here, (max, min, omega)));
                 let n = secant.len() - 1;
                 let mut lifted =
@@ -320,7 +321,7 @@ fn fixed_sweep(
             return Ok(Some(FixedSweep {
                 harmonics: h,
                 worst_error: fixed_worst,
-                points: fixed.points(),
+                points: fixed.points.len(),
                 folds: fixed.folds.iter().map(|w| w / rod.omega_1).collect(),
                 seconds: fixed.solve_seconds,
             }));

@@ -465,7 +465,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     )
     .map_err(|e| input_error(&args.scene, e))?;
     bar.finish_and_clear();
-    let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.tip];
+    let mut columns: Vec<&[f64]> = vec![&solution.times, &solution.observed];
     let mut headers = vec!["t".to_string(), "u_tip".to_string()];
     for (i, f) in solution.contact_forces.iter().enumerate() {
         columns.push(f);
@@ -506,7 +506,7 @@ fn solve_plot(solution: &Solution, rod: &Structure) -> Plot {
     let mut series = vec![Series::new(
         crate::words::describe_method(solution),
         t.clone(),
-        solution.tip.clone(),
+        solution.observed.clone(),
     )];
     series.extend(crate::figures::obstacle_lines(rod, 0.0, 1.0));
     Plot {
@@ -627,8 +627,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
     let (response, fold_accuracy) =
         run_sweep(&rod, &scene, &settings).map_err(|e| input_error(&args.scene, e))?;
     let ratio = response.omega_ratio();
-    let st = &response.stability;
-    let (stable, floquet) = crate::output::stability_numbers(st);
+    let (stable, floquet) = crate::output::stability_numbers(&response);
     let force_mean = response.contact_force_mean();
     let contact_columns = response.contact_columns();
     let mut headers = vec![
@@ -642,16 +641,22 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         "contact_force_mean",
         "max_penetration",
     ];
+    let points = &response.points;
+    let omega: Vec<f64> = points.iter().map(|p| p.omega).collect();
+    let observed_max: Vec<f64> = points.iter().map(|p| p.observed_max).collect();
+    let observed_min: Vec<f64> = points.iter().map(|p| p.observed_min).collect();
+    let amplitude = response.amplitudes();
+    let max_penetration: Vec<f64> = points.iter().map(|p| p.stability.max_penetration).collect();
     let mut columns: Vec<&[f64]> = vec![
-        &response.omega,
+        &omega,
         &ratio,
-        &response.tip_max,
-        &response.tip_min,
-        &response.amplitude,
+        &observed_max,
+        &observed_min,
+        &amplitude,
         &stable,
         &floquet,
         &force_mean,
-        &st.max_penetration,
+        &max_penetration,
     ];
     for (name, values) in &contact_columns {
         headers.push(name);
@@ -723,10 +728,8 @@ fn run_sweep(
 
 /// The SVG of a sweep: the amplitude against the frequency ratio `ratio`, by stability.
 fn sweep_plot(scene: &Scene, response: &FrequencyResponse, ratio: &[f64]) -> Plot {
-    let label = match (
-        response.harmonics.iter().min(),
-        response.harmonics.iter().max(),
-    ) {
+    let harmonics = response.harmonics();
+    let label = match (harmonics.iter().min(), harmonics.iter().max()) {
         (Some(lo), Some(hi)) if lo != hi => {
             format!("{} H = {lo} to {hi}", scene.solver.method.name())
         }
@@ -736,8 +739,8 @@ fn sweep_plot(scene: &Scene, response: &FrequencyResponse, ratio: &[f64]) -> Plo
             scene.solver.harmonics
         ),
     };
-    let stable = &response.stability.stable;
-    let mut series = stability_series(&label, 0, ratio, &response.amplitude, stable);
+    let stable = &response.stable();
+    let mut series = stability_series(&label, 0, ratio, &response.amplitudes(), stable);
     series.extend(stability_key(stable));
     Plot {
         untitled: "frequency response",

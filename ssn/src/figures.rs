@@ -112,10 +112,10 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
         series.push(Series::new(
             format!("SSN-HB H = {h}"),
             phase.clone(),
-            s.tip.clone(),
+            s.observed.clone(),
         ));
         csv_columns.push((format!("t_over_T_H{h}"), phase));
-        csv_columns.push((format!("u_tip_H{h}"), s.tip.clone()));
+        csv_columns.push((format!("u_tip_H{h}"), s.observed.clone()));
         rows.push(Fig1Row {
             mass,
             harmonics: Some(h),
@@ -132,10 +132,10 @@ pub fn figure_1(out: &Path, mass: MassModel) -> Result<Vec<Fig1Row>, CliError> {
     series.push(Series::dashed(
         "reference (time marching)",
         phase.clone(),
-        reference.tip.clone(),
+        reference.observed.clone(),
     ));
     csv_columns.push(("t_over_T_reference".into(), phase));
-    csv_columns.push(("u_tip_reference".into(), reference.tip.clone()));
+    csv_columns.push(("u_tip_reference".into(), reference.observed.clone()));
     rows.push(Fig1Row {
         mass,
         harmonics: None,
@@ -231,7 +231,7 @@ fn period_figures(
                 color,
             ));
         }
-        let u = &s.tip;
+        let u = &s.observed;
         let m = u.len();
         let dt = period / m as f64;
         let v: Vec<f64> = (0..m)
@@ -540,10 +540,11 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
             .peak()
             .map(|(i, a)| (a, ratio[i]))
             .unwrap_or((f64::NAN, f64::NAN));
-        let stable = &r.stability.stable;
+        let stable = &r.stable();
+        let amplitude = r.amplitudes();
         curves.push(Fig2Curve {
             gap,
-            points: r.points(),
+            points: r.points.len(),
             folds: r.folds.iter().map(|w| w / rod.omega_1).collect(),
             peak,
             seconds: r.solve_seconds + r.stability_seconds,
@@ -553,7 +554,7 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
         });
         let key = label.replace(' ', "_");
         columns.push((format!("omega_ratio_{key}"), ratio.clone()));
-        columns.push((format!("amplitude_{key}"), r.amplitude.clone()));
+        columns.push((format!("amplitude_{key}"), amplitude.clone()));
         columns.push((
             format!("stable_{key}"),
             stable
@@ -561,12 +562,12 @@ pub fn figure_2_curves(harmonics: usize, mass: MassModel) -> Result<Fig2, CliErr
                 .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
                 .collect(),
         ));
-        let mut pieces = stability_series(&label, k, &ratio, &r.amplitude, stable);
+        let mut pieces = stability_series(&label, k, &ratio, &amplitude, stable);
         if !r.fold_indices.is_empty() {
             let (x, y) = r
                 .fold_indices
                 .iter()
-                .map(|&i| (ratio[i], r.amplitude[i]))
+                .map(|&i| (ratio[i], amplitude[i]))
                 .unzip();
             pieces.push(Series::markers("", x, y).with_color(k));
             folds_marked = true;

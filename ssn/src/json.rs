@@ -11,7 +11,7 @@ use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummar
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
-use semismooth_contact::sweep::FrequencyResponse;
+use semismooth_contact::sweep::{FrequencyResponse, ResponsePoint};
 
 use crate::state::HbState;
 
@@ -167,8 +167,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
     ] {
         counters.insert(name.to_string(), value.into());
     }
-    let st = &r.stability;
-    let events: Vec<serde_json::Value> = st
+    let events: Vec<serde_json::Value> = r
         .events
         .iter()
         .map(|e| {
@@ -181,35 +180,35 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
             })
         })
         .collect();
+    let points = &r.points;
+    let column = |value: fn(&ResponsePoint) -> Value| points.iter().map(value).collect::<Vec<_>>();
+    // Without friction points the list is empty, not a list of empty lists.
+    let friction = if points.iter().all(|p| p.friction.is_empty()) {
+        Vec::new()
+    } else {
+        column(|p| {
+            p.friction
+                .iter()
+                .enumerate()
+                .map(|(f, s)| friction_summary_json(f, s))
+                .collect()
+        })
+    };
     let mut doc = json!({
-        "points": r.points(),
-        "omega": r.omega,
+        "points": points.len(),
+        "omega": column(|p| json!(p.omega)),
         "omega_ratio": r.omega_ratio(),
-        "tip_max": r.tip_max,
-        "tip_min": r.tip_min,
-        "amplitude": r.amplitude,
-        "stable": st.stable,
-        "floquet_max_abs": st.floquet_max_abs,
-        "placed_by_fold": st.placed_by_fold,
+        "tip_max": column(|p| json!(p.observed_max)),
+        "tip_min": column(|p| json!(p.observed_min)),
+        "amplitude": column(|p| json!(p.amplitude)),
+        "stable": column(|p| json!(p.stability.stable)),
+        "floquet_max_abs": column(|p| json!(p.stability.floquet_max_abs)),
+        "placed_by_fold": column(|p| json!(p.stability.placed_by_fold)),
         "contact_force_mean": r.contact_force_mean(),
-        "max_penetration": st.max_penetration,
-        "contacts": r
-            .contacts
-            .iter()
-            .map(|point| point.iter().map(contact_json).collect::<Vec<_>>())
-            .collect::<Vec<_>>(),
-        "friction": r
-            .friction
-            .iter()
-            .map(|point| {
-                point
-                    .iter()
-                    .enumerate()
-                    .map(|(f, s)| friction_summary_json(f, s))
-                    .collect::<Vec<_>>()
-            })
-            .collect::<Vec<_>>(),
-        "stability_note": st.undecided.as_ref().map(crate::words::undecided),
+        "max_penetration": column(|p| json!(p.stability.max_penetration)),
+        "contacts": column(|p| p.contacts.iter().map(contact_json).collect()),
+        "friction": friction,
+        "stability_note": r.undecided.as_ref().map(crate::words::undecided),
         "stability_seconds": r.stability_seconds,
         "events": events,
         "folds": r.folds,
@@ -219,19 +218,19 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "termination": crate::words::sweep_termination(r),
         "counters": counters,
     });
-    if !r.harmonics.is_empty() {
-        doc["harmonics"] = json!(r.harmonics);
-        doc["time_samples"] = json!(r.time_samples);
+    if r.is_harmonic_balance() {
+        doc["harmonics"] = json!(r.harmonics());
+        doc["time_samples"] = json!(r.time_samples());
     }
     if let Some(a) = &r.accuracy {
-        doc["error_estimate"] = json!(a.estimates);
+        doc["error_estimate"] = json!(column(|p| json!(p.error_estimate)));
         doc["accuracy"] = json!({
             "target": a.target,
             "basis": "the change of the observed extremes against H/2 solved from the truncated \
                       point, times 1/(2^p - 1) with p = HB_ORDER",
             "order": semismooth_contact::solve::accuracy::HB_ORDER,
-            "points_met": a.met(),
-            "worst_estimate": a.worst(),
+            "points_met": a.met(points),
+            "worst_estimate": r.worst_estimate(),
             "raises": a.raises,
             "lowers": a.lowers,
             "failed_raises": a.failed_raises,

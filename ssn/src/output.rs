@@ -146,18 +146,20 @@ pub fn stability_series(
 
 /// A branch's stability as numbers, one per point: `stable` 1 / 0 (NaN when undecided: an
 /// empty CSV cell) and the largest Floquet multiplier modulus (NaN when undecided).
-pub fn stability_numbers(st: &semismooth_contact::sweep::BranchStability) -> (Vec<f64>, Vec<f64>) {
-    let stable = st
-        .stable
+pub fn stability_numbers(
+    response: &semismooth_contact::sweep::FrequencyResponse,
+) -> (Vec<f64>, Vec<f64>) {
+    response
+        .points
         .iter()
-        .map(|s| s.map_or(f64::NAN, |b| f64::from(u8::from(b))))
-        .collect();
-    let floquet = st
-        .floquet_max_abs
-        .iter()
-        .map(|a| a.unwrap_or(f64::NAN))
-        .collect();
-    (stable, floquet)
+        .map(|p| {
+            let s = &p.stability;
+            (
+                s.stable.map_or(f64::NAN, |b| f64::from(u8::from(b))),
+                s.floquet_max_abs.unwrap_or(f64::NAN),
+            )
+        })
+        .unzip()
 }
 
 /// Legend entries in black for the stability styles that `stable` uses (no points):

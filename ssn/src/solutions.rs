@@ -88,7 +88,7 @@ fn svg_text(set: &SolutionSet, rod: &Structure) -> Result<String, crate::exit::C
             };
             Series {
                 style,
-                ..Series::new(label, t, s.solution.tip.clone())
+                ..Series::new(label, t, s.solution.observed.clone())
             }
         })
         .collect();

@@ -463,13 +463,13 @@ pub fn sweeps(cases: &[SweepCase]) -> Result<Table, TableError> {
         };
         table.rows.push(vec![
             label,
-            r.points().to_string(),
+            r.points.len().to_string(),
             r.continuation.corrector_iterations.to_string(),
             r.corners.to_string(),
             r.folds.len().to_string(),
             r.corner_folds.len().to_string(),
             format!("{highest:.5}"),
-            format!("{peak:.5} ({:.4})", r.omega[ip] / rod.omega_1),
+            format!("{peak:.5} ({:.4})", r.points[ip].omega / rod.omega_1),
             format!("{:.3}", r.solve_seconds),
         ]);
     }
@@ -691,7 +691,7 @@ pub fn performance() -> Result<Table, TableError> {
         crate::figures::figure_2_branch(Some(0.5), 20, MassModel::Consistent).map_err(figure)?;
     table.rows.push(vec![
         "Fig. 2, the gap 0.5 curve at H = 20".into(),
-        format!("{} points", r.points()),
+        format!("{} points", r.points.len()),
         format!("{:.3}", r.solve_seconds),
     ]);
     let rod = build_rod(&RodSpec {

@@ -122,7 +122,7 @@ fn branch_termination(r: &FrequencyResponse, t: &ContinuationTermination) -> Str
         ),
         ContinuationTermination::MaxPoints { points } => format!(
             "point limit ({points} points) at omega_ratio {}",
-            r.omega.last().map_or(f64::NAN, |w| ratio(*w))
+            r.points.last().map_or(f64::NAN, |p| ratio(p.omega))
         ),
         ContinuationTermination::StepTooSmall {
             parameter,
@@ -355,7 +355,8 @@ pub fn fold_accuracy(fold: &FoldAccuracy, omega_1: f64) -> String {
 
 /// The lines of `ssn sweep` on a branch whose harmonics were chosen point by point: the
 /// range of harmonics, how many points meet the target and the largest estimate.
-pub fn branch_accuracy(accuracy: &BranchAccuracy, harmonics: &[usize]) -> String {
+pub fn branch_accuracy(accuracy: &BranchAccuracy, response: &FrequencyResponse) -> String {
+    let harmonics = response.harmonics();
     let lo = harmonics.iter().min().copied().unwrap_or(0);
     let hi = harmonics.iter().max().copied().unwrap_or(0);
     format!(
@@ -366,10 +367,10 @@ pub fn branch_accuracy(accuracy: &BranchAccuracy, harmonics: &[usize]) -> String
         accuracy.target,
         accuracy.raises,
         accuracy.lowers,
-        accuracy.met(),
-        accuracy.estimates.len(),
-        accuracy
-            .worst()
+        accuracy.met(&response.points),
+        response.points.len(),
+        response
+            .worst_estimate()
             .map_or("not estimated".to_string(), |w| format!("{w:.2e}")),
     )
 }
@@ -410,10 +411,9 @@ pub(crate) fn sweep_text(
     omega_1: f64,
 ) -> String {
     let ratio = response.omega_ratio();
-    let st = &response.stability;
     let mut t = format!(
         "sweep             {} points, omega/omega_1 from {:.4} to {:.4}\n",
-        response.points(),
+        response.points.len(),
         ratio.first().copied().unwrap_or(f64::NAN),
         ratio.last().copied().unwrap_or(f64::NAN)
     );
@@ -424,7 +424,7 @@ pub(crate) fn sweep_text(
         );
     }
     if let Some(a) = &response.accuracy {
-        t += &branch_accuracy(a, &response.harmonics);
+        t += &branch_accuracy(a, response);
     }
     t += &format!(
         "folds             {}\n",
@@ -438,17 +438,19 @@ pub(crate) fn sweep_text(
             semismooth_contact::sweep::TURNING_POINT_EXCURSION
         );
     }
-    let unstable = st.stable.iter().filter(|s| **s == Some(false)).count();
-    let undecided_count = st.stable.iter().filter(|s| s.is_none()).count();
+    let stable = response.stable();
+    let unstable = stable.iter().filter(|s| **s == Some(false)).count();
+    let undecided_count = stable.iter().filter(|s| s.is_none()).count();
     t += &format!(
         "stability         {} stable, {unstable} unstable, {undecided_count} undecided{}\n",
-        st.stable.len() - unstable - undecided_count,
-        st.undecided
+        stable.len() - unstable - undecided_count,
+        response
+            .undecided
             .as_ref()
             .map(|u| format!(" ({})", undecided(u)))
             .unwrap_or_default()
     );
-    for e in &st.events {
+    for e in &response.events {
         t += &format!(
             "  {:<15} at omega/omega_1 = {:.4}\n",
             e.kind.name(),

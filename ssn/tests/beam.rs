@@ -125,27 +125,31 @@ fn a_sweep_through_the_first_resonance_folds_at_the_stop_and_is_linear_off_conta
     let ratio = r.omega_ratio();
     eprintln!(
         "{} points, folds {:?}, peak {:?}",
-        r.points(),
+        r.points.len(),
         r.folds.iter().map(|w| w / s.omega_1).collect::<Vec<_>>(),
         r.peak().map(|(i, a)| (ratio[i], a))
     );
     // Off contact (both ends), the branch is the linear response, exactly.
-    for i in [0, r.points() - 1] {
-        let w = r.omega[i];
+    for i in [0, r.points.len() - 1] {
+        let w = r.points[i].omega;
         let z = common::exact_linear(&s.model, w)[s.observed_dof];
-        assert!(r.tip_max[i] < gap);
+        assert!(r.points[i].observed_max < gap);
         assert!(
-            common::relative(r.amplitude[i], z.norm()) < 1e-4,
+            common::relative(r.points[i].amplitude, z.norm()) < 1e-4,
             "omega/omega_1 = {}: {} vs {}",
             ratio[i],
-            r.amplitude[i],
+            r.points[i].amplitude,
             z.norm()
         );
     }
     // The stop bounds the tip, stiffens the beam (peak above omega_1) and folds the branch.
     let (peak, _) = r.peak().unwrap();
     assert!(ratio[peak] > 1.0, "{}", ratio[peak]);
-    let highest = r.tip_max.iter().cloned().fold(f64::MIN, f64::max);
+    let highest = r
+        .column(|p| p.observed_max)
+        .iter()
+        .cloned()
+        .fold(f64::MIN, f64::max);
     // SSN-HB enforces the contact on the Fourier projection: the reconstructed tip passes
     // the stop by up to 5 % of the gap at H = 10 (measured 1.050).
     assert!(highest < 1.06 * gap && highest > gap, "{highest}");

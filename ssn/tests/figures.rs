@@ -44,11 +44,11 @@ fn paper_fig2_branches_change_stability_at_their_folds() {
         let (rod, r) = figure_2_branch(Some(gap), 5, MassModel::Consistent).unwrap();
         assert!(r.converged());
         let w1 = rod.omega_1;
-        let stable = &r.stability.stable;
+        let stable = &r.stable();
         assert_eq!(r.fold_indices.len(), 2, "gap {gap}: {:?}", r.folds);
         let (upper, lower) = (r.fold_indices[0], r.fold_indices[1]);
-        let contact = (0..r.points())
-            .find(|&i| r.tip_max[i] > gap)
+        let contact = (0..r.points.len())
+            .find(|&i| r.points[i].observed_max > gap)
             .expect("a contact");
         let unstable_between = (upper + 1..lower)
             .filter(|&i| stable[i] == Some(false))
@@ -60,11 +60,16 @@ fn paper_fig2_branches_change_stability_at_their_folds() {
         );
         assert_eq!(unstable_between, lower - upper - 1, "gap {gap}");
         assert!(
-            (lower + 1..r.points()).all(|i| stable[i] == Some(true)),
+            (lower + 1..r.points.len()).all(|i| stable[i] == Some(true)),
             "gap {gap}"
         );
-        for (i, (verdict, omega)) in stable.iter().zip(&r.omega).take(upper).enumerate() {
-            let grazing = i >= contact && *omega < r.omega[contact] + 0.02 * w1;
+        for (i, (verdict, omega)) in stable
+            .iter()
+            .zip(&r.column(|p| p.omega))
+            .take(upper)
+            .enumerate()
+        {
+            let grazing = i >= contact && *omega < r.points[contact].omega + 0.02 * w1;
             assert!(
                 *verdict == Some(true) || grazing,
                 "gap {gap}: unstable at {:.4} before the upper fold",
@@ -93,28 +98,29 @@ fn paper_fig2_branch_is_unstable_between_its_folds_and_where_it_grazes() {
         .collect();
     reversals.sort_unstable();
     let (first, last) = (reversals[0], reversals[reversals.len() - 1]);
-    let contact = (0..r.points())
-        .find(|&i| r.tip_max[i] > 0.5)
+    let contact = (0..r.points.len())
+        .find(|&i| r.points[i].observed_max > 0.5)
         .expect("a contact");
-    let st = &r.stability;
-    let grazing: Vec<usize> = (0..first)
-        .filter(|&i| st.stable[i] == Some(false))
-        .collect();
+    let stable = r.stable();
+    let grazing: Vec<usize> = (0..first).filter(|&i| stable[i] == Some(false)).collect();
     println!(
         "folds {:?}, first contact at {:.4}, unstable below the first reversal at {:?}",
         r.folds.iter().map(|w| w / w1).collect::<Vec<_>>(),
-        r.omega[contact] / w1,
-        grazing.iter().map(|&i| r.omega[i] / w1).collect::<Vec<_>>()
+        r.points[contact].omega / w1,
+        grazing
+            .iter()
+            .map(|&i| r.points[i].omega / w1)
+            .collect::<Vec<_>>()
     );
-    assert!(st.stable.iter().all(|s| s.is_some()));
-    assert!((first..=last).any(|i| st.stable[i] == Some(false)));
-    assert!((last + 1..r.points()).all(|i| st.stable[i] == Some(true)));
+    assert!(stable.iter().all(|s| s.is_some()));
+    assert!((first..=last).any(|i| stable[i] == Some(false)));
+    assert!((last + 1..r.points.len()).all(|i| stable[i] == Some(true)));
     // The grazing band: within 0.02 omega_1 above the first contact (measured 0.982 to
     // 0.994 with the contact at 0.982).
     assert!(!grazing.is_empty());
     assert!(grazing
         .iter()
-        .all(|&i| i >= contact && r.omega[i] < r.omega[contact] + 0.02 * w1));
+        .all(|&i| i >= contact && r.points[i].omega < r.points[contact].omega + 0.02 * w1));
     let options = MarchOptions {
         steps_per_period: 1000,
         tolerance: 1e-6,
@@ -122,7 +128,11 @@ fn paper_fig2_branch_is_unstable_between_its_folds_and_where_it_grazes() {
         scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
     };
     let middle = grazing[grazing.len() / 2];
-    for (omega, settles) in [(0.97 * w1, true), (r.omega[middle], false), (w1, true)] {
+    for (omega, settles) in [
+        (0.97 * w1, true),
+        (r.points[middle].omega, false),
+        (w1, true),
+    ] {
         let result = march_to_steady_state(&rod.model, omega, &options, &[rod.tip_dof()]);
         // Measured: settled in 190 and 81 periods at 0.97 and 1; a period-to-period change
         // of 1e-4 to 3e-3 after 1500 periods in the band.
@@ -150,7 +160,13 @@ fn modified_mass_branch_is_fine_and_dashed_between_its_folds() {
     let (rod, r) = figure_2_branch(Some(0.25), 20, MassModel::Modified).unwrap();
     assert!(r.converged());
     let ratio = r.omega_ratio();
-    let series = stability_series("gap 0.25", 0, &ratio, &r.amplitude, &r.stability.stable);
+    let series = stability_series(
+        "gap 0.25",
+        0,
+        &ratio,
+        &r.column(|p| p.amplitude),
+        &r.stable(),
+    );
     // The axes of Fig. 2: omega/omega_1 over [0.5, 2], the amplitude from about 0.007
     // (at 2 omega_1) up to the linear resonance; 0.98 times the linear rod's amplitude at
     // exactly omega_1 (one linear solve, at most the peak) is below the figure's range.
@@ -171,7 +187,7 @@ fn modified_mass_branch_is_fine_and_dashed_between_its_folds() {
     let step = longest_plotted_step_on(&series, 1.5, y_range);
     println!(
         "modified mass H = 20, gap 0.25: {} points, folds {:?}, longest plotted step {step:.4}",
-        r.points(),
+        r.points.len(),
         r.folds.iter().map(|w| w / rod.omega_1).collect::<Vec<_>>()
     );
     assert!(step <= FIG2_PLOTTED_STEP, "{step}");

@@ -45,9 +45,9 @@ fn fold_count_does_not_depend_on_the_step() {
     println!(
         "step 0.01: {} points, folds {a:?}, {} corner reversals; step 0.002: {} points, \
          folds {b:?}, {} corner reversals",
-        coarse.points(),
+        coarse.points.len(),
         coarse.corner_folds.len(),
-        fine.points(),
+        fine.points.len(),
         fine.corner_folds.len()
     );
     assert_eq!(a.len(), 2);
@@ -77,7 +77,7 @@ fn small_reversals_and_penalty_corners_are_listed_as_corners() {
         "ssn-hb step 0.002: {} corner reversals; penalty k_p = 1000: {} points, folds {:?}, \
          {} corner reversals",
         fine.corner_folds.len(),
-        penalty.points(),
+        penalty.points.len(),
         ratios(&penalty, &penalty.folds),
         penalty.corner_folds.len()
     );

@@ -73,8 +73,11 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                     "{mass:?} H={harmonics} p0={p0} gap={gap}: sweep {}",
                     branch.termination
                 );
-                let branch_ratio: Vec<f64> =
-                    branch.omega.iter().map(|w| w / base.omega_1).collect();
+                let branch_ratio: Vec<f64> = branch
+                    .column(|p| p.omega)
+                    .iter()
+                    .map(|w| w / base.omega_1)
+                    .collect();
                 for &ratio in &ratios {
                     let rod = build_rod(&grid_rod(mass, p0, gap, ratio)).unwrap();
                     let sol = solve(&rod, rod.omega(), &settings, None).unwrap();
@@ -87,7 +90,8 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                     }
                     converged += 1;
                     worst = worst.max(sol.iterations);
-                    let on_branch = branch_tip_max_at(&branch_ratio, &branch.tip_max, ratio);
+                    let on_branch =
+                        branch_tip_max_at(&branch_ratio, &branch.column(|p| p.observed_max), ratio);
                     let distance = on_branch
                         .iter()
                         .map(|a| (a - sol.stats.max).abs())
@@ -162,9 +166,15 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
                 "p0={p0} gap={gap}: {}",
                 branch.termination
             );
-            let branch_ratio: Vec<f64> = branch.omega.iter().map(|w| w / base.omega_1).collect();
+            let branch_ratio: Vec<f64> = branch
+                .column(|p| p.omega)
+                .iter()
+                .map(|w| w / base.omega_1)
+                .collect();
             for ratio in [0.8, 1.0, 1.2, 1.4, 1.6] {
-                if branch_tip_max_at(&branch_ratio, &branch.tip_max, ratio).len() != 1 {
+                if branch_tip_max_at(&branch_ratio, &branch.column(|p| p.observed_max), ratio).len()
+                    != 1
+                {
                     continue;
                 }
                 let rod = build_rod(&grid_rod(MassModel::Modified, p0, gap, ratio)).unwrap();
@@ -228,8 +238,12 @@ fn ten_contacts_on_a_fine_rod_converge_from_zero_on_the_branch() {
     let branch =
         frequency_response(&rod, &common::sweep_solver(Method::SsnHb, 20), &sweep, None).unwrap();
     assert!(branch.converged(), "sweep: {}", branch.termination);
-    let ratio: Vec<f64> = branch.omega.iter().map(|w| w / rod.omega_1).collect();
-    let on_branch = branch_tip_max_at(&ratio, &branch.tip_max, 1.0);
+    let ratio: Vec<f64> = branch
+        .column(|p| p.omega)
+        .iter()
+        .map(|w| w / rod.omega_1)
+        .collect();
+    let on_branch = branch_tip_max_at(&ratio, &branch.column(|p| p.observed_max), 1.0);
     let distance = on_branch
         .iter()
         .map(|a| (a - sol.stats.max).abs())

@@ -488,11 +488,15 @@ fn continuation_crosses_the_grazing_point() {
             Ok(Ok(c)) => c,
         };
         let ratios = curve.omega_ratio();
-        let touching = curve.tip_max.iter().filter(|&&m| m >= gap - 1e-3).count();
-        let worst = curve
-            .tip_max
+        let touching = curve
+            .points
             .iter()
-            .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+            .filter(|p| p.observed_max >= gap - 1e-3)
+            .count();
+        let worst = curve
+            .points
+            .iter()
+            .fold(f64::NEG_INFINITY, |a, p| a.max(p.observed_max));
         let last = *ratios.last().expect("at least one point");
         println!(
             "HARD | {:<34} | {:<10} | {:<28} | {:>5} | points {} | last ratio {last:.4} | touching {} | max tip {:.6}",
@@ -500,7 +504,7 @@ fn continuation_crosses_the_grazing_point() {
             method.name(),
             if curve.converged() { "converged".to_string() } else { format!("NOT: {}", curve.termination) },
             curve.initial_iterations,
-            curve.points(),
+            curve.points.len(),
             touching,
             worst,
         );
@@ -515,12 +519,8 @@ fn continuation_crosses_the_grazing_point() {
             "{}: ends at {last}",
             method.name()
         );
-        for v in curve
-            .tip_max
-            .iter()
-            .chain(&curve.tip_min)
-            .chain(&curve.omega)
-        {
+        let values = curve.points.iter();
+        for v in values.flat_map(|p| [p.observed_max, p.observed_min, p.omega]) {
             assert!(
                 v.is_finite(),
                 "{}: non-finite point on the branch",
@@ -528,10 +528,10 @@ fn continuation_crosses_the_grazing_point() {
             );
         }
         assert!(
-            curve.tip_max[0] < gap - 0.1,
+            curve.points[0].observed_max < gap - 0.1,
             "{}: starts in contact: {}",
             method.name(),
-            curve.tip_max[0]
+            curve.points[0].observed_max
         );
         // Twice the HB truncation bound for a half amplitude of at most ~1 (module docs),
         // plus the penalty's own penetration.
@@ -547,8 +547,9 @@ fn continuation_crosses_the_grazing_point() {
             method.name()
         );
         // The end point against Lemke at the same frequency.
-        let end_min = *curve.tip_min.last().expect("at least one point");
-        let half_amplitude = 0.5 * (curve.tip_max.last().unwrap() - end_min);
+        let end = curve.points.last().expect("at least one point");
+        let end_min = end.observed_min;
+        let half_amplitude = 0.5 * (end.observed_max - end_min);
         // Measured 3.0e-6 for both methods (bound 2.6e-3): at most MARGIN times that.
         let bound = hb_vs_lcp_bound(half_amplitude, harmonics, lemke.time_samples);
         let tol = bound.min(MARGIN * 3.0e-6);

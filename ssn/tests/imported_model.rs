@@ -79,8 +79,8 @@ fn exported_rod_reimported_gives_the_built_in_answer_to_round_off() {
         for &method in methods {
             let a = solve(&rod, &scene, method);
             let b = solve(&imported, &imported_scene, method);
-            let scale = common::max_abs(&a.tip).max(1e-300);
-            let diff = common::max_abs_diff(&a.tip, &b.tip);
+            let scale = common::max_abs(&a.observed).max(1e-300);
+            let diff = common::max_abs_diff(&a.observed, &b.observed);
             assert!(
                 diff <= 1e-12 * scale,
                 "{name} {method:?}: tip differs by {diff:e} (scale {scale})"

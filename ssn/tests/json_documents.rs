@@ -21,8 +21,8 @@ fn sweep_json_has_the_documented_fields_one_entry_per_point() {
     for key in common::json_fields::SWEEP {
         assert!(v.get(key).is_some(), "{key}");
     }
-    assert_eq!(v["points"].as_u64().unwrap() as usize, r.points());
-    assert_eq!(v["omega"].as_array().unwrap().len(), r.points());
+    assert_eq!(v["points"].as_u64().unwrap() as usize, r.points.len());
+    assert_eq!(v["omega"].as_array().unwrap().len(), r.points.len());
     assert_eq!(v["folds"].as_array().unwrap().len(), r.folds.len());
     assert_eq!(v["converged"].as_bool(), Some(true));
 }

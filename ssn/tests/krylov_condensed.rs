@@ -69,9 +69,9 @@ fn compare_paths(stops: usize) {
     // (of size O(1), gap 1) agree to round-off: measured at most 3.2e-13 (observed dof)
     // and 6.3e-13 (forces) over 30 and 100 stops, asserted at 1e-11. A GMRES that stopped
     // at its tolerance instead would move them by |J^-1| 1e-10.
-    let amplitude = dense.tip.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let amplitude = dense.observed.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(amplitude > 1.0, "the observed pad reaches the casing");
-    let tip = common::max_abs_diff(&dense.tip, &krylov.tip);
+    let tip = common::max_abs_diff(&dense.observed, &krylov.observed);
     eprintln!(
         "{stops} stops: iterations {} / {}, tip difference {tip:e}",
         dense.iterations, krylov.iterations

@@ -210,7 +210,7 @@ proptest! {
                     ("penetration", st.max_penetration), ("mean force", st.mean_contact_force)] {
                     prop_assert!(v.is_finite(), "{name} = {v} ({}, {})\n{text}", s.converged(), s.termination);
                 }
-                prop_assert!(s.tip.iter().all(|v| v.is_finite()), "non-finite tip\n{text}");
+                prop_assert!(s.observed.iter().all(|v| v.is_finite()), "non-finite tip\n{text}");
                 for f in &s.contact_forces {
                     prop_assert!(f.iter().all(|v| v.is_finite()), "non-finite force\n{text}");
                 }

@@ -181,9 +181,9 @@ fn nearest(
 ) -> usize {
     range
         .min_by(|&a, &b| {
-            (r.omega[a] / omega_1 - ratio)
+            (r.points[a].omega / omega_1 - ratio)
                 .abs()
-                .total_cmp(&(r.omega[b] / omega_1 - ratio).abs())
+                .total_cmp(&(r.points[b].omega / omega_1 - ratio).abs())
         })
         .unwrap()
 }
@@ -200,14 +200,14 @@ fn largest_multiplier_predicts_the_decay_and_growth_rates_of_time_marching() {
     let cases = [
         (nearest(&r, w1, 0..upper_fold, 1.14), true),
         (nearest(&r, w1, upper_fold..lower_fold, 1.14), false),
-        (nearest(&r, w1, lower_fold..r.points(), 1.14), true),
+        (nearest(&r, w1, lower_fold..r.points.len(), 1.14), true),
     ];
     for (i, stable) in cases {
-        let omega = r.omega[i];
-        let s = stability_of(&rod, &scene, omega, &r.states[i]);
+        let omega = r.points[i].omega;
+        let s = stability_of(&rod, &scene, omega, &r.points[i].state);
         assert_eq!(s.stable, Some(stable), "point {i} at {}: {s:?}", omega / w1);
         let mu = s.floquet_max_abs.unwrap();
-        let map = map_stability_of(&rod, h, omega, &r.states[i]);
+        let map = map_stability_of(&rod, h, omega, &r.points[i].state);
         let orbit = map.orbit.clone().unwrap();
         // Stable: the march decays towards the orbit from 1e-4; unstable: it leaves it from
         // 1e-9 (the growth stays linear over the periods fitted: 1e-9 mu^40 < 1e-5).
@@ -242,22 +242,22 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
     let w1 = rod.omega_1;
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
     let middle = nearest(&r, w1, upper_fold..lower_fold, 1.14);
-    let omega = r.omega[middle];
-    let s = stability_of(&rod, &scene, omega, &r.states[middle]);
+    let omega = r.points[middle].omega;
+    let s = stability_of(&rod, &scene, omega, &r.points[middle].state);
     assert_eq!(s.stable, Some(false));
-    let map = map_stability_of(&rod, h, omega, &r.states[middle]);
+    let map = map_stability_of(&rod, h, omega, &r.points[middle].state);
     // The two stable solutions at exactly this frequency: Newton from the nearest points of
     // the upper and lower branches.
     let mut stable_tips = Vec::new();
-    for range in [0..upper_fold, lower_fold..r.points()] {
+    for range in [0..upper_fold, lower_fold..r.points.len()] {
         let i = nearest(&r, w1, range, omega / w1);
-        let sol = solve(&rod, omega, &scene.solver, Some(&r.states[i])).unwrap();
+        let sol = solve(&rod, omega, &scene.solver, Some(&r.points[i].state)).unwrap();
         assert!(sol.converged(), "{}", sol.termination);
         let st = stability_of(&rod, &scene, omega, &sol.state);
         assert_eq!(st.stable, Some(true));
         stable_tips.push(sol.stats.min);
     }
-    let unstable_tip = r.tip_min[middle];
+    let unstable_tip = r.points[middle].observed_min;
     // Nudged off the unstable orbit both ways, the march settles on one of the stable ones
     // (the branches are 0.7 apart; the march and SSN-HB at H = 20 differ by 3.6e-3 relative
     // on the upper branch at this forcing, measured).
@@ -295,8 +295,8 @@ fn marching_from_an_unstable_solution_lands_on_a_stable_branch() {
 fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
     let (rod, _, r) = strong_sweep();
     let w1 = rod.omega_1;
-    let st = &r.stability;
-    assert_eq!(st.stable.len(), r.points());
+    let stable = r.stable();
+    assert_eq!(stable.len(), r.points.len());
     // The two turning points of the branch: the jump-down near 1.185 and the jump-up near
     // 1.098 omega_1 (1.1846 and 1.0982 measured with the default steps; every step at most
     // 0.002 moves them by less than 4e-4).
@@ -307,8 +307,8 @@ fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
         "{fold_ratios:?}"
     );
     let (upper_fold, lower_fold) = (r.fold_indices[0], r.fold_indices[1]);
-    for (i, s) in st.stable.iter().enumerate() {
-        let ratio = r.omega[i] / w1;
+    for (i, s) in stable.iter().enumerate() {
+        let ratio = r.points[i].omega / w1;
         if i == upper_fold || i == lower_fold {
             // At a fold a multiplier is 1: either answer, or none when the time-stepping
             // map's own fold lies just below the harmonic-balance one.
@@ -318,20 +318,24 @@ fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
         assert_eq!(*s, Some(expected), "point {i} at omega_ratio {ratio:.5}");
         // The largest modulus agrees with the verdict unless the real multiplier nearest
         // +1 was placed by the fold parity (module `sweep::branch`).
-        let mu = st.floquet_max_abs[i].unwrap();
+        let mu = r.points[i].stability.floquet_max_abs.unwrap();
         assert!(
-            (mu < 1.0) == expected || st.placed_by_fold[i],
+            (mu < 1.0) == expected || r.points[i].stability.placed_by_fold,
             "point {i} at omega_ratio {ratio:.5}: |mu| {mu}"
         );
     }
-    let placed = st.placed_by_fold.iter().filter(|p| **p).count();
+    let placed = r
+        .points
+        .iter()
+        .filter(|p| p.stability.placed_by_fold)
+        .count();
     println!("{placed} points placed by the fold parity");
     assert!(placed <= 4, "{placed} points placed by the fold parity");
     // Two fold events, where the continuation found the folds (1.1846 and 1.0982): the
     // interpolated crossing of |mu| = 1 lies between the neighbouring points, which are at
     // most 1.1e-3 omega_1 from the fold here.
-    assert_eq!(st.events.len(), 2, "{:?}", st.events);
-    for (e, fold) in st.events.iter().zip(&r.folds) {
+    assert_eq!(r.events.len(), 2, "{:?}", r.events);
+    for (e, fold) in r.events.iter().zip(&r.folds) {
         assert_eq!(e.kind, BifurcationKind::Fold);
         assert!(
             ((e.omega - fold) / w1).abs() < 2e-3,
@@ -343,9 +347,9 @@ fn the_strong_sweep_is_unstable_exactly_between_its_folds() {
     // Contact diagnostics: no contact on the lower branch far from the overhang, contact
     // (a negative mean force) on the upper branch.
     let first = 0;
-    assert_eq!(st.contact_force_mean[first], 0.0);
-    assert_eq!(st.max_penetration[first], 0.0);
-    assert!(st.contact_force_mean[upper_fold - 2] < 0.0);
+    assert_eq!(r.points[first].stability.contact_force_mean, 0.0);
+    assert_eq!(r.points[first].stability.max_penetration, 0.0);
+    assert!(r.points[upper_fold - 2].stability.contact_force_mean < 0.0);
 }
 
 #[test]
@@ -445,13 +449,15 @@ fn a_sweep_without_stability_leaves_every_point_undecided_with_the_reason() {
     let rod = build_rod(&scene.rod).unwrap();
     let r = frequency_response(&rod, &scene.solver, sweep, None).unwrap();
     assert!(r.converged(), "{}", r.termination);
-    let st = &r.stability;
-    assert!(st.stable.iter().all(|s| s.is_none()));
+    assert!(r.stable().iter().all(|s| s.is_none()));
     assert_eq!(
-        st.undecided,
+        r.undecided,
         Some(semismooth_contact::stability::Undecided::NotRequested)
     );
-    assert!(st.events.is_empty());
+    assert!(r.events.is_empty());
     // The contact diagnostics are still computed.
-    assert_eq!(st.contact_force_mean.len(), r.points());
+    assert_eq!(
+        r.column(|p| p.stability.contact_force_mean).len(),
+        r.points.len()
+    );
 }

@@ -98,8 +98,8 @@ fn an_obstacle_on_the_negative_side_mirrors_one_on_the_positive_side() {
     for method in [Method::SsnHb, Method::PenaltyHb, Method::March] {
         let a = solve(&up, &up_scene, method, 20);
         let b = solve(&down, &down_scene, method, 20);
-        let mirrored: Vec<f64> = b.tip.iter().map(|v| -v).collect();
-        let diff = common::max_abs_diff(&a.tip, &mirrored);
+        let mirrored: Vec<f64> = b.observed.iter().map(|v| -v).collect();
+        let diff = common::max_abs_diff(&a.observed, &mirrored);
         assert!(diff < 1e-10, "{method:?}: {diff:e}");
         let (fa, fb) = (mean(&a.contact_forces[0]), mean(&b.contact_forces[0]));
         assert!(

@@ -126,7 +126,7 @@ pub(super) fn solve_march(
     let final_state = period.final_state;
     let period = Period {
         times,
-        tip: tip_series,
+        observed: tip_series,
         contact_forces: forces,
         contact_displacements: contact_u,
         friction,

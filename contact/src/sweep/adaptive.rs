@@ -45,7 +45,7 @@
 //!
 //! The branch starts at [`HARMONICS_LADDER`]`[0]` harmonics (the scene's `harmonics` is
 //! ignored with a target), each point's harmonics and estimate are in
-//! [`FrequencyResponse::harmonics`] and [`BranchAccuracy::estimates`].
+//! [`ResponsePoint::harmonics`] and [`ResponsePoint::error_estimate`].
 
 use std::time::Instant;
 
@@ -59,7 +59,8 @@ use semismooth::{Factorize, ParameterDependent, Residual};
 use super::response::HbTip;
 use super::{
     check_sweep, continuation_error, continuation_options, hb_solver, reference_amplitude,
-    set_events, ssn_continuation, sweep_termination, FrequencyResponse, SweepTermination,
+    set_events, ssn_continuation, sweep_termination, FrequencyResponse, ResponsePoint,
+    SweepTermination,
 };
 use crate::hb::{resize_harmonics, HbJacobian, SsnHb};
 use crate::model::{StructuralModel, Structure};
@@ -89,9 +90,6 @@ pub const LOWER_BELOW: f64 = 0.25;
 pub struct BranchAccuracy {
     /// The relative accuracy asked of each point's observed displacement.
     pub target: f64,
-    /// The estimated relative error of each point (module documentation; `None` where the
-    /// solve at `H/2` did not converge).
-    pub estimates: Vec<Option<f64>>,
     /// Points solved again with more harmonics.
     pub raises: usize,
     /// Changes to fewer harmonics.
@@ -107,11 +105,11 @@ pub struct BranchAccuracy {
 }
 
 impl BranchAccuracy {
-    /// Points whose estimate meets the target.
-    pub fn met(&self) -> usize {
-        self.estimates
+    /// The points of `points` whose estimate meets the target.
+    pub fn met(&self, points: &[ResponsePoint]) -> usize {
+        points
             .iter()
-            .filter(|e| e.is_some_and(|e| e <= self.target))
+            .filter(|p| p.error_estimate.is_some_and(|e| e <= self.target))
             .count()
     }
 
@@ -119,7 +117,6 @@ impl BranchAccuracy {
     fn none_yet(target: f64, max_harmonics: usize) -> Self {
         Self {
             target,
-            estimates: Vec::new(),
             raises: 0,
             lowers: 0,
             failed_raises: 0,
@@ -127,11 +124,6 @@ impl BranchAccuracy {
             estimate_seconds: 0.0,
             estimate_counters: RunCounters::default(),
         }
-    }
-
-    /// The largest estimate over the points (`None` if none was estimated).
-    pub fn worst(&self) -> Option<f64> {
-        self.estimates.iter().flatten().copied().reduce(f64::max)
     }
 }
 
@@ -320,14 +312,14 @@ fn take_up_with(
     Ok((report.converged().then_some((y, omega)), counters))
 }
 
-/// The point `x` (at `h` harmonics) and `omega` of the SSN-HB branch of `rod` swept with
+/// The point `x` (at `h` harmonics) and `omega` of the SSN-HB branch of `structure` swept with
 /// `settings` over `sweep`, taken up at `to` harmonics across the branch (normal to
 /// `direction`, a tangent or secant at the point: state part at `h` harmonics, then the
 /// frequency component) or, failing that, at its frequency: the state at `to` harmonics
 /// and its frequency, `None` when neither converged. The reference of a point's error
 /// that follows the same solution through a fold.
 pub fn take_up(
-    rod: &Structure,
+    structure: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     (x, omega, h): (&[f64], f64, usize),
@@ -335,11 +327,11 @@ pub fn take_up(
     to: usize,
 ) -> Result<Option<BranchPointAt>, RunError> {
     let at = at_harmonics(settings, to);
-    let mut problem = SsnHb::new(&rod.model, omega, &hb_options(&at))?;
+    let mut problem = SsnHb::new(&structure.model, omega, &hb_options(&at))?;
     let mut solver = hb_solver(at.linear_solver);
-    let u_ref = reference_amplitude(rod);
+    let u_ref = reference_amplitude(structure);
     let (found, _) = take_up_with(
-        (rod, &at, sweep, u_ref),
+        (structure, &at, sweep, u_ref),
         &mut problem,
         &mut *solver,
         (x, omega, h),
@@ -352,17 +344,18 @@ pub fn take_up(
 /// one side at the ends), both carried to point `i`'s harmonics when they differ: the
 /// state part, then the frequency component. Panics if `i` is not a point of `response`.
 pub fn secant(response: &FrequencyResponse, i: usize, dofs: usize, contacts: usize) -> Vec<f64> {
-    let last = response.points() - 1;
+    let points = &response.points;
+    let last = points.len() - 1;
     let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
-    let at = |j: usize| match (response.harmonics.get(j), response.harmonics.get(i)) {
-        (Some(&from), Some(&to)) if from != to => {
-            resize_harmonics(&response.states[j], from, to, dofs, contacts)
+    let at = |j: usize| match (points[j].harmonics, points[i].harmonics) {
+        (Some(from), Some(to)) if from != to => {
+            resize_harmonics(&points[j].state, from, to, dofs, contacts)
         }
-        _ => response.states[j].clone(),
+        _ => points[j].state.clone(),
     };
     let (xa, xb) = (at(a), at(b));
     let mut d: Vec<f64> = xb.iter().zip(&xa).map(|(u, v)| u - v).collect();
-    d.push(response.omega[b] - response.omega[a]);
+    d.push(points[b].omega - points[a].omega);
     d
 }
 
@@ -627,7 +620,7 @@ impl Adaptive<'_> {
         let (h, target, limit) = (self.h, self.accuracy.target, self.limit);
         let omega = point.parameter;
         let (max, min) = tip.extremes(&point.state)?;
-        let index = self.response.points();
+        let index = self.response.points.len();
         let direction = here.as_ref().map(|r| r.direction.as_slice());
         let estimate = self
             .estimator
@@ -649,11 +642,11 @@ impl Adaptive<'_> {
             }
         }
         let nt = default_hb_time_samples(h);
-        self.response
-            .push(omega, max, min, point.iterations, point.state);
-        self.response.harmonics.push(h);
-        self.response.time_samples.push(nt);
-        self.accuracy.estimates.push(estimate);
+        let mut record = ResponsePoint::new(omega, (max, min), point.iterations, point.state);
+        record.harmonics = Some(h);
+        record.time_samples = Some(nt);
+        record.error_estimate = estimate;
+        self.response.points.push(record);
         if let Some(report) = self.progress {
             report(index, omega / self.rod.omega_1);
         }
@@ -722,7 +715,7 @@ impl Adaptive<'_> {
                 // The raised start could not be corrected: back to the old harmonics.
                 let (old, back) = self.fallback.take()?;
                 self.accuracy.failed_raises += 1;
-                self.no_raise_at = Some(self.response.points());
+                self.no_raise_at = Some(self.response.points.len());
                 Some(Switch {
                     from: old,
                     to: old,
@@ -806,9 +799,10 @@ impl Adaptive<'_> {
         response.continuation = counters;
         response.termination = sweep_termination(termination);
         response.output_points = response
-            .harmonics
+            .points
             .iter()
-            .map(|&h| output_points(h))
+            .filter_map(|p| p.harmonics)
+            .map(output_points)
             .max()
             .unwrap_or(HB_OUTPUT_POINTS);
         accuracy.estimate_seconds = estimator.seconds;

@@ -43,39 +43,57 @@ pub struct BifurcationEvent {
     pub uncertainty: Option<f64>,
 }
 
-/// Per-point stability and contact diagnostics of a branch.
+/// Stability and contact diagnostics of one point of a branch.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct PointStability {
+    /// Stable / unstable / undecided.
+    pub stable: Option<bool>,
+    /// Largest multiplier modulus (`None`: undecided).
+    pub floquet_max_abs: Option<f64>,
+    /// Mean contact force of the first contact over a period (0 without contact).
+    pub contact_force_mean: f64,
+    /// Largest penetration `max(0, u - g)` over the period and the contacts.
+    pub max_penetration: f64,
+    /// Whether the verdict comes from the branch's fold count: the point's real multiplier
+    /// nearest `+1`, within [`FOLD_BAND`], lies on the other side of `+1` than the number
+    /// of folds before it requires, and is counted on that side (module documentation).
+    pub placed_by_fold: bool,
+}
+
+impl Default for PointStability {
+    /// Undecided, its diagnostics not computed (NaN).
+    fn default() -> Self {
+        Self {
+            stable: None,
+            floquet_max_abs: None,
+            contact_force_mean: f64::NAN,
+            max_penetration: f64::NAN,
+            placed_by_fold: false,
+        }
+    }
+}
+
+/// The stability of a branch: one record per point, and the stability changes between
+/// them.
 #[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
 pub struct BranchStability {
-    /// Stable / unstable / undecided, one per point.
-    pub stable: Vec<Option<bool>>,
-    /// Largest multiplier modulus, one per point (`None`: undecided).
-    pub floquet_max_abs: Vec<Option<f64>>,
-    /// Mean contact force of the first contact over a period (0 without contact).
-    pub contact_force_mean: Vec<f64>,
-    /// Largest penetration `max(0, u - g)` over the period and the contacts.
-    pub max_penetration: Vec<f64>,
+    /// Stability and contact diagnostics of each point, in branch order.
+    pub points: Vec<PointStability>,
     /// Stability changes in branch order.
     pub events: Vec<BifurcationEvent>,
     /// Why points are undecided (the first reason met), `None` when all are decided.
     pub undecided: Option<Undecided>,
-    /// Whether the point's verdict comes from the branch's fold count: its real multiplier
-    /// nearest `+1`, within [`FOLD_BAND`], lies on the other side of `+1` than the number
-    /// of folds before it requires, and is counted on that side (module documentation).
-    pub placed_by_fold: Vec<bool>,
 }
 
 impl BranchStability {
     /// `points` undecided points, all for `reason`.
     pub fn not_decided(points: usize, reason: Undecided) -> Self {
         Self {
-            stable: vec![None; points],
-            floquet_max_abs: vec![None; points],
-            contact_force_mean: vec![f64::NAN; points],
-            max_penetration: vec![f64::NAN; points],
+            points: vec![PointStability::default(); points],
             events: Vec::new(),
             undecided: Some(reason),
-            placed_by_fold: vec![false; points],
         }
     }
 }
@@ -147,13 +165,13 @@ pub const FOLD_BAND: f64 = 0.25;
 /// `multipliers` only the contact diagnostics are computed and every point is undecided
 /// ([`Undecided::NotRequested`]).
 pub fn branch_stability(
-    rod: &Structure,
+    structure: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
     multipliers: bool,
     progress: Option<&dyn Fn(usize)>,
 ) -> Result<BranchStability, StabilityError> {
-    let points = response.points();
+    let points = response.points.len();
     let mut out = BranchStability::default();
     if !settings.method.is_harmonic_balance() {
         return Ok(BranchStability::not_decided(
@@ -161,21 +179,27 @@ pub fn branch_stability(
             Undecided::NotHarmonicBalance(settings.method),
         ));
     }
-    let analyses = point_analyses(rod, settings, response, multipliers, progress, &mut out)?;
+    let analyses = point_analyses(
+        structure,
+        settings,
+        response,
+        multipliers,
+        progress,
+        &mut out,
+    )?;
     // The folds only: a zigzag of the truncated balance (`corner_folds`) turns back and
     // forth within the fold excursion, and counting its two reversals would flip the
     // verdict of the points between them.
     // They come in branch order, with their frequencies in `folds`.
     let reversals = &response.fold_indices;
     let outside = fold_consistent_counts(&analyses, reversals);
-    for (s, counts) in analyses.iter().zip(&outside) {
+    for ((s, counts), point) in analyses.iter().zip(&outside).zip(&mut out.points) {
         if s.stable.is_none() && out.undecided.is_none() {
             out.undecided.clone_from(&s.undecided);
         }
-        out.stable.push(counts.map(|(c, _)| c.is_stable()));
-        out.floquet_max_abs.push(s.floquet_max_abs);
-        out.placed_by_fold
-            .push(counts.is_some_and(|(_, placed)| placed));
+        point.stable = counts.map(|(c, _)| c.is_stable());
+        point.floquet_max_abs = s.floquet_max_abs;
+        point.placed_by_fold = counts.is_some_and(|(_, placed)| placed);
     }
     out.events = bifurcation_events(response, &analyses, &outside);
     Ok(out)
@@ -213,23 +237,27 @@ fn point_analyses(
     // with the point's harmonics (built again where they change along the branch).
     let mut current = response.point_settings(settings, 0);
     let (mut reconstruction, mut analysis) = analysers(rod, &current)?;
-    let mut analyses: Vec<Stability> = Vec::with_capacity(response.points());
-    for (i, x) in response.states.iter().enumerate() {
+    let mut analyses: Vec<Stability> = Vec::with_capacity(response.points.len());
+    for (i, point) in response.points.iter().enumerate() {
+        let x = &point.state;
         let at = response.point_settings(settings, i);
         if (at.harmonics, at.time_samples) != (current.harmonics, current.time_samples) {
             (reconstruction, analysis) = analysers(rod, &at)?;
             current = at;
         }
         let s = if multipliers {
-            analysis.of(response.omega[i], x)?
+            analysis.of(point.omega, x)?
         } else {
             Stability::not_decided(Undecided::NotRequested)
         };
         let (mean, penetration) = reconstruction
             .summary(x, rod.observed_dof)
             .unwrap_or((f64::NAN, f64::NAN));
-        out.contact_force_mean.push(mean);
-        out.max_penetration.push(penetration);
+        out.points.push(PointStability {
+            contact_force_mean: mean,
+            max_penetration: penetration,
+            ..PointStability::default()
+        });
         analyses.push(s);
         if let Some(report) = progress {
             report(i + 1);
@@ -249,14 +277,14 @@ fn bifurcation_events(
     let reversals = &response.fold_indices;
     let mut events = Vec::new();
     let mut last: Option<usize> = None;
-    for i in 0..response.points() {
+    for i in 0..response.points.len() {
         let Some((after, _)) = outside[i] else {
             continue;
         };
         if let Some(j) = last {
             let (before, _) = outside[j].expect("decided");
             if let Some(kind) = crossing_of(before, after) {
-                let (w0, w1) = (response.omega[j], response.omega[i]);
+                let (w0, w1) = (response.points[j].omega, response.points[i].omega);
                 let (omega, uncertainty) = match reversals.iter().position(|&r| j <= r && r <= i) {
                     // A fold of the branch between the two: the crossing is the fold.
                     Some(k) if kind == BifurcationKind::Fold => (response.folds[k], None),

@@ -1,4 +1,4 @@
-//! Every contact of every point of a branch ([`FrequencyResponse::contacts`]), with the
+//! Every contact of every point of a branch ([`ResponsePoint::contacts`]), with the
 //! numbers `ssn solve` reports for one solution ([`ContactReport`]): gap, mean force,
 //! largest penetration, fraction of the period in contact, displacement range.
 //!
@@ -12,21 +12,36 @@ use crate::model::Structure;
 use crate::settings::SolverSettings;
 use crate::solve::{set_closed_fractions, HarmonicProblem, HbReconstruction, RunError};
 
-use super::FrequencyResponse;
+use super::{FrequencyResponse, ResponsePoint};
 
-/// Per-contact reports and friction summaries of every point of a branch, one list per
-/// point in the model's order of contacts and friction points.
-pub(super) type BranchReports = (Vec<Vec<ContactReport>>, Vec<Vec<FrictionSummary>>);
+/// Per-contact reports and friction summaries of a point, in the model's order of contacts
+/// and friction points.
+type PointReports = (Vec<ContactReport>, Vec<FrictionSummary>);
 
-/// The per-contact reports of each point of `response` and, for harmonic balance, the
-/// friction summaries (one list per point; none without friction points). Methods that do
-/// not sweep give no points and no lists.
-pub(super) fn branch_reports(
-    rod: &Structure,
+/// Sets the per-contact reports of each point of `response` and, for harmonic balance, the
+/// friction summaries (none without friction points). Methods that do not sweep have no
+/// points.
+pub(super) fn set_branch_reports(
+    structure: &Structure,
+    settings: &SolverSettings,
+    response: &mut FrequencyResponse,
+) -> Result<(), RunError> {
+    let reports = branch_reports(structure, settings, response)?;
+    for (point, (contacts, friction)) in response.points.iter_mut().zip(reports) {
+        point.contacts = contacts;
+        point.friction = friction;
+    }
+    Ok(())
+}
+
+/// The per-contact reports and friction summaries of each point of `response`
+/// ([`set_branch_reports`]).
+fn branch_reports(
+    structure: &Structure,
     settings: &SolverSettings,
     response: &FrequencyResponse,
-) -> Result<BranchReports, RunError> {
-    let model = &rod.model;
+) -> Result<Vec<PointReports>, RunError> {
+    let model = &structure.model;
     let contacts: Vec<(usize, f64)> = model.contacts.iter().map(|c| (c.dof(), c.gap)).collect();
     let friction_points = model.friction.len();
     let points = response.output_points;
@@ -49,29 +64,24 @@ pub(super) fn branch_reports(
     };
     // The reconstructions over one period do not depend on the frequency: any valid one,
     // with the point's harmonics (built again where they change along the branch).
-    let omega = rod.omega_1;
+    let omega = structure.omega_1;
     let build = |s: &SolverSettings| -> Result<Box<dyn HbReconstruction>, RunError> {
         let problem = HarmonicProblem::of(model, omega, s)?;
         Ok(problem.into_reconstruction())
     };
-    let hb = || -> Result<BranchReports, RunError> {
+    let hb = || -> Result<Vec<PointReports>, RunError> {
         let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
-        let mut reports = Vec::with_capacity(response.points());
-        let mut friction = Vec::new();
-        for (i, x) in response.states.iter().enumerate() {
+        let mut reports = Vec::with_capacity(response.points.len());
+        for (i, ResponsePoint { state: x, .. }) in response.points.iter().enumerate() {
             let at = response.point_settings(settings, i);
             let key = (at.harmonics, at.time_samples);
             if current.as_ref().is_none_or(|(k, _)| *k != key) {
                 current = Some((key, build(&at)?));
             }
             let (_, problem) = current.as_ref().expect("built above");
-            let (point, point_friction) = report(problem.as_ref(), x)?;
-            reports.push(point);
-            if friction_points > 0 {
-                friction.push(point_friction);
-            }
+            reports.push(report(problem.as_ref(), x)?);
         }
-        Ok((reports, friction))
+        Ok(reports)
     };
     if settings.method.is_harmonic_balance() {
         return hb();
@@ -81,14 +91,14 @@ pub(super) fn branch_reports(
     let m = contacts.len();
     let reports = if settings.method.is_lcp() {
         response
-            .states
+            .points
             .iter()
-            .map(|y| lcp_point_contacts(&contacts, y, m))
+            .map(|p| (lcp_point_contacts(&contacts, &p.state, m), Vec::new()))
             .collect()
     } else {
         Vec::new()
     };
-    Ok((reports, Vec::new()))
+    Ok(reports)
 }
 
 /// The reports of an LCP state `y = (w, z)` with `m` contacts (module documentation).

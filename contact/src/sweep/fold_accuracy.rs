@@ -60,6 +60,7 @@ pub const MAX_SEGMENT_POINTS: usize = 400;
 
 /// One rung of a fold's ladder.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FoldRung {
     /// Harmonics.
     pub harmonics: usize,
@@ -136,13 +137,13 @@ fn coarse_error(coarse: f64, fine: f64) -> f64 {
     (fine - coarse).abs() * rp / (rp - 1.0)
 }
 
-/// Each fold of `response` (a harmonic-balance sweep of `rod` with `settings` over
+/// Each fold of `response` (a harmonic-balance sweep of `structure` with `settings` over
 /// `sweep`) to a relative accuracy `target` with at most `max_harmonics` harmonics
 /// ([`MAX_FOLD_HARMONICS`] by default; module documentation). `Err` when a segment
 /// could not run (the method is no harmonic balance, a bad setting); a ladder that did not
 /// meet the target says why in [`FoldAccuracy::stop`].
 pub fn refine_folds(
-    rod: &Structure,
+    structure: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     response: &FrequencyResponse,
@@ -155,20 +156,20 @@ pub fn refine_folds(
             what: "fold frequencies to an accuracy (harmonic balance only: ssn-hb, penalty-hb)",
         });
     }
-    let omega_1 = rod.omega_1;
+    let omega_1 = structure.omega_1;
     let mut out = Vec::with_capacity(response.folds.len());
     for (&fold, &index) in response.folds.iter().zip(&response.fold_indices) {
         // The start: the last point at least APPROACH omega_1 before the fold.
         let start = (0..index)
             .rev()
-            .find(|&j| (response.omega[j] - fold).abs() >= APPROACH * omega_1)
+            .find(|&j| (response.points[j].omega - fold).abs() >= APPROACH * omega_1)
             .unwrap_or(0);
         let ladder = Ladder {
-            rod,
+            rod: structure,
             settings,
             sweep,
-            start_omega: response.omega[start],
-            heading: fold - response.omega[start],
+            start_omega: response.points[start].omega,
+            heading: fold - response.points[start].omega,
             fold,
             u_ref: response.reference_amplitude,
             max_harmonics,
@@ -183,7 +184,7 @@ pub fn refine_folds(
         };
         // The start of the next rung: the branch point, then each rung's corrected start.
         let from = (
-            response.states[start].clone(),
+            response.points[start].state.clone(),
             response.point_settings(settings, start).harmonics,
         );
         out.push(ladder.climb(first, from, target)?);

@@ -4,10 +4,11 @@
 //! [`frequency_response`] solves at `omega_from = omega_ratio_from * omega_1` by globalized
 //! Newton from zero, then follows the branch with the core's
 //! [`Continuation`] until the frequency leaves
-//! `[omega_from, omega_to]` (through folds, where the frequency turns back). Each point is
-//! reduced to the tip over one period: `tip_max`, `tip_min` and the amplitude
-//! `max_t |u_tip(t)|` (with contact the maximum sits at the gap along the contact branch, so
-//! the negative excursion carries the information).
+//! `[omega_from, omega_to]` (through folds, where the frequency turns back). Each point is a
+//! [`ResponsePoint`] record: its frequency, the observed dof over one period reduced to
+//! `observed_max`, `observed_min` and the amplitude `max_t |u(t)|` (with contact the maximum
+//! sits at the gap along the contact branch, so the negative excursion carries the
+//! information), its state, stability, contacts and friction points.
 //!
 //! # What a step length means
 //!
@@ -60,8 +61,8 @@
 //!   (`κ` = the scene's `c`, default the contact stiffness scale; the force unit of the
 //!   arclength), with the active-block solver [`FrequencyLcpSolver`] and the analytic
 //!   `dF/dω`. It starts from the one-call solve's mesh-sequenced min-map solve at `omega_from`.
-//!   The tip extremes are taken on the `Nt` nodes (`u_tip = g - w` when the tip is a
-//!   contact, else from the LCP of the point's frequency with the tip observed). The
+//!   The observed extremes are taken on the `Nt` nodes (`u = g - w` when the observed dof
+//!   is a contact, else from the LCP of the point's frequency with that dof observed). The
 //!   discrete LCP branch has a small fold at many changes of the active set (a node
 //!   entering or leaving contact), reported in `corner_folds` (see below). Known limit: a contact on a
 //!   node with mass (the ill-posed case without an impact law, module `lcp`): the branch
@@ -102,7 +103,7 @@ use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
-pub use response::{FrequencyResponse, SweepTermination, TURNING_POINT_EXCURSION};
+pub use response::{FrequencyResponse, ResponsePoint, SweepTermination, TURNING_POINT_EXCURSION};
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
@@ -115,7 +116,7 @@ use crate::solve::{
 use crate::stability::Undecided;
 use branch::branch_stability;
 pub(crate) use branch::Reconstruction;
-pub use branch::{BifurcationEvent, BranchStability};
+pub use branch::{BifurcationEvent, BranchStability, PointStability};
 
 /// Weight `θ` of the state in the arclength (module documentation: with the scaling used
 /// here any `θ` in `(0, 1)` gives the same geometry; `1/2` keeps both parts of the θ-norm
@@ -366,7 +367,7 @@ fn continuation_error(e: ContinuationError) -> RunError {
     }
 }
 
-/// Reduces a state to `(tip_max, tip_min)` over one period.
+/// Reduces a state to the observed dof's `(max, min)` over one period.
 type TipMeasure<'m, P> = dyn FnMut(&P, &[f64], f64) -> Result<(f64, f64), RunError> + 'm;
 
 /// Everything [`follow`] needs besides the problem, the solver and the measure.
@@ -437,13 +438,14 @@ where
     while let Some(point) = continuation.next() {
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
-        response.push(omega, max, min, point.iterations, point.state);
+        let mut record = ResponsePoint::new(omega, (max, min), point.iterations, point.state);
         if settings.method.is_harmonic_balance() {
-            response.harmonics.push(settings.harmonics);
-            response.time_samples.push(settings.time_samples);
+            record.harmonics = Some(settings.harmonics);
+            record.time_samples = Some(settings.time_samples);
         }
+        response.points.push(record);
         if let Some(report) = progress {
-            report(response.points() - 1, omega / omega_1);
+            report(response.points.len() - 1, omega / omega_1);
         }
     }
     let c = continuation.counters();
@@ -517,7 +519,7 @@ pub enum SweepProgress {
     },
 }
 
-/// Frequency-response curve of the rod with the scene's method (module documentation):
+/// Frequency-response curve of the structure with the scene's method (module documentation):
 /// globalized Newton at `omega_ratio_from`, then pseudo-arclength continuation in `ω` up to
 /// `omega_ratio_to`. `progress` hears of each accepted point, then of each point whose
 /// stability is computed.
@@ -530,12 +532,12 @@ pub enum SweepProgress {
 /// to meet it ([`adaptive`]; the scene's `harmonics` is then ignored).
 ///
 /// Each point then gets its stability and contact diagnostics
-/// ([`crate::sweep::branch::branch_stability`], in [`FrequencyResponse::stability`]) unless
+/// ([`crate::sweep::branch::branch_stability`], in [`ResponsePoint::stability`]) unless
 /// [`SweepSettings::stability`] is off (the points are then undecided with
 /// [`Undecided::NotRequested`], their contact diagnostics still computed); a failure there
 /// leaves the points undecided with the reason.
 pub fn frequency_response(
-    rod: &Structure,
+    structure: &Structure,
     settings: &SolverSettings,
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(SweepProgress)>,
@@ -551,23 +553,24 @@ pub fn frequency_response(
     let branch_progress = branch_progress.as_ref().map(|p| p as &dyn Fn(usize, f64));
     let mut response = match settings.accuracy {
         Some(target) if settings.method.adapts_harmonics() => {
-            adaptive::adaptive_branch(rod, settings, sweep, target, branch_progress)?
+            adaptive::adaptive_branch(structure, settings, sweep, target, branch_progress)?
         }
-        _ => follow_branch(rod, settings, sweep, branch_progress)?,
+        _ => follow_branch(structure, settings, sweep, branch_progress)?,
     };
-    (response.contacts, response.friction) = contacts::branch_reports(rod, settings, &response)?;
+    contacts::set_branch_reports(structure, settings, &mut response)?;
     let started = Instant::now();
-    let total = response.points();
+    let total = response.points.len();
     let stability_progress =
         progress.map(|report| move |done: usize| report(SweepProgress::Stability { done, total }));
-    response.stability = branch_stability(
-        rod,
+    let stability = branch_stability(
+        structure,
         settings,
         &response,
         sweep.stability,
         stability_progress.as_ref().map(|p| p as &dyn Fn(usize)),
     )
     .unwrap_or_else(|err| BranchStability::not_decided(total, Undecided::Failed(err)));
+    response.set_stability(stability);
     response.stability_seconds = started.elapsed().as_secs_f64();
     Ok(response)
 }

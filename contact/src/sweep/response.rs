@@ -7,31 +7,25 @@ use crate::contacts::{ContactReport, FrictionSummary};
 use crate::hb::HbError;
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::{RunCounters, RunError};
+use crate::stability::Undecided;
 use crate::sweep::adaptive::BranchAccuracy;
-use crate::sweep::branch::BranchStability;
+use crate::sweep::branch::{BifurcationEvent, BranchStability, PointStability};
 
 /// One number of a [`ContactReport`].
 type ContactField = fn(&ContactReport) -> f64;
 
-/// A frequency-response curve: one entry per branch point, in branch order (the frequency
-/// is not monotone across folds).
+/// A frequency-response curve: one record per branch point ([`ResponsePoint`]), in branch
+/// order (the frequency is not monotone across folds), and what belongs to the branch
+/// (folds and corners as indices into the points, termination, work, timings).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct FrequencyResponse {
     /// Method used.
     pub method: Method,
-    /// First natural frequency of the rod (the curve's frequency unit).
+    /// First natural frequency of the structure (the curve's frequency unit).
     pub omega_1: f64,
-    /// Forcing frequency `ω` of each point (absolute).
-    pub omega: Vec<f64>,
-    /// `max_t u_tip(t)` over one period.
-    pub tip_max: Vec<f64>,
-    /// `min_t u_tip(t)` over one period.
-    pub tip_min: Vec<f64>,
-    /// `max_t |u_tip(t)|` over one period.
-    pub amplitude: Vec<f64>,
-    /// Corrector iterations of each point (the first: those of the start correction).
-    pub iterations: Vec<usize>,
+    /// The branch points, in branch order.
+    pub points: Vec<ResponsePoint>,
     /// Frequencies `ω` (absolute) where the branch turns back, in branch order: the turning
     /// points whose frequency excursion to the next one is at least
     /// [`TURNING_POINT_EXCURSION`] `ω_1` (the core continuation's `fold_excursion`).
@@ -51,8 +45,8 @@ pub struct FrequencyResponse {
     pub omega_to: f64,
     /// Why the sweep stopped ([`FrequencyResponse::converged`]).
     pub termination: SweepTermination,
-    /// Wall time of the whole computation after the rod was built (reference amplitude,
-    /// initial Newton solve, continuation, tip reconstructions).
+    /// Wall time of the whole computation after the structure was built (reference
+    /// amplitude, initial Newton solve, continuation, reconstructions of the observed dof).
     pub solve_seconds: f64,
     /// Work counters (initial Newton solve + continuation).
     pub counters: RunCounters,
@@ -66,27 +60,85 @@ pub struct FrequencyResponse {
     pub corners: usize,
     /// `u_ref` of the step scaling (module documentation).
     pub reference_amplitude: f64,
-    /// Tip samples per period used for `tip_max`, `tip_min`, `amplitude`.
+    /// Samples per period of the observed dof used for the points' extremes and amplitude.
     pub output_points: usize,
-    /// The method's unknowns at each point (HB coefficients `[U; Lambda]` or `U`, LCP
-    /// `[w; z]`), unscaled, for warm starts and re-solves.
-    pub states: Vec<Vec<f64>>,
-    /// Stability, contact diagnostics and bifurcations of the points.
-    pub stability: BranchStability,
+    /// Stability changes between neighbouring points, in branch order.
+    pub events: Vec<BifurcationEvent>,
+    /// Why points are undecided (the first reason met), `None` when all are decided.
+    pub undecided: Option<Undecided>,
     /// Wall time of the stability analysis (not in `solve_seconds`).
     pub stability_seconds: f64,
-    /// Every contact of each point, in the scene's order (as `ssn solve` reports them).
-    pub contacts: Vec<Vec<ContactReport>>,
-    /// Harmonic balance: the harmonics of each point's state (empty for the LCP).
-    pub harmonics: Vec<usize>,
-    /// Harmonic balance: the AFT samples of each point (empty for the LCP).
-    pub time_samples: Vec<usize>,
     /// With an accuracy target ([`SolverSettings::accuracy`], SSN-HB): the harmonics chosen
-    /// point by point and each point's error estimate ([`super::adaptive`]).
+    /// point by point, what they achieved ([`super::adaptive`]; each point's estimate is its
+    /// [`ResponsePoint::error_estimate`]).
     pub accuracy: Option<BranchAccuracy>,
-    /// Every friction point of each point, in the model's order (stick fraction, force
-    /// and slip velocity amplitudes, as `ssn solve` reports them).
-    pub friction: Vec<Vec<FrictionSummary>>,
+}
+
+/// One point of a frequency-response branch: its frequency, the extremes of the observed
+/// dof over one period, the solver's state and work, its stability and its contacts.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ResponsePoint {
+    /// Forcing frequency `ω` (absolute).
+    pub omega: f64,
+    /// `max_t u(t)` of the observed dof over one period.
+    pub observed_max: f64,
+    /// `min_t u(t)` of the observed dof over one period.
+    pub observed_min: f64,
+    /// `max_t |u(t)|` of the observed dof over one period.
+    pub amplitude: f64,
+    /// Corrector iterations (the first point: those of the start correction).
+    pub iterations: usize,
+    /// The method's unknowns (HB coefficients `[U; Lambda]` or `U`, LCP `[w; z]`),
+    /// unscaled, for warm starts and re-solves.
+    pub state: Vec<f64>,
+    /// Harmonic balance: the harmonics of the state (`None` for the LCP).
+    pub harmonics: Option<usize>,
+    /// Harmonic balance: the AFT samples of the state (`None` for the LCP).
+    pub time_samples: Option<usize>,
+    /// With an accuracy target (SSN-HB, harmonics chosen point by point): the estimated
+    /// relative error of the observed extremes ([`super::adaptive`]; `None` without a
+    /// target or where the solve at `H/2` did not converge).
+    pub error_estimate: Option<f64>,
+    /// Stability and contact diagnostics (undecided until the branch's stability is
+    /// computed).
+    pub stability: PointStability,
+    /// Every contact, in the scene's order (as `ssn solve` reports them).
+    pub contacts: Vec<ContactReport>,
+    /// Every friction point, in the model's order (stick fraction, force and slip velocity
+    /// amplitudes, as `ssn solve` reports them).
+    pub friction: Vec<FrictionSummary>,
+}
+
+impl ResponsePoint {
+    /// A point at `omega` with the observed extremes `(max, min)`, its corrector
+    /// `iterations` and `state`, not yet analysed.
+    pub(super) fn new(
+        omega: f64,
+        (max, min): (f64, f64),
+        iterations: usize,
+        state: Vec<f64>,
+    ) -> Self {
+        Self {
+            omega,
+            observed_max: max,
+            observed_min: min,
+            amplitude: max.abs().max(min.abs()),
+            iterations,
+            state,
+            harmonics: None,
+            time_samples: None,
+            error_estimate: None,
+            stability: PointStability::default(),
+            contacts: Vec::new(),
+            friction: Vec::new(),
+        }
+    }
+
+    /// The point's mean contact force: the sum of its contacts' mean forces.
+    pub fn contact_force_mean(&self) -> f64 {
+        self.contacts.iter().map(|c| c.force_mean).sum()
+    }
 }
 
 /// Why a sweep stopped.
@@ -135,11 +187,7 @@ impl FrequencyResponse {
         Self {
             method,
             omega_1,
-            omega: Vec::new(),
-            tip_max: Vec::new(),
-            tip_min: Vec::new(),
-            amplitude: Vec::new(),
-            iterations: Vec::new(),
+            points: Vec::new(),
             folds: Vec::new(),
             fold_indices: Vec::new(),
             corner_folds: Vec::new(),
@@ -155,14 +203,10 @@ impl FrequencyResponse {
             corners: 0,
             reference_amplitude: u_ref,
             output_points: 0,
-            states: Vec::new(),
-            stability: BranchStability::default(),
+            events: Vec::new(),
+            undecided: None,
             stability_seconds: 0.0,
-            contacts: Vec::new(),
-            harmonics: Vec::new(),
-            time_samples: Vec::new(),
             accuracy: None,
-            friction: Vec::new(),
         }
     }
 
@@ -170,7 +214,12 @@ impl FrequencyResponse {
     /// a point out of range).
     pub fn point_settings(&self, settings: &SolverSettings, i: usize) -> SolverSettings {
         let mut s = settings.clone();
-        if let (Some(&h), Some(&nt)) = (self.harmonics.get(i), self.time_samples.get(i)) {
+        if let Some(&ResponsePoint {
+            harmonics: Some(h),
+            time_samples: Some(nt),
+            ..
+        }) = self.points.get(i)
+        {
             s.harmonics = h;
             s.time_samples = nt;
         }
@@ -187,45 +236,71 @@ impl FrequencyResponse {
         )
     }
 
-    pub(super) fn push(
-        &mut self,
-        omega: f64,
-        max: f64,
-        min: f64,
-        iterations: usize,
-        state: Vec<f64>,
-    ) {
-        self.omega.push(omega);
-        self.tip_max.push(max);
-        self.tip_min.push(min);
-        self.amplitude.push(max.abs().max(min.abs()));
-        self.iterations.push(iterations);
-        self.states.push(state);
+    /// Each point's stability from `stability` (one record per point), with the branch's
+    /// events and the reason for undecided points.
+    pub(super) fn set_stability(&mut self, stability: BranchStability) {
+        for (point, s) in self.points.iter_mut().zip(stability.points) {
+            point.stability = s;
+        }
+        self.events = stability.events;
+        self.undecided = stability.undecided;
     }
 
-    /// Number of branch points.
-    pub fn points(&self) -> usize {
-        self.omega.len()
+    /// Whether the branch has harmonic-balance points (their harmonics and AFT samples).
+    pub fn is_harmonic_balance(&self) -> bool {
+        self.points.first().is_some_and(|p| p.harmonics.is_some())
+    }
+
+    /// Harmonic balance: the harmonics of each point (empty for the LCP).
+    pub fn harmonics(&self) -> Vec<usize> {
+        self.points.iter().filter_map(|p| p.harmonics).collect()
+    }
+
+    /// With an accuracy target: the largest error estimate over the points (`None` if none
+    /// was estimated).
+    pub fn worst_estimate(&self) -> Option<f64> {
+        self.points
+            .iter()
+            .filter_map(|p| p.error_estimate)
+            .reduce(f64::max)
+    }
+
+    /// Harmonic balance: the AFT samples of each point (empty for the LCP).
+    pub fn time_samples(&self) -> Vec<usize> {
+        self.points.iter().filter_map(|p| p.time_samples).collect()
+    }
+
+    /// One value of each point, in branch order (a column of the branch: e.g.
+    /// `response.column(|p| p.observed_max)`).
+    pub fn column<T>(&self, value: impl Fn(&ResponsePoint) -> T) -> Vec<T> {
+        self.points.iter().map(value).collect()
+    }
+
+    /// `ω` of each point (absolute).
+    pub fn omegas(&self) -> Vec<f64> {
+        self.points.iter().map(|p| p.omega).collect()
     }
 
     /// `ω / ω_1` of each point.
     pub fn omega_ratio(&self) -> Vec<f64> {
-        self.omega.iter().map(|w| w / self.omega_1).collect()
+        self.points.iter().map(|p| p.omega / self.omega_1).collect()
     }
 
-    /// The mean contact force of each point: the sum of its contacts' mean forces (the
-    /// stability diagnostics' value, NaN, where the contacts were not computed).
+    /// Stable / unstable / undecided, one per point.
+    pub fn stable(&self) -> Vec<Option<bool>> {
+        self.points.iter().map(|p| p.stability.stable).collect()
+    }
+
+    /// `max_t |u(t)|` of the observed dof at each point.
+    pub fn amplitudes(&self) -> Vec<f64> {
+        self.points.iter().map(|p| p.amplitude).collect()
+    }
+
+    /// The mean contact force of each point: the sum of its contacts' mean forces.
     pub fn contact_force_mean(&self) -> Vec<f64> {
-        (0..self.points())
-            .map(|i| match self.contacts.get(i) {
-                Some(point) => point.iter().map(|c| c.force_mean).sum(),
-                None => self
-                    .stability
-                    .contact_force_mean
-                    .get(i)
-                    .copied()
-                    .unwrap_or(f64::NAN),
-            })
+        self.points
+            .iter()
+            .map(ResponsePoint::contact_force_mean)
             .collect()
     }
 
@@ -234,7 +309,12 @@ impl FrequencyResponse {
     /// `contact{k}_contact_fraction`, `contact{k}_displacement_min` and
     /// `contact{k}_displacement_max`, one value per point (NaN where not computed).
     pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
-        let count = self.contacts.iter().map(Vec::len).max().unwrap_or(0);
+        let count = self
+            .points
+            .iter()
+            .map(|p| p.contacts.len())
+            .max()
+            .unwrap_or(0);
         let fields: [(&str, ContactField); 5] = [
             ("force_mean", |c| c.force_mean),
             ("max_penetration", |c| c.max_penetration),
@@ -246,9 +326,9 @@ impl FrequencyResponse {
         for k in 0..count {
             for (name, field) in fields {
                 let values = self
-                    .contacts
+                    .points
                     .iter()
-                    .map(|point| point.get(k).map_or(f64::NAN, field))
+                    .map(|point| point.contacts.get(k).map_or(f64::NAN, field))
                     .collect();
                 columns.push((format!("contact{k}_{name}"), values));
             }
@@ -258,9 +338,9 @@ impl FrequencyResponse {
 
     /// Index and value of the largest amplitude (`None` for an empty curve).
     pub fn peak(&self) -> Option<(usize, f64)> {
-        self.amplitude
+        self.points
             .iter()
-            .copied()
+            .map(|p| p.amplitude)
             .enumerate()
             .fold(None, |best, (i, a)| match best {
                 Some((_, b)) if b >= a => best,

@@ -176,7 +176,7 @@ pub fn linear_history_error(
         .iter()
         .map(|t| z.re * (w * t).cos() - z.im * (w * t).sin())
         .collect();
-    (max_abs_diff(&solution.tip, &exact), z.norm())
+    (max_abs_diff(&solution.observed, &exact), z.norm())
 }
 
 pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {

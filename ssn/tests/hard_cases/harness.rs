@@ -274,7 +274,7 @@ pub(crate) fn print_row(case: &str, method: Method, outcome: &Outcome) {
 pub(crate) fn assert_finite(case: &str, method: Method, s: &Solution) {
     let what = format!("{case} / {}", method.name());
     assert!(
-        s.tip.iter().all(|v| v.is_finite()),
+        s.observed.iter().all(|v| v.is_finite()),
         "{what}: non-finite tip"
     );
     for f in &s.contact_forces {
@@ -394,8 +394,8 @@ pub(crate) fn run(case: &str, spec: &RodSpec, base: &SolverSettings, method: Met
                 .unwrap_or_else(|e| panic!("{case}: second run failed: {e}"));
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(
-                bits(&s.tip),
-                bits(&again.tip),
+                bits(&s.observed),
+                bits(&again.observed),
                 "{case} / {}: tip differs run to run",
                 method.name()
             );

@@ -410,10 +410,10 @@ fn change_against(
     Ok((change, other.solve_seconds, other.counters))
 }
 
-/// The error estimate of `solution`, a converged solve of `rod` at `omega` with `settings`
+/// The error estimate of `solution`, a converged solve of `structure` at `omega` with `settings`
 /// (module documentation).
 pub fn estimate(
-    rod: &Structure,
+    structure: &Structure,
     omega: f64,
     settings: &SolverSettings,
     solution: &Solution,
@@ -421,7 +421,7 @@ pub fn estimate(
     if !solution.converged() {
         return Err(NoEstimate::NotConverged);
     }
-    let mut comparison = comparison(settings, rod)?;
+    let mut comparison = comparison(settings, structure)?;
     let formulation = crate::solve::formulation::of(settings.method);
     if formulation.marches() {
         comparison.settings.max_periods = comparison
@@ -429,9 +429,14 @@ pub fn estimate(
             .max_periods
             .min(solution.iterations.max(MIN_COMPARISON_PERIODS));
     }
-    let start = carried_start(rod, solution, &comparison.settings);
-    let (change, mut seconds, mut counters) =
-        change_against(rod, omega, solution, &comparison.settings, start.as_deref())?;
+    let start = carried_start(structure, solution, &comparison.settings);
+    let (change, mut seconds, mut counters) = change_against(
+        structure,
+        omega,
+        solution,
+        &comparison.settings,
+        start.as_deref(),
+    )?;
     let mut parts = change.scaled(comparison.factor);
     let mut basis = EstimateBasis {
         against: Discretisation::of(&comparison.settings),
@@ -440,7 +445,7 @@ pub fn estimate(
         time_samples_check: None,
     };
     if formulation.penalises_contact() {
-        let (penalty, penalty_parts, s, c) = penalty_part(rod, omega, settings, solution)?;
+        let (penalty, penalty_parts, s, c) = penalty_part(structure, omega, settings, solution)?;
         parts = parts.plus(&penalty_parts);
         seconds += s;
         counters = counters + c;

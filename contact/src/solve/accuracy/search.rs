@@ -309,22 +309,22 @@ pub(crate) fn check_target(target: f64) -> Result<(), RunError> {
     Ok(())
 }
 
-/// Solves `rod` at `omega` with the cheapest discretisation of `settings.method` whose
+/// Solves `structure` at `omega` with the cheapest discretisation of `settings.method` whose
 /// estimated relative error meets `target` (module documentation), from `warm_start` on the
 /// first rung when it fits. `Err` only when a solve could not run; a search that did not
 /// meet the target returns its last answer with the reason in [`DiscretisationSearch::stop`].
 pub fn solve_to_accuracy(
-    rod: &Structure,
+    structure: &Structure,
     omega: f64,
     settings: &SolverSettings,
     target: f64,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
     check_target(target)?;
-    let mut ladder = Ladder::new(rod, settings);
+    let mut ladder = Ladder::new(structure, settings);
     let mut record = Record::new(target);
     let first = solve_as_given(
-        rod,
+        structure,
         omega,
         &ladder.settings(settings, ladder.start),
         warm_start,
@@ -355,7 +355,7 @@ pub fn solve_to_accuracy(
             _ => (2 * current.level).min(ladder.limit),
         };
         let (fine, change) = match pair(
-            rod,
+            structure,
             omega,
             (settings, &ladder),
             &mut record,
@@ -372,9 +372,14 @@ pub fn solve_to_accuracy(
             let b = basis(&fine);
             let chosen = (current, coarse_error, b);
             match failed {
-                Some(below) if finer_partner => {
-                    between(rod, omega, (settings, &ladder), &mut record, below, chosen)?
-                }
+                Some(below) if finer_partner => between(
+                    structure,
+                    omega,
+                    (settings, &ladder),
+                    &mut record,
+                    below,
+                    chosen,
+                )?,
                 _ => chosen,
             }
         } else if !finer_partner && fine_error.largest() <= target {
@@ -389,7 +394,7 @@ pub fn solve_to_accuracy(
         // Harmonic balance: the AFT samples on their own.
         if finer_partner && ladder.sample_factor < MAX_SAMPLE_FACTOR {
             let (rung, error, basis, met) = check_samples(
-                rod,
+                structure,
                 omega,
                 (settings, &mut ladder),
                 &mut record,
@@ -401,9 +406,9 @@ pub fn solve_to_accuracy(
                 current = rung;
                 continue;
             }
-            return finish_met(rod, omega, settings, record, rung, (error, basis));
+            return finish_met(structure, omega, settings, record, rung, (error, basis));
         }
-        return finish_met(rod, omega, settings, record, chosen, (error, basis));
+        return finish_met(structure, omega, settings, record, chosen, (error, basis));
     }
 }
 
