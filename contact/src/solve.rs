@@ -389,12 +389,18 @@ where
         .iter()
         .fold(0.0f64, |a, c| a.max(c.gap.abs()))
         .max(f64::MIN_POSITIVE);
-    let options = newton_options(settings).with_residual_floor(roundoff_floor(
+    let mut options = newton_options(settings).with_residual_floor(roundoff_floor(
         model,
         problem.dim(),
         gap_scale,
         extra_stiffness,
     ));
+    if model.contacts.is_empty() && model.friction.is_empty() {
+        // The unknowns are displacements alone, and round-off grows with them (a linear
+        // response near resonance): the floor per unit displacement.
+        let per_displacement = roundoff_floor(model, problem.dim(), 1.0, extra_stiffness);
+        options = options.with_residual_floor_per_state(per_displacement);
+    }
     let report = match settings.linear_solver.condensed() {
         Some(condensed) => {
             let mut solver = structured_solver(condensed, settings.tolerance);

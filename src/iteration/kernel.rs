@@ -340,7 +340,8 @@ impl Kernel {
         if !norm.is_finite() {
             return Some(Stop::NonFinite);
         }
-        (rules.min_iterations == 0 && norm <= tolerance).then_some(Stop::Converged)
+        let converged = norm <= tolerance.max(rules.tolerances.floor_at(y));
+        (rules.min_iterations == 0 && converged).then_some(Stop::Converged)
     }
 
     /// Goes back to the run's initial guess (`y` overwritten) and resets the line-search
@@ -475,7 +476,10 @@ impl Kernel {
                 self.best_g.copy_from_slice(&self.g);
             }
         }
-        if progress.iterations >= rules.min_iterations && norm <= progress.tolerance {
+        // The round-off floor grows with the iterate (a linear response near resonance).
+        let floor = rules.tolerances.floor_at(y);
+        if progress.iterations >= rules.min_iterations && norm <= progress.tolerance.max(floor) {
+            progress.tolerance = progress.tolerance.max(floor);
             return Some(Stop::Converged);
         }
         if rules
@@ -485,13 +489,11 @@ impl Kernel {
             return Some(Stop::Stagnated);
         }
         if step_norm <= rules.tolerances.step_tolerance * (1.0 + system.step_norm(y)) {
-            return Some(
-                if norm <= FLOOR_STALL_FACTOR * rules.tolerances.residual_floor {
-                    Stop::ConvergedAtFloor
-                } else {
-                    Stop::Stalled { step_norm }
-                },
-            );
+            return Some(if norm <= FLOOR_STALL_FACTOR * floor {
+                Stop::ConvergedAtFloor
+            } else {
+                Stop::Stalled { step_norm }
+            });
         }
         None
     }

@@ -335,6 +335,10 @@ pub struct Tolerances {
     /// tolerance is at least this, and a stall with `|F| <= 100 residual_floor` is
     /// convergence ([`Termination::ConvergedAtRoundoff`]).
     pub residual_floor: f64,
+    /// `|F|_2` that round-off produces per unit of the iterate's largest entry, `>= 0`
+    /// (0 = off): at an iterate `x` the tolerance is at least this times `max_i |x_i|` (a
+    /// linear problem near resonance, whose answer and round-off grow together).
+    pub residual_floor_per_state: f64,
     /// Stall threshold on the accepted step, `>= 0`.
     pub step_tolerance: f64,
 }
@@ -345,6 +349,7 @@ impl Default for Tolerances {
             absolute_tolerance: DEFAULT_ABSOLUTE_TOLERANCE,
             relative_tolerance: 0.0,
             residual_floor: 0.0,
+            residual_floor_per_state: 0.0,
             step_tolerance: DEFAULT_STEP_TOLERANCE,
         }
     }
@@ -366,11 +371,22 @@ impl Tolerances {
             .max(self.residual_floor)
     }
 
+    /// The round-off floor at the iterate `x`: `residual_floor + residual_floor_per_state
+    /// max_i |x_i|`.
+    pub(crate) fn floor_at(&self, x: &[f64]) -> f64 {
+        if self.residual_floor_per_state == 0.0 {
+            return self.residual_floor;
+        }
+        let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        self.residual_floor + self.residual_floor_per_state * largest
+    }
+
     /// Checks every field; the error names the field, the value and the allowed range.
     pub fn validate(&self) -> Result<(), NewtonError> {
         for (name, t) in [
             ("absolute_tolerance", self.absolute_tolerance),
             ("residual_floor", self.residual_floor),
+            ("residual_floor_per_state", self.residual_floor_per_state),
             ("step_tolerance", self.step_tolerance),
         ] {
             if !(t.is_finite() && t >= 0.0) {

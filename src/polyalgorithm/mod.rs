@@ -50,7 +50,7 @@
 //!
 //! | field | default | meaning |
 //! |---|---|---|
-//! | `tolerances` | [`Tolerances::default`]: `1e-10`, `0`, `0`, `1e-15` | as for [`NewtonOptions`] |
+//! | `tolerances` | [`Tolerances::default`]: `1e-10`, `0`, `0`, `0`, `1e-15` | as for [`NewtonOptions`] |
 //! | `max_iterations` | `200` | the budget of every attempt together (Newton and corrector iterations) |
 //! | `full_steps` | `30` | iterations of the first attempt (and of each finish on `F` after a path) |
 //! | `memory` | `10` | memory of the non-monotone line search (attempt 3) |
@@ -394,6 +394,16 @@ impl SolveOptions {
         match &mut self {
             Self::Newton(options) => options.tolerances.residual_floor = floor,
             Self::Polyalgorithm(options) => options.tolerances.residual_floor = floor,
+        }
+        self
+    }
+
+    /// The same with the residual floor per unit of the iterate's largest entry
+    /// ([`Tolerances::residual_floor_per_state`]) set to `floor`.
+    pub fn with_residual_floor_per_state(mut self, floor: f64) -> Self {
+        match &mut self {
+            Self::Newton(options) => options.tolerances.residual_floor_per_state = floor,
+            Self::Polyalgorithm(options) => options.tolerances.residual_floor_per_state = floor,
         }
         self
     }

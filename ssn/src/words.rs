@@ -530,13 +530,7 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
             )?;
         }
         writeln!(t, "solve time        {:.3} ms", 1e3 * s.solve_seconds)?;
-        writeln!(
-            t,
-            "tip max / min     {:.6} / {:.6}",
-            s.stats.max, s.stats.min
-        )?;
-        writeln!(t, "max penetration   {:.3e}", s.stats.max_penetration)?;
-        writeln!(t, "mean contact force {:.6e}", s.stats.mean_contact_force)?;
+        t += &result_lines(s);
         t += &estimate_lines(s);
         if s.contacts.len() > 1 {
             for c in &s.contacts {
@@ -563,6 +557,21 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
         )
     })();
     t
+}
+
+/// The tip's extremes, the largest penetration and the mean contact force of a converged
+/// run; a run that did not converge has no result, and its best iterate's numbers are not
+/// printed as one.
+fn result_lines(s: &Solution) -> String {
+    if !s.converged() {
+        return "tip max / min     none: the solve did not converge
+"
+        .to_string();
+    }
+    format!(
+        "tip max / min     {:.6} / {:.6}\nmax penetration   {:.3e}\nmean contact force {:.6e}\n",
+        s.stats.max, s.stats.min, s.stats.max_penetration, s.stats.mean_contact_force
+    )
 }
 
 /// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.

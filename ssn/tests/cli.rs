@@ -433,6 +433,25 @@ fn a_run_that_does_not_converge_prints_its_json_and_exits_1() {
     );
 }
 
+#[test]
+fn a_run_that_does_not_converge_prints_no_result_in_its_text() {
+    let scene = scenes_dir().join("paper_fig1_modified_mass.toml");
+    let scene = scene.to_str().expect("a UTF-8 path");
+    let out = ssn(&["solve", scene, "--set", "solver.max_iterations=1"]);
+    assert_eq!(out.status.code(), Some(1), "stderr {}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("converged         false"), "{text}");
+    // The best iterate is not an answer: no tip extremes, penetration or force that could
+    // be read as one.
+    assert!(
+        text.contains("tip max / min     none: the solve did not converge"),
+        "{text}"
+    );
+    for key in ["max penetration", "mean contact force"] {
+        assert!(!text.contains(key), "{key} printed:\n{text}");
+    }
+}
+
 fn natural_frequencies_line(text: &str) -> Vec<f64> {
     let line = text
         .lines()

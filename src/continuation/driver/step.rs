@@ -80,6 +80,7 @@ where
                     absolute_tolerance: tolerance,
                     relative_tolerance: 0.0,
                     residual_floor: 0.0,
+                    residual_floor_per_state: 0.0,
                     step_tolerance: self.options.step_tolerance,
                 },
                 max_iterations,
