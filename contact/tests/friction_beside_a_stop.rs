@@ -93,11 +93,11 @@ fn the_friction_with_stop_grid_converges_from_zero_in_every_case() {
                 let open = |s: &Solution| s.contacts[0].contact_fraction == 0.0;
                 if armijo.converged() && open(&solution) && open(&armijo) {
                     compared += 1;
-                    let scale = solution.tip.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                    let scale = solution.observed.iter().fold(1.0f64, |m, v| m.max(v.abs()));
                     let difference = solution
-                        .tip
+                        .observed
                         .iter()
-                        .zip(&armijo.tip)
+                        .zip(&armijo.observed)
                         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
                     assert!(difference <= 1e-6 * scale, "{case}: {difference:e}");
                 }

@@ -44,7 +44,7 @@ fn a_linear_chain_at_resonance_converges_with_one_factorization() {
     let difference = solution
         .times
         .iter()
-        .zip(&solution.tip)
+        .zip(&solution.observed)
         .map(|(t, u)| (u - (z.re * (omega * t).cos() - z.im * (omega * t).sin())).abs())
         .fold(0.0f64, f64::max);
     assert!(
