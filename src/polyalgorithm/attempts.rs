@@ -68,14 +68,7 @@ impl<J> Polyalgorithm<J> {
         if termination.converged() || ends_run(&termination) {
             return ended(termination, Strategy::FullSteps, vec![attempt], tolerance);
         }
-        let first_step = self
-            .work
-            .kernel
-            .step_norms
-            .first()
-            .copied()
-            .unwrap_or(f64::NAN);
-        let scale = path::state_scale(first_step, x.len());
+        let scale = path::state_scale(&self.work.kernel.step_norms, x.len());
         let best = Best::new(x, self.work.kernel.residual(), run.smallest);
         let mut attempts = Attempts {
             solver: self,
