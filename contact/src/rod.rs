@@ -393,6 +393,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         load: HarmonicLoad::cosine(load),
         contacts,
         friction: Vec::new(),
+        cyclic: None,
     };
     let omega_1 = natural_frequencies(&model, 1)?[0];
     model.damping = match spec.damping {
