@@ -4,6 +4,7 @@
 //! against the full disk's under engine orders 0, 3 and 7, on every linear solver.
 
 use nalgebra::{Complex, Matrix2, Vector2};
+use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
 use semismooth_contact::solve::{solve, Solution};
@@ -203,4 +204,43 @@ fn the_sector_with_a_casing_contact_solves_the_full_disk_under_engine_orders_0_3
             assert!(gap < 1e-10 * scale, "EO {engine_order} {choice:?}: {gap:e}");
         }
     }
+}
+
+#[test]
+fn bad_sectors_and_formulations_without_the_couplings_are_refused_with_their_numbers() {
+    use semismooth_contact::cyclic::InvalidSector;
+    use semismooth_contact::model::{ContactPoint, StructuralModel};
+    let disk = tuned_disk();
+    let loading = DiskLoading::shipped((0..BLADES).collect());
+    let (sector, _) = disk.cyclic_sector(&loading, 3).unwrap();
+    let model = sector.model().clone();
+    let new = |model: StructuralModel, left: Vec<usize>, right: Vec<usize>| {
+        CyclicSector::new(model, left, right, BLADES, 3).err()
+    };
+    assert_eq!(
+        new(model.clone(), vec![0], vec![]),
+        Some(InvalidSector::InterfaceLengths { left: 1, right: 0 })
+    );
+    assert_eq!(
+        new(model.clone(), vec![0], vec![0]),
+        Some(InvalidSector::InterfaceDof { dof: 0, dofs: 4 })
+    );
+    let on_right = model.clone().with_contact(ContactPoint::new(3, 1.0));
+    assert_eq!(
+        new(on_right, vec![0], vec![3]),
+        Some(InvalidSector::RowOnRightInterface { row: 1, dof: 3 })
+    );
+    assert!(CyclicSector::new(model, vec![0], vec![3], 0, 3).is_err());
+    assert!(sector.structure(3).is_err());
+    // The reduced model carries couplings that only the harmonic operator reads.
+    let reduced = sector.reduce();
+    assert!(natural_frequencies(&reduced, 1).is_err());
+    let lcp = semismooth_contact::lcp::PeriodicLcp::new(&reduced, 1.0, Default::default());
+    assert!(lcp.is_err());
+    let structure = sector.structure(1).unwrap();
+    let march = SolverSettings {
+        method: semismooth_contact::settings::Method::March,
+        ..SolverSettings::default()
+    };
+    assert!(solve(&structure, 1.0, &march, None).is_err());
 }

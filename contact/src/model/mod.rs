@@ -95,6 +95,13 @@ pub enum InvalidModel {
         /// `N`.
         dofs: usize,
     },
+    /// A reduced cyclic sector given to a formulation that reads `K`, `M`, `D` without the
+    /// harmonic operator's interface couplings.
+    #[error("a reduced cyclic sector cannot be solved by {formulation}: allowed the harmonic-balance formulations")]
+    CyclicCoupling {
+        /// The formulation.
+        formulation: &'static str,
+    },
     /// A dof of a sector list is out of range or in two sectors.
     #[error(
         "sector dof {dof} is out of range or in two sectors: allowed distinct dofs in 0..{dofs}"
@@ -321,6 +328,15 @@ impl StructuralModel {
         self.load.validate(n)?;
         contact::validate_rows(&self.contacts, &self.friction, n)?;
         Ok(())
+    }
+
+    /// [`InvalidModel::CyclicCoupling`] for a reduced cyclic sector: for the formulations
+    /// (`formulation`) that read the matrices without the harmonic operator.
+    pub(crate) fn refuse_cyclic(&self, formulation: &'static str) -> Result<(), InvalidModel> {
+        match self.cyclic {
+            Some(_) => Err(InvalidModel::CyclicCoupling { formulation }),
+            None => Ok(()),
+        }
     }
 
     /// Number of degrees of freedom `N`.
