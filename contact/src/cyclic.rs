@@ -231,7 +231,7 @@ impl CyclicSector {
             load: self.reduce_load(phi),
             contacts,
             friction,
-            cyclic: Some(CyclicCoupling::new(phi, terms)),
+            cyclic: Some(CyclicCoupling::new(phi, self.sectors, terms)),
         }
     }
 

@@ -257,7 +257,7 @@ impl HarmonicOperator {
                 matrix: empty(),
                 sign: t.sign,
             });
-            CyclicCoupling::new(c.phase_step, terms.collect())
+            CyclicCoupling::new(c.phase_step, c.sectors, terms.collect())
         });
         Self {
             dofs: self.dofs,

@@ -45,13 +45,44 @@ pub struct CouplingTerm {
 pub struct CyclicCoupling {
     /// The inter-sector phase `phi = 2 pi EO / N` of harmonic 1.
     pub phase_step: f64,
+    /// The number of sectors `N` of the disk.
+    pub sectors: usize,
     /// The coupling matrices.
     pub terms: Vec<CouplingTerm>,
 }
 
 impl CyclicCoupling {
-    /// The couplings `terms` with the phase `phase_step` per harmonic.
-    pub fn new(phase_step: f64, terms: Vec<CouplingTerm>) -> Self {
-        Self { phase_step, terms }
+    /// The couplings `terms` of a disk of `sectors` sectors with the phase `phase_step` per
+    /// harmonic.
+    pub fn new(phase_step: f64, sectors: usize, terms: Vec<CouplingTerm>) -> Self {
+        Self {
+            phase_step,
+            sectors,
+            terms,
+        }
+    }
+
+    /// The amplitude `max_t |u_s(t)|` of one dof in every sector `s = 0..N` from its
+    /// harmonic coefficients in sector 0 (`[u_0, a_1, b_1, ..., a_H, b_H]`), sector `s`
+    /// delayed by `s EO T / N`, sampled at `samples` instants of the period.
+    pub fn sector_amplitudes(&self, coefficients: &[f64], samples: usize) -> Vec<f64> {
+        let harmonics = coefficients.len().saturating_sub(1) / 2;
+        let samples = samples.max(1);
+        let constant = coefficients.first().copied().unwrap_or(0.0);
+        (0..self.sectors)
+            .map(|s| {
+                let delay = s as f64 * self.phase_step;
+                (0..samples)
+                    .map(|n| {
+                        let theta = 2.0 * std::f64::consts::PI * n as f64 / samples as f64;
+                        (1..=harmonics).fold(constant, |u, k| {
+                            let angle = k as f64 * (theta - delay);
+                            let (a, b) = (coefficients[2 * k - 1], coefficients[2 * k]);
+                            u + a * angle.cos() + b * angle.sin()
+                        })
+                    })
+                    .fold(0.0f64, |m, u| m.max(u.abs()))
+            })
+            .collect()
     }
 }
