@@ -246,6 +246,16 @@ fn bad_sectors_and_formulations_without_the_couplings_are_refused_with_their_num
         ..SolverSettings::default()
     };
     assert!(solve(&structure, 1.0, &march, None).is_err());
+    // A dof in two sectors or out of range is named with the model's size.
+    use semismooth_contact::model::{HarmonicLoad, InvalidModel};
+    let load = || HarmonicLoad::cosine(vec![1.0; 3]);
+    for sectors in [vec![vec![0], vec![0]], vec![vec![1], vec![3]]] {
+        let bad = sectors[1][0];
+        assert_eq!(
+            load().delayed_by_sector(&sectors, 1),
+            Err(InvalidModel::SectorDof { dof: bad, dofs: 3 })
+        );
+    }
 }
 
 /// The blade-tip amplitudes the sector recovers for every blade are the full disk's, each
