@@ -66,6 +66,7 @@ impl StructuralModel {
             load: HarmonicLoad::cosine(load),
             contacts: Vec::new(),
             friction: Vec::new(),
+            cyclic: None,
         }
     }
 

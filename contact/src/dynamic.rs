@@ -152,9 +152,19 @@ impl DynamicStiffness {
         slots: usize,
         max_columns: usize,
     ) -> Result<Self, LinearSolveError> {
-        let n = stiffness.nrows();
         let mut sources = vec![stiffness.clone(), mass.clone()];
         sources.extend(damping.cloned());
+        Self::with_sources(sources, slots, max_columns)
+    }
+
+    /// `Z = sum_s c_s A_s` over any `N x N` sources (the first one `K`; all checked by the
+    /// caller), factored per coefficient list with [`DynamicStiffness::factor_combination`].
+    pub(crate) fn with_sources(
+        sources: Vec<SparseMatrix>,
+        slots: usize,
+        max_columns: usize,
+    ) -> Result<Self, LinearSolveError> {
+        let n = sources[0].nrows();
         let refs: Vec<&SparseMatrix> = sources.iter().collect();
         let pattern = UnionPattern::new(n, &refs);
         let mut lu = SparseLu::new()
@@ -179,9 +189,20 @@ impl DynamicStiffness {
         mass: c64,
         damping: c64,
     ) -> Result<(), LinearSolveError> {
-        let coefficients = [c64::new(1.0, 0.0), mass, damping];
-        self.pattern
-            .combine(self.sources.iter().zip(coefficients), &mut self.values);
+        self.factor_combination(slot, &[c64::new(1.0, 0.0), mass, damping])
+    }
+
+    /// Factors `sum_s coefficients[s] A_s` (the sources in their order) into `slot`, with
+    /// the breakdown of [`DynamicStiffness::factor`].
+    pub(crate) fn factor_combination(
+        &mut self,
+        slot: usize,
+        coefficients: &[c64],
+    ) -> Result<(), LinearSolveError> {
+        self.pattern.combine(
+            self.sources.iter().zip(coefficients.iter().copied()),
+            &mut self.values,
+        );
         match self.lu.factor_slot(slot, self.pattern.matrix(&self.values)) {
             // The pivot's position in the factorization is a column of the ordering.
             Err(LinearSolveError::Singular {

@@ -10,6 +10,7 @@
 
 pub mod builder;
 pub mod contacts;
+pub mod cyclic;
 mod dynamic;
 mod error;
 pub mod exact;

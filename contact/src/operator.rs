@@ -24,7 +24,9 @@ use faer::{c64, Mat, MatMut};
 use semismooth::linalg::LinearSolveError;
 
 use crate::dynamic::{DynamicStiffness, UnionPattern};
-use crate::model::{sparse_mul_add, HarmonicLoad, SparseMatrix, StructuralModel};
+use crate::model::{
+    sparse_mul_add, CouplingTerm, CyclicCoupling, HarmonicLoad, SparseMatrix, StructuralModel,
+};
 
 /// The parameters of the coefficients `c_s(k, w, p)`: the angular frequency `w` and the
 /// modal damping `xi` (module documentation).
@@ -75,6 +77,7 @@ pub(crate) struct HarmonicOperator {
     stiffness: SparseMatrix,
     mass: SparseMatrix,
     damping: Option<SparseMatrix>,
+    coupling: Option<CyclicCoupling>,
     load: HarmonicLoad,
 }
 
@@ -88,20 +91,37 @@ impl HarmonicOperator {
             stiffness: model.stiffness.clone(),
             mass: model.mass.clone(),
             damping: model.damping.clone(),
+            coupling: model.cyclic.clone(),
             load: model.load.clone(),
         }
     }
 
-    /// The sources `K`, `M`, `D` (`D` absent without damping) with their coefficients.
-    fn terms(&self, c: Coefficients) -> impl Iterator<Item = (&SparseMatrix, c64)> + '_ {
-        [
+    /// Every source of harmonic `k` with its coefficient, from the coefficients `c` of
+    /// `[K, M, D]` (`D` absent without damping): a cyclic coupling `B_t` takes
+    /// `c[source_t] e^{i sign_t k phi}`.
+    fn terms(&self, k: usize, c: Coefficients) -> impl Iterator<Item = (&SparseMatrix, c64)> + '_ {
+        let own = [
             Some(&self.stiffness),
             Some(&self.mass),
             self.damping.as_ref(),
         ]
         .into_iter()
         .zip(c)
-        .filter_map(|(a, c)| a.map(|a| (a, c)))
+        .filter_map(|(a, c)| a.map(|a| (a, c)));
+        let coupling = self.coupling.iter().flat_map(move |coupling| {
+            let phase = k as f64 * coupling.phase_step;
+            (coupling.terms.iter()).map(move |t| (&t.matrix, coupled(t, phase, c)))
+        });
+        own.chain(coupling)
+    }
+
+    /// Every source in the order of [`HarmonicOperator::terms`].
+    fn source_matrices(&self) -> Vec<SparseMatrix> {
+        let mut sources = vec![self.stiffness.clone(), self.mass.clone()];
+        sources.extend(self.damping.clone());
+        let coupling = self.coupling.iter().flat_map(|c| &c.terms);
+        sources.extend(coupling.map(|t| t.matrix.clone()));
+        sources
     }
 
     /// `c_s(k, w, xi)` of `[K, M, D]`: `[1, -(k w)^2 - i k w xi, i k w]`.
@@ -142,13 +162,8 @@ impl HarmonicOperator {
     fn apply_with(&self, coefficients: impl Fn(usize) -> Coefficients, u: &[f64], out: &mut [f64]) {
         let n = self.dofs;
         out.fill(0.0);
-        let sources = [
-            Some(&self.stiffness),
-            Some(&self.mass),
-            self.damping.as_ref(),
-        ];
-        for (a, c) in sources.iter().zip(coefficients(0)) {
-            if let (Some(a), true) = (a, c.re != 0.0) {
+        for (a, c) in self.terms(0, coefficients(0)) {
+            if c.re != 0.0 {
                 sparse_mul_add(a.as_ref(), c.re, &u[..n], &mut out[..n]);
             }
         }
@@ -156,10 +171,8 @@ impl HarmonicOperator {
             let (cos, sin) = ((2 * k - 1) * n, 2 * k * n);
             let (a, b) = (&u[cos..cos + n], &u[sin..sin + n]);
             let (out_c, out_s) = out[cos..sin + n].split_at_mut(n);
-            for (matrix, c) in sources.iter().zip(coefficients(k)) {
-                let Some(matrix) = matrix.map(|m| m.as_ref()) else {
-                    continue;
-                };
+            for (matrix, c) in self.terms(k, coefficients(k)) {
+                let matrix = matrix.as_ref();
                 // z = a - i b: Z z = (Re Z a + Im Z b) - i (Re Z b - Im Z a).
                 if c.re != 0.0 {
                     sparse_mul_add(matrix, c.re, a, out_c);
@@ -214,14 +227,14 @@ impl HarmonicOperator {
                 }
             }
         };
-        for (a, c) in self.terms(Self::coefficients(0, p)) {
+        for (a, c) in self.terms(0, Self::coefficients(0, p)) {
             if c.re != 0.0 {
                 add(a, 0, 0, c.re);
             }
         }
         for k in 1..=self.harmonics {
             let (cos, sin) = ((2 * k - 1) * n, 2 * k * n);
-            for (a, c) in self.terms(Self::coefficients(k, p)) {
+            for (a, c) in self.terms(k, Self::coefficients(k, p)) {
                 if c.re != 0.0 {
                     add(a, cos, cos, c.re);
                     add(a, sin, sin, c.re);
@@ -234,17 +247,40 @@ impl HarmonicOperator {
         }
     }
 
+    /// The operator with `1 x 1` empty matrices and no load: its [`HarmonicOperator::terms`]
+    /// give the coefficients of every source without holding the matrices twice.
+    fn without_matrices(&self) -> Self {
+        let empty = || SparseMatrix::try_new_from_triplets(1, 1, &[]).expect("a 1 x 1 matrix");
+        let coupling = self.coupling.as_ref().map(|c| {
+            let terms = c.terms.iter().map(|t| CouplingTerm {
+                source: t.source,
+                matrix: empty(),
+                sign: t.sign,
+            });
+            CyclicCoupling::new(c.phase_step, c.sectors, terms.collect())
+        });
+        Self {
+            dofs: self.dofs,
+            harmonics: self.harmonics,
+            stiffness: empty(),
+            mass: empty(),
+            damping: self.damping.as_ref().map(|_| empty()),
+            coupling,
+            load: HarmonicLoad::zero(0),
+        }
+    }
+
     /// Empty factorizations of every `Z_k` (`k = 0..=H`), with scratch for solves of up to
     /// `max_columns` right-hand sides at once.
     pub(crate) fn factors(&self, max_columns: usize) -> Result<HarmonicFactors, LinearSolveError> {
         Ok(HarmonicFactors {
-            stiffness: DynamicStiffness::new(
-                &self.stiffness,
-                &self.mass,
-                self.damping.as_ref(),
+            stiffness: DynamicStiffness::with_sources(
+                self.source_matrices(),
                 self.harmonics + 1,
                 max_columns,
             )?,
+            operator: self.without_matrices(),
+            coefficients: Vec::new(),
             dofs: self.dofs,
             harmonics: self.harmonics,
             key: None,
@@ -253,12 +289,23 @@ impl HarmonicOperator {
     }
 }
 
+/// `c[source] e^{i sign phase}`: the coefficient of a coupling term at the harmonic
+/// phase `phase = k phi`.
+fn coupled(term: &CouplingTerm, phase: f64, c: Coefficients) -> c64 {
+    let angle = term.sign * phase;
+    c[term.source.index()] * c64::new(angle.cos(), angle.sin())
+}
+
 /// The sparse complex LU of every `Z_k(w, p)`, `k = 0..=H`, of one [`HarmonicOperator`]
 /// (module documentation): [`HarmonicFactors::factor`] refactors only when a parameter
 /// changed.
 #[derive(Debug)]
 pub(crate) struct HarmonicFactors {
     stiffness: DynamicStiffness,
+    /// The operator's coupling phases and which sources it has (its matrices emptied).
+    operator: HarmonicOperator,
+    /// Scratch: the coefficients of every source at one harmonic.
+    coefficients: Vec<c64>,
     dofs: usize,
     harmonics: usize,
     /// The parameters of the factorizations held (`None`: none or failed).
@@ -278,9 +325,11 @@ impl HarmonicFactors {
         self.key = None;
         let n = self.dofs;
         for k in 0..=self.harmonics {
-            let [_, mass, damping] = HarmonicOperator::coefficients(k, p);
+            let base = HarmonicOperator::coefficients(k, p);
+            self.coefficients.clear();
+            (self.coefficients).extend(self.operator.terms(k, base).map(|(_, c)| c));
             self.stiffness
-                .factor(k, mass, damping)
+                .factor_combination(k, &self.coefficients)
                 .map_err(|e| match e {
                     LinearSolveError::Singular {
                         index,

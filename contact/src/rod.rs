@@ -393,6 +393,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         load: HarmonicLoad::cosine(load),
         contacts,
         friction: Vec::new(),
+        cyclic: None,
     };
     let omega_1 = natural_frequencies(&model, 1)?[0];
     model.damping = match spec.damping {
@@ -492,9 +493,18 @@ const ACCEPTED_EIGEN_CHANGE: f64 = 1e-9;
 /// `Y <- K^{-1} M Y` with Rayleigh–Ritz (sparse LU of K, cost linear in n for a rod),
 /// until the requested frequencies change by less than 1e-13 relative, or by less than
 /// 1e-9 and no less than at the iteration before (the round-off level of large models), or,
-/// after 200 iterations, by less than 1e-9 (clustered spectra converge slowly).
+/// after 200 iterations, by less than 1e-9 (clustered spectra converge slowly). A reduced
+/// cyclic sector is refused: its frequencies are per nodal diameter
+/// ([`crate::cyclic::CyclicSector::nodal_diameter_model`]).
 pub fn natural_frequencies(model: &StructuralModel, count: usize) -> Result<Vec<f64>, ModelError> {
     let n = model.dofs();
+    if let Some(coupling) = &model.cyclic {
+        return Err(ModelError::InvalidParameter {
+            name: "cyclic coupling phase of a model for natural frequencies",
+            value: coupling.phase_step,
+            allowed: "a model without cyclic couplings (a sector's nodal-diameter model)",
+        });
+    }
     if count == 0 {
         return Ok(Vec::new());
     }

@@ -32,6 +32,7 @@
 
 use faer::sparse::Triplet;
 
+use crate::cyclic::CyclicSector;
 use crate::dynamic::UnionPattern;
 use crate::model::{
     ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
@@ -201,6 +202,7 @@ impl BladedDisk {
                 .map(|&j| ContactPoint::new(Self::pad(j), loading.gap))
                 .collect(),
             friction: Vec::new(),
+            cyclic: None,
         };
         let omega_1 = natural_frequencies(&model, 1)?[0];
         model.damping = Some(UnionPattern::linear_combination(
@@ -214,6 +216,74 @@ impl BladedDisk {
             omega_1,
             observed_dof,
         })
+    }
+}
+
+impl BladedDisk {
+    /// The dofs `[d_j, b_j, p_j]` of each sector `j` (for [`HarmonicLoad::delayed_by_sector`]).
+    pub fn sector_dofs(&self) -> Vec<Vec<usize>> {
+        (0..self.blades)
+            .map(|j| vec![3 * j, 3 * j + 1, 3 * j + 2])
+            .collect()
+    }
+
+    /// One sector of the tuned disk (the mistuning is ignored) under `loading` and the
+    /// engine order `engine_order`, with the lowest natural frequency `omega_1` of the disk
+    /// that scales its damping ([`CyclicSector::lowest_frequency`]). The sector's dofs are `d, b, p` of blade 0
+    /// and the next sector's disk dof `d'` (3, the right interface of the left dof 0): the
+    /// ground, blade and pad springs and the ring spring `d - d'`, unit masses on `d`, `b`.
+    /// Cyclic symmetry needs a stop on every blade or on none: its pad meets the casing
+    /// when `loading.stops` lists every blade, and other stops are
+    /// [`ModelError::InvalidParameter`].
+    pub fn cyclic_sector(
+        &self,
+        loading: &DiskLoading,
+        engine_order: usize,
+    ) -> Result<(CyclicSector, f64), ModelError> {
+        let mut stops = loading.stops.clone();
+        stops.sort_unstable();
+        stops.dedup();
+        if self.blades == 0 || !(stops.is_empty() || stops == (0..self.blades).collect::<Vec<_>>())
+        {
+            return Err(ModelError::InvalidParameter {
+                name: "stop blades of a cyclic sector",
+                value: stops.len() as f64,
+                allowed: "every blade of a disk of at least one blade, or none",
+            });
+        }
+        let (k_g, k_d, k_b, k_c) = (1.0, 1.0, 1.0, 10.0);
+        let mut t = vec![Triplet::new(0, 0, k_g)];
+        for (i, j, s) in [(0, 3, k_d), (0, 1, k_b), (1, 2, k_c)] {
+            t.extend([
+                Triplet::new(i, i, s),
+                Triplet::new(j, j, s),
+                Triplet::new(i, j, -s),
+                Triplet::new(j, i, -s),
+            ]);
+        }
+        let stiffness =
+            SparseMatrix::try_new_from_triplets(4, 4, &t).expect("entries within 4 x 4");
+        let mass = [Triplet::new(0, 0, 1.0), Triplet::new(1, 1, 1.0)];
+        let mass = SparseMatrix::try_new_from_triplets(4, 4, &mass).expect("entries within 4 x 4");
+        let mut model =
+            StructuralModel::new(mass, stiffness, vec![0.0, loading.amplitude, 0.0, 0.0]);
+        if !stops.is_empty() {
+            model = model.with_contact(ContactPoint::new(Self::pad(0), loading.gap));
+        }
+        let sector = |model| {
+            // The sector's interfaces and rows are valid by construction: only a
+            // non-finite gap, amplitude or damping is left to refuse.
+            CyclicSector::new(model, vec![0], vec![3], self.blades, engine_order).map_err(|_| {
+                ModelError::InvalidParameter {
+                    name: "disk loading",
+                    value: f64::NAN,
+                    allowed: "a finite gap, load amplitude and damping ratio",
+                }
+            })
+        };
+        let omega_1 = sector(model.clone())?.lowest_frequency()?;
+        let model = model.with_rayleigh_damping(0.0, 2.0 * loading.zeta / omega_1);
+        Ok((sector(model)?, omega_1))
     }
 }
 

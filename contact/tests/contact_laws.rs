@@ -128,6 +128,7 @@ fn rotating_oscillator() -> StructuralModel {
         load,
         contacts: Vec::new(),
         friction: Vec::new(),
+        cyclic: None,
     }
 }
 

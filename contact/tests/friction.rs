@@ -42,6 +42,7 @@ fn oscillator(m: f64, c: f64, k: f64, f0: f64, friction: f64) -> StructuralModel
             0.5,
             2.0 * friction,
         )],
+        cyclic: None,
     }
 }
 

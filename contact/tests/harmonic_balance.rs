@@ -64,6 +64,7 @@ fn chain(
         load: HarmonicLoad::cosine((0..n).map(|i| 0.3 + 0.1 * i as f64).collect()),
         contacts,
         friction: Vec::new(),
+        cyclic: None,
     };
     (model, omega)
 }

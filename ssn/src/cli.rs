@@ -128,6 +128,7 @@ pub fn prepare(
             let parts = &scene.load_parts;
             crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
                 .map_err(CliError::BadInput)?;
+            let structure = scene.apply_cyclic(structure).map_err(CliError::BadInput)?;
             if solves {
                 let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
                 crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
@@ -226,7 +227,9 @@ pub const RESONANCE_AMPLIFICATION: f64 = 1e9;
 /// periodic solution (the response grows without bound), so nothing is run.
 fn check_resonance(scene: &Scene, structure: &Structure, omega: f64) -> Result<(), String> {
     let model = &structure.model;
-    if !model.contacts.is_empty() || model.damping.is_some() {
+    // A reduced cyclic sector's undamped response depends on its couplings, which the
+    // amplification check does not read.
+    if !model.contacts.is_empty() || model.damping.is_some() || model.cyclic.is_some() {
         return Ok(());
     }
     match model.undamped_amplification(omega) {
@@ -482,6 +485,9 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         outputs,
         || {
             let mut v = crate::json::solution_json(&args.scene, &solution);
+            if let Some(amplitudes) = crate::json::blade_amplitudes(&rod, &solution) {
+                v["blade_amplitudes"] = amplitudes;
+            }
             if let Some(s) = &start {
                 v["started_from"] = s.to_json();
             }

@@ -8,6 +8,7 @@ use serde_json::{json, Value};
 
 use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummary};
+use semismooth_contact::model::Structure;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
@@ -382,4 +383,22 @@ pub fn fold_accuracy_json(folds: &[FoldAccuracy], omega_1: f64) -> Value {
             })
         })
         .collect()
+}
+
+/// The observed dof's amplitude in every sector of the full disk, recovered from a reduced
+/// cyclic sector's harmonic-balance solution (`None` for any other structure or method).
+pub fn blade_amplitudes(structure: &Structure, s: &Solution) -> Option<Value> {
+    let coupling = structure.model.cyclic.as_ref()?;
+    let (n, harmonics) = (structure.model.dofs(), s.harmonics?);
+    let dof = structure.observed_dof;
+    let coefficients: Vec<f64> = (0..2 * harmonics + 1)
+        .map(|j| s.state.get(j * n + dof).copied())
+        .collect::<Option<_>>()?;
+    let amplitudes = coupling.sector_amplitudes(&coefficients, s.time_samples);
+    Some(Value::from(
+        amplitudes
+            .into_iter()
+            .map(finite_or_null)
+            .collect::<Vec<_>>(),
+    ))
 }

@@ -69,6 +69,7 @@ fn tuned(blades: usize, gap: f64) -> StructuralModel {
             .map(|j| ContactPoint::new(BladedDisk::pad(j), gap))
             .collect(),
         friction: Vec::new(),
+        cyclic: None,
     };
     let omega_1 = natural_frequencies(&model, 1).unwrap()[0];
     let beta = 2.0 * 0.01 / omega_1;

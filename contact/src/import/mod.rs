@@ -341,6 +341,7 @@ pub fn assemble(parts: ModelParts, attach: &Attachments) -> Result<Structure, Mo
         load: crate::model::HarmonicLoad::cosine(load),
         contacts,
         friction,
+        cyclic: None,
     };
     let omega_1 = first_frequency(&model)?;
     if let Some(d) = attach.damping {

@@ -62,6 +62,7 @@ impl PeriodicLcp {
         with_derivative: bool,
     ) -> Result<Self, LcpError> {
         model.validate()?;
+        model.refuse_cyclic("the periodic LCP")?;
         check_omega(omega)?;
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);

@@ -192,6 +192,7 @@ impl<'a> TimeMarcher<'a> {
     ) -> Result<Self, MarchError> {
         options.validate()?;
         model.validate()?;
+        model.refuse_cyclic("time marching")?;
         check_omega(omega)?;
         let n = model.dofs();
         let m = model.contact_count();

@@ -114,6 +114,43 @@ impl HarmonicLoad {
         Ok(())
     }
 
+    /// The engine-order excitation of a disk of `N = sector_dofs.len()` sectors: the load
+    /// with the dofs of sector `s` (`sector_dofs[s]`) delayed by `s EO T / N`, harmonic `k`'s
+    /// parts `(c, s)` rotated by `a = k s phi`, `phi = 2 pi EO / N`, into
+    /// `(c cos a - s sin a, c sin a + s cos a)`; dofs of no sector keep their phase. A dof
+    /// out of range or in two sectors is [`InvalidModel::SectorDof`].
+    pub fn delayed_by_sector(
+        mut self,
+        sector_dofs: &[Vec<usize>],
+        engine_order: usize,
+    ) -> Result<Self, InvalidModel> {
+        let mut sector_of = vec![None; self.dofs];
+        for (s, dofs) in sector_dofs.iter().enumerate() {
+            for &dof in dofs {
+                match sector_of.get_mut(dof) {
+                    Some(slot @ None) => *slot = Some(s),
+                    _ => {
+                        return Err(InvalidModel::SectorDof {
+                            dof,
+                            dofs: self.dofs,
+                        })
+                    }
+                }
+            }
+        }
+        let sectors = sector_dofs.len().max(1);
+        let phi = 2.0 * std::f64::consts::PI * (engine_order % sectors) as f64 / sectors as f64;
+        for h in &mut self.harmonics {
+            for (dof, sector) in sector_of.iter().enumerate() {
+                let angle = h.harmonic as f64 * sector.unwrap_or(0) as f64 * phi;
+                let (c, s) = (h.cosine[dof], h.sine[dof]);
+                h.cosine[dof] = c * angle.cos() - s * angle.sin();
+                h.sine[dof] = c * angle.sin() + s * angle.cos();
+            }
+        }
+        Ok(self)
+    }
+
     /// The load with every part multiplied by `factor`.
     pub fn scaled(mut self, factor: f64) -> Self {
         for h in &mut self.harmonics {

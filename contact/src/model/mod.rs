@@ -25,11 +25,13 @@ use num_traits::Zero;
 use semismooth::{Factorize, InvalidOption, LinearSolve};
 
 mod contact;
+mod coupling;
 mod load;
 
 pub use contact::{
     ContactDirection, ContactPoint, ContactRow, FrictionPoint, InvalidRow, NormalForce,
 };
+pub use coupling::{CouplingSource, CouplingTerm, CyclicCoupling};
 pub use load::{HarmonicLoad, LoadHarmonic};
 
 /// Sparse symmetric matrix storage used for `M`, `D` and `K` (column-compressed, faer).
@@ -54,6 +56,10 @@ pub struct StructuralModel {
     /// Coulomb friction points (tangential rows of `G`, each under a contact's normal
     /// force or a prescribed normal load); empty: frictionless.
     pub friction: Vec<FrictionPoint>,
+    /// The phase-shifted interface couplings of a reduced cyclic sector
+    /// ([`crate::cyclic::CyclicSector`]); `None` for every other model. Only the harmonic
+    /// operator (the harmonic-balance formulations) reads them.
+    pub cyclic: Option<CyclicCoupling>,
 }
 
 /// A structure ready for every method: the model, its first finite natural frequency
@@ -86,6 +92,23 @@ pub enum InvalidModel {
         rows: usize,
         /// Columns found.
         cols: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// A reduced cyclic sector given to a formulation that reads `K`, `M`, `D` without the
+    /// harmonic operator's interface couplings.
+    #[error("a reduced cyclic sector cannot be solved by {formulation}: allowed the harmonic-balance formulations")]
+    CyclicCoupling {
+        /// The formulation.
+        formulation: &'static str,
+    },
+    /// A dof of a sector list is out of range or in two sectors.
+    #[error(
+        "sector dof {dof} is out of range or in two sectors: allowed distinct dofs in 0..{dofs}"
+    )]
+    SectorDof {
+        /// The dof.
+        dof: usize,
         /// `N`.
         dofs: usize,
     },
@@ -288,9 +311,32 @@ impl StructuralModel {
             }
             first_non_finite(part, matrix.val())?;
         }
+        let couplings = self.cyclic.iter().flat_map(|c| &c.terms);
+        for matrix in couplings.map(|t| &t.matrix) {
+            let (rows, cols) = (matrix.nrows(), matrix.ncols());
+            if rows != n || cols != n {
+                let part = "cyclic coupling matrix";
+                return Err(InvalidModel::MatrixSize {
+                    part,
+                    rows,
+                    cols,
+                    dofs: n,
+                });
+            }
+            first_non_finite("cyclic coupling matrix", matrix.val())?;
+        }
         self.load.validate(n)?;
         contact::validate_rows(&self.contacts, &self.friction, n)?;
         Ok(())
+    }
+
+    /// [`InvalidModel::CyclicCoupling`] for a reduced cyclic sector: for the formulations
+    /// (`formulation`) that read the matrices without the harmonic operator.
+    pub(crate) fn refuse_cyclic(&self, formulation: &'static str) -> Result<(), InvalidModel> {
+        match self.cyclic {
+            Some(_) => Err(InvalidModel::CyclicCoupling { formulation }),
+            None => Ok(()),
+        }
     }
 
     /// Number of degrees of freedom `N`.
@@ -598,6 +644,7 @@ mod tests {
             load: HarmonicLoad::cosine(vec![0.0, 0.0, 1.0]),
             contacts: vec![ContactPoint::new(2, 0.1)],
             friction: Vec::new(),
+            cyclic: None,
         }
     }
 

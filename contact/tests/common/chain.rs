@@ -32,6 +32,7 @@ pub fn chain(gap: f64, zeta: f64, load: [f64; 2]) -> Structure {
         load: HarmonicLoad::cosine(load.to_vec()),
         contacts: vec![ContactPoint::new(1, gap)],
         friction: Vec::new(),
+        cyclic: None,
     };
     Structure {
         model,

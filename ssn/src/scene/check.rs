@@ -190,6 +190,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
+    let (engine_order, cyclic) = ck.cyclic_keys(&raw.forcing, raw.cyclic, &model, &bladed_disk)?;
     Ok(Scene {
         path: path.to_path_buf(),
         title: raw.title,
@@ -198,6 +199,8 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         bladed_disk,
         output_dof,
         load_parts,
+        engine_order,
+        cyclic,
         solver,
         sweep,
     })

@@ -32,11 +32,13 @@ use semismooth_contact::rod::{
 
 mod check;
 mod contacts;
+mod cyclic;
 mod disk;
 mod load_parts;
 mod nodes;
 mod overrides;
 
+pub use cyclic::{CyclicSpec, EngineOrderSpec, MAX_SECTORS};
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
 
@@ -73,6 +75,10 @@ pub struct Scene {
     /// The load parts of a `[model]` scene beyond its cosine `vector` (`[forcing]
     /// vector_sin`, `static`, `[[forcing.harmonic]]`), added when its structure is built.
     pub load_parts: Vec<LoadPart>,
+    /// `[forcing] engine_order` on a full model: the sectors' load delays.
+    pub engine_order: Option<EngineOrderSpec>,
+    /// `[cyclic]`: the `[model]` is one sector of a tuned disk.
+    pub cyclic: Option<CyclicSpec>,
     /// Solver settings.
     pub solver: SolverSettings,
     /// Frequency sweep, if declared.
@@ -86,6 +92,7 @@ struct RawScene {
     rod: Option<RawRod>,
     model: Option<RawModel>,
     bladed_disk: Option<disk::RawBladedDisk>,
+    cyclic: Option<cyclic::RawCyclic>,
     damping: Option<RawDamping>,
     forcing: RawForcing,
     contact: Option<RawContact>,
@@ -169,6 +176,8 @@ struct RawForcing {
     amplitude: f64,
     omega_ratio: Option<f64>,
     omega: Option<f64>,
+    engine_order: Option<i64>,
+    sector_dofs: Option<Vec<Vec<i64>>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,0 +1,88 @@
+//! The interface couplings of a cyclic sector whose right interface dofs were eliminated
+//! ([`crate::cyclic`]): each coupling matrix enters harmonic `k` of the harmonic operator
+//! with the coefficient of its source (`K`, `M` or `D`) times `e^{i sign k phi}`.
+
+use super::SparseMatrix;
+
+/// Which source of the harmonic operator a coupling matrix follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CouplingSource {
+    /// Coefficient 1.
+    Stiffness,
+    /// Coefficient `-(k w)^2 - i k w xi`.
+    Mass,
+    /// Coefficient `i k w`.
+    Damping,
+}
+
+impl CouplingSource {
+    /// The index of the source in the operator's `[K, M, D]`.
+    pub(crate) fn index(self) -> usize {
+        match self {
+            Self::Stiffness => 0,
+            Self::Mass => 1,
+            Self::Damping => 2,
+        }
+    }
+}
+
+/// One coupling matrix: `matrix` enters harmonic `k` as `c_source(k) e^{i sign k phi}`.
+#[derive(Debug, Clone)]
+pub struct CouplingTerm {
+    /// The source whose coefficient it takes.
+    pub source: CouplingSource,
+    /// `N x N`, on the model's dofs.
+    pub matrix: SparseMatrix,
+    /// `+1` or `-1`.
+    pub sign: f64,
+}
+
+/// The phase-shifted interface couplings of a reduced cyclic sector: harmonic `k` of the
+/// operator is `Z_k = sum_s c_s(k) A_s + sum_t c_t(k) e^{i sign_t k phi} B_t`.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct CyclicCoupling {
+    /// The inter-sector phase `phi = 2 pi EO / N` of harmonic 1.
+    pub phase_step: f64,
+    /// The number of sectors `N` of the disk.
+    pub sectors: usize,
+    /// The coupling matrices.
+    pub terms: Vec<CouplingTerm>,
+}
+
+impl CyclicCoupling {
+    /// The couplings `terms` of a disk of `sectors` sectors with the phase `phase_step` per
+    /// harmonic.
+    pub fn new(phase_step: f64, sectors: usize, terms: Vec<CouplingTerm>) -> Self {
+        Self {
+            phase_step,
+            sectors,
+            terms,
+        }
+    }
+
+    /// The amplitude `max_t |u_s(t)|` of one dof in every sector `s = 0..N` from its
+    /// harmonic coefficients in sector 0 (`[u_0, a_1, b_1, ..., a_H, b_H]`), sector `s`
+    /// delayed by `s EO T / N`, sampled at `samples` instants of the period.
+    pub fn sector_amplitudes(&self, coefficients: &[f64], samples: usize) -> Vec<f64> {
+        let harmonics = coefficients.len().saturating_sub(1) / 2;
+        let samples = samples.max(1);
+        let constant = coefficients.first().copied().unwrap_or(0.0);
+        (0..self.sectors)
+            .map(|s| {
+                let delay = s as f64 * self.phase_step;
+                (0..samples)
+                    .map(|n| {
+                        let theta = 2.0 * std::f64::consts::PI * n as f64 / samples as f64;
+                        (1..=harmonics).fold(constant, |u, k| {
+                            let angle = k as f64 * (theta - delay);
+                            let (a, b) = (coefficients[2 * k - 1], coefficients[2 * k]);
+                            u + a * angle.cos() + b * angle.sin()
+                        })
+                    })
+                    .fold(0.0f64, |m, u| m.max(u.abs()))
+            })
+            .collect()
+    }
+}

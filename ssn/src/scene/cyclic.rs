@@ -1,0 +1,209 @@
+//! `[cyclic]` on a `[model]` sector and `[forcing] engine_order` on a full model.
+//!
+//! ```toml
+//! [cyclic]               # the [model] files are one sector of a tuned disk
+//! sectors = 24           # N >= 1
+//! engine_order = 3       # EO >= 0
+//! left = [1, 2]          # 1-based interface dofs; right[j] is the next sector's left[j]
+//! right = [7, 8]
+//!
+//! [forcing]              # on a full model (or a [bladed_disk]): sector s lags 2 pi EO s / N
+//! engine_order = 3
+//! sector_dofs = [[1, 2, 3], [4, 5, 6]]   # 1-based; the [bladed_disk] builder knows its own
+//! ```
+
+use serde::Deserialize;
+
+use semismooth_contact::cyclic::CyclicSector;
+use semismooth_contact::matrix_market::ModelSpec;
+use semismooth_contact::model::Structure;
+
+use super::check::Check;
+use super::{RawForcing, Scene, SceneError};
+
+/// Largest `[cyclic] sectors` and `engine_order` accepted.
+pub const MAX_SECTORS: usize = 100_000;
+
+/// The `[cyclic]` section as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCyclic {
+    sectors: i64,
+    engine_order: i64,
+    left: Vec<i64>,
+    right: Vec<i64>,
+}
+
+/// A `[model]` scene's `[cyclic]` section: its structure is one sector of `sectors`,
+/// excited by `engine_order`, with matching 0-based interface dofs `left` and `right`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CyclicSpec {
+    /// The number of sectors `N`.
+    pub sectors: usize,
+    /// The engine order `EO`.
+    pub engine_order: usize,
+    /// Left interface dofs (0-based).
+    pub left: Vec<usize>,
+    /// Right interface dofs (0-based), `right[j]` the next sector's `left[j]`.
+    pub right: Vec<usize>,
+}
+
+/// `[forcing] engine_order` on a full model: the load on the dofs of sector `s` delayed by
+/// `s EO T / N`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EngineOrderSpec {
+    /// The engine order `EO`.
+    pub engine_order: usize,
+    /// The dofs of each sector (0-based).
+    pub sector_dofs: Vec<Vec<usize>>,
+}
+
+impl Check<'_> {
+    /// `[forcing] engine_order` (on a `[model]` or `[bladed_disk]`: `model`; `bladed_disk`
+    /// its mistuning) and `[cyclic]` (on a `[model]` only), not both.
+    pub(super) fn cyclic_keys(
+        &self,
+        f: &RawForcing,
+        raw: Option<RawCyclic>,
+        model: &Option<ModelSpec>,
+        bladed_disk: &Option<Vec<f64>>,
+    ) -> Result<(Option<EngineOrderSpec>, Option<CyclicSpec>), SceneError> {
+        let engine_order = match model.is_some() {
+            true => self.engine_order(f, bladed_disk.as_ref().map(Vec::len))?,
+            false if f.engine_order.is_some() => {
+                return Err(self.invalid(
+                    "forcing.engine_order",
+                    "given in a [rod] scene",
+                    "engine_order on a [model] or [bladed_disk] scene",
+                ))
+            }
+            false => None,
+        };
+        let is_model = model.is_some() && bladed_disk.is_none();
+        let cyclic = raw.map(|c| self.cyclic(c, is_model)).transpose()?;
+        if cyclic.is_some() && engine_order.is_some() {
+            return Err(self.invalid(
+                "forcing.engine_order",
+                "given together with [cyclic]",
+                "the sector's engine order in [cyclic] engine_order",
+            ));
+        }
+        Ok((engine_order, cyclic))
+    }
+
+    /// `[cyclic]` (only on a `[model]` scene: `model`).
+    fn cyclic(&self, raw: RawCyclic, model: bool) -> Result<CyclicSpec, SceneError> {
+        if !model {
+            return Err(self.invalid(
+                "cyclic",
+                "given without a [model] section",
+                "[cyclic] on a [model] scene whose files are one sector",
+            ));
+        }
+        let sectors = self.count("cyclic.sectors", raw.sectors, 1, MAX_SECTORS)?;
+        let engine_order = self.count("cyclic.engine_order", raw.engine_order, 0, MAX_SECTORS)?;
+        let dofs = |key: &str, list: &[i64]| -> Result<Vec<usize>, SceneError> {
+            list.iter()
+                .map(|&d| Ok(self.count(key, d, 1, usize::MAX >> 1)? - 1))
+                .collect()
+        };
+        let (left, right) = (
+            dofs("cyclic.left", &raw.left)?,
+            dofs("cyclic.right", &raw.right)?,
+        );
+        if left.len() != right.len() {
+            return Err(self.invalid(
+                "cyclic.right",
+                format!("{} dofs", right.len()),
+                &format!("as many dofs as cyclic.left ({})", left.len()),
+            ));
+        }
+        Ok(CyclicSpec {
+            sectors,
+            engine_order,
+            left,
+            right,
+        })
+    }
+
+    /// `[forcing] engine_order` and `sector_dofs`; a `[bladed_disk]` of `disk_blades`
+    /// blades gives its own sectors. `None` without `engine_order`.
+    fn engine_order(
+        &self,
+        f: &RawForcing,
+        disk_blades: Option<usize>,
+    ) -> Result<Option<EngineOrderSpec>, SceneError> {
+        let Some(order) = f.engine_order else {
+            if f.sector_dofs.is_some() {
+                return Err(self.invalid(
+                    "forcing.sector_dofs",
+                    "given without forcing.engine_order",
+                    "sector_dofs together with engine_order",
+                ));
+            }
+            return Ok(None);
+        };
+        let engine_order = self.count("forcing.engine_order", order, 0, MAX_SECTORS)?;
+        let sector_dofs = match (&f.sector_dofs, disk_blades) {
+            (None, Some(blades)) => (0..blades)
+                .map(|j| vec![3 * j, 3 * j + 1, 3 * j + 2])
+                .collect(),
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    "forcing.sector_dofs",
+                    "given in a [bladed_disk] scene",
+                    "nothing: the disk's sectors are its blades",
+                ))
+            }
+            (None, None) => {
+                return Err(self.invalid(
+                    "forcing.sector_dofs",
+                    "missing",
+                    "the 1-based dofs of each sector, [[...], [...], ...]",
+                ))
+            }
+            (Some(lists), None) => lists
+                .iter()
+                .map(|list| {
+                    (list.iter())
+                        .map(|&d| Ok(self.count("forcing.sector_dofs", d, 1, usize::MAX >> 1)? - 1))
+                        .collect::<Result<Vec<usize>, SceneError>>()
+                })
+                .collect::<Result<_, _>>()?,
+        };
+        Ok(Some(EngineOrderSpec {
+            engine_order,
+            sector_dofs,
+        }))
+    }
+}
+
+impl Scene {
+    /// The structure of the scene's model with its engine-order load delayed sector by
+    /// sector, or reduced to its cyclic sector (observed at its observed dof); errors in
+    /// words naming the scene key.
+    pub fn apply_cyclic(&self, structure: Structure) -> Result<Structure, String> {
+        let mut structure = structure;
+        if let Some(eo) = &self.engine_order {
+            let load = structure.model.load.clone();
+            structure.model.load = load
+                .delayed_by_sector(&eo.sector_dofs, eo.engine_order)
+                .map_err(|e| format!("invalid `forcing.sector_dofs`: {e}"))?;
+        }
+        let Some(c) = &self.cyclic else {
+            return Ok(structure);
+        };
+        let observed = structure.observed_dof;
+        let sector = CyclicSector::new(
+            structure.model,
+            c.left.clone(),
+            c.right.clone(),
+            c.sectors,
+            c.engine_order,
+        )
+        .map_err(|e| format!("invalid [cyclic]: {e}"))?;
+        sector
+            .structure(observed)
+            .map_err(|e| format!("invalid [cyclic]: {e}"))
+    }
+}

@@ -1,0 +1,153 @@
+//! `[cyclic]` on a `[model]` sector and `[forcing] engine_order` on a `[bladed_disk]`: the
+//! sector scene and the full disk scene under the same engine order answer the same
+//! harmonic balance, and the sector's `blade_amplitudes` are the full disk's blade tips.
+
+use std::path::{Path, PathBuf};
+
+use semismooth_contact::matrix_market::model_matrix_files;
+use semismooth_contact::solve::Solution;
+use semismooth_contact::structures::{BladedDisk, DiskLoading};
+use ssn::cli::{load, Loaded};
+
+const BLADES: usize = 8;
+const HARMONICS: usize = 5;
+
+/// A fresh directory for one test.
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ssn-cyclic-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The sections both scenes share: Rayleigh damping `beta K`, the forcing frequency, the
+/// solver (64 samples: a multiple of N, so the sector delay is a whole number of samples;
+/// one complementarity constant, on which the AFT-projected equations depend).
+fn common(beta: f64, omega: f64) -> String {
+    format!(
+        "[damping]\nalpha = 0.0\nbeta = {beta:e}\n\n[solver]\nharmonics = {HARMONICS}\n\
+         time_samples = 64\nc = 5.0\ntolerance = 1e-13\n\n[forcing]\namplitude = 0.06\n\
+         omega = {omega:e}\n"
+    )
+}
+
+fn solved(path: &Path) -> (Loaded, Solution) {
+    let loaded = load(path).unwrap_or_else(|e| panic!("{e}"));
+    let s = semismooth_contact::solve(&loaded.structure, loaded.omega, &loaded.scene.solver, None)
+        .unwrap();
+    assert!(s.converged(), "{:?}", s.termination);
+    (loaded, s)
+}
+
+#[test]
+fn a_sector_scene_answers_the_full_disk_scene_under_the_same_engine_order() {
+    let dir = temp_dir("sector");
+    let disk = BladedDisk {
+        blades: BLADES,
+        mistuning: 0.0,
+    };
+    let loading = DiskLoading::shipped((0..BLADES).collect());
+    let (sector, omega_1) = disk.cyclic_sector(&loading, 3).unwrap();
+    let beta = 2.0 * loading.zeta / omega_1;
+    let omega = 0.9;
+    let m = sector.model();
+    for (name, text) in model_matrix_files(&m.stiffness, &m.mass, &[0.0, 1.0, 0.0, 0.0]) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let sector_scene = dir.join("sector.toml");
+    std::fs::write(
+        &sector_scene,
+        format!(
+            "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n\n[cyclic]\nsectors = {BLADES}\n\
+             engine_order = 3\nleft = [1]\nright = [4]\n\n[[contact.point]]\ndof = 3\ngap = 1.0\n\n\
+             [output]\ndof = 2\n\n{}vector = \"f.mtx\"\n",
+            common(beta, omega)
+        ),
+    )
+    .unwrap();
+    let full_scene = dir.join("full.toml");
+    std::fs::write(
+        &full_scene,
+        format!(
+            "[bladed_disk]\nblades = {BLADES}\n\n[contact]\ngap = 1.0\n\n{}engine_order = 3\n",
+            common(beta, omega)
+        ),
+    )
+    .unwrap();
+    let (sector_loaded, sector_solution) = solved(&sector_scene);
+    let (full_loaded, full_solution) = solved(&full_scene);
+    assert!(full_solution
+        .contacts
+        .iter()
+        .any(|c| c.contact_fraction > 0.0));
+    let n = 3 * BLADES;
+    let u_full = &full_solution.state[..n * (2 * HARMONICS + 1)];
+    let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let reduced = &sector_solution.state[..3 * (2 * HARMONICS + 1)];
+    for s in 0..BLADES {
+        let u_s = sector.sector_coefficients(reduced, HARMONICS, s);
+        for j in 0..2 * HARMONICS + 1 {
+            for dof in 0..3 {
+                let gap = (u_s[j * 4 + dof] - u_full[j * n + 3 * s + dof]).abs();
+                // Same equations, both converged below 1e-13 on damped, well-conditioned
+                // Jacobians (the library's test finds 1e-13): 1e-10 leaves a wide margin.
+                assert!(
+                    gap < 1e-10 * scale,
+                    "sector {s} harmonic row {j} dof {dof}: {gap:e}"
+                );
+            }
+        }
+    }
+    // Every blade's tip amplitude: the full disk's blade 0 tip is its observed dof.
+    let amplitudes =
+        ssn::json::blade_amplitudes(&sector_loaded.structure, &sector_solution).unwrap();
+    let amplitudes = amplitudes.as_array().unwrap();
+    assert_eq!(amplitudes.len(), BLADES);
+    assert_eq!(full_loaded.structure.observed_dof, 1);
+    let tip_0 = (0..64)
+        .map(|i| {
+            let t = 2.0 * std::f64::consts::PI * i as f64 / 64.0;
+            (1..=HARMONICS).fold(u_full[1], |u, k| {
+                let (a, b) = (u_full[(2 * k - 1) * n + 1], u_full[2 * k * n + 1]);
+                u + a * (k as f64 * t).cos() + b * (k as f64 * t).sin()
+            })
+        })
+        .fold(0.0f64, |m, u| m.max(u.abs()));
+    for a in amplitudes {
+        // The same 64 samples of the same coefficients, reordered by whole-sample delays.
+        assert!(
+            (a.as_f64().unwrap() - tip_0).abs() < 1e-10 * tip_0,
+            "{a} vs {tip_0}"
+        );
+    }
+    assert!(ssn::json::blade_amplitudes(&full_loaded.structure, &full_solution).is_none());
+}
+
+#[test]
+fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
+    let dir = temp_dir("refused");
+    let cases = [
+        (
+            "[rod]\nelements = 4\n[forcing]\namplitude = 0.1\nengine_order = 2\n",
+            "forcing.engine_order",
+        ),
+        (
+            "[bladed_disk]\nblades = 4\n[forcing]\namplitude = 0.1\nsector_dofs = [[1]]\n",
+            "forcing.sector_dofs",
+        ),
+        (
+            "[bladed_disk]\nblades = 4\n[cyclic]\nsectors = 4\nengine_order = 1\nleft = [1]\n\
+             right = [4]\n[forcing]\namplitude = 0.1\n",
+            "cyclic",
+        ),
+    ];
+    for (i, (text, key)) in cases.iter().enumerate() {
+        let path = dir.join(format!("case{i}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let message = match load(&path) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("case {i} loaded"),
+        };
+        assert!(message.contains(key), "case {i}: {message}");
+    }
+}
