@@ -7,7 +7,10 @@ use semismooth::linalg::FaerDenseLu;
 use semismooth::Residual;
 
 use super::{AmplitudeMeasure, Epmc, LinearMode, ModesError};
-use crate::hb::HbOptions;
+use crate::hb::{HbError, HbOptions, ResponseSummary};
+
+/// Times per period of the points' summaries (at least `4 H + 4`).
+const SUMMARY_POINTS: usize = 1024;
 use crate::model::StructuralModel;
 
 /// What [`backbone`] computes.
@@ -63,6 +66,9 @@ pub struct BackbonePoint {
     pub damping_ratio: f64,
     /// The period mean of the mechanical energy ([`Epmc::energy`]).
     pub energy: f64,
+    /// Extremes of the summary dof ([`Backbone::summary_dof`]), penetration and mean
+    /// contact forces over the period.
+    pub summary: ResponseSummary,
     /// The EPMC unknowns `[U; Lambda; w; xi]`.
     pub unknowns: Vec<f64>,
 }
@@ -76,6 +82,9 @@ pub struct Backbone {
     pub linear: LinearMode,
     /// The points, the first corrected at `amplitude_from`.
     pub points: Vec<BackbonePoint>,
+    /// The dof of the points' summaries: the measured dof, or the largest entry of the
+    /// mode's shape.
+    pub summary_dof: usize,
     /// Amplitudes where the branch turns back.
     pub folds: Vec<f64>,
     /// Why the continuation ended.
@@ -119,20 +128,32 @@ pub fn backbone(
         .map_err(|e| ModesError::Continuation(e.to_string()))?
         .with_dense_fallback()
         .run();
+    let summary_dof = match options.measure {
+        AmplitudeMeasure::Dof(dof) => dof,
+        _ => (0..linear.shape.len())
+            .max_by(|&i, &j| linear.shape[i].abs().total_cmp(&linear.shape[j].abs()))
+            .unwrap_or(0),
+    };
+    let len = epmc.hb_len();
+    let times = SUMMARY_POINTS.max(4 * options.hb.harmonics + 4);
     let points = branch
         .points
         .iter()
-        .map(|p| BackbonePoint {
-            amplitude: p.parameter,
-            omega: epmc.omega(&p.state),
-            modal_damping: epmc.modal_damping(&p.state),
-            damping_ratio: epmc.damping_ratio(&p.state),
-            energy: epmc.energy(&p.state),
-            unknowns: p.state.clone(),
+        .map(|p| {
+            Ok(BackbonePoint {
+                amplitude: p.parameter,
+                omega: epmc.omega(&p.state),
+                modal_damping: epmc.modal_damping(&p.state),
+                damping_ratio: epmc.damping_ratio(&p.state),
+                energy: epmc.energy(&p.state),
+                summary: epmc.hb().summary(&p.state[..len], summary_dof, times)?,
+                unknowns: p.state.clone(),
+            })
         })
-        .collect();
+        .collect::<Result<_, HbError>>()?;
     Ok(Backbone {
         linear,
+        summary_dof,
         folds: branch.fold_parameters(),
         points,
         termination: branch.termination,
