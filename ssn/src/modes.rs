@@ -5,6 +5,7 @@ use serde_json::{json, Value};
 
 use semismooth::continuation::ContinuationTermination;
 use semismooth_contact::hb::HbOptions;
+use semismooth_contact::model::Structure;
 use semismooth_contact::modes::{backbone, AmplitudeMeasure, Backbone, BackboneOptions};
 
 use crate::cli::{Loaded, RunArgs, Workload};
@@ -21,27 +22,8 @@ pub fn command(args: &RunArgs) -> Result<(), CliError> {
     } = crate::cli::load_with(&args.scene, &args.set, Workload::Branch)?;
     crate::cli::claim_model_files(&mut outputs, &scene)?;
     let bad = |e: String| CliError::BadInput(format!("{}: {e}", args.scene.display()));
-    let Some(settings) = scene.modes.clone() else {
-        return Err(bad(
-            "no [modes] section: add amplitude_from and amplitude_to (the observed dof's \
-             amplitude)"
-                .into(),
-        ));
-    };
-    let mut options = BackboneOptions::new(
-        settings.mode,
-        AmplitudeMeasure::Dof(structure.observed_dof),
-        settings.amplitude_from,
-        settings.amplitude_to,
-    );
-    options.hb = HbOptions {
-        harmonics: scene.solver.harmonics,
-        time_samples: Some(scene.solver.time_samples),
-        c: scene.solver.c,
-    };
-    options.continuation.max_points = settings.max_points;
     let started = std::time::Instant::now();
-    let branch = backbone(&structure.model, &options).map_err(|e| bad(e.to_string()))?;
+    let branch = run(&scene, &structure).map_err(bad)?;
     let seconds = started.elapsed().as_secs_f64();
     if let Some(csv) = &args.csv {
         outputs.add(csv, csv_text(&branch).into_bytes());
@@ -59,6 +41,31 @@ pub fn command(args: &RunArgs) -> Result<(), CliError> {
         || summary(&branch),
         complete,
     )
+}
+
+/// The backbone of `scene`'s `[modes]` on `structure` (the observed dof's amplitude, the
+/// scene's harmonic balance); `Err` names what is missing or wrong.
+pub fn run(scene: &Scene, structure: &Structure) -> Result<Backbone, String> {
+    let Some(settings) = scene.modes.clone() else {
+        return Err(
+            "no [modes] section: add amplitude_from and amplitude_to (the observed \
+                    dof's amplitude)"
+                .into(),
+        );
+    };
+    let mut options = BackboneOptions::new(
+        settings.mode,
+        AmplitudeMeasure::Dof(structure.observed_dof),
+        settings.amplitude_from,
+        settings.amplitude_to,
+    );
+    options.hb = HbOptions {
+        harmonics: scene.solver.harmonics,
+        time_samples: Some(scene.solver.time_samples),
+        c: scene.solver.c,
+    };
+    options.continuation.max_points = settings.max_points;
+    backbone(&structure.model, &options).map_err(|e| e.to_string())
 }
 
 /// The JSON document of `ssn modes` (also `ssn.modes(scene)` in Python).
