@@ -5,15 +5,16 @@ use faer::sparse::Triplet;
 use semismooth::continuation::ContinuationTermination;
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions, Tolerances};
-use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
+use semismooth::polyalgorithm::{self, solve_smoothing, PolyalgorithmOptions};
 use semismooth::{ParameterDependent, Residual};
 use semismooth_contact::hb::{HbOptions, SsnHb};
 use semismooth_contact::model::{
     ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel,
 };
 use semismooth_contact::modes::{
-    backbone, AmplitudeMeasure, BackboneOptions, BackbonePoint, Epmc, LinearMode,
+    backbone, AmplitudeMeasure, Backbone, BackboneOptions, BackbonePoint, Epmc, LinearMode,
 };
+use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 
 fn sparse(n: usize, entries: &[(usize, usize, f64)]) -> SparseMatrix {
     let t: Vec<_> = entries
@@ -222,51 +223,129 @@ fn quarter_period_later(x: &[f64], harmonics: usize, widths: &[usize]) -> Vec<f6
     out
 }
 
-/// The forced response's phase resonance (the cosine part of harmonic 1 of the mass zero:
-/// the response lags the force by a quarter period): `(w, |U_1|, xi)` with the modal damping
-/// `xi = F b_1 / (w sum_k k^2 |U_k|^2)` that balances the force's work per cycle,
-/// `pi F b_1`, against `xi` times `integral u'^2 dt = pi w sum_k k^2 |U_k|^2` (unit mass).
-/// Found by the secant method in `w` on SSN-HB solves, from `x` at `w`. Last: the share
-/// `sqrt(sum_{k >= 2} k^2 |U_k|^2 / sum_k k^2 |U_k|^2)` of the harmonics above the first in
-/// the velocity.
+/// `u^T A u` of a sparse symmetric `A`.
+fn quadratic(a: &SparseMatrix, u: &[f64]) -> f64 {
+    let a = a.as_ref();
+    (0..a.ncols())
+        .map(|j| {
+            let column: f64 = (a.row_idx_of_col(j).zip(a.val_of_col(j)))
+                .map(|(i, v)| v * u[i])
+                .sum();
+            column * u[j]
+        })
+        .sum()
+}
+
+/// A forced response's phase resonance at a dof and the modal damping of its energy
+/// balance.
+struct PhaseResonance {
+    omega: f64,
+    /// `|U_1|` of the dof (its sine part: the cosine part is zero).
+    amplitude: f64,
+    /// `xi = f . b_1 / (w sum_k k^2 |U_k|_M^2)`: the force's work per cycle, `pi f . b_1`,
+    /// against `xi` times `integral u'^T M u' dt = pi w sum_k k^2 |U_k|_M^2`.
+    modal_damping: f64,
+    /// `sqrt(1 - |U_1|_M^2 / sum_k k^2 |U_k|_M^2)`: the share of the harmonics above the
+    /// first in the velocity.
+    higher: f64,
+}
+
+/// The phase resonance of `model`'s forced response at `dof` (the cosine part of its
+/// harmonic 1 zero: it lags the cosine force by a quarter period), by the secant method in
+/// `w` on SSN-HB solves from `x` at `w`.
 fn phase_resonance(
     model: &StructuralModel,
     options: &HbOptions,
+    dof: usize,
     mut w: f64,
     x: &mut Vec<f64>,
-) -> (f64, f64, f64, f64) {
+) -> PhaseResonance {
+    let n = model.dofs();
+    let (cos, sin) = (n + dof, 2 * n + dof);
     let mut hb = SsnHb::new(model, w, options).unwrap();
     let newton = PolyalgorithmOptions::default();
     let cosine_part = |hb: &mut SsnHb, w: f64, x: &mut Vec<f64>| {
         hb.set_omega(w).unwrap();
         let report = solve_smoothing(hb, &mut FaerDenseLu::new(), x, &newton).unwrap();
         assert!(report.converged(), "{report:?}");
-        x[2]
+        x[cos]
     };
     let (mut w_old, mut f_old) = (w * 1.001, cosine_part(&mut hb, w * 1.001, x));
     for _ in 0..30 {
         let f = cosine_part(&mut hb, w, x);
         // The solves' own tolerance leaves |F| ~ 1e-10 and the cosine part moves by
         // about that much: stop there.
-        if f.abs() < 1e-9 * x[4].abs() || f == f_old {
+        if f.abs() < 1e-9 * x[sin].abs() || f == f_old {
             break;
         }
         let next = w - f * (w - w_old) / (f - f_old);
         (w_old, f_old, w) = (w, f, next);
     }
-    assert!(x[2].abs() < 1e-9 * x[4].abs(), "{} {}", x[2], x[4]);
-    let force = model.load.forcing_cosine()[0];
-    let h = options.harmonics;
-    let motion: f64 = (1..=h)
-        .map(|k| (k * k) as f64 * (x[2 * (2 * k - 1)].powi(2) + x[2 * 2 * k].powi(2)))
+    assert!(x[cos].abs() < 1e-9 * x[sin].abs(), "{} {}", x[cos], x[sin]);
+    let block = |j: usize| &x[j * n..(j + 1) * n];
+    let mass = |j: usize| quadratic(&model.mass, block(j));
+    let motion: f64 = (1..=options.harmonics)
+        .map(|k| (k * k) as f64 * (mass(2 * k - 1) + mass(2 * k)))
         .sum();
-    let b1 = x[4];
-    let higher = 1.0 - b1 * b1 / motion;
+    let force: f64 = (model.load.forcing_cosine().iter().zip(block(2)))
+        .map(|(f, b)| f * b)
+        .sum();
+    PhaseResonance {
+        omega: w,
+        amplitude: x[sin].abs(),
+        modal_damping: force / (w * motion),
+        higher: (1.0 - (mass(1) + mass(2)) / motion).max(0.0).sqrt(),
+    }
+}
+
+/// The relative differences in `w` and `xi` between the phase resonance of `forced` at
+/// `dof` and `branch` at that amplitude (Newton on `epmc` from the branch point whose
+/// energy balance `xi w |U_c1|_M^2 = f . U_c1` fits `forced`'s load `f` best), and the
+/// share of the higher harmonics; `widths` are the dofs and the contact rows.
+fn backbone_against_forced(
+    branch: &Backbone,
+    epmc: &mut Epmc,
+    forced: &StructuralModel,
+    dof: usize,
+    widths: &[usize],
+) -> (f64, f64, f64) {
+    let n = forced.dofs();
+    let basis = epmc.hb().basis();
+    let options = HbOptions {
+        harmonics: basis.harmonics(),
+        time_samples: Some(basis.time_samples()),
+        c: Some(epmc.hb().c()),
+    };
+    let load = forced.load.forcing_cosine();
+    let misfit = |p: &BackbonePoint| {
+        let first = &p.unknowns[n..2 * n];
+        let work: f64 = load.iter().zip(first).map(|(f, a)| f * a).sum();
+        (p.modal_damping * p.omega * quadratic(&forced.mass, first) / work - 1.0).abs()
+    };
+    let start = (branch.points.iter())
+        .min_by(|p, q| misfit(p).total_cmp(&misfit(q)))
+        .unwrap();
+    let len = epmc.hb_len();
+    let mut x = quarter_period_later(&start.unknowns[..len], options.harmonics, widths);
+    let resonance = phase_resonance(forced, &options, dof, start.omega, &mut x);
+    // The backbone at that amplitude, exactly (Newton on EPMC from the point nearest in
+    // amplitude).
+    epmc.set_parameter(resonance.amplitude);
+    let nearest = (branch.points.iter())
+        .min_by(|p, q| {
+            let d = |p: &BackbonePoint| (p.amplitude - resonance.amplitude).abs();
+            d(p).total_cmp(&d(q))
+        })
+        .unwrap();
+    let mut y = nearest.unknowns.clone();
+    let newton = PolyalgorithmOptions::default();
+    let report = polyalgorithm::solve(epmc, &mut FaerDenseLu::new(), &mut y, &newton).unwrap();
+    assert!(report.converged(), "{report:?}");
+    let (w, xi) = (resonance.omega, resonance.modal_damping);
     (
-        w,
-        b1.abs(),
-        force * b1 / (w * motion),
-        higher.max(0.0).sqrt(),
+        ((w - epmc.omega(&y)) / w).abs(),
+        ((xi - epmc.modal_damping(&y)) / xi).abs(),
+        resonance.higher,
     )
 }
 
@@ -289,46 +368,57 @@ fn jenkins_backbone_carries_the_phase_resonances_of_the_forced_responses() {
     let first = &branch.points[0];
     assert!((first.omega - 2.0).abs() < 1e-12 && (first.damping_ratio - c / 4.0).abs() < 1e-12);
     let mut epmc = Epmc::new(&free, &options, 1, AmplitudeMeasure::Dof(0)).unwrap();
-    let len = epmc.hb_len();
     for force in [0.02, 0.1, 0.3, 0.6] {
-        // Start at the backbone point whose single-harmonic energy balance F = xi w a fits.
-        let start = branch
-            .points
-            .iter()
-            .min_by(|p, q| {
-                let miss =
-                    |p: &BackbonePoint| (p.modal_damping * p.omega * p.amplitude - force).abs();
-                miss(p).total_cmp(&miss(q))
-            })
-            .unwrap();
-        let mut x = quarter_period_later(&start.unknowns[..len], options.harmonics, &[2, 1]);
         let forced = jenkins(c, k_t, limit, force);
-        let (w, amplitude, xi, higher) = phase_resonance(&forced, &options, start.omega, &mut x);
-        // The backbone at that amplitude, exactly (Newton on EPMC from the nearest point).
-        epmc.set_parameter(amplitude);
-        let mut y = start.unknowns.clone();
-        let report = solve(
-            &mut epmc,
-            &mut FaerDenseLu::new(),
-            &mut y,
-            &NewtonOptions::default(),
-        )
-        .unwrap();
-        assert!(report.converged());
+        let (dw, dxi, higher) = backbone_against_forced(&branch, &mut epmc, &forced, 0, &[2, 1]);
         // The forced motion and the EPMC motion differ only through the harmonics above
         // the first (the force is harmonic 1, -xi M u' has every harmonic): relative
         // differences of the order of their share `higher` of the velocity (measured
         // 3e-3 to 4e-2). Measured differences: w 2e-6 to 6e-4, xi 7e-4 to 5e-3.
-        let w_epmc = epmc.omega(&y);
-        let xi_epmc = epmc.modal_damping(&y);
-        let (dw, dxi) = (((w - w_epmc) / w).abs(), ((xi - xi_epmc) / xi).abs());
-        assert!(
-            dw < higher && dw < 1e-3,
-            "F {force}: w {w} {w_epmc} {higher}"
-        );
-        assert!(
-            dxi < higher && dxi < 1e-2,
-            "F {force}: xi {xi} {xi_epmc} {higher}"
-        );
+        assert!(dw < higher && dw < 1e-3, "F {force}: w {dw} {higher}");
+        assert!(dxi < higher && dxi < 1e-2, "F {force}: xi {dxi} {higher}");
+    }
+}
+
+#[test]
+fn rod_backbone_carries_the_phase_resonances_of_the_forced_responses() {
+    // The paper's rod with a massless contact node, its tip stop at 0.5, 1 % damping.
+    let mut spec = RodSpec::canonical();
+    spec.mass = MassModel::Modified;
+    let rod = build_rod(&spec).unwrap();
+    let (model, tip) = (&rod.structure.model, rod.tip_dof());
+    let options = HbOptions {
+        harmonics: 10,
+        ..HbOptions::default()
+    };
+    let mut backbone_options = BackboneOptions::new(1, AmplitudeMeasure::Dof(tip), 0.05, 1.5);
+    backbone_options.hb = options;
+    let branch = backbone(model, &backbone_options).unwrap();
+    assert!(matches!(
+        branch.termination,
+        ContinuationTermination::ReachedBound { .. }
+    ));
+    let mut epmc = Epmc::new(model, &options, 1, AmplitudeMeasure::Dof(tip)).unwrap();
+    let widths = [model.dofs(), model.contact_count()];
+    for scale in [0.2, 1.0, 3.0] {
+        let mut forced = model.clone();
+        forced.load = forced.load.scaled(scale);
+        let (dw, dxi, higher) = backbone_against_forced(&branch, &mut epmc, &forced, tip, &widths);
+        if scale < 0.5 {
+            // Open all period (tip amplitude below the gap): the linear mode 1 against the
+            // linear forced response, whose distributed load also drives the other modes
+            // off resonance and shifts the tip's phase resonance (measured 6.5e-6 in both).
+            assert!(higher == 0.0 && dw < 1e-5 && dxi < 1e-5, "{dw} {dxi}");
+        } else {
+            // Impacting: the harmonics above the first carry a share `higher` of 0.24 and
+            // 0.40 of the velocity; the resonance frequency was measured 1.6e-2 off the
+            // backbone at both levels. The damping is not compared: the rod's damping is
+            // stiffness-proportional and dissipates the higher harmonics far more than
+            // `-xi M u'` does (measured 50 % and 13 % apart).
+            assert!(
+                dw < 2e-2 && dw < higher * higher,
+                "scale {scale}: {dw} {higher}"
+            );
+        }
     }
 }
