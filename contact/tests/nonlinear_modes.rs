@@ -13,6 +13,7 @@ use semismooth_contact::model::{
 };
 use semismooth_contact::modes::{
     backbone, AmplitudeMeasure, Backbone, BackboneOptions, BackbonePoint, Epmc, LinearMode,
+    ModesError, MAX_DENSE_UNKNOWNS,
 };
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 
@@ -421,4 +422,23 @@ fn rod_backbone_carries_the_phase_resonances_of_the_forced_responses() {
             );
         }
     }
+}
+
+#[test]
+fn a_backbone_too_large_for_the_dense_solve_is_refused_before_any_work() {
+    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.1, 1.0);
+    options.hb.harmonics = 2000;
+    // (2 dofs + 1 contact) (2 H + 1) + 2 unknowns.
+    match backbone(&damped_chain(0.0, 0.0), &options) {
+        Err(ModesError::TooLarge { unknowns, limit }) => {
+            assert_eq!((unknowns, limit), (3 * 4001 + 2, MAX_DENSE_UNKNOWNS));
+        }
+        other => panic!("{other:?}"),
+    }
+    // An amplitude range that is empty is refused too.
+    let empty = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.5, 0.5);
+    assert!(backbone(&damped_chain(0.0, 0.0), &empty).is_err());
+    // So is a dof out of range.
+    let outside = BackboneOptions::new(1, AmplitudeMeasure::Dof(7), 0.1, 0.5);
+    assert!(backbone(&damped_chain(0.0, 0.0), &outside).is_err());
 }

@@ -6,7 +6,7 @@ use semismooth::continuation::{
 use semismooth::linalg::FaerDenseLu;
 use semismooth::Residual;
 
-use super::{AmplitudeMeasure, Epmc, LinearMode, ModesError};
+use super::{AmplitudeMeasure, Epmc, LinearMode, ModesError, MAX_DENSE_UNKNOWNS};
 use crate::hb::{HbError, HbOptions, ResponseSummary};
 
 /// Times per period of the points' summaries (at least `4 H + 4`).
@@ -95,11 +95,21 @@ pub struct Backbone {
 
 /// The backbone of `model`'s mode `options.mode` ([`Epmc`]): from its linear mode at
 /// `amplitude_from` to `amplitude_to`, by pseudo-arclength continuation of the bordered EPMC
-/// system (dense LU of the whole bordered Jacobian). `Err` only when it cannot start.
+/// system (dense LU of the whole bordered Jacobian, at most [`MAX_DENSE_UNKNOWNS`]
+/// unknowns). `Err` only when it cannot start.
 pub fn backbone(
     model: &StructuralModel,
     options: &BackboneOptions,
 ) -> Result<Backbone, ModesError> {
+    // Checked before the (dense) linear mode is computed.
+    let rows = model.dofs() + model.contact_count() + model.friction_count();
+    let unknowns = rows.saturating_mul(2 * options.hb.harmonics + 1) + 2;
+    if unknowns > MAX_DENSE_UNKNOWNS {
+        return Err(ModesError::TooLarge {
+            unknowns,
+            limit: MAX_DENSE_UNKNOWNS,
+        });
+    }
     let mut epmc = Epmc::new(model, &options.hb, options.mode, options.measure)?;
     let (from, to) = (options.amplitude_from, options.amplitude_to);
     semismooth::InvalidOption::check(

@@ -67,10 +67,24 @@ pub enum ModesError {
         /// The mode.
         mode: usize,
     },
+    /// The bordered Jacobian, factored densely, would be too large.
+    #[error(
+        "{unknowns} EPMC unknowns exceed the {limit} of the dense bordered solve: reduce the \
+         harmonics or the dofs"
+    )]
+    TooLarge {
+        /// `(N + m)(2H + 1) + 2`.
+        unknowns: usize,
+        /// [`MAX_DENSE_UNKNOWNS`].
+        limit: usize,
+    },
     /// The continuation could not start (options, range).
     #[error("continuation: {0}")]
     Continuation(String),
 }
+
+/// The largest number of EPMC unknowns [`backbone`] factors densely (a matrix of 512 MB).
+pub const MAX_DENSE_UNKNOWNS: usize = 8000;
 
 /// What the amplitude of a nonlinear mode measures: the cosine part of harmonic 1 of a
 /// linear functional of `u`, once the phase makes the sine part zero.
