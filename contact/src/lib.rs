@@ -22,6 +22,7 @@ pub mod lcp;
 pub mod march;
 pub mod matrix_market;
 pub mod model;
+pub mod modes;
 pub mod operator;
 pub mod rod;
 pub mod settings;

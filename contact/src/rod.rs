@@ -438,7 +438,7 @@ fn to_dense(m: &SparseMatrix) -> DMatrix<f64> {
 /// Rayleigh–Ritz on a basis `Y` (n x p): the generalized problem `K v = omega^2 M v`
 /// restricted to span(Y), returned as the eigenvalues `nu = 1/omega^2` of
 /// `L^{-1} (Y^T M Y) L^{-T}` with `Y^T K Y = L L^T`, descending, with Ritz vectors.
-fn rayleigh_ritz(
+pub(crate) fn rayleigh_ritz(
     k_y: &DMatrix<f64>,
     m_y: &DMatrix<f64>,
     y: &DMatrix<f64>,

@@ -377,6 +377,25 @@ fn solutions(py: Python<'_>, scene: &Scene) -> PyResult<SolutionSet> {
     Ok(SolutionSet::new(&set))
 }
 
+/// The backbone of the scene's `[modes]` (`ssn modes`) as the document of `ssn modes
+/// --json` (a dict); the GIL is released while it runs.
+#[pyfunction]
+fn modes<'py>(py: Python<'py>, scene: &Scene) -> PyResult<Bound<'py, PyAny>> {
+    let doc = detached(py, scene, Workload::Branch, |loaded| {
+        let started = std::time::Instant::now();
+        let branch =
+            ssn::modes::run(&loaded.scene, &loaded.structure).map_err(RunFailure::Input)?;
+        let seconds = started.elapsed().as_secs_f64();
+        Ok(ssn::modes::document(
+            &loaded.scene,
+            &branch,
+            loaded.structure.omega_1,
+            seconds,
+        ))
+    })?;
+    to_dict(py, &doc)
+}
+
 /// The Floquet stability of the harmonic-balance solution at the scene's frequency (the
 /// solve of `solve`, then its monodromy; a method other than SSN-HB or penalty HB is a
 /// `SceneError`, a solve that did not converge a `NotConvergedError`); the GIL is released
@@ -547,6 +566,7 @@ fn _ssn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(solutions, m)?)?;
+    m.add_function(wrap_pyfunction!(modes, m)?)?;
     m.add_function(wrap_pyfunction!(stability, m)?)?;
     m.add_function(wrap_pyfunction!(run_case, m)?)?;
     m.add_function(wrap_pyfunction!(study_table, m)?)?;

@@ -13,6 +13,7 @@ The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same s
 - ``solve``, ``sweep``, ``solutions``, ``stability``: results with numpy arrays and
   ``to_dict()`` equal to the JSON of ``ssn solve/sweep/solutions --json``; the GIL is
   released while they run;
+- ``modes(scene)``: the backbone of the scene's ``[modes]``, the dict of ``ssn modes --json``;
 - ``study(scene, cases, executor=None, run="solve")`` on any
   ``concurrent.futures.Executor``; ``study_file`` reads the cases of an ``ssn study`` file;
 - ``Solution.termination_kind``: why the solve stopped, a ``Termination`` member;
@@ -30,6 +31,7 @@ from ._ssn import (
     SolutionSet,
     Stability,
     limit_threads,
+    modes,
     solutions,
     solve,
     stability,
@@ -59,6 +61,7 @@ __all__ = [
     "Termination",
     "TooLargeError",
     "limit_threads",
+    "modes",
     "run_case",
     "solutions",
     "solve",

@@ -124,6 +124,8 @@ def sweep(scene: Scene) -> FrequencyResponse:
     """``ssn sweep``: the frequency response over the scene's ``[sweep]`` (GIL released)."""
 def solutions(scene: Scene) -> SolutionSet:
     """``ssn solutions``: every periodic solution at the scene's frequency."""
+def modes(scene: Scene) -> dict[str, Any]:
+    """``ssn modes``: the backbone of the scene's ``[modes]``, as ``ssn modes --json``."""
 def stability(scene: Scene) -> Stability:
     """The Floquet stability of the harmonic-balance solution at the scene's frequency."""
 def run_case(scene: Scene, index: int, values: Mapping[str, Value], run: str) -> str:

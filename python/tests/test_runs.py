@@ -57,6 +57,14 @@ def test_solve_sweep_and_solutions_equal_the_command_line(cli):
     assert found.displacements.shape[0] == 3
 
 
+def test_modes_equals_the_command_line(cli):
+    path = SCENES / "paper_rod_modes.toml"
+    doc = ssn.modes(ssn.Scene.from_file(path))
+    assert_same_document(doc, cli("modes", path))
+    # The first point is the linear mode: the scene's damping ratio.
+    assert doc["points"][0]["damping_ratio"] == pytest.approx(0.01, abs=1e-12)
+
+
 def test_with_values_equals_set_on_the_command_line(cli):
     values = {"forcing.omega_ratio": 1.1, "solver.harmonics": 12, "contact.gap": 0.3}
     scene = ssn.Scene.from_file(FIG1).with_values(values)

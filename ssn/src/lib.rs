@@ -16,6 +16,7 @@ pub mod input_file;
 pub mod io;
 pub mod json;
 pub mod limits;
+pub mod modes;
 pub mod output;
 pub mod progress;
 pub mod scene;

@@ -117,6 +117,21 @@ enum Command {
         mut_arg("svg", |a| a.help("Write the tip over one period of every solution as SVG"))
     )]
     Solutions(RunArgs),
+    /// The backbone of a nonlinear mode (EPMC on SSN-HB): frequency, damping ratio and
+    /// energy against the observed dof's amplitude over the scene's [modes] range.
+    #[command(
+        after_help = "Example:\n  ssn modes SCENE.toml --json --csv backbone.csv --svg backbone.svg\n\n\
+        Scene: [modes] mode (default 1), amplitude_from, amplitude_to, max_points.\n\n\
+        JSON fields: scene, mode, linear {omega, damping_ratio}, observed_dof, harmonics,\n  \
+        damping_convention, amplitude_measure, points [{amplitude, energy, omega,\n  \
+        omega_ratio, damping_ratio, modal_damping, displacement_max, displacement_min,\n  \
+        max_penetration, contacts [{force_mean}]}], folds, converged, termination,\n  \
+        solve_seconds\n\n",
+        mut_arg("json", |a| a.help("Print the backbone as JSON on stdout")),
+        mut_arg("csv", |a| a.help("Write one CSV row per backbone point")),
+        mut_arg("svg", |a| a.help("Write the frequency and damping against the amplitude as SVG"))
+    )]
+    Modes(RunArgs),
     /// Accuracy against cost: every method over its discretisation settings, error against a
     /// converged reference versus wall time (table, CSV and a log-log SVG in --out).
     #[command(
@@ -201,6 +216,7 @@ fn main() -> ExitCode {
         Some(Command::Solve(solve)) => cli::solve(solve),
         Some(Command::Sweep(sweep)) => cli::sweep(sweep),
         Some(Command::Solutions(run)) => ssn::solutions::command(run),
+        Some(Command::Modes(run)) => ssn::modes::command(run),
         Some(Command::Study(study)) => ssn::study::command::command(study),
     };
     match result {
@@ -251,6 +267,7 @@ impl Command {
             Command::Solve(_) => "solve",
             Command::Sweep(_) => "sweep",
             Command::Solutions(_) => "solutions",
+            Command::Modes(_) => "modes",
             Command::ExportModel { .. } => "export-model",
             Command::Compare { .. } => "compare",
             Command::SceneCheck { .. } => "scene-check",

@@ -189,6 +189,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         ck.friction_method(&solver, m)?;
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
+    let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
     let (engine_order, cyclic) = ck.cyclic_keys(&raw.forcing, raw.cyclic, &model, &bladed_disk)?;
     Ok(Scene {
@@ -203,6 +204,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         cyclic,
         solver,
         sweep,
+        modes,
     })
 }
 
@@ -764,6 +766,27 @@ impl Check<'_> {
             )?,
             stability: sw.stability.unwrap_or(defaults.stability),
             ..defaults
+        })
+    }
+}
+
+impl Check<'_> {
+    /// `[modes]`: a mode number >= 1 and two different positive amplitudes.
+    fn modes(&self, m: &RawModes) -> Result<ModesSettings, SceneError> {
+        let from = self.positive("modes.amplitude_from", m.amplitude_from)?;
+        let to = self.positive("modes.amplitude_to", m.amplitude_to)?;
+        if to == from {
+            return Err(self.invalid(
+                "modes.amplitude_to",
+                to,
+                "a value different from amplitude_from",
+            ));
+        }
+        Ok(ModesSettings {
+            mode: self.count_or("modes.mode", m.mode, 1, 1_000_000, 1)?,
+            amplitude_from: from,
+            amplitude_to: to,
+            max_points: self.count_or("modes.max_points", m.max_points, 2, 1_000_000, 1000)?,
         })
     }
 }

@@ -83,6 +83,22 @@ pub struct Scene {
     pub solver: SolverSettings,
     /// Frequency sweep, if declared.
     pub sweep: Option<SweepSettings>,
+    /// Nonlinear mode (`ssn modes`), if declared.
+    pub modes: Option<ModesSettings>,
+}
+
+/// `[modes]`: which linear mode the backbone starts from and the range of the observed
+/// dof's amplitude (the cosine part of its harmonic 1, the phase making the sine part zero).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModesSettings {
+    /// Which linear mode (1: the lowest natural frequency).
+    pub mode: usize,
+    /// The amplitude of the first point.
+    pub amplitude_from: f64,
+    /// The amplitude of the last point.
+    pub amplitude_to: f64,
+    /// Largest number of points.
+    pub max_points: usize,
 }
 
 #[derive(Debug, Deserialize)]
@@ -101,6 +117,7 @@ struct RawScene {
     #[serde(default)]
     solver: RawSolver,
     sweep: Option<RawSweep>,
+    modes: Option<RawModes>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -262,6 +279,15 @@ struct RawSweep {
     max_step: Option<f64>,
     max_points: Option<i64>,
     stability: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModes {
+    mode: Option<i64>,
+    amplitude_from: f64,
+    amplitude_to: f64,
+    max_points: Option<i64>,
 }
 
 /// Largest harmonic count accepted.

@@ -1,0 +1,185 @@
+//! A nonlinear mode's backbone: EPMC followed in its amplitude by the core's continuation.
+
+use semismooth::continuation::{
+    Continuation, ContinuationCounters, ContinuationOptions, ContinuationTermination, Direction,
+};
+use semismooth::linalg::FaerDenseLu;
+use semismooth::Residual;
+
+use super::{AmplitudeMeasure, Epmc, LinearMode, ModesError, MAX_DENSE_UNKNOWNS};
+use crate::hb::{HbError, HbOptions, ResponseSummary};
+
+/// Times per period of the points' summaries (at least `4 H + 4`).
+const SUMMARY_POINTS: usize = 1024;
+use crate::model::StructuralModel;
+
+/// What [`backbone`] computes.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct BackboneOptions {
+    /// The harmonic balance (`H`, `Nt`, `c`).
+    pub hb: HbOptions,
+    /// Which linear mode to start from (1: the lowest).
+    pub mode: usize,
+    /// What the amplitude measures.
+    pub measure: AmplitudeMeasure,
+    /// The amplitude of the first point (small: the linear mode).
+    pub amplitude_from: f64,
+    /// The amplitude where the backbone ends.
+    pub amplitude_to: f64,
+    /// The continuation (its parameter bounds are set from the amplitude range; without a
+    /// `state_scale` one is made from the amplitude range, `omega_n` and the stiffness).
+    pub continuation: ContinuationOptions,
+}
+
+impl BackboneOptions {
+    /// Mode `mode` from `amplitude_from` to `amplitude_to` with the default HB and
+    /// continuation.
+    pub fn new(
+        mode: usize,
+        measure: AmplitudeMeasure,
+        amplitude_from: f64,
+        amplitude_to: f64,
+    ) -> Self {
+        Self {
+            hb: HbOptions::default(),
+            mode,
+            measure,
+            amplitude_from,
+            amplitude_to,
+            continuation: ContinuationOptions::default(),
+        }
+    }
+}
+
+/// One point of a backbone.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct BackbonePoint {
+    /// The amplitude (the continuation parameter, [`AmplitudeMeasure`]).
+    pub amplitude: f64,
+    /// The frequency `w` of the periodic motion.
+    pub omega: f64,
+    /// The modal damping `xi` (the term `-xi M u'`).
+    pub modal_damping: f64,
+    /// NLvib's damping ratio `xi / (2 w)`.
+    pub damping_ratio: f64,
+    /// The period mean of the mechanical energy ([`Epmc::energy`]).
+    pub energy: f64,
+    /// Extremes of the summary dof ([`Backbone::summary_dof`]), penetration and mean
+    /// contact forces over the period.
+    pub summary: ResponseSummary,
+    /// The EPMC unknowns `[U; Lambda; w; xi]`.
+    pub unknowns: Vec<f64>,
+}
+
+/// A backbone: its points in the order of the branch, the folds of the amplitude, why it
+/// ended, the work.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct Backbone {
+    /// The linear mode it starts from.
+    pub linear: LinearMode,
+    /// The points, the first corrected at `amplitude_from`.
+    pub points: Vec<BackbonePoint>,
+    /// The dof of the points' summaries: the measured dof, or the largest entry of the
+    /// mode's shape.
+    pub summary_dof: usize,
+    /// Amplitudes where the branch turns back.
+    pub folds: Vec<f64>,
+    /// Why the continuation ended.
+    pub termination: ContinuationTermination,
+    /// The continuation's work counters.
+    pub counters: ContinuationCounters,
+}
+
+/// The backbone of `model`'s mode `options.mode` ([`Epmc`]): from its linear mode at
+/// `amplitude_from` to `amplitude_to`, by pseudo-arclength continuation of the bordered EPMC
+/// system (dense LU of the whole bordered Jacobian, at most [`MAX_DENSE_UNKNOWNS`]
+/// unknowns). `Err` only when it cannot start.
+pub fn backbone(
+    model: &StructuralModel,
+    options: &BackboneOptions,
+) -> Result<Backbone, ModesError> {
+    // Checked before the (dense) linear mode is computed.
+    let rows = model.dofs() + model.contact_count() + model.friction_count();
+    let unknowns = rows.saturating_mul(2 * options.hb.harmonics + 1) + 2;
+    if unknowns > MAX_DENSE_UNKNOWNS {
+        return Err(ModesError::TooLarge {
+            unknowns,
+            limit: MAX_DENSE_UNKNOWNS,
+        });
+    }
+    let mut epmc = Epmc::new(model, &options.hb, options.mode, options.measure)?;
+    let (from, to) = (options.amplitude_from, options.amplitude_to);
+    semismooth::InvalidOption::check(
+        from.is_finite() && to.is_finite() && from > 0.0 && to > 0.0 && from != to,
+        "amplitude range",
+        to,
+        "two different positive amplitudes",
+    )
+    .map_err(|e| ModesError::Hb(e.into()))?;
+    let x0 = epmc.linear_start(from);
+    let mut continuation = options.continuation.clone();
+    continuation.parameter_min = from.min(to);
+    continuation.parameter_max = from.max(to);
+    continuation.direction = if to > from {
+        Direction::Increasing
+    } else {
+        Direction::Decreasing
+    };
+    continuation.parameter_scale = (to - from).abs();
+    if continuation.state_scale.is_none() {
+        continuation.state_scale = Some(state_scale(&epmc, from.abs().max(to.abs())));
+    }
+    let linear = epmc.linear_mode().clone();
+    let mut solver = FaerDenseLu::new();
+    let branch = Continuation::new(&mut epmc, &mut solver, &x0, from, continuation)
+        .map_err(|e| ModesError::Continuation(e.to_string()))?
+        .with_dense_fallback()
+        .run();
+    let summary_dof = match options.measure {
+        AmplitudeMeasure::Dof(dof) => dof,
+        _ => (0..linear.shape.len())
+            .max_by(|&i, &j| linear.shape[i].abs().total_cmp(&linear.shape[j].abs()))
+            .unwrap_or(0),
+    };
+    let len = epmc.hb_len();
+    let times = SUMMARY_POINTS.max(4 * options.hb.harmonics + 4);
+    let points = branch
+        .points
+        .iter()
+        .map(|p| {
+            Ok(BackbonePoint {
+                amplitude: p.parameter,
+                omega: epmc.omega(&p.state),
+                modal_damping: epmc.modal_damping(&p.state),
+                damping_ratio: epmc.damping_ratio(&p.state),
+                energy: epmc.energy(&p.state),
+                summary: epmc.hb().summary(&p.state[..len], summary_dof, times)?,
+                unknowns: p.state.clone(),
+            })
+        })
+        .collect::<Result<_, HbError>>()?;
+    Ok(Backbone {
+        linear,
+        summary_dof,
+        folds: branch.fold_parameters(),
+        points,
+        termination: branch.termination,
+        counters: branch.counters,
+    })
+}
+
+/// Typical sizes of the EPMC unknowns: `amplitude` for the displacements, the stiffness
+/// scale times it for the forces, `omega_n` for `w` and `xi`.
+fn state_scale(epmc: &Epmc, amplitude: f64) -> Vec<f64> {
+    let displacements = epmc.hb().displacement_len();
+    let len = epmc.hb_len();
+    let omega = epmc.linear_mode().omega;
+    let mut scale = vec![amplitude; epmc.dim()];
+    scale[displacements..len].fill(epmc.row_scale * amplitude);
+    scale[len] = omega;
+    scale[len + 1] = omega;
+    scale
+}
