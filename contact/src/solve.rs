@@ -395,7 +395,7 @@ where
         gap_scale,
         extra_stiffness,
     ));
-    if model.contacts.is_empty() && model.friction.is_empty() {
+    if model.row_count() == 0 {
         // The unknowns are displacements alone, and round-off grows with them (a linear
         // response near resonance): the floor per unit displacement.
         let per_displacement = roundoff_floor(model, problem.dim(), 1.0, extra_stiffness);

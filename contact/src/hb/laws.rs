@@ -20,8 +20,8 @@ use semismooth::linalg::LinearSolveError;
 use semismooth::InvalidOption;
 
 use super::{HbError, LinearData};
-use crate::law::{ContactLaw, Coulomb, LawGroup, LawSamples, Measure, Unilateral};
-use crate::model::StructuralModel;
+use crate::law::{ContactLaw, Coulomb, FrictionDisk, LawGroup, LawSamples, Measure, Unilateral};
+use crate::model::{NormalForce, NormalLaw, StructuralModel};
 
 /// One group of rows of `G` and its law.
 #[derive(Debug, Clone)]
@@ -55,7 +55,9 @@ pub(crate) struct LawLayout {
 
 impl LawLayout {
     /// The groups of `model` (a [`Unilateral`] law per contact, a [`Coulomb`] law per
-    /// friction point) followed by `added` (validated against the `dofs` and the rows).
+    /// friction point, a [`Unilateral`] law on the normal row, if any, and a
+    /// [`FrictionDisk`] on the tangent rows per frictional contact) followed by `added`
+    /// (validated against the `dofs` and the rows).
     pub(crate) fn new(
         model: &StructuralModel,
         added: &[LawGroup],
@@ -71,7 +73,23 @@ impl LawLayout {
                 vec![0.0],
             ));
         }
-        let own = model.contacts.len() + model.friction.len();
+        let mut row = model.contacts.len() + model.friction.len();
+        for point in &model.frictional_contacts {
+            let normal = match point.normal {
+                NormalLaw::Unilateral { gap, .. } => {
+                    laws.push((Arc::new(Unilateral), vec![gap]));
+                    row += 1;
+                    NormalForce::Contact(row - 1)
+                }
+                NormalLaw::Prescribed(load) => NormalForce::Prescribed(load),
+            };
+            laws.push((
+                Arc::new(FrictionDisk::new(point.coefficient, normal)),
+                vec![0.0, 0.0],
+            ));
+            row += 2;
+        }
+        let own = row;
         let total = own + added.iter().map(|g| g.rows.len()).sum::<usize>();
         let mut first = own;
         for group in added {

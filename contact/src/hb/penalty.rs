@@ -173,6 +173,12 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
+        if !model.frictional_contacts.is_empty() {
+            return Err(HbError::Unsupported {
+                formulation: "penalty harmonic balance",
+                what: "frictional contacts (the Coulomb disk; use ssn-hb)",
+            });
+        }
         if model
             .friction
             .iter()

@@ -335,6 +335,7 @@ pub fn assemble(parts: ModelParts, attach: &Attachments) -> Result<Structure, Mo
             reason: e.to_string(),
         })?;
     let mut model = StructuralModel {
+        frictional_contacts: Vec::new(),
         mass,
         damping,
         stiffness,

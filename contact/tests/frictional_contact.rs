@@ -1,0 +1,358 @@
+//! 3-D frictional contacts (a normal row and two tangent rows under the Coulomb disk) in
+//! SSN-HB, against closed forms that need no code of ours.
+//!
+//! - A point sliding on a circle of radius `r` under a constant normal force `N` feels a
+//!   force of constant magnitude `mu N` opposite to its velocity: it dissipates
+//!   `2 pi mu N r` per cycle and the force is a pure first harmonic, so harmonic balance is
+//!   exact at any `H >= 1`. The isotropic oscillator `m x'' + c x' + k x = F e^{i w t} +
+//!   lambda_t` then slides on the circle of radius `r` with
+//!   `((k - m w^2)^2 + c^2 w^2) r^2 + 2 c w b r + b^2 - F^2 = 0`, `b = mu N`.
+//! - On an ellipse of semi-axes `a >= b_e` the dissipated energy is `mu N` times the
+//!   perimeter, `4 mu N a E(e)` with `e^2 = 1 - b_e^2 / a^2` and `E` the complete elliptic
+//!   integral of the second kind (computed here by the arithmetic-geometric mean).
+//! - With a spring `k_t` in series with the slider (3-D Jenkins element, the slider a
+//!   massless internal pair of dofs), a circle of radius `r` drags the slider on a circle
+//!   of radius `sqrt(r^2 - (mu N / k_t)^2)` (the spring, stretched by `mu N / k_t`, pulls
+//!   the slider along its velocity, at right angles to the radius of the slider's circle):
+//!   the energy is `2 pi mu N sqrt(r^2 - (mu N / k_t)^2)`.
+//! - Two independent one-dimensional laws on the same circle give a square wave in each
+//!   direction: `8 mu N r`, a factor `4 / pi` too much.
+//!
+//! The ellipse, the Jenkins element and the two 1-D laws are driven kinematically: the
+//! point is tied to an imposed orbit `X(t)` by a stiff spring `K_d` (load `K_d X(t)`), so
+//! its orbit is `X` up to `mu N / K_d`; the closed forms are evaluated on the orbit the
+//! solver returns (its first harmonic).
+
+use semismooth::linalg::FaerDenseLu;
+use semismooth::newton::Tolerances;
+use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
+use semismooth::{Factorize, Residual};
+use semismooth_contact::hb::{CondensedSolve, HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
+use semismooth_contact::model::{
+    ContactRow, FrictionPoint, FrictionalContact, HarmonicLoad, SparseMatrix, StructuralModel,
+};
+use std::f64::consts::PI;
+
+/// A diagonal `n x n` matrix.
+fn diagonal(values: &[f64]) -> SparseMatrix {
+    let entries: Vec<_> = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| faer::sparse::Triplet::new(i, i, *v))
+        .collect();
+    SparseMatrix::try_new_from_triplets(values.len(), values.len(), &entries).unwrap()
+}
+
+/// A model with diagonal `M`, `D`, `K`, `load` and no contact.
+fn model(
+    mass: &[f64],
+    damping: &[f64],
+    stiffness: SparseMatrix,
+    load: HarmonicLoad,
+) -> StructuralModel {
+    StructuralModel {
+        mass: diagonal(mass),
+        damping: Some(diagonal(damping)),
+        stiffness,
+        load,
+        contacts: Vec::new(),
+        friction: Vec::new(),
+        frictional_contacts: Vec::new(),
+    }
+}
+
+/// SSN-HB on `model` at `omega` solved from zero with `solver` to `|F| <= tolerance`.
+fn solve(
+    model: &StructuralModel,
+    (omega, harmonics, tolerance): (f64, usize, f64),
+    solver: &mut dyn Factorize<HbJacobian>,
+) -> (SsnHb, Vec<f64>) {
+    let options = HbOptions {
+        harmonics,
+        ..HbOptions::default()
+    };
+    let mut hb = SsnHb::new(model, omega, &options).unwrap();
+    let mut x = vec![0.0; hb.dim()];
+    let newton = PolyalgorithmOptions {
+        tolerances: Tolerances::absolute(tolerance),
+        ..PolyalgorithmOptions::default()
+    };
+    let report = solve_smoothing(&mut hb, solver, &mut x, &newton).unwrap();
+    assert!(report.converged(), "{:?}", report.termination);
+    (hb, x)
+}
+
+/// The first-harmonic amplitude of `dof` (`U` index `j N + dof`).
+fn first_harmonic(x: &[f64], dofs: usize, dof: usize) -> (f64, f64) {
+    (x[dofs + dof], x[2 * dofs + dof])
+}
+
+/// The complete elliptic integral of the second kind `E(e)` by the arithmetic-geometric
+/// mean: `E = K (1 - sum_n 2^(n-1) c_n^2)`, `K = pi / (2 AGM(1, sqrt(1 - e^2)))`
+/// (quadratic convergence: ten steps reach round-off).
+fn elliptic_e(e: f64) -> f64 {
+    let (mut a, mut b, mut c) = (1.0f64, (1.0 - e * e).sqrt(), e);
+    let (mut sum, mut weight) = (0.5 * c * c, 0.5);
+    for _ in 0..10 {
+        let (an, bn) = (0.5 * (a + b), (a * b).sqrt());
+        c = 0.5 * (a - b);
+        weight *= 2.0;
+        sum += weight * c * c;
+        (a, b) = (an, bn);
+    }
+    PI / (2.0 * a) * (1.0 - sum)
+}
+
+#[test]
+fn the_elliptic_integral_has_its_known_values() {
+    // E(0) = pi / 2 and E(1 / sqrt 2) = 1.3506438810476755 (Abramowitz & Stegun 17.3).
+    assert!((elliptic_e(0.0) - PI / 2.0).abs() < 1e-15);
+    assert!((elliptic_e(0.5f64.sqrt()) - 1.350_643_881_047_675_5).abs() < 1e-14);
+}
+
+// The circle under the normal law: an oscillator (x, y, z) pressed along z against an
+// obstacle at `z <= GAP` by a constant load, driven in (x, y) by a rotating load.
+const MASS: f64 = 1.0;
+const DAMPING: f64 = 0.05;
+const STIFFNESS: f64 = 1.0;
+const FORCE: f64 = 1.0;
+const OMEGA: f64 = 1.3;
+const MU: f64 = 0.3;
+const PRESS: f64 = 2.0;
+const GAP: f64 = 0.5;
+
+/// The pressed rotating oscillator: the normal force is `-(PRESS - STIFFNESS GAP)`.
+fn pressed_rotor() -> StructuralModel {
+    let mut load = HarmonicLoad::zero(3);
+    load.add_harmonic(0, &[0.0, 0.0, PRESS], &[0.0; 3]).unwrap();
+    load.add_harmonic(1, &[FORCE, 0.0, 0.0], &[0.0, FORCE, 0.0])
+        .unwrap();
+    let mut model = model(&[MASS; 3], &[DAMPING; 3], diagonal(&[STIFFNESS; 3]), load);
+    model
+        .frictional_contacts
+        .push(FrictionalContact::unilateral(
+            ContactRow::unit(2, 1.0),
+            GAP,
+            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+            MU,
+        ));
+    model
+}
+
+/// The radius of the sliding circle under the slip limit `b` (module documentation).
+fn circle_radius(b: f64) -> f64 {
+    let w = OMEGA;
+    let a = (STIFFNESS - MASS * w * w).powi(2) + (DAMPING * w).powi(2);
+    let half_linear = DAMPING * w * b;
+    (-half_linear + (half_linear * half_linear - a * (b * b - FORCE * FORCE)).sqrt()) / a
+}
+
+/// A point pressed by the normal law slides on the circle of the closed form, through the
+/// dense, condensed and matrix-free linear paths alike, with a pure first-harmonic force,
+/// and dissipates `2 pi mu N r` per cycle: exact at `H = 1` and at `H = 4`.
+#[test]
+fn a_pressed_point_on_a_circle_dissipates_two_pi_mu_n_r_with_a_first_harmonic_force() {
+    let model = pressed_rotor();
+    let normal = PRESS - STIFFNESS * GAP;
+    let radius = circle_radius(MU * normal);
+    for harmonics in [1, 4] {
+        let at = (OMEGA, harmonics, 1e-12);
+        let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
+        let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
+        let (_, condensed) = solve(&model, at, &mut { condensed });
+        let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
+        let (_, krylov) = solve(&model, at, &mut { krylov });
+        // Each path stops at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned
+        // Jacobian: the iterates agree far below 1e-10.
+        for other in [&condensed, &krylov] {
+            let gap = dense
+                .iter()
+                .zip(other)
+                .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+            assert!(gap < 1e-10, "H = {harmonics}: paths differ by {gap:e}");
+        }
+        // Every sample of the laws is exact on the circle: only Newton's error remains.
+        for dof in 0..2 {
+            let (a, b) = first_harmonic(&dense, 3, dof);
+            assert!((a.hypot(b) - radius).abs() < 1e-10, "H = {harmonics}");
+        }
+        let report = hb.frictional_contact_report(&dense, 0, 64).unwrap();
+        let expected = 2.0 * PI * MU * normal * radius;
+        assert!(
+            (report.dissipated_energy - expected).abs() < 1e-10 * expected,
+            "H = {harmonics}: {} against {expected}",
+            report.dissipated_energy
+        );
+        assert_eq!(
+            (
+                report.slip_fraction,
+                report.stick_fraction,
+                report.separated_fraction
+            ),
+            (1.0, 0.0, 0.0)
+        );
+        for f in report.normal_force {
+            assert!((f + normal).abs() < 1e-10);
+        }
+        // The forces (index U_len + j m + row; rows: normal, t1, t2) beyond harmonic 1
+        // vanish, and the normal force is constant.
+        let (lambda, m) = (&dense[3 * (2 * harmonics + 1)..], 3);
+        for (i, value) in lambda.iter().enumerate() {
+            let (j, row) = (i / m, i % m);
+            let expected_zero = if row == 0 {
+                j != 0
+            } else {
+                !(1..=2).contains(&j)
+            };
+            if expected_zero {
+                assert!(value.abs() < 1e-10, "harmonic {j} of row {row}: {value:e}");
+            }
+        }
+    }
+}
+
+// The kinematically driven point: a stiff spring `DRIVE` to the imposed orbit, a unit
+// mass, the slip limit `SLIP` (`mu = 0.5` under `N = 2`).
+const DRIVE: f64 = 1e6;
+const SLIP_MU: f64 = 0.5;
+const NORMAL_LOAD: f64 = 2.0;
+const SLIP: f64 = SLIP_MU * NORMAL_LOAD;
+const DRIVE_OMEGA: f64 = 1.0;
+
+/// Two unit masses tied by springs `drive` to the orbit `(a cos t, b sin t)` (the load
+/// `drive (a cos t, b sin t)`), among `dofs` dofs (the others massless) with `stiffness`;
+/// no friction yet.
+fn driven((a, b, drive): (f64, f64, f64), stiffness: SparseMatrix, dofs: usize) -> StructuralModel {
+    let mut load = HarmonicLoad::zero(dofs);
+    let (mut cosine, mut sine) = (vec![0.0; dofs], vec![0.0; dofs]);
+    cosine[0] = drive * a;
+    sine[1] = drive * b;
+    load.add_harmonic(1, &cosine, &sine).unwrap();
+    let mut mass = vec![0.0; dofs];
+    mass[..2].fill(1.0);
+    model(&mass, &vec![0.0; dofs], stiffness, load)
+}
+
+/// The disk under the prescribed load on the rows of dofs `first`, `first + 1`.
+fn prescribed_disk(first: usize) -> FrictionalContact {
+    FrictionalContact::prescribed(
+        NORMAL_LOAD,
+        [
+            ContactRow::unit(first, 1.0),
+            ContactRow::unit(first + 1, 1.0),
+        ],
+        SLIP_MU,
+    )
+}
+
+/// The semi-axes of the orbit `P cos t + Q sin t` of the first harmonics of dofs 0, 1:
+/// the singular values of `[P Q]`.
+fn semi_axes(x: &[f64], dofs: usize) -> (f64, f64) {
+    let (p0, q0) = first_harmonic(x, dofs, 0);
+    let (p1, q1) = first_harmonic(x, dofs, 1);
+    // Eigenvalues of [P Q]^T [P Q].
+    let (a, b, c) = (p0 * p0 + p1 * p1, p0 * q0 + p1 * q1, q0 * q0 + q1 * q1);
+    let (mean, half) = (0.5 * (a + c), (0.25 * (a - c) * (a - c) + b * b).sqrt());
+    ((mean + half).sqrt(), (mean - half).max(0.0).sqrt())
+}
+
+/// A point driven on an ellipse (semi-axes 1 and 0.6) dissipates `mu N` times its
+/// perimeter `4 a E(e)`, at every `H` (a table of the relative error against `H`).
+#[test]
+fn a_point_on_an_ellipse_dissipates_mu_n_times_its_perimeter() {
+    let mut model = driven((1.0, 0.6, DRIVE), diagonal(&[DRIVE; 2]), 2);
+    model.frictional_contacts.push(prescribed_disk(0));
+    for harmonics in [1, 2, 4, 8] {
+        // |F| <= 1e-6 on loads of size DRIVE = 1e6 is round-off level.
+        let (hb, x) = solve(
+            &model,
+            (DRIVE_OMEGA, harmonics, 1e-6),
+            &mut FaerDenseLu::new(),
+        );
+        let (major, minor) = semi_axes(&x, 2);
+        let e = (1.0 - (minor / major).powi(2)).sqrt();
+        let expected = 4.0 * SLIP * major * elliptic_e(e);
+        let report = hb.frictional_contact_report(&x, 0, 512).unwrap();
+        let error = (report.dissipated_energy / expected - 1.0).abs();
+        println!(
+            "H = {harmonics}: energy {:.12} closed form {expected:.12} relative error {error:.1e}",
+            report.dissipated_energy
+        );
+        // The orbit is an ellipse up to the friction's pull, SLIP / DRIVE = 1e-6 of its
+        // size, in the higher harmonics; the rectangle rule on 512 samples of the smooth
+        // force is exact to far below that.
+        assert!(error < 1e-5, "H = {harmonics}: relative error {error:e}");
+        assert_eq!(report.slip_fraction, 1.0);
+    }
+}
+
+/// A 3-D Jenkins element (spring `k_t` to a massless slider pair under the disk) driven on
+/// a circle dissipates `2 pi mu N sqrt(r^2 - (mu N / k_t)^2)`, exactly at `H = 1`.
+#[test]
+fn a_jenkins_element_on_a_circle_dissipates_the_closed_form_energy() {
+    // On a circle the drive's stiffness does not matter: a soft one keeps every dof's
+    // residual O(1), and Newton's tolerance 1e-12 gives the energy to ~1e-11.
+    let (kt, drive) = (2.0 * SLIP, 10.0);
+    let mut entries = Vec::new();
+    for d in 0..2 {
+        let (x, s) = (d, d + 2);
+        for (i, j, v) in [(x, x, drive + kt), (x, s, -kt), (s, x, -kt), (s, s, kt)] {
+            entries.push(faer::sparse::Triplet::new(i, j, v));
+        }
+    }
+    let stiffness = SparseMatrix::try_new_from_triplets(4, 4, &entries).unwrap();
+    let mut model = driven((1.0, 1.0, drive), stiffness, 4);
+    model.frictional_contacts.push(prescribed_disk(2));
+    for harmonics in [1, 3] {
+        let (hb, x) = solve(
+            &model,
+            (DRIVE_OMEGA, harmonics, 1e-12),
+            &mut FaerDenseLu::new(),
+        );
+        let (r, minor) = semi_axes(&x, 4);
+        assert!((r - minor).abs() < 1e-10, "a circle: {r} and {minor}");
+        let expected = 2.0 * PI * SLIP * (r * r - (SLIP / kt).powi(2)).sqrt();
+        let report = hb.frictional_contact_report(&x, 0, 64).unwrap();
+        // Exact on the circle: Newton's error alone.
+        let error = (report.dissipated_energy / expected - 1.0).abs();
+        assert!(error < 1e-10, "H = {harmonics}: relative error {error:e}");
+    }
+}
+
+/// Two independent 1-D Coulomb laws on the same driven circle dissipate `8 mu N r`, the
+/// square's `4 / pi` times the disk's `2 pi mu N r`: they are not the disk.
+#[test]
+fn two_independent_one_dimensional_laws_do_not_dissipate_the_disk_energy() {
+    let mut model = driven((1.0, 1.0, DRIVE), diagonal(&[DRIVE; 2]), 2);
+    for d in 0..2 {
+        model.friction.push(FrictionPoint::prescribed(
+            ContactRow::unit(d, 1.0),
+            SLIP_MU,
+            NORMAL_LOAD,
+        ));
+    }
+    let points = 1024;
+    let (hb, x) = solve(&model, (DRIVE_OMEGA, 8, 1e-6), &mut FaerDenseLu::new());
+    let (r, _) = semi_axes(&x, 2);
+    let period = 2.0 * PI / DRIVE_OMEGA;
+    let energy: f64 = (0..2)
+        .map(|f| {
+            let report = hb.friction_report(&x, f, points).unwrap();
+            let power: f64 = report
+                .force
+                .iter()
+                .zip(&report.slip_velocity)
+                .map(|(f, v)| f * v)
+                .sum();
+            -power * period / points as f64
+        })
+        .sum();
+    // The rectangle rule on the square wave's two jumps per period errs by O(1 / points).
+    let square = 8.0 * SLIP * r;
+    assert!(
+        (energy / square - 1.0).abs() < 1e-2,
+        "{energy} against {square}"
+    );
+    let disk = 2.0 * PI * SLIP * r;
+    assert!(energy / disk > 1.2, "{energy} against the disk's {disk}");
+}
