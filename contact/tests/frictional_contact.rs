@@ -29,7 +29,8 @@ use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::{Factorize, Residual};
 use semismooth_contact::hb::{CondensedSolve, HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_contact::model::{
-    ContactRow, FrictionPoint, FrictionalContact, HarmonicLoad, SparseMatrix, StructuralModel,
+    ContactPoint, ContactRow, FrictionPoint, FrictionalContact, HarmonicLoad, SparseMatrix,
+    StructuralModel,
 };
 use std::f64::consts::PI;
 
@@ -61,14 +62,26 @@ fn model(
     }
 }
 
-/// SSN-HB on `model` at `omega` solved from zero with `solver` to `|F| <= tolerance`.
+/// SSN-HB on `model` at `omega` solved from zero with `solver` to `|F| <= tolerance`
+/// (the model's default complementarity constant).
 fn solve(
     model: &StructuralModel,
+    at: (f64, usize, f64),
+    solver: &mut dyn Factorize<HbJacobian>,
+) -> (SsnHb, Vec<f64>) {
+    solve_with_c(model, at, None, solver)
+}
+
+/// [`solve`] with the complementarity constant `c` (`None`: the model's default).
+fn solve_with_c(
+    model: &StructuralModel,
     (omega, harmonics, tolerance): (f64, usize, f64),
+    c: Option<f64>,
     solver: &mut dyn Factorize<HbJacobian>,
 ) -> (SsnHb, Vec<f64>) {
     let options = HbOptions {
         harmonics,
+        c,
         ..HbOptions::default()
     };
     let mut hb = SsnHb::new(model, omega, &options).unwrap();
@@ -355,4 +368,99 @@ fn two_independent_one_dimensional_laws_do_not_dissipate_the_disk_energy() {
     );
     let disk = 2.0 * PI * SLIP * r;
     assert!(energy / disk > 1.2, "{energy} against the disk's {disk}");
+}
+
+/// A mass on (x, y) pressed on a flat by a massless normal dof z (spring 10, preload
+/// through the gap -0.05: `N = 0.5` at rest) under a normal load `0.8 cos(w t)` that lifts
+/// it off for part of each period, driven in the plane by `(fx cos w t, fy sin w t)`, with
+/// `mu = 0.4`.
+fn lifting(fx: f64, fy: f64) -> StructuralModel {
+    let mut load = HarmonicLoad::zero(3);
+    load.add_harmonic(1, &[fx, 0.0, 0.8], &[0.0, fy, 0.0])
+        .unwrap();
+    let stiffness = diagonal(&[1.0, 1.0, 10.0]);
+    model(&[1.0, 1.0, 0.0], &[0.1, 0.1, 0.0], stiffness, load)
+}
+
+/// With the motion along one tangent only, the disk is the interval: the 3-D contact
+/// reproduces the 1-D friction point on a unilateral contact (another formulation of the
+/// library, checked against time marching elsewhere) through liftoff, to Newton's
+/// tolerance.
+#[test]
+fn a_disk_moving_along_one_tangent_is_the_one_dimensional_law_through_liftoff() {
+    let (w, harmonics) = (0.8, 10);
+    let mut disk = lifting(0.3, 0.0);
+    disk.frictional_contacts.push(FrictionalContact::unilateral(
+        ContactRow::unit(2, 1.0),
+        -0.05,
+        [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+        0.4,
+    ));
+    let mut line = lifting(0.3, 0.0);
+    line.contacts.push(ContactPoint::new(2, -0.05));
+    line.friction
+        .push(FrictionPoint::on_contact(ContactRow::unit(0, 1.0), 0.4, 0));
+    // One `c` for both (the truncated equations' solution depends on it; the models'
+    // defaults differ by their rows).
+    let at = (w, harmonics, 1e-12);
+    let (hb, x_disk) = solve_with_c(&disk, at, Some(10.0), &mut FaerDenseLu::new());
+    let (_, x_line) = solve_with_c(&line, at, Some(10.0), &mut FaerDenseLu::new());
+    // U (3 (2H + 1)) agrees; the disk's forces are (normal, t1, t2), the line's
+    // (normal, t1).
+    let size = 2 * harmonics + 1;
+    let gap = (0..3 * size).fold(0.0f64, |a, i| a.max((x_disk[i] - x_line[i]).abs()));
+    assert!(gap < 1e-9, "displacements differ by {gap:e}");
+    for j in 0..size {
+        let (disk_forces, line_forces) = (&x_disk[3 * size + 3 * j..], &x_line[3 * size + 2 * j..]);
+        assert!((disk_forces[0] - line_forces[0]).abs() < 1e-9);
+        assert!((disk_forces[1] - line_forces[1]).abs() < 1e-9);
+        assert!(disk_forces[2].abs() < 1e-9);
+    }
+    let report = hb.frictional_contact_report(&x_disk, 0, 512).unwrap();
+    assert!(report.separated_fraction > 0.1, "{report:?}");
+}
+
+/// With a turning slip and liftoff (the disk's radius follows the normal force to zero),
+/// the dense, condensed and matrix-free linear paths give one solution, which slips and
+/// separates over parts of the period.
+#[test]
+fn a_turning_slip_with_liftoff_agrees_across_linear_paths() {
+    let mut model = lifting(0.3, 0.2);
+    model
+        .frictional_contacts
+        .push(FrictionalContact::unilateral(
+            ContactRow::unit(2, 1.0),
+            -0.05,
+            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+            0.4,
+        ));
+    let at = (0.8, 10, 1e-12);
+    let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
+    let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
+    let (_, condensed) = solve(&model, at, &mut { condensed });
+    let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
+    let (_, krylov) = solve(&model, at, &mut { krylov });
+    // |F| <= 1e-12 with an O(100)-conditioned Jacobian: agreement far below 1e-9.
+    for other in [&condensed, &krylov] {
+        let gap = dense
+            .iter()
+            .zip(other)
+            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        assert!(gap < 1e-9, "paths differ by {gap:e}");
+    }
+    let report = hb.frictional_contact_report(&dense, 0, 512).unwrap();
+    println!(
+        "stick {} slip {} separated {} energy {}",
+        report.stick_fraction,
+        report.slip_fraction,
+        report.separated_fraction,
+        report.dissipated_energy
+    );
+    assert!(
+        report.separated_fraction > 0.05 && report.slip_fraction > 0.05,
+        "{report:?}"
+    );
+    assert!(report.dissipated_energy > 0.0);
+    let total = report.stick_fraction + report.slip_fraction + report.separated_fraction;
+    assert!((total - 1.0).abs() < 1e-12);
 }
