@@ -33,6 +33,7 @@ use semismooth_contact::rod::{
 mod check;
 mod contacts;
 mod disk;
+mod frictional;
 mod load_parts;
 mod nodes;
 mod overrides;
@@ -196,6 +197,11 @@ struct RawContactPoint {
     tangent_nodes: Option<Vec<i64>>,
     tangent_components: Option<Vec<i64>>,
     tangent_coefficients: Option<Vec<f64>>,
+    tangent2_dofs: Option<Vec<i64>>,
+    tangent2_coefficients: Option<Vec<f64>>,
+    normal: Option<Vec<f64>>,
+    tangents: Option<Vec<Vec<f64>>>,
+    tangential_stiffness: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
