@@ -464,3 +464,183 @@ fn a_turning_slip_with_liftoff_agrees_across_linear_paths() {
     let total = report.stick_fraction + report.slip_fraction + report.separated_fraction;
     assert!((total - 1.0).abs() < 1e-12);
 }
+
+/// A point pressed (static load 3, stiffness 4 along z) against an obstacle whose gap moves,
+/// `gap(t) = 0.25 + 0.1 cos w t + 0.05 sin 2 w t`, follows it while the contact holds, so
+/// its normal force is `m z'' + c z' + k z - P` with `z = gap(t)`: a constant, a first and a
+/// second harmonic, exact at `H = 2` through every linear path; undriven in the plane, it
+/// sticks with no tangential force.
+#[test]
+fn a_point_pressed_on_a_moving_obstacle_carries_the_closed_form_normal_force() {
+    let (w, press, stiffness, damping, gap) = (1.3, 3.0, 4.0, 0.05, 0.25);
+    let (a1, b2) = (0.1, 0.05);
+    let mut load = HarmonicLoad::zero(3);
+    load.add_harmonic(0, &[0.0, 0.0, press], &[0.0; 3]).unwrap();
+    let mut model = model(
+        &[1.0; 3],
+        &[damping; 3],
+        diagonal(&[1.0, 1.0, stiffness]),
+        load,
+    );
+    model.frictional_contacts.push(
+        FrictionalContact::unilateral(
+            ContactRow::unit(2, 1.0),
+            gap,
+            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+            MU,
+        )
+        .with_moving_gap(vec![a1, 0.0], vec![0.0, b2]),
+    );
+    // Coefficients (constant, cos 1, sin 1, cos 2, sin 2) of the normal force.
+    let expected = [
+        stiffness * gap - press,
+        (stiffness - w * w) * a1,
+        -damping * w * a1,
+        2.0 * damping * w * b2,
+        (stiffness - 4.0 * w * w) * b2,
+    ];
+    for harmonics in [2, 4] {
+        let at = (w, harmonics, 1e-12);
+        let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
+        let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
+        let (_, condensed) = solve(&model, at, &mut { condensed });
+        let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
+        let (_, krylov) = solve(&model, at, &mut { krylov });
+        for other in [&condensed, &krylov] {
+            let gap = dense
+                .iter()
+                .zip(other)
+                .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+            assert!(gap < 1e-10, "H = {harmonics}: paths differ by {gap:e}");
+        }
+        let size = 2 * harmonics + 1;
+        let lambda = &dense[3 * size..];
+        for (j, value) in lambda.iter().step_by(3).enumerate() {
+            let expected = expected.get(j).copied().unwrap_or(0.0);
+            // Every sample of the laws is exact: Newton's error alone.
+            assert!(
+                (value - expected).abs() < 1e-10,
+                "H = {harmonics}, coefficient {j}: {value} against {expected}"
+            );
+        }
+        // The point follows the gap: z's coefficients are the gap's.
+        let z = |j: usize| dense[j * 3 + 2];
+        let gap_coefficients = [gap, a1, 0.0, 0.0, b2];
+        for (j, g) in gap_coefficients.iter().enumerate() {
+            assert!(
+                (z(j) - g).abs() < 1e-10,
+                "H = {harmonics}: z_{j} = {}",
+                z(j)
+            );
+        }
+        let report = hb.frictional_contact_report(&dense, 0, 64).unwrap();
+        assert_eq!(report.stick_fraction, 1.0);
+        assert!(report.dissipated_energy.abs() < 1e-12);
+    }
+    // A gap on harmonic 2 does not fit a basis of one harmonic.
+    let options = HbOptions {
+        harmonics: 1,
+        ..HbOptions::default()
+    };
+    assert!(SsnHb::new(&model, w, &options).is_err());
+}
+
+/// The same pressed point under an obstacle that also slides past at `v = (2, 1)`, far
+/// faster than the point moves: the friction force is `mu N(t) v / |v|` with the closed-form
+/// `N(t)`, the point's tangential motion the linear response to it, and the energy
+/// `mu |v| N_0 T - mu int N (u' . v / |v|) dt`; all exact at `H = 2`. The residual's
+/// `w`-derivative (the obstacle's offset `v / w` moves with `w`) matches central differences.
+#[test]
+fn a_point_under_a_sliding_moving_obstacle_is_dragged_by_the_closed_form_force() {
+    use semismooth::ParameterDependent;
+    let (w, press, stiffness, damping, gap) = (1.3, 3.0, 4.0, 0.05, 0.25);
+    let (a1, b2, velocity) = (0.1, 0.05, [2.0, 1.0]);
+    let mut load = HarmonicLoad::zero(3);
+    load.add_harmonic(0, &[0.0, 0.0, press], &[0.0; 3]).unwrap();
+    let mut model = model(
+        &[1.0; 3],
+        &[damping; 3],
+        diagonal(&[1.0, 1.0, stiffness]),
+        load,
+    );
+    model.frictional_contacts.push(
+        FrictionalContact::unilateral(
+            ContactRow::unit(2, 1.0),
+            gap,
+            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+            MU,
+        )
+        .with_moving_gap(vec![a1, 0.0], vec![0.0, b2])
+        .with_sliding_velocity(velocity),
+    );
+    // N = -lambda_n: coefficients (constant, cos 1, sin 1, cos 2, sin 2).
+    let normal = [
+        press - stiffness * gap,
+        -(stiffness - w * w) * a1,
+        damping * w * a1,
+        -2.0 * damping * w * b2,
+        -(stiffness - 4.0 * w * w) * b2,
+    ];
+    let speed = velocity[0].hypot(velocity[1]);
+    let direction = [velocity[0] / speed, velocity[1] / speed];
+    // The scalar response along `direction` to `mu N(t)`: unit mass, stiffness and damping.
+    let mut response = [MU * normal[0], 0.0, 0.0, 0.0, 0.0];
+    for h in 1..=2 {
+        let (kk, cw) = (1.0 - (h as f64 * w).powi(2), damping * h as f64 * w);
+        let (fc, fs) = (MU * normal[2 * h - 1], MU * normal[2 * h]);
+        let det = kk * kk + cw * cw;
+        response[2 * h - 1] = (kk * fc - cw * fs) / det;
+        response[2 * h] = (cw * fc + kk * fs) / det;
+    }
+    let period = 2.0 * PI / w;
+    let mut drag = 0.0;
+    for h in 1..=2 {
+        let hw = h as f64 * w;
+        let (velocity_c, velocity_s) = (hw * response[2 * h], -hw * response[2 * h - 1]);
+        drag += 0.5 * period * (normal[2 * h - 1] * velocity_c + normal[2 * h] * velocity_s);
+    }
+    let energy = MU * speed * normal[0] * period - MU * drag;
+    let harmonics = 2;
+    let (mut hb, x) = solve(&model, (w, harmonics, 1e-12), &mut FaerDenseLu::new());
+    let size = 2 * harmonics + 1;
+    for j in 0..size {
+        for (a, e) in direction.iter().enumerate() {
+            // Every sample of the laws is exact: Newton's error alone.
+            let force = x[3 * size + 3 * j + 1 + a];
+            assert!(
+                (force - MU * normal[j] * e).abs() < 1e-10,
+                "force {a} coefficient {j}"
+            );
+            let displacement = x[3 * j + a];
+            assert!(
+                (displacement - response[j] * e).abs() < 1e-10,
+                "u_{a} coefficient {j}"
+            );
+        }
+    }
+    let report = hb.frictional_contact_report(&x, 0, 64).unwrap();
+    assert!(
+        (report.dissipated_energy - energy).abs() < 1e-10 * energy,
+        "{} against {energy}",
+        report.dissipated_energy
+    );
+    assert_eq!(report.slip_fraction, 1.0);
+    // dR/dw against central differences (the residual is smooth here: sliding all period).
+    let mut derivative = vec![0.0; hb.dim()];
+    let mut scratch = vec![0.0; hb.dim()];
+    hb.residual_parameter_derivative(&x, &mut derivative, &mut scratch)
+        .unwrap();
+    let step = 1e-6;
+    let mut at = |omega: f64| {
+        hb.set_parameter(omega);
+        let mut r = vec![0.0; hb.dim()];
+        hb.residual(&x, &mut r).unwrap();
+        r
+    };
+    let (plus, minus) = (at(w + step), at(w - step));
+    for (i, d) in derivative.iter().enumerate() {
+        let fd = (plus[i] - minus[i]) / (2.0 * step);
+        // Central differences of an O(10) residual with a step of 1e-6: error ~1e-8.
+        assert!((d - fd).abs() < 1e-6, "entry {i}: {d} against {fd}");
+    }
+}

@@ -21,7 +21,8 @@ pub struct FrictionalContactReport {
     /// Tangential force, two components: the disk law's projection of the truncated series
     /// (inside the disk by construction).
     pub tangential_force: [Vec<f64>; 2],
-    /// Slip velocity `(g_1 . u', g_2 . u')`.
+    /// Slip velocity `(g_1 . u', g_2 . u')` relative to the obstacle (minus its sliding
+    /// velocity).
     pub slip_velocity: [Vec<f64>; 2],
     /// Energy dissipated per cycle, `-int_0^T lambda_t . v_t dt` (rectangle rule on the
     /// samples: exact for trigonometric polynomials of degree below `points`).
@@ -71,8 +72,15 @@ impl SsnHb {
         // Closed-law normal force (the unilateral projection), and the disk's radius from
         // the normal force series as the residual samples it.
         let (normal_force, radius) = match &contact.normal {
-            NormalLaw::Unilateral { gap, .. } => {
-                let offset = |j: usize| if j == 0 { c * gap } else { 0.0 };
+            NormalLaw::Unilateral { .. } => {
+                // c times the (moving) gap's coefficient j.
+                let harmonics = &lin.laws.offset_harmonics[*first];
+                let offset = |j: usize| match j {
+                    0 => c * lin.laws.offsets[*first],
+                    j => harmonics
+                        .get((j - 1) / 2)
+                        .map_or(0.0, |(a, b)| c * if j % 2 == 1 { *a } else { *b }),
+                };
                 let z = sample(&|j| {
                     lambda[j * m + first] - c * lin.measured_coefficient(*first, u, j) + offset(j)
                 })?;
@@ -92,16 +100,17 @@ impl SsnHb {
         let mut slip_velocity = [Vec::new(), Vec::new()];
         for a in 0..2 {
             let i = tangent + a;
-            // The phase velocity without the mean-slip anchor on its constant.
-            let phase = |j: usize| {
-                if j == 0 {
-                    0.0
-                } else {
-                    lin.measured_coefficient(i, u, j)
-                }
+            let sliding = lin.laws.sliding[i];
+            // The slip velocity relative to the obstacle, without the mean-slip anchor on
+            // its constant; the argument with the obstacle's offset `s / w`.
+            let slip = |j: usize| match j {
+                0 => -sliding,
+                j => omega * lin.measured_coefficient(i, u, j),
             };
-            slip_velocity[a] = sample(&|j| omega * phase(j))?;
-            argument[a] = sample(&|j| lambda[j * m + i] - c * lin.measured_coefficient(i, u, j))?;
+            let offset = |j: usize| if j == 0 { c * sliding / omega } else { 0.0 };
+            slip_velocity[a] = sample(&slip)?;
+            argument[a] =
+                sample(&|j| lambda[j * m + i] - c * lin.measured_coefficient(i, u, j) + offset(j))?;
         }
         Ok(FrictionalContactReport::from_samples(
             p,

@@ -187,6 +187,7 @@ macro_rules! omega_parameter {
                     self.displacement_len(),
                     out,
                 );
+                self.add_sliding_omega_derivative(x, out);
                 Ok(())
             }
         }
@@ -339,6 +340,17 @@ impl LinearData {
         model.validate()?;
         validate_basis(harmonics, time_samples)?;
         model.load.check_harmonics(harmonics)?;
+        for (point, p) in model.frictional_contacts.iter().enumerate() {
+            let harmonic = p.gap_harmonics().len();
+            if harmonic > harmonics {
+                return Err(InvalidModel::MovingGapHarmonic {
+                    point,
+                    harmonic,
+                    harmonics,
+                }
+                .into());
+            }
+        }
         let basis = match time_samples {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
             None => FourierBasis::with_default_samples(harmonics),

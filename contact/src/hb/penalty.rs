@@ -163,6 +163,10 @@ impl PenaltyHb {
         Ok(u)
     }
 
+    /// No sliding obstacle in penalty harmonic balance (it refuses frictional contacts):
+    /// nothing to add to `dR/dw`.
+    pub(crate) fn add_sliding_omega_derivative(&mut self, _x: &[f64], _out: &mut [f64]) {}
+
     /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
     /// model, the frequency and the options.
     pub fn new(

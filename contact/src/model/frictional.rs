@@ -36,6 +36,15 @@ pub struct FrictionalContact {
     pub tangents: [ContactRow; 2],
     /// The friction coefficient `mu >= 0`.
     pub coefficient: f64,
+    /// A moving obstacle's gap on harmonics 1, 2, ... of the response's frequency `w`:
+    /// `gap(t) = gap + sum_k (gap_cos[k-1] cos k w t + gap_sin[k-1] sin k w t)` (empty: a
+    /// fixed obstacle; unilateral normal law only).
+    pub gap_cos: Vec<f64>,
+    /// The sine coefficients of the moving gap (as `gap_cos`).
+    pub gap_sin: Vec<f64>,
+    /// The obstacle's constant velocity along the two tangents: the slip is the
+    /// structure's tangential velocity minus it (`[0, 0]`: a fixed obstacle).
+    pub sliding_velocity: [f64; 2],
 }
 
 impl FrictionalContact {
@@ -51,6 +60,9 @@ impl FrictionalContact {
             normal: NormalLaw::Unilateral { row: normal, gap },
             tangents,
             coefficient,
+            gap_cos: Vec::new(),
+            gap_sin: Vec::new(),
+            sliding_velocity: [0.0; 2],
         }
     }
 
@@ -61,7 +73,34 @@ impl FrictionalContact {
             normal: NormalLaw::Prescribed(normal_load),
             tangents,
             coefficient,
+            gap_cos: Vec::new(),
+            gap_sin: Vec::new(),
+            sliding_velocity: [0.0; 2],
         }
+    }
+
+    /// The contact against an obstacle sliding past at the constant `velocity` along the
+    /// two tangents.
+    pub fn with_sliding_velocity(mut self, velocity: [f64; 2]) -> Self {
+        self.sliding_velocity = velocity;
+        self
+    }
+
+    /// The contact against an obstacle whose gap moves periodically: the cosine and sine
+    /// coefficients of `gap(t) - gap` on harmonics 1, 2, ... (a missing coefficient is 0).
+    pub fn with_moving_gap(mut self, gap_cos: Vec<f64>, gap_sin: Vec<f64>) -> Self {
+        self.gap_cos = gap_cos;
+        self.gap_sin = gap_sin;
+        self
+    }
+
+    /// The moving gap's `(cos, sin)` coefficients on harmonics 1, 2, ... (empty: fixed).
+    pub(crate) fn gap_harmonics(&self) -> Vec<(f64, f64)> {
+        let count = self.gap_cos.len().max(self.gap_sin.len());
+        let at = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.0);
+        (0..count)
+            .map(|k| (at(&self.gap_cos, k), at(&self.gap_sin, k)))
+            .collect()
     }
 
     /// The normal row, when the normal law is unilateral.
@@ -122,9 +161,23 @@ pub(super) fn validate_frictional(
                 "a finite mu >= 0",
             ));
         }
+        let moving = p.gap_cos.iter().chain(&p.gap_sin);
+        if let Some(v) = p.sliding_velocity.iter().find(|v| !v.is_finite()) {
+            return Err(value("sliding velocity", *v, "a finite number"));
+        }
+        if let Some(v) = moving.clone().find(|v| !v.is_finite()) {
+            return Err(value("moving gap coefficient", *v, "a finite number"));
+        }
         match p.normal {
             NormalLaw::Unilateral { gap, .. } if !gap.is_finite() => {
                 return Err(value("gap", gap, "a finite number"));
+            }
+            NormalLaw::Prescribed(load) if moving.count() > 0 => {
+                return Err(value(
+                    "moving gap under the normal load",
+                    load,
+                    "a moving gap on a unilateral normal law only",
+                ));
             }
             NormalLaw::Prescribed(load) if !(load.is_finite() && load > 0.0) => {
                 return Err(value("normal load", load, "a finite N > 0"));

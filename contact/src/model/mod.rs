@@ -239,6 +239,19 @@ pub enum InvalidModel {
         /// What is allowed.
         allowed: &'static str,
     },
+    /// A moving obstacle's gap is on a harmonic the formulation's basis does not hold.
+    #[error(
+        "frictional contact {point} has a moving gap on harmonic {harmonic}: allowed harmonics \
+         1..={harmonics}"
+    )]
+    MovingGapHarmonic {
+        /// Index of the frictional contact.
+        point: usize,
+        /// The highest harmonic of its gap.
+        harmonic: usize,
+        /// The number of harmonics `H` of the basis.
+        harmonics: usize,
+    },
     /// Two rows of a frictional contact are parallel.
     #[error(
         "frictional contact {point} has parallel rows: allowed a normal and two tangent rows \

@@ -4,7 +4,9 @@
 //! optional unit `tangents = [[...], [...]]` orthogonal to it and to each other (completed
 //! by the program when absent), or rows: `dofs`/`coefficients` for the normal,
 //! `tangent_dofs`/`tangent_coefficients` and `tangent2_dofs`/`tangent2_coefficients` for
-//! the two tangents.
+//! the two tangents. A moving obstacle adds `gap_cos`/`gap_sin` (the gap's Fourier
+//! coefficients on harmonics 1, 2, ... of the response's frequency) and
+//! `sliding_velocity = [v1, v2]` (the obstacle's velocity along the two tangents).
 
 use semismooth_contact::model::{ContactRow, FrictionalContact};
 
@@ -18,7 +20,8 @@ const UNIT_TOLERANCE: f64 = 1e-9;
 
 /// Whether a `[[contact.point]]` declares a 3-D frictional contact.
 pub(super) fn is_frictional(p: &RawContactPoint) -> bool {
-    p.normal.is_some() || p.tangents.is_some() || p.tangent2_dofs.is_some()
+    let moving = p.gap_cos.is_some() || p.gap_sin.is_some() || p.sliding_velocity.is_some();
+    p.normal.is_some() || p.tangents.is_some() || p.tangent2_dofs.is_some() || moving
 }
 
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -74,7 +77,41 @@ impl Check<'_> {
             Some(n) => self.node_frame(p, n)?,
             None => self.row_frame(p)?,
         };
-        Ok(FrictionalContact::unilateral(normal, gap, tangents, mu))
+        let point = FrictionalContact::unilateral(normal, gap, tangents, mu);
+        self.moving_obstacle(p, point)
+    }
+
+    /// The point with its obstacle's moving gap and sliding velocity (finite numbers).
+    fn moving_obstacle(
+        &self,
+        p: &RawContactPoint,
+        point: FrictionalContact,
+    ) -> Result<FrictionalContact, SceneError> {
+        let finite = |key: &str, values: &[f64]| -> Result<Vec<f64>, SceneError> {
+            values
+                .iter()
+                .map(|v| self.response_scale(key, *v))
+                .collect()
+        };
+        let gap_cos = finite("contact.point.gap_cos", p.gap_cos.as_deref().unwrap_or(&[]))?;
+        let gap_sin = finite("contact.point.gap_sin", p.gap_sin.as_deref().unwrap_or(&[]))?;
+        let velocity = match p.sliding_velocity.as_deref() {
+            None => [0.0; 2],
+            Some(&[v1, v2]) => {
+                let v = finite("contact.point.sliding_velocity", &[v1, v2])?;
+                [v[0], v[1]]
+            }
+            Some(other) => {
+                return Err(self.invalid(
+                    "contact.point.sliding_velocity",
+                    format!("{} values", other.len()),
+                    "two values [v1, v2]: the obstacle's velocity along the two tangents",
+                ))
+            }
+        };
+        Ok(point
+            .with_moving_gap(gap_cos, gap_sin)
+            .with_sliding_velocity(velocity))
     }
 
     /// The rows of `node`'s three components along `normal` and the tangents.

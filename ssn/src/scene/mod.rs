@@ -202,6 +202,9 @@ struct RawContactPoint {
     normal: Option<Vec<f64>>,
     tangents: Option<Vec<Vec<f64>>>,
     tangential_stiffness: Option<f64>,
+    gap_cos: Option<Vec<f64>>,
+    gap_sin: Option<Vec<f64>>,
+    sliding_velocity: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
