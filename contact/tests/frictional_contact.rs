@@ -95,6 +95,30 @@ fn solve_with_c(
     (hb, x)
 }
 
+/// SSN-HB on `model` through the dense LU, the condensed dense LU and matrix-free GMRES on
+/// the condensed system, each to `|F| <= 1e-12`; asserts that they agree within
+/// `agreement` and returns the dense path's problem and solution.
+fn solve_on_every_path(
+    model: &StructuralModel,
+    (omega, harmonics): (f64, usize),
+    agreement: f64,
+) -> (SsnHb, Vec<f64>) {
+    let at = (omega, harmonics, 1e-12);
+    let (hb, dense) = solve(model, at, &mut FaerDenseLu::new());
+    let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
+    let (_, condensed) = solve(model, at, &mut { condensed });
+    let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
+    let (_, krylov) = solve(model, at, &mut { krylov });
+    for other in [&condensed, &krylov] {
+        let gap = dense
+            .iter()
+            .zip(other)
+            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        assert!(gap < agreement, "H = {harmonics}: paths differ by {gap:e}");
+    }
+    (hb, dense)
+}
+
 /// The first-harmonic amplitude of `dof` (`U` index `j N + dof`).
 fn first_harmonic(x: &[f64], dofs: usize, dof: usize) -> (f64, f64) {
     (x[dofs + dof], x[2 * dofs + dof])
@@ -169,21 +193,9 @@ fn a_pressed_point_on_a_circle_dissipates_two_pi_mu_n_r_with_a_first_harmonic_fo
     let normal = PRESS - STIFFNESS * GAP;
     let radius = circle_radius(MU * normal);
     for harmonics in [1, 4] {
-        let at = (OMEGA, harmonics, 1e-12);
-        let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
-        let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
-        let (_, condensed) = solve(&model, at, &mut { condensed });
-        let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
-        let (_, krylov) = solve(&model, at, &mut { krylov });
         // Each path stops at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned
         // Jacobian: the iterates agree far below 1e-10.
-        for other in [&condensed, &krylov] {
-            let gap = dense
-                .iter()
-                .zip(other)
-                .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
-            assert!(gap < 1e-10, "H = {harmonics}: paths differ by {gap:e}");
-        }
+        let (hb, dense) = solve_on_every_path(&model, (OMEGA, harmonics), 1e-10);
         // Every sample of the laws is exact on the circle: only Newton's error remains.
         for dof in 0..2 {
             let (a, b) = first_harmonic(&dense, 3, dof);
@@ -434,20 +446,8 @@ fn a_turning_slip_with_liftoff_agrees_across_linear_paths() {
             [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
             0.4,
         ));
-    let at = (0.8, 10, 1e-12);
-    let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
-    let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
-    let (_, condensed) = solve(&model, at, &mut { condensed });
-    let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
-    let (_, krylov) = solve(&model, at, &mut { krylov });
     // |F| <= 1e-12 with an O(100)-conditioned Jacobian: agreement far below 1e-9.
-    for other in [&condensed, &krylov] {
-        let gap = dense
-            .iter()
-            .zip(other)
-            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
-        assert!(gap < 1e-9, "paths differ by {gap:e}");
-    }
+    let (hb, dense) = solve_on_every_path(&model, (0.8, 10), 1e-9);
     let report = hb.frictional_contact_report(&dense, 0, 512).unwrap();
     println!(
         "stick {} slip {} separated {} energy {}",
@@ -465,6 +465,36 @@ fn a_turning_slip_with_liftoff_agrees_across_linear_paths() {
     assert!((total - 1.0).abs() < 1e-12);
 }
 
+// The point pressed on a moving obstacle: static load, stiffness along z, mean gap, and the
+// gap's motion `0.1 cos w t + 0.05 sin 2 w t`.
+const MOVING_OMEGA: f64 = 1.3;
+const PRESS_Z: f64 = 3.0;
+const STIFFNESS_Z: f64 = 4.0;
+const GAP_Z: f64 = 0.25;
+const MOVING_GAP: (f64, f64) = (0.1, 0.05);
+
+/// Unit masses (damping 0.05) on springs (1, 1, 4), pressed along z on an obstacle whose gap
+/// moves by `MOVING_GAP` and which slides past at `velocity` in the (x, y) plane.
+fn pressed_on_moving_obstacle(velocity: [f64; 2]) -> StructuralModel {
+    let mut load = HarmonicLoad::zero(3);
+    load.add_harmonic(0, &[0.0, 0.0, PRESS_Z], &[0.0; 3])
+        .unwrap();
+    let stiffness = diagonal(&[1.0, 1.0, STIFFNESS_Z]);
+    let mut model = model(&[1.0; 3], &[DAMPING; 3], stiffness, load);
+    let (a1, b2) = MOVING_GAP;
+    model.frictional_contacts.push(
+        FrictionalContact::unilateral(
+            ContactRow::unit(2, 1.0),
+            GAP_Z,
+            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
+            MU,
+        )
+        .with_moving_gap(vec![a1, 0.0], vec![0.0, b2])
+        .with_sliding_velocity(velocity),
+    );
+    model
+}
+
 /// A point pressed (static load 3, stiffness 4 along z) against an obstacle whose gap moves,
 /// `gap(t) = 0.25 + 0.1 cos w t + 0.05 sin 2 w t`, follows it while the contact holds, so
 /// its normal force is `m z'' + c z' + k z - P` with `z = gap(t)`: a constant, a first and a
@@ -472,25 +502,9 @@ fn a_turning_slip_with_liftoff_agrees_across_linear_paths() {
 /// sticks with no tangential force.
 #[test]
 fn a_point_pressed_on_a_moving_obstacle_carries_the_closed_form_normal_force() {
-    let (w, press, stiffness, damping, gap) = (1.3, 3.0, 4.0, 0.05, 0.25);
-    let (a1, b2) = (0.1, 0.05);
-    let mut load = HarmonicLoad::zero(3);
-    load.add_harmonic(0, &[0.0, 0.0, press], &[0.0; 3]).unwrap();
-    let mut model = model(
-        &[1.0; 3],
-        &[damping; 3],
-        diagonal(&[1.0, 1.0, stiffness]),
-        load,
-    );
-    model.frictional_contacts.push(
-        FrictionalContact::unilateral(
-            ContactRow::unit(2, 1.0),
-            gap,
-            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
-            MU,
-        )
-        .with_moving_gap(vec![a1, 0.0], vec![0.0, b2]),
-    );
+    let (w, press, stiffness, damping, gap) = (MOVING_OMEGA, PRESS_Z, STIFFNESS_Z, DAMPING, GAP_Z);
+    let (a1, b2) = MOVING_GAP;
+    let model = pressed_on_moving_obstacle([0.0; 2]);
     // Coefficients (constant, cos 1, sin 1, cos 2, sin 2) of the normal force.
     let expected = [
         stiffness * gap - press,
@@ -500,19 +514,8 @@ fn a_point_pressed_on_a_moving_obstacle_carries_the_closed_form_normal_force() {
         (stiffness - 4.0 * w * w) * b2,
     ];
     for harmonics in [2, 4] {
-        let at = (w, harmonics, 1e-12);
-        let (hb, dense) = solve(&model, at, &mut FaerDenseLu::new());
-        let condensed = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
-        let (_, condensed) = solve(&model, at, &mut { condensed });
-        let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
-        let (_, krylov) = solve(&model, at, &mut { krylov });
-        for other in [&condensed, &krylov] {
-            let gap = dense
-                .iter()
-                .zip(other)
-                .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
-            assert!(gap < 1e-10, "H = {harmonics}: paths differ by {gap:e}");
-        }
+        // |F| <= 1e-12 on an O(1) problem: the paths agree far below 1e-10.
+        let (hb, dense) = solve_on_every_path(&model, (w, harmonics), 1e-10);
         let size = 2 * harmonics + 1;
         let lambda = &dense[3 * size..];
         for (j, value) in lambda.iter().step_by(3).enumerate() {
@@ -553,26 +556,9 @@ fn a_point_pressed_on_a_moving_obstacle_carries_the_closed_form_normal_force() {
 #[test]
 fn a_point_under_a_sliding_moving_obstacle_is_dragged_by_the_closed_form_force() {
     use semismooth::ParameterDependent;
-    let (w, press, stiffness, damping, gap) = (1.3, 3.0, 4.0, 0.05, 0.25);
-    let (a1, b2, velocity) = (0.1, 0.05, [2.0, 1.0]);
-    let mut load = HarmonicLoad::zero(3);
-    load.add_harmonic(0, &[0.0, 0.0, press], &[0.0; 3]).unwrap();
-    let mut model = model(
-        &[1.0; 3],
-        &[damping; 3],
-        diagonal(&[1.0, 1.0, stiffness]),
-        load,
-    );
-    model.frictional_contacts.push(
-        FrictionalContact::unilateral(
-            ContactRow::unit(2, 1.0),
-            gap,
-            [ContactRow::unit(0, 1.0), ContactRow::unit(1, 1.0)],
-            MU,
-        )
-        .with_moving_gap(vec![a1, 0.0], vec![0.0, b2])
-        .with_sliding_velocity(velocity),
-    );
+    let (w, press, stiffness, damping, gap) = (MOVING_OMEGA, PRESS_Z, STIFFNESS_Z, DAMPING, GAP_Z);
+    let ((a1, b2), velocity) = (MOVING_GAP, [2.0, 1.0]);
+    let model = pressed_on_moving_obstacle(velocity);
     // N = -lambda_n: coefficients (constant, cos 1, sin 1, cos 2, sin 2).
     let normal = [
         press - stiffness * gap,

@@ -59,6 +59,12 @@ fn scene(dir: &std::path::Path, contact: &str) -> PathBuf {
     path
 }
 
+/// The first frictional contact of the JSON document of `ssn solve --json` on `scene`.
+fn first_frictional_contact(scene: &std::path::Path) -> serde_json::Value {
+    let args = ["solve", scene.to_str().unwrap(), "--json", "--quiet"];
+    json_success(&ssn(&args))["frictional_contacts"][0].clone()
+}
+
 /// The radius of the sliding circle (module documentation).
 fn circle_radius() -> f64 {
     let (w, b) = (OMEGA, MU * NORMAL);
@@ -83,13 +89,8 @@ fn a_node_contact_in_a_scene_reports_the_circle_dissipation() {
     let expected = 2.0 * PI * MU * NORMAL * circle_radius();
     for form in forms {
         let path = scene(&dir, form);
-        let v = json_success(&ssn(&[
-            "solve",
-            path.to_str().unwrap(),
-            "--json",
-            "--quiet",
-        ]));
-        let point = &v["frictional_contacts"][0];
+        let point = first_frictional_contact(&path);
+        let point = &point;
         let energy = point["dissipated_energy"].as_f64().unwrap();
         // Exact on the circle at any H: Newton's tolerance alone (1e-10 of the forces).
         assert!(
@@ -165,5 +166,45 @@ fn a_bad_frame_or_coefficient_is_refused_with_its_key() {
         .replace("ssn-hb", "march");
     let message = Scene::from_toml(&text, &path).unwrap_err().to_string();
     assert!(message.contains("solver.method"), "{message}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A moving obstacle in a scene: the node pressed (static 2, gap 0.5) on an obstacle whose
+/// gap moves by `0.1 cos w t` and which slides past at `(2, 1)`, no other load (amplitude
+/// 0). The friction force is `mu N(t) v / |v|`, `N = P - k gap(t) - c gap' - m gap''`, and
+/// the energy `mu |v| N_0 T - mu int N (u' . v / |v|) dt` with `u` the linear response to
+/// that force (the closed form of `contact/tests/frictional_contact.rs`, one harmonic).
+#[test]
+fn a_moving_obstacle_in_a_scene_drags_the_node_with_the_closed_form_energy() {
+    let dir = node_files("moving");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3\ngap_cos = [0.1]\n\
+         sliding_velocity = [2.0, 1.0]",
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.replace("amplitude = 1.0", "amplitude = 0.0")).unwrap();
+    let point = first_frictional_contact(&path);
+    let point = &point;
+    let (w, c, a1) = (OMEGA, 0.05, 0.1);
+    let (n0, nc, ns) = (2.0 - 0.5, -(1.0 - w * w) * a1, c * w * a1);
+    let speed = 5f64.sqrt();
+    // The scalar response along v / |v| to mu N(t) on harmonic 1 (unit m, k; damping c).
+    let (kk, cw) = (1.0 - w * w, c * w);
+    let det = kk * kk + cw * cw;
+    let (uc, us) = (
+        MU * (kk * nc - cw * ns) / det,
+        MU * (cw * nc + kk * ns) / det,
+    );
+    let period = 2.0 * PI / w;
+    let drag = 0.5 * period * (nc * w * us - ns * w * uc);
+    let expected = MU * speed * n0 * period - MU * drag;
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Exact at any H: every sample of the laws is; Newton's tolerance alone.
+    assert!(
+        (energy - expected).abs() < 1e-8 * expected,
+        "{energy} against {expected}"
+    );
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
     std::fs::remove_dir_all(&dir).ok();
 }
