@@ -20,8 +20,8 @@ use faer::sparse::Triplet;
 
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, FrictionPoint, HarmonicLoad, InvalidModel, SparseMatrix, StructuralModel,
-    Structure,
+    ContactPoint, FrictionPoint, FrictionalContact, HarmonicLoad, InvalidModel, SparseMatrix,
+    StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -60,6 +60,7 @@ impl StructuralModel {
     /// `M u'' + K u = load cos(omega t)`: no damping and no contact until they are added.
     pub fn new(mass: SparseMatrix, stiffness: SparseMatrix, load: Vec<f64>) -> Self {
         Self {
+            frictional_contacts: Vec::new(),
             mass,
             damping: None,
             stiffness,
@@ -102,6 +103,12 @@ impl StructuralModel {
     /// The model with one more Coulomb friction point.
     pub fn with_friction(mut self, point: FrictionPoint) -> Self {
         self.friction.push(point);
+        self
+    }
+
+    /// The model with one more 3-D frictional contact.
+    pub fn with_frictional_contact(mut self, point: FrictionalContact) -> Self {
+        self.frictional_contacts.push(point);
         self
     }
 }

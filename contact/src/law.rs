@@ -22,14 +22,21 @@
 //!   `N = max(0, -lambda_n)` of the contact read; smoothed by `phi_mu` in each of its two
 //!   `max` terms.
 //!
-//! A law coupling several rows (the friction disk of a 2-D tangent plane) is one more type
-//! implementing [`ContactLaw`], attached to a model's rows by a [`LawGroup`].
+//! - [`FrictionDisk`]: Coulomb friction on two tangential rows, the radial projection onto
+//!   the disk of radius `mu_c N` (a 3-D frictional contact's tangent plane).
+//!
+//! A law coupling several rows is one more type implementing [`ContactLaw`], attached to a
+//! model's rows by a [`LawGroup`].
 //!
 //! Reference: P. Alart, A. Curnier, CMAME 92 (1991) 353–375.
 
 use std::sync::Arc;
 
 use crate::model::{ContactRow, NormalForce};
+
+mod disk;
+
+pub use disk::FrictionDisk;
 
 /// What the rows of a group measure (the `y` of the law's argument).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

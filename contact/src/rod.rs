@@ -387,6 +387,7 @@ pub fn build_rod(spec: &RodSpec) -> Result<RodModel, ModelError> {
         .map(|c| ContactPoint::new(c.node - 1, c.gap))
         .collect();
     let mut model = StructuralModel {
+        frictional_contacts: Vec::new(),
         mass,
         damping: None,
         stiffness,

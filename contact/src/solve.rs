@@ -34,8 +34,8 @@ use semismooth::{GeneralizedJacobian, Residual};
 use crate::contacts::{contact_reports, ContactReport, FrictionReport};
 use crate::contacts::{period_statistics, PeriodStatistics};
 use crate::hb::{
-    CondensedSolve, HbError, HbJacobian, HbOptions, PenaltyHb, PenaltyHbOptions, SsnHb,
-    StructuredHbSolver,
+    CondensedSolve, FrictionalContactReport, HbError, HbJacobian, HbOptions, PenaltyHb,
+    PenaltyHbOptions, SsnHb, StructuredHbSolver,
 };
 use crate::lcp::{
     ActiveSetSolver, LcpScheme, PeriodicLcp, PeriodicLcpOptions, DEFAULT_ACTIVE_SET_REGULARIZATION,
@@ -240,6 +240,9 @@ pub struct Solution {
     /// Every friction point over the period, at [`Solution::times`] (harmonic balance and
     /// time marching; empty for the LCP, which has no friction).
     pub friction: Vec<FrictionReport>,
+    /// Every 3-D frictional contact over the period (SSN-HB; empty for other methods,
+    /// which refuse them).
+    pub frictional_contacts: Vec<FrictionalContactReport>,
     /// Work counters.
     pub counters: RunCounters,
     /// The method's unknowns, for warm starts: HB coefficients, the LCP's `z`, the state
@@ -395,7 +398,7 @@ where
         gap_scale,
         extra_stiffness,
     ));
-    if model.contacts.is_empty() && model.friction.is_empty() {
+    if model.row_count() == 0 {
         // The unknowns are displacements alone, and round-off grows with them (a linear
         // response near resonance): the floor per unit displacement.
         let per_displacement = roundoff_floor(model, problem.dim(), 1.0, extra_stiffness);
@@ -502,6 +505,7 @@ fn solution(
         method,
         contacts,
         friction: period.friction,
+        frictional_contacts: Vec::new(),
         harmonics: method.is_harmonic_balance().then_some(settings.harmonics),
         time_samples,
         lcp_scheme: method.is_lcp().then_some(settings.lcp_scheme),
@@ -675,6 +679,9 @@ pub(super) fn solve_ssn_hb(
     let outcome = Outcome::of_newton(&report, seconds);
     let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
     sol.c = (problem.contacts() > 0).then(|| problem.c());
+    sol.frictional_contacts = (0..problem.frictional_contacts())
+        .map(|p| problem.frictional_contact_report(&sol.state, p, points))
+        .collect::<Result<_, _>>()?;
     Ok(sol)
 }
 

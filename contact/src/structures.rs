@@ -192,6 +192,7 @@ impl BladedDisk {
         let (stiffness, mass, shape) = self.matrices();
         let n = self.dofs();
         let mut model = StructuralModel {
+            frictional_contacts: Vec::new(),
             mass,
             damping: None,
             stiffness,

@@ -122,6 +122,7 @@ fn rotating_oscillator() -> StructuralModel {
     let mut load = HarmonicLoad::zero(2);
     load.add_harmonic(1, &[FORCE, 0.0], &[0.0, FORCE]).unwrap();
     StructuralModel {
+        frictional_contacts: Vec::new(),
         mass: diagonal(MASS),
         damping: Some(diagonal(DAMPING)),
         stiffness: diagonal(STIFFNESS),

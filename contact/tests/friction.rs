@@ -31,6 +31,7 @@ fn oscillator(m: f64, c: f64, k: f64, f0: f64, friction: f64) -> StructuralModel
         SparseMatrix::try_new_from_triplets(1, 1, &[faer::sparse::Triplet::new(0, 0, v)]).unwrap()
     };
     StructuralModel {
+        frictional_contacts: Vec::new(),
         mass: one(m),
         damping: (c > 0.0).then(|| one(c)),
         stiffness: one(k),

@@ -58,6 +58,7 @@ fn chain(
         SparseColMat::try_new_from_triplets(n, n, &dt).unwrap()
     });
     let model = StructuralModel {
+        frictional_contacts: Vec::new(),
         mass,
         damping,
         stiffness,

@@ -9,6 +9,7 @@ use serde_json::{json, Value};
 use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummary};
 use semismooth_contact::model::Structure;
+use semismooth_contact::hb::FrictionalContactReport;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
@@ -52,6 +53,24 @@ pub fn friction_json(f: &FrictionReport) -> Value {
     v["force"] = json!(series(&f.force));
     v["slip_velocity"] = json!(series(&f.slip_velocity));
     v
+}
+
+/// The JSON object of one 3-D frictional contact of a solution: `point`, `normal_force`,
+/// `tangential_force` (two series), `slip_velocity` (two series) over the period (at the
+/// times of the solution's CSV), `dissipated_energy` per cycle, `stick_fraction`,
+/// `slip_fraction`, `separated_fraction`.
+pub fn frictional_contact_json(p: &FrictionalContactReport) -> Value {
+    let series = |s: &[f64]| s.iter().map(|x| finite_or_null(*x)).collect::<Vec<_>>();
+    json!({
+        "point": p.point,
+        "normal_force": series(&p.normal_force),
+        "tangential_force": [series(&p.tangential_force[0]), series(&p.tangential_force[1])],
+        "slip_velocity": [series(&p.slip_velocity[0]), series(&p.slip_velocity[1])],
+        "dissipated_energy": finite_or_null(p.dissipated_energy),
+        "stick_fraction": finite_or_null(p.stick_fraction),
+        "slip_fraction": finite_or_null(p.slip_fraction),
+        "separated_fraction": finite_or_null(p.separated_fraction),
+    })
 }
 
 /// The JSON fields of the Newton-style counters: `residual_evaluations`,
@@ -106,6 +125,14 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
     });
     if let Some(h) = s.harmonics {
         v["harmonics"] = json!(h);
+    }
+    if !s.frictional_contacts.is_empty() {
+        let points: Vec<Value> = s
+            .frictional_contacts
+            .iter()
+            .map(frictional_contact_json)
+            .collect();
+        v["frictional_contacts"] = json!(points);
     }
     if let Some(scheme) = s.lcp_scheme {
         v["lcp_scheme"] = json!(scheme.name());

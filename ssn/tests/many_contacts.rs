@@ -61,6 +61,7 @@ fn tuned(blades: usize, gap: f64) -> StructuralModel {
     }
     .matrices();
     let mut model = StructuralModel {
+        frictional_contacts: Vec::new(),
         mass,
         damping: Some(stiffness.clone()),
         stiffness,

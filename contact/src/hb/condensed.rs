@@ -233,8 +233,8 @@ impl CondensedSsnHb {
         let lin = &self.full.state.linear;
         let (m, y) = (lin.contacts(), &self.y);
         let measured = |row: usize, j: usize| y[j * m + row];
-        let c = self.full.c();
-        (self.laws).sample(&mut self.aft, lin, (g, c), lambda, measured);
+        let at = (g, self.full.c(), self.full.omega());
+        (self.laws).sample(&mut self.aft, lin, at, lambda, measured);
     }
 }
 
@@ -329,7 +329,16 @@ impl ParameterDependent for CondensedSsnHb {
         let c = self.full.c();
         // dy/dw = -G A^{-1} (dA/dw) U.
         let moved = std::mem::take(&mut self.full_w);
-        let dy = |row: usize, j: usize| -lin.measured_coefficient(row, &moved, j);
+        // (and the sliding offsets s / w move by -s / w^2: as y by s / w^2).
+        let omega = self.full.omega();
+        let dy = |row: usize, j: usize| {
+            let sliding = if j == 0 {
+                lin.laws.sliding[row] / (omega * omega)
+            } else {
+                0.0
+            };
+            sliding - lin.measured_coefficient(row, &moved, j)
+        };
         for g in 0..lin.laws.groups.len() {
             self.sample_group(lambda, g);
             let at = (g, c, self.smoothing);

@@ -20,8 +20,8 @@ use semismooth::linalg::LinearSolveError;
 use semismooth::InvalidOption;
 
 use super::{HbError, LinearData};
-use crate::law::{ContactLaw, Coulomb, LawGroup, LawSamples, Measure, Unilateral};
-use crate::model::StructuralModel;
+use crate::law::{ContactLaw, Coulomb, FrictionDisk, LawGroup, LawSamples, Measure, Unilateral};
+use crate::model::{NormalForce, NormalLaw, StructuralModel};
 
 /// One group of rows of `G` and its law.
 #[derive(Debug, Clone)]
@@ -51,11 +51,19 @@ pub(crate) struct LawLayout {
     pub(crate) velocity_rows: Vec<usize>,
     /// The offset `o_a` of each row in its law's argument.
     pub(crate) offsets: Vec<f64>,
+    /// The offsets' `(cos, sin)` coefficients on harmonics 1, 2, ... of each row (a moving
+    /// obstacle's gap; empty for most rows).
+    pub(crate) offset_harmonics: Vec<Vec<(f64, f64)>>,
+    /// The obstacle's sliding velocity `s_a` of each slip row (0 for most rows): its offset
+    /// is `s_a / w`, the velocity per radian.
+    pub(crate) sliding: Vec<f64>,
 }
 
 impl LawLayout {
     /// The groups of `model` (a [`Unilateral`] law per contact, a [`Coulomb`] law per
-    /// friction point) followed by `added` (validated against the `dofs` and the rows).
+    /// friction point, a [`Unilateral`] law on the normal row, if any, and a
+    /// [`FrictionDisk`] on the tangent rows per frictional contact) followed by `added`
+    /// (validated against the `dofs` and the rows).
     pub(crate) fn new(
         model: &StructuralModel,
         added: &[LawGroup],
@@ -71,7 +79,26 @@ impl LawLayout {
                 vec![0.0],
             ));
         }
-        let own = model.contacts.len() + model.friction.len();
+        let mut row = model.contacts.len() + model.friction.len();
+        let (mut moving, mut sliding) = (Vec::new(), Vec::new());
+        for point in &model.frictional_contacts {
+            let normal = match point.normal {
+                NormalLaw::Unilateral { gap, .. } => {
+                    laws.push((Arc::new(Unilateral), vec![gap]));
+                    moving.push((row, point.gap_harmonics()));
+                    row += 1;
+                    NormalForce::Contact(row - 1)
+                }
+                NormalLaw::Prescribed(load) => NormalForce::Prescribed(load),
+            };
+            laws.push((
+                Arc::new(FrictionDisk::new(point.coefficient, normal)),
+                vec![0.0, 0.0],
+            ));
+            sliding.push((row, point.sliding_velocity));
+            row += 2;
+        }
+        let own = row;
         let total = own + added.iter().map(|g| g.rows.len()).sum::<usize>();
         let mut first = own;
         for group in added {
@@ -87,9 +114,17 @@ impl LawLayout {
             velocity: Vec::with_capacity(total),
             velocity_rows: Vec::new(),
             offsets: Vec::with_capacity(total),
+            offset_harmonics: vec![Vec::new(); total],
+            sliding: vec![0.0; total],
         };
         for (law, offsets) in laws {
             layout.push(law, offsets);
+        }
+        for (row, harmonics) in moving {
+            layout.offset_harmonics[row] = harmonics;
+        }
+        for (row, velocity) in sliding {
+            layout.sliding[row..row + 2].copy_from_slice(&velocity);
         }
         Ok(layout)
     }
@@ -257,13 +292,13 @@ impl LawSampler {
     }
 
     /// Samples group `g`'s arguments `z_a = lambda_a - c (y_a - o_a)` and the forces it
-    /// reads: `forces` the rows' force coefficients (index `j m + row`), `measured(row, j)`
-    /// coefficient `j` of the row's measured quantity `y`.
+    /// reads at the frequency `omega`: `forces` the rows' force coefficients (index
+    /// `j m + row`), `measured(row, j)` coefficient `j` of the row's measured quantity `y`.
     pub(crate) fn sample(
         &mut self,
         aft: &mut Aft,
         lin: &LinearData,
-        (g, c): (usize, f64),
+        (g, c, omega): (usize, f64, f64),
         forces: &[f64],
         measured: impl Fn(usize, usize) -> f64,
     ) {
@@ -275,7 +310,11 @@ impl LawSampler {
             for (j, coeff) in coeffs.iter_mut().enumerate() {
                 *coeff = forces[j * m + row] - c * measured(row, j);
             }
-            coeffs[0] += c * lin.laws.offsets[row];
+            coeffs[0] += c * (lin.laws.offsets[row] + lin.laws.sliding[row] / omega);
+            for (k, (a, b)) in lin.laws.offset_harmonics[row].iter().enumerate() {
+                coeffs[2 * k + 1] += c * a;
+                coeffs[2 * k + 2] += c * b;
+            }
             aft.coefficients_to_samples();
             self.z[a * nt..(a + 1) * nt].copy_from_slice(aft.samples());
         }

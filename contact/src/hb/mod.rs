@@ -187,6 +187,7 @@ macro_rules! omega_parameter {
                     self.displacement_len(),
                     out,
                 );
+                self.add_sliding_omega_derivative(x, out);
                 Ok(())
             }
         }
@@ -194,6 +195,7 @@ macro_rules! omega_parameter {
 }
 
 mod condensed;
+mod disk;
 mod friction;
 mod jacobian;
 mod krylov;
@@ -209,11 +211,12 @@ use semismooth::harmonic::{Aft, FourierBasis, HarmonicError};
 use semismooth::InvalidOption;
 
 use crate::law::LawGroup;
-use crate::model::{ContactRow, InvalidModel, NormalForce, StructuralModel};
+use crate::model::{ContactRow, FrictionalContact, InvalidModel, NormalForce, StructuralModel};
 use crate::operator::{HarmonicOperator, HarmonicParameters, OperatorParameter};
 
 pub(crate) use crate::law::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use condensed::CondensedSsnHb;
+pub use disk::FrictionalContactReport;
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
 pub(crate) use laws::LawLayout;
@@ -313,6 +316,8 @@ pub(crate) struct LinearData {
     pub(crate) friction: Vec<(f64, NormalForce)>,
     /// The row groups with their laws and the pattern of their Jacobian blocks.
     pub(crate) laws: LawLayout,
+    /// Each frictional contact with the index of its first row.
+    pub(crate) frictional: Vec<(usize, FrictionalContact)>,
 }
 
 impl LinearData {
@@ -335,6 +340,17 @@ impl LinearData {
         model.validate()?;
         validate_basis(harmonics, time_samples)?;
         model.load.check_harmonics(harmonics)?;
+        for (point, p) in model.frictional_contacts.iter().enumerate() {
+            let harmonic = p.gap_harmonics().len();
+            if harmonic > harmonics {
+                return Err(InvalidModel::MovingGapHarmonic {
+                    point,
+                    harmonic,
+                    harmonics,
+                }
+                .into());
+            }
+        }
         let basis = match time_samples {
             Some(nt) => FourierBasis::new(harmonics, nt)?,
             None => FourierBasis::with_default_samples(harmonics),
@@ -342,6 +358,15 @@ impl LinearData {
         let mut rows: Vec<ContactRow> = model.rows().cloned().collect();
         let laws = LawLayout::new(model, groups, model.dofs())?;
         rows.extend(groups.iter().flat_map(|g| g.rows.iter().cloned()));
+        let mut first = model.contacts.len() + model.friction.len();
+        let frictional = model
+            .frictional_contacts
+            .iter()
+            .map(|p| {
+                first += p.row_count();
+                (first - p.row_count(), p.clone())
+            })
+            .collect();
         Ok(Self {
             dofs: model.dofs(),
             basis,
@@ -354,6 +379,7 @@ impl LinearData {
                 .map(|f| (f.coefficient, f.normal))
                 .collect(),
             laws,
+            frictional,
         })
     }
 

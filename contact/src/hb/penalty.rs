@@ -163,6 +163,10 @@ impl PenaltyHb {
         Ok(u)
     }
 
+    /// No sliding obstacle in penalty harmonic balance (it refuses frictional contacts):
+    /// nothing to add to `dR/dw`.
+    pub(crate) fn add_sliding_omega_derivative(&mut self, _x: &[f64], _out: &mut [f64]) {}
+
     /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
     /// model, the frequency and the options.
     pub fn new(
@@ -173,6 +177,12 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
+        if !model.frictional_contacts.is_empty() {
+            return Err(HbError::Unsupported {
+                formulation: "penalty harmonic balance",
+                what: "frictional contacts (the Coulomb disk; use ssn-hb)",
+            });
+        }
         if model
             .friction
             .iter()

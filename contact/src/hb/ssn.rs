@@ -232,13 +232,41 @@ impl SsnHb {
             .collect()
     }
 
+    /// `dR/dw` of the force equations through the sliding obstacles' offsets `s / w` (as
+    /// the measured `y` moving by `s / w^2`) into their groups' rows of `out[len..]` (zero
+    /// before: the force equations have no other dependence on `w`).
+    pub(crate) fn add_sliding_omega_derivative(&mut self, x: &[f64], out: &mut [f64]) {
+        let lin = self.state.linear.clone();
+        if lin.laws.sliding.iter().all(|s| *s == 0.0) {
+            return;
+        }
+        let (len, omega) = (self.displacement_len(), self.state.omega);
+        let dy = |row: usize, j: usize| {
+            if j == 0 {
+                lin.laws.sliding[row] / (omega * omega)
+            } else {
+                0.0
+            }
+        };
+        for (g, group) in lin.laws.groups.iter().enumerate() {
+            let rows = group.first..group.first + group.law.rows();
+            if lin.laws.sliding[rows].iter().all(|s| *s == 0.0) {
+                continue;
+            }
+            self.sample_group(x, g);
+            let at = (g, self.c, self.smoothing);
+            (self.laws).measured_response(&mut self.state.aft, &lin, at, dy, &mut out[len..]);
+        }
+    }
+
     /// Samples group `g`'s arguments `z = lambda - c (y - o)` and the forces it reads
     /// from the full unknowns `x = [U; Lambda]`.
     fn sample_group(&mut self, x: &[f64], g: usize) {
         let lin = self.state.linear.clone();
         let (u, forces) = x.split_at(lin.dofs * lin.size());
         let measured = |row: usize, j: usize| lin.measured_coefficient(row, u, j);
-        (self.laws).sample(&mut self.state.aft, &lin, (g, self.c), forces, measured);
+        let at = (g, self.c, self.state.omega);
+        (self.laws).sample(&mut self.state.aft, &lin, at, forces, measured);
     }
 }
 

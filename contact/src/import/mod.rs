@@ -35,7 +35,8 @@ use semismooth::Factorize;
 
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, ContactRow, FrictionPoint, SparseMatrix, StructuralModel, Structure,
+    ContactPoint, ContactRow, FrictionPoint, FrictionalContact, SparseMatrix, StructuralModel,
+    Structure,
 };
 use crate::rod::{natural_frequencies, DampingSpec};
 
@@ -99,8 +100,11 @@ pub struct Attachments {
     pub contacts: Vec<DofContact>,
     /// Friction points under a prescribed normal load.
     pub friction: Vec<DofFriction>,
+    /// 3-D frictional contacts (rows 0-based).
+    pub frictional_contacts: Vec<FrictionalContact>,
     /// Observed dof (0-based); `None`: the first contact dof, else the first friction
-    /// point's, else the largest load entry.
+    /// point's, else the first frictional contact's first tangent dof, else the largest
+    /// load entry.
     pub observed_dof: Option<usize>,
     /// Damping built from `K` and `M` (not with a damping matrix).
     pub damping: Option<DampingSpec>,
@@ -160,6 +164,11 @@ pub enum DofUse {
         /// Index in [`Attachments::friction`].
         point: usize,
     },
+    /// A row of frictional contact `point`.
+    FrictionalContactRow {
+        /// Index in [`Attachments::frictional_contacts`].
+        point: usize,
+    },
     /// [`Attachments::observed_dof`].
     Observed,
 }
@@ -172,6 +181,9 @@ impl std::fmt::Display for DofUse {
                 write!(f, "the tangential row of contact {}", contact + 1)
             }
             DofUse::FrictionRow { point } => write!(f, "the row of friction point {}", point + 1),
+            DofUse::FrictionalContactRow { point } => {
+                write!(f, "a row of frictional contact {}", point + 1)
+            }
             DofUse::Observed => f.write_str("the observed dof"),
         }
     }
@@ -335,6 +347,7 @@ pub fn assemble(parts: ModelParts, attach: &Attachments) -> Result<Structure, Mo
             reason: e.to_string(),
         })?;
     let mut model = StructuralModel {
+        frictional_contacts: attach.frictional_contacts.clone(),
         mass,
         damping,
         stiffness,
@@ -413,6 +426,11 @@ fn attached(
             friction.push(FrictionPoint::on_contact(tangent.clone(), *mu, i));
         }
     }
+    for (point, p) in attach.frictional_contacts.iter().enumerate() {
+        for row in p.rows() {
+            row_in_range(DofUse::FrictionalContactRow { point }, row)?;
+        }
+    }
     for (point, f) in attach.friction.iter().enumerate() {
         row_in_range(DofUse::FrictionRow { point }, &f.tangent)?;
         friction.push(FrictionPoint::prescribed(
@@ -426,7 +444,10 @@ fn attached(
         None => match (contacts.first(), friction.first()) {
             (Some(c), _) => c.dof(),
             (None, Some(f)) => f.tangent.first_dof(),
-            (None, None) => largest_entry(load),
+            (None, None) => match attach.frictional_contacts.first() {
+                Some(p) => p.tangents[0].first_dof(),
+                None => largest_entry(load),
+            },
         },
     };
     Ok((contacts, friction, observed_dof))
@@ -547,6 +568,7 @@ mod tests {
                 friction: None,
             }],
             friction: Vec::new(),
+            frictional_contacts: Vec::new(),
             observed_dof: None,
             damping: None,
             amplitude: 2.0,

@@ -67,9 +67,9 @@ impl PeriodicLcp {
         if model.contacts.is_empty() {
             return Err(LcpError::NoContacts);
         }
-        if !model.friction.is_empty() {
+        if model.has_friction() {
             return Err(LcpError::Friction {
-                points: model.friction.len(),
+                points: model.friction.len() + model.frictional_contacts.len(),
             });
         }
         for (contact, c) in model.contacts.iter().enumerate() {

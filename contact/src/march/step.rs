@@ -197,6 +197,13 @@ impl<'a> TimeMarcher<'a> {
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
+        if !model.frictional_contacts.is_empty() {
+            return Err(MarchError::InvalidOption(InvalidOption::new(
+                "frictional contacts marched in time",
+                model.frictional_contacts.len() as f64,
+                "none: time marching has no Coulomb disk yet; solve them with ssn-hb",
+            )));
+        }
         let scheme = Scheme::resolve(model, options.scheme);
         if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
             return Err(MarchError::InvalidOption(InvalidOption::new(

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::import::{assemble, Attachments, DofMap, DofUse, ModelError, ModelParts, Part};
-use crate::model::{SparseMatrix, Structure};
+use crate::model::{FrictionalContact, SparseMatrix, Structure};
 use crate::rod::{DampingSpec, FrequencySpec};
 
 mod read;
@@ -67,6 +67,8 @@ pub struct ModelSpec {
     pub contacts: Vec<DofContact>,
     /// Friction points under a prescribed normal load (`[[friction.point]]`).
     pub friction: Vec<DofFriction>,
+    /// 3-D frictional contacts (rows 0-based).
+    pub frictional_contacts: Vec<FrictionalContact>,
     /// Observed dof (0-based); `None`: the first contact dof, else the first friction
     /// point's, else the largest load entry.
     pub observed_dof: Option<usize>,
@@ -87,6 +89,7 @@ impl ModelSpec {
         Attachments {
             contacts: self.contacts.clone(),
             friction: self.friction.clone(),
+            frictional_contacts: self.frictional_contacts.clone(),
             observed_dof: self.observed_dof,
             damping: self.damping,
             amplitude: self.amplitude,
@@ -118,6 +121,7 @@ impl ModelSpec {
                 Some(f) if !single(&f.tangent) => "friction.point.dofs",
                 _ => "friction.point.dof",
             },
+            DofUse::FrictionalContactRow { .. } => "contact.point",
             DofUse::Observed => "output.dof",
         }
     }

@@ -26,12 +26,14 @@ use semismooth::{Factorize, InvalidOption, LinearSolve};
 
 mod contact;
 mod coupling;
+mod frictional;
 mod load;
 
 pub use contact::{
     ContactDirection, ContactPoint, ContactRow, FrictionPoint, InvalidRow, NormalForce,
 };
 pub use coupling::{CouplingSource, CouplingTerm, CyclicCoupling};
+pub use frictional::{FrictionalContact, NormalLaw};
 pub use load::{HarmonicLoad, LoadHarmonic};
 
 /// Sparse symmetric matrix storage used for `M`, `D` and `K` (column-compressed, faer).
@@ -60,6 +62,9 @@ pub struct StructuralModel {
     /// ([`crate::cyclic::CyclicSector`]); `None` for every other model. Only the harmonic
     /// operator (the harmonic-balance formulations) reads them.
     pub cyclic: Option<CyclicCoupling>,
+    /// 3-D frictional contacts (a normal row and two tangent rows each, under the Coulomb
+    /// disk); empty: none.
+    pub frictional_contacts: Vec<FrictionalContact>,
 }
 
 /// A structure ready for every method: the model, its first finite natural frequency
@@ -235,6 +240,50 @@ pub enum InvalidModel {
         /// The shared contact.
         contact: usize,
     },
+    /// A frictional contact's row is on a dof that does not exist.
+    #[error("frictional contact {point} is on dof {dof}: allowed 0..{dofs}")]
+    FrictionalContactDofOutOfRange {
+        /// Index of the frictional contact.
+        point: usize,
+        /// The dof.
+        dof: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// A frictional contact's coefficient, gap or normal load is out of its range.
+    #[error("frictional contact {point} has {part} {value}: allowed {allowed}")]
+    FrictionalContactValue {
+        /// Index of the frictional contact.
+        point: usize,
+        /// `"friction coefficient"`, `"gap"` or `"normal load"`.
+        part: &'static str,
+        /// The value found.
+        value: f64,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+    /// A moving obstacle's gap is on a harmonic the formulation's basis does not hold.
+    #[error(
+        "frictional contact {point} has a moving gap on harmonic {harmonic}: allowed harmonics \
+         1..={harmonics}"
+    )]
+    MovingGapHarmonic {
+        /// Index of the frictional contact.
+        point: usize,
+        /// The highest harmonic of its gap.
+        harmonic: usize,
+        /// The number of harmonics `H` of the basis.
+        harmonics: usize,
+    },
+    /// Two rows of a frictional contact are parallel.
+    #[error(
+        "frictional contact {point} has parallel rows: allowed a normal and two tangent rows \
+         independent of each other"
+    )]
+    FrictionalContactParallelRows {
+        /// Index of the frictional contact.
+        point: usize,
+    },
     /// A matrix entry given in code lies outside the `N x N` matrix.
     #[error("matrix entry ({row}, {col}) is outside the {dofs} x {dofs} matrix")]
     EntryOutOfRange {
@@ -327,6 +376,7 @@ impl StructuralModel {
         }
         self.load.validate(n)?;
         contact::validate_rows(&self.contacts, &self.friction, n)?;
+        frictional::validate_frictional(&self.frictional_contacts, n)?;
         Ok(())
     }
 
@@ -355,12 +405,25 @@ impl StructuralModel {
     }
 
     /// Every row of `G`: the contacts' normal rows, then the friction points' tangential
-    /// rows (the order of the force unknowns of harmonic balance).
+    /// rows, then the frictional contacts' rows (the order of the force unknowns of
+    /// harmonic balance).
     pub fn rows(&self) -> impl Iterator<Item = &ContactRow> + '_ {
         self.contacts
             .iter()
             .map(|c| &c.row)
             .chain(self.friction.iter().map(|f| &f.tangent))
+            .chain(self.frictional_contacts.iter().flat_map(|p| p.rows()))
+    }
+
+    /// Whether the model has friction: a friction point or a frictional contact.
+    pub fn has_friction(&self) -> bool {
+        !(self.friction.is_empty() && self.frictional_contacts.is_empty())
+    }
+
+    /// Number of rows of `G` ([`StructuralModel::rows`]).
+    pub fn row_count(&self) -> usize {
+        let frictional: usize = self.frictional_contacts.iter().map(|p| p.row_count()).sum();
+        self.contacts.len() + self.friction.len() + frictional
     }
 
     /// Stiffness scale seen by the contacts: the mean of `g K g^T` over the rows of `G`
@@ -368,7 +431,7 @@ impl StructuralModel {
     /// into a force and is the default for the complementarity constant `c` and the unit
     /// of penalty stiffnesses.
     pub fn contact_stiffness_scale(&self) -> f64 {
-        let rows = self.contacts.len() + self.friction.len();
+        let rows = self.row_count();
         if rows == 0 {
             return 1.0;
         }
@@ -421,7 +484,7 @@ impl StructuralModel {
     /// rest of the structure free. Independent of the mesh (for the rod: `EA / x_node`);
     /// `None` without contacts or when `K` cannot be factored.
     pub fn static_contact_stiffness(&self) -> Option<f64> {
-        let m = self.contacts.len() + self.friction.len();
+        let m = self.row_count();
         mean_stiffness(diagonal(&self.static_contact_compliance()?, m))
     }
 
@@ -436,14 +499,16 @@ impl StructuralModel {
     /// `m` for `m` contacts that move and close as one; `None` when the static contact
     /// stiffness is.
     pub fn shared_contact_stiffness(&self) -> Option<f64> {
-        let m = self.contacts.len() + self.friction.len();
+        let m = self.row_count();
         let (mut compliance, load_motion) = self.static_contact_response()?;
         let stiffness = mean_stiffness(diagonal(&compliance, m))?;
         let largest = diagonal(&compliance, m).fold(0.0, f64::max);
         // (A friction point's row has no gap: it is engaged at rest, as a closed contact.)
         let gaps = self.contacts.iter().map(|c| c.gap);
+        let frictional = self.frictional_contacts.iter().flat_map(|p| p.offsets());
         let closing: Vec<f64> = gaps
             .chain(self.friction.iter().map(|_| 0.0))
+            .chain(frictional)
             .zip(&load_motion)
             .map(|(gap, motion)| closing_load_factor(gap, *motion))
             .collect();
@@ -638,6 +703,7 @@ mod tests {
             SparseMatrix::try_new_from_triplets(3, 3, &t).unwrap()
         };
         StructuralModel {
+            frictional_contacts: Vec::new(),
             mass: matrix(2.0, 0.5),
             damping: Some(matrix(0.2, -0.1)),
             stiffness: matrix(2.0, -1.0),

@@ -355,11 +355,11 @@ impl HbStability {
             Some(k) => ClosedContact::Spring(k),
         };
         let n = model.dofs();
-        let (phases, refused) = if !model.friction.is_empty() {
+        let (phases, refused) = if model.has_friction() {
             (
                 None,
                 Some(Undecided::Friction {
-                    points: model.friction.len(),
+                    points: model.friction.len() + model.frictional_contacts.len(),
                 }),
             )
         } else if let Some(contact) = model.contacts.iter().position(|c| c.direction().is_none()) {

@@ -246,8 +246,8 @@ fn map_undecided(
             found: u.len(),
         });
     }
-    let reason = if !model.friction.is_empty() {
-        let points = model.friction.len();
+    let reason = if model.has_friction() {
+        let points = model.friction.len() + model.frictional_contacts.len();
         Undecided::Friction { points }
     } else if resolve_scheme(model, MarchScheme::Auto) != MarchScheme::MasslessContactTrapezoidal {
         Undecided::MassCarryingContact

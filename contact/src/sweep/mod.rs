@@ -156,6 +156,7 @@ fn reference_amplitude(rod: &Structure) -> f64 {
     let mut model = rod.model.clone();
     model.contacts.clear();
     model.friction.clear();
+    model.frictional_contacts.clear();
     let dofs = model.dofs().max(1);
     let options = PenaltyHbOptions {
         harmonics: 1,
@@ -257,7 +258,7 @@ fn penalty_continuation(
     MethodContinuation {
         units: vec![1.0; problem.dim()],
         residual_floor: f64::EPSILON * options.penalty_stiffness * largest_gap(model, u_ref),
-        affine_pieces: model.friction.is_empty(),
+        affine_pieces: !model.has_friction(),
     }
 }
 
@@ -639,7 +640,7 @@ pub(crate) fn follow_branch(
                 &mut measure,
                 // With friction (regularised, smooth) the branch is not piecewise affine.
                 |c| {
-                    if model.friction.is_empty() {
+                    if !model.has_friction() {
                         c.with_affine_pieces()
                     } else {
                         c

@@ -21,6 +21,7 @@ pub fn chain(gap: f64, zeta: f64, load: [f64; 2]) -> Structure {
     let omega_1 = ((3.0 - 5f64.sqrt()) / 2.0).sqrt();
     let c = 2.0 * zeta / omega_1;
     let model = StructuralModel {
+        frictional_contacts: Vec::new(),
         mass: matrix(&[(0, 0, 1.0), (1, 1, 1.0)]),
         damping: Some(matrix(&[
             (0, 0, 2.0 * c),

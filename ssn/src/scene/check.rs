@@ -517,7 +517,7 @@ impl Check<'_> {
             path: self.path,
             dof_map: dof_map.as_ref(),
         };
-        let contacts = contact
+        let (contacts, frictional_contacts) = contact
             .map(|c| ck.dof_contacts(c))
             .transpose()?
             .unwrap_or_default();
@@ -537,6 +537,7 @@ impl Check<'_> {
             frequency,
             contacts,
             friction,
+            frictional_contacts,
             observed_dof,
             dof_map,
         })
@@ -548,6 +549,17 @@ impl Check<'_> {
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
+        if !m.frictional_contacts.is_empty() && solver.method != Method::SsnHb {
+            return Err(self.invalid(
+                "solver.method",
+                format!(
+                    "\"{}\" with {} 3-D frictional contacts",
+                    solver.method.name(),
+                    m.frictional_contacts.len()
+                ),
+                "\"ssn-hb\" (the Coulomb disk of 3-D frictional contacts)",
+            ));
+        }
         let allowed = match solver.method.friction() {
             _ if points == 0 => return Ok(()),
             FrictionSupport::Exact => return Ok(()),

@@ -6,7 +6,7 @@
 //! `node` and `component` (lists `nodes` and `components`) name a dof instead (module
 //! `nodes`).
 
-use semismooth_contact::model::ContactRow;
+use semismooth_contact::model::{ContactRow, FrictionalContact};
 
 use super::check::Check;
 use super::*;
@@ -29,7 +29,7 @@ struct RawRow<'a> {
 
 /// Largest departure of `|cos|` from 1 at which a tangential row counts as parallel to
 /// its normal row (round-off of rows given to 16 digits).
-const PARALLEL_TOLERANCE: f64 = 1e-9;
+pub(super) const PARALLEL_TOLERANCE: f64 = 1e-9;
 
 /// The Euclidean norm of `values`, scaled by the largest magnitude so that squares of
 /// tiny or huge entries neither underflow nor overflow.
@@ -47,7 +47,7 @@ fn scaled_norm(values: &[f64]) -> f64 {
 }
 
 /// The cosine of the angle between two rows of `G` (as vectors over the dofs).
-fn row_cosine(a: &ContactRow, b: &ContactRow) -> f64 {
+pub(super) fn row_cosine(a: &ContactRow, b: &ContactRow) -> f64 {
     let dot: f64 = a
         .entries()
         .map(|(dof, x)| {
@@ -62,8 +62,12 @@ fn row_cosine(a: &ContactRow, b: &ContactRow) -> f64 {
 
 impl Check<'_> {
     /// `[[contact.point]]` entries of a `[model]` scene (module documentation); one
-    /// contact per dof and direction.
-    pub(super) fn dof_contacts(&self, c: RawContact) -> Result<Vec<DofContact>, SceneError> {
+    /// contact per dof and direction; the 3-D frictional contacts (module `frictional`)
+    /// apart.
+    pub(super) fn dof_contacts(
+        &self,
+        c: RawContact,
+    ) -> Result<(Vec<DofContact>, Vec<FrictionalContact>), SceneError> {
         let allowed = "[[contact.point]] entries with dof (or dofs and coefficients), gap and \
                        optional direction";
         let points = match (c.gap, c.node, c.point) {
@@ -77,19 +81,14 @@ impl Check<'_> {
             }
         };
         let mut contacts: Vec<DofContact> = Vec::with_capacity(points.len());
+        let mut frictional = Vec::new();
         for (index, p) in points.into_iter().enumerate() {
             let entry = index + 1;
-            let row = self.row(RawRow {
-                section: "contact.point",
-                node: p.node,
-                component: p.component,
-                dof: p.dof,
-                direction: p.direction,
-                dofs: p.dofs.as_deref(),
-                nodes: p.nodes.as_deref(),
-                components: p.components.as_deref(),
-                coefficients: p.coefficients.as_deref(),
-            })?;
+            if super::frictional::is_frictional(&p) {
+                frictional.push(self.frictional_contact(&p)?);
+                continue;
+            }
+            let row = self.contact_row(&p)?;
             let gap = self.response_scale("contact.point.gap", p.gap)?;
             if let Some((dof, sign)) = row.single() {
                 let same = |c: &DofContact| c.row.single() == Some((dof, sign));
@@ -123,13 +122,28 @@ impl Check<'_> {
             let friction = self.contact_friction(&p, &row)?;
             contacts.push(DofContact { row, gap, friction });
         }
-        Ok(contacts)
+        Ok((contacts, frictional))
+    }
+
+    /// The normal row of a `[[contact.point]]`.
+    pub(super) fn contact_row(&self, p: &RawContactPoint) -> Result<ContactRow, SceneError> {
+        self.row(RawRow {
+            section: "contact.point",
+            node: p.node,
+            component: p.component,
+            dof: p.dof,
+            direction: p.direction,
+            dofs: p.dofs.as_deref(),
+            nodes: p.nodes.as_deref(),
+            components: p.components.as_deref(),
+            coefficients: p.coefficients.as_deref(),
+        })
     }
 
     /// A contact's `friction`, `tangent_dofs` (or `tangent_nodes` with `tangent_components`)
     /// and `tangent_coefficients`: all three or none; the tangential row is not parallel to
     /// the contact's `normal` row (a slip along the normal is no slip).
-    fn contact_friction(
+    pub(super) fn contact_friction(
         &self,
         p: &RawContactPoint,
         normal: &ContactRow,
@@ -247,7 +261,7 @@ impl Check<'_> {
     }
 
     /// A Coulomb coefficient: finite and `>= 0`.
-    fn friction_coefficient(&self, key: &str, mu: f64) -> Result<f64, SceneError> {
+    pub(super) fn friction_coefficient(&self, key: &str, mu: f64) -> Result<f64, SceneError> {
         if (0.0..=MAX_RESPONSE_SCALE).contains(&mu) {
             Ok(mu)
         } else {
@@ -327,7 +341,7 @@ impl Check<'_> {
 
     /// The row `sum_k coefficients[k] u[dofs[k] - 1]`: distinct 1-based dofs, one finite
     /// coefficient per dof, not all zero.
-    fn combination(
+    pub(super) fn combination(
         &self,
         dofs_key: &str,
         coefficients_key: &str,

@@ -144,6 +144,7 @@ impl Check<'_> {
             frequency,
             contacts,
             friction: Vec::new(),
+            frictional_contacts: Vec::new(),
             observed_dof: observed_dof.or(Some(BladedDisk::tip(0))),
             dof_map: None,
         };

@@ -34,6 +34,7 @@ mod check;
 mod contacts;
 mod cyclic;
 mod disk;
+mod frictional;
 mod load_parts;
 mod nodes;
 mod overrides;
@@ -222,6 +223,14 @@ struct RawContactPoint {
     tangent_nodes: Option<Vec<i64>>,
     tangent_components: Option<Vec<i64>>,
     tangent_coefficients: Option<Vec<f64>>,
+    tangent2_dofs: Option<Vec<i64>>,
+    tangent2_coefficients: Option<Vec<f64>>,
+    normal: Option<Vec<f64>>,
+    tangents: Option<Vec<Vec<f64>>>,
+    tangential_stiffness: Option<f64>,
+    gap_cos: Option<Vec<f64>>,
+    gap_sin: Option<Vec<f64>>,
+    sliding_velocity: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -85,7 +85,7 @@ impl Check<'_> {
 
     /// The 1-based dof of `node`'s `component` in the dof map: refused without a map, for a
     /// node the map does not name, or a component it does not give that node.
-    fn resolve(
+    pub(super) fn resolve(
         &self,
         node_key: &str,
         component_key: &str,
