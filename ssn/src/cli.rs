@@ -254,8 +254,10 @@ pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<()
         let mut files = vec![
             (&spec.mass, "[model] mass"),
             (&spec.stiffness, "[model] stiffness"),
-            (&spec.forcing_vector, "[forcing] vector"),
         ];
+        if spec.load_dof.is_none() {
+            files.push((&spec.forcing_vector, "[forcing] vector"));
+        }
         if let Some(d) = &spec.damping_matrix {
             files.push((d, "[model] damping"));
         }

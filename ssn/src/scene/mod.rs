@@ -25,7 +25,9 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use semismooth_contact::import::DofMap;
-use semismooth_contact::matrix_market::{DofContact, DofFriction, DofMapFile, ModelSpec};
+use semismooth_contact::matrix_market::{
+    DofContact, DofFriction, DofMapFile, MatrixFormat, ModelSpec,
+};
 use semismooth_contact::rod::{
     DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
 };
@@ -110,10 +112,20 @@ struct RawRod {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawModel {
+    #[serde(default)]
+    format: RawMatrixFormat,
     mass: String,
     stiffness: String,
     damping: Option<String>,
     dof_map: Option<String>,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+enum RawMatrixFormat {
+    #[default]
+    MatrixMarket,
+    Calculix,
 }
 
 #[derive(Debug, Deserialize)]
@@ -162,6 +174,8 @@ enum RawLoad {
 struct RawForcing {
     load: Option<RawLoad>,
     vector: Option<String>,
+    node: Option<i64>,
+    component: Option<i64>,
     vector_sin: Option<String>,
     #[serde(rename = "static")]
     constant: Option<String>,
