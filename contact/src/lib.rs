@@ -22,6 +22,7 @@ pub mod march;
 pub mod matrix_market;
 pub mod model;
 pub mod operator;
+pub mod reduction;
 pub mod rod;
 pub mod settings;
 pub mod solutions;
