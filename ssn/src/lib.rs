@@ -18,6 +18,7 @@ pub mod json;
 pub mod limits;
 pub mod output;
 pub mod progress;
+pub mod reduce;
 pub mod scene;
 pub mod solutions;
 pub mod source;

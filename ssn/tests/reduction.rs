@@ -135,3 +135,41 @@ fn the_reduced_forced_response_with_tip_contact_converges_to_the_full_one_as_mod
     // 8 fixed-interface modes: the response to 1e-3 of its amplitude (measured 2.1e-4).
     assert!(errors[2] < 1e-3, "{errors:?}");
 }
+
+#[test]
+fn a_reduction_section_solves_the_reduced_structure_and_its_mistakes_are_named() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/calculix_cantilever");
+    let loaded = ssn::cli::load(&dir.join("cantilever_reduced.toml")).unwrap();
+    assert_eq!(loaded.structure.model.dofs(), 17);
+    let (scene, full) = cantilever();
+    // The scene's frequency ratio keeps the full model's omega_1 as its unit.
+    assert_eq!(loaded.omega, scene.omega(full.omega_1));
+    let by_hand = reduce(&full, 16);
+    let a = observed(&loaded.scene, &loaded.structure, loaded.omega);
+    let b = observed(&scene, &by_hand.structure, loaded.omega);
+    // The same reduction of the same matrices: the same arithmetic.
+    assert_eq!(a, b);
+    let text = std::fs::read_to_string(dir.join("cantilever_reduced.toml")).unwrap();
+    let path = dir.join("cantilever_reduced.toml");
+    for (from, to, words) in [
+        (
+            "modes = 16",
+            "modes = 16\ncutoff_ratio = 2.0",
+            &["reduction.cutoff_ratio", "either `modes`"][..],
+        ),
+        ("modes = 16", "", &["reduction.modes", "missing"]),
+        ("modes = 16", "modes = 0", &["reduction.modes", "0"]),
+        (
+            "\"craig-bampton\"",
+            "\"guyan\"",
+            &["guyan", "craig-bampton"],
+        ),
+    ] {
+        let e = Scene::from_toml(&text.replace(from, to), &path)
+            .unwrap_err()
+            .to_string();
+        for w in words {
+            assert!(e.contains(w), "`{w}` not in: {e}");
+        }
+    }
+}

@@ -190,6 +190,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
+    let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
         title: raw.title,
@@ -200,6 +201,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         load_parts,
         solver,
         sweep,
+        reduction,
     })
 }
 

@@ -38,9 +38,11 @@ mod disk;
 mod load_parts;
 mod nodes;
 mod overrides;
+mod reduction;
 
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
+pub use reduction::{ModeSelection, ReductionSpec, MAX_REDUCTION_MODES};
 
 pub use overrides::{
     normal_key, parse_value, read_scene_text, Override, OverrideError, MAX_KEY_PARTS,
@@ -79,6 +81,8 @@ pub struct Scene {
     pub solver: SolverSettings,
     /// Frequency sweep, if declared.
     pub sweep: Option<SweepSettings>,
+    /// The reduction of the structure before it is solved (`[reduction]`), if declared.
+    pub reduction: Option<ReductionSpec>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -96,6 +100,7 @@ struct RawScene {
     #[serde(default)]
     solver: RawSolver,
     sweep: Option<RawSweep>,
+    reduction: Option<reduction::RawReduction>,
 }
 
 #[derive(Debug, Deserialize)]
