@@ -24,6 +24,7 @@ pub mod matrix_market;
 pub mod model;
 pub mod modes;
 pub mod operator;
+pub mod reduction;
 pub mod rod;
 pub mod settings;
 pub mod solutions;

@@ -151,6 +151,15 @@ pub fn prepare(
     let omega = scene.omega(structure.omega_1);
     check_scales(&scene, structure.omega_1, omega).map_err(|e| input_error(path, e))?;
     check_resonance(&scene, &structure, omega).map_err(|e| input_error(path, e))?;
+    // scene-check reduces the structure itself, to print both models' frequencies.
+    let structure = match (&scene.reduction, workload) {
+        (Some(spec), w) if w != Workload::Check => {
+            crate::reduce::reduce(&scene, spec, &structure, omega)
+                .map_err(|e| input_error(path, e))?
+                .structure
+        }
+        _ => structure,
+    };
     Ok(Loaded {
         scene,
         structure,
@@ -257,8 +266,10 @@ pub(crate) fn claim_model_files(set: &mut OutputSet, scene: &Scene) -> Result<()
         let mut files = vec![
             (&spec.mass, "[model] mass"),
             (&spec.stiffness, "[model] stiffness"),
-            (&spec.forcing_vector, "[forcing] vector"),
         ];
+        if spec.load_dof.is_none() {
+            files.push((&spec.forcing_vector, "[forcing] vector"));
+        }
         if let Some(d) = &spec.damping_matrix {
             files.push((d, "[model] damping"));
         }
@@ -856,7 +867,20 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         other => other,
     }
     .map_err(|e| input_error(path, e))?;
-    write_text(&describe(&scene, &rod, omega, &modes))?;
+    let mut text = describe(&scene, &rod, omega, &modes);
+    if let Some(spec) = &scene.reduction {
+        let reduced =
+            crate::reduce::reduce(&scene, spec, &rod, omega).map_err(|e| input_error(path, e))?;
+        let model = &reduced.structure.model;
+        let count = modes.len().min(model.dofs());
+        let reduced_modes = natural_frequencies(model, count).map_err(|e| input_error(path, e))?;
+        text.push_str(&crate::reduce::reduction_lines(
+            &reduced,
+            &modes,
+            &reduced_modes,
+        ));
+    }
+    write_text(&text)?;
     Ok(())
 }
 

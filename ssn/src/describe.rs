@@ -204,10 +204,13 @@ pub fn describe_imported(
         None if spec.damping_matrix.is_some() => "damping           from the damping file".into(),
         _ => damping_line(spec.damping.as_ref(), structure.omega_1),
     });
+    let shape = match spec.load_dof {
+        Some(dof) => format!("a unit point load on dof {}", dof_words(spec, dof)),
+        None => printable(&spec.forcing_vector.display().to_string()),
+    };
     line(format!(
-        "forcing           {} x {}, omega = {:.6} ({:.4} omega_1)",
+        "forcing           {} x {shape}, omega = {:.6} ({:.4} omega_1)",
         spec.amplitude,
-        printable(&spec.forcing_vector.display().to_string()),
         omega,
         omega / structure.omega_1
     ));

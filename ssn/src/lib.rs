@@ -19,6 +19,7 @@ pub mod limits;
 pub mod modes;
 pub mod output;
 pub mod progress;
+pub mod reduce;
 pub mod scene;
 pub mod solutions;
 pub mod source;

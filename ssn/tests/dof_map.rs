@@ -12,6 +12,8 @@ use semismooth_contact::model::Structure;
 use semismooth_contact::solve::Solution;
 use ssn::scene::Scene;
 
+mod common;
+
 fn fixture() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/node_lattice")
 }
@@ -26,16 +28,7 @@ fn solve(scene: &Scene, structure: &Structure) -> Solution {
 /// The message of the scene `by_node.toml` with `edit` applied (its directory kept), from
 /// reading the scene or else from importing its files.
 fn error_of_edited(edit: impl Fn(String) -> String) -> String {
-    let path = fixture().join("by_node.toml");
-    let text = edit(std::fs::read_to_string(&path).unwrap());
-    let scene = match Scene::from_toml(&text, &path) {
-        Ok(s) => s,
-        Err(e) => return e.to_string(),
-    };
-    match build_imported(scene.model.as_ref().unwrap()) {
-        Ok(_) => panic!("accepted:\n{text}"),
-        Err(e) => e.to_string(),
-    }
+    common::error_of_edited_scene(&fixture().join("by_node.toml"), edit)
 }
 
 #[test]

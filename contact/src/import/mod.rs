@@ -453,11 +453,19 @@ fn attached(
     Ok((contacts, friction, observed_dof))
 }
 
+/// Models with more dofs than this find `omega_1` by shift-invert block Lanczos
+/// ([`crate::reduction::lowest_frequencies`]) instead of subspace iteration
+/// ([`natural_frequencies`]), which converges slowly on large 3-D models.
+pub const LANCZOS_MIN_DOFS: usize = 2000;
+
 /// The lowest finite natural frequency of `(K, M)`, in `[MIN_OMEGA_1, 1 / MIN_OMEGA_1]`.
 fn first_frequency(model: &StructuralModel) -> Result<f64, ModelError> {
-    let omega_1 = natural_frequencies(model, 1).map_err(|e| ModelError::NoFrequency {
-        reason: e.to_string(),
-    })?[0];
+    let no_frequency = |reason: String| ModelError::NoFrequency { reason };
+    let omega_1 = if model.dofs() > LANCZOS_MIN_DOFS {
+        crate::reduction::lowest_frequencies(model, 1).map_err(|e| no_frequency(e.to_string()))?[0]
+    } else {
+        natural_frequencies(model, 1).map_err(|e| no_frequency(e.to_string()))?[0]
+    };
     if !(MIN_OMEGA_1..=1.0 / MIN_OMEGA_1).contains(&omega_1) {
         return Err(ModelError::FrequencyOutOfRange { omega_1 });
     }

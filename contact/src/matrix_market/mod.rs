@@ -25,7 +25,10 @@ use crate::import::{assemble, Attachments, DofMap, DofUse, ModelError, ModelPart
 use crate::model::{FrictionalContact, SparseMatrix, Structure};
 use crate::rod::{DampingSpec, FrequencySpec};
 
+mod calculix;
 mod read;
+
+pub use calculix::{calculix_matrix_text, parse_calculix_matrix, read_calculix_matrix};
 
 pub use read::{
     matrix_market_text, parse_matrix, read_matrix, vector_market_text, MAX_ENTRY_MAGNITUDE,
@@ -44,11 +47,35 @@ pub struct DofMapFile {
     pub map: Arc<DofMap>,
 }
 
+/// The format of a model's matrix files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum MatrixFormat {
+    /// Matrix Market files ([`read_matrix`]).
+    #[default]
+    MatrixMarket,
+    /// CalculiX `.sti` / `.mas` files ([`read_calculix_matrix`]), sized by the dof map
+    /// (required); the load vector is still a Matrix Market file.
+    CalculiX,
+}
+
+impl MatrixFormat {
+    /// The format's name in a scene: `"matrix-market"`, `"calculix"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MatrixFormat::MatrixMarket => "matrix-market",
+            MatrixFormat::CalculiX => "calculix",
+        }
+    }
+}
+
 /// Everything a `[model]` scene declares (paths resolved against the scene's directory).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelSpec {
     /// The scene file (for messages).
     pub scene: PathBuf,
+    /// The format of the matrix files (`mass`, `stiffness`, `damping_matrix`).
+    pub format: MatrixFormat,
     /// Mass matrix file.
     pub mass: PathBuf,
     /// Stiffness matrix file.
@@ -57,8 +84,11 @@ pub struct ModelSpec {
     pub damping_matrix: Option<PathBuf>,
     /// Damping from the `[damping]` section (not with a damping file).
     pub damping: Option<DampingSpec>,
-    /// Load shape file (`N x 1`).
+    /// Load shape file (`N x 1`, Matrix Market), unless `load_dof` is given.
     pub forcing_vector: PathBuf,
+    /// A unit point load on this 0-based dof as the load shape, in place of the
+    /// `forcing_vector` file (then unused).
+    pub load_dof: Option<usize>,
     /// Load amplitude (multiplies the load shape).
     pub amplitude: f64,
     /// Forcing frequency (`Ratio` in units of `omega_1`).
@@ -155,6 +185,15 @@ pub enum ImportError {
     NotRegular {
         /// The file.
         path: PathBuf,
+    },
+    /// The CalculiX reader rejected the file (the message has the line, what was found and
+    /// what is allowed).
+    #[error("{path}: not a valid CalculiX matrix file: {message}")]
+    CalculiX {
+        /// The file.
+        path: PathBuf,
+        /// The reader's message.
+        message: String,
     },
     /// The Matrix Market reader rejected the file (the message has the line, what was
     /// found and what is allowed).
@@ -264,9 +303,28 @@ pub enum ImportError {
     },
 }
 
-/// Reads and checks the files of `spec` and assembles the structure (module documentation).
+/// Reads and checks the files of `spec` (in its [`MatrixFormat`]) and assembles the
+/// structure (module documentation).
 pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
-    build_imported_with(spec, read_matrix)
+    match spec.format {
+        MatrixFormat::MatrixMarket => build_imported_with(spec, read_matrix),
+        MatrixFormat::CalculiX => {
+            let dofs =
+                spec.dof_map
+                    .as_ref()
+                    .map(|m| m.map.len())
+                    .ok_or_else(|| ImportError::Model {
+                        scene: spec.scene.clone(),
+                        reason: "format = \"calculix\" without a dof_map: allowed a CalculiX \
+                             model with its .dof file (which gives the matrices' size)"
+                            .into(),
+                    })?;
+            build_imported_with(spec, |path: &Path| match path == spec.forcing_vector {
+                true => read_matrix(path),
+                false => read_calculix_matrix(path, dofs),
+            })
+        }
+    }
 }
 
 /// [`build_imported`] with the matrices of `spec`'s file names given by `read` (matrices
@@ -278,7 +336,10 @@ pub fn build_imported_with(
     let stiffness = read(&spec.stiffness)?;
     let mass = read(&spec.mass)?;
     let damping = spec.damping_matrix.as_deref().map(&read).transpose()?;
-    let load = read(&spec.forcing_vector)?;
+    let load = match spec.load_dof {
+        Some(dof) => point_load(spec, dof, stiffness.nrows())?,
+        None => read(&spec.forcing_vector)?,
+    };
     let parts = ModelParts {
         mass,
         stiffness,
@@ -296,6 +357,23 @@ pub fn build_imported_with(
         });
     }
     Ok(structure)
+}
+
+/// The load shape of a unit point load on the 0-based `dof` of a model of `dofs` rows.
+fn point_load(spec: &ModelSpec, dof: usize, dofs: usize) -> Result<SparseMatrix, ImportError> {
+    if dof >= dofs {
+        return Err(ImportError::DofOutOfRange {
+            scene: spec.scene.clone(),
+            key: "forcing.node",
+            value: dof + 1,
+            dofs,
+        });
+    }
+    let unit = [faer::sparse::Triplet::new(dof, 0, 1.0)];
+    SparseMatrix::try_new_from_triplets(dofs, 1, &unit).map_err(|e| ImportError::Model {
+        scene: spec.scene.clone(),
+        reason: format!("cannot store the point load: {e:?}"),
+    })
 }
 
 impl ImportError {

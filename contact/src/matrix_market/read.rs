@@ -37,8 +37,10 @@ enum Format {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Field {
+pub(super) enum Field {
+    /// Real numbers (Fortran `D` exponents allowed).
     Real,
+    /// Integers.
     Integer,
 }
 
@@ -52,6 +54,11 @@ enum Symmetry {
 /// Reads the Matrix Market file `path` (module documentation) as a sparse matrix; the
 /// zeros of an array file are dropped, duplicate coordinate entries summed.
 pub fn read_matrix(path: &Path) -> Result<SparseMatrix, ImportError> {
+    parse(&mut open_lines(path)?, path)
+}
+
+/// The lines of the regular file `path`, bounded as a Matrix Market file's.
+pub(super) fn open_lines(path: &Path) -> Result<Lines<impl BufRead>, ImportError> {
     let io = |source| ImportError::Io {
         path: path.to_path_buf(),
         source,
@@ -69,28 +76,25 @@ pub fn read_matrix(path: &Path) -> Result<SparseMatrix, ImportError> {
             path: path.to_path_buf(),
         });
     }
-    let mut reader = Lines {
-        input: BufReader::new(file.take(MAX_MATRIX_FILE_BYTES + 1)),
-        line: 0,
-        read: 0,
-        buffer: Vec::new(),
-    };
-    parse(&mut reader, path)
+    Ok(Lines::new(BufReader::new(
+        file.take(MAX_MATRIX_FILE_BYTES + 1),
+    )))
 }
 
 /// Parses Matrix Market text (`path` for messages only).
 pub fn parse_matrix(text: &str, path: &Path) -> Result<SparseMatrix, ImportError> {
-    let mut reader = Lines {
-        input: BufReader::new(text.as_bytes().take(MAX_MATRIX_FILE_BYTES + 1)),
-        line: 0,
-        read: 0,
-        buffer: Vec::new(),
-    };
-    parse(&mut reader, path)
+    parse(&mut text_lines(text), path)
+}
+
+/// The lines of `text`, bounded as a file's.
+pub(super) fn text_lines(text: &str) -> Lines<impl BufRead + '_> {
+    Lines::new(BufReader::new(
+        text.as_bytes().take(MAX_MATRIX_FILE_BYTES + 1),
+    ))
 }
 
 /// A line reader that counts lines and bytes and bounds both.
-struct Lines<R> {
+pub(super) struct Lines<R> {
     input: R,
     line: usize,
     read: u64,
@@ -98,8 +102,22 @@ struct Lines<R> {
 }
 
 impl<R: BufRead> Lines<R> {
+    fn new(input: R) -> Self {
+        Self {
+            input,
+            line: 0,
+            read: 0,
+            buffer: Vec::new(),
+        }
+    }
+
+    /// The 1-based number of the line last read.
+    pub(super) fn line(&self) -> usize {
+        self.line
+    }
+
     /// The next line (without its end), `None` at the end of the file.
-    fn next(&mut self, path: &Path) -> Result<Option<String>, ImportError> {
+    pub(super) fn next(&mut self, path: &Path) -> Result<Option<String>, ImportError> {
         self.buffer.clear();
         let n = (&mut self.input)
             .take(MAX_LINE_BYTES + 1)
@@ -131,7 +149,7 @@ impl<R: BufRead> Lines<R> {
     }
 
     /// A defect of the current line.
-    fn error(&self, path: &Path, message: String) -> ImportError {
+    pub(super) fn error(&self, path: &Path, message: String) -> ImportError {
         ImportError::MatrixMarket {
             path: path.to_path_buf(),
             message: format!("line {}: {message}", self.line),
@@ -151,7 +169,7 @@ impl<R: BufRead> Lines<R> {
 }
 
 /// The line quoted for a message (control characters escaped, long lines cut).
-fn quoted(line: &str) -> String {
+pub(super) fn quoted(line: &str) -> String {
     let t: String = line.trim().chars().take(60).collect();
     let cut = if line.trim().chars().count() > 60 {
         "..."
@@ -212,7 +230,7 @@ fn count(word: &str, what: &str) -> Result<usize, String> {
 }
 
 /// A value of the field `field`: finite, magnitude at most [`MAX_ENTRY_MAGNITUDE`].
-fn value(word: &str, field: Field) -> Result<f64, String> {
+pub(super) fn value(word: &str, field: Field) -> Result<f64, String> {
     let v = match field {
         Field::Integer => word
             .parse::<i64>()
@@ -233,7 +251,7 @@ fn value(word: &str, field: Field) -> Result<f64, String> {
 }
 
 /// Appends to `v` without aborting when memory runs out.
-fn push(
+pub(super) fn push(
     v: &mut Vec<Triplet<usize, usize, f64>>,
     t: Triplet<usize, usize, f64>,
 ) -> Result<(), String> {

@@ -1,7 +1,7 @@
 //! Validation of a parsed scene, section by section: every refusal names the file, the key,
 //! the value and what is allowed.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::*;
 use semismooth_contact::solve::FrictionSupport;
@@ -192,6 +192,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
     let (engine_order, cyclic) = ck.cyclic_keys(&raw.forcing, raw.cyclic, &model, &bladed_disk)?;
+    let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
         title: raw.title,
@@ -205,6 +206,7 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         solver,
         sweep,
         modes,
+        reduction,
     })
 }
 
@@ -494,14 +496,6 @@ impl Check<'_> {
                 "`vector` (a Matrix Market file of the load shape, N x 1)",
             ));
         }
-        let vector = f.vector.as_deref().ok_or_else(|| {
-            self.invalid(
-                "forcing.vector",
-                "missing",
-                "a Matrix Market file of the load shape, N x 1 (relative to the scene)",
-            )
-        })?;
-        let forcing_vector = file("forcing.vector", vector)?;
         let (_, amplitude, frequency) = self.forcing(f)?;
         let dof_map = m
             .dof_map
@@ -513,10 +507,23 @@ impl Check<'_> {
                 Ok(DofMapFile { path, map })
             })
             .transpose()?;
+        let format = match m.format {
+            RawMatrixFormat::MatrixMarket => MatrixFormat::MatrixMarket,
+            RawMatrixFormat::Calculix if dof_map.is_none() => {
+                return Err(self.invalid(
+                    "model.dof_map",
+                    "missing with format = \"calculix\"",
+                    "the CalculiX .dof file written beside the .sti and .mas files (it gives \
+                     the matrices' size and each row's node and component)",
+                ))
+            }
+            RawMatrixFormat::Calculix => MatrixFormat::CalculiX,
+        };
         let ck = Check {
             path: self.path,
             dof_map: dof_map.as_ref(),
         };
+        let (forcing_vector, load_dof) = ck.load_shape(f, &file)?;
         let (contacts, frictional_contacts) = contact
             .map(|c| ck.dof_contacts(c))
             .transpose()?
@@ -528,11 +535,13 @@ impl Check<'_> {
         let observed_dof = output.map(|o| ck.model_output(o)).transpose()?;
         Ok(ModelSpec {
             scene: self.path.to_path_buf(),
+            format,
             mass,
             stiffness,
             damping_matrix,
             damping,
             forcing_vector,
+            load_dof,
             amplitude,
             frequency,
             contacts,
@@ -541,6 +550,35 @@ impl Check<'_> {
             observed_dof,
             dof_map,
         })
+    }
+
+    /// `[forcing]` of a `[model]` scene: the load shape from a `vector` file, or a unit point
+    /// load on `node`'s `component` (through the dof map; 0-based dof), not both.
+    fn load_shape(
+        &self,
+        f: &RawForcing,
+        file: &dyn Fn(&str, &str) -> Result<PathBuf, SceneError>,
+    ) -> Result<(PathBuf, Option<usize>), SceneError> {
+        if f.vector.is_some() && f.node.is_some() {
+            return Err(self.invalid(
+                "forcing.node",
+                "given together with `vector`",
+                "either `vector` (a load shape file) or `node` and `component` (a unit point \
+                 load)",
+            ));
+        }
+        if let Some(dof) = self.address("forcing", None, f.node, f.component)? {
+            return Ok((PathBuf::new(), Some(dof as usize - 1)));
+        }
+        let vector = f.vector.as_deref().ok_or_else(|| {
+            self.invalid(
+                "forcing.vector",
+                "missing",
+                "a Matrix Market file of the load shape, N x 1 (relative to the scene), or \
+                 `node` and `component` (a unit point load, through the [model] dof_map)",
+            )
+        })?;
+        Ok((file("forcing.vector", vector)?, None))
     }
 
     /// A scene with friction is solved by the methods that model it: `ssn-hb` and `march`

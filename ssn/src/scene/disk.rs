@@ -83,13 +83,15 @@ impl Check<'_> {
                 "a finite number in (-1, 1e6] (blade stiffness k_b (1 + mistuning) > 0)",
             ));
         }
-        if f.vector.is_some() || f.load.is_some() {
+        let given = [
+            ("forcing.vector", f.vector.is_some()),
+            ("forcing.load", f.load.is_some()),
+            ("forcing.node", f.node.is_some()),
+            ("forcing.component", f.component.is_some()),
+        ];
+        if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
             return Err(self.invalid(
-                if f.vector.is_some() {
-                    "forcing.vector"
-                } else {
-                    "forcing.load"
-                },
+                key,
                 "given in a [bladed_disk] scene",
                 "only `amplitude` and the frequency: the disk's load is a unit force on every \
                  blade tip",
@@ -139,7 +141,9 @@ impl Check<'_> {
             stiffness: PathBuf::from(STIFFNESS),
             damping_matrix: None,
             damping,
+            format: MatrixFormat::MatrixMarket,
             forcing_vector: PathBuf::from(LOAD),
+            load_dof: None,
             amplitude,
             frequency,
             contacts,

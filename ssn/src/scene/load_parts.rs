@@ -54,6 +54,8 @@ impl Check<'_> {
         if !model {
             let given = [
                 ("forcing.vector", f.vector.is_some()),
+                ("forcing.node", f.node.is_some()),
+                ("forcing.component", f.component.is_some()),
                 ("forcing.vector_sin", f.vector_sin.is_some()),
                 ("forcing.static", f.constant.is_some()),
                 ("forcing.harmonic", f.harmonic.is_some()),

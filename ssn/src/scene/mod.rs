@@ -25,7 +25,9 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use semismooth_contact::import::DofMap;
-use semismooth_contact::matrix_market::{DofContact, DofFriction, DofMapFile, ModelSpec};
+use semismooth_contact::matrix_market::{
+    DofContact, DofFriction, DofMapFile, MatrixFormat, ModelSpec,
+};
 use semismooth_contact::rod::{
     DampingSpec, FrequencySpec, LoadKind, MassModel, RodContact, RodSpec,
 };
@@ -38,10 +40,12 @@ mod frictional;
 mod load_parts;
 mod nodes;
 mod overrides;
+mod reduction;
 
 pub use cyclic::{CyclicSpec, EngineOrderSpec, MAX_SECTORS};
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
+pub use reduction::{ModeSelection, ReductionSpec, MAX_REDUCTION_MODES};
 
 pub use overrides::{
     normal_key, parse_value, read_scene_text, Override, OverrideError, MAX_KEY_PARTS,
@@ -86,6 +90,8 @@ pub struct Scene {
     pub sweep: Option<SweepSettings>,
     /// Nonlinear mode (`ssn modes`), if declared.
     pub modes: Option<ModesSettings>,
+    /// The reduction of the structure before it is solved (`[reduction]`), if declared.
+    pub reduction: Option<ReductionSpec>,
 }
 
 /// `[modes]`: which linear mode the backbone starts from and the range of the observed
@@ -119,6 +125,7 @@ struct RawScene {
     solver: RawSolver,
     sweep: Option<RawSweep>,
     modes: Option<RawModes>,
+    reduction: Option<reduction::RawReduction>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -135,10 +142,20 @@ struct RawRod {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawModel {
+    #[serde(default)]
+    format: RawMatrixFormat,
     mass: String,
     stiffness: String,
     damping: Option<String>,
     dof_map: Option<String>,
+}
+
+#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+enum RawMatrixFormat {
+    #[default]
+    MatrixMarket,
+    Calculix,
 }
 
 #[derive(Debug, Deserialize)]
@@ -187,6 +204,8 @@ enum RawLoad {
 struct RawForcing {
     load: Option<RawLoad>,
     vector: Option<String>,
+    node: Option<i64>,
+    component: Option<i64>,
     vector_sin: Option<String>,
     #[serde(rename = "static")]
     constant: Option<String>,

@@ -7,6 +7,7 @@ pub mod json_fields;
 
 #[path = "../../../contact/tests/common/mod.rs"]
 mod library;
+#[allow(unused_imports)] // not every test uses the library helpers
 pub use library::*;
 
 use std::path::{Path, PathBuf};
@@ -28,4 +29,18 @@ pub fn shipped_model(name: &str, edit: impl Fn(String) -> String) -> (Scene, Str
     let scene = Scene::from_toml(&edit(text), &path).unwrap();
     let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
     (scene, structure)
+}
+
+/// The message of the scene file `path` with `edit` applied to its text (its directory
+/// kept), from reading the scene or else from importing its files; panics if both accept.
+pub fn error_of_edited_scene(path: &Path, edit: impl Fn(String) -> String) -> String {
+    let text = edit(std::fs::read_to_string(path).unwrap());
+    let scene = match Scene::from_toml(&text, path) {
+        Ok(s) => s,
+        Err(e) => return e.to_string(),
+    };
+    match build_imported(scene.model.as_ref().unwrap()) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
 }

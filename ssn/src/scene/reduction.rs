@@ -1,0 +1,85 @@
+//! `[reduction]`: the structure reduced by component mode synthesis before it is solved
+//! (module `semismooth_contact::reduction`). `method = "craig-bampton"` keeps the contact,
+//! friction, observed and loaded dofs and the fixed-interface modes of the rest: `modes = N`
+//! of them, or those below `cutoff_ratio` times the highest harmonic's frequency
+//! (`H omega`), not both.
+
+use semismooth_contact::reduction::ModeCount;
+
+use super::check::Check;
+use super::*;
+
+/// Largest `[reduction] modes`.
+pub const MAX_REDUCTION_MODES: usize = 100_000;
+
+/// How many fixed-interface modes a reduction keeps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModeSelection {
+    /// `modes = N`: the lowest `N`.
+    Count(usize),
+    /// `cutoff_ratio = r`: every mode below `r H omega`.
+    CutoffRatio(f64),
+}
+
+/// A validated `[reduction]` section.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReductionSpec {
+    /// The interior modes kept.
+    pub modes: ModeSelection,
+}
+
+impl ReductionSpec {
+    /// The modes to keep at the forcing frequency `omega` with `harmonics` harmonics.
+    pub fn mode_count(&self, omega: f64, harmonics: usize) -> ModeCount {
+        match self.modes {
+            ModeSelection::Count(n) => ModeCount::Count(n),
+            ModeSelection::CutoffRatio(r) => ModeCount::Below(r * harmonics as f64 * omega),
+        }
+    }
+}
+
+#[derive(Debug, Deserialize, Clone, Copy)]
+#[serde(rename_all = "kebab-case")]
+pub(super) enum RawReductionMethod {
+    CraigBampton,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawReduction {
+    #[allow(dead_code)] // one method today: its name is checked by serde
+    method: RawReductionMethod,
+    modes: Option<i64>,
+    cutoff_ratio: Option<f64>,
+}
+
+impl Check<'_> {
+    /// `[reduction]`: the method and either `modes` or `cutoff_ratio`.
+    pub(super) fn reduction(&self, r: &RawReduction) -> Result<ReductionSpec, SceneError> {
+        let modes = match (r.modes, r.cutoff_ratio) {
+            (Some(n), None) => {
+                ModeSelection::Count(self.count("reduction.modes", n, 1, MAX_REDUCTION_MODES)?)
+            }
+            (None, Some(c)) => {
+                ModeSelection::CutoffRatio(self.positive("reduction.cutoff_ratio", c)?)
+            }
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    "reduction.cutoff_ratio",
+                    "given together with `modes`",
+                    "either `modes` (a count) or `cutoff_ratio` (times the highest \
+                     harmonic's frequency)",
+                ))
+            }
+            (None, None) => {
+                return Err(self.invalid(
+                    "reduction.modes",
+                    "missing",
+                    "`modes` (the fixed-interface modes kept, >= 1) or `cutoff_ratio` (the \
+                     modes below this many times the highest harmonic's frequency)",
+                ))
+            }
+        };
+        Ok(ReductionSpec { modes })
+    }
+}

@@ -1,0 +1,175 @@
+//! Craig–Bampton reduction of the CalculiX cantilever (`fixtures/calculix_cantilever`:
+//! 216 dofs, tip contact, point load and observed dof on the tip centre's y): the reduced
+//! natural frequencies against the full model's, and the forced response with contact on
+//! the reduced model against the full model's (exact condensation), as modes are added.
+
+use std::path::Path;
+
+use semismooth_contact::matrix_market::build_imported;
+use semismooth_contact::model::Structure;
+use semismooth_contact::reduction::{
+    boundary_dofs, craig_bampton, lowest_frequencies, CraigBampton, ModeCount,
+};
+use semismooth_contact::rod::natural_frequencies;
+use ssn::scene::Scene;
+
+fn cantilever() -> (Scene, Structure) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/calculix_cantilever/cantilever.toml");
+    let scene = Scene::from_path(path).unwrap();
+    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
+    (scene, structure)
+}
+
+fn reduce(full: &Structure, modes: usize) -> CraigBampton {
+    craig_bampton(full, &boundary_dofs(full, &[]), ModeCount::Count(modes)).unwrap()
+}
+
+#[test]
+fn lanczos_frequencies_are_the_subspace_iterations() {
+    let (_, full) = cantilever();
+    let lanczos = lowest_frequencies(&full.model, 10).unwrap();
+    let subspace = natural_frequencies(&full.model, 10).unwrap();
+    for (a, b) in lanczos.iter().zip(&subspace) {
+        // Two solvers converged to 1e-10 (relative residual) and the subspace iteration's
+        // own stopping rule: agreement to 1e-8.
+        assert!((a - b).abs() < 1e-8 * b, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn reduced_frequencies_approach_the_full_ones_from_above_and_equal_them_with_every_mode() {
+    let (_, full) = cantilever();
+    let exact = natural_frequencies(&full.model, 6).unwrap();
+    let mut previous = vec![f64::INFINITY; 6];
+    for modes in [8, 16, 32, 64, 215] {
+        let reduced = reduce(&full, modes);
+        assert_eq!(reduced.boundary.len(), 1);
+        assert_eq!(reduced.structure.model.dofs(), 1 + modes);
+        let freqs = natural_frequencies(&reduced.structure.model, 6).unwrap();
+        for k in 0..6 {
+            let error = freqs[k] / exact[k] - 1.0;
+            // Rayleigh–Ritz: the reduced frequency bounds the full one from above (to the
+            // eigensolvers' 1e-9).
+            assert!(error > -1e-9, "{modes} modes, mode {}: {error:e}", k + 1);
+            assert!(error <= previous[k] + 1e-9, "{modes} modes, mode {}", k + 1);
+            previous[k] = error;
+        }
+    }
+    // Every interior mode: T is square and invertible, the reduction exact.
+    assert!(previous.iter().all(|e| e.abs() < 1e-8), "{previous:?}");
+}
+
+#[test]
+fn a_frequency_cut_off_keeps_the_interface_modes_below_it_and_the_error_falls_as_it_rises() {
+    let (_, full) = cantilever();
+    let exact = natural_frequencies(&full.model, 6).unwrap();
+    let mut previous = f64::INFINITY;
+    for factor in [2.0, 4.0, 8.0, 16.0] {
+        let cut_off = factor * exact[5];
+        let boundary = boundary_dofs(&full, &[]);
+        let reduced = craig_bampton(&full, &boundary, ModeCount::Below(cut_off)).unwrap();
+        let kept = &reduced.interface_frequencies;
+        assert!(kept.iter().all(|w| *w <= cut_off), "{kept:?}");
+        assert!(kept.windows(2).all(|p| p[0] <= p[1]));
+        // The next interior mode lies above the cut-off: one more mode by count has it.
+        let one_more = reduce(&full, kept.len() + 1);
+        assert!(one_more.interface_frequencies[kept.len()] > cut_off);
+        let freqs = natural_frequencies(&reduced.structure.model, 6).unwrap();
+        let worst = freqs
+            .iter()
+            .zip(&exact)
+            .map(|(r, e)| r / e - 1.0)
+            .fold(0.0f64, f64::max);
+        eprintln!(
+            "cut-off {factor} omega_6: {} modes, worst error {worst:e}",
+            kept.len()
+        );
+        // More modes, a smaller error (Rayleigh–Ritz on a larger space).
+        assert!(worst <= previous + 1e-9, "{worst:e} after {previous:e}");
+        previous = worst;
+    }
+    // 16 times the highest frequency of interest: the six to 1e-5 (measured 2.7e-6; 2, 4,
+    // 8 times: 3.6e-3, 4.5e-4, 3.4e-5).
+    assert!(previous < 1e-5, "{previous:e}");
+}
+
+/// The observed dof's samples of the scene's solve on `structure` at the absolute `omega`.
+fn observed(scene: &Scene, structure: &Structure, omega: f64) -> Vec<f64> {
+    let s = semismooth_contact::solve(structure, omega, &scene.solver, None).unwrap();
+    assert!(
+        s.converged(),
+        "{} dofs: {}",
+        structure.model.dofs(),
+        s.termination
+    );
+    s.observed
+}
+
+#[test]
+fn the_reduced_forced_response_with_tip_contact_converges_to_the_full_one_as_modes_are_added() {
+    let (scene, full) = cantilever();
+    let omega = scene.omega(full.omega_1);
+    let exact = observed(&scene, &full, omega);
+    let scale = exact.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // The contact closes: the tip reaches the gap.
+    assert!(scale > 0.0015 * 0.999, "{scale}");
+    let mut errors = Vec::new();
+    for modes in [2, 4, 8, 16, 32, 64, 215] {
+        let reduced = reduce(&full, modes);
+        let x = observed(&scene, &reduced.structure, omega);
+        let error = x
+            .iter()
+            .zip(&exact)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+            / scale;
+        eprintln!("{modes} modes: response error {error:e}");
+        errors.push(error);
+    }
+    for pair in errors.windows(2) {
+        assert!(pair[1] <= pair[0] * 1.01 + 1e-9, "{errors:?}");
+    }
+    // Every interior mode: the same equations in other coordinates, solved to the Newton
+    // tolerance (1e-10 relative residual by default) on a conditioning of about 1e4.
+    assert!(errors[errors.len() - 1] < 1e-9, "{errors:?}");
+    // 8 fixed-interface modes: the response to 1e-3 of its amplitude (measured 2.1e-4).
+    assert!(errors[2] < 1e-3, "{errors:?}");
+}
+
+#[test]
+fn a_reduction_section_solves_the_reduced_structure_and_its_mistakes_are_named() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/calculix_cantilever");
+    let loaded = ssn::cli::load(&dir.join("cantilever_reduced.toml")).unwrap();
+    assert_eq!(loaded.structure.model.dofs(), 17);
+    let (scene, full) = cantilever();
+    // The scene's frequency ratio keeps the full model's omega_1 as its unit.
+    assert_eq!(loaded.omega, scene.omega(full.omega_1));
+    let by_hand = reduce(&full, 16);
+    let a = observed(&loaded.scene, &loaded.structure, loaded.omega);
+    let b = observed(&scene, &by_hand.structure, loaded.omega);
+    // The same reduction of the same matrices: the same arithmetic.
+    assert_eq!(a, b);
+    let text = std::fs::read_to_string(dir.join("cantilever_reduced.toml")).unwrap();
+    let path = dir.join("cantilever_reduced.toml");
+    for (from, to, words) in [
+        (
+            "modes = 16",
+            "modes = 16\ncutoff_ratio = 2.0",
+            &["reduction.cutoff_ratio", "either `modes`"][..],
+        ),
+        ("modes = 16", "", &["reduction.modes", "missing"]),
+        ("modes = 16", "modes = 0", &["reduction.modes", "0"]),
+        (
+            "\"craig-bampton\"",
+            "\"guyan\"",
+            &["guyan", "craig-bampton"],
+        ),
+    ] {
+        let e = Scene::from_toml(&text.replace(from, to), &path)
+            .unwrap_err()
+            .to_string();
+        for w in words {
+            assert!(e.contains(w), "`{w}` not in: {e}");
+        }
+    }
+}
