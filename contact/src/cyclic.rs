@@ -232,6 +232,10 @@ impl CyclicSector {
             contacts,
             friction,
             cyclic: Some(CyclicCoupling::new(phi, self.sectors, terms)),
+            frictional_contacts: (m.frictional_contacts.iter())
+                .map(|c| c.with_rows(|r| Ok::<_, std::convert::Infallible>(self.reduce_row(r))))
+                .map(|c| c.unwrap_or_else(|never| match never {}))
+                .collect(),
         }
     }
 

@@ -59,6 +59,7 @@ fn model(
         contacts: Vec::new(),
         friction: Vec::new(),
         frictional_contacts: Vec::new(),
+        cyclic: None,
     }
 }
 

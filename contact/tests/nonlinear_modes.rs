@@ -41,6 +41,8 @@ fn damped_chain(alpha: f64, beta: f64) -> StructuralModel {
         load: HarmonicLoad::zero(2),
         contacts: vec![ContactPoint::new(1, 100.0)],
         friction: Vec::new(),
+        cyclic: None,
+        frictional_contacts: Vec::new(),
     }
 }
 
@@ -112,6 +114,8 @@ fn bilinear(gap: f64, k_c: f64) -> StructuralModel {
         load: HarmonicLoad::zero(2),
         contacts: vec![ContactPoint::new(1, gap)],
         friction: Vec::new(),
+        cyclic: None,
+        frictional_contacts: Vec::new(),
     }
 }
 
@@ -201,6 +205,8 @@ fn jenkins(c: f64, k_t: f64, limit: f64, force: f64) -> StructuralModel {
             0.5,
             2.0 * limit,
         )],
+        cyclic: None,
+        frictional_contacts: Vec::new(),
     }
 }
 

@@ -8,8 +8,8 @@ use serde_json::{json, Value};
 
 use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummary};
-use semismooth_contact::model::Structure;
 use semismooth_contact::hb::FrictionalContactReport;
+use semismooth_contact::model::Structure;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;

@@ -111,6 +111,27 @@ impl FrictionalContact {
         }
     }
 
+    /// The same contact with each of its rows replaced by `map(row)` (a renumbering onto
+    /// reduced coordinates); the first error of `map`, if any.
+    pub fn with_rows<E>(
+        &self,
+        mut map: impl FnMut(&ContactRow) -> Result<ContactRow, E>,
+    ) -> Result<Self, E> {
+        let normal = match &self.normal {
+            NormalLaw::Unilateral { row, gap } => NormalLaw::Unilateral {
+                row: map(row)?,
+                gap: *gap,
+            },
+            NormalLaw::Prescribed(load) => NormalLaw::Prescribed(*load),
+        };
+        let tangents = [map(&self.tangents[0])?, map(&self.tangents[1])?];
+        Ok(Self {
+            normal,
+            tangents,
+            ..self.clone()
+        })
+    }
+
     /// Its rows of `G`: the normal row (when unilateral), then the two tangent rows.
     pub fn rows(&self) -> impl Iterator<Item = &ContactRow> + '_ {
         self.normal_row().into_iter().chain(&self.tangents)

@@ -108,6 +108,9 @@ pub fn boundary_dofs(structure: &Structure, extra: &[usize]) -> Vec<usize> {
     for f in &model.friction {
         b.extend_from_slice(f.tangent.dofs());
     }
+    for row in model.frictional_contacts.iter().flat_map(|c| c.rows()) {
+        b.extend_from_slice(row.dofs());
+    }
     for h in model.load.harmonics() {
         for (i, (c, s)) in h.cosine.iter().zip(&h.sine).enumerate() {
             if *c != 0.0 || *s != 0.0 {
@@ -241,6 +244,11 @@ fn reduced_structure(
     t: &[Vec<f64>],
 ) -> Result<Structure, ReductionError> {
     let model = &full.model;
+    if model.cyclic.is_some() {
+        let why = "a cyclic sector's interface couplings are not reduced: reduce the sector \
+                   before it is made cyclic";
+        return Err(ReductionError::Invalid(why.into()));
+    }
     let r = t.len();
     let dot = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
     let mut load = HarmonicLoad::zero(r);
@@ -282,6 +290,10 @@ fn reduced_structure(
         load,
         contacts,
         friction,
+        cyclic: None,
+        frictional_contacts: (model.frictional_contacts.iter())
+            .map(|c| c.with_rows(row))
+            .collect::<Result<_, ReductionError>>()?,
     };
     reduced
         .validate()
