@@ -105,6 +105,15 @@ impl<'a> Check<'a> {
     }
 }
 
+/// The sections a `[rod]` scene reads beside `[rod]` and `[forcing]`: damping, contacts,
+/// whether friction points were given, the observed dof.
+type RodParts = (
+    Option<RawDamping>,
+    Option<RawContact>,
+    bool,
+    Option<RawOutput>,
+);
+
 /// Validates a parsed scene section by section, in file order; the first invalid value is
 /// the error.
 pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
@@ -131,25 +140,8 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
             ))
         }
         (Some(raw_rod), None, None) => {
-            let mut rod = ck.rod(raw_rod)?;
-            ck.load_parts(&raw.forcing, false, 0)?;
-            rod.damping = raw.damping.map(|d| ck.damping(&d)).transpose()?;
-            (rod.load, rod.amplitude, rod.frequency) = ck.forcing(&raw.forcing)?;
-            if let Some(c) = raw.contact {
-                rod.contacts = ck.contacts(c, rod.elements)?;
-            }
-            if raw.friction.is_some() {
-                return Err(ck.invalid(
-                    "friction.point",
-                    "given in a [rod] scene",
-                    "[[friction.point]] in [model] scenes (`ssn export-model` writes a rod as \
-                     one)",
-                ));
-            }
-            let output_dof = raw
-                .output
-                .map(|o| ck.output_dof(o, rod.elements))
-                .transpose()?;
+            let parts = (raw.damping, raw.contact, raw.friction.is_some(), raw.output);
+            let (rod, output_dof) = ck.rod_scene(raw_rod, &raw.forcing, parts)?;
             (rod, None, output_dof)
         }
         (None, Some(m), None) => {
@@ -211,6 +203,34 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
 }
 
 impl Check<'_> {
+    /// A `[rod]` scene: the rod with its damping, forcing and contacts, and its observed
+    /// dof; friction points (`with_friction`) are refused, they belong to `[model]` scenes.
+    fn rod_scene(
+        &self,
+        raw_rod: &RawRod,
+        forcing: &RawForcing,
+        (damping, contact, with_friction, output): RodParts,
+    ) -> Result<(RodSpec, Option<usize>), SceneError> {
+        let mut rod = self.rod(raw_rod)?;
+        self.load_parts(forcing, false, 0)?;
+        rod.damping = damping.map(|d| self.damping(&d)).transpose()?;
+        (rod.load, rod.amplitude, rod.frequency) = self.forcing(forcing)?;
+        if let Some(c) = contact {
+            rod.contacts = self.contacts(c, rod.elements)?;
+        }
+        if with_friction {
+            return Err(self.invalid(
+                "friction.point",
+                "given in a [rod] scene",
+                "[[friction.point]] in [model] scenes (`ssn export-model` writes a rod as one)",
+            ));
+        }
+        let output_dof = output
+            .map(|o| self.output_dof(o, rod.elements))
+            .transpose()?;
+        Ok((rod, output_dof))
+    }
+
     /// `[rod]`: the mesh and the material; the other sections fill in damping, forcing and
     /// contacts (none until they do).
     fn rod(&self, r: &RawRod) -> Result<RodSpec, SceneError> {
