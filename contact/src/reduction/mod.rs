@@ -152,11 +152,7 @@ pub fn craig_bampton(
     }
     let (k_ii, k_ib) = split(&model.stiffness, &place, interior.len(), boundary.len())?;
     let (m_ii, _) = split(&model.mass, &place, interior.len(), boundary.len())?;
-    let mut lu = FaerSparseLu::new();
-    lu.factor(&k_ii)
-        .map_err(|e| ReductionError::Factorization {
-            reason: e.to_string(),
-        })?;
+    let mut lu = factored(&k_ii)?;
     let fixed = lowest_modes(&mut lu, &m_ii, modes)?;
     let mut transform = Vec::with_capacity(boundary.len() + fixed.shapes.len());
     for (k, mut psi) in k_ib.into_iter().enumerate() {
@@ -298,12 +294,7 @@ fn reduced_structure(
     reduced
         .validate()
         .map_err(|e| ReductionError::Invalid(e.to_string()))?;
-    let mut lu = FaerSparseLu::new();
-    lu.factor(&reduced.stiffness)
-        .map_err(|e| ReductionError::Factorization {
-            reason: e.to_string(),
-        })?;
-    let omega_1 = lowest_modes(&mut lu, &reduced.mass, ModeCount::Count(1))?.omegas[0];
+    let omega_1 = lowest_frequencies(&reduced, 1)?[0];
     Ok(Structure {
         model: reduced,
         omega_1,
@@ -317,10 +308,16 @@ pub fn lowest_frequencies(
     model: &StructuralModel,
     count: usize,
 ) -> Result<Vec<f64>, ReductionError> {
+    let mut lu = factored(&model.stiffness)?;
+    Ok(lowest_modes(&mut lu, &model.mass, ModeCount::Count(count))?.omegas)
+}
+
+/// The sparse LU of `matrix`, or why it failed.
+fn factored(matrix: &SparseMatrix) -> Result<FaerSparseLu, ReductionError> {
     let mut lu = FaerSparseLu::new();
-    lu.factor(&model.stiffness)
+    lu.factor(matrix)
         .map_err(|e| ReductionError::Factorization {
             reason: e.to_string(),
         })?;
-    Ok(lowest_modes(&mut lu, &model.mass, ModeCount::Count(count))?.omegas)
+    Ok(lu)
 }

@@ -15,7 +15,7 @@
 use faer::{Mat, Side};
 use semismooth::LinearSolve;
 
-use crate::model::SparseMatrix;
+use crate::model::{sparse_mul_add, SparseMatrix};
 
 use super::ReductionError;
 
@@ -55,17 +55,10 @@ struct Krylov<'a, S> {
     seed: u64,
 }
 
-/// `M x`.
+/// `A x` (the model's sparse product).
 pub(super) fn times(a: &SparseMatrix, x: &[f64]) -> Vec<f64> {
     let mut y = vec![0.0; a.nrows()];
-    let r = a.as_ref();
-    for (j, &xj) in x.iter().enumerate() {
-        if xj != 0.0 {
-            for (i, v) in r.row_idx_of_col(j).zip(r.val_of_col(j)) {
-                y[i] += v * xj;
-            }
-        }
-    }
+    sparse_mul_add(a.as_ref(), 1.0, x, &mut y);
     y
 }
 
