@@ -1,7 +1,9 @@
 //! Nonlinear modes (EPMC on SSN-HB) against closed forms: the linear mode at small
 //! amplitude, and the backbone of the bilinear oscillator (a stop through a spring).
 
-use faer::sparse::Triplet;
+mod common;
+
+use common::sparse;
 use semismooth::continuation::ContinuationTermination;
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions, Tolerances};
@@ -16,14 +18,6 @@ use semismooth_contact::modes::{
     ModesError, MAX_DENSE_UNKNOWNS,
 };
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
-
-fn sparse(n: usize, entries: &[(usize, usize, f64)]) -> SparseMatrix {
-    let t: Vec<_> = entries
-        .iter()
-        .map(|&(i, j, v)| Triplet::new(i, j, v))
-        .collect();
-    SparseMatrix::try_new_from_triplets(n, n, &t).unwrap()
-}
 
 /// The chain `M = I`, `K = [[2, -1], [-1, 2]]` (natural frequencies 1 and sqrt 3, modes
 /// (1, 1) and (1, -1)), proportional damping `D = alpha M + beta K`, a contact on dof 1

@@ -88,6 +88,7 @@
 pub mod adaptive;
 pub mod branch;
 mod contacts;
+pub mod doubling;
 pub mod fold_accuracy;
 mod response;
 
@@ -384,6 +385,9 @@ struct Setup<'a> {
     /// Starting guess of the Newton solve at `omega_from` (zero when `None`) and the work
     /// spent computing it.
     start: Option<(Vec<f64>, WorkCounters)>,
+    /// Bounds of the frequency in place of the sweep's `[omega_from, omega_to]` (a branch
+    /// that starts inside the sweep's range).
+    bounds: Option<(f64, f64)>,
 }
 
 /// Newton at `omega_from` (the problem's `smoothing` offered to the polyalgorithm), then the
@@ -403,7 +407,7 @@ where
 {
     let (settings, sweep, omega_1) = (setup.settings, setup.sweep, setup.omega_1);
     let n = problem.dim();
-    let options = continuation_options(
+    let mut options = continuation_options(
         settings,
         sweep,
         omega_1,
@@ -411,6 +415,9 @@ where
         setup.u_ref,
         &setup.method,
     )?;
+    if let Some((lo, hi)) = setup.bounds {
+        (options.parameter_min, options.parameter_max) = (lo, hi);
+    }
 
     let omega_from = sweep.omega_ratio_from * omega_1;
     problem.set_parameter(omega_from);
@@ -573,6 +580,9 @@ pub fn frequency_response(
     .unwrap_or_else(|err| BranchStability::not_decided(total, Undecided::Failed(err)));
     response.set_stability(stability);
     response.stability_seconds = started.elapsed().as_secs_f64();
+    if sweep.stability && settings.method == crate::settings::Method::SsnHb {
+        response.period_two = doubling::period_two_branches(structure, settings, sweep, &response);
+    }
     Ok(response)
 }
 
@@ -603,6 +613,7 @@ pub(crate) fn follow_branch(
         output_points,
         started,
         start: None,
+        bounds: None,
     };
     let formulation = crate::solve::formulation::of(settings.method);
     if let Some(what) = formulation.continuation_refusal() {

@@ -72,6 +72,9 @@ pub struct FrequencyResponse {
     /// point by point, what they achieved ([`super::adaptive`]; each point's estimate is its
     /// [`ResponsePoint::error_estimate`]).
     pub accuracy: Option<BranchAccuracy>,
+    /// The period-2 branches born at the branch's period doublings (SSN-HB with
+    /// stability; [`super::doubling`]), in branch order.
+    pub period_two: Vec<super::doubling::PeriodTwoOutcome>,
 }
 
 /// One point of a frequency-response branch: its frequency, the extremes of the observed
@@ -207,6 +210,7 @@ impl FrequencyResponse {
             undecided: None,
             stability_seconds: 0.0,
             accuracy: None,
+            period_two: Vec::new(),
         }
     }
 

@@ -21,6 +21,15 @@ use semismooth_contact::settings::{
 use semismooth_contact::solve::{solve, RunError, Solution};
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
+/// The `n x n` sparse matrix with the `(row, column, value)` entries.
+pub fn sparse(n: usize, entries: &[(usize, usize, f64)]) -> SparseMatrix {
+    let t: Vec<_> = entries
+        .iter()
+        .map(|&(i, j, v)| faer::sparse::Triplet::new(i, j, v))
+        .collect();
+    SparseMatrix::try_new_from_triplets(n, n, &t).unwrap()
+}
+
 /// The canonical rod of the paper's Fig. 1 (20 elements, tip gap 0.5, forced at
 /// `omega_1`) with the mass model `mass`.
 pub fn canonical(mass: MassModel) -> RodSpec {
