@@ -424,6 +424,92 @@ fn rod_backbone_carries_the_phase_resonances_of_the_forced_responses() {
     }
 }
 
+/// The chain `M = diag(1, 1, 0)`, `K` of the springs ground - 0 - 1 - ground (unit) and 1 - 2
+/// (`k_c`), the massless node 2 held by a stop at `gap`, damping `alpha M`, the load
+/// `force (1, 1, 0) cos(w t)` along the first mode `(1, 1)` (`omega_1 = 1` while the stop
+/// is open).
+fn chain_with_stop(gap: f64, k_c: f64, alpha: f64, force: f64) -> StructuralModel {
+    StructuralModel {
+        mass: sparse(3, &[(0, 0, 1.0), (1, 1, 1.0)]),
+        damping: Some(sparse(3, &[(0, 0, alpha), (1, 1, alpha)])),
+        stiffness: sparse(
+            3,
+            &[
+                (0, 0, 2.0),
+                (0, 1, -1.0),
+                (1, 0, -1.0),
+                (1, 1, 2.0 + k_c),
+                (1, 2, -k_c),
+                (2, 1, -k_c),
+                (2, 2, k_c),
+            ],
+        ),
+        load: HarmonicLoad::cosine(vec![force, force, 0.0]),
+        contacts: vec![ContactPoint::new(2, gap)],
+        friction: Vec::new(),
+        cyclic: None,
+        frictional_contacts: Vec::new(),
+    }
+}
+
+#[test]
+fn chain_backbone_by_energy_carries_the_phase_resonances_of_the_forced_responses() {
+    let (gap, k_c, alpha) = (0.5, 3.0, 0.3);
+    let options = HbOptions {
+        harmonics: 15,
+        ..HbOptions::default()
+    };
+    let free = chain_with_stop(gap, k_c, alpha, 0.0);
+    // The energy of the linear mode (1, 1, 1) a cos(w t) is a^2 (module `Epmc::energy`):
+    // from a = 0.1 to well past the stop at 0.5.
+    let (e_from, e_to) = (0.01, 4.0);
+    let mut backbone_options =
+        BackboneOptions::by_energy(1, AmplitudeMeasure::Dof(1), e_from, e_to);
+    backbone_options.hb = options;
+    let branch = backbone(&free, &backbone_options).unwrap();
+    let (first, last) = (&branch.points[0], branch.points.last().unwrap());
+    // The first point is the linear mode at that energy: w = 1, xi = alpha, a = 0.1.
+    assert!((first.energy - e_from).abs() < 1e-14, "{}", first.energy);
+    assert!((first.omega - 1.0).abs() < 1e-12 && (first.amplitude - 0.1).abs() < 1e-12);
+    // It ends at the first point past the energy bound.
+    assert!(matches!(
+        branch.termination,
+        ContinuationTermination::ReachedBound { bound, .. } if bound == e_to
+    ));
+    let before = &branch.points[branch.points.len() - 2];
+    assert!(
+        last.energy >= e_to && before.energy < e_to,
+        "{} {}",
+        before.energy,
+        last.energy
+    );
+    assert!(
+        last.omega > 1.05,
+        "the stop stiffens the mode: {}",
+        last.omega
+    );
+    let mut epmc = Epmc::new(&free, &options, 1, AmplitudeMeasure::Dof(1)).unwrap();
+    // Force levels whose resonance amplitudes f / alpha are below the gap, at about 2 and
+    // 3 gaps.
+    for force in [0.09, 0.3, 0.45] {
+        let forced = chain_with_stop(gap, k_c, alpha, force);
+        let (dw, dxi, higher) = backbone_against_forced(&branch, &mut epmc, &forced, 1, &[3, 1]);
+        println!("force {force}: dw {dw:.2e}, dxi {dxi:.2e}, higher {higher:.2e}");
+        // Mass-proportional damping is EPMC's `-xi M u'`, so xi = alpha on the backbone
+        // and in the forced energy balance alike but for the work of the sampled contact
+        // force over a period (truncation); the frequency differs through the harmonics
+        // above the first. Both by less than the square of their share `higher`.
+        assert!(
+            dxi <= higher * higher + 1e-12 && dxi < 1e-3,
+            "F {force}: xi {dxi}"
+        );
+        assert!(
+            dw <= higher * higher + 1e-9 && dw < 1e-2,
+            "F {force}: w {dw} {higher}"
+        );
+    }
+}
+
 #[test]
 fn a_backbone_too_large_for_the_dense_solve_is_refused_before_any_work() {
     let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.1, 1.0);

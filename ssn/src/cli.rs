@@ -26,6 +26,7 @@ use semismooth_contact::matrix_market::{build_imported, build_imported_with};
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::{RunError, Solution};
+use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
 use semismooth_contact::sweep::fold_accuracy::{refine_folds, FoldAccuracy, MAX_FOLD_HARMONICS};
 use semismooth_contact::sweep::{FrequencyResponse, SweepProgress};
 
@@ -758,7 +759,27 @@ fn sweep_plot(scene: &Scene, response: &FrequencyResponse, ratio: &[f64]) -> Plo
     };
     let stable = &response.stable();
     let mut series = stability_series(&label, 0, ratio, &response.amplitudes(), stable);
-    series.extend(stability_key(stable));
+    let mut verdicts = stable.clone();
+    // The period-2 branches born at period doublings, each in a colour of its own.
+    for (k, outcome) in response.period_two.iter().enumerate() {
+        if let PeriodTwoOutcome::Followed(b) = outcome {
+            let branch = &b.response;
+            let label = format!(
+                "period 2 from omega / omega_1 = {:.4}",
+                b.from.omega / response.omega_1
+            );
+            let stable = branch.stable();
+            series.extend(stability_series(
+                &label,
+                k + 1,
+                &branch.omega_ratio(),
+                &branch.amplitudes(),
+                &stable,
+            ));
+            verdicts.extend(stable);
+        }
+    }
+    series.extend(stability_key(&verdicts));
     Plot {
         untitled: "frequency response",
         x_label: "forcing frequency omega / omega_1",

@@ -12,8 +12,9 @@ use semismooth_contact::hb::FrictionalContactReport;
 use semismooth_contact::model::Structure;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
+use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
 use semismooth_contact::sweep::fold_accuracy::FoldAccuracy;
-use semismooth_contact::sweep::{FrequencyResponse, ResponsePoint};
+use semismooth_contact::sweep::{BifurcationEvent, FrequencyResponse, ResponsePoint};
 
 use crate::state::HbState;
 
@@ -182,8 +183,9 @@ pub fn finite_or_null(v: f64) -> Value {
 /// harmonic balance: per point `harmonics` and `time_samples`; with an accuracy target
 /// (SSN-HB, harmonics chosen per point): per point `error_estimate` and the summary
 /// `accuracy` {`target`, `basis`, `order`, `points_met`, `worst_estimate`, `raises`,
-/// `lowers`, `failed_raises`, `max_harmonics`, `estimate_seconds`, `estimate_counters`}.
-/// Non-finite numbers become `null`.
+/// `lowers`, `failed_raises`, `max_harmonics`, `estimate_seconds`, `estimate_counters`};
+/// at period doublings (SSN-HB with stability) `period_two`, one document per doubling
+/// (`period_two_json`). Non-finite numbers become `null`.
 pub fn response_json(r: &FrequencyResponse) -> Value {
     let mut counters = newton_counters(&r.counters);
     for (name, value) in [
@@ -195,19 +197,8 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
     ] {
         counters.insert(name.to_string(), value.into());
     }
-    let events: Vec<serde_json::Value> = r
-        .events
-        .iter()
-        .map(|e| {
-            json!({
-                "kind": e.kind.name(),
-                "omega": e.omega,
-                "omega_ratio": e.omega / r.omega_1,
-                "index": e.index,
-                "uncertainty_ratio": e.uncertainty.map(|u| u / r.omega_1),
-            })
-        })
-        .collect();
+    let events: Vec<serde_json::Value> =
+        r.events.iter().map(|e| event_json(e, r.omega_1)).collect();
     let points = &r.points;
     let column = |value: fn(&ResponsePoint) -> Value| points.iter().map(value).collect::<Vec<_>>();
     // Without friction points the list is empty, not a list of empty lists.
@@ -250,6 +241,13 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         doc["harmonics"] = json!(r.harmonics());
         doc["time_samples"] = json!(r.time_samples());
     }
+    if !r.period_two.is_empty() {
+        doc["period_two"] = r
+            .period_two
+            .iter()
+            .map(|o| period_two_json(o, r.omega_1))
+            .collect();
+    }
     if let Some(a) = &r.accuracy {
         doc["error_estimate"] = json!(column(|p| json!(p.error_estimate)));
         doc["accuracy"] = json!({
@@ -268,6 +266,45 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         });
     }
     doc
+}
+
+/// A stability change of a branch: `kind`, `omega`, `omega_ratio`, `index`,
+/// `uncertainty_ratio`.
+fn event_json(e: &BifurcationEvent, omega_1: f64) -> Value {
+    json!({
+        "kind": e.kind.name(),
+        "omega": e.omega,
+        "omega_ratio": e.omega / omega_1,
+        "index": e.index,
+        "uncertainty_ratio": e.uncertainty.map(|u| u / omega_1),
+    })
+}
+
+/// The period-2 branch born at a period doubling: `period_multiple` (2), `from_event`,
+/// then either the branch as [`response_json`] (its `omega` the forcing frequency, its
+/// `harmonics` those of `omega / 2`, its points' stability that of the `2T`-periodic orbit)
+/// with `start_omega_ratio` and `next_event` (the next period doubling of a cascade, where
+/// the branch was cut, or null), or `not_started` (why).
+fn period_two_json(outcome: &PeriodTwoOutcome, omega_1: f64) -> Value {
+    match outcome {
+        PeriodTwoOutcome::Followed(b) => {
+            let mut doc = response_json(&b.response);
+            doc["period_multiple"] = json!(b.period_multiple);
+            doc["from_event"] = event_json(&b.from, omega_1);
+            doc["start_omega_ratio"] = json!(b.start_omega / omega_1);
+            doc["next_event"] = b
+                .next_event
+                .as_ref()
+                .map_or(Value::Null, |e| event_json(e, omega_1));
+            doc
+        }
+        PeriodTwoOutcome::NotStarted { from, reason } => json!({
+            "period_multiple": 2,
+            "from_event": event_json(from, omega_1),
+            "not_started": reason,
+        }),
+        _ => json!({ "period_multiple": 2 }),
+    }
 }
 
 /// The JSON of `ssn solutions --json`: `omega`, `omega_ratio`, `window`,

@@ -121,7 +121,8 @@ enum Command {
     /// energy against the observed dof's amplitude over the scene's [modes] range.
     #[command(
         after_help = "Example:\n  ssn modes SCENE.toml --json --csv backbone.csv --svg backbone.svg\n\n\
-        Scene: [modes] mode (default 1), amplitude_from, amplitude_to, max_points.\n\n\
+        Scene: [modes] mode (default 1), amplitude_from and amplitude_to, or energy_from\n  \
+        and energy_to, max_points; solver.method ssn-hb (others are refused).\n\n\
         JSON fields: scene, mode, linear {omega, damping_ratio}, observed_dof, harmonics,\n  \
         damping_convention, amplitude_measure, points [{amplitude, energy, omega,\n  \
         omega_ratio, damping_ratio, modal_damping, displacement_max, displacement_min,\n  \

@@ -1,5 +1,6 @@
 //! `ssn modes SCENE`: the backbone of a nonlinear mode ([`semismooth_contact::modes`],
-//! EPMC on SSN-HB) over the scene's `[modes]` amplitude range of the observed dof.
+//! EPMC on SSN-HB) over the scene's `[modes]` amplitude range of the observed dof, or its
+//! energy range. Another `solver.method` is refused: EPMC is posed on SSN-HB alone.
 
 use serde_json::{json, Value};
 
@@ -11,7 +12,7 @@ use semismooth_contact::modes::{backbone, AmplitudeMeasure, Backbone, BackboneOp
 use crate::cli::{Loaded, RunArgs, Workload};
 use crate::exit::CliError;
 use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
-use crate::scene::Scene;
+use crate::scene::{Method, Scene};
 
 /// `ssn modes SCENE`: the backbone (module documentation); text or JSON on stdout, a CSV
 /// row per point, an SVG of the frequency and the damping ratio against the amplitude.
@@ -53,12 +54,23 @@ pub fn run(scene: &Scene, structure: &Structure) -> Result<Backbone, String> {
                 .into(),
         );
     };
-    let mut options = BackboneOptions::new(
-        settings.mode,
-        AmplitudeMeasure::Dof(structure.observed_dof),
-        settings.amplitude_from,
-        settings.amplitude_to,
-    );
+    if scene.solver.method != Method::SsnHb {
+        return Err(format!(
+            "solver.method = \"{}\": ssn modes computes the extended periodic motion on \
+             ssn-hb only (set solver.method = \"ssn-hb\" or leave it out)",
+            scene.solver.method.name()
+        ));
+    }
+    let measure = AmplitudeMeasure::Dof(structure.observed_dof);
+    let mut options = match settings.energy_range {
+        Some((from, to)) => BackboneOptions::by_energy(settings.mode, measure, from, to),
+        None => BackboneOptions::new(
+            settings.mode,
+            measure,
+            settings.amplitude_from,
+            settings.amplitude_to,
+        ),
+    };
     options.hb = HbOptions {
         harmonics: scene.solver.harmonics,
         time_samples: Some(scene.solver.time_samples),

@@ -86,3 +86,61 @@ fn equal_amplitudes_are_refused_naming_the_key() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("modes.amplitude_to"), "{err}");
 }
+
+#[test]
+fn an_energy_range_gives_the_amplitude_backbone_between_the_same_energies() {
+    let path = scenes_dir().join("paper_rod_modes.toml");
+    let by_amplitude = json_success(&ssn(&["modes", path.to_str().unwrap(), "--json"]));
+    let points = by_amplitude["points"].as_array().unwrap();
+    let energy = |p: &serde_json::Value| p["energy"].as_f64().unwrap();
+    let (e_from, e_to) = (energy(&points[0]), energy(points.last().unwrap()));
+    // The same scene with the energies of the amplitude backbone's ends as its range.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let text = text
+        .replace(
+            "amplitude_from = 0.05",
+            &format!("energy_from = {e_from:e}"),
+        )
+        .replace("amplitude_to = 1.5", &format!("energy_to = {e_to:e}"));
+    assert!(text.contains("energy_to"), "{text}");
+    let dir = std::env::temp_dir().join(format!("ssn-modes-energy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("rod_modes_energy.toml");
+    std::fs::write(&scene, text).unwrap();
+    let by_energy = json_success(&ssn(&["modes", scene.to_str().unwrap(), "--json"]));
+    assert_eq!(by_energy["converged"], true, "{by_energy}");
+    let pts = by_energy["points"].as_array().unwrap();
+    let amplitude = |p: &serde_json::Value| p["amplitude"].as_f64().unwrap();
+    // It starts at the linear mode of that energy: amplitude 0.05 again, to round-off.
+    assert!((amplitude(&pts[0]) - 0.05).abs() < 1e-12, "{}", pts[0]);
+    assert!((energy(&pts[0]) - e_from).abs() < 1e-12 * e_from);
+    // It ends at the first point at or past e_to, so at amplitude 1.5 or one step beyond;
+    // the point before it is below both.
+    let (last, before) = (&pts[pts.len() - 1], &pts[pts.len() - 2]);
+    assert!(
+        energy(last) >= e_to && energy(before) < e_to,
+        "{before} {last}"
+    );
+    assert!(
+        amplitude(before) < 1.5 && amplitude(last) >= 1.5 - 1e-9,
+        "{before} {last}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_method_other_than_ssn_hb_is_refused_naming_the_key() {
+    let path = scenes_dir().join("paper_rod_modes.toml");
+    let out = ssn(&[
+        "modes",
+        path.to_str().unwrap(),
+        "--set",
+        "solver.method=\"penalty-hb\"",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("solver.method") && err.contains("ssn-hb"),
+        "{err}"
+    );
+}

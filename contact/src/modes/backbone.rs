@@ -1,7 +1,8 @@
 //! A nonlinear mode's backbone: EPMC followed in its amplitude by the core's continuation.
 
 use semismooth::continuation::{
-    Continuation, ContinuationCounters, ContinuationOptions, ContinuationTermination, Direction,
+    Branch, Continuation, ContinuationCounters, ContinuationOptions, ContinuationTermination,
+    Direction,
 };
 use semismooth::linalg::FaerDenseLu;
 use semismooth::Residual;
@@ -27,6 +28,12 @@ pub struct BackboneOptions {
     pub amplitude_from: f64,
     /// The amplitude where the backbone ends.
     pub amplitude_to: f64,
+    /// With [`BackboneOptions::by_energy`]: the energy range `(from, to)` ([`Epmc::energy`])
+    /// in place of the amplitude range. The first point is the linear mode of energy
+    /// `from`; the backbone ends at the first point whose energy reaches `to` (the
+    /// amplitude range is then only a safety bound: from the first point to twice the
+    /// linear mode's amplitude at energy `to`, since a stop stiffens the mode).
+    pub energy_range: Option<(f64, f64)>,
     /// The continuation (its parameter bounds are set from the amplitude range; without a
     /// `state_scale` one is made from the amplitude range, `omega_n` and the stiffness).
     pub continuation: ContinuationOptions,
@@ -47,9 +54,41 @@ impl BackboneOptions {
             measure,
             amplitude_from,
             amplitude_to,
+            energy_range: None,
             continuation: ContinuationOptions::default(),
         }
     }
+
+    /// Mode `mode` from the energy `energy_from` to `energy_to` (the period mean of the
+    /// mechanical energy, the natural measure of a conservative system's backbone).
+    pub fn by_energy(
+        mode: usize,
+        measure: AmplitudeMeasure,
+        energy_from: f64,
+        energy_to: f64,
+    ) -> Self {
+        Self {
+            energy_range: Some((energy_from, energy_to)),
+            ..Self::new(mode, measure, f64::NAN, f64::NAN)
+        }
+    }
+}
+
+/// The amplitude range of `options`: as given, or from its energy range on the linear
+/// mode of `epmc` (whose energy is quadratic in the amplitude).
+fn amplitude_range(epmc: &Epmc, options: &BackboneOptions) -> Result<(f64, f64), ModesError> {
+    let Some((from, to)) = options.energy_range else {
+        return Ok((options.amplitude_from, options.amplitude_to));
+    };
+    semismooth::InvalidOption::check(
+        from.is_finite() && to.is_finite() && from > 0.0 && to > from,
+        "energy range",
+        to,
+        "two positive energies, increasing",
+    )
+    .map_err(|e| ModesError::Hb(e.into()))?;
+    let unit = epmc.energy(&epmc.linear_start(1.0));
+    Ok(((from / unit).sqrt(), 2.0 * (to / unit).sqrt()))
 }
 
 /// One point of a backbone.
@@ -111,7 +150,7 @@ pub fn backbone(
         });
     }
     let mut epmc = Epmc::new(model, &options.hb, options.mode, options.measure)?;
-    let (from, to) = (options.amplitude_from, options.amplitude_to);
+    let (from, to) = amplitude_range(&epmc, options)?;
     semismooth::InvalidOption::check(
         from.is_finite() && to.is_finite() && from > 0.0 && to > 0.0 && from != to,
         "amplitude range",
@@ -134,10 +173,13 @@ pub fn backbone(
     }
     let linear = epmc.linear_mode().clone();
     let mut solver = FaerDenseLu::new();
-    let branch = Continuation::new(&mut epmc, &mut solver, &x0, from, continuation)
+    let continuation = Continuation::new(&mut epmc, &mut solver, &x0, from, continuation)
         .map_err(|e| ModesError::Continuation(e.to_string()))?
-        .with_dense_fallback()
-        .run();
+        .with_dense_fallback();
+    let branch = match options.energy_range {
+        Some((_, energy_to)) => up_to_energy(continuation, energy_to),
+        None => continuation.run(),
+    };
     let summary_dof = match options.measure {
         AmplitudeMeasure::Dof(dof) => dof,
         _ => (0..linear.shape.len())
@@ -169,6 +211,39 @@ pub fn backbone(
         termination: branch.termination,
         counters: branch.counters,
     })
+}
+
+/// The branch of `continuation` up to its first point whose energy reaches `energy_to`
+/// (then ended as at a bound: `ReachedBound` with the energies).
+fn up_to_energy(mut continuation: Continuation<'_, Epmc, FaerDenseLu>, energy_to: f64) -> Branch {
+    let mut points = Vec::new();
+    let mut reached = None;
+    while let Some(point) = continuation.next() {
+        let energy = continuation.problem().energy(&point.state);
+        points.push(point);
+        if energy >= energy_to {
+            reached = Some(energy);
+            break;
+        }
+    }
+    let termination = match reached {
+        Some(parameter) => ContinuationTermination::ReachedBound {
+            parameter,
+            bound: energy_to,
+        },
+        None => continuation
+            .termination()
+            .cloned()
+            .unwrap_or(ContinuationTermination::MaxPoints {
+                points: points.len(),
+            }),
+    };
+    Branch {
+        points,
+        events: continuation.events().to_vec(),
+        termination,
+        counters: continuation.counters(),
+    }
 }
 
 /// Typical sizes of the EPMC unknowns: `amplitude` for the displacements, the stiffness

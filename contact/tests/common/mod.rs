@@ -23,11 +23,7 @@ use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
 /// The `n x n` sparse matrix with the `(row, column, value)` entries.
 pub fn sparse(n: usize, entries: &[(usize, usize, f64)]) -> SparseMatrix {
-    let t: Vec<_> = entries
-        .iter()
-        .map(|&(i, j, v)| faer::sparse::Triplet::new(i, j, v))
-        .collect();
-    SparseMatrix::try_new_from_triplets(n, n, &t).unwrap()
+    semismooth_contact::builder::sparse_matrix(n, entries).unwrap()
 }
 
 /// The canonical rod of the paper's Fig. 1 (20 elements, tip gap 0.5, forced at

@@ -841,21 +841,48 @@ impl Check<'_> {
 }
 
 impl Check<'_> {
-    /// `[modes]`: a mode number >= 1 and two different positive amplitudes.
+    /// `[modes]`: a mode number >= 1 and two different positive amplitudes, or two
+    /// increasing positive energies.
     fn modes(&self, m: &RawModes) -> Result<ModesSettings, SceneError> {
-        let from = self.positive("modes.amplitude_from", m.amplitude_from)?;
-        let to = self.positive("modes.amplitude_to", m.amplitude_to)?;
-        if to == from {
-            return Err(self.invalid(
-                "modes.amplitude_to",
-                to,
-                "a value different from amplitude_from",
-            ));
-        }
+        let (amplitudes, energy_range) =
+            match (m.amplitude_from, m.amplitude_to, m.energy_from, m.energy_to) {
+                (Some(from), Some(to), None, None) => {
+                    let from = self.positive("modes.amplitude_from", from)?;
+                    let to = self.positive("modes.amplitude_to", to)?;
+                    if to == from {
+                        return Err(self.invalid(
+                            "modes.amplitude_to",
+                            to,
+                            "a value different from amplitude_from",
+                        ));
+                    }
+                    ((from, to), None)
+                }
+                (None, None, Some(from), Some(to)) => {
+                    let from = self.positive("modes.energy_from", from)?;
+                    let to = self.positive("modes.energy_to", to)?;
+                    if to <= from {
+                        return Err(self.invalid(
+                            "modes.energy_to",
+                            to,
+                            "a value above energy_from",
+                        ));
+                    }
+                    ((f64::NAN, f64::NAN), Some((from, to)))
+                }
+                _ => {
+                    return Err(self.invalid(
+                        "modes.amplitude_from",
+                        m.amplitude_from.unwrap_or(f64::NAN),
+                        "amplitude_from and amplitude_to, or energy_from and energy_to (one pair)",
+                    ))
+                }
+            };
         Ok(ModesSettings {
             mode: self.count_or("modes.mode", m.mode, 1, 1_000_000, 1)?,
-            amplitude_from: from,
-            amplitude_to: to,
+            amplitude_from: amplitudes.0,
+            amplitude_to: amplitudes.1,
+            energy_range,
             max_points: self.count_or("modes.max_points", m.max_points, 2, 1_000_000, 1000)?,
         })
     }

@@ -95,15 +95,18 @@ pub struct Scene {
 }
 
 /// `[modes]`: which linear mode the backbone starts from and the range of the observed
-/// dof's amplitude (the cosine part of its harmonic 1, the phase making the sine part zero).
+/// dof's amplitude (the cosine part of its harmonic 1, the phase making the sine part zero)
+/// or of the energy.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModesSettings {
     /// Which linear mode (1: the lowest natural frequency).
     pub mode: usize,
-    /// The amplitude of the first point.
+    /// The amplitude of the first point (NaN with `energy_range`).
     pub amplitude_from: f64,
-    /// The amplitude of the last point.
+    /// The amplitude of the last point (NaN with `energy_range`).
     pub amplitude_to: f64,
+    /// `energy_from`, `energy_to`: the energy range in place of the amplitudes.
+    pub energy_range: Option<(f64, f64)>,
     /// Largest number of points.
     pub max_points: usize,
 }
@@ -313,8 +316,10 @@ struct RawSweep {
 #[serde(deny_unknown_fields)]
 struct RawModes {
     mode: Option<i64>,
-    amplitude_from: f64,
-    amplitude_to: f64,
+    amplitude_from: Option<f64>,
+    amplitude_to: Option<f64>,
+    energy_from: Option<f64>,
+    energy_to: Option<f64>,
     max_points: Option<i64>,
 }
 

@@ -1,0 +1,99 @@
+//! Backbones per second: the nonlinear mode of the paper's rod with its stop and of a
+//! friction-damped oscillator (a Jenkins element), timed; prints the table of
+//! `docs/modes.md`.
+//!
+//! `cargo run --release -p semismooth-contact --example backbone_timing`
+//!
+//! Each backbone is computed `REPEATS` times and the fastest wall time is reported with its
+//! points, corrector iterations (one dense LU of the bordered EPMC Jacobian each) and points
+//! per second.
+
+use std::time::Instant;
+
+use semismooth_contact::builder::sparse_matrix;
+use semismooth_contact::hb::HbOptions;
+use semismooth_contact::model::{ContactRow, FrictionPoint, HarmonicLoad, StructuralModel};
+use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions};
+use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+
+/// Runs per backbone; the fastest is reported.
+const REPEATS: usize = 3;
+
+/// `u'' + 0.01 u' + u + 3 (u - w) = 0`, the massless slider `w` held by Coulomb friction
+/// of limit 0.5 (the tests' Jenkins element).
+fn jenkins() -> StructuralModel {
+    let sparse = |entries: &[(usize, usize, f64)]| sparse_matrix(2, entries).unwrap();
+    StructuralModel {
+        mass: sparse(&[(0, 0, 1.0)]),
+        damping: Some(sparse(&[(0, 0, 0.01)])),
+        stiffness: sparse(&[(0, 0, 4.0), (0, 1, -3.0), (1, 0, -3.0), (1, 1, 3.0)]),
+        load: HarmonicLoad::zero(2),
+        contacts: Vec::new(),
+        friction: vec![FrictionPoint::prescribed(
+            ContactRow::unit(1, 1.0),
+            0.5,
+            1.0,
+        )],
+        cyclic: None,
+        frictional_contacts: Vec::new(),
+    }
+}
+
+fn main() {
+    let rod = build_rod(&RodSpec {
+        mass: MassModel::Modified,
+        ..RodSpec::canonical()
+    })
+    .unwrap();
+    let tip = rod.tip_dof();
+    let cases = [
+        (
+            "rod with a tip stop (20 elements, modified mass)",
+            rod.structure.model.clone(),
+            tip,
+            20,
+            (0.05, 1.5),
+        ),
+        (
+            "Jenkins element (friction-damped oscillator)",
+            jenkins(),
+            0,
+            15,
+            (0.01, 3.0),
+        ),
+    ];
+    println!(
+        "| backbone | H | unknowns | amplitude range | points | corrector iterations | seconds | points / s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for (name, model, dof, harmonics, (from, to)) in cases {
+        let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(dof), from, to);
+        options.hb = HbOptions {
+            harmonics,
+            ..HbOptions::default()
+        };
+        let rows = model.dofs() + model.contact_count() + model.friction_count();
+        let unknowns = rows * (2 * harmonics + 1) + 2;
+        let mut best = f64::INFINITY;
+        let mut result = None;
+        for _ in 0..REPEATS {
+            let started = Instant::now();
+            let branch = backbone(&model, &options).unwrap();
+            best = best.min(started.elapsed().as_secs_f64());
+            result = Some(branch);
+        }
+        let branch = result.unwrap();
+        let points = branch.points.len();
+        println!(
+            "| {name} | {harmonics} | {unknowns} | {from} to {to} | {points} | {} | {best:.3} | {:.1} |",
+            branch.counters.corrector_iterations,
+            points as f64 / best
+        );
+    }
+    println!(
+        "\n(wall time, best of {REPEATS}; load average {})",
+        std::fs::read_to_string("/proc/loadavg")
+            .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+            .unwrap_or_default()
+    );
+}
