@@ -9,14 +9,14 @@
 //! `T`), so it splits into an even and an odd block. The odd block is the harmonic balance
 //! of the perturbations `p(t + T) = -p(t)`: it is singular exactly where the multiplier is
 //! `-1` (Hill's method), and its kernel is the Floquet vector of that multiplier on the
-//! odd harmonics. Near the crossing its smallest singular direction `v` ([`odd_kernel`], by
+//! odd harmonics. Near the crossing its smallest singular direction `v` (`odd_kernel`, by
 //! inverse iteration) is that vector to within the distance of the point to the crossing.
 //!
 //! The branch starts at the solutions of `R(X, nu) = 0` with `v . (X - X_T) = eps` (the
-//! anchored system, [`Anchored`]; `w` free): on the `T`-branch `v . (X - X_T)` stays zero
+//! anchored system, `Anchored`; `w` free): on the `T`-branch `v . (X - X_T)` stays zero
 //! (even against odd harmonics), so a solution with `eps != 0` is a `2T`-periodic one. Two
 //! amplitudes `eps` and `2 eps` give the branch's direction in `w`; from the first, the
-//! sweep's continuation follows it ([`super::follow`], in `nu`) with the sweep's step
+//! sweep's continuation follows it (in `nu`) with the sweep's step
 //! rules and bounds. Its points get their stability from the monodromy over `2T`
 //! ([`super::branch::branch_stability`] on the model forced on harmonic 2 of `nu`); at
 //! the first period doubling of the period-2 branch (the next of a cascade) it is cut and
