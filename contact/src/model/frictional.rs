@@ -103,6 +103,22 @@ impl FrictionalContact {
             .collect()
     }
 
+    /// The obstacle's gap and its rate at time `t` of a response at angular frequency
+    /// `omega`: `(gap(t), gap'(t))` (the fixed gap and 0 under a prescribed load).
+    pub fn gap_at(&self, omega: f64, t: f64) -> (f64, f64) {
+        let NormalLaw::Unilateral { gap, .. } = self.normal else {
+            return (0.0, 0.0);
+        };
+        let (mut value, mut rate) = (gap, 0.0);
+        for (k, (a, b)) in self.gap_harmonics().into_iter().enumerate() {
+            let kw = (k + 1) as f64 * omega;
+            let (sin, cos) = (kw * t).sin_cos();
+            value += a * cos + b * sin;
+            rate += kw * (b * cos - a * sin);
+        }
+        (value, rate)
+    }
+
     /// The normal row, when the normal law is unilateral.
     pub fn normal_row(&self) -> Option<&ContactRow> {
         match &self.normal {

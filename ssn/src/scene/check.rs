@@ -607,7 +607,9 @@ impl Check<'_> {
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
-        if !m.frictional_contacts.is_empty() && solver.method != Method::SsnHb {
+        if !m.frictional_contacts.is_empty()
+            && !matches!(solver.method, Method::SsnHb | Method::March)
+        {
             return Err(self.invalid(
                 "solver.method",
                 format!(
@@ -615,7 +617,7 @@ impl Check<'_> {
                     solver.method.name(),
                     m.frictional_contacts.len()
                 ),
-                "\"ssn-hb\" (the Coulomb disk of 3-D frictional contacts)",
+                "\"ssn-hb\" or \"march\" (the Coulomb disk of 3-D frictional contacts)",
             ));
         }
         let allowed = match solver.method.friction() {
