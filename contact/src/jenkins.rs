@@ -6,6 +6,10 @@
 //! `k_t [g_a; -e_a] [g_a; -e_a]^T` per direction) and moves the contact's tangent rows onto
 //! the sliders: the friction force acts on the sliders and reaches the structure through
 //! the springs. The sliders carry no mass, damping or load; the other rows are unchanged.
+//! [`expand_tangential_stiffness`] does it for every contact that carries a
+//! [`FrictionalContact::tangential_stiffness`](crate::model::FrictionalContact).
+//! [`expand_tangential_stiffness`] does it for every contact that carries a
+//! [`FrictionalContact::tangential_stiffness`](crate::model::FrictionalContact).
 
 use faer::sparse::Triplet;
 
@@ -83,7 +87,38 @@ pub fn with_tangential_stiffness(
         load,
         ..model.clone()
     };
-    out.frictional_contacts[point].tangents =
-        [ContactRow::unit(n, 1.0), ContactRow::unit(n + 1, 1.0)];
+    let contact = &mut out.frictional_contacts[point];
+    contact.tangents = [ContactRow::unit(n, 1.0), ContactRow::unit(n + 1, 1.0)];
+    contact.tangential_stiffness = None;
     Ok(out)
+}
+
+/// The model with the slider dofs of every frictional contact that carries a tangential
+/// stiffness ([`with_tangential_stiffness`], in the contacts' order); unchanged without one.
+pub fn expand_tangential_stiffness(
+    model: StructuralModel,
+) -> Result<StructuralModel, InvalidModel> {
+    let mut model = model;
+    for point in 0..model.frictional_contacts.len() {
+        if let Some(kt) = model.frictional_contacts[point].tangential_stiffness {
+            model = with_tangential_stiffness(&model, point, kt)?;
+        }
+    }
+    Ok(model)
+}
+
+/// Refuses a model whose frictional contact still carries a tangential stiffness (the
+/// solvers see only the expanded slider dofs).
+pub(crate) fn refuse_unexpanded(model: &StructuralModel) -> Result<(), InvalidModel> {
+    let carried = (model.frictional_contacts.iter().enumerate())
+        .find_map(|(p, c)| c.tangential_stiffness.map(|kt| (p, kt)));
+    match carried {
+        Some((point, value)) => Err(InvalidModel::FrictionalContactValue {
+            point,
+            part: "tangential stiffness not expanded",
+            value,
+            allowed: "slider dofs written by jenkins::expand_tangential_stiffness",
+        }),
+        None => Ok(()),
+    }
 }

@@ -22,6 +22,7 @@ use crate::progress::progress_spinner;
 use crate::scene::{Override, Scene, SweepSettings};
 use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
+use semismooth_contact::jenkins::expand_tangential_stiffness;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with};
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
@@ -128,7 +129,9 @@ pub fn prepare(
             let parts = &scene.load_parts;
             crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
                 .map_err(CliError::BadInput)?;
-            let structure = scene.apply_cyclic(structure).map_err(CliError::BadInput)?;
+            let mut structure = scene.apply_cyclic(structure).map_err(CliError::BadInput)?;
+            structure.model = expand_tangential_stiffness(structure.model)
+                .map_err(|e| CliError::BadInput(e.to_string()))?;
             if solves {
                 let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
                 crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;

@@ -148,6 +148,41 @@ fn the_circle_scene_marched_in_time_dissipates_two_pi_mu_n_r() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The circle scene with `tangential_stiffness = kt` (a 3-D Jenkins element: two massless
+/// slider dofs behind springs `kt`) slides the node on a circle of radius `r` (its x
+/// amplitude, `tip_max` with the output on node 7's first component) and dissipates
+/// `2 pi mu N sqrt(r^2 - (mu N / kt)^2)`, below the rigid contact's `2 pi mu N r`.
+#[test]
+fn a_node_contact_with_tangential_stiffness_dissipates_the_jenkins_closed_form() {
+    let dir = node_files("jenkins");
+    let kt = 1.0;
+    let path = scene(
+        &dir,
+        &format!(
+            "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3\n\
+             tangential_stiffness = {kt}"
+        ),
+    );
+    let text = std::fs::read_to_string(&path).unwrap() + "\n[output]\nnode = 7\ncomponent = 1\n";
+    std::fs::write(&path, text).unwrap();
+    let args = ["solve", path.to_str().unwrap(), "--json", "--quiet"];
+    let document = json_success(&ssn(&args));
+    let r = document["tip_max"].as_f64().unwrap();
+    let point = &document["frictional_contacts"][0];
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    let slip = MU * NORMAL;
+    let expected = 2.0 * PI * slip * (r * r - (slip / kt).powi(2)).sqrt();
+    // Exact at any H on the circle; r is the largest of the output samples of
+    // r cos(w t + phi), within r (1 - cos(pi / samples)) of r: 1e-4 relative is ample.
+    assert!(
+        (energy - expected).abs() < 1e-4 * expected,
+        "{energy} against {expected} (r = {r})"
+    );
+    assert!(energy < 2.0 * PI * slip * r);
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A normal that is not a unit vector, tangents not orthogonal to it, a negative
 /// coefficient, a second tangent parallel to the first and a method without the disk are
 /// refused with the key and the value.
@@ -175,7 +210,7 @@ fn a_bad_frame_or_coefficient_is_refused_with_its_key() {
         ),
         (
             "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3\n\
-             tangential_stiffness = 10.0",
+             tangential_stiffness = -10.0",
             "contact.point.tangential_stiffness",
         ),
     ];

@@ -196,6 +196,7 @@ impl<'a> TimeMarcher<'a> {
         options.validate()?;
         model.validate()?;
         model.refuse_cyclic("time marching")?;
+        crate::jenkins::refuse_unexpanded(model)?;
         check_omega(omega)?;
         let n = model.dofs();
         let m = model.contact_count();
