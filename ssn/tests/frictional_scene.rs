@@ -254,8 +254,61 @@ fn a_moving_obstacle_in_a_scene_drags_the_node_with_the_closed_form_energy() {
     std::fs::write(&path, text.replace("amplitude = 1.0", "amplitude = 0.0")).unwrap();
     let point = first_frictional_contact(&path);
     let point = &point;
+    let expected = dragged_energy(2.0 - 0.5);
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Exact at any H: every sample of the laws is; Newton's tolerance alone.
+    assert!(
+        (energy - expected).abs() < 1e-8 * expected,
+        "{energy} against {expected}"
+    );
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The same moving obstacle driving a scene with no `[forcing]` at all (no static press:
+/// the obstacle preloads the node through the gap -1.5, `N_0 = 1.5`), its period from
+/// `[obstacle] omega`: the same closed-form energy.
+#[test]
+fn a_scene_driven_by_its_moving_obstacle_alone_needs_no_forcing() {
+    let dir = node_files("obstacle-only");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = -1.5\nfriction = 0.3\ngap_cos = [0.1]\n\
+         sliding_velocity = [2.0, 1.0]",
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    let start = text.find("[forcing]").unwrap();
+    let end = text.find("[[contact.point]]").unwrap();
+    let text = format!(
+        "{}[obstacle]\nomega = {OMEGA}\n\n{}",
+        &text[..start],
+        &text[end..]
+    );
+    std::fs::write(&path, text).unwrap();
+    let point = first_frictional_contact(&path);
+    let expected = dragged_energy(1.5);
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Exact at any H: Newton's tolerance alone.
+    assert!(
+        (energy - expected).abs() < 1e-8 * expected,
+        "{energy} against {expected}"
+    );
+    // Without a moving obstacle a scene still needs its [forcing].
+    let still = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("gap_cos = [0.1]\nsliding_velocity = [2.0, 1.0]", "");
+    let message = Scene::from_toml(&still, &path).unwrap_err().to_string();
+    assert!(message.contains("forcing"), "{message}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The energy per cycle of the node (unit mass and stiffness, damping 0.05) pressed with the
+/// mean normal force `n0` on the obstacle whose gap moves by `0.1 cos w t` and which slides
+/// at `(2, 1)`: `mu |v| N_0 T - mu int N (u' . v / |v|) dt`, `u` the linear response along
+/// `v / |v|` to `mu N(t)` on harmonic 1.
+fn dragged_energy(n0: f64) -> f64 {
     let (w, c, a1) = (OMEGA, 0.05, 0.1);
-    let (n0, nc, ns) = (2.0 - 0.5, -(1.0 - w * w) * a1, c * w * a1);
+    let (nc, ns) = (-(1.0 - w * w) * a1, c * w * a1);
     let speed = 5f64.sqrt();
     // The scalar response along v / |v| to mu N(t) on harmonic 1 (unit m, k; damping c).
     let (kk, cw) = (1.0 - w * w, c * w);
@@ -266,13 +319,5 @@ fn a_moving_obstacle_in_a_scene_drags_the_node_with_the_closed_form_energy() {
     );
     let period = 2.0 * PI / w;
     let drag = 0.5 * period * (nc * w * us - ns * w * uc);
-    let expected = MU * speed * n0 * period - MU * drag;
-    let energy = point["dissipated_energy"].as_f64().unwrap();
-    // Exact at any H: every sample of the laws is; Newton's tolerance alone.
-    assert!(
-        (energy - expected).abs() < 1e-8 * expected,
-        "{energy} against {expected}"
-    );
-    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
-    std::fs::remove_dir_all(&dir).ok();
+    MU * speed * n0 * period - MU * drag
 }
