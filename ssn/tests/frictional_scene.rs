@@ -115,6 +115,41 @@ fn a_node_contact_in_a_scene_reports_the_circle_dissipation() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `ssn solve --csv` on the circle scene writes each 3-D contact's forces and slip
+/// velocities as columns, the tangential force of magnitude `mu N` on every row (the
+/// closed form), and the text summary has the contact's line.
+#[test]
+fn the_csv_and_the_text_of_a_solve_carry_the_3d_contact() {
+    let dir = node_files("csv");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
+    );
+    let csv = dir.join("out.csv");
+    let out = ssn(&[
+        "solve",
+        path.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let summary = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(summary.contains("3-D contact 1"), "{summary}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t1, t2) = (column("contact3d_1_t1"), column("contact3d_1_t2"));
+    column("contact3d_1_v2");
+    for row in lines.filter(|l| !l.is_empty()) {
+        let values: Vec<f64> = row.split(',').map(|v| v.trim().parse().unwrap()).collect();
+        // Exact on the circle: Newton's tolerance, and the CSV's printed digits.
+        let magnitude = values[t1].hypot(values[t2]);
+        assert!((magnitude - MU * NORMAL).abs() < 1e-6, "{row}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The circle scene marched in time (`method = "march"`, the node massive: Moreau–Jean
 /// with the impact law on the normal row and the disk per step) settles on the same
 /// circle: its normal force, slip fraction and dissipation against `2 pi mu N r`.
