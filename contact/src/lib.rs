@@ -17,6 +17,7 @@ pub mod exact;
 pub mod from_zero;
 pub mod hb;
 pub mod import;
+pub mod jenkins;
 pub mod law;
 pub mod lcp;
 pub mod march;

@@ -312,13 +312,9 @@ fn a_point_on_an_ellipse_dissipates_mu_n_times_its_perimeter() {
     }
 }
 
-/// A 3-D Jenkins element (spring `k_t` to a massless slider pair under the disk) driven on
-/// a circle dissipates `2 pi mu N sqrt(r^2 - (mu N / k_t)^2)`, exactly at `H = 1`.
-#[test]
-fn a_jenkins_element_on_a_circle_dissipates_the_closed_form_energy() {
-    // On a circle the drive's stiffness does not matter: a soft one keeps every dof's
-    // residual O(1), and Newton's tolerance 1e-12 gives the energy to ~1e-11.
-    let (kt, drive) = (2.0 * SLIP, 10.0);
+/// The driven point (drive stiffness `drive`) with a hand-built 3-D Jenkins element: springs
+/// `kt` from dofs 0, 1 to the massless sliders 2, 3 written in `K`, the disk on the sliders.
+fn hand_built_jenkins(kt: f64, drive: f64) -> StructuralModel {
     let mut entries = Vec::new();
     for d in 0..2 {
         let (x, s) = (d, d + 2);
@@ -329,6 +325,17 @@ fn a_jenkins_element_on_a_circle_dissipates_the_closed_form_energy() {
     let stiffness = SparseMatrix::try_new_from_triplets(4, 4, &entries).unwrap();
     let mut model = driven((1.0, 1.0, drive), stiffness, 4);
     model.frictional_contacts.push(prescribed_disk(2));
+    model
+}
+
+/// A 3-D Jenkins element (spring `k_t` to a massless slider pair under the disk) driven on
+/// a circle dissipates `2 pi mu N sqrt(r^2 - (mu N / k_t)^2)`, exactly at `H = 1`.
+#[test]
+fn a_jenkins_element_on_a_circle_dissipates_the_closed_form_energy() {
+    // On a circle the drive's stiffness does not matter: a soft one keeps every dof's
+    // residual O(1), and Newton's tolerance 1e-12 gives the energy to ~1e-11.
+    let (kt, drive) = (2.0 * SLIP, 10.0);
+    let model = hand_built_jenkins(kt, drive);
     for harmonics in [1, 3] {
         let (hb, x) = solve(
             &model,
@@ -630,4 +637,37 @@ fn a_point_under_a_sliding_moving_obstacle_is_dragged_by_the_closed_form_force()
         // Central differences of an O(10) residual with a step of 1e-6: error ~1e-8.
         assert!((d - fd).abs() < 1e-6, "entry {i}: {d} against {fd}");
     }
+}
+
+/// `jenkins::with_tangential_stiffness` on the driven point builds the hand-written Jenkins
+/// element of [`a_jenkins_element_on_a_circle_dissipates_the_closed_form_energy`]: the
+/// same solution to Newton's tolerance, and `2 pi mu N sqrt(r^2 - (mu N / k_t)^2)` on the
+/// circle; a bad stiffness or index is refused.
+#[test]
+fn the_tangential_stiffness_sugar_is_the_hand_built_jenkins_element() {
+    use semismooth_contact::jenkins::with_tangential_stiffness;
+    let (kt, drive) = (2.0 * SLIP, 10.0);
+    let mut point = driven((1.0, 1.0, drive), diagonal(&[drive; 2]), 2);
+    point.frictional_contacts.push(prescribed_disk(0));
+    let sugar = with_tangential_stiffness(&point, 0, kt).unwrap();
+    assert_eq!(sugar.dofs(), 4);
+    assert!(with_tangential_stiffness(&point, 0, 0.0).is_err());
+    assert!(with_tangential_stiffness(&point, 1, kt).is_err());
+    let (hb, x) = solve(&sugar, (DRIVE_OMEGA, 3, 1e-12), &mut FaerDenseLu::new());
+    let (r, minor) = semi_axes(&x, 4);
+    // Exact on the circle: Newton's error alone (|F| <= 1e-12 on O(1) residuals).
+    assert!((r - minor).abs() < 1e-10, "a circle: {r} and {minor}");
+    let expected = 2.0 * PI * SLIP * (r * r - (SLIP / kt).powi(2)).sqrt();
+    let report = hb.frictional_contact_report(&x, 0, 64).unwrap();
+    assert!((report.dissipated_energy / expected - 1.0).abs() < 1e-10);
+    let (_, y) = solve(
+        &hand_built_jenkins(kt, drive),
+        (DRIVE_OMEGA, 3, 1e-12),
+        &mut FaerDenseLu::new(),
+    );
+    let gap = x
+        .iter()
+        .zip(&y)
+        .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+    assert!(gap < 1e-10, "{gap:e}");
 }

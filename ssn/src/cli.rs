@@ -22,6 +22,7 @@ use crate::progress::progress_spinner;
 use crate::scene::{Override, Scene, SweepSettings};
 use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
+use semismooth_contact::jenkins::expand_tangential_stiffness;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with};
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
@@ -129,7 +130,9 @@ pub fn prepare(
             let parts = &scene.load_parts;
             crate::scene::add_load_parts(parts, spec.amplitude, &mut structure.model, matrices)
                 .map_err(CliError::BadInput)?;
-            let structure = scene.apply_cyclic(structure).map_err(CliError::BadInput)?;
+            let mut structure = scene.apply_cyclic(structure).map_err(CliError::BadInput)?;
+            structure.model = expand_tangential_stiffness(structure.model)
+                .map_err(|e| CliError::BadInput(e.to_string()))?;
             if solves {
                 let need = crate::limits::structure_memory(&structure, &scene.solver, compare);
                 crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
@@ -486,6 +489,7 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         columns.push(f);
         headers.push(format!("lambda_{i}"));
     }
+    frictional_columns(&solution, &mut columns, &mut headers);
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
         solve_plot(&solution, &rod)
@@ -515,6 +519,29 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         // An accuracy target not met is a run that did not converge (exit code 1).
         solution.converged() && solution.search.as_ref().is_none_or(|s| s.met()),
     )
+}
+
+/// The CSV columns of each 3-D frictional contact `p` (1-based) at the solution's times:
+/// `contact3d_{p}_normal`, `_t1`, `_t2` (forces) and `_v1`, `_v2` (slip velocities).
+fn frictional_columns<'a>(
+    solution: &'a Solution,
+    columns: &mut Vec<&'a [f64]>,
+    headers: &mut Vec<String>,
+) {
+    let times = solution.times.len();
+    for p in &solution.frictional_contacts {
+        let series = [
+            ("normal", &p.normal_force),
+            ("t1", &p.tangential_force[0]),
+            ("t2", &p.tangential_force[1]),
+            ("v1", &p.slip_velocity[0]),
+            ("v2", &p.slip_velocity[1]),
+        ];
+        for (name, values) in series.into_iter().filter(|(_, v)| v.len() == times) {
+            columns.push(values);
+            headers.push(format!("contact3d_{}_{name}", p.point + 1));
+        }
+    }
 }
 
 /// The SVG of a solve: the tip over one period, with the obstacles of `rod`.

@@ -545,6 +545,7 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
                 )?;
             }
         }
+        t += &frictional_contact_lines(s);
         writeln!(
             t,
             "work              {} residuals, {} Jacobians, {} factorizations, {} solves, {} FFTs{}",
@@ -572,6 +573,27 @@ fn result_lines(s: &Solution) -> String {
         "tip max / min     {:.6} / {:.6}\nmax penetration   {:.3e}\nmean contact force {:.6e}\n",
         s.stats.max, s.stats.min, s.stats.max_penetration, s.stats.mean_contact_force
     )
+}
+
+/// One line per 3-D frictional contact: its energy per cycle, largest normal force and
+/// stick / slip / separated fractions (nothing without one).
+fn frictional_contact_lines(s: &Solution) -> String {
+    s.frictional_contacts
+        .iter()
+        .map(|p| {
+            let normal = p.normal_force.iter().fold(0.0f64, |a, f| a.max(-f));
+            format!(
+                "  3-D contact {:<3} energy per cycle {:.6e}, max normal force {:.6e}, stick / \
+                 slip / separated {:.1} / {:.1} / {:.1} % of the period\n",
+                p.point + 1,
+                p.dissipated_energy,
+                normal,
+                100.0 * p.stick_fraction,
+                100.0 * p.slip_fraction,
+                100.0 * p.separated_fraction
+            )
+        })
+        .collect()
 }
 
 /// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.

@@ -115,6 +115,109 @@ fn a_node_contact_in_a_scene_reports_the_circle_dissipation() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `ssn solve --csv` on the circle scene writes each 3-D contact's forces and slip
+/// velocities as columns, the tangential force of magnitude `mu N` on every row (the
+/// closed form), and the text summary has the contact's line.
+#[test]
+fn the_csv_and_the_text_of_a_solve_carry_the_3d_contact() {
+    let dir = node_files("csv");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
+    );
+    let csv = dir.join("out.csv");
+    let out = ssn(&[
+        "solve",
+        path.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let summary = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(summary.contains("3-D contact 1"), "{summary}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t1, t2) = (column("contact3d_1_t1"), column("contact3d_1_t2"));
+    column("contact3d_1_v2");
+    for row in lines.filter(|l| !l.is_empty()) {
+        let values: Vec<f64> = row.split(',').map(|v| v.trim().parse().unwrap()).collect();
+        // Exact on the circle: Newton's tolerance, and the CSV's printed digits.
+        let magnitude = values[t1].hypot(values[t2]);
+        assert!((magnitude - MU * NORMAL).abs() < 1e-6, "{row}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The circle scene marched in time (`method = "march"`, the node massive: Moreau–Jean
+/// with the impact law on the normal row and the disk per step) settles on the same
+/// circle: its normal force, slip fraction and dissipation against `2 pi mu N r`.
+#[test]
+fn the_circle_scene_marched_in_time_dissipates_two_pi_mu_n_r() {
+    let dir = node_files("circle-march");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
+    );
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "method = \"ssn-hb\"\nharmonics = 3",
+        "method = \"march\"\nsteps_per_period = 1000",
+    );
+    std::fs::write(&path, text).unwrap();
+    let point = first_frictional_contact(&path);
+    let expected = 2.0 * PI * MU * NORMAL * circle_radius();
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Moreau–Jean is first order here: the friction impulse acts on the end-of-step
+    // velocity, and the node rests on the obstacle at the O(h) penetration of its landing
+    // (the velocity-level impact law keeps it), which lowers N by O(h). Measured 1.7e-3
+    // relative at 1000 steps per period; asserted 5e-3.
+    assert!(
+        (energy - expected).abs() < 5e-3 * expected,
+        "{energy} against {expected}"
+    );
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
+    for f in point["normal_force"].as_array().unwrap() {
+        assert!((f.as_f64().unwrap() + NORMAL).abs() < 5e-3 * NORMAL);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The circle scene with `tangential_stiffness = kt` (a 3-D Jenkins element: two massless
+/// slider dofs behind springs `kt`) slides the node on a circle of radius `r` (its x
+/// amplitude, `tip_max` with the output on node 7's first component) and dissipates
+/// `2 pi mu N sqrt(r^2 - (mu N / kt)^2)`, below the rigid contact's `2 pi mu N r`.
+#[test]
+fn a_node_contact_with_tangential_stiffness_dissipates_the_jenkins_closed_form() {
+    let dir = node_files("jenkins");
+    let kt = 1.0;
+    let path = scene(
+        &dir,
+        &format!(
+            "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3\n\
+             tangential_stiffness = {kt}"
+        ),
+    );
+    let text = std::fs::read_to_string(&path).unwrap() + "\n[output]\nnode = 7\ncomponent = 1\n";
+    std::fs::write(&path, text).unwrap();
+    let args = ["solve", path.to_str().unwrap(), "--json", "--quiet"];
+    let document = json_success(&ssn(&args));
+    let r = document["tip_max"].as_f64().unwrap();
+    let point = &document["frictional_contacts"][0];
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    let slip = MU * NORMAL;
+    let expected = 2.0 * PI * slip * (r * r - (slip / kt).powi(2)).sqrt();
+    // Exact at any H on the circle; r is the largest of the output samples of
+    // r cos(w t + phi), within r (1 - cos(pi / samples)) of r: 1e-4 relative is ample.
+    assert!(
+        (energy - expected).abs() < 1e-4 * expected,
+        "{energy} against {expected} (r = {r})"
+    );
+    assert!(energy < 2.0 * PI * slip * r);
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A normal that is not a unit vector, tangents not orthogonal to it, a negative
 /// coefficient, a second tangent parallel to the first and a method without the disk are
 /// refused with the key and the value.
@@ -142,7 +245,7 @@ fn a_bad_frame_or_coefficient_is_refused_with_its_key() {
         ),
         (
             "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3\n\
-             tangential_stiffness = 10.0",
+             tangential_stiffness = -10.0",
             "contact.point.tangential_stiffness",
         ),
     ];
@@ -163,7 +266,7 @@ fn a_bad_frame_or_coefficient_is_refused_with_its_key() {
     );
     let text = std::fs::read_to_string(&path)
         .unwrap()
-        .replace("ssn-hb", "march");
+        .replace("ssn-hb", "penalty-hb");
     let message = Scene::from_toml(&text, &path).unwrap_err().to_string();
     assert!(message.contains("solver.method"), "{message}");
     std::fs::remove_dir_all(&dir).ok();
@@ -186,8 +289,61 @@ fn a_moving_obstacle_in_a_scene_drags_the_node_with_the_closed_form_energy() {
     std::fs::write(&path, text.replace("amplitude = 1.0", "amplitude = 0.0")).unwrap();
     let point = first_frictional_contact(&path);
     let point = &point;
+    let expected = dragged_energy(2.0 - 0.5);
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Exact at any H: every sample of the laws is; Newton's tolerance alone.
+    assert!(
+        (energy - expected).abs() < 1e-8 * expected,
+        "{energy} against {expected}"
+    );
+    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The same moving obstacle driving a scene with no `[forcing]` at all (no static press:
+/// the obstacle preloads the node through the gap -1.5, `N_0 = 1.5`), its period from
+/// `[obstacle] omega`: the same closed-form energy.
+#[test]
+fn a_scene_driven_by_its_moving_obstacle_alone_needs_no_forcing() {
+    let dir = node_files("obstacle-only");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = -1.5\nfriction = 0.3\ngap_cos = [0.1]\n\
+         sliding_velocity = [2.0, 1.0]",
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    let start = text.find("[forcing]").unwrap();
+    let end = text.find("[[contact.point]]").unwrap();
+    let text = format!(
+        "{}[obstacle]\nomega = {OMEGA}\n\n{}",
+        &text[..start],
+        &text[end..]
+    );
+    std::fs::write(&path, text).unwrap();
+    let point = first_frictional_contact(&path);
+    let expected = dragged_energy(1.5);
+    let energy = point["dissipated_energy"].as_f64().unwrap();
+    // Exact at any H: Newton's tolerance alone.
+    assert!(
+        (energy - expected).abs() < 1e-8 * expected,
+        "{energy} against {expected}"
+    );
+    // Without a moving obstacle a scene still needs its [forcing].
+    let still = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("gap_cos = [0.1]\nsliding_velocity = [2.0, 1.0]", "");
+    let message = Scene::from_toml(&still, &path).unwrap_err().to_string();
+    assert!(message.contains("forcing"), "{message}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The energy per cycle of the node (unit mass and stiffness, damping 0.05) pressed with the
+/// mean normal force `n0` on the obstacle whose gap moves by `0.1 cos w t` and which slides
+/// at `(2, 1)`: `mu |v| N_0 T - mu int N (u' . v / |v|) dt`, `u` the linear response along
+/// `v / |v|` to `mu N(t)` on harmonic 1.
+fn dragged_energy(n0: f64) -> f64 {
     let (w, c, a1) = (OMEGA, 0.05, 0.1);
-    let (n0, nc, ns) = (2.0 - 0.5, -(1.0 - w * w) * a1, c * w * a1);
+    let (nc, ns) = (-(1.0 - w * w) * a1, c * w * a1);
     let speed = 5f64.sqrt();
     // The scalar response along v / |v| to mu N(t) on harmonic 1 (unit m, k; damping c).
     let (kk, cw) = (1.0 - w * w, c * w);
@@ -198,13 +354,5 @@ fn a_moving_obstacle_in_a_scene_drags_the_node_with_the_closed_form_energy() {
     );
     let period = 2.0 * PI / w;
     let drag = 0.5 * period * (nc * w * us - ns * w * uc);
-    let expected = MU * speed * n0 * period - MU * drag;
-    let energy = point["dissipated_energy"].as_f64().unwrap();
-    // Exact at any H: every sample of the laws is; Newton's tolerance alone.
-    assert!(
-        (energy - expected).abs() < 1e-8 * expected,
-        "{energy} against {expected}"
-    );
-    assert_eq!(point["slip_fraction"].as_f64(), Some(1.0));
-    std::fs::remove_dir_all(&dir).ok();
+    MU * speed * n0 * period - MU * drag
 }

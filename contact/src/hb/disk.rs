@@ -123,6 +123,63 @@ impl SsnHb {
 }
 
 impl FrictionalContactReport {
+    /// The report of a time-marched contact from its normal force, tangential force and
+    /// slip velocity at the equal steps of one period (the closing sample dropped) of a
+    /// response at `omega`: a closed step sticks where `|v_t|` is below `stick_velocity`,
+    /// the energy is the rectangle rule on the steps.
+    pub fn from_march(
+        point: usize,
+        normal_force: Vec<f64>,
+        (tangential_force, slip_velocity): ([Vec<f64>; 2], [Vec<f64>; 2]),
+        omega: f64,
+        stick_velocity: f64,
+    ) -> Self {
+        let stuck = (0..normal_force.len())
+            .map(|n| slip_velocity[0][n].hypot(slip_velocity[1][n]) <= stick_velocity)
+            .collect();
+        Self::from_series(
+            point,
+            normal_force,
+            (tangential_force, slip_velocity),
+            stuck,
+            omega,
+        )
+    }
+
+    /// The report from the series and whether each sample sticks (when closed): the
+    /// energy `-int lambda_t . v_t dt` by the rectangle rule, the fractions.
+    fn from_series(
+        point: usize,
+        normal_force: Vec<f64>,
+        (tangential_force, slip_velocity): ([Vec<f64>; 2], [Vec<f64>; 2]),
+        stuck: Vec<bool>,
+        omega: f64,
+    ) -> Self {
+        let points = normal_force.len();
+        let (mut stick, mut slip, mut work) = (0usize, 0usize, 0.0);
+        for n in 0..points {
+            work += tangential_force[0][n] * slip_velocity[0][n]
+                + tangential_force[1][n] * slip_velocity[1][n];
+            match (normal_force[n] < 0.0, stuck[n]) {
+                (true, true) => stick += 1,
+                (true, false) => slip += 1,
+                (false, _) => {}
+            }
+        }
+        let fraction = |k: usize| k as f64 / points.max(1) as f64;
+        let period = 2.0 * std::f64::consts::PI / omega;
+        Self {
+            point,
+            normal_force,
+            tangential_force,
+            slip_velocity,
+            dissipated_energy: -work * period / points.max(1) as f64,
+            stick_fraction: fraction(stick),
+            slip_fraction: fraction(slip),
+            separated_fraction: fraction(points - stick - slip),
+        }
+    }
+
     /// The report from the normal force, the disk law's arguments `z_t` and radii, the slip
     /// velocity samples and the angular frequency (the period `2 pi / omega`).
     fn from_samples(
@@ -134,32 +191,16 @@ impl FrictionalContactReport {
     ) -> Self {
         let points = normal_force.len();
         let mut force = [vec![0.0; points], vec![0.0; points]];
-        let (mut stick, mut slip, mut work) = (0usize, 0usize, 0.0);
+        let mut stuck = vec![false; points];
         for n in 0..points {
             let z = [argument[0][n], argument[1][n]];
             let (norm, r) = (z[0].hypot(z[1]), radius[n]);
             let scale = if norm > r { r / norm } else { 1.0 };
             for a in 0..2 {
                 force[a][n] = scale * z[a];
-                work += force[a][n] * slip_velocity[a][n];
             }
-            match (normal_force[n] < 0.0, norm < r) {
-                (true, true) => stick += 1,
-                (true, false) => slip += 1,
-                (false, _) => {}
-            }
+            stuck[n] = norm < r;
         }
-        let fraction = |k: usize| k as f64 / points.max(1) as f64;
-        let period = 2.0 * std::f64::consts::PI / omega;
-        Self {
-            point,
-            normal_force,
-            tangential_force: force,
-            slip_velocity,
-            dissipated_energy: -work * period / points.max(1) as f64,
-            stick_fraction: fraction(stick),
-            slip_fraction: fraction(slip),
-            separated_fraction: fraction(points - stick - slip),
-        }
+        Self::from_series(point, normal_force, (force, slip_velocity), stuck, omega)
     }
 }

@@ -338,6 +338,7 @@ impl LinearData {
         groups: &[LawGroup],
     ) -> Result<Self, HbError> {
         model.validate()?;
+        crate::jenkins::refuse_unexpanded(model)?;
         validate_basis(harmonics, time_samples)?;
         model.load.check_harmonics(harmonics)?;
         for (point, p) in model.frictional_contacts.iter().enumerate() {

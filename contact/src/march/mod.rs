@@ -320,6 +320,13 @@ pub struct SteadyPeriod {
     /// One series per friction point, at [`SteadyPeriod::times`]: its slip velocity
     /// `g_t . v` at the end of the step.
     pub slip_velocities: Vec<Vec<f64>>,
+    /// One series per row of the 3-D frictional contacts (per contact its normal force
+    /// `<= 0` when unilateral, then its two tangential forces), at
+    /// [`SteadyPeriod::times`] (impulse / h).
+    pub frictional_forces: Vec<Vec<f64>>,
+    /// Two series per 3-D frictional contact, at [`SteadyPeriod::times`]: its slip
+    /// velocity `g_a . v` minus the obstacle's sliding velocity, `a = 1, 2`.
+    pub frictional_slip_velocities: Vec<Vec<f64>>,
     /// Periods marched, the reported one included.
     pub periods: usize,
     /// Relative period-to-period change of the last period (below the tolerance).
@@ -445,11 +452,14 @@ pub(crate) fn column_max_abs(m: &SparseMatrix, j: usize) -> f64 {
 pub fn resolve_scheme(model: &StructuralModel, scheme: MarchScheme) -> MarchScheme {
     let massless = |dof: &usize| column_max_abs(&model.mass, *dof) == 0.0;
     match scheme {
-        MarchScheme::Auto if !model.friction.is_empty() => {
-            if model
-                .contacts
+        MarchScheme::Auto if model.has_friction() => {
+            let normal_rows = model
+                .frictional_contacts
                 .iter()
-                .flat_map(|c| c.row.dofs())
+                .filter_map(|p| p.normal_row());
+            if (model.contacts.iter().map(|c| &c.row))
+                .chain(normal_rows)
+                .flat_map(|row| row.dofs())
                 .any(massless)
             {
                 MarchScheme::MoreauJean {
@@ -530,9 +540,12 @@ pub fn march_from_state(
     let mut series = vec![0.0; nobs * samples];
     let mut previous_series = vec![0.0; nobs * samples];
     let mut forces = vec![0.0; m * samples];
-    // Friction forces and slip velocities `g_t . v` of the current period.
+    // Friction forces and slip velocities `g_t . v` of the current period, then the 3-D
+    // contacts' row forces and slip velocities.
     let nf = model.friction_count();
-    let mut friction = vec![0.0; 2 * nf * samples];
+    let (nr, nd) = (model.row_count() - m - nf, model.frictional_contacts.len());
+    let width = 2 * nf + nr + 2 * nd;
+    let mut friction = vec![0.0; width * samples];
     let mut start = vec![0.0; 2 * n];
     let mut previous_start = vec![0.0; 2 * n];
     let record = |marcher: &TimeMarcher,
@@ -543,11 +556,15 @@ pub fn march_from_state(
             series[s * nobs + o] = marcher.displacement()[dof];
         }
         forces[s * m..(s + 1) * m].copy_from_slice(marcher.contact_force());
-        let (force, velocity) = friction[2 * nf * s..2 * nf * (s + 1)].split_at_mut(nf);
+        let (force, rest) = friction[width * s..width * (s + 1)].split_at_mut(nf);
+        let (velocity, disks) = rest.split_at_mut(nf);
         force.copy_from_slice(marcher.friction_force());
         for (v, point) in velocity.iter_mut().zip(&model.friction) {
             *v = point.tangent.dot(marcher.velocity());
         }
+        let (disk_force, disk_velocity) = disks.split_at_mut(nr);
+        disk_force.copy_from_slice(marcher.frictional_force());
+        marcher.frictional_slip_velocities(disk_velocity);
     };
     let mut change = f64::INFINITY;
     let h = marcher.step_size();
@@ -556,11 +573,11 @@ pub fn march_from_state(
                  (forces, friction): (&[f64], &[f64]),
                  periods: usize,
                  change: f64| {
-        let friction_series = |offset: usize| -> Vec<Vec<f64>> {
-            (0..nf)
+        let friction_series = |offset: usize, count: usize| -> Vec<Vec<f64>> {
+            (0..count)
                 .map(|f| {
                     (0..samples)
-                        .map(|s| friction[2 * nf * s + offset + f])
+                        .map(|s| friction[width * s + offset + f])
                         .collect()
                 })
                 .collect()
@@ -576,8 +593,10 @@ pub fn march_from_state(
             contact_forces: (0..m)
                 .map(|k| (0..samples).map(|s| forces[s * m + k]).collect())
                 .collect(),
-            friction_forces: friction_series(0),
-            slip_velocities: friction_series(nf),
+            friction_forces: friction_series(0, nf),
+            slip_velocities: friction_series(nf, nf),
+            frictional_forces: friction_series(2 * nf, nr),
+            frictional_slip_velocities: friction_series(2 * nf + nr, 2 * nd),
             periods,
             period_change: change,
             counters: marcher.counters(),

@@ -173,7 +173,10 @@ pub struct TimeMarcher<'a> {
     coulomb: Option<Box<CoulombStep>>,
     /// Friction forces of the last step (impulse / h), one per friction point.
     friction_force: Vec<f64>,
-    /// `G v_free` of every row, `e g . v_n` and the predicted state of every contact.
+    /// Forces of the last step (impulse / h) on the 3-D frictional contacts' rows (normal
+    /// when unilateral, then the two tangents, per contact).
+    frictional_force: Vec<f64>,
+    /// `G v_free` of every row, `e g . v_n` and the predicted state of every unilateral row.
     row_free: Vec<f64>,
     restitution: Vec<f64>,
     closed: Vec<bool>,
@@ -193,27 +196,21 @@ impl<'a> TimeMarcher<'a> {
         options.validate()?;
         model.validate()?;
         model.refuse_cyclic("time marching")?;
+        crate::jenkins::refuse_unexpanded(model)?;
         check_omega(omega)?;
         let n = model.dofs();
         let m = model.contact_count();
         initial.check(n, m)?;
-        if !model.frictional_contacts.is_empty() {
-            return Err(MarchError::InvalidOption(InvalidOption::new(
-                "frictional contacts marched in time",
-                model.frictional_contacts.len() as f64,
-                "none: time marching has no Coulomb disk yet; solve them with ssn-hb",
-            )));
-        }
         let scheme = Scheme::resolve(model, options.scheme);
-        if scheme == Scheme::Trapezoidal && !model.friction.is_empty() {
+        if scheme == Scheme::Trapezoidal && model.has_friction() {
             return Err(MarchError::InvalidOption(InvalidOption::new(
-                "friction points marched by the trapezoidal scheme (every row dof massless)",
-                model.friction.len() as f64,
+                "friction marched by the trapezoidal scheme (every row dof massless)",
+                (model.friction.len() + model.frictional_contacts.len()) as f64,
                 "none: Coulomb's law acts on velocities, the trapezoidal scheme imposes \
                           positions; march with MoreauJean",
             )));
         }
-        let rows = m + model.friction_count();
+        let rows = model.row_count();
         let massless: Vec<bool> = (0..n)
             .map(|j| column_max_abs(&model.mass, j) == 0.0)
             .collect();
@@ -254,8 +251,9 @@ impl<'a> TimeMarcher<'a> {
                 w[(i, k)] = row_i.dot(col);
             }
         }
-        let coulomb =
-            (!model.friction.is_empty()).then(|| Box::new(CoulombStep::new(model, w.clone(), h)));
+        let coulomb = model
+            .has_friction()
+            .then(|| Box::new(CoulombStep::new(model, w.clone(), h)));
         let mut marcher = Self {
             model,
             scheme,
@@ -281,9 +279,10 @@ impl<'a> TimeMarcher<'a> {
             active: Vec::with_capacity(m),
             coulomb,
             friction_force: vec![0.0; model.friction_count()],
+            frictional_force: vec![0.0; rows - m - model.friction_count()],
             row_free: vec![0.0; rows],
-            restitution: vec![0.0; m],
-            closed: vec![false; m],
+            restitution: vec![0.0; rows],
+            closed: vec![false; rows],
             counters: MarchCounters {
                 factorizations: 1,
                 linear_solves: rows as u64 + 1,
@@ -352,6 +351,22 @@ impl<'a> TimeMarcher<'a> {
     /// Friction forces of the last step (impulse / h), one per friction point.
     pub fn friction_force(&self) -> &[f64] {
         &self.friction_force
+    }
+
+    /// Forces of the last step (impulse / h) on the 3-D frictional contacts' rows: per
+    /// contact its normal force (when unilateral; `<= 0`) and its two tangential forces.
+    pub fn frictional_force(&self) -> &[f64] {
+        &self.frictional_force
+    }
+
+    /// Writes the slip velocities of the 3-D frictional contacts, `g_a . v` minus the
+    /// obstacle's sliding velocity, two per contact, into `out`.
+    pub fn frictional_slip_velocities(&self, out: &mut [f64]) {
+        let tangents = (self.model.frictional_contacts.iter())
+            .flat_map(|p| p.tangents.iter().zip(p.sliding_velocity));
+        for (o, (row, sliding)) in out.iter_mut().zip(tangents) {
+            *o = row.dot(&self.v) - sliding;
+        }
     }
 
     /// Work so far.
@@ -507,7 +522,7 @@ impl<'a> TimeMarcher<'a> {
         sparse_mul_add(model.stiffness.as_ref(), -h, &self.tmp, &mut self.rhs);
         self.solve_rhs()?;
         if self.coulomb.is_some() {
-            self.solve_contacts_with_friction(j, e)?;
+            self.solve_contacts_with_friction(j, (theta, e))?;
         } else {
             self.solve_impacts(j, e)?;
         }
@@ -536,20 +551,58 @@ impl<'a> TimeMarcher<'a> {
     }
 
     /// The Moreau–Jean contact and friction step on `rhs = v_free` (module
-    /// [`super::friction`]): contacts closed by the predicted gap, the impulses by the
-    /// core's semismooth Newton, `rhs += Y r`.
-    fn solve_contacts_with_friction(&mut self, j: usize, e: f64) -> Result<(), MarchError> {
+    /// [`super::friction`]): unilateral rows closed by the predicted gap, the impulses by the
+    /// core's semismooth Newton, `rhs += Y r`. A moving obstacle enters as the relative
+    /// velocities: its gap rate `gap'(t)` off a 3-D contact's normal row, its sliding
+    /// velocity off the tangent rows. A 3-D contact's normal row on massless dofs only
+    /// carries no inertia, so it takes Signorini's law on the positions at `t_{n+1}`
+    /// instead of an impact law: `g_n . u_{n+1} <= gap(t_{n+1})` with
+    /// `u_{n+1} = u_n + h (theta v_{n+1} + (1 - theta) v_n)`, i.e. the row velocity
+    /// `g_n . v_{n+1}` at most `(gap(t_{n+1}) - g_n . u_n - h (1 - theta) g_n . v_n) /
+    /// (h theta)`, always in the step's problem (no predicted active set, which a massless
+    /// dof resting on the gap would leave by round-off and then jump past the obstacle).
+    fn solve_contacts_with_friction(
+        &mut self,
+        j: usize,
+        (theta, e): (f64, f64),
+    ) -> Result<(), MarchError> {
         let model = self.model;
         let (n, h) = (self.u.len(), self.h);
         for (k, row) in model.rows().enumerate() {
             self.row_free[k] = row.dot(&self.rhs);
         }
-        for (k, ct) in model.contacts.iter().enumerate() {
-            let (gu, gv) = (ct.row.dot(&self.u), ct.row.dot(&self.v));
-            self.closed[k] = ct.gap - (gu + 0.5 * h * gv) <= 0.0;
-            self.restitution[k] = e * gv;
+        let unilateral = model.contacts.iter().map(|ct| (&ct.row, ct.gap, 0.0, 0.0));
+        let (t, omega) = (j as f64 * h, self.omega());
+        let mut row = model.contact_count() + model.friction_count();
+        let mut obstacles = Vec::new();
+        for point in &model.frictional_contacts {
+            if let Some(normal) = point.normal_row() {
+                let (gap, _) = point.gap_at(omega, t + 0.5 * h);
+                let (_, rate_before) = point.gap_at(omega, t);
+                let (gap_after, rate_after) = point.gap_at(omega, t + h);
+                if normal.dofs().iter().all(|d| self.massless[*d]) {
+                    let (gu, gv) = (normal.dot(&self.u), normal.dot(&self.v));
+                    let reach = gap_after - gu - h * (1.0 - theta) * gv;
+                    self.row_free[row] -= reach / (h * theta);
+                    (self.closed[row], self.restitution[row]) = (true, 0.0);
+                } else {
+                    self.row_free[row] -= rate_after;
+                    obstacles.push((row, (normal, gap, rate_before, rate_after)));
+                }
+                row += 1;
+            }
+            for a in 0..2 {
+                self.row_free[row + a] -= point.sliding_velocity[a];
+            }
+            row += 2;
         }
-        let coulomb = self.coulomb.as_mut().expect("friction points present");
+        let rows = (0..model.contact_count()).zip(unilateral);
+        for (k, (normal, gap, rate_before, _)) in rows.chain(obstacles) {
+            let (gu, gv) = (normal.dot(&self.u), normal.dot(&self.v));
+            self.closed[k] = gap - (gu + 0.5 * h * gv) <= 0.0;
+            self.restitution[k] = e * (gv - rate_before);
+        }
+        let coulomb = self.coulomb.as_mut().expect("friction present");
         let solved = coulomb.solve(&self.row_free, &self.restitution, &self.closed);
         solved.map_err(|unsolved| MarchError::FrictionSolve {
             period: self.completed_periods + 1,
@@ -558,13 +611,15 @@ impl<'a> TimeMarcher<'a> {
             tolerance: unsolved.tolerance,
         })?;
         self.counters.contact_solves += 1;
-        let m = model.contact_count();
+        let (m, nf) = (model.contact_count(), model.friction_count());
         let mut any = false;
         for (k, r) in coulomb.impulses().enumerate() {
             if k < m {
                 self.lambda[k] = r / h;
-            } else {
+            } else if k < m + nf {
                 self.friction_force[k - m] = r / h;
+            } else {
+                self.frictional_force[k - m - nf] = r / h;
             }
             if r != 0.0 {
                 any = true;
@@ -578,6 +633,11 @@ impl<'a> TimeMarcher<'a> {
             self.counters.active_steps += 1;
         }
         Ok(())
+    }
+
+    /// The forcing's angular frequency `2 pi / (steps_per_period h)`.
+    fn omega(&self) -> f64 {
+        2.0 * PI / (self.steps_per_period as f64 * self.h)
     }
 }
 

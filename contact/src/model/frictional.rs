@@ -45,6 +45,10 @@ pub struct FrictionalContact {
     /// The obstacle's constant velocity along the two tangents: the slip is the
     /// structure's tangential velocity minus it (`[0, 0]`: a fixed obstacle).
     pub sliding_velocity: [f64; 2],
+    /// A spring `k_t` in series with the slider (3-D Jenkins element) still to be written
+    /// as slider dofs by [`crate::jenkins::expand_tangential_stiffness`]; the solvers refuse
+    /// a model that still carries one (`None`: a rigid contact).
+    pub tangential_stiffness: Option<f64>,
 }
 
 impl FrictionalContact {
@@ -63,6 +67,7 @@ impl FrictionalContact {
             gap_cos: Vec::new(),
             gap_sin: Vec::new(),
             sliding_velocity: [0.0; 2],
+            tangential_stiffness: None,
         }
     }
 
@@ -76,7 +81,15 @@ impl FrictionalContact {
             gap_cos: Vec::new(),
             gap_sin: Vec::new(),
             sliding_velocity: [0.0; 2],
+            tangential_stiffness: None,
         }
+    }
+
+    /// The contact with a spring `kt` in series with its slider (to be expanded by
+    /// [`crate::jenkins::expand_tangential_stiffness`]).
+    pub fn with_tangential_stiffness(mut self, kt: f64) -> Self {
+        self.tangential_stiffness = Some(kt);
+        self
     }
 
     /// The contact against an obstacle sliding past at the constant `velocity` along the
@@ -101,6 +114,22 @@ impl FrictionalContact {
         (0..count)
             .map(|k| (at(&self.gap_cos, k), at(&self.gap_sin, k)))
             .collect()
+    }
+
+    /// The obstacle's gap and its rate at time `t` of a response at angular frequency
+    /// `omega`: `(gap(t), gap'(t))` (the fixed gap and 0 under a prescribed load).
+    pub fn gap_at(&self, omega: f64, t: f64) -> (f64, f64) {
+        let NormalLaw::Unilateral { gap, .. } = self.normal else {
+            return (0.0, 0.0);
+        };
+        let (mut value, mut rate) = (gap, 0.0);
+        for (k, (a, b)) in self.gap_harmonics().into_iter().enumerate() {
+            let kw = (k + 1) as f64 * omega;
+            let (sin, cos) = (kw * t).sin_cos();
+            value += a * cos + b * sin;
+            rate += kw * (b * cos - a * sin);
+        }
+        (value, rate)
     }
 
     /// The normal row, when the normal law is unilateral.

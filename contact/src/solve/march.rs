@@ -5,11 +5,12 @@
 use std::time::Instant;
 
 use super::{solution, Outcome, Period, RunCounters, RunError, Solution, Termination};
-use crate::contacts::march_friction_report;
+use crate::contacts::{march_friction_report, MARCH_STICK_VELOCITY};
+use crate::hb::FrictionalContactReport;
 use crate::march::{
     march_from_state, MarchError, MarchOptions, MarchScheme, MarchState, SteadyPeriod,
 };
-use crate::model::{NormalForce, StructuralModel, Structure};
+use crate::model::{NormalForce, NormalLaw, StructuralModel, Structure};
 use crate::settings::SolverSettings;
 
 /// The time-marching scheme of `settings`: Moreau–Jean with the restitution when it is
@@ -123,6 +124,7 @@ pub(super) fn solve_march(
             march_friction_report(f, cut(force), cut(velocity), &limit, velocity_scale)
         })
         .collect();
+    let frictional_contacts = frictional_reports(model, &period, velocity_scale, cut);
     let final_state = period.final_state;
     let period = Period {
         times,
@@ -137,7 +139,7 @@ pub(super) fn solve_march(
         final_state.contact_force,
     ]
     .concat();
-    Ok(solution(
+    let mut solution = solution(
         rod,
         omega,
         settings,
@@ -145,7 +147,41 @@ pub(super) fn solve_march(
         outcome,
         period,
         state,
-    ))
+    );
+    solution.frictional_contacts = frictional_contacts;
+    Ok(solution)
+}
+
+/// The reports of the 3-D frictional contacts over a marched period (each series shortened
+/// by `cut`); a closed step sticks below [`MARCH_STICK_VELOCITY`] times the velocity scale
+/// (the larger of `velocity_scale` and the largest slip speed).
+fn frictional_reports(
+    model: &StructuralModel,
+    period: &SteadyPeriod,
+    velocity_scale: f64,
+    cut: impl Fn(&Vec<f64>) -> Vec<f64>,
+) -> Vec<FrictionalContactReport> {
+    let mut rows = period.frictional_forces.iter();
+    let mut slips = period.frictional_slip_velocities.iter();
+    let mut reports = Vec::new();
+    for (p, point) in model.frictional_contacts.iter().enumerate() {
+        let normal = match point.normal {
+            NormalLaw::Unilateral { .. } => cut(rows.next().expect("a normal row")),
+            NormalLaw::Prescribed(load) => vec![-load; cut(&period.times).len()],
+        };
+        let force = [(); 2].map(|_| cut(rows.next().expect("a tangent row")));
+        let slip = [(); 2].map(|_| cut(slips.next().expect("a slip velocity")));
+        let speed =
+            (0..slip[0].len()).fold(velocity_scale, |a, n| a.max(slip[0][n].hypot(slip[1][n])));
+        reports.push(FrictionalContactReport::from_march(
+            p,
+            normal,
+            (force, slip),
+            period.omega,
+            MARCH_STICK_VELOCITY * speed,
+        ));
+    }
+    reports
 }
 
 /// The observed dofs of a march: the tip, then every dof of the contacts' rows (their gap

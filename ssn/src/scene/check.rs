@@ -116,15 +116,16 @@ type RodParts = (
 
 /// Validates a parsed scene section by section, in file order; the first invalid value is
 /// the error.
-pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
+pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let ck = Check::new(path);
+    let forcing = ck.forcing_or_obstacle(&mut raw)?;
     let mut bladed_disk = None;
     let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
         (None, None, Some(d)) => {
             let (model, mistuning) = ck.bladed_disk(
                 d,
                 raw.damping,
-                &raw.forcing,
+                &forcing,
                 (raw.contact, raw.friction),
                 raw.output,
             )?;
@@ -141,14 +142,14 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
         }
         (Some(raw_rod), None, None) => {
             let parts = (raw.damping, raw.contact, raw.friction.is_some(), raw.output);
-            let (rod, output_dof) = ck.rod_scene(raw_rod, &raw.forcing, parts)?;
+            let (rod, output_dof) = ck.rod_scene(raw_rod, &forcing, parts)?;
             (rod, None, output_dof)
         }
         (None, Some(m), None) => {
             let model = ck.model(
                 m,
                 raw.damping,
-                &raw.forcing,
+                &forcing,
                 (raw.contact, raw.friction),
                 raw.output,
             )?;
@@ -182,8 +183,8 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
-    let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
-    let (engine_order, cyclic) = ck.cyclic_keys(&raw.forcing, raw.cyclic, &model, &bladed_disk)?;
+    let load_parts = ck.load_parts(&forcing, model.is_some(), solver.harmonics)?;
+    let (engine_order, cyclic) = ck.cyclic_keys(&forcing, raw.cyclic, &model, &bladed_disk)?;
     let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
@@ -572,6 +573,39 @@ impl Check<'_> {
         })
     }
 
+    /// `[forcing]`, or for a `[model]` scene driven by its moving obstacles alone (a 3-D
+    /// contact with `gap_cos`, `gap_sin` or `sliding_velocity`) and without `[forcing]`, no
+    /// load with the period of `[obstacle] omega` (else `omega_1`); `[obstacle] omega`
+    /// beside `[forcing]` sets the forcing's `omega` when that is not given.
+    fn forcing_or_obstacle(&self, raw: &mut RawScene) -> Result<RawForcing, SceneError> {
+        let omega = raw.obstacle.as_ref().map(|o| o.omega);
+        if let Some(mut forcing) = raw.forcing.take() {
+            if forcing.omega.is_none() && forcing.omega_ratio.is_none() {
+                forcing.omega = omega;
+            }
+            return Ok(forcing);
+        }
+        let points = raw.contact.as_ref().and_then(|c| c.point.as_deref());
+        let moving = points
+            .unwrap_or(&[])
+            .iter()
+            .any(|p| p.gap_cos.is_some() || p.gap_sin.is_some() || p.sliding_velocity.is_some());
+        if !(moving && raw.model.is_some()) {
+            return Err(self.invalid(
+                "forcing",
+                "missing",
+                "a [forcing] section, or (a [model] scene whose only excitation is a moving \
+                 obstacle: gap_cos, gap_sin or sliding_velocity on a 3-D contact) [obstacle] \
+                 omega",
+            ));
+        }
+        Ok(RawForcing {
+            load_free: true,
+            omega,
+            ..RawForcing::default()
+        })
+    }
+
     /// `[forcing]` of a `[model]` scene: the load shape from a `vector` file, or a unit point
     /// load on `node`'s `component` (through the dof map; 0-based dof), not both.
     fn load_shape(
@@ -586,6 +620,10 @@ impl Check<'_> {
                 "either `vector` (a load shape file) or `node` and `component` (a unit point \
                  load)",
             ));
+        }
+        if f.load_free {
+            // A unit load on dof 0 times the amplitude 0: no load.
+            return Ok((PathBuf::new(), Some(0)));
         }
         if let Some(dof) = self.address("forcing", None, f.node, f.component)? {
             return Ok((PathBuf::new(), Some(dof as usize - 1)));
@@ -607,7 +645,9 @@ impl Check<'_> {
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
-        if !m.frictional_contacts.is_empty() && solver.method != Method::SsnHb {
+        if !m.frictional_contacts.is_empty()
+            && !matches!(solver.method, Method::SsnHb | Method::March)
+        {
             return Err(self.invalid(
                 "solver.method",
                 format!(
@@ -615,7 +655,7 @@ impl Check<'_> {
                     solver.method.name(),
                     m.frictional_contacts.len()
                 ),
-                "\"ssn-hb\" (the Coulomb disk of 3-D frictional contacts)",
+                "\"ssn-hb\" or \"march\" (the Coulomb disk of 3-D frictional contacts)",
             ));
         }
         let allowed = match solver.method.friction() {

@@ -64,12 +64,15 @@ impl Check<'_> {
             )
         })?;
         let mu = self.friction_coefficient("contact.point.friction", mu)?;
-        if let Some(kt) = p.tangential_stiffness {
+        if let Some(kt) = p
+            .tangential_stiffness
+            .filter(|kt| !(kt.is_finite() && *kt > 0.0))
+        {
             return Err(self.invalid(
                 "contact.point.tangential_stiffness",
                 kt,
-                "none yet: a spring in series with the slider is written in the matrices as \
-                 a massless node tied to the contact node, the contact on that node",
+                "a finite k_t > 0 (a spring in series with the slider in each tangent \
+                 direction)",
             ));
         }
         let gap = self.response_scale("contact.point.gap", p.gap)?;
@@ -77,7 +80,10 @@ impl Check<'_> {
             Some(n) => self.node_frame(p, n)?,
             None => self.row_frame(p)?,
         };
-        let point = FrictionalContact::unilateral(normal, gap, tangents, mu);
+        let mut point = FrictionalContact::unilateral(normal, gap, tangents, mu);
+        if let Some(kt) = p.tangential_stiffness {
+            point = point.with_tangential_stiffness(kt);
+        }
         self.moving_obstacle(p, point)
     }
 

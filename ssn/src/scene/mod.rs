@@ -120,7 +120,8 @@ struct RawScene {
     bladed_disk: Option<disk::RawBladedDisk>,
     cyclic: Option<cyclic::RawCyclic>,
     damping: Option<RawDamping>,
-    forcing: RawForcing,
+    forcing: Option<RawForcing>,
+    obstacle: Option<RawObstacle>,
     contact: Option<RawContact>,
     friction: Option<RawFrictionSection>,
     output: Option<RawOutput>,
@@ -202,9 +203,19 @@ enum RawLoad {
     Tip,
 }
 
+/// `[obstacle]`: the period of a scene driven by its moving obstacles alone.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawObstacle {
+    omega: f64,
+}
+
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 struct RawForcing {
+    /// No load at all (a `[model]` scene driven by its moving obstacles): not a key.
+    #[serde(skip)]
+    load_free: bool,
     load: Option<RawLoad>,
     vector: Option<String>,
     node: Option<i64>,
