@@ -228,6 +228,23 @@ impl BladedDisk {
             .collect()
     }
 
+    /// The whole disk's harmonic-major coefficients (`3 B (2 H + 1)`, the layout of
+    /// [`BladedDisk::structure`]) recovered from the reduced coefficients `reduced` of
+    /// `sector` (one of [`BladedDisk::cyclic_sector`]): blade `j`'s `d, b, p` are sector
+    /// `j`'s dofs 0, 1, 2 ([`CyclicSector::sector_coefficients`]).
+    pub fn recover(&self, sector: &CyclicSector, reduced: &[f64], harmonics: usize) -> Vec<f64> {
+        let n = self.dofs();
+        let mut full = vec![0.0; n * (2 * harmonics + 1)];
+        let sector_dofs = sector.model().dofs();
+        for j in 0..self.blades {
+            let u = sector.sector_coefficients(reduced, harmonics, j);
+            for (row, block) in full.chunks_exact_mut(n).enumerate() {
+                block[3 * j..3 * j + 3].copy_from_slice(&u[row * sector_dofs..][..3]);
+            }
+        }
+        full
+    }
+
     /// One sector of the tuned disk (the mistuning is ignored) under `loading` and the
     /// engine order `engine_order`, with the lowest natural frequency `omega_1` of the disk
     /// that scales its damping ([`CyclicSector::lowest_frequency`]). The sector's dofs are `d, b, p` of blade 0

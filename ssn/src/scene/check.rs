@@ -119,6 +119,7 @@ type RodParts = (
 pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let ck = Check::new(path);
     let mut bladed_disk = None;
+    let neighbour_rows = ck.neighbour_rows(raw.contact.as_ref(), raw.friction.as_ref())?;
     let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
         (None, None, Some(d)) => {
             let (model, mistuning) = ck.bladed_disk(
@@ -183,7 +184,12 @@ pub(super) fn resolve(raw: RawScene, path: &Path) -> Result<Scene, SceneError> {
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&raw.forcing, model.is_some(), solver.harmonics)?;
-    let (engine_order, cyclic) = ck.cyclic_keys(&raw.forcing, raw.cyclic, &model, &bladed_disk)?;
+    let (engine_order, cyclic) = ck.cyclic_keys(
+        &raw.forcing,
+        (raw.cyclic, neighbour_rows),
+        &model,
+        &bladed_disk,
+    )?;
     let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),

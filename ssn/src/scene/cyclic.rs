@@ -11,15 +11,32 @@
 //! engine_order = 3
 //! sector_dofs = [[1, 2, 3], [4, 5, 6]]   # 1-based; the [bladed_disk] builder knows its own
 //! ```
+//!
+//! A contact between sectors on a `[cyclic]` sector: its row also reads the next sector's
+//! dofs (numbered as this sector's), delayed by `EO T / N`.
+//!
+//! ```toml
+//! [[contact.point]]      # the pad against the next sector's blade
+//! dofs = [3]
+//! coefficients = [1.0]
+//! neighbour_dofs = [2]
+//! neighbour_coefficients = [-1.0]
+//! gap = 0.1
+//! friction = 0.3         # its friction row may read the next sector too
+//! tangent_dofs = [2]
+//! tangent_coefficients = [1.0]
+//! tangent_neighbour_dofs = [1]
+//! tangent_neighbour_coefficients = [-1.0]
+//! ```
 
 use serde::Deserialize;
 
 use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::matrix_market::ModelSpec;
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{NeighbourRow, Structure};
 
 use super::check::Check;
-use super::{RawForcing, Scene, SceneError};
+use super::{RawContact, RawForcing, RawFrictionSection, Scene, SceneError};
 
 /// Largest `[cyclic] sectors` and `engine_order` accepted.
 pub const MAX_SECTORS: usize = 100_000;
@@ -46,6 +63,9 @@ pub struct CyclicSpec {
     pub left: Vec<usize>,
     /// Right interface dofs (0-based), `right[j]` the next sector's `left[j]`.
     pub right: Vec<usize>,
+    /// The rows between this sector and the next (`neighbour_dofs` of the contacts and
+    /// friction points), numbered as the model numbers its rows.
+    pub neighbour_rows: Vec<NeighbourRow>,
 }
 
 /// `[forcing] engine_order` on a full model: the load on the dofs of sector `s` delayed by
@@ -64,7 +84,7 @@ impl Check<'_> {
     pub(super) fn cyclic_keys(
         &self,
         f: &RawForcing,
-        raw: Option<RawCyclic>,
+        (raw, neighbour_rows): (Option<RawCyclic>, Vec<NeighbourRow>),
         model: &Option<ModelSpec>,
         bladed_disk: &Option<Vec<f64>>,
     ) -> Result<(Option<EngineOrderSpec>, Option<CyclicSpec>), SceneError> {
@@ -81,6 +101,17 @@ impl Check<'_> {
         };
         let is_model = model.is_some() && bladed_disk.is_none();
         let cyclic = raw.map(|c| self.cyclic(c, is_model)).transpose()?;
+        let cyclic = cyclic.map(|c| CyclicSpec {
+            neighbour_rows: neighbour_rows.clone(),
+            ..c
+        });
+        if cyclic.is_none() && !neighbour_rows.is_empty() {
+            return Err(self.invalid(
+                "contact.point.neighbour_dofs",
+                "given without [cyclic]",
+                "rows on the next sector's dofs in a [cyclic] sector scene",
+            ));
+        }
         if cyclic.is_some() && engine_order.is_some() {
             return Err(self.invalid(
                 "forcing.engine_order",
@@ -123,7 +154,73 @@ impl Check<'_> {
             engine_order,
             left,
             right,
+            neighbour_rows: Vec::new(),
         })
+    }
+
+    /// The parts on the next sector of the scene's rows (module documentation), numbered
+    /// as the model numbers its rows: the contacts, their friction rows, the friction
+    /// points.
+    pub(super) fn neighbour_rows(
+        &self,
+        contact: Option<&RawContact>,
+        friction: Option<&RawFrictionSection>,
+    ) -> Result<Vec<NeighbourRow>, SceneError> {
+        let points = contact.and_then(|c| c.point.as_deref()).unwrap_or_default();
+        let points: Vec<_> = (points.iter())
+            .filter(|p| !super::frictional::is_frictional(p))
+            .collect();
+        let frictions = points.iter().filter(|p| p.friction.is_some()).count();
+        let mut rows = Vec::new();
+        let mut part = |row: usize, key: &str, dofs: &Option<Vec<i64>>, a: &Option<Vec<f64>>| {
+            let (dofs_key, a_key) = (
+                format!("{key}neighbour_dofs"),
+                format!("{key}neighbour_coefficients"),
+            );
+            match (dofs, a) {
+                (None, None) => Ok(()),
+                (Some(dofs), Some(a)) => {
+                    let part = self.combination(&dofs_key, &a_key, dofs, a)?;
+                    rows.push(NeighbourRow { row, part });
+                    Ok(())
+                }
+                (Some(_), None) => {
+                    Err(self.invalid(&a_key, "missing", "one coefficient per neighbour dof"))
+                }
+                (None, Some(_)) => Err(self.invalid(
+                    &dofs_key,
+                    "missing",
+                    "the next sector's 1-based dofs of the row",
+                )),
+            }
+        };
+        let mut friction_row = points.len();
+        for (i, p) in points.iter().enumerate() {
+            part(
+                i,
+                "contact.point.",
+                &p.neighbour_dofs,
+                &p.neighbour_coefficients,
+            )?;
+            if p.friction.is_some() {
+                let (dofs, a) = (&p.tangent_neighbour_dofs, &p.tangent_neighbour_coefficients);
+                part(friction_row, "contact.point.tangent_", dofs, a)?;
+                friction_row += 1;
+            }
+        }
+        let friction_points = friction
+            .and_then(|f| f.point.as_deref())
+            .unwrap_or_default();
+        for (f, p) in friction_points.iter().enumerate() {
+            let row = points.len() + frictions + f;
+            part(
+                row,
+                "friction.point.",
+                &p.neighbour_dofs,
+                &p.neighbour_coefficients,
+            )?;
+        }
+        Ok(rows)
     }
 
     /// `[forcing] engine_order` and `sector_dofs`; a `[bladed_disk]` of `disk_blades`
@@ -201,6 +298,7 @@ impl Scene {
             c.sectors,
             c.engine_order,
         )
+        .and_then(|s| s.with_neighbour_rows(c.neighbour_rows.clone()))
         .map_err(|e| format!("invalid [cyclic]: {e}"))?;
         sector
             .structure(observed)
