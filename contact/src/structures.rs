@@ -245,6 +245,36 @@ impl BladedDisk {
         full
     }
 
+    /// The whole disk's harmonic-balance unknowns `[U; Lambda]` recovered from a sector's
+    /// solution `state` (`[U_r; Lambda_r]`, [`crate::solve::Solution::state`]): `U` by
+    /// [`BladedDisk::recover`], and row `r` of blade `j` (full row `r B + j`: every
+    /// blade's copy of the sector's row 0, then of row 1, ...) the sector's row `r` delayed
+    /// by `j EO T / N`. A warm start for the full disk at the same frequency.
+    pub fn recover_state(
+        &self,
+        sector: &CyclicSector,
+        state: &[f64],
+        harmonics: usize,
+    ) -> Vec<f64> {
+        let size = 2 * harmonics + 1;
+        let (u, lambda) = state.split_at(sector.reduced_dofs().len() * size);
+        let mut full = self.recover(sector, u, harmonics);
+        let rows = lambda.len() / size;
+        let mut forces = vec![0.0; rows * self.blades * size];
+        for j in 0..self.blades {
+            let mut delayed = lambda.to_vec();
+            let angle = j as f64 * sector.phase_step();
+            crate::cyclic::delay_coefficients(&mut delayed, rows, harmonics, angle);
+            for (h, block) in delayed.chunks_exact(rows).enumerate() {
+                for (r, &value) in block.iter().enumerate() {
+                    forces[h * rows * self.blades + r * self.blades + j] = value;
+                }
+            }
+        }
+        full.extend(forces);
+        full
+    }
+
     /// One sector of the tuned disk (the mistuning is ignored) under `loading` and the
     /// engine order `engine_order`, with the lowest natural frequency `omega_1` of the disk
     /// that scales its damping ([`CyclicSector::lowest_frequency`]). The sector's dofs are `d, b, p` of blade 0
