@@ -245,3 +245,42 @@ fn a_sector_scene_with_a_friction_damper_between_sectors_answers_the_full_disk()
     // 1e-13 (the library's test finds 2e-13): 1e-10 leaves a wide margin.
     assert!(worst < 1e-10 * scale, "{:e}", worst / scale);
 }
+
+#[test]
+fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bladed_disk_sector.toml");
+    let (loaded, sector_solution) = solved(&path);
+    let blades = 100;
+    let disk = BladedDisk {
+        blades,
+        mistuning: 0.0,
+    };
+    let loading = DiskLoading {
+        amplitude: 0.06,
+        ..DiskLoading::shipped((0..blades).collect())
+    };
+    let (sector, omega_1) = disk.cyclic_sector(&loading, 3).unwrap();
+    // The scene's written frequency and damping are the disk's to the digits written.
+    assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
+    let mut full = disk.structure(&loading).unwrap();
+    full.model.load = (full.model.load.clone())
+        .delayed_by_sector(&disk.sector_dofs(), 3)
+        .unwrap();
+    let full_solution =
+        semismooth_contact::solve(&full, loaded.omega, &loaded.scene.solver, None).unwrap();
+    assert!(full_solution.converged());
+    assert!(full_solution
+        .contacts
+        .iter()
+        .all(|c| c.contact_fraction > 0.0));
+    let len = 3 * blades * (2 * HARMONICS + 1);
+    let u_full = &full_solution.state[..len];
+    let recovered = disk.recover(&sector, &sector_solution.state, HARMONICS);
+    let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = (recovered.iter().zip(u_full)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    // The beta written to 16 digits is the disk's 2 zeta / omega_1 to a rounding; the same
+    // equations otherwise (100 samples, a multiple of N / gcd(N, EO)): 1e-10.
+    assert!(worst < 1e-10 * scale, "{:e}", worst / scale);
+    let amplitudes = ssn::json::blade_amplitudes(&loaded.structure, &sector_solution).unwrap();
+    assert_eq!(amplitudes.as_array().unwrap().len(), blades);
+}
