@@ -32,10 +32,11 @@
 
 use faer::sparse::Triplet;
 
-use crate::cyclic::CyclicSector;
+use crate::cyclic::{CyclicSector, InvalidSector};
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
+    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, NeighbourRow, SparseMatrix,
+    StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -332,6 +333,66 @@ impl BladedDisk {
         let omega_1 = sector(model.clone())?.lowest_frequency()?;
         let model = model.with_rayleigh_damping(0.0, 2.0 * loading.zeta / omega_1);
         Ok((sector(model)?, omega_1))
+    }
+}
+
+/// An under-platform damper between neighbouring blades of a [`BladedDisk`]: blade `j`'s
+/// pad against the mean of the next blade's tip and disk dof,
+/// `p_j - (b_{j+1} + d_{j+1}) / 2 - gap <= 0`, with Coulomb friction `friction` (the
+/// damper's normal force; none at 0) on the slip `b_j - d_{j+1}`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BladeDamper {
+    /// Clearance of the damper.
+    pub gap: f64,
+    /// Coulomb coefficient `mu >= 0`.
+    pub friction: f64,
+}
+
+impl BladeDamper {
+    /// The damper between every pair of neighbours of the whole disk `disk` added to its
+    /// `model` (contacts blade by blade, then their friction rows).
+    pub fn add_to_disk(&self, disk: &BladedDisk, model: &mut StructuralModel) {
+        let first = model.contacts.len();
+        let blades = disk.blades;
+        for j in 0..blades {
+            let next = 3 * ((j + 1) % blades);
+            let row = ContactRow::new(vec![3 * j + 2, next + 1, next], vec![1.0, -0.5, -0.5]);
+            (model.contacts).push(ContactPoint::on_row(row.expect("a valid row"), self.gap));
+        }
+        for j in (0..blades).filter(|_| self.friction > 0.0) {
+            let next = 3 * ((j + 1) % blades);
+            let slip = ContactRow::new(vec![3 * j + 1, next], vec![1.0, -1.0]);
+            let point =
+                FrictionPoint::on_contact(slip.expect("a valid row"), self.friction, first + j);
+            model.friction.push(point);
+        }
+    }
+
+    /// The damper on the sector `sector` of [`BladedDisk::cyclic_sector`]: its own part on
+    /// the pad (and tip), its neighbour part on the next sector's tip and disk dof.
+    pub fn add_to_sector(&self, sector: &CyclicSector) -> Result<CyclicSector, InvalidSector> {
+        let mut model = sector.model().clone();
+        let contact = model.contacts.len();
+        model
+            .contacts
+            .push(ContactPoint::on_row(ContactRow::unit(2, 1.0), self.gap));
+        let part = ContactRow::new(vec![1, 0], vec![-0.5, -0.5]).expect("a valid row");
+        let mut rows = sector.neighbour_rows().to_vec();
+        rows.push(NeighbourRow { row: contact, part });
+        if self.friction > 0.0 {
+            let tangent = ContactRow::unit(1, 1.0);
+            model
+                .friction
+                .push(FrictionPoint::on_contact(tangent, self.friction, contact));
+            let row = model.contacts.len() + model.friction.len() - 1;
+            rows.push(NeighbourRow {
+                row,
+                part: ContactRow::unit(0, -1.0),
+            });
+        }
+        let (left, right) = (sector.left().to_vec(), sector.right().to_vec());
+        CyclicSector::new(model, left, right, sector.sectors(), sector.engine_order())?
+            .with_neighbour_rows(rows)
     }
 }
 

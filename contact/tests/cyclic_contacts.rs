@@ -5,13 +5,11 @@
 //! frictionless and with Coulomb friction on the damper.
 
 use semismooth_contact::cyclic::{CyclicSector, InvalidSector};
-use semismooth_contact::model::{
-    ContactPoint, ContactRow, FrictionPoint, InvalidModel, NeighbourRow, Structure,
-};
+use semismooth_contact::model::{ContactPoint, ContactRow, InvalidModel, NeighbourRow, Structure};
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, Method, SolverSettings};
 use semismooth_contact::solve::{solve, Solution};
-use semismooth_contact::structures::{BladedDisk, DiskLoading};
+use semismooth_contact::structures::{BladeDamper, BladedDisk, DiskLoading};
 
 const BLADES: usize = 8;
 /// The damper's clearance: the pads close on the neighbours near each resonance.
@@ -29,19 +27,15 @@ fn loading() -> DiskLoading {
     DiskLoading::shipped(Vec::new())
 }
 
-/// The damper row of sector `s` on the full disk's dofs: its pad `p_s` against the mean
-/// of the next sector's blade tip and disk dof, `p_s - (b_{s+1} + d_{s+1}) / 2`.
-fn damper_row(s: usize) -> ContactRow {
-    let next = 3 * ((s + 1) % BLADES);
-    ContactRow::new(vec![3 * s + 2, next + 1, next], vec![1.0, -0.5, -0.5]).unwrap()
+fn damper(friction: bool) -> BladeDamper {
+    BladeDamper {
+        gap: GAP,
+        friction: if friction { MU } else { 0.0 },
+    }
 }
 
-/// The damper's tangential row: blade tip `b_s` against the next sector's disk dof.
-fn slip_row(s: usize) -> ContactRow {
-    ContactRow::new(vec![3 * s + 1, 3 * ((s + 1) % BLADES)], vec![1.0, -1.0]).unwrap()
-}
-
-/// The full disk with a damper between every pair of neighbours and the engine-order load.
+/// The full disk with a damper between every pair of neighbours (rows written blade by
+/// blade on the disk's dofs) and the engine-order load.
 fn full_disk(engine_order: usize, friction: bool) -> Structure {
     let disk = disk();
     let mut structure = disk.structure(&loading()).unwrap();
@@ -49,45 +43,15 @@ fn full_disk(engine_order: usize, friction: bool) -> Structure {
     model.load = (model.load.clone())
         .delayed_by_sector(&disk.sector_dofs(), engine_order)
         .unwrap();
-    for s in 0..BLADES {
-        model
-            .contacts
-            .push(ContactPoint::on_row(damper_row(s), GAP));
-    }
-    if friction {
-        for s in 0..BLADES {
-            (model.friction).push(FrictionPoint::on_contact(slip_row(s), MU, s));
-        }
-    }
+    damper(friction).add_to_disk(&disk, model);
     structure
 }
 
 /// The sector with the same damper: its own part on the sector's pad (and tip), the
-/// neighbour part on the next sector's tip and disk dof (dofs 1 and 0 of the sector's
-/// numbering).
+/// neighbour part on the next sector's tip and disk dof.
 fn sector(engine_order: usize, friction: bool) -> CyclicSector {
     let (sector, _) = disk().cyclic_sector(&loading(), engine_order).unwrap();
-    let mut model = sector.model().clone();
-    let own = ContactRow::unit(2, 1.0);
-    model.contacts.push(ContactPoint::on_row(own, GAP));
-    let mut neighbour_rows = vec![NeighbourRow {
-        row: 0,
-        part: ContactRow::new(vec![1, 0], vec![-0.5, -0.5]).unwrap(),
-    }];
-    if friction {
-        let tangent = ContactRow::unit(1, 1.0);
-        model
-            .friction
-            .push(FrictionPoint::on_contact(tangent, MU, 0));
-        neighbour_rows.push(NeighbourRow {
-            row: 1,
-            part: ContactRow::unit(0, -1.0),
-        });
-    }
-    CyclicSector::new(model, vec![0], vec![3], BLADES, engine_order)
-        .unwrap()
-        .with_neighbour_rows(neighbour_rows)
-        .unwrap()
+    damper(friction).add_to_sector(&sector).unwrap()
 }
 
 fn settings(harmonics: usize, linear_solver: LinearSolverChoice) -> SolverSettings {

@@ -178,7 +178,7 @@ fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
 
 #[test]
 fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_full_disk() {
-    use semismooth_contact::model::{ContactPoint, ContactRow, FrictionPoint};
+    use semismooth_contact::structures::BladeDamper;
     let (blades, engine_order, gap, mu) = (24, 3, 0.2, 0.3);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blisk_dampers_sector.toml");
     let (loaded, sector_solution) = solved(&scene);
@@ -189,23 +189,13 @@ fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_ful
     let loading = DiskLoading::shipped(Vec::new());
     let (sector, omega_1) = disk.cyclic_sector(&loading, engine_order).unwrap();
     assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
-    // The full disk with the damper between every pair of neighbours: the pad against the
-    // mean of the next blade's tip and disk dof, the friction row the tip against the next
-    // disk dof.
+    // The full disk with the damper between every pair of neighbours, written blade by
+    // blade on the disk's dofs.
     let mut full = disk.structure(&loading).unwrap();
-    let model = &mut full.model;
-    model.load = (model.load.clone())
+    full.model.load = (full.model.load.clone())
         .delayed_by_sector(&disk.sector_dofs(), engine_order)
         .unwrap();
-    for s in 0..blades {
-        let next = 3 * ((s + 1) % blades);
-        let row = ContactRow::new(vec![3 * s + 2, next + 1, next], vec![1.0, -0.5, -0.5]);
-        model.contacts.push(ContactPoint::on_row(row.unwrap(), gap));
-        let tangent = ContactRow::new(vec![3 * s + 1, next], vec![1.0, -1.0]).unwrap();
-        model
-            .friction
-            .push(FrictionPoint::on_contact(tangent, mu, s));
-    }
+    BladeDamper { gap, friction: mu }.add_to_disk(&disk, &mut full.model);
     let settings = &loaded.scene.solver;
     let full_solution = semismooth_contact::solve(&full, loaded.omega, settings, None).unwrap();
     assert!(full_solution.converged());
