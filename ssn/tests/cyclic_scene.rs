@@ -251,3 +251,44 @@ fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
     let amplitudes = ssn::json::blade_amplitudes(&loaded.structure, &sector_solution).unwrap();
     assert_eq!(amplitudes.as_array().unwrap().len(), blades);
 }
+
+#[test]
+fn interface_nodes_through_a_dof_map_give_the_interface_dofs() {
+    let dir = temp_dir("nodes");
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blade_sector");
+    for name in ["K.mtx", "M.mtx", "f.mtx"] {
+        std::fs::copy(shipped.join(name), dir.join(name)).unwrap();
+    }
+    // Rows in a shuffled order: node 4 (the next sector's disk dof) is row 1, node 1 row 4.
+    std::fs::write(dir.join("nodes.dof"), "4.1\n2.1\n3.1\n1.1\n").unwrap();
+    let scene = |interface: &str, map: &str| {
+        format!(
+            "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n{map}\n[cyclic]\nsectors = 8\n\
+             engine_order = 1\n{interface}\n[forcing]\nvector = \"f.mtx\"\namplitude = 0.1\n"
+        )
+    };
+    let read = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        ssn::scene::Scene::from_path(&path)
+    };
+    let map = "dof_map = \"nodes.dof\"";
+    let by_nodes = read(
+        "nodes.toml",
+        scene("left_nodes = [4]\nright_nodes = [1]", map),
+    );
+    let cyclic = by_nodes.unwrap().cyclic.unwrap();
+    assert_eq!((cyclic.left, cyclic.right), (vec![0], vec![3]));
+    let refused = [
+        (scene("left_nodes = [4]\nright_nodes = [1]", ""), "dof_map"),
+        (
+            scene("left_nodes = [4]\nright_nodes = [9]", map),
+            "cyclic.right_nodes",
+        ),
+        (scene("left = [1]\nright_nodes = [1]", map), "cyclic.left"),
+    ];
+    for (i, (text, key)) in refused.into_iter().enumerate() {
+        let message = read(&format!("bad{i}.toml"), text).unwrap_err().to_string();
+        assert!(message.contains(key), "case {i}: {message}");
+    }
+}

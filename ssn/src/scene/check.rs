@@ -31,6 +31,17 @@ impl<'a> Check<'a> {
         self.dof_map
     }
 
+    /// The checks of the same file with the `[model]`'s dof map `dof_map`.
+    pub(super) fn with_dof_map<'b>(&self, dof_map: Option<&'b DofMapFile>) -> Check<'b>
+    where
+        'a: 'b,
+    {
+        Check {
+            path: self.path,
+            dof_map,
+        }
+    }
+
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
         SceneError::invalid(self.path, key, value, allowed)
     }

@@ -5,7 +5,8 @@
 //! sectors = 24           # N >= 1
 //! engine_order = 3       # EO >= 0
 //! left = [1, 2]          # 1-based interface dofs; right[j] is the next sector's left[j]
-//! right = [7, 8]
+//! right = [7, 8]         # (or left_nodes/right_nodes through the [model] dof_map: every
+//!                        # component of left_nodes[j] against the same of right_nodes[j])
 //!
 //! [forcing]              # on a full model (or a [bladed_disk]): sector s lags 2 pi EO s / N
 //! engine_order = 3
@@ -47,8 +48,10 @@ pub const MAX_SECTORS: usize = 100_000;
 pub(super) struct RawCyclic {
     sectors: i64,
     engine_order: i64,
-    left: Vec<i64>,
-    right: Vec<i64>,
+    left: Option<Vec<i64>>,
+    right: Option<Vec<i64>>,
+    left_nodes: Option<Vec<i64>>,
+    right_nodes: Option<Vec<i64>>,
 }
 
 /// A `[model]` scene's `[cyclic]` section: its structure is one sector of `sectors`,
@@ -100,7 +103,8 @@ impl Check<'_> {
             false => None,
         };
         let is_model = model.is_some() && bladed_disk.is_none();
-        let cyclic = raw.map(|c| self.cyclic(c, is_model)).transpose()?;
+        let with_map = self.with_dof_map(model.as_ref().and_then(|m| m.dof_map.as_ref()));
+        let cyclic = raw.map(|c| with_map.cyclic(c, is_model)).transpose()?;
         let cyclic = cyclic.map(|c| CyclicSpec {
             neighbour_rows: neighbour_rows.clone(),
             ..c
@@ -138,10 +142,20 @@ impl Check<'_> {
                 .map(|&d| Ok(self.count(key, d, 1, usize::MAX >> 1)? - 1))
                 .collect()
         };
-        let (left, right) = (
-            dofs("cyclic.left", &raw.left)?,
-            dofs("cyclic.right", &raw.right)?,
-        );
+        let (left, right) = match (&raw.left, &raw.right, &raw.left_nodes, &raw.right_nodes) {
+            (Some(left), Some(right), None, None) => {
+                (dofs("cyclic.left", left)?, dofs("cyclic.right", right)?)
+            }
+            (None, None, Some(left), Some(right)) => self.interface_nodes(left, right)?,
+            _ => {
+                return Err(self.invalid(
+                    "cyclic.left",
+                    "an incomplete or mixed interface",
+                    "`left` and `right` (1-based dofs), or `left_nodes` and `right_nodes` \
+                     (through the [model] dof_map)",
+                ))
+            }
+        };
         if left.len() != right.len() {
             return Err(self.invalid(
                 "cyclic.right",
@@ -156,6 +170,52 @@ impl Check<'_> {
             right,
             neighbour_rows: Vec::new(),
         })
+    }
+
+    /// `[cyclic] left_nodes`/`right_nodes` as 0-based dofs through the dof map: every
+    /// component of `left[j]` (ascending) against the same component of `right[j]`.
+    fn interface_nodes(
+        &self,
+        left: &[i64],
+        right: &[i64],
+    ) -> Result<(Vec<usize>, Vec<usize>), SceneError> {
+        if left.len() != right.len() {
+            return Err(self.invalid(
+                "cyclic.right_nodes",
+                format!("{} nodes", right.len()),
+                &format!("as many nodes as cyclic.left_nodes ({})", left.len()),
+            ));
+        }
+        let components = |node: i64| match (self.dof_map(), u64::try_from(node)) {
+            (Some(map), Ok(n)) => map.map.components(n),
+            _ => Vec::new(),
+        };
+        let (mut left_dofs, mut right_dofs) = (Vec::new(), Vec::new());
+        for (&l, &r) in left.iter().zip(right) {
+            for (key, node) in [("cyclic.left_nodes", l), ("cyclic.right_nodes", r)] {
+                if components(node).is_empty() {
+                    // No dof map, or a node it does not name: its error names the file.
+                    self.resolve(key, key, node, None)?;
+                }
+            }
+            let (cl, cr) = (components(l), components(r));
+            if cl != cr {
+                return Err(self.invalid(
+                    "cyclic.right_nodes",
+                    format!("node {r} with components {cr:?} against node {l}'s {cl:?}"),
+                    "a right node with the components of its left node",
+                ));
+            }
+            for c in cl {
+                let c = Some(i64::from(c));
+                let dof = |key, node| -> Result<usize, SceneError> {
+                    Ok(self.resolve(key, key, node, c)? as usize - 1)
+                };
+                left_dofs.push(dof("cyclic.left_nodes", l)?);
+                right_dofs.push(dof("cyclic.right_nodes", r)?);
+            }
+        }
+        Ok((left_dofs, right_dofs))
     }
 
     /// The parts on the next sector of the scene's rows (module documentation), numbered
