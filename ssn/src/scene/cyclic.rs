@@ -57,6 +57,7 @@ pub(super) struct RawCyclic {
 /// A `[model]` scene's `[cyclic]` section: its structure is one sector of `sectors`,
 /// excited by `engine_order`, with matching 0-based interface dofs `left` and `right`.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct CyclicSpec {
     /// The number of sectors `N`.
     pub sectors: usize,
