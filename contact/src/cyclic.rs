@@ -28,7 +28,7 @@ use faer::sparse::Triplet;
 
 use crate::model::{
     ContactPoint, ContactRow, CouplingSource, CouplingTerm, CyclicCoupling, FrictionPoint,
-    HarmonicLoad, InvalidModel, SparseMatrix, StructuralModel, Structure,
+    HarmonicLoad, InvalidModel, NeighbourRow, SparseMatrix, StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -86,6 +86,8 @@ pub struct CyclicSector {
     kept: Vec<usize>,
     /// The reduced dof of each sector dof (a right dof: its left dof's).
     reduced_of: Vec<usize>,
+    /// The rows that also take the next sector's dofs, on the sector's dofs.
+    neighbour_rows: Vec<NeighbourRow>,
 }
 
 impl CyclicSector {
@@ -143,7 +145,44 @@ impl CyclicSector {
             engine_order,
             kept,
             reduced_of,
+            neighbour_rows: Vec::new(),
         })
+    }
+
+    /// The sector with contacts between sectors: each [`NeighbourRow`] adds to row `row` of
+    /// the sector model ([`StructuralModel::rows`]: contacts, friction points, frictional
+    /// contacts) the part `part` on the next sector's dofs (numbered as this sector's, not
+    /// on the right interface). The row then measures `g . u(t) + n . u(t - EO T / N)`, and
+    /// its force acts on both sectors (module documentation of the coupling,
+    /// [`NeighbourRow`]).
+    pub fn with_neighbour_rows(mut self, rows: Vec<NeighbourRow>) -> Result<Self, InvalidSector> {
+        let (count, n) = (self.model.rows().count(), self.model.dofs());
+        for neighbour in &rows {
+            let dof = neighbour.part.dofs().iter().copied().max().unwrap_or(0);
+            if neighbour.row >= count || dof >= n {
+                let (row, rows, dofs) = (neighbour.row, count, n);
+                return Err(InvalidModel::NeighbourRow {
+                    row,
+                    rows,
+                    dof,
+                    dofs,
+                }
+                .into());
+            }
+            if let Some(&dof) = (neighbour.part.dofs().iter()).find(|d| self.right.contains(d)) {
+                return Err(InvalidSector::RowOnRightInterface {
+                    row: neighbour.row,
+                    dof,
+                });
+            }
+        }
+        self.neighbour_rows = rows;
+        Ok(self)
+    }
+
+    /// The rows between this sector and the next ([`CyclicSector::with_neighbour_rows`]).
+    pub fn neighbour_rows(&self) -> &[NeighbourRow] {
+        &self.neighbour_rows
     }
 
     /// The number of sectors `N`.
@@ -231,7 +270,16 @@ impl CyclicSector {
             load: self.reduce_load(phi),
             contacts,
             friction,
-            cyclic: Some(CyclicCoupling::new(phi, self.sectors, terms)),
+            cyclic: Some(
+                CyclicCoupling::new(phi, self.sectors, terms).with_neighbour_rows(
+                    (self.neighbour_rows.iter())
+                        .map(|r| NeighbourRow {
+                            row: r.row,
+                            part: self.reduce_row(&r.part),
+                        })
+                        .collect(),
+                ),
+            ),
             frictional_contacts: (m.frictional_contacts.iter())
                 .map(|c| c.with_rows(|r| Ok::<_, std::convert::Infallible>(self.reduce_row(r))))
                 .map(|c| c.unwrap_or_else(|never| match never {}))

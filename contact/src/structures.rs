@@ -32,10 +32,11 @@
 
 use faer::sparse::Triplet;
 
-use crate::cyclic::CyclicSector;
+use crate::cyclic::{CyclicSector, InvalidSector};
 use crate::dynamic::UnionPattern;
 use crate::model::{
-    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
+    ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, NeighbourRow, SparseMatrix,
+    StructuralModel, Structure,
 };
 use crate::rod::{natural_frequencies, ModelError};
 
@@ -228,6 +229,53 @@ impl BladedDisk {
             .collect()
     }
 
+    /// The whole disk's harmonic-major coefficients (`3 B (2 H + 1)`, the layout of
+    /// [`BladedDisk::structure`]) recovered from the reduced coefficients `reduced` of
+    /// `sector` (one of [`BladedDisk::cyclic_sector`]): blade `j`'s `d, b, p` are sector
+    /// `j`'s dofs 0, 1, 2 ([`CyclicSector::sector_coefficients`]).
+    pub fn recover(&self, sector: &CyclicSector, reduced: &[f64], harmonics: usize) -> Vec<f64> {
+        let n = self.dofs();
+        let mut full = vec![0.0; n * (2 * harmonics + 1)];
+        let sector_dofs = sector.model().dofs();
+        for j in 0..self.blades {
+            let u = sector.sector_coefficients(reduced, harmonics, j);
+            for (row, block) in full.chunks_exact_mut(n).enumerate() {
+                block[3 * j..3 * j + 3].copy_from_slice(&u[row * sector_dofs..][..3]);
+            }
+        }
+        full
+    }
+
+    /// The whole disk's harmonic-balance unknowns `[U; Lambda]` recovered from a sector's
+    /// solution `state` (`[U_r; Lambda_r]`, [`crate::solve::Solution::state`]): `U` by
+    /// [`BladedDisk::recover`], and row `r` of blade `j` (full row `r B + j`: every
+    /// blade's copy of the sector's row 0, then of row 1, ...) the sector's row `r` delayed
+    /// by `j EO T / N`. A warm start for the full disk at the same frequency.
+    pub fn recover_state(
+        &self,
+        sector: &CyclicSector,
+        state: &[f64],
+        harmonics: usize,
+    ) -> Vec<f64> {
+        let size = 2 * harmonics + 1;
+        let (u, lambda) = state.split_at(sector.reduced_dofs().len() * size);
+        let mut full = self.recover(sector, u, harmonics);
+        let rows = lambda.len() / size;
+        let mut forces = vec![0.0; rows * self.blades * size];
+        for j in 0..self.blades {
+            let mut delayed = lambda.to_vec();
+            let angle = j as f64 * sector.phase_step();
+            crate::cyclic::delay_coefficients(&mut delayed, rows, harmonics, angle);
+            for (h, block) in delayed.chunks_exact(rows).enumerate() {
+                for (r, &value) in block.iter().enumerate() {
+                    forces[h * rows * self.blades + r * self.blades + j] = value;
+                }
+            }
+        }
+        full.extend(forces);
+        full
+    }
+
     /// One sector of the tuned disk (the mistuning is ignored) under `loading` and the
     /// engine order `engine_order`, with the lowest natural frequency `omega_1` of the disk
     /// that scales its damping ([`CyclicSector::lowest_frequency`]). The sector's dofs are `d, b, p` of blade 0
@@ -285,6 +333,66 @@ impl BladedDisk {
         let omega_1 = sector(model.clone())?.lowest_frequency()?;
         let model = model.with_rayleigh_damping(0.0, 2.0 * loading.zeta / omega_1);
         Ok((sector(model)?, omega_1))
+    }
+}
+
+/// An under-platform damper between neighbouring blades of a [`BladedDisk`]: blade `j`'s
+/// pad against the mean of the next blade's tip and disk dof,
+/// `p_j - (b_{j+1} + d_{j+1}) / 2 - gap <= 0`, with Coulomb friction `friction` (the
+/// damper's normal force; none at 0) on the slip `b_j - d_{j+1}`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BladeDamper {
+    /// Clearance of the damper.
+    pub gap: f64,
+    /// Coulomb coefficient `mu >= 0`.
+    pub friction: f64,
+}
+
+impl BladeDamper {
+    /// The damper between every pair of neighbours of the whole disk `disk` added to its
+    /// `model` (contacts blade by blade, then their friction rows).
+    pub fn add_to_disk(&self, disk: &BladedDisk, model: &mut StructuralModel) {
+        let first = model.contacts.len();
+        let blades = disk.blades;
+        for j in 0..blades {
+            let next = 3 * ((j + 1) % blades);
+            let row = ContactRow::new(vec![3 * j + 2, next + 1, next], vec![1.0, -0.5, -0.5]);
+            (model.contacts).push(ContactPoint::on_row(row.expect("a valid row"), self.gap));
+        }
+        for j in (0..blades).filter(|_| self.friction > 0.0) {
+            let next = 3 * ((j + 1) % blades);
+            let slip = ContactRow::new(vec![3 * j + 1, next], vec![1.0, -1.0]);
+            let point =
+                FrictionPoint::on_contact(slip.expect("a valid row"), self.friction, first + j);
+            model.friction.push(point);
+        }
+    }
+
+    /// The damper on the sector `sector` of [`BladedDisk::cyclic_sector`]: its own part on
+    /// the pad (and tip), its neighbour part on the next sector's tip and disk dof.
+    pub fn add_to_sector(&self, sector: &CyclicSector) -> Result<CyclicSector, InvalidSector> {
+        let mut model = sector.model().clone();
+        let contact = model.contacts.len();
+        model
+            .contacts
+            .push(ContactPoint::on_row(ContactRow::unit(2, 1.0), self.gap));
+        let part = ContactRow::new(vec![1, 0], vec![-0.5, -0.5]).expect("a valid row");
+        let mut rows = sector.neighbour_rows().to_vec();
+        rows.push(NeighbourRow { row: contact, part });
+        if self.friction > 0.0 {
+            let tangent = ContactRow::unit(1, 1.0);
+            model
+                .friction
+                .push(FrictionPoint::on_contact(tangent, self.friction, contact));
+            let row = model.contacts.len() + model.friction.len() - 1;
+            rows.push(NeighbourRow {
+                row,
+                part: ContactRow::unit(0, -1.0),
+            });
+        }
+        let (left, right) = (sector.left().to_vec(), sector.right().to_vec());
+        CyclicSector::new(model, left, right, sector.sectors(), sector.engine_order())?
+            .with_neighbour_rows(rows)
     }
 }
 

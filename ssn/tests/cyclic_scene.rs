@@ -1,6 +1,8 @@
 //! `[cyclic]` on a `[model]` sector and `[forcing] engine_order` on a `[bladed_disk]`: the
 //! sector scene and the full disk scene under the same engine order answer the same
-//! harmonic balance, and the sector's `blade_amplitudes` are the full disk's blade tips.
+//! harmonic balance, and the sector's `blade_amplitudes` are the full disk's blade tips;
+//! a sector scene with a friction damper between sectors (`neighbour_dofs`) answers the
+//! full disk built in code with the damper between every pair of neighbours.
 
 use std::path::{Path, PathBuf};
 
@@ -126,6 +128,17 @@ fn a_sector_scene_answers_the_full_disk_scene_under_the_same_engine_order() {
 #[test]
 fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
     let dir = temp_dir("refused");
+    let disk = BladedDisk {
+        blades: BLADES,
+        mistuning: 0.0,
+    };
+    let (sector, _) = disk
+        .cyclic_sector(&DiskLoading::shipped(Vec::new()), 1)
+        .unwrap();
+    let m = sector.model();
+    for (name, text) in model_matrix_files(&m.stiffness, &m.mass, &[0.0, 1.0, 0.0, 0.0]) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
     let cases = [
         (
             "[rod]\nelements = 4\n[forcing]\namplitude = 0.1\nengine_order = 2\n",
@@ -140,6 +153,17 @@ fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
              right = [4]\n[forcing]\namplitude = 0.1\n",
             "cyclic",
         ),
+        (
+            "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n[forcing]\namplitude = 0.1\n\
+             vector = \"f.mtx\"\n[[contact.point]]\ndof = 3\ngap = 1.0\nneighbour_dofs = [2]\n\
+             neighbour_coefficients = [-1.0]\n",
+            "contact.point.neighbour_dofs",
+        ),
+        (
+            "[bladed_disk]\nblades = 4\n[forcing]\namplitude = 0.1\n[[contact.point]]\ndof = 3\n\
+             gap = 1.0\nneighbour_dofs = [2]\n",
+            "contact.point.neighbour_coefficients",
+        ),
     ];
     for (i, (text, key)) in cases.iter().enumerate() {
         let path = dir.join(format!("case{i}.toml"));
@@ -148,6 +172,123 @@ fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
             Err(e) => e.to_string(),
             Ok(_) => panic!("case {i} loaded"),
         };
+        assert!(message.contains(key), "case {i}: {message}");
+    }
+}
+
+#[test]
+fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_full_disk() {
+    use semismooth_contact::structures::BladeDamper;
+    let (blades, engine_order, gap, mu) = (24, 3, 0.2, 0.3);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blisk_dampers_sector.toml");
+    let (loaded, sector_solution) = solved(&scene);
+    let disk = BladedDisk {
+        blades,
+        mistuning: 0.0,
+    };
+    let loading = DiskLoading::shipped(Vec::new());
+    let (sector, omega_1) = disk.cyclic_sector(&loading, engine_order).unwrap();
+    assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
+    // The full disk with the damper between every pair of neighbours, written blade by
+    // blade on the disk's dofs.
+    let mut full = disk.structure(&loading).unwrap();
+    full.model.load = (full.model.load.clone())
+        .delayed_by_sector(&disk.sector_dofs(), engine_order)
+        .unwrap();
+    BladeDamper { gap, friction: mu }.add_to_disk(&disk, &mut full.model);
+    let settings = &loaded.scene.solver;
+    let full_solution = semismooth_contact::solve(&full, loaded.omega, settings, None).unwrap();
+    assert!(full_solution.converged());
+    assert!(full_solution
+        .contacts
+        .iter()
+        .all(|c| c.contact_fraction > 0.0));
+    let u_full = &full_solution.state[..3 * blades * (2 * HARMONICS + 1)];
+    let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let recovered = disk.recover(&sector, &sector_solution.state, HARMONICS);
+    let worst = (recovered.iter().zip(u_full)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    // The same discrete equations (64 samples, a multiple of N / gcd(N, EO) = 8; beta
+    // written to 16 digits), both converged below 1e-13 (the library's test finds 2e-13):
+    // 1e-10 leaves a wide margin.
+    assert!(worst < 1e-10 * scale, "{:e}", worst / scale);
+}
+
+#[test]
+fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bladed_disk_sector.toml");
+    let (loaded, sector_solution) = solved(&path);
+    let blades = 100;
+    let disk = BladedDisk {
+        blades,
+        mistuning: 0.0,
+    };
+    let loading = DiskLoading {
+        amplitude: 0.06,
+        ..DiskLoading::shipped((0..blades).collect())
+    };
+    let (sector, omega_1) = disk.cyclic_sector(&loading, 3).unwrap();
+    // The scene's written frequency and damping are the disk's to the digits written.
+    assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
+    let mut full = disk.structure(&loading).unwrap();
+    full.model.load = (full.model.load.clone())
+        .delayed_by_sector(&disk.sector_dofs(), 3)
+        .unwrap();
+    let full_solution =
+        semismooth_contact::solve(&full, loaded.omega, &loaded.scene.solver, None).unwrap();
+    assert!(full_solution.converged());
+    assert!(full_solution
+        .contacts
+        .iter()
+        .all(|c| c.contact_fraction > 0.0));
+    let len = 3 * blades * (2 * HARMONICS + 1);
+    let u_full = &full_solution.state[..len];
+    let recovered = disk.recover(&sector, &sector_solution.state, HARMONICS);
+    let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = (recovered.iter().zip(u_full)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    // The beta written to 16 digits is the disk's 2 zeta / omega_1 to a rounding; the same
+    // equations otherwise (100 samples, a multiple of N / gcd(N, EO)): 1e-10.
+    assert!(worst < 1e-10 * scale, "{:e}", worst / scale);
+    let amplitudes = ssn::json::blade_amplitudes(&loaded.structure, &sector_solution).unwrap();
+    assert_eq!(amplitudes.as_array().unwrap().len(), blades);
+}
+
+#[test]
+fn interface_nodes_through_a_dof_map_give_the_interface_dofs() {
+    let dir = temp_dir("nodes");
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blade_sector");
+    for name in ["K.mtx", "M.mtx", "f.mtx"] {
+        std::fs::copy(shipped.join(name), dir.join(name)).unwrap();
+    }
+    // Rows in a shuffled order: node 4 (the next sector's disk dof) is row 1, node 1 row 4.
+    std::fs::write(dir.join("nodes.dof"), "4.1\n2.1\n3.1\n1.1\n").unwrap();
+    let scene = |interface: &str, map: &str| {
+        format!(
+            "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n{map}\n[cyclic]\nsectors = 8\n\
+             engine_order = 1\n{interface}\n[forcing]\nvector = \"f.mtx\"\namplitude = 0.1\n"
+        )
+    };
+    let read = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        ssn::scene::Scene::from_path(&path)
+    };
+    let map = "dof_map = \"nodes.dof\"";
+    let by_nodes = read(
+        "nodes.toml",
+        scene("left_nodes = [4]\nright_nodes = [1]", map),
+    );
+    let cyclic = by_nodes.unwrap().cyclic.unwrap();
+    assert_eq!((cyclic.left, cyclic.right), (vec![0], vec![3]));
+    let refused = [
+        (scene("left_nodes = [4]\nright_nodes = [1]", ""), "dof_map"),
+        (
+            scene("left_nodes = [4]\nright_nodes = [9]", map),
+            "cyclic.right_nodes",
+        ),
+        (scene("left = [1]\nright_nodes = [1]", map), "cyclic.left"),
+    ];
+    for (i, (text, key)) in refused.into_iter().enumerate() {
+        let message = read(&format!("bad{i}.toml"), text).unwrap_err().to_string();
         assert!(message.contains(key), "case {i}: {message}");
     }
 }

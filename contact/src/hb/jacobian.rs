@@ -127,12 +127,12 @@ impl DenseAssemble for HbJacobian {
         let (n, m, size) = (lin.dofs, lin.contacts(), lin.size());
         let offset = n * size;
         if let ContactCoupling::Complementarity { .. } = self.coupling {
-            for (i, row) in lin.rows.iter().enumerate() {
+            for i in 0..m {
                 for j in 0..size {
-                    for (dof, a) in row.entries() {
-                        // dR_u / dLambda = -G^T.
-                        out[(j * n + dof, offset + j * m + i)] -= a;
-                    }
+                    // dR_u / dLambda = -G^T.
+                    lin.row_terms(i, j, |l, dof, a| {
+                        out[(l * n + dof, offset + j * m + i)] -= a
+                    });
                     out[(offset + j * m + i, offset + j * m + i)] += 1.0;
                 }
             }
@@ -143,11 +143,12 @@ impl DenseAssemble for HbJacobian {
             match self.coupling {
                 ContactCoupling::Complementarity { c } => {
                     for j in 0..size {
-                        for (dof, g) in lin.rows[b].entries() {
-                            for l in 0..size {
-                                // dR_a / dU = c Q_ab M_b G_b.
-                                out[(offset + j * m + a, l * n + dof)] += c * g * measured(j, l);
-                            }
+                        for l in 0..size {
+                            // dR_a / dU = c Q_ab M_b G_b.
+                            let weight = c * measured(j, l);
+                            lin.row_terms(b, l, |l2, dof, g| {
+                                out[(offset + j * m + a, l2 * n + dof)] += weight * g;
+                            });
                         }
                         for l in 0..size {
                             // dR_a / dLambda_b = [a = b] I - Q_ab.
@@ -157,14 +158,14 @@ impl DenseAssemble for HbJacobian {
                 }
                 ContactCoupling::Penalty { stiffness } => {
                     // k_p G_a^T Q_ab M_b G_b.
-                    for (r, ga) in lin.rows[a].entries() {
-                        for (col, gb) in lin.rows[b].entries() {
-                            for j in 0..size {
-                                for l in 0..size {
-                                    out[(j * n + r, l * n + col)] +=
-                                        stiffness * ga * gb * measured(j, l);
-                                }
-                            }
+                    for j in 0..size {
+                        for l in 0..size {
+                            let weight = stiffness * measured(j, l);
+                            lin.row_terms(a, j, |j2, r, ga| {
+                                lin.row_terms(b, l, |l2, col, gb| {
+                                    out[(j2 * n + r, l2 * n + col)] += weight * ga * gb;
+                                });
+                            });
                         }
                     }
                 }

@@ -91,19 +91,17 @@ impl KrylovOperator for CondensedOperator<'_> {
         for k in 0..=lin.basis.harmonics() {
             // G^T p_k in complex form p_c - i p_s.
             self.rhs.fill(c64::new(0.0, 0.0));
-            for (i, row) in lin.rows.iter().enumerate() {
+            for i in 0..m {
                 let z = if k == 0 {
                     c64::new(p[i], 0.0)
                 } else {
                     c64::new(p[(2 * k - 1) * m + i], -p[2 * k * m + i])
                 };
-                for (dof, a) in row.entries() {
-                    self.rhs[(dof, 0)] += z * a;
-                }
+                lin.add_row_column(i, k, z, self.rhs.as_mut(), 0);
             }
             self.dynamic.solve_in_place(k, self.rhs.as_mut())?;
-            for (i, row) in lin.rows.iter().enumerate() {
-                let v = lin.measured(i, k, super::structured::row_of(row, self.rhs.as_ref(), 0));
+            for i in 0..m {
+                let v = lin.measured(i, k, lin.row_complex(i, k, self.rhs.as_ref(), 0));
                 if k == 0 {
                     t[i] = v.re;
                 } else {

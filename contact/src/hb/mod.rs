@@ -200,6 +200,7 @@ mod friction;
 mod jacobian;
 mod krylov;
 mod laws;
+mod neighbour;
 mod penalty;
 mod ssn;
 mod structured;
@@ -318,6 +319,8 @@ pub(crate) struct LinearData {
     pub(crate) laws: LawLayout,
     /// Each frictional contact with the index of its first row.
     pub(crate) frictional: Vec<(usize, FrictionalContact)>,
+    /// The parts of the rows on the next cyclic sector's dofs.
+    pub(crate) neighbours: neighbour::NeighbourParts,
 }
 
 impl LinearData {
@@ -369,6 +372,7 @@ impl LinearData {
             })
             .collect();
         Ok(Self {
+            neighbours: neighbour::NeighbourParts::of(model, rows.len()),
             dofs: model.dofs(),
             basis,
             operator: HarmonicOperator::new(model, harmonics),
@@ -404,13 +408,13 @@ impl LinearData {
     /// `out[j m + i] = g_i . U_j`: the rows of `G` applied to the harmonic-major
     /// coefficients `u` (index `j N + dof`), harmonic-major out (index `j m + i`).
     pub(crate) fn gather_rows(&self, u: &[f64], out: &mut [f64]) {
-        let (n, m) = (self.dofs, self.contacts());
+        let m = self.contacts();
         if m == 0 {
             return;
         }
         for (j, block) in out.chunks_exact_mut(m).enumerate() {
-            for (o, row) in block.iter_mut().zip(&self.rows) {
-                *o = row.dot_at(u, j * n);
+            for (i, o) in block.iter_mut().enumerate() {
+                *o = self.row_dot(i, u, j);
             }
         }
     }
@@ -444,14 +448,12 @@ impl LinearData {
     /// Coefficient `j` of row `i`'s measured quantity ([`LinearData::gather_measured`])
     /// from the displacement coefficients `u` (index `j N + dof`).
     pub(crate) fn measured_coefficient(&self, i: usize, u: &[f64], j: usize) -> f64 {
-        let n = self.dofs;
-        let row = &self.rows[i];
         match (self.is_velocity_row(i), j) {
-            (false, _) => row.dot_at(u, j * n),
-            (true, 0) => MEAN_SLIP_ANCHOR * row.dot_at(u, 0),
+            (false, _) => self.row_dot(i, u, j),
+            (true, 0) => MEAN_SLIP_ANCHOR * self.row_dot(i, u, 0),
             // Harmonic k of (a, b) is (k b, -k a).
-            (true, j) if j % 2 == 1 => j.div_ceil(2) as f64 * row.dot_at(u, (j + 1) * n),
-            (true, j) => -((j / 2) as f64) * row.dot_at(u, (j - 1) * n),
+            (true, j) if j % 2 == 1 => j.div_ceil(2) as f64 * self.row_dot(i, u, j + 1),
+            (true, j) => -((j / 2) as f64) * self.row_dot(i, u, j - 1),
         }
     }
 
@@ -468,13 +470,13 @@ impl LinearData {
 
     /// `u[j N + .] += alpha G^T p_j`: the row forces `p` (index `j m + i`) on the dofs.
     pub(crate) fn scatter_rows(&self, p: &[f64], alpha: f64, u: &mut [f64]) {
-        let (n, m) = (self.dofs, self.contacts());
+        let m = self.contacts();
         if m == 0 {
             return;
         }
         for (j, block) in p.chunks_exact(m).enumerate() {
-            for (pi, row) in block.iter().zip(&self.rows) {
-                row.add_transpose_at(alpha * pi, u, j * n);
+            for (i, pi) in block.iter().enumerate() {
+                self.add_row_transpose(i, alpha * pi, u, j);
             }
         }
     }
@@ -641,9 +643,7 @@ pub(crate) fn row_samples(
     points: usize,
 ) -> Result<Vec<f64>, HbError> {
     lin.check_contact(row)?;
-    let coeffs: Vec<f64> = (0..lin.size())
-        .map(|j| lin.rows[row].dot_at(u, j * lin.dofs))
-        .collect();
+    let coeffs: Vec<f64> = (0..lin.size()).map(|j| lin.row_dot(row, u, j)).collect();
     samples_of(lin, &coeffs, points)
 }
 

@@ -310,9 +310,8 @@ impl PenaltyHb {
         check_len("HB unknowns", self.dim(), u.len())?;
         let lin = &self.state.linear;
         lin.check_normal_row(contact)?;
-        let row = &lin.rows[contact];
         let mut coeffs: Vec<f64> = (0..lin.size())
-            .map(|j| row.dot_at(u, j * lin.dofs))
+            .map(|j| lin.row_dot(contact, u, j))
             .collect();
         coeffs[0] -= lin.gaps[contact];
         super::switching_intervals(lin, &coeffs)
@@ -389,9 +388,8 @@ impl PenaltyHb {
     fn gap_samples(&mut self, u: &[f64], i: usize) {
         let lin = &self.state.linear;
         let coeffs = self.state.aft.coefficients_mut();
-        let row = &lin.rows[i];
         for (j, c) in coeffs.iter_mut().enumerate() {
-            *c = row.dot_at(u, j * lin.dofs);
+            *c = lin.row_dot(i, u, j);
         }
         coeffs[0] -= lin.gaps[i];
         self.state.aft.coefficients_to_samples();
@@ -405,7 +403,6 @@ impl Residual for PenaltyHb {
 
     fn residual(&mut self, u: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
         let lin = self.state.linear.clone();
-        let n = lin.dofs;
         lin.dynamic_residual(&self.state.parameters(), u, out);
         for f in 0..lin.friction.len() {
             // - G_t^T P lambda_t = + G_t^T P b tanh(y / eta).
@@ -415,9 +412,9 @@ impl Residual for PenaltyHb {
                 *s = -force;
             }
             self.state.aft.samples_to_coefficients();
-            let row = &lin.rows[lin.normal_rows() + f];
+            let row = lin.normal_rows() + f;
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                row.add_transpose_at(*c, out, j * n);
+                lin.add_row_transpose(row, *c, out, j);
             }
         }
         for i in 0..lin.normal_rows() {
@@ -428,9 +425,8 @@ impl Residual for PenaltyHb {
             }
             self.state.aft.samples_to_coefficients();
             // - G^T P lambda = + k_p G^T P max(0, G u - g).
-            let row = &lin.rows[i];
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
-                row.add_transpose_at(*c, out, j * n);
+                lin.add_row_transpose(i, *c, out, j);
             }
         }
         Ok(())

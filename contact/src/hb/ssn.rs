@@ -217,9 +217,8 @@ impl SsnHb {
         lin.check_normal_row(contact)?;
         let (n, m) = (lin.dofs, lin.contacts());
         let offset = n * lin.size();
-        let row = &lin.rows[contact];
         let mut coeffs: Vec<f64> = (0..lin.size())
-            .map(|j| self.c * row.dot_at(x, j * n) - x[offset + j * m + contact])
+            .map(|j| self.c * lin.row_dot(contact, x, j) - x[offset + j * m + contact])
             .collect();
         coeffs[0] -= self.c * lin.gaps[contact];
         super::switching_intervals(lin, &coeffs)

@@ -2,7 +2,7 @@
 //! ([`crate::cyclic`]): each coupling matrix enters harmonic `k` of the harmonic operator
 //! with the coefficient of its source (`K`, `M` or `D`) times `e^{i sign k phi}`.
 
-use super::SparseMatrix;
+use super::{ContactRow, SparseMatrix};
 
 /// Which source of the harmonic operator a coupling matrix follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,6 +49,22 @@ pub struct CyclicCoupling {
     pub sectors: usize,
     /// The coupling matrices.
     pub terms: Vec<CouplingTerm>,
+    /// The rows of `G` that also take the next sector's dofs (contacts between sectors).
+    pub neighbour_rows: Vec<NeighbourRow>,
+}
+
+/// The part of one row of `G` on the next sector's dofs: the row measures
+/// `g . u(t) + n . u_next(t)` with `u_next(t) = u(t - EO T / N)`, so harmonic `k` of the
+/// neighbour's dofs is this sector's rotated by `k phi` (`e^{-i k phi}` on `a - i b`), and
+/// the force `lambda` acts on the next sector through `n^T` (on this sector's dofs, the
+/// previous sector's force: rotated back, `e^{+i k phi}`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NeighbourRow {
+    /// The row's index in [`super::StructuralModel::rows`] (contacts, friction points,
+    /// frictional contacts' rows).
+    pub row: usize,
+    /// The coefficients on the next sector's dofs (numbered as this sector's).
+    pub part: ContactRow,
 }
 
 impl CyclicCoupling {
@@ -59,7 +75,14 @@ impl CyclicCoupling {
             phase_step,
             sectors,
             terms,
+            neighbour_rows: Vec::new(),
         }
+    }
+
+    /// The couplings with the rows `neighbour_rows` between this sector and the next.
+    pub fn with_neighbour_rows(mut self, neighbour_rows: Vec<NeighbourRow>) -> Self {
+        self.neighbour_rows = neighbour_rows;
+        self
     }
 
     /// The amplitude `max_t |u_s(t)|` of one dof in every sector `s = 0..N` from its

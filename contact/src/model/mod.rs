@@ -32,7 +32,7 @@ mod load;
 pub use contact::{
     ContactDirection, ContactPoint, ContactRow, FrictionPoint, InvalidRow, NormalForce,
 };
-pub use coupling::{CouplingSource, CouplingTerm, CyclicCoupling};
+pub use coupling::{CouplingSource, CouplingTerm, CyclicCoupling, NeighbourRow};
 pub use frictional::{FrictionalContact, NormalLaw};
 pub use load::{HarmonicLoad, LoadHarmonic};
 
@@ -113,6 +113,18 @@ pub enum InvalidModel {
     )]
     SectorDof {
         /// The dof.
+        dof: usize,
+        /// `N`.
+        dofs: usize,
+    },
+    /// A row between sectors names no row of the model or a dof out of range.
+    #[error("row {row} between sectors with largest neighbour dof {dof}: allowed rows in 0..{rows} and dofs in 0..{dofs}")]
+    NeighbourRow {
+        /// The row index.
+        row: usize,
+        /// The model's rows.
+        rows: usize,
+        /// The largest dof of its neighbour part.
         dof: usize,
         /// `N`.
         dofs: usize,
@@ -373,6 +385,18 @@ impl StructuralModel {
                 });
             }
             first_non_finite("cyclic coupling matrix", matrix.val())?;
+        }
+        let rows = self.rows().count();
+        for neighbour in self.cyclic.iter().flat_map(|c| &c.neighbour_rows) {
+            let dof = neighbour.part.largest_dof();
+            if neighbour.row >= rows || dof >= n {
+                return Err(InvalidModel::NeighbourRow {
+                    row: neighbour.row,
+                    rows,
+                    dof,
+                    dofs: n,
+                });
+            }
         }
         self.load.validate(n)?;
         contact::validate_rows(&self.contacts, &self.friction, n)?;

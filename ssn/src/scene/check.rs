@@ -31,6 +31,17 @@ impl<'a> Check<'a> {
         self.dof_map
     }
 
+    /// The checks of the same file with the `[model]`'s dof map `dof_map`.
+    pub(super) fn with_dof_map<'b>(&self, dof_map: Option<&'b DofMapFile>) -> Check<'b>
+    where
+        'a: 'b,
+    {
+        Check {
+            path: self.path,
+            dof_map,
+        }
+    }
+
     pub(super) fn invalid(&self, key: &str, value: impl ToString, allowed: &str) -> SceneError {
         SceneError::invalid(self.path, key, value, allowed)
     }
@@ -120,6 +131,7 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
     let ck = Check::new(path);
     let forcing = ck.forcing_or_obstacle(&mut raw)?;
     let mut bladed_disk = None;
+    let neighbour_rows = ck.neighbour_rows(raw.contact.as_ref(), raw.friction.as_ref())?;
     let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
         (None, None, Some(d)) => {
             let (model, mistuning) = ck.bladed_disk(
@@ -184,7 +196,12 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&forcing, model.is_some(), solver.harmonics)?;
-    let (engine_order, cyclic) = ck.cyclic_keys(&forcing, raw.cyclic, &model, &bladed_disk)?;
+    let (engine_order, cyclic) = ck.cyclic_keys(
+        &forcing,
+        (raw.cyclic, neighbour_rows),
+        &model,
+        &bladed_disk,
+    )?;
     let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),

@@ -5,21 +5,39 @@
 //! sectors = 24           # N >= 1
 //! engine_order = 3       # EO >= 0
 //! left = [1, 2]          # 1-based interface dofs; right[j] is the next sector's left[j]
-//! right = [7, 8]
+//! right = [7, 8]         # (or left_nodes/right_nodes through the [model] dof_map: every
+//!                        # component of left_nodes[j] against the same of right_nodes[j])
 //!
 //! [forcing]              # on a full model (or a [bladed_disk]): sector s lags 2 pi EO s / N
 //! engine_order = 3
 //! sector_dofs = [[1, 2, 3], [4, 5, 6]]   # 1-based; the [bladed_disk] builder knows its own
+//! ```
+//!
+//! A contact between sectors on a `[cyclic]` sector: its row also reads the next sector's
+//! dofs (numbered as this sector's), delayed by `EO T / N`.
+//!
+//! ```toml
+//! [[contact.point]]      # the pad against the next sector's blade
+//! dofs = [3]
+//! coefficients = [1.0]
+//! neighbour_dofs = [2]
+//! neighbour_coefficients = [-1.0]
+//! gap = 0.1
+//! friction = 0.3         # its friction row may read the next sector too
+//! tangent_dofs = [2]
+//! tangent_coefficients = [1.0]
+//! tangent_neighbour_dofs = [1]
+//! tangent_neighbour_coefficients = [-1.0]
 //! ```
 
 use serde::Deserialize;
 
 use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::matrix_market::ModelSpec;
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{NeighbourRow, Structure};
 
 use super::check::Check;
-use super::{RawForcing, Scene, SceneError};
+use super::{RawContact, RawForcing, RawFrictionSection, Scene, SceneError};
 
 /// Largest `[cyclic] sectors` and `engine_order` accepted.
 pub const MAX_SECTORS: usize = 100_000;
@@ -30,13 +48,16 @@ pub const MAX_SECTORS: usize = 100_000;
 pub(super) struct RawCyclic {
     sectors: i64,
     engine_order: i64,
-    left: Vec<i64>,
-    right: Vec<i64>,
+    left: Option<Vec<i64>>,
+    right: Option<Vec<i64>>,
+    left_nodes: Option<Vec<i64>>,
+    right_nodes: Option<Vec<i64>>,
 }
 
 /// A `[model]` scene's `[cyclic]` section: its structure is one sector of `sectors`,
 /// excited by `engine_order`, with matching 0-based interface dofs `left` and `right`.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct CyclicSpec {
     /// The number of sectors `N`.
     pub sectors: usize,
@@ -46,6 +67,9 @@ pub struct CyclicSpec {
     pub left: Vec<usize>,
     /// Right interface dofs (0-based), `right[j]` the next sector's `left[j]`.
     pub right: Vec<usize>,
+    /// The rows between this sector and the next (`neighbour_dofs` of the contacts and
+    /// friction points), numbered as the model numbers its rows.
+    pub neighbour_rows: Vec<NeighbourRow>,
 }
 
 /// `[forcing] engine_order` on a full model: the load on the dofs of sector `s` delayed by
@@ -64,7 +88,7 @@ impl Check<'_> {
     pub(super) fn cyclic_keys(
         &self,
         f: &RawForcing,
-        raw: Option<RawCyclic>,
+        (raw, neighbour_rows): (Option<RawCyclic>, Vec<NeighbourRow>),
         model: &Option<ModelSpec>,
         bladed_disk: &Option<Vec<f64>>,
     ) -> Result<(Option<EngineOrderSpec>, Option<CyclicSpec>), SceneError> {
@@ -80,7 +104,19 @@ impl Check<'_> {
             false => None,
         };
         let is_model = model.is_some() && bladed_disk.is_none();
-        let cyclic = raw.map(|c| self.cyclic(c, is_model)).transpose()?;
+        let with_map = self.with_dof_map(model.as_ref().and_then(|m| m.dof_map.as_ref()));
+        let cyclic = raw.map(|c| with_map.cyclic(c, is_model)).transpose()?;
+        let cyclic = cyclic.map(|c| CyclicSpec {
+            neighbour_rows: neighbour_rows.clone(),
+            ..c
+        });
+        if cyclic.is_none() && !neighbour_rows.is_empty() {
+            return Err(self.invalid(
+                "contact.point.neighbour_dofs",
+                "given without [cyclic]",
+                "rows on the next sector's dofs in a [cyclic] sector scene",
+            ));
+        }
         if cyclic.is_some() && engine_order.is_some() {
             return Err(self.invalid(
                 "forcing.engine_order",
@@ -107,10 +143,20 @@ impl Check<'_> {
                 .map(|&d| Ok(self.count(key, d, 1, usize::MAX >> 1)? - 1))
                 .collect()
         };
-        let (left, right) = (
-            dofs("cyclic.left", &raw.left)?,
-            dofs("cyclic.right", &raw.right)?,
-        );
+        let (left, right) = match (&raw.left, &raw.right, &raw.left_nodes, &raw.right_nodes) {
+            (Some(left), Some(right), None, None) => {
+                (dofs("cyclic.left", left)?, dofs("cyclic.right", right)?)
+            }
+            (None, None, Some(left), Some(right)) => self.interface_nodes(left, right)?,
+            _ => {
+                return Err(self.invalid(
+                    "cyclic.left",
+                    "an incomplete or mixed interface",
+                    "`left` and `right` (1-based dofs), or `left_nodes` and `right_nodes` \
+                     (through the [model] dof_map)",
+                ))
+            }
+        };
         if left.len() != right.len() {
             return Err(self.invalid(
                 "cyclic.right",
@@ -123,7 +169,119 @@ impl Check<'_> {
             engine_order,
             left,
             right,
+            neighbour_rows: Vec::new(),
         })
+    }
+
+    /// `[cyclic] left_nodes`/`right_nodes` as 0-based dofs through the dof map: every
+    /// component of `left[j]` (ascending) against the same component of `right[j]`.
+    fn interface_nodes(
+        &self,
+        left: &[i64],
+        right: &[i64],
+    ) -> Result<(Vec<usize>, Vec<usize>), SceneError> {
+        if left.len() != right.len() {
+            return Err(self.invalid(
+                "cyclic.right_nodes",
+                format!("{} nodes", right.len()),
+                &format!("as many nodes as cyclic.left_nodes ({})", left.len()),
+            ));
+        }
+        let components = |node: i64| match (self.dof_map(), u64::try_from(node)) {
+            (Some(map), Ok(n)) => map.map.components(n),
+            _ => Vec::new(),
+        };
+        let (mut left_dofs, mut right_dofs) = (Vec::new(), Vec::new());
+        for (&l, &r) in left.iter().zip(right) {
+            for (key, node) in [("cyclic.left_nodes", l), ("cyclic.right_nodes", r)] {
+                if components(node).is_empty() {
+                    // No dof map, or a node it does not name: its error names the file.
+                    self.resolve(key, key, node, None)?;
+                }
+            }
+            let (cl, cr) = (components(l), components(r));
+            if cl != cr {
+                return Err(self.invalid(
+                    "cyclic.right_nodes",
+                    format!("node {r} with components {cr:?} against node {l}'s {cl:?}"),
+                    "a right node with the components of its left node",
+                ));
+            }
+            for c in cl {
+                let c = Some(i64::from(c));
+                let dof = |key, node| -> Result<usize, SceneError> {
+                    Ok(self.resolve(key, key, node, c)? as usize - 1)
+                };
+                left_dofs.push(dof("cyclic.left_nodes", l)?);
+                right_dofs.push(dof("cyclic.right_nodes", r)?);
+            }
+        }
+        Ok((left_dofs, right_dofs))
+    }
+
+    /// The parts on the next sector of the scene's rows (module documentation), numbered
+    /// as the model numbers its rows: the contacts, their friction rows, the friction
+    /// points.
+    pub(super) fn neighbour_rows(
+        &self,
+        contact: Option<&RawContact>,
+        friction: Option<&RawFrictionSection>,
+    ) -> Result<Vec<NeighbourRow>, SceneError> {
+        let points = contact.and_then(|c| c.point.as_deref()).unwrap_or_default();
+        let points: Vec<_> = (points.iter())
+            .filter(|p| !super::frictional::is_frictional(p))
+            .collect();
+        let frictions = points.iter().filter(|p| p.friction.is_some()).count();
+        let mut rows = Vec::new();
+        let mut part = |row: usize, key: &str, dofs: &Option<Vec<i64>>, a: &Option<Vec<f64>>| {
+            let (dofs_key, a_key) = (
+                format!("{key}neighbour_dofs"),
+                format!("{key}neighbour_coefficients"),
+            );
+            match (dofs, a) {
+                (None, None) => Ok(()),
+                (Some(dofs), Some(a)) => {
+                    let part = self.combination(&dofs_key, &a_key, dofs, a)?;
+                    rows.push(NeighbourRow { row, part });
+                    Ok(())
+                }
+                (Some(_), None) => {
+                    Err(self.invalid(&a_key, "missing", "one coefficient per neighbour dof"))
+                }
+                (None, Some(_)) => Err(self.invalid(
+                    &dofs_key,
+                    "missing",
+                    "the next sector's 1-based dofs of the row",
+                )),
+            }
+        };
+        let mut friction_row = points.len();
+        for (i, p) in points.iter().enumerate() {
+            part(
+                i,
+                "contact.point.",
+                &p.neighbour_dofs,
+                &p.neighbour_coefficients,
+            )?;
+            if p.friction.is_some() {
+                let (dofs, a) = (&p.tangent_neighbour_dofs, &p.tangent_neighbour_coefficients);
+                part(friction_row, "contact.point.tangent_", dofs, a)?;
+                friction_row += 1;
+            }
+        }
+        let friction_points = friction
+            .and_then(|f| f.point.as_deref())
+            .unwrap_or_default();
+        for (f, p) in friction_points.iter().enumerate() {
+            let row = points.len() + frictions + f;
+            part(
+                row,
+                "friction.point.",
+                &p.neighbour_dofs,
+                &p.neighbour_coefficients,
+            )?;
+        }
+        Ok(rows)
     }
 
     /// `[forcing] engine_order` and `sector_dofs`; a `[bladed_disk]` of `disk_blades`
@@ -201,6 +359,7 @@ impl Scene {
             c.sectors,
             c.engine_order,
         )
+        .and_then(|s| s.with_neighbour_rows(c.neighbour_rows.clone()))
         .map_err(|e| format!("invalid [cyclic]: {e}"))?;
         sector
             .structure(observed)

@@ -264,6 +264,10 @@ struct RawContactPoint {
     gap_cos: Option<Vec<f64>>,
     gap_sin: Option<Vec<f64>>,
     sliding_velocity: Option<Vec<f64>>,
+    neighbour_dofs: Option<Vec<i64>>,
+    neighbour_coefficients: Option<Vec<f64>>,
+    tangent_neighbour_dofs: Option<Vec<i64>>,
+    tangent_neighbour_coefficients: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -284,6 +288,8 @@ struct RawFrictionPoint {
     coefficients: Option<Vec<f64>>,
     normal_load: Option<f64>,
     friction: Option<f64>,
+    neighbour_dofs: Option<Vec<i64>>,
+    neighbour_coefficients: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize, Default)]

@@ -10,8 +10,8 @@ use super::super::jacobian::ContactCoupling;
 use super::super::krylov::{CondensedOperator, CondensedPreconditioner};
 use super::super::LinearData;
 use super::{
-    finite_step, gather_contacts, receptance_columns, row_of, FactoredCondensed,
-    StructuredHbSolver, KRYLOV_RELATIVE_TOLERANCE,
+    finite_step, gather_contacts, receptance_columns, FactoredCondensed, StructuredHbSolver,
+    KRYLOV_RELATIVE_TOLERANCE,
 };
 
 /// GMRES restart length and iteration budget of the matrix-free condensed solve. A restart
@@ -213,9 +213,9 @@ impl StructuredHbSolver {
         for k in 0..=harmonics {
             let r = &mut self.receptance[k];
             receptance_columns(dynamic, lin, k, &mut self.block_rhs, |first, z| {
-                for (i, row) in lin.rows.iter().enumerate() {
+                for i in 0..lin.contacts() {
                     for j in 0..z.ncols() {
-                        r[(i, first + j)] = lin.measured(i, k, row_of(row, z, j));
+                        r[(i, first + j)] = lin.measured(i, k, lin.row_complex(i, k, z, j));
                     }
                 }
             })?;

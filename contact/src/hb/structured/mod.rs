@@ -36,7 +36,6 @@ use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::laws::{copy_blocks, LawLayout};
 use super::LinearData;
-use crate::model::ContactRow;
 use crate::operator::{HarmonicFactors, HarmonicParameters};
 
 mod matrix_free;
@@ -324,7 +323,7 @@ impl StructuredHbSolver {
                     for j in 0..z.ncols() {
                         let i = first + j;
                         diagonal[k * lin.contacts() + i] =
-                            lin.measured(i, k, row_of(&lin.rows[i], z, j));
+                            lin.measured(i, k, lin.row_complex(i, k, z, j));
                     }
                 })?;
                 continue;
@@ -332,14 +331,14 @@ impl StructuredHbSolver {
             let z = &mut self.response[k];
             z.fill(c64::new(0.0, 0.0));
             // Columns of G^T (two rows may share a dof).
-            for (i, row) in lin.rows.iter().enumerate() {
-                set_column(row, z.as_mut(), i);
+            for i in 0..lin.contacts() {
+                lin.add_row_column(i, k, c64::new(1.0, 0.0), z.as_mut(), i);
             }
             dynamic.solve_in_place(k, z.as_mut())?;
             let r = &mut self.receptance[k];
-            for (i, row) in lin.rows.iter().enumerate() {
+            for i in 0..lin.contacts() {
                 for ip in 0..lin.contacts() {
-                    r[(i, ip)] = lin.measured(i, k, row_of(row, z.as_ref(), ip));
+                    r[(i, ip)] = lin.measured(i, k, lin.row_complex(i, k, z.as_ref(), ip));
                 }
             }
         }
@@ -400,7 +399,7 @@ fn receptance_columns(
         let mut z = block.as_mut().subcols_mut(0, count);
         z.fill(c64::new(0.0, 0.0));
         for j in 0..count {
-            set_column(&lin.rows[first + j], z.as_mut(), j);
+            lin.add_row_column(first + j, k, c64::new(1.0, 0.0), z.as_mut(), j);
         }
         dynamic.solve_in_place(k, z.as_mut())?;
         visit(first, z.as_ref());
@@ -413,20 +412,6 @@ fn receptance_columns(
 /// `j N + dof`).
 fn gather_contacts(lin: &LinearData, u: &[f64], out: &mut [f64]) {
     lin.gather_measured(u, out);
-}
-
-/// Column `col` of `z` set to the row `g` (a column of `G^T`; the column is zero before).
-fn set_column(row: &ContactRow, mut z: MatMut<'_, c64>, col: usize) {
-    for (dof, a) in row.entries() {
-        z[(dof, col)] = c64::new(a, 0.0);
-    }
-}
-
-/// `g . z[:, col]` (complex).
-pub(crate) fn row_of(row: &ContactRow, z: faer::MatRef<'_, c64>, col: usize) -> c64 {
-    let mut entries = row.entries();
-    let (d, a) = entries.next().expect("a row has at least one dof");
-    entries.fold(z[(d, col)] * a, |s, (d, a)| s + z[(d, col)] * a)
 }
 
 /// `Ok` unless the solved step holds a non-finite entry.
