@@ -14,14 +14,15 @@
 //! Reference: Craig & Bampton (1968), coupling of substructures for dynamic analyses.
 
 use faer::sparse::Triplet;
-use semismooth::linalg::FaerSparseLu;
-use semismooth::Factorize;
 
 use crate::model::{
     ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
 };
 
+mod cholesky;
 mod modes;
+
+pub(crate) use cholesky::StiffnessFactor;
 
 pub use modes::{lowest_modes, ModeCount, Modes, BLOCK, MODE_TOLERANCE};
 
@@ -152,7 +153,7 @@ pub fn craig_bampton(
     }
     let (k_ii, k_ib) = split(&model.stiffness, &place, interior.len(), boundary.len())?;
     let (m_ii, _) = split(&model.mass, &place, interior.len(), boundary.len())?;
-    let mut lu = factored(&k_ii)?;
+    let mut lu = StiffnessFactor::new(&k_ii)?;
     let fixed = lowest_modes(&mut lu, &m_ii, modes)?;
     let mut transform = Vec::with_capacity(boundary.len() + fixed.shapes.len());
     for (k, mut psi) in k_ib.into_iter().enumerate() {
@@ -303,21 +304,11 @@ fn reduced_structure(
 }
 
 /// The lowest `count` natural frequencies of `model` (ascending) by [`lowest_modes`] on
-/// one sparse factorization of `K`.
+/// one sparse factorization of `K` (Cholesky, or LU when `K` is not positive definite).
 pub fn lowest_frequencies(
     model: &StructuralModel,
     count: usize,
 ) -> Result<Vec<f64>, ReductionError> {
-    let mut lu = factored(&model.stiffness)?;
+    let mut lu = StiffnessFactor::new(&model.stiffness)?;
     Ok(lowest_modes(&mut lu, &model.mass, ModeCount::Count(count))?.omegas)
-}
-
-/// The sparse LU of `matrix`, or why it failed.
-fn factored(matrix: &SparseMatrix) -> Result<FaerSparseLu, ReductionError> {
-    let mut lu = FaerSparseLu::new();
-    lu.factor(matrix)
-        .map_err(|e| ReductionError::Factorization {
-            reason: e.to_string(),
-        })?;
-    Ok(lu)
 }
