@@ -1,9 +1,10 @@
 //! A scene's `[reduction]` applied to its structure: Craig–Bampton onto the contact,
 //! friction, observed and loaded dofs (`semismooth_contact::reduction`). The reduced
-//! structure keeps the full model's `omega_1` as the unit of the scene's frequency ratios.
+//! structure keeps the full model's `omega_1` as the unit of the scene's frequency ratios;
+//! `modal_damping` replaces its damping.
 
 use semismooth_contact::model::Structure;
-use semismooth_contact::reduction::{boundary_dofs, craig_bampton, CraigBampton};
+use semismooth_contact::reduction::{boundary_dofs, craig_bampton, modal_damping, CraigBampton};
 
 use crate::scene::{ReductionSpec, Scene};
 
@@ -20,6 +21,10 @@ pub fn reduce(
     let mut reduced =
         craig_bampton(full, &boundary, modes).map_err(|e| format!("[reduction]: {e}"))?;
     reduced.structure.omega_1 = full.omega_1;
+    if let Some(zeta) = spec.modal_damping {
+        let model = &mut reduced.structure.model;
+        model.damping = Some(modal_damping(model, zeta).map_err(|e| format!("[reduction]: {e}"))?);
+    }
     Ok(reduced)
 }
 

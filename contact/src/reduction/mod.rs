@@ -20,7 +20,10 @@ use crate::model::{
 };
 
 mod cholesky;
+mod damping;
 mod modes;
+
+pub use damping::modal_damping;
 
 pub(crate) use cholesky::StiffnessFactor;
 

@@ -2,7 +2,8 @@
 //! (module `semismooth_contact::reduction`). `method = "craig-bampton"` keeps the contact,
 //! friction, observed and loaded dofs and the fixed-interface modes of the rest: `modes = N`
 //! of them, or those below `cutoff_ratio` times the highest harmonic's frequency
-//! (`H omega`), not both.
+//! (`H omega`), not both. `modal_damping = zeta` replaces the reduced model's damping by
+//! modal damping of ratio `zeta` on each of its modes.
 
 use semismooth_contact::reduction::ModeCount;
 
@@ -26,6 +27,9 @@ pub enum ModeSelection {
 pub struct ReductionSpec {
     /// The interior modes kept.
     pub modes: ModeSelection,
+    /// `modal_damping = zeta`: the reduced model's damping is modal damping of this ratio
+    /// (`semismooth_contact::reduction::modal_damping`) instead of the projected one.
+    pub modal_damping: Option<f64>,
 }
 
 impl ReductionSpec {
@@ -51,6 +55,7 @@ pub(super) struct RawReduction {
     method: RawReductionMethod,
     modes: Option<i64>,
     cutoff_ratio: Option<f64>,
+    modal_damping: Option<f64>,
 }
 
 impl Check<'_> {
@@ -80,6 +85,12 @@ impl Check<'_> {
                 ))
             }
         };
-        Ok(ReductionSpec { modes })
+        let modal_damping = (r.modal_damping)
+            .map(|z| self.non_negative("reduction.modal_damping", z))
+            .transpose()?;
+        Ok(ReductionSpec {
+            modes,
+            modal_damping,
+        })
     }
 }
