@@ -871,6 +871,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         let count = modes.len().min(model.dofs());
         let reduced_modes = natural_frequencies(model, count).map_err(|e| input_error(path, e))?;
         text.push_str(&crate::reduce::reduction_lines(
+            spec.method,
             &reduced,
             &modes,
             &reduced_modes,

@@ -21,9 +21,11 @@ use crate::model::{
 
 mod cholesky;
 mod damping;
+mod massless;
 mod modes;
 
 pub use damping::modal_damping;
+pub use massless::massless_boundary;
 
 pub(crate) use cholesky::StiffnessFactor;
 
@@ -136,12 +138,7 @@ pub fn craig_bampton(
 ) -> Result<CraigBampton, ReductionError> {
     let model = &full.model;
     let n = model.dofs();
-    if let Some(&d) = boundary.iter().find(|&&d| d >= n) {
-        return Err(ReductionError::DofOutOfRange {
-            dof: d + 1,
-            dofs: n,
-        });
-    }
+    check_boundary(boundary, n)?;
     // Position of each dof: Ok(boundary index) or Err(interior index).
     let mut place = vec![Err(0); n];
     for (k, &d) in boundary.iter().enumerate() {
@@ -179,6 +176,20 @@ pub fn craig_bampton(
         interface_frequencies: fixed.omegas,
         transform,
     })
+}
+
+/// Every boundary dof exists (`< n`) and leaves an interior.
+fn check_boundary(boundary: &[usize], n: usize) -> Result<(), ReductionError> {
+    if let Some(&d) = boundary.iter().find(|&&d| d >= n) {
+        return Err(ReductionError::DofOutOfRange {
+            dof: d + 1,
+            dofs: n,
+        });
+    }
+    if boundary.len() >= n {
+        return Err(ReductionError::NoInterior { dofs: n });
+    }
+    Ok(())
 }
 
 /// `scale v` placed on the `interior` dofs of a vector of length `n`.
