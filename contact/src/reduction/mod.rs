@@ -11,6 +11,10 @@
 //! its mass. With every interior mode the reduction is exact (`T` square and invertible);
 //! the reduced frequencies bound the full ones from above (Rayleigh–Ritz).
 //!
+//! [`massless_boundary`] reduces onto the same boundary with free-interface modes and
+//! residual flexibility (MacNeal), the boundary massless; [`modal_damping`] gives a reduced
+//! model modal damping.
+//!
 //! Reference: Craig & Bampton (1968), coupling of substructures for dynamic analyses.
 
 use faer::sparse::Triplet;
@@ -74,7 +78,9 @@ pub enum ReductionError {
     Invalid(String),
 }
 
-/// A structure reduced by Craig–Bampton (module documentation).
+/// A structure reduced by Craig–Bampton (module documentation) or by the massless-boundary
+/// reduction ([`massless_boundary`]: then the interface frequencies are the free-interface
+/// ones).
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct CraigBampton {
