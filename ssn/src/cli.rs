@@ -22,9 +22,11 @@ use crate::progress::progress_spinner;
 use crate::scene::{Override, Scene, SweepSettings};
 use crate::state::{read_state, HbState, StateShape};
 pub use crate::work::Workload;
+use semismooth_contact::import::LANCZOS_MIN_DOFS;
 use semismooth_contact::jenkins::expand_tangential_stiffness;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with};
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{StructuralModel, Structure};
+use semismooth_contact::reduction::lowest_frequencies;
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::{RunError, Solution};
 use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
@@ -908,13 +910,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         structure: rod,
         omega,
     } = load_for(path, Workload::Check)?;
-    let modes = match natural_frequencies(&rod.model, 5.min(rod.model.dofs())) {
-        Err(ModelError::TooManyModes { available, .. }) => {
-            natural_frequencies(&rod.model, available)
-        }
-        other => other,
-    }
-    .map_err(|e| input_error(path, e))?;
+    let modes = first_frequencies(&rod.model).map_err(|e| input_error(path, e))?;
     let mut text = describe(&scene, &rod, omega, &modes);
     if let Some(spec) = &scene.reduction {
         let reduced =
@@ -923,6 +919,7 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
         let count = modes.len().min(model.dofs());
         let reduced_modes = natural_frequencies(model, count).map_err(|e| input_error(path, e))?;
         text.push_str(&crate::reduce::reduction_lines(
+            spec.method,
             &reduced,
             &modes,
             &reduced_modes,
@@ -930,6 +927,19 @@ pub fn scene_check(path: &Path) -> Result<(), CliError> {
     }
     write_text(&text)?;
     Ok(())
+}
+
+/// Up to five lowest natural frequencies of `model`: shift-invert Lanczos on a sparse
+/// Cholesky above [`LANCZOS_MIN_DOFS`] dofs (a 3-D model), subspace iteration below.
+fn first_frequencies(model: &StructuralModel) -> Result<Vec<f64>, String> {
+    if model.dofs() > LANCZOS_MIN_DOFS {
+        return lowest_frequencies(model, 5).map_err(|e| e.to_string());
+    }
+    match natural_frequencies(model, 5.min(model.dofs())) {
+        Err(ModelError::TooManyModes { available, .. }) => natural_frequencies(model, available),
+        other => other,
+    }
+    .map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

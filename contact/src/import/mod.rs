@@ -38,6 +38,7 @@ use crate::model::{
     ContactPoint, ContactRow, FrictionPoint, FrictionalContact, SparseMatrix, StructuralModel,
     Structure,
 };
+use crate::reduction::{lowest_modes, ModeCount, ReductionError, StiffnessFactor};
 use crate::rod::{natural_frequencies, DampingSpec};
 
 /// Largest magnitude of an entry of a model (the scale rule of the rod's data and load
@@ -341,11 +342,6 @@ pub fn assemble(parts: ModelParts, attach: &Attachments) -> Result<Structure, Mo
         }
     }
     let (contacts, friction, observed_dof) = attached(attach, n, &load)?;
-    FaerSparseLu::new()
-        .factor(&stiffness)
-        .map_err(|e| ModelError::SingularStiffness {
-            reason: e.to_string(),
-        })?;
     let mut model = StructuralModel {
         frictional_contacts: attach.frictional_contacts.clone(),
         mass,
@@ -458,12 +454,24 @@ fn attached(
 /// ([`natural_frequencies`]), which converges slowly on large 3-D models.
 pub const LANCZOS_MIN_DOFS: usize = 2000;
 
-/// The lowest finite natural frequency of `(K, M)`, in `[MIN_OMEGA_1, 1 / MIN_OMEGA_1]`.
+/// The lowest finite natural frequency of `(K, M)`, in `[MIN_OMEGA_1, 1 / MIN_OMEGA_1]`,
+/// after checking that `K` is nonsingular. A large model's `K` is factored once (sparse
+/// Cholesky, LU if not positive definite), for the check and the Lanczos steps both.
 fn first_frequency(model: &StructuralModel) -> Result<f64, ModelError> {
     let no_frequency = |reason: String| ModelError::NoFrequency { reason };
+    let singular = |reason: String| ModelError::SingularStiffness { reason };
     let omega_1 = if model.dofs() > LANCZOS_MIN_DOFS {
-        crate::reduction::lowest_frequencies(model, 1).map_err(|e| no_frequency(e.to_string()))?[0]
+        let mut factor = StiffnessFactor::new(&model.stiffness).map_err(|e| match e {
+            ReductionError::Factorization { reason } => singular(reason),
+            e => singular(e.to_string()),
+        })?;
+        lowest_modes(&mut factor, &model.mass, ModeCount::Count(1))
+            .map_err(|e| no_frequency(e.to_string()))?
+            .omegas[0]
     } else {
+        FaerSparseLu::new()
+            .factor(&model.stiffness)
+            .map_err(|e| singular(e.to_string()))?;
         natural_frequencies(model, 1).map_err(|e| no_frequency(e.to_string()))?[0]
     };
     if !(MIN_OMEGA_1..=1.0 / MIN_OMEGA_1).contains(&omega_1) {

@@ -11,17 +11,27 @@
 //! its mass. With every interior mode the reduction is exact (`T` square and invertible);
 //! the reduced frequencies bound the full ones from above (Rayleigh–Ritz).
 //!
+//! [`massless_boundary`] reduces onto the same boundary with free-interface modes and
+//! residual flexibility (MacNeal), the boundary massless; [`modal_damping`] gives a reduced
+//! model modal damping.
+//!
 //! Reference: Craig & Bampton (1968), coupling of substructures for dynamic analyses.
 
 use faer::sparse::Triplet;
-use semismooth::linalg::FaerSparseLu;
-use semismooth::Factorize;
 
 use crate::model::{
     ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
 };
 
+mod cholesky;
+mod damping;
+mod massless;
 mod modes;
+
+pub use damping::modal_damping;
+pub use massless::massless_boundary;
+
+pub(crate) use cholesky::StiffnessFactor;
 
 pub use modes::{lowest_modes, ModeCount, Modes, BLOCK, MODE_TOLERANCE};
 
@@ -68,7 +78,9 @@ pub enum ReductionError {
     Invalid(String),
 }
 
-/// A structure reduced by Craig–Bampton (module documentation).
+/// A structure reduced by Craig–Bampton (module documentation) or by the massless-boundary
+/// reduction ([`massless_boundary`]: then the interface frequencies are the free-interface
+/// ones).
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct CraigBampton {
@@ -132,12 +144,7 @@ pub fn craig_bampton(
 ) -> Result<CraigBampton, ReductionError> {
     let model = &full.model;
     let n = model.dofs();
-    if let Some(&d) = boundary.iter().find(|&&d| d >= n) {
-        return Err(ReductionError::DofOutOfRange {
-            dof: d + 1,
-            dofs: n,
-        });
-    }
+    check_boundary(boundary, n)?;
     // Position of each dof: Ok(boundary index) or Err(interior index).
     let mut place = vec![Err(0); n];
     for (k, &d) in boundary.iter().enumerate() {
@@ -152,7 +159,7 @@ pub fn craig_bampton(
     }
     let (k_ii, k_ib) = split(&model.stiffness, &place, interior.len(), boundary.len())?;
     let (m_ii, _) = split(&model.mass, &place, interior.len(), boundary.len())?;
-    let mut lu = factored(&k_ii)?;
+    let mut lu = StiffnessFactor::new(&k_ii)?;
     let fixed = lowest_modes(&mut lu, &m_ii, modes)?;
     let mut transform = Vec::with_capacity(boundary.len() + fixed.shapes.len());
     for (k, mut psi) in k_ib.into_iter().enumerate() {
@@ -175,6 +182,20 @@ pub fn craig_bampton(
         interface_frequencies: fixed.omegas,
         transform,
     })
+}
+
+/// Every boundary dof exists (`< n`) and leaves an interior.
+fn check_boundary(boundary: &[usize], n: usize) -> Result<(), ReductionError> {
+    if let Some(&d) = boundary.iter().find(|&&d| d >= n) {
+        return Err(ReductionError::DofOutOfRange {
+            dof: d + 1,
+            dofs: n,
+        });
+    }
+    if boundary.len() >= n {
+        return Err(ReductionError::NoInterior { dofs: n });
+    }
+    Ok(())
 }
 
 /// `scale v` placed on the `interior` dofs of a vector of length `n`.
@@ -303,21 +324,11 @@ fn reduced_structure(
 }
 
 /// The lowest `count` natural frequencies of `model` (ascending) by [`lowest_modes`] on
-/// one sparse factorization of `K`.
+/// one sparse factorization of `K` (Cholesky, or LU when `K` is not positive definite).
 pub fn lowest_frequencies(
     model: &StructuralModel,
     count: usize,
 ) -> Result<Vec<f64>, ReductionError> {
-    let mut lu = factored(&model.stiffness)?;
+    let mut lu = StiffnessFactor::new(&model.stiffness)?;
     Ok(lowest_modes(&mut lu, &model.mass, ModeCount::Count(count))?.omegas)
-}
-
-/// The sparse LU of `matrix`, or why it failed.
-fn factored(matrix: &SparseMatrix) -> Result<FaerSparseLu, ReductionError> {
-    let mut lu = FaerSparseLu::new();
-    lu.factor(matrix)
-        .map_err(|e| ReductionError::Factorization {
-            reason: e.to_string(),
-        })?;
-    Ok(lu)
 }

@@ -45,7 +45,7 @@ mod reduction;
 pub use cyclic::{CyclicSpec, EngineOrderSpec, MAX_SECTORS};
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
-pub use reduction::{ModeSelection, ReductionSpec, MAX_REDUCTION_MODES};
+pub use reduction::{ModeSelection, ReductionMethod, ReductionSpec, MAX_REDUCTION_MODES};
 
 pub use overrides::{
     normal_key, parse_value, read_scene_text, Override, OverrideError, MAX_KEY_PARTS,

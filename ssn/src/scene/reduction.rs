@@ -2,7 +2,9 @@
 //! (module `semismooth_contact::reduction`). `method = "craig-bampton"` keeps the contact,
 //! friction, observed and loaded dofs and the fixed-interface modes of the rest: `modes = N`
 //! of them, or those below `cutoff_ratio` times the highest harmonic's frequency
-//! (`H omega`), not both.
+//! (`H omega`), not both. `method = "massless-boundary"` keeps the same dofs massless
+//! beside free-interface modes (MacNeal's residual flexibility). `modal_damping = zeta` replaces the reduced model's damping by
+//! modal damping of ratio `zeta` on each of its modes.
 
 use semismooth_contact::reduction::ModeCount;
 
@@ -21,11 +23,35 @@ pub enum ModeSelection {
     CutoffRatio(f64),
 }
 
+/// Which reduction: `method = "craig-bampton"` or `"massless-boundary"` (MacNeal).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReductionMethod {
+    /// Fixed-interface modes and static constraint modes; the boundary keeps its mass.
+    CraigBampton,
+    /// Free-interface modes and the boundary's residual flexibility; a massless boundary.
+    MasslessBoundary,
+}
+
+impl ReductionMethod {
+    /// The scene's name of the method.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::CraigBampton => "craig-bampton",
+            Self::MasslessBoundary => "massless-boundary",
+        }
+    }
+}
+
 /// A validated `[reduction]` section.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReductionSpec {
+    /// The method.
+    pub method: ReductionMethod,
     /// The interior modes kept.
     pub modes: ModeSelection,
+    /// `modal_damping = zeta`: the reduced model's damping is modal damping of this ratio
+    /// (`semismooth_contact::reduction::modal_damping`) instead of the projected one.
+    pub modal_damping: Option<f64>,
 }
 
 impl ReductionSpec {
@@ -42,15 +68,16 @@ impl ReductionSpec {
 #[serde(rename_all = "kebab-case")]
 pub(super) enum RawReductionMethod {
     CraigBampton,
+    MasslessBoundary,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawReduction {
-    #[allow(dead_code)] // one method today: its name is checked by serde
     method: RawReductionMethod,
     modes: Option<i64>,
     cutoff_ratio: Option<f64>,
+    modal_damping: Option<f64>,
 }
 
 impl Check<'_> {
@@ -80,6 +107,17 @@ impl Check<'_> {
                 ))
             }
         };
-        Ok(ReductionSpec { modes })
+        let modal_damping = (r.modal_damping)
+            .map(|z| self.non_negative("reduction.modal_damping", z))
+            .transpose()?;
+        let method = match r.method {
+            RawReductionMethod::CraigBampton => ReductionMethod::CraigBampton,
+            RawReductionMethod::MasslessBoundary => ReductionMethod::MasslessBoundary,
+        };
+        Ok(ReductionSpec {
+            method,
+            modes,
+            modal_damping,
+        })
     }
 }

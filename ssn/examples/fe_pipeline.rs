@@ -1,0 +1,122 @@
+//! The steps of a finite-element scene timed one by one: parse the scene (and the `.dof`
+//! map), read the CalculiX matrices, import (read, symmetry and range checks, `omega_1`),
+//! `omega_1` alone (one sparse Cholesky of `K` and shift-invert Lanczos), the scene's
+//! `[reduction]` (Cholesky of `K_ii`, fixed-interface modes, constraint modes, projection)
+//! and one harmonic-balance solve of the reduced model at the scene's frequency. Prints a
+//! Markdown table of wall and CPU seconds per step and the load average before and after
+//! (the machine may be shared: compare ratios between steps, not absolute times).
+//!
+//! ```sh
+//! # the 54,000-dof cantilever with 16 tip contacts (docs/finite_element_models.md):
+//! python3 ssn/examples/fe_pipeline_deck.py /tmp/fe_big 80 14 14 && (cd /tmp/fe_big && ccx big)
+//! cargo run --release -p ssn --example fe_pipeline -- /tmp/fe_big            # big.toml
+//! cargo run --release -p ssn --example fe_pipeline -- DIR scene.toml
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use semismooth_contact::matrix_market::read_calculix_matrix;
+use semismooth_contact::reduction::lowest_frequencies;
+use ssn::cli::prepare;
+use ssn::scene::Scene;
+use ssn::work::Workload;
+
+/// User plus system CPU seconds of this process so far (`/proc/self/stat`, 100 ticks a
+/// second); 0 where there is no `/proc`.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the parenthesised command name: utime and stime are the 12th and 13th.
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |k: usize| {
+        fields
+            .get(k)
+            .and_then(|f| f.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// Times `f`, prints its row and returns its value.
+fn step<T>(rows: &mut Vec<(String, f64, f64)>, name: &str, f: impl FnOnce() -> T) -> T {
+    let (wall, cpu) = (Instant::now(), cpu_seconds());
+    let value = f();
+    let row = (
+        name.to_string(),
+        wall.elapsed().as_secs_f64(),
+        cpu_seconds() - cpu,
+    );
+    eprintln!("{:<40} {:>8.2} s wall {:>8.2} s CPU", row.0, row.1, row.2);
+    rows.push(row);
+    value
+}
+
+fn main() {
+    let dir = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .expect("usage: fe_pipeline DIR [SCENE]"),
+    );
+    let name = std::env::args().nth(2).unwrap_or_else(|| "big.toml".into());
+    let path = dir.join(name);
+    let load_before = load_average();
+    let mut rows = Vec::new();
+    let scene = step(&mut rows, "parse the scene and the .dof map", || {
+        Scene::from_path(&path).unwrap_or_else(|e| panic!("{e}"))
+    });
+    let spec = scene.model.clone().expect("a [model] scene");
+    let n = spec.dof_map.as_ref().map_or(0, |d| d.map.len());
+    step(&mut rows, "read K and M (.sti, .mas)", || {
+        let read = |p: &Path| read_calculix_matrix(p, n).unwrap_or_else(|e| panic!("{e}"));
+        (read(&spec.stiffness), read(&spec.mass))
+    });
+    let loaded = step(&mut rows, "import (read, checks, omega_1)", || {
+        prepare(scene.clone(), Workload::Check, None).unwrap_or_else(|e| panic!("{e}"))
+    });
+    let full = &loaded.structure;
+    let omega_1 = step(&mut rows, "omega_1 alone (Cholesky + Lanczos)", || {
+        lowest_frequencies(&full.model, 1).unwrap_or_else(|e| panic!("{e}"))[0]
+    });
+    let spec = scene.reduction.as_ref().expect("a [reduction] section");
+    let reduced = step(&mut rows, "reduce (Craig-Bampton)", || {
+        ssn::reduce::reduce(&scene, spec, full, loaded.omega).unwrap_or_else(|e| panic!("{e}"))
+    });
+    let solution = step(&mut rows, "solve one frequency (reduced)", || {
+        semismooth_contact::solve(&reduced.structure, loaded.omega, &scene.solver, None)
+            .unwrap_or_else(|e| panic!("{e}"))
+    });
+    let total: (f64, f64) = rows.iter().fold((0.0, 0.0), |t, r| (t.0 + r.1, t.1 + r.2));
+    println!(
+        "model: {} dofs, {} contacts, omega_1 = {omega_1:.6} (import: {:.6}); reduced to {} \
+         dofs ({} boundary, {} modes up to {:.6})",
+        full.model.dofs(),
+        full.model.contacts.len(),
+        full.omega_1,
+        reduced.structure.model.dofs(),
+        reduced.boundary.len(),
+        reduced.interface_frequencies.len(),
+        reduced.interface_frequencies.last().copied().unwrap_or(0.0),
+    );
+    let peak = solution.observed.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    println!(
+        "solve: converged {} in {} iterations, max |u_observed| = {peak:.6e}",
+        solution.converged(),
+        solution.iterations
+    );
+    println!(
+        "load average (1, 5, 15 min): before {load_before}, after {}",
+        load_average()
+    );
+    println!("\n| step | wall s | CPU s |\n|---|---|---|");
+    for (name, wall, cpu) in &rows {
+        println!("| {name} | {wall:.2} | {cpu:.2} |");
+    }
+    println!("| total | {:.2} | {:.2} |", total.0, total.1);
+}
