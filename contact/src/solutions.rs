@@ -126,11 +126,11 @@ pub fn find_solutions(
         seconds: 0.0,
     };
     for i in 1..branch.points.len() {
-        let Some(start) = crossing_start(&branch, i, omega) else {
+        let Some((start, from)) = crossing_start(&branch, i, omega) else {
             continue;
         };
         set.crossings += 1;
-        let solution = solve(structure, omega, settings, Some(&start))?;
+        let solution = correct_crossing(structure, omega, settings, &branch, (&start, from))?;
         set.counters = set.counters + solution.counters;
         if !solution.converged() {
             set.failed_corrections.push(FailedCorrection {
@@ -144,10 +144,19 @@ pub fn find_solutions(
         if is_known(&set.solutions, x) {
             continue;
         }
-        let stability = analysis
-            .of(omega, x)
-            .unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
-        let contacts = reconstruction.contacts(&structure.model, x)?;
+        // With an accuracy target each solution has its own harmonics: its own analysis.
+        let (stability, contacts) = if solution.harmonics == Some(settings.harmonics) {
+            let contacts = reconstruction.contacts(&structure.model, x)?;
+            (analysis.of(omega, x), contacts)
+        } else {
+            let solved = &solution.settings;
+            let contacts = Reconstruction::new(&structure.model, omega, solved)?
+                .contacts(&structure.model, x)?;
+            let stability =
+                HbStability::new(&structure.model, solved).and_then(|mut own| own.of(omega, x));
+            (stability, contacts)
+        };
+        let stability = stability.unwrap_or_else(|e| Stability::not_decided(Undecided::Failed(e)));
         set.solutions.push(PeriodicSolution {
             solution,
             contacts,
@@ -202,8 +211,10 @@ fn search_window(
 }
 
 /// The start of the correction at `omega` when the branch crosses it between its points
-/// `i - 1` and `i` (interpolated linearly in the frequency); `None` when it does not.
-fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<Vec<f64>> {
+/// `i - 1` and `i` (interpolated linearly in the frequency), with the point whose
+/// discretisation it is on; `None` when it does not cross. Points of different harmonics
+/// (a branch followed to an accuracy) give the nearer point's state.
+fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<(Vec<f64>, usize)> {
     let (w0, w1) = (branch.points[i - 1].omega, branch.points[i].omega);
     // Each crossing once: the left point strictly on one side (or exactly at w*).
     let crosses = (w0 - omega) * (w1 - omega) < 0.0 || w1 == omega;
@@ -215,14 +226,35 @@ fn crossing_start(branch: &FrequencyResponse, i: usize, omega: f64) -> Option<Ve
     } else {
         1.0
     };
-    Some(
-        branch.points[i - 1]
-            .state
-            .iter()
-            .zip(&branch.points[i].state)
-            .map(|(a, b)| a + t * (b - a))
-            .collect(),
-    )
+    let (a, b) = (&branch.points[i - 1].state, &branch.points[i].state);
+    if a.len() != b.len() {
+        let nearer = if t < 0.5 { i - 1 } else { i };
+        return Some((branch.points[nearer].state.clone(), nearer));
+    }
+    Some((a.iter().zip(b).map(|(a, b)| a + t * (b - a)).collect(), i))
+}
+
+/// The solve at `omega` from `start` on the discretisation of branch point `from`: with an
+/// accuracy target, the search whose first rung is that point's harmonics (a start on
+/// another rung would be dropped for zero, and zero finds one solution of several).
+fn correct_crossing(
+    structure: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    branch: &FrequencyResponse,
+    (start, from): (&[f64], usize),
+) -> Result<Solution, RunError> {
+    match settings.accuracy {
+        None => solve(structure, omega, settings, Some(start)),
+        Some(target) => crate::solve::accuracy::search::solve_to_accuracy_from(
+            structure,
+            omega,
+            settings,
+            target,
+            Some(start),
+            branch.points[from].harmonics,
+        ),
+    }
 }
 
 /// Whether the state `x` is one of `solutions` (within [`SAME_SOLUTION`] of its norm).

@@ -248,20 +248,19 @@ fn reference_points(
     adaptive: &FrequencyResponse,
     reference_harmonics: usize,
 ) -> Result<(Vec<Option<Reference>>, Vec<f64>), RunError> {
-    let (dofs, contacts) = (rod.model.dofs(), rod.model.contact_count());
+    let (dofs, rows) = (rod.model.dofs(), rod.model.row_count());
     let mut references: Vec<Option<Reference>> = Vec::with_capacity(adaptive.points.len());
     let mut errors = Vec::with_capacity(adaptive.points.len());
     for (i, p) in adaptive.points.iter().enumerate() {
         let h = p.harmonics.unwrap_or(0);
-        let secant = secant(adaptive, i, dofs, contacts);
+        let secant = secant(adaptive, i, dofs, rows);
         let point = (p.state.as_slice(), p.omega, h);
         match taken_up(rod, sweep, point, &secant, reference_harmonics)? {
             Some((state, (max, min, omega))) => {
                 let here = (p.observed_max, p.observed_min, p.omega);
                 errors.push(point_distance(here, (max, min, omega)));
                 let n = secant.len() - 1;
-                let mut lifted =
-                    resize_harmonics(&secant[..n], h, reference_harmonics, dofs, contacts);
+                let mut lifted = resize_harmonics(&secant[..n], h, reference_harmonics, dofs, rows);
                 lifted.push(secant[n]);
                 references.push(Some(Reference {
                     state,

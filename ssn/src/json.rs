@@ -349,7 +349,10 @@ pub fn solutions_json(set: &SolutionSet) -> Value {
                 "iterations": s.solution.iterations,
                 "residual_norm": s.solution.residual_norm,
                 "state": HbState::from_unknowns(
-                    set.shape,
+                    semismooth_contact::solve::StateShape {
+                        harmonics: s.solution.harmonics.unwrap_or(set.shape.harmonics),
+                        ..set.shape
+                    },
                     set.omega,
                     set.omega_1,
                     &s.solution.state

@@ -252,7 +252,8 @@ impl HbState {
         let contacts = match &self.contact_force {
             Some(l) => {
                 stacked.extend_from_slice(l);
-                self.contacts
+                // Every row of G (contacts, then friction rows) per harmonic.
+                l.len() / (2 * self.harmonics + 1)
             }
             None => 0,
         };

@@ -150,3 +150,40 @@ fn the_condensed_solve_of_the_damper_scene_is_the_full_one() {
         "{largest} vs {limit}"
     );
 }
+
+#[test]
+fn a_friction_sweep_to_an_accuracy_changes_harmonics_with_the_friction_forces() {
+    // The damper swept near its resonance with an accuracy target instead of harmonics: the
+    // branch changes harmonics (48 down to 8 here), carrying the friction rows' forces with
+    // the contact's. Each point is the solution at its own harmonics: a plain solve from zero
+    // at its frequency and discretisation gives its extremes to 1e-8 relative (the Newton
+    // tolerances of both runs).
+    let scene = scene(|t| {
+        t.replace("harmonics = 7", "accuracy = 1e-3")
+            .replace("omega_ratio_from = 0.9", "omega_ratio_from = 0.97")
+            .replace("omega_ratio_to = 1.3", "omega_ratio_to = 1.0")
+    })
+    .unwrap();
+    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
+    let sweep = scene.sweep.as_ref().unwrap();
+    let r = semismooth_contact::sweep::frequency_response(&structure, &scene.solver, sweep, None)
+        .unwrap();
+    assert!(r.converged(), "{}", r.termination);
+    let harmonics: std::collections::BTreeSet<usize> =
+        r.points.iter().filter_map(|p| p.harmonics).collect();
+    assert!(
+        harmonics.len() > 1,
+        "one discretisation only: {harmonics:?}"
+    );
+    for (i, p) in r.points.iter().enumerate() {
+        let at = r.point_settings(&scene.solver, i);
+        let s = semismooth_contact::solve(&structure, p.omega, &at, None).unwrap();
+        assert!(s.converged(), "{}", s.termination);
+        let error = (s.stats.max - p.observed_max).abs() / s.stats.max.abs();
+        assert!(
+            error < 1e-8,
+            "point {i} at H = {:?}: {error:e}",
+            p.harmonics
+        );
+    }
+}

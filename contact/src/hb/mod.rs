@@ -571,7 +571,8 @@ pub(crate) fn check_positive(
 
 /// Harmonic-balance unknowns of `from` harmonics carried to `to` harmonics: the
 /// displacement coefficients (`(2 from + 1) dofs`, harmonic-major) and then, when `x` has
-/// them, the contact-force coefficients (`(2 from + 1) contacts`), each block lifted with
+/// them, the force coefficients of every row of `G` (`(2 from + 1) contacts`, `contacts` the
+/// rows: normal, friction and 3-D contact rows), each block lifted with
 /// zero higher harmonics or truncated (the Galerkin projection onto `to` harmonics). A
 /// block that `x` is too short for is taken as zero.
 pub fn resize_harmonics(

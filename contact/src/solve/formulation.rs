@@ -299,7 +299,7 @@ pub(crate) trait Formulation: Sync {
                 to.harmonics,
                 rod.model.dofs(),
                 if self.carries_contact_forces() {
-                    rod.model.contact_count()
+                    rod.model.row_count()
                 } else {
                     0
                 },

@@ -50,8 +50,8 @@
 use std::time::Instant;
 
 use semismooth::continuation::{
-    BranchPoint, Continuation, ContinuationCounters, ContinuationEvent, ContinuationTermination,
-    FoldDetector, Resumption,
+    BranchPoint, Continuation, ContinuationCounters, ContinuationEvent, ContinuationOptions,
+    ContinuationTermination, FoldDetector, Resumption,
 };
 use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, ParameterDependent, Residual};
@@ -276,16 +276,17 @@ fn take_up_with(
     direction: Option<&[f64]>,
 ) -> Result<(Option<BranchPointAt>, RunCounters), RunError> {
     let model = &rod.model;
-    let (dofs, contacts) = (model.dofs(), model.contact_count());
+    let (dofs, rows) = (model.dofs(), model.row_count());
     let to = settings.harmonics;
-    let mut y = resize_harmonics(x, h, to, dofs, contacts);
+    let mut y = resize_harmonics(x, h, to, dofs, rows);
     let mut counters = RunCounters::default();
     if let Some(direction) = direction {
         let n = x.len();
-        let mut carried = resize_harmonics(&direction[..n], h, to, dofs, contacts);
+        let mut carried = resize_harmonics(&direction[..n], h, to, dofs, rows);
         carried.push(direction[n]);
         let method = ssn_continuation(model, problem, u_ref);
         let options = continuation_options(settings, sweep, rod.omega_1, dofs, u_ref, &method)?;
+        let options = widened(options, omega);
         let resumption = Resumption {
             state: y.clone(),
             parameter: omega,
@@ -342,14 +343,15 @@ pub fn take_up(
 
 /// The secant of `response` at its point `i` (from the point before to the point after,
 /// one side at the ends), both carried to point `i`'s harmonics when they differ: the
-/// state part, then the frequency component. Panics if `i` is not a point of `response`.
-pub fn secant(response: &FrequencyResponse, i: usize, dofs: usize, contacts: usize) -> Vec<f64> {
+/// state part, then the frequency component (`rows`: the rows of `G`, whose forces the state
+/// holds). Panics if `i` is not a point of `response`.
+pub fn secant(response: &FrequencyResponse, i: usize, dofs: usize, rows: usize) -> Vec<f64> {
     let points = &response.points;
     let last = points.len() - 1;
     let (a, b) = (i.saturating_sub(1), (i + 1).min(last));
     let at = |j: usize| match (points[j].harmonics, points[i].harmonics) {
         (Some(from), Some(to)) if from != to => {
-            resize_harmonics(&points[j].state, from, to, dofs, contacts)
+            resize_harmonics(&points[j].state, from, to, dofs, rows)
         }
         _ => points[j].state.clone(),
     };
@@ -381,11 +383,20 @@ fn newton_at(
     )?)
 }
 
+/// `options` whose parameter bounds hold `omega`: a take-up corrects the one point there (a
+/// point landed on a bound carries the rounding of its interpolation, and a last point the
+/// run could not land lies past it).
+fn widened(mut options: ContinuationOptions, omega: f64) -> ContinuationOptions {
+    options.parameter_min = options.parameter_min.min(omega);
+    options.parameter_max = options.parameter_max.max(omega);
+    options
+}
+
 /// The resumption `r` of a run at `from` harmonics carried to `to` harmonics.
-fn carried(r: Resumption, from: usize, to: usize, dofs: usize, contacts: usize) -> Resumption {
+fn carried(r: Resumption, from: usize, to: usize, dofs: usize, rows: usize) -> Resumption {
     let n = r.state.len();
-    let state = resize_harmonics(&r.state, from, to, dofs, contacts);
-    let mut direction = resize_harmonics(&r.direction[..n], from, to, dofs, contacts);
+    let state = resize_harmonics(&r.state, from, to, dofs, rows);
+    let mut direction = resize_harmonics(&r.direction[..n], from, to, dofs, rows);
     direction.push(r.direction[n]);
     Resumption {
         state,
@@ -626,8 +637,14 @@ impl Adaptive<'_> {
             .estimator
             .estimate(omega, h, &point.state, (max, min), direction)?;
         let wanted = estimate.map(|e| wanted_harmonics(h, e, target));
-        let raise =
-            estimate.is_some_and(|e| e > target) && h < limit && self.no_raise_at != Some(index);
+        // A last point the run could not land exactly on the bound lies past it: the
+        // continuation cannot resume there, so it is reported at these harmonics.
+        let (lo, hi) = self.sweep_bounds();
+        let resumable = (lo..=hi).contains(&omega);
+        let raise = estimate.is_some_and(|e| e > target)
+            && h < limit
+            && self.no_raise_at != Some(index)
+            && resumable;
         if raise {
             if let Some(r) = here.take() {
                 let wanted = wanted
@@ -665,6 +682,12 @@ impl Adaptive<'_> {
             }
         }
         Ok(None)
+    }
+
+    /// The sweep's frequency interval, as the continuation's bounds.
+    fn sweep_bounds(&self) -> (f64, f64) {
+        let (a, b) = (self.sweep.omega_ratio_from, self.sweep.omega_ratio_to);
+        (a.min(b) * self.rod.omega_1, a.max(b) * self.rod.omega_1)
     }
 
     /// After a resumed start at new harmonics that gave nothing: the point there by
@@ -749,10 +772,10 @@ impl Adaptive<'_> {
         self.fallback = (switch.first != First::New && switch.from != switch.to)
             .then(|| (switch.from, switch.resumption.clone()));
         let model = &self.rod.model;
-        let (dofs, contacts) = (model.dofs(), model.contact_count());
+        let (dofs, rows) = (model.dofs(), model.row_count());
         let to = switch.to;
         let resumed_at = switch.resumption.parameter;
-        let carried = carried(switch.resumption, switch.from, to, dofs, contacts);
+        let carried = carried(switch.resumption, switch.from, to, dofs, rows);
         self.h = to;
         let problem = SsnHb::new(
             model,

@@ -320,8 +320,25 @@ pub fn solve_to_accuracy(
     target: f64,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
+    solve_to_accuracy_from(structure, omega, settings, target, warm_start, None)
+}
+
+/// [`solve_to_accuracy`] whose first rung is `first_level` (e.g. the harmonics of the
+/// state `warm_start` was taken from: a branch point's), kept inside the method's ladder;
+/// `None`: the ladder's own first level.
+pub(crate) fn solve_to_accuracy_from(
+    structure: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    target: f64,
+    warm_start: Option<&[f64]>,
+    first_level: Option<usize>,
+) -> Result<Solution, RunError> {
     check_target(target)?;
     let mut ladder = Ladder::new(structure, settings);
+    if let Some(level) = first_level {
+        ladder.start = level.clamp(ladder.start, ladder.limit);
+    }
     let mut record = Record::new(target);
     let first = solve_as_given(
         structure,
