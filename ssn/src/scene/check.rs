@@ -196,12 +196,8 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&forcing, model.is_some(), solver.harmonics)?;
-    let (engine_order, cyclic) = ck.cyclic_keys(
-        &forcing,
-        (raw.cyclic, neighbour_rows),
-        &model,
-        &bladed_disk,
-    )?;
+    let (engine_order, cyclic) =
+        ck.cyclic_keys(&forcing, (raw.cyclic, neighbour_rows), &model, &bladed_disk)?;
     let reduction = raw.reduction.map(|r| ck.reduction(&r)).transpose()?;
     Ok(Scene {
         path: path.to_path_buf(),
