@@ -164,12 +164,17 @@ pub struct SweepSettings {
     pub max_points: usize,
     /// Whether each point gets its Floquet multipliers (`[sweep] stability`).
     pub stability: bool,
+    /// Whether an SSN-HB sweep with stability switches to the period-2 branch at its period
+    /// doublings and follows it (`[sweep] period_two`; each branch costs a sweep at twice
+    /// the harmonics).
+    pub period_two: bool,
 }
 
 impl SweepSettings {
     /// A sweep from `omega_ratio_from` to `omega_ratio_to` (units of omega_1) with the
     /// scene defaults: `step = 0.01`, `min_step = 1e-5`, `max_step = 0.05`,
-    /// `max_points = 2000`, `stability = true` (not validated; the sweep checks).
+    /// `max_points = 2000`, `stability = true`, `period_two = false` (not validated; the
+    /// sweep checks).
     pub fn new(omega_ratio_from: f64, omega_ratio_to: f64) -> Self {
         Self {
             omega_ratio_from,
@@ -179,6 +184,7 @@ impl SweepSettings {
             max_step: 0.05,
             max_points: 2000,
             stability: true,
+            period_two: false,
         }
     }
 }

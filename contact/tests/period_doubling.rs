@@ -112,6 +112,7 @@ fn the_period_two_branch_starts_where_the_marching_map_flips_and_marching_stays_
     };
     let mut sweep = SweepSettings::new(1.5, 3.2);
     sweep.step = 0.02;
+    sweep.period_two = true;
     let r = frequency_response(&structure, &settings, &sweep, None).unwrap();
     let event = r
         .events

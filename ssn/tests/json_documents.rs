@@ -54,6 +54,7 @@ fn sweep_json_carries_the_period_two_branch_with_period_multiple_two() {
     use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
     let mut sweep = SweepSettings::new(1.5, 3.2);
     sweep.step = 0.02;
+    sweep.period_two = true;
     let r = frequency_response(
         &bilinear_oscillator(),
         &common::sweep_solver(Method::SsnHb, 20),

@@ -580,7 +580,7 @@ pub fn frequency_response(
     .unwrap_or_else(|err| BranchStability::not_decided(total, Undecided::Failed(err)));
     response.set_stability(stability);
     response.stability_seconds = started.elapsed().as_secs_f64();
-    if sweep.stability && settings.method == crate::settings::Method::SsnHb {
+    if sweep.stability && sweep.period_two && settings.method == crate::settings::Method::SsnHb {
         response.period_two = doubling::period_two_branches(structure, settings, sweep, &response);
     }
     Ok(response)

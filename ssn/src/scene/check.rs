@@ -888,6 +888,7 @@ impl Check<'_> {
                 defaults.max_points,
             )?,
             stability: sw.stability.unwrap_or(defaults.stability),
+            period_two: sw.period_two.unwrap_or(defaults.period_two),
             ..defaults
         })
     }

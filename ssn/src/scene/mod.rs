@@ -327,6 +327,7 @@ struct RawSweep {
     max_step: Option<f64>,
     max_points: Option<i64>,
     stability: Option<bool>,
+    period_two: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
