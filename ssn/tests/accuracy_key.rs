@@ -146,3 +146,42 @@ fn a_sweep_with_an_accuracy_reports_each_fold_with_its_uncertainty_and_harmonics
         assert_eq!(rungs[0]["omega_ratio"], fold["sweep_omega_ratio"], "{fold}");
     }
 }
+
+#[test]
+fn an_accuracy_set_on_the_command_line_replaces_the_scenes_harmonics() {
+    // The shipped scene sets harmonics = 20; `--set solver.accuracy` chooses the
+    // discretisation instead (the file's harmonics dropped), and the tip minimum meets the
+    // target against the time-marching reference (its own error 4e-8).
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/paper_fig1_modified_mass.toml");
+    let out = Command::new(SSN)
+        .args(["solve", path.to_str().unwrap(), "--json", "--quiet"])
+        .args(["--set", "solver.accuracy=1e-3"])
+        .output()
+        .unwrap();
+    let json: Value = serde_json::from_slice(&out.stdout).unwrap_or(Value::Null);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(json["accuracy"]["met"], true, "{}", json["accuracy"]);
+    let tip_min = json["tip_min"].as_f64().unwrap();
+    let error = (tip_min - REFERENCE_TIP_MIN).abs() / REFERENCE_TIP_MIN.abs();
+    assert!(error <= 1e-3, "tip min {tip_min}, error {error:.2e}");
+    // Both on the command line: refused as in a file.
+    let out = Command::new(SSN)
+        .args(["solve", path.to_str().unwrap(), "--json", "--quiet"])
+        .args([
+            "--set",
+            "solver.accuracy=1e-3",
+            "--set",
+            "solver.harmonics=10",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(message.contains("solver.harmonics"), "{message}");
+}

@@ -7,7 +7,9 @@
 //! Keys are dotted paths as in the README's scene table (`forcing.omega_ratio`,
 //! `solver.harmonics`); an array of tables is indexed by a number
 //! (`contact.point.0.gap`, 0-based). Values are TOML values (`1.1`, `40`, `"ssn-hb"`,
-//! `[0.01, -0.02]`); a bare word that is not one (`ssn-hb`) is read as a string.
+//! `[0.01, -0.02]`); a bare word that is not one (`ssn-hb`) is read as a string. An
+//! override of `solver.accuracy` replaces the file's discretisation keys (`harmonics`,
+//! `time_samples`, `steps_per_period`): the target chooses them.
 
 use std::fmt;
 use std::path::Path;
@@ -126,6 +128,7 @@ impl Scene {
             apply(&mut document, o)
                 .map_err(|reason| SceneError::parse(path, format!("--set {o}: {reason}")))?;
         }
+        drop_overridden_discretisation(&mut document, overrides);
         let named = overrides
             .iter()
             .map(|o| format!("--set {o}"))
@@ -152,6 +155,33 @@ impl Scene {
 /// bytes).
 pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
     read_input_file(path, FileKind::Scene)
+}
+
+/// The `[solver]` keys that fix a discretisation, which an accuracy target chooses itself.
+const DISCRETISATION_KEYS: [&str; 3] = ["harmonics", "time_samples", "steps_per_period"];
+
+/// An accuracy target given by override replaces the file's discretisation: the file's
+/// `solver.harmonics`, `time_samples` and `steps_per_period` are dropped unless an override
+/// sets them too (which the scene then refuses beside the target, as in a file).
+fn drop_overridden_discretisation(document: &mut toml::Table, overrides: &[Override]) {
+    let key = |o: &Override| {
+        o.key
+            .split('.')
+            .map(str::trim)
+            .collect::<Vec<_>>()
+            .join(".")
+    };
+    let keys: Vec<String> = overrides.iter().map(key).collect();
+    if !keys.iter().any(|k| k == "solver.accuracy") {
+        return;
+    }
+    if let Some(toml::Value::Table(solver)) = document.get_mut("solver") {
+        for name in DISCRETISATION_KEYS {
+            if !keys.contains(&format!("solver.{name}")) {
+                solver.remove(name);
+            }
+        }
+    }
 }
 
 /// Sets `o.key` in `document`, creating the tables on its path; an index into an array of
