@@ -154,6 +154,14 @@ impl Ladder {
         }
     }
 
+    /// This ladder starting at `level` (kept inside it; `None`: its own first level).
+    fn starting_at(mut self, level: Option<usize>) -> Self {
+        if let Some(level) = level {
+            self.start = level.clamp(self.start, self.limit);
+        }
+        self
+    }
+
     /// `base` with the discretisation `level` and neither an estimate nor a target.
     fn settings(&self, base: &SolverSettings, level: usize) -> SolverSettings {
         let mut s = base.clone();
@@ -335,10 +343,7 @@ pub(crate) fn solve_to_accuracy_from(
     first_level: Option<usize>,
 ) -> Result<Solution, RunError> {
     check_target(target)?;
-    let mut ladder = Ladder::new(structure, settings);
-    if let Some(level) = first_level {
-        ladder.start = level.clamp(ladder.start, ladder.limit);
-    }
+    let mut ladder = Ladder::new(structure, settings).starting_at(first_level);
     let mut record = Record::new(target);
     let first = solve_as_given(
         structure,
