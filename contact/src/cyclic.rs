@@ -281,8 +281,7 @@ impl CyclicSector {
                 ),
             ),
             frictional_contacts: (m.frictional_contacts.iter())
-                .map(|c| c.with_rows(|r| Ok::<_, std::convert::Infallible>(self.reduce_row(r))))
-                .map(|c| c.unwrap_or_else(|never| match never {}))
+                .map(|c| c.map_rows(|r| self.reduce_row(r)))
                 .collect(),
         }
     }

@@ -8,8 +8,12 @@ use semismooth_contact::cyclic::{CyclicSector, InvalidSector};
 use semismooth_contact::model::{ContactPoint, ContactRow, InvalidModel, NeighbourRow, Structure};
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, Method, SolverSettings};
-use semismooth_contact::solve::{solve, Solution};
+use semismooth_contact::solve::solve;
 use semismooth_contact::structures::{BladeDamper, BladedDisk, DiskLoading};
+
+#[path = "common/sector.rs"]
+mod sector;
+use sector::{converged, settings};
 
 const BLADES: usize = 8;
 /// The damper's clearance: the pads close on the neighbours near each resonance.
@@ -52,27 +56,6 @@ fn full_disk(engine_order: usize, friction: bool) -> Structure {
 fn sector(engine_order: usize, friction: bool) -> CyclicSector {
     let (sector, _) = disk().cyclic_sector(&loading(), engine_order).unwrap();
     damper(friction).add_to_sector(&sector).unwrap()
-}
-
-fn settings(harmonics: usize, linear_solver: LinearSolverChoice) -> SolverSettings {
-    SolverSettings {
-        harmonics,
-        // A multiple of N: the delay EO T / N is a whole number of samples, so the full
-        // disk's AFT equations are exactly equivariant under the sector shift.
-        time_samples: 64,
-        tolerance: 1e-13,
-        // One complementarity constant for both: the AFT-projected equations depend on it.
-        c: Some(5.0),
-        linear_solver,
-        estimate_error: false,
-        ..SolverSettings::default()
-    }
-}
-
-fn converged(structure: &Structure, omega: f64, s: &SolverSettings) -> Solution {
-    let solution = solve(structure, omega, s, None).unwrap();
-    assert!(solution.converged(), "{:?}", solution.termination);
-    solution
 }
 
 /// The largest difference between the sector's response recovered on every sector and the

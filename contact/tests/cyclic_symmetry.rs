@@ -10,6 +10,10 @@ use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
 use semismooth_contact::solve::{solve, Solution};
 use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
+#[path = "common/sector.rs"]
+mod sector;
+use sector::{converged, settings};
+
 const BLADES: usize = 8;
 
 fn tuned_disk() -> BladedDisk {
@@ -29,31 +33,6 @@ fn full_disk(loading: &DiskLoading, engine_order: usize) -> semismooth_contact::
         .delayed_by_sector(&disk.sector_dofs(), engine_order)
         .unwrap();
     structure
-}
-
-fn settings(harmonics: usize, linear_solver: LinearSolverChoice) -> SolverSettings {
-    SolverSettings {
-        harmonics,
-        // A multiple of N: the sector delay EO T / N is a whole number of samples, so the
-        // full disk's AFT is exactly equivariant and the sector poses the same equations.
-        time_samples: 64,
-        tolerance: 1e-13,
-        // One complementarity constant for both: the AFT-projected equations depend on it.
-        c: Some(5.0),
-        linear_solver,
-        estimate_error: false,
-        ..SolverSettings::default()
-    }
-}
-
-fn converged(
-    structure: &semismooth_contact::model::Structure,
-    omega: f64,
-    s: &SolverSettings,
-) -> Solution {
-    let solution = solve(structure, omega, s, None).unwrap();
-    assert!(solution.converged(), "{:?}", solution.termination);
-    solution
 }
 
 #[test]

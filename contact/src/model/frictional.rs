@@ -60,22 +60,23 @@ impl FrictionalContact {
         tangents: [ContactRow; 2],
         coefficient: f64,
     ) -> Self {
-        Self {
-            normal: NormalLaw::Unilateral { row: normal, gap },
+        Self::under(
+            NormalLaw::Unilateral { row: normal, gap },
             tangents,
             coefficient,
-            gap_cos: Vec::new(),
-            gap_sin: Vec::new(),
-            sliding_velocity: [0.0; 2],
-            tangential_stiffness: None,
-        }
+        )
     }
 
     /// Friction `coefficient` in the plane of `tangents` under the constant normal load
     /// `normal_load` (the disk's radius is `coefficient * normal_load`).
     pub fn prescribed(normal_load: f64, tangents: [ContactRow; 2], coefficient: f64) -> Self {
+        Self::under(NormalLaw::Prescribed(normal_load), tangents, coefficient)
+    }
+
+    /// A fixed obstacle with no tangential spring under the normal law `normal`.
+    fn under(normal: NormalLaw, tangents: [ContactRow; 2], coefficient: f64) -> Self {
         Self {
-            normal: NormalLaw::Prescribed(normal_load),
+            normal,
             tangents,
             coefficient,
             gap_cos: Vec::new(),
@@ -137,6 +138,15 @@ impl FrictionalContact {
         match &self.normal {
             NormalLaw::Unilateral { row, .. } => Some(row),
             NormalLaw::Prescribed(_) => None,
+        }
+    }
+
+    /// The same contact with every row mapped by `map`, which cannot fail (a change of
+    /// coordinates: [`FrictionalContact::with_rows`] for a map that can).
+    pub fn map_rows(&self, mut map: impl FnMut(&ContactRow) -> ContactRow) -> Self {
+        match self.with_rows(|r| Ok::<_, std::convert::Infallible>(map(r))) {
+            Ok(contact) => contact,
+            Err(never) => match never {},
         }
     }
 
