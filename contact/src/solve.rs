@@ -26,7 +26,8 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonOptions, NewtonReport, Strategy, Tolerances, WorkCounters,
+    self, Globalization, NewtonOptions, NewtonReport, StateFloor, Strategy, Tolerances,
+    WorkCounters,
 };
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
@@ -385,25 +386,15 @@ fn newton_hb<P>(
     (extra_stiffness, smoothing): (f64, Option<SmoothingOf<P>>),
 ) -> Result<NewtonReport, RunError>
 where
-    P: GeneralizedJacobian<Jacobian = HbJacobian>,
+    P: GeneralizedJacobian<Jacobian = HbJacobian> + DisplacementBlock,
 {
-    let gap_scale = model
-        .contacts
-        .iter()
-        .fold(0.0f64, |a, c| a.max(c.gap.abs()))
-        .max(f64::MIN_POSITIVE);
-    let mut options = newton_options(settings).with_residual_floor(roundoff_floor(
+    let floor = displacement_floor(
         model,
         problem.dim(),
-        gap_scale,
+        problem.displacement_len(),
         extra_stiffness,
-    ));
-    if model.row_count() == 0 {
-        // The unknowns are displacements alone, and round-off grows with them (a linear
-        // response near resonance): the floor per unit displacement.
-        let per_displacement = roundoff_floor(model, problem.dim(), 1.0, extra_stiffness);
-        options = options.with_residual_floor_per_state(per_displacement);
-    }
+    );
+    let options = newton_options(settings).with_state_floor(floor);
     let report = match settings.linear_solver.condensed() {
         Some(condensed) => {
             let mut solver = structured_solver(condensed, settings.tolerance);
@@ -437,6 +428,53 @@ pub(crate) fn roundoff_floor(
         .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
         .fold(extra_stiffness, f64::max);
     f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
+}
+
+/// The round-off floor of a harmonic-balance residual at an iterate whose first
+/// `displacements` entries are displacement coefficients: [`roundoff_floor`] with `max|u|`
+/// the iterate's largest displacement coefficient, capped by the largest gap when the model
+/// has contact rows (a closed contact's dof reaches its gap, an open one's never does: a
+/// floor scaled by a large gap alone would pass the zero guess) and uncapped without them
+/// (a linear response near resonance, whose round-off grows with it).
+pub(crate) fn displacement_floor(
+    model: &crate::model::StructuralModel,
+    dim: usize,
+    displacements: usize,
+    extra_stiffness: f64,
+) -> StateFloor {
+    let cap = if model.row_count() == 0 {
+        f64::INFINITY
+    } else {
+        model
+            .contacts
+            .iter()
+            .fold(0.0f64, |a, c| a.max(c.gap.abs()))
+            .max(f64::MIN_POSITIVE)
+    };
+    StateFloor {
+        per_unit: roundoff_floor(model, dim, 1.0, extra_stiffness),
+        entries: Some(displacements),
+        cap,
+    }
+}
+
+/// A harmonic-balance problem whose unknowns start with the displacement coefficients.
+pub(crate) trait DisplacementBlock {
+    /// How many leading unknowns are displacement coefficients.
+    fn displacement_len(&self) -> usize;
+}
+
+impl DisplacementBlock for SsnHb {
+    fn displacement_len(&self) -> usize {
+        SsnHb::displacement_len(self)
+    }
+}
+
+impl DisplacementBlock for PenaltyHb {
+    fn displacement_len(&self) -> usize {
+        // Penalty HB's unknowns are the displacement coefficients alone.
+        self.dim()
+    }
 }
 
 /// How a run ended, as its outputs report it.

@@ -2,6 +2,7 @@
 
 use super::ContinuationError;
 use crate::linesearch::LineSearchOptions;
+use crate::newton::StateFloor;
 
 /// In which direction of the parameter the branch is followed from the starting point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -58,6 +59,10 @@ pub struct ContinuationOptions {
     /// The corrector has converged when the 2-norm `|F(x, p)| <= corrector_tolerance`
     /// (after at least one Newton correction). Default `1e-10`.
     pub corrector_tolerance: f64,
+    /// The round-off floor in proportion to the corrected state's size (its parameter not
+    /// counted): the corrector's tolerance is at least [`StateFloor::at`] of the state.
+    /// Default [`StateFloor::OFF`].
+    pub corrector_state_floor: StateFloor,
     /// The corrector gives up (stalled) when a correction has `|dy|_θ <= step_tolerance
     /// (1 + |y|_θ)` while `|F|` is still above the tolerance. Default `1e-14`.
     pub step_tolerance: f64,
@@ -166,6 +171,7 @@ impl Default for ContinuationOptions {
             target_iterations: 3,
             max_corrector_iterations: 10,
             corrector_tolerance: 1e-10,
+            corrector_state_floor: StateFloor::OFF,
             step_tolerance: 1e-14,
             parameter_min: f64::NEG_INFINITY,
             parameter_max: f64::INFINITY,
@@ -280,6 +286,13 @@ impl ContinuationOptions {
                 self.fold_excursion,
                 "finite and >= 0",
             ));
+        }
+        if let Some((field, value, allowed)) = self.corrector_state_floor.invalid_field() {
+            let name = match field {
+                "per_unit" => "corrector_state_floor.per_unit",
+                _ => "corrector_state_floor.cap",
+            };
+            return Err(invalid(name, value, allowed));
         }
         if !(self.step_tolerance.is_finite() && self.step_tolerance >= 0.0) {
             return Err(invalid(

@@ -322,6 +322,58 @@ impl NewtonReport {
 pub(crate) const DEFAULT_ABSOLUTE_TOLERANCE: f64 = 1e-10;
 /// Stall threshold on the accepted step of the drivers' defaults.
 pub(crate) const DEFAULT_STEP_TOLERANCE: f64 = 1e-15;
+/// The `|F|_2` that round-off produces at an iterate `x`, in proportion to its size:
+/// `per_unit min(max_{i < entries} |x_i|, cap)`. The entries are the leading block of `x`
+/// whose size sets the round-off (e.g. the displacements, not the forces beside them); the
+/// cap bounds the size that counts (e.g. by a gap that no open contact reaches).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StateFloor {
+    /// Round-off per unit of size, `>= 0` (0 = off).
+    pub per_unit: f64,
+    /// How many leading entries of `x` measure its size (`None`: all of them).
+    pub entries: Option<usize>,
+    /// The largest size that counts, `> 0` (`f64::INFINITY`: no cap).
+    pub cap: f64,
+}
+
+impl StateFloor {
+    /// No floor.
+    pub const OFF: Self = Self {
+        per_unit: 0.0,
+        entries: None,
+        cap: f64::INFINITY,
+    };
+
+    /// `per_unit` times the largest entry of the whole iterate, uncapped.
+    pub fn per_unit(per_unit: f64) -> Self {
+        Self {
+            per_unit,
+            ..Self::OFF
+        }
+    }
+
+    /// The first field out of range, its value and what is allowed (`None`: valid).
+    pub fn invalid_field(&self) -> Option<(&'static str, f64, &'static str)> {
+        if !(self.per_unit.is_finite() && self.per_unit >= 0.0) {
+            return Some(("per_unit", self.per_unit, "finite and >= 0"));
+        }
+        if self.cap.is_nan() || self.cap <= 0.0 {
+            return Some(("cap", self.cap, "> 0 (infinity: no cap)"));
+        }
+        None
+    }
+
+    /// The floor at the iterate `x`.
+    pub fn at(&self, x: &[f64]) -> f64 {
+        if self.per_unit == 0.0 {
+            return 0.0;
+        }
+        let block = &x[..self.entries.unwrap_or(x.len()).min(x.len())];
+        let largest = block.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        self.per_unit * largest.min(self.cap)
+    }
+}
+
 /// When a run of a driver ([`NewtonOptions`](crate::newton::NewtonOptions), the polyalgorithm's options) has converged,
 /// `|F|_2 <= max(absolute, relative |F(x_0)|_2, residual_floor)`, or stalled,
 /// `alpha |d| <= step_tolerance (1 + |x|)`.
@@ -335,10 +387,10 @@ pub struct Tolerances {
     /// tolerance is at least this, and a stall with `|F| <= 100 residual_floor` is
     /// convergence ([`Termination::ConvergedAtRoundoff`]).
     pub residual_floor: f64,
-    /// `|F|_2` that round-off produces per unit of the iterate's largest entry, `>= 0`
-    /// (0 = off): at an iterate `x` the tolerance is at least this times `max_i |x_i|` (a
-    /// linear problem near resonance, whose answer and round-off grow together).
-    pub residual_floor_per_state: f64,
+    /// `|F|_2` that round-off produces per unit of the iterate's size (0 = off): at an
+    /// iterate `x` the tolerance is at least [`StateFloor::at`]`(x)` (a linear problem near
+    /// resonance, whose answer and round-off grow together).
+    pub state_floor: StateFloor,
     /// Stall threshold on the accepted step, `>= 0`.
     pub step_tolerance: f64,
 }
@@ -349,7 +401,7 @@ impl Default for Tolerances {
             absolute_tolerance: DEFAULT_ABSOLUTE_TOLERANCE,
             relative_tolerance: 0.0,
             residual_floor: 0.0,
-            residual_floor_per_state: 0.0,
+            state_floor: StateFloor::OFF,
             step_tolerance: DEFAULT_STEP_TOLERANCE,
         }
     }
@@ -371,14 +423,9 @@ impl Tolerances {
             .max(self.residual_floor)
     }
 
-    /// The round-off floor at the iterate `x`: `residual_floor + residual_floor_per_state
-    /// max_i |x_i|`.
+    /// The round-off floor at the iterate `x`: `residual_floor + state_floor.at(x)`.
     pub(crate) fn floor_at(&self, x: &[f64]) -> f64 {
-        if self.residual_floor_per_state == 0.0 {
-            return self.residual_floor;
-        }
-        let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        self.residual_floor + self.residual_floor_per_state * largest
+        self.residual_floor + self.state_floor.at(x)
     }
 
     /// Checks every field; the error names the field, the value and the allowed range.
@@ -386,7 +433,6 @@ impl Tolerances {
         for (name, t) in [
             ("absolute_tolerance", self.absolute_tolerance),
             ("residual_floor", self.residual_floor),
-            ("residual_floor_per_state", self.residual_floor_per_state),
             ("step_tolerance", self.step_tolerance),
         ] {
             if !(t.is_finite() && t >= 0.0) {
@@ -405,7 +451,17 @@ impl Tolerances {
                 "[0, 1)",
             )));
         }
-        Ok(())
+        match self.state_floor.invalid_field() {
+            Some((field, value, allowed)) => Err(NewtonError::InvalidOption(InvalidOption::new(
+                match field {
+                    "per_unit" => "state_floor.per_unit",
+                    _ => "state_floor.cap",
+                },
+                value,
+                allowed,
+            ))),
+            None => Ok(()),
+        }
     }
 }
 
@@ -429,5 +485,29 @@ mod tests {
         assert_eq!(norm2(&[0.0, 0.0]), 0.0);
         assert_eq!(norm2(&[1.0, f64::NAN]), f64::INFINITY);
         assert_eq!(norm2(&[f64::INFINITY]), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_state_floor_measures_its_leading_entries_up_to_its_cap() {
+        let x = [3.0, -5.0, 100.0];
+        assert_eq!(StateFloor::OFF.at(&x), 0.0);
+        assert_eq!(StateFloor::per_unit(2.0).at(&x), 200.0);
+        let displacements = StateFloor {
+            per_unit: 2.0,
+            entries: Some(2),
+            cap: f64::INFINITY,
+        };
+        assert_eq!(displacements.at(&x), 10.0);
+        let capped = StateFloor {
+            cap: 4.0,
+            ..displacements
+        };
+        assert_eq!(capped.at(&x), 8.0);
+        assert_eq!(capped.invalid_field(), None);
+        let nan_cap = StateFloor {
+            cap: f64::NAN,
+            ..displacements
+        };
+        assert_eq!(nan_cap.invalid_field().map(|f| f.0), Some("cap"));
     }
 }

@@ -36,7 +36,7 @@
 //! | `tolerances.absolute_tolerance` | `1e-10` | converged when `\|F\|_2 <= max(abs, rel \|F(x_0)\|_2, floor)` |
 //! | `tolerances.relative_tolerance` | `0` (off) | see above; in `[0, 1)` |
 //! | `tolerances.residual_floor` | `0` (off) | `\|F\|` round-off alone produces near a solution: the tolerance is at least this, and a run that stalls with `\|F\| <= 100 floor` has converged ([`Termination::ConvergedAtRoundoff`]) |
-//! | `tolerances.residual_floor_per_state` | `0` (off) | round-off per unit of `max_i \|x_i\|`: at an iterate `x` the tolerance is at least this times `max_i \|x_i\|` (a linear response near resonance, whose round-off grows with it) |
+//! | `tolerances.state_floor` | [`StateFloor::OFF`] | round-off in proportion to the iterate's size: at an iterate `x` the tolerance is at least `per_unit min(max_{i < entries} \|x_i\|, cap)` (a linear response near resonance, whose round-off grows with it) |
 //! | `tolerances.step_tolerance` | `1e-15` | stalled when `alpha \|d\| <= step_tol (1 + \|x\|)` |
 //! | `max_iterations` | `200` | Newton iterations (not counting line-search trials) |
 //! | `globalization` | [`Globalization::hybrid`] | [`None`](Globalization::None), [`Armijo`](Globalization::Armijo), [`NonMonotone`](Globalization::NonMonotone) (memory 10) or [`Hybrid`](Globalization::Hybrid) (30 full steps, then non-monotone with memory 10); line searches with [`LineSearchOptions::default`] (`sigma = 1e-4`, `shrink = 0.5`, `min_step = 1e-10`) |
@@ -89,8 +89,8 @@ use crate::iteration::kernel::{
     Kernel, KernelRules, NewtonSystem, Run, StepRule, Stop, FLOOR_STALL_FACTOR,
 };
 pub use crate::iteration::{
-    Attempt, NewtonError, NewtonReport, Strategy, Termination, Tolerances, WorkCounters,
-    EXACT_RESIDUAL,
+    Attempt, NewtonError, NewtonReport, StateFloor, Strategy, Termination, Tolerances,
+    WorkCounters, EXACT_RESIDUAL,
 };
 use crate::iteration::{Log, Outcome};
 use crate::linalg::LinearSolveError;

@@ -130,8 +130,9 @@ use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::iteration::Log;
 use crate::linesearch::LineSearchOptions;
 use crate::newton::{
-    self, validate_line_search, NewtonError, NewtonOptions, NewtonReport, Termination, Tolerances,
-    WorkCounters, Workspace, DEFAULT_FULL_STEPS, DEFAULT_MAX_ITERATIONS, DEFAULT_MEMORY,
+    self, validate_line_search, NewtonError, NewtonOptions, NewtonReport, StateFloor, Termination,
+    Tolerances, WorkCounters, Workspace, DEFAULT_FULL_STEPS, DEFAULT_MAX_ITERATIONS,
+    DEFAULT_MEMORY,
 };
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, Smoothing};
 
@@ -398,12 +399,12 @@ impl SolveOptions {
         self
     }
 
-    /// The same with the residual floor per unit of the iterate's largest entry
-    /// ([`Tolerances::residual_floor_per_state`]) set to `floor`.
-    pub fn with_residual_floor_per_state(mut self, floor: f64) -> Self {
+    /// The same with the residual floor in proportion to the iterate's size
+    /// ([`Tolerances::state_floor`]) set to `floor`.
+    pub fn with_state_floor(mut self, floor: StateFloor) -> Self {
         match &mut self {
-            Self::Newton(options) => options.tolerances.residual_floor_per_state = floor,
-            Self::Polyalgorithm(options) => options.tolerances.residual_floor_per_state = floor,
+            Self::Newton(options) => options.tolerances.state_floor = floor,
+            Self::Polyalgorithm(options) => options.tolerances.state_floor = floor,
         }
         self
     }

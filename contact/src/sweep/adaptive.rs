@@ -70,7 +70,7 @@ use crate::solve::accuracy::search::{
 };
 use crate::solve::accuracy::HB_ORDER;
 use crate::solve::{
-    hb_options, newton_options, roundoff_floor, RunCounters, RunError, HB_OUTPUT_POINTS,
+    displacement_floor, hb_options, newton_options, RunCounters, RunError, HB_OUTPUT_POINTS,
 };
 
 /// The harmonics a branch may use, in increasing order. It starts at 8: at 4 the pair
@@ -370,12 +370,8 @@ fn newton_at(
     solver: &mut dyn Factorize<HbJacobian>,
     x: &mut [f64],
 ) -> Result<semismooth::newton::NewtonReport, RunError> {
-    let gap = model
-        .contacts
-        .iter()
-        .fold(0.0f64, |a, c| a.max(c.gap.abs()));
-    let floor = roundoff_floor(model, problem.dim(), gap.max(f64::MIN_POSITIVE), 0.0);
-    Ok(newton_options(settings).with_residual_floor(floor).solve(
+    let floor = displacement_floor(model, problem.dim(), problem.displacement_len(), 0.0);
+    Ok(newton_options(settings).with_state_floor(floor).solve(
         problem,
         solver,
         x,

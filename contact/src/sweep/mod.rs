@@ -99,7 +99,7 @@ use semismooth::continuation::{
     ContinuationTermination, Direction, Predictor, RestartPolicy,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::WorkCounters;
+use semismooth::newton::{StateFloor, WorkCounters};
 use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
@@ -221,9 +221,9 @@ fn check_sweep(sweep: &SweepSettings) -> Result<(), RunError> {
 struct MethodContinuation {
     /// Per unknown: 1 for displacements, the force unit for forces.
     units: Vec<f64>,
-    /// Rounding floor of `|F|` (0 where negligible): the corrector tolerance is at least
-    /// this.
-    residual_floor: f64,
+    /// Rounding floor of `|F|` in proportion to the state's displacements (off where
+    /// negligible): the corrector tolerance is at least this.
+    floor: StateFloor,
     /// The branch is piecewise affine and its corners are crossed exactly.
     affine_pieces: bool,
 }
@@ -238,18 +238,18 @@ fn ssn_continuation(model: &StructuralModel, problem: &SsnHb, u_ref: f64) -> Met
         .collect();
     MethodContinuation {
         units,
-        residual_floor: crate::solve::roundoff_floor(
-            model,
-            problem.dim(),
-            largest_gap(model, u_ref),
-            0.0,
-        ),
+        floor: StateFloor {
+            per_unit: crate::solve::roundoff_floor(model, problem.dim(), 1.0, 0.0),
+            entries: Some(split),
+            cap: largest_gap(model, u_ref),
+        },
         affine_pieces: false,
     }
 }
 
 /// Penalty HB's units and rounding floor: the penalty force is `k_p` times gaps computed
-/// to `ε |u|` (`|u|` about the gap in contact); its branch is piecewise affine.
+/// to `ε |u|` (`|u|` at most the larger of the gap and `u_ref` in contact); its branch is
+/// piecewise affine.
 fn penalty_continuation(
     model: &StructuralModel,
     problem: &PenaltyHb,
@@ -258,7 +258,11 @@ fn penalty_continuation(
 ) -> MethodContinuation {
     MethodContinuation {
         units: vec![1.0; problem.dim()],
-        residual_floor: f64::EPSILON * options.penalty_stiffness * largest_gap(model, u_ref),
+        floor: StateFloor {
+            per_unit: f64::EPSILON * options.penalty_stiffness,
+            entries: None,
+            cap: largest_gap(model, u_ref),
+        },
         affine_pieces: !model.has_friction(),
     }
 }
@@ -298,12 +302,13 @@ fn continuation_options(
         target_iterations: TARGET_ITERATIONS,
         max_corrector_iterations: MAX_CORRECTOR_ITERATIONS,
         corrector_tolerance: if method.affine_pieces {
-            // |F| cannot be computed below its rounding floor (a stiff penalty puts it
-            // near the scene's tolerance).
-            settings.tolerance.max(method.residual_floor)
+            // |F| cannot be computed below its rounding floor (`corrector_state_floor`: a
+            // stiff penalty puts it near the scene's tolerance).
+            settings.tolerance
         } else {
-            (CORRECTOR_TOLERANCE_FACTOR * settings.tolerance).max(method.residual_floor)
+            CORRECTOR_TOLERANCE_FACTOR * settings.tolerance
         },
+        corrector_state_floor: method.floor,
         parameter_min: lo * omega_1,
         parameter_max: hi * omega_1,
         max_points: sweep.max_points,
@@ -717,7 +722,7 @@ fn follow_lcp<'a>(
     };
     let method = MethodContinuation {
         units,
-        residual_floor: 0.0,
+        floor: StateFloor::OFF,
         affine_pieces: false,
     };
     let setup = Setup {

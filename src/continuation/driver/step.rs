@@ -7,7 +7,7 @@ use crate::continuation::{
     BranchPoint, ContinuationTermination, CorrectorFailure, Direction, Predictor,
 };
 use crate::iteration::kernel::{KernelRules, StepRule};
-use crate::newton::Tolerances;
+use crate::newton::{StateFloor, Tolerances};
 use crate::{Factorize, GeneralizedJacobian, ParameterDependent};
 
 /// The squared θ-norm of the state (parameter) part of a unit direction below which a
@@ -65,6 +65,7 @@ where
         y.extend_from_slice(x);
         y.push(*p);
         let tolerance = self.options.corrector_tolerance * self.problem.tolerance_scale(*p);
+        let floor = self.options.corrector_state_floor;
         let corrector = Corrector {
             problem: &mut *self.problem,
             solver: &mut *self.solver,
@@ -80,7 +81,11 @@ where
                     absolute_tolerance: tolerance,
                     relative_tolerance: 0.0,
                     residual_floor: 0.0,
-                    residual_floor_per_state: 0.0,
+                    // The floor measures the state, not the parameter appended to it.
+                    state_floor: StateFloor {
+                        entries: Some(floor.entries.map_or(n, |e| e.min(n))),
+                        ..floor
+                    },
                     step_tolerance: self.options.step_tolerance,
                 },
                 max_iterations,
