@@ -231,8 +231,13 @@ pub struct Solution {
     pub times: Vec<f64>,
     /// Displacement of the observed dof ([`Structure::observed_dof`]) at `times`.
     pub observed: Vec<f64>,
-    /// Contact forces at `times`, one series per contact.
+    /// Contact forces at `times`, one series per contact: each contact's law applied to the
+    /// samples (never tension, `<= 0`).
     pub contact_forces: Vec<Vec<f64>>,
+    /// SSN-HB: the truncated Fourier series of each contact force at `times` (the unknowns
+    /// themselves; they ring above zero around a contact's transitions, by the truncation
+    /// error). Empty for the other methods, whose forces are samples of the law.
+    pub contact_force_series: Vec<Vec<f64>>,
     /// Statistics of the observed dof (penetration over all contacts; the mean contact
     /// force is the sum of the contacts' mean forces).
     pub stats: PeriodStatistics,
@@ -508,6 +513,8 @@ struct Period {
     times: Vec<f64>,
     observed: Vec<f64>,
     contact_forces: Vec<Vec<f64>>,
+    /// The truncated series of each contact force (SSN-HB; empty otherwise).
+    contact_force_series: Vec<Vec<f64>>,
     contact_displacements: Vec<Vec<f64>>,
     friction: Vec<FrictionReport>,
 }
@@ -566,6 +573,7 @@ fn solution(
         times: period.times,
         observed: period.observed,
         contact_forces: period.contact_forces,
+        contact_force_series: period.contact_force_series,
         counters: outcome.counters,
         state,
         error_estimate: Err(NoEstimate::Off),
@@ -589,6 +597,9 @@ fn hb_outputs(
     let contact_forces = (0..contacts)
         .map(|i| problem.contact_force(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
+    let contact_force_series = (0..contacts)
+        .filter_map(|i| problem.contact_force_series(&x, i, points).transpose())
+        .collect::<Result<Vec<_>, _>>()?;
     let contact_displacements = (0..contacts)
         .map(|i| problem.row_displacement(&x, i, points))
         .collect::<Result<Vec<_>, _>>()?;
@@ -606,6 +617,7 @@ fn hb_outputs(
         times,
         observed: tip,
         contact_forces,
+        contact_force_series,
         contact_displacements,
         friction,
     };
@@ -883,6 +895,7 @@ fn solve_lcp(
         times: lcp.times(),
         observed: tip_series,
         contact_forces: forces,
+        contact_force_series: Vec::new(),
         contact_displacements: contact_u,
         friction: Vec::new(),
     };

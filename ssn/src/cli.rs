@@ -491,6 +491,10 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
         columns.push(f);
         headers.push(format!("lambda_{i}"));
     }
+    for (i, f) in solution.contact_force_series.iter().enumerate() {
+        columns.push(f);
+        headers.push(format!("lambda_series_{i}"));
+    }
     frictional_columns(&solution, &mut columns, &mut headers);
     let headers: Vec<&str> = headers.iter().map(String::as_str).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {

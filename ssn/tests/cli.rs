@@ -418,6 +418,73 @@ fn a_writable_output_is_complete_csv() {
     );
 }
 
+/// The columns of an `ssn solve --csv` file by header.
+fn csv_columns(text: &str) -> std::collections::HashMap<String, Vec<f64>> {
+    let mut lines = text.lines();
+    let headers: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); headers.len()];
+    for line in lines.filter(|l| !l.is_empty()) {
+        for (column, value) in columns.iter_mut().zip(line.split(',')) {
+            column.push(value.trim().parse().unwrap());
+        }
+    }
+    headers.into_iter().zip(columns).collect()
+}
+
+#[test]
+fn the_contact_force_column_is_the_law_on_the_samples_and_never_tension() {
+    let dir = TempDir::new("force-law");
+    let csv = dir.0.join("force.csv");
+    let scene = scenes_dir().join("paper_fig1.toml");
+    // AFT samples on the output grid (1024 points), so that the law's samples are the
+    // ones the equations project.
+    let out = ssn(&[
+        "solve",
+        scene.to_str().unwrap(),
+        "--set",
+        "solver.time_samples=1024",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let columns = csv_columns(&std::fs::read_to_string(&csv).unwrap());
+    let (law, series) = (&columns["lambda_0"], &columns["lambda_series_0"]);
+    assert!(
+        law.iter().all(|&f| f <= 0.0),
+        "tension in the law's samples"
+    );
+    // The truncated series rings into tension (about +0.027 against a peak of -0.25).
+    let ringing = series.iter().fold(f64::NEG_INFINITY, |m, &f| m.max(f));
+    assert!(ringing > 1e-2, "largest series value {ringing}");
+    // Independent of the output code: the equations say the series is the projection of
+    // the law's samples on harmonics 0..=20, here a DFT of the column. Both are
+    // reconstructions of a converged solve to 1e-10: 1e-9 leaves a margin of 10.
+    let n = law.len();
+    let projection: Vec<f64> = (0..n)
+        .map(|t| {
+            (0..=20)
+                .map(|k| {
+                    let weight = if k == 0 { 1.0 } else { 2.0 } / n as f64;
+                    let (a, b) = law.iter().enumerate().fold((0.0, 0.0), |(a, b), (s, f)| {
+                        let phase = 2.0 * std::f64::consts::PI * (k * s) as f64 / n as f64;
+                        (a + f * phase.cos(), b + f * phase.sin())
+                    });
+                    let phase = 2.0 * std::f64::consts::PI * (k * t) as f64 / n as f64;
+                    weight * (a * phase.cos() + b * phase.sin())
+                })
+                .sum()
+        })
+        .collect();
+    let difference = projection
+        .iter()
+        .zip(series)
+        .fold(0.0f64, |m, (p, s)| m.max((p - s).abs()));
+    assert!(
+        difference <= 1e-9,
+        "series against the law's projection: {difference:e}"
+    );
+}
+
 #[test]
 fn a_run_that_does_not_converge_prints_its_json_and_exits_1() {
     let (out, json) = solve_text("noconv", &format!("{CANONICAL}max_iterations = 1\n"));

@@ -212,6 +212,13 @@ impl SsnHb {
     /// the generalized Jacobian treats as active (`h_n = 1`), with the interval ends
     /// refined between the `Nt` samples on the truncated Fourier series.
     pub fn closed_intervals(&self, x: &[f64], contact: usize) -> Result<Vec<(f64, f64)>, HbError> {
+        let coeffs = self.switching_coefficients(x, contact)?;
+        super::switching_intervals(&self.state.linear, &coeffs)
+    }
+
+    /// The harmonics of contact `contact`'s switching function `c (g . u - g) - lambda`
+    /// (positive where the law is active).
+    fn switching_coefficients(&self, x: &[f64], contact: usize) -> Result<Vec<f64>, HbError> {
         check_len("HB unknowns", self.dim(), x.len())?;
         let lin = &self.state.linear;
         lin.check_normal_row(contact)?;
@@ -221,7 +228,27 @@ impl SsnHb {
             .map(|j| self.c * lin.row_dot(contact, x, j) - x[offset + j * m + contact])
             .collect();
         coeffs[0] -= self.c * lin.gaps[contact];
-        super::switching_intervals(lin, &coeffs)
+        Ok(coeffs)
+    }
+
+    /// The contact law applied to the reconstructed samples, `-max(0, c (g . u(t_n) - g) -
+    /// lambda(t_n))` at `points` equally spaced times: `lambda(t_n)` where the equation
+    /// holds, never tension where the truncated series of `lambda` rings above zero.
+    pub fn contact_force_law_samples(
+        &self,
+        x: &[f64],
+        contact: usize,
+        points: usize,
+    ) -> Result<Vec<f64>, HbError> {
+        let coeffs = self.switching_coefficients(x, contact)?;
+        let basis = FourierBasis::new(self.state.linear.basis.harmonics(), points)?;
+        let mut aft = semismooth::harmonic::Aft::new(basis);
+        let mut out = vec![0.0; points];
+        aft.to_time(&coeffs, &mut out)?;
+        Ok(out
+            .into_iter()
+            .map(|s| if s > 0.0 { -s } else { 0.0 })
+            .collect())
     }
 
     fn contact_coefficients(&self, lambda: &[f64], contact: usize) -> Vec<f64> {

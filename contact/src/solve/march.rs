@@ -130,6 +130,7 @@ pub(super) fn solve_march(
         times,
         observed: tip_series,
         contact_forces: forces,
+        contact_force_series: Vec::new(),
         contact_displacements: contact_u,
         friction,
     };

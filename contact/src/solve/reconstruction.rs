@@ -7,7 +7,16 @@ use crate::hb::{HbError, PenaltyHb, SsnHb};
 /// Reconstruction a harmonic-balance problem offers for the outputs.
 pub(crate) trait HbReconstruction {
     fn displacement(&self, x: &[f64], dof: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// Contact `i`'s force, its law applied to the samples (never tension).
     fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError>;
+    /// Contact `i`'s force as its truncated Fourier series, where the method has one (it
+    /// may ring above zero around the contact's transitions).
+    fn contact_force_series(
+        &self,
+        x: &[f64],
+        i: usize,
+        points: usize,
+    ) -> Result<Option<Vec<f64>>, HbError>;
     /// The fractions of the period where contact `i`'s law is active (closed).
     fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError>;
     /// `g_i . u` of row `i` of `G`.
@@ -16,9 +25,10 @@ pub(crate) trait HbReconstruction {
     fn friction(&self, x: &[f64], f: usize, points: usize) -> Result<FrictionReport, HbError>;
 }
 
-/// Both harmonic-balance problems reconstruct through the same inherent methods.
+/// Both harmonic-balance problems reconstruct through the same inherent methods, but for
+/// their force samples (`$law`) and series (`$series`).
 macro_rules! hb_reconstruction {
-    ($($problem:ty),*) => {$(
+    ($($problem:ty => $law:ident, $series:expr);*) => {$(
         impl HbReconstruction for $problem {
             fn displacement(
                 &self,
@@ -29,7 +39,16 @@ macro_rules! hb_reconstruction {
                 self.displacement_samples(x, dof, points)
             }
             fn contact_force(&self, x: &[f64], i: usize, points: usize) -> Result<Vec<f64>, HbError> {
-                self.contact_force_samples(x, i, points)
+                self.$law(x, i, points)
+            }
+            fn contact_force_series(
+                &self,
+                x: &[f64],
+                i: usize,
+                points: usize,
+            ) -> Result<Option<Vec<f64>>, HbError> {
+                let series: fn(&$problem, &[f64], usize, usize) -> _ = $series;
+                series(self, x, i, points)
             }
             fn closed_intervals(&self, x: &[f64], i: usize) -> Result<Vec<(f64, f64)>, HbError> {
                 self.closed_intervals(x, i)
@@ -54,4 +73,7 @@ macro_rules! hb_reconstruction {
     )*};
 }
 
-hb_reconstruction!(SsnHb, PenaltyHb);
+hb_reconstruction!(
+    SsnHb => contact_force_law_samples, |p, x, i, points| p.contact_force_samples(x, i, points).map(Some);
+    PenaltyHb => contact_force_samples, |_, _, _, _| Ok(None)
+);
