@@ -232,6 +232,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "events": events,
         "folds": r.folds,
         "corner_folds": r.corner_folds,
+        "peak": r.located_peak.as_ref().map(|p| peak_json(p, r.omega_1)),
         "converged": r.converged(),
         "solve_seconds": r.solve_seconds,
         "termination": crate::words::sweep_termination(r),
@@ -468,4 +469,16 @@ pub fn blade_amplitudes(structure: &Structure, s: &Solution) -> Option<Value> {
             .map(finite_or_null)
             .collect::<Vec<_>>(),
     ))
+}
+
+/// The located peak: where, how large, how it was found (`location` as
+/// [`crate::words::peak_location`] names it).
+fn peak_json(peak: &semismooth_contact::sweep::peak::LocatedPeak, omega_1: f64) -> Value {
+    json!({
+        "omega": peak.omega,
+        "omega_ratio": peak.omega / omega_1,
+        "amplitude": peak.amplitude,
+        "solves": peak.solves,
+        "location": crate::words::peak_location(&peak.location),
+    })
 }

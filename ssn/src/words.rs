@@ -11,6 +11,7 @@ use semismooth_contact::solve::{Diagnosis, DiscretisationKind, Solution, Termina
 use semismooth_contact::stability::Undecided;
 use semismooth_contact::sweep::adaptive::BranchAccuracy;
 use semismooth_contact::sweep::fold_accuracy::{FoldAccuracy, FoldStop};
+use semismooth_contact::sweep::peak::{LocatedPeak, PeakLocation};
 use semismooth_contact::sweep::{FrequencyResponse, SweepTermination};
 
 /// How a run ended: `converged`, the core's name of a Newton termination, or a sentence
@@ -417,7 +418,14 @@ pub(crate) fn sweep_text(
         ratio.first().copied().unwrap_or(f64::NAN),
         ratio.last().copied().unwrap_or(f64::NAN)
     );
-    if let Some((i, a)) = response.peak() {
+    if let Some(peak) = &response.located_peak {
+        t += &format!(
+            "peak amplitude    {:.6} at omega/omega_1 = {:.6}: {}\n",
+            peak.amplitude,
+            peak.omega / omega_1,
+            peak_words(peak)
+        );
+    } else if let Some((i, a)) = response.peak() {
         t += &format!(
             "peak amplitude    {a:.6} at omega/omega_1 = {:.4}\n",
             ratio[i]
@@ -601,5 +609,32 @@ pub(crate) fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String 
     match c.krylov_iterations {
         0 => String::new(),
         k => format!(", {k} GMRES iterations"),
+    }
+}
+
+/// The JSON name of a peak's location: `located`, `at_edge`, `at_fold`, `not_located`.
+pub fn peak_location(location: &PeakLocation) -> &'static str {
+    match location {
+        PeakLocation::Located => "located",
+        PeakLocation::AtEdge => "at_edge",
+        PeakLocation::AtFold => "at_fold",
+        _ => "not_located",
+    }
+}
+
+/// How a sweep's peak was found, in words.
+fn peak_words(peak: &LocatedPeak) -> String {
+    match &peak.location {
+        PeakLocation::Located => {
+            format!("located between the branch points ({} solves)", peak.solves)
+        }
+        PeakLocation::AtEdge => {
+            "the largest amplitude is at the edge of the branch: the peak may lie outside it".into()
+        }
+        PeakLocation::AtFold => "at a fold of the branch".into(),
+        PeakLocation::NotLocated(reason) => {
+            format!("the largest branch point (not located: {reason})")
+        }
+        _ => "the largest branch point".into(),
     }
 }

@@ -5,6 +5,7 @@
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::Structure;
 use semismooth_contact::solve::Solution;
+use semismooth_contact::sweep::peak::PeakLocation;
 use ssn::scene::Scene;
 
 /// The shipped scene with `edit` applied to its text, or the error it gives.
@@ -186,4 +187,54 @@ fn a_friction_sweep_to_an_accuracy_changes_harmonics_with_the_friction_forces() 
             p.harmonics
         );
     }
+}
+
+#[test]
+fn the_sweeps_peak_is_located_between_its_points_as_the_largest_plain_solve() {
+    // The damper's branch points lie about 0.01 omega_1 apart near the peak, where the
+    // largest point misses the peak by up to the curvature times that step squared. The
+    // located peak must be the maximum of plain solves from zero on a grid 100 times finer
+    // around it: at least as large as every one (1e-9: the solves' tolerance), and above the
+    // largest within 1e-6 (half a grid step, 5e-5 omega_1, costs about (5e-5 / zeta)^2 / 2
+    // ~ 1e-6 relative at zeta = 0.05).
+    let scene = scene(|t| t).unwrap();
+    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
+    let sweep = scene.sweep.as_ref().unwrap();
+    let r = semismooth_contact::sweep::frequency_response(&structure, &scene.solver, sweep, None)
+        .unwrap();
+    let peak = r.located_peak.clone().expect("a peak");
+    assert_eq!(peak.location, PeakLocation::Located, "{peak:?}");
+    let (i, largest_point) = r.peak().unwrap();
+    assert!(peak.amplitude >= largest_point, "{peak:?} below point {i}");
+    let omega_1 = structure.omega_1;
+    let grid_max = (-20..=20)
+        .map(|k| {
+            let omega = peak.omega + k as f64 * 1e-4 * omega_1;
+            let s = semismooth_contact::solve(&structure, omega, &scene.solver, None).unwrap();
+            assert!(s.converged(), "{}", s.termination);
+            s.stats.max.abs().max(s.stats.min.abs())
+        })
+        .fold(0.0f64, f64::max);
+    assert!(
+        peak.amplitude >= grid_max * (1.0 - 1e-9),
+        "located {} below a grid solve {grid_max}",
+        peak.amplitude
+    );
+    assert!(
+        peak.amplitude <= grid_max * (1.0 + 1e-6),
+        "located {} above the grid's largest {grid_max}",
+        peak.amplitude
+    );
+}
+
+#[test]
+fn a_peak_beyond_the_window_is_reported_at_its_edge() {
+    let scene = scene(|t| t.replace("omega_ratio_to = 1.3", "omega_ratio_to = 0.97")).unwrap();
+    let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
+    let sweep = scene.sweep.as_ref().unwrap();
+    let r = semismooth_contact::sweep::frequency_response(&structure, &scene.solver, sweep, None)
+        .unwrap();
+    let peak = r.located_peak.expect("a peak");
+    assert_eq!(peak.location, PeakLocation::AtEdge);
+    assert_eq!(peak.omega, r.points.last().unwrap().omega);
 }

@@ -90,6 +90,7 @@ pub mod branch;
 mod contacts;
 pub mod doubling;
 pub mod fold_accuracy;
+pub mod peak;
 mod response;
 
 use std::time::Instant;
@@ -571,6 +572,9 @@ pub fn frequency_response(
         _ => follow_branch(structure, settings, sweep, branch_progress)?,
     };
     contacts::set_branch_reports(structure, settings, &mut response)?;
+    if settings.method.is_harmonic_balance() {
+        response.located_peak = peak::locate_peak(structure, settings, &response);
+    }
     let started = Instant::now();
     let total = response.points.len();
     let stability_progress =

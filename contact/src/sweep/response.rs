@@ -75,6 +75,9 @@ pub struct FrequencyResponse {
     /// The period-2 branches born at the branch's period doublings (SSN-HB with
     /// stability; [`super::doubling`]), in branch order.
     pub period_two: Vec<super::doubling::PeriodTwoOutcome>,
+    /// The peak located between the branch points (harmonic balance;
+    /// [`super::peak::locate_peak`]), `None` for other methods or an empty branch.
+    pub located_peak: Option<super::peak::LocatedPeak>,
 }
 
 /// One point of a frequency-response branch: its frequency, the extremes of the observed
@@ -211,6 +214,7 @@ impl FrequencyResponse {
             stability_seconds: 0.0,
             accuracy: None,
             period_two: Vec::new(),
+            located_peak: None,
         }
     }
 
