@@ -238,17 +238,27 @@ fn solve_every_shipped_scene_prints_the_documented_json() {
 
 /// A tolerance below the model's round-off floor is raised to it and the JSON reports the
 /// tolerance actually used: the scene asks 1e-300, the run converges against
-/// `eps max K_ii sqrt(n) max|g|` with `K_ii = 2 EA / h = 40` (20 elements), `n = 21 x 41`
-/// SSN-HB unknowns at H = 20 and the gap 0.5; at the scene's default 1e-10 the floor is
-/// below it and the tolerance is the scene's.
+/// `eps max K_ii sqrt(n) min(max|U|, max|g|)` with `K_ii = 2 EA / h = 40` (20 elements),
+/// `n = 21 x 41` SSN-HB unknowns at H = 20, `max|U|` the answer's largest displacement
+/// coefficient and the gap 0.5; at the scene's default 1e-10 the floor is below it and the
+/// tolerance is the scene's.
 #[test]
 fn a_tolerance_below_the_round_off_floor_is_raised_and_reported() {
-    let (out, json) = solve_text(
-        "tolerance",
+    let dir = TempDir::new("tolerance");
+    let scene = dir.write(
+        "scene.toml",
         &CANONICAL.replace("[solver]", "[solver]\ntolerance = 1e-300"),
     );
+    let state = dir.0.join("state.json");
+    let (out, json) = solve_json(&scene, &["--state", state.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let floor = f64::EPSILON * 40.0 * (21.0f64 * 41.0).sqrt() * 0.5;
+    let state: Value = serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).unwrap();
+    let largest = state["displacement"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .fold(0.0f64, |m, u| m.max(u.as_f64().unwrap().abs()));
+    let floor = f64::EPSILON * 40.0 * (21.0f64 * 41.0).sqrt() * largest.min(0.5);
     let used = json["effective_tolerance"].as_f64().unwrap();
     assert!((used / floor - 1.0).abs() < 1e-12, "{used:e} vs {floor:e}");
     assert!(json["residual_norm"].as_f64().unwrap() <= used);
