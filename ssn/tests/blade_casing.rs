@@ -69,4 +69,66 @@ fn the_blade_casing_sweep_over_rotor_speed_finds_the_stiffened_flap_resonance() 
     let last = ratio[ratio.len() - 1];
     assert!((last - 1.6).abs() < 1e-9, "ended at {last}");
     assert!(at > 1.0 && at < 1.5, "peak {peak} at {at}");
+    // Every point's 3-D contact summary: the tip slides whenever it touches, so its
+    // largest tangential force is mu times its largest normal force (the disk's boundary),
+    // it dissipates, and it never sticks. The disk's radius is mu times the multiplier
+    // series' -lambda_n, the reported normal force the normal law's projection of the
+    // truncated series: they differ by the truncation at the contact's onset (measured
+    // up to 8.6e-3 relative at H = 20 over the sweep; asserted 2e-2).
+    let summaries = document["frictional_contacts"].as_array().unwrap();
+    assert_eq!(summaries.len(), amplitude.len());
+    for point in summaries {
+        let contact = &point[0];
+        let number = |name: &str| contact[name].as_f64().unwrap();
+        let (normal, tangential) = (number("max_normal_force"), number("max_tangential_force"));
+        assert!(normal > 0.0, "{contact}");
+        assert!(
+            (tangential - 0.3 * normal).abs() < 2e-2 * 0.3 * normal,
+            "{contact}"
+        );
+        assert!(number("dissipated_energy") > 0.0, "{contact}");
+        assert_eq!(number("stick_fraction"), 0.0, "{contact}");
+        let fractions = number("slip_fraction") + number("separated_fraction");
+        assert!((fractions - 1.0).abs() < 1e-12, "{contact}");
+    }
+}
+
+/// `ssn sweep --csv` on the shipped scene writes the 3-D contact's columns, one value per
+/// point, equal to the JSON's.
+#[test]
+fn the_blade_casing_sweep_csv_has_the_3d_contact_columns() {
+    let (scene, _) = blade_casing::scene_structure();
+    let path = scene.path.to_str().unwrap();
+    let csv = std::env::temp_dir().join(format!("ssn-blade-casing-{}.csv", std::process::id()));
+    let args = [
+        "sweep",
+        path,
+        "--json",
+        "--quiet",
+        "--csv",
+        csv.to_str().unwrap(),
+    ];
+    let document = json_success(&ssn(&args));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::remove_file(&csv).ok();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let energy = (header.iter())
+        .position(|h| *h == "contact3d_1_dissipated_energy")
+        .expect("the energy column");
+    for name in [
+        "max_normal_force",
+        "max_tangential_force",
+        "separated_fraction",
+    ] {
+        let column = format!("contact3d_1_{name}");
+        assert!(header.contains(&column.as_str()), "{header:?}");
+    }
+    let json = document["frictional_contacts"].as_array().unwrap();
+    for (row, point) in lines.zip(json) {
+        let value: f64 = row.split(',').nth(energy).unwrap().trim().parse().unwrap();
+        let expected = point[0]["dissipated_energy"].as_f64().unwrap();
+        // The CSV writes numbers in shortest round-trip notation: equal.
+        assert_eq!(value, expected);
+    }
 }

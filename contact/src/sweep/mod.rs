@@ -90,6 +90,7 @@ pub mod branch;
 mod contacts;
 pub mod doubling;
 pub mod fold_accuracy;
+mod frictional;
 mod response;
 
 use std::time::Instant;
@@ -566,6 +567,7 @@ pub fn frequency_response(
         _ => follow_branch(structure, settings, sweep, branch_progress)?,
     };
     contacts::set_branch_reports(structure, settings, &mut response)?;
+    frictional::set_frictional_summaries(structure, settings, &mut response)?;
     let started = Instant::now();
     let total = response.points.len();
     let stability_progress =
