@@ -42,9 +42,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let hb = harmonic_balance(&case, 40);
     let marched = march(&case, 4000);
     let normal = &hb.report.normal_force;
-    let (n_max, n_min) = normal
-        .iter()
-        .fold((0.0f64, f64::INFINITY), |(hi, lo), f| (hi.max(-f), lo.min(-f)));
+    let (n_max, n_min) = normal.iter().fold((0.0f64, f64::INFINITY), |(hi, lo), f| {
+        (hi.max(-f), lo.min(-f))
+    });
     let mu = 0.4;
     let (hx, hy) = closed(&hb.report.tangential_force);
     let (mx, my) = closed(&marched.report.tangential_force);
@@ -53,8 +53,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let series = [
         Series::new("SSN-HB, H = 40", hx, hy),
         Series::dashed("3-D Moreau-Jean march, 4000 steps per period", mx, my),
-        Series::dashed(format!("Coulomb disk at the largest N = {n_max:.3}"), ox, oy),
-        Series::dashed(format!("Coulomb disk at the smallest N = {n_min:.3}"), ix, iy),
+        Series::dashed(
+            format!("Coulomb disk at the largest N = {n_max:.3}"),
+            ox,
+            oy,
+        ),
+        Series::dashed(
+            format!("Coulomb disk at the smallest N = {n_min:.3}"),
+            ix,
+            iy,
+        ),
     ];
     let spec = PlotSpec {
         title: "Tangential force orbit of a 3-D frictional contact (stick-slip, turning slip)"
@@ -72,6 +80,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.dissipated_energy, r.stick_fraction, r.slip_fraction, r.separated_fraction
         );
     }
-    println!("normal force in [{n_min:.4}, {n_max:.4}]; wrote {}", path.display());
+    println!(
+        "normal force in [{n_min:.4}, {n_max:.4}]; wrote {}",
+        path.display()
+    );
     Ok(())
 }

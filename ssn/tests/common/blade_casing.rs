@@ -5,9 +5,13 @@
 
 #![allow(dead_code)]
 
+#[path = "../../../contact/tests/common/disk_march.rs"]
+mod disk_march;
+
 use std::f64::consts::PI;
 use std::path::Path;
 
+use disk_march::first_harmonic;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::Residual;
 use semismooth_contact::builder::sparse_matrix;
@@ -236,18 +240,6 @@ pub fn extrapolated(coarse: &Measures, fine: &Measures) -> Measures {
     out.report.dissipated_energy =
         2.0 * fine.report.dissipated_energy - coarse.report.dissipated_energy;
     out
-}
-
-/// The amplitude of the first harmonic of equally spaced samples over one period.
-pub fn first_harmonic(u: &[f64]) -> f64 {
-    let n = u.len() as f64;
-    let (mut a, mut b) = (0.0, 0.0);
-    for (j, v) in u.iter().enumerate() {
-        let (sin, cos) = (2.0 * PI * j as f64 / n).sin_cos();
-        a += v * cos;
-        b += v * sin;
-    }
-    2.0 * a.hypot(b) / n
 }
 
 /// SSN-HB with `harmonics` at `omega` from zero (asserted converged), measured on 4096
