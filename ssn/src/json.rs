@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 
 use semismooth_contact::accuracy::{Discretisation, DiscretisationSearch};
 use semismooth_contact::contacts::{ContactReport, FrictionReport, FrictionSummary};
-use semismooth_contact::hb::FrictionalContactReport;
+use semismooth_contact::hb::{FrictionalContactReport, FrictionalContactSummary};
 use semismooth_contact::model::Structure;
 use semismooth_contact::solutions::SolutionSet;
 use semismooth_contact::solve::{RunCounters, Solution};
@@ -56,22 +56,34 @@ pub fn friction_json(f: &FrictionReport) -> Value {
     v
 }
 
-/// The JSON object of one 3-D frictional contact of a solution: `point`, `normal_force`,
-/// `tangential_force` (two series), `slip_velocity` (two series) over the period (at the
-/// times of the solution's CSV), `dissipated_energy` per cycle, `stick_fraction`,
-/// `slip_fraction`, `separated_fraction`.
+/// The JSON object of one 3-D frictional contact's numbers (a sweep point's): `point`,
+/// `max_normal_force`, `max_tangential_force`, `dissipated_energy` per cycle,
+/// `stick_fraction`, `slip_fraction`, `separated_fraction`.
+pub fn frictional_summary_json(s: &FrictionalContactSummary) -> Value {
+    json!({
+        "point": s.point,
+        "max_normal_force": finite_or_null(s.max_normal_force),
+        "max_tangential_force": finite_or_null(s.max_tangential_force),
+        "dissipated_energy": finite_or_null(s.dissipated_energy),
+        "stick_fraction": finite_or_null(s.stick_fraction),
+        "slip_fraction": finite_or_null(s.slip_fraction),
+        "separated_fraction": finite_or_null(s.separated_fraction),
+    })
+}
+
+/// The JSON object of one 3-D frictional contact of a solution: its numbers
+/// ([`frictional_summary_json`]) and `normal_force`, `tangential_force` (two series),
+/// `slip_velocity` (two series) over the period (at the times of the solution's CSV).
 pub fn frictional_contact_json(p: &FrictionalContactReport) -> Value {
     let series = |s: &[f64]| s.iter().map(|x| finite_or_null(*x)).collect::<Vec<_>>();
-    json!({
-        "point": p.point,
-        "normal_force": series(&p.normal_force),
-        "tangential_force": [series(&p.tangential_force[0]), series(&p.tangential_force[1])],
-        "slip_velocity": [series(&p.slip_velocity[0]), series(&p.slip_velocity[1])],
-        "dissipated_energy": finite_or_null(p.dissipated_energy),
-        "stick_fraction": finite_or_null(p.stick_fraction),
-        "slip_fraction": finite_or_null(p.slip_fraction),
-        "separated_fraction": finite_or_null(p.separated_fraction),
-    })
+    let mut v = frictional_summary_json(&p.summary());
+    v["normal_force"] = json!(series(&p.normal_force));
+    v["tangential_force"] = json!([
+        series(&p.tangential_force[0]),
+        series(&p.tangential_force[1])
+    ]);
+    v["slip_velocity"] = json!([series(&p.slip_velocity[0]), series(&p.slip_velocity[1])]);
+    v
 }
 
 /// The JSON fields of the Newton-style counters: `residual_evaluations`,
@@ -213,6 +225,15 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
                 .collect()
         })
     };
+    let frictional = if points.iter().all(|p| p.frictional_contacts.is_empty()) {
+        Vec::new()
+    } else {
+        column(|p| {
+            (p.frictional_contacts.iter())
+                .map(frictional_summary_json)
+                .collect()
+        })
+    };
     let mut doc = json!({
         "points": points.len(),
         "omega": column(|p| json!(p.omega)),
@@ -227,6 +248,7 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "max_penetration": column(|p| json!(p.stability.max_penetration)),
         "contacts": column(|p| p.contacts.iter().map(contact_json).collect()),
         "friction": friction,
+        "frictional_contacts": frictional,
         "stability_note": r.undecided.as_ref().map(crate::words::undecided),
         "stability_seconds": r.stability_seconds,
         "events": events,

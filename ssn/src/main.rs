@@ -88,14 +88,18 @@ enum Command {
         JSON fields: points, omega, omega_ratio, tip_max, tip_min, amplitude, stable,\n  \
         floquet_max_abs, contact_force_mean (sum over the contacts), max_penetration,\n  \
         contacts (per point, the list of ssn solve), friction (per point: point,\n  \
-        stick_fraction, force_amplitude, slip_velocity_amplitude, slip_limit_max) (arrays\n  \
-        in branch order),\n  \
+        stick_fraction, force_amplitude, slip_velocity_amplitude, slip_limit_max),\n  \
+        frictional_contacts (per point, per 3-D contact: point, max_normal_force,\n  \
+        max_tangential_force, dissipated_energy, stick_fraction, slip_fraction,\n  \
+        separated_fraction) (arrays in branch order),\n  \
         stability_note, events [{kind, omega, omega_ratio, index}], folds (omega where the\n  \
         branch turns), corner_folds (reversals of less than 5e-3 omega_1: corners),\n  \
         converged, termination, solve_seconds, counters\n\n\
         CSV: one row per point; contact k (from 0) adds contact{k}_force_mean,\n  \
         contact{k}_max_penetration, contact{k}_contact_fraction, contact{k}_displacement_min,\n  \
-        contact{k}_displacement_max\n\n",
+        contact{k}_displacement_max; 3-D contact p (from 1) adds\n  \
+        contact3d_{p}_max_normal_force, _max_tangential_force, _dissipated_energy,\n  \
+        _stick_fraction, _slip_fraction, _separated_fraction\n\n",
         mut_arg("scene", |a| a.help("Scene file (TOML) with a [sweep] section")),
         mut_arg("json", |a| a.help("Print the branch as JSON on stdout")),
         mut_arg("csv", |a| a.help("Write the branch as CSV")),

@@ -35,6 +35,45 @@ pub struct FrictionalContactReport {
     pub separated_fraction: f64,
 }
 
+/// The numbers of a [`FrictionalContactReport`] without its series: what a sweep keeps
+/// per point and contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct FrictionalContactSummary {
+    /// Index of the frictional contact (the model's order).
+    pub point: usize,
+    /// Largest normal force magnitude over the period, `max_t -lambda_n(t)`.
+    pub max_normal_force: f64,
+    /// Largest tangential force magnitude over the period, `max_t |lambda_t(t)|`.
+    pub max_tangential_force: f64,
+    /// Energy dissipated per cycle (as the report's).
+    pub dissipated_energy: f64,
+    /// Fraction of the period it sticks.
+    pub stick_fraction: f64,
+    /// Fraction of the period it slips.
+    pub slip_fraction: f64,
+    /// Fraction of the period it is open.
+    pub separated_fraction: f64,
+}
+
+impl FrictionalContactReport {
+    /// Its numbers: the largest force magnitudes over the samples, the energy and the
+    /// fractions.
+    pub fn summary(&self) -> FrictionalContactSummary {
+        let [t1, t2] = &self.tangential_force;
+        let largest = |values: &mut dyn Iterator<Item = f64>| values.fold(0.0f64, f64::max);
+        FrictionalContactSummary {
+            point: self.point,
+            max_normal_force: largest(&mut self.normal_force.iter().map(|f| -f)),
+            max_tangential_force: largest(&mut t1.iter().zip(t2).map(|(a, b)| a.hypot(*b))),
+            dissipated_energy: self.dissipated_energy,
+            stick_fraction: self.stick_fraction,
+            slip_fraction: self.slip_fraction,
+            separated_fraction: self.separated_fraction,
+        }
+    }
+}
+
 impl SsnHb {
     /// Number of frictional contacts.
     pub fn frictional_contacts(&self) -> usize {

@@ -217,7 +217,7 @@ use crate::operator::{HarmonicOperator, HarmonicParameters, OperatorParameter};
 
 pub(crate) use crate::law::{smoothed_max, smoothed_max_mu_derivative, smoothed_max_slope};
 pub use condensed::CondensedSsnHb;
-pub use disk::FrictionalContactReport;
+pub use disk::{FrictionalContactReport, FrictionalContactSummary};
 pub use jacobian::{ContactCoupling, HbJacobian};
 pub use krylov::KRYLOV_THRESHOLD;
 pub(crate) use laws::LawLayout;

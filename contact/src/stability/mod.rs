@@ -396,10 +396,10 @@ impl HbStability {
     /// `omega` (module documentation).
     pub fn of(&mut self, omega: f64, x: &[f64]) -> Result<Stability, StabilityError> {
         check_omega(omega)?;
-        let mut intervals = self.closed_intervals(x)?;
         if let Some(reason) = &self.refused {
             return Ok(Stability::not_decided(reason.clone()));
         }
+        let mut intervals = self.closed_intervals(x)?;
         // A contact held exactly rebounds at its impacts; a penalty spring does not.
         let rebounds = if self.formulation.closed_contact_stiffness().is_none() {
             self.rebounds(omega, x, &mut intervals)?

@@ -90,6 +90,7 @@ pub mod branch;
 mod contacts;
 pub mod doubling;
 pub mod fold_accuracy;
+mod frictional;
 pub mod peak;
 mod response;
 
@@ -572,6 +573,7 @@ pub fn frequency_response(
         _ => follow_branch(structure, settings, sweep, branch_progress)?,
     };
     contacts::set_branch_reports(structure, settings, &mut response)?;
+    frictional::set_frictional_summaries(structure, settings, &mut response)?;
     if settings.method.is_harmonic_balance() {
         response.located_peak = peak::locate_peak(structure, settings, &response);
     }

@@ -4,7 +4,7 @@ use semismooth::continuation::{ContinuationCounters, ContinuationTermination, Co
 use semismooth::harmonic::{Aft, FourierBasis};
 
 use crate::contacts::{ContactReport, FrictionSummary};
-use crate::hb::HbError;
+use crate::hb::{FrictionalContactSummary, HbError};
 use crate::settings::{Method, SolverSettings, SweepSettings};
 use crate::solve::{RunCounters, RunError};
 use crate::stability::Undecided;
@@ -114,6 +114,9 @@ pub struct ResponsePoint {
     /// Every friction point, in the model's order (stick fraction, force and slip velocity
     /// amplitudes, as `ssn solve` reports them).
     pub friction: Vec<FrictionSummary>,
+    /// Every 3-D frictional contact, in the model's order (SSN-HB branches; its largest
+    /// forces, energy per cycle and fractions, as `ssn solve` reports them).
+    pub frictional_contacts: Vec<FrictionalContactSummary>,
 }
 
 impl ResponsePoint {
@@ -138,6 +141,7 @@ impl ResponsePoint {
             stability: PointStability::default(),
             contacts: Vec::new(),
             friction: Vec::new(),
+            frictional_contacts: Vec::new(),
         }
     }
 
@@ -315,8 +319,45 @@ impl FrequencyResponse {
     /// The CSV columns of the contacts: for contact `k` (the scene's order, from 0, as the
     /// `lambda_k` of `ssn solve --csv`) `contact{k}_force_mean`, `contact{k}_max_penetration`,
     /// `contact{k}_contact_fraction`, `contact{k}_displacement_min` and
-    /// `contact{k}_displacement_max`, one value per point (NaN where not computed).
+    /// `contact{k}_displacement_max`, one value per point (NaN where not computed); then
+    /// for 3-D frictional contact `p` (from 1, as `ssn solve --csv`)
+    /// `contact3d_{p}_max_normal_force`, `_max_tangential_force`, `_dissipated_energy`,
+    /// `_stick_fraction`, `_slip_fraction`, `_separated_fraction`.
     pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
+        let mut columns = self.unilateral_contact_columns();
+        columns.extend(self.frictional_contact_columns());
+        columns
+    }
+
+    /// The 3-D frictional contacts' columns of [`Self::contact_columns`].
+    fn frictional_contact_columns(&self) -> Vec<(String, Vec<f64>)> {
+        type Field = fn(&FrictionalContactSummary) -> f64;
+        let count = (self.points.iter())
+            .map(|p| p.frictional_contacts.len())
+            .max()
+            .unwrap_or(0);
+        let fields: [(&str, Field); 6] = [
+            ("max_normal_force", |c| c.max_normal_force),
+            ("max_tangential_force", |c| c.max_tangential_force),
+            ("dissipated_energy", |c| c.dissipated_energy),
+            ("stick_fraction", |c| c.stick_fraction),
+            ("slip_fraction", |c| c.slip_fraction),
+            ("separated_fraction", |c| c.separated_fraction),
+        ];
+        let mut columns = Vec::with_capacity(count * fields.len());
+        for k in 0..count {
+            for (name, field) in fields {
+                let values = (self.points.iter())
+                    .map(|point| point.frictional_contacts.get(k).map_or(f64::NAN, field))
+                    .collect();
+                columns.push((format!("contact3d_{}_{name}", k + 1), values));
+            }
+        }
+        columns
+    }
+
+    /// The 1-D contacts' columns of [`Self::contact_columns`].
+    fn unilateral_contact_columns(&self) -> Vec<(String, Vec<f64>)> {
         let count = self
             .points
             .iter()
