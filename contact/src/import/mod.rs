@@ -45,6 +45,7 @@ use crate::rod::{natural_frequencies, DampingSpec};
 /// amplitude).
 pub const MAX_ENTRY_MAGNITUDE: f64 = 1e100;
 
+mod ansys_mapping;
 mod dof_map;
 
 pub use dof_map::{DofMap, DofMapError, NodeComponent, MAX_COMPONENT, MAX_DOF_MAP_BYTES};
