@@ -531,28 +531,13 @@ impl Check<'_> {
             ));
         }
         let (_, amplitude, frequency) = self.forcing(f)?;
-        let dof_map = m
-            .dof_map
-            .map(|name| -> Result<DofMapFile, SceneError> {
-                let path = file("model.dof_map", &name)?;
-                let map = DofMap::read(&path)
-                    .map_err(|e| SceneError::parse(self.path, format!("`model.dof_map`: {e}")))?;
-                let map = std::sync::Arc::new(map);
-                Ok(DofMapFile { path, map })
-            })
-            .transpose()?;
-        let format = match m.format {
-            RawMatrixFormat::MatrixMarket => MatrixFormat::MatrixMarket,
-            RawMatrixFormat::Calculix if dof_map.is_none() => {
-                return Err(self.invalid(
-                    "model.dof_map",
-                    "missing with format = \"calculix\"",
-                    "the CalculiX .dof file written beside the .sti and .mas files (it gives \
-                     the matrices' size and each row's node and component)",
-                ))
-            }
-            RawMatrixFormat::Calculix => MatrixFormat::CalculiX,
+        let files = super::formats::ModelFiles {
+            stiffness: &stiffness,
+            mass: &mass,
+            damping: damping_matrix.as_deref(),
+            dof_map: m.dof_map.map(|d| file("model.dof_map", &d)).transpose()?,
         };
+        let (format, dof_map) = self.model_format(m.format, files)?;
         let ck = Check {
             path: self.path,
             dof_map: dof_map.as_ref(),
