@@ -131,3 +131,83 @@ fn a_dof_map_beside_labelled_files_and_a_defect_of_a_file_are_named() {
         assert!(e.contains(w), "`{w}` not in: {e}");
     }
 }
+
+/// The normal row of the beam's single 3-D contact at node 20 with the contact keys `keys`
+/// (`[model] mesh = "beam.inp"`), as a dense vector over the 48 dofs.
+fn normal_of(keys: &str) -> Result<Vec<f64>, String> {
+    let model = format!("{}\nmesh = \"beam.inp\"", MODELS[0].0);
+    let text = scene_text(&model).replace(
+        "[[contact.point]]\nnode = 20\ncomponent = 2\ngap = 1e-7",
+        &format!("[[contact.point]]\nnode = 20\ngap = 1e-7\nfriction = 0.0\n{keys}"),
+    );
+    let scene =
+        Scene::from_toml(&text, fixture_dir().join("beam.toml")).map_err(|e| e.to_string())?;
+    let spec = scene.model.as_ref().unwrap();
+    let row = spec.frictional_contacts[0].normal_row().unwrap();
+    let mut v = vec![0.0; 48];
+    for (&d, &c) in row.dofs().iter().zip(row.coefficients()) {
+        v[d] += c;
+    }
+    Ok(v)
+}
+
+#[test]
+fn a_radial_normal_is_the_hand_computed_direction_from_the_axis_to_the_node() {
+    // Node 20 is at (40, 10, 10) (beam.inp); the axis along x through (0, 5, 5) leaves
+    // (0, 5, 5) from the axis to the node: the normal (0, 1, 1) / sqrt 2.
+    let radial =
+        normal_of("normal = \"radial\"\naxis = [2.0, 0.0, 0.0]\naxis_origin = [0.0, 5.0, 5.0]")
+            .unwrap();
+    let dof = std::fs::read_to_string(fixture_dir().join("beam.dof")).unwrap();
+    let row = |c: u8| {
+        dof.lines()
+            .position(|l| l.trim() == format!("20.{c}"))
+            .unwrap()
+    };
+    let s = 0.5f64.sqrt();
+    for (c, want) in [(1, 0.0), (2, s), (3, s)] {
+        // The direction is a difference and a division of numbers exact in binary: the
+        // rounding of 1/sqrt 2 alone, a few ulps.
+        assert!((radial[row(c)] - want).abs() < 1e-15, "{c}: {radial:?}");
+    }
+    assert_eq!(radial.iter().filter(|v| **v != 0.0).count(), 2);
+    let given = normal_of("normal = [0.0, 0.7071067811865476, 0.7071067811865476]").unwrap();
+    for (a, b) in radial.iter().zip(&given) {
+        assert!((a - b).abs() < 1e-15);
+    }
+    for (keys, words) in [
+        (
+            "normal = \"radial\"",
+            &["contact.point.axis", "missing"][..],
+        ),
+        (
+            "normal = \"radial\"\naxis = [1.0, 0.0]",
+            &["contact.point.axis", "3 finite"],
+        ),
+        (
+            "normal = \"outward\"",
+            &["contact.point.normal", "\"radial\""],
+        ),
+        (
+            "normal = \"radial\"\naxis = [1.0, 0.0, 0.0]\naxis_origin = [0.0, 10.0, 10.0]",
+            &["contact.point.axis", "does not pass through the node"],
+        ),
+        (
+            "normal = [0.0, 1.0, 0.0]\naxis = [1.0, 0.0, 0.0]",
+            &["contact.point.axis", "only with"],
+        ),
+    ] {
+        let e = normal_of(keys).unwrap_err();
+        for w in words {
+            assert!(e.contains(w), "`{w}` not in: {e}");
+        }
+    }
+    let text = scene_text(MODELS[0].0).replace(
+        "[[contact.point]]\nnode = 20\ncomponent = 2\ngap = 1e-7",
+        "[[contact.point]]\nnode = 20\ngap = 1e-7\nfriction = 0.0\nnormal = \"radial\"\naxis = [1.0, 0.0, 0.0]",
+    );
+    let e = Scene::from_toml(&text, fixture_dir().join("beam.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[model] mesh"), "{e}");
+}

@@ -10,6 +10,8 @@ pub(super) struct Check<'a> {
     path: &'a Path,
     /// The `[model]`'s dof map, once read.
     dof_map: Option<&'a DofMapFile>,
+    /// The `[model]`'s mesh node coordinates, once read.
+    mesh: Option<&'a semismooth_contact::import::MeshNodes>,
 }
 
 impl<'a> Check<'a> {
@@ -18,12 +20,18 @@ impl<'a> Check<'a> {
         Check {
             path,
             dof_map: None,
+            mesh: None,
         }
     }
 
     /// The scene file.
     pub(super) fn path(&self) -> &Path {
         self.path
+    }
+
+    /// The `[model]`'s mesh (`None`: none, or not read yet).
+    pub(super) fn mesh(&self) -> Option<&semismooth_contact::import::MeshNodes> {
+        self.mesh
     }
 
     /// The `[model]`'s dof map (`None`: none, or not read yet).
@@ -39,6 +47,7 @@ impl<'a> Check<'a> {
         Check {
             path: self.path,
             dof_map,
+            mesh: None,
         }
     }
 
@@ -538,9 +547,12 @@ impl Check<'_> {
             dof_map: m.dof_map.map(|d| file("model.dof_map", &d)).transpose()?,
         };
         let (format, dof_map) = self.model_format(m.format, files)?;
+        let mesh = m.mesh.map(|d| file("model.mesh", &d)).transpose()?;
+        let mesh = mesh.map(|p| self.mesh_nodes(&p)).transpose()?;
         let ck = Check {
             path: self.path,
             dof_map: dof_map.as_ref(),
+            mesh: mesh.as_ref(),
         };
         let (forcing_vector, load_dof) = ck.load_shape(f, &file)?;
         let (contacts, frictional_contacts) = contact

@@ -8,15 +8,28 @@
 //! | `"abaqus"` | `*_STIF<n>.mtx` | the node labels of the matrix files (no `dof_map`) |
 //! | `"nastran-dmig"` | `.pch` | the grid labels of the DMIG matrices (no `dof_map`) |
 //! | `"harwell-boeing"` | `.matrix`, `.hb`, `.rsa`, `.rua` | `dof_map` = Ansys' mapping file, optional |
+//!
+//! `[model] mesh = "x.inp"` reads the node coordinates of a CalculiX or Abaqus input deck,
+//! from which a 3-D contact's `normal = "radial"` is computed (module `frictional`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use semismooth_contact::import::{DofMap, Part};
+use semismooth_contact::import::{radial_direction, DofMap, MeshNodes, Part};
 use semismooth_contact::matrix_market::{labelled_files_dof_map, DofMapFile, MatrixFormat};
 
 use super::check::Check;
-use super::{RawMatrixFormat, SceneError};
+use super::{RawContactPoint, RawMatrixFormat, SceneError};
+
+/// A contact's `normal`: a vector, or a name of a computed normal (`"radial"`).
+#[derive(Debug, Clone, serde::Deserialize)]
+#[serde(untagged)]
+pub(super) enum RawNormal {
+    /// `[nx, ny, nz]`.
+    Vector(Vec<f64>),
+    /// `"radial"`.
+    Named(String),
+}
 
 /// The files of a `[model]` (paths resolved).
 pub(super) struct ModelFiles<'a> {
@@ -120,6 +133,89 @@ impl Check<'_> {
             path: files.stiffness.to_path_buf(),
             map: Arc::new(map),
         })
+    }
+}
+
+impl Check<'_> {
+    /// The node coordinates of the input deck `path` (`[model] mesh`).
+    pub(super) fn mesh_nodes(&self, path: &Path) -> Result<MeshNodes, SceneError> {
+        MeshNodes::read_inp(path)
+            .map_err(|e| SceneError::parse(self.path(), format!("`model.mesh`: {e}")))
+    }
+
+    /// The normal vector of `p` (before its unit check): as given, or `"radial"` about
+    /// `axis` through `axis_origin` at the node's mesh coordinates.
+    pub(super) fn normal_vector(
+        &self,
+        p: &RawContactPoint,
+        normal: &RawNormal,
+    ) -> Result<Vec<f64>, SceneError> {
+        let three = |key: &str, v: &[f64]| -> Result<[f64; 3], SceneError> {
+            let finite = v.iter().all(|x| x.is_finite());
+            v.try_into()
+                .ok()
+                .filter(|_| finite)
+                .ok_or_else(|| self.invalid(key, format!("{v:?}"), "3 finite values [x, y, z]"))
+        };
+        let name = match normal {
+            RawNormal::Vector(v) => {
+                if p.axis.is_some() || p.axis_origin.is_some() {
+                    return Err(self.invalid(
+                        "contact.point.axis",
+                        "given with a normal vector",
+                        "`axis` (and `axis_origin`) only with normal = \"radial\"",
+                    ));
+                }
+                return Ok(v.clone());
+            }
+            RawNormal::Named(name) if name == "radial" => name,
+            RawNormal::Named(other) => {
+                return Err(self.invalid(
+                    "contact.point.normal",
+                    format!("\"{other}\""),
+                    "a unit vector [nx, ny, nz] or \"radial\" (about `axis`)",
+                ))
+            }
+        };
+        let mesh = self.mesh().ok_or_else(|| {
+            self.invalid(
+                "contact.point.normal",
+                format!("\"{name}\" without a [model] mesh"),
+                "a [model] mesh = \"x.inp\" (the node coordinates) with normal = \"radial\"",
+            )
+        })?;
+        let axis = p.axis.as_deref().ok_or_else(|| {
+            self.invalid(
+                "contact.point.axis",
+                "missing",
+                "the axis [ax, ay, az] of normal = \"radial\"",
+            )
+        })?;
+        let axis = three("contact.point.axis", axis)?;
+        let origin = match p.axis_origin.as_deref() {
+            Some(o) => three("contact.point.axis_origin", o)?,
+            None => [0.0; 3],
+        };
+        let node = p.node.unwrap_or(0);
+        let point = u64::try_from(node)
+            .ok()
+            .and_then(|n| mesh.coordinates(n))
+            .ok_or_else(|| {
+                self.invalid(
+                    "contact.point.node",
+                    node,
+                    "a node of the [model] mesh (its coordinates give the radial normal)",
+                )
+            })?;
+        let n = radial_direction(point, origin, axis).ok_or_else(|| {
+            self.invalid(
+                "contact.point.axis",
+                format!("{axis:?} through {origin:?}, with node {node} at {point:?}"),
+                "a nonzero axis that does not pass through the node (the radial normal \
+                 needs a distance)",
+            )
+        })?;
+        Ok(n.to_vec())
     }
 }
 

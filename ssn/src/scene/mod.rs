@@ -151,6 +151,7 @@ struct RawModel {
     stiffness: String,
     damping: Option<String>,
     dof_map: Option<String>,
+    mesh: Option<String>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy)]
@@ -259,7 +260,9 @@ struct RawContactPoint {
     tangent_coefficients: Option<Vec<f64>>,
     tangent2_dofs: Option<Vec<i64>>,
     tangent2_coefficients: Option<Vec<f64>>,
-    normal: Option<Vec<f64>>,
+    normal: Option<formats::RawNormal>,
+    axis: Option<Vec<f64>>,
+    axis_origin: Option<Vec<f64>>,
     tangents: Option<Vec<Vec<f64>>>,
     tangential_stiffness: Option<f64>,
     gap_cos: Option<Vec<f64>>,
