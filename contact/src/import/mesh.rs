@@ -81,7 +81,7 @@ impl MeshNodes {
             };
             let words: Vec<&str> = t.split(',').map(str::trim).collect();
             let words = match words.last() {
-                Some(w) if w.is_empty() => &words[..words.len() - 1],
+                Some(&"") => &words[..words.len() - 1],
                 _ => &words[..],
             };
             if !(2..=4).contains(&words.len()) {
