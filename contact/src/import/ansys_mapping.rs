@@ -16,7 +16,8 @@ const ALLOWED: &str = "`equation node dof` (equation 1..=N once each, node >= 1,
                        UX, UY, UZ, ROTX, ROTY, ROTZ)";
 
 impl DofMap {
-    /// Reads Ansys' mapping file `path` (module documentation of [`super::ansys_mapping`]).
+    /// Reads Ansys' mapping file `path`: a title line, then `equation node dof` lines (dof
+    /// `UX`, `UY`, `UZ`, `ROTX`, `ROTY`, `ROTZ`), every equation `1..=N` once.
     pub fn read_ansys_mapping(path: &Path) -> Result<Self, DofMapError> {
         Self::parse_ansys_mapping(&read_text(path)?, path)
     }

@@ -33,6 +33,7 @@ pub struct LabelledEntry {
 
 /// How a file stores its matrix.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Storage {
     /// Symmetric: one triangle (the other its mirror), or both with equal values.
     Symmetric,
