@@ -9,6 +9,7 @@
 
 mod convert;
 mod errors;
+mod model;
 mod results;
 
 use std::collections::BTreeMap;
@@ -563,6 +564,7 @@ fn _ssn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<FrequencyResponse>()?;
     m.add_class::<SolutionSet>()?;
     m.add_class::<Stability>()?;
+    m.add_class::<model::Model>()?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(solutions, m)?)?;

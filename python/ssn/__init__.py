@@ -13,6 +13,8 @@ The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same s
 - ``solve``, ``sweep``, ``solutions``, ``stability``: results with numpy arrays and
   ``to_dict()`` equal to the JSON of ``ssn solve/sweep/solutions --json``; the GIL is
   released while they run;
+- ``Model.from_scene(scene)``: the structure, ``frequencies(count)`` and
+  ``reduce(method, modes=None, cutoff=None)`` (Craig-Bampton or massless boundary);
 - ``modes(scene)``: the backbone of the scene's ``[modes]``, the dict of ``ssn modes --json``;
 - ``study(scene, cases, executor=None, run="solve")`` on any
   ``concurrent.futures.Executor``; ``study_file`` reads the cases of an ``ssn study`` file;
@@ -26,6 +28,7 @@ The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same s
 
 from ._ssn import (
     FrequencyResponse,
+    Model,
     Scene,
     Solution,
     SolutionSet,
@@ -49,6 +52,7 @@ from ._study import StudyRecords, run_case, study, study_file
 
 __all__ = [
     "FrequencyResponse",
+    "Model",
     "NotConvergedError",
     "Scene",
     "SceneError",

@@ -121,39 +121,7 @@ impl DofMap {
     /// Reads the dof map file `path` (module documentation): a regular file of at most
     /// [`MAX_DOF_MAP_BYTES`] bytes.
     pub fn read(path: &Path) -> Result<Self, DofMapError> {
-        let io = |source| DofMapError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let not_regular = || DofMapError::NotRegular {
-            path: path.to_path_buf(),
-        };
-        if !std::fs::metadata(path).map_err(io)?.is_file() {
-            return Err(not_regular());
-        }
-        let file = std::fs::File::open(path).map_err(io)?;
-        // The path may have been replaced between the two looks: check what was opened.
-        if !file.metadata().map_err(io)?.is_file() {
-            return Err(not_regular());
-        }
-        let mut bytes = Vec::new();
-        file.take(MAX_DOF_MAP_BYTES + 1)
-            .read_to_end(&mut bytes)
-            .map_err(io)?;
-        if bytes.len() as u64 > MAX_DOF_MAP_BYTES {
-            return Err(DofMapError::TooLarge {
-                path: path.to_path_buf(),
-                limit: MAX_DOF_MAP_BYTES,
-            });
-        }
-        let text = String::from_utf8(bytes).map_err(|e| {
-            let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-                .iter()
-                .filter(|b| **b == b'\n')
-                .count();
-            line_error(path, line, "", "not text (invalid UTF-8)")
-        })?;
-        Self::parse(&text, path)
+        Self::parse(&read_text(path)?, path)
     }
 
     /// Parses dof map text (`path` for messages only).
@@ -226,6 +194,43 @@ impl DofMap {
     }
 }
 
+/// The text of the regular file `path` of at most [`MAX_DOF_MAP_BYTES`] bytes.
+pub(super) fn read_text(path: &Path) -> Result<String, DofMapError> {
+    let io = |source| DofMapError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let not_regular = || DofMapError::NotRegular {
+        path: path.to_path_buf(),
+    };
+    if !std::fs::metadata(path).map_err(io)?.is_file() {
+        return Err(not_regular());
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    // The path may have been replaced between the two looks: check what was opened.
+    if !file.metadata().map_err(io)?.is_file() {
+        return Err(not_regular());
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_DOF_MAP_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_DOF_MAP_BYTES {
+        return Err(DofMapError::TooLarge {
+            path: path.to_path_buf(),
+            limit: MAX_DOF_MAP_BYTES,
+        });
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+            .iter()
+            .filter(|b| **b == b'\n')
+            .count();
+        line_error(path, line, "", "not text (invalid UTF-8)")
+    })?;
+    Ok(text)
+}
+
 /// A line's node and component.
 fn node_component(t: &str) -> Result<NodeComponent, String> {
     let words: Vec<&str> = t.split_whitespace().collect();
@@ -248,7 +253,7 @@ fn node_component(t: &str) -> Result<NodeComponent, String> {
 }
 
 /// A defect of line `line` whose text is `text`.
-fn line_error(path: &Path, line: usize, text: &str, problem: &str) -> DofMapError {
+pub(super) fn line_error(path: &Path, line: usize, text: &str, problem: &str) -> DofMapError {
     let cut: String = text.chars().take(60).collect();
     let more = if text.chars().count() > 60 { "..." } else { "" };
     DofMapError::Line {

@@ -45,9 +45,12 @@ use crate::rod::{natural_frequencies, DampingSpec};
 /// amplitude).
 pub const MAX_ENTRY_MAGNITUDE: f64 = 1e100;
 
+mod ansys_mapping;
 mod dof_map;
+mod mesh;
 
 pub use dof_map::{DofMap, DofMapError, NodeComponent, MAX_COMPONENT, MAX_DOF_MAP_BYTES};
+pub use mesh::{radial_direction, MeshError, MeshNodes};
 
 /// Smallest first natural frequency of an imported model (its inverse the largest): the
 /// rod's scale rule.

@@ -25,10 +25,18 @@ use crate::import::{assemble, Attachments, DofMap, DofUse, ModelError, ModelPart
 use crate::model::{FrictionalContact, SparseMatrix, Structure};
 use crate::rod::{DampingSpec, FrequencySpec};
 
+mod abaqus;
 mod calculix;
+mod harwell_boeing;
+mod labelled;
+mod nastran;
 mod read;
 
+pub use abaqus::{parse_abaqus_matrix, read_abaqus_matrix};
 pub use calculix::{calculix_matrix_text, parse_calculix_matrix, read_calculix_matrix};
+pub use harwell_boeing::{parse_harwell_boeing, read_harwell_boeing};
+pub use labelled::{labelled_dof_map, LabelledEntry, LabelledMatrix, Storage};
+pub use nastran::{parse_dmig, read_dmig, select_dmig, DmigMatrix};
 
 pub use read::{
     matrix_market_text, parse_matrix, read_matrix, vector_market_text, MAX_ENTRY_MAGNITUDE,
@@ -57,6 +65,15 @@ pub enum MatrixFormat {
     /// CalculiX `.sti` / `.mas` files ([`read_calculix_matrix`]), sized by the dof map
     /// (required); the load vector is still a Matrix Market file.
     CalculiX,
+    /// Abaqus `*MATRIX OUTPUT, FORMAT=MATRIX INPUT` files ([`read_abaqus_matrix`]): the
+    /// rows are the (node, dof) pairs the files name ([`labelled_dof_map`]).
+    Abaqus,
+    /// Nastran DMIG matrices in a punch file ([`read_dmig`], [`select_dmig`]): the rows are
+    /// the (grid, component) pairs the matrices name ([`labelled_dof_map`]).
+    NastranDmig,
+    /// Harwell-Boeing files ([`read_harwell_boeing`]), the rows' nodes and dofs in Ansys'
+    /// mapping file ([`DofMap::read_ansys_mapping`], optional).
+    HarwellBoeing,
 }
 
 impl MatrixFormat {
@@ -65,7 +82,27 @@ impl MatrixFormat {
         match self {
             MatrixFormat::MatrixMarket => "matrix-market",
             MatrixFormat::CalculiX => "calculix",
+            MatrixFormat::Abaqus => "abaqus",
+            MatrixFormat::NastranDmig => "nastran-dmig",
+            MatrixFormat::HarwellBoeing => "harwell-boeing",
         }
+    }
+
+    /// The kind of file, as messages name it: `"Matrix Market"`, `"Abaqus matrix"`, ...
+    pub const fn file_kind(self) -> &'static str {
+        match self {
+            MatrixFormat::MatrixMarket => "Matrix Market",
+            MatrixFormat::CalculiX => "CalculiX matrix",
+            MatrixFormat::Abaqus => "Abaqus matrix",
+            MatrixFormat::NastranDmig => "Nastran DMIG",
+            MatrixFormat::HarwellBoeing => "Harwell-Boeing",
+        }
+    }
+
+    /// Whether the matrix files name their rows by node and component themselves (the
+    /// dof map is then theirs, [`labelled_files_dof_map`], not a file of its own).
+    pub fn labels_rows(self) -> bool {
+        matches!(self, MatrixFormat::Abaqus | MatrixFormat::NastranDmig)
     }
 }
 
@@ -195,6 +232,18 @@ pub enum ImportError {
         /// The reader's message.
         message: String,
     },
+    /// The reader of a finite-element code's matrix file (Abaqus, Nastran DMIG,
+    /// Harwell-Boeing) rejected it (the message has the line, what was found and what is
+    /// allowed).
+    #[error("{path}: not a valid {format} file: {message}")]
+    FileFormat {
+        /// The file.
+        path: PathBuf,
+        /// The format, in words (`"Abaqus matrix"`, `"Nastran DMIG"`, `"Harwell-Boeing"`).
+        format: &'static str,
+        /// The reader's message.
+        message: String,
+    },
     /// The Matrix Market reader rejected the file (the message has the line, what was
     /// found and what is allowed).
     #[error("{path}: not a valid Matrix Market file: {message}")]
@@ -304,27 +353,107 @@ pub enum ImportError {
 }
 
 /// Reads and checks the files of `spec` (in its [`MatrixFormat`]) and assembles the
-/// structure (module documentation).
+/// structure (module documentation). The load vector file is Matrix Market in every format.
 pub fn build_imported(spec: &ModelSpec) -> Result<Structure, ImportError> {
+    let load_or = |part: Part,
+                   path: &Path,
+                   read: &dyn Fn() -> Result<SparseMatrix, ImportError>| {
+        match part {
+            Part::Load => read_matrix(path),
+            _ => read(),
+        }
+    };
     match spec.format {
         MatrixFormat::MatrixMarket => build_imported_with(spec, read_matrix),
         MatrixFormat::CalculiX => {
-            let dofs =
-                spec.dof_map
-                    .as_ref()
-                    .map(|m| m.map.len())
-                    .ok_or_else(|| ImportError::Model {
-                        scene: spec.scene.clone(),
-                        reason: "format = \"calculix\" without a dof_map: allowed a CalculiX \
-                             model with its .dof file (which gives the matrices' size)"
-                            .into(),
-                    })?;
-            build_imported_with(spec, |path: &Path| match path == spec.forcing_vector {
-                true => read_matrix(path),
-                false => read_calculix_matrix(path, dofs),
+            let dofs = required_map(spec)?.len();
+            build_parts(spec, |part, path| {
+                load_or(part, path, &|| read_calculix_matrix(path, dofs))
+            })
+        }
+        MatrixFormat::HarwellBoeing => build_parts(spec, |part, path| {
+            load_or(part, path, &|| read_harwell_boeing(path))
+        }),
+        MatrixFormat::Abaqus => {
+            let map = required_map(spec)?;
+            let kind = spec.format.file_kind();
+            build_parts(spec, |part, path| {
+                load_or(part, path, &|| {
+                    read_abaqus_matrix(path)?.on_rows(map, path, kind)
+                })
+            })
+        }
+        MatrixFormat::NastranDmig => {
+            let map = required_map(spec)?;
+            let kind = spec.format.file_kind();
+            build_parts(spec, |part, path| {
+                load_or(part, path, &|| {
+                    select_dmig(&read_dmig(path)?, part, path)?.on_rows(map, path, kind)
+                })
             })
         }
     }
+}
+
+/// The dof map of `spec`, which its format needs (it gives the matrices' rows).
+fn required_map(spec: &ModelSpec) -> Result<&DofMap, ImportError> {
+    spec.dof_map
+        .as_ref()
+        .map(|m| m.map.as_ref())
+        .ok_or_else(|| ImportError::Model {
+            scene: spec.scene.clone(),
+            reason: format!(
+                "format = \"{}\" without a dof map: allowed a CalculiX model with its .dof \
+                 file (which gives the matrices' size), or Abaqus and Nastran files, whose \
+                 node labels give it",
+                spec.format.name()
+            ),
+        })
+}
+
+/// The dof map of matrix files that name their rows by node and component
+/// ([`MatrixFormat::labels_rows`]): every (node, component) that the `files` (each the
+/// file of its part; several parts may share a Nastran punch file) name, sorted by node,
+/// then component ([`labelled_dof_map`]).
+pub fn labelled_files_dof_map(
+    format: MatrixFormat,
+    files: &[(Part, &Path)],
+) -> Result<DofMap, ImportError> {
+    let mut matrices = Vec::with_capacity(files.len());
+    let mut punch_files: Vec<(&Path, Vec<DmigMatrix>)> = Vec::new();
+    for &(part, path) in files {
+        let matrix = match format {
+            MatrixFormat::Abaqus => read_abaqus_matrix(path)?,
+            MatrixFormat::NastranDmig => {
+                if !punch_files.iter().any(|(p, _)| *p == path) {
+                    punch_files.push((path, read_dmig(path)?));
+                }
+                let (_, all) = punch_files
+                    .iter()
+                    .find(|(p, _)| *p == path)
+                    .unwrap_or_else(|| unreachable!("the punch file was read just above"));
+                select_dmig(all, part, path)?.clone()
+            }
+            other => {
+                return Err(ImportError::Model {
+                    scene: path.to_path_buf(),
+                    reason: format!(
+                        "format = \"{}\" has no node labels in its matrix files: allowed \
+                         \"abaqus\" or \"nastran-dmig\"",
+                        other.name()
+                    ),
+                })
+            }
+        };
+        matrices.push(matrix);
+    }
+    let all: Vec<&LabelledMatrix> = matrices.iter().collect();
+    labelled_dof_map(&all).ok_or_else(|| ImportError::Model {
+        scene: files
+            .first()
+            .map_or_else(PathBuf::new, |f| f.1.to_path_buf()),
+        reason: "the matrix files name no node: allowed at least one entry".into(),
+    })
 }
 
 /// [`build_imported`] with the matrices of `spec`'s file names given by `read` (matrices
@@ -333,12 +462,24 @@ pub fn build_imported_with(
     spec: &ModelSpec,
     read: impl Fn(&Path) -> Result<SparseMatrix, ImportError>,
 ) -> Result<Structure, ImportError> {
-    let stiffness = read(&spec.stiffness)?;
-    let mass = read(&spec.mass)?;
-    let damping = spec.damping_matrix.as_deref().map(&read).transpose()?;
+    build_parts(spec, |_, path| read(path))
+}
+
+/// [`build_imported_with`] with `read` told which part it reads.
+fn build_parts(
+    spec: &ModelSpec,
+    read: impl Fn(Part, &Path) -> Result<SparseMatrix, ImportError>,
+) -> Result<Structure, ImportError> {
+    let stiffness = read(Part::Stiffness, &spec.stiffness)?;
+    let mass = read(Part::Mass, &spec.mass)?;
+    let damping = spec
+        .damping_matrix
+        .as_deref()
+        .map(|p| read(Part::Damping, p))
+        .transpose()?;
     let load = match spec.load_dof {
         Some(dof) => point_load(spec, dof, stiffness.nrows())?,
-        None => read(&spec.forcing_vector)?,
+        None => read(Part::Load, &spec.forcing_vector)?,
     };
     let parts = ModelParts {
         mass,

@@ -10,6 +10,8 @@ pub(super) struct Check<'a> {
     path: &'a Path,
     /// The `[model]`'s dof map, once read.
     dof_map: Option<&'a DofMapFile>,
+    /// The `[model]`'s mesh node coordinates, once read.
+    mesh: Option<&'a semismooth_contact::import::MeshNodes>,
 }
 
 impl<'a> Check<'a> {
@@ -18,12 +20,18 @@ impl<'a> Check<'a> {
         Check {
             path,
             dof_map: None,
+            mesh: None,
         }
     }
 
     /// The scene file.
     pub(super) fn path(&self) -> &Path {
         self.path
+    }
+
+    /// The `[model]`'s mesh (`None`: none, or not read yet).
+    pub(super) fn mesh(&self) -> Option<&semismooth_contact::import::MeshNodes> {
+        self.mesh
     }
 
     /// The `[model]`'s dof map (`None`: none, or not read yet).
@@ -39,6 +47,7 @@ impl<'a> Check<'a> {
         Check {
             path: self.path,
             dof_map,
+            mesh: None,
         }
     }
 
@@ -531,31 +540,19 @@ impl Check<'_> {
             ));
         }
         let (_, amplitude, frequency) = self.forcing(f)?;
-        let dof_map = m
-            .dof_map
-            .map(|name| -> Result<DofMapFile, SceneError> {
-                let path = file("model.dof_map", &name)?;
-                let map = DofMap::read(&path)
-                    .map_err(|e| SceneError::parse(self.path, format!("`model.dof_map`: {e}")))?;
-                let map = std::sync::Arc::new(map);
-                Ok(DofMapFile { path, map })
-            })
-            .transpose()?;
-        let format = match m.format {
-            RawMatrixFormat::MatrixMarket => MatrixFormat::MatrixMarket,
-            RawMatrixFormat::Calculix if dof_map.is_none() => {
-                return Err(self.invalid(
-                    "model.dof_map",
-                    "missing with format = \"calculix\"",
-                    "the CalculiX .dof file written beside the .sti and .mas files (it gives \
-                     the matrices' size and each row's node and component)",
-                ))
-            }
-            RawMatrixFormat::Calculix => MatrixFormat::CalculiX,
+        let files = super::formats::ModelFiles {
+            stiffness: &stiffness,
+            mass: &mass,
+            damping: damping_matrix.as_deref(),
+            dof_map: m.dof_map.map(|d| file("model.dof_map", &d)).transpose()?,
         };
+        let (format, dof_map) = self.model_format(m.format, files)?;
+        let mesh = m.mesh.map(|d| file("model.mesh", &d)).transpose()?;
+        let mesh = mesh.map(|p| self.mesh_nodes(&p)).transpose()?;
         let ck = Check {
             path: self.path,
             dof_map: dof_map.as_ref(),
+            mesh: mesh.as_ref(),
         };
         let (forcing_vector, load_dof) = ck.load_shape(f, &file)?;
         let (contacts, frictional_contacts) = contact

@@ -4,7 +4,9 @@
 //! optional unit `tangents = [[...], [...]]` orthogonal to it and to each other (completed
 //! by the program when absent), or rows: `dofs`/`coefficients` for the normal,
 //! `tangent_dofs`/`tangent_coefficients` and `tangent2_dofs`/`tangent2_coefficients` for
-//! the two tangents. A moving obstacle adds `gap_cos`/`gap_sin` (the gap's Fourier
+//! the two tangents. With a `[model] mesh`, `normal = "radial"` is the unit vector from an
+//! `axis = [ax, ay, az]` through `axis_origin` (default the origin) to the node,
+//! perpendicular to the axis. A moving obstacle adds `gap_cos`/`gap_sin` (the gap's Fourier
 //! coefficients on harmonics 1, 2, ... of the response's frequency) and
 //! `sliding_velocity = [v1, v2]` (the obstacle's velocity along the two tangents).
 
@@ -77,7 +79,7 @@ impl Check<'_> {
         }
         let gap = self.response_scale("contact.point.gap", p.gap)?;
         let (normal, tangents) = match &p.normal {
-            Some(n) => self.node_frame(p, n)?,
+            Some(n) => self.node_frame(p, &self.normal_vector(p, n)?)?,
             None => self.row_frame(p)?,
         };
         let mut point = FrictionalContact::unilateral(normal, gap, tangents, mu);

@@ -24,7 +24,6 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use semismooth_contact::import::DofMap;
 use semismooth_contact::matrix_market::{
     DofContact, DofFriction, DofMapFile, MatrixFormat, ModelSpec,
 };
@@ -36,6 +35,7 @@ mod check;
 mod contacts;
 mod cyclic;
 mod disk;
+mod formats;
 mod frictional;
 mod load_parts;
 mod nodes;
@@ -146,20 +146,22 @@ struct RawRod {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawModel {
-    #[serde(default)]
-    format: RawMatrixFormat,
+    format: Option<RawMatrixFormat>,
     mass: String,
     stiffness: String,
     damping: Option<String>,
     dof_map: Option<String>,
+    mesh: Option<String>,
 }
 
-#[derive(Debug, Deserialize, Default, Clone, Copy)]
+#[derive(Debug, Deserialize, Clone, Copy)]
 #[serde(rename_all = "kebab-case")]
 enum RawMatrixFormat {
-    #[default]
     MatrixMarket,
     Calculix,
+    Abaqus,
+    NastranDmig,
+    HarwellBoeing,
 }
 
 #[derive(Debug, Deserialize)]
@@ -258,7 +260,9 @@ struct RawContactPoint {
     tangent_coefficients: Option<Vec<f64>>,
     tangent2_dofs: Option<Vec<i64>>,
     tangent2_coefficients: Option<Vec<f64>>,
-    normal: Option<Vec<f64>>,
+    normal: Option<formats::RawNormal>,
+    axis: Option<Vec<f64>>,
+    axis_origin: Option<Vec<f64>>,
     tangents: Option<Vec<Vec<f64>>>,
     tangential_stiffness: Option<f64>,
     gap_cos: Option<Vec<f64>>,
