@@ -39,6 +39,8 @@
 
 use nalgebra::{Complex, DMatrix};
 
+use crate::model::SparseMatrix;
+
 /// The first harmonic of a Jenkins element's force per unit displacement amplitude.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -105,6 +107,46 @@ pub fn modal_terms(
         .collect();
     terms.sort_by(|a, b| a.omega.total_cmp(&b.omega));
     Some(terms)
+}
+
+/// The modal terms of a structure whose Jenkins element is a spring from dof `attached`
+/// to a massless slider dof `slider` (its only spring; the Coulomb law acts on it): the
+/// structure without the slider and its spring (`k_t = K[slider, slider]` comes off
+/// `K[attached, attached]`), damping `alpha M + beta K` of what remains, participations
+/// those of `attached` ([`modal_terms`]). With `beta = 0` it is the model's own
+/// `D = alpha M` (a `beta K` of the whole model would damp the spring too). Returns the
+/// terms and `k_t`; `None` for indices out of range or equal, or a singular remaining `M`.
+pub fn terms_without_slider(
+    stiffness: &SparseMatrix,
+    mass: &SparseMatrix,
+    rayleigh: (f64, f64),
+    attached: usize,
+    slider: usize,
+) -> Option<(Vec<ModalTerm>, f64)> {
+    let n = stiffness.nrows();
+    if attached >= n || slider >= n || attached == slider || mass.nrows() != n {
+        return None;
+    }
+    // Dof i of the model is dof `i - (i > slider)` of the structure without the slider.
+    let index = |i: usize| if i > slider { i - 1 } else { i };
+    let dense = |a: &SparseMatrix| {
+        let mut out = DMatrix::zeros(n - 1, n - 1);
+        let a = a.as_ref();
+        for j in (0..n).filter(|&j| j != slider) {
+            for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+                if i != slider {
+                    out[(index(i), index(j))] += *v;
+                }
+            }
+        }
+        out
+    };
+    let kt = crate::model::diagonal_entry(stiffness, slider);
+    let mut k = dense(stiffness);
+    k[(index(attached), index(attached))] -= kt;
+    let mut g = vec![0.0; n - 1];
+    g[index(attached)] = 1.0;
+    Some((modal_terms(&k, &dense(mass), rayleigh, &g)?, kt))
 }
 
 /// One point of a single-harmonic nonlinear mode.

@@ -4,13 +4,12 @@
 mod common;
 
 use common::sparse;
-use nalgebra::DMatrix;
 use semismooth::continuation::ContinuationTermination;
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, NewtonOptions, Tolerances};
 use semismooth::polyalgorithm::{self, solve_smoothing, PolyalgorithmOptions};
 use semismooth::{ParameterDependent, Residual};
-use semismooth_contact::describing_function::{jenkins_mode, modal_terms};
+use semismooth_contact::describing_function::{jenkins_mode, terms_without_slider};
 use semismooth_contact::hb::{HbOptions, SsnHb};
 use semismooth_contact::model::{
     ContactPoint, ContactRow, FrictionPoint, HarmonicLoad, SparseMatrix, StructuralModel,
@@ -20,7 +19,7 @@ use semismooth_contact::modes::{
     ModesError, MAX_DENSE_UNKNOWNS,
 };
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
-use semismooth_contact::structures::cantilever_with_tip_pad;
+use semismooth_contact::structures::cantilever_with_tip_spring;
 
 /// The chain `M = I`, `K = [[2, -1], [-1, 2]]` (natural frequencies 1 and sqrt 3, modes
 /// (1, 1) and (1, -1)), proportional damping `D = alpha M + beta K`, a contact on dof 1
@@ -532,8 +531,8 @@ fn a_backbone_too_large_for_the_dense_solve_is_refused_before_any_work() {
     assert!(backbone(&damped_chain(0.0, 0.0), &outside).is_err());
 }
 
-/// The cantilever of `structures::cantilever_with_tip_pad` (beam units, `elements`
-/// elements) with its pad's spring softened to `kt`, the pad held to the ground by a
+/// The cantilever of `structures::cantilever_with_tip_spring` (beam units, `elements`
+/// elements, the pad's spring `kt`), the pad held to the ground by a
 /// Coulomb slider of slip force `slip`: a Jenkins element (`kt`, `slip`) on the tip
 /// deflection. Damping `alpha M` (the pad is massless: undamped), load `force` times the
 /// uniform unit load.
@@ -544,50 +543,15 @@ fn beam_with_friction_damper(
     slip: f64,
     force: f64,
 ) -> StructuralModel {
-    let (k, m, f) = cantilever_with_tip_pad(elements);
-    let n = k.nrows();
-    let (tip, pad) = (2 * elements - 2, n - 1);
-    let mut entries = Vec::new();
-    let kr = k.as_ref();
-    for j in 0..n {
-        for (i, v) in kr.row_idx_of_col(j).zip(kr.val_of_col(j)) {
-            entries.push((i, j, *v));
-        }
-    }
-    let change = kt - dense_block(&k, n)[(pad, pad)];
-    for (i, j, sign) in [
-        (tip, tip, 1.0),
-        (tip, pad, -1.0),
-        (pad, tip, -1.0),
-        (pad, pad, 1.0),
-    ] {
-        entries.push((i, j, sign * change));
-    }
-    StructuralModel::new(
-        m,
-        sparse(n, &entries),
-        f.iter().map(|v| force * v).collect(),
-    )
-    .with_rayleigh_damping(alpha, 0.0)
-    .with_friction(FrictionPoint::prescribed(
-        ContactRow::unit(pad, 1.0),
-        0.5,
-        2.0 * slip,
-    ))
-}
-
-/// The dense `n x n` leading block of `a`.
-fn dense_block(a: &SparseMatrix, n: usize) -> DMatrix<f64> {
-    let mut out = DMatrix::zeros(n, n);
-    let a = a.as_ref();
-    for j in 0..n {
-        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
-            if i < n {
-                out[(i, j)] = *v;
-            }
-        }
-    }
-    out
+    let (k, m, f) = cantilever_with_tip_spring(elements, kt);
+    let pad = k.nrows() - 1;
+    StructuralModel::new(m, k, f.iter().map(|v| force * v).collect())
+        .with_rayleigh_damping(alpha, 0.0)
+        .with_friction(FrictionPoint::prescribed(
+            ContactRow::unit(pad, 1.0),
+            0.5,
+            2.0 * slip,
+        ))
 }
 
 /// `sqrt(1 - |U_1|_M^2 / sum_k k^2 |U_k|_M^2)`: the share of the harmonics above the first
@@ -633,12 +597,9 @@ fn friction_damped_beam_backbone_follows_the_describing_function_and_the_forced_
     // The reference: the beam without the pad (the pad's spring k_t comes off the tip),
     // its modes by a dense eigensolver, the Jenkins element's describing function on the
     // tip and the secular equation for (w, xi): the single-harmonic mode.
-    let mut k = dense_block(&free.stiffness, n - 1);
-    k[(tip, tip)] -= kt;
-    let m = dense_block(&free.mass, n - 1);
-    let mut g = vec![0.0; n - 1];
-    g[tip] = 1.0;
-    let terms = modal_terms(&k, &m, (alpha, 0.0), &g).unwrap();
+    let (terms, spring) =
+        terms_without_slider(&free.stiffness, &free.mass, (alpha, 0.0), tip, n - 1).unwrap();
+    assert!((spring - kt).abs() < 1e-12, "{spring}");
     let (mut worst, mut worst_sliding) = ((0.0f64, 0.0f64), 0.0f64);
     for p in &branch.points {
         let r = jenkins_mode(&terms, kt, slip, 1, &[p.amplitude]).unwrap()[0];
