@@ -1,6 +1,6 @@
-//! Backbones per second: the nonlinear mode of the paper's rod with its stop and of a
-//! friction-damped oscillator (a Jenkins element), timed; prints the table of
-//! `docs/modes.md`.
+//! Backbones per second: the nonlinear mode of the paper's rod with its stop, of a
+//! friction-damped oscillator (a Jenkins element) and of a friction-damped cantilever (the
+//! model of `scenes/beam_friction_modes.toml`), timed; prints the table of `docs/modes.md`.
 //!
 //! `cargo run --release -p semismooth-contact --example backbone_timing`
 //!
@@ -15,6 +15,7 @@ use semismooth_contact::hb::HbOptions;
 use semismooth_contact::model::{ContactRow, FrictionPoint, HarmonicLoad, StructuralModel};
 use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
+use semismooth_contact::structures::cantilever_with_tip_spring;
 
 /// Runs per backbone; the fastest is reported.
 const REPEATS: usize = 3;
@@ -39,6 +40,20 @@ fn jenkins() -> StructuralModel {
     }
 }
 
+/// The cantilever of `scenes/beam_friction_modes.toml`: 10 elements, its tip pad on a spring
+/// 0.3 held by a Coulomb slider of slip force 0.003, `D = 0.05 M`.
+fn friction_beam() -> StructuralModel {
+    let (k, m, f) = cantilever_with_tip_spring(10, 0.3);
+    let pad = k.nrows() - 1;
+    StructuralModel::new(m, k, f)
+        .with_rayleigh_damping(0.05, 0.0)
+        .with_friction(FrictionPoint::prescribed(
+            ContactRow::unit(pad, 1.0),
+            0.5,
+            0.006,
+        ))
+}
+
 fn main() {
     let rod = build_rod(&RodSpec {
         mass: MassModel::Modified,
@@ -53,6 +68,7 @@ fn main() {
             tip,
             20,
             (0.05, 1.5),
+            None,
         ),
         (
             "Jenkins element (friction-damped oscillator)",
@@ -60,16 +76,27 @@ fn main() {
             0,
             15,
             (0.01, 3.0),
+            None,
+        ),
+        (
+            "cantilever with a friction damper at its tip (10 elements)",
+            friction_beam(),
+            18,
+            15,
+            (0.001, 0.5),
+            // The scene's c: the slider's stiffness.
+            Some(0.3),
         ),
     ];
     println!(
         "| backbone | H | unknowns | amplitude range | points | corrector iterations | seconds | points / s |"
     );
     println!("|---|---|---|---|---|---|---|---|");
-    for (name, model, dof, harmonics, (from, to)) in cases {
+    for (name, model, dof, harmonics, (from, to), c) in cases {
         let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(dof), from, to);
         options.hb = HbOptions {
             harmonics,
+            c,
             ..HbOptions::default()
         };
         let rows = model.dofs() + model.contact_count() + model.friction_count();

@@ -11,6 +11,7 @@
 pub mod builder;
 pub mod contacts;
 pub mod cyclic;
+pub mod describing_function;
 mod dynamic;
 mod error;
 pub mod exact;

@@ -464,3 +464,34 @@ pub fn cantilever_with_tip_pad(elements: usize) -> (SparseMatrix, SparseMatrix, 
     let m = SparseMatrix::try_new_from_triplets(n, n, &m).expect("entries within the dofs");
     (k, m, f)
 }
+
+/// [`cantilever_with_tip_pad`] with the pad's spring `pad_stiffness` (finite, `> 0`) in
+/// place of `10 x 3 EI / L^3`: a Coulomb slider holding the pad makes a Jenkins element of
+/// that stiffness on the tip deflection (dof `2 elements - 2`; the pad is dof
+/// `2 elements`).
+pub fn cantilever_with_tip_spring(
+    elements: usize,
+    pad_stiffness: f64,
+) -> (SparseMatrix, SparseMatrix, Vec<f64>) {
+    let (k, m, f) = cantilever_with_tip_pad(elements);
+    let n = k.nrows();
+    let (tip, pad) = (2 * elements - 2, 2 * elements);
+    let change = pad_stiffness - PAD_STIFFNESS_FACTOR * 3.0;
+    let mut entries = Vec::with_capacity(k.compute_nnz() + 4);
+    let kr = k.as_ref();
+    for j in 0..n {
+        for (i, v) in kr.row_idx_of_col(j).zip(kr.val_of_col(j)) {
+            entries.push(Triplet::new(i, j, *v));
+        }
+    }
+    for (i, j, sign) in [
+        (tip, tip, 1.0),
+        (tip, pad, -1.0),
+        (pad, tip, -1.0),
+        (pad, pad, 1.0),
+    ] {
+        entries.push(Triplet::new(i, j, sign * change));
+    }
+    let k = SparseMatrix::try_new_from_triplets(n, n, &entries).expect("entries within the dofs");
+    (k, m, f)
+}

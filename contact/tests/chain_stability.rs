@@ -9,9 +9,9 @@ mod chain;
 #[path = "common/orbit_march.rs"]
 mod orbit_march;
 
-use orbit_march::{distance, snapshot};
+use orbit_march::{distance, moreau_jean, snapshot};
 use semismooth::floquet::BifurcationKind;
-use semismooth_contact::march::{MarchOptions, MarchScheme, TimeMarcher};
+use semismooth_contact::march::TimeMarcher;
 use semismooth_contact::model::Structure;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::stability::{hb_stability, hb_state};
@@ -45,14 +45,7 @@ fn march_from_orbit(
     let model = &structure.model;
     let n = model.dofs();
     let start = hb_state(model, harmonics, omega, &x[..n * (2 * harmonics + 1)], 0.0).unwrap();
-    let options = MarchOptions {
-        steps_per_period: STEPS,
-        scheme: MarchScheme::MoreauJean {
-            theta: 0.5,
-            restitution: 1.0,
-        },
-        ..MarchOptions::default()
-    };
+    let options = moreau_jean(STEPS, 1.0);
     let mut marcher = TimeMarcher::new(model, omega, &options, &start).unwrap();
     let origin = snapshot(&marcher, omega);
     let mut previous = origin.clone();

@@ -7,8 +7,8 @@
 #[path = "common/orbit_march.rs"]
 mod orbit_march;
 
-use orbit_march::{distance, snapshot};
-use semismooth_contact::march::{MarchOptions, MarchScheme, TimeMarcher};
+use orbit_march::{distance, moreau_jean, snapshot};
+use semismooth_contact::march::TimeMarcher;
 use semismooth_contact::rod::{build_rod, RodModel, RodSpec};
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::stability::{hb_stability, hb_state};
@@ -60,11 +60,7 @@ fn marcher_from_orbit<'a>(
     for (i, u) in start.displacement.iter_mut().enumerate() {
         *u += perturbation * ((i + 1) as f64 * 0.7).sin();
     }
-    let options = MarchOptions {
-        steps_per_period,
-        scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
-        ..MarchOptions::default()
-    };
+    let options = moreau_jean(steps_per_period, 0.0);
     TimeMarcher::new(&rod.model, omega, &options, &start).unwrap()
 }
 
@@ -111,11 +107,7 @@ fn largest_multiplier_predicts_the_decay_and_growth_of_moreau_jean_marching_on_a
     // Stable points with contact on the upper branch: march to the Moreau–Jean orbit, then
     // perturb it by 1e-6 per dof and fit the decay over periods 2 to 20 (the dominant mode
     // by then, still above round-off).
-    let options = MarchOptions {
-        steps_per_period: STEPS,
-        scheme: MarchScheme::MOREAU_JEAN_DEFAULT,
-        ..MarchOptions::default()
-    };
+    let options = moreau_jean(STEPS, 0.0);
     let mut checked = 0;
     for i in (upper_fold / 2..upper_fold).step_by(16) {
         let omega = r.points[i].omega;

@@ -10,6 +10,7 @@ import time
 import numpy as np
 import pytest
 import scipy.io
+import scipy.linalg
 import scipy.sparse
 
 import ssn
@@ -63,6 +64,25 @@ def test_modes_equals_the_command_line(cli):
     assert_same_document(doc, cli("modes", path))
     # The first point is the linear mode: the scene's damping ratio.
     assert doc["points"][0]["damping_ratio"] == pytest.approx(0.01, abs=1e-12)
+
+
+def test_modes_starts_at_the_stuck_natural_frequency_of_the_friction_beam():
+    # The cantilever whose tip pad (dof 21, 1-based) a Coulomb slider holds: stuck at small
+    # amplitude, the mode is the linear one of K, M without the pad's dof.
+    path = SCENES / "beam_friction_modes.toml"
+    doc = ssn.modes(ssn.Scene.from_file(path).with_values({"modes.amplitude_to": 0.02}))
+    k = scipy.io.mmread(SCENES / "beam_friction" / "K.mtx").toarray()
+    m = scipy.io.mmread(SCENES / "beam_friction" / "M.mtx").toarray()
+    kept = [i for i in range(k.shape[0]) if i != 20]
+    omega2 = scipy.linalg.eigh(k[np.ix_(kept, kept)], m[np.ix_(kept, kept)], eigvals_only=True)
+    omega_n = np.sqrt(omega2[0])
+    first = doc["points"][0]
+    # Round-off of two dense eigensolvers on a 20-dof beam (entries up to 2.4e4).
+    assert first["omega"] == pytest.approx(omega_n, rel=1e-10)
+    # The scene's D = 0.05 M: damping ratio 0.05 / (2 omega_n).
+    assert first["damping_ratio"] == pytest.approx(0.05 / (2 * omega_n), rel=1e-10)
+    # Past the slip onset (tip amplitude 0.01) the slider softens the mode.
+    assert doc["points"][-1]["omega"] < omega_n * (1 - 1e-3)
 
 
 def test_with_values_equals_set_on_the_command_line(cli):

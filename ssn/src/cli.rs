@@ -678,41 +678,9 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
     let (response, fold_accuracy) =
         run_sweep(&rod, &scene, &settings).map_err(|e| input_error(&args.scene, e))?;
     let ratio = response.omega_ratio();
-    let (stable, floquet) = crate::output::stability_numbers(&response);
-    let force_mean = response.contact_force_mean();
-    let contact_columns = response.contact_columns();
-    let mut headers = vec![
-        "omega",
-        "omega_ratio",
-        "tip_max",
-        "tip_min",
-        "amplitude",
-        "stable",
-        "floquet_max_abs",
-        "contact_force_mean",
-        "max_penetration",
-    ];
-    let points = &response.points;
-    let omega: Vec<f64> = points.iter().map(|p| p.omega).collect();
-    let observed_max: Vec<f64> = points.iter().map(|p| p.observed_max).collect();
-    let observed_min: Vec<f64> = points.iter().map(|p| p.observed_min).collect();
-    let amplitude = response.amplitudes();
-    let max_penetration: Vec<f64> = points.iter().map(|p| p.stability.max_penetration).collect();
-    let mut columns: Vec<&[f64]> = vec![
-        &omega,
-        &ratio,
-        &observed_max,
-        &observed_min,
-        &amplitude,
-        &stable,
-        &floquet,
-        &force_mean,
-        &max_penetration,
-    ];
-    for (name, values) in &contact_columns {
-        headers.push(name);
-        columns.push(values);
-    }
+    let table = crate::sweep_table::sweep_columns(&response);
+    let headers: Vec<&str> = table.iter().map(|(name, _)| name.as_str()).collect();
+    let columns: Vec<&[f64]> = table.iter().map(|(_, values)| values.as_slice()).collect();
     args.queue_outputs(&mut outputs, &scene, &headers, &columns, || {
         sweep_plot(&scene, &response, &ratio)
     })?;

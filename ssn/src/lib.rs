@@ -25,6 +25,7 @@ pub mod solutions;
 pub mod source;
 pub mod state;
 pub mod study;
+pub mod sweep_table;
 pub mod tables;
 pub mod words;
 pub mod work;

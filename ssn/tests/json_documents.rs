@@ -49,19 +49,25 @@ fn bilinear_oscillator() -> semismooth_contact::model::Structure {
     }
 }
 
-#[test]
-fn sweep_json_carries_the_period_two_branch_with_period_multiple_two() {
-    use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
+/// The sweep of [`bilinear_oscillator`] from 1.5 to 3.2 (H = 20, step 0.02), following
+/// period-2 branches or not.
+fn bilinear_sweep(period_two: bool) -> semismooth_contact::sweep::FrequencyResponse {
     let mut sweep = SweepSettings::new(1.5, 3.2);
     sweep.step = 0.02;
-    sweep.period_two = true;
-    let r = frequency_response(
+    sweep.period_two = period_two;
+    frequency_response(
         &bilinear_oscillator(),
         &common::sweep_solver(Method::SsnHb, 20),
         &sweep,
         None,
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn sweep_json_carries_the_period_two_branch_with_period_multiple_two() {
+    use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
+    let r = bilinear_sweep(true);
     let Some(PeriodTwoOutcome::Followed(b)) = r.period_two.first() else {
         panic!("{:?}", r.period_two);
     };
@@ -86,4 +92,51 @@ fn sweep_json_carries_the_period_two_branch_with_period_multiple_two() {
     // The period-2 branch is on the forcing frequency's scale, beside the event it left.
     let from = doc["from_event"]["omega"].as_f64().unwrap();
     assert!((omega[0] - from).abs() < 0.05, "{} vs {from}", omega[0]);
+}
+
+#[test]
+fn sweep_csv_rows_carry_the_period_two_points_after_the_sweeps_own() {
+    use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
+    let r = bilinear_sweep(true);
+    let branches: Vec<_> = (r.period_two.iter())
+        .filter_map(|o| match o {
+            PeriodTwoOutcome::Followed(b) => Some(&b.response),
+            _ => None,
+        })
+        .collect();
+    assert!(!branches.is_empty(), "{:?}", r.period_two);
+    let table = ssn::sweep_table::sweep_columns(&r);
+    let column = |name: &str| &table.iter().find(|(n, _)| n == name).unwrap().1;
+    let rows = r.points.len() + branches.iter().map(|b| b.points.len()).sum::<usize>();
+    assert!(table.iter().all(|(_, values)| values.len() == rows));
+    // The sweep's own rows first (branch 0, period 1), then each branch's in its order.
+    let mut start = r.points.len();
+    let sweep_omega: Vec<f64> = r.points.iter().map(|p| p.omega).collect();
+    assert_eq!(column("omega")[..start], sweep_omega[..]);
+    assert!(column("branch")[..start].iter().all(|&b| b == 0.0));
+    assert!(column("period_multiple")[..start].iter().all(|&m| m == 1.0));
+    for (k, b) in branches.iter().enumerate() {
+        let end = start + b.points.len();
+        let omega: Vec<f64> = b.points.iter().map(|p| p.omega).collect();
+        assert_eq!(column("omega")[start..end], omega[..]);
+        assert_eq!(column("amplitude")[start..end], b.amplitudes()[..]);
+        assert!(column("branch")[start..end]
+            .iter()
+            .all(|&v| v == (k + 1) as f64));
+        assert!(column("period_multiple")[start..end]
+            .iter()
+            .all(|&m| m == 2.0));
+        start = end;
+    }
+    // Without period-2 branches the table has neither column.
+    let plain = bilinear_sweep(false);
+    let names: Vec<String> = (ssn::sweep_table::sweep_columns(&plain).into_iter())
+        .map(|(n, _)| n)
+        .collect();
+    assert!(
+        !names
+            .iter()
+            .any(|n| n == "branch" || n == "period_multiple"),
+        "{names:?}"
+    );
 }

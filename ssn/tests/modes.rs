@@ -5,7 +5,9 @@
 mod process;
 
 use process::{json_success, ssn};
+use semismooth_contact::describing_function::{jenkins_mode, terms_without_slider};
 use semismooth_contact::rod::{build_rod, natural_frequencies};
+use semismooth_contact::structures::cantilever_with_tip_spring;
 use ssn::scene::Scene;
 
 /// The shipped scenes, `scenes/` at the root of the repository.
@@ -142,5 +144,38 @@ fn a_method_other_than_ssn_hb_is_refused_naming_the_key() {
     assert!(
         err.contains("solver.method") && err.contains("ssn-hb"),
         "{err}"
+    );
+}
+
+#[test]
+fn friction_beam_scene_backbone_follows_the_single_harmonic_mode() {
+    // The scene's matrices are `cantilever_with_tip_spring(10, 0.3)`: a Jenkins element
+    // (k_t = 0.3, slip force 0.003) on the tip deflection, D = 0.05 M.
+    let path = scenes_dir().join("beam_friction_modes.toml");
+    let json = json_success(&ssn(&["modes", path.to_str().unwrap(), "--json"]));
+    assert_eq!(json["converged"], true, "{json}");
+    let (k, m, _) = cantilever_with_tip_spring(10, 0.3);
+    let (terms, kt) = terms_without_slider(&k, &m, (0.05, 0.0), 18, 20).unwrap();
+    let points = json["points"].as_array().unwrap();
+    assert!(points.len() >= 20, "{}", points.len());
+    let value = |p: &serde_json::Value, key: &str| p[key].as_f64().unwrap();
+    let mut largest = (0.0f64, 0.0f64);
+    for p in points {
+        let r = jenkins_mode(&terms, kt, 0.003, 1, &[value(p, "amplitude")]).unwrap()[0];
+        let dw = (value(p, "omega") / r.omega - 1.0).abs();
+        let dzeta = (value(p, "damping_ratio") / r.damping_ratio - 1.0).abs();
+        largest = (largest.0.max(dw), largest.1.max(dzeta));
+    }
+    // As in the library's test of the same beam (`contact/tests/nonlinear_modes.rs`): the
+    // describing function is the one-harmonic limit, the differences EPMC's truncation of
+    // the slider's kinked motion at H = 15, largest at the onset of slip (measured 4.2e-4 in
+    // w, 2.9e-2 in the damping ratio).
+    assert!(largest.0 < 1e-3 && largest.1 < 5e-2, "{largest:?}");
+    // The damping ratio passes through a maximum about three times the stuck one.
+    let zeta: Vec<f64> = points.iter().map(|p| value(p, "damping_ratio")).collect();
+    let peak = zeta.iter().copied().fold(0.0, f64::max);
+    assert!(
+        peak > 3.0 * zeta[0] && peak > 2.0 * zeta[zeta.len() - 1],
+        "{zeta:?}"
     );
 }
