@@ -176,6 +176,31 @@ impl BladedDisk {
     /// [`DiskLoading::omega`]. A stop out of range or no blade is
     /// [`ModelError::InvalidParameter`].
     pub fn structure(&self, loading: &DiskLoading) -> Result<Structure, ModelError> {
+        self.structure_with_mistuning(loading, &self.deterministic_mistuning())
+    }
+
+    /// [`BladedDisk::structure`] with blade `j`'s stiffness `k_b (1 + mistuning[j])` in
+    /// place of the builder's pattern (one finite value above -1 per blade; `self.mistuning`
+    /// is not used).
+    pub fn structure_with_mistuning(
+        &self,
+        loading: &DiskLoading,
+        mistuning: &[f64],
+    ) -> Result<Structure, ModelError> {
+        if mistuning.len() != self.blades {
+            return Err(ModelError::InvalidParameter {
+                name: "mistuning pattern length",
+                value: mistuning.len() as f64,
+                allowed: "one value per blade",
+            });
+        }
+        if let Some(&delta) = mistuning.iter().find(|d| !(d.is_finite() && **d > -1.0)) {
+            return Err(ModelError::InvalidParameter {
+                name: "blade mistuning",
+                value: delta,
+                allowed: "finite and above -1 (a positive blade stiffness)",
+            });
+        }
         if self.blades == 0 {
             return Err(ModelError::InvalidParameter {
                 name: "blades",
@@ -190,7 +215,7 @@ impl BladedDisk {
                 allowed: "a blade index below the number of blades",
             });
         }
-        let (stiffness, mass, shape) = self.matrices();
+        let (stiffness, mass, shape) = Self::mistuned_matrices(mistuning);
         let n = self.dofs();
         let mut model = StructuralModel {
             frictional_contacts: Vec::new(),

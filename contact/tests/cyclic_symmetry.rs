@@ -271,3 +271,26 @@ fn check_blade_amplitudes(
         );
     }
 }
+
+#[test]
+fn an_explicit_mistuning_pattern_builds_the_builders_disk_and_bad_patterns_are_refused() {
+    let disk = BladedDisk {
+        blades: BLADES,
+        mistuning: 0.02,
+    };
+    let loading = DiskLoading::shipped((0..BLADES).collect());
+    let builder = disk.structure(&loading).unwrap();
+    let explicit =
+        (disk.structure_with_mistuning(&loading, &disk.deterministic_mistuning())).unwrap();
+    // The same assembly of the same numbers: equal to the last bit.
+    let dense = |s: &semismooth_contact::model::Structure| s.model.stiffness.to_dense();
+    assert_eq!(dense(&builder), dense(&explicit));
+    assert_eq!(builder.omega_1, explicit.omega_1);
+    for bad in [
+        vec![0.0; BLADES - 1],
+        vec![-1.0; BLADES],
+        vec![f64::NAN; BLADES],
+    ] {
+        assert!(disk.structure_with_mistuning(&loading, &bad).is_err());
+    }
+}

@@ -292,3 +292,96 @@ fn interface_nodes_through_a_dof_map_give_the_interface_dofs() {
         assert!(message.contains(key), "case {i}: {message}");
     }
 }
+
+#[test]
+fn a_sector_scene_with_a_3d_frictional_contact_between_sectors_answers_the_full_disk() {
+    use semismooth_contact::model::{ContactRow, FrictionalContact};
+    use semismooth_contact::rod::natural_frequencies;
+    let (engine_order, gap, mu) = (3, 0.2, 0.3);
+    let disk = BladedDisk {
+        blades: BLADES,
+        mistuning: 0.0,
+    };
+    // The amplitude of `common`.
+    let loading = DiskLoading {
+        amplitude: 0.06,
+        ..DiskLoading::shipped(Vec::new())
+    };
+    let (sector, omega_1) = disk.cyclic_sector(&loading, engine_order).unwrap();
+    let nd = sector.nodal_diameter(1);
+    let omega = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+    let dir = temp_dir("frictional3d");
+    let m = sector.model();
+    for (name, text) in model_matrix_files(&m.stiffness, &m.mass, &[0.0, 1.0, 0.0, 0.0]) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let scene = dir.join("sector.toml");
+    // The pad against the next blade's tip and disk dof; tangents b - d' and d - b'.
+    std::fs::write(
+        &scene,
+        format!(
+            "[model]\nmass = \"M.mtx\"\nstiffness = \"K.mtx\"\n\n[cyclic]\nsectors = {BLADES}\n\
+             engine_order = {engine_order}\nleft = [1]\nright = [4]\n\n{common}\
+             vector = \"f.mtx\"\n\n[output]\ndof = 2\n\n[[contact.point]]\ndofs = [3]\n\
+             coefficients = [1.0]\nneighbour_dofs = [2, 1]\n\
+             neighbour_coefficients = [-0.5, -0.5]\ngap = {gap}\nfriction = {mu}\n\
+             tangent_dofs = [2]\ntangent_coefficients = [1.0]\ntangent_neighbour_dofs = [1]\n\
+             tangent_neighbour_coefficients = [-1.0]\ntangent2_dofs = [1]\n\
+             tangent2_coefficients = [1.0]\ntangent2_neighbour_dofs = [2]\n\
+             tangent2_neighbour_coefficients = [-1.0]\n",
+            common = common(2.0 * loading.zeta / omega_1, omega),
+        ),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    // A second tangent's neighbour part without a second tangent, and neighbour parts on
+    // a contact with a tangential spring, are refused with their keys.
+    let bad = [
+        (
+            text.replace("tangent2_dofs = [1]\ntangent2_coefficients = [1.0]\n", ""),
+            "contact.point.tangent2_neighbour_dofs",
+        ),
+        (
+            text.replace(
+                "friction = 0.3",
+                "friction = 0.3\ntangential_stiffness = 1.0",
+            ),
+            "contact.point.tangential_stiffness",
+        ),
+    ];
+    for (i, (bad, key)) in bad.iter().enumerate() {
+        let path = dir.join(format!("bad{i}.toml"));
+        std::fs::write(&path, bad).unwrap();
+        let message = load(&path).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(message.contains(key), "{message}");
+    }
+    let (loaded, sector_solution) = solved(&scene);
+    let mut full = disk.structure(&loading).unwrap();
+    full.model.load = (full.model.load.clone())
+        .delayed_by_sector(&disk.sector_dofs(), engine_order)
+        .unwrap();
+    let row = |dofs: Vec<usize>, a: Vec<f64>| ContactRow::new(dofs, a).unwrap();
+    for j in 0..BLADES {
+        let (own, next) = (3 * j, 3 * ((j + 1) % BLADES));
+        let normal = row(vec![own + 2, next + 1, next], vec![1.0, -0.5, -0.5]);
+        let t1 = row(vec![own + 1, next], vec![1.0, -1.0]);
+        let t2 = row(vec![own, next + 1], vec![1.0, -1.0]);
+        (full.model.frictional_contacts).push(FrictionalContact::unilateral(
+            normal,
+            gap,
+            [t1, t2],
+            mu,
+        ));
+    }
+    let full_solution =
+        semismooth_contact::solve(&full, loaded.omega, &loaded.scene.solver, None).unwrap();
+    assert!(full_solution.converged());
+    assert!((full_solution.frictional_contacts.iter()).all(|c| c.separated_fraction < 1.0));
+    let u_full = &full_solution.state[..3 * BLADES * (2 * HARMONICS + 1)];
+    let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let recovered = disk.recover(&sector, &sector_solution.state, HARMONICS);
+    let worst = (recovered.iter().zip(u_full)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    // The same discrete equations (64 samples, a multiple of N), both converged below
+    // 1e-13 (the library's test measures 1e-14): 1e-10 leaves a wide margin.
+    assert!(worst < 1e-10 * scale, "{:e}", worst / scale);
+}

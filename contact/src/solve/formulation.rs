@@ -174,6 +174,22 @@ impl HarmonicProblem {
         }
     }
 
+    /// SSN-HB's complementarity constant `c` (`None` for penalty HB).
+    pub(crate) fn complementarity_constant(&self) -> Option<f64> {
+        match self {
+            Self::Ssn(p) => Some(p.c()),
+            Self::Penalty(_) => None,
+        }
+    }
+
+    /// The AFT samples per period `Nt`.
+    pub(crate) fn time_samples(&self) -> usize {
+        match self {
+            Self::Ssn(p) => p.basis().time_samples(),
+            Self::Penalty(p) => p.basis().time_samples(),
+        }
+    }
+
     /// The stiffness of a closed contact: `None` where the contact holds exactly
     /// (SSN-HB), the penalty stiffness of penalty HB.
     pub(crate) fn closed_contact_stiffness(&self) -> Option<f64> {

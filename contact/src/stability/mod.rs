@@ -25,6 +25,14 @@
 //! set of closed contacts and reused along a sweep, so a point costs a few small dense
 //! products (about the cost of its Newton solve; `docs/sweeps.md` has the measurements).
 //!
+//! # A cyclic sector
+//!
+//! A reduced cyclic sector's travelling wave is perturbed on every nodal diameter, not only
+//! on its own interface phase, and its contact phases would read `K`, `M` without the
+//! couplings: [`HbStability`] decides it by Hill's method over the nodal-diameter families
+//! (module [`hill`]), each a sector problem with its own interface phase, their union the
+//! full disk's Hill problem.
+//!
 //! # What the verdict means with a contact dof that carries mass
 //!
 //! Harmonic balance imposes no impact law: its contact holds in the Galerkin sense, and
@@ -70,6 +78,7 @@
 //! uses this to place the crossing at the fold. The zigzags of a truncated balance
 //! (reversals within the fold excursion) are not counted.
 
+pub mod hill;
 mod phases;
 mod shooting;
 
@@ -335,6 +344,9 @@ pub struct HbStability {
     phases: Option<PhaseModel>,
     /// Why nothing is decided (too many dofs).
     refused: Option<Undecided>,
+    /// A reduced cyclic sector: Hill's method over the nodal-diameter families
+    /// ([`hill`]), not the contact phases (which read `K`, `M` without the couplings).
+    sector: bool,
 }
 
 impl HbStability {
@@ -355,6 +367,7 @@ impl HbStability {
             Some(k) => ClosedContact::Spring(k),
         };
         let n = model.dofs();
+        let sector = model.cyclic.is_some();
         let (phases, refused) = if model.has_friction() {
             (
                 None,
@@ -362,6 +375,8 @@ impl HbStability {
                     points: model.friction.len() + model.frictional_contacts.len(),
                 }),
             )
+        } else if sector {
+            (None, None)
         } else if let Some(contact) = model.contacts.iter().position(|c| c.direction().is_none()) {
             (None, Some(Undecided::GeneralContactRow { contact }))
         } else if n > MAX_DOFS {
@@ -381,6 +396,7 @@ impl HbStability {
             harmonics: settings.harmonics,
             phases,
             refused,
+            sector,
         })
     }
 
@@ -400,6 +416,9 @@ impl HbStability {
             return Ok(Stability::not_decided(reason.clone()));
         }
         let mut intervals = self.closed_intervals(x)?;
+        if self.sector {
+            return self.sector_stability(omega, &intervals);
+        }
         // A contact held exactly rebounds at its impacts; a penalty spring does not.
         let rebounds = if self.formulation.closed_contact_stiffness().is_none() {
             self.rebounds(omega, x, &mut intervals)?
@@ -409,6 +428,97 @@ impl HbStability {
         let phases = self.phases.as_mut().expect("built when not refused");
         let period = 2.0 * std::f64::consts::PI / omega;
         switched_stability(phases, period, &intervals, &rebounds)
+    }
+
+    /// Hill's problem of the solution whose contacts are closed on `intervals`, at `omega`.
+    fn hill_problem(&self, omega: f64, intervals: &[Vec<(f64, f64)>]) -> hill::HillProblem<'_> {
+        let nt = self.formulation.time_samples();
+        let active = (intervals.iter())
+            .map(|iv| (0..nt).map(|n| holds(iv, n as f64 / nt as f64)).collect())
+            .collect();
+        hill::HillProblem {
+            model: &self.model,
+            harmonics: self.harmonics,
+            omega,
+            active,
+            law: match self.formulation.closed_contact_stiffness() {
+                Some(k) => hill::ClosedLaw::Penalty(k),
+                None => hill::ClosedLaw::Multiplier(
+                    (self.formulation.complementarity_constant()).unwrap_or(1.0),
+                ),
+            },
+        }
+    }
+
+    /// The stability of a cyclic sector's solution over every nodal-diameter family
+    /// ([`hill`]); [`Undecided::TooCostly`] above [`MAX_WORK`] (`30 d^3` per family, `d`
+    /// the pencil's dimension).
+    fn sector_stability(
+        &self,
+        omega: f64,
+        intervals: &[Vec<(f64, f64)>],
+    ) -> Result<Stability, StabilityError> {
+        let problem = self.hill_problem(omega, intervals);
+        let (families, _) = hill::families(&self.model);
+        let size = (2 * self.harmonics + 1) as f64;
+        let d = (2 * self.model.dofs() + intervals.len()) as f64 * size;
+        let work = 30.0 * d.powi(3) * families.len() as f64;
+        let (phases, closings) = switching_counts(&problem.active);
+        if work > MAX_WORK {
+            return Ok(Stability::not_decided(Undecided::TooCostly {
+                phases,
+                work,
+            }));
+        }
+        Ok(Stability::of(problem.multipliers()?, phases, closings))
+    }
+
+    /// The multipliers of one nodal-diameter family `family` (`0..N`, [`hill`]) of the
+    /// solution `x` at `omega` by Hill's method; family 0 of a model that is not a cyclic
+    /// sector is its whole Hill problem. `Err` for friction (no closed-contact law).
+    pub fn family_multipliers(
+        &self,
+        omega: f64,
+        x: &[f64],
+        family: usize,
+    ) -> Result<Multipliers, StabilityError> {
+        check_omega(omega)?;
+        self.refuse_friction()?;
+        let intervals = self.closed_intervals(x)?;
+        let values = self
+            .hill_problem(omega, &intervals)
+            .family_multipliers(family)?;
+        Ok(Multipliers::from_values(values))
+    }
+
+    /// Every finite eigenvalue `(re, im)` of family `family`'s Hill pencil
+    /// ([`HbStability::family_multipliers`]), each Floquet exponent with its copies shifted
+    /// by multiples of `i omega`, in no particular order.
+    pub fn family_exponents(
+        &self,
+        omega: f64,
+        x: &[f64],
+        family: usize,
+    ) -> Result<Vec<(f64, f64)>, StabilityError> {
+        check_omega(omega)?;
+        self.refuse_friction()?;
+        let intervals = self.closed_intervals(x)?;
+        let exponents = self
+            .hill_problem(omega, &intervals)
+            .family_exponents(family)?;
+        Ok(exponents.iter().map(|(_, l)| (l.re, l.im)).collect())
+    }
+
+    /// `Err` for a model with friction (Hill's problem here has no friction law).
+    fn refuse_friction(&self) -> Result<(), StabilityError> {
+        if self.model.has_friction() {
+            return Err(StabilityError::InvalidOption {
+                name: "friction points",
+                value: (self.model.friction.len() + self.model.frictional_contacts.len()) as f64,
+                allowed: "none: Hill's method here carries no friction law",
+            });
+        }
+        Ok(())
     }
 
     /// The closed intervals of contacts on dofs with mass that the orbit `x` leaves at
@@ -499,6 +609,20 @@ struct Rebound {
     velocity: Vec<f64>,
     /// The load's phase `omega t` at the impact.
     load_phase: f64,
+}
+
+/// The contact phases per period (sample indices where the set of closed contacts
+/// changes, at least 1) and the closings (a contact's samples going from open to closed)
+/// of the switching samples `active`.
+fn switching_counts(active: &[Vec<bool>]) -> (usize, usize) {
+    let nt = active.first().map_or(0, Vec::len);
+    let changes = (0..nt)
+        .filter(|&n| active.iter().any(|a| a[n] != a[(n + nt - 1) % nt]))
+        .count();
+    let closings = (active.iter())
+        .map(|a| (0..nt).filter(|&n| a[n] && !a[(n + nt - 1) % nt]).count())
+        .sum();
+    (changes.max(1), closings)
 }
 
 /// Whether contact phase intervals `intervals` hold the fraction `t` of the period.

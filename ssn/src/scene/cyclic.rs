@@ -29,6 +29,10 @@
 //! tangent_neighbour_dofs = [1]
 //! tangent_neighbour_coefficients = [-1.0]
 //! ```
+//!
+//! A 3-D contact between sectors (rows with `tangent2_dofs`) takes the same keys on its
+//! normal and first tangent, and `tangent2_neighbour_dofs`/`tangent2_neighbour_coefficients`
+//! on its second tangent (a rigid contact: not with `tangential_stiffness`).
 
 use serde::Deserialize;
 
@@ -227,8 +231,8 @@ impl Check<'_> {
         contact: Option<&RawContact>,
         friction: Option<&RawFrictionSection>,
     ) -> Result<Vec<NeighbourRow>, SceneError> {
-        let points = contact.and_then(|c| c.point.as_deref()).unwrap_or_default();
-        let points: Vec<_> = (points.iter())
+        let all = contact.and_then(|c| c.point.as_deref()).unwrap_or_default();
+        let points: Vec<_> = (all.iter())
             .filter(|p| !super::frictional::is_frictional(p))
             .collect();
         let frictions = points.iter().filter(|p| p.friction.is_some()).count();
@@ -257,6 +261,13 @@ impl Check<'_> {
         };
         let mut friction_row = points.len();
         for (i, p) in points.iter().enumerate() {
+            if p.tangent2_neighbour_dofs.is_some() || p.tangent2_neighbour_coefficients.is_some() {
+                return Err(self.invalid(
+                    "contact.point.tangent2_neighbour_dofs",
+                    "given without a second tangent",
+                    "a 3-D contact (tangent2_dofs) whose second tangent reads the next sector",
+                ));
+            }
             part(
                 i,
                 "contact.point.",
@@ -280,6 +291,37 @@ impl Check<'_> {
                 &p.neighbour_dofs,
                 &p.neighbour_coefficients,
             )?;
+        }
+        // The 3-D contacts' rows follow: normal, tangent, second tangent of each.
+        let first = points.len() + frictions + friction_points.len();
+        let frictional = all.iter().filter(|p| super::frictional::is_frictional(p));
+        for (j, p) in frictional.enumerate() {
+            let row = first + 3 * j;
+            let parts = [
+                &p.neighbour_dofs,
+                &p.tangent_neighbour_dofs,
+                &p.tangent2_neighbour_dofs,
+            ];
+            if parts.iter().any(|d| d.is_some()) && p.tangential_stiffness.is_some() {
+                return Err(self.invalid(
+                    "contact.point.tangential_stiffness",
+                    "given with neighbour parts",
+                    "a rigid 3-D contact between sectors (no tangential_stiffness)",
+                ));
+            }
+            part(
+                row,
+                "contact.point.",
+                &p.neighbour_dofs,
+                &p.neighbour_coefficients,
+            )?;
+            let (dofs, a) = (&p.tangent_neighbour_dofs, &p.tangent_neighbour_coefficients);
+            part(row + 1, "contact.point.tangent_", dofs, a)?;
+            let (dofs, a) = (
+                &p.tangent2_neighbour_dofs,
+                &p.tangent2_neighbour_coefficients,
+            );
+            part(row + 2, "contact.point.tangent2_", dofs, a)?;
         }
         Ok(rows)
     }

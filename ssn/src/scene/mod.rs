@@ -272,6 +272,8 @@ struct RawContactPoint {
     neighbour_coefficients: Option<Vec<f64>>,
     tangent_neighbour_dofs: Option<Vec<i64>>,
     tangent_neighbour_coefficients: Option<Vec<f64>>,
+    tangent2_neighbour_dofs: Option<Vec<i64>>,
+    tangent2_neighbour_coefficients: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
