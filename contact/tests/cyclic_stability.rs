@@ -9,7 +9,7 @@ use semismooth_contact::model::Structure;
 use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
 use semismooth_contact::solve::Solution;
-use semismooth_contact::stability::{hb_stability, HbStability, Stability};
+use semismooth_contact::stability::{hb_stability, HbStability, Stability, Undecided};
 use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
 #[path = "common/sector.rs"]
@@ -159,6 +159,35 @@ fn the_sectors_verdicts_are_the_full_disks_monodromy_and_its_own_family_alone_mi
             // sector's own interface phase does not see.
             assert_eq!(hill.stable, Some(false));
             assert!(own_family.max_abs() < 1.0, "{}", own_family.max_abs());
+        }
+    }
+}
+
+#[test]
+fn a_sector_whose_contacts_close_is_undecided_below_the_harmonics_its_verdicts_need() {
+    // At H = 4 Hill's verdict at 0.98 differs from the full disk's monodromy (docs/cyclic.md);
+    // the sector says so instead of giving it. With the casing open the verdict stands
+    // (exact at any H: the harmonics decouple).
+    let s = run(4, 48);
+    let sector = sector().structure(1).unwrap();
+    for (ratio, closes) in [(0.9, false), (0.98, true)] {
+        let (omega, own, full) = solutions(ratio, &s);
+        assert_eq!(
+            full.contacts.iter().any(|c| c.contact_fraction > 0.0),
+            closes
+        );
+        let mut analysis = HbStability::new(&sector.model, &s).unwrap();
+        let verdict = analysis.of(omega, &own.state).unwrap();
+        if closes {
+            assert_eq!(verdict.stable, None);
+            assert_eq!(
+                verdict.undecided,
+                Some(Undecided::SectorContactHarmonics { harmonics: 4 })
+            );
+        } else {
+            let reference = hb_stability(&full_disk().model, &s, omega, &full.state).unwrap();
+            assert_eq!(verdict.stable, reference.stable);
+            assert!(verdict.stable.is_some());
         }
     }
 }

@@ -171,6 +171,12 @@ pub fn undecided(u: &Undecided) -> String {
              floating-point operations (limit {:.0e})",
             semismooth_contact::stability::MAX_WORK
         ),
+        Undecided::SectorContactHarmonics { harmonics } => format!(
+            "a cyclic sector whose contacts close, at H = {harmonics}: Hill's method decides \
+             it from H = {} (below, its truncation error turned verdicts against the full \
+             disk's monodromy)",
+            semismooth_contact::stability::SECTOR_CONTACT_HARMONICS
+        ),
         Undecided::Marginal { max_abs } => format!(
             "the largest Floquet multiplier has modulus {max_abs} (on the unit circle to within \
              {:e}: an undamped model)",

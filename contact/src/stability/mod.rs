@@ -179,6 +179,11 @@ impl From<InvalidOption> for StabilityError {
     }
 }
 
+/// Fewest harmonics with which a cyclic sector's stability is decided where its contacts
+/// close (Hill's method): against the full disk's monodromy, a verdict differed at `H = 4`
+/// and the leading multiplier was within 1e-2 at `H = 16` (`docs/cyclic.md`).
+pub const SECTOR_CONTACT_HARMONICS: usize = 16;
+
 /// Why a periodic solution's stability is not decided.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -212,6 +217,13 @@ pub enum Undecided {
         phases: usize,
         /// Estimated floating-point operations.
         work: f64,
+    },
+    /// A cyclic sector whose contacts close, analysed with fewer than
+    /// [`SECTOR_CONTACT_HARMONICS`] harmonics: Hill's multipliers carry the Galerkin error
+    /// of the sampled contact constraint, large enough there to turn verdicts.
+    SectorContactHarmonics {
+        /// The harmonics of the analysis.
+        harmonics: usize,
     },
     /// The largest multiplier is on the unit circle to within [`MARGINAL`] (an undamped
     /// model).
@@ -464,6 +476,12 @@ impl HbStability {
         let d = (2 * self.model.dofs() + intervals.len()) as f64 * size;
         let work = 30.0 * d.powi(3) * families.len() as f64;
         let (phases, closings) = switching_counts(&problem.active);
+        let closes = problem.active.iter().flatten().any(|&closed| closed);
+        if closes && self.harmonics < SECTOR_CONTACT_HARMONICS {
+            return Ok(Stability::not_decided(Undecided::SectorContactHarmonics {
+                harmonics: self.harmonics,
+            }));
+        }
         if work > MAX_WORK {
             return Ok(Stability::not_decided(Undecided::TooCostly {
                 phases,
