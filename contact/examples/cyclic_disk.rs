@@ -142,10 +142,7 @@ fn main() {
         blades >= 1 && harmonics >= 1,
         "BLADES and HARMONICS: positive integers"
     );
-    let disk = BladedDisk {
-        blades,
-        mistuning: 0.0,
-    };
+    let disk = BladedDisk::tuned(blades);
     let loading = DiskLoading {
         amplitude: 0.06,
         ..DiskLoading::shipped((0..blades).collect())

@@ -162,10 +162,7 @@ fn main() {
         amplitude: 0.06,
         ..DiskLoading::shipped((0..BLADES).collect())
     };
-    let tuned = BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    };
+    let tuned = BladedDisk::tuned(BLADES);
     let (sector, _) = tuned
         .cyclic_sector(&loading, ENGINE_ORDER)
         .expect("a sector");

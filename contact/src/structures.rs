@@ -89,6 +89,14 @@ impl DiskLoading {
 }
 
 impl BladedDisk {
+    /// The tuned disk of `blades` sectors (no mistuning: cyclically symmetric).
+    pub fn tuned(blades: usize) -> Self {
+        Self {
+            blades,
+            mistuning: 0.0,
+        }
+    }
+
     /// Number of dofs `3 B`.
     pub fn dofs(&self) -> usize {
         3 * self.blades

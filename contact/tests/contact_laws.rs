@@ -121,16 +121,9 @@ fn rotating_oscillator() -> StructuralModel {
     };
     let mut load = HarmonicLoad::zero(2);
     load.add_harmonic(1, &[FORCE, 0.0], &[0.0, FORCE]).unwrap();
-    StructuralModel {
-        frictional_contacts: Vec::new(),
-        mass: diagonal(MASS),
-        damping: Some(diagonal(DAMPING)),
-        stiffness: diagonal(STIFFNESS),
-        load,
-        contacts: Vec::new(),
-        friction: Vec::new(),
-        cyclic: None,
-    }
+    StructuralModel::new(diagonal(MASS), diagonal(STIFFNESS), vec![0.0; 2])
+        .with_damping(diagonal(DAMPING))
+        .with_load(load)
 }
 
 /// The friction disk on the two dofs' rows.

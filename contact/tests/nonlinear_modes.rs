@@ -30,16 +30,11 @@ fn damped_chain(alpha: f64, beta: f64) -> StructuralModel {
         .iter()
         .map(|&(i, j, v)| (i, j, beta * v + if i == j { alpha } else { 0.0 }))
         .collect();
-    StructuralModel {
-        mass: sparse(2, &[(0, 0, 1.0), (1, 1, 1.0)]),
-        damping: Some(sparse(2, &d)),
-        stiffness: sparse(2, &k),
-        load: HarmonicLoad::zero(2),
-        contacts: vec![ContactPoint::new(1, 100.0)],
-        friction: Vec::new(),
-        cyclic: None,
-        frictional_contacts: Vec::new(),
-    }
+    let mass = sparse(2, &[(0, 0, 1.0), (1, 1, 1.0)]);
+    StructuralModel::new(mass, sparse(2, &k), vec![0.0; 2])
+        .with_damping(sparse(2, &d))
+        .with_load(HarmonicLoad::zero(2))
+        .with_contact(ContactPoint::new(1, 100.0))
 }
 
 #[test]

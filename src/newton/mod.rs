@@ -291,11 +291,17 @@ impl<J> Default for Workspace<J> {
 }
 
 impl<J> Workspace<J> {
-    /// Checks `x` against `problem` and sizes the workspace for it; the problem's counters
-    /// at the start of the solve.
-    pub fn begin<P>(&mut self, problem: &P, x: &[f64]) -> Result<ProblemCounters, NewtonError>
+    /// Checks `x` against `problem` and sizes the workspace for it; the solve's work is
+    /// counted from here.
+    pub fn begin<P, S>(
+        &mut self,
+        problem: &P,
+        linear: &S,
+        x: &[f64],
+    ) -> Result<MeasuredSolve, NewtonError>
     where
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
+        S: Factorize<J> + ?Sized,
     {
         let n = problem.dim();
         if x.len() != n {
@@ -308,7 +314,12 @@ impl<J> Workspace<J> {
             self.jacobian = None;
         }
         self.dim = n;
-        Ok(problem.problem_counters())
+        Ok(MeasuredSolve {
+            problem_start: problem.problem_counters(),
+            krylov_start: linear.krylov_iterations(),
+            counters: WorkCounters::default(),
+            log: Log::default(),
+        })
     }
 
     /// One run of the kernel with the plain direction and `rules.step` throughout; its
@@ -370,6 +381,29 @@ impl<J> Workspace<J> {
     }
 }
 
+/// A solve under way ([`Workspace::begin`]): the work counted so far and the problem's
+/// and the linear solver's totals at its start.
+pub(crate) struct MeasuredSolve {
+    problem_start: ProblemCounters,
+    krylov_start: u64,
+    pub counters: WorkCounters,
+    pub log: Log,
+}
+
+impl MeasuredSolve {
+    /// The report of the solve's `outcome`, with the problem's and the linear solver's work
+    /// since its start.
+    pub fn report<P, S>(mut self, problem: &P, linear: &S, outcome: Outcome) -> NewtonReport
+    where
+        P: GeneralizedJacobian + ?Sized,
+        S: Factorize<P::Jacobian> + ?Sized,
+    {
+        self.counters.problem = problem.problem_counters().since(&self.problem_start);
+        self.counters.krylov_iterations = linear.krylov_iterations() - self.krylov_start;
+        NewtonReport::new(outcome, self.log, self.counters)
+    }
+}
+
 /// A reusable semismooth Newton solver: options plus every buffer of the iteration and
 /// the Jacobian `J`, kept between [`NewtonSolver::solve`] calls.
 ///
@@ -408,10 +442,7 @@ impl<J> NewtonSolver<J> {
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
-        let start = self.work.begin(problem, x)?;
-        let krylov_start = linear.krylov_iterations();
-        let mut counters = WorkCounters::default();
-        let mut log = Log::default();
+        let mut measured = self.work.begin(problem, linear, x)?;
         let backtracking = |memory, line_search| StepRule::Backtracking {
             memory,
             line_search,
@@ -435,7 +466,7 @@ impl<J> NewtonSolver<J> {
             linear,
             x,
             &rules,
-            (&mut counters, &mut log),
+            (&mut measured.counters, &mut measured.log),
             |kernel, system, x, rules, counters| {
                 full_steps_first(kernel, system, x, rules, full_steps, counters)
             },
@@ -447,15 +478,13 @@ impl<J> NewtonSolver<J> {
             }
             _ => Strategy::LineSearch,
         };
-        counters.problem = problem.problem_counters().since(&start);
-        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
         let outcome = Outcome {
             attempts: vec![Attempt::new(strategy, run.iterations, &termination)],
             termination,
             strategy,
             tolerance: run.tolerance,
         };
-        Ok(NewtonReport::new(outcome, log, counters))
+        Ok(measured.report(problem, linear, outcome))
     }
 }
 

@@ -127,12 +127,10 @@ mod attempts;
 mod path;
 
 use crate::iteration::kernel::{KernelRules, StepRule};
-use crate::iteration::Log;
 use crate::linesearch::LineSearchOptions;
 use crate::newton::{
     self, validate_line_search, NewtonError, NewtonOptions, NewtonReport, StateFloor, Termination,
-    Tolerances, WorkCounters, Workspace, DEFAULT_FULL_STEPS, DEFAULT_MAX_ITERATIONS,
-    DEFAULT_MEMORY,
+    Tolerances, Workspace, DEFAULT_FULL_STEPS, DEFAULT_MAX_ITERATIONS, DEFAULT_MEMORY,
 };
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, Smoothing};
 
@@ -310,14 +308,10 @@ impl<J> Polyalgorithm<J> {
         P: GeneralizedJacobian<Jacobian = J> + ?Sized,
         S: Factorize<J> + ?Sized,
     {
-        let start = self.work.begin(problem, x)?;
-        let krylov_start = linear.krylov_iterations();
-        let mut counters = WorkCounters::default();
-        let mut log = Log::default();
-        let outcome = self.run(problem, linear, x, smoothing, (&mut counters, &mut log));
-        counters.problem = problem.problem_counters().since(&start);
-        counters.krylov_iterations = linear.krylov_iterations() - krylov_start;
-        Ok(NewtonReport::new(outcome, log, counters))
+        let mut measured = self.work.begin(problem, linear, x)?;
+        let work = (&mut measured.counters, &mut measured.log);
+        let outcome = self.run(problem, linear, x, smoothing, work);
+        Ok(measured.report(problem, linear, outcome))
     }
 }
 

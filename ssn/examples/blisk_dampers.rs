@@ -72,10 +72,7 @@ fn check_against_full_disk(disk: &BladedDisk, sector: &CyclicSector, at: (f64, &
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let write = std::env::args().any(|a| a == "--write");
-    let disk = BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    };
+    let disk = BladedDisk::tuned(BLADES);
     let loading = DiskLoading::shipped(Vec::new());
     println!("| EO | peak omega / omega_1 (dampers) | peak tip amplitude (dampers) | peak (no dampers) | points | reached the upper bound | sector sweep (s) | full disk at the peak |");
     println!("|---|---|---|---|---|---|---|---|");

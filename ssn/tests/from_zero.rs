@@ -21,7 +21,7 @@ mod common;
 use semismooth_contact::from_zero::{
     forty_element_rod, grid_frequency_ratios, grid_rod, many_contacts_rod, GRID_GAPS,
 };
-use semismooth_contact::rod::{build_rod, MassModel};
+use semismooth_contact::rod::{build_rod, MassModel, RodModel};
 use semismooth_contact::solve::solve;
 use semismooth_contact::sweep::frequency_response;
 use ssn::scene::{Method, SolverSettings, SweepSettings};
@@ -34,6 +34,25 @@ fn branch_tip_max_at(omega: &[f64], tip_max: &[f64], at: f64) -> Vec<f64> {
         .filter(|(w, _)| (w[0] - at) * (w[1] - at) <= 0.0 && w[0] != w[1])
         .map(|(w, a)| a[0] + (a[1] - a[0]) * (at - w[0]) / (w[1] - w[0]))
         .collect()
+}
+
+/// The frequency response of `base` followed by continuation from the linear regime (0.7 to
+/// 1.7 omega_1, steps of at most 0.01) with `settings`, asserted converged (`case` names it):
+/// each point's omega / omega_1 and tip maximum.
+fn followed_branch(base: &RodModel, settings: &SolverSettings, case: &str) -> (Vec<f64>, Vec<f64>) {
+    let sweep = SweepSettings {
+        step: 0.01,
+        max_step: 0.01,
+        ..SweepSettings::new(0.7, 1.7)
+    };
+    let branch = frequency_response(base, settings, &sweep, None).unwrap();
+    assert!(branch.converged(), "{case}: sweep {}", branch.termination);
+    let ratios = branch
+        .column(|p| p.omega)
+        .iter()
+        .map(|w| w / base.omega_1)
+        .collect();
+    (ratios, branch.column(|p| p.observed_max))
 }
 
 /// Points (of 126 per group) measured to converge from zero, and the most iterations a
@@ -62,22 +81,8 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
         for p0 in [0.1, 0.4] {
             for gap in GRID_GAPS {
                 let base = build_rod(&grid_rod(mass, p0, gap, 1.0)).unwrap();
-                let sweep = SweepSettings {
-                    step: 0.01,
-                    max_step: 0.01,
-                    ..SweepSettings::new(0.7, 1.7)
-                };
-                let branch = frequency_response(&base, &sweep_settings, &sweep, None).unwrap();
-                assert!(
-                    branch.converged(),
-                    "{mass:?} H={harmonics} p0={p0} gap={gap}: sweep {}",
-                    branch.termination
-                );
-                let branch_ratio: Vec<f64> = branch
-                    .column(|p| p.omega)
-                    .iter()
-                    .map(|w| w / base.omega_1)
-                    .collect();
+                let case = format!("{mass:?} H={harmonics} p0={p0} gap={gap}");
+                let (branch_ratio, branch_tip_max) = followed_branch(&base, &sweep_settings, &case);
                 for &ratio in &ratios {
                     let rod = build_rod(&grid_rod(mass, p0, gap, ratio)).unwrap();
                     let sol = solve(&rod, rod.omega(), &settings, None).unwrap();
@@ -90,8 +95,7 @@ fn the_public_grid_converges_from_zero_on_the_measured_points_and_on_the_branch(
                     }
                     converged += 1;
                     worst = worst.max(sol.iterations);
-                    let on_branch =
-                        branch_tip_max_at(&branch_ratio, &branch.column(|p| p.observed_max), ratio);
+                    let on_branch = branch_tip_max_at(&branch_ratio, &branch_tip_max, ratio);
                     let distance = on_branch
                         .iter()
                         .map(|a| (a - sol.stats.max).abs())
@@ -149,32 +153,11 @@ fn solutions_from_zero_agree_with_time_marching_where_the_branch_is_single_value
     for p0 in [0.1, 0.4] {
         for gap in GRID_GAPS {
             let base = build_rod(&grid_rod(MassModel::Modified, p0, gap, 1.0)).unwrap();
-            let sweep = SweepSettings {
-                step: 0.01,
-                max_step: 0.01,
-                ..SweepSettings::new(0.7, 1.7)
-            };
-            let branch = frequency_response(
-                &base,
-                &common::sweep_solver(Method::SsnHb, 20),
-                &sweep,
-                None,
-            )
-            .unwrap();
-            assert!(
-                branch.converged(),
-                "p0={p0} gap={gap}: {}",
-                branch.termination
-            );
-            let branch_ratio: Vec<f64> = branch
-                .column(|p| p.omega)
-                .iter()
-                .map(|w| w / base.omega_1)
-                .collect();
+            let sweep_settings = common::sweep_solver(Method::SsnHb, 20);
+            let case = format!("p0={p0} gap={gap}");
+            let (branch_ratio, branch_tip_max) = followed_branch(&base, &sweep_settings, &case);
             for ratio in [0.8, 1.0, 1.2, 1.4, 1.6] {
-                if branch_tip_max_at(&branch_ratio, &branch.column(|p| p.observed_max), ratio).len()
-                    != 1
-                {
+                if branch_tip_max_at(&branch_ratio, &branch_tip_max, ratio).len() != 1 {
                     continue;
                 }
                 let rod = build_rod(&grid_rod(MassModel::Modified, p0, gap, ratio)).unwrap();

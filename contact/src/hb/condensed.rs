@@ -1,5 +1,7 @@
 //! SSN-HB condensed onto the contact-force coefficients.
 
+use std::sync::Arc;
+
 use faer::{c64, Mat};
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::{
@@ -11,7 +13,7 @@ use super::jacobian::{ContactCoupling, HbJacobian};
 use super::laws::LawSampler;
 use super::ssn::{HbOptions, SsnHb};
 use super::structured::{condensed_matrix, CondensedSolve, StructuredHbSolver};
-use super::{check_len, HbError, ResponseSummary};
+use super::{check_len, HbError, LinearData, ResponseSummary};
 use crate::model::{mean_stiffness, StructuralModel};
 use crate::operator::OperatorParameter;
 
@@ -227,6 +229,24 @@ impl CondensedSsnHb {
         }
     }
 
+    /// Forms `y = y_lin + R Lambda` (factoring first if needed), then samples each group
+    /// `g` of the laws in turn ([`CondensedSsnHb::sample_group`]) and calls `each` on it;
+    /// the linear data the groups were read from.
+    fn for_each_group(
+        &mut self,
+        lambda: &[f64],
+        mut each: impl FnMut(&mut Self, &LinearData, usize),
+    ) -> Result<Arc<LinearData>, EvaluationError> {
+        self.ensure_factored()?;
+        let lin = self.full.state.linear.clone();
+        self.contact_displacements(lambda);
+        for g in 0..lin.laws.groups.len() {
+            self.sample_group(lambda, g);
+            each(self, &lin, g);
+        }
+        Ok(lin)
+    }
+
     /// Samples group `g`'s arguments `z = lambda - c (y - o)` and the forces it reads
     /// from `y = y_lin + R Lambda`.
     fn sample_group(&mut self, lambda: &[f64], g: usize) {
@@ -244,14 +264,9 @@ impl Residual for CondensedSsnHb {
     }
 
     fn residual(&mut self, lambda: &[f64], out: &mut [f64]) -> Result<(), EvaluationError> {
-        self.ensure_factored()?;
-        let lin = self.full.state.linear.clone();
-        self.contact_displacements(lambda);
-        for g in 0..lin.laws.groups.len() {
-            self.sample_group(lambda, g);
-            let at = (g, self.smoothing);
-            (self.laws).residual(&mut self.aft, &lin, at, lambda, out);
-        }
+        self.for_each_group(lambda, |s, lin, g| {
+            (s.laws).residual(&mut s.aft, lin, (g, s.smoothing), lambda, out);
+        })?;
         Ok(())
     }
 
@@ -270,16 +285,11 @@ impl GeneralizedJacobian for CondensedSsnHb {
     }
 
     fn jacobian(&mut self, lambda: &[f64], jac: &mut Mat<f64>) -> Result<(), EvaluationError> {
-        self.ensure_factored()?;
-        let lin = self.full.state.linear.clone();
+        let lin = self.for_each_group(lambda, |s, lin, g| {
+            let blocks = (s.q.as_mut_slice(), s.cross.as_mut_slice());
+            (s.laws).jacobian(&mut s.aft, lin, (g, s.smoothing), blocks, &mut s.active);
+        })?;
         let m = lin.contacts();
-        self.contact_displacements(lambda);
-        for g in 0..lin.laws.groups.len() {
-            self.sample_group(lambda, g);
-            let blocks = (self.q.as_mut_slice(), self.cross.as_mut_slice());
-            let at = (g, self.smoothing);
-            (self.laws).jacobian(&mut self.aft, &lin, at, blocks, &mut self.active);
-        }
         condensed_matrix(
             &self.receptance,
             (&lin.laws, &self.q, &self.cross),
@@ -366,14 +376,9 @@ impl Smoothing for CondensedSsnHb {
         lambda: &[f64],
         out: &mut [f64],
     ) -> Result<(), EvaluationError> {
-        self.ensure_factored()?;
-        let lin = self.full.state.linear.clone();
-        self.contact_displacements(lambda);
-        for g in 0..lin.laws.groups.len() {
-            self.sample_group(lambda, g);
-            let at = (g, self.smoothing);
-            (self.laws).smoothing_derivative(&mut self.aft, &lin, at, out);
-        }
+        self.for_each_group(lambda, |s, lin, g| {
+            (s.laws).smoothing_derivative(&mut s.aft, lin, (g, s.smoothing), out);
+        })?;
         Ok(())
     }
 }

@@ -234,6 +234,20 @@ impl HarmonicProblem {
     }
 }
 
+/// A formulation's solve of `rod` at `omega` from a warm start (used where it fits) with the
+/// discretisation of the settings and no error estimate.
+pub(crate) type SolveAt = fn(
+    rod: &Structure,
+    omega: f64,
+    settings: &SolverSettings,
+    warm_start: Option<&[f64]>,
+) -> Result<Solution, RunError>;
+
+/// A formulation's harmonic-balance problem of a model at `omega` with the settings'
+/// discretisation.
+pub(crate) type BuildHarmonicProblem =
+    fn(&StructuralModel, f64, &SolverSettings) -> Result<HarmonicProblem, HbError>;
+
 /// What the library asks of a formulation (module documentation). The defaults are those
 /// of a formulation that is neither harmonic balance nor continuable in the frequency.
 pub(crate) trait Formulation: Sync {
@@ -243,6 +257,9 @@ pub(crate) trait Formulation: Sync {
     /// The parameter its discretisation is refined in.
     fn discretisation(&self) -> DiscretisationKind;
 
+    /// Its solve ([`SolveAt`]).
+    fn solver(&self) -> SolveAt;
+
     /// Solves `rod` at `omega` from `warm_start` with the discretisation of `settings`
     /// and no error estimate.
     fn solve(
@@ -251,7 +268,9 @@ pub(crate) trait Formulation: Sync {
         omega: f64,
         settings: &SolverSettings,
         warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError>;
+    ) -> Result<Solution, RunError> {
+        (self.solver())(rod, omega, settings, warm_start)
+    }
 
     /// The accuracy search's ladder: the order in the discretisation, the first level and
     /// the finest (by default those of its kind of discretisation).
@@ -328,14 +347,21 @@ pub(crate) trait Formulation: Sync {
         }
     }
 
+    /// How its harmonic-balance problem is built ([`BuildHarmonicProblem`]; `None`: it is
+    /// not harmonic balance).
+    fn harmonic_builder(&self) -> Option<BuildHarmonicProblem> {
+        None
+    }
+
     /// Its harmonic-balance problem at `omega` (`None`: not harmonic balance).
     fn harmonic_problem(
         &self,
-        _model: &StructuralModel,
-        _omega: f64,
-        _settings: &SolverSettings,
+        model: &StructuralModel,
+        omega: f64,
+        settings: &SolverSettings,
     ) -> Option<Result<HarmonicProblem, HbError>> {
-        None
+        self.harmonic_builder()
+            .map(|build| build(model, omega, settings))
     }
 
     /// Why it cannot be continued in the frequency (`None`: it can).
@@ -391,22 +417,13 @@ impl Formulation for SsnHbFormulation {
     fn discretisation(&self) -> DiscretisationKind {
         DiscretisationKind::Harmonics
     }
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        super::solve_ssn_hb(rod, omega, settings, warm_start)
+    fn solver(&self) -> SolveAt {
+        super::solve_ssn_hb
     }
-    fn harmonic_problem(
-        &self,
-        model: &StructuralModel,
-        omega: f64,
-        settings: &SolverSettings,
-    ) -> Option<Result<HarmonicProblem, HbError>> {
-        Some(SsnHb::new(model, omega, &hb_options(settings)).map(HarmonicProblem::Ssn))
+    fn harmonic_builder(&self) -> Option<BuildHarmonicProblem> {
+        Some(|model, omega, settings| {
+            SsnHb::new(model, omega, &hb_options(settings)).map(HarmonicProblem::Ssn)
+        })
     }
     fn adapts_harmonics(&self) -> bool {
         true
@@ -429,22 +446,13 @@ impl Formulation for PenaltyHbFormulation {
     fn discretisation(&self) -> DiscretisationKind {
         DiscretisationKind::Harmonics
     }
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        super::solve_penalty_hb(rod, omega, settings, warm_start)
+    fn solver(&self) -> SolveAt {
+        super::solve_penalty_hb
     }
-    fn harmonic_problem(
-        &self,
-        model: &StructuralModel,
-        omega: f64,
-        settings: &SolverSettings,
-    ) -> Option<Result<HarmonicProblem, HbError>> {
-        Some(penalty_problem(model, omega, settings).map(HarmonicProblem::Penalty))
+    fn harmonic_builder(&self) -> Option<BuildHarmonicProblem> {
+        Some(|model, omega, settings| {
+            penalty_problem(model, omega, settings).map(HarmonicProblem::Penalty)
+        })
     }
     fn penalises_contact(&self) -> bool {
         true
@@ -464,14 +472,8 @@ impl Formulation for LcpLemkeFormulation {
     fn discretisation(&self) -> DiscretisationKind {
         DiscretisationKind::TimeSamples
     }
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        _warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        super::solve_lcp_by_lemke(rod, omega, settings)
+    fn solver(&self) -> SolveAt {
+        |rod, omega, settings, _warm_start| super::solve_lcp_by_lemke(rod, omega, settings)
     }
     fn carried_start(&self, _: &Structure, _: &Solution, _: &SolverSettings) -> Option<Vec<f64>> {
         // Lemke starts from its own basis.
@@ -496,14 +498,8 @@ impl Formulation for LcpSsnFormulation {
     fn discretisation(&self) -> DiscretisationKind {
         DiscretisationKind::TimeSamples
     }
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        super::solve_lcp_by_min_map(rod, omega, settings, warm_start)
+    fn solver(&self) -> SolveAt {
+        super::solve_lcp_by_min_map
     }
 }
 
@@ -517,14 +513,8 @@ impl Formulation for MarchFormulation {
     fn discretisation(&self) -> DiscretisationKind {
         DiscretisationKind::StepsPerPeriod
     }
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        super::march::solve_march(rod, omega, settings, warm_start)
+    fn solver(&self) -> SolveAt {
+        super::march::solve_march
     }
     fn continuation_refusal(&self) -> Option<&'static str> {
         Some(
