@@ -171,6 +171,25 @@ pub fn contact_reports(
         .collect()
 }
 
+/// Sets each report's mean force to the mean of its contact's truncated force series
+/// (`series`, one per contact; nothing when empty): a harmonic-balance contact's mean force
+/// is the series' constant term, what the mean of the equations balances, not the mean of
+/// the law's samples on the output grid.
+pub(crate) fn set_series_means(
+    reports: &mut [ContactReport],
+    contacts: &[(usize, f64)],
+    series: &[Vec<f64>],
+    displacements: &[Vec<f64>],
+) {
+    if series.is_empty() {
+        return;
+    }
+    let of_series = contact_reports(contacts, series, displacements);
+    for (report, of_series) in reports.iter_mut().zip(of_series) {
+        report.force_mean = of_series.force_mean;
+    }
+}
+
 /// Summary of one period of a contact response, from samples at equal time steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]

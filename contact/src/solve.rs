@@ -32,7 +32,7 @@ use semismooth::newton::{
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
 
-use crate::contacts::{contact_reports, ContactReport, FrictionReport};
+use crate::contacts::{contact_reports, set_series_means, ContactReport, FrictionReport};
 use crate::contacts::{period_statistics, PeriodStatistics};
 use crate::hb::{
     CondensedSolve, FrictionalContactReport, HbError, HbJacobian, HbOptions, PenaltyHb,
@@ -530,13 +530,21 @@ fn solution(
     state: Vec<f64>,
 ) -> Solution {
     let method = settings.method;
-    let contacts = contact_reports(
-        &rod.model
-            .contacts
-            .iter()
-            .map(|c| (c.dof(), c.gap))
-            .collect::<Vec<_>>(),
+    let points: Vec<_> = rod
+        .model
+        .contacts
+        .iter()
+        .map(|c| (c.dof(), c.gap))
+        .collect();
+    let mut contacts = contact_reports(
+        &points,
         &period.contact_forces,
+        &period.contact_displacements,
+    );
+    set_series_means(
+        &mut contacts,
+        &points,
+        &period.contact_force_series,
         &period.contact_displacements,
     );
     let mut stats = statistics(

@@ -198,7 +198,10 @@ fn a_dash_writes_the_csv_to_standard_output() {
     let o = ssn(&["solve", &fig1(), "--quiet", "--csv", "-"]);
     assert_exit(&o, 0, "--csv -");
     let text = out(&o);
-    assert!(text.starts_with("t,u_tip,lambda_0\n"), "{text}");
+    assert!(
+        text.starts_with("t,u_tip,lambda_0,lambda_series_0\n"),
+        "{text}"
+    );
     assert_eq!(text.lines().count(), 1025);
     // Without --quiet the text summary already has standard output.
     let o = ssn(&["solve", &fig1(), "--csv", "-"]);
@@ -707,18 +710,19 @@ fn a_run_that_cannot_finish_in_time_is_refused_with_its_work_estimate() {
 
 /// A tolerance the formulation cannot reach is raised to its round-off floor and reported
 /// (`effective_tolerance` in the JSON, a `tolerance ... effective` line in the text), never
-/// a silent "converged": penalty HB's floor is `eps k_p sqrt(n) max|g|` (its force term is
-/// `k_p` times a gap), with the default `k_p = 1e5 K[tip, tip] = 2e6` on the 20-element
-/// rod, `n = 20 x 41` unknowns at H = 20 and the gap 0.5: 6.36e-9, above the default 1e-10
+/// a silent "converged": penalty HB's floor is `eps k_p sqrt(n) min(max|U|, max|g|)` (its
+/// force term is `k_p` times a gap, `max|U|` the answer's largest displacement
+/// coefficient), with the default `k_p = 1e5 K[tip, tip] = 2e6` on the 20-element rod,
+/// `n = 20 x 41` unknowns at H = 20 and the gap 0.5: about 5e-9, above the default 1e-10
 /// too. The LCP's min-map (a length) has the floor `eps sqrt(n) max|q|`.
 #[test]
 fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
     let dir = tempfile::tempdir().unwrap();
     let base = std::fs::read_to_string(fig1()).unwrap();
-    let penalty_floor = f64::EPSILON * 2e6 * (20.0f64 * 41.0).sqrt() * 0.5;
-    for (method, tolerance, floor) in [
-        ("penalty-hb", "1e-300", Some(penalty_floor)),
-        ("penalty-hb", "1e-10", Some(penalty_floor)),
+    let penalty_per_unit = f64::EPSILON * 2e6 * (20.0f64 * 41.0).sqrt();
+    for (method, tolerance, per_unit) in [
+        ("penalty-hb", "1e-300", Some(penalty_per_unit)),
+        ("penalty-hb", "1e-10", Some(penalty_per_unit)),
         ("lcp-ssn", "1e-300", None),
     ] {
         let text = base.replace(
@@ -727,16 +731,28 @@ fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
         );
         let path = dir.path().join(format!("{method}_{tolerance}.toml"));
         std::fs::write(&path, text).unwrap();
+        let state = dir.path().join(format!("{method}_{tolerance}.state.json"));
         let path = path.to_str().unwrap();
-        let o = ssn(&["solve", path, "--json"]);
+        let mut args = vec!["solve", path, "--json"];
+        if per_unit.is_some() {
+            args.extend(["--state", state.to_str().unwrap()]);
+        }
+        let o = ssn(&args);
         assert_exit(&o, 0, path);
         let json: serde_json::Value = serde_json::from_str(&out(&o)).expect("JSON");
         let used = json["effective_tolerance"].as_f64().unwrap();
         let asked: f64 = tolerance.parse().unwrap();
         assert!(used > asked, "{method} {tolerance}: {json}");
         assert!(json["residual_norm"].as_f64().unwrap() <= used);
-        match floor {
-            Some(f) => assert!((used / f - 1.0).abs() < 1e-12, "{used:e} vs {f:e}"),
+        match per_unit {
+            Some(per_unit) => {
+                let state: serde_json::Value =
+                    serde_json::from_str(&std::fs::read_to_string(&state).unwrap()).unwrap();
+                let largest = (state["displacement"].as_array().unwrap().iter())
+                    .fold(0.0f64, |m, u| m.max(u.as_f64().unwrap().abs()));
+                let f = per_unit * largest.min(0.5);
+                assert!((used / f - 1.0).abs() < 1e-12, "{used:e} vs {f:e}");
+            }
             // The LCP's q is of the gap's size: the floor is a few ulps of 0.5 x 16.
             None => assert!(used < 1e-13, "{used:e}"),
         }
@@ -751,7 +767,8 @@ fn a_tolerance_below_the_round_off_floor_is_reported_for_every_newton_method() {
 }
 
 /// `ssn solve --csv` carries one force column per contact (`lambda_0`, `lambda_1`, in the
-/// order of the JSON's `contacts`), and the mean of each column over the period (uniform
+/// order of the JSON's `contacts`: the law on the samples), then the truncated series
+/// (`lambda_series_0`, `lambda_series_1`), the mean of which over the period (uniform
 /// samples of a trigonometric polynomial of lower degree: exactly its constant term) is the
 /// JSON's `force_mean` of that contact, whose sum is `contact_force_mean`.
 #[test]
@@ -770,14 +787,26 @@ fn the_solve_csv_has_a_force_column_per_contact_matching_the_json() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header, ["t", "u_tip", "lambda_0", "lambda_1"]);
+    assert_eq!(
+        header,
+        [
+            "t",
+            "u_tip",
+            "lambda_0",
+            "lambda_1",
+            "lambda_series_0",
+            "lambda_series_1"
+        ]
+    );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     let contacts = json["contacts"].as_array().unwrap();
     let mut sum = 0.0;
     for (i, contact) in contacts.iter().enumerate() {
-        let mean = rows.iter().map(|r| r[2 + i]).sum::<f64>() / rows.len() as f64;
+        let mean = rows.iter().map(|r| r[4 + i]).sum::<f64>() / rows.len() as f64;
+        // The law's samples (never tension) stay at or below zero.
+        assert!(rows.iter().all(|r| r[2 + i] <= 0.0), "contact {i}: tension");
         let reported = contact["force_mean"].as_f64().unwrap();
         // Measured: equal to the last bit.
         assert!(

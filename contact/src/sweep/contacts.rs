@@ -7,7 +7,7 @@
 //! branch (`lcp-ssn`) has them at its `Nt` time nodes: the state is `(w, z)`, time-major,
 //! so contact `c` has displacement `u = g - w[n m + c]` and force `-z[n m + c]` at node `n`.
 
-use crate::contacts::{contact_reports, ContactReport, FrictionSummary};
+use crate::contacts::{contact_reports, set_series_means, ContactReport, FrictionSummary};
 use crate::model::Structure;
 use crate::settings::SolverSettings;
 use crate::solve::{set_closed_fractions, HarmonicProblem, HbReconstruction, RunError};
@@ -55,7 +55,11 @@ fn branch_reports(
         let closed = (0..contacts.len())
             .map(|i| problem.closed_intervals(x, i))
             .collect::<Result<Vec<_>, _>>()?;
+        let series = (0..contacts.len())
+            .filter_map(|i| problem.contact_force_series(x, i, points).transpose())
+            .collect::<Result<Vec<_>, _>>()?;
         let mut reports = contact_reports(&contacts, &forces, &displacements);
+        set_series_means(&mut reports, &contacts, &series, &displacements);
         set_closed_fractions(&mut reports, &closed);
         let friction = (0..friction_points)
             .map(|f| Ok(problem.friction(x, f, points)?.summary))
