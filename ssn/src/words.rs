@@ -574,19 +574,47 @@ pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSetting
     t
 }
 
-/// The tip's extremes, the largest penetration and the mean contact force of a converged
-/// run; a run that did not converge has no result, and its best iterate's numbers are not
-/// printed as one.
+/// The tip's extremes, the largest penetration and the mean contact force (with unilateral
+/// contacts) and the friction points of a converged run; a run that did not converge has no
+/// result, and its best iterate's numbers are not printed as one.
 fn result_lines(s: &Solution) -> String {
     if !s.converged() {
         return "tip max / min     none: the solve did not converge
 "
         .to_string();
     }
-    format!(
-        "tip max / min     {:.6} / {:.6}\nmax penetration   {:.3e}\nmean contact force {:.6e}\n",
-        s.stats.max, s.stats.min, s.stats.max_penetration, s.stats.mean_contact_force
-    )
+    let mut t = format!(
+        "tip max / min     {:.6} / {:.6}\n",
+        s.stats.max, s.stats.min
+    );
+    // Penetration and mean force belong to unilateral contacts: a friction-only run has none.
+    if !s.contacts.is_empty() {
+        t += &format!(
+            "max penetration   {:.3e}\nmean contact force {:.6e}\n",
+            s.stats.max_penetration, s.stats.mean_contact_force
+        );
+    }
+    t + &friction_lines(s)
+}
+
+/// One line per friction point: the fraction of the period it sticks, its largest force
+/// against its largest slip limit, and its largest slip velocity (nothing without one).
+fn friction_lines(s: &Solution) -> String {
+    s.friction
+        .iter()
+        .map(|f| {
+            let summary = &f.summary;
+            format!(
+                "  friction {:<3}    stick {:.1} % of the period, max force {:.6e} (slip limit \
+                 {:.6e}), max slip velocity {:.6e}\n",
+                f.point + 1,
+                100.0 * summary.stick_fraction,
+                summary.force_amplitude,
+                summary.slip_limit_max,
+                summary.slip_velocity_amplitude
+            )
+        })
+        .collect()
 }
 
 /// One line per 3-D frictional contact: its energy per cycle, largest normal force and

@@ -77,6 +77,32 @@ fn a_solve_reports_each_friction_point_with_its_series() {
 }
 
 #[test]
+fn a_friction_only_summary_shows_the_friction_point_and_no_contact_lines() {
+    // The damper has no unilateral contact: its text summary has no penetration or mean
+    // contact force line (they would read 0), and one line for its friction point with the
+    // JSON's stick fraction and force against the slip limit mu N.
+    let json = run("solve", &[]);
+    let scene =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/friction_damper.toml");
+    let out = Command::new(SSN).arg("solve").arg(&scene).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(!text.contains("max penetration"), "{text}");
+    assert!(!text.contains("mean contact force"), "{text}");
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("friction 1 "))
+        .unwrap_or_else(|| panic!("no friction line: {text}"));
+    let f = &json["friction"][0];
+    let stick = format!("stick {:.1} %", 100.0 * number(&f["stick_fraction"]));
+    let force = format!("max force {:.6e}", number(&f["force_amplitude"]));
+    let limit = format!("(slip limit {SLIP_LIMIT:.6e})");
+    for part in [stick, force, limit] {
+        assert!(line.contains(&part), "{part} not in {line}");
+    }
+}
+
+#[test]
 fn a_sweep_through_the_damped_resonance_and_the_solutions_on_it() {
     let sweep = run("sweep", &[]);
     assert_eq!(sweep["converged"], true);
