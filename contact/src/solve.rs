@@ -11,8 +11,11 @@
 pub mod accuracy;
 mod march;
 mod raised_c;
+mod roundoff;
 pub use raised_c::RAISED_C_FACTOR;
 pub(crate) mod formulation;
+use roundoff::DisplacementBlock;
+pub(crate) use roundoff::{displacement_floor, roundoff_floor};
 mod reconstruction;
 
 pub(crate) use formulation::HarmonicProblem;
@@ -26,8 +29,7 @@ use semismooth::continuation::{homotopy, HomotopySchedule};
 use semismooth::lemke::{Lemke, LemkeOptions, LemkeTermination};
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{
-    self, Globalization, NewtonOptions, NewtonReport, StateFloor, Strategy, Tolerances,
-    WorkCounters,
+    self, Globalization, NewtonOptions, NewtonReport, Strategy, Tolerances, WorkCounters,
 };
 use semismooth::polyalgorithm::{PolyalgorithmOptions, SmoothingOf, SolveOptions};
 use semismooth::{GeneralizedJacobian, Residual};
@@ -417,69 +419,6 @@ pub fn structured_solver(condensed: CondensedSolve, tolerance: f64) -> Structure
     StructuredHbSolver::new()
         .with_condensed_solve(condensed)
         .with_krylov_tolerance(0.01 * tolerance)
-}
-
-/// Round-off level of a harmonic-balance residual: one ulp of the largest force term,
-/// `eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
-/// the iterate) within 100 times of it has converged as far as floating point allows:
-/// large models (10^5 elements, 4 10^6 unknowns) stall near 1e-9 in force units.
-pub(crate) fn roundoff_floor(
-    model: &crate::model::StructuralModel,
-    dim: usize,
-    u_max: f64,
-    extra_stiffness: f64,
-) -> f64 {
-    let k_max = (0..model.dofs())
-        .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
-        .fold(extra_stiffness, f64::max);
-    f64::EPSILON * k_max * (dim as f64).sqrt() * u_max
-}
-
-/// The round-off floor of a harmonic-balance residual at an iterate whose first
-/// `displacements` entries are displacement coefficients: [`roundoff_floor`] with `max|u|`
-/// the iterate's largest displacement coefficient, capped by the largest gap when the model
-/// has contact rows (a closed contact's dof reaches its gap, an open one's never does: a
-/// floor scaled by a large gap alone would pass the zero guess) and uncapped without them
-/// (a linear response near resonance, whose round-off grows with it).
-pub(crate) fn displacement_floor(
-    model: &crate::model::StructuralModel,
-    dim: usize,
-    displacements: usize,
-    extra_stiffness: f64,
-) -> StateFloor {
-    let cap = if model.row_count() == 0 {
-        f64::INFINITY
-    } else {
-        model
-            .contacts
-            .iter()
-            .fold(0.0f64, |a, c| a.max(c.gap.abs()))
-            .max(f64::MIN_POSITIVE)
-    };
-    StateFloor {
-        per_unit: roundoff_floor(model, dim, 1.0, extra_stiffness),
-        entries: Some(displacements),
-        cap,
-    }
-}
-
-/// A harmonic-balance problem whose unknowns start with the displacement coefficients.
-pub(crate) trait DisplacementBlock {
-    /// How many leading unknowns are displacement coefficients.
-    fn displacement_len(&self) -> usize;
-}
-
-impl DisplacementBlock for SsnHb {
-    fn displacement_len(&self) -> usize {
-        SsnHb::displacement_len(self)
-    }
-}
-
-impl DisplacementBlock for PenaltyHb {
-    fn displacement_len(&self) -> usize {
-        // Penalty HB's unknowns are the displacement coefficients alone.
-        self.dim()
-    }
 }
 
 /// How a run ended, as its outputs report it.
