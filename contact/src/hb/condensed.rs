@@ -362,8 +362,14 @@ impl ParameterDependent for CondensedSsnHb {
 /// The smoothing path of [`SsnHb`] on the condensed unknowns: each `max` of the laws
 /// becomes `phi_mu` (the polyalgorithm's start from far away).
 impl Smoothing for CondensedSsnHb {
+    /// As [`SsnHb`]'s, from the contact rows' linear response `y_lin` held here.
     fn smoothing_scale(&self) -> f64 {
-        self.full.smoothing_scale()
+        if self.stale {
+            return self.full.smoothing_scale();
+        }
+        let (m, y) = (self.full.contacts(), &self.contact_linear);
+        let reach = |row: usize| -> f64 { y[row..].iter().step_by(m).map(|v| v.abs()).sum() };
+        (self.full.state.linear.laws).smoothing_scale(self.full.c(), Some(&reach))
     }
 
     fn set_smoothing(&mut self, mu: f64) {

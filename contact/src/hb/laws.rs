@@ -129,6 +129,25 @@ impl LawLayout {
         Ok(layout)
     }
 
+    /// The polyalgorithm's smoothing scale `mu_0` for the penalty `c` (see
+    /// `semismooth::Smoothing`): the larger of `c e` with `e` the gaps' extent `max_a
+    /// reach_a` and the largest slip limit under a prescribed load. Without `reach`, a
+    /// row's reach is its gap `|o_a|`; with it, `min(|o_a|, reach(a))` where `reach(a) > 0`
+    /// (how far the row's measured quantity moves in a reached state): a stop beyond the
+    /// motion is blurred only over the motion.
+    pub(crate) fn smoothing_scale(&self, c: f64, reach: Option<&dyn Fn(usize) -> f64>) -> f64 {
+        let within = |row: usize, gap: f64| match reach.map(|reach| reach(row)) {
+            Some(r) if r > 0.0 => gap.min(r),
+            _ => gap,
+        };
+        let extent = (self.offsets.iter().enumerate())
+            .filter(|(_, o)| **o != 0.0)
+            .fold(0.0f64, |a, (row, o)| a.max(within(row, o.abs())));
+        // A friction point under a prescribed load switches at its slip limit.
+        let force = (self.groups.iter()).fold(0.0, |a, group| group.law.force_scale().max(a));
+        (c * extent.max(f64::MIN_POSITIVE)).max(force)
+    }
+
     fn push(&mut self, law: Arc<dyn ContactLaw>, offsets: Vec<f64>) {
         let first = self.velocity.len();
         let (k, velocity) = (law.rows(), law.measure() == Measure::Velocity);

@@ -2,6 +2,7 @@
 //! equations (5)-(6)).
 
 use semismooth::harmonic::FourierBasis;
+use semismooth::linalg::LinearSolveError;
 use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual, Smoothing};
 
 use super::jacobian::{ContactCoupling, HbJacobian};
@@ -285,6 +286,18 @@ impl SsnHb {
         }
     }
 
+    /// `U = A(w, p)^{-1} F`, the response with every contact force zero (factored afresh:
+    /// it is asked for only when full Newton steps failed).
+    fn linear_response(&self) -> Result<Vec<f64>, LinearSolveError> {
+        let lin = &self.state.linear;
+        let mut factors = lin.operator.factors(1)?;
+        factors.factor(&self.state.parameters())?;
+        let mut u = vec![0.0; lin.dofs * lin.size()];
+        lin.operator.load_coefficients(&mut u);
+        factors.solve_real(&mut u)?;
+        Ok(u)
+    }
+
     /// Samples group `g`'s arguments `z = lambda - c (y - o)` and the forces it reads
     /// from the full unknowns `x = [U; Lambda]`.
     fn sample_group(&mut self, x: &[f64], g: usize) {
@@ -347,12 +360,21 @@ impl GeneralizedJacobian for SsnHb {
 }
 
 impl Smoothing for SsnHb {
+    /// The gaps counted up to the reach of the linear response (contacts open) at each
+    /// row, the slip limits as they are (see `LawLayout::smoothing_scale`).
     fn smoothing_scale(&self) -> f64 {
-        let laws = &self.state.linear.laws;
-        let g = laws.offsets.iter().fold(0.0f64, |a, g| a.max(g.abs()));
-        // A friction point under a prescribed load switches at its slip limit.
-        let force = (laws.groups.iter()).fold(0.0, |a, group| group.law.force_scale().max(a));
-        (self.c * g.max(f64::MIN_POSITIVE)).max(force)
+        let lin = &self.state.linear;
+        match self.linear_response() {
+            Ok(u) => {
+                let reach = |row: usize| -> f64 {
+                    (0..lin.size())
+                        .map(|j| lin.measured_coefficient(row, &u, j).abs())
+                        .sum()
+                };
+                lin.laws.smoothing_scale(self.c, Some(&reach))
+            }
+            Err(_) => lin.laws.smoothing_scale(self.c, None),
+        }
     }
 
     fn set_smoothing(&mut self, mu: f64) {
