@@ -122,6 +122,7 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "time_samples": s.time_samples,
         "omega": s.omega,
         "omega_ratio": s.omega / s.omega_1,
+        "omega_1": s.omega_1,
         "converged": s.converged(),
         "termination": crate::words::termination(&s.termination),
         "iterations": s.iterations,
@@ -191,7 +192,8 @@ pub fn finite_or_null(v: f64) -> Value {
 /// `contact_force_mean` (the sum over the contacts), `max_penetration`, `contacts` (per
 /// point, the list of [`ContactReport`]s), then `stability_note` (why points are
 /// undecided), `stability_seconds`, `events` ({`kind`, `omega`, `omega_ratio`,
-/// `index`}), `folds`, `corner_folds`, `converged`, `solve_seconds`, `termination`, `counters`;
+/// `index`}), `folds`, `corner_folds` (rad per unit time) and `fold_ratios`,
+/// `corner_fold_ratios` (units of `omega_1`), `omega_1`, `converged`, `solve_seconds`, `termination`, `counters`;
 /// harmonic balance: per point `harmonics` and `time_samples`; with an accuracy target
 /// (SSN-HB, harmonics chosen per point): per point `error_estimate` and the summary
 /// `accuracy` {`target`, `basis`, `order`, `points_met`, `worst_estimate`, `raises`,
@@ -199,6 +201,7 @@ pub fn finite_or_null(v: f64) -> Value {
 /// at period doublings (SSN-HB with stability) `period_two`, one document per doubling
 /// (`period_two_json`). Non-finite numbers become `null`.
 pub fn response_json(r: &FrequencyResponse) -> Value {
+    let ratios = |omegas: &[f64]| omegas.iter().map(|w| w / r.omega_1).collect::<Vec<_>>();
     let mut counters = newton_counters(&r.counters);
     for (name, value) in [
         ("corrector_iterations", r.continuation.corrector_iterations),
@@ -254,6 +257,9 @@ pub fn response_json(r: &FrequencyResponse) -> Value {
         "events": events,
         "folds": r.folds,
         "corner_folds": r.corner_folds,
+        "fold_ratios": ratios(&r.folds),
+        "corner_fold_ratios": ratios(&r.corner_folds),
+        "omega_1": r.omega_1,
         "peak": r.located_peak.as_ref().map(|p| peak_json(p, r.omega_1)),
         "converged": r.converged(),
         "solve_seconds": r.solve_seconds,

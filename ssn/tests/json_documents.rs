@@ -27,6 +27,43 @@ fn sweep_json_has_the_documented_fields_one_entry_per_point() {
     assert_eq!(v["converged"].as_bool(), Some(true));
 }
 
+#[test]
+fn sweep_and_solve_json_carry_omega_1_and_the_folds_in_its_units() {
+    let rod = common::fig2_rod_model(Some(0.5), 0.04, MassModel::Consistent);
+    let r = frequency_response(
+        &rod,
+        &common::sweep_solver(Method::SsnHb, 3),
+        &SweepSettings::new(0.8, 1.2),
+        None,
+    )
+    .unwrap();
+    let v = ssn::json::response_json(&r);
+    assert_eq!(v["omega_1"].as_f64(), Some(rod.omega_1));
+    assert!(!r.folds.is_empty(), "the forced rod folds in this window");
+    for (folds, ratios) in [
+        ("folds", "fold_ratios"),
+        ("corner_folds", "corner_fold_ratios"),
+    ] {
+        let (folds, ratios) = (v[folds].as_array().unwrap(), v[ratios].as_array().unwrap());
+        assert_eq!(folds.len(), ratios.len());
+        for (w, ratio) in folds.iter().zip(ratios) {
+            // One division: the ratio times omega_1 is the fold to the last bit or two.
+            let back = ratio.as_f64().unwrap() * rod.omega_1;
+            assert!((back - w.as_f64().unwrap()).abs() <= 4.0 * f64::EPSILON * back.abs());
+        }
+    }
+    let solution = semismooth_contact::solve::solve(
+        &rod,
+        rod.omega_1,
+        &common::sweep_solver(Method::SsnHb, 3),
+        None,
+    )
+    .unwrap();
+    let doc = ssn::json::solution_json(std::path::Path::new("rod.toml"), &solution);
+    assert_eq!(doc["omega_1"].as_f64(), Some(rod.omega_1));
+    assert_eq!(doc["omega_ratio"].as_f64(), Some(1.0));
+}
+
 /// The bilinear oscillator `u'' + 0.04 u' + u = -20 (u - w) + cos(w t)`, its massless node
 /// `w` against a stop at 0: a period doubling near `w = 2.43`.
 fn bilinear_oscillator() -> semismooth_contact::model::Structure {
