@@ -6,14 +6,13 @@
 
 use semismooth_contact::cyclic::{CyclicSector, InvalidSector};
 use semismooth_contact::model::{ContactPoint, ContactRow, InvalidModel, NeighbourRow, Structure};
-use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, Method, SolverSettings};
 use semismooth_contact::solve::solve;
 use semismooth_contact::structures::{BladeDamper, BladedDisk, DiskLoading};
 
 #[path = "common/sector.rs"]
 mod sector;
-use sector::{converged, settings};
+use sector::{converged, engine_order_disk, nodal_diameter_resonance, settings};
 
 const BLADES: usize = 8;
 /// The damper's clearance: the pads close on the neighbours near each resonance.
@@ -21,10 +20,7 @@ const GAP: f64 = 0.2;
 const MU: f64 = 0.3;
 
 fn disk() -> BladedDisk {
-    BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    }
+    BladedDisk::tuned(BLADES)
 }
 
 fn loading() -> DiskLoading {
@@ -42,12 +38,8 @@ fn damper(friction: bool) -> BladeDamper {
 /// blade on the disk's dofs) and the engine-order load.
 fn full_disk(engine_order: usize, friction: bool) -> Structure {
     let disk = disk();
-    let mut structure = disk.structure(&loading()).unwrap();
-    let model = &mut structure.model;
-    model.load = (model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), engine_order)
-        .unwrap();
-    damper(friction).add_to_disk(&disk, model);
+    let mut structure = engine_order_disk(&disk, &loading(), engine_order);
+    damper(friction).add_to_disk(&disk, &mut structure.model);
     structure
 }
 
@@ -75,8 +67,7 @@ fn sector_against_full_disk(engine_order: usize, friction: bool, runs: &[SolverS
     let full = full_disk(engine_order, friction);
     let sector = sector(engine_order, friction);
     let structure = sector.structure(1).unwrap();
-    let nd = sector.nodal_diameter(1);
-    let omega = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+    let omega = nodal_diameter_resonance(&sector);
     let reference = converged(&full, omega, &runs[0]);
     let fractions: Vec<f64> = (reference.contacts.iter())
         .map(|c| c.contact_fraction)
@@ -179,8 +170,7 @@ fn a_sector_sweep_with_friction_dampers_between_sectors_is_the_full_disk_at_ever
     let sector = sector(engine_order, true);
     let structure = sector.structure(1).unwrap();
     let full = full_disk(engine_order, true);
-    let nd = sector.nodal_diameter(1);
-    let resonance = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+    let resonance = nodal_diameter_resonance(&sector);
     let ratio = resonance / structure.omega_1;
     let sweep = SweepSettings {
         stability: false,

@@ -5,23 +5,19 @@
 
 use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::model::{ContactRow, FrictionalContact, NeighbourRow, Structure};
-use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::LinearSolverChoice;
 use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
 #[path = "common/sector.rs"]
 mod sector;
-use sector::{converged, settings};
+use sector::{converged, engine_order_disk, nodal_diameter_resonance, settings};
 
 const BLADES: usize = 8;
 const GAP: f64 = 0.2;
 const MU: f64 = 0.3;
 
 fn disk() -> BladedDisk {
-    BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    }
+    BladedDisk::tuned(BLADES)
 }
 
 fn row(dofs: Vec<usize>, coefficients: Vec<f64>) -> ContactRow {
@@ -31,12 +27,8 @@ fn row(dofs: Vec<usize>, coefficients: Vec<f64>) -> ContactRow {
 /// Blade `j`'s contact on the full disk's dofs `[d, b, p]` per blade: normal
 /// `p_j - (b_{j+1} + d_{j+1}) / 2`, tangents `b_j - d_{j+1}` and `d_j - b_{j+1}`.
 fn full_disk(engine_order: usize) -> Structure {
-    let disk = disk();
-    let mut structure = disk.structure(&DiskLoading::shipped(Vec::new())).unwrap();
+    let mut structure = engine_order_disk(&disk(), &DiskLoading::shipped(Vec::new()), engine_order);
     let model = &mut structure.model;
-    model.load = (model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), engine_order)
-        .unwrap();
     for j in 0..BLADES {
         let (own, next) = (3 * j, 3 * ((j + 1) % BLADES));
         let normal = row(vec![own + 2, next + 1, next], vec![1.0, -0.5, -0.5]);
@@ -84,8 +76,7 @@ fn a_3d_frictional_contact_between_sectors_solves_the_full_disk_under_engine_ord
     for engine_order in [0, 3, 7] {
         let full = full_disk(engine_order);
         let sector = sector(engine_order);
-        let nd = sector.nodal_diameter(1);
-        let omega = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+        let omega = nodal_diameter_resonance(&sector);
         let run = settings(harmonics, LinearSolverChoice::Structured);
         let reference = converged(&full, omega, &run);
         // Every blade's contact separates, sticks and slips in the period: the normal law

@@ -6,7 +6,6 @@
 
 use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::model::Structure;
-use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
 use semismooth_contact::solve::Solution;
 use semismooth_contact::stability::{hb_stability, HbStability, Stability, Undecided};
@@ -14,16 +13,13 @@ use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
 #[path = "common/sector.rs"]
 mod sector;
-use sector::{converged, settings};
+use sector::{converged, engine_order_disk, nodal_diameter_resonance, settings};
 
 const BLADES: usize = 6;
 const ENGINE_ORDER: usize = 1;
 
 fn disk() -> BladedDisk {
-    BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    }
+    BladedDisk::tuned(BLADES)
 }
 
 /// Three times the shipped load: the casing closes near the nodal-diameter resonance.
@@ -35,13 +31,7 @@ fn casing() -> DiskLoading {
 }
 
 fn full_disk() -> Structure {
-    let disk = disk();
-    let mut structure = disk.structure(&casing()).unwrap();
-    let model = &mut structure.model;
-    model.load = (model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), ENGINE_ORDER)
-        .unwrap();
-    structure
+    engine_order_disk(&disk(), &casing(), ENGINE_ORDER)
 }
 
 fn sector() -> CyclicSector {
@@ -60,8 +50,7 @@ fn run(harmonics: usize, time_samples: usize) -> SolverSettings {
 /// disk's, solved from the recovered sector state.
 fn solutions(ratio: f64, s: &SolverSettings) -> (f64, Solution, Solution) {
     let sector = sector();
-    let nd = sector.nodal_diameter(1);
-    let omega = ratio * natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+    let omega = ratio * nodal_diameter_resonance(&sector);
     let own = converged(&sector.structure(1).unwrap(), omega, s);
     let start = disk().recover_state(&sector, &own.state, s.harmonics);
     let full = semismooth_contact::solve::solve(&full_disk(), omega, s, Some(&start)).unwrap();

@@ -12,27 +12,18 @@ use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
 #[path = "common/sector.rs"]
 mod sector;
-use sector::{converged, settings};
+use sector::{converged, engine_order_disk, nodal_diameter_resonance, settings};
 
 const BLADES: usize = 8;
 
 fn tuned_disk() -> BladedDisk {
-    BladedDisk {
-        blades: BLADES,
-        mistuning: 0.0,
-    }
+    BladedDisk::tuned(BLADES)
 }
 
 /// The full tuned disk under `loading` with the load of sector `s` delayed by
-/// `s EO T / N`, and its first natural frequency.
+/// `s EO T / N`.
 fn full_disk(loading: &DiskLoading, engine_order: usize) -> semismooth_contact::model::Structure {
-    let disk = tuned_disk();
-    let mut structure = disk.structure(loading).unwrap();
-    let load = structure.model.load.clone();
-    structure.model.load = load
-        .delayed_by_sector(&disk.sector_dofs(), engine_order)
-        .unwrap();
-    structure
+    engine_order_disk(&tuned_disk(), loading, engine_order)
 }
 
 #[test]
@@ -144,8 +135,7 @@ fn the_sector_with_a_casing_contact_solves_the_full_disk_under_engine_orders_0_3
         assert!((omega_1 - full.omega_1).abs() < 1e-12 * omega_1);
         let sector_structure = sector.structure(1).unwrap();
         // Forced at the resonance of the engine order's nodal diameter: the casing closes.
-        let nd = sector.nodal_diameter(1);
-        let omega = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
+        let omega = nodal_diameter_resonance(&sector);
         let reference = converged(
             &full,
             omega,

@@ -8,7 +8,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use serde_json::{json, Value};
 
-use semismooth_contact::model::Structure;
+use pyo3::exceptions::PyValueError;
+use semismooth_contact::model::{CyclicCoupling, Structure};
 use semismooth_contact::solutions::SolutionSet as LibSolutionSet;
 use semismooth_contact::stability::Stability as LibStability;
 use semismooth_contact::sweep::FrequencyResponse as LibResponse;
@@ -120,21 +121,55 @@ impl Solution {
         s: &semismooth_contact::solve::Solution,
         structure: &Structure,
     ) -> Solution {
-        let doc = ssn::json::solution_json(scene, s);
+        let mut doc = ssn::json::solution_json(scene, s);
+        let mut arrays = vec![
+            vector("times", &s.times),
+            vector("displacement", &s.observed),
+            matrix("contact_forces", &s.contact_forces),
+            vector("state", &s.state),
+            vector("observed_dof", &[structure.observed_dof as f64]),
+        ];
+        if let Some(amplitudes) = ssn::json::blade_amplitudes(structure, s) {
+            let values: Vec<f64> = (amplitudes.as_array().into_iter().flatten())
+                .map(|a| a.as_f64().unwrap_or(f64::NAN))
+                .collect();
+            arrays.push(vector("blade_amplitudes", &values));
+            arrays.extend(sector_recovery(structure, s));
+            doc["blade_amplitudes"] = amplitudes;
+        }
         Solution {
             converged: s.converged(),
-            stored: Stored {
-                arrays: vec![
-                    vector("times", &s.times),
-                    vector("displacement", &s.observed),
-                    matrix("contact_forces", &s.contact_forces),
-                    vector("state", &s.state),
-                    vector("observed_dof", &[structure.observed_dof as f64]),
-                ],
-                doc,
-            },
+            stored: Stored { arrays, doc },
         }
     }
+
+    /// The values of the stored array `name` (`None` when this solution has none).
+    fn stored_array(&self, name: &str) -> Option<&[f64]> {
+        (self.stored.arrays.iter())
+            .find(|(n, _, _)| n == name)
+            .map(|(_, _, v)| v.as_slice())
+    }
+}
+
+/// What a cyclic sector's solution keeps to give any blade's time series on request: the
+/// observed dof's harmonic coefficients `[u_0, a_1, b_1, ...]` and `[N, phi]`.
+fn sector_recovery(
+    structure: &Structure,
+    s: &semismooth_contact::solve::Solution,
+) -> Vec<(String, Vec<usize>, Vec<f64>)> {
+    let (Some(coupling), Some(harmonics)) = (structure.model.cyclic.as_ref(), s.harmonics) else {
+        return Vec::new();
+    };
+    let (n, dof) = (structure.model.dofs(), structure.observed_dof);
+    let coefficients: Option<Vec<f64>> = (0..2 * harmonics + 1)
+        .map(|j| s.state.get(j * n + dof).copied())
+        .collect();
+    coefficients.map_or_else(Vec::new, |c| {
+        vec![
+            vector("observed_coefficients", &c),
+            vector("cyclic", &[coupling.sectors as f64, coupling.phase_step]),
+        ]
+    })
 }
 
 result_methods!(Solution, "Solution", {
@@ -220,6 +255,46 @@ result_methods!(Solution, "Solution", {
     #[getter]
     fn omega(&self) -> f64 {
         self.stored.doc["omega"].as_f64().unwrap_or(f64::NAN)
+    }
+
+    /// A cyclic sector's solve: the observed dof's amplitude `max_t |u|` in every sector of
+    /// the full disk (the JSON's `blade_amplitudes`); `None` for any other scene.
+    #[getter]
+    fn blade_amplitudes<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        if self.stored_array("blade_amplitudes").is_none() {
+            return Ok(None);
+        }
+        self.stored.array(py, "blade_amplitudes").map(Some)
+    }
+
+    /// A cyclic sector's solve: the observed dof's displacement in sector `blade` of the
+    /// full disk at `times`, `u_blade(t) = u_0(t - blade EO T / N)` from the harmonics of
+    /// `displacement` (`ValueError` for another scene or a blade outside `0..N`).
+    fn blade_displacement<'py>(
+        &self,
+        py: Python<'py>,
+        blade: usize,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (Some(cyclic), Some(coefficients), Some(times)) = (
+            self.stored_array("cyclic"),
+            self.stored_array("observed_coefficients"),
+            self.stored_array("times"),
+        ) else {
+            return Err(PyValueError::new_err(
+                "blade_displacement: the solution is not a [cyclic] sector's harmonic balance",
+            ));
+        };
+        let sectors = cyclic[0] as usize;
+        if blade >= sectors {
+            return Err(PyValueError::new_err(format!(
+                "blade_displacement: blade {blade}: allowed 0..{sectors} (the disk's sectors)"
+            )));
+        }
+        let coupling = CyclicCoupling::new(cyclic[1], sectors, Vec::new());
+        let omega = self.omega();
+        let phases: Vec<f64> = times.iter().map(|t| omega * t).collect();
+        let series = coupling.sector_series(coefficients, blade, &phases);
+        Ok(PyArray1::from_vec(py, series).into_any())
     }
 
     fn __repr__(&self) -> String {

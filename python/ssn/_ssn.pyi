@@ -80,6 +80,8 @@ class Solution:
     state: npt.NDArray[np.float64]
     contacts: list[dict[str, Any]]
     friction: list[dict[str, Any]]
+    blade_amplitudes: Optional[npt.NDArray[np.float64]]
+    def blade_displacement(self, blade: int) -> npt.NDArray[np.float64]: ...
     def to_dict(self) -> dict[str, Any]: ...
 
 class FrequencyResponse:

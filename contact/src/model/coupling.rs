@@ -89,22 +89,32 @@ impl CyclicCoupling {
     /// harmonic coefficients in sector 0 (`[u_0, a_1, b_1, ..., a_H, b_H]`), sector `s`
     /// delayed by `s EO T / N`, sampled at `samples` instants of the period.
     pub fn sector_amplitudes(&self, coefficients: &[f64], samples: usize) -> Vec<f64> {
-        let harmonics = coefficients.len().saturating_sub(1) / 2;
         let samples = samples.max(1);
-        let constant = coefficients.first().copied().unwrap_or(0.0);
+        let phases: Vec<f64> = (0..samples)
+            .map(|n| 2.0 * std::f64::consts::PI * n as f64 / samples as f64)
+            .collect();
         (0..self.sectors)
             .map(|s| {
-                let delay = s as f64 * self.phase_step;
-                (0..samples)
-                    .map(|n| {
-                        let theta = 2.0 * std::f64::consts::PI * n as f64 / samples as f64;
-                        (1..=harmonics).fold(constant, |u, k| {
-                            let angle = k as f64 * (theta - delay);
-                            let (a, b) = (coefficients[2 * k - 1], coefficients[2 * k]);
-                            u + a * angle.cos() + b * angle.sin()
-                        })
-                    })
+                (self.sector_series(coefficients, s, &phases).iter())
                     .fold(0.0f64, |m, u| m.max(u.abs()))
+            })
+            .collect()
+    }
+
+    /// One dof's displacement in sector `sector` at the phases `theta = omega t` (radians)
+    /// from its harmonic coefficients in sector 0 (`[u_0, a_1, b_1, ..., a_H, b_H]`):
+    /// `u_s(t) = u_0(t - s EO T / N)`, i.e. harmonic `k` at the angle `k (theta - s phi)`.
+    pub fn sector_series(&self, coefficients: &[f64], sector: usize, phases: &[f64]) -> Vec<f64> {
+        let harmonics = coefficients.len().saturating_sub(1) / 2;
+        let constant = coefficients.first().copied().unwrap_or(0.0);
+        let delay = sector as f64 * self.phase_step;
+        (phases.iter())
+            .map(|theta| {
+                (1..=harmonics).fold(constant, |u, k| {
+                    let angle = k as f64 * (theta - delay);
+                    let (a, b) = (coefficients[2 * k - 1], coefficients[2 * k]);
+                    u + a * angle.cos() + b * angle.sin()
+                })
             })
             .collect()
     }

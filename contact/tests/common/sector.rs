@@ -1,9 +1,15 @@
 //! What the cyclic-sector tests share: the settings under which a sector and its full disk
-//! pose the same equations, and a solve asserted converged.
+//! pose the same equations, a solve asserted converged, the full disk under an engine-order
+//! load and the resonance a sector's engine order excites.
 
+#![allow(dead_code)]
+
+use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::model::Structure;
+use semismooth_contact::rod::natural_frequencies;
 use semismooth_contact::settings::{LinearSolverChoice, SolverSettings};
 use semismooth_contact::solve::{solve, Solution};
+use semismooth_contact::structures::{BladedDisk, DiskLoading};
 
 /// `harmonics` and `linear_solver` with the settings that make the sector's equations the
 /// full disk's.
@@ -27,4 +33,26 @@ pub fn converged(structure: &Structure, omega: f64, s: &SolverSettings) -> Solut
     let solution = solve(structure, omega, s, None).unwrap();
     assert!(solution.converged(), "{:?}", solution.termination);
     solution
+}
+
+/// The full `disk` under `loading` with the engine-order load: the load of sector `s`
+/// delayed by `s EO T / N`.
+pub fn engine_order_disk(
+    disk: &BladedDisk,
+    loading: &DiskLoading,
+    engine_order: usize,
+) -> Structure {
+    let mut structure = disk.structure(loading).unwrap();
+    let load = structure.model.load.clone();
+    structure.model.load = load
+        .delayed_by_sector(&disk.sector_dofs(), engine_order)
+        .unwrap();
+    structure
+}
+
+/// The first natural frequency of the nodal diameter on which the sector's first harmonic
+/// lives (the resonance its engine order excites).
+pub fn nodal_diameter_resonance(sector: &CyclicSector) -> f64 {
+    let nd = sector.nodal_diameter(1);
+    natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0]
 }
