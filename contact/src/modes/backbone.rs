@@ -193,55 +193,19 @@ pub fn backbone(
     )
     .map_err(|e| ModesError::Hb(e.into()))?;
     let x0 = epmc.linear_start(from);
-    let mut continuation = options.continuation.clone();
-    continuation.parameter_min = from.min(to);
-    continuation.parameter_max = from.max(to);
-    continuation.direction = if to > from {
-        Direction::Increasing
-    } else {
-        Direction::Decreasing
-    };
-    continuation.parameter_scale = (to - from).abs();
-    if continuation.state_scale.is_none() {
-        continuation.state_scale = Some(state_scale(&epmc, from.abs().max(to.abs())));
-    }
-    if let Some(relative) = options.relative_tolerance {
-        semismooth::InvalidOption::check(
-            relative.is_finite() && relative > 0.0,
-            "relative tolerance",
-            relative,
-            "a positive number",
-        )
-        .map_err(|e| ModesError::Hb(e.into()))?;
-        continuation.corrector_tolerance = relative * epmc.force_scale(from.abs().max(to.abs()));
-    }
+    let continuation = continuation_options(&epmc, options, from, to)?;
     let linear = epmc.linear_mode().clone();
     let energy_to = options.energy_range.map(|(_, to)| to);
+    let start = (x0.as_slice(), from);
     let branch = match options.solve {
+        // The dense fallback of the continuation's own border is affordable here.
         EpmcSolve::Dense => {
-            // The dense fallback of the continuation's own border is affordable here.
-            let mut solver = FaerDenseLu::new();
-            follow(
-                &mut epmc,
-                &mut solver,
-                &x0,
-                from,
-                continuation,
-                energy_to,
-                true,
-            )?
+            let solver = &mut FaerDenseLu::new();
+            follow(&mut epmc, solver, start, continuation, energy_to, true)?
         }
         EpmcSolve::Structured => {
-            let mut solver = EpmcStructuredSolver::new();
-            follow(
-                &mut epmc,
-                &mut solver,
-                &x0,
-                from,
-                continuation,
-                energy_to,
-                false,
-            )?
+            let solver = &mut EpmcStructuredSolver::new();
+            follow(&mut epmc, solver, start, continuation, energy_to, false)?
         }
     };
     let summary_dof = match options.measure {
@@ -277,14 +241,46 @@ pub fn backbone(
     })
 }
 
-/// The branch of `epmc` from `x0` at amplitude `from` with `solver`, up to the energy
-/// `energy_to` if any ([`up_to_energy`]); `dense_fallback`: the continuation may factor its
-/// bordered matrix densely when `solver` fails.
+/// The continuation options of `options` for the amplitude range `from`..`to`: its bounds,
+/// direction and scales, and the corrector's tolerance from the relative one.
+fn continuation_options(
+    epmc: &Epmc,
+    options: &BackboneOptions,
+    from: f64,
+    to: f64,
+) -> Result<ContinuationOptions, ModesError> {
+    let mut continuation = options.continuation.clone();
+    continuation.parameter_min = from.min(to);
+    continuation.parameter_max = from.max(to);
+    continuation.direction = if to > from {
+        Direction::Increasing
+    } else {
+        Direction::Decreasing
+    };
+    continuation.parameter_scale = (to - from).abs();
+    if continuation.state_scale.is_none() {
+        continuation.state_scale = Some(state_scale(epmc, from.abs().max(to.abs())));
+    }
+    if let Some(relative) = options.relative_tolerance {
+        semismooth::InvalidOption::check(
+            relative.is_finite() && relative > 0.0,
+            "relative tolerance",
+            relative,
+            "a positive number",
+        )
+        .map_err(|e| ModesError::Hb(e.into()))?;
+        continuation.corrector_tolerance = relative * epmc.force_scale(from.abs().max(to.abs()));
+    }
+    Ok(continuation)
+}
+
+/// The branch of `epmc` from `(x0, amplitude)` with `solver`, up to the energy `energy_to`
+/// if any ([`up_to_energy`]); `dense_fallback`: the continuation may factor its bordered
+/// matrix densely when `solver` fails.
 fn follow<S: Factorize<EpmcJacobian>>(
     epmc: &mut Epmc,
     solver: &mut S,
-    x0: &[f64],
-    from: f64,
+    (x0, from): (&[f64], f64),
     options: ContinuationOptions,
     energy_to: Option<f64>,
     dense_fallback: bool,
