@@ -19,7 +19,10 @@
 //! Jacobian alone is singular on every periodic motion of an autonomous system (the time
 //! shift `U'` is in its kernel), so the bordered matrix is factored as a whole
 //! ([`EpmcJacobian`] is [`DenseAssemble`], for the core's dense LU), and the
-//! continuation adds its own border to that regular matrix.
+//! continuation adds its own border to that regular matrix. For large models
+//! ([`Epmc::deflated`], [`EpmcStructuredSolver`]) a grounding spring `s` on one dof makes
+//! the inner Jacobian regular and the residual takes it out again: the inner block is
+//! factored by the structured HB solver once per iteration, under a border `2H + 3` wide.
 //!
 //! At small amplitude (contacts open, friction points stuck) the solution is the linear
 //! mode ([`linear_mode`]): `w = omega_n`, `xi = phi^T D phi = 2 zeta omega_n`. The damping
@@ -74,7 +77,7 @@ pub enum ModesError {
     /// The bordered Jacobian, factored densely, would be too large.
     #[error(
         "{unknowns} EPMC unknowns exceed the {limit} of the dense bordered solve: reduce the \
-         harmonics or the dofs"
+         harmonics or the dofs, or use the structured solve"
     )]
     TooLarge {
         /// `(N + m)(2H + 1) + 2`.
