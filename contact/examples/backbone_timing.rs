@@ -4,16 +4,16 @@
 //!
 //! `cargo run --release -p semismooth-contact --example backbone_timing`
 //!
-//! Each backbone is computed `REPEATS` times and the fastest wall time is reported with its
-//! points, corrector iterations (one dense LU of the bordered EPMC Jacobian each) and points
-//! per second.
+//! Each backbone is computed `REPEATS` times with each solve (the dense LU of the bordered
+//! EPMC Jacobian, and the structured solve) and the fastest wall time is reported with its
+//! points, corrector iterations (one factorization each) and points per second.
 
 use std::time::Instant;
 
 use semismooth_contact::builder::sparse_matrix;
 use semismooth_contact::hb::HbOptions;
 use semismooth_contact::model::{ContactRow, FrictionPoint, HarmonicLoad, StructuralModel};
-use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions};
+use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions, EpmcSolve};
 use semismooth_contact::rod::{build_rod, MassModel, RodSpec};
 use semismooth_contact::structures::cantilever_with_tip_spring;
 
@@ -89,16 +89,20 @@ fn main() {
         ),
     ];
     println!(
-        "| backbone | H | unknowns | amplitude range | points | corrector iterations | seconds | points / s |"
+        "| backbone | solve | H | unknowns | amplitude range | points | corrector iterations | seconds | points / s |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
-    for (name, model, dof, harmonics, (from, to), c) in cases {
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let runs = cases.into_iter().flat_map(|case| {
+        [EpmcSolve::Dense, EpmcSolve::Structured].map(|solve| (case.clone(), solve))
+    });
+    for ((name, model, dof, harmonics, (from, to), c), solve) in runs {
         let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(dof), from, to);
         options.hb = HbOptions {
             harmonics,
             c,
             ..HbOptions::default()
         };
+        options.solve = solve;
         let rows = model.dofs() + model.contact_count() + model.friction_count();
         let unknowns = rows * (2 * harmonics + 1) + 2;
         let mut best = f64::INFINITY;
@@ -112,7 +116,7 @@ fn main() {
         let branch = result.unwrap();
         let points = branch.points.len();
         println!(
-            "| {name} | {harmonics} | {unknowns} | {from} to {to} | {points} | {} | {best:.3} | {:.1} |",
+            "| {name} | {solve:?} | {harmonics} | {unknowns} | {from} to {to} | {points} | {} | {best:.3} | {:.1} |",
             branch.counters.corrector_iterations,
             points as f64 / best
         );

@@ -7,7 +7,9 @@ use serde_json::{json, Value};
 use semismooth::continuation::ContinuationTermination;
 use semismooth_contact::hb::HbOptions;
 use semismooth_contact::model::Structure;
-use semismooth_contact::modes::{backbone, AmplitudeMeasure, Backbone, BackboneOptions};
+use semismooth_contact::modes::{
+    backbone, AmplitudeMeasure, Backbone, BackboneOptions, EpmcSolve, MAX_DENSE_UNKNOWNS,
+};
 
 use crate::cli::{Loaded, RunArgs, Workload};
 use crate::exit::CliError;
@@ -77,7 +79,13 @@ pub fn run(scene: &Scene, structure: &Structure) -> Result<Backbone, String> {
         c: scene.solver.c,
     };
     options.continuation.max_points = settings.max_points;
-    backbone(&structure.model, &options).map_err(|e| e.to_string())
+    // Beyond the dense bordered solve's reach, the structured one (same equations).
+    let model = &structure.model;
+    let rows = model.dofs() + model.contact_count() + model.friction_count();
+    if rows.saturating_mul(2 * scene.solver.harmonics + 1) + 2 > MAX_DENSE_UNKNOWNS {
+        options.solve = EpmcSolve::Structured;
+    }
+    backbone(model, &options).map_err(|e| e.to_string())
 }
 
 /// The JSON document of `ssn modes` (also `ssn.modes(scene)` in Python).

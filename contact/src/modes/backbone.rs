@@ -5,14 +5,33 @@ use semismooth::continuation::{
     Direction,
 };
 use semismooth::linalg::FaerDenseLu;
-use semismooth::Residual;
+use semismooth::{Factorize, Residual};
 
-use super::{AmplitudeMeasure, Epmc, LinearMode, ModesError, MAX_DENSE_UNKNOWNS};
+use super::{
+    AmplitudeMeasure, Epmc, EpmcJacobian, EpmcStructuredSolver, LinearMode, ModesError,
+    MAX_DENSE_UNKNOWNS,
+};
 use crate::hb::{HbError, HbOptions, ResponseSummary};
 
 /// Times per period of the points' summaries (at least `4 H + 4`).
 const SUMMARY_POINTS: usize = 1024;
 use crate::model::StructuralModel;
+
+/// How [`backbone`] solves the bordered EPMC system at each corrector iteration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum EpmcSolve {
+    /// Dense LU of the whole bordered Jacobian (at most [`MAX_DENSE_UNKNOWNS`] unknowns).
+    #[default]
+    Dense,
+    /// [`EpmcStructuredSolver`] on [`Epmc::deflated`]: one structured factorization of the
+    /// inner HB Jacobian per iteration (per-harmonic sparse LU and condensation onto the
+    /// contacts), for models of thousands of dofs.
+    Structured,
+}
+
+/// Default of [`BackboneOptions::relative_tolerance`].
+pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-12;
 
 /// What [`backbone`] computes.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,6 +53,15 @@ pub struct BackboneOptions {
     /// amplitude range is then only a safety bound: from the first point to twice the
     /// linear mode's amplitude at energy `to`, since a stop stiffens the mode).
     pub energy_range: Option<(f64, f64)>,
+    /// How each corrector iteration is solved. Default [`EpmcSolve::Dense`].
+    pub solve: EpmcSolve,
+    /// The corrector's tolerance relative to the size of the forces
+    /// ([`Epmc::force_scale`] at the largest amplitude of the range): it replaces the
+    /// continuation's absolute `corrector_tolerance`, so that a model in other units
+    /// (SI: stiffness 1e9, amplitudes 1e-6) follows the same backbone as its
+    /// nondimensional twin. `None` keeps the absolute one. Default
+    /// `Some(`[`DEFAULT_RELATIVE_TOLERANCE`]`)`.
+    pub relative_tolerance: Option<f64>,
     /// The continuation (its parameter bounds are set from the amplitude range; without a
     /// `state_scale` one is made from the amplitude range, `omega_n` and the stiffness).
     pub continuation: ContinuationOptions,
@@ -55,6 +83,8 @@ impl BackboneOptions {
             amplitude_from,
             amplitude_to,
             energy_range: None,
+            solve: EpmcSolve::Dense,
+            relative_tolerance: Some(DEFAULT_RELATIVE_TOLERANCE),
             continuation: ContinuationOptions::default(),
         }
     }
@@ -134,8 +164,9 @@ pub struct Backbone {
 
 /// The backbone of `model`'s mode `options.mode` ([`Epmc`]): from its linear mode at
 /// `amplitude_from` to `amplitude_to`, by pseudo-arclength continuation of the bordered EPMC
-/// system (dense LU of the whole bordered Jacobian, at most [`MAX_DENSE_UNKNOWNS`]
-/// unknowns). `Err` only when it cannot start.
+/// system ([`EpmcSolve`]: dense LU of the whole bordered Jacobian, at most
+/// [`MAX_DENSE_UNKNOWNS`] unknowns, or the structured solve). `Err` only when it cannot
+/// start.
 pub fn backbone(
     model: &StructuralModel,
     options: &BackboneOptions,
@@ -143,13 +174,16 @@ pub fn backbone(
     // Checked before the (dense) linear mode is computed.
     let rows = model.dofs() + model.contact_count() + model.friction_count();
     let unknowns = rows.saturating_mul(2 * options.hb.harmonics + 1) + 2;
-    if unknowns > MAX_DENSE_UNKNOWNS {
+    if options.solve == EpmcSolve::Dense && unknowns > MAX_DENSE_UNKNOWNS {
         return Err(ModesError::TooLarge {
             unknowns,
             limit: MAX_DENSE_UNKNOWNS,
         });
     }
-    let mut epmc = Epmc::new(model, &options.hb, options.mode, options.measure)?;
+    let mut epmc = match options.solve {
+        EpmcSolve::Dense => Epmc::new(model, &options.hb, options.mode, options.measure)?,
+        EpmcSolve::Structured => Epmc::deflated(model, &options.hb, options.mode, options.measure)?,
+    };
     let (from, to) = amplitude_range(&epmc, options)?;
     semismooth::InvalidOption::check(
         from.is_finite() && to.is_finite() && from > 0.0 && to > 0.0 && from != to,
@@ -159,26 +193,20 @@ pub fn backbone(
     )
     .map_err(|e| ModesError::Hb(e.into()))?;
     let x0 = epmc.linear_start(from);
-    let mut continuation = options.continuation.clone();
-    continuation.parameter_min = from.min(to);
-    continuation.parameter_max = from.max(to);
-    continuation.direction = if to > from {
-        Direction::Increasing
-    } else {
-        Direction::Decreasing
-    };
-    continuation.parameter_scale = (to - from).abs();
-    if continuation.state_scale.is_none() {
-        continuation.state_scale = Some(state_scale(&epmc, from.abs().max(to.abs())));
-    }
+    let continuation = continuation_options(&epmc, options, from, to)?;
     let linear = epmc.linear_mode().clone();
-    let mut solver = FaerDenseLu::new();
-    let continuation = Continuation::new(&mut epmc, &mut solver, &x0, from, continuation)
-        .map_err(|e| ModesError::Continuation(e.to_string()))?
-        .with_dense_fallback();
-    let branch = match options.energy_range {
-        Some((_, energy_to)) => up_to_energy(continuation, energy_to),
-        None => continuation.run(),
+    let energy_to = options.energy_range.map(|(_, to)| to);
+    let start = (x0.as_slice(), from);
+    let branch = match options.solve {
+        // The dense fallback of the continuation's own border is affordable here.
+        EpmcSolve::Dense => {
+            let solver = &mut FaerDenseLu::new();
+            follow(&mut epmc, solver, start, continuation, energy_to, true)?
+        }
+        EpmcSolve::Structured => {
+            let solver = &mut EpmcStructuredSolver::new();
+            follow(&mut epmc, solver, start, continuation, energy_to, false)?
+        }
     };
     let summary_dof = match options.measure {
         AmplitudeMeasure::Dof(dof) => dof,
@@ -213,9 +241,67 @@ pub fn backbone(
     })
 }
 
+/// The continuation options of `options` for the amplitude range `from`..`to`: its bounds,
+/// direction and scales, and the corrector's tolerance from the relative one.
+fn continuation_options(
+    epmc: &Epmc,
+    options: &BackboneOptions,
+    from: f64,
+    to: f64,
+) -> Result<ContinuationOptions, ModesError> {
+    let mut continuation = options.continuation.clone();
+    continuation.parameter_min = from.min(to);
+    continuation.parameter_max = from.max(to);
+    continuation.direction = if to > from {
+        Direction::Increasing
+    } else {
+        Direction::Decreasing
+    };
+    continuation.parameter_scale = (to - from).abs();
+    if continuation.state_scale.is_none() {
+        continuation.state_scale = Some(state_scale(epmc, from.abs().max(to.abs())));
+    }
+    if let Some(relative) = options.relative_tolerance {
+        semismooth::InvalidOption::check(
+            relative.is_finite() && relative > 0.0,
+            "relative tolerance",
+            relative,
+            "a positive number",
+        )
+        .map_err(|e| ModesError::Hb(e.into()))?;
+        continuation.corrector_tolerance = relative * epmc.force_scale(from.abs().max(to.abs()));
+    }
+    Ok(continuation)
+}
+
+/// The branch of `epmc` from `(x0, amplitude)` with `solver`, up to the energy `energy_to`
+/// if any ([`up_to_energy`]); `dense_fallback`: the continuation may factor its bordered
+/// matrix densely when `solver` fails.
+fn follow<S: Factorize<EpmcJacobian>>(
+    epmc: &mut Epmc,
+    solver: &mut S,
+    (x0, from): (&[f64], f64),
+    options: ContinuationOptions,
+    energy_to: Option<f64>,
+    dense_fallback: bool,
+) -> Result<Branch, ModesError> {
+    let mut continuation = Continuation::new(epmc, solver, x0, from, options)
+        .map_err(|e| ModesError::Continuation(e.to_string()))?;
+    if dense_fallback {
+        continuation = continuation.with_dense_fallback();
+    }
+    Ok(match energy_to {
+        Some(energy_to) => up_to_energy(continuation, energy_to),
+        None => continuation.run(),
+    })
+}
+
 /// The branch of `continuation` up to its first point whose energy reaches `energy_to`
 /// (then ended as at a bound: `ReachedBound` with the energies).
-fn up_to_energy(mut continuation: Continuation<'_, Epmc, FaerDenseLu>, energy_to: f64) -> Branch {
+fn up_to_energy<S: Factorize<EpmcJacobian>>(
+    mut continuation: Continuation<'_, Epmc, S>,
+    energy_to: f64,
+) -> Branch {
     let mut points = Vec::new();
     let mut reached = None;
     while let Some(point) = continuation.next() {

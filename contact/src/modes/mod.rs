@@ -19,7 +19,10 @@
 //! Jacobian alone is singular on every periodic motion of an autonomous system (the time
 //! shift `U'` is in its kernel), so the bordered matrix is factored as a whole
 //! ([`EpmcJacobian`] is [`DenseAssemble`], for the core's dense LU), and the
-//! continuation adds its own border to that regular matrix.
+//! continuation adds its own border to that regular matrix. For large models
+//! ([`Epmc::deflated`], [`EpmcStructuredSolver`]) a grounding spring `s` on one dof makes
+//! the inner Jacobian regular and the residual takes it out again: the inner block is
+//! factored by the structured HB solver once per iteration, under a border `2H + 3` wide.
 //!
 //! At small amplitude (contacts open, friction points stuck) the solution is the linear
 //! mode ([`linear_mode`]): `w = omega_n`, `xi = phi^T D phi = 2 zeta omega_n`. The damping
@@ -31,6 +34,7 @@
 
 mod backbone;
 mod linear;
+mod structured;
 
 use faer::MatMut;
 use semismooth::linalg::DenseAssemble;
@@ -40,8 +44,11 @@ use crate::hb::{HbError, HbJacobian, HbOptions, SsnHb};
 use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
 use crate::operator::OperatorParameter;
 
-pub use backbone::{backbone, Backbone, BackboneOptions, BackbonePoint};
+pub use backbone::{
+    backbone, Backbone, BackboneOptions, BackbonePoint, EpmcSolve, DEFAULT_RELATIVE_TOLERANCE,
+};
 pub use linear::{linear_mode, LinearMode};
+pub use structured::EpmcStructuredSolver;
 
 /// Why a nonlinear mode could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -70,7 +77,7 @@ pub enum ModesError {
     /// The bordered Jacobian, factored densely, would be too large.
     #[error(
         "{unknowns} EPMC unknowns exceed the {limit} of the dense bordered solve: reduce the \
-         harmonics or the dofs"
+         harmonics or the dofs, or use the structured solve"
     )]
     TooLarge {
         /// `(N + m)(2H + 1) + 2`.
@@ -112,6 +119,19 @@ pub struct Epmc {
     /// `K` and `M`, for the energy.
     stiffness: SparseMatrix,
     mass: SparseMatrix,
+    /// The grounding spring the inner harmonic balance carries for the structured solve
+    /// ([`Epmc::deflated`]); `None`: the model's own stiffness.
+    deflation: Option<Deflation>,
+}
+
+/// A grounding spring `s` at one dof, added to the stiffness of [`Epmc`]'s inner harmonic
+/// balance on every harmonic and taken out again by the residual (`R = R~ - s E U`, `E`
+/// the dof's entry of every harmonic block): it makes the inner Jacobian regular
+/// ([`EpmcStructuredSolver`]) without changing the equations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Deflation {
+    dof: usize,
+    stiffness: f64,
 }
 
 impl Epmc {
@@ -123,11 +143,52 @@ impl Epmc {
         mode: usize,
         measure: AmplitudeMeasure,
     ) -> Result<Self, ModesError> {
+        Self::build(model, options, mode, measure, false)
+    }
+
+    /// The same problem for [`EpmcStructuredSolver`]: its inner harmonic balance carries a
+    /// grounding spring of the stiffness scale at the largest entry `d` of the mode's
+    /// shape, which the residual and [`EpmcJacobian`]'s dense form take out again
+    /// (`R = R~ - s E U`). Same equations, same solutions; the inner Jacobian `J~ = J + s E`
+    /// is regular where `J` is not (the time shift `U'` and, at small amplitude, the linear
+    /// mode itself, on which `J~` adds `s phi_d^2`).
+    pub fn deflated(
+        model: &StructuralModel,
+        options: &HbOptions,
+        mode: usize,
+        measure: AmplitudeMeasure,
+    ) -> Result<Self, ModesError> {
+        Self::build(model, options, mode, measure, true)
+    }
+
+    fn build(
+        model: &StructuralModel,
+        options: &HbOptions,
+        mode: usize,
+        measure: AmplitudeMeasure,
+        deflate: bool,
+    ) -> Result<Self, ModesError> {
         let mut free = model.clone();
         free.load = crate::model::HarmonicLoad::zero(model.dofs());
         let linear = linear_mode(&free, mode)?;
-        let hb = SsnHb::new(&free, linear.omega, options)?;
         let n = model.dofs();
+        let row_scale = (0..n)
+            .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
+            .fold(0.0f64, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let deflation = deflate.then(|| Deflation {
+            dof: (0..n)
+                .max_by(|&i, &j| linear.shape[i].abs().total_cmp(&linear.shape[j].abs()))
+                .unwrap_or(0),
+            stiffness: row_scale,
+        });
+        let mut options = *options;
+        if let Some(spring) = deflation {
+            // The model's own c: its default reads the stiffness the spring changes.
+            options.c = options.c.or(Some(free.default_complementarity_constant()));
+            free.stiffness = grounded(&model.stiffness, spring)?;
+        }
+        let hb = SsnHb::new(&free, linear.omega, &options)?;
         let weights = match measure {
             AmplitudeMeasure::ModalCoordinate => {
                 let mut w = vec![0.0; n];
@@ -146,10 +207,6 @@ impl Epmc {
         if seen.abs() <= 1e-10 * largest * weights.iter().fold(0.0f64, |m, v| m.max(v.abs())) {
             return Err(ModesError::AmplitudeNotSeen { mode });
         }
-        let row_scale = (0..n)
-            .map(|i| crate::model::diagonal_entry(&model.stiffness, i).abs())
-            .fold(0.0f64, f64::max)
-            .max(f64::MIN_POSITIVE);
         Ok(Self {
             hb,
             weights,
@@ -158,7 +215,23 @@ impl Epmc {
             mode: linear,
             stiffness: model.stiffness.clone(),
             mass: model.mass.clone(),
+            deflation,
         })
+    }
+
+    /// True when built by [`Epmc::deflated`] (for [`EpmcStructuredSolver`]).
+    pub fn is_deflated(&self) -> bool {
+        self.deflation.is_some()
+    }
+
+    /// The size of a displacement of the linear start at `amplitude` (its largest entry),
+    /// times the stiffness scale: the size of the forces, which the corrector's relative
+    /// tolerance multiplies ([`BackboneOptions::relative_tolerance`]).
+    pub fn force_scale(&self, amplitude: f64) -> f64 {
+        let n = self.hb.dofs();
+        let start = self.linear_start(amplitude);
+        let largest = start[n..2 * n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        self.row_scale * largest
     }
 
     /// The linear mode followed.
@@ -270,6 +343,12 @@ impl Residual for Epmc {
         let len = self.hb_len();
         self.set_operator(x)?;
         self.hb.residual(&x[..len], &mut out[..len])?;
+        if let Some(spring) = self.deflation {
+            let n = self.hb.dofs();
+            for j in 0..self.hb.basis().basis_size() {
+                out[j * n + spring.dof] -= spring.stiffness * x[j * n + spring.dof];
+            }
+        }
         out[len] = self.row_scale * self.measure(x, 2);
         out[len + 1] = self.row_scale * (self.measure(x, 1) - self.amplitude);
         Ok(())
@@ -289,6 +368,8 @@ pub struct EpmcJacobian {
     columns: Vec<f64>,
     /// `row_scale a` (length `N`).
     row: Vec<f64>,
+    /// The grounding spring `inner` carries ([`Epmc::deflated`]).
+    deflation: Option<Deflation>,
 }
 
 impl DenseAssemble for EpmcJacobian {
@@ -311,6 +392,11 @@ impl DenseAssemble for EpmcJacobian {
             out[(len, 2 * n + dof)] = *a;
             out[(len + 1, n + dof)] = *a;
         }
+        if let Some(spring) = self.deflation {
+            for j in 0..self.inner.harmonics() * 2 + 1 {
+                out[(j * n + spring.dof, j * n + spring.dof)] -= spring.stiffness;
+            }
+        }
     }
 }
 
@@ -322,6 +408,7 @@ impl GeneralizedJacobian for Epmc {
             inner: self.hb.new_jacobian(),
             columns: vec![0.0; 2 * self.hb_len()],
             row: self.weights.iter().map(|a| self.row_scale * a).collect(),
+            deflation: self.deflation,
         }
     }
 
@@ -362,4 +449,18 @@ impl ParameterDependent for Epmc {
         out[self.hb_len() + 1] = -self.row_scale;
         Ok(())
     }
+}
+
+/// `K + s e_d e_d^T` of the grounding spring `spring`.
+fn grounded(stiffness: &SparseMatrix, spring: Deflation) -> Result<SparseMatrix, ModesError> {
+    let n = stiffness.nrows();
+    let mut entries: Vec<(usize, usize, f64)> = Vec::with_capacity(stiffness.compute_nnz() + 1);
+    let symbolic = stiffness.symbolic();
+    for j in 0..n {
+        for q in symbolic.col_range(j) {
+            entries.push((symbolic.row_idx()[q], j, stiffness.val()[q]));
+        }
+    }
+    entries.push((spring.dof, spring.dof, spring.stiffness));
+    crate::builder::sparse_matrix(n, &entries).map_err(|e| ModesError::Hb(HbError::from(e)))
 }
