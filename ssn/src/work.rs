@@ -141,7 +141,8 @@ pub const MASS_CARRYING_SMOOTHING_HARMONICS: usize = 40;
 pub const MASS_CARRYING_NEWTON_ITERATIONS: f64 = 60.0;
 
 /// Newton iterations expected of one solve of `scene` with `settings` and `contacts`
-/// contacts: [`MASS_CARRYING_NEWTON_ITERATIONS`] for SSN-HB on a rod whose contacts carry
+/// contacts: [`MASS_CARRYING_NEWTON_ITERATIONS`] for SSN-HB (off the dense solver, whose
+/// estimate counts its own factorizations) on a rod whose contacts carry
 /// mass (consistent or lumped mass, or a stop away from the modified mass's massless tip)
 /// from [`MASS_CARRYING_SMOOTHING_HARMONICS`] on, else what [`crate::limits`] counts. An
 /// imported model's contact masses are not known before it is read: its count is the
@@ -154,6 +155,7 @@ pub fn counted_solve_iterations(scene: &Scene, contacts: usize, settings: &Solve
         && contacts > 0
         && (rod.mass != MassModel::Modified || rod.contacts.iter().any(|c| c.node != rod.elements));
     let smoothing = settings.method.carries_contact_forces()
+        && settings.linear_solver != crate::scene::LinearSolverChoice::Dense
         && settings.harmonics >= MASS_CARRYING_SMOOTHING_HARMONICS;
     if carries_mass && smoothing {
         counted.max(MASS_CARRYING_NEWTON_ITERATIONS)
