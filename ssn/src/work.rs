@@ -208,7 +208,8 @@ fn march_work(
 /// Periods counted beyond the decay of the slowest free vibration: from rest the transient
 /// off resonance is larger than the response it is measured against. The rod of 10
 /// elements without contact (zeta 0.003 to 0.05, 0.8 to 1.3 `omega_1`) settled in 1.0 to
-/// 1.33 times the decay's periods, with a stop at 0.33 to 1.0 times.
+/// 1.33 times the decay's periods; with a stop at 0.27 to 1.0 times (a stop at resonance
+/// dissipates: the estimate is then up to 4.8 times the count, on the safe side).
 pub const MARCH_SETTLING_MARGIN: f64 = 1.3;
 
 /// The periods a march from rest takes to settle on `scene` with `settings` (the first
