@@ -140,7 +140,8 @@ pub fn prepare(
                 crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
             }
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
-            let work = crate::work::scene_work(&scene, n, m, workload);
+            let omega_1 = Some(structure.omega_1);
+            let work = crate::work::scene_work_at(&scene, (n, m), omega_1, workload);
             crate::limits::check_work(&work, work_limit).map_err(|e| too_large(path, e))?;
             structure
         }
@@ -675,8 +676,10 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
         ));
     };
     settings.stability &= !sweep_args.no_stability;
+    let started = std::time::Instant::now();
     let (response, fold_accuracy) =
         run_sweep(&rod, &scene, &settings).map_err(|e| input_error(&args.scene, e))?;
+    let seconds = started.elapsed().as_secs_f64();
     let ratio = response.omega_ratio();
     let table = crate::sweep_table::sweep_columns(&response);
     let headers: Vec<&str> = table.iter().map(|(name, _)| name.as_str()).collect();
@@ -694,7 +697,7 @@ pub fn sweep(sweep_args: &SweepArgs) -> Result<(), CliError> {
             }
             json
         },
-        || crate::words::sweep_text(&response, fold_accuracy.as_deref(), rod.omega_1),
+        || crate::words::sweep_text(&response, fold_accuracy.as_deref(), rod.omega_1, seconds),
         response.converged() && folds_met,
     )
 }

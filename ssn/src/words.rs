@@ -411,11 +411,13 @@ pub(crate) fn folds_summary(folds: &[f64], omega_1: f64) -> String {
 }
 
 /// The text summary of `ssn sweep`: the branch, its accuracy, folds, stability, the folds
-/// located to an accuracy target (`folds`), the work and how it ended.
+/// located to an accuracy target (`folds`), the work, how it ended and the wall time of
+/// the whole run (`seconds`) with its parts.
 pub(crate) fn sweep_text(
     response: &FrequencyResponse,
     folds: Option<&[FoldAccuracy]>,
     omega_1: f64,
+    seconds: f64,
 ) -> String {
     let ratio = response.omega_ratio();
     let mut t = format!(
@@ -481,12 +483,24 @@ pub(crate) fn sweep_text(
         gmres_words(&response.counters)
     );
     t += &format!(
-        "converged         {} ({}), {:.3} s\n",
+        "converged         {} ({}), {}\n",
         response.converged(),
         sweep_termination(response),
-        response.solve_seconds
+        sweep_seconds(response, seconds)
     );
     t
+}
+
+/// A sweep's wall time `seconds` (the whole run) and its parts: the branch, its stability
+/// analysis, and the rest (the peak's location, the contact reports, the folds located to
+/// an accuracy target).
+fn sweep_seconds(response: &FrequencyResponse, seconds: f64) -> String {
+    let (branch, stability) = (response.solve_seconds, response.stability_seconds);
+    let rest = (seconds - branch - stability).max(0.0);
+    format!(
+        "{seconds:.3} s (the branch {branch:.3} s, its stability {stability:.3} s, the rest \
+         {rest:.3} s)"
+    )
 }
 
 /// The method and its discretisation, as the first line of `ssn solve` names them.

@@ -65,6 +65,17 @@ pub enum Workload {
 /// marching and, for a branch, its points; for `scene-check` only its natural frequencies
 /// and for `export-model` nothing (they solve nothing).
 pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workload) -> WorkEstimate {
+    scene_work_at(scene, (dofs, contacts), None, workload)
+}
+
+/// [`scene_work`] of a structure whose first natural frequency `omega_1` is known (an
+/// imported model once built): the time marching's settling periods follow from it.
+pub fn scene_work_at(
+    scene: &Scene,
+    (dofs, contacts): (usize, usize),
+    omega_1: Option<f64>,
+    workload: Workload,
+) -> WorkEstimate {
     let settings = compared(&scene.solver, workload == Workload::Compare);
     let size_key = if scene.model.is_some() {
         "the model's size"
@@ -87,13 +98,25 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
     } else {
         "solver.linear_solver, solver.harmonics, rod.elements"
     };
-    let one = match workload {
+    let mut one = match workload {
         Workload::Solve => solve_work(dofs, contacts, &settings, dense_keys),
         _ => size_work(dofs, contacts, &settings, dense_keys),
     };
+    if workload != Workload::Branch {
+        let counted = counted_newton_iterations(contacts, &settings);
+        let expected = counted_solve_iterations(scene, contacts, &settings);
+        if expected > counted {
+            one.flops *= expected / counted;
+            one.what += &format!(
+                "; each solve counted at {expected} iterations, not {counted}: Newton stagnates \
+                 on a contact dof with mass from H = {MASS_CARRYING_SMOOTHING_HARMONICS} and \
+                 smoothing takes over"
+            );
+        }
+    }
     let mut estimates = vec![one];
     if settings.method.marches() || workload == Workload::Compare {
-        estimates.push(march_work(dofs, &settings, size_key));
+        estimates.push(march_work(scene, dofs, &settings, omega_1, size_key));
     }
     if workload == Workload::Branch {
         estimates.push(branch_work(scene, dofs, contacts, &settings));
@@ -105,6 +128,40 @@ pub fn scene_work(scene: &Scene, dofs: usize, contacts: usize, workload: Workloa
             _ => Some(e),
         })
         .expect("at least one estimate")
+}
+
+/// Harmonics from which plain Newton stagnates on an SSN-HB solve whose contact dof carries
+/// mass and the smoothing strategy takes over: the rod with consistent mass and a tip stop
+/// took 10 and 12 Newton iterations at H = 20 and 30, 46 at H = 40 (smoothing).
+pub const MASS_CARRYING_SMOOTHING_HARMONICS: usize = 40;
+
+/// Newton iterations counted for such a solve (and for its error estimate's solve, which
+/// meets the same stagnation): measured 46, 56 and 66 at H = 40, 60 and 80 on 20 elements,
+/// 46 and 47 at H = 40 and 80 on 3,000 elements.
+pub const MASS_CARRYING_NEWTON_ITERATIONS: f64 = 60.0;
+
+/// Newton iterations expected of one solve of `scene` with `settings` and `contacts`
+/// contacts: [`MASS_CARRYING_NEWTON_ITERATIONS`] for SSN-HB (off the dense solver, whose
+/// estimate counts its own factorizations) on a rod whose contacts carry
+/// mass (consistent or lumped mass, or a stop away from the modified mass's massless tip)
+/// from [`MASS_CARRYING_SMOOTHING_HARMONICS`] on, else what [`crate::limits`] counts. An
+/// imported model's contact masses are not known before it is read: its count is the
+/// latter.
+pub fn counted_solve_iterations(scene: &Scene, contacts: usize, settings: &SolverSettings) -> f64 {
+    use semismooth_contact::rod::MassModel;
+    let counted = counted_newton_iterations(contacts, settings);
+    let rod = &scene.rod;
+    let carries_mass = scene.model.is_none()
+        && contacts > 0
+        && (rod.mass != MassModel::Modified || rod.contacts.iter().any(|c| c.node != rod.elements));
+    let smoothing = settings.method.carries_contact_forces()
+        && settings.linear_solver != crate::scene::LinearSolverChoice::Dense
+        && settings.harmonics >= MASS_CARRYING_SMOOTHING_HARMONICS;
+    if carries_mass && smoothing {
+        counted.max(MASS_CARRYING_NEWTON_ITERATIONS)
+    } else {
+        counted
+    }
 }
 
 /// Operations per dof of the natural frequencies `scene-check` prints (subspace iteration
@@ -122,13 +179,23 @@ fn eigen_work(dofs: usize, size_key: &'static str) -> WorkEstimate {
     }
 }
 
-/// Time marching: at most `max_periods x steps_per_period` steps of every dof.
-fn march_work(dofs: usize, settings: &SolverSettings, size_key: &'static str) -> WorkEstimate {
-    let steps = settings.max_periods as f64 * settings.steps_per_period as f64;
+/// Time marching: [`counted_march_periods`] of `steps_per_period` steps of every dof (the
+/// error estimate's march, at half the steps from the settled state, took 0.18 to 0.24 of
+/// the march's time on the rod and the beam: within the margin).
+fn march_work(
+    scene: &Scene,
+    dofs: usize,
+    settings: &SolverSettings,
+    omega_1: Option<f64>,
+    size_key: &'static str,
+) -> WorkEstimate {
+    let periods = counted_march_periods(scene, settings, omega_1);
+    let steps = periods * settings.steps_per_period as f64;
     WorkEstimate {
         flops: steps * dofs as f64 * MARCH_FLOPS_PER_DOF_STEP,
         what: format!(
-            "time marching of {dofs} dofs over up to {} periods of {} steps",
+            "time marching of {dofs} dofs over about {periods:.0} periods (of at most {}) of {} \
+             steps",
             settings.max_periods, settings.steps_per_period
         ),
         keys: match size_key {
@@ -136,6 +203,53 @@ fn march_work(dofs: usize, settings: &SolverSettings, size_key: &'static str) ->
             _ => "solver.max_periods, solver.steps_per_period, the model's size",
         },
     }
+}
+
+/// Periods counted beyond the decay of the slowest free vibration: from rest the transient
+/// off resonance is larger than the response it is measured against. The rod of 10
+/// elements without contact (zeta 0.003 to 0.05, 0.8 to 1.3 `omega_1`) settled in 1.0 to
+/// 1.33 times the decay's periods; with a stop at 0.27 to 1.0 times (a stop at resonance
+/// dissipates: the estimate is then up to 4.8 times the count, on the safe side).
+pub const MARCH_SETTLING_MARGIN: f64 = 1.3;
+
+/// The periods a march from rest takes to settle on `scene` with `settings` (the first
+/// natural frequency `omega_1` where known, else the clamped rod's
+/// `(pi / 2) sqrt(EA / rho A) / L`): its slowest free vibration decays as `exp(-sigma t)`
+/// (`sigma = zeta omega_1` for stiffness-proportional damping, `(alpha + beta omega_1^2) / 2`
+/// for Rayleigh's), so the period-to-period change `x exp(-k x)`, `x = sigma T`, falls below
+/// `solver.march_tolerance` after `k = ln(x / tol) / x` periods; times
+/// [`MARCH_SETTLING_MARGIN`], at most `solver.max_periods`, which it is where the decay is
+/// unknown (a damping matrix file) or zero.
+pub fn counted_march_periods(
+    scene: &Scene,
+    settings: &SolverSettings,
+    omega_1: Option<f64>,
+) -> f64 {
+    use semismooth_contact::rod::DampingSpec;
+    let most = settings.max_periods as f64;
+    let (damping, omega_1) = match &scene.model {
+        Some(model) => (model.damping, omega_1),
+        None => {
+            let rod = &scene.rod;
+            let wave_speed = (rod.axial_stiffness / rod.mass_per_length).sqrt();
+            let clamped = std::f64::consts::FRAC_PI_2 * wave_speed / rod.length;
+            (rod.damping, omega_1.or(Some(clamped)))
+        }
+    };
+    let (Some(damping), Some(omega_1)) = (damping, omega_1) else {
+        return most;
+    };
+    let sigma = match damping {
+        DampingSpec::StiffnessProportional { zeta } => zeta * omega_1,
+        DampingSpec::Rayleigh { alpha, beta } => 0.5 * (alpha + beta * omega_1 * omega_1),
+    };
+    let x = sigma * 2.0 * std::f64::consts::PI / scene.omega(omega_1);
+    let tolerance = settings.march_tolerance;
+    if !(x > 0.0 && x.is_finite() && tolerance > 0.0) {
+        return most;
+    }
+    let periods = MARCH_SETTLING_MARGIN * (x / tolerance).ln().max(1.0) / x;
+    periods.ceil().clamp(2.0, most)
 }
 
 /// A branch over the `[sweep]` window (for `ssn solutions` without one: half to twice the
@@ -167,16 +281,41 @@ fn branch_work(
     } else {
         0.0
     };
+    let stability = point_stability_work(scene, dofs, settings);
     let per_point = CORRECTOR_ITERATIONS_PER_POINT * (factorization + contact_jacobian)
-        + BRANCH_FLOPS_PER_DOF_FUNCTION * dofs as f64 * functions;
+        + BRANCH_FLOPS_PER_DOF_FUNCTION * dofs as f64 * functions
+        + stability;
     WorkEstimate {
         flops: points * per_point,
         what: format!(
             "a branch of at least {points:.0} points (the window over sweep.max_step, and \
-             {BRANCH_POINTS_PER_HARMONIC} per harmonic), each {per_point:.1e} operations"
+             {BRANCH_POINTS_PER_HARMONIC} per harmonic), each {per_point:.1e} operations \
+             ({stability:.1e} its stability)"
         ),
         keys: "sweep.max_step, sweep.omega_ratio_from/to, solver.harmonics, the structure's size",
     }
+}
+
+/// Operations of one point's stability per cubed state dimension `(2N)^3`: the products of
+/// the phase propagators (`10 d^3` each, two phases for a contact that opens and closes)
+/// and the monodromy's eigenvalues (`25 d^3`), the library's own count
+/// ([`semismooth_contact::stability::MAX_WORK`]'s).
+pub const STABILITY_FLOPS_PER_CUBED_STATE: f64 = 45.0;
+
+/// The stability analysis of one branch point of a harmonic-balance sweep that asks for it
+/// ([`STABILITY_FLOPS_PER_CUBED_STATE`] `(2N)^3`), at most the library's limit
+/// [`semismooth_contact::stability::MAX_WORK`] (above it the point is left undecided), and
+/// none above [`semismooth_contact::stability::MAX_DOFS`] dofs or with friction (not
+/// analysed).
+fn point_stability_work(scene: &Scene, dofs: usize, settings: &SolverSettings) -> f64 {
+    use semismooth_contact::stability::{MAX_DOFS, MAX_WORK};
+    let asked = scene.sweep.as_ref().is_some_and(|s| s.stability);
+    let friction = (scene.model.as_ref())
+        .is_some_and(|m| !m.friction.is_empty() || !m.frictional_contacts.is_empty());
+    if !asked || friction || dofs > MAX_DOFS || !settings.method.is_harmonic_balance() {
+        return 0.0;
+    }
+    (STABILITY_FLOPS_PER_CUBED_STATE * (2.0 * dofs as f64).powi(3)).min(MAX_WORK)
 }
 
 /// Points counted for the branch of `scene` with `settings` (`sweep` and `solutions`): its
