@@ -2,15 +2,18 @@
 //! map), read the CalculiX matrices, import (read, symmetry and range checks, `omega_1`),
 //! `omega_1` alone (one sparse Cholesky of `K` and shift-invert Lanczos), the scene's
 //! `[reduction]` (Cholesky of `K_ii`, fixed-interface modes, constraint modes, projection)
-//! and one harmonic-balance solve of the reduced model at the scene's frequency. Prints a
-//! Markdown table of wall and CPU seconds per step and the load average before and after
-//! (the machine may be shared: compare ratios between steps, not absolute times).
+//! and one harmonic-balance solve of the reduced model at the scene's frequency; with
+//! `--exact`, also the exact unreduced solve (the condensation onto the contact unknowns
+//! with one sparse factorization per harmonic of the full model) and the difference of the
+//! two answers at the observed dof. Prints a Markdown table of wall and CPU seconds and the
+//! peak resident memory after each step, and the load average before and after (the
+//! machine may be shared: compare ratios between steps, not absolute times).
 //!
 //! ```sh
 //! # the 54,000-dof cantilever with 16 tip contacts (docs/finite_element_models.md):
 //! python3 ssn/examples/fe_pipeline_deck.py /tmp/fe_big 80 14 14 && (cd /tmp/fe_big && ccx big)
 //! cargo run --release -p ssn --example fe_pipeline -- /tmp/fe_big            # big.toml
-//! cargo run --release -p ssn --example fe_pipeline -- DIR scene.toml
+//! cargo run --release -p ssn --example fe_pipeline -- DIR scene.toml [--exact]
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -38,6 +41,18 @@ fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
+/// The peak resident memory of this process so far in MB (`VmHWM` of `/proc/self/status`);
+/// 0 where there is no `/proc`.
+fn peak_megabytes() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let kb = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+        .unwrap_or(0.0);
+    kb / 1024.0
+}
+
 fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
@@ -45,26 +60,37 @@ fn load_average() -> String {
 }
 
 /// Times `f`, prints its row and returns its value.
-fn step<T>(rows: &mut Vec<(String, f64, f64)>, name: &str, f: impl FnOnce() -> T) -> T {
+fn step<T>(rows: &mut Vec<Row>, name: &str, f: impl FnOnce() -> T) -> T {
     let (wall, cpu) = (Instant::now(), cpu_seconds());
     let value = f();
     let row = (
         name.to_string(),
         wall.elapsed().as_secs_f64(),
         cpu_seconds() - cpu,
+        peak_megabytes(),
     );
-    eprintln!("{:<40} {:>8.2} s wall {:>8.2} s CPU", row.0, row.1, row.2);
+    eprintln!(
+        "{:<40} {:>8.2} s wall {:>8.2} s CPU {:>8.0} MB peak",
+        row.0, row.1, row.2, row.3
+    );
     rows.push(row);
     value
 }
+
+/// A step's name, wall and CPU seconds, and the peak resident memory after it (MB).
+type Row = (String, f64, f64, f64);
 
 fn main() {
     let dir = PathBuf::from(
         std::env::args()
             .nth(1)
-            .expect("usage: fe_pipeline DIR [SCENE]"),
+            .expect("usage: fe_pipeline DIR [SCENE] [--exact]"),
     );
-    let name = std::env::args().nth(2).unwrap_or_else(|| "big.toml".into());
+    let exact = std::env::args().any(|a| a == "--exact");
+    let name = std::env::args()
+        .nth(2)
+        .filter(|a| a != "--exact")
+        .unwrap_or_else(|| "big.toml".into());
     let path = dir.join(name);
     let load_before = load_average();
     let mut rows = Vec::new();
@@ -92,6 +118,28 @@ fn main() {
         semismooth_contact::solve(&reduced.structure, loaded.omega, &scene.solver, None)
             .unwrap_or_else(|e| panic!("{e}"))
     });
+    if exact {
+        let full_solution = step(&mut rows, "solve one frequency (exact, unreduced)", || {
+            semismooth_contact::solve(full, loaded.omega, &scene.solver, None)
+                .unwrap_or_else(|e| panic!("{e}"))
+        });
+        let scale = full_solution
+            .observed
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let difference = full_solution
+            .observed
+            .iter()
+            .zip(&solution.observed)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        println!(
+            "exact: converged {} in {} iterations; max |u_reduced - u_exact| over the period \
+             = {:.2e} of max |u_exact| = {scale:.6e}",
+            full_solution.converged(),
+            full_solution.iterations,
+            difference / scale
+        );
+    }
     let total: (f64, f64) = rows.iter().fold((0.0, 0.0), |t, r| (t.0 + r.1, t.1 + r.2));
     println!(
         "model: {} dofs, {} contacts, omega_1 = {omega_1:.6} (import: {:.6}); reduced to {} \
@@ -114,9 +162,9 @@ fn main() {
         "load average (1, 5, 15 min): before {load_before}, after {}",
         load_average()
     );
-    println!("\n| step | wall s | CPU s |\n|---|---|---|");
-    for (name, wall, cpu) in &rows {
-        println!("| {name} | {wall:.2} | {cpu:.2} |");
+    println!("\n| step | wall s | CPU s | peak MB after |\n|---|---|---|---|");
+    for (name, wall, cpu, peak) in &rows {
+        println!("| {name} | {wall:.2} | {cpu:.2} | {peak:.0} |");
     }
-    println!("| total | {:.2} | {:.2} |", total.0, total.1);
+    println!("| total | {:.2} | {:.2} | |", total.0, total.1);
 }

@@ -26,7 +26,7 @@ use semismooth_contact::import::LANCZOS_MIN_DOFS;
 use semismooth_contact::jenkins::expand_tangential_stiffness;
 use semismooth_contact::matrix_market::{build_imported, build_imported_with};
 use semismooth_contact::model::{StructuralModel, Structure};
-use semismooth_contact::reduction::lowest_frequencies;
+use semismooth_contact::reduction::{lowest_frequencies, CraigBampton};
 use semismooth_contact::rod::{build_rod, natural_frequencies, ModelError};
 use semismooth_contact::solve::{RunError, Solution};
 use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
@@ -92,6 +92,27 @@ pub fn prepare(
     workload: Workload,
     matrices: Option<MatrixSource>,
 ) -> Result<Loaded, CliError> {
+    prepare_keeping_reduction(scene, workload, matrices).map(|(loaded, _)| loaded)
+}
+
+/// [`load_with`], keeping the scene's reduction (its transform recovers the full model's
+/// displacement) beside the reduced structure.
+pub fn load_keeping_reduction(
+    path: &Path,
+    overrides: &[Override],
+    workload: Workload,
+) -> Result<(Loaded, Option<CraigBampton>), CliError> {
+    let scene =
+        Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
+    prepare_keeping_reduction(scene, workload, None)
+}
+
+/// [`prepare`], and the scene's reduction when it has one (not for `Workload::Check`).
+fn prepare_keeping_reduction(
+    scene: Scene,
+    workload: Workload,
+    matrices: Option<MatrixSource>,
+) -> Result<(Loaded, Option<CraigBampton>), CliError> {
     let path = scene.path.clone();
     let path = path.as_path();
     let compare = workload == Workload::Compare;
@@ -159,19 +180,22 @@ pub fn prepare(
     check_scales(&scene, structure.omega_1, omega).map_err(|e| input_error(path, e))?;
     check_resonance(&scene, &structure, omega).map_err(|e| input_error(path, e))?;
     // scene-check reduces the structure itself, to print both models' frequencies.
-    let structure = match (&scene.reduction, workload) {
-        (Some(spec), w) if w != Workload::Check => {
+    let reduction = match (&scene.reduction, workload) {
+        (Some(spec), w) if w != Workload::Check => Some(
             crate::reduce::reduce(&scene, spec, &structure, omega)
-                .map_err(|e| input_error(path, e))?
-                .structure
-        }
-        _ => structure,
+                .map_err(|e| input_error(path, e))?,
+        ),
+        _ => None,
     };
-    Ok(Loaded {
+    let structure = reduction
+        .as_ref()
+        .map_or(structure, |r| r.structure.clone());
+    let loaded = Loaded {
         scene,
         structure,
         omega,
-    })
+    };
+    Ok((loaded, reduction))
 }
 
 /// Largest ratio of a forcing or sweep frequency to `omega_1` (and smallest, inverted):
@@ -347,6 +371,13 @@ pub struct SolveArgs {
     /// The solution of an `ssn solutions --json` file to start from (1 = the first listed).
     #[arg(long, requires = "start", allow_hyphen_values = true, value_parser = entry_number)]
     pub entry: Option<usize>,
+    /// Write the periodic response on the `[model] mesh` for ParaView into this directory:
+    /// `response_000.vtu`, ... at instants of the period, and `response.pvd` to animate them.
+    #[arg(long)]
+    pub vtu: Option<PathBuf>,
+    /// Instants of the period written by --vtu (t_k = k T / N).
+    #[arg(long, requires = "vtu", default_value_t = crate::paraview::DEFAULT_FRAMES)]
+    pub vtu_frames: usize,
 }
 
 /// `--entry K`: a solution counted from 1 (a negative or zero `K` is named as such, not
@@ -459,12 +490,22 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     if let Some(state) = &solve_args.state {
         outputs.target(state, "--state")?;
     }
+    let (loaded, reduction) = load_keeping_reduction(&args.scene, &args.set, Workload::Solve)?;
     let Loaded {
         scene,
         structure: rod,
         omega,
-    } = load_with(&args.scene, &args.set, Workload::Solve)?;
+    } = loaded;
     claim_model_files(&mut outputs, &scene)?;
+    let picture = match &solve_args.vtu {
+        Some(dir) => Some(crate::paraview::plan(
+            &mut outputs,
+            &scene,
+            dir,
+            solve_args.vtu_frames,
+        )?),
+        None => None,
+    };
     let shape = StateShape {
         method: scene.solver.method,
         harmonics: scene.solver.harmonics,
@@ -503,6 +544,11 @@ pub fn solve(solve_args: &SolveArgs) -> Result<(), CliError> {
     })?;
     if let Some(path) = &solve_args.state {
         outputs.add(path, state_document(&solution, shape)?.into_bytes());
+    }
+    if let (Some(dir), Some(picture)) = (&solve_args.vtu, &picture) {
+        let frames = (dir.as_path(), solve_args.vtu_frames);
+        let reduced = reduction.as_ref();
+        crate::paraview::queue(&mut outputs, frames, picture, &solution, shape, reduced)?;
     }
     args.finish(
         outputs,

@@ -18,6 +18,7 @@ pub mod json;
 pub mod limits;
 pub mod modes;
 pub mod output;
+pub mod paraview;
 pub mod progress;
 pub mod reduce;
 pub mod scene;

@@ -1,12 +1,15 @@
 //! Node coordinates of a finite-element mesh, read from the `*NODE` blocks of a CalculiX or
 //! Abaqus input deck (`.inp`): data lines `node, x, y, z` (a missing coordinate is 0), node
 //! labels `>= 1`, each node once. Other keywords' blocks and `**` comments are skipped;
-//! `*INCLUDE` is not followed. With the coordinates, a contact's normal can be computed
-//! from the geometry ([`radial_direction`]).
+//! `*INCLUDE, INPUT=file` is followed ([`MAX_INCLUDE_DEPTH`] deep, relative to the including
+//! file, cycles refused). With the coordinates, a contact's normal can be computed from the
+//! geometry ([`radial_direction`]). The `*ELEMENT` blocks give the cells ([`MeshElements`]).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+pub use super::deck::MAX_INCLUDE_DEPTH;
+use super::deck::{Deck, IncludeError};
 use super::dof_map::read_text;
 use super::DofMapError;
 
@@ -20,6 +23,21 @@ pub enum MeshError {
     /// A data line of a `*NODE` block is not a node and its coordinates.
     #[error("{path}: line {line}: `{text}`: {problem}: allowed `node, x, y, z` (node >= 1)")]
     Line {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// The line's text (cut at 60 characters).
+        text: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An `*INCLUDE` could not be followed.
+    #[error("{0}")]
+    Include(#[from] IncludeError),
+    /// A data line of an `*ELEMENT` block is not an element and its nodes.
+    #[error("{path}: line {line}: `{text}`: {problem}: allowed `element, node, node, ...` (labels >= 1; a line ending in a comma continues)")]
+    ElementLine {
         /// The file.
         path: PathBuf,
         /// 1-based line.
@@ -50,33 +68,16 @@ impl MeshNodes {
         Self::parse_inp(&text, path)
     }
 
-    /// Parses the text of an input deck (`path` for messages only).
+    /// Parses the text of the input deck `path` (its includes are read from disk).
     pub fn parse_inp(text: &str, path: &Path) -> Result<Self, MeshError> {
+        let deck = Deck::parse(text, path)?;
         let mut coordinates = HashMap::new();
         let mut first_line = HashMap::new();
-        let mut in_nodes = false;
-        for (k, line) in text.lines().enumerate() {
-            let t = line.trim();
-            if t.starts_with("**") || t.is_empty() {
-                continue;
-            }
-            if t.starts_with('*') {
-                let keyword = t.split(',').next().unwrap_or("").trim();
-                in_nodes = keyword.eq_ignore_ascii_case("*NODE");
-                continue;
-            }
-            if !in_nodes {
-                continue;
-            }
+        for (line, t) in block_lines(&deck, "*NODE") {
             let error = |problem: String| MeshError::Line {
-                path: path.to_path_buf(),
-                line: k + 1,
-                text: t
-                    .chars()
-                    .take(60)
-                    .collect::<String>()
-                    .escape_default()
-                    .to_string(),
+                path: deck.file_of(line).to_path_buf(),
+                line: line.line,
+                text: shown(t),
                 problem,
             };
             let words: Vec<&str> = t.split(',').map(str::trim).collect();
@@ -100,8 +101,14 @@ impl MeshNodes {
                     .filter(|v| v.is_finite())
                     .ok_or_else(|| error(format!("coordinate `{w}`")))?;
             }
-            if let Some(first) = first_line.insert(node, k + 1) {
-                return Err(error(format!("node {node} again (first on line {first})")));
+            let place = (deck.file_of(line).display().to_string(), line.line);
+            if let Some(first) = first_line.insert(node, place) {
+                let at = if first.0 == deck.file_of(line).display().to_string() {
+                    format!("line {}", first.1)
+                } else {
+                    format!("{} line {}", first.0, first.1)
+                };
+                return Err(error(format!("node {node} again (first on {at})")));
             }
             coordinates.insert(node, x);
         }
@@ -111,6 +118,14 @@ impl MeshNodes {
             });
         }
         Ok(Self { coordinates })
+    }
+
+    /// Every node and its coordinates, by ascending label.
+    pub fn sorted(&self) -> Vec<(u64, [f64; 3])> {
+        let mut nodes: Vec<(u64, [f64; 3])> =
+            self.coordinates.iter().map(|(n, x)| (*n, *x)).collect();
+        nodes.sort_unstable_by_key(|(n, _)| *n);
+        nodes
     }
 
     /// The coordinates of `node`, if the mesh has it.
@@ -126,6 +141,132 @@ impl MeshNodes {
     /// No node (only a default value; a read mesh has one).
     pub fn is_empty(&self) -> bool {
         self.coordinates.is_empty()
+    }
+}
+
+/// The data lines of the deck's blocks whose keyword is `keyword` (case-insensitive), with
+/// the parameters of the block's keyword line: `(line, text)`.
+fn block_lines<'d>(deck: &'d Deck, keyword: &str) -> Vec<(&'d super::deck::DeckLine, &'d str)> {
+    keyword_blocks(deck, keyword)
+        .into_iter()
+        .flat_map(|(_, lines)| lines)
+        .collect()
+}
+
+/// The blocks of `keyword`: each keyword line's text and its data lines.
+fn keyword_blocks<'d>(
+    deck: &'d Deck,
+    keyword: &str,
+) -> Vec<(&'d str, Vec<(&'d super::deck::DeckLine, &'d str)>)> {
+    let mut blocks: Vec<(&str, Vec<_>)> = Vec::new();
+    let mut inside = false;
+    for line in &deck.lines {
+        let t = line.text.as_str();
+        if t.starts_with('*') {
+            let word = t.split(',').next().unwrap_or("").trim();
+            inside = word.eq_ignore_ascii_case(keyword);
+            if inside {
+                blocks.push((t, Vec::new()));
+            }
+        } else if inside {
+            if let Some(b) = blocks.last_mut() {
+                b.1.push((line, t));
+            }
+        }
+    }
+    blocks
+}
+
+/// A line's text as a message shows it: escaped, cut at 60 characters.
+fn shown(t: &str) -> String {
+    t.chars()
+        .take(60)
+        .collect::<String>()
+        .escape_default()
+        .to_string()
+}
+
+/// One element of a mesh: its label, its type as the deck names it (upper case, e.g.
+/// `C3D8`) and its nodes in the deck's order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MeshElement {
+    /// The element label (`>= 1`).
+    pub label: u64,
+    /// `TYPE=` of its `*ELEMENT` block, upper case (empty when the block names none).
+    pub kind: String,
+    /// Its node labels.
+    pub nodes: Vec<u64>,
+}
+
+/// The elements of an input deck's `*ELEMENT` blocks (`*ELEMENT, TYPE=C3D8`, data lines
+/// `element, node, node, ...`; a line ending in a comma continues on the next line).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MeshElements {
+    /// In the deck's order.
+    pub elements: Vec<MeshElement>,
+}
+
+impl MeshElements {
+    /// Reads the `*ELEMENT` blocks of the input deck `path` and its includes.
+    pub fn read_inp(path: &Path) -> Result<Self, MeshError> {
+        let text = read_text(path).map_err(MeshError::File)?;
+        Self::parse_inp(&text, path)
+    }
+
+    /// Parses the `*ELEMENT` blocks of the deck `path` whose text is `text`.
+    pub fn parse_inp(text: &str, path: &Path) -> Result<Self, MeshError> {
+        let deck = Deck::parse(text, path)?;
+        let mut elements = Vec::new();
+        for (head, lines) in keyword_blocks(&deck, "*ELEMENT") {
+            let kind = head
+                .split(',')
+                .skip(1)
+                .find_map(|p| {
+                    let (k, v) = p.split_once('=')?;
+                    k.trim()
+                        .eq_ignore_ascii_case("TYPE")
+                        .then(|| v.trim().to_uppercase())
+                })
+                .unwrap_or_default();
+            let mut pending: Option<(&super::deck::DeckLine, Vec<u64>)> = None;
+            for (line, t) in lines {
+                let error = |problem: String| MeshError::ElementLine {
+                    path: deck.file_of(line).to_path_buf(),
+                    line: line.line,
+                    text: shown(t),
+                    problem,
+                };
+                let continues = t.ends_with(',');
+                let mut labels = pending.take().unwrap_or((line, Vec::new()));
+                for w in t.trim_end_matches(',').split(',').map(str::trim) {
+                    match w.parse::<u64>() {
+                        Ok(n) if n >= 1 => labels.1.push(n),
+                        _ => return Err(error(format!("label `{w}`"))),
+                    }
+                }
+                if continues {
+                    pending = Some(labels);
+                } else if labels.1.len() < 2 {
+                    return Err(error("an element without nodes".into()));
+                } else {
+                    elements.push(element(&kind, &labels.1));
+                }
+            }
+            // A block's last line may end in a comma: its element ends with the block.
+            if let Some((_, labels)) = pending.filter(|p| p.1.len() >= 2) {
+                elements.push(element(&kind, &labels));
+            }
+        }
+        Ok(Self { elements })
+    }
+}
+
+/// The element of type `kind` whose label and nodes are `labels`.
+fn element(kind: &str, labels: &[u64]) -> MeshElement {
+    MeshElement {
+        label: labels[0],
+        kind: kind.to_string(),
+        nodes: labels[1..].to_vec(),
     }
 }
 
@@ -188,6 +329,28 @@ mod tests {
             }
             assert!(e.starts_with("m.inp: "), "{e}");
         }
+    }
+
+    #[test]
+    fn element_blocks_give_types_and_nodes_and_a_trailing_comma_continues_the_line() {
+        let deck = "*NODE\n1, 0, 0, 0\n*ELEMENT, TYPE=c3d8, ELSET=E\n\
+                    4, 1, 2, 3, 4, 5, 6, 7, 8\n*ELEMENT, ELSET=F, TYPE=C3D20\n\
+                    5, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15,\n\
+                    16, 17, 18, 19, 20\n*BOUNDARY\n1, 1, 3\n";
+        let e = MeshElements::parse_inp(deck, Path::new("m.inp"))
+            .unwrap()
+            .elements;
+        assert_eq!(e.len(), 2);
+        assert_eq!((e[0].label, e[0].kind.as_str()), (4, "C3D8"));
+        assert_eq!(e[0].nodes, (1..=8).collect::<Vec<u64>>());
+        assert_eq!((e[1].label, e[1].kind.as_str()), (5, "C3D20"));
+        assert_eq!(e[1].nodes, (1..=20).collect::<Vec<u64>>());
+        let bad = MeshElements::parse_inp("*ELEMENT, TYPE=S4\n1, 2, x\n", Path::new("m.inp"));
+        let bad = bad.unwrap_err().to_string();
+        assert!(
+            bad.starts_with("m.inp: line 2: `1, 2, x`: label `x`"),
+            "{bad}"
+        );
     }
 
     #[test]

@@ -46,11 +46,15 @@ use crate::rod::{natural_frequencies, DampingSpec};
 pub const MAX_ENTRY_MAGNITUDE: f64 = 1e100;
 
 mod ansys_mapping;
+mod deck;
 mod dof_map;
 mod mesh;
 
+pub use deck::IncludeError;
 pub use dof_map::{DofMap, DofMapError, NodeComponent, MAX_COMPONENT, MAX_DOF_MAP_BYTES};
-pub use mesh::{radial_direction, MeshError, MeshNodes};
+pub use mesh::{
+    radial_direction, MeshElement, MeshElements, MeshError, MeshNodes, MAX_INCLUDE_DEPTH,
+};
 
 /// Smallest first natural frequency of an imported model (its inverse the largest): the
 /// rod's scale rule.

@@ -243,8 +243,12 @@ fn header(card: &Card, path: &Path) -> Result<LabelledMatrix, ImportError> {
         }
     };
     if !matches!(text(card, 3), "1" | "2") {
+        let kind = match text(card, 3) {
+            "3" | "4" => " (a complex matrix)",
+            _ => "",
+        };
         let m = format!(
-            "TIN `{}`: allowed 1 or 2 (real; a structure's matrices are real)",
+            "TIN `{}`{kind}: allowed 1 or 2 (real; a structure's matrices are real)",
             text(card, 3)
         );
         return Err(field_error(path, card, 3, m));
@@ -364,6 +368,15 @@ DMIG*   KAAX                           5               1\n\
                 &["line 1", "field 4", "IFO `2`", "6 (symmetric)"][..],
             ),
             ("DMIG,K,0,6,3\n", &["line 1", "field 5", "TIN `3`", "real"]),
+            (
+                "$ header\nDMIG,KAAX,0,6,4\n",
+                &[
+                    "line 2",
+                    "field 5",
+                    "TIN `4` (a complex matrix)",
+                    "allowed 1 or 2",
+                ],
+            ),
             ("DMIG,K,5,1,,5,1,2.\n", &["line 1", "before its header"]),
             (
                 "DMIG,K,0,6,2\nDMIG,K,5,1,,5,7,2.\n",

@@ -141,6 +141,12 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
     let forcing = ck.forcing_or_obstacle(&mut raw)?;
     let mut bladed_disk = None;
     let neighbour_rows = ck.neighbour_rows(raw.contact.as_ref(), raw.friction.as_ref())?;
+    // The mesh deck's path (read and checked with the model: `Check::model`).
+    let mesh = raw
+        .model
+        .as_ref()
+        .and_then(|m| m.mesh.as_deref())
+        .map(|name| path.parent().unwrap_or(Path::new("")).join(name));
     let (rod, model, output_dof) = match (&raw.rod, raw.model, raw.bladed_disk) {
         (None, None, Some(d)) => {
             let (model, mistuning) = ck.bladed_disk(
@@ -213,6 +219,7 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
         title: raw.title,
         rod,
         model,
+        mesh,
         bladed_disk,
         output_dof,
         load_parts,

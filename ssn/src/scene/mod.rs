@@ -71,6 +71,8 @@ pub struct Scene {
     pub rod: RodSpec,
     /// The imported structure of a `[model]` scene (`None` for a `[rod]` scene).
     pub model: Option<ModelSpec>,
+    /// The `[model] mesh` input deck (node coordinates and elements), if given.
+    pub mesh: Option<PathBuf>,
     /// The blade stiffness deviations of a `[bladed_disk]` scene, one per blade (`None`
     /// otherwise); its `model` names the disk's matrices ([`bladed_disk_matrices`]).
     pub bladed_disk: Option<Vec<f64>>,
