@@ -112,3 +112,48 @@ fn the_friction_with_stop_grid_converges_from_zero_in_all_96_cases() {
     // The comparison is not vacuous.
     assert!(compared >= 24, "compared with Armijo on {compared} cases");
 }
+
+/// The same grid at `H = 20` (AFT samples by the default rule): every case converges from
+/// zero, and its residual evaluated again by a fresh problem at `H = 20` meets the run's
+/// tolerance (10 x for the summation order of a new evaluation).
+#[test]
+fn the_friction_with_stop_grid_converges_from_zero_at_twenty_harmonics() {
+    const HARMONICS: usize = 20;
+    let mut failed = Vec::new();
+    for gap in [100.0, 0.5] {
+        for normal_load in NORMAL_LOADS {
+            for omega_ratio in OMEGA_RATIOS {
+                let chain = chain_with_friction(gap, normal_load);
+                let settings = SolverSettings {
+                    estimate_error: false,
+                    ..SolverSettings::with_harmonics(HARMONICS)
+                };
+                let omega = omega_ratio * chain.omega_1;
+                let solution = solve(&chain, omega, &settings, None).expect("the solve runs");
+                let case = format!("gap {gap}, N = {normal_load}, omega = {omega_ratio} omega_1");
+                if !solution.converged() {
+                    failed.push(case);
+                    continue;
+                }
+                let options = HbOptions {
+                    c: solution.c,
+                    harmonics: HARMONICS,
+                    time_samples: Some(settings.time_samples),
+                    ..HbOptions::default()
+                };
+                let mut problem = SsnHb::new(&chain.model, omega, &options).expect("a problem");
+                let mut f = vec![0.0; problem.dim()];
+                problem.residual(&solution.state, &mut f).expect("F");
+                let again = f.iter().map(|v| v * v).sum::<f64>().sqrt();
+                let tolerance = solution.effective_tolerance.expect("a Newton method");
+                assert!(again <= 10.0 * tolerance, "{case}: |F| = {again:e}");
+            }
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "{} of 96 failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
+}
