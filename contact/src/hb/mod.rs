@@ -195,6 +195,7 @@ macro_rules! omega_parameter {
 }
 
 mod condensed;
+mod coupled_rows;
 mod disk;
 mod friction;
 mod jacobian;

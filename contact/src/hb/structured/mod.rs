@@ -32,6 +32,7 @@ use faer::{c64, Conj, Mat, MatMut, Par};
 use semismooth::linalg::{check_pivots, Gmres, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{Factorize, LinearSolve};
 
+use super::coupled_rows::CoupledRows;
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::laws::{copy_blocks, LawLayout};
@@ -133,8 +134,11 @@ pub struct StructuredHbSolver {
     gmres: Gmres,
     krylov_absolute_tolerance: f64,
     krylov_iterations: u64,
-    /// `R_k,ii` at index `k m + i` (matrix-free path).
-    receptance_diagonal: Vec<c64>,
+    /// The units of rows coupled by their laws (matrix-free path).
+    coupled_rows: CoupledRows,
+    /// `R_k[a, b]` between the rows of each unit at index `k E + entry(a, b)` of
+    /// `coupled_rows` (matrix-free path).
+    unit_receptance: Vec<c64>,
     contact_blocks: ContactBlocks,
     block_rhs: Mat<c64>,
     /// Matrix-free path: `schur` holds the LU of the dense condensed matrix of a recent
@@ -198,7 +202,8 @@ impl StructuredHbSolver {
             gmres: Gmres::new(),
             krylov_absolute_tolerance: 0.0,
             krylov_iterations: 0,
-            receptance_diagonal: Vec::new(),
+            coupled_rows: CoupledRows::default(),
+            unit_receptance: Vec::new(),
             contact_blocks: ContactBlocks::default(),
             block_rhs: Mat::zeros(0, 0),
             dense_preconditioner: false,
@@ -289,7 +294,8 @@ impl StructuredHbSolver {
         self.work_res = Vec::with_capacity(n * size + nc);
         (self.q, self.cross) = lin.laws.zero_blocks(size);
         if self.krylov {
-            self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
+            self.coupled_rows = CoupledRows::new(&lin.laws, m);
+            self.unit_receptance = vec![c64::new(0.0, 0.0); (h + 1) * self.coupled_rows.entries()];
             self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
             self.response.clear();
             self.receptance.clear();
@@ -317,13 +323,16 @@ impl StructuredHbSolver {
         dynamic.factor(&jac.parameters)?;
         for k in 0..=lin.basis.harmonics() {
             if self.krylov {
-                // R_k,ii only.
-                let diagonal = &mut self.receptance_diagonal;
+                // R_k[a, i] between the rows of each unit only.
+                let (rows, store) = (&self.coupled_rows, &mut self.unit_receptance);
+                let entries = rows.entries();
                 receptance_columns(dynamic, &lin, k, &mut self.block_rhs, |first, z| {
                     for j in 0..z.ncols() {
                         let i = first + j;
-                        diagonal[k * lin.contacts() + i] =
-                            lin.measured(i, k, lin.row_complex(i, k, z, j));
+                        for &a in &rows.units[rows.place[i].0] {
+                            store[k * entries + rows.entry(a, i)] =
+                                lin.measured(a, k, lin.row_complex(a, k, z, j));
+                        }
                     }
                 })?;
                 continue;
