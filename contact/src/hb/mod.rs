@@ -203,6 +203,7 @@ mod krylov;
 mod laws;
 mod neighbour;
 mod penalty;
+mod penalty_disk;
 mod ssn;
 mod structured;
 

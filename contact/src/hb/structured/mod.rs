@@ -569,8 +569,10 @@ impl StructuredHbSolver {
                 for r in 0..nc {
                     self.work_a[r] = self.work_b[(r, 0)];
                 }
-                // dU = w - k_p A^{-1} G^T Q y.
+                // dU = w - k_p A^{-1} G^T (Q + X) y.
                 lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
+                lin.laws
+                    .apply_x_add(&self.cross, m, &self.work_a, &mut self.work_c);
                 self.add_response(&self.work_c, -stiffness, &mut w);
                 rhs.copy_from_slice(&w);
             }
@@ -603,6 +605,8 @@ impl StructuredHbSolver {
                 lin.laws.apply_x_add(&self.cross, m, x_l, out_l);
             }
             ContactCoupling::Penalty { stiffness } => {
+                lin.laws
+                    .apply_x_add(&self.cross, m, &self.work_a, &mut self.work_c);
                 lin.scatter_rows(&self.work_c, stiffness, out);
             }
         }
@@ -804,29 +808,51 @@ pub(crate) fn condensed_matrix(
                 complementarity_columns(receptance, qab, (a, b), (c, m), out.as_mut());
             }
             ContactCoupling::Penalty { stiffness } => {
-                // Column (l, b) of Q is Q_ab[:, l] on row a: S e += k_p R_{:, a} Q_ab[:, l].
-                for l in 0..size {
-                    let col = l * m + b;
-                    for i in 0..m {
-                        let r0 = receptance[0][(i, a)].re;
-                        out[(i, col)] += stiffness * r0 * qab[(0, l)];
-                        for (kk, rk) in receptance.iter().enumerate().skip(1) {
-                            let (jc, js) = (2 * kk - 1, 2 * kk);
-                            let r = rk[(i, a)];
-                            let (pc, ps) = (qab[(jc, l)], qab[(js, l)]);
-                            out[(jc * m + i, col)] += stiffness * (r.re * pc + r.im * ps);
-                            out[(js * m + i, col)] += stiffness * (-r.im * pc + r.re * ps);
-                        }
-                    }
-                }
+                penalty_columns(receptance, qab, (a, b), (stiffness, m), out.as_mut());
             }
         }
     }
-    for col in 0..m * size {
-        out[(col, col)] += 1.0;
+    match coupling {
+        ContactCoupling::Complementarity { .. } => {
+            for col in 0..m * size {
+                out[(col, col)] += 1.0;
+            }
+            layout.add_x_dense(cross, m, out);
+        }
+        ContactCoupling::Penalty { stiffness } => {
+            // A penalty law's slope on the rows it reads enters as Q does.
+            for (xas, &(a, s)) in cross.iter().zip(&layout.x_pairs) {
+                penalty_columns(receptance, xas, (a, s), (stiffness, m), out.as_mut());
+            }
+            for col in 0..m * size {
+                out[(col, col)] += 1.0;
+            }
+        }
     }
-    if let ContactCoupling::Complementarity { .. } = coupling {
-        layout.add_x_dense(cross, m, out);
+}
+
+/// Adds the columns `l m + b` of `k_p R B` for the block `B` between rows `a` and `b`
+/// (column `(l, b)` of `B` is `B[:, l]` on row `a`: `S e += k_p R_{:, a} B[:, l]`).
+fn penalty_columns(
+    receptance: &[Mat<c64>],
+    block: &Mat<f64>,
+    (a, b): (usize, usize),
+    (stiffness, m): (f64, usize),
+    mut out: MatMut<'_, f64>,
+) {
+    for l in 0..block.ncols() {
+        let col = l * m + b;
+        for i in 0..m {
+            let r0 = receptance[0][(i, a)].re;
+            out[(i, col)] += stiffness * r0 * block[(0, l)];
+            for (kk, rk) in receptance.iter().enumerate().skip(1) {
+                let (jc, js) = (2 * kk - 1, 2 * kk);
+                let r = rk[(i, a)];
+                let (pc, ps) = (block[(jc, l)], block[(js, l)]);
+                out[(jc * m + i, col)] += stiffness * (r.re * pc + r.im * ps);
+                out[(js * m + i, col)] += stiffness * (-r.im * pc + r.re * ps);
+            }
+        }
     }
 }
 
