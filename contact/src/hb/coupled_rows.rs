@@ -43,14 +43,14 @@ impl CoupledRows {
         let mut unit_of_root = vec![usize::MAX; rows];
         let mut units: Vec<Vec<usize>> = Vec::new();
         let mut place = vec![(0, 0); rows];
-        for row in 0..rows {
+        for (row, at) in place.iter_mut().enumerate() {
             let r = find(&mut root, row);
             if unit_of_root[r] == usize::MAX {
                 unit_of_root[r] = units.len();
                 units.push(Vec::new());
             }
             let unit = unit_of_root[r];
-            place[row] = (unit, units[unit].len());
+            *at = (unit, units[unit].len());
             units[unit].push(row);
         }
         let mut offsets = Vec::with_capacity(units.len() + 1);
