@@ -248,8 +248,8 @@ pub struct Solution {
     /// Every friction point over the period, at [`Solution::times`] (harmonic balance and
     /// time marching; empty for the LCP, which has no friction).
     pub friction: Vec<FrictionReport>,
-    /// Every 3-D frictional contact over the period (SSN-HB; empty for other methods,
-    /// which refuse them).
+    /// Every 3-D frictional contact over the period (SSN-HB, time marching, and penalty HB
+    /// with its regularised law; empty for the LCP, which refuses them).
     pub frictional_contacts: Vec<FrictionalContactReport>,
     /// Work counters.
     pub counters: RunCounters,
@@ -710,7 +710,7 @@ pub(super) fn solve_penalty_hb(
     // cannot cross from zero, so without a warm start its width is narrowed in log
     // from the static slip itself (a soft, nearly viscous law) by factors of 10.
     let width = settings.friction_regularisation;
-    if warm_start.is_none() && !model.friction.is_empty() && width < 1.0 {
+    if warm_start.is_none() && model.has_friction() && width < 1.0 {
         let stages = homotopy(
             0.0,
             -width.ln(),
@@ -725,7 +725,9 @@ pub(super) fn solve_penalty_hb(
         homotopy_iterations += stages.iterations;
         problem.set_friction_regularisation(width)?;
     }
-    if warm_start.is_none() && !model.contacts.is_empty() {
+    let unilateral = (model.frictional_contacts.iter())
+        .any(|p| matches!(p.normal, crate::model::NormalLaw::Unilateral { .. }));
+    if warm_start.is_none() && (!model.contacts.is_empty() || unilateral) {
         let k0 = model
             .static_contact_stiffness()
             .map(|s| DEFAULT_C_FACTOR * s)
@@ -764,6 +766,9 @@ pub(super) fn solve_penalty_hb(
         }
         sol.stats.mean_contact_force = sol.contacts.iter().map(|c| c.force_mean).sum();
     }
+    sol.frictional_contacts = (0..problem.frictional_contacts())
+        .map(|p| problem.frictional_contact_report(&sol.state, p, points))
+        .collect::<Result<_, _>>()?;
     Ok(sol)
 }
 

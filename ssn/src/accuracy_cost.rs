@@ -397,7 +397,8 @@ fn sweep_settings(
         .friction
         .iter()
         .all(|f| matches!(f.normal, NormalForce::Prescribed(_)));
-    if !rod.model.friction.is_empty() && prescribed {
+    // (The regularised disk of 3-D contacts takes any normal law.)
+    if (!rod.model.friction.is_empty() && prescribed) || !rod.model.frictional_contacts.is_empty() {
         for h in [10, 40] {
             for width in [1e-1, 1e-2, 1e-3] {
                 let nt = default_hb_time_samples(h);

@@ -1,7 +1,7 @@
 //! A scene's resolved structure and run in words (`ssn scene-check`).
 
 use semismooth_contact::matrix_market::ModelSpec;
-use semismooth_contact::model::Structure;
+use semismooth_contact::model::{FrictionalContact, NormalLaw, Structure};
 use semismooth_contact::rod::DampingSpec;
 
 use crate::io::printable;
@@ -214,7 +214,8 @@ pub fn describe_imported(
         omega,
         omega / structure.omega_1
     ));
-    if spec.contacts.is_empty() {
+    let frictional = &structure.model.frictional_contacts;
+    if spec.contacts.is_empty() && spec.friction.is_empty() && frictional.is_empty() {
         line("contact           none: linear problem (one factorization, no FFT)".into());
     }
     for c in &spec.contacts {
@@ -244,12 +245,55 @@ pub fn describe_imported(
             row_words(&f.tangent)
         ));
     }
+    for t in frictional_contact_lines(frictional) {
+        line(t);
+    }
     line(format!(
         "observed dof      {}",
         dof_words(spec, structure.observed_dof)
     ));
     out.push_str(&describe_run(scene, structure));
     out
+}
+
+/// At most this many 3-D frictional contacts are described one by one.
+const DESCRIBED_FRICTIONAL_CONTACTS: usize = 8;
+
+/// One line per 3-D frictional contact (the first [`DESCRIBED_FRICTIONAL_CONTACTS`], then
+/// how many more): its normal law, friction coefficient, tangent rows and moving obstacle.
+fn frictional_contact_lines(contacts: &[FrictionalContact]) -> Vec<String> {
+    let mut lines: Vec<String> = (contacts.iter().take(DESCRIBED_FRICTIONAL_CONTACTS))
+        .map(|c| {
+            let normal = match &c.normal {
+                NormalLaw::Unilateral { row, gap } => format!("{} <= gap {gap}", row_words(row)),
+                NormalLaw::Prescribed(load) => format!("normal load {load}"),
+                _ => "normal law".into(),
+            };
+            let moving = if c.gap_cos.is_empty() && c.gap_sin.is_empty() {
+                String::new()
+            } else {
+                format!(", moving gap cos {:?} sin {:?}", c.gap_cos, c.gap_sin)
+            };
+            let sliding = if c.sliding_velocity == [0.0; 2] {
+                String::new()
+            } else {
+                format!(", obstacle sliding at {:?}", c.sliding_velocity)
+            };
+            format!(
+                "contact 3-D       {normal}, mu = {} on the slips {} and {}{moving}{sliding}",
+                c.coefficient,
+                row_words(&c.tangents[0]),
+                row_words(&c.tangents[1])
+            )
+        })
+        .collect();
+    if contacts.len() > DESCRIBED_FRICTIONAL_CONTACTS {
+        lines.push(format!(
+            "contact 3-D       and {} more",
+            contacts.len() - DESCRIBED_FRICTIONAL_CONTACTS
+        ));
+    }
+    lines
 }
 
 /// The 0-based `dof` as a scene names it: `7`, or `7 (node 9, component 1)` with a dof map.

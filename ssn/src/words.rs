@@ -638,11 +638,13 @@ fn frictional_contact_lines(s: &Solution) -> String {
         .iter()
         .map(|p| {
             let normal = p.normal_force.iter().fold(0.0f64, |a, f| a.max(-f));
+            let mean = -p.normal_force.iter().sum::<f64>() / p.normal_force.len().max(1) as f64;
             format!(
-                "  3-D contact {:<3} energy per cycle {:.6e}, max normal force {:.6e}, stick / \
-                 slip / separated {:.1} / {:.1} / {:.1} % of the period\n",
+                "  3-D contact {:<3} energy per cycle {:.6e}, normal force mean {:.6e} max \
+                 {:.6e}, stick / slip / separated {:.1} / {:.1} / {:.1} % of the period\n",
                 p.point + 1,
                 p.dissipated_energy,
+                mean,
                 normal,
                 100.0 * p.stick_fraction,
                 100.0 * p.slip_fraction,

@@ -264,9 +264,10 @@ fn a_bad_frame_or_coefficient_is_refused_with_its_key() {
         &dir,
         "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
     );
+    // (Penalty HB has the regularised vector law: the periodic LCP has no disk.)
     let text = std::fs::read_to_string(&path)
         .unwrap()
-        .replace("ssn-hb", "penalty-hb");
+        .replace("ssn-hb", "lcp-lemke");
     let message = Scene::from_toml(&text, &path).unwrap_err().to_string();
     assert!(message.contains("solver.method"), "{message}");
     std::fs::remove_dir_all(&dir).ok();
@@ -355,4 +356,57 @@ fn dragged_energy(n0: f64) -> f64 {
     let period = 2.0 * PI / w;
     let drag = 0.5 * period * (nc * w * us - ns * w * uc);
     MU * speed * n0 * period - MU * drag
+}
+
+/// `ssn scene-check` on a scene whose only contact is a 3-D node contact describes it (not
+/// a linear problem), and the summary of `ssn solve` gives its normal force's mean: the
+/// closed form `N = 1.5` (constant on the circle, to Newton's tolerance; printed to 7
+/// digits).
+#[test]
+fn scene_check_describes_a_3d_contact_and_the_solve_summary_gives_its_mean_normal_force() {
+    let dir = node_files("check");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
+    );
+    let path = path.to_str().unwrap();
+    let check = ssn(&["scene-check", path]);
+    assert_eq!(check.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&check.stdout).to_string();
+    assert!(!text.contains("linear problem"), "{text}");
+    assert!(
+        text.contains("contact 3-D") && text.contains("mu = 0.3"),
+        "{text}"
+    );
+    let solve = ssn(&["solve", path]);
+    assert_eq!(solve.status.code(), Some(0));
+    let summary = String::from_utf8_lossy(&solve.stdout).to_string();
+    assert!(
+        summary.contains("normal force mean 1.500000e0"),
+        "{summary}"
+    );
+}
+
+/// `penalty-hb` solves a scene with a 3-D node contact by the regularised vector law: on the
+/// circle (the slip speed `w r`, far above the default band) it is Coulomb's force, and the
+/// energy is the closed form `2 pi mu N r` within the penalty's relative compliance
+/// (`1 / k_p` of the default `1e5` times the contact stiffness: agreement within 1e-4).
+#[test]
+fn penalty_hb_on_a_3d_node_contact_dissipates_two_pi_mu_n_r() {
+    let dir = node_files("penalty");
+    let path = scene(
+        &dir,
+        "node = 7\nnormal = [0.0, 0.0, 1.0]\ngap = 0.5\nfriction = 0.3",
+    );
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("method = \"ssn-hb\"", "method = \"penalty-hb\"");
+    std::fs::write(&path, text).unwrap();
+    let contact = first_frictional_contact(&path);
+    let energy = contact["dissipated_energy"].as_f64().unwrap();
+    let expected = 2.0 * PI * MU * NORMAL * circle_radius();
+    assert!(
+        (energy - expected).abs() < 1e-4 * expected,
+        "{energy} against {expected}"
+    );
 }

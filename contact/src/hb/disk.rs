@@ -187,7 +187,7 @@ impl FrictionalContactReport {
 
     /// The report from the series and whether each sample sticks (when closed): the
     /// energy `-int lambda_t . v_t dt` by the rectangle rule, the fractions.
-    fn from_series(
+    pub(super) fn from_series(
         point: usize,
         normal_force: Vec<f64>,
         (tangential_force, slip_velocity): ([Vec<f64>; 2], [Vec<f64>; 2]),

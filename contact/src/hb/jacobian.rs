@@ -158,23 +158,43 @@ impl DenseAssemble for HbJacobian {
                 }
                 ContactCoupling::Penalty { stiffness } => {
                     // k_p G_a^T Q_ab M_b G_b.
-                    for j in 0..size {
-                        for l in 0..size {
-                            let weight = stiffness * measured(j, l);
-                            lin.row_terms(a, j, |j2, r, ga| {
-                                lin.row_terms(b, l, |l2, col, gb| {
-                                    out[(j2 * n + r, l2 * n + col)] += weight * ga * gb;
-                                });
-                            });
-                        }
-                    }
+                    add_penalty_block(lin, measured, (a, b), stiffness, out.as_mut());
                 }
+            }
+        }
+        if let ContactCoupling::Penalty { stiffness } = self.coupling {
+            // k_p G_a^T X_as M_s G_s: a penalty law's slope on the rows it reads.
+            for (x, &(a, s)) in self.cross.iter().zip(&lin.laws.x_pairs) {
+                let measured = measured_block(x, lin.is_velocity_row(s));
+                add_penalty_block(lin, measured, (a, s), stiffness, out.as_mut());
             }
         }
         if let ContactCoupling::Complementarity { .. } = self.coupling {
             // dR_a / dLambda_s = X_as of each group on the rows it reads.
             let lambda_block = out.submatrix_mut(offset, offset, m * size, m * size);
             lin.laws.add_x_dense(&self.cross, m, lambda_block);
+        }
+    }
+}
+
+/// `out += k_p G_a^T B M_b G_b` for the block `B` (entries `measured(j, l)` of `B M_b`)
+/// between rows `a` and `b`.
+fn add_penalty_block(
+    lin: &LinearData,
+    measured: impl Fn(usize, usize) -> f64,
+    (a, b): (usize, usize),
+    stiffness: f64,
+    mut out: MatMut<'_, f64>,
+) {
+    let (n, size) = (lin.dofs, lin.size());
+    for j in 0..size {
+        for l in 0..size {
+            let weight = stiffness * measured(j, l);
+            lin.row_terms(a, j, |j2, r, ga| {
+                lin.row_terms(b, l, |l2, col, gb| {
+                    out[(j2 * n + r, l2 * n + col)] += weight * ga * gb;
+                });
+            });
         }
     }
 }

@@ -13,11 +13,16 @@
 //! **Preconditioner.** Dropping the receptance between different contacts (`R_ij`,
 //! `i != j`) leaves `S` block diagonal over contacts: `S_i = I - Q_i + c Q_i R_ii` with the
 //! exact activity of contact `i` and its own receptance `R_ii` (a scalar per harmonic).
-//! The diagonal `R_k,ii` is computed once per frequency (one sparse solve per contact and
-//! harmonic, in blocks of [`RECEPTANCE_BLOCK`] right-hand sides), the `(2H + 1)`-square
-//! blocks are factored by dense LU once per Newton iteration (`O(m H^3)`), and applying
-//! them costs `O(m H^2)`. It is exact when the contacts do not interact; GMRES corrects for
-//! their coupling through the structure.
+//! Rows whose laws couple them (the normal and two tangent rows of a 3-D frictional
+//! contact: the disk's 2 x 2 blocks and its column on the normal force) form one unit
+//! ([`CoupledRows`]) and keep, in one `u (2H + 1)`-square block, the law's blocks and the
+//! receptance between them: dropping the disk's off-diagonal blocks, which carry the
+//! turning of a sliding force, left GMRES without a useful preconditioner. The
+//! receptance between the rows of each unit is computed once per frequency (one sparse
+//! solve per row and harmonic, in blocks of [`RECEPTANCE_BLOCK`] right-hand sides), the
+//! blocks are factored by dense LU once per Newton iteration (`O(m u^2 H^3)`), and
+//! applying them costs `O(m u H^2)`. It is exact when the units do not interact; GMRES
+//! corrects for their coupling through the structure.
 //!
 //! **Dense preconditioner.** Contacts close together (every second node of a fine rod)
 //! are coupled through the structure far beyond their own blocks: the receptance between
@@ -43,6 +48,8 @@ use faer::perm::PermRef;
 use faer::{c64, Conj, Mat, Par};
 use semismooth::linalg::{check_pivots, KrylovOperator, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 
+use super::coupled_rows::CoupledRows;
+use super::laws::LawLayout;
 use super::structured::FactoredCondensed;
 use super::LinearData;
 use crate::operator::HarmonicFactors;
@@ -74,7 +81,7 @@ pub(crate) struct CondensedOperator<'a> {
 /// The preconditioner of GMRES on the condensed system: the contact blocks, or the dense
 /// LU of the condensed matrix at a recent iterate (module documentation).
 pub(crate) enum CondensedPreconditioner<'a> {
-    Blocks(&'a mut ContactBlocks),
+    Blocks(&'a mut ContactBlocks, &'a CoupledRows),
     Dense(FactoredCondensed<'a>),
 }
 
@@ -123,7 +130,7 @@ impl KrylovOperator for CondensedOperator<'_> {
 
     fn precondition(&mut self, b: &[f64], out: &mut [f64]) -> Result<(), LinearSolveError> {
         match &mut self.preconditioner {
-            CondensedPreconditioner::Blocks(blocks) => blocks.solve(b, out),
+            CondensedPreconditioner::Blocks(blocks, rows) => blocks.solve(rows, b, out),
             CondensedPreconditioner::Dense(lu) => {
                 lu.solve(b, out);
                 Ok(())
@@ -136,14 +143,16 @@ impl KrylovOperator for CondensedOperator<'_> {
 /// is computed.
 pub(crate) const RECEPTANCE_BLOCK: usize = 32;
 
-/// The block-Jacobi preconditioner over contacts: `S_i = I - Q_i + c Q_i R_ii` per contact
-/// (`(2H + 1)` square, the exact activity of contact `i` with its own receptance
-/// `R_ii`, the coupling between contacts dropped), factored by dense LU.
+/// The block-Jacobi preconditioner over units of coupled rows ([`CoupledRows`]):
+/// `S_u = I - Q_u + c Q_u R_uu + X_u` per unit (`u (2H + 1)` square: the exact activity
+/// of the unit's laws, their blocks between its rows and the receptance between its rows;
+/// the coupling between units dropped), factored by dense LU. A unit of one row is the
+/// contact block `S_i = I - Q_i + c Q_i R_ii`.
 pub(crate) struct ContactBlocks {
     blocks: Vec<Mat<f64>>,
     fwd: Vec<Vec<usize>>,
     inv: Vec<Vec<usize>>,
-    /// Contact with no active sample: `S_i = I`.
+    /// Unit with no active sample and no read: `S_u = I`.
     identity: Vec<bool>,
     rhs: Mat<f64>,
     mem: Option<MemBuffer>,
@@ -162,109 +171,196 @@ impl Default for ContactBlocks {
     }
 }
 
+/// Adds `c Q_ab R~` to the columns `(place of b2) size ..` of the rows `(place of a) size
+/// ..` of `s`, `R~` the real form of the receptance `R_k[b, b2]` on each harmonic's pair
+/// (`r(k)`).
+fn add_law_block(
+    s: &mut Mat<f64>,
+    qab: &Mat<f64>,
+    (pa, pb2): (usize, usize),
+    r: impl Fn(usize) -> c64,
+    c: f64,
+) {
+    let size = qab.nrows();
+    let (row0, col0) = (pa * size, pb2 * size);
+    for l in 0..size {
+        let k = l.div_ceil(2);
+        let rk = r(k);
+        for row in 0..size {
+            let value = if k == 0 {
+                rk.re * qab[(row, 0)]
+            } else if l % 2 == 1 {
+                rk.re * qab[(row, l)] - rk.im * qab[(row, l + 1)]
+            } else {
+                rk.im * qab[(row, l - 1)] + rk.re * qab[(row, l)]
+            };
+            s[(row0 + row, col0 + l)] += c * value;
+        }
+    }
+}
+
 impl ContactBlocks {
-    /// Factors `S_i` for the rows' diagonal blocks `Q_ii` (a row group's blocks between
-    /// its rows are dropped with the receptance between rows), the receptance diagonal
-    /// `r[k m + i] = R_k,ii` and `c`.
-    pub(crate) fn factor<'q>(
+    /// Sizes the blocks of `rows`' units for `size = 2H + 1` basis functions.
+    fn allocate(&mut self, rows: &CoupledRows, size: usize) -> Result<(), LinearSolveError> {
+        let widths: Vec<usize> = rows.units.iter().map(|u| u.len() * size).collect();
+        let widest = widths.iter().copied().max().unwrap_or(0);
+        self.blocks = widths.iter().map(|&w| Mat::zeros(w, w)).collect();
+        self.fwd = widths.iter().map(|&w| vec![0; w]).collect();
+        self.inv = self.fwd.clone();
+        self.identity = vec![true; widths.len()];
+        self.rhs = Mat::zeros(widest, 1);
+        let req = StackReq::any_of(&[
+            dense_lu::lu_in_place_scratch::<usize, f64>(
+                widest,
+                widest,
+                Par::Seq,
+                Default::default(),
+            ),
+            dense_solve::solve_in_place_scratch::<usize, f64>(widest, 1, Par::Seq),
+        ]);
+        self.mem = Some(
+            MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
+                during: "allocating the contact-block preconditioner",
+            })?,
+        );
+        Ok(())
+    }
+
+    /// Factors `S_u` of every unit of `rows` from the law blocks `Q_ab` and `X_as` of
+    /// `layout` (`blocks`), the receptance between each unit's rows (`r[k E + entry(a,
+    /// b)] = R_k[a, b]`, `E` the entries of `rows`) and `c`.
+    pub(crate) fn factor(
         &mut self,
-        q: impl ExactSizeIterator<Item = &'q Mat<f64>> + Clone,
+        (rows, layout): (&CoupledRows, &LawLayout),
+        (q, cross): (&[Mat<f64>], &[Mat<f64>]),
         r: &[c64],
         c: f64,
     ) -> Result<(), LinearSolveError> {
-        let m = q.len();
-        let size = q.clone().next().map_or(0, |qi| qi.nrows());
-        if self.blocks.len() != m || self.rhs.nrows() != size {
-            self.blocks = (0..m).map(|_| Mat::zeros(size, size)).collect();
-            self.fwd = vec![vec![0; size]; m];
-            self.inv = vec![vec![0; size]; m];
-            self.identity = vec![true; m];
-            self.rhs = Mat::zeros(size, 1);
-            let req = StackReq::any_of(&[
-                dense_lu::lu_in_place_scratch::<usize, f64>(
-                    size,
-                    size,
-                    Par::Seq,
-                    Default::default(),
-                ),
-                dense_solve::solve_in_place_scratch::<usize, f64>(size, 1, Par::Seq),
-            ]);
-            self.mem =
-                Some(
-                    MemBuffer::try_new(req).map_err(|_| LinearSolveError::OutOfMemory {
-                        during: "allocating the contact-block preconditioner",
-                    })?,
-                );
+        let size = q.first().map_or(0, |qi| qi.nrows());
+        let fits = self.blocks.len() == rows.units.len()
+            && self
+                .blocks
+                .iter()
+                .zip(&rows.units)
+                .all(|(b, u)| b.nrows() == u.len() * size);
+        if !fits || self.mem.is_none() {
+            self.allocate(rows, size)?;
         }
+        let entries = rows.entries();
+        for s in &mut self.blocks {
+            s.fill(0.0);
+        }
+        self.identity.fill(true);
+        for (qab, &(a, b)) in q.iter().zip(&layout.q_pairs) {
+            let ((unit, pa), (_, pb)) = (rows.place[a], rows.place[b]);
+            if (0..size).all(|l| qab.col_as_slice(l).iter().all(|v| *v == 0.0)) {
+                continue;
+            }
+            self.identity[unit] = false;
+            for (pb2, &b2) in rows.units[unit].iter().enumerate() {
+                let at = rows.entry(b, b2);
+                add_law_block(
+                    &mut self.blocks[unit],
+                    qab,
+                    (pa, pb2),
+                    |k| r[k * entries + at],
+                    c,
+                );
+            }
+            // - Q_ab on the columns of b (after c Q R: a unit of one row then sums as
+            // c Q R - Q).
+            let s = &mut self.blocks[unit];
+            for l in 0..size {
+                for row in 0..size {
+                    s[(pa * size + row, pb * size + l)] -= qab[(row, l)];
+                }
+            }
+        }
+        for (xas, &(a, s_row)) in cross.iter().zip(&layout.x_pairs) {
+            let ((unit, pa), (_, ps)) = (rows.place[a], rows.place[s_row]);
+            if (0..size).all(|l| xas.col_as_slice(l).iter().all(|v| *v == 0.0)) {
+                continue;
+            }
+            self.identity[unit] = false;
+            let s = &mut self.blocks[unit];
+            for l in 0..size {
+                for row in 0..size {
+                    s[(pa * size + row, ps * size + l)] += xas[(row, l)];
+                }
+            }
+        }
+        self.factor_units()
+    }
+
+    /// LU of every unit's `I + S_u` (the identity added here), the identity units skipped.
+    fn factor_units(&mut self) -> Result<(), LinearSolveError> {
         let Some(mem) = self.mem.as_mut() else {
             return Err(LinearSolveError::NotFactored);
         };
-        for (i, qi) in q.enumerate() {
-            self.identity[i] = (0..size).all(|l| qi.col_as_slice(l).iter().all(|v| *v == 0.0));
-            if self.identity[i] {
+        for (unit, s) in self.blocks.iter_mut().enumerate() {
+            if self.identity[unit] {
                 continue;
             }
-            let s = &mut self.blocks[i];
-            // c Q_i R~_i, column by column (R~ couples the pair of each harmonic).
-            for l in 0..size {
-                let k = l.div_ceil(2);
-                let rk = r[k * m + i];
-                for row in 0..size {
-                    let value = if k == 0 {
-                        rk.re * qi[(row, 0)]
-                    } else if l % 2 == 1 {
-                        rk.re * qi[(row, l)] - rk.im * qi[(row, l + 1)]
-                    } else {
-                        rk.im * qi[(row, l - 1)] + rk.re * qi[(row, l)]
-                    };
-                    s[(row, l)] = c * value - qi[(row, l)];
-                }
+            let width = s.nrows();
+            for l in 0..width {
                 s[(l, l)] += 1.0;
             }
             dense_lu::lu_in_place(
                 s.as_mut(),
-                &mut self.fwd[i],
-                &mut self.inv[i],
+                &mut self.fwd[unit],
+                &mut self.inv[unit],
                 Par::Seq,
                 MemStack::new(mem),
                 Default::default(),
             );
-            check_pivots((0..size).map(|j| s[(j, j)]), DEFAULT_PIVOT_THRESHOLD)?;
+            check_pivots((0..width).map(|j| s[(j, j)]), DEFAULT_PIVOT_THRESHOLD)?;
         }
         Ok(())
     }
 
-    /// `out = blockdiag(S_i)^{-1} b` (index `j m + i`).
-    pub(crate) fn solve(&mut self, b: &[f64], out: &mut [f64]) -> Result<(), LinearSolveError> {
-        let m = self.blocks.len();
+    /// `out = blockdiag(S_u)^{-1} b` (index `j m + row`) over the units of `rows`.
+    pub(crate) fn solve(
+        &mut self,
+        rows: &CoupledRows,
+        b: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), LinearSolveError> {
+        let m = rows.place.len();
         let Some(mem) = self.mem.as_mut() else {
             out.copy_from_slice(b);
             return Ok(());
         };
-        let size = self.rhs.nrows();
-        for i in 0..m {
-            if self.identity[i] {
-                for j in 0..size {
-                    out[j * m + i] = b[j * m + i];
+        for (unit, members) in rows.units.iter().enumerate() {
+            let s = &self.blocks[unit];
+            let size = s.nrows() / members.len().max(1);
+            if self.identity[unit] {
+                for &row in members {
+                    for j in 0..size {
+                        out[j * m + row] = b[j * m + row];
+                    }
                 }
                 continue;
             }
-            for j in 0..size {
-                self.rhs[(j, 0)] = b[j * m + i];
+            for (p, &row) in members.iter().enumerate() {
+                for j in 0..size {
+                    self.rhs[(p * size + j, 0)] = b[j * m + row];
+                }
             }
-            let s = &self.blocks[i];
-            let perm = PermRef::new_checked(&self.fwd[i], &self.inv[i], size);
+            let width = s.nrows();
+            let perm = PermRef::new_checked(&self.fwd[unit], &self.inv[unit], width);
             dense_solve::solve_in_place_with_conj(
                 s.as_ref(),
                 s.as_ref(),
                 perm,
                 Conj::No,
-                self.rhs.as_mut(),
+                self.rhs.as_mut().subrows_mut(0, width),
                 Par::Seq,
                 MemStack::new(mem),
             );
-            for j in 0..size {
-                out[j * m + i] = self.rhs[(j, 0)];
+            for (p, &row) in members.iter().enumerate() {
+                for j in 0..size {
+                    out[j * m + row] = self.rhs[(p * size + j, 0)];
+                }
             }
         }
         Ok(())

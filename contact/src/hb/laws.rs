@@ -174,6 +174,16 @@ impl LawLayout {
         });
     }
 
+    /// The index of the block `Q_ab` (rows `a`, `b` of one group), if there is one.
+    pub(crate) fn q_block(&self, a: usize, b: usize) -> Option<usize> {
+        self.q_pairs.iter().position(|&pair| pair == (a, b))
+    }
+
+    /// The index of the block `X_as` (row `a`'s law reading row `s`), if there is one.
+    pub(crate) fn x_block(&self, a: usize, s: usize) -> Option<usize> {
+        self.x_pairs.iter().position(|&pair| pair == (a, s))
+    }
+
     /// `(2H + 1)`-square zero blocks for every `Q` block and every `X` block.
     pub(crate) fn zero_blocks(&self, size: usize) -> (Vec<Mat<f64>>, Vec<Mat<f64>>) {
         let zeros = |count: usize| (0..count).map(|_| Mat::zeros(size, size)).collect();

@@ -195,6 +195,7 @@ macro_rules! omega_parameter {
 }
 
 mod condensed;
+mod coupled_rows;
 mod disk;
 mod friction;
 mod jacobian;
@@ -202,6 +203,7 @@ mod krylov;
 mod laws;
 mod neighbour;
 mod penalty;
+mod penalty_disk;
 mod ssn;
 mod structured;
 

@@ -16,6 +16,7 @@ use semismooth::{EvaluationError, GeneralizedJacobian, ProblemCounters, Residual
 
 use super::friction::FrictionPeriod;
 use super::jacobian::{ContactCoupling, HbJacobian};
+use super::penalty_disk::{disk_widths, DiskSamples};
 use super::{
     check_len, check_positive, displacement_summary, row_samples, validate_basis, HbError, HbState,
     LinearData, ResponseSummary,
@@ -49,6 +50,24 @@ fn static_slips(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
             } else {
                 c
             }
+        })
+        .collect()
+}
+
+/// The static compliance `C_tt` of the first tangent row of each frictional contact of
+/// `model` (`1 / (g_t K g_t^T)` when `K` cannot be factored).
+fn disk_compliances(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
+    let m = lin.contacts();
+    let compliance = model.static_contact_compliance();
+    lin.frictional
+        .iter()
+        .map(|(first, contact)| {
+            let t = first + contact.row_count() - 2;
+            compliance
+                .as_ref()
+                .map(|c| c[t * m + t])
+                .filter(|c| c.is_finite() && *c > 0.0)
+                .unwrap_or_else(|| 1.0 / lin.rows[t].quadratic_form(&model.stiffness))
         })
         .collect()
 }
@@ -140,6 +159,13 @@ pub struct PenaltyHb {
     /// The regularised laws' force and slope samples (`Nt` each).
     force: Vec<f64>,
     slope: Vec<f64>,
+    /// The static compliance `C_tt` of each frictional contact's first tangent row.
+    disk_compliance: Vec<f64>,
+    /// The band `eta` of each frictional contact's regularised disk law
+    /// ([`super::penalty_disk`]).
+    pub(super) disk_eta: Vec<f64>,
+    /// Samples of one frictional contact (reused).
+    pub(super) disk_samples: DiskSamples,
 }
 
 impl PenaltyHb {
@@ -163,10 +189,6 @@ impl PenaltyHb {
         Ok(u)
     }
 
-    /// No sliding obstacle in penalty harmonic balance (it refuses frictional contacts):
-    /// nothing to add to `dR/dw`.
-    pub(crate) fn add_sliding_omega_derivative(&mut self, _x: &[f64], _out: &mut [f64]) {}
-
     /// Builds the problem at the forcing frequency `omega` (finite, `> 0`); validates the
     /// model, the frequency and the options.
     pub fn new(
@@ -177,12 +199,6 @@ impl PenaltyHb {
         options.validate()?;
         super::check_omega(omega)?;
         let kp = options.penalty_stiffness;
-        if !model.frictional_contacts.is_empty() {
-            return Err(HbError::Unsupported {
-                formulation: "penalty harmonic balance",
-                what: "frictional contacts (the Coulomb disk; use ssn-hb)",
-            });
-        }
         if model
             .friction
             .iter()
@@ -196,6 +212,7 @@ impl PenaltyHb {
         }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
         let static_slip = static_slips(model, &linear);
+        let disk_compliance = disk_compliances(model, &linear);
         let nt = linear.basis.time_samples();
         let mut problem = Self {
             state: HbState::new(linear, omega),
@@ -206,6 +223,9 @@ impl PenaltyHb {
             static_slip,
             force: vec![0.0; nt],
             slope: vec![0.0; nt],
+            disk_compliance,
+            disk_eta: Vec::new(),
+            disk_samples: DiskSamples::default(),
         };
         problem.set_friction_regularisation(DEFAULT_FRICTION_REGULARISATION)?;
         Ok(problem)
@@ -220,6 +240,7 @@ impl PenaltyHb {
             "a finite width > 0 relative to the static slip mu N C_tt",
         )?;
         self.eta = self.static_slip.iter().map(|s| relative * s).collect();
+        self.disk_eta = disk_widths(&self.state.linear, &self.disk_compliance, relative);
         Ok(())
     }
 
@@ -429,6 +450,7 @@ impl Residual for PenaltyHb {
                 lin.add_row_transpose(i, *c, out, j);
             }
         }
+        self.add_frictional_residual(u, out);
         Ok(())
     }
 
@@ -479,7 +501,7 @@ impl GeneralizedJacobian for PenaltyHb {
                 self.state.write_weighted_contact_block(jac, i);
             }
         }
-        Ok(())
+        self.write_frictional_jacobian(u, jac)
     }
 }
 

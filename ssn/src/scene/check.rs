@@ -658,12 +658,16 @@ impl Check<'_> {
 
     /// A scene with friction is solved by the methods that model it: `ssn-hb` and `march`
     /// (exact Coulomb friction), and `penalty-hb` (regularised friction) when every
-    /// friction point has a prescribed normal load.
+    /// friction point has a prescribed normal load (3-D frictional contacts: any normal
+    /// law).
     fn friction_method(&self, solver: &SolverSettings, m: &ModelSpec) -> Result<(), SceneError> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
         if !m.frictional_contacts.is_empty()
-            && !matches!(solver.method, Method::SsnHb | Method::March)
+            && !matches!(
+                solver.method,
+                Method::SsnHb | Method::March | Method::PenaltyHb
+            )
         {
             return Err(self.invalid(
                 "solver.method",
@@ -672,7 +676,8 @@ impl Check<'_> {
                     solver.method.name(),
                     m.frictional_contacts.len()
                 ),
-                "\"ssn-hb\" or \"march\" (the Coulomb disk of 3-D frictional contacts)",
+                "\"ssn-hb\" or \"march\" (the Coulomb disk of 3-D frictional contacts), or \
+                 \"penalty-hb\" (its regularised vector law)",
             ));
         }
         let allowed = match solver.method.friction() {

@@ -48,9 +48,12 @@ impl StructuredHbSolver {
         let Some((lin, _)) = &self.factored_for else {
             return Err(LinearSolveError::NotFactored);
         };
-        let diagonal = lin.laws.diagonal.iter().map(|&block| &self.q[block]);
-        self.contact_blocks
-            .factor(diagonal, &self.receptance_diagonal, c)?;
+        self.contact_blocks.factor(
+            (&self.coupled_rows, &lin.laws),
+            (&self.q, &self.cross),
+            &self.unit_receptance,
+            c,
+        )?;
         self.schur_factorizations += 1;
         self.schur_ready = true;
         Ok(())
@@ -148,7 +151,7 @@ impl StructuredHbSolver {
                 rhs: &mut self.work_b,
             })
         } else {
-            CondensedPreconditioner::Blocks(&mut self.contact_blocks)
+            CondensedPreconditioner::Blocks(&mut self.contact_blocks, &self.coupled_rows)
         };
         let mut operator = CondensedOperator {
             dynamic,

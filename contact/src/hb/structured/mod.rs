@@ -32,6 +32,7 @@ use faer::{c64, Conj, Mat, MatMut, Par};
 use semismooth::linalg::{check_pivots, Gmres, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
 use semismooth::{Factorize, LinearSolve};
 
+use super::coupled_rows::CoupledRows;
 use super::jacobian::{ContactCoupling, HbJacobian};
 use super::krylov::{ContactBlocks, KRYLOV_THRESHOLD, RECEPTANCE_BLOCK};
 use super::laws::{copy_blocks, LawLayout};
@@ -133,8 +134,11 @@ pub struct StructuredHbSolver {
     gmres: Gmres,
     krylov_absolute_tolerance: f64,
     krylov_iterations: u64,
-    /// `R_k,ii` at index `k m + i` (matrix-free path).
-    receptance_diagonal: Vec<c64>,
+    /// The units of rows coupled by their laws (matrix-free path).
+    coupled_rows: CoupledRows,
+    /// `R_k[a, b]` between the rows of each unit at index `k E + entry(a, b)` of
+    /// `coupled_rows` (matrix-free path).
+    unit_receptance: Vec<c64>,
     contact_blocks: ContactBlocks,
     block_rhs: Mat<c64>,
     /// Matrix-free path: `schur` holds the LU of the dense condensed matrix of a recent
@@ -198,7 +202,8 @@ impl StructuredHbSolver {
             gmres: Gmres::new(),
             krylov_absolute_tolerance: 0.0,
             krylov_iterations: 0,
-            receptance_diagonal: Vec::new(),
+            coupled_rows: CoupledRows::default(),
+            unit_receptance: Vec::new(),
             contact_blocks: ContactBlocks::default(),
             block_rhs: Mat::zeros(0, 0),
             dense_preconditioner: false,
@@ -289,7 +294,8 @@ impl StructuredHbSolver {
         self.work_res = Vec::with_capacity(n * size + nc);
         (self.q, self.cross) = lin.laws.zero_blocks(size);
         if self.krylov {
-            self.receptance_diagonal = vec![c64::new(0.0, 0.0); (h + 1) * m];
+            self.coupled_rows = CoupledRows::new(&lin.laws, m);
+            self.unit_receptance = vec![c64::new(0.0, 0.0); (h + 1) * self.coupled_rows.entries()];
             self.block_rhs = Mat::zeros(n, RECEPTANCE_BLOCK.min(m));
             self.response.clear();
             self.receptance.clear();
@@ -317,13 +323,16 @@ impl StructuredHbSolver {
         dynamic.factor(&jac.parameters)?;
         for k in 0..=lin.basis.harmonics() {
             if self.krylov {
-                // R_k,ii only.
-                let diagonal = &mut self.receptance_diagonal;
+                // R_k[a, i] between the rows of each unit only.
+                let (rows, store) = (&self.coupled_rows, &mut self.unit_receptance);
+                let entries = rows.entries();
                 receptance_columns(dynamic, &lin, k, &mut self.block_rhs, |first, z| {
                     for j in 0..z.ncols() {
                         let i = first + j;
-                        diagonal[k * lin.contacts() + i] =
-                            lin.measured(i, k, lin.row_complex(i, k, z, j));
+                        for &a in &rows.units[rows.place[i].0] {
+                            store[k * entries + rows.entry(a, i)] =
+                                lin.measured(a, k, lin.row_complex(a, k, z, j));
+                        }
                     }
                 })?;
                 continue;
@@ -560,8 +569,10 @@ impl StructuredHbSolver {
                 for r in 0..nc {
                     self.work_a[r] = self.work_b[(r, 0)];
                 }
-                // dU = w - k_p A^{-1} G^T Q y.
+                // dU = w - k_p A^{-1} G^T (Q + X) y.
                 lin.laws.apply_q(&self.q, m, &self.work_a, &mut self.work_c);
+                lin.laws
+                    .apply_x_add(&self.cross, m, &self.work_a, &mut self.work_c);
                 self.add_response(&self.work_c, -stiffness, &mut w);
                 rhs.copy_from_slice(&w);
             }
@@ -594,6 +605,8 @@ impl StructuredHbSolver {
                 lin.laws.apply_x_add(&self.cross, m, x_l, out_l);
             }
             ContactCoupling::Penalty { stiffness } => {
+                lin.laws
+                    .apply_x_add(&self.cross, m, &self.work_a, &mut self.work_c);
                 lin.scatter_rows(&self.work_c, stiffness, out);
             }
         }
@@ -795,29 +808,51 @@ pub(crate) fn condensed_matrix(
                 complementarity_columns(receptance, qab, (a, b), (c, m), out.as_mut());
             }
             ContactCoupling::Penalty { stiffness } => {
-                // Column (l, b) of Q is Q_ab[:, l] on row a: S e += k_p R_{:, a} Q_ab[:, l].
-                for l in 0..size {
-                    let col = l * m + b;
-                    for i in 0..m {
-                        let r0 = receptance[0][(i, a)].re;
-                        out[(i, col)] += stiffness * r0 * qab[(0, l)];
-                        for (kk, rk) in receptance.iter().enumerate().skip(1) {
-                            let (jc, js) = (2 * kk - 1, 2 * kk);
-                            let r = rk[(i, a)];
-                            let (pc, ps) = (qab[(jc, l)], qab[(js, l)]);
-                            out[(jc * m + i, col)] += stiffness * (r.re * pc + r.im * ps);
-                            out[(js * m + i, col)] += stiffness * (-r.im * pc + r.re * ps);
-                        }
-                    }
-                }
+                penalty_columns(receptance, qab, (a, b), (stiffness, m), out.as_mut());
             }
         }
     }
-    for col in 0..m * size {
-        out[(col, col)] += 1.0;
+    match coupling {
+        ContactCoupling::Complementarity { .. } => {
+            for col in 0..m * size {
+                out[(col, col)] += 1.0;
+            }
+            layout.add_x_dense(cross, m, out);
+        }
+        ContactCoupling::Penalty { stiffness } => {
+            // A penalty law's slope on the rows it reads enters as Q does.
+            for (xas, &(a, s)) in cross.iter().zip(&layout.x_pairs) {
+                penalty_columns(receptance, xas, (a, s), (stiffness, m), out.as_mut());
+            }
+            for col in 0..m * size {
+                out[(col, col)] += 1.0;
+            }
+        }
     }
-    if let ContactCoupling::Complementarity { .. } = coupling {
-        layout.add_x_dense(cross, m, out);
+}
+
+/// Adds the columns `l m + b` of `k_p R B` for the block `B` between rows `a` and `b`
+/// (column `(l, b)` of `B` is `B[:, l]` on row `a`: `S e += k_p R_{:, a} B[:, l]`).
+fn penalty_columns(
+    receptance: &[Mat<c64>],
+    block: &Mat<f64>,
+    (a, b): (usize, usize),
+    (stiffness, m): (f64, usize),
+    mut out: MatMut<'_, f64>,
+) {
+    for l in 0..block.ncols() {
+        let col = l * m + b;
+        for i in 0..m {
+            let r0 = receptance[0][(i, a)].re;
+            out[(i, col)] += stiffness * r0 * block[(0, l)];
+            for (kk, rk) in receptance.iter().enumerate().skip(1) {
+                let (jc, js) = (2 * kk - 1, 2 * kk);
+                let r = rk[(i, a)];
+                let (pc, ps) = (block[(jc, l)], block[(js, l)]);
+                out[(jc * m + i, col)] += stiffness * (r.re * pc + r.im * ps);
+                out[(js * m + i, col)] += stiffness * (-r.im * pc + r.re * ps);
+            }
+        }
     }
 }
 
