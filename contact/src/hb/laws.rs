@@ -133,8 +133,8 @@ impl LawLayout {
     /// `semismooth::Smoothing`): the larger of `c e` with `e` the gaps' extent `max_a
     /// reach_a` and the largest slip limit under a prescribed load. Without `reach`, a
     /// row's reach is its gap `|o_a|`; with it, `min(|o_a|, reach(a))` where `reach(a) > 0`
-    /// (how far the row's measured quantity moves in a reached state): a stop beyond the
-    /// motion is blurred only over the motion.
+    /// (how far the row's measured quantity moves in the response with every contact force
+    /// zero): a stop beyond that motion is blurred only over the motion.
     pub(crate) fn smoothing_scale(&self, c: f64, reach: Option<&dyn Fn(usize) -> f64>) -> f64 {
         let within = |row: usize, gap: f64| match reach.map(|reach| reach(row)) {
             Some(r) if r > 0.0 => gap.min(r),
