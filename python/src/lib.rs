@@ -16,7 +16,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
@@ -28,7 +27,7 @@ use ssn::study::{Case, RunKind};
 use ssn::work::Workload;
 
 use convert::{python_json, python_value, toml_value};
-use errors::{bad_input, run_failure, RunFailure};
+use errors::{bad_input, bad_type, run_failure, RunFailure};
 use results::{FrequencyResponse, Solution, SolutionSet, Stability};
 
 /// The path of a scene built in Python from matrices (its `[model]` file names are keys of
@@ -61,21 +60,13 @@ impl Scene {
         values
             .iter()
             .map(|(k, v)| {
-                let py = k.py();
                 let key: String = k.extract().map_err(|_| {
-                    PyTypeError::new_err(format!(
+                    bad_type(format!(
                         "scene key {}: allowed a str such as \"forcing.amplitude\"",
                         k.repr().map_or_else(|_| "?".into(), |r| r.to_string())
                     ))
                 })?;
-                let value = toml_value(&v).map_err(|e| {
-                    let message = format!("`{key}`: {}", e.value(py));
-                    if e.is_instance_of::<PyTypeError>(py) {
-                        PyTypeError::new_err(message)
-                    } else {
-                        PyValueError::new_err(message)
-                    }
-                })?;
+                let value = toml_value(&v, &key)?;
                 Override::new(&key, value).map_err(bad_input)
             })
             .collect()
@@ -150,7 +141,9 @@ impl Scene {
     /// other key is refused); optional damping matrix `damping`; any other scene key in `values`
     /// (`damping.zeta`, `forcing.amplitude` (default 1), `forcing.omega_ratio`,
     /// `solver.harmonics`, `output.dof` (1-based, as in scene files), ...). The checks of
-    /// an imported model apply (symmetry, sizes, a nonsingular stiffness).
+    /// an imported model apply (symmetry, sizes, a nonsingular stiffness); what a scene file
+    /// refuses in a contact is refused naming the contact by its 0-based index (`SceneError`,
+    /// `SceneTypeError` for a value of the wrong type).
     #[staticmethod]
     #[pyo3(signature = (mass, stiffness, load, contacts = None, damping = None, values = None))]
     fn from_matrices(
@@ -197,15 +190,18 @@ impl Scene {
         forcing.insert("amplitude".into(), 1.0.into());
         table.insert("forcing".into(), toml::Value::Table(forcing));
         if let Some(contacts) = contacts {
-            let list: Vec<Bound<'_, PyDict>> =
-                helpers.call_method1("contacts", (contacts,))?.extract()?;
+            let list: Vec<Bound<'_, PyDict>> = helpers
+                .call_method1("contacts", (contacts, matrices[Path::new("K.mtx")].nrows()))?
+                .extract()?;
             if !list.is_empty() {
                 let points: Vec<toml::Value> = list
                     .iter()
                     .map(|point| {
                         let mut p = toml::Table::new();
                         for (k, v) in point.iter() {
-                            p.insert(k.extract()?, toml_value(&v)?);
+                            let key: String = k.extract()?;
+                            let value = toml_value(&v, &format!("contact.point.{key}"))?;
+                            p.insert(key, value);
                         }
                         Ok(toml::Value::Table(p))
                     })
