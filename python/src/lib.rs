@@ -156,31 +156,26 @@ impl Scene {
         values: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Scene> {
         let helpers = py.import("ssn._convert")?;
+        type Coo = (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>);
+        let parts: Vec<(String, Coo)> = helpers
+            .call_method1("parts", (mass, stiffness, load, damping))?
+            .extract()?;
         let mut matrices = BTreeMap::new();
-        let mut read =
-            |name: &str, argument: &str, what: &Bound<'_, PyAny>, vector: bool| -> PyResult<()> {
-                let coo = helpers.call_method1("coo", (what, vector, argument))?;
-                let (rows, cols, i, j, v): (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>) =
-                    coo.extract()?;
-                let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
-                    .iter()
-                    .zip(&j)
-                    .zip(&v)
-                    .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
-                    .collect();
-                let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
-                    .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
-                matrices.insert(PathBuf::from(name), matrix);
-                Ok(())
-            };
-        read("M.mtx", "mass", mass, false)?;
-        read("K.mtx", "stiffness", stiffness, false)?;
-        read("f.mtx", "load", load, true)?;
+        for (name, (rows, cols, i, j, v)) in parts {
+            let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
+                .iter()
+                .zip(&j)
+                .zip(&v)
+                .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
+                .collect();
+            let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
+                .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
+            matrices.insert(PathBuf::from(name), matrix);
+        }
         let mut model = toml::Table::new();
         model.insert("mass".into(), "M.mtx".into());
         model.insert("stiffness".into(), "K.mtx".into());
-        if let Some(d) = damping {
-            read("D.mtx", "damping", d, false)?;
+        if damping.is_some() {
             model.insert("damping".into(), "D.mtx".into());
         }
         let mut table = toml::Table::new();

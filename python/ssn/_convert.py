@@ -293,3 +293,71 @@ def contacts(items, dofs):
             _check_pair(k, point, out)
         out.append(point)
     return out
+
+
+#: Largest relative asymmetry ``|a_ij - a_ji| / max |a|`` of a mass or stiffness matrix (as
+#: for an imported model: round-off).
+SYMMETRY_TOLERANCE = 1e-9
+
+
+def _summed(n, i, j, v):
+    """The entries ``(i, j, v)`` of an ``n``-column matrix with duplicates summed, as sorted
+    keys ``i n + j`` and their values."""
+    keys, inverse = np.unique(np.asarray(i) * n + np.asarray(j), return_inverse=True)
+    values = np.zeros(len(keys))
+    np.add.at(values, inverse, v)
+    return keys, values
+
+
+def _check_symmetric(name, n, i, j, v):
+    """Refuses a matrix with ``|a_ij - a_ji| > SYMMETRY_TOLERANCE max |a|``, naming the
+    first such entry 0-based."""
+    keys, values = _summed(n, i, j, v)
+    if len(keys) == 0:
+        return
+    rows, cols = keys // n, keys % n
+    transposed_keys = cols * n + rows
+    at = np.minimum(np.searchsorted(keys, transposed_keys), len(keys) - 1)
+    transposed = np.where(keys[at] == transposed_keys, values[at], 0.0)
+    tolerance = SYMMETRY_TOLERANCE * np.abs(values).max()
+    bad = np.flatnonzero(np.abs(values - transposed) > tolerance)
+    if len(bad):
+        k = bad[0]
+        r, c = int(rows[k]), int(cols[k])
+        raise SceneError(
+            f"{name}: not symmetric: entry ({r}, {c}) (0-based) = {values[k]:e} but ({c}, {r}) "
+            f"= {transposed[k]:e}: allowed |a_ij - a_ji| <= {tolerance:e} (relative "
+            f"{SYMMETRY_TOLERANCE:e} of the largest entry)"
+        )
+    diagonal = np.flatnonzero((rows == cols) & (values < 0.0))
+    if name == "mass" and len(diagonal):
+        d = int(rows[diagonal[0]])
+        raise SceneError(
+            f"mass: entry ({d}, {d}) (0-based) = {values[diagonal[0]]:e}: allowed >= 0 (0: a "
+            "massless dof)"
+        )
+
+
+def parts(mass, stiffness, load, damping=None):
+    """The model's parts as ``[(file name, coo)]`` (``coo`` as :func:`coo` gives it), after
+    the checks of an imported model that name an entry, here 0-based with the argument's
+    name: sizes (``stiffness`` N x N, ``mass`` and ``damping`` as ``stiffness``, ``load`` of
+    length N), symmetry of ``mass`` and ``stiffness``, a mass diagonal >= 0."""
+    k = coo(stiffness, name="stiffness")
+    n = k[0]
+    if k[1] != n or n == 0:
+        raise SceneError(f"stiffness: shape ({k[0]}, {k[1]}): allowed N x N with N >= 1")
+    f = coo(load, True, "load")
+    if f[0] != n:
+        raise SceneError(f"load: length {f[0]}: allowed {n} (one entry per dof of the stiffness)")
+    square = [("M.mtx", "mass", coo(mass, name="mass")), ("K.mtx", "stiffness", k)]
+    if damping is not None:
+        square.append(("D.mtx", "damping", coo(damping, name="damping")))
+    for _, name, (rows, cols, i, j, v) in square:
+        if (rows, cols) != (n, n):
+            raise SceneError(
+                f"{name}: shape ({rows}, {cols}): allowed ({n}, {n}), the stiffness' shape"
+            )
+        if name != "damping":
+            _check_symmetric(name, n, i, j, v)
+    return [(file, matrix) for file, _, matrix in square] + [("f.mtx", f)]

@@ -211,3 +211,26 @@ def test_rows_nested_without_end_or_containing_themselves_are_refused_with_their
     for row in [itself, deep]:
         refused(ssn.SceneTypeError, "contact 0: row", contacts=[{"row": row, "gap": 0.1}])
         refused(ssn.SceneTypeError, "contact 0: dof", contacts=[(row, 0.1)])
+
+
+def test_matrices_the_model_refuses_are_named_by_argument_with_0_based_entries():
+    """The checks of an imported model that name an entry (symmetry, a negative mass, the
+    sizes) name the argument and the entry 0-based, as numpy indexes it (a scene file's
+    `K.mtx` would say entry (1, 2))."""
+    refused(
+        ssn.SceneError, "stiffness: not symmetric", "entry (0, 1) (0-based)",
+        stiffness=np.array([[2.0, -1.0], [0.0, 1.0]]),
+    )
+    # Within the import's tolerance (1e-9 of the largest entry): accepted, as from a file.
+    nearly = K + np.array([[0.0, 1e-10], [0.0, 0.0]])
+    ssn.Scene.from_matrices(M, nearly, F, values={"damping.zeta": 0.02})
+    refused(ssn.SceneError, "mass: entry (1, 1) (0-based)", ">= 0", mass=np.diag([1.0, -1.0]))
+    refused(ssn.SceneError, "load: length 3", "allowed 2", load=np.ones(3))
+    refused(ssn.SceneError, "mass: shape (3, 3)", "allowed (2, 2)", mass=np.eye(3))
+    refused(ssn.SceneError, "damping: shape (2, 3)", damping=np.ones((2, 3)))
+    refused(ssn.SceneError, "stiffness: shape (2, 3)", stiffness=np.ones((2, 3)))
+    # The names of the in-memory files never reach the user.
+    for bad in [{"mass": np.eye(3)}, {"load": np.ones(3)}, {"stiffness": np.triu(K)}]:
+        with pytest.raises(ssn.SceneError) as raised:
+            ssn.Scene.from_matrices(**({"mass": M, "stiffness": K, "load": F} | bad))
+        assert ".mtx" not in str(raised.value), str(raised.value)
