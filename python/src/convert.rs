@@ -28,7 +28,11 @@ fn nested_toml_value(value: &Bound<'_, PyAny>, key: &str, depth: usize) -> PyRes
         return Ok(toml::Value::Boolean(value.extract()?));
     }
     if value.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(value.extract()?));
+        return value.extract().map(toml::Value::Integer).map_err(|_| {
+            bad_input(format!(
+                "`{key}`: the integer {value}: allowed integers of magnitude below 2^63"
+            ))
+        });
     }
     if value.is_instance_of::<PyFloat>() {
         return Ok(toml::Value::Float(value.extract()?));

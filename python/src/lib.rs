@@ -52,11 +52,22 @@ impl Scene {
         Ok(Scene { source })
     }
 
-    /// The overrides of a `{key: value}` mapping, in its order.
-    fn overrides(values: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<Override>> {
+    /// The overrides of a `{key: value}` dict, in its order; anything else than a dict is
+    /// refused as `SceneTypeError`.
+    fn overrides(values: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
         let Some(values) = values else {
             return Ok(Vec::new());
         };
+        let values = values.cast::<PyDict>().map_err(|_| {
+            bad_type(format!(
+                "values: a {}: allowed a dict from scene keys (such as forcing.amplitude) \
+                 to values",
+                values
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".into(), |n| n.to_string())
+            ))
+        })?;
         values
             .iter()
             .map(|(k, v)| {
@@ -104,7 +115,7 @@ impl Scene {
         mass: String,
         zeta: Option<f64>,
         omega_ratio: f64,
-        values: Option<&Bound<'_, PyDict>>,
+        values: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Scene> {
         let mut table = toml::Table::new();
         let section = |pairs: Vec<(&str, toml::Value)>| {
@@ -153,7 +164,7 @@ impl Scene {
         load: &Bound<'_, PyAny>,
         contacts: Option<&Bound<'_, PyAny>>,
         damping: Option<&Bound<'_, PyAny>>,
-        values: Option<&Bound<'_, PyDict>>,
+        values: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Scene> {
         let helpers = py.import("ssn._convert")?;
         type Coo = (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>);
@@ -218,7 +229,7 @@ impl Scene {
 
     /// A copy with scene keys set (`{"forcing.amplitude": 0.1, "contact.gap": 0.3}`: the
     /// keys of `ssn solve --set`, checked as in a scene file).
-    fn with_values(&self, values: &Bound<'_, PyDict>) -> PyResult<Scene> {
+    fn with_values(&self, values: &Bound<'_, PyAny>) -> PyResult<Scene> {
         Scene::checked(self.source.with(&Scene::overrides(Some(values))?))
     }
 
@@ -446,7 +457,7 @@ fn run_case(
     py: Python<'_>,
     scene: &Scene,
     index: usize,
-    values: &Bound<'_, PyDict>,
+    values: &Bound<'_, PyAny>,
     run: &str,
 ) -> PyResult<String> {
     let kind = RunKind::from_name(run).ok_or_else(|| {

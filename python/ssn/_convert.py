@@ -17,6 +17,8 @@ def _real(a, name):
     """``a`` as a float array; a complex array is refused (its imaginary part would be lost)."""
     try:
         complex_values = np.iscomplexobj(a)
+        if np.asarray(a).dtype == bool:
+            raise TypeError("booleans")
         if not complex_values:
             return np.asarray(a, dtype=float)
     except (TypeError, ValueError, RecursionError) as e:

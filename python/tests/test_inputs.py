@@ -234,3 +234,16 @@ def test_matrices_the_model_refuses_are_named_by_argument_with_0_based_entries()
         with pytest.raises(ssn.SceneError) as raised:
             ssn.Scene.from_matrices(**({"mass": M, "stiffness": K, "load": F} | bad))
         assert ".mtx" not in str(raised.value), str(raised.value)
+
+
+def test_values_that_are_not_a_dict_or_out_of_range_integers_are_scene_errors():
+    rod = ssn.Scene.rod()
+    with pytest.raises(ssn.SceneTypeError, match="values: a list: allowed a dict"):
+        rod.with_values([("forcing.amplitude", 0.1)])
+    with pytest.raises(ssn.SceneTypeError, match="values: a list: allowed a dict"):
+        ssn.Scene.from_matrices(M, K, F, values=[1])
+    with pytest.raises(ssn.SceneError, match="`rod.elements`: the integer 2361183241434822606848"):
+        rod.with_values({"rod.elements": 2**71})
+    # Booleans are not numbers of a matrix or a row (as they are no dof).
+    refused(ssn.SceneTypeError, "contact 0: row", contacts=[{"row": [True, False], "gap": 0.1}])
+    refused(ssn.SceneTypeError, "mass", mass=np.eye(2, dtype=bool))
