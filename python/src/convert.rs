@@ -1,8 +1,9 @@
 //! Conversions between Python objects and the scene's TOML values and the JSON documents.
 
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+
+use crate::errors::{bad_input, bad_type};
 
 /// Deepest nesting of lists in a scene value (a scene key takes a number, a list of them,
 /// or a list of such lists): deeper is refused before it can exhaust the stack, which a
@@ -10,23 +11,28 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 pub const MAX_VALUE_DEPTH: usize = 8;
 
 /// A Python value as a TOML value: bool, int, float, str, and lists or tuples (or numpy
-/// arrays, through `tolist()`) of them, nested at most [`MAX_VALUE_DEPTH`] deep.
-pub fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
-    nested_toml_value(value, 0)
+/// arrays, through `tolist()`) of them, nested at most [`MAX_VALUE_DEPTH`] deep. `key`
+/// names the value in the `SceneError` (`SceneTypeError` for a wrong type) that refuses it.
+pub fn toml_value(value: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    nested_toml_value(value, key, 0)
 }
 
-fn nested_toml_value(value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Value> {
+fn nested_toml_value(value: &Bound<'_, PyAny>, key: &str, depth: usize) -> PyResult<toml::Value> {
     if depth > MAX_VALUE_DEPTH {
-        return Err(PyValueError::new_err(format!(
-            "lists nested more than {MAX_VALUE_DEPTH} deep (or a list that contains itself): \
-             allowed a number, a string, a bool or a list of them"
+        return Err(bad_input(format!(
+            "`{key}`: lists nested more than {MAX_VALUE_DEPTH} deep (or a list that contains \
+             itself): allowed a number, a string, a bool or a list of them"
         )));
     }
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.extract()?));
     }
     if value.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(value.extract()?));
+        return value.extract().map(toml::Value::Integer).map_err(|_| {
+            bad_input(format!(
+                "`{key}`: the integer {value}: allowed integers of magnitude below 2^63"
+            ))
+        });
     }
     if value.is_instance_of::<PyFloat>() {
         return Ok(toml::Value::Float(value.extract()?));
@@ -38,7 +44,7 @@ fn nested_toml_value(value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::V
         let items: Vec<Bound<'_, PyAny>> = value.try_iter()?.collect::<PyResult<_>>()?;
         return items
             .iter()
-            .map(|item| nested_toml_value(item, depth + 1))
+            .map(|item| nested_toml_value(item, key, depth + 1))
             .collect::<PyResult<Vec<_>>>()
             .map(toml::Value::Array);
     }
@@ -46,11 +52,11 @@ fn nested_toml_value(value: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::V
     if value.hasattr("tolist")? {
         let plain = value.call_method0("tolist")?;
         if !plain.is(value) {
-            return nested_toml_value(&plain, depth + 1);
+            return nested_toml_value(&plain, key, depth + 1);
         }
     }
-    Err(PyTypeError::new_err(format!(
-        "a scene value must be a bool, int, float, str or a list of them, not {}",
+    Err(bad_type(format!(
+        "`{key}`: a value of type {}: allowed a bool, int, float, str or a list of them",
         value.get_type().name()?
     )))
 }

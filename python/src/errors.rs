@@ -42,6 +42,11 @@ pub(crate) fn bad_input(e: impl std::fmt::Display) -> PyErr {
     exception("SceneError", e.to_string(), Vec::new())
 }
 
+/// A value of the wrong type as `SceneTypeError` (a `SceneError` and a `TypeError`).
+pub(crate) fn bad_type(e: impl std::fmt::Display) -> PyErr {
+    exception("SceneTypeError", e.to_string(), Vec::new())
+}
+
 /// Why a run of a scene failed: the scene could not be loaded (the command line's
 /// [`CliError`]), the library refused or could not carry out the computation, or a result
 /// that needs a converged solve did not get one.

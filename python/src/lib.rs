@@ -16,7 +16,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
@@ -28,7 +27,7 @@ use ssn::study::{Case, RunKind};
 use ssn::work::Workload;
 
 use convert::{python_json, python_value, toml_value};
-use errors::{bad_input, run_failure, RunFailure};
+use errors::{bad_input, bad_type, run_failure, RunFailure};
 use results::{FrequencyResponse, Solution, SolutionSet, Stability};
 
 /// The path of a scene built in Python from matrices (its `[model]` file names are keys of
@@ -53,29 +52,32 @@ impl Scene {
         Ok(Scene { source })
     }
 
-    /// The overrides of a `{key: value}` mapping, in its order.
-    fn overrides(values: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<Override>> {
+    /// The overrides of a `{key: value}` dict, in its order; anything else than a dict is
+    /// refused as `SceneTypeError`.
+    fn overrides(values: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
         let Some(values) = values else {
             return Ok(Vec::new());
         };
+        let values = values.cast::<PyDict>().map_err(|_| {
+            bad_type(format!(
+                "values: a {}: allowed a dict from scene keys (such as forcing.amplitude) \
+                 to values",
+                values
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".into(), |n| n.to_string())
+            ))
+        })?;
         values
             .iter()
             .map(|(k, v)| {
-                let py = k.py();
                 let key: String = k.extract().map_err(|_| {
-                    PyTypeError::new_err(format!(
+                    bad_type(format!(
                         "scene key {}: allowed a str such as \"forcing.amplitude\"",
                         k.repr().map_or_else(|_| "?".into(), |r| r.to_string())
                     ))
                 })?;
-                let value = toml_value(&v).map_err(|e| {
-                    let message = format!("`{key}`: {}", e.value(py));
-                    if e.is_instance_of::<PyTypeError>(py) {
-                        PyTypeError::new_err(message)
-                    } else {
-                        PyValueError::new_err(message)
-                    }
-                })?;
+                let value = toml_value(&v, &key)?;
                 Override::new(&key, value).map_err(bad_input)
             })
             .collect()
@@ -113,7 +115,7 @@ impl Scene {
         mass: String,
         zeta: Option<f64>,
         omega_ratio: f64,
-        values: Option<&Bound<'_, PyDict>>,
+        values: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Scene> {
         let mut table = toml::Table::new();
         let section = |pairs: Vec<(&str, toml::Value)>| {
@@ -150,7 +152,9 @@ impl Scene {
     /// other key is refused); optional damping matrix `damping`; any other scene key in `values`
     /// (`damping.zeta`, `forcing.amplitude` (default 1), `forcing.omega_ratio`,
     /// `solver.harmonics`, `output.dof` (1-based, as in scene files), ...). The checks of
-    /// an imported model apply (symmetry, sizes, a nonsingular stiffness).
+    /// an imported model apply (symmetry, sizes, a nonsingular stiffness); what a scene file
+    /// refuses in a contact is refused naming the contact by its 0-based index (`SceneError`,
+    /// `SceneTypeError` for a value of the wrong type).
     #[staticmethod]
     #[pyo3(signature = (mass, stiffness, load, contacts = None, damping = None, values = None))]
     fn from_matrices(
@@ -160,34 +164,29 @@ impl Scene {
         load: &Bound<'_, PyAny>,
         contacts: Option<&Bound<'_, PyAny>>,
         damping: Option<&Bound<'_, PyAny>>,
-        values: Option<&Bound<'_, PyDict>>,
+        values: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Scene> {
         let helpers = py.import("ssn._convert")?;
+        type Coo = (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>);
+        let parts: Vec<(String, Coo)> = helpers
+            .call_method1("parts", (mass, stiffness, load, damping))?
+            .extract()?;
         let mut matrices = BTreeMap::new();
-        let mut read =
-            |name: &str, argument: &str, what: &Bound<'_, PyAny>, vector: bool| -> PyResult<()> {
-                let coo = helpers.call_method1("coo", (what, vector, argument))?;
-                let (rows, cols, i, j, v): (usize, usize, Vec<usize>, Vec<usize>, Vec<f64>) =
-                    coo.extract()?;
-                let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
-                    .iter()
-                    .zip(&j)
-                    .zip(&v)
-                    .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
-                    .collect();
-                let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
-                    .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
-                matrices.insert(PathBuf::from(name), matrix);
-                Ok(())
-            };
-        read("M.mtx", "mass", mass, false)?;
-        read("K.mtx", "stiffness", stiffness, false)?;
-        read("f.mtx", "load", load, true)?;
+        for (name, (rows, cols, i, j, v)) in parts {
+            let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = i
+                .iter()
+                .zip(&j)
+                .zip(&v)
+                .map(|((&i, &j), &v)| faer::sparse::Triplet::new(i, j, v))
+                .collect();
+            let matrix = SparseMatrix::try_new_from_triplets(rows, cols, &triplets)
+                .map_err(|e| bad_input(format!("{name}: {e:?}")))?;
+            matrices.insert(PathBuf::from(name), matrix);
+        }
         let mut model = toml::Table::new();
         model.insert("mass".into(), "M.mtx".into());
         model.insert("stiffness".into(), "K.mtx".into());
-        if let Some(d) = damping {
-            read("D.mtx", "damping", d, false)?;
+        if damping.is_some() {
             model.insert("damping".into(), "D.mtx".into());
         }
         let mut table = toml::Table::new();
@@ -197,15 +196,18 @@ impl Scene {
         forcing.insert("amplitude".into(), 1.0.into());
         table.insert("forcing".into(), toml::Value::Table(forcing));
         if let Some(contacts) = contacts {
-            let list: Vec<Bound<'_, PyDict>> =
-                helpers.call_method1("contacts", (contacts,))?.extract()?;
+            let list: Vec<Bound<'_, PyDict>> = helpers
+                .call_method1("contacts", (contacts, matrices[Path::new("K.mtx")].nrows()))?
+                .extract()?;
             if !list.is_empty() {
                 let points: Vec<toml::Value> = list
                     .iter()
                     .map(|point| {
                         let mut p = toml::Table::new();
                         for (k, v) in point.iter() {
-                            p.insert(k.extract()?, toml_value(&v)?);
+                            let key: String = k.extract()?;
+                            let value = toml_value(&v, &format!("contact.point.{key}"))?;
+                            p.insert(key, value);
                         }
                         Ok(toml::Value::Table(p))
                     })
@@ -227,7 +229,7 @@ impl Scene {
 
     /// A copy with scene keys set (`{"forcing.amplitude": 0.1, "contact.gap": 0.3}`: the
     /// keys of `ssn solve --set`, checked as in a scene file).
-    fn with_values(&self, values: &Bound<'_, PyDict>) -> PyResult<Scene> {
+    fn with_values(&self, values: &Bound<'_, PyAny>) -> PyResult<Scene> {
         Scene::checked(self.source.with(&Scene::overrides(Some(values))?))
     }
 
@@ -455,7 +457,7 @@ fn run_case(
     py: Python<'_>,
     scene: &Scene,
     index: usize,
-    values: &Bound<'_, PyDict>,
+    values: &Bound<'_, PyAny>,
     run: &str,
 ) -> PyResult<String> {
     let kind = RunKind::from_name(run).ok_or_else(|| {

@@ -14,6 +14,7 @@ use semismooth_contact::reduction::{
 use semismooth_contact::rod::natural_frequencies;
 use ssn::work::Workload;
 
+use crate::errors::bad_input;
 use crate::Scene;
 
 /// A structure: mass, stiffness, damping, contacts, load and observed dof, as a scene builds
@@ -79,7 +80,7 @@ impl Model {
             (Some(n), None) => ModeCount::Count(n),
             (None, Some(w)) if w.is_finite() && w > 0.0 => ModeCount::Below(w),
             _ => {
-                return Err(PyValueError::new_err(format!(
+                return Err(bad_input(format!(
                     "modes = {modes:?}, cutoff = {cutoff:?}: allowed one of them, `modes` a \
                      count or `cutoff` a finite angular frequency > 0"
                 )))
@@ -91,7 +92,7 @@ impl Model {
             "craig-bampton" => craig_bampton,
             "massless-boundary" => massless_boundary,
             other => {
-                return Err(PyValueError::new_err(format!(
+                return Err(bad_input(format!(
                     "method {other:?}: allowed \"craig-bampton\" or \"massless-boundary\""
                 )))
             }

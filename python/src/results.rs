@@ -8,11 +8,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use serde_json::{json, Value};
 
-use pyo3::exceptions::PyValueError;
 use semismooth_contact::model::{CyclicCoupling, Structure};
 use semismooth_contact::solutions::SolutionSet as LibSolutionSet;
 use semismooth_contact::stability::Stability as LibStability;
 use semismooth_contact::sweep::FrequencyResponse as LibResponse;
+
+use crate::errors::bad_input;
 
 /// A result's document and arrays (name, shape, values in row-major order).
 #[derive(Debug, Clone)]
@@ -280,13 +281,13 @@ result_methods!(Solution, "Solution", {
             self.stored_array("observed_coefficients"),
             self.stored_array("times"),
         ) else {
-            return Err(PyValueError::new_err(
+            return Err(bad_input(
                 "blade_displacement: the solution is not a [cyclic] sector's harmonic balance",
             ));
         };
         let sectors = cyclic[0] as usize;
         if blade >= sectors {
-            return Err(PyValueError::new_err(format!(
+            return Err(bad_input(format!(
                 "blade_displacement: blade {blade}: allowed 0..{sectors} (the disk's sectors)"
             )));
         }

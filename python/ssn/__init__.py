@@ -21,6 +21,7 @@ The Python face of ``semismooth-contact`` and of the ``ssn`` program: the same s
 - ``Solution.termination_kind``: why the solve stopped, a ``Termination`` member;
 - exceptions by kind, all ``SsnError``: ``SceneError`` (a ``ValueError``): a bad scene,
   value or case, with the command line's message (file, key, value, what is allowed);
+  ``SceneTypeError`` (a ``SceneError`` and a ``TypeError``): a value of the wrong type;
   ``TooLargeError`` (a ``SceneError``): a run refused up front by its memory or work
   estimate; ``SolveError`` (a ``RuntimeError``): the computation could not be carried out,
   ``NotConvergedError`` (``termination``, ``iterations``, ``residual_norm``) among them.
@@ -43,6 +44,7 @@ from ._ssn import (
 from ._errors import (
     NotConvergedError,
     SceneError,
+    SceneTypeError,
     SolveError,
     SsnError,
     TooLargeError,
@@ -56,6 +58,7 @@ __all__ = [
     "NotConvergedError",
     "Scene",
     "SceneError",
+    "SceneTypeError",
     "Solution",
     "SolutionSet",
     "SolveError",

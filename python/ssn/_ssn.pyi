@@ -48,7 +48,9 @@ class Scene:
         several dofs (``"dof"`` instead of ``"row"``; ``"friction": mu`` with
         ``"tangent": T_row`` adds Coulomb friction; other keys are refused); other scene
         keys (``damping.zeta``, ``forcing.amplitude``, ``solver.harmonics``, ``output.dof``
-        (1-based), ...) in ``values``."""
+        (1-based), ...) in ``values``. Refusals are ``SceneError`` (``SceneTypeError`` for a
+        wrong type) naming the argument, the contact by its 0-based index and entries
+        0-based."""
     def with_values(self, values: Mapping[str, Value]) -> Scene:
         """A copy with scene keys set (the keys of ``ssn solve --set``)."""
     @property

@@ -136,3 +136,114 @@ def test_deep_keys_and_values_are_refused_without_exhausting_the_stack():
     itself.append(itself)
     with pytest.raises(ValueError, match="contains itself"):
         rod.with_values({"forcing.amplitude": itself})
+
+
+def test_every_refusal_of_a_python_input_is_a_scene_error_of_the_package():
+    """Bad values are ``ssn.SceneError``; values of the wrong type ``ssn.SceneTypeError``,
+    which is both a ``SceneError`` and a ``TypeError``."""
+    assert issubclass(ssn.SceneTypeError, ssn.SceneError)
+    assert issubclass(ssn.SceneTypeError, TypeError)
+    for kwargs in [
+        {"stiffness": K + 1e-3j * np.eye(2)},
+        {"load": np.ones((10, 2))},
+        {"mass": np.array([[np.nan, 0.0], [0.0, 1.0]])},
+        {"contacts": [(1.7, 0.1)]},
+        {"contacts": [(1, 0.1), (1, 0.2)]},
+        {"contacts": [{"dof": 1, "gap": 0.1, "friction": 0.3}]},
+    ]:
+        refused(ssn.SceneError, **kwargs)
+    for kwargs in [
+        {"contacts": [{"dof": "1", "gap": 0.1}]},
+        {"contacts": [(1, "0.1")]},
+        {"contacts": 5},
+        {"contacts": {"dof": 1, "gap": 0.1}},
+        {"mass": [[object(), 0.0], [0.0, 1.0]]},
+    ]:
+        refused(ssn.SceneTypeError, "allowed", **kwargs)
+    rod = ssn.Scene.rod()
+    with pytest.raises(ssn.SceneTypeError, match="`forcing.amplitude`.*allowed"):
+        rod.with_values({"forcing.amplitude": object()})
+    with pytest.raises(ssn.SceneTypeError, match="scene key 3: allowed"):
+        rod.with_values({3: 1.0})
+    itself = []
+    itself.append(itself)
+    with pytest.raises(ssn.SceneError, match="`forcing.amplitude`.*contains itself"):
+        rod.with_values({"forcing.amplitude": itself})
+
+
+def test_a_contact_the_matrices_refuse_is_named_by_its_python_index():
+    """Whatever a scene file would refuse in a contact is refused with the contact's 0-based
+    index and 0-based dofs (the second contact here: `contact 1`, never `contact 2` or
+    `entry 2` as the scene file's 1-based numbering would say)."""
+    good = (0, 0.1)
+    for bad, words in [
+        ((2, 0.1), ["dof 2", "from 0 to 1"]),
+        ({"row": [0.0, 0.0, 1.0], "gap": 0.1}, ["row", "3 entries", "allowed 2"]),
+        ((1, np.nan), ["gap nan", "finite"]),
+        ((1, 0.1, 2), ["direction 2", "allowed 1", "or -1"]),
+        ({"row": [1.0, -1.0], "gap": 0.1, "friction": -0.3, "tangent": [1.0, 1.0]},
+         ["friction -0.3", "mu >= 0"]),
+        ({"row": [1.0, -1.0], "gap": 0.1, "friction": 0.3, "tangent": [-2.0, 2.0]},
+         ["tangent parallel", "independent"]),
+        ({"row": [1.0, -1e200], "gap": 0.1}, ["row entry 1e+200", "<= 1e100"]),
+        ({"row": [1e-300, 0.0], "gap": 0.1}, ["row of Euclidean norm 1e-300", ">= 1e-100"]),
+    ]:
+        with pytest.raises(ssn.SceneError) as raised:
+            ssn.Scene.from_matrices(M, K, F, contacts=[good, bad])
+        message = str(raised.value)
+        assert message.startswith("contact 1: "), message
+        for word in words:
+            assert word in message, message
+        assert "contact 2" not in message and "entry 2" not in message, message
+    # Two stops on one dof with no room between them: both indices and the dof 0-based.
+    refused(
+        ssn.SceneError, "contacts 0 and 2", "dof 1 (0-based)", "clearance -0.1",
+        contacts=[(1, 0.1), good, (1, -0.2, -1)],
+    )
+
+
+def test_rows_nested_without_end_or_containing_themselves_are_refused_with_their_contact():
+    itself = [1.0]
+    itself.append(itself)
+    deep = 1.0
+    for _ in range(100_000):
+        deep = [deep]
+    for row in [itself, deep]:
+        refused(ssn.SceneTypeError, "contact 0: row", contacts=[{"row": row, "gap": 0.1}])
+        refused(ssn.SceneTypeError, "contact 0: dof", contacts=[(row, 0.1)])
+
+
+def test_matrices_the_model_refuses_are_named_by_argument_with_0_based_entries():
+    """The checks of an imported model that name an entry (symmetry, a negative mass, the
+    sizes) name the argument and the entry 0-based, as numpy indexes it (a scene file's
+    `K.mtx` would say entry (1, 2))."""
+    refused(
+        ssn.SceneError, "stiffness: not symmetric", "entry (0, 1) (0-based)",
+        stiffness=np.array([[2.0, -1.0], [0.0, 1.0]]),
+    )
+    # Within the import's tolerance (1e-9 of the largest entry): accepted, as from a file.
+    nearly = K + np.array([[0.0, 1e-10], [0.0, 0.0]])
+    ssn.Scene.from_matrices(M, nearly, F, values={"damping.zeta": 0.02})
+    refused(ssn.SceneError, "mass: entry (1, 1) (0-based)", ">= 0", mass=np.diag([1.0, -1.0]))
+    refused(ssn.SceneError, "load: length 3", "allowed 2", load=np.ones(3))
+    refused(ssn.SceneError, "mass: shape (3, 3)", "allowed (2, 2)", mass=np.eye(3))
+    refused(ssn.SceneError, "damping: shape (2, 3)", damping=np.ones((2, 3)))
+    refused(ssn.SceneError, "stiffness: shape (2, 3)", stiffness=np.ones((2, 3)))
+    # The names of the in-memory files never reach the user.
+    for bad in [{"mass": np.eye(3)}, {"load": np.ones(3)}, {"stiffness": np.triu(K)}]:
+        with pytest.raises(ssn.SceneError) as raised:
+            ssn.Scene.from_matrices(**({"mass": M, "stiffness": K, "load": F} | bad))
+        assert ".mtx" not in str(raised.value), str(raised.value)
+
+
+def test_values_that_are_not_a_dict_or_out_of_range_integers_are_scene_errors():
+    rod = ssn.Scene.rod()
+    with pytest.raises(ssn.SceneTypeError, match="values: a list: allowed a dict"):
+        rod.with_values([("forcing.amplitude", 0.1)])
+    with pytest.raises(ssn.SceneTypeError, match="values: a list: allowed a dict"):
+        ssn.Scene.from_matrices(M, K, F, values=[1])
+    with pytest.raises(ssn.SceneError, match="`rod.elements`: the integer 2361183241434822606848"):
+        rod.with_values({"rod.elements": 2**71})
+    # Booleans are not numbers of a matrix or a row (as they are no dof).
+    refused(ssn.SceneTypeError, "contact 0: row", contacts=[{"row": [True, False], "gap": 0.1}])
+    refused(ssn.SceneTypeError, "mass", mass=np.eye(2, dtype=bool))

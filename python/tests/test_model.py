@@ -49,3 +49,11 @@ def test_a_bad_method_or_mode_choice_is_refused(model):
         model.reduce(modes=4, cutoff=1.0)
     with pytest.raises(ValueError, match="one of them"):
         model.reduce()
+
+
+def test_a_bad_reduction_method_or_mode_count_is_a_scene_error():
+    model = ssn.Model.from_scene(ssn.Scene.rod(elements=4))
+    with pytest.raises(ssn.SceneError, match="method \"guyan\": allowed"):
+        model.reduce("guyan", modes=2)
+    with pytest.raises(ssn.SceneError, match="allowed one of them"):
+        model.reduce(modes=2, cutoff=1.0)
