@@ -185,3 +185,62 @@ fn an_accuracy_set_on_the_command_line_replaces_the_scenes_harmonics() {
     let message = String::from_utf8_lossy(&out.stderr);
     assert!(message.contains("solver.harmonics"), "{message}");
 }
+
+#[test]
+fn an_accuracy_just_below_the_smallest_allowed_is_refused_and_the_smallest_accepted() {
+    // The documented range starts at 1e-7: 9.999e-8 is outside it, 1e-7 inside.
+    let path = scene("below", "method = \"ssn-hb\"\naccuracy = 9.999e-8\n");
+    let (out, _) = solve_json(&path);
+    assert_eq!(out.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&out.stderr);
+    for word in ["solver.accuracy", "0.00000009999", "1e-7"] {
+        assert!(message.contains(word), "`{word}` in {message}");
+    }
+    // 1e-7 passes the key's check: whatever follows (the search's work limit or its
+    // outcome) does not name the key as invalid.
+    let out = Command::new(SSN)
+        .args(["solve", path.to_str().unwrap(), "--quiet"])
+        .args(["--set", "solver.accuracy=1e-7"])
+        .env("SSN_WORK_LIMIT", "1")
+        .output()
+        .unwrap();
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(!message.contains("invalid `solver.accuracy`"), "{message}");
+}
+
+#[test]
+fn an_accuracy_set_on_the_command_line_is_taken_by_every_shipped_hb_scene_and_says_what_it_replaces(
+) {
+    // Every shipped scene that sets `harmonics` (as `docs/sweeps.md` suggests) takes
+    // `--set solver.accuracy=1e-4`: its discretisation keys are replaced, and the output
+    // says which. A work limit of one operation stops each run after its scene is read, so
+    // no solve runs here (the solves to a target are checked above).
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&scenes).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        if path.extension().is_none_or(|e| e != "toml") || !text.contains("\nharmonics = ") {
+            continue;
+        }
+        let out = Command::new(SSN)
+            .args(["solve", path.to_str().unwrap()])
+            .args(["--set", "solver.accuracy=1e-4"])
+            .env("SSN_WORK_LIMIT", "1")
+            .output()
+            .unwrap();
+        let message = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !message.contains("given with solver.accuracy"),
+            "{}: {message}",
+            path.display()
+        );
+        assert!(
+            message.contains("--set solver.accuracy replaces the scene's solver.harmonics = "),
+            "{}: {message}",
+            path.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10, "{checked} scenes");
+}
