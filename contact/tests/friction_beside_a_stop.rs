@@ -139,7 +139,6 @@ fn the_friction_with_stop_grid_converges_from_zero_at_twenty_harmonics() {
                     c: solution.c,
                     harmonics: HARMONICS,
                     time_samples: Some(settings.time_samples),
-                    ..HbOptions::default()
                 };
                 let mut problem = SsnHb::new(&chain.model, omega, &options).expect("a problem");
                 let mut f = vec![0.0; problem.dim()];
