@@ -77,9 +77,22 @@ pub fn load_with(
     overrides: &[Override],
     workload: Workload,
 ) -> Result<Loaded, CliError> {
-    let scene =
-        Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
-    prepare(scene, workload, None)
+    prepare(scene_with(path, overrides)?, workload, None)
+}
+
+/// The scene at `path` with `overrides`; the file's discretisation keys an accuracy
+/// override replaced are said on standard error (unless `--quiet`).
+fn scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, CliError> {
+    let (scene, replaced) =
+        Scene::from_path_noting(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
+    if !replaced.is_empty() && !crate::io::quiet() {
+        eprintln!(
+            "note: --set solver.accuracy replaces the scene's {}: the accuracy target chooses \
+             the discretisation",
+            replaced.join(", ")
+        );
+    }
+    Ok(scene)
 }
 
 pub use crate::scene::MatrixSource;
@@ -102,9 +115,7 @@ pub fn load_keeping_reduction(
     overrides: &[Override],
     workload: Workload,
 ) -> Result<(Loaded, Option<CraigBampton>), CliError> {
-    let scene =
-        Scene::from_path_with(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
-    prepare_keeping_reduction(scene, workload, None)
+    prepare_keeping_reduction(scene_with(path, overrides)?, workload, None)
 }
 
 /// [`prepare`], and the scene's reduction when it has one (not for `Workload::Check`).

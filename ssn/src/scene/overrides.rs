@@ -118,9 +118,19 @@ impl Scene {
         path: impl AsRef<Path>,
         overrides: &[Override],
     ) -> Result<Scene, SceneError> {
+        Scene::from_toml_noting(text, path, overrides).map(|(scene, _)| scene)
+    }
+
+    /// [`Scene::from_toml_with`], and the file's discretisation keys an accuracy override
+    /// replaced, as `solver.harmonics = 20` (empty when none was).
+    pub fn from_toml_noting(
+        text: &str,
+        path: impl AsRef<Path>,
+        overrides: &[Override],
+    ) -> Result<(Scene, Vec<String>), SceneError> {
         let path = path.as_ref();
         if overrides.is_empty() {
-            return Scene::from_toml(text, path);
+            return Scene::from_toml(text, path).map(|scene| (scene, Vec::new()));
         }
         let mut document: toml::Table =
             toml::from_str(text).map_err(|e| SceneError::parse(path, e.to_string().trim_end()))?;
@@ -128,7 +138,7 @@ impl Scene {
             apply(&mut document, o)
                 .map_err(|reason| SceneError::parse(path, format!("--set {o}: {reason}")))?;
         }
-        drop_overridden_discretisation(&mut document, overrides);
+        let replaced = drop_overridden_discretisation(&mut document, overrides);
         let named = overrides
             .iter()
             .map(|o| format!("--set {o}"))
@@ -137,7 +147,7 @@ impl Scene {
         let raw: RawScene = document.try_into().map_err(|e| {
             SceneError::parse(path, format!("with {named}: {}", e.to_string().trim_end()))
         })?;
-        super::check::resolve(raw, path)
+        super::check::resolve(raw, path).map(|scene| (scene, replaced))
     }
 
     /// Reads a scene file and applies `overrides` ([`Scene::from_toml_with`]).
@@ -145,9 +155,17 @@ impl Scene {
         path: impl AsRef<Path>,
         overrides: &[Override],
     ) -> Result<Scene, SceneError> {
+        Scene::from_path_noting(path, overrides).map(|(scene, _)| scene)
+    }
+
+    /// Reads a scene file and applies `overrides` ([`Scene::from_toml_noting`]).
+    pub fn from_path_noting(
+        path: impl AsRef<Path>,
+        overrides: &[Override],
+    ) -> Result<(Scene, Vec<String>), SceneError> {
         let path = path.as_ref();
         let text = read_scene_text(path)?;
-        Scene::from_toml_with(&text, path, overrides)
+        Scene::from_toml_noting(&text, path, overrides)
     }
 }
 
@@ -162,8 +180,12 @@ const DISCRETISATION_KEYS: [&str; 3] = ["harmonics", "time_samples", "steps_per_
 
 /// An accuracy target given by override replaces the file's discretisation: the file's
 /// `solver.harmonics`, `time_samples` and `steps_per_period` are dropped unless an override
-/// sets them too (which the scene then refuses beside the target, as in a file).
-fn drop_overridden_discretisation(document: &mut toml::Table, overrides: &[Override]) {
+/// sets them too (which the scene then refuses beside the target, as in a file). Returns
+/// the keys dropped with their values (`solver.harmonics = 20`).
+fn drop_overridden_discretisation(
+    document: &mut toml::Table,
+    overrides: &[Override],
+) -> Vec<String> {
     let key = |o: &Override| {
         o.key
             .split('.')
@@ -172,16 +194,21 @@ fn drop_overridden_discretisation(document: &mut toml::Table, overrides: &[Overr
             .join(".")
     };
     let keys: Vec<String> = overrides.iter().map(key).collect();
+    let mut dropped = Vec::new();
     if !keys.iter().any(|k| k == "solver.accuracy") {
-        return;
+        return dropped;
     }
     if let Some(toml::Value::Table(solver)) = document.get_mut("solver") {
         for name in DISCRETISATION_KEYS {
-            if !keys.contains(&format!("solver.{name}")) {
-                solver.remove(name);
+            if keys.contains(&format!("solver.{name}")) {
+                continue;
+            }
+            if let Some(value) = solver.remove(name) {
+                dropped.push(format!("solver.{name} = {value}"));
             }
         }
     }
+    dropped
 }
 
 /// Sets `o.key` in `document`, creating the tables on its path; an index into an array of
