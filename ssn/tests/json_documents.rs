@@ -4,10 +4,11 @@ mod common;
 
 use semismooth_contact::rod::MassModel;
 use semismooth_contact::settings::{Method, SweepSettings};
-use semismooth_contact::sweep::frequency_response;
+use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
-#[test]
-fn sweep_json_has_the_documented_fields_one_entry_per_point() {
+/// The forced rod of fig. 2 (gap 0.5, load 0.04, consistent mass) swept by SSN-HB at
+/// `H = 3` over 0.8-1.2 `omega_1`.
+fn swept_rod() -> (semismooth_contact::model::Structure, FrequencyResponse) {
     let rod = common::fig2_rod_model(Some(0.5), 0.04, MassModel::Consistent);
     let r = frequency_response(
         &rod,
@@ -16,6 +17,12 @@ fn sweep_json_has_the_documented_fields_one_entry_per_point() {
         None,
     )
     .unwrap();
+    (rod, r)
+}
+
+#[test]
+fn sweep_json_has_the_documented_fields_one_entry_per_point() {
+    let (_, r) = swept_rod();
     assert!(r.converged(), "{}", r.termination);
     let v = ssn::json::response_json(&r);
     for key in common::json_fields::SWEEP {
@@ -29,14 +36,7 @@ fn sweep_json_has_the_documented_fields_one_entry_per_point() {
 
 #[test]
 fn sweep_and_solve_json_carry_omega_1_and_the_folds_in_its_units() {
-    let rod = common::fig2_rod_model(Some(0.5), 0.04, MassModel::Consistent);
-    let r = frequency_response(
-        &rod,
-        &common::sweep_solver(Method::SsnHb, 3),
-        &SweepSettings::new(0.8, 1.2),
-        None,
-    )
-    .unwrap();
+    let (rod, r) = swept_rod();
     let v = ssn::json::response_json(&r);
     assert_eq!(v["omega_1"].as_f64(), Some(rod.omega_1));
     assert!(!r.folds.is_empty(), "the forced rod folds in this window");
