@@ -8,7 +8,7 @@ use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
 /// The forced rod of fig. 2 (gap 0.5, load 0.04, consistent mass) swept by SSN-HB at
 /// `H = 3` over 0.8-1.2 `omega_1`.
-fn swept_rod() -> (semismooth_contact::model::Structure, FrequencyResponse) {
+fn swept_rod() -> (semismooth_contact::rod::RodModel, FrequencyResponse) {
     let rod = common::fig2_rod_model(Some(0.5), 0.04, MassModel::Consistent);
     let r = frequency_response(
         &rod,
