@@ -64,6 +64,24 @@ fn unknowns(model: &StructuralModel) -> usize {
     (model.dofs() + model.contact_count()) * (2 * HARMONICS + 1) + 2
 }
 
+/// Prints one row of the table; returns the seconds per corrector iteration.
+fn print_row(
+    solve: EpmcSolve,
+    elements: usize,
+    model: &StructuralModel,
+    branch: &Backbone,
+    seconds: f64,
+) -> f64 {
+    let iterations = branch.counters.corrector_iterations;
+    println!(
+        "| {solve:?} | {elements} | {} | {} | {iterations} | {seconds:.2} | {:.1} |",
+        unknowns(model),
+        branch.points.len(),
+        1e3 * seconds / iterations as f64
+    );
+    seconds / iterations as f64
+}
+
 fn main() {
     let (model, tip) = rod(100);
     println!(
@@ -73,14 +91,8 @@ fn main() {
     let mut runs = Vec::new();
     for solve in [EpmcSolve::Dense, EpmcSolve::Structured] {
         let (branch, seconds) = timed(&model, tip, 1.5, 1000, solve);
-        let iterations = branch.counters.corrector_iterations;
-        println!(
-            "| {solve:?} | 100 | {} | {} | {iterations} | {seconds:.2} | {:.1} |",
-            unknowns(&model),
-            branch.points.len(),
-            1e3 * seconds / iterations as f64
-        );
-        runs.push((branch, seconds / iterations as f64));
+        let per_iteration = print_row(solve, 100, &model, &branch, seconds);
+        runs.push((branch, per_iteration));
     }
     let difference = runs[0]
         .0
@@ -94,13 +106,7 @@ fn main() {
     linear_mode(&model, 1).expect("the rod has a first mode");
     let eigen_seconds = started.elapsed().as_secs_f64();
     let (branch, seconds) = timed(&model, tip, 1.5, 1000, EpmcSolve::Structured);
-    let iterations = branch.counters.corrector_iterations;
-    println!(
-        "| Structured | 2000 | {} | {} | {iterations} | {seconds:.2} | {:.1} |",
-        unknowns(&model),
-        branch.points.len(),
-        1e3 * seconds / iterations as f64
-    );
+    print_row(EpmcSolve::Structured, 2000, &model, &branch, seconds);
     println!(
         "\n100 elements: speed-up per iteration {:.0}, largest relative difference in w {difference:.1e}; \
          2000 elements: last point w = {:.4} at tip amplitude {:.3} ({:?}), its linear mode \

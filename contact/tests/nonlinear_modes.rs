@@ -618,13 +618,13 @@ fn friction_damped_beam_backbone_follows_the_describing_function_and_the_forced_
     // first carry at most 4e-3 of its velocity, so the differences are EPMC's truncation:
     // the slider's kinked motion (coefficients falling like k^-2) at H = 15. Measured
     // largest differences 8.4e-4 in w and 4.1e-2 in xi at H = 7, 4.2e-4 and 2.9e-2 at
-    // H = 15, at the onset of slip (a few a_s); beyond 10 a_s xi within 4e-3.
+    // H = 15, at the onset of slip (a few a_s); beyond 10 a_s xi within 4e-3 (6e-3 asserted).
     println!(
         "largest differences: w {:.1e}, xi {:.1e}; xi beyond 10 a_s {worst_sliding:.1e}",
         worst.0, worst.1
     );
     assert!(worst.0 < 1e-3 && worst.1 < 5e-2, "{worst:?}");
-    assert!(worst_sliding < 1e-2, "{worst_sliding}");
+    assert!(worst_sliding < 6e-3, "{worst_sliding}");
     let mut epmc = Epmc::new(&free, &options, 1, AmplitudeMeasure::Dof(tip)).unwrap();
     // Resonance amplitudes about 0.5 a_s (stuck), 3 a_s, 10 a_s and 40 a_s.
     for force in [0.06, 0.3, 1.0, 3.0] {
@@ -633,10 +633,10 @@ fn friction_damped_beam_backbone_follows_the_describing_function_and_the_forced_
         // The forced and the EPMC motions differ through the harmonics above the first
         // (share `higher` of the velocity, at most 4e-3) and through the uniform load's
         // drive of the other modes off resonance (the stuck level, higher = 0). Measured
-        // below 2.6e-5 in w and xi at every level.
+        // below 2.6e-5 in w and xi at every level (5e-5 asserted).
         println!("force {force}: dw {dw:.1e}, dxi {dxi:.1e}, higher {higher:.1e}");
         assert!(
-            dw < 1e-4 && dxi < 1e-4,
+            dw < 5e-5 && dxi < 5e-5,
             "F {force}: w {dw}, xi {dxi}, higher {higher}"
         );
     }
@@ -697,7 +697,7 @@ fn structured_epmc_solve_agrees_with_the_dense_lu_on_stop_and_friction_points() 
         assert!((&a - &b).norm_max() < 1e-13 * a.norm_max());
         // A right-hand side with every entry nonzero, solved both ways.
         let rhs: Vec<f64> = (0..len)
-            .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0)
+            .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.01)
             .collect();
         let (mut dense, mut structured) = (rhs.clone(), rhs.clone());
         let mut lu = FaerDenseLu::new();

@@ -73,7 +73,6 @@ const CELLS: &[(&[&str], usize, CellType)] = &[
 /// cells, and where each matrix row's displacement goes.
 #[derive(Debug, Clone)]
 pub struct MeshPicture {
-    labels: Vec<u64>,
     points: Vec<f64>,
     connectivity: Vec<u64>,
     offsets: Vec<u64>,
@@ -100,7 +99,6 @@ impl MeshPicture {
             .map(|(k, (n, _))| (*n, k))
             .collect();
         let mut picture = Self {
-            labels: sorted.iter().map(|(n, _)| *n).collect(),
             points: sorted.iter().flat_map(|(_, x)| *x).collect(),
             connectivity: Vec::new(),
             offsets: Vec::new(),
@@ -153,11 +151,6 @@ impl MeshPicture {
             picture.rows.push((row, 3 * k + nc.component as usize - 1));
         }
         Ok(picture)
-    }
-
-    /// Node labels, in the order of the points.
-    pub fn labels(&self) -> &[u64] {
-        &self.labels
     }
 
     /// The point vectors (3 per point) of the full model's displacement `u`.

@@ -196,8 +196,8 @@ fn an_accuracy_just_below_the_smallest_allowed_is_refused_and_the_smallest_accep
     for word in ["solver.accuracy", "0.00000009999", "1e-7"] {
         assert!(message.contains(word), "`{word}` in {message}");
     }
-    // 1e-7 passes the key's check: whatever follows (the search's work limit or its
-    // outcome) does not name the key as invalid.
+    // 1e-7 passes the key's check and reaches the work estimate, which a limit of one
+    // operation refuses (exit 2, naming the limit), not the key.
     let out = Command::new(SSN)
         .args(["solve", path.to_str().unwrap(), "--quiet"])
         .args(["--set", "solver.accuracy=1e-7"])
@@ -205,6 +205,8 @@ fn an_accuracy_just_below_the_smallest_allowed_is_refused_and_the_smallest_accep
         .output()
         .unwrap();
     let message = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{message}");
+    assert!(message.contains("SSN_WORK_LIMIT"), "{message}");
     assert!(!message.contains("invalid `solver.accuracy`"), "{message}");
 }
 

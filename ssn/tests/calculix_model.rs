@@ -16,24 +16,6 @@ fn fixture() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/calculix_cantilever")
 }
 
-/// The eigenvalues `omega^2` CalculiX printed in its `.dat` (EIGENVALUE OUTPUT, mode
-/// order).
-fn calculix_eigenvalues() -> Vec<f64> {
-    let dat = std::fs::read_to_string(fixture().join("cantilever_modes.dat")).unwrap();
-    let table = dat
-        .split("E I G E N V A L U E   O U T P U T")
-        .nth(1)
-        .unwrap();
-    let table = table.split("P A R T I C I P A T I O N").next().unwrap();
-    table
-        .lines()
-        .filter_map(|l| {
-            let w: Vec<&str> = l.split_whitespace().collect();
-            (w.len() == 5 && w[0].parse::<usize>().is_ok()).then(|| w[1].parse().unwrap())
-        })
-        .collect()
-}
-
 /// The 0-based row of `node.component` in the fixture's `.dof` file, read from its lines.
 fn dof_file_row(node: u64, component: u8) -> usize {
     let dof = std::fs::read_to_string(fixture().join("cantilever.dof")).unwrap();
@@ -50,7 +32,7 @@ fn natural_frequencies_of_the_read_matrices_are_those_calculix_printed() {
     let scene = Scene::from_path(fixture().join("cantilever.toml")).unwrap();
     let structure = build_imported(scene.model.as_ref().unwrap()).unwrap();
     assert_eq!(structure.model.dofs(), 216);
-    let printed = calculix_eigenvalues();
+    let printed = common::calculix_eigenvalues(&fixture().join("cantilever_modes.dat"));
     assert_eq!(printed.len(), 10);
     let ours = natural_frequencies(&structure.model, printed.len()).unwrap();
     for (k, (w, lambda)) in ours.iter().zip(&printed).enumerate() {

@@ -4,6 +4,8 @@
 //! dof are named by node and component. Every format, given or detected from the file
 //! names, gives the same structure, and its natural frequencies are those CalculiX printed.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use semismooth_contact::matrix_market::{build_imported, MatrixFormat};
@@ -52,29 +54,12 @@ fn imported(model: &str) -> Result<(Scene, Structure), String> {
     Ok((scene, structure))
 }
 
-/// The eigenvalues `omega^2` CalculiX printed for the beam (`beam_modes.dat`).
-fn calculix_eigenvalues() -> Vec<f64> {
-    let dat = std::fs::read_to_string(fixture_dir().join("beam_modes.dat")).unwrap();
-    let table = dat
-        .split("E I G E N V A L U E   O U T P U T")
-        .nth(1)
-        .unwrap();
-    let table = table.split("P A R T I C I P A T I O N").next().unwrap();
-    table
-        .lines()
-        .filter_map(|l| {
-            let w: Vec<&str> = l.split_whitespace().collect();
-            (w.len() == 5 && w[0].parse::<usize>().is_ok()).then(|| w[1].parse().unwrap())
-        })
-        .collect()
-}
-
 #[test]
 fn every_format_given_or_detected_gives_the_same_structure_and_calculix_frequencies() {
     let (_, reference) = imported(MODELS[0].0).unwrap();
     let model = &reference.model;
     assert_eq!(model.dofs(), 48);
-    let printed = calculix_eigenvalues();
+    let printed = common::calculix_eigenvalues(&fixture_dir().join("beam_modes.dat"));
     assert_eq!(printed.len(), 4);
     let ours = natural_frequencies(model, printed.len()).unwrap();
     for (k, (w, lambda)) in ours.iter().zip(&printed).enumerate() {

@@ -181,12 +181,12 @@ fn a_reduced_models_frames_recover_the_full_field_at_every_node() {
     }
     // Every node's recovered displacement against the full model's solve: the reduction's
     // error (16 modes: 2.7e-5 of the amplitude at the tip, docs/finite_element_models.md);
-    // the interior nodes, which the truncated modes move more, measured 2.2e-4: within 1e-3.
+    // the interior nodes, which the truncated modes move more, measured 2.2e-4: within 5e-4.
     eprintln!(
         "worst recovered displacement error / tip amplitude: {:.2e}",
         worst / amplitude
     );
-    assert!(worst < 1e-3 * amplitude, "{worst:e} of {amplitude:e}");
+    assert!(worst < 5e-4 * amplitude, "{worst:e} of {amplitude:e}");
     std::fs::remove_dir_all(dir).unwrap();
     std::fs::remove_dir_all(full_dir).unwrap();
 }

@@ -367,9 +367,7 @@ impl Smoothing for CondensedSsnHb {
         if self.stale {
             return self.full.smoothing_scale();
         }
-        let (m, y) = (self.full.contacts(), &self.contact_linear);
-        let reach = |row: usize| -> f64 { y[row..].iter().step_by(m).map(|v| v.abs()).sum() };
-        (self.full.state.linear.laws).smoothing_scale(self.full.c(), Some(&reach))
+        (self.full.state.linear.laws).smoothing_scale(self.full.c(), Some(&self.contact_linear))
     }
 
     fn set_smoothing(&mut self, mu: f64) {

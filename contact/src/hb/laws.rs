@@ -131,14 +131,20 @@ impl LawLayout {
 
     /// The polyalgorithm's smoothing scale `mu_0` for the penalty `c` (see
     /// `semismooth::Smoothing`): the larger of `c e` with `e` the gaps' extent `max_a
-    /// reach_a` and the largest slip limit under a prescribed load. Without `reach`, a
-    /// row's reach is its gap `|o_a|`; with it, `min(|o_a|, reach(a))` where `reach(a) > 0`
-    /// (how far the row's measured quantity moves in the response with every contact force
-    /// zero): a stop beyond that motion is blurred only over the motion.
-    pub(crate) fn smoothing_scale(&self, c: f64, reach: Option<&dyn Fn(usize) -> f64>) -> f64 {
-        let within = |row: usize, gap: f64| match reach.map(|reach| reach(row)) {
-            Some(r) if r > 0.0 => gap.min(r),
-            _ => gap,
+    /// reach_a` and the largest slip limit under a prescribed load. Without `linear`, a
+    /// row's reach is its gap `|o_a|`; with the measured coefficients `y` of the response
+    /// with every contact force zero (index `j m + a`), `min(|o_a|, sum_j |y_ja|)` where that
+    /// sum is positive: a stop beyond that motion is blurred only over the motion.
+    pub(crate) fn smoothing_scale(&self, c: f64, linear: Option<&[f64]>) -> f64 {
+        let m = self.offsets.len();
+        let within = |row: usize, gap: f64| {
+            let reach: f64 =
+                linear.map_or(0.0, |y| y[row..].iter().step_by(m).map(|v| v.abs()).sum());
+            if reach > 0.0 {
+                gap.min(reach)
+            } else {
+                gap
+            }
         };
         let extent = (self.offsets.iter().enumerate())
             .filter(|(_, o)| **o != 0.0)

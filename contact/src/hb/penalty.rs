@@ -25,21 +25,29 @@ use crate::contacts::FrictionReport;
 use crate::law::LawSamples;
 use crate::model::{NormalForce, StructuralModel};
 
-/// The static slip `b C_tt` of each friction point of `model` (`C_tt` the static compliance
-/// of its row; `1 / (g_t K g_t^T)` when `K` cannot be factored).
-fn static_slips(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
+/// The static compliance `C_ii` of row `i` from the contact rows' static compliance
+/// `compliance` (`m x m`, row-major), or `1 / (g_i K g_i^T)` when `K` could not be factored.
+fn row_compliance(
+    model: &StructuralModel,
+    lin: &LinearData,
+    compliance: Option<&[f64]>,
+    i: usize,
+) -> f64 {
     let m = lin.contacts();
-    let compliance = model.static_contact_compliance();
+    compliance
+        .map(|c| c[i * m + i])
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .unwrap_or_else(|| 1.0 / lin.rows[i].quadratic_form(&model.stiffness))
+}
+
+/// The static slip `b C_tt` of each friction point of `model` (`C_tt` its row's
+/// [`row_compliance`]).
+fn static_slips(model: &StructuralModel, lin: &LinearData, compliance: Option<&[f64]>) -> Vec<f64> {
     lin.friction
         .iter()
         .enumerate()
         .map(|(f, &(mu, normal))| {
-            let i = lin.normal_rows() + f;
-            let c = compliance
-                .as_ref()
-                .map(|c| c[i * m + i])
-                .filter(|c| c.is_finite() && *c > 0.0)
-                .unwrap_or_else(|| 1.0 / lin.rows[i].quadratic_form(&model.stiffness));
+            let c = row_compliance(model, lin, compliance, lin.normal_rows() + f);
             let b = match normal {
                 NormalForce::Prescribed(load) => mu * load,
                 NormalForce::Contact(_) => 0.0,
@@ -54,20 +62,17 @@ fn static_slips(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
         .collect()
 }
 
-/// The static compliance `C_tt` of the first tangent row of each frictional contact of
-/// `model` (`1 / (g_t K g_t^T)` when `K` cannot be factored).
-fn disk_compliances(model: &StructuralModel, lin: &LinearData) -> Vec<f64> {
-    let m = lin.contacts();
-    let compliance = model.static_contact_compliance();
+/// The static compliance `C_tt` ([`row_compliance`]) of the first tangent row of each
+/// frictional contact of `model`.
+fn disk_compliances(
+    model: &StructuralModel,
+    lin: &LinearData,
+    compliance: Option<&[f64]>,
+) -> Vec<f64> {
     lin.frictional
         .iter()
         .map(|(first, contact)| {
-            let t = first + contact.row_count() - 2;
-            compliance
-                .as_ref()
-                .map(|c| c[t * m + t])
-                .filter(|c| c.is_finite() && *c > 0.0)
-                .unwrap_or_else(|| 1.0 / lin.rows[t].quadratic_form(&model.stiffness))
+            row_compliance(model, lin, compliance, first + contact.row_count() - 2)
         })
         .collect()
 }
@@ -211,8 +216,10 @@ impl PenaltyHb {
             });
         }
         let linear = LinearData::new(model, options.harmonics, options.time_samples)?;
-        let static_slip = static_slips(model, &linear);
-        let disk_compliance = disk_compliances(model, &linear);
+        // One factorization of K for both: the contact rows' static compliance.
+        let compliance = model.static_contact_compliance();
+        let static_slip = static_slips(model, &linear, compliance.as_deref());
+        let disk_compliance = disk_compliances(model, &linear, compliance.as_deref());
         let nt = linear.basis.time_samples();
         let mut problem = Self {
             state: HbState::new(linear, omega),

@@ -364,17 +364,12 @@ impl Smoothing for SsnHb {
     /// row, the slip limits as they are (see `LawLayout::smoothing_scale`).
     fn smoothing_scale(&self) -> f64 {
         let lin = &self.state.linear;
-        match self.linear_response() {
-            Ok(u) => {
-                let reach = |row: usize| -> f64 {
-                    (0..lin.size())
-                        .map(|j| lin.measured_coefficient(row, &u, j).abs())
-                        .sum()
-                };
-                lin.laws.smoothing_scale(self.c, Some(&reach))
-            }
-            Err(_) => lin.laws.smoothing_scale(self.c, None),
-        }
+        let measured = self.linear_response().ok().map(|u| {
+            let mut y = vec![0.0; lin.contacts() * lin.size()];
+            lin.gather_measured(&u, &mut y);
+            y
+        });
+        lin.laws.smoothing_scale(self.c, measured.as_deref())
     }
 
     fn set_smoothing(&mut self, mu: f64) {

@@ -44,3 +44,21 @@ pub fn error_of_edited_scene(path: &Path, edit: impl Fn(String) -> String) -> St
         Err(e) => e.to_string(),
     }
 }
+
+/// The eigenvalues `omega^2` CalculiX printed in the `.dat` file `dat` (EIGENVALUE OUTPUT,
+/// mode order).
+pub fn calculix_eigenvalues(dat: &Path) -> Vec<f64> {
+    let dat = std::fs::read_to_string(dat).unwrap();
+    let table = dat
+        .split("E I G E N V A L U E   O U T P U T")
+        .nth(1)
+        .unwrap();
+    let table = table.split("P A R T I C I P A T I O N").next().unwrap();
+    table
+        .lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (w.len() == 5 && w[0].parse::<usize>().is_ok()).then(|| w[1].parse().unwrap())
+        })
+        .collect()
+}
