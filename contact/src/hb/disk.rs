@@ -107,19 +107,13 @@ impl SsnHb {
             aft.to_time(&coeffs, &mut out)?;
             Ok(out)
         };
-        let tangent = first + contact.row_count() - 2;
+        let (_, tangents) = contact.rows_from(*first);
         // Closed-law normal force (the unilateral projection), and the disk's radius from
         // the normal force series as the residual samples it.
         let (normal_force, radius) = match &contact.normal {
             NormalLaw::Unilateral { .. } => {
                 // c times the (moving) gap's coefficient j.
-                let harmonics = &lin.laws.offset_harmonics[*first];
-                let offset = |j: usize| match j {
-                    0 => c * lin.laws.offsets[*first],
-                    j => harmonics
-                        .get((j - 1) / 2)
-                        .map_or(0.0, |(a, b)| c * if j % 2 == 1 { *a } else { *b }),
-                };
+                let offset = |j: usize| c * lin.laws.offset_coefficient(*first, j);
                 let z = sample(&|j| {
                     lambda[j * m + first] - c * lin.measured_coefficient(*first, u, j) + offset(j)
                 })?;
@@ -137,8 +131,7 @@ impl SsnHb {
         };
         let mut argument = [Vec::new(), Vec::new()];
         let mut slip_velocity = [Vec::new(), Vec::new()];
-        for a in 0..2 {
-            let i = tangent + a;
+        for (a, i) in tangents.into_iter().enumerate() {
             let sliding = lin.laws.sliding[i];
             // The slip velocity relative to the obstacle, without the mean-slip anchor on
             // its constant; the argument with the obstacle's offset `s / w`.

@@ -45,6 +45,8 @@ pub(crate) struct LawLayout {
     pub(crate) x_pairs: Vec<(usize, usize)>,
     /// The index of `Q_aa` of each row.
     pub(crate) diagonal: Vec<usize>,
+    /// The index in `groups` of each row's group.
+    group_of_row: Vec<usize>,
     /// Whether each row measures a slip velocity.
     pub(crate) velocity: Vec<bool>,
     /// The rows that measure a slip velocity.
@@ -111,6 +113,7 @@ impl LawLayout {
             q_pairs: Vec::new(),
             x_pairs: Vec::new(),
             diagonal: Vec::with_capacity(total),
+            group_of_row: Vec::with_capacity(total),
             velocity: Vec::with_capacity(total),
             velocity_rows: Vec::new(),
             offsets: Vec::with_capacity(total),
@@ -167,6 +170,7 @@ impl LawLayout {
             }
             self.x_pairs.extend(law.reads().iter().map(|&s| (a, s)));
             self.velocity.push(velocity);
+            self.group_of_row.push(self.groups.len());
             if velocity {
                 self.velocity_rows.push(a);
             }
@@ -180,14 +184,37 @@ impl LawLayout {
         });
     }
 
+    /// The group owning row `a` and `a`'s index in it.
+    fn group_of(&self, a: usize) -> Option<(&RowGroup, usize)> {
+        let group = &self.groups[*self.group_of_row.get(a)?];
+        Some((group, a - group.first))
+    }
+
     /// The index of the block `Q_ab` (rows `a`, `b` of one group), if there is one.
     pub(crate) fn q_block(&self, a: usize, b: usize) -> Option<usize> {
-        self.q_pairs.iter().position(|&pair| pair == (a, b))
+        let (group, local) = self.group_of(a)?;
+        let k = group.law.rows();
+        let other = b.checked_sub(group.first).filter(|&b| b < k)?;
+        Some(group.q_first + local * k + other)
     }
 
     /// The index of the block `X_as` (row `a`'s law reading row `s`), if there is one.
     pub(crate) fn x_block(&self, a: usize, s: usize) -> Option<usize> {
-        self.x_pairs.iter().position(|&pair| pair == (a, s))
+        let (group, local) = self.group_of(a)?;
+        let reads = group.law.reads();
+        let read = reads.iter().position(|&r| r == s)?;
+        Some(group.x_first + local * reads.len() + read)
+    }
+
+    /// Coefficient `j` (`[a_0, a_1, b_1, a_2, b_2, ...]`) of row `row`'s offset `o_a`: the
+    /// constant offset, then the moving obstacle's harmonics (0 beyond them).
+    pub(crate) fn offset_coefficient(&self, row: usize, j: usize) -> f64 {
+        match j {
+            0 => self.offsets[row],
+            j => self.offset_harmonics[row]
+                .get((j - 1) / 2)
+                .map_or(0.0, |(a, b)| if j % 2 == 1 { *a } else { *b }),
+        }
     }
 
     /// `(2H + 1)`-square zero blocks for every `Q` block and every `X` block.
@@ -346,9 +373,8 @@ impl LawSampler {
                 *coeff = forces[j * m + row] - c * measured(row, j);
             }
             coeffs[0] += c * (lin.laws.offsets[row] + lin.laws.sliding[row] / omega);
-            for (k, (a, b)) in lin.laws.offset_harmonics[row].iter().enumerate() {
-                coeffs[2 * k + 1] += c * a;
-                coeffs[2 * k + 2] += c * b;
+            for j in 1..=2 * lin.laws.offset_harmonics[row].len() {
+                coeffs[j] += c * lin.laws.offset_coefficient(row, j);
             }
             aft.coefficients_to_samples();
             self.z[a * nt..(a + 1) * nt].copy_from_slice(aft.samples());

@@ -72,7 +72,7 @@ fn disk_compliances(
     lin.frictional
         .iter()
         .map(|(first, contact)| {
-            row_compliance(model, lin, compliance, first + contact.row_count() - 2)
+            row_compliance(model, lin, compliance, contact.rows_from(*first).1[0])
         })
         .collect()
 }

@@ -23,17 +23,16 @@ use super::disk::FrictionalContactReport;
 use super::jacobian::HbJacobian;
 use super::penalty::PenaltyHb;
 use super::{check_len, HbError, LinearData};
-use crate::model::{FrictionalContact, NormalLaw};
+use crate::model::NormalLaw;
 
 /// The regularised force of one sample (`normal` the force `N >= 0`, `y` the phase
-/// velocity, `eta` the band), and `d lambda / d y` (row-major 2 x 2).
-pub(crate) fn regularised_disk(
+/// velocity, `r = |y|`, `eta` the band), and `d lambda / d y` (row-major 2 x 2).
+fn regularised_disk(
     coefficient: f64,
     normal: f64,
-    y: [f64; 2],
+    (y, r): ([f64; 2], f64),
     eta: f64,
 ) -> ([f64; 2], [f64; 4]) {
-    let r = y[0].hypot(y[1]);
     let d = r.max(eta);
     let b = coefficient * normal;
     let force = [-b * y[0] / d, -b * y[1] / d];
@@ -54,21 +53,26 @@ pub(crate) fn regularised_disk(
 }
 
 /// One frictional contact's samples on a grid: the normal force `N >= 0`, whether the
-/// penalty spring acts, and the two phase velocities.
+/// penalty spring acts, the two phase velocities and, once [`DiskSamples::evaluate_law`]
+/// ran, their norm `|y|`, the regularised force and its slope `d lambda / d y` (row-major
+/// 2 x 2). The buffers are reused from call to call.
 #[derive(Debug, Default)]
 pub(crate) struct DiskSamples {
     normal: Vec<f64>,
     closed: Vec<bool>,
     y: [Vec<f64>; 2],
+    speed: Vec<f64>,
+    force: [Vec<f64>; 2],
+    slope: [Vec<f64>; 4],
 }
 
-/// The rows of a frictional contact that starts at `first`: its normal row (when
-/// unilateral) and its two tangent rows.
-fn disk_rows(first: usize, contact: &FrictionalContact) -> (Option<usize>, [usize; 2]) {
-    match contact.normal {
-        NormalLaw::Unilateral { .. } => (Some(first), [first + 1, first + 2]),
-        NormalLaw::Prescribed(_) => (None, [first, first + 1]),
+/// Writes the samples of the series whose coefficient `j` is `coefficient(j)` into `aft`'s
+/// samples.
+fn to_samples(aft: &mut Aft, coefficient: impl Fn(usize) -> f64) {
+    for (j, c) in aft.coefficients_mut().iter_mut().enumerate() {
+        *c = coefficient(j);
     }
+    aft.coefficients_to_samples();
 }
 
 impl DiskSamples {
@@ -82,64 +86,72 @@ impl DiskSamples {
         (kp, omega): (f64, f64),
     ) {
         let (first, contact) = &lin.frictional[p];
-        let (normal, tangents) = disk_rows(*first, contact);
+        let (normal, tangents) = contact.rows_from(*first);
         let nt = aft.samples().len();
-        let series = |aft: &mut Aft, coefficient: &dyn Fn(usize) -> f64, out: &mut Vec<f64>| {
-            for (j, c) in aft.coefficients_mut().iter_mut().enumerate() {
-                *c = coefficient(j);
-            }
-            aft.coefficients_to_samples();
-            out.clear();
-            out.extend_from_slice(aft.samples());
-        };
+        self.closed.clear();
+        self.normal.clear();
         match (normal, &contact.normal) {
-            (Some(n), NormalLaw::Unilateral { gap, .. }) => {
-                let harmonics = &lin.laws.offset_harmonics[n];
-                let offset = |j: usize| match j {
-                    0 => *gap,
-                    j => harmonics
-                        .get((j - 1) / 2)
-                        .map_or(0.0, |(a, b)| if j % 2 == 1 { *a } else { *b }),
-                };
-                let mut penetration = Vec::new();
-                series(aft, &|j| lin.row_dot(n, u, j) - offset(j), &mut penetration);
-                self.closed = penetration.iter().map(|s| *s > 0.0).collect();
-                self.normal = penetration.iter().map(|s| kp * s.max(0.0)).collect();
+            (Some(n), NormalLaw::Unilateral { .. }) => {
+                to_samples(aft, |j| {
+                    lin.row_dot(n, u, j) - lin.laws.offset_coefficient(n, j)
+                });
+                let penetration = aft.samples();
+                self.closed.extend(penetration.iter().map(|s| *s > 0.0));
+                self.normal
+                    .extend(penetration.iter().map(|s| kp * s.max(0.0)));
             }
             (_, NormalLaw::Prescribed(load)) => {
-                self.normal = vec![*load; nt];
-                self.closed = vec![true; nt];
+                self.normal.resize(nt, *load);
+                self.closed.resize(nt, true);
             }
             _ => {}
         }
         for (a, &t) in tangents.iter().enumerate() {
             let sliding = lin.laws.sliding[t];
-            let mut y = std::mem::take(&mut self.y[a]);
-            series(
-                aft,
-                &|j| match j {
-                    0 => -sliding / omega,
-                    j => lin.measured_coefficient(t, u, j),
-                },
-                &mut y,
-            );
-            self.y[a] = y;
+            to_samples(aft, |j| match j {
+                0 => -sliding / omega,
+                j => lin.measured_coefficient(t, u, j),
+            });
+            self.y[a].clear();
+            self.y[a].extend_from_slice(aft.samples());
         }
     }
 
-    /// The regularised force and its slope at sample `n` (band `eta`, coefficient `mu`).
-    fn law(&self, n: usize, mu: f64, eta: f64) -> ([f64; 2], [f64; 4]) {
-        regularised_disk(mu, self.normal[n], [self.y[0][n], self.y[1][n]], eta)
+    /// `|y|`, the regularised force and its slope at every sample (band `eta`, coefficient
+    /// `mu`): the law and its hypot evaluated once per sample.
+    fn evaluate_law(&mut self, mu: f64, eta: f64) {
+        let nt = self.normal.len();
+        let buffers = (self.force.iter_mut().chain(&mut self.slope)).chain([&mut self.speed]);
+        for values in buffers {
+            values.resize(nt, 0.0);
+        }
+        for n in 0..nt {
+            let y = [self.y[0][n], self.y[1][n]];
+            let r = y[0].hypot(y[1]);
+            let (force, slope) = regularised_disk(mu, self.normal[n], (y, r), eta);
+            self.speed[n] = r;
+            self.force[0][n] = force[0];
+            self.force[1][n] = force[1];
+            for (values, s) in self.slope.iter_mut().zip(slope) {
+                values[n] = s;
+            }
+        }
+    }
+
+    /// The number of samples where the penalty spring acts.
+    fn closed_count(&self) -> usize {
+        self.closed.iter().filter(|c| **c).count()
     }
 }
 
 impl PenaltyHb {
-    /// The samples of frictional contact `p` at `u` on the AFT's grid (in the reused
-    /// storage: give it back to `disk_samples`).
+    /// The samples of frictional contact `p` at `u` on the AFT's grid and its law at them
+    /// (in the reused storage: give it back to `disk_samples`).
     fn sampled(&mut self, lin: &LinearData, p: usize, u: &[f64]) -> DiskSamples {
         let (kp, omega) = (self.penalty_stiffness(), self.state.omega);
         let mut samples = std::mem::take(&mut self.disk_samples);
         samples.sample(&mut self.state.aft, (lin, p), u, (kp, omega));
+        samples.evaluate_law(lin.frictional[p].1.coefficient, self.disk_eta[p]);
         samples
     }
 
@@ -149,9 +161,8 @@ impl PenaltyHb {
         let lin = self.state.linear.clone();
         for p in 0..lin.frictional.len() {
             let (first, contact) = &lin.frictional[p];
-            let (normal, tangents) = disk_rows(*first, contact);
+            let (normal, tangents) = contact.rows_from(*first);
             let samples = self.sampled(&lin, p, u);
-            let eta = self.disk_eta[p];
             let mut add = |aft: &mut Aft, row: usize, value: &dyn Fn(usize) -> f64| {
                 for (n, s) in aft.samples_mut().iter_mut().enumerate() {
                     *s = value(n);
@@ -166,9 +177,7 @@ impl PenaltyHb {
                 add(&mut self.state.aft, n, &|k| samples.normal[k]);
             }
             for (a, &t) in tangents.iter().enumerate() {
-                add(&mut self.state.aft, t, &|k| {
-                    -samples.law(k, contact.coefficient, eta).0[a]
-                });
+                add(&mut self.state.aft, t, &|k| -samples.force[a][k]);
             }
             self.disk_samples = samples;
         }
@@ -186,7 +195,7 @@ impl PenaltyHb {
         let kp = self.penalty_stiffness();
         for p in 0..lin.frictional.len() {
             let (first, contact) = &lin.frictional[p];
-            let (normal, tangents) = disk_rows(*first, contact);
+            let (normal, tangents) = contact.rows_from(*first);
             let samples = self.sampled(&lin, p, u);
             let (eta, mu) = (self.disk_eta[p], contact.coefficient);
             let aft = &mut self.state.aft;
@@ -196,9 +205,10 @@ impl PenaltyHb {
                 }
                 aft.samples_multiplication_matrix(block);
             };
+            let active = samples.closed_count();
             if let Some(n) = normal {
                 let closed = |k: usize| if samples.closed[k] { 1.0 } else { 0.0 };
-                jac.active[n] = samples.closed.iter().filter(|c| **c).count();
+                jac.active[n] = active;
                 write(&mut jac.q[lin.laws.diagonal[n]], &closed);
                 for (a, &t) in tangents.iter().enumerate() {
                     let Some(x) = lin.laws.x_block(t, n) else {
@@ -206,21 +216,17 @@ impl PenaltyHb {
                     };
                     // -(d lambda_a / d s_n) / k_p = mu [s_n > 0] y_a / max(|y|, eta).
                     write(&mut jac.cross[x], &|k| {
-                        let (y0, y1) = (samples.y[0][k], samples.y[1][k]);
-                        let y = if a == 0 { y0 } else { y1 };
-                        mu * closed(k) * y / y0.hypot(y1).max(eta)
+                        mu * closed(k) * samples.y[a][k] / samples.speed[k].max(eta)
                     });
                 }
             }
             for (a, &ta) in tangents.iter().enumerate() {
-                jac.active[ta] = samples.closed.iter().filter(|c| **c).count();
+                jac.active[ta] = active;
                 for (b, &tb) in tangents.iter().enumerate() {
                     let Some(q) = lin.laws.q_block(ta, tb) else {
                         continue;
                     };
-                    write(&mut jac.q[q], &|k| {
-                        -samples.law(k, mu, eta).1[2 * a + b] / kp
-                    });
+                    write(&mut jac.q[q], &|k| -samples.slope[2 * a + b][k] / kp);
                 }
             }
             self.disk_samples = samples;
@@ -235,18 +241,17 @@ impl PenaltyHb {
         let omega = self.state.omega;
         for p in 0..lin.frictional.len() {
             let (first, contact) = &lin.frictional[p];
-            let (_, tangents) = disk_rows(*first, contact);
+            let (_, tangents) = contact.rows_from(*first);
             let rate = tangents.map(|t| lin.laws.sliding[t] / (omega * omega));
             if rate == [0.0; 2] {
                 continue;
             }
             let samples = self.sampled(&lin, p, u);
-            let eta = self.disk_eta[p];
             for (a, &t) in tangents.iter().enumerate() {
                 let aft = &mut self.state.aft;
+                let (along, across) = (&samples.slope[2 * a], &samples.slope[2 * a + 1]);
                 for (n, s) in aft.samples_mut().iter_mut().enumerate() {
-                    let slope = samples.law(n, contact.coefficient, eta).1;
-                    *s = -(slope[2 * a] * rate[0] + slope[2 * a + 1] * rate[1]);
+                    *s = -(along[n] * rate[0] + across[n] * rate[1]);
                 }
                 aft.samples_to_coefficients();
                 for (j, c) in aft.coefficients().iter().enumerate() {
@@ -308,14 +313,9 @@ impl PenaltyHb {
             };
         }
         let eta = self.disk_eta[p];
-        let mut force = [vec![0.0; points], vec![0.0; points]];
-        let mut stuck = vec![false; points];
-        for n in 0..points {
-            let (f, _) = samples.law(n, contact.coefficient, eta);
-            force[0][n] = f[0];
-            force[1][n] = f[1];
-            stuck[n] = samples.y[0][n].hypot(samples.y[1][n]) < eta;
-        }
+        samples.evaluate_law(contact.coefficient, eta);
+        let stuck = samples.speed.iter().map(|r| *r < eta).collect();
+        let force = std::mem::take(&mut samples.force);
         let velocity = samples.y.map(|y| y.iter().map(|v| omega * v).collect());
         let normal = samples.normal.iter().map(|n| -n).collect();
         Ok(FrictionalContactReport::from_series(

@@ -181,6 +181,13 @@ impl FrictionalContact {
         2 + usize::from(self.normal_row().is_some())
     }
 
+    /// Its rows of `G` when they start at `first`: the normal row (on a unilateral contact)
+    /// and the two tangent rows, the last two.
+    pub(crate) fn rows_from(&self, first: usize) -> (Option<usize>, [usize; 2]) {
+        let tangent = first + self.row_count() - 2;
+        (self.normal_row().map(|_| first), [tangent, tangent + 1])
+    }
+
     /// The offset of each of its rows in its law's argument: the gap on the normal row,
     /// 0 on the tangent rows.
     pub(crate) fn offsets(&self) -> Vec<f64> {
