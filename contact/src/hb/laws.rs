@@ -373,8 +373,9 @@ impl LawSampler {
                 *coeff = forces[j * m + row] - c * measured(row, j);
             }
             coeffs[0] += c * (lin.laws.offsets[row] + lin.laws.sliding[row] / omega);
-            for j in 1..=2 * lin.laws.offset_harmonics[row].len() {
-                coeffs[j] += c * lin.laws.offset_coefficient(row, j);
+            let moving = 2 * lin.laws.offset_harmonics[row].len();
+            for (j, coeff) in coeffs.iter_mut().enumerate().take(moving + 1).skip(1) {
+                *coeff += c * lin.laws.offset_coefficient(row, j);
             }
             aft.coefficients_to_samples();
             self.z[a * nt..(a + 1) * nt].copy_from_slice(aft.samples());

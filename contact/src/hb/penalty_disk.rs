@@ -54,16 +54,22 @@ fn regularised_disk(
 
 /// One frictional contact's samples on a grid: the normal force `N >= 0`, whether the
 /// penalty spring acts, the two phase velocities and, once [`DiskSamples::evaluate_law`]
-/// ran, their norm `|y|`, the regularised force and its slope `d lambda / d y` (row-major
-/// 2 x 2). The buffers are reused from call to call.
+/// ran, the law at each sample. The buffers are reused from call to call.
 #[derive(Debug, Default)]
 pub(crate) struct DiskSamples {
     normal: Vec<f64>,
     closed: Vec<bool>,
     y: [Vec<f64>; 2],
-    speed: Vec<f64>,
-    force: [Vec<f64>; 2],
-    slope: [Vec<f64>; 4],
+    law: Vec<LawSample>,
+}
+
+/// The regularised law at one sample: `|y|`, the force and its slope `d lambda / d y`
+/// (row-major 2 x 2).
+#[derive(Debug, Clone, Copy)]
+struct LawSample {
+    speed: f64,
+    force: [f64; 2],
+    slope: [f64; 4],
 }
 
 /// Writes the samples of the series whose coefficient `j` is `coefficient(j)` into `aft`'s
@@ -120,21 +126,16 @@ impl DiskSamples {
     /// `|y|`, the regularised force and its slope at every sample (band `eta`, coefficient
     /// `mu`): the law and its hypot evaluated once per sample.
     fn evaluate_law(&mut self, mu: f64, eta: f64) {
-        let nt = self.normal.len();
-        let buffers = (self.force.iter_mut().chain(&mut self.slope)).chain([&mut self.speed]);
-        for values in buffers {
-            values.resize(nt, 0.0);
-        }
-        for n in 0..nt {
+        self.law.clear();
+        for (n, normal) in self.normal.iter().enumerate() {
             let y = [self.y[0][n], self.y[1][n]];
-            let r = y[0].hypot(y[1]);
-            let (force, slope) = regularised_disk(mu, self.normal[n], (y, r), eta);
-            self.speed[n] = r;
-            self.force[0][n] = force[0];
-            self.force[1][n] = force[1];
-            for (values, s) in self.slope.iter_mut().zip(slope) {
-                values[n] = s;
-            }
+            let speed = y[0].hypot(y[1]);
+            let (force, slope) = regularised_disk(mu, *normal, (y, speed), eta);
+            self.law.push(LawSample {
+                speed,
+                force,
+                slope,
+            });
         }
     }
 
@@ -177,7 +178,7 @@ impl PenaltyHb {
                 add(&mut self.state.aft, n, &|k| samples.normal[k]);
             }
             for (a, &t) in tangents.iter().enumerate() {
-                add(&mut self.state.aft, t, &|k| -samples.force[a][k]);
+                add(&mut self.state.aft, t, &|k| -samples.law[k].force[a]);
             }
             self.disk_samples = samples;
         }
@@ -216,7 +217,7 @@ impl PenaltyHb {
                     };
                     // -(d lambda_a / d s_n) / k_p = mu [s_n > 0] y_a / max(|y|, eta).
                     write(&mut jac.cross[x], &|k| {
-                        mu * closed(k) * samples.y[a][k] / samples.speed[k].max(eta)
+                        mu * closed(k) * samples.y[a][k] / samples.law[k].speed.max(eta)
                     });
                 }
             }
@@ -226,7 +227,7 @@ impl PenaltyHb {
                     let Some(q) = lin.laws.q_block(ta, tb) else {
                         continue;
                     };
-                    write(&mut jac.q[q], &|k| -samples.slope[2 * a + b][k] / kp);
+                    write(&mut jac.q[q], &|k| -samples.law[k].slope[2 * a + b] / kp);
                 }
             }
             self.disk_samples = samples;
@@ -249,9 +250,8 @@ impl PenaltyHb {
             let samples = self.sampled(&lin, p, u);
             for (a, &t) in tangents.iter().enumerate() {
                 let aft = &mut self.state.aft;
-                let (along, across) = (&samples.slope[2 * a], &samples.slope[2 * a + 1]);
-                for (n, s) in aft.samples_mut().iter_mut().enumerate() {
-                    *s = -(along[n] * rate[0] + across[n] * rate[1]);
+                for (s, law) in aft.samples_mut().iter_mut().zip(&samples.law) {
+                    *s = -(law.slope[2 * a] * rate[0] + law.slope[2 * a + 1] * rate[1]);
                 }
                 aft.samples_to_coefficients();
                 for (j, c) in aft.coefficients().iter().enumerate() {
@@ -314,8 +314,8 @@ impl PenaltyHb {
         }
         let eta = self.disk_eta[p];
         samples.evaluate_law(contact.coefficient, eta);
-        let stuck = samples.speed.iter().map(|r| *r < eta).collect();
-        let force = std::mem::take(&mut samples.force);
+        let stuck = samples.law.iter().map(|law| law.speed < eta).collect();
+        let force = [0, 1].map(|a| samples.law.iter().map(|law| law.force[a]).collect());
         let velocity = samples.y.map(|y| y.iter().map(|v| omega * v).collect());
         let normal = samples.normal.iter().map(|n| -n).collect();
         Ok(FrictionalContactReport::from_series(
