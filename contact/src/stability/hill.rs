@@ -94,9 +94,18 @@ impl HillProblem<'_> {
     /// `k phi - 2 pi r / N` on harmonic `k`), each with its eigenvector's mean harmonic
     /// (`NaN` where the eigenvector is not finite: a repeated eigenvalue).
     pub(crate) fn family_exponents(&self, r: usize) -> Result<Vec<(f64, c64)>, StabilityError> {
+        self.family_exponents_on(r, &self.source_matrices())
+    }
+
+    /// [`HillProblem::family_exponents`] with the model's dense `[K, M, D]` built once.
+    fn family_exponents_on(
+        &self,
+        r: usize,
+        sources: &[Mat<c64>; 3],
+    ) -> Result<Vec<(f64, c64)>, StabilityError> {
         let (_, sectors) = families(self.model);
         let theta = 2.0 * PI * (r % sectors) as f64 / sectors as f64;
-        let (a, b) = self.pencil(theta);
+        let (a, b) = self.pencil(theta, sources);
         // Shift and invert: `C = (A - sigma B)^{-1} B` has the eigenvalues
         // `nu = 1 / (lambda - sigma)` with the same eigenvectors, the infinite `lambda` at
         // `nu = 0` (a standard Schur form, where the QZ iteration on this pencil's many
@@ -134,7 +143,16 @@ impl HillProblem<'_> {
     /// harmonic 0 (module documentation). `Err` when an eigenvector is not finite (a
     /// repeated eigenvalue whose copy cannot be told).
     pub(crate) fn family_multipliers(&self, r: usize) -> Result<Vec<(f64, f64)>, StabilityError> {
-        let exponents = self.family_exponents(r)?;
+        self.family_multipliers_on(r, &self.source_matrices())
+    }
+
+    /// [`HillProblem::family_multipliers`] with the model's dense `[K, M, D]` built once.
+    fn family_multipliers_on(
+        &self,
+        r: usize,
+        sources: &[Mat<c64>; 3],
+    ) -> Result<Vec<(f64, f64)>, StabilityError> {
+        let exponents = self.family_exponents_on(r, sources)?;
         if let Some(&(centre, _)) = exponents.iter().find(|(c, _)| !c.is_finite()) {
             return Err(StabilityError::InvalidOption {
                 name: "Hill eigenvector mean harmonic",
@@ -156,9 +174,10 @@ impl HillProblem<'_> {
     /// The multipliers of every family (module documentation).
     pub(crate) fn multipliers(&self) -> Result<Multipliers, StabilityError> {
         let (list, sectors) = families(self.model);
+        let sources = self.source_matrices();
         let mut values = Vec::new();
         for r in list {
-            let family = self.family_multipliers(r)?;
+            let family = self.family_multipliers_on(r, &sources)?;
             if r != 0 && 2 * r != sectors {
                 values.extend(family.iter().map(|&(re, im)| (re, -im)));
             }
@@ -167,8 +186,9 @@ impl HillProblem<'_> {
         Ok(Multipliers::from_values(values))
     }
 
-    /// `(A, B)` of the pencil `A x = lambda B x` of family phase `theta`.
-    fn pencil(&self, theta: f64) -> (Mat<c64>, Mat<c64>) {
+    /// `(A, B)` of the pencil `A x = lambda B x` of family phase `theta` (`sources` the
+    /// model's dense `[K, M, D]`).
+    fn pencil(&self, theta: f64, sources: &[Mat<c64>; 3]) -> (Mat<c64>, Mat<c64>) {
         let model = self.model;
         let (n, h) = (model.dofs(), self.harmonics as isize);
         let size = 2 * self.harmonics + 1;
@@ -181,10 +201,12 @@ impl HillProblem<'_> {
         let (v0, l0) = (n * size, 2 * n * size);
         let phase_step = model.cyclic.as_ref().map_or(0.0, |c| c.phase_step);
         let psi = |j: usize| (j as isize - h) as f64 * phase_step - theta;
+        let mut matrices = sources.clone();
         for j in 0..size {
             let ikw = c64::new(0.0, (j as isize - h) as f64 * self.omega);
             let (p, v) = (j * n, v0 + j * n);
-            let [k, mass, damping] = self.matrices(psi(j));
+            self.phased_matrices(sources, psi(j), &mut matrices);
+            let [k, mass, damping] = &matrices;
             for d in 0..n {
                 a[(p + d, v + d)] = c64::new(1.0, 0.0);
                 a[(p + d, p + d)] = -ikw;
@@ -203,12 +225,15 @@ impl HillProblem<'_> {
             let dft = switching_dft(&self.active[i], self.harmonics);
             let part = self.neighbour_part(i);
             // Row i of harmonic j (`g + e^{-i psi} n`) and its column of G^T (`g + e^{+i psi} n`).
-            let read = |j: usize| row_vector(row, part, n, c64::from_polar(1.0, -psi(j)));
-            let force = |j: usize| row_vector(row, part, n, c64::from_polar(1.0, psi(j)));
-            for kj in 0..size {
-                for lj in 0..size {
+            let reads: Vec<_> = (0..size)
+                .map(|j| row_vector(row, part, n, c64::from_polar(1.0, -psi(j))))
+                .collect();
+            let forces: Vec<_> = (0..size)
+                .map(|j| row_vector(row, part, n, c64::from_polar(1.0, psi(j))))
+                .collect();
+            for (kj, f) in forces.iter().enumerate() {
+                for (lj, g) in reads.iter().enumerate() {
                     let hd = dft[kj + size - 1 - lj];
-                    let g = read(lj);
                     match self.law {
                         ClosedLaw::Multiplier(c) => {
                             let row_index = l0 + kj * m + i;
@@ -218,7 +243,6 @@ impl HillProblem<'_> {
                             a[(row_index, l0 + lj * m + i)] -= hd;
                         }
                         ClosedLaw::Penalty(kp) => {
-                            let f = force(kj);
                             for (r, &fr) in f.iter().enumerate() {
                                 for (d, &gd) in g.iter().enumerate() {
                                     a[(v0 + kj * n + r, lj * n + d)] -= hd * fr * gd * kp;
@@ -229,7 +253,7 @@ impl HillProblem<'_> {
                 }
                 if let ClosedLaw::Multiplier(_) = self.law {
                     a[(l0 + kj * m + i, l0 + kj * m + i)] += c64::new(1.0, 0.0);
-                    for (d, &fd) in force(kj).iter().enumerate() {
+                    for (d, &fd) in f.iter().enumerate() {
                         a[(v0 + kj * n + d, l0 + kj * m + i)] += fd;
                     }
                 }
@@ -246,41 +270,50 @@ impl HillProblem<'_> {
             .map(|r| &r.part)
     }
 
-    /// Dense complex `[K, M, D]` of harmonic phase `psi`: each source plus its couplings
-    /// with `e^{i sign psi}`.
-    fn matrices(&self, psi: f64) -> [Mat<c64>; 3] {
+    /// The model's dense complex `[K, M, D]` without the cyclic couplings.
+    fn source_matrices(&self) -> [Mat<c64>; 3] {
         let model = self.model;
         let n = model.dofs();
         let mut out = [(); 3].map(|_| Mat::<c64>::zeros(n, n));
-        let add = |target: &mut Mat<c64>, matrix: &SparseMatrix, factor: c64| {
-            let matrix = matrix.as_ref();
-            for col in 0..matrix.ncols() {
-                for (r, &value) in matrix.row_idx_of_col(col).zip(matrix.val_of_col(col)) {
-                    target[(r, col)] += factor * value;
-                }
-            }
-        };
         let one = c64::new(1.0, 0.0);
-        add(&mut out[0], &model.stiffness, one);
-        add(&mut out[1], &model.mass, one);
+        add_sparse(&mut out[0], &model.stiffness, one);
+        add_sparse(&mut out[1], &model.mass, one);
         if let Some(damping) = &model.damping {
-            add(&mut out[2], damping, one);
+            add_sparse(&mut out[2], damping, one);
         }
-        if let Some(coupling) = &model.cyclic {
+        out
+    }
+
+    /// `out` = dense complex `[K, M, D]` of harmonic phase `psi`: `sources`
+    /// ([`HillProblem::source_matrices`]) plus each coupling with `e^{i sign psi}`.
+    fn phased_matrices(&self, sources: &[Mat<c64>; 3], psi: f64, out: &mut [Mat<c64>; 3]) {
+        for (target, source) in out.iter_mut().zip(sources) {
+            target.copy_from(source);
+        }
+        if let Some(coupling) = &self.model.cyclic {
             for term in &coupling.terms {
                 let index = match term.source {
                     CouplingSource::Stiffness => 0,
                     CouplingSource::Mass => 1,
                     CouplingSource::Damping => 2,
                 };
-                add(
+                add_sparse(
                     &mut out[index],
                     &term.matrix,
                     c64::from_polar(1.0, term.sign * psi),
                 );
             }
         }
-        out
+    }
+}
+
+/// `target += factor matrix`.
+fn add_sparse(target: &mut Mat<c64>, matrix: &SparseMatrix, factor: c64) {
+    let matrix = matrix.as_ref();
+    for col in 0..matrix.ncols() {
+        for (r, &value) in matrix.row_idx_of_col(col).zip(matrix.val_of_col(col)) {
+            target[(r, col)] += factor * value;
+        }
     }
 }
 
