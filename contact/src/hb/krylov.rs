@@ -50,7 +50,7 @@ use semismooth::linalg::{check_pivots, KrylovOperator, LinearSolveError, DEFAULT
 
 use super::coupled_rows::CoupledRows;
 use super::laws::LawLayout;
-use super::structured::FactoredCondensed;
+use super::structured::{law_receptance_column, real_receptance, FactoredCondensed};
 use super::LinearData;
 use crate::operator::HarmonicFactors;
 
@@ -171,31 +171,23 @@ impl Default for ContactBlocks {
     }
 }
 
-/// Adds `c Q_ab R~` to the columns `(place of b2) size ..` of the rows `(place of a) size
-/// ..` of `s`, `R~` the real form of the receptance `R_k[b, b2]` on each harmonic's pair
-/// (`r(k)`).
+/// Adds `c Q_ab R~ - [own] Q_ab` to the columns `(place of b2) size ..` of the rows
+/// `(place of a) size ..` of `s`, `R~` the real form of the receptance `R_k[b, b2]` on each
+/// harmonic's pair (`r(k)`), `own` when `b2 = b`.
 fn add_law_block(
     s: &mut Mat<f64>,
     qab: &Mat<f64>,
-    (pa, pb2): (usize, usize),
+    (pa, pb2, own): (usize, usize, bool),
     r: impl Fn(usize) -> c64,
     c: f64,
 ) {
     let size = qab.nrows();
     let (row0, col0) = (pa * size, pb2 * size);
     for l in 0..size {
-        let k = l.div_ceil(2);
-        let rk = r(k);
-        for row in 0..size {
-            let value = if k == 0 {
-                rk.re * qab[(row, 0)]
-            } else if l % 2 == 1 {
-                rk.re * qab[(row, l)] - rk.im * qab[(row, l + 1)]
-            } else {
-                rk.im * qab[(row, l - 1)] + rk.re * qab[(row, l)]
-            };
-            s[(row0 + row, col0 + l)] += c * value;
-        }
+        let rho = real_receptance(r(l.div_ceil(2)), l);
+        law_receptance_column(qab, (l, own), rho, c, |row, value| {
+            s[(row0 + row, col0 + l)] += value;
+        });
     }
 }
 
@@ -252,7 +244,7 @@ impl ContactBlocks {
         }
         self.identity.fill(true);
         for (qab, &(a, b)) in q.iter().zip(&layout.q_pairs) {
-            let ((unit, pa), (_, pb)) = (rows.place[a], rows.place[b]);
+            let (unit, pa) = rows.place[a];
             if (0..size).all(|l| qab.col_as_slice(l).iter().all(|v| *v == 0.0)) {
                 continue;
             }
@@ -262,18 +254,10 @@ impl ContactBlocks {
                 add_law_block(
                     &mut self.blocks[unit],
                     qab,
-                    (pa, pb2),
+                    (pa, pb2, b2 == b),
                     |k| r[k * entries + at],
                     c,
                 );
-            }
-            // - Q_ab on the columns of b (after c Q R: a unit of one row then sums as
-            // c Q R - Q).
-            let s = &mut self.blocks[unit];
-            for l in 0..size {
-                for row in 0..size {
-                    s[(pa * size + row, pb * size + l)] -= qab[(row, l)];
-                }
             }
         }
         for (xas, &(a, s_row)) in cross.iter().zip(&layout.x_pairs) {

@@ -775,8 +775,15 @@ impl FactoredCondensed<'_> {
 /// (`rho_sin` is 0 for `k = 0`).
 #[inline]
 fn receptance_column(receptance: &[Mat<c64>], l: usize, i: usize, ip: usize) -> (f64, f64) {
+    real_receptance(receptance[l.div_ceil(2)][(i, ip)], l)
+}
+
+/// The real form of the receptance entry `r = R_k[i, i']` on basis function `l` of harmonic
+/// `k = ceil(l / 2)`: the response's coefficients `(rho_cos_or_const, rho_sin)` on harmonic
+/// `k` to a unit load on `l` (`rho_sin` 0 for `k = 0`).
+#[inline]
+pub(crate) fn real_receptance(r: c64, l: usize) -> (f64, f64) {
     let k = l.div_ceil(2);
-    let r = receptance[k][(i, ip)];
     if k == 0 {
         (r.re, 0.0)
     } else if l % 2 == 1 {
@@ -865,27 +872,42 @@ fn complementarity_columns(
     (c, m): (f64, usize),
     mut out: MatMut<'_, f64>,
 ) {
-    let size = qab.ncols();
-    for l in 0..size {
-        let k = l.div_ceil(2);
-        // Basis functions of harmonic k: (first, count).
-        let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
-        let (q0, ql) = (qab.col_as_slice(first), qab.col_as_slice(l));
-        let q1 = qab.col_as_slice(first + count - 1);
+    for l in 0..qab.ncols() {
         for ip in 0..m {
             let col = l * m + ip;
-            let (rho0, rho1) = receptance_column(receptance, l, b, ip);
-            let rho1 = if count == 2 { rho1 } else { 0.0 };
-            for (j, ((x, y), d)) in q0.iter().zip(q1).zip(ql).enumerate() {
-                let mut value = c * rho0 * x;
-                if count == 2 {
-                    value += c * rho1 * y;
-                }
-                if b == ip {
-                    value -= d;
-                }
+            let rho = receptance_column(receptance, l, b, ip);
+            law_receptance_column(qab, (l, b == ip), rho, c, |j, value| {
                 out[(j * m + a, col)] += value;
-            }
+            });
         }
+    }
+}
+
+/// Column `l` of `c Q_ab R~ - [own] Q_ab` (`R~` the real form of one receptance entry on
+/// harmonic `k = ceil(l / 2)`, `rho` from [`real_receptance`]: it couples only harmonic
+/// `k`'s basis functions; `own` when the entry is `b`'s own, `R_k[b, b]`):
+/// `visit(j, c (rho_0 Q[j, first] + rho_1 Q[j, first + 1]) - [own] Q[j, l])` for every row
+/// `j`, `first` harmonic `k`'s first basis function.
+#[inline]
+pub(crate) fn law_receptance_column(
+    qab: &Mat<f64>,
+    (l, own): (usize, bool),
+    (rho0, rho1): (f64, f64),
+    c: f64,
+    mut visit: impl FnMut(usize, f64),
+) {
+    let k = l.div_ceil(2);
+    let (first, count) = if k == 0 { (0, 1) } else { (2 * k - 1, 2) };
+    let (q0, q1) = (qab.col_as_slice(first), qab.col_as_slice(first + count - 1));
+    let ql = qab.col_as_slice(l);
+    for (j, ((x, y), d)) in q0.iter().zip(q1).zip(ql).enumerate() {
+        let mut value = c * rho0 * x;
+        if count == 2 {
+            value += c * rho1 * y;
+        }
+        if own {
+            value -= d;
+        }
+        visit(j, value);
     }
 }
