@@ -101,10 +101,23 @@ fn scan(structure: &Structure) -> Vec<Option<Vec<f64>>> {
         .collect()
 }
 
-/// The largest tip amplitude over a scan's converged points and `blades` blades.
+/// The most points of one scan that may fail to converge (measured: 1 on two of the nine
+/// scans, those of the tuned disk with the casing; 0 on the others).
+const MAX_UNCONVERGED: usize = 1;
+
+/// The largest tip amplitude over a scan's points and `blades` blades, at most
+/// [`MAX_UNCONVERGED`] of them unconverged (a peak over the converged points alone could
+/// miss the resonance).
 fn scan_peak(structure: &Structure, blades: usize) -> f64 {
     let n = structure.model.dofs();
-    (scan(structure).iter().flatten()).fold(0.0f64, |m, u| m.max(largest_tip(u, n, blades)))
+    let states = scan(structure);
+    let unconverged = states.iter().filter(|s| s.is_none()).count();
+    eprintln!("unconverged points {unconverged} of {}", states.len());
+    assert!(
+        unconverged <= MAX_UNCONVERGED,
+        "{unconverged} points did not converge"
+    );
+    (states.iter().flatten()).fold(0.0f64, |m, u| m.max(largest_tip(u, n, blades)))
 }
 
 /// The tuned disk's peak by one cyclic sector (its reduced dof 1 is blade 0's tip; every
