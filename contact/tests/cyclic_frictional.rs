@@ -79,12 +79,15 @@ fn a_3d_frictional_contact_between_sectors_solves_the_full_disk_under_engine_ord
         let omega = nodal_diameter_resonance(&sector);
         let run = settings(harmonics, LinearSolverChoice::Structured);
         let reference = converged(&full, omega, &run);
-        // Every blade's contact separates, sticks and slips in the period: the normal law
-        // and the friction disk are both active.
+        // Every blade's contact separates and slips in the period: the normal law and the
+        // friction disk are both active. Under EO 0 it also sticks (measured 0.3% of the
+        // period); under EO 3 it never does (measured 0), so the stick phase is asserted
+        // for EO 0 alone.
         for c in &reference.frictional_contacts {
             let (sep, stick, slip) = (c.separated_fraction, c.stick_fraction, c.slip_fraction);
             eprintln!("EO {engine_order}: separated {sep:.3} stick {stick:.3} slip {slip:.3}");
             assert!(sep > 0.0 && sep < 1.0 && slip > 0.0, "EO {engine_order}");
+            assert!(engine_order != 0 || stick > 0.0, "EO 0 sticks: {stick}");
         }
         let solution = converged(&sector.structure(1).unwrap(), omega, &run);
         let u_full = &reference.state[..3 * BLADES * (2 * harmonics + 1)];
