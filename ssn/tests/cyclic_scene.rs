@@ -4,23 +4,21 @@
 //! a sector scene with a friction damper between sectors (`neighbour_dofs`) answers the
 //! full disk built in code with the damper between every pair of neighbours.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use semismooth_contact::matrix_market::model_matrix_files;
 use semismooth_contact::solve::Solution;
 use semismooth_contact::structures::{BladedDisk, DiskLoading};
 use ssn::cli::{load, Loaded};
 
+mod common;
+#[path = "../../contact/tests/common/sector.rs"]
+mod sector;
+
+use sector::{converged, engine_order_disk, nodal_diameter_resonance};
+
 const BLADES: usize = 8;
 const HARMONICS: usize = 5;
-
-/// A fresh directory for one test.
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ssn-cyclic-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The sections both scenes share: Rayleigh damping `beta K`, the forcing frequency, the
 /// solver (64 samples: a multiple of N, so the sector delay is a whole number of samples;
@@ -33,17 +31,17 @@ fn common(beta: f64, omega: f64) -> String {
     )
 }
 
+/// The scene at `path` loaded and its solve, asserted converged.
 fn solved(path: &Path) -> (Loaded, Solution) {
     let loaded = load(path).unwrap_or_else(|e| panic!("{e}"));
-    let s = semismooth_contact::solve(&loaded.structure, loaded.omega, &loaded.scene.solver, None)
-        .unwrap();
-    assert!(s.converged(), "{:?}", s.termination);
+    let s = converged(&loaded.structure, loaded.omega, &loaded.scene.solver);
     (loaded, s)
 }
 
 #[test]
 fn a_sector_scene_answers_the_full_disk_scene_under_the_same_engine_order() {
-    let dir = temp_dir("sector");
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let disk = BladedDisk {
         blades: BLADES,
         mistuning: 0.0,
@@ -127,7 +125,8 @@ fn a_sector_scene_answers_the_full_disk_scene_under_the_same_engine_order() {
 
 #[test]
 fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
-    let dir = temp_dir("refused");
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let disk = BladedDisk {
         blades: BLADES,
         mistuning: 0.0,
@@ -180,7 +179,7 @@ fn cyclic_and_engine_order_keys_are_refused_where_they_do_not_belong() {
 fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_full_disk() {
     use semismooth_contact::structures::BladeDamper;
     let (blades, engine_order, gap, mu) = (24, 3, 0.2, 0.3);
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blisk_dampers_sector.toml");
+    let scene = common::scenes_dir().join("blisk_dampers_sector.toml");
     let (loaded, sector_solution) = solved(&scene);
     let disk = BladedDisk {
         blades,
@@ -191,14 +190,9 @@ fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_ful
     assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
     // The full disk with the damper between every pair of neighbours, written blade by
     // blade on the disk's dofs.
-    let mut full = disk.structure(&loading).unwrap();
-    full.model.load = (full.model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), engine_order)
-        .unwrap();
+    let mut full = engine_order_disk(&disk, &loading, engine_order);
     BladeDamper { gap, friction: mu }.add_to_disk(&disk, &mut full.model);
-    let settings = &loaded.scene.solver;
-    let full_solution = semismooth_contact::solve(&full, loaded.omega, settings, None).unwrap();
-    assert!(full_solution.converged());
+    let full_solution = converged(&full, loaded.omega, &loaded.scene.solver);
     assert!(full_solution
         .contacts
         .iter()
@@ -215,7 +209,7 @@ fn the_shipped_blisk_sector_with_friction_dampers_between_blades_answers_the_ful
 
 #[test]
 fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/bladed_disk_sector.toml");
+    let path = common::scenes_dir().join("bladed_disk_sector.toml");
     let (loaded, sector_solution) = solved(&path);
     let blades = 100;
     let disk = BladedDisk {
@@ -229,13 +223,8 @@ fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
     let (sector, omega_1) = disk.cyclic_sector(&loading, 3).unwrap();
     // The scene's written frequency and damping are the disk's to the digits written.
     assert!((loaded.structure.omega_1 - omega_1).abs() < 1e-12);
-    let mut full = disk.structure(&loading).unwrap();
-    full.model.load = (full.model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), 3)
-        .unwrap();
-    let full_solution =
-        semismooth_contact::solve(&full, loaded.omega, &loaded.scene.solver, None).unwrap();
-    assert!(full_solution.converged());
+    let full = engine_order_disk(&disk, &loading, 3);
+    let full_solution = converged(&full, loaded.omega, &loaded.scene.solver);
     assert!(full_solution
         .contacts
         .iter()
@@ -254,8 +243,9 @@ fn the_shipped_sector_scene_is_the_full_100_blade_disk_under_engine_order_3() {
 
 #[test]
 fn interface_nodes_through_a_dof_map_give_the_interface_dofs() {
-    let dir = temp_dir("nodes");
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/blade_sector");
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let shipped = common::scenes_dir().join("blade_sector");
     for name in ["K.mtx", "M.mtx", "f.mtx"] {
         std::fs::copy(shipped.join(name), dir.join(name)).unwrap();
     }
@@ -296,7 +286,6 @@ fn interface_nodes_through_a_dof_map_give_the_interface_dofs() {
 #[test]
 fn a_sector_scene_with_a_3d_frictional_contact_between_sectors_answers_the_full_disk() {
     use semismooth_contact::model::{ContactRow, FrictionalContact};
-    use semismooth_contact::rod::natural_frequencies;
     let (engine_order, gap, mu) = (3, 0.2, 0.3);
     let disk = BladedDisk {
         blades: BLADES,
@@ -308,9 +297,9 @@ fn a_sector_scene_with_a_3d_frictional_contact_between_sectors_answers_the_full_
         ..DiskLoading::shipped(Vec::new())
     };
     let (sector, omega_1) = disk.cyclic_sector(&loading, engine_order).unwrap();
-    let nd = sector.nodal_diameter(1);
-    let omega = natural_frequencies(&sector.nodal_diameter_model(nd), 1).unwrap()[0];
-    let dir = temp_dir("frictional3d");
+    let omega = nodal_diameter_resonance(&sector);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let m = sector.model();
     for (name, text) in model_matrix_files(&m.stiffness, &m.mass, &[0.0, 1.0, 0.0, 0.0]) {
         std::fs::write(dir.join(name), text).unwrap();
@@ -356,10 +345,7 @@ fn a_sector_scene_with_a_3d_frictional_contact_between_sectors_answers_the_full_
         assert!(message.contains(key), "{message}");
     }
     let (loaded, sector_solution) = solved(&scene);
-    let mut full = disk.structure(&loading).unwrap();
-    full.model.load = (full.model.load.clone())
-        .delayed_by_sector(&disk.sector_dofs(), engine_order)
-        .unwrap();
+    let mut full = engine_order_disk(&disk, &loading, engine_order);
     let row = |dofs: Vec<usize>, a: Vec<f64>| ContactRow::new(dofs, a).unwrap();
     for j in 0..BLADES {
         let (own, next) = (3 * j, 3 * ((j + 1) % BLADES));
@@ -373,9 +359,7 @@ fn a_sector_scene_with_a_3d_frictional_contact_between_sectors_answers_the_full_
             mu,
         ));
     }
-    let full_solution =
-        semismooth_contact::solve(&full, loaded.omega, &loaded.scene.solver, None).unwrap();
-    assert!(full_solution.converged());
+    let full_solution = converged(&full, loaded.omega, &loaded.scene.solver);
     assert!((full_solution.frictional_contacts.iter()).all(|c| c.separated_fraction < 1.0));
     let u_full = &full_solution.state[..3 * BLADES * (2 * HARMONICS + 1)];
     let scale = u_full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
