@@ -123,6 +123,7 @@ pub fn document(scene: &Scene, branch: &Backbone, omega_1: f64, seconds: f64) ->
         "converged": matches!(branch.termination, ContinuationTermination::ReachedBound { .. }),
         "termination": format!("{:?}", branch.termination),
         "solve_seconds": seconds,
+        "bordered_solve": format!("{:?}", branch.solve).to_lowercase(),
     })
 }
 

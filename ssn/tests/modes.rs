@@ -194,6 +194,8 @@ fn a_rod_beyond_the_dense_limit_gets_its_backbone_from_the_structured_solve() {
     ]));
     let coarse = json_success(&ssn(&["modes", path.to_str().unwrap(), "--json"]));
     assert_eq!(refined["converged"], true, "{refined}");
+    assert_eq!(refined["bordered_solve"], "structured");
+    assert_eq!(coarse["bordered_solve"], "dense");
     let mut scene = Scene::from_path(&path).unwrap();
     scene.rod.elements = 200;
     let omega_1 = natural_frequencies(&build_rod(&scene.rod).unwrap().model, 1).unwrap()[0];

@@ -160,6 +160,8 @@ pub struct Backbone {
     pub termination: ContinuationTermination,
     /// The continuation's work counters.
     pub counters: ContinuationCounters,
+    /// How the bordered system was solved (the options' [`EpmcSolve`]).
+    pub solve: EpmcSolve,
 }
 
 /// The backbone of `model`'s mode `options.mode` ([`Epmc`]): from its linear mode at
@@ -238,6 +240,7 @@ pub fn backbone(
         points,
         termination: branch.termination,
         counters: branch.counters,
+        solve: options.solve,
     })
 }
 
