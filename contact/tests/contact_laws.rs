@@ -16,9 +16,9 @@ use std::sync::Arc;
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::Tolerances;
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
-use semismooth::{Factorize, Residual};
+use semismooth::{Factorize, GeneralizedJacobian, Smoothing};
 use semismooth_contact::hb::{
-    CondensedSolve, HbError, HbJacobian, HbOptions, SsnHb, StructuredHbSolver,
+    CondensedSolve, CondensedSsnHb, HbError, HbJacobian, HbOptions, SsnHb, StructuredHbSolver,
 };
 use semismooth_contact::law::{ContactLaw, LawGroup, LawSamples, Measure};
 use semismooth_contact::model::{ContactRow, HarmonicLoad, SparseMatrix, StructuralModel};
@@ -143,22 +143,43 @@ fn circle_radius() -> f64 {
     (-half_linear + (half_linear * half_linear - a * (b * b - FORCE * FORCE)).sqrt()) / a
 }
 
-/// SSN-HB with the disk solved from zero with `solver` to `|F| <= 1e-12`.
-fn solve_with(solver: &mut dyn Factorize<HbJacobian>, harmonics: usize) -> Vec<f64> {
-    let options = HbOptions {
+/// The HB options of the disk problems: `harmonics` and `c = k`.
+fn disk_options(harmonics: usize) -> HbOptions {
+    HbOptions {
         harmonics,
         c: Some(STIFFNESS),
         ..HbOptions::default()
-    };
-    let mut hb = SsnHb::with_laws(&rotating_oscillator(), OMEGA, &options, &[disk()]).unwrap();
-    let mut x = vec![0.0; hb.dim()];
+    }
+}
+
+/// Solves `problem` from zero with its smoothing path and `solver` to `|F| <= 1e-12`.
+fn solve_from_zero<P, S>(problem: &mut P, solver: &mut S) -> Vec<f64>
+where
+    P: GeneralizedJacobian + Smoothing,
+    S: Factorize<P::Jacobian> + ?Sized,
+{
+    let mut x = vec![0.0; problem.dim()];
     let newton = PolyalgorithmOptions {
         tolerances: Tolerances::absolute(1e-12),
         ..PolyalgorithmOptions::default()
     };
-    let report = solve_smoothing(&mut hb, solver, &mut x, &newton).unwrap();
+    let report = solve_smoothing(problem, solver, &mut x, &newton).unwrap();
     assert!(report.converged(), "{:?}", report.termination);
     x
+}
+
+/// SSN-HB with the disk solved from zero with `solver` to `|F| <= 1e-12`.
+fn solve_with(solver: &mut dyn Factorize<HbJacobian>, harmonics: usize) -> Vec<f64> {
+    let options = disk_options(harmonics);
+    let mut hb = SsnHb::with_laws(&rotating_oscillator(), OMEGA, &options, &[disk()]).unwrap();
+    solve_from_zero(&mut hb, solver)
+}
+
+/// The largest entry-wise difference of two vectors.
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
 }
 
 /// The disk law (two rows, a full 2 x 2 Jacobian block per sample) gives one solution
@@ -175,10 +196,7 @@ fn a_two_row_friction_disk_agrees_across_linear_paths_and_with_the_sliding_circl
     // Each path stops at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned
     // Jacobian: the iterates agree far below 1e-10.
     for (name, other) in [("condensed dense", &condensed), ("matrix-free", &krylov)] {
-        let gap = dense
-            .iter()
-            .zip(other)
-            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        let gap = max_difference(&dense, other);
         assert!(gap < 1e-10, "{name} differs from dense by {gap:e}");
     }
     // U index j N + dof: harmonic 1 of x is (U[2], U[4]), of y (U[3], U[5]).
@@ -199,6 +217,35 @@ fn a_two_row_friction_disk_agrees_across_linear_paths_and_with_the_sliding_circl
         .chain(&dense[6..2 * (2 * harmonics + 1)])
         .fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(rest < 1e-10, "off-circle coefficients {rest:e}");
+}
+
+/// The condensed problem (contact forces only) takes the disk through the same
+/// constructor shape as the full one, and its expanded root is the full problem's.
+#[test]
+fn the_condensed_problem_takes_the_disk_law_and_agrees_with_the_full_one() {
+    let harmonics = 5;
+    let full = solve_with(&mut FaerDenseLu::new(), harmonics);
+    let options = disk_options(harmonics);
+    let model = rotating_oscillator();
+    let mut condensed = CondensedSsnHb::with_laws(&model, OMEGA, &options, &[disk()]).unwrap();
+    let lambda = solve_from_zero(&mut condensed, &mut FaerDenseLu::new());
+    let expanded = condensed.expand(&lambda).unwrap();
+    // Both stop at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned Jacobian
+    // (the condensed one is the Schur complement of the full one): they agree far below
+    // 1e-10.
+    let gap = max_difference(&full, &expanded);
+    assert!(gap < 1e-10, "condensed differs from full by {gap:e}");
+    let refused = CondensedSsnHb::with_laws(
+        &model,
+        OMEGA,
+        &options,
+        &[{
+            let mut short = disk();
+            short.offsets.pop();
+            short
+        }],
+    );
+    assert!(matches!(refused, Err(HbError::DimensionMismatch { .. })));
 }
 
 /// A group whose offsets or reads do not fit its rows is refused with the sizes, not a
