@@ -18,8 +18,8 @@ use roundoff::DisplacementBlock;
 pub(crate) use roundoff::{displacement_floor, roundoff_floor};
 mod reconstruction;
 
-pub(crate) use formulation::HarmonicProblem;
 pub use formulation::{DiscretisationKind, FrictionSupport};
+pub(crate) use formulation::{HarmonicProblem, SolveRequest};
 pub(crate) use march::march_scheme;
 pub(crate) use reconstruction::HbReconstruction;
 
@@ -654,18 +654,20 @@ pub(crate) fn solve_as_given(
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
-    let mut solution = formulation::of(settings.method).solve(rod, omega, settings, warm_start)?;
+    let request = SolveRequest {
+        rod,
+        omega,
+        settings,
+        warm_start,
+    };
+    let mut solution = (formulation::of(settings.method).solver())(request)?;
     solution.settings = solution.solved_settings(settings);
     Ok(solution)
 }
 
 /// The SSN-HB solve of `rod` at `omega` (module documentation of [`solve`]).
-pub(super) fn solve_ssn_hb(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_ssn_hb(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     let model = &rod.model;
     let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
     let mut x = initial_state(problem.dim(), warm_start);
@@ -684,12 +686,8 @@ pub(super) fn solve_ssn_hb(
 
 /// The penalty-HB solve of `rod` at `omega`, through the penalty and regularisation
 /// homotopies from a cold start.
-pub(super) fn solve_penalty_hb(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_penalty_hb(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     let model = &rod.model;
     let tip = rod.observed_dof;
     let scale = model.contact_stiffness_scale();
@@ -780,22 +778,14 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
 }
 
 /// The periodic LCP of `rod` at `omega` solved by Lemke's pivoting.
-pub(super) fn solve_lcp_by_lemke(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-) -> Result<Solution, RunError> {
-    solve_lcp(rod, omega, settings, &lcp_by_lemke)
+pub(super) fn solve_lcp_by_lemke(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    solve_lcp(request.rod, request.omega, request.settings, &lcp_by_lemke)
 }
 
 /// The periodic LCP of `rod` at `omega` solved by semismooth Newton on its min map, from
 /// `warm_start` (contact forces) when it fits.
-pub(super) fn solve_lcp_by_min_map(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_lcp_by_min_map(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     solve_lcp(rod, omega, settings, &|lcp| {
         lcp_by_min_map(&rod.model, omega, settings, lcp, warm_start)
     })
