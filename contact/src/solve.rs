@@ -460,14 +460,13 @@ struct Period {
 
 /// The solution record of a run of the scene's method at `omega`.
 fn solution(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     time_samples: usize,
     outcome: Outcome<'_>,
     period: Period,
     state: Vec<f64>,
 ) -> Solution {
+    let (rod, omega, settings, _) = request.parts();
     let method = settings.method;
     let points: Vec<_> = rod
         .model
@@ -532,13 +531,12 @@ fn solution(
 /// The tip, the contact forces and the statistics of an HB solution on `points` times.
 fn hb_outputs(
     problem: &impl HbReconstruction,
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     outcome: Outcome<'_>,
     x: Vec<f64>,
     points: usize,
 ) -> Result<Solution, RunError> {
+    let (rod, omega, settings, _) = request.parts();
     let tip = problem.displacement(&x, rod.observed_dof, points)?;
     let contacts = rod.model.contacts.len();
     let contact_forces = (0..contacts)
@@ -568,15 +566,7 @@ fn hb_outputs(
         contact_displacements,
         friction,
     };
-    let mut solution = solution(
-        rod,
-        omega,
-        settings,
-        settings.time_samples,
-        outcome,
-        period,
-        x,
-    );
+    let mut solution = solution(request, settings.time_samples, outcome, period, x);
     set_closed_fractions(&mut solution.contacts, &closed);
     Ok(solution)
 }
@@ -676,7 +666,7 @@ pub(super) fn solve_ssn_hb(request: SolveRequest<'_>) -> Result<Solution, RunErr
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);
-    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    let mut sol = hb_outputs(&problem, request, outcome, x, points)?;
     sol.c = (problem.contacts() > 0).then(|| problem.c());
     sol.frictional_contacts = (0..problem.frictional_contacts())
         .map(|p| problem.frictional_contact_report(&sol.state, p, points))
@@ -753,7 +743,7 @@ pub(super) fn solve_penalty_hb(request: SolveRequest<'_>) -> Result<Solution, Ru
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);
-    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    let mut sol = hb_outputs(&problem, request, outcome, x, points)?;
     // The mean penalty force as the equations see it: over the Nt AFT samples (a
     // finer grid resolves narrow force peaks the quadrature does not).
     if problem.contacts() > 0 {
@@ -779,25 +769,24 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
 
 /// The periodic LCP of `rod` at `omega` solved by Lemke's pivoting.
 pub(super) fn solve_lcp_by_lemke(request: SolveRequest<'_>) -> Result<Solution, RunError> {
-    solve_lcp(request.rod, request.omega, request.settings, &lcp_by_lemke)
+    solve_lcp(request, &lcp_by_lemke)
 }
 
 /// The periodic LCP of `rod` at `omega` solved by semismooth Newton on its min map, from
 /// `warm_start` (contact forces) when it fits.
 pub(super) fn solve_lcp_by_min_map(request: SolveRequest<'_>) -> Result<Solution, RunError> {
     let (rod, omega, settings, warm_start) = request.parts();
-    solve_lcp(rod, omega, settings, &|lcp| {
+    solve_lcp(request, &|lcp| {
         lcp_by_min_map(&rod.model, omega, settings, lcp, warm_start)
     })
 }
 
 /// The periodic LCP of `rod` at `omega` solved by `solve_lcp` and reduced to a [`Solution`].
 fn solve_lcp(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     solve_lcp: &dyn Fn(&PeriodicLcp) -> Result<LcpRun, RunError>,
 ) -> Result<Solution, RunError> {
+    let (rod, omega, settings, _) = request.parts();
     let model = &rod.model;
     if model.contacts.is_empty() {
         return Err(RunError::Unsupported {
@@ -841,15 +830,7 @@ fn solve_lcp(
         contact_displacements: contact_u,
         friction: Vec::new(),
     };
-    let mut sol = solution(
-        rod,
-        omega,
-        settings,
-        settings.time_samples,
-        outcome,
-        period,
-        z,
-    );
+    let mut sol = solution(request, settings.time_samples, outcome, period, z);
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
     if !sol.converged() && lcp.has_alternating_null_vector() {
         sol.diagnosis = Some(Diagnosis::AlternatingNullVector);

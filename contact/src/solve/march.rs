@@ -138,15 +138,7 @@ pub(super) fn solve_march(request: SolveRequest<'_>) -> Result<Solution, RunErro
         final_state.contact_force,
     ]
     .concat();
-    let mut solution = solution(
-        rod,
-        omega,
-        settings,
-        settings.steps_per_period,
-        outcome,
-        period,
-        state,
-    );
+    let mut solution = solution(request, settings.steps_per_period, outcome, period, state);
     solution.frictional_contacts = frictional_contacts;
     Ok(solution)
 }
