@@ -18,8 +18,8 @@ use roundoff::DisplacementBlock;
 pub(crate) use roundoff::{displacement_floor, roundoff_floor};
 mod reconstruction;
 
-pub(crate) use formulation::HarmonicProblem;
 pub use formulation::{DiscretisationKind, FrictionSupport};
+pub(crate) use formulation::{HarmonicProblem, SolveRequest};
 pub(crate) use march::march_scheme;
 pub(crate) use reconstruction::HbReconstruction;
 
@@ -460,14 +460,13 @@ struct Period {
 
 /// The solution record of a run of the scene's method at `omega`.
 fn solution(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     time_samples: usize,
     outcome: Outcome<'_>,
     period: Period,
     state: Vec<f64>,
 ) -> Solution {
+    let (rod, omega, settings, _) = request.parts();
     let method = settings.method;
     let points: Vec<_> = rod
         .model
@@ -532,13 +531,12 @@ fn solution(
 /// The tip, the contact forces and the statistics of an HB solution on `points` times.
 fn hb_outputs(
     problem: &impl HbReconstruction,
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     outcome: Outcome<'_>,
     x: Vec<f64>,
     points: usize,
 ) -> Result<Solution, RunError> {
+    let (rod, omega, settings, _) = request.parts();
     let tip = problem.displacement(&x, rod.observed_dof, points)?;
     let contacts = rod.model.contacts.len();
     let contact_forces = (0..contacts)
@@ -568,15 +566,7 @@ fn hb_outputs(
         contact_displacements,
         friction,
     };
-    let mut solution = solution(
-        rod,
-        omega,
-        settings,
-        settings.time_samples,
-        outcome,
-        period,
-        x,
-    );
+    let mut solution = solution(request, settings.time_samples, outcome, period, x);
     set_closed_fractions(&mut solution.contacts, &closed);
     Ok(solution)
 }
@@ -654,18 +644,20 @@ pub(crate) fn solve_as_given(
     settings: &SolverSettings,
     warm_start: Option<&[f64]>,
 ) -> Result<Solution, RunError> {
-    let mut solution = formulation::of(settings.method).solve(rod, omega, settings, warm_start)?;
+    let request = SolveRequest {
+        rod,
+        omega,
+        settings,
+        warm_start,
+    };
+    let mut solution = (formulation::of(settings.method).solver())(request)?;
     solution.settings = solution.solved_settings(settings);
     Ok(solution)
 }
 
 /// The SSN-HB solve of `rod` at `omega` (module documentation of [`solve`]).
-pub(super) fn solve_ssn_hb(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_ssn_hb(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     let model = &rod.model;
     let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
     let mut x = initial_state(problem.dim(), warm_start);
@@ -674,7 +666,7 @@ pub(super) fn solve_ssn_hb(
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);
-    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    let mut sol = hb_outputs(&problem, request, outcome, x, points)?;
     sol.c = (problem.contacts() > 0).then(|| problem.c());
     sol.frictional_contacts = (0..problem.frictional_contacts())
         .map(|p| problem.frictional_contact_report(&sol.state, p, points))
@@ -684,12 +676,8 @@ pub(super) fn solve_ssn_hb(
 
 /// The penalty-HB solve of `rod` at `omega`, through the penalty and regularisation
 /// homotopies from a cold start.
-pub(super) fn solve_penalty_hb(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_penalty_hb(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     let model = &rod.model;
     let tip = rod.observed_dof;
     let scale = model.contact_stiffness_scale();
@@ -755,7 +743,7 @@ pub(super) fn solve_penalty_hb(
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);
-    let mut sol = hb_outputs(&problem, rod, omega, settings, outcome, x, points)?;
+    let mut sol = hb_outputs(&problem, request, outcome, x, points)?;
     // The mean penalty force as the equations see it: over the Nt AFT samples (a
     // finer grid resolves narrow force peaks the quadrature does not).
     if problem.contacts() > 0 {
@@ -780,34 +768,25 @@ fn initial_state(dim: usize, warm_start: Option<&[f64]>) -> Vec<f64> {
 }
 
 /// The periodic LCP of `rod` at `omega` solved by Lemke's pivoting.
-pub(super) fn solve_lcp_by_lemke(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-) -> Result<Solution, RunError> {
-    solve_lcp(rod, omega, settings, &lcp_by_lemke)
+pub(super) fn solve_lcp_by_lemke(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    solve_lcp(request, &lcp_by_lemke)
 }
 
 /// The periodic LCP of `rod` at `omega` solved by semismooth Newton on its min map, from
 /// `warm_start` (contact forces) when it fits.
-pub(super) fn solve_lcp_by_min_map(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
-    solve_lcp(rod, omega, settings, &|lcp| {
+pub(super) fn solve_lcp_by_min_map(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
+    solve_lcp(request, &|lcp| {
         lcp_by_min_map(&rod.model, omega, settings, lcp, warm_start)
     })
 }
 
 /// The periodic LCP of `rod` at `omega` solved by `solve_lcp` and reduced to a [`Solution`].
 fn solve_lcp(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
+    request: SolveRequest<'_>,
     solve_lcp: &dyn Fn(&PeriodicLcp) -> Result<LcpRun, RunError>,
 ) -> Result<Solution, RunError> {
+    let (rod, omega, settings, _) = request.parts();
     let model = &rod.model;
     if model.contacts.is_empty() {
         return Err(RunError::Unsupported {
@@ -851,15 +830,7 @@ fn solve_lcp(
         contact_displacements: contact_u,
         friction: Vec::new(),
     };
-    let mut sol = solution(
-        rod,
-        omega,
-        settings,
-        settings.time_samples,
-        outcome,
-        period,
-        z,
-    );
+    let mut sol = solution(request, settings.time_samples, outcome, period, z);
     sol.stats.max_penetration = sol.stats.max_penetration.max(0.0);
     if !sol.converged() && lcp.has_alternating_null_vector() {
         sol.diagnosis = Some(Diagnosis::AlternatingNullVector);

@@ -4,24 +4,24 @@
 //!
 //! Check with no code of ours: an isotropic two-dof oscillator `m x'' + c x' + k x =
 //! F (cos w t, sin w t) + lambda` with the disk law `|lambda| <= b` under a constant normal
-//! load slides on a circle. With `z = x + i y = Z e^{i w t}` the friction force is
-//! `-b i Z / |Z| e^{i w t}` (opposing the velocity, of constant magnitude), so
-//! `(k - m w^2 + i (c w + b / r)) r = F` in modulus with `r = |Z|`:
-//! `((k - m w^2)^2 + c^2 w^2) r^2 + 2 c w b r + b^2 - F^2 = 0`. The force is a pure first
-//! harmonic and every time sample of the law is exact, so harmonic balance with any `H`
-//! has this solution.
+//! load slides on the circle of the closed form in `common/rotating_oscillator.rs`. The
+//! force is a pure first harmonic and every time sample of the law is exact, so harmonic
+//! balance with any `H` has this solution.
 
 use std::sync::Arc;
 
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::Tolerances;
-use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
-use semismooth::{Factorize, Residual};
+use semismooth::Factorize;
 use semismooth_contact::hb::{
-    CondensedSolve, HbError, HbJacobian, HbOptions, SsnHb, StructuredHbSolver,
+    CondensedSolve, CondensedSsnHb, HbError, HbJacobian, HbOptions, SsnHb, StructuredHbSolver,
 };
 use semismooth_contact::law::{ContactLaw, LawGroup, LawSamples, Measure};
-use semismooth_contact::model::{ContactRow, HarmonicLoad, SparseMatrix, StructuralModel};
+use semismooth_contact::model::{ContactRow, HarmonicLoad, StructuralModel};
+
+#[path = "common/rotating_oscillator.rs"]
+mod rotating_oscillator;
+use rotating_oscillator::{circle_radius, diagonal, max_difference, solved_from_zero};
+use rotating_oscillator::{DAMPING, FORCE, MASS, OMEGA, STIFFNESS};
 
 /// `phi_mu(s) = (s + sqrt(s^2 + 4 mu^2)) / 2`, the smoothing of `max(0, s)`, with its
 /// slope and its `mu`-derivative (both 0 away from the kink at `mu = 0`).
@@ -102,25 +102,14 @@ impl ContactLaw for FrictionDisk {
     }
 }
 
-// The oscillator, its load and the disk's radius (`F > b`: it slides all period).
-const MASS: f64 = 1.0;
-const DAMPING: f64 = 0.05;
-const STIFFNESS: f64 = 1.0;
-const FORCE: f64 = 1.0;
+/// The disk's radius (`F > b`: the oscillator slides all period).
 const SLIP_LIMIT: f64 = 0.3;
-const OMEGA: f64 = 1.3;
 
 /// The isotropic two-dof oscillator under the rotating load `F (cos w t, sin w t)`.
 fn rotating_oscillator() -> StructuralModel {
-    let diagonal = |v: f64| {
-        let entries = [
-            faer::sparse::Triplet::new(0, 0, v),
-            faer::sparse::Triplet::new(1, 1, v),
-        ];
-        SparseMatrix::try_new_from_triplets(2, 2, &entries).unwrap()
-    };
     let mut load = HarmonicLoad::zero(2);
     load.add_harmonic(1, &[FORCE, 0.0], &[0.0, FORCE]).unwrap();
+    let diagonal = |v: f64| diagonal(&[v; 2]);
     StructuralModel::new(diagonal(MASS), diagonal(STIFFNESS), vec![0.0; 2])
         .with_damping(diagonal(DAMPING))
         .with_load(load)
@@ -135,30 +124,20 @@ fn disk() -> LawGroup {
     }
 }
 
-/// The radius of the sliding circle (module documentation).
-fn circle_radius() -> f64 {
-    let (w, b) = (OMEGA, SLIP_LIMIT);
-    let a = (STIFFNESS - MASS * w * w).powi(2) + (DAMPING * w).powi(2);
-    let half_linear = DAMPING * w * b;
-    (-half_linear + (half_linear * half_linear - a * (b * b - FORCE * FORCE)).sqrt()) / a
+/// The HB options of the disk problems: `harmonics` and `c = k`.
+fn disk_options(harmonics: usize) -> HbOptions {
+    HbOptions {
+        harmonics,
+        c: Some(STIFFNESS),
+        ..HbOptions::default()
+    }
 }
 
 /// SSN-HB with the disk solved from zero with `solver` to `|F| <= 1e-12`.
 fn solve_with(solver: &mut dyn Factorize<HbJacobian>, harmonics: usize) -> Vec<f64> {
-    let options = HbOptions {
-        harmonics,
-        c: Some(STIFFNESS),
-        ..HbOptions::default()
-    };
+    let options = disk_options(harmonics);
     let mut hb = SsnHb::with_laws(&rotating_oscillator(), OMEGA, &options, &[disk()]).unwrap();
-    let mut x = vec![0.0; hb.dim()];
-    let newton = PolyalgorithmOptions {
-        tolerances: Tolerances::absolute(1e-12),
-        ..PolyalgorithmOptions::default()
-    };
-    let report = solve_smoothing(&mut hb, solver, &mut x, &newton).unwrap();
-    assert!(report.converged(), "{:?}", report.termination);
-    x
+    solved_from_zero(&mut hb, solver, 1e-12)
 }
 
 /// The disk law (two rows, a full 2 x 2 Jacobian block per sample) gives one solution
@@ -175,14 +154,11 @@ fn a_two_row_friction_disk_agrees_across_linear_paths_and_with_the_sliding_circl
     // Each path stops at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned
     // Jacobian: the iterates agree far below 1e-10.
     for (name, other) in [("condensed dense", &condensed), ("matrix-free", &krylov)] {
-        let gap = dense
-            .iter()
-            .zip(other)
-            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        let gap = max_difference(&dense, other);
         assert!(gap < 1e-10, "{name} differs from dense by {gap:e}");
     }
     // U index j N + dof: harmonic 1 of x is (U[2], U[4]), of y (U[3], U[5]).
-    let radius = circle_radius();
+    let radius = circle_radius(SLIP_LIMIT);
     let amplitude = |dof: usize| dense[2 + dof].hypot(dense[4 + dof]);
     // Every sample of the law is exact on the circle, so the only error is Newton's
     // (|F| <= 1e-12 times a condition number of O(10)).
@@ -199,6 +175,35 @@ fn a_two_row_friction_disk_agrees_across_linear_paths_and_with_the_sliding_circl
         .chain(&dense[6..2 * (2 * harmonics + 1)])
         .fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(rest < 1e-10, "off-circle coefficients {rest:e}");
+}
+
+/// The condensed problem (contact forces only) takes the disk through the same
+/// constructor shape as the full one, and its expanded root is the full problem's.
+#[test]
+fn the_condensed_problem_takes_the_disk_law_and_agrees_with_the_full_one() {
+    let harmonics = 5;
+    let full = solve_with(&mut FaerDenseLu::new(), harmonics);
+    let options = disk_options(harmonics);
+    let model = rotating_oscillator();
+    let mut condensed = CondensedSsnHb::with_laws(&model, OMEGA, &options, &[disk()]).unwrap();
+    let lambda = solved_from_zero(&mut condensed, &mut FaerDenseLu::new(), 1e-12);
+    let expanded = condensed.expand(&lambda).unwrap();
+    // Both stop at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned Jacobian
+    // (the condensed one is the Schur complement of the full one): they agree far below
+    // 1e-10.
+    let gap = max_difference(&full, &expanded);
+    assert!(gap < 1e-10, "condensed differs from full by {gap:e}");
+    let refused = CondensedSsnHb::with_laws(
+        &model,
+        OMEGA,
+        &options,
+        &[{
+            let mut short = disk();
+            short.offsets.pop();
+            short
+        }],
+    );
+    assert!(matches!(refused, Err(HbError::DimensionMismatch { .. })));
 }
 
 /// A group whose offsets or reads do not fit its rows is refused with the sizes, not a

@@ -8,20 +8,16 @@ use semismooth_contact::cyclic::{CyclicSector, InvalidSector};
 use semismooth_contact::model::{ContactPoint, ContactRow, InvalidModel, NeighbourRow, Structure};
 use semismooth_contact::settings::{LinearSolverChoice, Method, SolverSettings};
 use semismooth_contact::solve::solve;
-use semismooth_contact::structures::{BladeDamper, BladedDisk, DiskLoading};
+use semismooth_contact::structures::{BladeDamper, DiskLoading};
 
 #[path = "common/sector.rs"]
 mod sector;
 use sector::{converged, engine_order_disk, nodal_diameter_resonance, settings};
+use sector::{relative_recovery_gap, tuned_disk as disk, BLADES};
 
-const BLADES: usize = 8;
 /// The damper's clearance: the pads close on the neighbours near each resonance.
 const GAP: f64 = 0.2;
 const MU: f64 = 0.3;
-
-fn disk() -> BladedDisk {
-    BladedDisk::tuned(BLADES)
-}
 
 fn loading() -> DiskLoading {
     DiskLoading::shipped(Vec::new())
@@ -50,15 +46,6 @@ fn sector(engine_order: usize, friction: bool) -> CyclicSector {
     damper(friction).add_to_sector(&sector).unwrap()
 }
 
-/// The largest difference between the sector's response recovered on every sector and the
-/// full disk's, relative to the full disk's largest coefficient.
-fn recovery_gap(sector: &CyclicSector, reduced: &[f64], full: &[f64], harmonics: usize) -> f64 {
-    let recovered = disk().recover(sector, reduced, harmonics);
-    let scale = full.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let gap = (recovered.iter().zip(full)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-    gap / scale
-}
-
 /// Solves the full disk (with the first of `runs`) and the sector (with each) at the
 /// resonance of the engine order's nodal diameter and returns the largest relative recovery
 /// gap.
@@ -77,12 +64,10 @@ fn sector_against_full_disk(engine_order: usize, friction: bool, runs: &[SolverS
         fractions.iter().all(|f| *f > 0.0 && *f < 1.0),
         "EO {engine_order}: contact fractions {fractions:?}"
     );
-    let u_full = &reference.state[..3 * BLADES * (2 * harmonics + 1)];
     let mut worst = 0.0f64;
     for run in runs {
         let solution = converged(&structure, omega, run);
-        let reduced = &solution.state[..3 * (2 * harmonics + 1)];
-        let gap = recovery_gap(&sector, reduced, u_full, harmonics);
+        let gap = relative_recovery_gap(&sector, &solution.state, &reference.state, harmonics);
         let (method, choice) = (run.method, run.linear_solver);
         eprintln!("EO {engine_order} friction {friction} {method:?} {choice:?}: gap {gap:e}");
         worst = worst.max(gap);

@@ -24,8 +24,6 @@
 //! solver returns (its first harmonic).
 
 use semismooth::linalg::FaerDenseLu;
-use semismooth::newton::Tolerances;
-use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::{Factorize, Residual};
 use semismooth_contact::hb::{CondensedSolve, HbJacobian, HbOptions, SsnHb, StructuredHbSolver};
 use semismooth_contact::model::{
@@ -34,15 +32,10 @@ use semismooth_contact::model::{
 };
 use std::f64::consts::PI;
 
-/// A diagonal `n x n` matrix.
-fn diagonal(values: &[f64]) -> SparseMatrix {
-    let entries: Vec<_> = values
-        .iter()
-        .enumerate()
-        .map(|(i, v)| faer::sparse::Triplet::new(i, i, *v))
-        .collect();
-    SparseMatrix::try_new_from_triplets(values.len(), values.len(), &entries).unwrap()
-}
+#[path = "common/rotating_oscillator.rs"]
+mod rotating_oscillator;
+use rotating_oscillator::{circle_radius, diagonal, max_difference, solved_from_zero};
+use rotating_oscillator::{DAMPING, FORCE, MASS, OMEGA, STIFFNESS};
 
 /// A model with diagonal `M`, `D`, `K`, `load` and no contact.
 fn model(
@@ -86,13 +79,7 @@ fn solve_with_c(
         ..HbOptions::default()
     };
     let mut hb = SsnHb::new(model, omega, &options).unwrap();
-    let mut x = vec![0.0; hb.dim()];
-    let newton = PolyalgorithmOptions {
-        tolerances: Tolerances::absolute(tolerance),
-        ..PolyalgorithmOptions::default()
-    };
-    let report = solve_smoothing(&mut hb, solver, &mut x, &newton).unwrap();
-    assert!(report.converged(), "{:?}", report.termination);
+    let x = solved_from_zero(&mut hb, solver, tolerance);
     (hb, x)
 }
 
@@ -111,10 +98,7 @@ fn solve_on_every_path(
     let krylov = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Krylov);
     let (_, krylov) = solve(model, at, &mut { krylov });
     for other in [&condensed, &krylov] {
-        let gap = dense
-            .iter()
-            .zip(other)
-            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        let gap = max_difference(&dense, other);
         assert!(gap < agreement, "H = {harmonics}: paths differ by {gap:e}");
     }
     (hb, dense)
@@ -150,11 +134,6 @@ fn the_elliptic_integral_has_its_known_values() {
 
 // The circle under the normal law: an oscillator (x, y, z) pressed along z against an
 // obstacle at `z <= GAP` by a constant load, driven in (x, y) by a rotating load.
-const MASS: f64 = 1.0;
-const DAMPING: f64 = 0.05;
-const STIFFNESS: f64 = 1.0;
-const FORCE: f64 = 1.0;
-const OMEGA: f64 = 1.3;
 const MU: f64 = 0.3;
 const PRESS: f64 = 2.0;
 const GAP: f64 = 0.5;
@@ -175,14 +154,6 @@ fn pressed_rotor() -> StructuralModel {
             MU,
         ));
     model
-}
-
-/// The radius of the sliding circle under the slip limit `b` (module documentation).
-fn circle_radius(b: f64) -> f64 {
-    let w = OMEGA;
-    let a = (STIFFNESS - MASS * w * w).powi(2) + (DAMPING * w).powi(2);
-    let half_linear = DAMPING * w * b;
-    (-half_linear + (half_linear * half_linear - a * (b * b - FORCE * FORCE)).sqrt()) / a
 }
 
 /// A point pressed by the normal law slides on the circle of the closed form, through the

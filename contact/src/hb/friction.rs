@@ -73,7 +73,7 @@ impl FrictionPeriod {
                 count: lin.friction.len(),
             });
         }
-        let i = lin.normal_rows() + f;
+        let i = lin.friction_row(f);
         let mut aft = Aft::new(FourierBasis::new(lin.basis.harmonics(), points)?);
         let size = lin.size();
         let mut sample = |coefficient: &dyn Fn(usize) -> f64| -> Result<Vec<f64>, HbError> {
@@ -126,7 +126,7 @@ impl SsnHb {
         let lambda = self.force_coefficients(x)?;
         let lin = &self.state.linear;
         let m = lin.contacts();
-        let i = lin.normal_rows() + f;
+        let i = lin.friction_row(f);
         let period = FrictionPeriod::reconstruct(
             lin,
             (u, self.state.omega, self.c()),

@@ -43,6 +43,8 @@ pub(crate) struct LawLayout {
     pub(crate) q_pairs: Vec<(usize, usize)>,
     /// `(a, s)`: the row and the row read of each `X` block.
     pub(crate) x_pairs: Vec<(usize, usize)>,
+    /// The group of each friction point (one tangential row, its group's `first`).
+    pub(crate) friction_groups: Vec<usize>,
     /// The index of `Q_aa` of each row.
     pub(crate) diagonal: Vec<usize>,
     /// The index in `groups` of each row's group.
@@ -75,7 +77,9 @@ impl LawLayout {
         for contact in &model.contacts {
             laws.push((Arc::new(Unilateral), vec![contact.gap]));
         }
+        let mut friction_groups = Vec::with_capacity(model.friction.len());
         for point in &model.friction {
+            friction_groups.push(laws.len());
             laws.push((
                 Arc::new(Coulomb::new(point.coefficient, point.normal)),
                 vec![0.0],
@@ -112,6 +116,7 @@ impl LawLayout {
             groups: Vec::with_capacity(laws.len()),
             q_pairs: Vec::new(),
             x_pairs: Vec::new(),
+            friction_groups,
             diagonal: Vec::with_capacity(total),
             group_of_row: Vec::with_capacity(total),
             velocity: Vec::with_capacity(total),

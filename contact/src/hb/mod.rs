@@ -315,7 +315,7 @@ pub(crate) struct LinearData {
     /// The gap of each contact (normal row).
     pub(crate) gaps: Vec<f64>,
     /// The Coulomb coefficient and the normal force of each friction point (tangential
-    /// row `gaps.len() + f`).
+    /// row [`LinearData::friction_row`]).
     pub(crate) friction: Vec<(f64, NormalForce)>,
     /// The row groups with their laws and the pattern of their Jacobian blocks.
     pub(crate) laws: LawLayout,
@@ -399,6 +399,17 @@ impl LinearData {
     /// Number of contacts (normal rows, the first rows of `G`).
     pub(crate) fn normal_rows(&self) -> usize {
         self.gaps.len()
+    }
+
+    /// The index of friction point `f`'s row group (its law a [`crate::law::Coulomb`] on
+    /// one row).
+    pub(crate) fn friction_group(&self, f: usize) -> usize {
+        self.laws.friction_groups[f]
+    }
+
+    /// The tangential row of friction point `f` (the first row of its group).
+    pub(crate) fn friction_row(&self, f: usize) -> usize {
+        self.laws.groups[self.friction_group(f)].first
     }
 
     /// Whether row `i` is a friction point's tangential row: its measured quantity is the

@@ -47,7 +47,7 @@ fn static_slips(model: &StructuralModel, lin: &LinearData, compliance: Option<&[
         .iter()
         .enumerate()
         .map(|(f, &(mu, normal))| {
-            let c = row_compliance(model, lin, compliance, lin.normal_rows() + f);
+            let c = row_compliance(model, lin, compliance, lin.friction_row(f));
             let b = match normal {
                 NormalForce::Prescribed(load) => mu * load,
                 NormalForce::Contact(_) => 0.0,
@@ -292,7 +292,7 @@ impl PenaltyHb {
     /// into the AFT's samples.
     fn friction_samples(&mut self, u: &[f64], f: usize) {
         let lin = &self.state.linear;
-        let i = lin.normal_rows() + f;
+        let i = lin.friction_row(f);
         let eta = self.eta[f];
         let coeffs = self.state.aft.coefficients_mut();
         coeffs[0] = 0.0;
@@ -302,11 +302,12 @@ impl PenaltyHb {
         self.state.aft.coefficients_to_samples();
     }
 
-    /// Row `i`'s regularised law ([`crate::law::ContactLaw::regularised`]) at the AFT's
-    /// samples into `force` and `slope`.
-    fn regularise(&mut self, i: usize) {
+    /// Row group `g`'s regularised law ([`crate::law::ContactLaw::regularised`]) at the
+    /// AFT's samples into `force` and `slope` (contact `i` is group `i`, friction point `f`
+    /// group [`LinearData::friction_group`]).
+    fn regularise(&mut self, g: usize) {
         let lin = &self.state.linear;
-        let law = &lin.laws.groups[i].law;
+        let law = &lin.laws.groups[g].law;
         let at = LawSamples {
             z: self.state.aft.samples(),
             read: &[],
@@ -315,7 +316,7 @@ impl PenaltyHb {
         };
         // (Every law of a model penalty HB accepts has its regularised form.)
         let regularised = law.regularised(&at, &mut self.force, &mut self.slope);
-        debug_assert!(regularised, "row {i} has no regularised law");
+        debug_assert!(regularised, "group {g} has no regularised law");
     }
 
     /// The penalty stiffness `k_p` in use.
@@ -435,12 +436,12 @@ impl Residual for PenaltyHb {
         for f in 0..lin.friction.len() {
             // - G_t^T P lambda_t = + G_t^T P b tanh(y / eta).
             self.friction_samples(u, f);
-            self.regularise(lin.normal_rows() + f);
+            self.regularise(lin.friction_group(f));
             for (s, force) in self.state.aft.samples_mut().iter_mut().zip(&self.force) {
                 *s = -force;
             }
             self.state.aft.samples_to_coefficients();
-            let row = lin.normal_rows() + f;
+            let row = lin.friction_row(f);
             for (j, c) in self.state.aft.coefficients().iter().enumerate() {
                 lin.add_row_transpose(row, *c, out, j);
             }
@@ -482,8 +483,8 @@ impl GeneralizedJacobian for PenaltyHb {
             // dR/dU = G_t^T P diag(b sech^2(y / eta) / eta) E D G_t, written as
             // k_p G_t^T Q D G_t (the coupling's stiffness divided out).
             self.friction_samples(u, f);
-            let i = lin.normal_rows() + f;
-            self.regularise(i);
+            self.regularise(lin.friction_group(f));
+            let i = lin.friction_row(f);
             let scale = -1.0 / (self.eta[f] * self.stiffness);
             for (s, d) in self.state.aft.samples_mut().iter_mut().zip(&self.slope) {
                 *s = scale * d;

@@ -234,14 +234,25 @@ impl HarmonicProblem {
     }
 }
 
-/// A formulation's solve of `rod` at `omega` from a warm start (used where it fits) with the
-/// discretisation of the settings and no error estimate.
-pub(crate) type SolveAt = fn(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError>;
+/// What a formulation's solve is asked: the structure `rod` at `omega` from a warm start
+/// (used where it fits) with the discretisation of `settings`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SolveRequest<'a> {
+    pub(crate) rod: &'a Structure,
+    pub(crate) omega: f64,
+    pub(crate) settings: &'a SolverSettings,
+    pub(crate) warm_start: Option<&'a [f64]>,
+}
+
+impl<'a> SolveRequest<'a> {
+    /// `(rod, omega, settings, warm_start)`.
+    pub(crate) fn parts(self) -> (&'a Structure, f64, &'a SolverSettings, Option<&'a [f64]>) {
+        (self.rod, self.omega, self.settings, self.warm_start)
+    }
+}
+
+/// A formulation's solve of a [`SolveRequest`], without error estimate.
+pub(crate) type SolveAt = fn(SolveRequest<'_>) -> Result<Solution, RunError>;
 
 /// A formulation's harmonic-balance problem of a model at `omega` with the settings'
 /// discretisation.
@@ -259,18 +270,6 @@ pub(crate) trait Formulation: Sync {
 
     /// Its solve ([`SolveAt`]).
     fn solver(&self) -> SolveAt;
-
-    /// Solves `rod` at `omega` from `warm_start` with the discretisation of `settings`
-    /// and no error estimate.
-    fn solve(
-        &self,
-        rod: &Structure,
-        omega: f64,
-        settings: &SolverSettings,
-        warm_start: Option<&[f64]>,
-    ) -> Result<Solution, RunError> {
-        (self.solver())(rod, omega, settings, warm_start)
-    }
 
     /// The accuracy search's ladder: the order in the discretisation, the first level and
     /// the finest (by default those of its kind of discretisation).
@@ -473,7 +472,7 @@ impl Formulation for LcpLemkeFormulation {
         DiscretisationKind::TimeSamples
     }
     fn solver(&self) -> SolveAt {
-        |rod, omega, settings, _warm_start| super::solve_lcp_by_lemke(rod, omega, settings)
+        super::solve_lcp_by_lemke
     }
     fn carried_start(&self, _: &Structure, _: &Solution, _: &SolverSettings) -> Option<Vec<f64>> {
         // Lemke starts from its own basis.

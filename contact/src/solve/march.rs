@@ -4,13 +4,15 @@
 
 use std::time::Instant;
 
-use super::{solution, Outcome, Period, RunCounters, RunError, Solution, Termination};
+use super::{
+    solution, Outcome, Period, RunCounters, RunError, Solution, SolveRequest, Termination,
+};
 use crate::contacts::{march_friction_report, MARCH_STICK_VELOCITY};
 use crate::hb::FrictionalContactReport;
 use crate::march::{
     march_from_state, MarchError, MarchOptions, MarchScheme, MarchState, SteadyPeriod,
 };
-use crate::model::{NormalForce, NormalLaw, StructuralModel, Structure};
+use crate::model::{NormalForce, NormalLaw, StructuralModel};
 use crate::settings::SolverSettings;
 
 /// The time-marching scheme of `settings`: Moreau–Jean with the restitution when it is
@@ -73,12 +75,8 @@ fn max_abs(v: &[f64]) -> f64 {
 
 /// Time marching from rest (or from `warm_start`, the [`Solution::state`] of a march of
 /// the same model) to the steady state.
-pub(super) fn solve_march(
-    rod: &Structure,
-    omega: f64,
-    settings: &SolverSettings,
-    warm_start: Option<&[f64]>,
-) -> Result<Solution, RunError> {
+pub(super) fn solve_march(request: SolveRequest<'_>) -> Result<Solution, RunError> {
+    let (rod, omega, settings, warm_start) = request.parts();
     let model = &rod.model;
     let tip = rod.observed_dof;
     let options = MarchOptions {
@@ -140,15 +138,7 @@ pub(super) fn solve_march(
         final_state.contact_force,
     ]
     .concat();
-    let mut solution = solution(
-        rod,
-        omega,
-        settings,
-        settings.steps_per_period,
-        outcome,
-        period,
-        state,
-    );
+    let mut solution = solution(request, settings.steps_per_period, outcome, period, state);
     solution.frictional_contacts = frictional_contacts;
     Ok(solution)
 }

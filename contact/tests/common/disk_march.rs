@@ -13,7 +13,7 @@
 use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
 use semismooth::Residual;
 use semismooth_contact::hb::{FrictionalContactReport, HbOptions, SsnHb, StructuredHbSolver};
-use semismooth_contact::march::{march_to_steady_state, MarchOptions};
+use semismooth_contact::march::{march_to_steady_state, MarchOptions, SteadyPeriod};
 use semismooth_contact::model::{
     ContactRow, FrictionalContact, HarmonicLoad, SparseMatrix, StructuralModel,
 };
@@ -82,37 +82,50 @@ pub fn oscillator(case: &Case) -> StructuralModel {
     }
 }
 
-/// What is compared: the first-harmonic amplitudes of `x` and `y`, and the contact's
-/// report over the period.
+/// What is compared: the first-harmonic amplitudes of two in-plane displacements, the
+/// mean normal force where it is compared, and the contact's report over the period.
 #[derive(Debug, Clone)]
 pub struct Measures {
     pub amplitude: [f64; 2],
+    /// `None` where the mean normal force is not compared.
+    pub mean_normal_force: Option<f64>,
     pub report: FrictionalContactReport,
 }
 
 impl Measures {
-    /// The largest relative difference to `reference` of the two amplitudes and the
-    /// dissipated energy.
+    /// The largest relative difference to `reference` of the two amplitudes, the dissipated
+    /// energy and (where both have it) the mean normal force.
     pub fn difference(&self, reference: &Measures) -> f64 {
         let relative = |a: f64, b: f64| (a - b).abs() / b.abs();
+        let normal = match (self.mean_normal_force, reference.mean_normal_force) {
+            (Some(a), Some(b)) => relative(a, b),
+            _ => 0.0,
+        };
         relative(self.amplitude[0], reference.amplitude[0])
             .max(relative(self.amplitude[1], reference.amplitude[1]))
             .max(relative(
                 self.report.dissipated_energy,
                 reference.report.dissipated_energy,
             ))
+            .max(normal)
     }
 }
 
-/// The march's first-order Richardson extrapolation `2 fine - coarse` of the amplitudes
-/// and the energy from `coarse` and `fine` (half the step), with `fine`'s series.
+/// The march's first-order Richardson extrapolation `2 fine - coarse` of every measure
+/// from `coarse` and `fine` (half the step), with `fine`'s series.
 pub fn extrapolated(coarse: &Measures, fine: &Measures) -> Measures {
+    let richardson = |f: f64, c: f64| 2.0 * f - c;
     let mut out = fine.clone();
     for a in 0..2 {
-        out.amplitude[a] = 2.0 * fine.amplitude[a] - coarse.amplitude[a];
+        out.amplitude[a] = richardson(fine.amplitude[a], coarse.amplitude[a]);
     }
-    out.report.dissipated_energy =
-        2.0 * fine.report.dissipated_energy - coarse.report.dissipated_energy;
+    out.mean_normal_force = (fine.mean_normal_force)
+        .zip(coarse.mean_normal_force)
+        .map(|(f, c)| richardson(f, c));
+    out.report.dissipated_energy = richardson(
+        fine.report.dissipated_energy,
+        coarse.report.dissipated_energy,
+    );
     out
 }
 
@@ -128,14 +141,18 @@ pub fn first_harmonic(u: &[f64]) -> f64 {
     2.0 * a.hypot(b) / n
 }
 
-/// SSN-HB with `harmonics` from zero (asserted converged), measured on 4096 points.
-pub fn harmonic_balance(case: &Case, harmonics: usize) -> Measures {
-    let model = oscillator(case);
+/// SSN-HB of `model` with `harmonics` at `omega` solved from zero (asserted converged):
+/// the problem and its solution.
+pub fn solved_from_zero(
+    model: &StructuralModel,
+    omega: f64,
+    harmonics: usize,
+) -> (SsnHb, Vec<f64>) {
     let options = HbOptions {
         harmonics,
         ..HbOptions::default()
     };
-    let mut hb = SsnHb::new(&model, case.omega, &options).unwrap();
+    let mut hb = SsnHb::new(model, omega, &options).unwrap();
     let mut x = vec![0.0; hb.dim()];
     let newton = PolyalgorithmOptions::default();
     let report = solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &newton).unwrap();
@@ -144,11 +161,44 @@ pub fn harmonic_balance(case: &Case, harmonics: usize) -> Measures {
         "H = {harmonics}: {:?}",
         report.termination
     );
+    (hb, x)
+}
+
+/// SSN-HB with `harmonics` from zero (asserted converged), measured on 4096 points.
+pub fn harmonic_balance(case: &Case, harmonics: usize) -> Measures {
+    let (hb, x) = solved_from_zero(&oscillator(case), case.omega, harmonics);
     let points = 4096;
     let amplitude =
         [0, 1].map(|dof| first_harmonic(&hb.displacement_samples(&x, dof, points).unwrap()));
     let report = hb.frictional_contact_report(&x, 0, points).unwrap();
-    Measures { amplitude, report }
+    Measures {
+        amplitude,
+        mean_normal_force: None,
+        report,
+    }
+}
+
+/// A march series over one period without its closing sample (the series hold both ends).
+pub fn one_period(series: &[f64]) -> Vec<f64> {
+    series[..series.len() - 1].to_vec()
+}
+
+/// The report of the first frictional contact over the march's steady `period` at `omega`
+/// (a slip below 1e-8 of the peak counts as stick).
+pub fn march_report(period: &SteadyPeriod, omega: f64) -> FrictionalContactReport {
+    let forces = &period.frictional_forces;
+    let slip = &period.frictional_slip_velocities;
+    let peak = (0..slip[0].len()).fold(0.0f64, |a, n| a.max(slip[0][n].hypot(slip[1][n])));
+    FrictionalContactReport::from_march(
+        0,
+        one_period(&forces[0]),
+        (
+            [one_period(&forces[1]), one_period(&forces[2])],
+            [one_period(&slip[0]), one_period(&slip[1])],
+        ),
+        omega,
+        1e-8 * peak,
+    )
 }
 
 /// The Moreau–Jean march (the model's scheme: `theta = 1` for the massless normal dof)
@@ -161,21 +211,10 @@ pub fn march(case: &Case, steps: usize) -> Measures {
         ..MarchOptions::default()
     };
     let period = march_to_steady_state(&model, case.omega, &options, &[0, 1]).unwrap();
-    // The series hold both ends of the period: drop the closing sample.
-    let cut = |v: &Vec<f64>| v[..v.len() - 1].to_vec();
-    let amplitude = [0, 1].map(|o| first_harmonic(&cut(&period.displacements[o])));
-    let forces = &period.frictional_forces;
-    let slip = &period.frictional_slip_velocities;
-    let peak = (0..slip[0].len()).fold(0.0f64, |a, n| a.max(slip[0][n].hypot(slip[1][n])));
-    let report = FrictionalContactReport::from_march(
-        0,
-        cut(&forces[0]),
-        (
-            [cut(&forces[1]), cut(&forces[2])],
-            [cut(&slip[0]), cut(&slip[1])],
-        ),
-        case.omega,
-        1e-8 * peak,
-    );
-    Measures { amplitude, report }
+    let amplitude = [0, 1].map(|o| first_harmonic(&one_period(&period.displacements[o])));
+    Measures {
+        amplitude,
+        mean_normal_force: None,
+        report: march_report(&period, case.omega),
+    }
 }

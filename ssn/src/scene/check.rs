@@ -664,10 +664,7 @@ impl Check<'_> {
         let on_contacts = m.contacts.iter().filter(|c| c.friction.is_some()).count();
         let points = m.friction.len() + on_contacts;
         if !m.frictional_contacts.is_empty()
-            && !matches!(
-                solver.method,
-                Method::SsnHb | Method::March | Method::PenaltyHb
-            )
+            && solver.method.friction() == FrictionSupport::Unsupported
         {
             return Err(self.invalid(
                 "solver.method",

@@ -11,11 +11,10 @@ mod disk_march;
 use std::f64::consts::PI;
 use std::path::Path;
 
-use disk_march::first_harmonic;
-use semismooth::polyalgorithm::{solve_smoothing, PolyalgorithmOptions};
-use semismooth::Residual;
+pub use disk_march::{extrapolated, Measures};
+use disk_march::{first_harmonic, march_report, one_period, solved_from_zero};
 use semismooth_contact::builder::sparse_matrix;
-use semismooth_contact::hb::{FrictionalContactReport, HbOptions, SsnHb, StructuredHbSolver};
+use semismooth_contact::hb::FrictionalContactReport;
 use semismooth_contact::march::{march_from_state, MarchOptions, MarchState, SteadyPeriod};
 use semismooth_contact::matrix_market::build_imported;
 use semismooth_contact::model::{SparseMatrix, Structure};
@@ -182,64 +181,25 @@ pub fn scene_structure() -> (Scene, Structure) {
     (scene, structure)
 }
 
-/// What is compared: the first-harmonic amplitudes of the tip's circumferential and axial
-/// displacements, the mean normal force, and the contact's report over the period.
-#[derive(Debug, Clone)]
-pub struct Measures {
-    pub amplitude: [f64; 2],
-    pub mean_normal_force: f64,
-    pub report: FrictionalContactReport,
-}
-
-impl Measures {
-    /// The largest relative difference to `reference` of the two amplitudes, the mean
-    /// normal force and the dissipated energy.
-    pub fn difference(&self, reference: &Measures) -> f64 {
-        let relative = |a: f64, b: f64| (a - b).abs() / b.abs();
-        relative(self.amplitude[0], reference.amplitude[0])
-            .max(relative(self.amplitude[1], reference.amplitude[1]))
-            .max(relative(
-                self.mean_normal_force,
-                reference.mean_normal_force,
-            ))
-            .max(relative(
-                self.report.dissipated_energy,
-                reference.report.dissipated_energy,
-            ))
+/// The measures of the tip's `(a, b)` samples over one period (the first-harmonic
+/// amplitudes of its circumferential and axial displacements) and the contact's report.
+fn measures_from_samples(a: &[f64], b: &[f64], report: FrictionalContactReport) -> Measures {
+    let plane = tip_plane();
+    let amplitude = plane.map(|row| {
+        let series: Vec<f64> = a
+            .iter()
+            .zip(b)
+            .map(|(a, b)| row[0] * a + row[1] * b)
+            .collect();
+        first_harmonic(&series)
+    });
+    let mean_normal_force =
+        report.normal_force.iter().sum::<f64>() / report.normal_force.len() as f64;
+    Measures {
+        amplitude,
+        mean_normal_force: Some(mean_normal_force),
+        report,
     }
-
-    /// From the samples of the tip's `(a, b)` over one period and the contact's report.
-    fn from_samples(a: &[f64], b: &[f64], report: FrictionalContactReport) -> Self {
-        let plane = tip_plane();
-        let amplitude = plane.map(|row| {
-            let series: Vec<f64> = a
-                .iter()
-                .zip(b)
-                .map(|(a, b)| row[0] * a + row[1] * b)
-                .collect();
-            first_harmonic(&series)
-        });
-        let mean_normal_force =
-            report.normal_force.iter().sum::<f64>() / report.normal_force.len() as f64;
-        Self {
-            amplitude,
-            mean_normal_force,
-            report,
-        }
-    }
-}
-
-/// The march's first-order Richardson extrapolation `2 fine - coarse` of every measure
-/// from `coarse` and `fine` (half the step), with `fine`'s series.
-pub fn extrapolated(coarse: &Measures, fine: &Measures) -> Measures {
-    let mut out = fine.clone();
-    for a in 0..2 {
-        out.amplitude[a] = 2.0 * fine.amplitude[a] - coarse.amplitude[a];
-    }
-    out.mean_normal_force = 2.0 * fine.mean_normal_force - coarse.mean_normal_force;
-    out.report.dissipated_energy =
-        2.0 * fine.report.dissipated_energy - coarse.report.dissipated_energy;
-    out
 }
 
 /// SSN-HB with `harmonics` at `omega` from zero (asserted converged), measured on 4096
@@ -249,23 +209,11 @@ pub fn harmonic_balance(
     omega: f64,
     harmonics: usize,
 ) -> (Measures, Vec<f64>) {
-    let options = HbOptions {
-        harmonics,
-        ..HbOptions::default()
-    };
-    let mut hb = SsnHb::new(&structure.model, omega, &options).unwrap();
-    let mut x = vec![0.0; hb.dim()];
-    let newton = PolyalgorithmOptions::default();
-    let report = solve_smoothing(&mut hb, &mut StructuredHbSolver::new(), &mut x, &newton).unwrap();
-    assert!(
-        report.converged(),
-        "H = {harmonics}: {:?}",
-        report.termination
-    );
+    let (hb, x) = solved_from_zero(&structure.model, omega, harmonics);
     let points = 4096;
     let [a, b] = [TIP[1], TIP[2]].map(|dof| hb.displacement_samples(&x, dof, points).unwrap());
     let report = hb.frictional_contact_report(&x, 0, points).unwrap();
-    (Measures::from_samples(&a, &b, report), x)
+    (measures_from_samples(&a, &b, report), x)
 }
 
 /// The Moreau–Jean march with `steps` per period from `start` to a period-to-period
@@ -283,24 +231,10 @@ pub fn march(
     };
     let model = &structure.model;
     let period = march_from_state(model, omega, &options, &[TIP[1], TIP[2]], start).unwrap();
-    // The series hold both ends of the period: drop the closing sample.
-    let cut = |v: &Vec<f64>| v[..v.len() - 1].to_vec();
-    let forces = &period.frictional_forces;
-    let slip = &period.frictional_slip_velocities;
-    let peak = (0..slip[0].len()).fold(0.0f64, |a, n| a.max(slip[0][n].hypot(slip[1][n])));
-    let report = FrictionalContactReport::from_march(
-        0,
-        cut(&forces[0]),
-        (
-            [cut(&forces[1]), cut(&forces[2])],
-            [cut(&slip[0]), cut(&slip[1])],
-        ),
-        omega,
-        1e-8 * peak,
-    );
+    let report = march_report(&period, omega);
     let d = &period.displacements;
     (
-        Measures::from_samples(&cut(&d[0]), &cut(&d[1]), report),
+        measures_from_samples(&one_period(&d[0]), &one_period(&d[1]), report),
         period,
     )
 }
