@@ -323,7 +323,8 @@ impl FrequencyResponse {
     /// for 3-D frictional contact `p` (from 1, as `ssn solve --csv`)
     /// `contact3d_{p}_max_normal_force`, `_max_tangential_force`, `_dissipated_energy`,
     /// `_stick_fraction`, `_slip_fraction`, `_separated_fraction`; then the friction points'
-    /// numbers (`friction{f}_stick_fraction`, ...: [`Self::friction_point_columns`]).
+    /// numbers, `friction{f}_<name>` for each name of [`FrictionSummary::NAMES`] (point `f`
+    /// from 0, as the JSON's `point`).
     pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
         let mut columns = self.unilateral_contact_columns();
         columns.extend(self.frictional_contact_columns());
