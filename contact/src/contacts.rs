@@ -63,6 +63,29 @@ pub struct FrictionSummary {
     pub slip_limit_max: f64,
 }
 
+impl FrictionSummary {
+    /// The names of [`FrictionSummary::named`]'s numbers, as the outputs (JSON, sweep CSV,
+    /// study table) spell them.
+    pub const NAMES: [&'static str; 4] = [
+        "stick_fraction",
+        "force_amplitude",
+        "slip_velocity_amplitude",
+        "slip_limit_max",
+    ];
+
+    /// The summary's numbers with their names ([`FrictionSummary::NAMES`]): the one list
+    /// every output of a friction point takes.
+    pub fn named(&self) -> [(&'static str, f64); 4] {
+        let [stick, force, velocity, limit] = Self::NAMES;
+        [
+            (stick, self.stick_fraction),
+            (force, self.force_amplitude),
+            (velocity, self.slip_velocity_amplitude),
+            (limit, self.slip_limit_max),
+        ]
+    }
+}
+
 impl FrictionReport {
     /// The report of friction point `point` from its force, slip velocity and slip limit
     /// samples and the samples where it sticks (all at the same equally spaced times).

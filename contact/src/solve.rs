@@ -15,7 +15,7 @@ mod roundoff;
 pub use raised_c::RAISED_C_FACTOR;
 pub(crate) mod formulation;
 use roundoff::DisplacementBlock;
-pub(crate) use roundoff::{displacement_floor, roundoff_floor};
+pub(crate) use roundoff::{displacement_floor, load_scaled_tolerance, roundoff_floor};
 mod reconstruction;
 
 pub use formulation::{DiscretisationKind, FrictionSupport};
@@ -379,7 +379,8 @@ pub fn newton_options(settings: &SolverSettings) -> SolveOptions {
 }
 
 /// A Newton solve with the linear solver chosen by the settings (and the problem's
-/// `smoothing` offered to the polyalgorithm), converged or not.
+/// `smoothing` offered to the polyalgorithm), converged or not, to the tolerance scaled by
+/// the load ([`load_scaled_tolerance`]).
 ///
 /// The residual floor of the Newton options is the round-off level of the model
 /// (`eps max K_ii sqrt(n) max|g|`: 4e-8 for 10^5 elements at H = 20, far below 1e-10 for
@@ -401,6 +402,10 @@ where
         problem.displacement_len(),
         extra_stiffness,
     );
+    let settings = &SolverSettings {
+        tolerance: load_scaled_tolerance(settings.tolerance, model),
+        ..settings.clone()
+    };
     let options = newton_options(settings).with_state_floor(floor);
     let report = match settings.linear_solver.condensed() {
         Some(condensed) => {

@@ -81,15 +81,24 @@ pub fn load_with(
 }
 
 /// The scene at `path` with `overrides`; the file's discretisation keys an accuracy
-/// override replaced are said on standard error (unless `--quiet`).
+/// override replaced, and sweep bounds replaced by bounds in another unit, are said on
+/// standard error (unless `--quiet`).
 fn scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, CliError> {
     let (scene, replaced) =
         Scene::from_path_noting(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
-    if !replaced.is_empty() && !crate::io::quiet() {
+    let (sweep, discretisation): (Vec<String>, Vec<String>) =
+        replaced.into_iter().partition(|k| k.starts_with("sweep."));
+    if !discretisation.is_empty() && !crate::io::quiet() {
         eprintln!(
             "note: --set solver.accuracy replaces the scene's {}: the accuracy target chooses \
              the discretisation",
-            replaced.join(", ")
+            discretisation.join(", ")
+        );
+    }
+    if !sweep.is_empty() && !crate::io::quiet() {
+        eprintln!(
+            "note: the sweep bounds set replace the scene's {}",
+            sweep.join(", ")
         );
     }
     Ok(scene)
@@ -120,7 +129,7 @@ pub fn load_keeping_reduction(
 
 /// [`prepare`], and the scene's reduction when it has one (not for `Workload::Check`).
 fn prepare_keeping_reduction(
-    scene: Scene,
+    mut scene: Scene,
     workload: Workload,
     matrices: Option<MatrixSource>,
 ) -> Result<(Loaded, Option<CraigBampton>), CliError> {
@@ -172,6 +181,7 @@ fn prepare_keeping_reduction(
                 crate::limits::check(&need, limit).map_err(|e| too_large(path, e))?;
             }
             let (n, m) = (structure.model.dofs(), structure.model.contacts.len());
+            scene.resolve_sweep_unit(structure.omega_1);
             let omega_1 = Some(structure.omega_1);
             let work = crate::work::scene_work_at(&scene, (n, m), omega_1, workload);
             crate::limits::check_work(&work, work_limit).map_err(|e| too_large(path, e))?;
@@ -187,6 +197,7 @@ fn prepare_keeping_reduction(
             rod
         }
     };
+    scene.resolve_sweep_unit(structure.omega_1);
     let omega = scene.omega(structure.omega_1);
     check_scales(&scene, structure.omega_1, omega).map_err(|e| input_error(path, e))?;
     check_resonance(&scene, &structure, omega).map_err(|e| input_error(path, e))?;

@@ -36,13 +36,11 @@ pub fn contact_json(c: &ContactReport) -> Value {
 /// The JSON object of one friction point's numbers over a period: `point`,
 /// `stick_fraction`, `force_amplitude`, `slip_velocity_amplitude`, `slip_limit_max`.
 pub fn friction_summary_json(point: usize, f: &FrictionSummary) -> Value {
-    json!({
-        "point": point,
-        "stick_fraction": finite_or_null(f.stick_fraction),
-        "force_amplitude": finite_or_null(f.force_amplitude),
-        "slip_velocity_amplitude": finite_or_null(f.slip_velocity_amplitude),
-        "slip_limit_max": finite_or_null(f.slip_limit_max),
-    })
+    let mut v = json!({ "point": point });
+    for (name, value) in f.named() {
+        v[name] = finite_or_null(value);
+    }
+    v
 }
 
 /// The JSON object of one friction point of a solution: its numbers

@@ -230,10 +230,8 @@ pub fn counted_march_periods(
     let (damping, omega_1) = match &scene.model {
         Some(model) => (model.damping, omega_1),
         None => {
-            let rod = &scene.rod;
-            let wave_speed = (rod.axial_stiffness / rod.mass_per_length).sqrt();
-            let clamped = std::f64::consts::FRAC_PI_2 * wave_speed / rod.length;
-            (rod.damping, omega_1.or(Some(clamped)))
+            let clamped = clamped_rod_omega_1(&scene.rod);
+            (scene.rod.damping, omega_1.or(Some(clamped)))
         }
     };
     let (Some(damping), Some(omega_1)) = (damping, omega_1) else {
@@ -250,6 +248,14 @@ pub fn counted_march_periods(
     }
     let periods = MARCH_SETTLING_MARGIN * (x / tolerance).ln().max(1.0) / x;
     periods.ceil().clamp(2.0, most)
+}
+
+/// The first natural frequency of the continuous clamped-free rod, `(pi / 2) c / L` with the
+/// wave speed `c = sqrt(EA / rho A)`: the estimate of a rod scene's `omega_1` before it is
+/// built.
+fn clamped_rod_omega_1(rod: &semismooth_contact::rod::RodSpec) -> f64 {
+    let wave_speed = (rod.axial_stiffness / rod.mass_per_length).sqrt();
+    std::f64::consts::FRAC_PI_2 * wave_speed / rod.length
 }
 
 /// A branch over the `[sweep]` window (for `ssn solutions` without one: half to twice the
@@ -324,11 +330,12 @@ fn point_stability_work(scene: &Scene, dofs: usize, settings: &SolverSettings) -
 /// [`CORRECTOR_ITERATIONS_PER_POINT`] corrector iterations.
 pub fn counted_branch_points(scene: &Scene, settings: &SolverSettings) -> f64 {
     let (range, max_step, max_points) = match &scene.sweep {
-        Some(s) => (
-            (s.omega_ratio_to - s.omega_ratio_from).abs(),
-            s.max_step,
-            s.max_points,
-        ),
+        Some(s) => {
+            // Bounds not yet resolved to ratios (a rod before it is built): the continuum's
+            // omega_1, within 0.03 % of the discrete rod's at 20 elements.
+            let (from, to) = scene.sweep_ratio_window(s, clamped_rod_omega_1(&scene.rod));
+            ((to - from).abs(), s.max_step, s.max_points)
+        }
         None => {
             let defaults = crate::scene::SweepSettings::new(0.5, 2.0);
             // [0.5 r, 2 r] around the scene's ratio r (1 when given as omega).

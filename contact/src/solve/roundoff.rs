@@ -6,6 +6,30 @@ use semismooth::Residual;
 
 use crate::hb::{PenaltyHb, SsnHb};
 
+/// The largest Newton tolerance of a forced harmonic-balance run relative to its load's
+/// size (see [`load_scaled_tolerance`]): six digits of the load balanced at least.
+pub(crate) const LOAD_RELATIVE_TOLERANCE: f64 = 1e-6;
+
+/// The Newton tolerance of a forced harmonic-balance run, in force units: `tolerance`, but
+/// at most [`LOAD_RELATIVE_TOLERANCE`] times the load's size `|f|` (the 2-norm of all its
+/// harmonic coefficients, the residual at the zero guess). A small load (a model in other
+/// units) is then solved to a relative accuracy instead of passing at the zero guess; a
+/// large one keeps the absolute tolerance, which the round-off floor raises with the
+/// response ([`displacement_floor`]). A model without load (driven by its obstacles) keeps
+/// `tolerance`.
+pub(crate) fn load_scaled_tolerance(tolerance: f64, model: &crate::model::StructuralModel) -> f64 {
+    let squares = (model.load.harmonics().iter())
+        .flat_map(|h| h.cosine.iter().chain(&h.sine))
+        .map(|v| v * v)
+        .sum::<f64>();
+    let size = squares.sqrt();
+    if size > 0.0 {
+        tolerance.min(LOAD_RELATIVE_TOLERANCE * size)
+    } else {
+        tolerance
+    }
+}
+
 /// Round-off level of a harmonic-balance residual: one ulp of the largest force term,
 /// `eps max_i K_ii sqrt(n) max|u|`. A Newton run that stalls (the step no longer moves
 /// the iterate) within 100 times of it has converged as far as floating point allows:

@@ -322,10 +322,33 @@ impl FrequencyResponse {
     /// `contact{k}_displacement_max`, one value per point (NaN where not computed); then
     /// for 3-D frictional contact `p` (from 1, as `ssn solve --csv`)
     /// `contact3d_{p}_max_normal_force`, `_max_tangential_force`, `_dissipated_energy`,
-    /// `_stick_fraction`, `_slip_fraction`, `_separated_fraction`.
+    /// `_stick_fraction`, `_slip_fraction`, `_separated_fraction`; then the friction points'
+    /// numbers, `friction{f}_<name>` for each name of [`FrictionSummary::NAMES`] (point `f`
+    /// from 0, as the JSON's `point`).
     pub fn contact_columns(&self) -> Vec<(String, Vec<f64>)> {
         let mut columns = self.unilateral_contact_columns();
         columns.extend(self.frictional_contact_columns());
+        columns.extend(self.friction_point_columns());
+        columns
+    }
+
+    /// The friction points' columns of [`Self::contact_columns`]: for friction point `f`
+    /// (the model's order, from 0, as the `point` of the JSON) `friction{f}_<name>` for each
+    /// name of [`FrictionSummary::NAMES`], one value per point (NaN where not computed).
+    fn friction_point_columns(&self) -> Vec<(String, Vec<f64>)> {
+        let count = (self.points.iter())
+            .map(|p| p.friction.len())
+            .max()
+            .unwrap_or(0);
+        let mut columns = Vec::with_capacity(count * FrictionSummary::NAMES.len());
+        for f in 0..count {
+            for (k, name) in FrictionSummary::NAMES.iter().enumerate() {
+                let values = (self.points.iter())
+                    .map(|point| point.friction.get(f).map_or(f64::NAN, |s| s.named()[k].1))
+                    .collect();
+                columns.push((format!("friction{f}_{name}"), values));
+            }
+        }
         columns
     }
 

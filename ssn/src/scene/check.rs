@@ -209,6 +209,8 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
         ck.friction_method(&solver, m)?;
     }
     let sweep = raw.sweep.map(|sw| ck.sweep(&sw)).transpose()?;
+    let sweep_unit = sweep.as_ref().map(|(_, unit)| *unit).unwrap_or_default();
+    let sweep = sweep.map(|(settings, _)| settings);
     let modes = raw.modes.map(|m| ck.modes(&m)).transpose()?;
     let load_parts = ck.load_parts(&forcing, model.is_some(), solver.harmonics)?;
     let (engine_order, cyclic) =
@@ -227,6 +229,7 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
         cyclic,
         solver,
         sweep,
+        sweep_unit,
         modes,
         reduction,
     })
@@ -859,18 +862,10 @@ impl Check<'_> {
         })
     }
 
-    /// `[sweep]`: a non-empty frequency interval and arclength steps with
-    /// `min_step <= step <= max_step`.
-    fn sweep(&self, sw: &RawSweep) -> Result<SweepSettings, SceneError> {
-        let from = self.positive("sweep.omega_ratio_from", sw.omega_ratio_from)?;
-        let to = self.positive("sweep.omega_ratio_to", sw.omega_ratio_to)?;
-        if to == from {
-            return Err(self.invalid(
-                "sweep.omega_ratio_to",
-                to,
-                "a value different from omega_ratio_from",
-            ));
-        }
+    /// `[sweep]`: a non-empty frequency interval in one unit (kept as given) and arclength
+    /// steps with `min_step <= step <= max_step`.
+    fn sweep(&self, sw: &RawSweep) -> Result<(SweepSettings, SweepUnit), SceneError> {
+        let (unit, from, to) = self.sweep_window(sw)?;
         let defaults = SweepSettings::new(from, to);
         let step = self.positive("sweep.step", sw.step.unwrap_or(defaults.step))?;
         let min_step = self.positive("sweep.min_step", sw.min_step.unwrap_or(defaults.min_step))?;
@@ -882,7 +877,7 @@ impl Check<'_> {
                 &format!("min_step ({min_step}) <= step <= max_step ({max_step})"),
             ));
         }
-        Ok(SweepSettings {
+        let settings = SweepSettings {
             step,
             min_step,
             max_step,
@@ -896,7 +891,8 @@ impl Check<'_> {
             stability: sw.stability.unwrap_or(defaults.stability),
             period_two: sw.period_two.unwrap_or(defaults.period_two),
             ..defaults
-        })
+        };
+        Ok((settings, unit))
     }
 }
 

@@ -41,11 +41,13 @@ mod load_parts;
 mod nodes;
 mod overrides;
 mod reduction;
+mod sweep_units;
 
 pub use cyclic::{CyclicSpec, EngineOrderSpec, MAX_SECTORS};
 pub use disk::{bladed_disk_matrices, MAX_BLADES};
 pub use load_parts::{add_load_parts, LoadPart, MatrixSource};
 pub use reduction::{ModeSelection, ReductionMethod, ReductionSpec, MAX_REDUCTION_MODES};
+pub use sweep_units::SweepUnit;
 
 pub use overrides::{
     normal_key, parse_value, read_scene_text, Override, OverrideError, MAX_KEY_PARTS,
@@ -88,8 +90,11 @@ pub struct Scene {
     pub cyclic: Option<CyclicSpec>,
     /// Solver settings.
     pub solver: SolverSettings,
-    /// Frequency sweep, if declared.
+    /// Frequency sweep, if declared (its bounds in `sweep_unit` until the run resolves them
+    /// to ratios of `omega_1`: [`Scene::resolve_sweep_unit`]).
     pub sweep: Option<SweepSettings>,
+    /// The unit of the `[sweep]` bounds as given.
+    pub sweep_unit: SweepUnit,
     /// Nonlinear mode (`ssn modes`), if declared.
     pub modes: Option<ModesSettings>,
     /// The reduction of the structure before it is solved (`[reduction]`), if declared.
@@ -328,8 +333,12 @@ struct RawSolver {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawSweep {
-    omega_ratio_from: f64,
-    omega_ratio_to: f64,
+    omega_ratio_from: Option<f64>,
+    omega_ratio_to: Option<f64>,
+    omega_from: Option<f64>,
+    omega_to: Option<f64>,
+    frequency_hz_from: Option<f64>,
+    frequency_hz_to: Option<f64>,
     step: Option<f64>,
     min_step: Option<f64>,
     max_step: Option<f64>,

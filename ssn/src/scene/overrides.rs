@@ -9,7 +9,8 @@
 //! (`contact.point.0.gap`, 0-based). Values are TOML values (`1.1`, `40`, `"ssn-hb"`,
 //! `[0.01, -0.02]`); a bare word that is not one (`ssn-hb`) is read as a string. An
 //! override of `solver.accuracy` replaces the file's discretisation keys (`harmonics`,
-//! `time_samples`, `steps_per_period`): the target chooses them.
+//! `time_samples`, `steps_per_period`): the target chooses them; sweep bounds in one unit
+//! (`sweep.frequency_hz_from`) replace the file's bounds in the others.
 
 use std::fmt;
 use std::path::Path;
@@ -138,7 +139,8 @@ impl Scene {
             apply(&mut document, o)
                 .map_err(|reason| SceneError::parse(path, format!("--set {o}: {reason}")))?;
         }
-        let replaced = drop_overridden_discretisation(&mut document, overrides);
+        let mut replaced = drop_overridden_discretisation(&mut document, overrides);
+        replaced.extend(drop_other_sweep_units(&mut document, overrides));
         let named = overrides
             .iter()
             .map(|o| format!("--set {o}"))
@@ -205,6 +207,37 @@ fn drop_overridden_discretisation(
             }
             if let Some(value) = solver.remove(name) {
                 dropped.push(format!("solver.{name} = {value}"));
+            }
+        }
+    }
+    dropped
+}
+
+/// Sweep bounds given by override in one unit replace the file's bounds in the others
+/// (`--set sweep.frequency_hz_from=...` on a scene in ratios): the file's bound keys of the
+/// other units are dropped unless an override sets them too (which the scene then refuses,
+/// as in a file). Returns the keys dropped with their values.
+fn drop_other_sweep_units(document: &mut toml::Table, overrides: &[Override]) -> Vec<String> {
+    use super::sweep_units::SWEEP_BOUND_KEYS;
+    let keys: Vec<String> = overrides.iter().map(|o| normal_key(&o.key)).collect();
+    let overridden = |name: &str| keys.contains(&format!("sweep.{name}"));
+    let mut dropped = Vec::new();
+    if !SWEEP_BOUND_KEYS
+        .iter()
+        .flatten()
+        .any(|name| overridden(name))
+    {
+        return dropped;
+    }
+    if let Some(toml::Value::Table(sweep)) = document.get_mut("sweep") {
+        for pair in SWEEP_BOUND_KEYS {
+            if pair.iter().any(|name| overridden(name)) {
+                continue;
+            }
+            for name in pair {
+                if let Some(value) = sweep.remove(name) {
+                    dropped.push(format!("sweep.{name} = {value}"));
+                }
             }
         }
     }

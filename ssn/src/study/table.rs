@@ -139,6 +139,49 @@ pub fn quantities(kind: RunKind, doc: &Value) -> Vec<(&'static str, Cell)> {
     }
 }
 
+/// The friction points' numbers of a case's document: a solve's `friction` list, a
+/// sweep's at its peak (the point of `peak_amplitude`); none for `solutions`.
+fn case_friction(kind: RunKind, doc: &Value) -> Vec<Value> {
+    let list = match kind {
+        RunKind::Solve => &doc["friction"],
+        RunKind::Sweep => {
+            let amplitude: Vec<f64> = (doc["amplitude"].as_array().into_iter().flatten())
+                .map(|v| v.as_f64().unwrap_or(f64::NAN))
+                .collect();
+            match finite_argmax(&amplitude) {
+                Some((peak, _)) => &doc["friction"][peak],
+                None => &Value::Null,
+            }
+        }
+        RunKind::Solutions => &Value::Null,
+    };
+    list.as_array().cloned().unwrap_or_default()
+}
+
+/// The columns of the friction points, after the quantities: for friction point `f` (from
+/// 0, as the JSON's `point`) `friction{f}_<name>` for each name of
+/// [`FrictionSummary::NAMES`] (a solve's values; a sweep's at its peak), as many points as
+/// the case with the most has (null where a case has fewer or failed).
+fn friction_columns(kind: RunKind, records: &[Value]) -> Vec<Column> {
+    use semismooth_contact::contacts::FrictionSummary;
+    let lists: Vec<Vec<Value>> = (records.iter())
+        .map(|r| case_friction(kind, &r["result"]))
+        .collect();
+    let count = lists.iter().map(Vec::len).max().unwrap_or(0);
+    let mut columns = Vec::with_capacity(count * FrictionSummary::NAMES.len());
+    for f in 0..count {
+        for name in FrictionSummary::NAMES {
+            columns.push(Column {
+                name: format!("friction{f}_{name}"),
+                cells: (lists.iter())
+                    .map(|list| list.get(f).map_or(Cell::Null, |p| num(&p[name])))
+                    .collect(),
+            });
+        }
+    }
+    columns
+}
+
 /// A number of the JSON document as a cell.
 fn num(v: &Value) -> Cell {
     Cell::float(v.as_f64())
@@ -323,6 +366,7 @@ impl Table {
                 cells: rows.iter().map(|row| row[j].1.clone()).collect(),
             });
         }
+        columns.extend(friction_columns(kind, records));
         Table { columns }
     }
 
