@@ -1,12 +1,14 @@
 //! The memory of a long SSN-HB sweep on a large model, keeping full states or only the
 //! contact forces ([`StateStorage`]).
 //!
-//! `cargo run --release -p semismooth-contact --example sweep_memory -- ELEMENTS H POINTS STORAGE`
+//! `cargo run --release -p semismooth-contact --example sweep_memory -- ELEMENTS H POINTS STORAGE [TOL]`
 //!
 //! Sweeps the modified-mass rod refined to `ELEMENTS` elements (`N = ELEMENTS` dofs, one tip
 //! contact at gap 0.5, distributed load 0.2) with `H` harmonics from `0.5 omega_1` upwards
 //! until `POINTS` points (step 0.005, stability off: the monodromy is limited to 400 dofs),
-//! storing `full` or `contact-forces`, and prints the points, the numbers their states keep
+//! storing `full` or `contact-forces` (Newton's tolerance on `|F|` `TOL`, default the
+//! scene's: at `10^5` elements the residual's round-off floor `eps max K_ii sqrt(n) max|u|`
+//! is near 5e-8, so give `1e-7`), and prints the points, the numbers their states keep
 //! against `(2H + 1)(N + m)` a point, the peak resident memory (`VmHWM` of
 //! `/proc/self/status`) and the wall time. Run it under `/usr/bin/time -v` for the
 //! maximum resident set size as the system counts it.
@@ -52,12 +54,15 @@ fn main() {
     })
     .expect("the rod builds");
     // The sweeps' settings of the tests: 100 Newton iterations, non-monotone line search.
-    let settings = SolverSettings {
+    let mut settings = SolverSettings {
         method: Method::SsnHb,
         max_iterations: 100,
         globalization: GlobalizationChoice::Nonmonotone,
         ..SolverSettings::with_harmonics(harmonics)
     };
+    if let Some(tolerance) = args.get(4) {
+        settings.tolerance = tolerance.parse().expect("argument 5: a tolerance");
+    }
     let sweep = SweepSettings {
         step: 0.005,
         max_step: 0.005,

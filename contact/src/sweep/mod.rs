@@ -82,6 +82,13 @@
 //! θ-length of a frequency step here): a reversal the branch leaves by at least that much
 //! is a fold (`folds`), the others are zigzags (`corner_folds`).
 //!
+//! # What a branch keeps
+//!
+//! Each point keeps the method's full state unless [`frequency_response_storing`] is asked
+//! for [`StateStorage::ContactForces`]: an SSN-HB branch then keeps `m (2H + 1)` numbers a
+//! point instead of `(2H + 1)(N + m)`, and its analyses read full states recovered by
+//! [`StateRecovery`] (module `storage`; measurements in `docs/finite_element_models.md`).
+//!
 //! Measured branch sizes, timings and limits are in `docs/sweeps.md` and
 //! `examples/lcp_sweep.rs`.
 
@@ -454,15 +461,18 @@ where
         return Ok(response);
     }
 
+    let mut compaction = setup.compaction;
+    if let Some(compaction) = &mut compaction {
+        compaction.verify(omega_from, &x);
+    }
     let mut continuation = configure(
         Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
     );
-    let mut compaction = setup.compaction;
     while let Some(point) = continuation.next() {
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
-        let state = match &mut compaction {
-            Some(compaction) => compaction.keep(omega, point.state),
+        let state = match &compaction {
+            Some(compaction) => compaction.keep(point.state),
             None => point.state,
         };
         let mut record = ResponsePoint::new(omega, (max, min), point.iterations, state);

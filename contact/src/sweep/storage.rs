@@ -23,15 +23,15 @@ use crate::solve::hb_options;
 
 use super::{FrequencyResponse, StateStorage};
 
-/// Largest difference, relative to the state's largest entry, between the first point's
-/// state and its recovery for a branch to keep only the contact forces: a structural
+/// Largest difference, relative to the state's largest entry, between the branch's start
+/// and its recovery for a branch to keep only the contact forces: a structural
 /// mismatch (a model whose `U` is not `A^{-1} (F + G^T Lambda)`) differs by order one, the
 /// corrector's residual by far less (module documentation).
 const RECOVERY_CHECK: f64 = 1e-6;
 
 /// Reduces the states of an SSN-HB branch to their contact forces as the points are
-/// accepted, once the first point's recovery reproduces its state (else the branch keeps
-/// full states).
+/// accepted, once the recovery reproduces the branch's start (else the branch keeps full
+/// states).
 pub(super) struct Compaction<'m> {
     model: &'m StructuralModel,
     settings: &'m SolverSettings,
@@ -61,13 +61,17 @@ impl<'m> Compaction<'m> {
         )
     }
 
-    /// What the branch keeps of `state`, accepted at `omega`.
-    pub(super) fn keep(&mut self, omega: f64, state: Vec<f64>) -> Vec<f64> {
-        let verified = match self.verified {
-            Some(verified) => verified,
-            None => *self.verified.insert(self.reproduces(omega, &state)),
-        };
-        if verified {
+    /// Checks the recovery on the branch's start `state` at `omega` (before the
+    /// continuation allocates its workspace, so the check's factorizations do not add to
+    /// the sweep's peak memory): without it the branch keeps full states.
+    pub(super) fn verify(&mut self, omega: f64, state: &[f64]) {
+        self.verified = Some(self.reproduces(omega, state));
+    }
+
+    /// What the branch keeps of `state`: its contact forces once [`Compaction::verify`]
+    /// passed, else all of it.
+    pub(super) fn keep(&self, state: Vec<f64>) -> Vec<f64> {
+        if self.verified == Some(true) {
             state[self.split..].to_vec()
         } else {
             state
