@@ -21,7 +21,7 @@ use crate::model::{StructuralModel, Structure};
 use crate::settings::SolverSettings;
 use crate::solve::{HarmonicProblem, RunError};
 use crate::stability::{HbStability, Stability, StabilityError, Undecided};
-use crate::sweep::FrequencyResponse;
+use crate::sweep::{FrequencyResponse, StateRecovery};
 
 /// Reconstruction points per period for the contact diagnostics.
 const DIAGNOSTIC_POINTS: usize = 1024;
@@ -238,8 +238,9 @@ fn point_analyses(
     let mut current = response.point_settings(settings, 0);
     let (mut reconstruction, mut analysis) = analysers(rod, &current)?;
     let mut analyses: Vec<Stability> = Vec::with_capacity(response.points.len());
+    let mut states = StateRecovery::new(rod, settings, response);
     for (i, point) in response.points.iter().enumerate() {
-        let x = &point.state;
+        let x = &*states.state(i)?;
         let at = response.point_settings(settings, i);
         if (at.harmonics, at.time_samples) != (current.harmonics, current.time_samples) {
             (reconstruction, analysis) = analysers(rod, &at)?;

@@ -12,7 +12,9 @@ use crate::model::Structure;
 use crate::settings::SolverSettings;
 use crate::solve::{set_closed_fractions, HarmonicProblem, HbReconstruction, RunError};
 
-use super::{FrequencyResponse, ResponsePoint};
+#[cfg(doc)]
+use super::ResponsePoint;
+use super::{FrequencyResponse, StateRecovery};
 
 /// Per-contact reports and friction summaries of a point, in the model's order of contacts
 /// and friction points.
@@ -76,7 +78,9 @@ fn branch_reports(
     let hb = || -> Result<Vec<PointReports>, RunError> {
         let mut current: Option<((usize, usize), Box<dyn HbReconstruction>)> = None;
         let mut reports = Vec::with_capacity(response.points.len());
-        for (i, ResponsePoint { state: x, .. }) in response.points.iter().enumerate() {
+        let mut states = StateRecovery::new(structure, settings, response);
+        for i in 0..response.points.len() {
+            let x = &*states.state(i)?;
             let at = response.point_settings(settings, i);
             let key = (at.harmonics, at.time_samples);
             if current.as_ref().is_none_or(|(k, _)| *k != key) {

@@ -37,6 +37,7 @@ use super::branch::branch_stability;
 use super::response::HbTip;
 use super::{
     hb_solver, reference_amplitude, ssn_continuation, BifurcationEvent, FrequencyResponse, Setup,
+    StateRecovery,
 };
 use crate::hb::{HbJacobian, SsnHb};
 use crate::model::{HarmonicLoad, StructuralModel, Structure};
@@ -176,7 +177,10 @@ pub fn period_two_branch(
     let mut problem = SsnHb::new(&half.model, nu, &hb_options(&doubled)).map_err(RunError::from)?;
     let rows = problem.dim() / (2 * doubled.harmonics + 1);
     let widths = [half.model.dofs(), rows - half.model.dofs()];
-    let lifted = lift(&point.state, single.harmonics, &widths);
+    let state = StateRecovery::new(structure, settings, response)
+        .state(index)
+        .map_err(RunError::from)?;
+    let lifted = lift(&state, single.harmonics, &widths);
     let kernel = odd_kernel(&mut problem, &lifted, doubled.harmonics, rows)?;
     let size = lifted[..problem.displacement_len()]
         .iter()
@@ -500,6 +504,7 @@ fn follow_half(
         started,
         start: Some((start, Default::default())),
         bounds: Some(bounds),
+        compaction: None,
     };
     super::follow(
         (problem, Some(SmoothingOf::new())),

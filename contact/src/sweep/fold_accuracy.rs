@@ -35,7 +35,7 @@ use semismooth::{Factorize, GeneralizedJacobian, ParameterDependent};
 use super::response::FrequencyResponse;
 use super::{
     continuation_error, continuation_options, hb_solver, penalty_continuation, ssn_continuation,
-    MethodContinuation,
+    MethodContinuation, StateRecovery,
 };
 use crate::hb::resize_harmonics;
 use crate::model::Structure;
@@ -158,6 +158,7 @@ pub fn refine_folds(
     }
     let omega_1 = structure.omega_1;
     let mut out = Vec::with_capacity(response.folds.len());
+    let mut states = StateRecovery::new(structure, settings, response);
     for (&fold, &index) in response.folds.iter().zip(&response.fold_indices) {
         // The start: the last point at least APPROACH omega_1 before the fold.
         let start = (0..index)
@@ -184,7 +185,7 @@ pub fn refine_folds(
         };
         // The start of the next rung: the branch point, then each rung's corrected start.
         let from = (
-            response.points[start].state.clone(),
+            states.state(start)?.into_owned(),
             response.point_settings(settings, start).harmonics,
         );
         out.push(ladder.climb(first, from, target)?);

@@ -10,7 +10,7 @@ use crate::model::Structure;
 use crate::settings::{Method, SolverSettings};
 use crate::solve::{hb_options, RunError};
 
-use super::{FrequencyResponse, ResponsePoint};
+use super::{FrequencyResponse, ResponsePoint, StateRecovery};
 
 /// Sets the 3-D frictional contacts' summaries of each point of an SSN-HB `response`
 /// (nothing for other methods or without 3-D contacts).
@@ -27,7 +27,9 @@ pub(super) fn set_frictional_summaries(
     let points = response.output_points;
     let mut current: Option<((usize, usize), SsnHb)> = None;
     let mut summaries = Vec::with_capacity(response.points.len());
-    for (i, ResponsePoint { state, omega, .. }) in response.points.iter().enumerate() {
+    let mut states = StateRecovery::new(structure, settings, response);
+    for (i, ResponsePoint { omega, .. }) in response.points.iter().enumerate() {
+        let state = &*states.state(i)?;
         let at = response.point_settings(settings, i);
         let key = (at.harmonics, at.time_samples);
         if current.as_ref().is_none_or(|(k, _)| *k != key) {

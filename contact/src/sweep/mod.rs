@@ -82,6 +82,13 @@
 //! θ-length of a frequency step here): a reversal the branch leaves by at least that much
 //! is a fold (`folds`), the others are zigzags (`corner_folds`).
 //!
+//! # What a branch keeps
+//!
+//! Each point keeps the method's full state unless [`frequency_response_storing`] is asked
+//! for [`StateStorage::ContactForces`]: an SSN-HB branch then keeps `m (2H + 1)` numbers a
+//! point instead of `(2H + 1)(N + m)`, and its analyses read full states recovered by
+//! [`StateRecovery`] (module `storage`; measurements in `docs/finite_element_models.md`).
+//!
 //! Measured branch sizes, timings and limits are in `docs/sweeps.md` and
 //! `examples/lcp_sweep.rs`.
 
@@ -93,6 +100,7 @@ pub mod fold_accuracy;
 mod frictional;
 pub mod peak;
 mod response;
+mod storage;
 
 use std::time::Instant;
 
@@ -106,7 +114,11 @@ use semismooth::polyalgorithm::SmoothingOf;
 use semismooth::{Factorize, GeneralizedJacobian, LinearSolve, ParameterDependent, Residual};
 
 use response::{extremes, HbTip};
-pub use response::{FrequencyResponse, ResponsePoint, SweepTermination, TURNING_POINT_EXCURSION};
+pub use response::{
+    FrequencyResponse, ResponsePoint, StateStorage, SweepTermination, TURNING_POINT_EXCURSION,
+};
+use storage::Compaction;
+pub use storage::StateRecovery;
 
 use crate::hb::{HbError, HbJacobian, PenaltyHb, PenaltyHbOptions, SsnHb, StructuredHbSolver};
 use crate::lcp::{solve_min_map_sequenced, FrequencyLcp, FrequencyLcpSolver};
@@ -395,6 +407,8 @@ struct Setup<'a> {
     /// Bounds of the frequency in place of the sweep's `[omega_from, omega_to]` (a branch
     /// that starts inside the sweep's range).
     bounds: Option<(f64, f64)>,
+    /// What the points keep of their states (`None`: the full states).
+    compaction: Option<Compaction<'a>>,
 }
 
 /// Newton at `omega_from` (the problem's `smoothing` offered to the polyalgorithm), then the
@@ -447,13 +461,21 @@ where
         return Ok(response);
     }
 
+    let mut compaction = setup.compaction;
+    if let Some(compaction) = &mut compaction {
+        compaction.verify(omega_from, &x);
+    }
     let mut continuation = configure(
         Continuation::new(problem, solver, &x, omega_from, options).map_err(continuation_error)?,
     );
     while let Some(point) = continuation.next() {
         let omega = point.parameter;
         let (max, min) = measure(continuation.problem(), &point.state, omega)?;
-        let mut record = ResponsePoint::new(omega, (max, min), point.iterations, point.state);
+        let state = match &compaction {
+            Some(compaction) => compaction.keep(point.state),
+            None => point.state,
+        };
+        let mut record = ResponsePoint::new(omega, (max, min), point.iterations, state);
         if settings.method.is_harmonic_balance() {
             record.harmonics = Some(settings.harmonics);
             record.time_samples = Some(settings.time_samples);
@@ -475,6 +497,7 @@ where
     response.corners = c.corners as usize;
     response.continuation = c;
     response.termination = sweep_termination(termination);
+    response.state_storage = compaction.map_or(StateStorage::Full, |c| c.storage());
     response.solve_seconds = setup.started.elapsed().as_secs_f64();
     Ok(response)
 }
@@ -557,6 +580,24 @@ pub fn frequency_response(
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(SweepProgress)>,
 ) -> Result<FrequencyResponse, RunError> {
+    frequency_response_storing(structure, settings, sweep, StateStorage::Full, progress)
+}
+
+/// [`frequency_response`] keeping of each point's state what `storage` says: with
+/// [`StateStorage::ContactForces`] an SSN-HB branch (without an accuracy target) keeps
+/// `m (2H + 1)` numbers a point instead of `(2H + 1)(N + m)`, and the stability, contact
+/// reports, peak search and period doubling read full states recovered point by point
+/// ([`StateRecovery`], one factorization of the dynamic blocks per point and analysis).
+/// The frequencies, observed extremes and folds are those of [`frequency_response`]
+/// (taken before the states are reduced); the quantities read from recovered states differ
+/// from them by the corrector's residual in the equations of motion (module `storage`).
+pub fn frequency_response_storing(
+    structure: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    storage: StateStorage,
+    progress: Option<&dyn Fn(SweepProgress)>,
+) -> Result<FrequencyResponse, RunError> {
     let branch_progress = progress.map(|report| {
         move |points: usize, omega_ratio: f64| {
             report(SweepProgress::Branch {
@@ -570,7 +611,7 @@ pub fn frequency_response(
         Some(target) if settings.method.adapts_harmonics() => {
             adaptive::adaptive_branch(structure, settings, sweep, target, branch_progress)?
         }
-        _ => follow_branch(structure, settings, sweep, branch_progress)?,
+        _ => follow_branch_storing(structure, settings, sweep, storage, branch_progress)?,
     };
     contacts::set_branch_reports(structure, settings, &mut response)?;
     frictional::set_frictional_summaries(structure, settings, &mut response)?;
@@ -604,6 +645,17 @@ pub(crate) fn follow_branch(
     sweep: &SweepSettings,
     progress: Option<&dyn Fn(usize, f64)>,
 ) -> Result<FrequencyResponse, RunError> {
+    follow_branch_storing(rod, settings, sweep, StateStorage::Full, progress)
+}
+
+/// The branch of [`frequency_response_storing`] without its stability.
+fn follow_branch_storing(
+    rod: &Structure,
+    settings: &SolverSettings,
+    sweep: &SweepSettings,
+    storage: StateStorage,
+    progress: Option<&dyn Fn(usize, f64)>,
+) -> Result<FrequencyResponse, RunError> {
     check_sweep(sweep)?;
     let started = Instant::now();
     let model = &rod.model;
@@ -625,6 +677,7 @@ pub(crate) fn follow_branch(
         started,
         start: None,
         bounds: None,
+        compaction: None,
     };
     let formulation = crate::solve::formulation::of(settings.method);
     if let Some(what) = formulation.continuation_refusal() {
@@ -641,10 +694,14 @@ pub(crate) fn follow_branch(
             let mut tip_rec = HbTip::new(settings.harmonics, output_points, dofs, tip)?;
             let mut measure = |_: &SsnHb, x: &[f64], _: f64| tip_rec.extremes(x);
             let method = ssn_continuation(model, &problem, u_ref);
+            let split = problem.displacement_len();
             follow(
                 (&mut problem, Some(SmoothingOf::new())),
                 &mut *hb_solver(settings.linear_solver),
-                setup(method, output_points),
+                Setup {
+                    compaction: Compaction::of(storage, model, settings, split),
+                    ..setup(method, output_points)
+                },
                 &mut measure,
                 |c| c,
                 progress,

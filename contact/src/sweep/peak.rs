@@ -13,7 +13,8 @@ use crate::model::Structure;
 use crate::settings::SolverSettings;
 use crate::solve::solve;
 
-use super::FrequencyResponse;
+use super::{FrequencyResponse, StateRecovery};
+use crate::hb::HbError;
 
 /// Largest number of solves the search spends on one peak.
 pub const MAX_PEAK_SOLVES: usize = 40;
@@ -75,12 +76,8 @@ pub fn locate_peak(
     if i == 0 || i + 1 == points.len() {
         return Some(unsearched(PeakLocation::AtEdge));
     }
-    let [a, b, c] = [i - 1, i, i + 1].map(|k| Sample {
-        omega: points[k].omega,
-        amplitude: points[k].amplitude,
-        state: points[k].state.clone(),
-    });
-    if (b.omega - a.omega) * (c.omega - b.omega) <= 0.0 {
+    let [wa, wb, wc] = [i - 1, i, i + 1].map(|k| points[k].omega);
+    if (wb - wa) * (wc - wb) <= 0.0 {
         return Some(unsearched(PeakLocation::AtFold));
     }
     let same_discretisation = [i - 1, i + 1]
@@ -91,6 +88,19 @@ pub fn locate_peak(
             "the neighbouring points have other harmonics".into(),
         )));
     }
+    let mut states = StateRecovery::new(structure, settings, response);
+    let mut sample = |k: usize| -> Result<Sample, HbError> {
+        Ok(Sample {
+            omega: points[k].omega,
+            amplitude: points[k].amplitude,
+            state: states.state(k)?.into_owned(),
+        })
+    };
+    let samples = (sample(i - 1), sample(i), sample(i + 1));
+    let (Ok(a), Ok(b), Ok(c)) = samples else {
+        let reason = "a neighbouring point's state could not be recovered".into();
+        return Some(unsearched(PeakLocation::NotLocated(reason)));
+    };
     let settings = SolverSettings {
         estimate_error: false,
         ..response.point_settings(settings, i)

@@ -78,6 +78,9 @@ pub struct FrequencyResponse {
     /// The peak located between the branch points (harmonic balance;
     /// [`super::peak::locate_peak`]), `None` for other methods or an empty branch.
     pub located_peak: Option<super::peak::LocatedPeak>,
+    /// What the points' [`ResponsePoint::state`] hold: the full unknowns, or the contact
+    /// forces alone (full states by [`super::StateRecovery`]).
+    pub state_storage: StateStorage,
 }
 
 /// One point of a frequency-response branch: its frequency, the extremes of the observed
@@ -96,7 +99,9 @@ pub struct ResponsePoint {
     /// Corrector iterations (the first point: those of the start correction).
     pub iterations: usize,
     /// The method's unknowns (HB coefficients `[U; Lambda]` or `U`, LCP `[w; z]`),
-    /// unscaled, for warm starts and re-solves.
+    /// unscaled, for warm starts and re-solves; with
+    /// [`StateStorage::ContactForces`] ([`FrequencyResponse::state_storage`]) SSN-HB's
+    /// `Lambda` alone, the full state given by [`super::StateRecovery`].
     pub state: Vec<f64>,
     /// Harmonic balance: the harmonics of the state (`None` for the LCP).
     pub harmonics: Option<usize>,
@@ -149,6 +154,20 @@ impl ResponsePoint {
     pub fn contact_force_mean(&self) -> f64 {
         self.contacts.iter().map(|c| c.force_mean).sum()
     }
+}
+
+/// What a sweep keeps of each branch point's state ([`ResponsePoint::state`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum StateStorage {
+    /// The method's full unknowns (SSN-HB: `[U; Lambda]`, `(2H + 1)(N + m)` numbers).
+    #[default]
+    Full,
+    /// SSN-HB: the contact-force coefficients `Lambda` alone (`m (2H + 1)` numbers, the
+    /// trailing part of `[U; Lambda]`); the full state is recovered on demand by
+    /// [`super::StateRecovery`]. Other methods, and branches whose harmonics change point by point
+    /// (an accuracy target), keep their full states.
+    ContactForces,
 }
 
 /// Why a sweep stopped.
@@ -219,7 +238,15 @@ impl FrequencyResponse {
             accuracy: None,
             period_two: Vec::new(),
             located_peak: None,
+            state_storage: StateStorage::Full,
         }
+    }
+
+    /// The numbers the points keep of their states (the sum of their
+    /// [`ResponsePoint::state`] lengths): `(2H + 1)(N + m)` a point for full SSN-HB
+    /// states, `m (2H + 1)` with [`StateStorage::ContactForces`].
+    pub fn stored_state_numbers(&self) -> usize {
+        self.points.iter().map(|p| p.state.len()).sum()
     }
 
     /// `settings` with the harmonics and AFT samples of point `i` (as given for the LCP or
