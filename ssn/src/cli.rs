@@ -88,18 +88,15 @@ fn scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, CliError> {
         Scene::from_path_noting(path, overrides).map_err(|e| CliError::BadInput(e.to_string()))?;
     let (sweep, discretisation): (Vec<String>, Vec<String>) =
         replaced.into_iter().partition(|k| k.starts_with("sweep."));
-    if !discretisation.is_empty() && !crate::io::quiet() {
-        eprintln!(
-            "note: --set solver.accuracy replaces the scene's {}: the accuracy target chooses \
-             the discretisation",
-            discretisation.join(", ")
-        );
-    }
-    if !sweep.is_empty() && !crate::io::quiet() {
-        eprintln!(
-            "note: the sweep bounds set replace the scene's {}",
-            sweep.join(", ")
-        );
+    const CHOSEN: &str = ": the accuracy target chooses the discretisation";
+    let notes = [
+        (discretisation, "--set solver.accuracy replaces", CHOSEN),
+        (sweep, "the sweep bounds set replace", ""),
+    ];
+    for (keys, what, why) in notes {
+        if !keys.is_empty() && !crate::io::quiet() {
+            eprintln!("note: {what} the scene's {}{why}", keys.join(", "));
+        }
     }
     Ok(scene)
 }
