@@ -114,8 +114,8 @@ pub struct ContinuationOptions {
     /// resolve is no fold).
     pub fold_excursion: f64,
     /// When the step has been halved to its end (the run would stop), try once to pass a
-    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
-    /// before giving up. Default `true`.
+    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*: two
+    /// hyperplanes, then the exit piece's tangent) before giving up. Default `true`.
     pub pass_corners: bool,
     /// The corrector may not leave the θ-ball of radius `trust_factor` times the largest
     /// step the next attempt can take (twice the last step, at most `max_step`) around the

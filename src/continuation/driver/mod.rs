@@ -2,6 +2,7 @@
 //! corner passes, bound landing, the trust ball, restarts and piecewise-affine corners.
 
 mod affine;
+mod exit;
 mod resume;
 mod step;
 
@@ -601,7 +602,11 @@ where
                 continue;
             }
             if self.options.pass_corners {
-                if let Some(accepted) = self.pass_corner(&last, ds) {
+                let passed = match self.pass_corner(&last, ds) {
+                    None if !self.finished() => self.pass_corner_by_exit(&last),
+                    passed => passed,
+                };
+                if let Some(accepted) = passed {
                     if let Some((point, chord)) = accepted {
                         self.after_accept(point, chord);
                     }
