@@ -83,14 +83,16 @@
 //!
 //! Where both fail (a fold at a corner: the branch leaves the corner going back in `p`, often
 //! along a piece nearly opposite to the incoming one), the exit-tangent pass
-//! ([`ContinuationCounters::exit_passes`]) takes the generalized Jacobian just past the last
+//! ([`ContinuationOptions::exit_tangents`], counted in
+//! [`ContinuationCounters::exit_passes`]) takes the generalized Jacobian just past the last
 //! point, at `y_k + δ d` for `δ` = 2, 16 and 128 times `min_step`, where the switched pieces
 //! are active: the kernel `e` of `[J, F_p]` there is the tangent of the piece that leaves the
 //! corner. The corrector is tried from `y_k ± ds e` on the hyperplane normal to `e`
 //! (`ds` = 4 and 32 times `δ`). A probe whose tangent is the incoming piece's (at `y_k`) is
 //! skipped, and a point whose chord from `y_k` lies along the incoming piece is refused
 //! (the piece the branch came by); the first other point is accepted with its tangent
-//! oriented along `e`. The problem supplies nothing beyond its generalized Jacobian.
+//! oriented along `e`. The problem supplies nothing beyond its generalized Jacobian. (A
+//! piecewise-affine branch crosses its corners exactly instead, below.)
 //!
 //! The corrector is the crate's Newton iteration ([`crate::newton`]: the same step rule and
 //! termination tests) with the bordered direction above; it takes full steps unless

@@ -114,9 +114,14 @@ pub struct ContinuationOptions {
     /// resolve is no fold).
     pub fold_excursion: f64,
     /// When the step has been halved to its end (the run would stop), try once to pass a
-    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*: two
-    /// hyperplanes, then the exit piece's tangent) before giving up. Default `true`.
+    /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
+    /// before giving up. Default `true`.
     pub pass_corners: bool,
+    /// With `pass_corners`, when the corner passes fail, follow the tangent of the piece
+    /// that leaves the corner (the generalized Jacobian just past it; module
+    /// documentation, *Corners*). Default `false`: on a branch whose exit piece is the
+    /// piece it came by, mirrored, the run could go back along it.
+    pub exit_tangents: bool,
     /// The corrector may not leave the θ-ball of radius `trust_factor` times the largest
     /// step the next attempt can take (twice the last step, at most `max_step`) around the
     /// last accepted point: an iterate outside it is rejected like one outside the
@@ -187,6 +192,7 @@ impl Default for ContinuationOptions {
             refine_folds: true,
             fold_excursion: 0.002,
             pass_corners: true,
+            exit_tangents: false,
             trust_factor: None,
             restarts: None,
         }

@@ -41,6 +41,8 @@
 //! - the corner passes ([`ContinuationOptions::pass_corners`]) and restarts with a
 //!   state-heavy metric ([`RestartPolicy`], its defaults), whose retrace test ends a sweep
 //!   that could only go back along the branch ("stalled at omega_ratio ...");
+//! - for SSN-HB, where the corner passes fail, the exit piece's tangent
+//!   ([`ContinuationOptions::exit_tangents`]): a stop on a mass-carrying dof folds at corners;
 //! - penalty HB is [`PiecewiseAffine`](semismooth::continuation::PiecewiseAffine) (its
 //!   switching functions are the gaps at the AFT samples): its corners are crossed exactly
 //!   ([`Continuation::with_affine_pieces`]), and its folds are corners.
@@ -228,6 +230,9 @@ struct MethodContinuation {
     floor: StateFloor,
     /// The branch is piecewise affine and its corners are crossed exactly.
     affine_pieces: bool,
+    /// Corners that the passes cannot turn are left along the exit piece's tangent
+    /// ([`ContinuationOptions::exit_tangents`]).
+    exit_tangents: bool,
 }
 
 /// SSN-HB's units (force coefficients count divided by `c`) and the round-off floor that
@@ -246,6 +251,7 @@ fn ssn_continuation(model: &StructuralModel, problem: &SsnHb, u_ref: f64) -> Met
             cap: largest_gap(model, u_ref),
         },
         affine_pieces: false,
+        exit_tangents: true,
     }
 }
 
@@ -266,6 +272,7 @@ fn penalty_continuation(
             cap: largest_gap(model, u_ref),
         },
         affine_pieces: !model.has_friction(),
+        exit_tangents: false,
     }
 }
 
@@ -335,6 +342,7 @@ fn continuation_options(
         fold_excursion: TURNING_POINT_EXCURSION,
         trust_factor: Some(TRUST_FACTOR),
         restarts: Some(RestartPolicy::default()),
+        exit_tangents: method.exit_tangents,
         ..ContinuationOptions::default()
     };
     options.validate().map_err(continuation_error)?;
@@ -730,6 +738,7 @@ fn follow_lcp<'a>(
         units,
         floor: StateFloor::OFF,
         affine_pieces: false,
+        exit_tangents: false,
     };
     let setup = Setup {
         start: Some((y0, start_counters)),

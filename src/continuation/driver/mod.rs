@@ -602,8 +602,10 @@ where
                 continue;
             }
             if self.options.pass_corners {
+                // A piecewise-affine branch crosses its corners exactly instead (`recover`).
+                let exit = self.options.exit_tangents && self.pieces.is_none();
                 let passed = match self.pass_corner(&last, ds) {
-                    None if !self.finished() => self.pass_corner_by_exit(&last),
+                    None if exit && !self.finished() => self.pass_corner_by_exit(&last),
                     passed => passed,
                 };
                 if let Some(accepted) = passed {
