@@ -154,7 +154,7 @@ fn mass_carrying_chains_sweep_past_their_corner_folds_through_solutions() {
                 // Ended or not, what the branch holds is solutions.
                 check_points(&structure, &settings, &r);
                 if r.converged() {
-                    complete.push((masses, gap, h));
+                    complete.push((masses, gap, h, r.continuation.exit_passes));
                 }
             }
         }
@@ -166,4 +166,7 @@ fn mass_carrying_chains_sweep_past_their_corner_folds_through_solutions() {
         complete.len()
     );
     assert_eq!(complete.len(), 6, "{complete:?}");
+    // The four that did not reach it before left a corner along an exit tangent.
+    let exits = complete.iter().filter(|c| c.3 > 0).count();
+    assert!(exits >= 4, "{complete:?}");
 }
