@@ -1,7 +1,7 @@
 //! Two-dof chains with a stop on the heavier mass (a contact that carries mass, no massless
 //! pad), as a family over masses, gaps and harmonics: SSN-HB's branch is piecewise smooth and
-//! folds at corners, where the continuation leaves along the tangent of the exit piece. Every
-//! sampled point of the swept branches is a solution of a fresh fixed-frequency problem.
+//! folds at corners. Every sampled point of the swept branches is a solution of a fresh
+//! fixed-frequency problem.
 
 use faer::sparse::Triplet;
 use semismooth::linalg::FaerDenseLu;
@@ -135,7 +135,7 @@ fn check_points(structure: &Structure, settings: &SolverSettings, r: &FrequencyR
 }
 
 #[test]
-fn mass_carrying_chains_sweep_past_their_corner_folds_through_solutions() {
+fn mass_carrying_chains_are_swept_through_solutions_up_to_their_corner_folds() {
     let mut complete = Vec::new();
     for masses in MASSES {
         for gap in GAPS {
@@ -159,14 +159,12 @@ fn mass_carrying_chains_sweep_past_their_corner_folds_through_solutions() {
             }
         }
     }
-    // Measured: 2 of these 16 sweeps reached 3 omega_1 before the exit-tangent pass
-    // (masses (3, 1), gap 0.5, H = 5 and 10), 6 with it.
+    // Measured: 2 of these 16 sweeps reach 3 omega_1 (masses (3, 1), gap 0.5, H = 5 and
+    // 10); with the core's exit-tangent pass turned on in the sweep, 6 (not the sweep's
+    // default: it moves another branch's period doubling).
     println!(
         "{} of 16 reach the upper bound: {complete:?}",
         complete.len()
     );
-    assert_eq!(complete.len(), 6, "{complete:?}");
-    // The four that did not reach it before left a corner along an exit tangent.
-    let exits = complete.iter().filter(|c| c.3 > 0).count();
-    assert!(exits >= 4, "{complete:?}");
+    assert_eq!(complete.len(), 2, "{complete:?}");
 }
