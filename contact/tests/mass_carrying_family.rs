@@ -159,12 +159,12 @@ fn mass_carrying_chains_are_swept_through_solutions_up_to_their_corner_folds() {
             }
         }
     }
-    // Measured: 2 of these 16 sweeps reach 3 omega_1 (masses (3, 1), gap 0.5, H = 5 and
-    // 10); with the core's exit-tangent pass turned on in the sweep, 6 (not the sweep's
-    // default: it moves another branch's period doubling).
+    // Measured: 3 of these 16 sweeps reach 3 omega_1 (masses (3, 1), gap 0.5, H = 5 and
+    // 10; masses (10, 1), gap 0.1, H = 5, which leaves a corner along an exit tangent
+    // after its restart retraced); without the exit-tangent pass, 2.
     println!(
         "{} of 16 reach the upper bound: {complete:?}",
         complete.len()
     );
-    assert_eq!(complete.len(), 2, "{complete:?}");
+    assert_eq!(complete.len(), 3, "{complete:?}");
 }

@@ -249,9 +249,9 @@ fn ssn_continuation(model: &StructuralModel, problem: &SsnHb, u_ref: f64) -> Met
             cap: largest_gap(model, u_ref),
         },
         affine_pieces: false,
-        // Off: with it the sweep of a rod against a bilinear spring at H = 20 takes another
-        // path and its period doubling moves off the marching map's flip.
-        exit_tangents: false,
+        // The last resort of a restart that went back along the branch (the paths of
+        // sweeps that end otherwise are unchanged).
+        exit_tangents: true,
     }
 }
 

@@ -3,7 +3,7 @@
 //! tangent of the piece that leaves the corner, and the branch goes on along it.
 
 use super::super::corrector::{Constraint, Corrector};
-use super::{Accepted, Continuation};
+use super::{Accepted, Continuation, Segment};
 use crate::continuation::BranchPoint;
 use crate::iteration::kernel::{KernelRules, StepRule};
 use crate::newton::Tolerances;
@@ -25,6 +25,30 @@ where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
+    /// After a restarted segment went back along the branch (its end would be
+    /// [`Retraced`](crate::continuation::ContinuationTermination::Retraced)): the main segment again at
+    /// `corner`, where its steps along `failed` failed for good, and the exit-tangent pass
+    /// there; the run goes on from the point it finds, else ends as it would have. The
+    /// restart's retrace test stays on: where the exit piece comes back to the points
+    /// before the corner, the run ends there, `Retraced` too.
+    pub(super) fn exit_after_retrace(&mut self, corner: BranchPoint, failed: Vec<f64>) {
+        let retraced = self.termination.take();
+        self.metric = self.main_metric.clone();
+        self.segment = Segment::Main;
+        self.direction = failed;
+        self.problem.set_parameter(corner.parameter);
+        self.last = Some(corner.clone());
+        match self.pass_corner_by_exit(&corner) {
+            Some(Some((point, chord))) => self.after_accept(point, chord),
+            Some(None) => {}
+            None => {
+                if let Some(termination) = retraced {
+                    self.finish(termination);
+                }
+            }
+        }
+    }
+
     /// The exit-tangent pass (module documentation, *Corners*): for each probe `y_q =
     /// y_k + δ d` past the last point `y_k` along the failed direction `d`, the unit
     /// tangent `e` of `[J(y_q), F_p(y_q)]` (the pieces active at `y_q`), then the corrector
