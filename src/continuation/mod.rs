@@ -82,9 +82,11 @@
 //! follows that tangent (the chord across the corner is no direction for the far piece).
 //!
 //! Where both fail (a fold at a corner: the branch leaves the corner going back in `p`, often
-//! along a piece nearly opposite to the incoming one), the exit-tangent pass
+//! along a piece nearly opposite to the incoming one), a restart may go back along the branch.
+//! As the last resort of such a retrace, the exit-tangent pass
 //! ([`ContinuationOptions::exit_tangents`], counted in
-//! [`ContinuationCounters::exit_passes`]) takes the generalized Jacobian just past the last
+//! [`ContinuationCounters::exit_passes`]) goes back to the corner where the restart began
+//! (the restart's retrace test stays on) and takes the generalized Jacobian just past the last
 //! point, at `y_k + δ d` for `δ` = 2, 16 and 128 times `min_step`, where the switched pieces
 //! are active: the kernel `e` of `[J, F_p]` there is the tangent of the piece that leaves the
 //! corner. The corrector is tried from `y_k ± ds e` on the hyperplane normal to `e`

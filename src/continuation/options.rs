@@ -117,10 +117,10 @@ pub struct ContinuationOptions {
     /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
     /// before giving up. Default `true`.
     pub pass_corners: bool,
-    /// With `pass_corners`, when the corner passes fail, follow the tangent of the piece
-    /// that leaves the corner (the generalized Jacobian just past it; module
-    /// documentation, *Corners*). Default `false`: on a branch whose exit piece is the
-    /// piece it came by, mirrored, the run could go back along it.
+    /// With `pass_corners` and `restarts`, when a restart from a corner the passes could
+    /// not turn goes back along the branch (the run would end `Retraced`), follow the
+    /// tangent of the piece that leaves that corner instead (the generalized Jacobian just
+    /// past it; module documentation, *Corners*). Default `false`.
     pub exit_tangents: bool,
     /// The corrector may not leave the θ-ball of radius `trust_factor` times the largest
     /// step the next attempt can take (twice the last step, at most `max_step`) around the
