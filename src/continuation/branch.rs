@@ -291,6 +291,9 @@ pub struct ContinuationCounters {
     pub rejected_steps: u64,
     /// Points accepted by a corner pass (module documentation, *Corners*).
     pub corner_passes: u64,
+    /// Of the corner passes, those along the tangent of the exit piece (module
+    /// documentation, *Corners*).
+    pub exit_passes: u64,
     /// Restarts after failed steps ([`ContinuationOptions::restarts`](super::ContinuationOptions::restarts)).
     pub restarts: u64,
     /// Corners of a piecewise-affine branch crossed exactly.
@@ -306,6 +309,7 @@ impl std::ops::AddAssign for ContinuationCounters {
         self.rejected_iterations += rhs.rejected_iterations;
         self.rejected_steps += rhs.rejected_steps;
         self.corner_passes += rhs.corner_passes;
+        self.exit_passes += rhs.exit_passes;
         self.restarts += rhs.restarts;
         self.corners += rhs.corners;
     }

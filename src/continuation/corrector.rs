@@ -179,6 +179,18 @@ enum BorderedFailure {
     NonFinite,
 }
 
+impl BorderedFailure {
+    /// The corrector's failure for this one at `iteration`.
+    fn at(self, iteration: usize) -> CorrectorFailure {
+        match self {
+            Self::Linear(error) => CorrectorFailure::LinearSolve { iteration, error },
+            Self::SingularBorder(pivot) => CorrectorFailure::SingularBorder { iteration, pivot },
+            Self::Evaluation(error) => CorrectorFailure::Evaluation { iteration, error },
+            Self::NonFinite => CorrectorFailure::NonFinite { iteration },
+        }
+    }
+}
+
 /// The bordered system seen by the kernel: unknowns `y = (x, p)`.
 struct BorderedSystem<'a, P: GeneralizedJacobian + ?Sized, S: ?Sized> {
     problem: &'a mut P,
@@ -445,19 +457,42 @@ where
                 residual_norm,
                 last_step,
             }),
-            Stop::Direction(BorderedFailure::Linear(error)) => {
-                Err(CorrectorFailure::LinearSolve { iteration, error })
-            }
-            Stop::Direction(BorderedFailure::SingularBorder(pivot)) => {
-                Err(CorrectorFailure::SingularBorder { iteration, pivot })
-            }
-            Stop::Direction(BorderedFailure::Evaluation(error)) | Stop::Evaluation(error) => {
-                Err(CorrectorFailure::Evaluation { iteration, error })
-            }
-            Stop::Direction(BorderedFailure::NonFinite) | Stop::NonFinite => {
-                Err(CorrectorFailure::NonFinite { iteration })
-            }
+            Stop::Direction(failure) => Err(failure.at(iteration)),
+            Stop::Evaluation(error) => Err(CorrectorFailure::Evaluation { iteration, error }),
+            Stop::NonFinite => Err(CorrectorFailure::NonFinite { iteration }),
         };
         (result, run.smallest)
+    }
+
+    /// The raw tangent at `y = (x, p)` without correcting it: the kernel of `[J, F_p]`
+    /// with the generalized Jacobian evaluated at `y` (so with the pieces active there),
+    /// written to `ws.tangent` as `(-a, 1)`, `J a = F_p`. The problem's parameter is left
+    /// at `p`.
+    pub fn tangent_at(
+        self,
+        y: &[f64],
+        work: &mut WorkCounters,
+        counts: &mut CorrectorCounts,
+    ) -> Result<(), CorrectorFailure> {
+        let n = self.metric.n;
+        let mut system = BorderedSystem {
+            problem: self.problem,
+            solver: self.solver,
+            ws: self.ws,
+            fallback: self.fallback,
+            metric: self.metric,
+            constraint: Constraint {
+                arclength: false,
+                w_p: 1.0,
+                target: y[n],
+            },
+            trust: None,
+            counts,
+        };
+        let zero = vec![0.0; n + 1];
+        let mut d = vec![0.0; n + 1];
+        system
+            .direction(y, &zero, &mut d, work)
+            .map_err(|failure| failure.at(0))
     }
 }

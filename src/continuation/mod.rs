@@ -81,6 +81,21 @@
 //! with its tangent oriented along that constraint's normal, and the next predictor
 //! follows that tangent (the chord across the corner is no direction for the far piece).
 //!
+//! Where both fail (a fold at a corner: the branch leaves the corner going back in `p`, often
+//! along a piece nearly opposite to the incoming one), a restart may go back along the branch.
+//! As the last resort of such a retrace, the exit-tangent pass
+//! ([`ContinuationOptions::exit_tangents`], counted in
+//! [`ContinuationCounters::exit_passes`]) goes back to the corner where the restart began
+//! (the restart's retrace test stays on) and takes the generalized Jacobian just past the last
+//! point, at `y_k + δ d` for `δ` = 2, 16 and 128 times `min_step`, where the switched pieces
+//! are active: the kernel `e` of `[J, F_p]` there is the tangent of the piece that leaves the
+//! corner. The corrector is tried from `y_k ± ds e` on the hyperplane normal to `e`
+//! (`ds` = 4 and 32 times `δ`). A probe whose tangent is the incoming piece's (at `y_k`) is
+//! skipped, and a point whose chord from `y_k` lies along the incoming piece is refused
+//! (the piece the branch came by); the first other point is accepted with its tangent
+//! oriented along `e`. The problem supplies nothing beyond its generalized Jacobian. (A
+//! piecewise-affine branch crosses its corners exactly instead, below.)
+//!
 //! The corrector is the crate's Newton iteration ([`crate::newton`]: the same step rule and
 //! termination tests) with the bordered direction above; it takes full steps unless
 //! [`ContinuationOptions::corrector_line_search`] asks for Armijo backtracking on

@@ -117,6 +117,11 @@ pub struct ContinuationOptions {
     /// corner of a piecewise-smooth branch (see the module documentation, *Corners*)
     /// before giving up. Default `true`.
     pub pass_corners: bool,
+    /// With `pass_corners` and `restarts`, when a restart from a corner the passes could
+    /// not turn goes back along the branch (the run would end `Retraced`), follow the
+    /// tangent of the piece that leaves that corner instead (the generalized Jacobian just
+    /// past it; module documentation, *Corners*). Default `false`.
+    pub exit_tangents: bool,
     /// The corrector may not leave the θ-ball of radius `trust_factor` times the largest
     /// step the next attempt can take (twice the last step, at most `max_step`) around the
     /// last accepted point: an iterate outside it is rejected like one outside the
@@ -187,6 +192,7 @@ impl Default for ContinuationOptions {
             refine_folds: true,
             fold_excursion: 0.002,
             pass_corners: true,
+            exit_tangents: false,
             trust_factor: None,
             restarts: None,
         }

@@ -240,6 +240,9 @@ struct MethodContinuation {
     floor: StateFloor,
     /// The branch is piecewise affine and its corners are crossed exactly.
     affine_pieces: bool,
+    /// Corners that the passes cannot turn are left along the exit piece's tangent
+    /// ([`ContinuationOptions::exit_tangents`]).
+    exit_tangents: bool,
 }
 
 /// SSN-HB's units (force coefficients count divided by `c`) and the round-off floor that
@@ -258,6 +261,9 @@ fn ssn_continuation(model: &StructuralModel, problem: &SsnHb, u_ref: f64) -> Met
             cap: largest_gap(model, u_ref),
         },
         affine_pieces: false,
+        // The last resort of a restart that went back along the branch (the paths of
+        // sweeps that end otherwise are unchanged).
+        exit_tangents: true,
     }
 }
 
@@ -278,6 +284,7 @@ fn penalty_continuation(
             cap: largest_gap(model, u_ref),
         },
         affine_pieces: !model.has_friction(),
+        exit_tangents: false,
     }
 }
 
@@ -347,6 +354,7 @@ fn continuation_options(
         fold_excursion: TURNING_POINT_EXCURSION,
         trust_factor: Some(TRUST_FACTOR),
         restarts: Some(RestartPolicy::default()),
+        exit_tangents: method.exit_tangents,
         ..ContinuationOptions::default()
     };
     options.validate().map_err(continuation_error)?;
@@ -787,6 +795,7 @@ fn follow_lcp<'a>(
         units,
         floor: StateFloor::OFF,
         affine_pieces: false,
+        exit_tangents: false,
     };
     let setup = Setup {
         start: Some((y0, start_counters)),

@@ -2,6 +2,7 @@
 //! corner passes, bound landing, the trust ball, restarts and piecewise-affine corners.
 
 mod affine;
+mod exit;
 mod resume;
 mod step;
 
@@ -35,6 +36,12 @@ enum Phase {
         carried: Vec<f64>,
     },
     Running,
+    /// A restarted segment went back along the branch: the exit-tangent pass is tried at
+    /// the corner where the restart began (`corner`, the failed direction `failed`).
+    Retraced {
+        corner: BranchPoint,
+        failed: Vec<f64>,
+    },
     Finished,
 }
 
@@ -136,6 +143,9 @@ where
     /// Joined states of the last emitted points (for the retrace test).
     recent: VecDeque<Vec<f64>>,
     retrace: Option<Retrace>,
+    /// With `exit_tangents`: the point where the steps of the main segment last failed for
+    /// good and a restart began, with the failed direction (the last resort of a retrace).
+    exit_corner: Option<(BranchPoint, Vec<f64>)>,
     /// Parameter component of the tangent at the last corrected (not corner) point.
     last_tangent_parameter: f64,
     pending: VecDeque<BranchPoint>,
@@ -228,6 +238,7 @@ where
             segment_points: 0,
             recent: VecDeque::with_capacity(window + 1),
             retrace: None,
+            exit_corner: None,
             last_tangent_parameter: 0.0,
             pending: VecDeque::new(),
             pieces: None,
@@ -434,7 +445,10 @@ where
                 // The point is dropped and the run ends here, whatever ended it before.
                 let parameter = retrace.anchor[self.metric.n];
                 self.termination = Some(ContinuationTermination::Retraced { parameter });
-                self.phase = Phase::Finished;
+                self.phase = match self.exit_corner.take() {
+                    Some((corner, failed)) => Phase::Retraced { corner, failed },
+                    None => Phase::Finished,
+                };
                 return false;
             }
         }
@@ -673,6 +687,11 @@ where
                 && self.last_tangent_parameter != 0.0
             {
                 self.counters.restarts += 1;
+                // A piecewise-affine branch crosses its corners exactly instead (above).
+                let exit = self.options.exit_tangents && self.pieces.is_none();
+                if exit && matches!(self.segment, Segment::Main) {
+                    self.exit_corner = Some((last.clone(), self.direction.clone()));
+                }
                 let direction = match (stuck, self.segment_direction) {
                     (true, Direction::Increasing) => Direction::Decreasing,
                     (true, Direction::Decreasing) => Direction::Increasing,
@@ -753,6 +772,7 @@ where
                 Phase::NotStarted { x0, p0 } => self.start(x0, p0, None),
                 Phase::Resuming { x0, p0, carried } => self.start(x0, p0, Some(&carried)),
                 Phase::Running => self.advance(),
+                Phase::Retraced { corner, failed } => self.exit_after_retrace(corner, failed),
             }
         }
     }
