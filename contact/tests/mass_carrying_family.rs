@@ -3,14 +3,15 @@
 //! folds at corners. Every sampled point of the swept branches is a solution of a fresh
 //! fixed-frequency problem.
 
-use faer::sparse::Triplet;
+#[allow(dead_code)]
+#[path = "common/chain.rs"]
+mod chain;
+
 use semismooth::linalg::FaerDenseLu;
 use semismooth::newton::{solve, Globalization, NewtonOptions, Tolerances};
 use semismooth::Residual;
 use semismooth_contact::hb::{HbOptions, SsnHb};
-use semismooth_contact::model::{
-    ContactPoint, HarmonicLoad, SparseMatrix, StructuralModel, Structure,
-};
+use semismooth_contact::model::Structure;
 use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
@@ -18,44 +19,11 @@ const MASSES: [[f64; 2]; 4] = [[1.0, 3.0], [3.0, 1.0], [1.0, 10.0], [10.0, 1.0]]
 const GAPS: [f64; 2] = [0.1, 0.5];
 const HARMONICS: [usize; 2] = [5, 10];
 
-fn matrix(entries: &[(usize, usize, f64)]) -> SparseMatrix {
-    let t: Vec<_> = entries
-        .iter()
-        .map(|&(i, j, v)| Triplet::new(i, j, v))
-        .collect();
-    SparseMatrix::try_new_from_triplets(2, 2, &t).unwrap()
-}
-
-/// Springs ground - 0 - 1 of unit stiffness, masses `masses`, stiffness-proportional damping
-/// of ratio 0.02 at the first mode, a force 0.1 on the free mass 1 and a stop at `gap` from
-/// the heavier mass (observed).
+/// The chain of `common/chain.rs` with masses `masses`, 2 % damping, a force 0.1 on the
+/// free mass 1 and a stop at `gap` from the heavier mass (observed).
 fn chain(masses: [f64; 2], gap: f64) -> Structure {
-    let [m0, m1] = masses;
-    // det(K - λ M) = m0 m1 λ² - (m0 + 2 m1) λ + 1 = 0: the smaller root is ω_1².
-    let b = m0 + 2.0 * m1;
-    let omega_1 = ((b - (b * b - 4.0 * m0 * m1).sqrt()) / (2.0 * m0 * m1)).sqrt();
-    let c = 2.0 * 0.02 / omega_1;
-    let contact_dof = if m1 >= m0 { 1 } else { 0 };
-    let model = StructuralModel {
-        frictional_contacts: Vec::new(),
-        mass: matrix(&[(0, 0, m0), (1, 1, m1)]),
-        damping: Some(matrix(&[
-            (0, 0, 2.0 * c),
-            (0, 1, -c),
-            (1, 0, -c),
-            (1, 1, c),
-        ])),
-        stiffness: matrix(&[(0, 0, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 1, 1.0)]),
-        load: HarmonicLoad::cosine(vec![0.0, 0.1]),
-        contacts: vec![ContactPoint::new(contact_dof, gap)],
-        friction: Vec::new(),
-        cyclic: None,
-    };
-    Structure {
-        model,
-        omega_1,
-        observed_dof: contact_dof,
-    }
+    let contact_dof = if masses[1] >= masses[0] { 1 } else { 0 };
+    chain::chain_with_masses(masses, contact_dof, gap, 0.02, [0.0, 0.1])
 }
 
 /// SSN-HB sweep from 0.5 to 3 `ω_1`, without stability.

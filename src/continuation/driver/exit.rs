@@ -2,7 +2,7 @@
 //! generalized Jacobian just past the point (where the switched pieces are active) gives the
 //! tangent of the piece that leaves the corner, and the branch goes on along it.
 
-use super::super::corrector::{Constraint, Corrector};
+use super::super::corrector::Corrector;
 use super::{Accepted, Continuation, Segment};
 use crate::continuation::BranchPoint;
 use crate::iteration::kernel::{KernelRules, StepRule};
@@ -133,20 +133,7 @@ where
     ) -> Option<Accepted> {
         let n = self.metric.n;
         self.metric.state_normal(&e[..n], &mut self.bordered.w);
-        let w_p = self.metric.parameter_dot(e[n], 1.0);
-        let w_dot_last: f64 = self
-            .bordered
-            .w
-            .iter()
-            .zip(&last.state)
-            .map(|(w, x)| w * x)
-            .sum::<f64>()
-            + w_p * last.parameter;
-        let constraint = Constraint {
-            arclength: true,
-            w_p,
-            target: w_dot_last + ds,
-        };
+        let constraint = self.arclength_constraint(last, e[n], ds);
         let mut x: Vec<f64> = last
             .state
             .iter()

@@ -578,20 +578,7 @@ where
             }
             self.direction_weights();
             let mut p = last.parameter + ds * self.direction[n];
-            let w_p = self.metric.parameter_dot(self.direction[n], 1.0);
-            let w_dot_last: f64 = self
-                .bordered
-                .w
-                .iter()
-                .zip(&last.state)
-                .map(|(u, v)| u * v)
-                .sum::<f64>()
-                + w_p * last.parameter;
-            let constraint = Constraint {
-                arclength: true,
-                w_p,
-                target: w_dot_last + ds,
-            };
+            let constraint = self.arclength_constraint(&last, self.direction[n], ds);
             let before = self.corrector_counts.iterations;
             let (corrected, smallest) = self.correct_at(&mut x, &mut p, constraint);
             let failure = match corrected {
@@ -721,6 +708,22 @@ where
         let n = self.metric.n;
         self.metric
             .state_normal(&self.direction[..n], &mut self.bordered.w);
+    }
+
+    /// The arclength constraint of a step `ds` from `last` along the direction whose
+    /// parameter component is `d_p`, with the state normal already in `bordered.w`:
+    /// `w · (x - x_last) + w_p (p - p_last) = ds`.
+    fn arclength_constraint(&self, last: &BranchPoint, d_p: f64, ds: f64) -> Constraint {
+        let w_p = self.metric.parameter_dot(d_p, 1.0);
+        let w_dot_last: f64 = (self.bordered.w.iter().zip(&last.state))
+            .map(|(w, x)| w * x)
+            .sum::<f64>()
+            + w_p * last.parameter;
+        Constraint {
+            arclength: true,
+            w_p,
+            target: w_dot_last + ds,
+        }
     }
 
     /// Books a rejected attempt (begun at `before` corrector iterations) and restores the
