@@ -2,7 +2,7 @@
 
 use semismooth::continuation::{
     Branch, Continuation, ContinuationCounters, ContinuationOptions, ContinuationTermination,
-    Direction,
+    Direction, RestartPolicy,
 };
 use semismooth::linalg::FaerDenseLu;
 use semismooth::{Factorize, Residual};
@@ -28,6 +28,38 @@ pub enum EpmcSolve {
     /// inner HB Jacobian per iteration (per-harmonic sparse LU and condensation onto the
     /// contacts), for models of thousands of dofs.
     Structured,
+}
+
+/// Corrector iterations allowed per attempted step of a backbone
+/// ([`ContinuationOptions::max_corrector_iterations`]): past the onset of contact at a stop
+/// the semismooth Newton corrector changes its active set sample by sample and may need
+/// more than the core's default 10.
+pub const BACKBONE_CORRECTOR_ITERATIONS: usize = 30;
+
+/// The smallest step of a backbone ([`ContinuationOptions::min_step`]), a quarter of the
+/// core's default: the corner at the onset of contact is passed with steps that small.
+pub const BACKBONE_MIN_STEP: f64 = 5e-4;
+
+/// The continuation a backbone starts from ([`BackboneOptions::continuation`]): the core's
+/// defaults, with [`BACKBONE_CORRECTOR_ITERATIONS`] and [`BACKBONE_MIN_STEP`], the step
+/// halved from `max_step` down to `min_step` before the run gives up, then the corner
+/// passes, restarts ([`RestartPolicy`]) and the exit-tangent pass
+/// ([`ContinuationOptions::exit_tangents`]). A mass hitting a rigid stop leaves the linear
+/// branch `w = omega_n` at a corner, `w - omega_n` growing like the square root of the
+/// amplitude past the onset; a stiff spring in front of the stop rounds it off only a
+/// little. Runs whose steps never fail take the same path as with the core's defaults.
+pub fn backbone_continuation() -> ContinuationOptions {
+    let defaults = ContinuationOptions::default();
+    // Halving from max_step down to min_step, plus one attempt at min_step.
+    let halvings = (defaults.max_step / BACKBONE_MIN_STEP).log2().ceil() as usize + 2;
+    ContinuationOptions {
+        min_step: BACKBONE_MIN_STEP,
+        max_corrector_iterations: BACKBONE_CORRECTOR_ITERATIONS,
+        max_consecutive_failures: halvings.max(defaults.max_consecutive_failures),
+        restarts: Some(RestartPolicy::default()),
+        exit_tangents: true,
+        ..defaults
+    }
 }
 
 /// Default of [`BackboneOptions::relative_tolerance`].
@@ -64,6 +96,7 @@ pub struct BackboneOptions {
     pub relative_tolerance: Option<f64>,
     /// The continuation (its parameter bounds are set from the amplitude range; without a
     /// `state_scale` one is made from the amplitude range, `omega_n` and the stiffness).
+    /// Default [`backbone_continuation`].
     pub continuation: ContinuationOptions,
 }
 
@@ -85,7 +118,7 @@ impl BackboneOptions {
             energy_range: None,
             solve: EpmcSolve::Dense,
             relative_tolerance: Some(DEFAULT_RELATIVE_TOLERANCE),
-            continuation: ContinuationOptions::default(),
+            continuation: backbone_continuation(),
         }
     }
 

@@ -45,7 +45,8 @@ use crate::model::{sparse_mul_add, SparseMatrix, StructuralModel};
 use crate::operator::OperatorParameter;
 
 pub use backbone::{
-    backbone, Backbone, BackboneOptions, BackbonePoint, EpmcSolve, DEFAULT_RELATIVE_TOLERANCE,
+    backbone, backbone_continuation, Backbone, BackboneOptions, BackbonePoint, EpmcSolve,
+    BACKBONE_CORRECTOR_ITERATIONS, BACKBONE_MIN_STEP, DEFAULT_RELATIVE_TOLERANCE,
 };
 pub use linear::{linear_mode, LinearMode};
 pub use structured::EpmcStructuredSolver;
