@@ -1,5 +1,6 @@
 //! Nonlinear modes (EPMC on SSN-HB) against closed forms: the linear mode at small
-//! amplitude, and the backbone of the bilinear oscillator (a stop through a spring).
+//! amplitude, and the backbone of the bilinear oscillator (a stop through a spring, soft
+//! and stiff).
 
 mod common;
 
@@ -177,6 +178,67 @@ fn bilinear_backbone_converges_to_its_closed_form_with_the_harmonics() {
     assert!(errors[1] < errors[0] / 4.0, "{errors:?}");
     assert!(errors[2] < errors[1] / 4.0, "{errors:?}");
     assert!(errors[2] < 1e-5, "{errors:?}");
+}
+
+/// [`bilinear_frequency`] of the oscillator whose largest excursion away from the stop is
+/// `b = -min u` (the amplitude of the ellipse about 0): `a - e = sqrt((b^2 - gap^2) / w_2^2 +
+/// (gap - e)^2)` by the same energy match. With a stiff spring the largest displacement
+/// barely passes `gap` and `w(a)` is too steep there to measure a backbone by; `w(b)` is not.
+fn bilinear_frequency_by_excursion(gap: f64, k_c: f64, b: f64) -> f64 {
+    if b <= gap {
+        return 1.0;
+    }
+    let e = k_c * gap / (1.0 + k_c);
+    let a = e + ((b * b - gap * gap) / (1.0 + k_c) + (gap - e).powi(2)).sqrt();
+    bilinear_frequency(gap, k_c, a)
+}
+
+/// The largest error of the backbone's frequency against
+/// [`bilinear_frequency_by_excursion`] of its own excursion, over the points in contact.
+fn stiff_bilinear_backbone_error(gap: f64, k_c: f64, harmonics: usize) -> f64 {
+    let model = bilinear(gap, k_c);
+    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.1, 2.0);
+    options.hb.harmonics = harmonics;
+    let branch = backbone(&model, &options).unwrap();
+    assert!(
+        matches!(
+            branch.termination,
+            ContinuationTermination::ReachedBound { .. }
+        ),
+        "H = {harmonics}: {:?}",
+        branch.termination
+    );
+    let epmc = Epmc::new(&model, &options.hb, 1, AmplitudeMeasure::Dof(0)).unwrap();
+    let mut error = 0.0f64;
+    for point in &branch.points {
+        let u = &point.unknowns[..epmc.hb_len()];
+        let samples = epmc.hb().displacement_samples(u, 0, 4096).unwrap();
+        let excursion = -samples.iter().copied().fold(f64::INFINITY, f64::min);
+        if excursion > 1.05 * gap {
+            let exact = bilinear_frequency_by_excursion(gap, k_c, excursion);
+            error = error.max((point.omega - exact).abs());
+        }
+    }
+    error
+}
+
+#[test]
+fn stiff_bilinear_backbone_passes_the_onset_and_converges_with_the_harmonics() {
+    // k_c = 3000: nearly the rigid stop's corner at the onset of contact (the backbone's
+    // continuation passes it at every H), and rigid-like convergence until the harmonics
+    // resolve the contact time pi / sqrt(1 + k_c) = 0.057 of the period 2 pi. Measured:
+    // 7.0e-2, 3.3e-2, 1.1e-2, 2.3e-3 at H = 10, 20, 40, 80 (factors 2.1, 3.0, 4.8; the
+    // largest error sits near the onset, so it moves with where the points fall).
+    // Asserted: a factor 1.5 per doubling, and below 3e-3 at H = 80 (30 % above).
+    let (gap, k_c) = (1.0, 3000.0);
+    let errors: Vec<f64> = [10, 20, 40, 80]
+        .iter()
+        .map(|&h| stiff_bilinear_backbone_error(gap, k_c, h))
+        .collect();
+    for pair in errors.windows(2) {
+        assert!(pair[1] < pair[0] / 1.5, "{errors:?}");
+    }
+    assert!(errors[3] < 3e-3, "{errors:?}");
 }
 
 /// The Jenkins oscillator: `m = k = 1`, light viscous damping `c` on the mass, a tangential
