@@ -679,7 +679,7 @@ fn friction_damped_beam_backbone_follows_the_describing_function_and_the_forced_
     // The describing function is the one-harmonic limit; the tip's harmonics above the
     // first carry at most 4e-3 of its velocity, so the differences are EPMC's truncation:
     // the slider's kinked motion (coefficients falling like k^-2) at H = 15. Measured
-    // largest differences 8.4e-4 in w and 4.1e-2 in xi at H = 7, 4.2e-4 and 2.9e-2 at
+    // largest differences 8.4e-4 in w and 4.1e-2 in xi at H = 7, 4.2e-4 and 3.2e-2 at
     // H = 15, at the onset of slip (a few a_s); beyond 10 a_s xi within 4e-3 (6e-3 asserted).
     println!(
         "largest differences: w {:.1e}, xi {:.1e}; xi beyond 10 a_s {worst_sliding:.1e}",
