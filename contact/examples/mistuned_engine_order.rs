@@ -73,7 +73,10 @@ fn amplitude(u: &[f64], n: usize, dof: usize) -> f64 {
 fn largest_tip(u: &[f64], n: usize, tips: &[usize]) -> (usize, f64) {
     (tips.iter().enumerate())
         .map(|(j, &dof)| (j, amplitude(u, n, dof)))
-        .fold((0, 0.0), |best, (j, a)| if a > best.1 { (j, a) } else { best })
+        .fold(
+            (0, 0.0),
+            |best, (j, a)| if a > best.1 { (j, a) } else { best },
+        )
 }
 
 /// An upward scan of `structure` over `POINTS` frequencies from `from` to `to`, each solve
@@ -166,7 +169,6 @@ fn fixed_frequency_gap(check: &Structure, traced: &Traced, start: &[f64], tips: 
     let (_, largest) = largest_tip(&solution.state, check.model.dofs(), tips);
     (largest - traced.amplitude).abs() / traced.amplitude
 }
-
 
 /// The short name of where a peak was found.
 fn location_name(location: &PeakLocation) -> String {
@@ -279,7 +281,12 @@ fn mistuned_disk(loading: &DiskLoading, pattern: &[f64]) -> Structure {
 
 /// The row of the full disk of `pattern` (amplitude `m`): its branch, its peak checked
 /// at fixed frequency, the scan beside it.
-fn mistuned_row(loading: &DiskLoading, (name, m): (&str, f64), pattern: &[f64], resonance: f64) -> Row {
+fn mistuned_row(
+    loading: &DiskLoading,
+    (name, m): (&str, f64),
+    pattern: &[f64],
+    resonance: f64,
+) -> Row {
     let full = mistuned_disk(loading, pattern);
     let tips: Vec<usize> = (0..BLADES).map(BladedDisk::tip).collect();
     let mut row = Row {
@@ -380,7 +387,11 @@ fn main() {
             mistuning: m,
         }
         .deterministic_mistuning();
-        let name = if m == 0.0 { "tuned (full)" } else { "builder's m sin(2.3 j)" };
+        let name = if m == 0.0 {
+            "tuned (full)"
+        } else {
+            "builder's m sin(2.3 j)"
+        };
         let row = mistuned_row(&loading, (name, m), &pattern, resonance);
         print!("{}", row.line(reference, resonance));
         amplitudes.push(row);

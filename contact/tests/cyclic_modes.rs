@@ -41,12 +41,8 @@ fn sector_of(engine_order: usize) -> (CyclicSector, Structure) {
 }
 
 fn backbone_of(structure: &Structure, mode: usize, tip: usize) -> Backbone {
-    let mut options = BackboneOptions::new(
-        mode,
-        AmplitudeMeasure::Dof(tip),
-        AMPLITUDES.0,
-        AMPLITUDES.1,
-    );
+    let mut options =
+        BackboneOptions::new(mode, AmplitudeMeasure::Dof(tip), AMPLITUDES.0, AMPLITUDES.1);
     options.hb = hb();
     backbone(&structure.model, &options).unwrap()
 }
@@ -65,17 +61,29 @@ fn a_sectors_backbone_under_engine_order_0_is_the_full_disks_nodal_diameter_0_ba
     // The casing is open at the first amplitude: the linear mode of harmonic 1's real
     // model, against the nodal-diameter model's eigenvalue (another dense eigensolve of
     // another matrix, twice the size): equal to round-off (measured 1.1e-15).
-    assert!((first.omega - nd0).abs() < 1e-12 * nd0, "{} {nd0}", first.omega);
+    assert!(
+        (first.omega - nd0).abs() < 1e-12 * nd0,
+        "{} {nd0}",
+        first.omega
+    );
 
     let disk = tuned_disk();
-    let full = disk.structure(&DiskLoading::shipped((0..BLADES).collect())).unwrap();
+    let full = disk
+        .structure(&DiskLoading::shipped((0..BLADES).collect()))
+        .unwrap();
     // The disk and tip dofs carry mass, the pads none: 2 N finite frequencies.
     let frequencies = natural_frequencies(&full.model, 2 * BLADES).unwrap();
-    let mode = 1 + (frequencies.iter())
-        .position(|w| (w - nd0).abs() < 1e-9 * nd0)
-        .expect("nodal diameter 0's frequency among the disk's");
+    let mode = 1
+        + (frequencies.iter())
+            .position(|w| (w - nd0).abs() < 1e-9 * nd0)
+            .expect("nodal diameter 0's frequency among the disk's");
     // The frequencies of the other nodal diameters lie apart (non-degenerate family).
-    assert!((frequencies.iter()).filter(|w| (*w - nd0).abs() < 1e-6 * nd0).count() == 1);
+    assert!(
+        (frequencies.iter())
+            .filter(|w| (*w - nd0).abs() < 1e-6 * nd0)
+            .count()
+            == 1
+    );
     let tip = BladedDisk::tip(0);
     let full_branch = backbone_of(&full, mode, tip);
 
@@ -95,7 +103,10 @@ fn a_sectors_backbone_under_engine_order_0_is_the_full_disks_nodal_diameter_0_ba
         worst = worst.max(size / epmc.force_scale(point.amplitude));
         let energy = epmc.energy(&x);
         let expected = BLADES as f64 * point.energy;
-        assert!((energy - expected).abs() < 1e-12 * expected, "{energy} {expected}");
+        assert!(
+            (energy - expected).abs() < 1e-12 * expected,
+            "{energy} {expected}"
+        );
     }
     eprintln!("largest full-disk residual over the sector's points, relative: {worst:e}");
     // The sector's corrector stops at 1e-12 of the force scale (the default relative
@@ -106,7 +117,10 @@ fn a_sectors_backbone_under_engine_order_0_is_the_full_disks_nodal_diameter_0_ba
     // The full disk's own backbone reaches the same amplitude at the same frequency and
     // damping: both corrected to 1e-12 of the force scale on the same equations (measured
     // equal to the last digit in frequency, 1e-16 apart in damping ratio).
-    let (a, b) = (sector_branch.points.last().unwrap(), full_branch.points.last().unwrap());
+    let (a, b) = (
+        sector_branch.points.last().unwrap(),
+        full_branch.points.last().unwrap(),
+    );
     assert_eq!(a.amplitude, b.amplitude);
     eprintln!(
         "at amplitude {}: omega {} (sector) {} (full), zeta {} {}; full {} points",
@@ -117,7 +131,12 @@ fn a_sectors_backbone_under_engine_order_0_is_the_full_disks_nodal_diameter_0_ba
         b.damping_ratio,
         full_branch.points.len()
     );
-    assert!((a.omega - b.omega).abs() < 1e-12 * b.omega, "{} {}", a.omega, b.omega);
+    assert!(
+        (a.omega - b.omega).abs() < 1e-12 * b.omega,
+        "{} {}",
+        a.omega,
+        b.omega
+    );
     assert!((a.damping_ratio - b.damping_ratio).abs() < 1e-12, "{a:?}");
     // The casing closed: the mode stiffened.
     assert!(a.omega > 1.01 * nd0, "{} {nd0}", a.omega);
@@ -140,5 +159,11 @@ fn a_sector_whose_harmonic_1_is_a_travelling_wave_is_refused_naming_its_nodal_di
     assert!(error.to_string().contains("travelling wave"), "{error}");
     // Engine order N/2 = 4: harmonic 1 on nodal diameter 4, a standing wave: accepted.
     let (_, structure) = sector_of(BLADES / 2);
-    Epmc::new(&structure.model, &hb(), 1, AmplitudeMeasure::Dof(structure.observed_dof)).unwrap();
+    Epmc::new(
+        &structure.model,
+        &hb(),
+        1,
+        AmplitudeMeasure::Dof(structure.observed_dof),
+    )
+    .unwrap();
 }

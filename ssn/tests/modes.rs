@@ -227,7 +227,10 @@ fn sector_modes_scene(dir: &std::path::Path, engine_order: usize) -> std::path::
     let text = std::fs::read_to_string(scenes_dir().join("bladed_disk_sector.toml"))
         .unwrap()
         .replace("\"blade_sector/", &format!("\"{}/", sector.display()))
-        .replace("engine_order = 3", &format!("engine_order = {engine_order}"));
+        .replace(
+            "engine_order = 3",
+            &format!("engine_order = {engine_order}"),
+        );
     let path = dir.join("sector_modes.toml");
     let modes = "\n[modes]\namplitude_from = 0.05\namplitude_to = 3.0\n";
     std::fs::write(&path, text + modes).unwrap();
@@ -243,13 +246,18 @@ fn a_sector_under_engine_order_0_starts_its_backbone_at_the_full_disks_nodal_dia
     // The full 100-blade disk (the sector's files are its sector) has nodal diameter 0
     // lowest: its first natural frequency, from a dense eigensolve of the whole disk.
     let disk = structures::BladedDisk::tuned(100);
-    let full = disk.structure(&structures::DiskLoading::shipped(Vec::new())).unwrap();
+    let full = disk
+        .structure(&structures::DiskLoading::shipped(Vec::new()))
+        .unwrap();
     let omega_0 = natural_frequencies(&full.model, 1).unwrap()[0];
     let points = json["points"].as_array().unwrap();
     let first = points[0]["omega"].as_f64().unwrap();
     // The casing is open at the first amplitude: the linear mode, to the round-off of two
     // eigensolves of different matrices (4 sector dofs against 300).
-    assert!((first - omega_0).abs() < 1e-10 * omega_0, "{first} {omega_0}");
+    assert!(
+        (first - omega_0).abs() < 1e-10 * omega_0,
+        "{first} {omega_0}"
+    );
     // Pressed into the casing at the last amplitude, the mode has stiffened.
     let last = points.last().unwrap()["omega"].as_f64().unwrap();
     assert!(last > 1.01 * omega_0, "{last} {omega_0}");

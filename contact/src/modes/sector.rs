@@ -33,7 +33,11 @@ fn real_phase(coupling: &CyclicCoupling, k: usize) -> Result<f64, ModesError> {
             sectors: n,
         });
     }
-    Ok(if (k as f64 * phi).cos() >= 0.0 { 1.0 } else { -1.0 })
+    Ok(if (k as f64 * phi).cos() >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    })
 }
 
 /// `a + cos(k phi) sum_t B_t` over the coupling terms of `source` (`a` itself without
@@ -98,7 +102,9 @@ pub(super) fn harmonic_model(
         .transpose()?;
     let contacts = model.contacts.len();
     for neighbour in &coupling.neighbour_rows {
-        if let Some(point) = (neighbour.row.checked_sub(contacts)).and_then(|f| real.friction.get_mut(f)) {
+        if let Some(point) =
+            (neighbour.row.checked_sub(contacts)).and_then(|f| real.friction.get_mut(f))
+        {
             *point = FrictionPoint {
                 tangent: merged_row(&point.tangent, &neighbour.part, cos),
                 ..point.clone()
@@ -115,7 +121,11 @@ pub(super) fn harmonic_stiffness_and_mass(
     model: &StructuralModel,
     harmonics: usize,
 ) -> Result<Vec<(SparseMatrix, SparseMatrix)>, ModesError> {
-    let count = if model.cyclic.is_some() { harmonics + 1 } else { 1 };
+    let count = if model.cyclic.is_some() {
+        harmonics + 1
+    } else {
+        1
+    };
     (0..count)
         .map(|k| harmonic_model(model, k).map(|m| (m.stiffness, m.mass)))
         .collect()
