@@ -1,36 +1,47 @@
-//! A mistuned bladed disk under an engine-order excitation, scanned on the full model (a
-//! mistuned disk has no cyclic symmetry), beside the tuned disk scanned on one cyclic sector:
-//! the largest blade-tip amplitude over the scan and over the blades, and its
-//! amplification factor against the tuned sector's peak, for several mistuning amplitudes
-//! of the builder's pattern `delta_j = m sin(2.3 j)` (`structures::BladedDisk`).
+//! A mistuned bladed disk under an engine-order excitation, swept on the full model (a
+//! mistuned disk has no cyclic symmetry) by pseudo-arclength continuation beside the tuned
+//! disk swept on one cyclic sector: the branch's points, folds and whether it reached the
+//! upper bound, the peak of the largest blade-tip amplitude located along the branch
+//! (`sweep::peak`), and its amplification factor against the tuned sector's peak.
 //!
 //! 24 blades, a casing contact on every blade (gap 1, three times the shipped load), engine
-//! order 3, 5 harmonics, 72 samples (a multiple of `N / gcd(N, EO) = 8`), scanned upward
-//! over 8 % either side of nodal diameter 3's resonance (161 frequencies, warm starts).
-//! The row "0 (full)" is the tuned disk scanned whole: its peak is the tuned sector's (the
-//! check of the sector's scan).
+//! order 3, 5 harmonics, 72 samples (a multiple of `N / gcd(N, EO) = 8`), swept over 8 %
+//! either side of nodal diameter 3's resonance (`SweepSettings::new` steps, no stability).
+//! Each peak is checked by a fixed-frequency solve at its frequency started from the
+//! peak's state moved by 1e-3 (the tuned sector's on the full tuned disk, from the
+//! recovered state): the relative difference of the largest blade-tip amplitude is
+//! printed. Beside each branch, the former upward scan (161 frequencies, warm starts): its
+//! largest amplitude and its failed solves.
 //!
-//! Then other mistuning patterns at amplitudes 0.01 and 0.05: the builder's, random
-//! (uniform in `[-m, m]` from a seeded xorshift generator, seed 1), alternate
-//! (`(-1)^j m`) and one rogue blade (blade 0 at `-m`, the others tuned), each against the
-//! same tuned peak.
+//! The builder's pattern `delta_j = m sin(2.3 j)` (`structures::BladedDisk`) at several
+//! amplitudes `m`, then other patterns at 0.01 and 0.05: random (uniform in `[-m, m]`
+//! from a seeded xorshift generator, seed 1), alternate (`(-1)^j m`) and one rogue blade
+//! (blade 0 at `-m`, the others tuned).
 //!
 //! `cargo run --release --example mistuned_engine_order [-- --write]`; `--write` puts the
-//! patterns' table into `docs/mistuning_patterns.md`.
+//! tables into `docs/mistuning_patterns.md`.
 
 use std::time::Instant;
 
+use semismooth_contact::cyclic::CyclicSector;
 use semismooth_contact::model::Structure;
 use semismooth_contact::rod::natural_frequencies;
-use semismooth_contact::settings::SolverSettings;
+use semismooth_contact::settings::{SolverSettings, SweepSettings};
 use semismooth_contact::solve::solve;
 use semismooth_contact::structures::{BladedDisk, DiskLoading};
+use semismooth_contact::sweep::peak::{locate_peak, PeakLocation};
+use semismooth_contact::sweep::{frequency_response, FrequencyResponse};
 
 const BLADES: usize = 24;
 const HARMONICS: usize = 5;
 const ENGINE_ORDER: usize = 3;
 /// Frequencies of each scan.
 const POINTS: usize = 161;
+/// Instants on which a tip amplitude is read: the sweep's own (`solve::HB_OUTPUT_POINTS`),
+/// so that the branch points and the peak search's solves measure alike.
+const INSTANTS: usize = 1024;
+/// The sweep window around the nodal-diameter resonance.
+const WINDOW: (f64, f64) = (0.92, 1.08);
 
 fn settings() -> SolverSettings {
     SolverSettings {
@@ -43,12 +54,12 @@ fn settings() -> SolverSettings {
     }
 }
 
-/// `max_t |u(t)|` of one dof from its harmonic-major coefficients (`n` dofs), on 144
-/// instants of the period.
+/// `max_t |u(t)|` of one dof from its harmonic-major coefficients (`n` dofs), on
+/// [`INSTANTS`] instants of the period.
 fn amplitude(u: &[f64], n: usize, dof: usize) -> f64 {
-    (0..144)
+    (0..INSTANTS)
         .map(|i| {
-            let t = 2.0 * std::f64::consts::PI * i as f64 / 144.0;
+            let t = 2.0 * std::f64::consts::PI * i as f64 / INSTANTS as f64;
             (1..=HARMONICS).fold(u[dof], |v, k| {
                 let (a, b) = (u[(2 * k - 1) * n + dof], u[2 * k * n + dof]);
                 v + a * (k as f64 * t).cos() + b * (k as f64 * t).sin()
@@ -57,13 +68,23 @@ fn amplitude(u: &[f64], n: usize, dof: usize) -> f64 {
         .fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
+/// The largest tip amplitude of the state `u` (`n` dofs) over the dofs `tips`, and the
+/// position in `tips` of the tip that has it.
+fn largest_tip(u: &[f64], n: usize, tips: &[usize]) -> (usize, f64) {
+    (tips.iter().enumerate())
+        .map(|(j, &dof)| (j, amplitude(u, n, dof)))
+        .fold(
+            (0, 0.0),
+            |best, (j, a)| if a > best.1 { (j, a) } else { best },
+        )
+}
+
 /// An upward scan of `structure` over `POINTS` frequencies from `from` to `to`, each solve
 /// warm-started from the previous one (so it follows the upper branch of an overhang until
-/// it jumps): the largest tip amplitude over the points and the blades `blades` (the tip of
-/// blade `j` is dof `3 j + 1`), the solves that did not converge, and the wall time.
-fn peak(structure: &Structure, from: f64, to: f64, blades: usize) -> (f64, usize, f64) {
+/// it jumps): the largest amplitude over the points and the tips `tips`, and the solves
+/// that did not converge.
+fn scan_peak(structure: &Structure, (from, to): (f64, f64), tips: &[usize]) -> (f64, usize) {
     let n = structure.model.dofs();
-    let start = Instant::now();
     let (mut largest, mut failed, mut warm): (f64, usize, Option<Vec<f64>>) = (0.0, 0, None);
     for i in 0..POINTS {
         let omega = from + (to - from) * i as f64 / (POINTS - 1) as f64;
@@ -73,12 +94,143 @@ fn peak(structure: &Structure, from: f64, to: f64, blades: usize) -> (f64, usize
             warm = None;
             continue;
         }
-        for j in 0..blades {
-            largest = largest.max(amplitude(&solution.state, n, 3 * j + 1));
-        }
+        largest = largest.max(largest_tip(&solution.state, n, tips).1);
         warm = Some(solution.state);
     }
-    (largest, failed, start.elapsed().as_secs_f64())
+    (largest, failed)
+}
+
+/// A branch and its peak over the blades.
+struct Traced {
+    response: FrequencyResponse,
+    /// The branch's continuation time, seconds.
+    seconds: f64,
+    /// The tip dof whose amplitude peaks, and the peak located along the branch on it.
+    tip: usize,
+    omega: f64,
+    amplitude: f64,
+    location: PeakLocation,
+    /// The state of the branch point nearest the peak (the largest of the branch's).
+    nearest: Vec<f64>,
+}
+
+/// The branch of `structure` over the window (units of `resonance`), and its peak
+/// over the tip dofs `tips`: the tip of the largest amplitude over the branch points is
+/// observed, and `sweep::peak::locate_peak` locates the peak between the branch points on
+/// it.
+fn trace(structure: &Structure, resonance: f64, tips: &[usize]) -> Traced {
+    let ratio = resonance / structure.omega_1;
+    let sweep = SweepSettings {
+        stability: false,
+        ..SweepSettings::new(WINDOW.0 * ratio, WINDOW.1 * ratio)
+    };
+    let start = Instant::now();
+    let mut response = frequency_response(structure, &settings(), &sweep, None).expect("a sweep");
+    let seconds = start.elapsed().as_secs_f64();
+    let n = structure.model.dofs();
+    let (mut blade, mut best) = (0, f64::NEG_INFINITY);
+    for point in &response.points {
+        let (j, a) = largest_tip(&point.state, n, tips);
+        if a > best {
+            (blade, best) = (j, a);
+        }
+    }
+    let observed = Structure {
+        observed_dof: tips[blade],
+        ..structure.clone()
+    };
+    for point in &mut response.points {
+        point.amplitude = amplitude(&point.state, n, tips[blade]);
+    }
+    let peak = locate_peak(&observed, &settings(), &response).expect("a branch with points");
+    let (i, _) = response.peak().expect("a branch with points");
+    let nearest = response.points[i].state.clone();
+    Traced {
+        response,
+        seconds,
+        tip: tips[blade],
+        omega: peak.omega,
+        amplitude: peak.amplitude,
+        location: peak.location,
+        nearest,
+    }
+}
+
+/// The relative difference between the peak amplitude of `traced` and the largest tip
+/// amplitude (over `tips`) of `check` solved at the peak's frequency from `start` (the
+/// state of the branch point nearest the peak, or the full disk's recovered from it) moved
+/// by 1e-3; NaN when that solve does not converge.
+fn fixed_frequency_gap(check: &Structure, traced: &Traced, start: &[f64], tips: &[usize]) -> f64 {
+    let moved: Vec<f64> = start.iter().map(|v| v * 1.001).collect();
+    let solution = solve(check, traced.omega, &settings(), Some(&moved)).expect("a solve");
+    if !solution.converged() {
+        return f64::NAN;
+    }
+    let (_, largest) = largest_tip(&solution.state, check.model.dofs(), tips);
+    (largest - traced.amplitude).abs() / traced.amplitude
+}
+
+/// The short name of where a peak was found.
+fn location_name(location: &PeakLocation) -> String {
+    match location {
+        PeakLocation::Located => "between points".into(),
+        PeakLocation::AtEdge => "at the branch's end".into(),
+        PeakLocation::AtFold => "at a fold".into(),
+        PeakLocation::NotLocated(reason) => format!("largest point ({reason})"),
+        other => format!("{other:?}"),
+    }
+}
+
+/// Where a branch ended: the upper bound, or the termination and the last point's
+/// frequency (units of `resonance`).
+fn end(traced: &Traced, resonance: f64) -> String {
+    let r = &traced.response;
+    let last = r.points.last().map_or(f64::NAN, |p| p.omega / resonance);
+    if r.converged() {
+        "reached the upper bound".into()
+    } else if last <= WINDOW.0 + 1e-12 {
+        format!("turned back to the lower bound {last:.2}")
+    } else {
+        format!("{} (last point {last:.6})", r.termination)
+    }
+}
+
+/// One row of a table: a disk's branch and peak, its amplification factor against the
+/// tuned peak, the fixed-frequency check and the scan beside it.
+struct Row {
+    name: String,
+    m: f64,
+    traced: Traced,
+    gap: f64,
+    scan: (f64, usize),
+}
+
+/// The header of the tables.
+const HEADER: &str = "| pattern | m | points | folds | end of the branch | peak omega / omega_r | \
+    peak tip amplitude | peak found | amplification factor | fixed-frequency check | sweep (s) \
+    | scan peak (failed solves) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+
+impl Row {
+    /// The row's markdown line, frequencies in units of `resonance`.
+    fn line(&self, tuned: f64, resonance: f64) -> String {
+        let t = &self.traced;
+        let (scan, failed) = self.scan;
+        format!(
+            "| {} | {} | {} | {} | {} | {:.6} | {:.6} | {} | {:.4} | {:.1e} | {:.2} | \
+             {scan:.6} ({failed}) |\n",
+            self.name,
+            self.m,
+            t.response.points.len(),
+            t.response.folds.len(),
+            end(t, resonance),
+            t.omega / resonance,
+            t.amplitude,
+            location_name(&t.location),
+            t.amplitude / tuned,
+            self.gap,
+            t.seconds,
+        )
+    }
 }
 
 /// Seed of the random pattern.
@@ -117,39 +269,9 @@ fn patterns(m: f64, blades: usize) -> Vec<(&'static str, Vec<f64>)> {
     ]
 }
 
-/// The markdown page of the patterns' amplification factors (`rows`: pattern, amplitude,
-/// failed solves, peak) against the tuned peak `tuned`.
-fn patterns_page(rows: &[(&str, f64, usize, f64)], tuned: f64) -> String {
-    let mut page = String::from(
-        "# Mistuning patterns under engine order 3\n\n\
-         Written by `cargo run --release --example mistuned_engine_order -- --write` (do not \
-         edit). The 24-blade disk with a casing contact on every blade (gap 1, three times the \
-         shipped load), engine order 3, 5 harmonics, 72 samples, scanned upward over 8 % either \
-         side of nodal diameter 3's resonance (161 frequencies, warm starts); blade `j`'s \
-         stiffness is `k_b (1 + delta_j)`. The amplification factor is the largest blade-tip \
-         amplitude over the scan and the blades against the tuned disk's peak by one cyclic \
-         sector. Failed solves (near the jumps of the overhangs) are counted, not used.\n\n",
-    );
-    page.push_str(&format!("Tuned peak (sector): {tuned:.6}.\n\n"));
-    page.push_str(
-        "| pattern | amplitude m | failed solves | peak tip amplitude | amplification factor |\n",
-    );
-    page.push_str("|---|---|---|---|---|\n");
-    for (name, m, failed, peak) in rows {
-        let factor = peak / tuned;
-        page.push_str(&format!(
-            "| {name} | {m} | {failed} | {peak:.6} | {factor:.3} |\n"
-        ));
-    }
-    page
-}
-
 /// The full disk of `pattern` under `loading` and the engine-order load.
 fn mistuned_disk(loading: &DiskLoading, pattern: &[f64]) -> Structure {
-    let disk = BladedDisk {
-        blades: pattern.len(),
-        mistuning: 0.0,
-    };
+    let disk = BladedDisk::tuned(pattern.len());
     let mut full = (disk.structure_with_mistuning(loading, pattern)).expect("the disk");
     full.model.load = (full.model.load.clone())
         .delayed_by_sector(&disk.sector_dofs(), ENGINE_ORDER)
@@ -157,61 +279,135 @@ fn mistuned_disk(loading: &DiskLoading, pattern: &[f64]) -> Structure {
     full
 }
 
+/// The row of the full disk of `pattern` (amplitude `m`): its branch, its peak checked
+/// at fixed frequency, the scan beside it.
+fn mistuned_row(
+    loading: &DiskLoading,
+    (name, m): (&str, f64),
+    pattern: &[f64],
+    resonance: f64,
+) -> Row {
+    let full = mistuned_disk(loading, pattern);
+    let tips: Vec<usize> = (0..BLADES).map(BladedDisk::tip).collect();
+    let mut row = Row {
+        name: name.to_string(),
+        m,
+        traced: trace(&full, resonance, &tips),
+        gap: f64::NAN,
+        scan: scan_peak(&full, (WINDOW.0 * resonance, WINDOW.1 * resonance), &tips),
+    };
+    let peak = &row.traced;
+    let observed = Structure {
+        observed_dof: peak.tip,
+        ..full
+    };
+    row.gap = fixed_frequency_gap(&observed, peak, &peak.nearest, &tips);
+    row
+}
+
+/// The tuned sector's row (the reference peak): its peak checked on the full tuned disk
+/// solved at the peak's frequency from the state recovered from the sector's.
+fn tuned_row(loading: &DiskLoading, sector: &CyclicSector, resonance: f64) -> Row {
+    let structure = sector.structure(1).expect("blade 0's tip");
+    // The sector's blade 0 tip is its reduced dof 1 (one sector: every blade is it, delayed).
+    let mut row = Row {
+        name: "tuned (sector)".into(),
+        m: 0.0,
+        traced: trace(&structure, resonance, &[structure.observed_dof]),
+        gap: f64::NAN,
+        scan: scan_peak(
+            &structure,
+            (WINDOW.0 * resonance, WINDOW.1 * resonance),
+            &[structure.observed_dof],
+        ),
+    };
+    let peak = &row.traced;
+    let recovered = BladedDisk::tuned(BLADES).recover_state(sector, &peak.nearest, HARMONICS);
+    let full = mistuned_disk(loading, &[0.0; BLADES]);
+    let tips: Vec<usize> = (0..BLADES).map(BladedDisk::tip).collect();
+    row.gap = fixed_frequency_gap(&full, peak, &recovered, &tips);
+    row
+}
+
+/// The markdown page of the tables (`tuned` the reference row, `amplitudes` the builder's
+/// pattern at several amplitudes, `others` the patterns).
+fn page(tuned: &Row, amplitudes: &[Row], others: &[Row], resonance: f64) -> String {
+    let reference = tuned.traced.amplitude;
+    let mut page = String::from(
+        "# Mistuning patterns under engine order 3\n\n\
+         Written by `cargo run --release --example mistuned_engine_order -- --write` (do not \
+         edit). The 24-blade disk with a casing contact on every blade (gap 1, three times the \
+         shipped load), engine order 3, 5 harmonics, 72 samples; blade `j`'s stiffness is \
+         `k_b (1 + delta_j)`. Each disk is swept by pseudo-arclength continuation \
+         (`sweep::frequency_response`, default steps, no stability) \
+         upward over 8 % either side of nodal diameter 3's resonance `omega_r`, the mistuned \
+         ones whole, the tuned one by one cyclic sector. The peak is the largest blade-tip \
+         amplitude over the blades and the branch, located along the branch on the blade that \
+         has it (`sweep::peak`: between branch points, at a fold, or at the branch's end); the \
+         amplification factor is it against the tuned sector's peak. The fixed-frequency \
+         check is the relative difference of the peak amplitude against the disk solved at \
+         the peak's frequency from the nearest branch point's state moved by 1e-3 (the tuned \
+         sector's on the full tuned disk, from the recovered state). The last column is the \
+         former upward scan (161 frequencies, warm \
+         starts): its largest amplitude and its failed solves.\n\n",
+    );
+    page.push_str(&format!(
+        "Tuned peak (sector): {reference:.6} at {:.6} omega_r.\n\n## The builder's pattern\n\n",
+        tuned.traced.omega / resonance
+    ));
+    page.push_str(HEADER);
+    for row in std::iter::once(tuned).chain(amplitudes) {
+        page.push_str(&row.line(reference, resonance));
+    }
+    page.push_str("\n## Patterns\n\n");
+    page.push_str(HEADER);
+    for row in others {
+        page.push_str(&row.line(reference, resonance));
+    }
+    page
+}
+
 fn main() {
     let loading = DiskLoading {
         amplitude: 0.06,
         ..DiskLoading::shipped((0..BLADES).collect())
     };
-    let tuned = BladedDisk::tuned(BLADES);
-    let (sector, _) = tuned
+    let (sector, _) = BladedDisk::tuned(BLADES)
         .cyclic_sector(&loading, ENGINE_ORDER)
         .expect("a sector");
     let nd = sector.nodal_diameter(1);
     let resonance = natural_frequencies(&sector.nodal_diameter_model(nd), 1).expect("modes")[0];
-    let (from, to) = (0.92 * resonance, 1.08 * resonance);
-    let structure = sector.structure(1).expect("blade 0's tip");
-    // The sector's blade 0 tip is its reduced dof 1 (one sector: every blade is it, delayed).
-    let (tuned_peak, failed, sector_seconds) = peak(&structure, from, to, 1);
-    println!(
-        "| mistuning | failed solves | peak tip amplitude | amplification factor | scan (s) |"
-    );
-    println!("|---|---|---|---|---|");
-    println!("| 0 (sector) | {failed} | {tuned_peak:.6} | 1.000 | {sector_seconds:.3} |");
-    for mistuning in [0.0, 0.005, 0.01, 0.02, 0.05] {
-        let disk = BladedDisk {
+    let tuned = tuned_row(&loading, &sector, resonance);
+    let reference = tuned.traced.amplitude;
+    print!("{HEADER}{}", tuned.line(reference, resonance));
+    let mut amplitudes = Vec::new();
+    for m in [0.0, 0.005, 0.01, 0.02, 0.05] {
+        let pattern = BladedDisk {
             blades: BLADES,
-            mistuning,
-        };
-        let mut full = disk.structure(&loading).expect("the disk");
-        full.model.load = (full.model.load.clone())
-            .delayed_by_sector(&disk.sector_dofs(), ENGINE_ORDER)
-            .expect("the disk's sectors");
-        let (largest, failed, seconds) = peak(&full, from, to, BLADES);
-        let name = if mistuning == 0.0 {
-            "0 (full)".to_string()
+            mistuning: m,
+        }
+        .deterministic_mistuning();
+        let name = if m == 0.0 {
+            "tuned (full)"
         } else {
-            mistuning.to_string()
+            "builder's m sin(2.3 j)"
         };
-        println!(
-            "| {name} | {failed} | {largest:.6} | {:.3} | {seconds:.3} |",
-            largest / tuned_peak
-        );
+        let row = mistuned_row(&loading, (name, m), &pattern, resonance);
+        print!("{}", row.line(reference, resonance));
+        amplitudes.push(row);
     }
-    let mut rows = Vec::new();
-    println!("\n| pattern | amplitude | failed solves | peak | amplification factor |");
-    println!("|---|---|---|---|---|");
+    let mut others = Vec::new();
     for m in [0.01, 0.05] {
         for (name, pattern) in patterns(m, BLADES) {
-            let full = mistuned_disk(&loading, &pattern);
-            let (largest, failed, _) = peak(&full, from, to, BLADES);
-            let factor = largest / tuned_peak;
-            println!("| {name} | {m} | {failed} | {largest:.6} | {factor:.3} |");
-            rows.push((name, m, failed, largest));
+            let row = mistuned_row(&loading, (name, m), &pattern, resonance);
+            print!("{}", row.line(reference, resonance));
+            others.push(row);
         }
     }
     if std::env::args().any(|a| a == "--write") {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/mistuning_patterns.md");
-        std::fs::write(path, patterns_page(&rows, tuned_peak)).expect("docs/ is writable");
+        let text = page(&tuned, &amplitudes, &others, resonance);
+        std::fs::write(path, text).expect("docs/ is writable");
         println!("wrote {path}");
     }
 }

@@ -7,7 +7,7 @@ mod process;
 use process::{json_success, ssn};
 use semismooth_contact::describing_function::{jenkins_mode, terms_without_slider};
 use semismooth_contact::rod::{build_rod, natural_frequencies};
-use semismooth_contact::structures::cantilever_with_tip_spring;
+use semismooth_contact::structures::{self, cantilever_with_tip_spring};
 use ssn::scene::Scene;
 
 /// The shipped scenes, `scenes/` at the root of the repository.
@@ -217,5 +217,61 @@ fn a_rod_beyond_the_dense_limit_gets_its_backbone_from_the_structured_solve() {
     assert!(
         omega(last) > 1.1 * omega_1 && difference < 1e-3,
         "{difference}"
+    );
+}
+
+/// The shipped 100-blade sector scene under `engine_order` with a `[modes]` section (blade
+/// tip amplitudes 0.05 to 3, the casing at gap 1 on the pad), written in `dir`.
+fn sector_modes_scene(dir: &std::path::Path, engine_order: usize) -> std::path::PathBuf {
+    let sector = scenes_dir().join("blade_sector");
+    let text = std::fs::read_to_string(scenes_dir().join("bladed_disk_sector.toml"))
+        .unwrap()
+        .replace("\"blade_sector/", &format!("\"{}/", sector.display()))
+        .replace(
+            "engine_order = 3",
+            &format!("engine_order = {engine_order}"),
+        );
+    let path = dir.join("sector_modes.toml");
+    let modes = "\n[modes]\namplitude_from = 0.05\namplitude_to = 3.0\n";
+    std::fs::write(&path, text + modes).unwrap();
+    path
+}
+
+#[test]
+fn a_sector_under_engine_order_0_starts_its_backbone_at_the_full_disks_nodal_diameter_0_mode() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = sector_modes_scene(tmp.path(), 0);
+    let json = json_success(&ssn(&["modes", path.to_str().unwrap(), "--json"]));
+    assert_eq!(json["converged"], true, "{json}");
+    // The full 100-blade disk (the sector's files are its sector) has nodal diameter 0
+    // lowest: its first natural frequency, from a dense eigensolve of the whole disk.
+    let disk = structures::BladedDisk::tuned(100);
+    let full = disk
+        .structure(&structures::DiskLoading::shipped(Vec::new()))
+        .unwrap();
+    let omega_0 = natural_frequencies(&full.model, 1).unwrap()[0];
+    let points = json["points"].as_array().unwrap();
+    let first = points[0]["omega"].as_f64().unwrap();
+    // The casing is open at the first amplitude: the linear mode, to the round-off of two
+    // eigensolves of different matrices (4 sector dofs against 300).
+    assert!(
+        (first - omega_0).abs() < 1e-10 * omega_0,
+        "{first} {omega_0}"
+    );
+    // Pressed into the casing at the last amplitude, the mode has stiffened.
+    let last = points.last().unwrap()["omega"].as_f64().unwrap();
+    assert!(last > 1.01 * omega_0, "{last} {omega_0}");
+}
+
+#[test]
+fn a_sector_whose_harmonic_1_is_a_travelling_wave_is_refused_with_the_reason() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = sector_modes_scene(tmp.path(), 3);
+    let out = ssn(&["modes", path.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("travelling wave") && err.contains("nodal diameter 3"),
+        "{err}"
     );
 }

@@ -30,9 +30,14 @@ pub struct LinearMode {
 /// its friction points held (stuck, `G_t u = 0`): the generalized eigenproblem
 /// `K phi = omega^2 M phi` on the null space of those rows, solved densely (Rayleigh-Ritz
 /// on an orthonormal basis of the null space; massless directions have no finite
-/// frequency and are not counted).
+/// frequency and are not counted). A reduced cyclic sector's mode is its harmonic 1's, on
+/// the real model of the couplings at their phase (module `sector`: engine order 0 or
+/// `N / 2` only, [`ModesError::TravellingWaveSector`] otherwise).
 pub fn linear_mode(model: &StructuralModel, index: usize) -> Result<LinearMode, ModesError> {
     model.validate().map_err(crate::hb::HbError::from)?;
+    if model.cyclic.is_some() {
+        return linear_mode(&super::sector::harmonic_model(model, 1)?, index);
+    }
     let n = model.dofs();
     let basis = stuck_null_space(model);
     let product = |m: &crate::model::SparseMatrix| {

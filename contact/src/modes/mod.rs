@@ -34,6 +34,7 @@
 
 mod backbone;
 mod linear;
+mod sector;
 mod structured;
 
 use faer::MatMut;
@@ -89,6 +90,20 @@ pub enum ModesError {
     /// The continuation could not start (options, range).
     #[error("continuation: {0}")]
     Continuation(String),
+    /// A reduced cyclic sector whose harmonic 1 lies on a travelling wave: its linear modes
+    /// have complex shapes, which the linear start does not take (module `sector`).
+    #[error(
+        "a cyclic sector's nonlinear mode starts from a standing wave: harmonic 1 lies on \
+         nodal diameter {nodal_diameter} of {sectors} sectors, whose modes are travelling waves \
+         (complex shapes); engine order 0 (or N/2 for even N) puts it on nodal diameter 0 \
+         (or N/2)"
+    )]
+    TravellingWaveSector {
+        /// Harmonic 1's nodal diameter, folded to `0..=N/2`.
+        nodal_diameter: usize,
+        /// `N`.
+        sectors: usize,
+    },
 }
 
 /// The largest number of EPMC unknowns [`backbone`] factors densely (a matrix of 512 MB).
@@ -117,9 +132,10 @@ pub struct Epmc {
     amplitude: f64,
     /// The load-free model's linear mode followed.
     mode: LinearMode,
-    /// `K` and `M`, for the energy.
-    stiffness: SparseMatrix,
-    mass: SparseMatrix,
+    /// `K` and `M` of each harmonic `0..=H` of a reduced cyclic sector (its couplings at
+    /// their real phases, module `sector`), one pair for every harmonic otherwise: the
+    /// energy.
+    energy_matrices: Vec<(SparseMatrix, SparseMatrix)>,
     /// The grounding spring the inner harmonic balance carries for the structured solve
     /// ([`Epmc::deflated`]); `None`: the model's own stiffness.
     deflation: Option<Deflation>,
@@ -190,10 +206,12 @@ impl Epmc {
             free.stiffness = grounded(&model.stiffness, spring)?;
         }
         let hb = SsnHb::new(&free, linear.omega, &options)?;
+        let energy_matrices = sector::harmonic_stiffness_and_mass(model, options.harmonics)?;
         let weights = match measure {
             AmplitudeMeasure::ModalCoordinate => {
                 let mut w = vec![0.0; n];
-                sparse_mul_add(model.mass.as_ref(), 1.0, &linear.shape, &mut w);
+                let mass = &energy_matrices[1.min(energy_matrices.len() - 1)].1;
+                sparse_mul_add(mass.as_ref(), 1.0, &linear.shape, &mut w);
                 w
             }
             AmplitudeMeasure::Dof(dof) => {
@@ -214,8 +232,7 @@ impl Epmc {
             row_scale,
             amplitude: 0.0,
             mode: linear,
-            stiffness: model.stiffness.clone(),
-            mass: model.mass.clone(),
+            energy_matrices,
             deflation,
         })
     }
@@ -288,7 +305,9 @@ impl Epmc {
     /// The period mean of the mechanical energy `u^T K u / 2 + u'^T M u' / 2` (exact by
     /// Parseval): `U_0^T K U_0 / 2 + sum_k (|U_k|_K^2 + (k w)^2 |U_k|_M^2) / 4`,
     /// `|U_k|_A^2 = a_k^T A a_k + b_k^T A b_k`. Constant along the motion of a conservative
-    /// system (rigid stops store no energy).
+    /// system (rigid stops store no energy). For a reduced cyclic sector harmonic `k` takes
+    /// its own `K`, `M` (with the couplings at its phase): the energy of one sector, the
+    /// disk's divided by `N`.
     pub fn energy(&self, x: &[f64]) -> f64 {
         let n = self.hb.dofs();
         let omega = self.omega(x);
@@ -297,11 +316,14 @@ impl Epmc {
             sparse_mul_add(a.as_ref(), 1.0, u, &mut y);
             y.iter().zip(u).map(|(p, q)| p * q).sum::<f64>()
         };
-        let mut energy = 0.5 * quadratic(&self.stiffness, &x[..n]);
+        let of_harmonic = |k: usize| &self.energy_matrices[k.min(self.energy_matrices.len() - 1)];
+        let mut energy = 0.5 * quadratic(&of_harmonic(0).0, &x[..n]);
         for j in 1..self.hb.basis().basis_size() {
             let u = &x[j * n..(j + 1) * n];
-            let kw = j.div_ceil(2) as f64 * omega;
-            energy += 0.25 * (quadratic(&self.stiffness, u) + kw * kw * quadratic(&self.mass, u));
+            let k = j.div_ceil(2);
+            let (stiffness, mass) = of_harmonic(k);
+            let kw = k as f64 * omega;
+            energy += 0.25 * (quadratic(stiffness, u) + kw * kw * quadratic(mass, u));
         }
         energy
     }
