@@ -177,15 +177,16 @@ fn a_two_row_friction_disk_agrees_across_linear_paths_and_with_the_sliding_circl
     assert!(rest < 1e-10, "off-circle coefficients {rest:e}");
 }
 
-/// The condensed problem (contact forces only) takes the disk through the same
-/// constructor shape as the full one, and its expanded root is the full problem's.
+/// The condensed form (contact forces only) of the full problem with the disk law has the
+/// full problem's root once expanded.
 #[test]
 fn the_condensed_problem_takes_the_disk_law_and_agrees_with_the_full_one() {
     let harmonics = 5;
     let full = solve_with(&mut FaerDenseLu::new(), harmonics);
     let options = disk_options(harmonics);
     let model = rotating_oscillator();
-    let mut condensed = CondensedSsnHb::with_laws(&model, OMEGA, &options, &[disk()]).unwrap();
+    let with_disk = SsnHb::with_laws(&model, OMEGA, &options, &[disk()]).unwrap();
+    let mut condensed = CondensedSsnHb::condense(with_disk).unwrap();
     let lambda = solved_from_zero(&mut condensed, &mut FaerDenseLu::new(), 1e-12);
     let expanded = condensed.expand(&lambda).unwrap();
     // Both stop at |F| <= 1e-12 on an O(1) problem with an O(10)-conditioned Jacobian
@@ -193,7 +194,7 @@ fn the_condensed_problem_takes_the_disk_law_and_agrees_with_the_full_one() {
     // 1e-10.
     let gap = max_difference(&full, &expanded);
     assert!(gap < 1e-10, "condensed differs from full by {gap:e}");
-    let refused = CondensedSsnHb::with_laws(
+    let refused = SsnHb::with_laws(
         &model,
         OMEGA,
         &options,

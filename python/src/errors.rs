@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyType;
 
 use semismooth_contact::{Error as LibraryError, ErrorKind};
-use ssn::exit::CliError;
+use ssn::load::LoadError;
 
 /// An attribute of an exception.
 pub(crate) enum Field {
@@ -47,11 +47,11 @@ pub(crate) fn bad_type(e: impl std::fmt::Display) -> PyErr {
     exception("SceneTypeError", e.to_string(), Vec::new())
 }
 
-/// Why a run of a scene failed: the scene could not be loaded (the command line's
-/// [`CliError`]), the library refused or could not carry out the computation, or a result
-/// that needs a converged solve did not get one.
+/// Why a run of a scene failed: the scene could not be loaded ([`LoadError`]), the library
+/// refused or could not carry out the computation, or a result that needs a converged solve
+/// did not get one.
 pub(crate) enum RunFailure {
-    Load(CliError),
+    Load(LoadError),
     Library(LibraryError),
     Input(String),
     NotConverged {
@@ -77,13 +77,13 @@ impl From<&str> for RunFailure {
 pub(crate) fn run_failure(path: &std::path::Path, failure: RunFailure) -> PyErr {
     let path = path.display();
     match failure {
-        RunFailure::Load(CliError::TooLarge(m)) => exception("TooLargeError", m, Vec::new()),
-        RunFailure::Load(CliError::NotConverged) => exception(
+        RunFailure::Load(LoadError::TooLarge(m)) => exception("TooLargeError", m, Vec::new()),
+        RunFailure::Load(LoadError::NotConverged) => exception(
             "SolveError",
             "the solver did not converge".into(),
             Vec::new(),
         ),
-        RunFailure::Load(CliError::BadInput(m) | CliError::Output(m)) => bad_input(m),
+        RunFailure::Load(LoadError::BadInput(m) | LoadError::Output(m)) => bad_input(m),
         RunFailure::Input(m) => bad_input(format!("{path}: {m}")),
         RunFailure::Library(e) => library_error(&format!("{path}: {e}"), &e),
         RunFailure::NotConverged {

@@ -6,6 +6,10 @@
 //! Everything that decides a number is the library's or the application's: scenes are read
 //! by `ssn::scene` (the same keys, defaults and messages as a scene file), the documents are
 //! `ssn::json`'s, a study case is `ssn::study::run::run_case`.
+//!
+//! It depends on `ssn` without its `cli` feature (no commands, arguments, progress bars,
+//! figures or ParaView files), because a Python scene is a scene file's text and keys and its
+//! results are the program's JSON documents, so that a script and `ssn` agree to the letter.
 
 mod convert;
 mod errors;
@@ -439,7 +443,7 @@ fn detached<T: Send>(
     py: Python<'_>,
     scene: &Scene,
     workload: Workload,
-    run: impl FnOnce(ssn::cli::Loaded) -> Result<T, RunFailure> + Send,
+    run: impl FnOnce(ssn::load::Loaded) -> Result<T, RunFailure> + Send,
 ) -> PyResult<T> {
     let source = scene.source.clone();
     py.detach(move || -> Result<T, RunFailure> {

@@ -404,11 +404,33 @@ pub(super) struct Corrector<'a, P: GeneralizedJacobian + ?Sized, S: ?Sized> {
     pub rules: KernelRules,
 }
 
-impl<P, S> Corrector<'_, P, S>
+impl<'a, P, S> Corrector<'a, P, S>
 where
     P: GeneralizedJacobian + ParameterDependent + ?Sized,
     S: Factorize<P::Jacobian> + ?Sized,
 {
+    /// The bordered system `[F; N]` of this corrector under `constraint`, counting its
+    /// solves into `counts`.
+    fn into_system<'c>(
+        self,
+        constraint: Constraint,
+        counts: &'c mut CorrectorCounts,
+    ) -> BorderedSystem<'c, P, S>
+    where
+        'a: 'c,
+    {
+        BorderedSystem {
+            problem: self.problem,
+            solver: self.solver,
+            ws: self.ws,
+            fallback: self.fallback,
+            metric: self.metric,
+            constraint,
+            trust: self.trust,
+            counts,
+        }
+    }
+
     /// Newton on `[F; N] = 0` from the joined point `y = (x, p)`. On success `y` holds the
     /// converged point, `ws.tangent` the raw tangent and the problem's parameter equals
     /// `p`; on failure the caller restores the parameter. Returns the smallest finite
@@ -421,18 +443,10 @@ where
         counts: &mut CorrectorCounts,
     ) -> (Result<Corrected, CorrectorFailure>, f64) {
         let n = self.metric.n;
+        let rules = self.rules;
         let mut kernel = std::mem::take(&mut self.ws.kernel);
-        let mut system = BorderedSystem {
-            problem: self.problem,
-            solver: self.solver,
-            ws: self.ws,
-            fallback: self.fallback,
-            metric: self.metric,
-            constraint,
-            trust: self.trust,
-            counts,
-        };
-        let run = kernel.run(&mut system, y, &self.rules, work);
+        let mut system = self.into_system(constraint, counts);
+        let run = kernel.run(&mut system, y, &rules, work);
         let residual_norm = norm2(&kernel.residual()[..n]);
         system.ws.kernel = kernel;
         let iteration = run.iterations;
@@ -475,20 +489,16 @@ where
         counts: &mut CorrectorCounts,
     ) -> Result<(), CorrectorFailure> {
         let n = self.metric.n;
-        let mut system = BorderedSystem {
-            problem: self.problem,
-            solver: self.solver,
-            ws: self.ws,
-            fallback: self.fallback,
-            metric: self.metric,
-            constraint: Constraint {
-                arclength: false,
-                w_p: 1.0,
-                target: y[n],
-            },
-            trust: None,
-            counts,
+        let constraint = Constraint {
+            arclength: false,
+            w_p: 1.0,
+            target: y[n],
         };
+        let untrusted = Corrector {
+            trust: None,
+            ..self
+        };
+        let mut system = untrusted.into_system(constraint, counts);
         let zero = vec![0.0; n + 1];
         let mut d = vec![0.0; n + 1];
         system

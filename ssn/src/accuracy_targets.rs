@@ -404,7 +404,7 @@ pub fn self_chosen_lines(
     let contact = !structure.model.contacts.is_empty();
     let mut out = String::new();
     for method in METHODS {
-        if !contact && !matches!(method, Method::SsnHb | Method::March) {
+        if !contact && method.needs_contact() {
             continue;
         }
         if skipped.iter().any(|(m, _)| *m == method) {

@@ -11,13 +11,17 @@ use semismooth_contact::modes::{
     backbone, AmplitudeMeasure, Backbone, BackboneOptions, EpmcSolve, MAX_DENSE_UNKNOWNS,
 };
 
+#[cfg(feature = "cli")]
 use crate::cli::{Loaded, RunArgs, Workload};
+#[cfg(feature = "cli")]
 use crate::exit::CliError;
+#[cfg(feature = "cli")]
 use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
 use crate::scene::{Method, Scene};
 
 /// `ssn modes SCENE`: the backbone (module documentation); text or JSON on stdout, a CSV
 /// row per point, an SVG of the frequency and the damping ratio against the amplitude.
+#[cfg(feature = "cli")]
 pub fn command(args: &RunArgs) -> Result<(), CliError> {
     let mut outputs = args.plan()?;
     let Loaded {
@@ -128,6 +132,7 @@ pub fn document(scene: &Scene, branch: &Backbone, omega_1: f64, seconds: f64) ->
 }
 
 /// One CSV row per point.
+#[cfg(feature = "cli")]
 fn csv_text(branch: &Backbone) -> String {
     let column = |f: &dyn Fn(&semismooth_contact::modes::BackbonePoint) -> f64| -> Vec<f64> {
         branch.points.iter().map(f).collect()
@@ -154,6 +159,7 @@ fn csv_text(branch: &Backbone) -> String {
 
 /// The frequency against the amplitude, and the damping ratio (times `omega_n`, to share
 /// the axis) when the mode is damped.
+#[cfg(feature = "cli")]
 fn svg_text(scene: &Scene, branch: &Backbone) -> Result<String, CliError> {
     let amplitude: Vec<f64> = branch.points.iter().map(|p| p.amplitude).collect();
     let mut series = vec![Series {
@@ -188,6 +194,7 @@ fn svg_text(scene: &Scene, branch: &Backbone) -> Result<String, CliError> {
 
 /// The text summary: the linear mode, the range covered, the extremes of the frequency
 /// and of the damping ratio, why it ended.
+#[cfg(feature = "cli")]
 fn summary(branch: &Backbone) -> String {
     let fold = |init: f64,
                 f: fn(f64, f64) -> f64,

@@ -1,15 +1,20 @@
 //! `ssn solutions SCENE`: every periodic response at the scene's frequency with its
 //! stability ([`semismooth_contact::solutions::find_solutions`]).
 
-use semismooth_contact::model::Structure;
-use semismooth_contact::solutions::{find_solutions, PeriodicSolution, SolutionSet};
-use semismooth_contact::solve::RunError;
+#[cfg(feature = "cli")]
+use semismooth_contact::{
+    model::Structure,
+    solutions::{find_solutions, PeriodicSolution, SolutionSet},
+    solve::RunError,
+};
 
+#[cfg(feature = "cli")]
 use crate::output::{csv_table, line_plot_svg, LineStyle, PlotSpec, Series};
 
 /// `ssn solutions SCENE`: every periodic solution at the scene's frequency (module
 /// documentation); text or JSON on stdout, a CSV row per solution, an SVG of the tip over
 /// one period (stable solid, unstable dashed, undecided dotted).
+#[cfg(feature = "cli")]
 pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> {
     use crate::exit::CliError;
     let crate::cli::Loaded {
@@ -33,6 +38,7 @@ pub fn command(args: &crate::cli::RunArgs) -> Result<(), crate::exit::CliError> 
 }
 
 /// The CSV of `ssn solutions`: a row per solution.
+#[cfg(feature = "cli")]
 fn csv_text(set: &SolutionSet) -> String {
     let column = |f: &dyn Fn(&PeriodicSolution) -> f64| -> Vec<f64> {
         set.solutions.iter().map(f).collect()
@@ -63,6 +69,7 @@ fn csv_text(set: &SolutionSet) -> String {
 
 /// The SVG of `ssn solutions`: the tip of each solution over one period, styled by its
 /// stability, with the obstacles of `rod`.
+#[cfg(feature = "cli")]
 fn svg_text(set: &SolutionSet, rod: &Structure) -> Result<String, crate::exit::CliError> {
     let mut series: Vec<Series> = set
         .solutions
@@ -107,6 +114,7 @@ fn svg_text(set: &SolutionSet, rod: &Structure) -> Result<String, crate::exit::C
 
 /// The text summary of `ssn solutions`: the search, each solution with its stability,
 /// what was not corrected or missed, and the work.
+#[cfg(feature = "cli")]
 fn summary(set: &SolutionSet) -> String {
     let mut t = format!(
         "omega/omega_1     {:.6}: {} solution(s) from {} crossing(s) of a {}-point branch \
@@ -199,6 +207,7 @@ fn incomplete(set: &semismooth_contact::solutions::SolutionSet) -> Option<String
 
 /// Refuses a forcing frequency outside the `[sweep]` window searched (exit code 2), naming
 /// the scene's own frequency key.
+#[cfg(feature = "cli")]
 fn check_window(scene: &crate::scene::Scene, ratio: f64) -> Result<(), crate::exit::CliError> {
     use semismooth_contact::rod::FrequencySpec;
     let Some(sweep) = &scene.sweep else {

@@ -11,8 +11,8 @@ use std::sync::Arc;
 use semismooth_contact::matrix_market::ImportError;
 use semismooth_contact::model::SparseMatrix;
 
-use crate::cli::{prepare, Loaded, Workload};
 use crate::exit::CliError;
+use crate::load::{prepare, Loaded, Workload};
 use crate::scene::{read_scene_text, Override, Scene, SceneError};
 
 /// A scene's text, path, overrides and in-memory matrices (module documentation).
@@ -63,7 +63,7 @@ impl SceneSource {
         Scene::from_toml_with(&self.text, &self.path, &self.overrides)
     }
 
-    /// The validated scene and its structure, as [`crate::cli::load_for`] builds them for a
+    /// The validated scene and its structure, as [`crate::load::load_for`] builds them for a
     /// run of `workload` (its memory and work limits).
     pub fn load(&self, workload: Workload) -> Result<Loaded, CliError> {
         let scene = self

@@ -389,7 +389,7 @@ const LISTED_FOLDS: usize = 8;
 /// their count, range, first and last (LCP and stiff-penalty branches have tens to
 /// hundreds of small folds where the contact moves from node to node; `--json` and
 /// `--csv` keep every one).
-pub(crate) fn folds_summary(folds: &[f64], omega_1: f64) -> String {
+pub fn folds_summary(folds: &[f64], omega_1: f64) -> String {
     let ratio: Vec<f64> = folds.iter().map(|w| w / omega_1).collect();
     match ratio.len() {
         0 => "none".into(),
@@ -413,7 +413,7 @@ pub(crate) fn folds_summary(folds: &[f64], omega_1: f64) -> String {
 /// The text summary of `ssn sweep`: the branch, its accuracy, folds, stability, the folds
 /// located to an accuracy target (`folds`), the work, how it ended and the wall time of
 /// the whole run (`seconds`) with its parts.
-pub(crate) fn sweep_text(
+pub fn sweep_text(
     response: &FrequencyResponse,
     folds: Option<&[FoldAccuracy]>,
     omega_1: f64,
@@ -504,7 +504,7 @@ fn sweep_seconds(response: &FrequencyResponse, seconds: f64) -> String {
 }
 
 /// The method and its discretisation, as the first line of `ssn solve` names them.
-pub(crate) fn describe_method(s: &Solution) -> String {
+pub fn describe_method(s: &Solution) -> String {
     match (s.harmonics, s.lcp_scheme) {
         (Some(h), _) => format!("{} H={h} Nt={}", s.method.name(), s.time_samples),
         (None, Some(scheme)) if scheme != semismooth_contact::lcp::LcpScheme::Trapezoidal => {
@@ -521,7 +521,7 @@ pub(crate) fn describe_method(s: &Solution) -> String {
 
 /// The text of `ssn solve`; `settings` gives the tolerance the scene asked for, which the
 /// text compares with the effective one.
-pub(crate) fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
+pub fn solution_text(s: &Solution, settings: &crate::scene::SolverSettings) -> String {
     use std::fmt::Write;
     let mut t = String::new();
     let c = &s.counters;
@@ -655,7 +655,7 @@ fn frictional_contact_lines(s: &Solution) -> String {
 }
 
 /// `, N GMRES iterations` when the matrix-free condensed solve ran, else nothing.
-pub(crate) fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String {
+pub fn gmres_words(c: &semismooth_contact::solve::RunCounters) -> String {
     match c.krylov_iterations {
         0 => String::new(),
         k => format!(", {k} GMRES iterations"),

@@ -9,7 +9,7 @@ mod process;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use process::{json_success, ssn};
+use process::{assert_success, json_success, ssn};
 use semismooth_contact::contacts::FrictionSummary;
 use serde_json::Value;
 
@@ -89,12 +89,7 @@ fn study_table_carries_the_friction_points_numbers_of_each_solve() {
         out.to_str().unwrap(),
         "--quiet",
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_success(&o);
     let columns = csv_columns(&out.join("results.csv"));
     for (row, load) in loads.iter().enumerate() {
         let set = format!("friction.point.0.normal_load={load}");

@@ -8,7 +8,7 @@ mod process;
 
 use std::path::{Path, PathBuf};
 
-use process::ssn;
+use process::{assert_success, ssn};
 use vtkio::model::{Attribute, CellType, DataSet, IOBuffer, Piece, Vtk};
 
 const FRAMES: usize = 8;
@@ -63,12 +63,7 @@ fn solve_with_pictures(dir: &Path, scene: &Path) -> Vec<(f64, f64)> {
         csv.to_str().unwrap(),
         "--quiet",
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_success(&o);
     std::fs::read_to_string(csv)
         .unwrap()
         .lines()

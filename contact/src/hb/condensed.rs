@@ -14,7 +14,6 @@ use super::laws::LawSampler;
 use super::ssn::{HbOptions, SsnHb};
 use super::structured::{condensed_matrix, CondensedSolve, StructuredHbSolver};
 use super::{check_len, HbError, LinearData, ResponseSummary};
-use crate::law::LawGroup;
 use crate::model::{mean_stiffness, StructuralModel};
 use crate::operator::OperatorParameter;
 
@@ -69,18 +68,12 @@ impl CondensedSsnHb {
     /// Builds the problem at the forcing frequency `omega` and factors `A(w)` (validates
     /// like [`SsnHb::new`]; a singular dynamic block is [`HbError::Linear`]).
     pub fn new(model: &StructuralModel, omega: f64, options: &HbOptions) -> Result<Self, HbError> {
-        Self::with_laws(model, omega, options, &[])
+        Self::condense(SsnHb::new(model, omega, options)?)
     }
 
-    /// [`CondensedSsnHb::new`] with the row groups `laws` added after the model's rows, as
-    /// [`SsnHb::with_laws`] adds them (and refuses a group that does not fit).
-    pub fn with_laws(
-        model: &StructuralModel,
-        omega: f64,
-        options: &HbOptions,
-        laws: &[LawGroup],
-    ) -> Result<Self, HbError> {
-        let full = SsnHb::with_laws(model, omega, options, laws)?;
+    /// The condensed form of the full problem `full` (with whatever row groups it was built
+    /// with, e.g. by [`SsnHb::with_laws`]); factors its `A(w)` as [`CondensedSsnHb::new`].
+    pub fn condense(full: SsnHb) -> Result<Self, HbError> {
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
         let (q, cross) = full.state.linear.laws.zero_blocks(size);

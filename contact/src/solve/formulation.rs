@@ -96,6 +96,12 @@ impl Method {
     pub fn marches(self) -> bool {
         of(self).marches()
     }
+
+    /// Whether the method applies only to a model with contact (the periodic LCP is posed
+    /// on the contact forces; penalty HB without contact is linear harmonic balance).
+    pub fn needs_contact(self) -> bool {
+        of(self).needs_contact()
+    }
 }
 
 /// How a formulation models friction.
@@ -393,6 +399,11 @@ pub(crate) trait Formulation: Sync {
     fn marches(&self) -> bool {
         false
     }
+
+    /// Whether it applies only with contact ([`Method::needs_contact`]).
+    fn needs_contact(&self) -> bool {
+        false
+    }
 }
 
 /// The formulation of `method`: the one match on the method in the library.
@@ -439,6 +450,9 @@ impl Formulation for SsnHbFormulation {
 struct PenaltyHbFormulation;
 
 impl Formulation for PenaltyHbFormulation {
+    fn needs_contact(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "penalty-hb"
     }
@@ -465,6 +479,9 @@ impl Formulation for PenaltyHbFormulation {
 struct LcpLemkeFormulation;
 
 impl Formulation for LcpLemkeFormulation {
+    fn needs_contact(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "lcp-lemke"
     }
@@ -491,6 +508,9 @@ impl Formulation for LcpLemkeFormulation {
 struct LcpSsnFormulation;
 
 impl Formulation for LcpSsnFormulation {
+    fn needs_contact(&self) -> bool {
+        true
+    }
     fn name(&self) -> &'static str {
         "lcp-ssn"
     }

@@ -25,6 +25,7 @@
 //! between two gaps is not blurred by different samples), and a case's values depend only
 //! on the study file and its number, never on the shard or thread that runs it.
 
+#[cfg(feature = "cli")]
 pub mod command;
 pub mod run;
 pub mod table;

@@ -13,16 +13,22 @@
 //! records of two studies never mix.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use super::table::Table;
-use super::{Case, RunKind, Study};
+use super::{Case, RunKind};
 use crate::exit::CliError;
-use crate::io::{prepare_directory, printable, write_atomically};
+use crate::io::{printable, write_atomically};
 use crate::source::SceneSource;
+// The study runner of `ssn study` (its thread pool, progress bar and manifest).
+#[cfg(feature = "cli")]
+use {
+    super::Study,
+    crate::io::prepare_directory,
+    rayon::prelude::*,
+    std::sync::atomic::{AtomicUsize, Ordering},
+};
 
 /// The `I`-th of `N` shards of a study (`--shard I/N`, `1 <= I <= N`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,8 +93,8 @@ pub fn run_case(scene: &SceneSource, case: &Case, kind: RunKind) -> Value {
 /// run converged (the exit code 0 of the command).
 pub fn run_document(scene: &SceneSource, kind: RunKind) -> Result<(Value, bool), CliError> {
     let loaded = scene.load(match kind {
-        RunKind::Solve => crate::cli::Workload::Solve,
-        RunKind::Sweep | RunKind::Solutions => crate::cli::Workload::Branch,
+        RunKind::Solve => crate::load::Workload::Solve,
+        RunKind::Sweep | RunKind::Solutions => crate::load::Workload::Branch,
     })?;
     let path = &scene.path;
     let bad = |e: semismooth_contact::solve::RunError| {
@@ -149,6 +155,7 @@ pub fn case_file(dir: &Path, case: usize) -> PathBuf {
 /// that a killed run leaves whole records only. Unlike the other outputs it is not synced to
 /// the disk: a record is checked when it is read ([`finished_record`]), so one damaged by a
 /// machine crash is run again, and a sync per case would cost more than a small solve.
+#[cfg(feature = "cli")]
 fn write_record(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     use std::io::Write;
     use std::os::unix::fs::PermissionsExt;
@@ -169,6 +176,7 @@ fn write_record(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
 
 /// The record of `case` in `dir` when it is there and is this study's record of these
 /// values.
+#[cfg(feature = "cli")]
 fn finished_record(dir: &Path, case: &Case, id: &str) -> Option<Value> {
     let text = std::fs::read_to_string(case_file(dir, case.index)).ok()?;
     let record: Value = serde_json::from_str(&text).ok()?;
@@ -227,6 +235,7 @@ pub struct StudyOutcome {
 }
 
 /// The manifest of a study directory: the scene and the study as written.
+#[cfg(feature = "cli")]
 fn manifest(scene: &SceneSource, study: &Study, study_text: &str) -> Value {
     json!({
         "format": "ssn-study",
@@ -245,6 +254,7 @@ fn manifest(scene: &SceneSource, study: &Study, study_text: &str) -> Value {
 /// Claims `dir` for this study: creates its manifest (exclusively: of two studies started
 /// together, one creates it and the other reads it), or checks that the one there is this
 /// study's (the scene and study texts and the case count; the paths may differ).
+#[cfg(feature = "cli")]
 fn claim_directory(dir: &Path, manifest: &Value) -> Result<(), CliError> {
     prepare_directory(&dir.join("cases"))?;
     let path = dir.join("study.json");
@@ -283,6 +293,7 @@ fn claim_directory(dir: &Path, manifest: &Value) -> Result<(), CliError> {
 
 /// Writes `manifest` to `path` unless a file is there already: staged beside it and linked
 /// into place without replacing anything, so the manifest is whole when it appears.
+#[cfg(feature = "cli")]
 fn create_manifest(path: &Path, manifest: &Value) -> Result<(), CliError> {
     use std::io::Write;
     if path.exists() {
@@ -309,6 +320,7 @@ fn create_manifest(path: &Path, manifest: &Value) -> Result<(), CliError> {
 }
 
 /// Options of [`run_study`].
+#[cfg(feature = "cli")]
 #[derive(Debug, Clone, Copy)]
 pub struct RunOptions {
     /// The shard to run.
@@ -321,6 +333,7 @@ pub struct RunOptions {
 /// (each case single-threaded: faer's own parallelism is switched off, so cases do not
 /// compete for the cores and every case's arithmetic is that of a serial run); writes the
 /// table when the shard is the whole study.
+#[cfg(feature = "cli")]
 pub fn run_study(
     scene: &SceneSource,
     study: &Study,

@@ -18,14 +18,19 @@ pub fn out(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
-/// The JSON document on the standard output of a run asserted to have exited with 0 (the
-/// assertion shows its standard error).
-pub fn json_success(o: &Output) -> serde_json::Value {
+/// Asserts that the run exited with 0 (the assertion shows its standard error).
+pub fn assert_success(o: &Output) {
     assert_eq!(
         o.status.code(),
         Some(0),
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// The JSON document on the standard output of a run asserted to have exited with 0
+/// ([`assert_success`]).
+pub fn json_success(o: &Output) -> serde_json::Value {
+    assert_success(o);
     serde_json::from_slice(&o.stdout).expect("a JSON document")
 }
