@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use crate::linalg::LinearSolveError;
+use crate::linalg::{LinearSolveError, SolveAccuracy};
 
 /// Why a problem could not evaluate its residual, Jacobian or parameter derivative at `x`.
 ///
@@ -414,6 +414,19 @@ const PARAMETER_STEP: f64 = 1e-7;
 pub trait LinearSolve {
     /// Solves `J x = rhs` in place with the last factorization.
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError>;
+
+    /// Solves `J x = rhs` in place as accurately as `accuracy` asks (an inexact Newton
+    /// step: an iterative solver may stop at `|J x - rhs| <= max(accuracy.relative |rhs|,
+    /// accuracy.absolute)`, or earlier by its own rule). The default, for direct solvers,
+    /// solves exactly ([`LinearSolve::solve_in_place`]).
+    fn solve_in_place_to(
+        &mut self,
+        rhs: &mut [f64],
+        accuracy: SolveAccuracy,
+    ) -> Result<(), LinearSolveError> {
+        let _ = accuracy;
+        self.solve_in_place(rhs)
+    }
 
     /// Solves `J X = R` in place for `ncols` right-hand sides stored one after the other
     /// (column-major, `columns.len() = n * ncols`) with the last factorization. The default

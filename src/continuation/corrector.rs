@@ -9,7 +9,7 @@ use super::CorrectorFailure;
 use crate::iteration::kernel::{norm2, Kernel, KernelRules, NewtonSystem, Stop};
 use crate::linalg::{
     check_finite_dense, check_pivots, BorderedError, BorderedSolver, LinearSolveError,
-    DEFAULT_PIVOT_THRESHOLD,
+    SolveAccuracy, DEFAULT_PIVOT_THRESHOLD,
 };
 use crate::newton::WorkCounters;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent};
@@ -234,6 +234,8 @@ where
         y: &[f64],
         g: &[f64],
         d: &mut [f64],
+        // The bordered solve is exact: its tangent is reused by the predictor.
+        _accuracy: SolveAccuracy,
         counters: &mut WorkCounters,
     ) -> Result<(), BorderedFailure> {
         let n = self.metric.n;
@@ -502,7 +504,7 @@ where
         let zero = vec![0.0; n + 1];
         let mut d = vec![0.0; n + 1];
         system
-            .direction(y, &zero, &mut d, work)
+            .direction(y, &zero, &mut d, SolveAccuracy::new(0.0, 0.0), work)
             .map_err(|failure| failure.at(0))
     }
 }

@@ -13,10 +13,13 @@
 //! step rule, possibly after [`Kernel::restart`] from the initial guess), then
 //! [`Kernel::finish`]; [`Kernel::run`] is the common case of one rule throughout.
 
+use crate::linalg::SolveAccuracy;
 use crate::linesearch::{
     backtrack, AcceptedStep, Backtrack, LineSearchOptions, NonMonotoneHistory,
 };
 use crate::EvaluationError;
+
+use super::forcing::Forcing;
 
 use super::{Tolerances, WorkCounters};
 
@@ -28,12 +31,14 @@ pub(crate) trait NewtonSystem {
     /// Writes `G(y)` into `g`.
     fn evaluate(&mut self, y: &[f64], g: &mut [f64]) -> Result<(), EvaluationError>;
 
-    /// Writes a Newton direction at `y` (where `G(y) = g`) into `d`.
+    /// Writes a Newton direction at `y` (where `G(y) = g`) into `d`, its linear solve
+    /// carried out as accurately as `accuracy` asks (an iterative solver's forcing term).
     fn direction(
         &mut self,
         y: &[f64],
         g: &[f64],
         d: &mut [f64],
+        accuracy: SolveAccuracy,
         counters: &mut WorkCounters,
     ) -> Result<(), Self::Failure>;
 
@@ -196,6 +201,8 @@ pub(crate) struct Kernel {
     start: Vec<f64>,
     history: Option<NonMonotoneHistory>,
     progress: Progress,
+    /// The inexact-Newton forcing term of the run ([`super::forcing`]).
+    forcing: Forcing,
     /// `|G|` at the initial guess and after each accepted step.
     pub residual_norms: Vec<f64>,
     /// Accepted step lengths.
@@ -309,6 +316,7 @@ impl Kernel {
             v.clear();
             v.reserve(capacity);
         }
+        self.forcing = Forcing::default();
         self.progress = Progress {
             norm: f64::INFINITY,
             best_norm: f64::INFINITY,
@@ -360,6 +368,7 @@ impl Kernel {
             Err(e) => return Some(Stop::Evaluation(e)),
         };
         self.progress.norm = norm;
+        self.forcing = Forcing::default();
         self.reset_history(step.memory()).push(merit_of(norm));
         None
     }
@@ -377,7 +386,9 @@ impl Kernel {
         counters: &mut WorkCounters,
     ) -> Option<Stop<S::Failure>> {
         while self.progress.iterations < until {
-            if let Err(e) = system.direction(y, &self.g, &mut self.d, counters) {
+            let tolerance = self.progress.tolerance.max(rules.tolerances.floor_at(y));
+            let accuracy = self.forcing.next(self.progress.norm, tolerance);
+            if let Err(e) = system.direction(y, &self.g, &mut self.d, accuracy, counters) {
                 return Some(Stop::Direction(e));
             }
             if self.d.iter().any(|v| !v.is_finite()) {

@@ -5,6 +5,7 @@
 //! [`crate::polyalgorithm`] (strategies from a poor guess) build on it; nothing here knows
 //! about them. The public types are re-exported by [`crate::newton`].
 
+pub(crate) mod forcing;
 pub(crate) mod kernel;
 
 use std::iter::Sum;

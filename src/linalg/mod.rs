@@ -45,6 +45,24 @@ pub use krylov::{Gmres, GmresOptions, GmresReport, KrylovOperator};
 pub use nalgebra_lu::NalgebraLu;
 pub use sparse::{diagonal_entry, FaerSparseLu, LuScalar, PivotRule, SparseLu};
 
+/// How accurately an iterative solver must solve `J x = r` (an inexact Newton step):
+/// `|J x - r| <= max(relative |r|, absolute)`. Direct solvers solve exactly whatever it asks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SolveAccuracy {
+    /// The share of `|r|` the linear residual may keep (the forcing term).
+    pub relative: f64,
+    /// A linear residual that is small enough whatever `|r|` is.
+    pub absolute: f64,
+}
+
+impl SolveAccuracy {
+    /// `|J x - r| <= max(relative |r|, absolute)`.
+    pub fn new(relative: f64, absolute: f64) -> Self {
+        Self { relative, absolute }
+    }
+}
+
 /// Default relative pivot threshold: a pivot `|u_ii| <= threshold * max_j |u_jj|` is
 /// treated as zero.
 pub const DEFAULT_PIVOT_THRESHOLD: f64 = 1e-13;

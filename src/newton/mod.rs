@@ -93,7 +93,7 @@ pub use crate::iteration::{
     WorkCounters, EXACT_RESIDUAL,
 };
 use crate::iteration::{Log, Outcome};
-use crate::linalg::LinearSolveError;
+use crate::linalg::{LinearSolveError, SolveAccuracy};
 pub use crate::linesearch::LineSearchOptions;
 use crate::InvalidOption;
 use crate::{EvaluationError, Factorize, GeneralizedJacobian, ProblemCounters};
@@ -252,6 +252,7 @@ where
         x: &[f64],
         f: &[f64],
         d: &mut [f64],
+        accuracy: SolveAccuracy,
         counters: &mut WorkCounters,
     ) -> Result<(), PlainFailure> {
         counters.jacobian_evaluations += 1;
@@ -266,7 +267,9 @@ where
             *di = -fi;
         }
         counters.linear_solves += 1;
-        self.solver.solve_in_place(d).map_err(PlainFailure::Linear)
+        self.solver
+            .solve_in_place_to(d, accuracy)
+            .map_err(PlainFailure::Linear)
     }
 }
 

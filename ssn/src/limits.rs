@@ -393,7 +393,7 @@ pub const KRYLOV_ITERATIONS_PER_NEWTON_MAX: f64 = 300.0;
 /// `N (H + 1) + m S^2 + m S b` (the `H + 1` sparse solves of a product, `Q` and the contact
 /// blocks, the Gram-Schmidt on the `2b` Krylov vectors of the current cycle). On the rod
 /// above (CPU time, a load of 5 on 2 cores, at 2.3e10 operations per second): 200 stops
-/// (no dense preconditioner: `m S > 6000`) took 30.2 s for 9,264 GMRES iterations, 63 per
+/// (no dense preconditioner: `m S = 8200` above its limit) took 30.2 s for 9,264 GMRES iterations, 63 per
 /// unit; 1,000 stops 194 s for 10,617, 72 per unit.
 pub const KRYLOV_PRODUCT_FLOPS: f64 = 70.0;
 

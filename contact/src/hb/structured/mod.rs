@@ -20,8 +20,10 @@
 //! restarted GMRES with the operator and preconditioner of [`super::krylov`], and
 //! `dU = A^{-1} (r_u + G^T dLambda)`. The step then satisfies `|J d - r| <= max(1e-10 |r|,
 //! tau)` with the absolute `tau` of [`StructuredHbSolver::with_krylov_tolerance`] (the
-//! `U` rows are solved exactly, so the full residual is the condensed one); a solve
-//! that does not reach it is [`LinearSolveError::NotConverged`].
+//! `U` rows are solved exactly, so the full residual is the condensed one), or at the
+//! looser accuracy a Newton run asks of its step (the inexact-Newton forcing term of
+//! [`LinearSolve::solve_in_place_to`]); a solve that does not reach it is
+//! [`LinearSolveError::NotConverged`].
 
 use std::sync::Arc;
 
@@ -29,7 +31,9 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor as dense_lu, solve as dense_solve};
 use faer::perm::PermRef;
 use faer::{c64, Conj, Mat, MatMut, Par};
-use semismooth::linalg::{check_pivots, Gmres, LinearSolveError, DEFAULT_PIVOT_THRESHOLD};
+use semismooth::linalg::{
+    check_pivots, Gmres, LinearSolveError, SolveAccuracy, DEFAULT_PIVOT_THRESHOLD,
+};
 use semismooth::{Factorize, LinearSolve};
 
 use super::coupled_rows::CoupledRows;
@@ -133,6 +137,9 @@ pub struct StructuredHbSolver {
     krylov: bool,
     gmres: Gmres,
     krylov_absolute_tolerance: f64,
+    /// The accuracy the current solve was asked for (an inexact Newton step), beside the
+    /// tolerance of the matrix-free path.
+    requested_accuracy: Option<SolveAccuracy>,
     krylov_iterations: u64,
     /// The units of rows coupled by their laws (matrix-free path).
     coupled_rows: CoupledRows,
@@ -201,6 +208,7 @@ impl StructuredHbSolver {
             krylov: false,
             gmres: Gmres::new(),
             krylov_absolute_tolerance: 0.0,
+            requested_accuracy: None,
             krylov_iterations: 0,
             coupled_rows: CoupledRows::default(),
             unit_receptance: Vec::new(),
@@ -474,6 +482,19 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
 impl LinearSolve for StructuredHbSolver {
     fn krylov_iterations(&self) -> u64 {
         self.krylov_iterations
+    }
+
+    /// The matrix-free path stops at the looser of `accuracy` and its own tolerance; the
+    /// dense path solves exactly.
+    fn solve_in_place_to(
+        &mut self,
+        rhs: &mut [f64],
+        accuracy: SolveAccuracy,
+    ) -> Result<(), LinearSolveError> {
+        self.requested_accuracy = Some(accuracy);
+        let solved = self.solve_in_place(rhs);
+        self.requested_accuracy = None;
+        solved
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolveError> {
