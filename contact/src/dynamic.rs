@@ -12,11 +12,7 @@
 //! - [`DynamicStiffness`]: the core's complex sparse LU ([`SparseLu<c64>`]: a fill-reducing
 //!   column ordering of that pattern computed once, then a numeric LU with partial pivoting
 //!   per coefficient pair into one of a fixed number of slots whose storage is reused, and
-//!   solves with scratch memory sized once). When every source is symmetric and faer's
-//!   analysis of the pattern chooses a supernodal factorization (2-D and 3-D meshes), `Z`
-//!   is complex symmetric and is factored instead as a real symmetric indefinite matrix of
-//!   twice its size by a supernodal `L B L^T` in a symmetric fill-reducing ordering
-//!   (module `symmetric`); banded chains keep the LU.
+//!   solves with scratch memory sized once).
 //!
 //! **Singularity.** A factorization is rejected ([`LinearSolveError::Singular`], carrying
 //! the original column of the pivot, the pivot and the largest pivot, both squared moduli)
@@ -34,10 +30,6 @@ use num_traits::Zero;
 use semismooth::linalg::{LinearSolveError, PivotRule, SparseLu};
 
 use crate::model::SparseMatrix;
-
-mod symmetric;
-
-use symmetric::SymmetricFactors;
 
 /// The union sparsity pattern of `N x N` source matrices and the diagonal, with the
 /// position in it of every stored entry of every source.
@@ -136,22 +128,15 @@ pub(crate) struct DynamicStiffness {
     /// `[K, M, D]` (`D` absent without damping).
     sources: Vec<SparseMatrix>,
     values: Vec<c64>,
-    factors: Factors,
-}
-
-/// The factorizations of `Z` (module documentation).
-#[derive(Debug)]
-enum Factors {
-    Lu(SparseLu<c64>),
-    Symmetric(Box<SymmetricFactors>),
+    lu: SparseLu<c64>,
 }
 
 impl std::fmt::Debug for DynamicStiffness {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DynamicStiffness")
-            .field("n", &self.pattern.symbolic.ncols())
+            .field("n", &self.lu.dim())
             .field("nnz", &self.pattern.nnz())
-            .field("factors", &self.factors)
+            .field("slots", &self.lu.slots())
             .finish_non_exhaustive()
     }
 }
@@ -182,28 +167,16 @@ impl DynamicStiffness {
         let n = sources[0].nrows();
         let refs: Vec<&SparseMatrix> = sources.iter().collect();
         let pattern = UnionPattern::new(n, &refs);
-        let symmetric = match sources.iter().all(is_symmetric) {
-            true => {
-                SymmetricFactors::analyze(pattern.symbolic.as_ref(), slots, max_columns, false)?
-            }
-            false => None,
-        };
-        let factors = match symmetric {
-            Some(factors) => Factors::Symmetric(Box::new(factors)),
-            None => {
-                let mut lu = SparseLu::new()
-                    .with_pivot_rule(PivotRule::Breakdown)
-                    .with_slots(slots)
-                    .with_solve_columns(max_columns);
-                lu.analyze_pattern(pattern.symbolic.as_ref())?;
-                Factors::Lu(lu)
-            }
-        };
+        let mut lu = SparseLu::new()
+            .with_pivot_rule(PivotRule::Breakdown)
+            .with_slots(slots)
+            .with_solve_columns(max_columns);
+        lu.analyze_pattern(pattern.symbolic.as_ref())?;
         Ok(Self {
             values: vec![c64::new(0.0, 0.0); pattern.nnz()],
             pattern,
             sources,
-            factors,
+            lu,
         })
     }
 
@@ -230,18 +203,14 @@ impl DynamicStiffness {
             self.sources.iter().zip(coefficients.iter().copied()),
             &mut self.values,
         );
-        let lu = match &mut self.factors {
-            Factors::Lu(lu) => lu,
-            Factors::Symmetric(factors) => return factors.factor(slot, &self.values),
-        };
-        match lu.factor_slot(slot, self.pattern.matrix(&self.values)) {
+        match self.lu.factor_slot(slot, self.pattern.matrix(&self.values)) {
             // The pivot's position in the factorization is a column of the ordering.
             Err(LinearSolveError::Singular {
                 index,
                 pivot,
                 max_pivot,
             }) => Err(LinearSolveError::Singular {
-                index: lu.pivot_column(index),
+                index: self.lu.pivot_column(index),
                 pivot,
                 max_pivot,
             }),
@@ -255,10 +224,7 @@ impl DynamicStiffness {
         slot: usize,
         rhs: MatMut<'_, c64>,
     ) -> Result<(), LinearSolveError> {
-        match &mut self.factors {
-            Factors::Lu(lu) => lu.solve_slot_in_place(slot, rhs),
-            Factors::Symmetric(factors) => factors.solve_in_place(slot, rhs),
-        }
+        self.lu.solve_slot_in_place(slot, rhs)
     }
 
     /// `y += (a K + b M + c D) x` for complex vectors (`x`, `y` of length `N`), the values
@@ -275,27 +241,6 @@ impl DynamicStiffness {
             .combine(self.sources.iter().zip(coefficients), values);
         crate::model::sparse_mul_add(self.pattern.matrix(values), c64::new(1.0, 0.0), x, y);
     }
-}
-
-/// True when `a` is square and equal to its transpose entry by entry.
-fn is_symmetric(a: &SparseMatrix) -> bool {
-    let a = a.as_ref();
-    let entry = |i: usize, j: usize| {
-        let rows = a.row_idx_of_col_raw(j);
-        let values = a.val_of_col(j);
-        let at = if rows.is_sorted() {
-            rows.binary_search(&i).ok()
-        } else {
-            rows.iter().position(|&r| r == i)
-        };
-        at.map(|p| values[p])
-    };
-    a.nrows() == a.ncols()
-        && (0..a.ncols()).all(|j| {
-            let rows = a.row_idx_of_col_raw(j).iter();
-            rows.zip(a.val_of_col(j))
-                .all(|(&i, &v)| entry(j, i).is_some_and(|w| w == v))
-        })
 }
 
 #[cfg(test)]
