@@ -5,8 +5,11 @@
 //! (`sweep::peak`), and its amplification factor against the tuned sector's peak.
 //!
 //! 24 blades, a casing contact on every blade (gap 1, three times the shipped load), engine
-//! order 3, 5 harmonics, 72 samples (a multiple of `N / gcd(N, EO) = 8`), swept over 8 %
-//! either side of nodal diameter 3's resonance (`SweepSettings::new` steps, no stability).
+//! order 3, 5 harmonics, 72 samples (a multiple of `N / gcd(N, EO) = 8`), swept from 0.92
+//! to 1.30 times nodal diameter 3's resonance (`SweepSettings::new` steps, no stability):
+//! the casing moves the tuned peak above the resonance, and the window's upper end is past
+//! it, so the tuned sector's peak is an interior maximum of its branch (checked: a peak at
+//! the window's end stops the example with an error).
 //! Each peak is checked by a fixed-frequency solve at its frequency started from the
 //! peak's state moved by 1e-3 (the tuned sector's on the full tuned disk, from the
 //! recovered state): the relative difference of the largest blade-tip amplitude is
@@ -40,8 +43,9 @@ const POINTS: usize = 161;
 /// Instants on which a tip amplitude is read: the sweep's own (`solve::HB_OUTPUT_POINTS`),
 /// so that the branch points and the peak search's solves measure alike.
 const INSTANTS: usize = 1024;
-/// The sweep window around the nodal-diameter resonance.
-const WINDOW: (f64, f64) = (0.92, 1.08);
+/// The sweep window in units of the nodal-diameter resonance: its upper end is past the
+/// tuned sector's peak, which the casing moves above the resonance.
+const WINDOW: (f64, f64) = (0.92, 1.30);
 
 fn settings() -> SolverSettings {
     SolverSettings {
@@ -340,8 +344,10 @@ fn page(tuned: &Row, amplitudes: &[Row], others: &[Row], resonance: f64) -> Stri
          shipped load), engine order 3, 5 harmonics, 72 samples; blade `j`'s stiffness is \
          `k_b (1 + delta_j)`. Each disk is swept by pseudo-arclength continuation \
          (`sweep::frequency_response`, default steps, no stability) \
-         upward over 8 % either side of nodal diameter 3's resonance `omega_r`, the mistuned \
-         ones whole, the tuned one by one cyclic sector. The peak is the largest blade-tip \
+         upward from 0.92 to 1.30 times nodal diameter 3's resonance `omega_r`, the mistuned \
+         ones whole, the tuned one by one cyclic sector. The tuned sector's peak is an interior \
+         maximum of its branch, below the window's upper end (the example stops with an error \
+         otherwise). The peak is the largest blade-tip \
          amplitude over the blades and the branch, located along the branch on the blade that \
          has it (`sweep::peak`: between branch points, at a fold, or at the branch's end); the \
          amplification factor is it against the tuned sector's peak. The fixed-frequency \
@@ -352,9 +358,18 @@ fn page(tuned: &Row, amplitudes: &[Row], others: &[Row], resonance: f64) -> Stri
          starts): its largest amplitude and its failed solves.\n\n",
     );
     page.push_str(&format!(
-        "Tuned peak (sector): {reference:.6} at {:.6} omega_r.\n\n## The builder's pattern\n\n",
+        "Tuned peak (sector): {reference:.6} at {:.6} omega_r.",
         tuned.traced.omega / resonance
     ));
+    let (scan, _) = tuned.scan;
+    if scan > reference * (1.0 + 1e-9) {
+        page.push_str(&format!(
+            " The tuned scan reaches {scan:.6}, above it: the tuned branch turned back at a \
+             corner below the tuned resonance's peak, and the amplification factors are \
+             against the branch's peak, not the resonance's."
+        ));
+    }
+    page.push_str("\n\n## The builder's pattern\n\n");
     page.push_str(HEADER);
     for row in std::iter::once(tuned).chain(amplitudes) {
         page.push_str(&row.line(reference, resonance));
@@ -365,6 +380,20 @@ fn page(tuned: &Row, amplitudes: &[Row], others: &[Row], resonance: f64) -> Stri
         page.push_str(&row.line(reference, resonance));
     }
     page
+}
+
+/// `Ok` when the peak of `traced` is an interior maximum of its branch: not at the
+/// branch's end and below the window's upper end (units of `resonance`).
+fn interior_peak(traced: &Traced, resonance: f64) -> Result<(), String> {
+    let at = traced.omega / resonance;
+    if matches!(traced.location, PeakLocation::AtEdge) || at >= WINDOW.1 - 1e-9 {
+        return Err(format!(
+            "the tuned peak {:.6} at {at:.6} omega_r is at the end of its branch or of the \
+             window (upper end {}): widen the window",
+            traced.amplitude, WINDOW.1
+        ));
+    }
+    Ok(())
 }
 
 fn main() {
@@ -378,6 +407,10 @@ fn main() {
     let nd = sector.nodal_diameter(1);
     let resonance = natural_frequencies(&sector.nodal_diameter_model(nd), 1).expect("modes")[0];
     let tuned = tuned_row(&loading, &sector, resonance);
+    if let Err(reason) = interior_peak(&tuned.traced, resonance) {
+        eprintln!("error: {reason}");
+        std::process::exit(1);
+    }
     let reference = tuned.traced.amplitude;
     print!("{HEADER}{}", tuned.line(reference, resonance));
     let mut amplitudes = Vec::new();
