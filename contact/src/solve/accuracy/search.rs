@@ -13,14 +13,6 @@
 //! the next discretisation is the one the error model `C h^p` predicts for the target,
 //! times [`SAFETY`], between [`MIN_RATIO`] and [`MAX_RATIO`] times the current one.
 //!
-//! Harmonic balance's error at a contact falls in `H` as a staircase, not as `C H^-p`:
-//! on the paper's rod (modified mass) the mean force's error is 1.5e-4, 9.2e-5, 2.1e-5,
-//! 2.4e-5, 2.0e-5, 5.6e-6 and 7.7e-6 at H = 160, 226, 320, 452, 640, 905 and 1280, so the
-//! change from 320 to 640 (1.4e-6) alone would put H = 320 at 3.5e-6. A rung's estimate is
-//! therefore the larger of its pair above and its pair below (the error the pair below
-//! predicts for it), and a rung between two is estimated at least at what the error model
-//! through them predicts.
-//!
 //! Harmonic balance then checks its AFT samples on their own ("Nt matters where contact
 //! opens and closes"): the chosen `H` is solved again with twice the samples (started from
 //! the same coefficients: a few iterations), the quadrature part of the error (order 2 in
@@ -285,24 +277,6 @@ impl Record {
         }
     }
 
-    /// Harmonic balance: the estimate of `rung` from its pair `above` or, where it is the
-    /// larger, from its pair `below` (a plateau of the error in H hides it from the pair
-    /// above: module documentation), recorded on its step.
-    fn larger_of_pairs(
-        &mut self,
-        rung: &Rung,
-        above: (RelativeErrors, EstimateBasis),
-        below: Option<(RelativeErrors, EstimateBasis)>,
-    ) -> (RelativeErrors, EstimateBasis) {
-        match below {
-            Some(below) if below.0.largest() > above.0.largest() => {
-                self.steps[rung.step].estimate = Some(below.0.largest());
-                below
-            }
-            _ => above,
-        }
-    }
-
     /// Richardson's estimates of the pair `(coarse, fine)` from the `change` between them
     /// with the convergence order `order`, recorded on their steps (the fine one's only
     /// without a finer partner): the coarse and the fine error.
@@ -415,12 +389,10 @@ pub(crate) fn solve_to_accuracy_from(
         };
         let (coarse_error, fine_error) =
             record.estimate_pair((&current, &fine), &change, ladder.order, finer_partner);
-        let (above, below) = ((coarse_error, record.basis(&fine, ladder.order)), last);
-        let (coarse_error, coarse_basis) =
-            record.larger_of_pairs(&current, above, below.filter(|_| finer_partner));
         let basis = |against: &Rung| record.basis(against, ladder.order);
         let (chosen, error, basis) = if coarse_error.largest() <= target {
-            let chosen = (current, coarse_error, coarse_basis);
+            let b = basis(&fine);
+            let chosen = (current, coarse_error, b);
             match failed {
                 Some(below) if finer_partner => between(
                     structure,
@@ -433,7 +405,8 @@ pub(crate) fn solve_to_accuracy_from(
                 _ => chosen,
             }
         } else if !finer_partner && fine_error.largest() <= target {
-            (fine, fine_error, basis(&current))
+            let b = basis(&current);
+            (fine, fine_error, b)
         } else {
             failed = Some((current.level, coarse_error.largest()));
             last = Some((fine_error, basis(&current)));
@@ -528,15 +501,7 @@ fn between(
     // The change was measured relative to the candidate; the chosen rung is its finer
     // partner: r = level / h.
     let rp = (level as f64 / h as f64).powf(ladder.order);
-    // At least what the error model through the two rungs predicts at `h` (a plateau of
-    // the error between `h` and the chosen rung hides it from their change).
-    let from_change = change.scaled(rp / (rp - 1.0));
-    let predicted = chosen.1.scaled((level as f64 / h as f64).powf(p));
-    let candidate_error = if predicted.largest() > from_change.largest() {
-        predicted
-    } else {
-        from_change
-    };
+    let candidate_error = change.scaled(rp / (rp - 1.0));
     record.steps[candidate.step].estimate = Some(candidate_error.largest());
     if candidate_error.largest() > record.target {
         return Ok(chosen);
