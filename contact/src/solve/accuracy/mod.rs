@@ -490,9 +490,9 @@ pub(crate) fn penalty_part(
 }
 
 /// The order in `H` harmonic balance's estimate assumes: the error of the contact's own
-/// series maximum (which the estimate reads clamped at the obstacle instead) falls like
-/// `H^-0.85` (measured from H = 20 to 320; the displacement has a kink where the contact
-/// closes, so its truncation error tends to `H^-1`); 0.75 keeps the estimate above the measured errors.
+/// displacement maximum, the largest part on the rods, falls like `H^-0.85` (measured
+/// from H = 20 to 320; the displacement has a kink where the contact closes, so its
+/// truncation error tends to `H^-1`); 0.75 keeps the estimate above the measured errors.
 pub const HB_ORDER: f64 = 0.75;
 
 /// Ratio of the harmonics of harmonic balance's comparison (2H, or H/2 for a model too
