@@ -217,14 +217,8 @@ pub(crate) fn set_series_means(
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct PeriodStatistics {
-    /// Largest displacement of the observed dof (of the samples as solved: a truncated
-    /// series overshoots an obstacle by its Gibbs ringing).
+    /// Largest displacement of the observed dof.
     pub max: f64,
-    /// Largest displacement of the observed dof through its contact's law: the samples
-    /// clamped at the obstacle, `max_t min(u(t), g)`, where the observed dof is a unilateral
-    /// contact `u <= g` on that dof alone (as the contact forces apply the law to samples);
-    /// `max` otherwise. The quantity the accuracy estimate reads.
-    pub max_clamped: f64,
     /// Smallest displacement.
     pub min: f64,
     /// Largest penetration `max(0, u - gap)` (0 without contact).
@@ -256,7 +250,6 @@ pub fn period_statistics(displacement: &[f64], contact: Option<(f64, &[f64])>) -
     };
     PeriodStatistics {
         max,
-        max_clamped: contact.map_or(max, |(gap, _)| max.min(gap)),
         min,
         max_penetration,
         mean_contact_force,
@@ -298,9 +291,7 @@ mod tests {
         let force = vec![-1.0; 100];
         let s = period_statistics(&u, Some((0.5, &force)));
         assert_eq!(s.max, 1.0);
-        assert_eq!(s.max_clamped, 0.5);
         assert!((s.min + 1.0).abs() < 1e-3);
-        assert_eq!(period_statistics(&u, None).max_clamped, 1.0);
         assert!((s.max_penetration - 0.5).abs() < 1e-15);
         assert_eq!(s.mean_contact_force, -1.0);
     }

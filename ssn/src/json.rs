@@ -128,7 +128,6 @@ pub fn solution_json(scene: &Path, s: &Solution) -> Value {
         "effective_tolerance": s.effective_tolerance,
         "solve_seconds": s.solve_seconds,
         "tip_max": finite_or_null(s.stats.max),
-        "tip_max_clamped": finite_or_null(s.stats.max_clamped),
         "tip_min": finite_or_null(s.stats.min),
         "max_penetration": finite_or_null(s.stats.max_penetration),
         "contact_force_mean": finite_or_null(s.stats.mean_contact_force),

@@ -601,14 +601,6 @@ fn result_lines(s: &Solution) -> String {
         "tip max / min     {:.6} / {:.6}\n",
         s.stats.max, s.stats.min
     );
-    // At a contact dof the truncated series overshoots the obstacle: its maximum through
-    // the law (what the accuracy estimate reads) is printed beside it.
-    if s.stats.max_clamped != s.stats.max {
-        t += &format!(
-            "tip max clamped   {:.6} (at the obstacle)\n",
-            s.stats.max_clamped
-        );
-    }
     // Penetration and mean force belong to unilateral contacts: a friction-only run has none.
     if !s.contacts.is_empty() {
         t += &format!(

@@ -7,10 +7,7 @@
 //! ([`RelativeErrors::between`]) has three parts:
 //!
 //! - `displacement_max`, `displacement_min`: `|u - u_ref|` of the largest and smallest
-//!   displacement, divided by the reference's largest excursion `max(|max|, |min|)`; at a
-//!   contact dof the largest is read through the law (the samples clamped at the obstacle,
-//!   [`crate::contacts::PeriodStatistics::max_clamped`]), not the truncated series'
-//!   overshoot past it, whose error falls only like `H^-0.85`;
+//!   displacement, divided by the reference's largest excursion `max(|max|, |min|)`;
 //! - `contact_force`: `max_k |F_k - F_ref,k|` over the contacts, divided by the largest
 //!   `|F_ref,k|` (`None` without contact force);
 //!
@@ -62,8 +59,7 @@ pub use search::{DiscretisationSearch, SearchStep, SearchStop};
 /// What a solution reports: the observed dof's extremes and the contacts' mean forces.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReportedQuantities {
-    /// Largest displacement of the observed dof over one period, through its contact's law
-    /// where it is a contact dof ([`crate::contacts::PeriodStatistics::max_clamped`]).
+    /// Largest displacement of the observed dof over one period.
     pub displacement_max: f64,
     /// Smallest displacement of the observed dof over one period.
     pub displacement_min: f64,
@@ -75,7 +71,7 @@ impl ReportedQuantities {
     /// The quantities `solution` reports.
     pub fn of(solution: &Solution) -> Self {
         Self {
-            displacement_max: solution.stats.max_clamped,
+            displacement_max: solution.stats.max,
             displacement_min: solution.stats.min,
             contact_forces: solution.contacts.iter().map(|c| c.force_mean).collect(),
         }
