@@ -35,6 +35,8 @@ use semismooth_contact::solve::{solve, RunError, Solution};
 pub const REFERENCE_STEPS: usize = 8000;
 /// Harmonics of the SSN-HB cross-check of the reference.
 pub const REFERENCE_HARMONICS: usize = 320;
+/// Steps per period of the study's time-marching entries.
+pub const MARCH_STEPS: [usize; 8] = [32, 64, 128, 250, 500, 1000, 2000, 4000];
 /// Repeats of a fast run (median taken).
 pub const REPEATS: usize = 3;
 /// Runs faster than this (seconds) are repeated [`REPEATS`] times.
@@ -434,7 +436,7 @@ fn sweep_settings(
             }
         }
     }
-    for steps in [32, 64, 128, 250, 500, 1000, 2000, 4000] {
+    for steps in MARCH_STEPS {
         out.push((
             Method::March,
             format!("steps={steps}"),
@@ -453,7 +455,7 @@ fn sweep_settings(
 /// of each attempt: 1e-10 reaches round-off with a massless contact node (trapezoidal
 /// scheme, about 150 periods); the Moreau–Jean scheme of a massive contact node chatters
 /// at the 1e-4 .. 1e-6 level, so 1e-6 is tried next.
-const REFERENCE_TOLERANCES: [(f64, usize); 2] = [(1e-10, 1000), (1e-6, 2000)];
+pub const REFERENCE_TOLERANCES: [(f64, usize); 2] = [(1e-10, 1000), (1e-6, 2000)];
 
 fn hb_settings(base: &SolverSettings, harmonics: usize) -> SolverSettings {
     SolverSettings {

@@ -230,13 +230,12 @@ fn check_scales(scene: &Scene, omega_1: f64, omega: f64) -> Result<(), String> {
         ));
     }
     if let Some(sweep) = &scene.sweep {
-        for (key, r) in [
-            ("sweep.omega_ratio_from", sweep.omega_ratio_from),
-            ("sweep.omega_ratio_to", sweep.omega_ratio_to),
-        ] {
+        let bounds = [sweep.omega_ratio_from, sweep.omega_ratio_to];
+        for (key, r) in scene.sweep_keys.into_iter().zip(bounds) {
             if !range.contains(&r) {
                 return Err(format!(
-                    "invalid `{key}` = {r}: allowed {:e}..={:e} (units of omega_1)",
+                    "invalid `{key}`: {r:e} times omega_1 = {omega_1:e}: allowed {:e}..={:e} \
+                     times omega_1",
                     range.start(),
                     range.end()
                 ));

@@ -2,7 +2,9 @@
 //! sweep followed period-2 branches (`[sweep] period_two = true`), one per point of each,
 //! told apart by two more columns, `branch` (0: the sweep; `k`: its `k`-th period-2 branch)
 //! and `period_multiple` (the orbit's period in periods of the forcing: 1 or 2). A sweep
-//! without period-2 branches has neither column.
+//! without period-2 branches has neither column. `contact_force_mean` and
+//! `max_penetration` (sums over the unilateral contacts) are written where the branch has
+//! unilateral contacts; the friction points' columns where it has friction points.
 
 use semismooth_contact::sweep::doubling::PeriodTwoOutcome;
 use semismooth_contact::sweep::FrequencyResponse;
@@ -24,15 +26,19 @@ fn branch_columns(response: &FrequencyResponse) -> Vec<(String, Vec<f64>)> {
         ("amplitude".to_string(), response.amplitudes()),
         ("stable".to_string(), stable),
         ("floquet_max_abs".to_string(), floquet),
-        (
+    ];
+    // The unilateral contacts' sums belong to a branch with such contacts: a damper-only
+    // (friction) or linear branch has no normal force and no penetration to report.
+    if points.iter().any(|p| !p.contacts.is_empty()) {
+        columns.push((
             "contact_force_mean".to_string(),
             response.contact_force_mean(),
-        ),
-        (
+        ));
+        columns.push((
             "max_penetration".to_string(),
             field(&|p| p.stability.max_penetration),
-        ),
-    ];
+        ));
+    }
     columns.extend(response.contact_columns());
     columns
 }

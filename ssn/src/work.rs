@@ -114,8 +114,11 @@ pub fn scene_work_at(
             );
         }
     }
+    if workload == Workload::Compare {
+        return compare_work(scene, (dofs, contacts), one, omega_1, size_key);
+    }
     let mut estimates = vec![one];
-    if settings.method.marches() || workload == Workload::Compare {
+    if settings.method.marches() {
         estimates.push(march_work(scene, dofs, &settings, omega_1, size_key));
     }
     if workload == Workload::Branch {
@@ -148,12 +151,8 @@ pub const MASS_CARRYING_NEWTON_ITERATIONS: f64 = 60.0;
 /// imported model's contact masses are not known before it is read: its count is the
 /// latter.
 pub fn counted_solve_iterations(scene: &Scene, contacts: usize, settings: &SolverSettings) -> f64 {
-    use semismooth_contact::rod::MassModel;
     let counted = counted_newton_iterations(contacts, settings);
-    let rod = &scene.rod;
-    let carries_mass = scene.model.is_none()
-        && contacts > 0
-        && (rod.mass != MassModel::Modified || rod.contacts.iter().any(|c| c.node != rod.elements));
+    let carries_mass = rod_contact_carries_mass(scene, contacts);
     let smoothing = settings.method.carries_contact_forces()
         && settings.linear_solver != crate::scene::LinearSolverChoice::Dense
         && settings.harmonics >= MASS_CARRYING_SMOOTHING_HARMONICS;
@@ -177,6 +176,72 @@ fn eigen_work(dofs: usize, size_key: &'static str) -> WorkEstimate {
         what: format!("the natural frequencies of {dofs} dofs"),
         keys: size_key,
     }
+}
+
+/// `ssn compare`: the SSN-HB solve at [`crate::accuracy_cost::REFERENCE_HARMONICS`] (`hb`,
+/// the largest of its harmonic-balance runs) plus every march it runs, which dominate:
+/// [`compare_march_steps`] steps of every dof.
+fn compare_work(
+    scene: &Scene,
+    (dofs, contacts): (usize, usize),
+    hb: WorkEstimate,
+    omega_1: Option<f64>,
+    size_key: &'static str,
+) -> WorkEstimate {
+    let steps = compare_march_steps(scene, contacts, omega_1);
+    let march = steps * dofs as f64 * MARCH_FLOPS_PER_DOF_STEP;
+    WorkEstimate {
+        flops: hb.flops + march,
+        what: format!(
+            "{}; and time marching of {dofs} dofs over about {steps:.1e} time steps (the \
+             reference at {} and {} steps per period, the study's marches at {:?})",
+            hb.what,
+            crate::accuracy_cost::REFERENCE_STEPS,
+            crate::accuracy_cost::REFERENCE_STEPS / 2,
+            crate::accuracy_cost::MARCH_STEPS
+        ),
+        keys: match size_key {
+            "rod.elements" => "solver.harmonics, solver.max_periods, rod.elements",
+            _ => "solver.harmonics, solver.max_periods, the model's size",
+        },
+    }
+}
+
+/// The time steps `ssn compare` marches ([`crate::accuracy_cost`]): each of its march
+/// entries ([`crate::accuracy_cost::MARCH_STEPS`] steps per period) over
+/// [`counted_march_periods`], and its reference at `REFERENCE_STEPS` and half of them over
+/// the periods counted at the first reference tolerance (1e-10, at most 1,000 periods). A
+/// rod whose contact carries mass marches with the Moreau–Jean scheme, which chatters and
+/// settles at neither tolerance: every entry runs `solver.max_periods` and the reference
+/// the periods of both tolerances at `REFERENCE_STEPS` (it stops before the half).
+pub fn compare_march_steps(scene: &Scene, contacts: usize, omega_1: Option<f64>) -> f64 {
+    use crate::accuracy_cost::{MARCH_STEPS, REFERENCE_STEPS, REFERENCE_TOLERANCES};
+    let settings = &scene.solver;
+    let ladder = MARCH_STEPS.iter().sum::<usize>() as f64;
+    if rod_contact_carries_mass(scene, contacts) {
+        let reference: usize = REFERENCE_TOLERANCES.iter().map(|(_, p)| p).sum();
+        return ladder * settings.max_periods as f64 + (REFERENCE_STEPS * reference) as f64;
+    }
+    let (tolerance, most) = REFERENCE_TOLERANCES[0];
+    let reference_settings = SolverSettings {
+        march_tolerance: tolerance,
+        max_periods: most,
+        ..settings.clone()
+    };
+    let reference = counted_march_periods(scene, &reference_settings, omega_1);
+    ladder * counted_march_periods(scene, settings, omega_1)
+        + (REFERENCE_STEPS + REFERENCE_STEPS / 2) as f64 * reference
+}
+
+/// Whether `scene` is a rod with `contacts` contacts one of which carries mass (consistent
+/// or lumped mass, or a stop away from the modified mass's massless tip); an imported
+/// model's contact masses are not known before it is read (false).
+fn rod_contact_carries_mass(scene: &Scene, contacts: usize) -> bool {
+    use semismooth_contact::rod::MassModel;
+    let rod = &scene.rod;
+    scene.model.is_none()
+        && contacts > 0
+        && (rod.mass != MassModel::Modified || rod.contacts.iter().any(|c| c.node != rod.elements))
 }
 
 /// Time marching: [`counted_march_periods`] of `steps_per_period` steps of every dof (the

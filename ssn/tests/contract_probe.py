@@ -33,6 +33,14 @@ def chain(d, extra="", k=CHAIN_K, m=CHAIN_M, f=CHAIN_F, tail=""):
     return "model.toml"
 
 
+def edited_chain(d, edit):
+    """The chain scene with its text passed through `edit`."""
+    path = os.path.join(d, chain(d))
+    text = edit(open(path).read())
+    open(path, "w").write(text)
+    return "model.toml"
+
+
 def rod(d, n=20, rod="", rest="[contact]\ngap = 0.5", name="rod.toml"):
     open(os.path.join(d, name), "w").write(ROD.format(n=n, rod=rod, rest=rest))
     return name
@@ -516,6 +524,65 @@ def _(d):
 @case("export-model of 2,000 elements with a stop on every node", 0, timeout=30)
 def _(d):
     return ["export-model", rod(d, n=2000, rest="[damping]\nzeta = 0.01\n" + pts(range(1, 2001))), "out"], {}, None
+
+
+# ---- sweep units, [cyclic], [modes], 3-D contact and [model] keys ------------------------
+for label, window, key in [
+        ("omega_from negative", "omega_from = -1.0\nomega_to = 2.0", "sweep.omega_from"),
+        ("frequency_hz_from NaN", "frequency_hz_from = nan\nfrequency_hz_to = 0.3", "sweep.frequency_hz_from"),
+        ("omega_from at 1e300", "omega_from = 1e300\nomega_to = 1.7e308", "sweep.omega_from"),
+        ("frequency_hz_to below the range", "frequency_hz_from = 1e-300\nfrequency_hz_to = 1e-299",
+         "sweep.frequency_hz_from"),
+        ("two units", "omega_ratio_from = 0.5\nomega_ratio_to = 1.5\nomega_from = 1.0", "sweep.omega_from"),
+        ("a lone frequency_hz_from", "frequency_hz_from = 0.2", "sweep.frequency_hz_to")]:
+    @case(f"[sweep] {label}", 2)
+    def _(d, window=window, key=key):
+        return ["sweep", rod(d, rest=f"[contact]\ngap = 0.5\n[sweep]\n{window}")], {}, mentions(key)
+
+
+for label, cyclic, key in [
+        ("sectors = 0", "sectors = 0\nengine_order = 0\nleft = [1]\nright = [2]", "cyclic.sectors"),
+        ("engine_order = -1", "sectors = 4\nengine_order = -1\nleft = [1]\nright = [2]", "cyclic.engine_order"),
+        ("an interface dof past the sector", "sectors = 4\nengine_order = 1\nleft = [1]\nright = [99]",
+         "cyclic.right` = 99"),
+        ("a dof on both sides", "sectors = 4\nengine_order = 1\nleft = [1]\nright = [1]", "cyclic.right` = 1"),
+        ("dof 0", "sectors = 4\nengine_order = 1\nleft = [0]\nright = [2]", "cyclic.left"),
+        ("sides of two lengths", "sectors = 4\nengine_order = 1\nleft = [1]\nright = [2, 3]", "cyclic.right"),
+        ("nodes without a dof_map", "sectors = 4\nengine_order = 1\nleft_nodes = [1]\nright_nodes = [2]",
+         "cyclic.left_nodes")]:
+    @case(f"[cyclic] {label}", 2)
+    def _(d, cyclic=cyclic, key=key):
+        return ["solve", edited_chain(d, lambda text: text + f"[cyclic]\n{cyclic}\n")], {}, mentions(key)
+
+
+for label, modes, key in [
+        ("mode = 0", "mode = 0\nenergy_from = 0.1\nenergy_to = 1.0", "modes.mode"),
+        ("max_points = 0", "max_points = 0\nenergy_from = 0.1\nenergy_to = 1.0", "modes.max_points"),
+        ("energy_from negative", "energy_from = -1.0\nenergy_to = 1.0", "modes.energy_from"),
+        ("amplitude_to NaN", "amplitude_from = 1.0\namplitude_to = nan", "modes.amplitude_to"),
+        ("two ranges", "energy_from = 0.1\nenergy_to = 1.0\namplitude_from = 0.1", "modes.amplitude_from")]:
+    @case(f"[modes] {label}", 2)
+    def _(d, modes=modes, key=key):
+        return ["modes", chain(d, extra=f"[modes]\n{modes}")], {}, mentions(key)
+
+
+for label, point, key in [
+        ("tangent2_dofs without friction", "tangent2_dofs = [1]", "contact.point.friction"),
+        ("tangent2_dofs without tangent coefficients", "friction = 0.3\ntangent_dofs = [1]\ntangent2_dofs = [2]",
+         "contact.point.tangent_coefficients"),
+        ("component without node", "component = 9", "contact.point.component"),
+        ("node beside dof", "node = 1", "contact.point.node")]:
+    @case(f"contact point {label}", 2)
+    def _(d, point=point, key=key):
+        return ["solve", chain(d, tail=point + "\n")], {}, mentions(key)
+
+
+for label, line, key in [("format of another name", 'format = "xyz"', "format"),
+                         ("calculix without a dof_map", 'format = "calculix"', "model.dof_map")]:
+    @case(f"[model] {label}", 2)
+    def _(d, line=line, key=key):
+        edit = lambda text: text.replace("[model]\n", f"[model]\n{line}\n", 1)
+        return ["solve", edited_chain(d, edit)], {}, mentions(key)
 
 
 NUMERIC = ("residual", "tip", "amplitude", "force", "omega", "penetration", "displacement")

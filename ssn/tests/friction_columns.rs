@@ -62,6 +62,33 @@ fn sweep_csv_carries_the_friction_points_numbers_of_the_json() {
     }
 }
 
+/// The damper has friction points and no unilateral contact: its sweep CSV carries the
+/// friction columns and none of the unilateral contacts' (`contact_force_mean`,
+/// `max_penetration`, `contact{k}_...`), which would be zeros of a law it does not have.
+#[test]
+fn damper_sweep_csv_has_the_columns_of_its_friction_points_and_none_of_normal_contact() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("sweep.csv");
+    let scene = damper();
+    let args = ["sweep", scene.to_str().unwrap(), "--quiet", "--csv"];
+    json_success(&ssn(
+        &[&args[..], &[csv.to_str().unwrap(), "--json"]].concat()
+    ));
+    let columns = csv_columns(&csv);
+    for name in FrictionSummary::NAMES {
+        assert!(columns.contains_key(&format!("friction0_{name}")), "{name}");
+    }
+    let normal: Vec<&String> = (columns.keys())
+        .filter(|k| {
+            *k == "contact_force_mean" || *k == "max_penetration" || k.starts_with("contact")
+        })
+        .collect();
+    assert!(
+        normal.is_empty(),
+        "columns of a law the scene lacks: {normal:?}"
+    );
+}
+
 /// A study of the damper's solve over two normal loads: its table has
 /// `friction0_<name>` equal to each case's `ssn solve --json` friction numbers.
 #[test]

@@ -230,6 +230,7 @@ pub(super) fn resolve(mut raw: RawScene, path: &Path) -> Result<Scene, SceneErro
         solver,
         sweep,
         sweep_unit,
+        sweep_keys: sweep_unit.keys(),
         modes,
         reduction,
     })

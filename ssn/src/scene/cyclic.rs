@@ -393,6 +393,7 @@ impl Scene {
         let Some(c) = &self.cyclic else {
             return Ok(structure);
         };
+        check_interface(c, structure.model.dofs())?;
         let observed = structure.observed_dof;
         let sector = CyclicSector::new(
             structure.model,
@@ -407,4 +408,22 @@ impl Scene {
             .structure(observed)
             .map_err(|e| format!("invalid [cyclic]: {e}"))
     }
+}
+
+/// `Err` naming the key (and the 1-based dof, as the scene writes it) where an interface
+/// dof of `[cyclic]` is beyond the sector's `dofs` or appears twice over both sides.
+fn check_interface(c: &CyclicSpec, dofs: usize) -> Result<(), String> {
+    let mut seen = std::collections::HashSet::new();
+    for (key, side) in [("cyclic.left", &c.left), ("cyclic.right", &c.right)] {
+        for &dof in side {
+            if dof >= dofs || !seen.insert(dof) {
+                return Err(format!(
+                    "invalid `{key}` = {}: allowed distinct dofs in 1..={dofs} over `left` and \
+                     `right` (1-based, as in Matrix Market)",
+                    dof + 1
+                ));
+            }
+        }
+    }
+    Ok(())
 }

@@ -95,6 +95,9 @@ pub struct Scene {
     pub sweep: Option<SweepSettings>,
     /// The unit of the `[sweep]` bounds as given.
     pub sweep_unit: SweepUnit,
+    /// The keys the `[sweep]` bounds were given with (kept once they are resolved to
+    /// ratios), for messages.
+    pub sweep_keys: [&'static str; 2],
     /// Nonlinear mode (`ssn modes`), if declared.
     pub modes: Option<ModesSettings>,
     /// The reduction of the structure before it is solved (`[reduction]`), if declared.
