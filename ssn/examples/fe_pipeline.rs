@@ -121,11 +121,14 @@ fn main() {
     if exact {
         let size = 2 * scene.solver.harmonics + 1;
         let full_solution = step(&mut rows, "solve one frequency (exact, unreduced)", || {
-            // Started from the reduced answer's contact forces (the same contact rows).
+            // The reduced solve's equations (its `c`, which it may have raised), started from
+            // its contact forces (the same contact rows).
             let forces = &solution.state[reduced.structure.model.dofs() * size..];
-            let cold = std::env::var_os("FE_PIPELINE_COLD").is_some();
-            let start = (!cold).then_some(forces);
-            semismooth_contact::solve::solve_condensed(full, loaded.omega, &scene.solver, start)
+            let settings = semismooth_contact::settings::SolverSettings {
+                c: solution.c,
+                ..scene.solver.clone()
+            };
+            semismooth_contact::solve::solve_condensed(full, loaded.omega, &settings, Some(forces))
                 .unwrap_or_else(|e| panic!("{e}"))
         });
         let scale = full_solution
