@@ -271,14 +271,18 @@ impl HarmonicOperator {
     }
 
     /// Empty factorizations of every `Z_k` (`k = 0..=H`), with scratch for solves of up to
-    /// `max_columns` right-hand sides at once.
-    pub(crate) fn factors(&self, max_columns: usize) -> Result<HarmonicFactors, LinearSolveError> {
+    /// `max_columns` right-hand sides at once; `one_at_a_time`: a single slot, each harmonic
+    /// factored when a solve needs it (replacing the previous one).
+    pub(crate) fn factors(
+        &self,
+        max_columns: usize,
+        one_at_a_time: bool,
+    ) -> Result<HarmonicFactors, LinearSolveError> {
+        let slots = if one_at_a_time { 1 } else { self.harmonics + 1 };
         Ok(HarmonicFactors {
-            stiffness: DynamicStiffness::with_sources(
-                self.source_matrices(),
-                self.harmonics + 1,
-                max_columns,
-            )?,
+            stiffness: DynamicStiffness::with_sources(self.source_matrices(), slots, max_columns)?,
+            one_at_a_time,
+            held: None,
             operator: self.without_matrices(),
             coefficients: Vec::new(),
             dofs: self.dofs,
@@ -298,10 +302,15 @@ fn coupled(term: &CouplingTerm, phase: f64, c: Coefficients) -> c64 {
 
 /// The sparse complex LU of every `Z_k(w, p)`, `k = 0..=H`, of one [`HarmonicOperator`]
 /// (module documentation): [`HarmonicFactors::factor`] refactors only when a parameter
-/// changed.
+/// changed. One at a time, only one harmonic's factorization is held: a solve on another
+/// harmonic factors it first (memory of one factor, a factorization per change of harmonic).
 #[derive(Debug)]
 pub(crate) struct HarmonicFactors {
     stiffness: DynamicStiffness,
+    /// One slot, refilled per harmonic on demand.
+    one_at_a_time: bool,
+    /// One at a time: the harmonic whose factorization the slot holds.
+    held: Option<usize>,
     /// The operator's coupling phases and which sources it has (its matrices emptied).
     operator: HarmonicOperator,
     /// Scratch: the coefficients of every source at one harmonic.
@@ -323,32 +332,60 @@ impl HarmonicFactors {
             return Ok(false);
         }
         self.key = None;
-        let n = self.dofs;
-        for k in 0..=self.harmonics {
-            let base = HarmonicOperator::coefficients(k, p);
-            self.coefficients.clear();
-            (self.coefficients).extend(self.operator.terms(k, base).map(|(_, c)| c));
-            self.stiffness
-                .factor_combination(k, &self.coefficients)
-                .map_err(|e| match e {
-                    LinearSolveError::Singular {
-                        index,
-                        pivot,
-                        max_pivot,
-                    } => LinearSolveError::Singular {
-                        index: if k == 0 {
-                            index
-                        } else {
-                            (2 * k - 1) * n + index
-                        },
-                        pivot,
-                        max_pivot,
-                    },
-                    other => other,
-                })?;
+        self.held = None;
+        if !self.one_at_a_time {
+            for k in 0..=self.harmonics {
+                self.factor_harmonic(k, k, p)?;
+            }
         }
         self.key = Some(*p);
         Ok(true)
+    }
+
+    /// Factors `Z_k(w, p)` into `slot` (a breakdown as [`HarmonicFactors::factor`]'s).
+    fn factor_harmonic(
+        &mut self,
+        k: usize,
+        slot: usize,
+        p: &HarmonicParameters,
+    ) -> Result<(), LinearSolveError> {
+        let n = self.dofs;
+        let base = HarmonicOperator::coefficients(k, p);
+        self.coefficients.clear();
+        (self.coefficients).extend(self.operator.terms(k, base).map(|(_, c)| c));
+        self.stiffness
+            .factor_combination(slot, &self.coefficients)
+            .map_err(|e| match e {
+                LinearSolveError::Singular {
+                    index,
+                    pivot,
+                    max_pivot,
+                } => LinearSolveError::Singular {
+                    index: if k == 0 {
+                        index
+                    } else {
+                        (2 * k - 1) * n + index
+                    },
+                    pivot,
+                    max_pivot,
+                },
+                other => other,
+            })
+    }
+
+    /// The slot holding `Z_k`'s factorization, factoring it first when one at a time and
+    /// another harmonic is held.
+    fn slot_of(&mut self, k: usize) -> Result<usize, LinearSolveError> {
+        if !self.one_at_a_time {
+            return Ok(k);
+        }
+        if self.held != Some(k) {
+            let key = self.key.ok_or(LinearSolveError::NotFactored)?;
+            self.held = None;
+            self.factor_harmonic(k, 0, &key)?;
+            self.held = Some(k);
+        }
+        Ok(0)
     }
 
     /// `rhs <- Z_k^{-1} rhs` (`rhs` has `N` rows).
@@ -357,39 +394,47 @@ impl HarmonicFactors {
         k: usize,
         rhs: MatMut<'_, c64>,
     ) -> Result<(), LinearSolveError> {
-        self.stiffness.solve_in_place(k, rhs)
+        let slot = self.slot_of(k)?;
+        self.stiffness.solve_in_place(slot, rhs)
     }
 
     /// `u <- A^{-1} u` on the harmonic-major real coefficients, harmonic by harmonic in
     /// complex form (`u_0`; `u_ck - i u_sk`).
     pub(crate) fn solve_real(&mut self, u: &mut [f64]) -> Result<(), LinearSolveError> {
+        for k in 0..=self.harmonics {
+            self.solve_real_harmonic(k, u)?;
+        }
+        Ok(())
+    }
+
+    /// `u <- A^{-1} u` on harmonic `k`'s part of the harmonic-major real coefficients `u`
+    /// (`u_0` for `k = 0`, `u_ck - i u_sk` in complex form otherwise); the rest untouched.
+    pub(crate) fn solve_real_harmonic(
+        &mut self,
+        k: usize,
+        u: &mut [f64],
+    ) -> Result<(), LinearSolveError> {
         if self.key.is_none() {
             return Err(LinearSolveError::NotFactored);
         }
         let n = self.dofs;
-        let (constant, harmonics) = u.split_at_mut(n);
-        for (z, &a) in first_column(&mut self.complex).iter_mut().zip(&*constant) {
-            *z = c64::new(a, 0.0);
+        let slot = self.slot_of(k)?;
+        let (cosine, mut sine) = if k == 0 {
+            (&mut u[..n], None)
+        } else {
+            let (c, s) = u[(2 * k - 1) * n..(2 * k + 1) * n].split_at_mut(n);
+            (c, Some(s))
+        };
+        let rhs = first_column(&mut self.complex);
+        for (i, z) in rhs.iter_mut().enumerate() {
+            *z = c64::new(cosine[i], sine.as_ref().map_or(0.0, |s| -s[i]));
         }
-        self.stiffness.solve_in_place(0, self.complex.as_mut())?;
-        for (a, z) in constant
-            .iter_mut()
-            .zip(first_column(&mut self.complex).iter())
-        {
-            *a = z.re;
-        }
-        for (k, pair) in harmonics.chunks_exact_mut(2 * n).enumerate() {
-            let (cosine, sine) = pair.split_at_mut(n);
-            let rhs = first_column(&mut self.complex);
-            for ((z, &a), &b) in rhs.iter_mut().zip(&*cosine).zip(&*sine) {
-                *z = c64::new(a, -b);
-            }
-            self.stiffness
-                .solve_in_place(k + 1, self.complex.as_mut())?;
-            let rhs = first_column(&mut self.complex);
-            for ((z, a), b) in rhs.iter().zip(cosine.iter_mut()).zip(sine.iter_mut()) {
-                *a = z.re;
-                *b = -z.im;
+        self.stiffness.solve_in_place(slot, self.complex.as_mut())?;
+        let rhs = first_column(&mut self.complex);
+        for (i, z) in rhs.iter().enumerate() {
+            cosine[i] = z.re;
+            if let Some(s) = sine.as_mut() {
+                s[i] = -z.im;
             }
         }
         Ok(())
@@ -603,7 +648,7 @@ mod tests {
     #[test]
     fn factors_invert_the_real_form_and_refactor_only_on_a_new_parameter() {
         let op = operator();
-        let mut factors = op.factors(1).unwrap();
+        let mut factors = op.factors(1, false).unwrap();
         let u = coefficients_u();
         let mut x = u.clone();
         assert_eq!(

@@ -9,8 +9,10 @@
 //! what happened.
 
 pub mod accuracy;
+mod condensed;
 mod march;
 mod raised_c;
+pub use condensed::solve_condensed;
 mod roundoff;
 pub use raised_c::RAISED_C_FACTOR;
 pub(crate) mod formulation;
@@ -671,7 +673,19 @@ pub(super) fn solve_ssn_hb(request: SolveRequest<'_>) -> Result<Solution, RunErr
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);
-    let mut sol = hb_outputs(&problem, request, outcome, x, points)?;
+    ssn_hb_solution(&problem, request, outcome, x, points)
+}
+
+/// The outputs of an SSN-HB solution `x` of `problem` on `points` times, with its `c` and
+/// frictional contacts.
+fn ssn_hb_solution(
+    problem: &SsnHb,
+    request: SolveRequest<'_>,
+    outcome: Outcome<'_>,
+    x: Vec<f64>,
+    points: usize,
+) -> Result<Solution, RunError> {
+    let mut sol = hb_outputs(problem, request, outcome, x, points)?;
     sol.c = (problem.contacts() > 0).then(|| problem.c());
     sol.frictional_contacts = (0..problem.frictional_contacts())
         .map(|p| problem.frictional_contact_report(&sol.state, p, points))

@@ -5,8 +5,7 @@ use std::sync::Arc;
 use faer::{c64, Mat};
 use semismooth::harmonic::{Aft, FourierBasis};
 use semismooth::{
-    EvaluationError, Factorize, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual,
-    Smoothing,
+    EvaluationError, GeneralizedJacobian, ParameterDependent, ProblemCounters, Residual, Smoothing,
 };
 
 use super::jacobian::{ContactCoupling, HbJacobian};
@@ -74,13 +73,38 @@ impl CondensedSsnHb {
     /// The condensed form of the full problem `full` (with whatever row groups it was built
     /// with, e.g. by [`SsnHb::with_laws`]); factors its `A(w)` as [`CondensedSsnHb::new`].
     pub fn condense(full: SsnHb) -> Result<Self, HbError> {
+        // The receptance blocks are read here: the dense condensed path keeps them.
+        let solver = StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense);
+        Self::condense_with(full, solver)
+    }
+
+    /// [`CondensedSsnHb::new`] holding one harmonic's sparse factorization at a time: each
+    /// `Z_k` is factored, solved for `Z_k^{-1} G^T` and `Z_k^{-1} F` (all the residual, the
+    /// Jacobian and [`CondensedSsnHb::expand`] read) and replaced by the next, so the memory
+    /// is one factor and `(2H + 1)(m + 1)` state-sized vectors instead of `H + 1` factors.
+    /// The same equations and answers as [`CondensedSsnHb::new`]; each change of `w`
+    /// refactors every harmonic once, and [`ParameterDependent::residual_parameter_derivative`]
+    /// refactors each again (a sweep is better served by [`CondensedSsnHb::new`]).
+    pub fn one_factorization_at_a_time(
+        model: &StructuralModel,
+        omega: f64,
+        options: &HbOptions,
+    ) -> Result<Self, HbError> {
+        let solver = StructuredHbSolver::new()
+            .with_condensed_solve(CondensedSolve::Dense)
+            .with_one_factorization_at_a_time();
+        Self::condense_with(SsnHb::new(model, omega, options)?, solver)
+    }
+
+    /// The condensed form of `full` with `solver` for the dynamic blocks (dense condensed
+    /// solve).
+    fn condense_with(full: SsnHb, solver: StructuredHbSolver) -> Result<Self, HbError> {
         let basis = full.basis();
         let (m, size) = (full.contacts(), basis.basis_size());
         let (q, cross) = full.state.linear.laws.zero_blocks(size);
         let mut this = Self {
             receptance: Vec::new(),
-            // The receptance blocks are read here: the dense condensed path keeps them.
-            solver: StructuredHbSolver::new().with_condensed_solve(CondensedSolve::Dense),
+            solver,
             linear_response: vec![0.0; full.displacement_len()],
             contact_linear: vec![0.0; m * size],
             y: vec![0.0; m * size],
@@ -103,12 +127,10 @@ impl CondensedSsnHb {
     /// Factors `A(w, p)` at the current parameters, then `A^{-1} F`, `G A^{-1} F` and `R`.
     fn refactor(&mut self) -> Result<(), HbError> {
         self.dynamic.parameters = self.full.state.parameters();
-        self.solver.factor(&self.dynamic)?;
         let lin = self.full.state.linear.clone();
         let (m, h) = (lin.contacts(), lin.basis.harmonics());
         lin.operator.load_coefficients(&mut self.linear_response);
-        self.solver
-            .apply_dynamic_inverse(&mut self.linear_response)?;
+        (self.solver).factor_and_apply_dynamic_inverse(&self.dynamic, &mut self.linear_response)?;
         lin.gather_measured(&self.linear_response, &mut self.contact_linear);
         self.receptance.resize_with(h + 1, || Mat::zeros(m, m));
         for (k, r) in self.receptance.iter_mut().enumerate() {
@@ -129,6 +151,11 @@ impl CondensedSsnHb {
             what: "omega (a dynamic block of harmonic balance is singular)",
             value: self.full.omega(),
         })
+    }
+
+    /// The full problem on `[U; Lambda]` whose solutions [`CondensedSsnHb::expand`] builds.
+    pub fn full_problem(&self) -> &SsnHb {
+        &self.full
     }
 
     /// The Fourier basis (`H`, `Nt`).

@@ -287,10 +287,10 @@ impl SsnHb {
     }
 
     /// `U = A(w, p)^{-1} F`, the response with every contact force zero (factored afresh:
-    /// it is asked for only when full Newton steps failed).
+    /// it is asked for only when full Newton steps failed; one harmonic's factor at a time).
     fn linear_response(&self) -> Result<Vec<f64>, LinearSolveError> {
         let lin = &self.state.linear;
-        let mut factors = lin.operator.factors(1)?;
+        let mut factors = lin.operator.factors(1, true)?;
         factors.factor(&self.state.parameters())?;
         let mut u = vec![0.0; lin.dofs * lin.size()];
         lin.operator.load_coefficients(&mut u);

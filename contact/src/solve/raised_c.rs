@@ -37,9 +37,7 @@ pub(super) fn ssn_hb_newton(
     model: &StructuralModel,
     omega: f64,
 ) -> Result<NewtonReport, RunError> {
-    let may_raise = settings.c.is_none()
-        && problem.contacts() > 0
-        && settings.globalization == GlobalizationChoice::Auto;
+    let may_raise = may_raise_c(settings, problem.contacts());
     // The start is kept only when a second run may need it (most solves converge).
     let start = may_raise.then(|| x.to_vec());
     let first = newton_hb(problem, x, settings, model, (0.0, Some(SmoothingOf::new())))?;
@@ -65,11 +63,23 @@ pub(super) fn ssn_hb_newton(
         return Ok(first);
     }
     *problem = raised_problem;
+    Ok(after_raise(first, raised))
+}
+
+/// Whether a run with `settings` on a problem with `contacts` contact rows may be repeated
+/// with `c` raised ([`ssn_hb_newton`]).
+pub(super) fn may_raise_c(settings: &SolverSettings, contacts: usize) -> bool {
+    settings.c.is_none() && contacts > 0 && settings.globalization == GlobalizationChoice::Auto
+}
+
+/// The report of the converged raised run counting the first run's iterations and work,
+/// the attempts of both in order.
+pub(super) fn after_raise(first: NewtonReport, raised: NewtonReport) -> NewtonReport {
     let mut attempts = first.attempts;
     attempts.extend(raised.attempts.iter().cloned());
     let mut report = raised;
     report.attempts = attempts;
     report.iterations += first.iterations;
     report.counters += first.counters;
-    Ok(report)
+    report
 }

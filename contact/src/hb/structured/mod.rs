@@ -157,6 +157,9 @@ pub struct StructuredHbSolver {
     /// Parameters of the full receptance `receptance` on the matrix-free path.
     receptance_parameters: Option<HarmonicParameters>,
     dense_preconditioner_factorizations: u64,
+    /// Hold one harmonic's sparse factorization at a time
+    /// ([`StructuredHbSolver::with_one_factorization_at_a_time`]).
+    one_factorization: bool,
 }
 
 impl std::fmt::Debug for StructuredHbSolver {
@@ -218,7 +221,19 @@ impl StructuredHbSolver {
             refresh_dense: false,
             receptance_parameters: None,
             dense_preconditioner_factorizations: 0,
+            one_factorization: false,
         }
+    }
+
+    /// Holds one harmonic's sparse factorization at a time: a solve with another harmonic
+    /// refactors it, so memory is one factor (plus the responses `Z_k^{-1} G^T`) while a
+    /// full Newton solve refactors every harmonic per step. Meant for
+    /// [`super::CondensedSsnHb::one_factorization_at_a_time`], which needs of each harmonic
+    /// only its responses, solved once per frequency.
+    pub fn with_one_factorization_at_a_time(mut self) -> Self {
+        self.one_factorization = true;
+        self.dynamic = None;
+        self
     }
 
     /// Chooses how the condensed system is solved (default [`CondensedSolve::Auto`]).
@@ -292,7 +307,7 @@ impl StructuredHbSolver {
         } else {
             m.max(1)
         };
-        let dynamic = lin.operator.factors(columns)?;
+        let dynamic = lin.operator.factors(columns, self.one_factorization)?;
         self.complex_rhs = Mat::zeros(n, 1);
         self.work_u = vec![0.0; n * size];
         self.work_a = vec![0.0; nc];
@@ -320,9 +335,34 @@ impl StructuredHbSolver {
         Ok(())
     }
 
+    /// Factors every harmonic's `Z_k(w, p)` and sets `u <- A(w, p)^{-1} u` with the same
+    /// factors harmonic by harmonic (one factorization per harmonic also one at a time),
+    /// forming the responses and receptances of [`Factorize::factor`] but not its condensed
+    /// matrix; only the solves with `A` ([`StructuredHbSolver::add_response`],
+    /// [`StructuredHbSolver::apply_dynamic_inverse`]) are ready after it.
+    pub(crate) fn factor_and_apply_dynamic_inverse(
+        &mut self,
+        jac: &HbJacobian,
+        u: &mut [f64],
+    ) -> Result<(), LinearSolveError> {
+        self.schur_ready = false;
+        let reuse = matches!(&self.factored_for,
+            Some((lin, p)) if Arc::ptr_eq(lin, &jac.linear) && p.same_as(&jac.parameters));
+        if reuse {
+            return self.apply_dynamic_inverse(u);
+        }
+        self.factored_for = None;
+        self.factor_dynamic(jac, Some(u))
+    }
+
     /// Factors every harmonic's `Z_k(w, p)` (unless factored there) and forms the responses
-    /// `Z_k^{-1} G^T` and receptances `G Z_k^{-1} G^T` (no allocation once prepared).
-    fn factor_dynamic(&mut self, jac: &HbJacobian) -> Result<(), LinearSolveError> {
+    /// `Z_k^{-1} G^T` and receptances `G Z_k^{-1} G^T` (no allocation once prepared); with
+    /// `also`, `also <- A^{-1} also` harmonic by harmonic with the same factors.
+    fn factor_dynamic(
+        &mut self,
+        jac: &HbJacobian,
+        mut also: Option<&mut [f64]>,
+    ) -> Result<(), LinearSolveError> {
         let lin = jac.linear.clone();
         self.prepare(&lin, jac.coupling)?;
         let Some((_, dynamic)) = &mut self.dynamic else {
@@ -330,6 +370,9 @@ impl StructuredHbSolver {
         };
         dynamic.factor(&jac.parameters)?;
         for k in 0..=lin.basis.harmonics() {
+            if let Some(u) = also.as_deref_mut() {
+                dynamic.solve_real_harmonic(k, u)?;
+            }
             if self.krylov {
                 // R_k[a, i] between the rows of each unit only.
                 let (rows, store) = (&self.coupled_rows, &mut self.unit_receptance);
@@ -450,7 +493,7 @@ impl Factorize<HbJacobian> for StructuredHbSolver {
             Some((lin, p)) if Arc::ptr_eq(lin, &jac.linear) && p.same_as(&jac.parameters));
         if !reuse {
             self.factored_for = None;
-            self.factor_dynamic(jac)?;
+            self.factor_dynamic(jac, None)?;
         }
         let lin = jac.linear.clone();
         let (m, size) = (lin.contacts(), lin.size());
