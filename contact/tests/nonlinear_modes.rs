@@ -136,14 +136,7 @@ fn bilinear_frequency(gap: f64, k_c: f64, a: f64) -> f64 {
 /// the points are conservative (`xi` zero to round-off).
 fn bilinear_backbone_error(gap: f64, k_c: f64, harmonics: usize) -> f64 {
     let model = bilinear(gap, k_c);
-    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.1, 2.0);
-    options.hb.harmonics = harmonics;
-    let branch = backbone(&model, &options).unwrap();
-    assert!(matches!(
-        branch.termination,
-        ContinuationTermination::ReachedBound { .. }
-    ));
-    let epmc = Epmc::new(&model, &options.hb, 1, AmplitudeMeasure::Dof(0)).unwrap();
+    let (branch, epmc) = common::mode_one_backbone(&model, 0.1, 2.0, harmonics);
     let mut error = 0.0f64;
     let mut in_contact = 0;
     for point in &branch.points {
@@ -197,18 +190,7 @@ fn bilinear_frequency_by_excursion(gap: f64, k_c: f64, b: f64) -> f64 {
 /// [`bilinear_frequency_by_excursion`] of its own excursion, over the points in contact.
 fn stiff_bilinear_backbone_error(gap: f64, k_c: f64, harmonics: usize) -> f64 {
     let model = bilinear(gap, k_c);
-    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), 0.1, 2.0);
-    options.hb.harmonics = harmonics;
-    let branch = backbone(&model, &options).unwrap();
-    assert!(
-        matches!(
-            branch.termination,
-            ContinuationTermination::ReachedBound { .. }
-        ),
-        "H = {harmonics}: {:?}",
-        branch.termination
-    );
-    let epmc = Epmc::new(&model, &options.hb, 1, AmplitudeMeasure::Dof(0)).unwrap();
+    let (branch, epmc) = common::mode_one_backbone(&model, 0.1, 2.0, harmonics);
     let mut error = 0.0f64;
     for point in &branch.points {
         let u = &point.unknowns[..epmc.hb_len()];

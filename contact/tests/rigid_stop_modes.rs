@@ -7,9 +7,7 @@ mod common;
 use std::f64::consts::PI;
 
 use common::sparse;
-use semismooth::continuation::ContinuationTermination;
 use semismooth_contact::model::{ContactPoint, HarmonicLoad, StructuralModel};
-use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions, Epmc};
 
 /// The gap `g` of the stop.
 const GAP: f64 = 1.0;
@@ -68,18 +66,7 @@ struct Measured {
 fn rigid_stop_backbone(harmonics: usize) -> Measured {
     let model = oscillator_against_stop(GAP);
     let (from, to) = AMPLITUDE_RANGE;
-    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), from, to);
-    options.hb.harmonics = harmonics;
-    let branch = backbone(&model, &options).unwrap();
-    assert!(
-        matches!(
-            branch.termination,
-            ContinuationTermination::ReachedBound { .. }
-        ),
-        "H = {harmonics}: {:?}",
-        branch.termination
-    );
-    let epmc = Epmc::new(&model, &options.hb, 1, AmplitudeMeasure::Dof(0)).unwrap();
+    let (branch, epmc) = common::mode_one_backbone(&model, from, to, harmonics);
     let mut measured = Measured {
         harmonics,
         points: branch.points.len(),

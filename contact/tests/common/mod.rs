@@ -244,3 +244,29 @@ pub fn first_harmonic(u: &[f64]) -> f64 {
     }
     2.0 * a.hypot(b) / n
 }
+
+/// The backbone of mode 1 of `model` over the amplitude `from..to` of dof 0 with
+/// `harmonics` harmonics, asserted to reach the end of the range, and the EPMC problem its
+/// points are read with.
+pub fn mode_one_backbone(
+    model: &StructuralModel,
+    from: f64,
+    to: f64,
+    harmonics: usize,
+) -> (semismooth_contact::modes::Backbone, semismooth_contact::modes::Epmc) {
+    use semismooth::continuation::ContinuationTermination;
+    use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions, Epmc};
+    let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), from, to);
+    options.hb.harmonics = harmonics;
+    let branch = backbone(model, &options).unwrap();
+    assert!(
+        matches!(
+            branch.termination,
+            ContinuationTermination::ReachedBound { .. }
+        ),
+        "H = {harmonics}: {:?}",
+        branch.termination
+    );
+    let epmc = Epmc::new(model, &options.hb, 1, AmplitudeMeasure::Dof(0)).unwrap();
+    (branch, epmc)
+}
