@@ -253,7 +253,10 @@ pub fn mode_one_backbone(
     from: f64,
     to: f64,
     harmonics: usize,
-) -> (semismooth_contact::modes::Backbone, semismooth_contact::modes::Epmc) {
+) -> (
+    semismooth_contact::modes::Backbone,
+    semismooth_contact::modes::Epmc,
+) {
     use semismooth::continuation::ContinuationTermination;
     use semismooth_contact::modes::{backbone, AmplitudeMeasure, BackboneOptions, Epmc};
     let mut options = BackboneOptions::new(1, AmplitudeMeasure::Dof(0), from, to);
