@@ -669,7 +669,7 @@ pub(super) fn solve_ssn_hb(request: SolveRequest<'_>) -> Result<Solution, RunErr
     let mut problem = SsnHb::new(model, omega, &hb_options(settings))?;
     let mut x = initial_state(problem.dim(), warm_start);
     let start = Instant::now();
-    let report = raised_c::ssn_hb_newton(&mut problem, &mut x, settings, model, omega)?;
+    let report = raised_c::ssn_hb_newton(&mut problem, &mut x, settings, model)?;
     let seconds = start.elapsed().as_secs_f64();
     let points = HB_OUTPUT_POINTS.max(settings.time_samples);
     let outcome = Outcome::of_newton(&report, seconds);

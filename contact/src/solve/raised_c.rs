@@ -15,18 +15,18 @@
 use semismooth::newton::NewtonReport;
 use semismooth::polyalgorithm::SmoothingOf;
 
-use super::{hb_options, newton_hb, RunError};
-use crate::hb::{HbOptions, SsnHb};
+use super::{newton_hb, RunError};
+use crate::hb::SsnHb;
 use crate::model::StructuralModel;
 use crate::settings::{GlobalizationChoice, SolverSettings};
 
 /// How much the default `c` is raised for the second start.
 pub const RAISED_C_FACTOR: f64 = 10.0;
 
-/// Newton on `problem` (built from `settings` at `omega`) from `x`. When `settings` leave
+/// Newton on `problem` (built from `settings`) from `x`. When `settings` leave
 /// `c` to its default and the globalization to the polyalgorithm (`auto`, of which this is
 /// the last resort) and the run does not converge, the same start is solved with
-/// [`RAISED_C_FACTOR`] times `c`; when that converges, `problem` becomes the raised problem
+/// [`RAISED_C_FACTOR`] times `c`; when that converges, `problem` keeps the raised `c`
 /// and `x` its answer, the report counting both runs' iterations and listing their attempts
 /// in order. When the raised run does not converge either, `x` and the report are the first
 /// run's.
@@ -35,7 +35,6 @@ pub(super) fn ssn_hb_newton(
     x: &mut [f64],
     settings: &SolverSettings,
     model: &StructuralModel,
-    omega: f64,
 ) -> Result<NewtonReport, RunError> {
     let may_raise = may_raise_c(settings, problem.contacts());
     // The start is kept only when a second run may need it (most solves converge).
@@ -44,25 +43,18 @@ pub(super) fn ssn_hb_newton(
     let Some(start) = start.filter(|_| !first.converged()) else {
         return Ok(first);
     };
-    let options = HbOptions {
-        c: Some(RAISED_C_FACTOR * problem.c()),
-        ..hb_options(settings)
-    };
-    let mut raised_problem = SsnHb::new(model, omega, &options)?;
+    // `c` enters only the contact rows: the same problem with `c` raised (no rebuild, and
+    // no second problem held beside the first).
+    let first_c = problem.c();
+    problem.set_c(RAISED_C_FACTOR * first_c)?;
     let first_x = x.to_vec();
     x.copy_from_slice(&start);
-    let raised = newton_hb(
-        &mut raised_problem,
-        x,
-        settings,
-        model,
-        (0.0, Some(SmoothingOf::new())),
-    )?;
+    let raised = newton_hb(problem, x, settings, model, (0.0, Some(SmoothingOf::new())))?;
     if !raised.converged() {
+        problem.set_c(first_c)?;
         x.copy_from_slice(&first_x);
         return Ok(first);
     }
-    *problem = raised_problem;
     Ok(after_raise(first, raised))
 }
 
